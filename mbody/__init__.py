@@ -1,0 +1,19 @@
+"""mbody: per-body Newton-Euler equations for multibody models.
+
+    model = mbody.load("models/seed_example_1.yaml")
+    asm = mbody.assemble(model)          # M v̇ + b = Q + G λ at the model's state
+    sol = asm.solve(known={"A.Fx": 0})   # accelerations, aligned with asm.coordinates
+"""
+
+from .assemble import Assembly, Solution, assemble
+from .errors import Issue, MbodyError, ModelError, UnknownReactionsError
+from .fbd import BodyEquations, Equation, ForceOnBody, FreeBodyDiagram
+from .model import Body, Joint, Load, Model, State, load, loads
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "Assembly", "Body", "BodyEquations", "Equation", "ForceOnBody", "FreeBodyDiagram",
+    "Issue", "Joint", "Load", "MbodyError", "Model", "ModelError", "Solution", "State",
+    "UnknownReactionsError", "assemble", "load", "loads",
+]

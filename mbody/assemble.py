@@ -1,0 +1,203 @@
+"""``assemble(model, state) -> Assembly``: the stacked Newton-Euler equations
+
+    M v̇ + b = Q + G λ
+
+with, per body in file order, Newton rows (world axes) then Euler rows (body axes).
+M is block diagonal and constant in body axes, so the assembly keeps its blocks (the
+model's masses and inertia tensors) and builds the sparse matrix only when asked for.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+import scipy.sparse as sp
+
+from . import conventions as cv
+from .errors import MbodyError, UnknownReactionsError, did_you_mean
+from .joints import ReactionColumns, g_matrix, reaction_columns, reaction_wrench
+from .loads import AppliedLoads, applied_loads, gyroscopic
+from .model import Model, State
+from .spatial import matvec
+
+
+def _select(model: Model, a6: np.ndarray) -> np.ndarray:
+    """(n, 6) per-body rows -> flat stacked vector in the model's coordinates."""
+    if model.dimension == cv.SPATIAL:
+        return a6.reshape(-1)
+    return a6[:, cv.PLANAR_SELECT].reshape(-1)
+
+
+def accelerations6(model: Model, rhs6: np.ndarray) -> np.ndarray:
+    """Block solve of M v̇ = rhs: (n, 6) -> (n, 6) [a_G (world), ω̇ (body axes)]."""
+    out = np.empty_like(rhs6)
+    out[:, :3] = rhs6[:, :3] / model.mass[:, None]
+    out[:, 3:] = matvec(model.J_inv, rhs6[:, 3:])
+    return out
+
+
+def mass_matrix(model: Model) -> sp.spmatrix:
+    """Block-diagonal M as a BSR matrix over the (n, 6, 6) (planar (n, 3, 3)) blocks."""
+    n = model.n
+    blocks = np.zeros((n, 6, 6))
+    idx = np.arange(3)
+    blocks[:, idx, idx] = model.mass[:, None]
+    blocks[:, 3:, 3:] = model.J
+    if model.dimension == cv.PLANAR:
+        blocks = blocks[:, cv.PLANAR_SELECT][:, :, cv.PLANAR_SELECT]
+    k = blocks.shape[1]
+    return sp.bsr_matrix((blocks, np.arange(n), np.arange(n + 1)), shape=(n * k, n * k))
+
+
+@dataclass(frozen=True)
+class Solution:
+    """Accelerations (aligned with `coordinates`) and the reaction values used.
+
+    Spatial rows: a_G in world axes (m/s^2), then ω̇ in body axes (rad/s^2);
+    planar rows: a_x, a_y (m/s^2), α (rad/s^2).
+    """
+
+    coordinates: list[str]
+    accelerations: np.ndarray
+    reactions: dict[str, float]
+
+    def as_dict(self) -> dict[str, float]:
+        return dict(zip(self.coordinates, self.accelerations.tolist(), strict=True))
+
+    def __getitem__(self, label: str) -> float:
+        try:
+            return float(self.accelerations[self.coordinates.index(label)])
+        except ValueError:
+            raise KeyError(f"no coordinate {label!r}; "
+                           f"{did_you_mean(label, self.coordinates)}") from None
+
+
+class Assembly:
+    """The stacked equations of a model at one state.
+
+    M: (N, N) sparse block-diagonal mass matrix; b: (N,) gyroscopic vector; Q: (N,)
+    applied generalised forces; G: (N, m) sparse reaction coupling. N = 3 n (planar) or
+    6 n (spatial); m = number of reaction unknowns. `coordinates` labels the rows,
+    `reactions` the columns of G. `bodies[name]` gives one body's free-body data and
+    its Newton-Euler pair.
+    """
+
+    def __init__(self, model: Model, state: State, loads: AppliedLoads, b6: np.ndarray):
+        self.model = model
+        self.state = state
+        self.loads = loads
+        self._b6 = b6
+        self._Q6 = np.concatenate((loads.W_F, loads.B_M), axis=1)
+
+    # -- the stacked system ------------------------------------------------------------
+    @property
+    def coordinates(self) -> list[str]:
+        return self.model.coordinates
+
+    @property
+    def reactions(self) -> list[str]:
+        return self.model.reactions
+
+    @property
+    def known(self) -> dict[str, float]:
+        """Reaction values given in the model file."""
+        return dict(self.model.known_reactions)
+
+    @cached_property
+    def M(self) -> sp.spmatrix:
+        return mass_matrix(self.model)
+
+    @cached_property
+    def b(self) -> np.ndarray:
+        return _select(self.model, self._b6)
+
+    @cached_property
+    def Q(self) -> np.ndarray:
+        return _select(self.model, self._Q6)
+
+    @cached_property
+    def columns(self) -> ReactionColumns:
+        return reaction_columns(self.model, self.state)
+
+    @cached_property
+    def G(self) -> sp.csc_matrix:
+        return g_matrix(self.model, self.columns)
+
+    @property
+    def shape(self) -> dict[str, tuple[int, ...]]:
+        N, m = len(self.coordinates), len(self.reactions)
+        return {"M": (N, N), "b": (N,), "Q": (N,), "G": (N, m)}
+
+    # -- per body ----------------------------------------------------------------------
+    @cached_property
+    def bodies(self) -> Mapping[str, BodyEquations]:
+        from .fbd import body_equations
+
+        return _LazyBodies(self, body_equations)
+
+    # -- solving -----------------------------------------------------------------------
+    def reaction_values(self, known: Mapping[str, float] | None = None) -> dict[str, float]:
+        """The file's known reaction values updated with `known`; labels are checked."""
+        values = dict(self.model.known_reactions)
+        labels = set(self.reactions)
+        for label, v in (known or {}).items():
+            if label not in labels:
+                hint = did_you_mean(label, self.reactions)
+                raise MbodyError(f"no reaction component {label!r} in this model"
+                                 + (f"; {hint}" if hint else ""))
+            values[label] = float(v)
+        return values
+
+    def solve(self, known: Mapping[str, float] | None = None) -> Solution:
+        """v̇ = M⁻¹ (Q + G λ − b) with every reaction value known (from the file or `known`).
+
+        Raises `UnknownReactionsError` naming the components still unknown.
+        """
+        values = self.reaction_values(known)
+        missing = [r for r in self.reactions if r not in values]
+        if missing:
+            raise UnknownReactionsError(missing)
+        rhs6 = self._Q6 - self._b6
+        if self.reactions:
+            lam = np.array([values[r] for r in self.reactions])
+            rhs6 = rhs6 + reaction_wrench(self.model, self.columns, lam)
+        acc = _select(self.model, accelerations6(self.model, rhs6))
+        return Solution(self.coordinates, acc, {r: values[r] for r in self.reactions})
+
+
+class _LazyBodies(Mapping):
+    """name -> BodyEquations, built on first access (presentation, not the hot path)."""
+
+    def __init__(self, asm: Assembly, build):
+        self._asm, self._build, self._cache = asm, build, {}
+
+    def __getitem__(self, name: str):
+        if name not in self._cache:
+            if name not in self._asm.model.index:
+                hint = did_you_mean(name, self._asm.model.body_names)
+                raise KeyError(f"no body named {name!r}" + (f"; {hint}" if hint else ""))
+            self._cache[name] = self._build(self._asm, self._asm.model.index[name])
+        return self._cache[name]
+
+    def __iter__(self):
+        return iter(self._asm.model.body_names)
+
+    def __len__(self) -> int:
+        return self._asm.model.n
+
+
+def assemble(model: Model, state: State | None = None) -> Assembly:
+    """The stacked Newton-Euler equations of `model` at `state` (default: its initial state)."""
+    state = model.initial if state is None else state
+    R = state.W_R_B
+    loads = applied_loads(model, state, R)
+    b6 = np.zeros((model.n, 6))
+    if model.dimension == cv.SPATIAL:
+        b6[:, 3:] = gyroscopic(model.J, state.omega)
+    return Assembly(model, state, loads, b6)
+
+
+from .fbd import BodyEquations  # noqa: E402  (type used in annotations only)

@@ -1,0 +1,49 @@
+"""Writing outputs without ever leaving a partial file: write a temporary file in the
+target's folder, flush it to disk, then rename it into place (atomic on POSIX)."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import IO
+
+
+@contextlib.contextmanager
+def atomic_path(target: str | os.PathLike[str], suffix: str = "") -> Iterator[Path]:
+    """Yield a temporary path next to `target`; on success rename it onto `target`.
+
+    On any exception the temporary file is removed and `target` is left untouched.
+    `suffix` keeps the extension for writers that look at it (numpy, scipy.io).
+    """
+    target = Path(target)
+    folder = target.parent if str(target.parent) else Path(".")
+    folder.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=suffix or target.suffix,
+                               dir=folder)
+    os.close(fd)
+    tmp_path = Path(tmp)
+    try:
+        yield tmp_path
+        with open(tmp_path, "rb+") as fh:
+            os.fsync(fh.fileno())
+        os.replace(tmp_path, target)
+    except BaseException:
+        tmp_path.unlink(missing_ok=True)
+        raise
+
+
+def write_atomic(target: str | os.PathLike[str], write: Callable[[IO], object] | bytes | str,
+                 binary: bool | None = None) -> Path:
+    """Write `write` (bytes, text, or a callable given the open file) atomically."""
+    if binary is None:
+        binary = not isinstance(write, str)
+    with atomic_path(target) as tmp, open(tmp, "wb" if binary else "w",
+                                          **({} if binary else {"encoding": "utf-8"})) as fh:
+        if callable(write):
+            write(fh)
+        else:
+            fh.write(write)
+    return Path(target)

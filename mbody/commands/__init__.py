@@ -1,0 +1,34 @@
+"""Sub-commands of `mbody`, one module per group; each module has `register(sub)`.
+
+A command handler takes the parsed namespace and returns an exit code; it raises
+`MbodyError` (or a subclass) for bad input, which `mbody.cli.main` turns into one
+paragraph on stderr and a non-zero exit code.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from ..errors import MbodyError
+
+EXIT_OK, EXIT_UNMET, EXIT_INPUT, EXIT_INTERNAL = 0, 1, 2, 70
+
+
+def load_model(path: str):
+    from ..model import load
+
+    return load(path)
+
+
+def parse_known(pairs: Sequence[str]) -> dict[str, float]:
+    """``["A.Fx=3", ...]`` -> ``{"A.Fx": 3.0}`` (labels are checked later, with hints)."""
+    out = {}
+    for p in pairs:
+        label, sep, value = p.partition("=")
+        if not sep:
+            raise MbodyError(f"--known expects LABEL=VALUE (for example A.Fx=3), got {p!r}")
+        try:
+            out[label.strip()] = float(value)
+        except ValueError:
+            raise MbodyError(f"--known {label}: {value!r} is not a number") from None
+    return out

@@ -1,0 +1,84 @@
+"""check, assemble, solve: the model, its equations and its accelerations."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+from ..errors import MbodyError
+from . import EXIT_OK, load_model, parse_known
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    s = sub.add_parser("check", help="validate a model and summarise it (graph, mobility)",
+                       description="Validate MODEL and print its bodies, loads, joints, "
+                       "reaction unknowns, body/joint graph and mobility count.")
+    s.add_argument("model", metavar="MODEL", help="a YAML model file")
+    s.set_defaults(run=check)
+
+    s = sub.add_parser("assemble", help="print every body's free body and Newton-Euler pair",
+                       description="For every body: its free-body list and its Newton and "
+                       "Euler equations with numbers filled in and reactions named; then the "
+                       "sizes of the stacked M, b, Q, G.")
+    s.add_argument("model", metavar="MODEL", help="a YAML model file")
+    s.add_argument("--body", metavar="NAME", help="only this body")
+    s.set_defaults(run=assemble)
+
+    s = sub.add_parser("solve", help="accelerations of every body (reactions known or absent)",
+                       description="Accelerations of every body when no unknown reactions "
+                       "remain (none, or all given in the file or with --known).")
+    s.add_argument("model", metavar="MODEL", help="a YAML model file")
+    s.add_argument("--known", metavar="LABEL=VALUE", action="append", default=[],
+                   help="a known reaction value, e.g. --known A.Fx=3 (repeatable)")
+    s.add_argument("--json", action="store_true", help="machine-readable output")
+    s.set_defaults(run=solve)
+
+
+def check(a: argparse.Namespace) -> int:
+    from ..assemble import assemble as _assemble
+    from ..graph import topology
+    from ..text import model_summary
+
+    model = load_model(a.model)
+    topo = topology(model, _assemble(model).G if model.reactions else None)
+    print(model_summary(model, topo))
+    print(f"\nOK: {a.model} is a valid model.")
+    return EXIT_OK
+
+
+def assemble(a: argparse.Namespace) -> int:
+    from ..assemble import assemble as _assemble
+    from ..text import assembly_text, body_text
+
+    model = load_model(a.model)
+    asm = _assemble(model)
+    if a.body:
+        try:
+            print(body_text(asm.bodies[a.body], model.dimension))
+        except KeyError as exc:
+            raise MbodyError(exc.args[0]) from None
+    else:
+        print(assembly_text(asm))
+    return EXIT_OK
+
+
+def solve(a: argparse.Namespace) -> int:
+    from ..assemble import assemble as _assemble
+    from ..text import solution_text
+
+    model = load_model(a.model)
+    sol = _assemble(model).solve(known=parse_known(a.known))
+    if a.json:
+        rpb = model.rows_per_body
+        acc = sol.accelerations.tolist()
+        by_body = {name: dict(zip(model.coordinates[i * rpb:(i + 1) * rpb],
+                                  acc[i * rpb:(i + 1) * rpb], strict=True))
+                   for i, name in enumerate(model.body_names)}
+        json.dump({"model": model.name, "coordinates": sol.coordinates,
+                   "accelerations": acc, "by_body": by_body, "reactions": sol.reactions},
+                  sys.stdout, indent=2)
+        print()
+    else:
+        print(solution_text(sol, model))
+    return EXIT_OK

@@ -1,0 +1,98 @@
+"""The single source of truth for labels, component names and frame rules.
+
+Everything here is data that exports repeat verbatim, so that a matrix read in MATLAB or
+on paper says which row is which body and which column is which joint.
+
+Internally every body is spatial: a planar body lives in the world x-y plane, turns
+about world z, and its three stacked rows are rows (x, y, 3) of the spatial six
+``[x, y, z, w1, w2, w3]`` (for a planar body, body axis 3 is world z).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+PLANAR, SPATIAL = 2, 3
+
+SPATIAL_ROWS = ("x", "y", "z", "w1", "w2", "w3")
+"""Row suffixes of a spatial body: Newton in world axes, then Euler in body axes."""
+PLANAR_ROWS = ("x", "y", "theta")
+"""Row suffixes of a planar body: Newton in world x, y, then Euler about z."""
+PLANAR_SELECT = np.array([0, 1, 5])
+"""Which of the six spatial rows a planar body keeps."""
+
+ACCELERATION_NAMES = {
+    "x": "a_x", "y": "a_y", "z": "a_z",
+    "w1": "alpha_1", "w2": "alpha_2", "w3": "alpha_3", "theta": "alpha",
+}
+"""How the unknown acceleration of each row is written in equations."""
+
+COMPONENTS = ("Fx", "Fy", "Fz", "Mx", "My", "Mz")
+"""Reaction component names; index k < 3 is a force along joint axis k, else a moment."""
+
+JOINT_COMPONENTS: dict[int, dict[str, tuple[str, ...]]] = {
+    PLANAR: {
+        "revolute": ("Fx", "Fy"),
+        "prismatic": ("Fy", "Mz"),
+        "fixed": ("Fx", "Fy", "Mz"),
+    },
+    SPATIAL: {
+        "revolute": ("Fx", "Fy", "Fz", "Mx", "My"),
+        "prismatic": ("Fx", "Fy", "Mx", "My", "Mz"),
+        "cylindrical": ("Fx", "Fy", "Mx", "My"),
+        "universal": ("Fx", "Fy", "Fz", "Mt"),
+        "spherical": ("Fx", "Fy", "Fz"),
+        "fixed": ("Fx", "Fy", "Fz", "Mx", "My", "Mz"),
+    },
+}
+"""Reaction components of each joint type: exactly the relative motions it prevents."""
+
+AXIS_REQUIRED = {
+    PLANAR: {"prismatic"},
+    SPATIAL: {"revolute", "prismatic", "cylindrical", "universal"},
+}
+"""Joint types that need an `axis` (universal also needs `axis2`)."""
+
+GROUND = "ground"
+
+SIGN_RULE = (
+    "the reaction acts on the child as +R at the joint point and on the parent as -R "
+    "(Newton's third law); components are along the joint frame axes, which are fixed "
+    "to the parent (to the world for ground)"
+)
+
+EQUATION = "M vdot + b = Q + G lambda"
+
+
+def coordinate_labels(names: list[str], dimension: int) -> list[str]:
+    """Row labels in stacking order: ``plate.x, plate.y, plate.theta, ...``."""
+    rows = PLANAR_ROWS if dimension == PLANAR else SPATIAL_ROWS
+    return [f"{n}.{r}" for n in names for r in rows]
+
+
+def rows_per_body(dimension: int) -> int:
+    return 3 if dimension == PLANAR else 6
+
+
+def conventions(dimension: int) -> dict[str, object]:
+    """The conventions as data, repeated in every export."""
+    planar = dimension == PLANAR
+    return {
+        "equation": EQUATION,
+        "dimension": dimension,
+        "units": "SI (kg, m, s, N, N m, rad)",
+        "rows_per_body": rows_per_body(dimension),
+        "row_order": list(PLANAR_ROWS if planar else SPATIAL_ROWS),
+        "newton_rows": "m a_G, mass-centre acceleration in world axes",
+        "euler_rows": ("I_G alpha about the mass centre (world z)" if planar else
+                       "J omega_dot + omega x (J omega), body axes, about the mass centre"),
+        "b": "gyroscopic vector: 0 on Newton rows, omega x (J omega) on Euler rows",
+        "Q": "applied forces (world axes) and their moments about the mass centre "
+             "(body axes), gravity and springs included",
+        "G": "one column per reaction unknown; G lambda is what the reactions put into each "
+             "body's rows; G^T v is the relative velocity each joint forbids",
+        "reaction_sign": SIGN_RULE,
+        "orientation": "planar: angle theta about world z; spatial: unit quaternion "
+                       "[w, x, y, z] (w first) of the body-to-world rotation W_R_B",
+        "angular_velocity": "planar: theta_dot; spatial: components along body axes",
+    }

@@ -1,0 +1,77 @@
+"""Errors for bad input: every problem carries its file, line and column.
+
+A `ModelError` holds every `Issue` found in one file so that a user fixes them all
+in one pass, the way a compiler reports all errors rather than the first.
+"""
+
+from __future__ import annotations
+
+import difflib
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Issue:
+    """One problem in a model file.
+
+    `line` and `column` are 1-based (as editors show them); 0 means "unknown".
+    `key` is the dotted path to the offending entry, e.g. ``bodies[2].inertia``.
+    """
+
+    file: str
+    line: int
+    column: int
+    key: str
+    message: str
+    hint: str = ""
+
+    def __str__(self) -> str:
+        where = self.file or "<model>"
+        if self.line:
+            where += f":{self.line}:{self.column}"
+        text = f"{where}: {self.key + ': ' if self.key else ''}{self.message}"
+        if self.hint:
+            text += f" ({self.hint})"
+        return text
+
+
+class MbodyError(Exception):
+    """Base class of every error mbody raises on purpose (bad input, bad request)."""
+
+
+class ModelError(MbodyError):
+    """A model file (or model dictionary) is invalid; `issues` lists every problem."""
+
+    def __init__(self, issues: Sequence[Issue]):
+        self.issues = list(issues)
+        super().__init__(self._text())
+
+    def _text(self) -> str:
+        n = len(self.issues)
+        head = f"{n} problem{'s' if n != 1 else ''} in the model:" if n > 1 else ""
+        body = "\n".join(str(i) for i in self.issues)
+        return f"{head}\n{body}" if head else body
+
+
+class UnknownReactionsError(MbodyError):
+    """Accelerations were asked for while some reaction components are still unknown."""
+
+    def __init__(self, unknown: Sequence[str]):
+        self.unknown = list(unknown)
+        shown = ", ".join(self.unknown[:20]) + (" ..." if len(self.unknown) > 20 else "")
+        super().__init__(
+            f"{len(self.unknown)} reaction component(s) are unknown: {shown}. "
+            "Give their values (in the file under 'reactions:', with --known LABEL=VALUE, "
+            "or solve(known={...})) to get the accelerations."
+        )
+
+
+class TrajectoryFileError(MbodyError):
+    """A trajectory file is unreadable, truncated or of the wrong kind."""
+
+
+def did_you_mean(word: str, choices: Iterable[str]) -> str:
+    """A 'did you mean ...?' hint for a misspelt name, or '' when nothing is close."""
+    close = difflib.get_close_matches(str(word), [str(c) for c in choices], n=1, cutoff=0.6)
+    return f"did you mean '{close[0]}'?" if close else ""

@@ -1,0 +1,335 @@
+"""`Model` (what the file says, as arrays) and `State` (where the bodies are and how fast).
+
+A `Model` is immutable and holds no state: masses ``(n,)``, inertia tensors ``(n, 3, 3)``
+in body axes, and the loads and joints as tables of index arrays, so that everything
+downstream is vectorised over bodies. Planar bodies are stored as spatial ones in the
+world x-y plane (see `conventions`).
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field, replace
+from functools import cached_property
+from typing import Any
+
+import numpy as np
+
+from . import conventions as cv
+from .errors import Issue
+from .loader import Document, load_file, load_text
+from .spatial import joint_frame_planar, joint_frame_spatial, quat_to_matrix
+from .validate import Spec, validate
+
+
+def _ro(a: np.ndarray) -> np.ndarray:
+    a = np.ascontiguousarray(a, dtype=float)
+    a.flags.writeable = False
+    return a
+
+
+@dataclass(frozen=True)
+class State:
+    """Positions and velocities of all bodies; every array has a leading body axis.
+
+    position: (n, 3) mass centres, world frame [m]
+    quaternion: (n, 4) body-to-world rotations W_R_B, [w, x, y, z]
+    velocity: (n, 3) mass-centre velocities, world frame [m/s]
+    omega: (n, 3) angular velocities, body axes [rad/s]
+    t: time [s] (for time-dependent loads)
+    """
+
+    position: np.ndarray
+    quaternion: np.ndarray
+    velocity: np.ndarray
+    omega: np.ndarray
+    t: float = 0.0
+
+    @cached_property
+    def W_R_B(self) -> np.ndarray:
+        """(n, 3, 3) body-to-world rotation matrices."""
+        return quat_to_matrix(self.quaternion)
+
+    def replace(self, **changes: Any) -> State:
+        return replace(self, **changes)
+
+    @classmethod
+    def planar(cls, position: np.ndarray, angle: np.ndarray, velocity: np.ndarray,
+               angular_velocity: np.ndarray, t: float = 0.0) -> State:
+        """A planar state from (n, 2) positions, (n,) angles, (n, 2) velocities, (n,) θ̇."""
+        n = len(angle)
+        pos = np.zeros((n, 3))
+        pos[:, :2] = position
+        vel = np.zeros((n, 3))
+        vel[:, :2] = velocity
+        q = np.zeros((n, 4))
+        q[:, 0] = np.cos(np.asarray(angle) / 2)
+        q[:, 3] = np.sin(np.asarray(angle) / 2)
+        om = np.zeros((n, 3))
+        om[:, 2] = angular_velocity
+        return cls(pos, q, vel, om, t)
+
+
+@dataclass(frozen=True)
+class Body:
+    """One rigid body as given in the file (a read-only view of the model's arrays)."""
+
+    name: str
+    index: int
+    mass: float  # kg
+    inertia: np.ndarray  # (3, 3) body axes about the mass centre, kg m^2 (planar: I_G at [2, 2])
+    shape: dict[str, Any] | None
+    color: str | None
+
+    @property
+    def I_G(self) -> float:
+        """Planar moment of inertia about the mass centre (the z-z entry)."""
+        return float(self.inertia[2, 2])
+
+
+@dataclass(frozen=True)
+class Load:
+    """An applied load as given in the file: force, torque or spring."""
+
+    name: str
+    type: str
+    bodies: tuple[str, ...]
+    vector: np.ndarray | None  # force or torque, in `frame`, 3-D
+    frame: str
+    at: tuple[np.ndarray, ...]  # attachment points: body axes (world for ground)
+    stiffness: float = 0.0
+    rest_length: float = 0.0
+    damping: float = 0.0
+
+
+@dataclass(frozen=True)
+class Joint:
+    """A joint: its reaction components and its frame at the initial pose."""
+
+    name: str
+    type: str
+    parent: str
+    child: str
+    at: np.ndarray  # (3,) world, initial pose
+    W_E0: np.ndarray  # (3, 3) joint frame at the initial pose, axes as columns (world)
+    components: tuple[str, ...]
+    axis: np.ndarray | None = None
+    axis2: np.ndarray | None = None
+
+    @property
+    def labels(self) -> list[str]:
+        return [f"{self.name}.{k}" for k in self.components]
+
+
+@dataclass(frozen=True)
+class ForceTable:
+    """Point forces and couples, one row per load (vectorised application).
+
+    body: (k,) body index; vector: (k, 3) force or torque components in its frame;
+    in_body: (k,) True when the components are in body axes; B_r: (k, 3) point of
+    application from the mass centre, body axes; couple: (k,) True for torques.
+    """
+
+    names: tuple[str, ...]
+    body: np.ndarray
+    vector: np.ndarray
+    in_body: np.ndarray
+    B_r: np.ndarray
+    couple: np.ndarray
+
+
+@dataclass(frozen=True)
+class SpringTable:
+    """Linear spring-dampers; index -1 is ground (its point is then in world axes).
+
+    a, b: (k,) end bodies; r_a, r_b: (k, 3) attachment points (body axes, world for
+    ground); stiffness, rest_length, damping: (k,).
+    """
+
+    names: tuple[str, ...]
+    a: np.ndarray
+    b: np.ndarray
+    r_a: np.ndarray
+    r_b: np.ndarray
+    stiffness: np.ndarray
+    rest_length: np.ndarray
+    damping: np.ndarray
+
+
+@dataclass(frozen=True)
+class ReactionTable:
+    """One row per reaction unknown (column of G), in label order.
+
+    joint: (m,) joint index; parent, child: (m,) body index (-1 = ground);
+    axis: (m,) 0-2 force along joint axis k, 3-5 moment about joint axis k-3,
+    6 the universal joint's moment about axis × axis2.
+    P_E: (m, 3) the column's joint axis fixed in the parent (body axes; world for ground);
+    B_r_child: (m, 3) the joint point on the child, child body axes;
+    C_axis2: (m, 3) a universal joint's child axis, child body axes (else 0).
+    """
+
+    labels: tuple[str, ...]
+    joint: np.ndarray
+    parent: np.ndarray
+    child: np.ndarray
+    axis: np.ndarray
+    P_E: np.ndarray
+    B_r_child: np.ndarray
+    C_axis2: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class Model:
+    """A validated multibody model: bodies, applied loads and joints, as arrays.
+
+    mass: (n,) kg. J: (n, 3, 3) inertia tensors, body axes, about the mass centres.
+    J_inv: (n, 3, 3) their inverses. gravity: (3,) world, m/s^2.
+    """
+
+    name: str
+    file: str
+    dimension: int
+    body_names: tuple[str, ...]
+    mass: np.ndarray
+    J: np.ndarray
+    J_inv: np.ndarray
+    gravity: np.ndarray
+    initial: State
+    bodies: dict[str, Body]
+    loads: tuple[Load, ...]
+    joints: tuple[Joint, ...]
+    forces: ForceTable
+    springs: SpringTable
+    reaction_table: ReactionTable
+    known_reactions: dict[str, float]
+    description: str = ""
+    warnings: tuple[Issue, ...] = field(default_factory=tuple)
+
+    # -- sizes and labels --------------------------------------------------------------
+    @property
+    def n(self) -> int:
+        """Number of bodies."""
+        return len(self.body_names)
+
+    @property
+    def rows_per_body(self) -> int:
+        return cv.rows_per_body(self.dimension)
+
+    @cached_property
+    def coordinates(self) -> list[str]:
+        return cv.coordinate_labels(list(self.body_names), self.dimension)
+
+    @property
+    def reactions(self) -> list[str]:
+        return list(self.reaction_table.labels)
+
+    @cached_property
+    def index(self) -> dict[str, int]:
+        return {n: i for i, n in enumerate(self.body_names)}
+
+    @cached_property
+    def graph(self):  # -> networkx.MultiGraph; imported lazily, it is slow to import
+        from .graph import body_graph
+
+        return body_graph(self)
+
+    @classmethod
+    def from_spec(cls, spec: Spec) -> Model:
+        return _build(spec)
+
+
+def load(source: str | os.PathLike[str] | dict, *, max_bytes: int | None = None) -> Model:
+    """Read, validate and build a model; raises `mbody.ModelError` listing every problem.
+
+    `source` is a path to a YAML file, or a dict with the same content (for scripts).
+    """
+    if isinstance(source, dict):
+        doc = Document(source, "<dict>")
+    else:
+        doc = load_file(source, **({"max_bytes": max_bytes} if max_bytes else {}))
+    return Model.from_spec(validate(doc))
+
+
+def loads(text: str, file: str = "<string>") -> Model:
+    """Like `load`, from YAML text."""
+    return Model.from_spec(validate(load_text(text, file)))
+
+
+def _build(spec: Spec) -> Model:
+    bs = spec.bodies
+    n = len(bs)
+    names = tuple(b.name for b in bs)
+    idx = {nm: i for i, nm in enumerate(names)}
+    mass = np.array([b.mass for b in bs], dtype=float)
+    J = np.array([b.inertia for b in bs], dtype=float).reshape(n, 3, 3)
+    J_inv = np.linalg.inv(J)
+    initial = State(
+        _ro(np.array([b.position for b in bs]).reshape(n, 3)),
+        _ro(np.array([b.quaternion for b in bs]).reshape(n, 4)),
+        _ro(np.array([b.velocity for b in bs]).reshape(n, 3)),
+        _ro(np.array([b.omega for b in bs]).reshape(n, 3)),
+    )
+    bodies = {b.name: Body(b.name, i, b.mass, _ro(J[i]), b.shape, b.color)
+              for i, b in enumerate(bs)}
+
+    loads = tuple(Load(ld.name, ld.type, ld.bodies, ld.vector, ld.frame, ld.at,
+                       ld.stiffness, ld.rest_length, ld.damping) for ld in spec.loads)
+    point = [ld for ld in spec.loads if ld.type in ("force", "torque")]
+    forces = ForceTable(
+        tuple(ld.name for ld in point),
+        np.array([idx[ld.bodies[0]] for ld in point], dtype=np.intp),
+        _ro(np.array([ld.vector for ld in point]).reshape(-1, 3)),
+        np.array([ld.frame == "body" for ld in point], dtype=bool),
+        _ro(np.array([ld.at[0] for ld in point]).reshape(-1, 3)),
+        np.array([ld.type == "torque" for ld in point], dtype=bool),
+    )
+    sp = [ld for ld in spec.loads if ld.type == "spring"]
+    springs = SpringTable(
+        tuple(ld.name for ld in sp),
+        np.array([idx.get(ld.bodies[0], -1) for ld in sp], dtype=np.intp),
+        np.array([idx.get(ld.bodies[1], -1) for ld in sp], dtype=np.intp),
+        _ro(np.array([ld.at[0] for ld in sp]).reshape(-1, 3)),
+        _ro(np.array([ld.at[1] for ld in sp]).reshape(-1, 3)),
+        _ro(np.array([ld.stiffness for ld in sp], dtype=float)),
+        _ro(np.array([ld.rest_length for ld in sp], dtype=float)),
+        _ro(np.array([ld.damping for ld in sp], dtype=float)),
+    )
+
+    R0 = initial.W_R_B
+    joints = []
+    rows: dict[str, list] = {k: [] for k in ("labels", "joint", "parent", "child", "axis",
+                                              "P_E", "B_r_child", "C_axis2")}
+    for jn, js in enumerate(spec.joints):
+        comps = cv.JOINT_COMPONENTS[spec.dimension][js.type]
+        W_E0 = (joint_frame_planar(js.axis) if spec.dimension == cv.PLANAR
+                else joint_frame_spatial(js.axis))
+        joints.append(Joint(js.name, js.type, js.parent, js.child, _ro(js.at), _ro(W_E0),
+                            comps, js.axis, js.axis2))
+        p, c = idx.get(js.parent, -1), idx[js.child]
+        P_E = W_E0 if p < 0 else R0[p].T @ W_E0  # joint frame fixed in the parent
+        B_r_child = R0[c].T @ (js.at - initial.position[c])
+        C_axis2 = R0[c].T @ js.axis2 if js.axis2 is not None else np.zeros(3)
+        for comp in comps:
+            k = 6 if comp == "Mt" else cv.COMPONENTS.index(comp)
+            rows["labels"].append(f"{js.name}.{comp}")
+            rows["joint"].append(jn)
+            rows["parent"].append(p)
+            rows["child"].append(c)
+            rows["axis"].append(k)
+            # Mt's direction is recomputed from both bodies; store axis (z) for it.
+            rows["P_E"].append(P_E[:, 2] if k == 6 else P_E[:, k % 3])
+            rows["B_r_child"].append(B_r_child)
+            rows["C_axis2"].append(C_axis2)
+    table = ReactionTable(
+        tuple(rows["labels"]),
+        np.array(rows["joint"], dtype=np.intp),
+        np.array(rows["parent"], dtype=np.intp),
+        np.array(rows["child"], dtype=np.intp),
+        np.array(rows["axis"], dtype=np.intp),
+        _ro(np.array(rows["P_E"]).reshape(-1, 3)),
+        _ro(np.array(rows["B_r_child"]).reshape(-1, 3)),
+        _ro(np.array(rows["C_axis2"]).reshape(-1, 3)),
+    )
+    return Model(spec.name, spec.file, spec.dimension, names, _ro(mass), _ro(J), _ro(J_inv),
+                 _ro(spec.gravity), initial, bodies, loads, tuple(joints), forces, springs,
+                 table, dict(spec.reactions), spec.description, tuple(spec.warnings))

@@ -1,0 +1,172 @@
+"""Readable text for models, assemblies and solutions (what the CLI prints)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import conventions as cv
+from .assemble import Assembly, Solution
+from .fbd import REACTION, BodyEquations
+from .graph import Topology
+from .model import Model
+
+
+def _v(x: np.ndarray, dim: int) -> str:
+    x = np.asarray(x)[:2] if dim == cv.PLANAR else np.asarray(x)
+    return "(" + ", ".join(_n(v) for v in x) + ")"
+
+
+def _n(x: float) -> str:
+    s = f"{x:.6g}"
+    return "0" if s in ("-0", "0") else s
+
+
+def _plural(k: int, word: str) -> str:
+    return f"{k} {word}{'' if k == 1 else 's'}"
+
+
+def model_summary(model: Model, topo: Topology) -> str:
+    dim = model.dimension
+    kind = "planar" if dim == cv.PLANAR else "spatial"
+    out = [f"model {model.name!r}: {kind}, {_plural(model.n, 'body')}, "
+           f"{_plural(len(model.loads), 'load')}, {_plural(len(model.joints), 'joint')}"
+           + (f"  [{model.file}]" if model.file else "")]
+    if model.description:
+        out.append(f"  {model.description.strip()}")
+    if np.any(model.gravity):
+        out.append(f"gravity {_v(model.gravity, dim)} m/s^2 (world)")
+    out.append("")
+    out.append(f"bodies ({model.n}, in stacking order):")
+    shown = model.body_names[:50]
+    for name in shown:
+        b = model.bodies[name]
+        if dim == cv.PLANAR:
+            inertia = f"I_G {_n(b.I_G)} kg m^2"
+        else:
+            J = b.inertia
+            inertia = ("I " + _v(np.diag(J), 3) if np.allclose(J, np.diag(np.diag(J)))
+                       else "I full tensor, principal " + _v(np.linalg.eigvalsh(J), 3))
+            inertia += " kg m^2"
+        out.append(f"  {name:<14} m {_n(b.mass)} kg, {inertia}")
+    if model.n > len(shown):
+        out.append(f"  ... and {model.n - len(shown)} more")
+    if model.loads:
+        out.append(f"loads ({len(model.loads)}):")
+        for ld in model.loads[:50]:
+            if ld.type == "spring":
+                what = (f"spring {ld.bodies[0]} - {ld.bodies[1]}, k {_n(ld.stiffness)} N/m, "
+                        f"rest {_n(ld.rest_length)} m, damping {_n(ld.damping)} N s/m")
+            elif ld.type == "torque":
+                tq = ld.vector[2] if dim == cv.PLANAR else ld.vector
+                what = f"torque on {ld.bodies[0]}: {_n(tq) if dim == 2 else _v(tq, 3)} N m" \
+                    + ("" if dim == 2 else f" ({ld.frame} axes)")
+            else:
+                what = (f"force on {ld.bodies[0]}: {_v(ld.vector, dim)} N ({ld.frame} axes) "
+                        f"at {_v(ld.at[0], dim)} m")
+            out.append(f"  {ld.name:<14} {what}")
+    if model.joints:
+        out.append(f"joints ({len(model.joints)}):")
+        for j in model.joints[:50]:
+            out.append(f"  {j.name:<14} {j.type} {j.parent} -> {j.child} at {_v(j.at, dim)}: "
+                       + ", ".join(j.labels))
+    unknown = [r for r in model.reactions if r not in model.known_reactions]
+    out.append(f"reaction unknowns ({len(unknown)}): " + (", ".join(unknown[:40]) or "none")
+               + (" ..." if len(unknown) > 40 else ""))
+    if model.known_reactions:
+        out.append("known reactions: " + ", ".join(f"{k} = {_n(v)}"
+                                                   for k, v in model.known_reactions.items()))
+    out.append("")
+    out.append(graph_summary(model, topo))
+    for w in model.warnings:
+        out.append(f"warning: {w}")
+    return "\n".join(out)
+
+
+def graph_summary(model: Model, topo: Topology) -> str:
+    per = 3 if model.dimension == cv.PLANAR else 6
+    g = model.graph
+    lines = [f"graph: {g.number_of_nodes()} nodes (bodies + ground), "
+             f"{g.number_of_edges()} joint edges; "
+             + ("a tree (no closed loops)" if topo.is_tree
+                else f"{_plural(topo.loops, 'closed loop')}")]
+    parts = [p for p in topo.parts if p != [cv.GROUND]]
+    lines.append(f"  connected parts: {len(topo.parts)}")
+    for p in parts[:10]:
+        lines.append("    " + ", ".join(p[:12]) + (" ..." if len(p) > 12 else ""))
+    if topo.floating:
+        lines.append(f"  attached to nothing ({len(topo.floating)}): "
+                     + ", ".join(topo.floating[:12]) + (" ..." if len(topo.floating) > 12 else ""))
+    if topo.rank is None:
+        lines.append(f"mobility: {topo.mobility} = {per} x {model.n} bodies - "
+                     f"{topo.constraints} reaction components (Gruebler; rank not computed)")
+    else:
+        lines.append(f"mobility: {topo.mobility} = {per} x {model.n} bodies - {topo.rank} "
+                     f"independent constraints ({topo.constraints} reaction components)")
+    if topo.redundant:
+        lines.append(f"warning: {len(topo.redundant)} redundant constraint(s): "
+                     + ", ".join(topo.redundant)
+                     + " (these reactions are not unique: they depend on the others)")
+    return "\n".join(lines)
+
+
+def body_text(eq: BodyEquations, dimension: int) -> str:
+    f = eq.fbd
+    out = [f"== {eq.body} ==  m {_n(f.mass)} kg, mass centre at {_v(f.W_position, dimension)} m"]
+    out.append("free body:")
+    hdr = (f"  {'force':<14}{'kind':<10}{'point (body, m)':<22}{'components (world)':<30}"
+           f"moment about G")
+    out.append(hdr)
+    for fo in f.forces:
+        if fo.kind == REACTION:
+            name = fo.label + ("" if fo.value is None else f"={_n(fo.value)}")
+            comp = ("unit " if fo.value is None else "") + _v(
+                fo.W_vector if fo.value is not None else fo.W_vector, dimension)
+        else:
+            name, comp = fo.name, _v(fo.W_vector, dimension)
+        unit = "N m" if fo.couple else "N"
+        point = "-" if fo.couple else _v(fo.B_r, dimension)
+        mom = _n(fo.B_moment[2]) if dimension == cv.PLANAR else _v(fo.B_moment, 3)
+        label = "couple" if fo.couple else fo.kind
+        if fo.kind == REACTION:
+            label = "reaction"
+        out.append(f"  {name:<14}{label:<10}{point:<22}{comp + ' ' + unit:<30}{mom}")
+    if not f.forces:
+        out.append("  (no forces)")
+    out.append("Newton (world axes):")
+    out += [f"  {e}" for e in eq.newton]
+    out.append("Euler (about the mass centre, " + ("z)" if dimension == 2 else "body axes):"))
+    out += [f"  {e}" for e in eq.euler]
+    return "\n".join(out)
+
+
+def assembly_text(asm: Assembly, max_bodies: int = 200) -> str:
+    model = asm.model
+    parts = [f"model {model.name!r}: M v_dot + b = Q + G lambda; rows per body: "
+             + ", ".join(cv.PLANAR_ROWS if model.dimension == 2 else cv.SPATIAL_ROWS)
+             + ("" if model.dimension == 2 else
+                " (Newton in world axes, Euler in body axes)")]
+    for name in model.body_names[:max_bodies]:
+        parts.append(body_text(asm.bodies[name], model.dimension))
+    if model.n > max_bodies:
+        parts.append(f"... {model.n - max_bodies} more bodies (use --body NAME)")
+    sh = asm.shape
+    parts.append("stacked: " + ", ".join(f"{k} {'x'.join(map(str, v))}" for k, v in sh.items())
+                 + f"  (reaction unknowns: {len(asm.reactions)})")
+    return "\n\n".join(parts)
+
+
+def solution_text(sol: Solution, model: Model) -> str:
+    rows = cv.PLANAR_ROWS if model.dimension == 2 else cv.SPATIAL_ROWS
+    units = {"x": "m/s^2", "y": "m/s^2", "z": "m/s^2", "theta": "rad/s^2"}
+    lines = [f"accelerations of {model.name!r} (Newton rows world axes"
+             + (", Euler rows body axes):" if model.dimension == 3 else "):")]
+    k = len(rows)
+    for i, name in enumerate(model.body_names):
+        vals = sol.accelerations[i * k:(i + 1) * k]
+        lines.append(f"  {name:<14}" + "  ".join(
+            f"{cv.ACCELERATION_NAMES[r]} = {_n(v)} {units.get(r, 'rad/s^2')}"
+            for r, v in zip(rows, vals, strict=True)))
+    if sol.reactions:
+        lines.append("reactions used: " + ", ".join(f"{k} = {_n(v)}"
+                                                    for k, v in sol.reactions.items()))
+    return "\n".join(lines)

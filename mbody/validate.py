@@ -1,0 +1,657 @@
+"""Every rule of the model-file contract, checked at the boundary.
+
+`validate(doc)` walks the loaded document once, collects every problem as an `Issue`
+with the file, line and column of the offending key or value, and raises one
+`ModelError` listing them all. On success it returns a `Spec`: the file's content
+normalised (defaults filled in, angles in radians, planar vectors padded to 3-D) and
+ready for `Model` to turn into arrays. Hot paths downstream carry no checks.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from . import conventions as cv
+from .errors import Issue, ModelError, did_you_mean
+from .loader import Document, Path_, dotted
+from .spatial import euler_to_quat, matrix_to_quat, shape_inertia
+
+TOP_KEYS = ("model", "dimension", "gravity", "bodies", "loads", "joints", "reactions",
+            "description")
+BODY_KEYS = ("name", "mass", "inertia", "position", "orientation", "angle", "velocity",
+             "angular_velocity", "shape", "color")
+LOAD_KEYS = {
+    "force": ("name", "type", "body", "force", "at", "frame"),
+    "torque": ("name", "type", "body", "torque", "frame"),
+    "spring": ("name", "type", "bodies", "at", "stiffness", "rest_length", "damping"),
+}
+JOINT_KEYS = ("name", "type", "parent", "child", "at", "axis", "axis2")
+ORIENTATION_KEYS = ("quaternion", "euler", "sequence", "matrix")
+SHAPES = {
+    cv.PLANAR: ("box", "disc", "ellipsoid", "sphere", "cylinder"),
+    cv.SPATIAL: ("box", "cylinder", "sphere", "ellipsoid", "disc"),
+}
+FRAMES = ("world", "body")
+DEFAULT_EULER_SEQUENCE = "ZYX"
+"""Intrinsic z-y'-x'' (yaw, pitch, roll), scipy's upper-case convention."""
+
+_ANGLE = re.compile(r"\s*([-+]?[0-9.eE+-]+)\s*(deg|rad)\s*")
+_RATE = re.compile(r"\s*([-+]?[0-9.eE+-]+)\s*(deg/s|rad/s)\s*")
+_TOL = 1e-6
+
+
+@dataclass
+class BodySpec:
+    name: str
+    mass: float
+    inertia: np.ndarray  # (3, 3) body axes about the mass centre
+    position: np.ndarray  # (3,) world
+    quaternion: np.ndarray  # (4,) w first, body to world
+    velocity: np.ndarray  # (3,) world
+    omega: np.ndarray  # (3,) body axes
+    shape: dict[str, Any] | None
+    color: str | None
+    line: int
+
+
+@dataclass
+class LoadSpec:
+    name: str
+    type: str
+    bodies: tuple[str, ...]
+    vector: np.ndarray | None = None  # force or torque, 3-D
+    frame: str = "world"
+    at: tuple[np.ndarray, ...] = ()  # body axes (world for ground), 3-D
+    stiffness: float = 0.0
+    rest_length: float = 0.0
+    damping: float = 0.0
+    line: int = 0
+
+
+@dataclass
+class JointSpec:
+    name: str
+    type: str
+    parent: str
+    child: str
+    at: np.ndarray  # (3,) world, initial pose
+    axis: np.ndarray | None
+    axis2: np.ndarray | None
+    line: int = 0
+
+
+@dataclass
+class Spec:
+    name: str
+    file: str
+    dimension: int
+    gravity: np.ndarray
+    bodies: list[BodySpec]
+    loads: list[LoadSpec]
+    joints: list[JointSpec]
+    reactions: dict[str, float]
+    description: str = ""
+    warnings: list[Issue] = field(default_factory=list)
+
+
+class _Checker:
+    def __init__(self, doc: Document):
+        self.doc = doc
+        self.issues: list[Issue] = []
+        self.warnings: list[Issue] = []
+        self.dim = cv.SPATIAL
+
+    # -- reporting -------------------------------------------------------------------
+    def err(self, path: Path_, message: str, hint: str = "", *, key: bool = False) -> None:
+        line, col = self.doc.where(path, key=key)
+        self.issues.append(Issue(self.doc.file, line, col, dotted(path), message, hint))
+
+    def warn(self, path: Path_, message: str, hint: str = "") -> None:
+        line, col = self.doc.where(path)
+        self.warnings.append(Issue(self.doc.file, line, col, dotted(path), message, hint))
+
+    # -- shapes of values --------------------------------------------------------------
+    def mapping(self, path: Path_, value: Any, allowed: tuple[str, ...],
+                required: tuple[str, ...] = (), what: str = "a mapping") -> bool:
+        if not isinstance(value, dict):
+            self.err(path, f"expected {what}, got {_kind(value)}")
+            return False
+        for k in value:
+            if k not in allowed:
+                self.err((*path, k), f"unknown key '{k}'",
+                         did_you_mean(k, allowed) or f"expected one of: {', '.join(allowed)}",
+                         key=True)
+        for k in required:
+            if k not in value:
+                self.err(path, f"missing required key '{k}'")
+        return True
+
+    def number(self, path: Path_, value: Any, *, positive: bool = False,
+               nonneg: bool = False) -> float | None:
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            self.err(path, f"expected a number, got {_kind(value)}")
+            return None
+        x = float(value)
+        if not math.isfinite(x):
+            self.err(path, f"expected a finite number, got {value}")
+            return None
+        if positive and x <= 0:
+            self.err(path, f"expected a number > 0, got {value}")
+            return None
+        if nonneg and x < 0:
+            self.err(path, f"expected a number >= 0, got {value}")
+            return None
+        return x
+
+    def angle(self, path: Path_, value: Any, rate: bool = False) -> float | None:
+        if isinstance(value, str):
+            m = (_RATE if rate else _ANGLE).fullmatch(value)
+            unit = "deg/s" if rate else "deg"
+            if not m:
+                self.err(path, f"expected a number (radians{'/s' if rate else ''}) or a string "
+                         f"like '30 {unit}', got '{value}'")
+                return None
+            try:
+                x = float(m.group(1))
+            except ValueError:
+                self.err(path, f"'{value}' is not a number followed by a unit")
+                return None
+            return math.radians(x) if m.group(2).startswith("deg") else x
+        return self.number(path, value)
+
+    def vector(self, path: Path_, value: Any, n: int, *, angles: bool = False,
+               rates: bool = False) -> np.ndarray | None:
+        if not isinstance(value, list):
+            self.err(path, f"expected a list of {n} numbers, got {_kind(value)}")
+            return None
+        if len(value) != n:
+            self.err(path, f"expected {n} components, got {len(value)}",
+                     "planar models use 2-D vectors" if n == 2 and len(value) == 3 else
+                     "spatial models use 3-D vectors" if n == 3 and len(value) == 2 else "")
+            return None
+        out = []
+        for i, v in enumerate(value):
+            x = (self.angle((*path, i), v, rate=rates) if angles or rates
+                 else self.number((*path, i), v))
+            if x is None:
+                return None
+            out.append(x)
+        return np.array(out, dtype=float)
+
+    def vec3(self, path: Path_, value: Any, rates: bool = False) -> np.ndarray | None:
+        """A d-vector from the file, returned padded to 3-D (planar z = 0)."""
+        v = self.vector(path, value, self.dim, rates=rates)
+        if v is None:
+            return None
+        return np.append(v, 0.0) if self.dim == cv.PLANAR else v
+
+    def matrix3(self, path: Path_, value: Any) -> np.ndarray | None:
+        if not (isinstance(value, list) and len(value) == 3
+                and all(isinstance(r, list) for r in value)):
+            self.err(path, f"expected a 3x3 matrix (a list of 3 rows), got {_kind(value)}")
+            return None
+        rows = [self.vector((*path, i), r, 3) for i, r in enumerate(value)]
+        if any(r is None for r in rows):
+            return None
+        return np.array(rows)
+
+    def name(self, path: Path_, value: Any, what: str) -> str | None:
+        if not isinstance(value, str) or not value.strip():
+            self.err(path, f"expected a {what} name (text), got {_kind(value)}")
+            return None
+        if "." in value or any(c.isspace() for c in value):
+            self.err(path, f"the {what} name '{value}' may not contain '.' or spaces",
+                     "reaction labels are written <joint>.<component>")
+            return None
+        return value
+
+    def choice(self, path: Path_, value: Any, choices: tuple[str, ...], what: str) -> str | None:
+        if not isinstance(value, str) or value not in choices:
+            self.err(path, f"unknown {what} {value!r}",
+                     did_you_mean(value, choices) or f"expected one of: {', '.join(choices)}")
+            return None
+        return value
+
+    def body_ref(self, path: Path_, value: Any, names: dict[str, int],
+                 allow_ground: bool) -> str | None:
+        choices = list(names) + ([cv.GROUND] if allow_ground else [])
+        if isinstance(value, str) and value in choices:
+            return value
+        if value == cv.GROUND and not allow_ground:
+            self.err(path, "'ground' is not allowed here", "name a body of the model")
+            return None
+        hint = did_you_mean(value, choices) if isinstance(value, str) else ""
+        self.err(path, f"no body named {value!r}",
+                 hint or f"bodies are: {', '.join(choices[:12])}"
+                 + (" ..." if len(choices) > 12 else ""))
+        return None
+
+
+def _missing(*values: Any) -> bool:
+    return any(v is None for v in values)
+
+
+def _kind(value: Any) -> str:
+    if value is None:
+        return "nothing (null)"
+    if isinstance(value, bool):
+        return f"a boolean ({str(value).lower()})"
+    if isinstance(value, int | float):
+        return f"the number {value}"
+    if isinstance(value, str):
+        return f"the text '{value}'"
+    if isinstance(value, list):
+        return f"a list of {len(value)}"
+    if isinstance(value, dict):
+        return "a mapping"
+    return type(value).__name__
+
+
+def validate(doc: Document) -> Spec:
+    """Check `doc` against the contract; return the normalised `Spec` or raise ModelError."""
+    c = _Checker(doc)
+    data = doc.data
+    if not c.mapping((), data, TOP_KEYS, ("dimension", "bodies"), what="a model mapping"):
+        raise ModelError(c.issues)
+
+    dim = data.get("dimension")
+    if dim not in (2, 3) or isinstance(dim, bool):
+        if "dimension" in data:
+            c.err(("dimension",), f"expected 2 (planar) or 3 (spatial), got {_kind(dim)}")
+        dim = 3
+    c.dim = int(dim)
+    name = data.get("model", None)
+    if name is None:
+        name = doc.file.rsplit("/", 1)[-1].removesuffix(".yaml").removesuffix(".yml")
+    elif not isinstance(name, str):
+        c.err(("model",), f"expected the model's name as text, got {_kind(name)}")
+    description = data.get("description", "")
+    if not isinstance(description, str):
+        c.err(("description",), f"expected text, got {_kind(description)}")
+        description = ""
+
+    gravity = np.zeros(3)
+    if data.get("gravity") is not None:
+        g = c.vec3(("gravity",), data["gravity"])
+        gravity = g if g is not None else gravity
+
+    bodies = _bodies(c, data.get("bodies"))
+    names = {b.name: i for i, b in enumerate(bodies)}
+    loads = _loads(c, data.get("loads"), names)
+    joints = _joints(c, data.get("joints"), names, bodies)
+    reactions = _reactions(c, data.get("reactions"), joints)
+
+    if c.issues:
+        raise ModelError(c.issues)
+    return Spec(str(name), doc.file, c.dim, gravity, bodies, loads, joints, reactions,
+                description, c.warnings)
+
+
+def _list(c: _Checker, path: Path_, value: Any, what: str, required: bool) -> list:
+    if value is None:
+        if required:
+            c.err(path, f"expected a list of {what}, got nothing")
+        return []
+    if not isinstance(value, list):
+        c.err(path, f"expected a list of {what}, got {_kind(value)}")
+        return []
+    if required and not value:
+        c.err(path, f"the model needs at least one of the {what}")
+    return value
+
+
+def _bodies(c: _Checker, value: Any) -> list[BodySpec]:
+    out: list[BodySpec] = []
+    seen: dict[str, int] = {}
+    for i, b in enumerate(_list(c, ("bodies",), value, "bodies", True)):
+        p: Path_ = ("bodies", i)
+        if not c.mapping(p, b, BODY_KEYS, ("name", "mass"), "a body mapping"):
+            continue
+        name = c.name((*p, "name"), b.get("name"), "body") if "name" in b else None
+        if name == cv.GROUND:
+            c.err((*p, "name"), "'ground' is reserved for the fixed world frame")
+            name = None
+        if name is not None and name in seen:
+            c.err((*p, "name"), f"duplicate body name '{name}'",
+                  f"first used by bodies[{seen[name]}]")
+        elif name is not None:
+            seen[name] = i
+        mass = c.number((*p, "mass"), b.get("mass"), positive=True) if "mass" in b else None
+        shape = _shape(c, (*p, "shape"), b["shape"]) if "shape" in b else None
+        inertia = None
+        if "inertia" in b:
+            inertia = _inertia(c, (*p, "inertia"), b["inertia"])
+        elif "mass" in b:
+            if shape is None:
+                if "shape" not in b:
+                    c.err(p, "missing required key 'inertia'",
+                          "give 'inertia', or a 'shape' to use a uniform solid's inertia")
+            elif mass is not None:
+                I = shape_inertia(shape, mass, c.dim)
+                inertia = (np.diag([I[0] / 2, I[0] / 2, I[0]]) if c.dim == cv.PLANAR
+                           else np.diag(I))
+        zero = np.zeros(3)
+        pos = c.vec3((*p, "position"), b["position"]) if "position" in b else zero
+        vel = c.vec3((*p, "velocity"), b["velocity"]) if "velocity" in b else zero
+        q = np.array([1.0, 0.0, 0.0, 0.0])
+        omega = zero
+        if c.dim == cv.PLANAR:
+            if "orientation" in b:
+                c.err((*p, "orientation"), "planar bodies give their angle with 'angle'",
+                      "write angle: 0.3 or angle: '30 deg'", key=True)
+            if "angle" in b:
+                th = c.angle((*p, "angle"), b["angle"])
+                if th is not None:
+                    q = np.array([math.cos(th / 2), 0.0, 0.0, math.sin(th / 2)])
+            if "angular_velocity" in b:
+                w = c.angle((*p, "angular_velocity"), b["angular_velocity"], rate=True)
+                omega = np.array([0.0, 0.0, w if w is not None else 0.0])
+        else:
+            if "angle" in b:
+                c.err((*p, "angle"), "spatial bodies give their attitude with 'orientation'",
+                      "write orientation: {euler: [0, 0, 0.3], sequence: ZYX}", key=True)
+            if "orientation" in b:
+                qq = _orientation(c, (*p, "orientation"), b["orientation"])
+                q = qq if qq is not None else q
+            if "angular_velocity" in b:
+                w3 = c.vector((*p, "angular_velocity"), b["angular_velocity"], 3, rates=True)
+                omega = w3 if w3 is not None else zero
+        color = b.get("color")
+        if color is not None and not isinstance(color, str):
+            c.err((*p, "color"), f"expected a colour name or '#rrggbb', got {_kind(color)}")
+            color = None
+        if _missing(name, mass, inertia, pos, vel):
+            continue
+        out.append(BodySpec(name, mass, inertia, pos, q, vel, omega, shape, color,
+                            c.doc.where(p)[0]))
+    return out
+
+
+def _inertia(c: _Checker, path: Path_, value: Any) -> np.ndarray | None:
+    if c.dim == cv.PLANAR:
+        I = c.number(path, value, positive=True) if not isinstance(value, list) else None
+        if isinstance(value, list):
+            c.err(path, "a planar body's inertia is the scalar I_G about its mass centre "
+                  f"(kg m^2), got {_kind(value)}")
+        return None if I is None else np.diag([I / 2, I / 2, I])
+    if isinstance(value, list) and value and all(isinstance(r, list) for r in value):
+        J = c.matrix3(path, value)
+        if J is None:
+            return None
+        scale = float(np.max(np.abs(J))) or 1.0
+        if np.max(np.abs(J - J.T)) > _TOL * scale:
+            c.err(path, "the inertia tensor is not symmetric",
+                  "entry (i, j) must equal entry (j, i)")
+            return None
+        principal = np.linalg.eigvalsh(J)
+    else:
+        v = c.vector(path, value, 3) if isinstance(value, list) else None
+        if not isinstance(value, list):
+            c.err(path, "expected principal moments [I1, I2, I3] or a 3x3 inertia tensor, "
+                  f"got {_kind(value)}")
+        if v is None:
+            return None
+        J, principal = np.diag(v), v
+    if np.any(principal <= 0):
+        c.err(path, "the inertia tensor is not positive definite "
+              f"(principal moments {_fmt(principal)})", "every principal moment must be > 0")
+        return None
+    a, b, d = np.sort(principal)
+    if a + b < d * (1 - _TOL):
+        c.err(path, f"the inertia is not physically realisable: the principal moments "
+              f"{_fmt(principal)} break the triangle inequality ({a:g} + {b:g} < {d:g})",
+              "every moment must be <= the sum of the other two")
+        return None
+    return J
+
+
+def _fmt(v: np.ndarray) -> str:
+    return "(" + ", ".join(f"{x:g}" for x in v) + ")"
+
+
+def _orientation(c: _Checker, path: Path_, value: Any) -> np.ndarray | None:
+    if not c.mapping(path, value, ORIENTATION_KEYS, what="an orientation mapping"):
+        return None
+    given = [k for k in ("quaternion", "euler", "matrix") if k in value]
+    if len(given) != 1:
+        c.err(path, "give exactly one of 'quaternion', 'euler' or 'matrix'"
+              + (f" (got {', '.join(given)})" if given else ""))
+        return None
+    kind = given[0]
+    if "sequence" in value and kind != "euler":
+        c.err((*path, "sequence"), "'sequence' goes with 'euler'", key=True)
+    if kind == "quaternion":
+        q = c.vector((*path, "quaternion"), value["quaternion"], 4)
+        if q is None:
+            return None
+        n = float(np.linalg.norm(q))
+        if n < 1e-12:
+            c.err((*path, "quaternion"), "the quaternion is zero", "identity is [1, 0, 0, 0]")
+            return None
+        if abs(n - 1) > 1e-6:
+            c.warn((*path, "quaternion"), f"the quaternion has norm {n:.6g}; it was normalised")
+        return q / n
+    if kind == "euler":
+        seq = value.get("sequence", DEFAULT_EULER_SEQUENCE)
+        if not (isinstance(seq, str) and len(seq) == 3 and (seq.isupper() or seq.islower())
+                and set(seq.lower()) <= set("xyz") and seq[0] != seq[1] and seq[1] != seq[2]):
+            c.err((*path, "sequence"), f"invalid Euler sequence {seq!r}",
+                  "three axes such as ZYX (intrinsic, upper case) or zyx (extrinsic, lower "
+                  "case), no axis twice in a row")
+            return None
+        ang = c.vector((*path, "euler"), value["euler"], 3, angles=True)
+        return None if ang is None else euler_to_quat(ang, seq)
+    R = c.matrix3((*path, "matrix"), value["matrix"])
+    if R is None:
+        return None
+    if np.max(np.abs(R.T @ R - np.eye(3))) > _TOL or np.linalg.det(R) < 0:
+        c.err((*path, "matrix"), "not a rotation matrix",
+              "it must be orthonormal (R^T R = I within 1e-6) with determinant +1")
+        return None
+    return matrix_to_quat(R)
+
+
+def _shape(c: _Checker, path: Path_, value: Any) -> dict[str, Any] | None:
+    allowed = SHAPES[c.dim]
+    if not c.mapping(path, value, allowed, what="a shape mapping such as {box: [a, b, c]}"):
+        return None
+    if len(value) != 1:
+        c.err(path, f"give exactly one shape, one of: {', '.join(allowed)}")
+        return None
+    kind, v = next(iter(value.items()))
+    p = (*path, kind)
+    if kind == "box" or kind == "ellipsoid":
+        n = c.dim
+        vec = c.vector(p, v, n)
+        if vec is None:
+            return None
+        if np.any(vec <= 0):
+            c.err(p, "every size must be > 0")
+            return None
+        return {kind: [float(x) for x in vec]}
+    keys = ("radius", "length") if kind == "cylinder" else ("radius",)
+    if not c.mapping(p, v, keys, keys, f"a mapping with {' and '.join(keys)}"):
+        return None
+    out = {}
+    for k in keys:
+        x = c.number((*p, k), v.get(k), positive=True) if k in v else None
+        if x is None:
+            return None
+        out[k] = x
+    return {kind: out}
+
+
+def _loads(c: _Checker, value: Any, names: dict[str, int]) -> list[LoadSpec]:
+    out: list[LoadSpec] = []
+    seen: dict[str, int] = {}
+    counters: dict[str, int] = {}
+    for i, ld in enumerate(_list(c, ("loads",), value, "loads", False)):
+        p: Path_ = ("loads", i)
+        if not isinstance(ld, dict):
+            c.err(p, f"expected a load mapping, got {_kind(ld)}")
+            continue
+        if "type" not in ld:
+            c.err(p, "missing required key 'type'", "one of: force, torque, spring")
+            continue
+        typ = c.choice((*p, "type"), ld["type"], tuple(LOAD_KEYS), "load type")
+        if typ is None:
+            continue
+        counters[typ] = counters.get(typ, 0) + 1
+        required = {"force": ("body", "force"), "torque": ("body", "torque"),
+                    "spring": ("bodies", "at", "stiffness")}[typ]
+        c.mapping(p, ld, LOAD_KEYS[typ], required)
+        if "name" in ld:
+            name = c.name((*p, "name"), ld["name"], "load")
+        else:
+            name = f"{typ}{counters[typ]}"
+        if name is not None and name in seen:
+            c.err((*p, "name"), f"duplicate load name '{name}'",
+                  f"first used by loads[{seen[name]}]")
+        elif name is not None:
+            seen[name] = i
+        line = c.doc.where(p)[0]
+        if typ in ("force", "torque"):
+            body = c.body_ref((*p, "body"), ld["body"], names, False) if "body" in ld else None
+            frame = ld.get("frame", "world")
+            frame = c.choice((*p, "frame"), frame, FRAMES, "frame")
+            if typ == "force":
+                vec = c.vec3((*p, "force"), ld["force"]) if "force" in ld else None
+                at = c.vec3((*p, "at"), ld["at"]) if "at" in ld else np.zeros(3)
+            else:
+                vec = _torque(c, (*p, "torque"), ld["torque"]) if "torque" in ld else None
+                at = np.zeros(3)
+            if _missing(name, body, frame, vec, at):
+                continue
+            out.append(LoadSpec(name, typ, (body,), vec, frame, (at,), line=line))
+        else:
+            pair = ld.get("bodies")
+            refs: list[str | None] = []
+            if not (isinstance(pair, list) and len(pair) == 2):
+                if "bodies" in ld:
+                    c.err((*p, "bodies"), f"expected two body names (or ground), got "
+                          f"{_kind(pair)}")
+            else:
+                refs = [c.body_ref((*p, "bodies", k), pair[k], names, True) for k in (0, 1)]
+                if refs[0] is not None and refs[0] == refs[1]:
+                    c.err((*p, "bodies"), "a spring needs two different ends")
+                    refs = []
+            at = ld.get("at")
+            pts: list[np.ndarray | None] = []
+            if not (isinstance(at, list) and len(at) == 2):
+                if "at" in ld:
+                    c.err((*p, "at"), "expected two attachment points "
+                          "[[..body axes or world for ground..], [..]]")
+            else:
+                pts = [c.vec3((*p, "at", k), at[k]) for k in (0, 1)]
+            k = c.number((*p, "stiffness"), ld["stiffness"], nonneg=True) \
+                if "stiffness" in ld else None
+            L0 = c.number((*p, "rest_length"), ld.get("rest_length", 0.0), nonneg=True)
+            damping = c.number((*p, "damping"), ld.get("damping", 0.0), nonneg=True)
+            if (len(refs) != 2 or len(pts) != 2
+                    or _missing(name, *refs, *pts, k, L0, damping)):
+                continue
+            out.append(LoadSpec(name, "spring", tuple(refs), None, "world", tuple(pts),
+                                k, L0, damping, line))
+    return out
+
+
+def _torque(c: _Checker, path: Path_, value: Any) -> np.ndarray | None:
+    if c.dim == cv.PLANAR:
+        if isinstance(value, list):
+            c.err(path, "a planar torque is a scalar (N m about z)", f"got {_kind(value)}")
+            return None
+        t = c.number(path, value)
+        return None if t is None else np.array([0.0, 0.0, t])
+    return c.vector(path, value, 3)
+
+
+def _joints(c: _Checker, value: Any, names: dict[str, int],
+            bodies: list[BodySpec]) -> list[JointSpec]:
+    out: list[JointSpec] = []
+    seen: dict[str, int] = {}
+    types = tuple(cv.JOINT_COMPONENTS[c.dim])
+    for i, j in enumerate(_list(c, ("joints",), value, "joints", False)):
+        p: Path_ = ("joints", i)
+        if not c.mapping(p, j, JOINT_KEYS, ("name", "type", "parent", "child", "at"),
+                         "a joint mapping"):
+            continue
+        name = c.name((*p, "name"), j["name"], "joint") if "name" in j else None
+        if name is not None and name in seen:
+            c.err((*p, "name"), f"duplicate joint name '{name}'",
+                  f"first used by joints[{seen[name]}]")
+        elif name is not None:
+            seen[name] = i
+        typ = None
+        if "type" in j:
+            typ = c.choice((*p, "type"), j["type"], types,
+                           f"{'planar' if c.dim == 2 else 'spatial'} joint type")
+        parent = c.body_ref((*p, "parent"), j["parent"], names, True) if "parent" in j else None
+        child = c.body_ref((*p, "child"), j["child"], names, True) if "child" in j else None
+        if child == cv.GROUND:
+            c.err((*p, "child"), "the child of a joint must be a body",
+                  "put ground as the parent")
+            child = None
+        if parent is not None and parent == child:
+            c.err((*p, "child"), f"the joint connects '{child}' to itself")
+            child = None
+        at = c.vec3((*p, "at"), j["at"]) if "at" in j else None
+        axis = axis2 = None
+        if "axis" in j:
+            axis = _axis(c, (*p, "axis"), j["axis"])
+        elif typ in cv.AXIS_REQUIRED[c.dim]:
+            c.err(p, f"a {typ} joint needs an 'axis'",
+                  "the slide direction" if typ == "prismatic" else "the rotation axis")
+        if "axis2" in j:
+            if typ != "universal":
+                c.err((*p, "axis2"), "'axis2' belongs to universal joints", key=True)
+            else:
+                axis2 = _axis(c, (*p, "axis2"), j["axis2"])
+        elif typ == "universal":
+            c.err(p, "a universal joint needs 'axis2' (the child's axis)")
+        if axis is not None and axis2 is not None and abs(float(axis @ axis2)) > 1e-6:
+            c.err((*p, "axis2"), "a universal joint's axes must be perpendicular",
+                  f"axis . axis2 = {float(axis @ axis2):.3g}")
+            continue
+        if _missing(name, typ, parent, child, at):
+            continue
+        out.append(JointSpec(name, typ, parent, child, at, axis, axis2, c.doc.where(p)[0]))
+    return out
+
+
+def _axis(c: _Checker, path: Path_, value: Any) -> np.ndarray | None:
+    a = c.vec3(path, value)
+    if a is None:
+        return None
+    n = float(np.linalg.norm(a))
+    if n < 1e-12:
+        c.err(path, "the axis is the zero vector")
+        return None
+    return a / n
+
+
+def _reactions(c: _Checker, value: Any, joints: list[JointSpec]) -> dict[str, float]:
+    if value is None:
+        return {}
+    if not isinstance(value, dict):
+        c.err(("reactions",), f"expected a mapping of reaction labels to values, got "
+              f"{_kind(value)}")
+        return {}
+    labels = [f"{j.name}.{k}" for j in joints for k in cv.JOINT_COMPONENTS[c.dim][j.type]]
+    out: dict[str, float] = {}
+    for label, v in value.items():
+        p: Path_ = ("reactions", label)
+        if label not in labels:
+            c.err(p, f"no reaction component '{label}'",
+                  did_you_mean(label, labels)
+                  or (f"the model's reaction components are: {', '.join(labels[:12])}"
+                      if labels else "the model has no joints"), key=True)
+            continue
+        x = c.number(p, v)
+        if x is not None:
+            out[label] = x
+    return out
