@@ -131,6 +131,7 @@ class BodyEquations:
 
 
 def _num(x: float) -> str:
+    x = 0.0 if abs(x) < 1e-12 else x  # rounding noise from rotations
     s = f"{x:.6g}"
     return "0" if s in ("-0", "0") else s
 

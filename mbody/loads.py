@@ -85,7 +85,7 @@ def applied_loads(model: Model, state: State, R: np.ndarray | None = None) -> Ap
 
     # Point forces and couples.
     Rf = R[ft.body]
-    vec = ft.vector
+    vec = ft.vector_at(state.t)
     W_vec = np.where(ft.in_body[:, None], matvec(Rf, vec), vec)
     B_vec = np.where(ft.in_body[:, None], vec, rmatvec(Rf, vec))
     couple = ft.couple[:, None]

@@ -137,6 +137,10 @@ class ForceTable:
     B_r: np.ndarray
     couple: np.ndarray
 
+    def vector_at(self, t: float) -> np.ndarray:
+        """(k, 3) load components at time `t` (constant loads: `vector` itself)."""
+        return self.vector
+
 
 @dataclass(frozen=True)
 class SpringTable:

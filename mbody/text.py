@@ -17,6 +17,7 @@ def _v(x: np.ndarray, dim: int) -> str:
 
 
 def _n(x: float) -> str:
+    x = 0.0 if abs(x) < 1e-12 else x  # rounding noise from rotations, e.g. -2.4e-17
     s = f"{x:.6g}"
     return "0" if s in ("-0", "0") else s
 
@@ -134,7 +135,7 @@ def body_text(eq: BodyEquations, dimension: int) -> str:
         out.append("  (no forces)")
     out.append("Newton (world axes):")
     out += [f"  {e}" for e in eq.newton]
-    out.append("Euler (about the mass centre, " + ("z)" if dimension == 2 else "body axes):"))
+    out.append("Euler (about the mass centre, " + ("z):" if dimension == 2 else "body axes):"))
     out += [f"  {e}" for e in eq.euler]
     return "\n".join(out)
 
