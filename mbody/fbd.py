@@ -8,7 +8,7 @@ moment about the mass centre. `BodyEquations` pairs it with the body's rows of
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -66,6 +66,7 @@ class FreeBodyDiagram:
     W_R_B: np.ndarray
     shape: dict | None
     forces: tuple[ForceOnBody, ...]
+    equations: tuple[Equation, ...] = ()  # the body's Newton-Euler rows, shown under drawings
 
     @property
     def applied(self) -> list[ForceOnBody]:
@@ -205,4 +206,5 @@ def body_equations(asm: Assembly, i: int) -> BodyEquations:
                             float(asm.Q[i * rpb + r]), reac,
                             {k: v for k, v in known.items() if k in reac}))
     nn = 2 if model.dimension == cv.PLANAR else 3
+    fbd = replace(fbd, equations=tuple(eqs))
     return BodyEquations(name, fbd, tuple(eqs[:nn]), tuple(eqs[nn:]))
