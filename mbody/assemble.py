@@ -17,7 +17,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from . import conventions as cv
-from .errors import MbodyError, UnknownReactionsError, did_you_mean
+from .errors import MbodyError, did_you_mean
 from .joints import ReactionColumns, g_matrix, reaction_columns, reaction_wrench
 from .loads import AppliedLoads, applied_loads, gyroscopic
 from .model import Model, State
@@ -63,6 +63,22 @@ class Solution:
     coordinates: list[str]
     accelerations: np.ndarray
     reactions: dict[str, float]
+    solved: tuple[str, ...] = ()
+    """Reaction components solved for (the rest were given)."""
+    not_unique: tuple[str, ...] = ()
+    """Solved components that redundant constraints leave undetermined (minimum norm)."""
+    residual: float | None = None
+    """Relative backward error of the constrained solve (None when nothing was solved)."""
+    condition: float | None = None
+    """1-norm condition estimate of the Schur complement Gᵀ M⁻¹ G (when asked for)."""
+    method: str = "block-diagonal M"
+
+    @property
+    def warnings(self) -> list[str]:
+        if not self.not_unique:
+            return []
+        return [f"redundant constraints: the reactions {', '.join(self.not_unique)} are not "
+                "unique; the minimum-norm values are given"]
 
     def as_dict(self) -> dict[str, float]:
         return dict(zip(self.coordinates, self.accelerations.tolist(), strict=True))
@@ -151,21 +167,48 @@ class Assembly:
             values[label] = float(v)
         return values
 
-    def solve(self, known: Mapping[str, float] | None = None) -> Solution:
-        """v̇ = M⁻¹ (Q + G λ − b) with every reaction value known (from the file or `known`).
+    def solve(self, known: Mapping[str, float] | None = None, *,
+              condition: bool = False) -> Solution:
+        """Accelerations, and the reactions not given (from the file or `known`).
 
-        Raises `UnknownReactionsError` naming the components still unknown.
+        With every reaction known (or none): v̇ = M⁻¹ (Q + G λ − b). Otherwise the
+        Newton-Euler pairs and the joint constraints are solved together,
+        ``M v̇ − G_U λ_U = Q − b + G_K λ_K``, ``G_Uᵀ v̇ = γ_U`` (see `mbody.kkt`); the
+        joints of known components are not enforced. `condition=True` also estimates the
+        condition number of the Schur complement.
         """
         values = self.reaction_values(known)
         missing = [r for r in self.reactions if r not in values]
         if missing:
-            raise UnknownReactionsError(missing)
+            return self._solve_constrained(values, condition)
         rhs6 = self._Q6 - self._b6
         if self.reactions:
             lam = np.array([values[r] for r in self.reactions])
             rhs6 = rhs6 + reaction_wrench(self.model, self.columns, lam)
         acc = _select(self.model, accelerations6(self.model, rhs6))
         return Solution(self.coordinates, acc, {r: values[r] for r in self.reactions})
+
+
+    def _solve_constrained(self, values: dict[str, float], condition: bool) -> Solution:
+        from .constraints import gamma
+        from .kkt import ConstrainedSystem
+
+        model = self.model
+        unknown = np.array([r not in values for r in self.reactions])
+        lam = np.array([values.get(r, 0.0) for r in self.reactions])
+        r6 = self._Q6 - self._b6 + reaction_wrench(model, self.columns, lam)
+        system = ConstrainedSystem(model, self.columns, unknown)
+        g_U = gamma(model, self.state, self.columns)[unknown]
+        acc6, lam_U = system.solve_refined(r6, g_U)
+        lam[unknown] = lam_U
+        labels = self.reactions
+        solved = tuple(labels[i] for i in system.U)
+        return Solution(self.coordinates, _select(model, acc6),
+                        dict(zip(labels, lam.tolist(), strict=True)), solved,
+                        tuple(solved[k] for k in system.fact.redundant if k >= 0),
+                        system.backward_error(r6, g_U, acc6, lam_U),
+                        system.fact.condition() if condition else None,
+                        system.fact.method)
 
 
 class _LazyBodies(Mapping):

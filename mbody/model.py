@@ -170,6 +170,12 @@ class ReactionTable:
     P_E: (m, 3) the column's joint axis fixed in the parent (body axes; world for ground);
     B_r_child: (m, 3) the joint point on the child, child body axes;
     C_axis2: (m, 3) a universal joint's child axis, child body axes (else 0).
+    B_r_parent: (m, 3) the joint point on the parent, parent body axes (world for ground).
+    P_E3, C_E3: (m, 3, 3) the whole joint frame fixed in the parent and in the child
+    (they coincide at the initial pose); used for position-level constraint errors.
+    rot_kind: (m,) for moment components: 1 = about an axis ⟂ a free rotation (revolute,
+    cylindrical: measured by the tilt of the joint z axis), 2 = all rotation locked
+    (fixed, prismatic: small rotation vector), 3 = universal; 0 for forces.
     """
 
     labels: tuple[str, ...]
@@ -180,6 +186,10 @@ class ReactionTable:
     P_E: np.ndarray
     B_r_child: np.ndarray
     C_axis2: np.ndarray
+    B_r_parent: np.ndarray
+    P_E3: np.ndarray
+    C_E3: np.ndarray
+    rot_kind: np.ndarray
 
 
 @dataclass(frozen=True, eq=False)
@@ -302,7 +312,8 @@ def _build(spec: Spec) -> Model:
     R0 = initial.W_R_B
     joints = []
     rows: dict[str, list] = {k: [] for k in ("labels", "joint", "parent", "child", "axis",
-                                              "P_E", "B_r_child", "C_axis2")}
+                                              "P_E", "B_r_child", "C_axis2", "B_r_parent",
+                                              "P_E3", "C_E3", "rot_kind")}
     for jn, js in enumerate(spec.joints):
         comps = cv.JOINT_COMPONENTS[spec.dimension][js.type]
         W_E0 = (joint_frame_planar(js.axis) if spec.dimension == cv.PLANAR
@@ -313,6 +324,9 @@ def _build(spec: Spec) -> Model:
         P_E = W_E0 if p < 0 else R0[p].T @ W_E0  # joint frame fixed in the parent
         B_r_child = R0[c].T @ (js.at - initial.position[c])
         C_axis2 = R0[c].T @ js.axis2 if js.axis2 is not None else np.zeros(3)
+        B_r_parent = js.at if p < 0 else R0[p].T @ (js.at - initial.position[p])
+        C_E = R0[c].T @ W_E0
+        free_turn = js.type in ("revolute", "cylindrical")
         for comp in comps:
             k = 6 if comp == "Mt" else cv.COMPONENTS.index(comp)
             rows["labels"].append(f"{js.name}.{comp}")
@@ -324,6 +338,10 @@ def _build(spec: Spec) -> Model:
             rows["P_E"].append(P_E[:, 2] if k == 6 else P_E[:, k % 3])
             rows["B_r_child"].append(B_r_child)
             rows["C_axis2"].append(C_axis2)
+            rows["B_r_parent"].append(B_r_parent)
+            rows["P_E3"].append(P_E)
+            rows["C_E3"].append(C_E)
+            rows["rot_kind"].append(0 if k < 3 else 3 if k == 6 else 1 if free_turn else 2)
     table = ReactionTable(
         tuple(rows["labels"]),
         np.array(rows["joint"], dtype=np.intp),
@@ -333,6 +351,10 @@ def _build(spec: Spec) -> Model:
         _ro(np.array(rows["P_E"]).reshape(-1, 3)),
         _ro(np.array(rows["B_r_child"]).reshape(-1, 3)),
         _ro(np.array(rows["C_axis2"]).reshape(-1, 3)),
+        _ro(np.array(rows["B_r_parent"]).reshape(-1, 3)),
+        _ro(np.array(rows["P_E3"]).reshape(-1, 3, 3)),
+        _ro(np.array(rows["C_E3"]).reshape(-1, 3, 3)),
+        np.array(rows["rot_kind"], dtype=np.intp),
     )
     return Model(spec.name, spec.file, spec.dimension, names, _ro(mass), _ro(J), _ro(J_inv),
                  _ro(spec.gravity), initial, bodies, loads, tuple(joints), forces, springs,

@@ -167,7 +167,45 @@ def solution_text(sol: Solution, model: Model) -> str:
         lines.append(f"  {name:<14}" + "  ".join(
             f"{cv.ACCELERATION_NAMES[r]} = {_n(v)} {units.get(r, 'rad/s^2')}"
             for r, v in zip(rows, vals, strict=True)))
-    if sol.reactions:
-        lines.append("reactions used: " + ", ".join(f"{k} = {_n(v)}"
-                                                    for k, v in sol.reactions.items()))
+    return "\n".join(lines)
+
+
+def reaction_table_text(asm: Assembly, sol: Solution) -> str:
+    """Joint, component, frame axis (world), value; then each joint's net force and couple
+    on its child (at the joint point) and on its parent (equal and opposite)."""
+    model = asm.model
+    dim = model.dimension
+    if not sol.reactions:
+        return ""
+    cols = asm.columns
+    t = model.reaction_table
+    lines = ["reactions (components along the joint frame axes, world components shown; "
+             "+R on the child, -R on the parent):",
+             f"  {'joint':<10}{'comp':<6}{'axis (world)':<28}{'value':>14}  {'':<8}"]
+    solved = set(sol.solved)
+    for c, label in enumerate(model.reactions):
+        joint, comp = label.split(".", 1)
+        unit = "N m" if cols.is_moment[c] else "N"
+        how = "solved" if label in solved else "given"
+        if label in sol.not_unique:
+            how = "not unique"
+        lines.append(f"  {joint:<10}{comp:<6}{_v(cols.W_e[c], 3):<28}"
+                     f"{_n(sol.reactions[label]):>14} {unit:<4} {how}")
+    lines.append("net joint loads (world axes, at the joint point):")
+    lam = np.array([sol.reactions[r] for r in model.reactions])
+    for jn, j in enumerate(model.joints):
+        sel = t.joint == jn
+        F = (lam[sel & ~cols.is_moment, None] * cols.W_e[sel & ~cols.is_moment]).sum(axis=0)
+        C = (lam[sel & cols.is_moment, None] * cols.W_e[sel & cols.is_moment]).sum(axis=0)
+        P = cols.W_P[np.flatnonzero(sel)[0]]
+        Cs = _n(C[2]) if dim == cv.PLANAR else _v(C, 3)
+        mCs = _n(-C[2]) if dim == cv.PLANAR else _v(-C, 3)
+        lines.append(f"  {j.name} at {_v(P, dim)}: on child {j.child}: F {_v(F, dim)} N, "
+                     f"C {Cs} N m; on parent {j.parent}: F {_v(-F, dim)} N, C {mCs} N m")
+    if sol.residual is not None:
+        lines.append(f"solve: {sol.method}; relative backward error {sol.residual:.1e}"
+                     + (f"; condition estimate {sol.condition:.2e}"
+                        if sol.condition is not None else ""))
+    for w in sol.warnings:
+        lines.append(f"warning: {w}")
     return "\n".join(lines)

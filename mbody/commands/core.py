@@ -65,10 +65,11 @@ def assemble(a: argparse.Namespace) -> int:
 
 def solve(a: argparse.Namespace) -> int:
     from ..assemble import assemble as _assemble
-    from ..text import solution_text
+    from ..text import reaction_table_text, solution_text
 
     model = load_model(a.model)
-    sol = _assemble(model).solve(known=parse_known(a.known))
+    asm = _assemble(model)
+    sol = asm.solve(known=parse_known(a.known), condition=True)
     if a.json:
         rpb = model.rows_per_body
         acc = sol.accelerations.tolist()
@@ -76,9 +77,15 @@ def solve(a: argparse.Namespace) -> int:
                                   acc[i * rpb:(i + 1) * rpb], strict=True))
                    for i, name in enumerate(model.body_names)}
         json.dump({"model": model.name, "coordinates": sol.coordinates,
-                   "accelerations": acc, "by_body": by_body, "reactions": sol.reactions},
+                   "accelerations": acc, "by_body": by_body, "reactions": sol.reactions,
+                   "solved": list(sol.solved), "not_unique": list(sol.not_unique),
+                   "backward_error": sol.residual, "condition": sol.condition,
+                   "warnings": sol.warnings},
                   sys.stdout, indent=2)
         print()
     else:
         print(solution_text(sol, model))
+        if sol.reactions:
+            print()
+            print(reaction_table_text(asm, sol))
     return EXIT_OK

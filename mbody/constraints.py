@@ -1,0 +1,115 @@
+"""Joint constraints at position and acceleration level, one per reaction component.
+
+Gᵀ is the velocity-level constraint Jacobian: ``Gᵀ v = φ̇`` (see `joints`). Here are the
+other two levels, vectorised over the m components:
+
+- ``phi(model, state)``: position errors φ (0 when the joint holds).
+  force along e (parent-fixed joint axis): φ = e · (P_c − P_p), P_c and P_p the joint
+  point carried by the child and by the parent;
+  moment, revolute/cylindrical (Mx, My): the tilt of the child's joint z axis seen in
+  the parent's joint frame, φ_x = −z_rel,y, φ_y = z_rel,x;
+  moment, fixed/prismatic: the small-rotation vector of R_rel = E_pᵀ E_c,
+  φ = ½ vee(R_rel − R_relᵀ); universal Mt: φ = −a · b (a on the parent, b on the child).
+- ``gamma(model, state)``: γ = −Ġᵀ v, the velocity-product terms, so that the joints
+  hold at acceleration level when ``Gᵀ v̇ = γ``. With w = e · (V_c(P) − V_p(P)):
+  force:  γ = −[(ω_p × e) · (V_c(P) − V_p(P)) + e · (ω_c × (ω_c × ρ_c) − ω_p × ṡ)],
+          ρ_c = P − x_c, s = P − x_p, ṡ = v_c + ω_c × ρ_c − v_p;
+  moment: γ = −(ω_p × e) · (ω_c − ω_p);
+  universal: γ = −ė · (ω_c − ω_p), ė = (ω_p × a) × b + a × (ω_c × b).
+  All vectors in world axes; ω_p, v_p are 0 for ground.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .joints import ReactionColumns
+from .model import Model, State
+from .spatial import cross, matvec
+
+
+def _parent(model: Model, state: State, R: np.ndarray):
+    t = model.reaction_table
+    on = t.parent >= 0
+    p = np.where(on, t.parent, 0)
+    Rp = np.where(on[:, None, None], R[p], np.eye(3))
+    x_p = np.where(on[:, None], state.position[p], 0.0)
+    v_p = np.where(on[:, None], state.velocity[p], 0.0)
+    w_p = np.where(on[:, None], matvec(Rp, state.omega[p]), 0.0)
+    return Rp, x_p, v_p, w_p
+
+
+def phi(model: Model, state: State, R: np.ndarray | None = None) -> np.ndarray:
+    """(m,) position errors of every reaction component's constraint (see module doc)."""
+    R = state.W_R_B if R is None else R
+    t = model.reaction_table
+    m = len(t.labels)
+    if m == 0:
+        return np.zeros(0)
+    Rp, x_p, _, _ = _parent(model, state, R)
+    Rc = R[t.child]
+    out = np.zeros(m)
+    f = t.rot_kind == 0
+    if f.any():
+        P_c = state.position[t.child[f]] + matvec(Rc[f], t.B_r_child[f])
+        P_p = x_p[f] + matvec(Rp[f], t.B_r_parent[f])
+        e = matvec(Rp[f], t.P_E[f])
+        out[f] = np.einsum("ij,ij->i", e, P_c - P_p)
+    mom = ~f
+    if mom.any():
+        E_p = Rp[mom] @ t.P_E3[mom]
+        E_c = Rc[mom] @ t.C_E3[mom]
+        R_rel = np.swapaxes(E_p, 1, 2) @ E_c
+        k = t.axis[mom] - 3
+        kind = t.rot_kind[mom]
+        val = np.zeros(mom.sum())
+        tilt = kind == 1  # z_rel = third column of R_rel
+        z = R_rel[tilt, :, 2]
+        val[tilt] = np.where(k[tilt] == 0, -z[:, 1], z[:, 0])
+        lock = kind == 2
+        A = R_rel[lock]
+        vee = 0.5 * np.stack((A[:, 2, 1] - A[:, 1, 2], A[:, 0, 2] - A[:, 2, 0],
+                              A[:, 1, 0] - A[:, 0, 1]), axis=1)
+        val[lock] = vee[np.arange(lock.sum()), k[lock]]
+        uni = kind == 3
+        if uni.any():
+            idx = np.flatnonzero(mom)[uni]
+            a = E_p[uni][:, :, 2]
+            b = matvec(Rc[idx], t.C_axis2[idx])
+            val[uni] = -np.einsum("ij,ij->i", a, b)
+        out[mom] = val
+    return out
+
+
+def gamma(model: Model, state: State, cols: ReactionColumns,
+          R: np.ndarray | None = None) -> np.ndarray:
+    """(m,) γ = −Ġᵀ v: the right-hand side of Gᵀ v̇ = γ (see module doc)."""
+    R = state.W_R_B if R is None else R
+    t = model.reaction_table
+    m = len(t.labels)
+    if m == 0:
+        return np.zeros(0)
+    Rp, x_p, v_p, w_p = _parent(model, state, R)
+    c = t.child
+    Rc = R[c]
+    w_c = matvec(Rc, state.omega[c])
+    e = cols.W_e
+    out = np.empty(m)
+    f = t.rot_kind == 0
+    rho = cols.W_P[f] - state.position[c[f]]
+    V_c = state.velocity[c[f]] + cross(w_c[f], rho)
+    s = cols.W_P[f] - x_p[f]
+    V_p = v_p[f] + cross(w_p[f], s)
+    s_dot = V_c - v_p[f]
+    out[f] = -(np.einsum("ij,ij->i", cross(w_p[f], e[f]), V_c - V_p)
+               + np.einsum("ij,ij->i", e[f],
+                           cross(w_c[f], cross(w_c[f], rho)) - cross(w_p[f], s_dot)))
+    mom = (t.rot_kind == 1) | (t.rot_kind == 2)
+    out[mom] = -np.einsum("ij,ij->i", cross(w_p[mom], e[mom]), w_c[mom] - w_p[mom])
+    uni = t.rot_kind == 3
+    if uni.any():
+        a = matvec(Rp[uni], t.P_E[uni])
+        b = matvec(Rc[uni], t.C_axis2[uni])
+        e_dot = cross(cross(w_p[uni], a), b) + cross(a, cross(w_c[uni], b))
+        out[uni] = -np.einsum("ij,ij->i", e_dot, w_c[uni] - w_p[uni])
+    return out

@@ -1,0 +1,223 @@
+"""Accelerations and unknown reactions together: the constrained Newton-Euler system
+
+    M v̇ − G_U λ_U = Q − b + G_K λ_K        (per-body Newton-Euler pairs)
+    G_Uᵀ v̇        = γ_U                    (the joints hold at acceleration level)
+
+with U the unknown reaction components and K the known ones (whose joints are then not
+enforced: their forces are given instead). M is block diagonal, so the Schur complement
+
+    S = G_Uᵀ M⁻¹ G_U,     S λ_U = γ_U − G_Uᵀ M⁻¹ (Q − b + G_K λ_K),     v̇ = M⁻¹(… + G_U λ_U)
+
+is small, sparse and symmetric positive semi-definite; for chains and trees its
+nonzeros lie in a narrow band around the diagonal (a joint couples only with the joints
+sharing one of its bodies), so a banded Cholesky factorisation solves it in time linear
+in the number of links. Redundant constraints make S singular; then the minimum-norm
+reactions are returned and the components that are not unique are named.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from scipy.sparse.csgraph import reverse_cuthill_mckee
+
+from .joints import ReactionColumns
+from .model import Model
+from .spatial import matvec
+
+DENSE_LIMIT = 300
+"""Up to this many unknown components, S is factorised densely (and checked for rank)."""
+RANK_RTOL = 1e-10
+"""Relative tolerance on S's eigenvalues (or pivots) below which a constraint is redundant."""
+
+
+def block_solve(model: Model, body: np.ndarray, g6: np.ndarray) -> np.ndarray:
+    """M_b⁻¹ g for rows g6 (k, 6) acting on bodies `body` (k,): [g_N / m, J⁻¹ g_E]."""
+    out = np.empty_like(g6)
+    out[:, :3] = g6[:, :3] / model.mass[body, None]
+    out[:, 3:] = matvec(model.J_inv[body], g6[:, 3:])
+    return out
+
+
+@dataclass
+class Factorisation:
+    """S = G_Uᵀ M⁻¹ G_U factorised once; `solve(rhs)` applies (a generalised) S⁻¹."""
+
+    method: str
+    size: int
+    redundant: list[int] = field(default_factory=list)
+    rank: int = 0
+    _solve: object = None
+    _S: sp.spmatrix | None = None
+
+    def solve(self, rhs: np.ndarray) -> np.ndarray:
+        return self._solve(rhs)
+
+    def condition(self) -> float:
+        """1-norm condition estimate of S (inf when singular)."""
+        if self.size == 0:
+            return 1.0
+        if self.redundant:
+            return float("inf")
+        S = self._S
+        if self.size <= DENSE_LIMIT:
+            return float(np.linalg.cond(S.toarray(), 1))
+        inv = spla.LinearOperator(S.shape, matvec=self.solve, rmatvec=self.solve,
+                                  dtype=float)
+        return float(spla.onenormest(S) * spla.onenormest(inv))
+
+
+class ConstrainedSystem:
+    """The constrained system of a model at one state, for a set of unknown components.
+
+    cols: the reaction columns at the state; unknown: (m,) bool mask of unknown components.
+    """
+
+    def __init__(self, model: Model, cols: ReactionColumns, unknown: np.ndarray):
+        self.model = model
+        self.cols = cols
+        t = model.reaction_table
+        self.unknown = np.asarray(unknown, dtype=bool)
+        U = np.flatnonzero(self.unknown)
+        self.U = U
+        mu = len(U)
+        n = model.n
+        on_p = t.parent[U] >= 0
+        # G_U (6n x mu) from each column's child and parent halves.
+        k = np.arange(6)
+        rows = np.concatenate(((t.child[U, None] * 6 + k).ravel(),
+                               (t.parent[U][on_p, None] * 6 + k).ravel()))
+        colidx = np.concatenate((np.repeat(np.arange(mu), 6),
+                                 np.repeat(np.arange(mu)[on_p], 6)))
+        g = np.concatenate((cols.child6[U].ravel(), cols.parent6[U][on_p].ravel()))
+        h = np.concatenate((block_solve(model, t.child[U], cols.child6[U]).ravel(),
+                            block_solve(model, t.parent[U][on_p],
+                                        cols.parent6[U][on_p]).ravel()))
+        shape = (6 * n, mu)
+        self.G = sp.csc_matrix((g, (rows, colidx)), shape=shape)
+        self.H = sp.csc_matrix((h, (rows, colidx)), shape=shape)  # M⁻¹ G_U
+        self.fact = self._factorise((self.G.T @ self.H).tocsr())
+
+    # -- factorisation -------------------------------------------------------------------
+    def _factorise(self, S: sp.csr_matrix) -> Factorisation:
+        mu = S.shape[0]
+        if mu == 0:
+            return Factorisation("none", 0, _solve=lambda r: r, _S=S)
+        if mu <= DENSE_LIMIT:
+            return self._dense(S)
+        coo = S.tocoo()
+        bw = int(np.max(np.abs(coo.row - coo.col)))
+        perm = None
+        if bw > 64:
+            perm = reverse_cuthill_mckee(S, symmetric_mode=True)
+            Sp = S[perm][:, perm].tocoo()
+            bw_p = int(np.max(np.abs(Sp.row - Sp.col)))
+            if bw_p < bw:
+                coo, bw = Sp, bw_p
+            else:
+                perm = None
+        if (bw + 1) * mu <= 5e7:
+            up = coo.row <= coo.col
+            ab = np.zeros((bw + 1, mu))
+            ab[bw + coo.row[up] - coo.col[up], coo.col[up]] = coo.data[up]
+            try:
+                cb = sla.cholesky_banded(ab, lower=False, check_finite=False)
+                d = cb[bw] ** 2
+                if d.min() > RANK_RTOL * d.max():
+                    def solve(r, cb=cb, perm=perm):
+                        if perm is None:
+                            return sla.cho_solve_banded((cb, False), r, check_finite=False)
+                        x = np.empty_like(r)
+                        x[perm] = sla.cho_solve_banded((cb, False), r[perm],
+                                                       check_finite=False)
+                        return x
+
+                    return Factorisation("banded Cholesky of the Schur complement", mu,
+                                         rank=mu, _solve=solve, _S=S)
+            except np.linalg.LinAlgError:
+                pass
+        if mu <= 4 * DENSE_LIMIT:
+            return self._dense(S)
+        try:
+            lu = spla.splu(S.tocsc())
+            return Factorisation("sparse LU of the Schur complement", mu, rank=mu,
+                                 _solve=lu.solve, _S=S)
+        except RuntimeError:  # exactly singular: minimum-norm by LSQR
+            def solve(r, S=S):
+                return spla.lsqr(S, r, atol=1e-15, btol=1e-15, iter_lim=20 * mu)[0]
+
+            return Factorisation("LSQR (rank-deficient, redundant constraints)", mu,
+                                 redundant=[-1], _solve=solve, _S=S)
+
+    def _dense(self, S: sp.csr_matrix) -> Factorisation:
+        A = S.toarray()
+        A = 0.5 * (A + A.T)
+        w, V = np.linalg.eigh(A)
+        tol = RANK_RTOL * max(w[-1], 0.0)
+        good = w > tol
+        rank = int(good.sum())
+        if rank == len(w):
+            cf = sla.cho_factor(A, check_finite=False)
+            return Factorisation("dense Cholesky of the Schur complement", len(w), rank=rank,
+                                 _solve=lambda r: sla.cho_solve(cf, r, check_finite=False),
+                                 _S=S)
+        # Minimum-norm solution through the pseudo-inverse; the null space of S (= that of
+        # G_U) tells which components are not unique.
+        Vg, wg = V[:, good], w[good]
+        null = V[:, ~good]
+        not_unique = np.flatnonzero(np.linalg.norm(null, axis=1) > 1e-8).tolist()
+        return Factorisation("dense pseudo-inverse of the Schur complement (redundant "
+                             "constraints)", len(w), redundant=not_unique, rank=rank,
+                             _solve=lambda r: Vg @ ((Vg.T @ r) / wg), _S=S)
+
+    # -- solving -------------------------------------------------------------------------
+    def solve(self, r6: np.ndarray, gamma_U: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Solve M v̇ − G_U λ = r (n, 6 rows), G_Uᵀ v̇ = γ_U; returns (v̇ (n, 6), λ_U)."""
+        model = self.model
+        a0 = block_solve(model, np.arange(model.n), r6).ravel()
+        lam = self.fact.solve(gamma_U - self.G.T @ a0)
+        acc = a0 + self.H @ lam
+        return acc.reshape(-1, 6), lam
+
+    def residual(self, r6: np.ndarray, gamma_U: np.ndarray, acc6: np.ndarray,
+                 lam: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Residuals (r1 (n, 6), r2 (mu,)) of the two block rows for a candidate solution."""
+        model = self.model
+        Ma = np.empty_like(acc6)
+        Ma[:, :3] = acc6[:, :3] * model.mass[:, None]
+        Ma[:, 3:] = matvec(model.J, acc6[:, 3:])
+        r1 = r6.ravel() - (Ma.ravel() - self.G @ lam)
+        r2 = gamma_U - self.G.T @ acc6.ravel()
+        return r1.reshape(-1, 6), r2
+
+    def backward_error(self, r6, gamma_U, acc6, lam) -> float:
+        """Norm-wise relative backward error ‖r‖∞ / (‖K‖∞ ‖x‖∞ + ‖f‖∞) of the KKT system."""
+        model = self.model
+        r1, r2 = self.residual(r6, gamma_U, acc6, lam)
+        absG = abs(self.G)
+        rowM = np.concatenate((np.repeat(model.mass[:, None], 3, axis=1),
+                               np.abs(model.J).sum(axis=2)), axis=1).ravel()
+        normK = max(float(np.max(rowM + np.asarray(absG.sum(axis=1)).ravel(), initial=0.0)),
+                    float(np.max(np.asarray(absG.sum(axis=0)).ravel(), initial=0.0)))
+        normx = max(float(np.max(np.abs(acc6), initial=0.0)),
+                    float(np.max(np.abs(lam), initial=0.0)))
+        normf = max(float(np.max(np.abs(r6), initial=0.0)),
+                    float(np.max(np.abs(gamma_U), initial=0.0)))
+        res = max(float(np.max(np.abs(r1), initial=0.0)), float(np.max(np.abs(r2), initial=0.0)))
+        denom = normK * normx + normf
+        return res / denom if denom > 0 else res
+
+    def solve_refined(self, r6: np.ndarray, gamma_U: np.ndarray, steps: int = 1):
+        """`solve` plus `steps` rounds of iterative refinement (same factorisation)."""
+        acc, lam = self.solve(r6, gamma_U)
+        if self.fact.redundant:
+            return acc, lam
+        for _ in range(steps):
+            r1, r2 = self.residual(r6, gamma_U, acc, lam)
+            da, dl = self.solve(r1, r2)
+            acc, lam = acc + da, lam + dl
+        return acc, lam
