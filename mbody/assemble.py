@@ -157,7 +157,7 @@ class Assembly:
     # -- solving -----------------------------------------------------------------------
     def reaction_values(self, known: Mapping[str, float] | None = None) -> dict[str, float]:
         """The file's known reaction values updated with `known`; labels are checked."""
-        values = dict(self.model.known_reactions)
+        values = self.model.known_reactions_at(self.state.t)
         labels = set(self.reactions)
         for label, v in (known or {}).items():
             if label not in labels:

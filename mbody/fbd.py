@@ -170,7 +170,7 @@ def body_equations(asm: Assembly, i: int) -> BodyEquations:
 
     t = model.reaction_table
     cols = asm.columns
-    known = model.known_reactions
+    known = model.known_reactions_at(asm.state.t)
     side: dict[str, float] = {}
     for c in np.flatnonzero((t.child == i) | (t.parent == i)):
         sign = 1.0 if t.child[c] == i else -1.0

@@ -17,6 +17,7 @@ import numpy as np
 
 from . import conventions as cv
 from .errors import Issue
+from .expr import Expression, ExpressionTable
 from .loader import Document, load_file, load_text
 from .spatial import joint_frame_planar, joint_frame_spatial, quat_to_matrix
 from .validate import Spec, validate
@@ -100,6 +101,9 @@ class Load:
     stiffness: float = 0.0
     rest_length: float = 0.0
     damping: float = 0.0
+    expressions: dict[int, Expression] = field(default_factory=dict)
+    """Components of `vector` that vary in time (3-D index -> expression of t);
+    `vector` holds their values at t = 0."""
 
 
 @dataclass(frozen=True)
@@ -136,10 +140,19 @@ class ForceTable:
     in_body: np.ndarray
     B_r: np.ndarray
     couple: np.ndarray
+    varying: ExpressionTable | None = None
+    """Entries of `vector` given as expressions of t (None: every load is constant)."""
 
-    def vector_at(self, t: float) -> np.ndarray:
-        """(k, 3) load components at time `t` (constant loads: `vector` itself)."""
-        return self.vector
+    def vector_at(self, t: float | np.ndarray) -> np.ndarray:
+        """(k, 3) load components at time `t` (constant loads: `vector` itself).
+
+        An array of times of shape S gives S + (k, 3); each distinct expression is
+        evaluated once per call, with numpy.
+        """
+        if self.varying is None:
+            return self.vector if np.ndim(t) == 0 else np.broadcast_to(
+                self.vector, (*np.shape(t), *self.vector.shape))
+        return self.varying.apply(self.vector, t)
 
 
 @dataclass(frozen=True)
@@ -218,6 +231,15 @@ class Model:
     known_reactions: dict[str, float]
     description: str = ""
     warnings: tuple[Issue, ...] = field(default_factory=tuple)
+    known_expressions: dict[str, Expression] = field(default_factory=dict)
+    """Known reaction values that vary in time (label -> expression of t)."""
+
+    def known_reactions_at(self, t: float) -> dict[str, float]:
+        """The known reaction values at time `t` (`known_reactions` holds t = 0)."""
+        if not self.known_expressions:
+            return dict(self.known_reactions)
+        return {**self.known_reactions,
+                **{k: float(e(t)) for k, e in self.known_expressions.items()}}
 
     # -- sizes and labels --------------------------------------------------------------
     @property
@@ -287,7 +309,8 @@ def _build(spec: Spec) -> Model:
               for i, b in enumerate(bs)}
 
     loads = tuple(Load(ld.name, ld.type, ld.bodies, ld.vector, ld.frame, ld.at,
-                       ld.stiffness, ld.rest_length, ld.damping) for ld in spec.loads)
+                       ld.stiffness, ld.rest_length, ld.damping, dict(ld.expressions))
+                  for ld in spec.loads)
     point = [ld for ld in spec.loads if ld.type in ("force", "torque")]
     forces = ForceTable(
         tuple(ld.name for ld in point),
@@ -296,6 +319,8 @@ def _build(spec: Spec) -> Model:
         np.array([ld.frame == "body" for ld in point], dtype=bool),
         _ro(np.array([ld.at[0] for ld in point]).reshape(-1, 3)),
         np.array([ld.type == "torque" for ld in point], dtype=bool),
+        ExpressionTable.build([(row, k, e) for row, ld in enumerate(point)
+                               for k, e in ld.expressions.items()]),
     )
     sp = [ld for ld in spec.loads if ld.type == "spring"]
     springs = SpringTable(
@@ -358,4 +383,5 @@ def _build(spec: Spec) -> Model:
     )
     return Model(spec.name, spec.file, spec.dimension, names, _ro(mass), _ro(J), _ro(J_inv),
                  _ro(spec.gravity), initial, bodies, loads, tuple(joints), forces, springs,
-                 table, dict(spec.reactions), spec.description, tuple(spec.warnings))
+                 table, dict(spec.reactions), spec.description, tuple(spec.warnings),
+                 dict(spec.reaction_expressions))

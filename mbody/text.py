@@ -64,6 +64,9 @@ def model_summary(model: Model, topo: Topology) -> str:
             else:
                 what = (f"force on {ld.bodies[0]}: {_v(ld.vector, dim)} N ({ld.frame} axes) "
                         f"at {_v(ld.at[0], dim)} m")
+            if ld.expressions:  # time-varying components: show the formulas, not t = 0
+                what += "; varying: " + ", ".join(
+                    f"{'xyz'[k]} = {e}" for k, e in sorted(ld.expressions.items()))
             out.append(f"  {ld.name:<14} {what}")
     if model.joints:
         out.append(f"joints ({len(model.joints)}):")
@@ -74,8 +77,9 @@ def model_summary(model: Model, topo: Topology) -> str:
     out.append(f"reaction unknowns ({len(unknown)}): " + (", ".join(unknown[:40]) or "none")
                + (" ..." if len(unknown) > 40 else ""))
     if model.known_reactions:
-        out.append("known reactions: " + ", ".join(f"{k} = {_n(v)}"
-                                                   for k, v in model.known_reactions.items()))
+        out.append("known reactions: " + ", ".join(
+            f"{k} = {model.known_expressions.get(k) or _n(v)}"
+            for k, v in model.known_reactions.items()))
     out.append("")
     out.append(graph_summary(model, topo))
     for w in model.warnings:

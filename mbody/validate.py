@@ -18,6 +18,7 @@ import numpy as np
 
 from . import conventions as cv
 from .errors import Issue, ModelError, did_you_mean
+from .expr import Expression, ExpressionError, check_finite, compile_expression
 from .loader import Document, Path_, dotted
 from .spatial import euler_to_quat, matrix_to_quat, shape_inertia
 
@@ -71,6 +72,8 @@ class LoadSpec:
     rest_length: float = 0.0
     damping: float = 0.0
     line: int = 0
+    expressions: dict[int, Expression] = field(default_factory=dict)
+    """Time-varying components of `vector`: component index -> expression of t."""
 
 
 @dataclass
@@ -97,6 +100,8 @@ class Spec:
     reactions: dict[str, float]
     description: str = ""
     warnings: list[Issue] = field(default_factory=list)
+    reaction_expressions: dict[str, Expression] = field(default_factory=dict)
+    """Known reaction values given as expressions of t (their t = 0 value is in reactions)."""
 
 
 class _Checker:
@@ -284,12 +289,13 @@ def validate(doc: Document) -> Spec:
     names = {b.name: i for i, b in enumerate(bodies)}
     loads = _loads(c, data.get("loads"), names)
     joints = _joints(c, data.get("joints"), names, bodies)
-    reactions = _reactions(c, data.get("reactions"), joints)
+    reaction_expressions: dict[str, Expression] = {}
+    reactions = _reactions(c, data.get("reactions"), joints, reaction_expressions)
 
     if c.issues:
         raise ModelError(c.issues)
     return Spec(str(name), doc.file, c.dim, gravity, bodies, loads, joints, reactions,
-                description, c.warnings)
+                description, c.warnings, reaction_expressions)
 
 
 def _list(c: _Checker, path: Path_, value: Any, what: str, required: bool) -> list:
@@ -519,15 +525,19 @@ def _loads(c: _Checker, value: Any, names: dict[str, int]) -> list[LoadSpec]:
             body = c.body_ref((*p, "body"), ld["body"], names, False) if "body" in ld else None
             frame = ld.get("frame", "world")
             frame = c.choice((*p, "frame"), frame, FRAMES, "frame")
+            exprs: dict[int, Expression] = {}
             if typ == "force":
-                vec = c.vec3((*p, "force"), ld["force"]) if "force" in ld else None
+                vec = (_varying(c, (*p, "force"), ld["force"], exprs, _Checker.vec3)
+                       if "force" in ld else None)
                 at = c.vec3((*p, "at"), ld["at"]) if "at" in ld else np.zeros(3)
             else:
-                vec = _torque(c, (*p, "torque"), ld["torque"]) if "torque" in ld else None
+                vec = (_varying(c, (*p, "torque"), ld["torque"], exprs, _torque)
+                       if "torque" in ld else None)
                 at = np.zeros(3)
             if _missing(name, body, frame, vec, at):
                 continue
-            out.append(LoadSpec(name, typ, (body,), vec, frame, (at,), line=line))
+            out.append(LoadSpec(name, typ, (body,), vec, frame, (at,), line=line,
+                                expressions=exprs))
         else:
             pair = ld.get("bodies")
             refs: list[str | None] = []
@@ -558,6 +568,54 @@ def _loads(c: _Checker, value: Any, names: dict[str, int]) -> list[LoadSpec]:
             out.append(LoadSpec(name, "spring", tuple(refs), None, "world", tuple(pts),
                                 k, L0, damping, line))
     return out
+
+
+def expression(c: _Checker, path: Path_, text: str) -> Expression | None:
+    """Compile a load expression of t; on error an issue naming the character."""
+    try:
+        e = compile_expression(text)
+    except ExpressionError as exc:
+        pos = exc.position
+        c.err(path, f"invalid expression: {exc.reason} at character {pos + 1} "
+              f"(marked |): \"{exc.text[:pos]}|{exc.text[pos:]}\"",
+              exc.hint or "see docs/expressions.md for the grammar")
+        return None
+    problem = check_finite(e, 0.0)
+    if problem:
+        c.err(path, f"{problem}: \"{text}\"")
+        return None
+    return e
+
+
+def _varying(c: _Checker, path: Path_, value: Any, exprs: dict[int, Expression],
+             read) -> np.ndarray | None:
+    """A load vector (or planar scalar torque) whose components may be expressions of t.
+
+    Each text component is compiled into `exprs` (by 3-D component index) and replaced by
+    its value at t = 0, so the vector is the load at the initial state.
+    """
+    planar_scalar = not isinstance(value, list)
+    if planar_scalar and not (read is _torque and c.dim == cv.PLANAR):
+        return read(c, path, value)  # not a vector: let the reader say what was expected
+    items = [value] if planar_scalar else list(value)
+    found: dict[int, Expression] = {}
+    ok = True
+    for i, v in enumerate(items):
+        if isinstance(v, str):
+            e = expression(c, path if planar_scalar else (*path, i), v)
+            ok = ok and e is not None
+            if e is not None:
+                found[2 if planar_scalar else i] = e
+            items[i] = 0.0
+    if not ok:
+        return None
+    vec = read(c, path, items[0] if planar_scalar else items)
+    if vec is None:
+        return None
+    for k, e in found.items():
+        vec[k] = e.value
+    exprs.update({k: e for k, e in found.items() if not e.constant})  # "2*pi" is a number
+    return vec
 
 
 def _torque(c: _Checker, path: Path_, value: Any) -> np.ndarray | None:
@@ -634,7 +692,8 @@ def _axis(c: _Checker, path: Path_, value: Any) -> np.ndarray | None:
     return a / n
 
 
-def _reactions(c: _Checker, value: Any, joints: list[JointSpec]) -> dict[str, float]:
+def _reactions(c: _Checker, value: Any, joints: list[JointSpec],
+               expressions: dict[str, Expression]) -> dict[str, float]:
     if value is None:
         return {}
     if not isinstance(value, dict):
@@ -650,6 +709,13 @@ def _reactions(c: _Checker, value: Any, joints: list[JointSpec]) -> dict[str, fl
                   did_you_mean(label, labels)
                   or (f"the model's reaction components are: {', '.join(labels[:12])}"
                       if labels else "the model has no joints"), key=True)
+            continue
+        if isinstance(v, str):  # a known value that varies in time, e.g. "40*cos(20*t)"
+            e = expression(c, p, v)
+            if e is not None:
+                out[label] = e.value
+                if not e.constant:
+                    expressions[label] = e
             continue
         x = c.number(p, v)
         if x is not None:
