@@ -158,7 +158,7 @@ class Assembly:
     def reaction_values(self, known: Mapping[str, float] | None = None) -> dict[str, float]:
         """The file's known reaction values updated with `known`; labels are checked."""
         values = self.model.known_reactions_at(self.state.t)
-        labels = set(self.reactions)
+        labels = self.model.reaction_index
         for label, v in (known or {}).items():
             if label not in labels:
                 hint = did_you_mean(label, self.reactions)
@@ -178,8 +178,7 @@ class Assembly:
         condition number of the Schur complement.
         """
         values = self.reaction_values(known)
-        missing = [r for r in self.reactions if r not in values]
-        if missing:
+        if len(values) < len(self.reactions):
             return self._solve_constrained(values, condition)
         rhs6 = self._Q6 - self._b6
         if self.reactions:
@@ -188,14 +187,16 @@ class Assembly:
         acc = _select(self.model, accelerations6(self.model, rhs6))
         return Solution(self.coordinates, acc, {r: values[r] for r in self.reactions})
 
-
     def _solve_constrained(self, values: dict[str, float], condition: bool) -> Solution:
         from .constraints import gamma
         from .kkt import ConstrainedSystem
 
         model = self.model
-        unknown = np.array([r not in values for r in self.reactions])
-        lam = np.array([values.get(r, 0.0) for r in self.reactions])
+        unknown = np.ones(len(self.reactions), dtype=bool)
+        lam = np.zeros(len(self.reactions))
+        for label, v in values.items():  # the given values only: few
+            k = model.reaction_index[label]
+            unknown[k], lam[k] = False, v
         r6 = self._Q6 - self._b6 + reaction_wrench(model, self.columns, lam)
         system = ConstrainedSystem(model, self.columns, unknown)
         g_U = gamma(model, self.state, self.columns)[unknown]

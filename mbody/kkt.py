@@ -156,6 +156,15 @@ class ConstrainedSystem:
     def _dense(self, S: sp.csr_matrix) -> Factorisation:
         A = S.toarray()
         A = 0.5 * (A + A.T)
+        try:  # the usual case: independent constraints, S positive definite
+            cf = sla.cho_factor(A, check_finite=False)
+            d = np.diag(cf[0]) ** 2
+            if d.min() > RANK_RTOL * d.max():
+                return Factorisation("dense Cholesky of the Schur complement", len(A),
+                                     rank=len(A), _S=S,
+                                     _solve=lambda r: sla.cho_solve(cf, r, check_finite=False))
+        except np.linalg.LinAlgError:
+            pass
         w, V = np.linalg.eigh(A)
         tol = RANK_RTOL * max(w[-1], 0.0)
         good = w > tol

@@ -255,9 +255,15 @@ class Model:
     def coordinates(self) -> list[str]:
         return cv.coordinate_labels(list(self.body_names), self.dimension)
 
-    @property
+    @cached_property
     def reactions(self) -> list[str]:
+        """Reaction labels, the column order of G (do not modify the list)."""
         return list(self.reaction_table.labels)
+
+    @cached_property
+    def reaction_index(self) -> dict[str, int]:
+        """reaction label -> column of G."""
+        return {r: i for i, r in enumerate(self.reaction_table.labels)}
 
     @cached_property
     def index(self) -> dict[str, int]:
