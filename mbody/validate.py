@@ -41,6 +41,16 @@ FRAMES = ("world", "body")
 DEFAULT_EULER_SEQUENCE = "ZYX"
 """Intrinsic z-y'-x'' (yaw, pitch, roll), scipy's upper-case convention."""
 
+_REQUIRED_HINTS = {
+    "dimension": "2 for a planar model, 3 for a spatial one",
+    "bodies": "a list of bodies, each with at least name, mass and inertia",
+    "name": "a name without spaces or dots",
+    "mass": "the mass in kg, a number > 0",
+    "type": "the kind of joint or load",
+    "parent": "a body name or ground",
+    "child": "a body name",
+    "at": "the joint point, world coordinates at the initial pose",
+}
 _ANGLE = re.compile(r"\s*([-+]?[0-9.eE+-]+)\s*(deg|rad)\s*")
 _RATE = re.compile(r"\s*([-+]?[0-9.eE+-]+)\s*(deg/s|rad/s)\s*")
 _TOL = 1e-6
@@ -133,7 +143,7 @@ class _Checker:
                          key=True)
         for k in required:
             if k not in value:
-                self.err(path, f"missing required key '{k}'")
+                self.err(path, f"missing required key '{k}'", _REQUIRED_HINTS.get(k, ""))
         return True
 
     def number(self, path: Path_, value: Any, *, positive: bool = False,
@@ -141,9 +151,13 @@ class _Checker:
         if isinstance(value, bool) or not isinstance(value, int | float):
             self.err(path, f"expected a number, got {_kind(value)}")
             return None
-        x = float(value)
+        try:
+            x = float(value)
+        except OverflowError:  # an integer with hundreds of digits
+            x = math.inf
         if not math.isfinite(x):
-            self.err(path, f"expected a finite number, got {value}")
+            shown = value if isinstance(value, float) else f"an integer of {len(str(value))} digits"
+            self.err(path, f"expected a finite number, got {shown}")
             return None
         if positive and x <= 0:
             self.err(path, f"expected a number > 0, got {value}")
@@ -224,9 +238,9 @@ class _Checker:
 
     def body_ref(self, path: Path_, value: Any, names: dict[str, int],
                  allow_ground: bool) -> str | None:
+        if isinstance(value, str) and (value in names or allow_ground and value == cv.GROUND):
+            return value  # the common case first: a dict lookup, not a list of every name
         choices = list(names) + ([cv.GROUND] if allow_ground else [])
-        if isinstance(value, str) and value in choices:
-            return value
         if value == cv.GROUND and not allow_ground:
             self.err(path, "'ground' is not allowed here", "name a body of the model")
             return None
@@ -268,7 +282,8 @@ def validate(doc: Document) -> Spec:
     if dim not in (2, 3) or isinstance(dim, bool):
         if "dimension" in data:
             c.err(("dimension",), f"expected 2 (planar) or 3 (spatial), got {_kind(dim)}")
-        dim = 3
+        # Every vector length depends on the dimension: checking on would only add noise.
+        raise ModelError(c.issues)
     c.dim = int(dim)
     name = data.get("model", None)
     if name is None:
@@ -300,7 +315,7 @@ def validate(doc: Document) -> Spec:
 
 def _list(c: _Checker, path: Path_, value: Any, what: str, required: bool) -> list:
     if value is None:
-        if required:
+        if required and path[-1] in c.doc.data:  # absent: already reported as missing
             c.err(path, f"expected a list of {what}, got nothing")
         return []
     if not isinstance(value, list):
@@ -645,7 +660,12 @@ def _joints(c: _Checker, value: Any, names: dict[str, int],
         elif name is not None:
             seen[name] = i
         typ = None
-        if "type" in j:
+        other = cv.JOINT_COMPONENTS[cv.PLANAR + cv.SPATIAL - c.dim]
+        if "type" in j and j["type"] in other and j["type"] not in types:
+            here, there = ("planar", "spatial") if c.dim == cv.PLANAR else ("spatial", "planar")
+            c.err((*p, "type"), f"'{j['type']}' is a {there} joint type; a {here} model "
+                  f"(dimension: {c.dim}) has: {', '.join(types)}")
+        elif "type" in j:
             typ = c.choice((*p, "type"), j["type"], types,
                            f"{'planar' if c.dim == 2 else 'spatial'} joint type")
         parent = c.body_ref((*p, "parent"), j["parent"], names, True) if "parent" in j else None
