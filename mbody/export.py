@@ -35,7 +35,7 @@ import scipy.sparse as sp
 
 from . import conventions as cv
 from .assemble import Assembly, Solution
-from .atomic import atomic_path
+from .atomic import _umask, atomic_path
 from .errors import MbodyError, UnknownReactionsError
 from .model import Model, State
 
@@ -418,6 +418,7 @@ def write_csv(asm: Assembly | ExportedAssembly, folder: str | os.PathLike[str],
     parent = folder.parent if str(folder.parent) else Path(".")
     parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".{folder.name}.", dir=parent))
+    os.chmod(tmp, 0o777 & ~_umask())  # mkdtemp makes 0700; give what mkdir() would
     try:
         for name, rows in _csv_tables(exp).items():
             with open(tmp / name, "w", newline="", encoding="utf-8") as fh:

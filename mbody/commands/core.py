@@ -23,6 +23,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                        "sizes of the stacked M, b, Q, G.")
     s.add_argument("model", metavar="MODEL", help="a YAML model file")
     s.add_argument("--body", metavar="NAME", help="only this body")
+    s.add_argument("--latex", metavar="FILE", nargs="?", const="-",
+                   help="write a LaTeX document (each body's pair, the stacked system) to "
+                   "FILE, or to standard output without FILE")
     s.set_defaults(run=assemble)
 
     s = sub.add_parser("solve", help="accelerations of every body (reactions known or absent)",
@@ -53,6 +56,10 @@ def assemble(a: argparse.Namespace) -> int:
 
     model = load_model(a.model)
     asm = _assemble(model)
+    if a.latex is not None:
+        from .export import latex
+
+        return latex(asm, a.latex, a.body)
     if a.body:
         try:
             print(body_text(asm.bodies[a.body], model.dimension))
