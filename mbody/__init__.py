@@ -7,13 +7,15 @@
 
 from .assemble import Assembly, Solution, assemble
 from .errors import Issue, MbodyError, ModelError, UnknownReactionsError
+from .export import ExportedAssembly, load_export
 from .fbd import BodyEquations, Equation, ForceOnBody, FreeBodyDiagram
 from .model import Body, Joint, Load, Model, State, load, loads
 
 __version__ = "0.1.0"
 
 __all__ = [
-    "Assembly", "Body", "BodyEquations", "Equation", "ForceOnBody", "FreeBodyDiagram",
+    "Assembly", "Body", "BodyEquations", "Equation", "ExportedAssembly", "ForceOnBody",
+    "FreeBodyDiagram", "load_export",
     "Issue", "Joint", "Load", "MbodyError", "Model", "ModelError", "Solution", "State",
     "UnknownReactionsError", "assemble", "load", "loads",
 ]
