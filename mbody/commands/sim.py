@@ -1,0 +1,73 @@
+"""simulate, plot: integrate a model's motion, and plot a saved run."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from . import EXIT_OK, load_model, parse_known
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    s = sub.add_parser("simulate", help="integrate the motion (reactions known or absent)",
+                       description="Integrate the Newton-Euler equations of MODEL from its "
+                       "initial state (every reaction value known: none, given in the file, "
+                       "or with --known), print the run summary with the drift of energy and "
+                       "angular momentum, and save the trajectory with -o.")
+    s.add_argument("model", metavar="MODEL", help="a YAML model file")
+    s.add_argument("--t-end", type=float, default=10.0, metavar="SECONDS",
+                   help="simulated time, s (default 10)")
+    s.add_argument("--fps", type=float, default=60.0,
+                   help="output samples per second (default 60)")
+    s.add_argument("-o", "--output", metavar="RUN.npz",
+                   help="save the trajectory here (.npz; read with mbody.Trajectory.load)")
+    s.add_argument("--rtol", type=float, default=None,
+                   help="relative tolerance per step (default 1e-10)")
+    s.add_argument("--atol", type=float, default=None,
+                   help="absolute tolerance per step (default 1e-12)")
+    s.add_argument("--method", default="DOP853",
+                   help="integrator: DOP853 (default), RK45, RK23, Radau, BDF, LSODA")
+    s.add_argument("--known", metavar="LABEL=VALUE", action="append", default=[],
+                   help="a known reaction value, e.g. --known A.Fx=3 (repeatable)")
+    s.add_argument("--progress", action="store_true",
+                   help="show the progress bar on stderr even when it is not a terminal")
+    s.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    s.set_defaults(run=simulate)
+
+    s = sub.add_parser("plot", help="plot a saved run: angular velocity, energy, momentum, "
+                       "drift", description="Plot the angular-velocity components, kinetic "
+                       "energy and angular momentum of a saved run over time, and their "
+                       "relative drift, in one multi-panel figure.")
+    s.add_argument("run", metavar="RUN.npz", help="a trajectory saved by 'mbody simulate -o'")
+    s.add_argument("-o", "--output", required=True, metavar="FILE",
+                   help="the figure: .png, .pdf or .svg")
+    s.add_argument("--body", action="append", default=None, metavar="NAME",
+                   help="bodies for the angular-velocity panel (repeatable; default the "
+                   "first 6)")
+    s.set_defaults(run=plot)
+
+
+def simulate(a: argparse.Namespace) -> int:
+    from ..simulate import DEFAULT_ATOL, DEFAULT_RTOL, summary
+    from ..simulate import simulate as _simulate
+
+    model = load_model(a.model)
+    traj = _simulate(model, a.t_end, a.fps,
+                     rtol=DEFAULT_RTOL if a.rtol is None else a.rtol,
+                     atol=DEFAULT_ATOL if a.atol is None else a.atol, method=a.method,
+                     known=parse_known(a.known),
+                     progress=(a.progress or sys.stderr.isatty()) and not a.no_progress)
+    if a.output:
+        traj.save(a.output)
+    print(summary(traj, a.output))
+    return EXIT_OK
+
+
+def plot(a: argparse.Namespace) -> int:
+    from ..plot import save_plot
+    from ..trajectory import Trajectory
+
+    traj = Trajectory.load(a.run)
+    save_plot(traj, a.output, a.body)
+    print(f"wrote {a.output}")
+    return EXIT_OK
