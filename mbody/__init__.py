@@ -10,6 +10,8 @@ from .errors import Issue, MbodyError, ModelError, UnknownReactionsError
 from .export import ExportedAssembly, load_export
 from .fbd import BodyEquations, Equation, ForceOnBody, FreeBodyDiagram
 from .model import Body, Joint, Load, Model, State, load, loads
+from .simulate import simulate
+from .trajectory import Trajectory
 
 __version__ = "0.1.0"
 
@@ -17,5 +19,6 @@ __all__ = [
     "Assembly", "Body", "BodyEquations", "Equation", "ExportedAssembly", "ForceOnBody",
     "FreeBodyDiagram", "load_export",
     "Issue", "Joint", "Load", "MbodyError", "Model", "ModelError", "Solution", "State",
+    "Trajectory", "simulate",
     "UnknownReactionsError", "assemble", "load", "loads",
 ]
