@@ -52,6 +52,10 @@ def mass_matrix(model: Model) -> sp.spmatrix:
     return sp.bsr_matrix((blocks, np.arange(n), np.arange(n + 1)), shape=(n * k, n * k))
 
 
+INCONSISTENT = 1e-8
+"""Relative backward error above which a constrained solve is reported as inconsistent."""
+
+
 @dataclass(frozen=True)
 class Solution:
     """Accelerations (aligned with `coordinates`) and the reaction values used.
@@ -75,10 +79,15 @@ class Solution:
 
     @property
     def warnings(self) -> list[str]:
-        if not self.not_unique:
-            return []
-        return [f"redundant constraints: the reactions {', '.join(self.not_unique)} are not "
-                "unique; the minimum-norm values are given"]
+        out = []
+        if self.not_unique:
+            out.append(f"redundant constraints: the reactions {', '.join(self.not_unique)} "
+                       "are not unique; the minimum-norm values are given")
+        if self.residual is not None and self.residual > INCONSISTENT:
+            out.append(f"the constraints are inconsistent at this state (relative residual "
+                       f"{self.residual:.1e}): the joints are not assembled, or the velocities "
+                       "break them; the least-squares accelerations are given")
+        return out
 
     def as_dict(self) -> dict[str, float]:
         return dict(zip(self.coordinates, self.accelerations.tolist(), strict=True))
@@ -141,6 +150,15 @@ class Assembly:
     @cached_property
     def G(self) -> sp.csc_matrix:
         return g_matrix(self.model, self.columns)
+
+    def jacobian(self) -> ConstraintJacobian:
+        """The constraint Jacobian Gᵀ (m x N) with labelled rows and columns, plus γ and φ."""
+        from .constraints import ConstraintJacobian, gamma, phi
+
+        return ConstraintJacobian(self.G.T.tocsr(), list(self.reactions),
+                                  list(self.coordinates),
+                                  gamma(self.model, self.state, self.columns),
+                                  phi(self.model, self.state))
 
     @property
     def shape(self) -> dict[str, tuple[int, ...]]:
@@ -244,4 +262,5 @@ def assemble(model: Model, state: State | None = None) -> Assembly:
     return Assembly(model, state, loads, b6)
 
 
+from .constraints import ConstraintJacobian  # noqa: E402  (annotations only)
 from .fbd import BodyEquations  # noqa: E402  (type used in annotations only)

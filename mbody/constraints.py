@@ -21,6 +21,8 @@ other two levels, vectorised over the m components:
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from .joints import ReactionColumns
@@ -113,3 +115,33 @@ def gamma(model: Model, state: State, cols: ReactionColumns,
         e_dot = cross(cross(w_p[uni], a), b) + cross(a, cross(w_c[uni], b))
         out[uni] = -np.einsum("ij,ij->i", e_dot, w_c[uni] - w_p[uni])
     return out
+
+
+@dataclass(frozen=True)
+class ConstraintJacobian:
+    """The velocity-level constraint Jacobian of the joints, Φ_v = Gᵀ, with labels.
+
+    matrix: (m, N) sparse; row k is the constraint that reaction component `rows[k]`
+    enforces, column i the coordinate `columns[i]` (rows of the stacked equations:
+    Newton in world axes, Euler in body axes). ``matrix @ v`` is the relative velocity
+    each joint forbids; ``matrix @ v̇ = gamma`` holds for motions that keep the joints;
+    `phi` are the position errors (0 when the joints are assembled).
+    """
+
+    matrix: object
+    rows: list[str]
+    columns: list[str]
+    gamma: np.ndarray
+    phi: np.ndarray
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self.matrix.shape
+
+    def toarray(self) -> np.ndarray:
+        return self.matrix.toarray()
+
+    def row(self, label: str) -> dict[str, float]:
+        """The nonzero entries of one constraint row, by coordinate label."""
+        r = self.matrix.getrow(self.rows.index(label)).tocoo()
+        return {self.columns[j]: float(v) for j, v in zip(r.col, r.data, strict=True)}
