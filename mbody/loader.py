@@ -106,7 +106,10 @@ def load_text(text: str, file: str = "<string>") -> Document:
         line, col = (mark.line + 1, mark.column + 1) if mark else (0, 0)
         msg = exc.problem or str(exc)
         if exc.context:
-            msg = f"{exc.context}: {msg}"
+            cm = exc.context_mark
+            started = (f" (started at line {cm.line + 1}, column {cm.column + 1})"
+                       if cm is not None and mark is not None and cm.line != mark.line else "")
+            msg = f"{exc.context}{started}: {msg}"
         raise ModelError([Issue(file, line, col, "", f"YAML syntax error: {msg}")]) from None
     except yaml.YAMLError as exc:
         raise ModelError([Issue(file, 0, 0, "", f"YAML error: {exc}")]) from None

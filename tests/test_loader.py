@@ -1,0 +1,333 @@
+"""The YAML boundary: what the loader refuses, how fast, and where it says the problem is.
+
+Every test loads real text from a file in `tmp_path` (or a string) and asserts the
+`Issue`'s file, line and column, computed from the text itself, plus the message.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from pathlib import Path
+
+import pytest
+import yaml
+
+import mbody
+from mbody import loader
+from mbody.errors import Issue, ModelError
+
+MODELS = Path(__file__).resolve().parent.parent / "models"
+
+
+BODY = "bodies:\n  - {name: a, mass: 1, inertia: 1}\n"
+
+
+def mark_of(text: str, needle: str, nth: int = 1) -> tuple[int, int]:
+    """1-based (line, column) of the `nth` occurrence of `needle` in `text`."""
+    at = -1
+    for _ in range(nth):
+        at = text.index(needle, at + 1)
+    line = text.count("\n", 0, at) + 1
+    return line, at - (text.rfind("\n", 0, at) + 1) + 1
+
+
+def issues(path: Path, text: str | bytes, **kw) -> list[Issue]:
+    if isinstance(text, bytes):
+        path.write_bytes(text)
+    else:
+        path.write_text(text, encoding="utf-8")
+    with pytest.raises(ModelError) as err:
+        mbody.load(path, **kw)
+    for i in err.value.issues:
+        assert i.file == str(path)
+    return err.value.issues
+
+
+def only(path: Path, text: str | bytes, **kw) -> Issue:
+    found = issues(path, text, **kw)
+    assert len(found) == 1, found
+    return found[0]
+
+
+@pytest.fixture(params=["libyaml", "python"])
+def any_parser(request, monkeypatch):
+    """Run a test with PyYAML's C parser and with its pure-Python fallback."""
+    if request.param == "python":
+        monkeypatch.setattr(loader, "_Loader", yaml.SafeLoader)
+    elif not hasattr(yaml, "CSafeLoader"):  # pragma: no cover
+        pytest.skip("PyYAML without libyaml")
+    return request.param
+
+
+# -- duplicate keys -------------------------------------------------------------------
+
+def test_duplicate_top_level_key_is_refused_with_both_lines(tmp_path, any_parser):
+    text = "model: x\ndimension: 2\n" + BODY + "dimension: 3\n"
+    i = only(tmp_path / "m.yaml", text)
+    assert (i.line, i.column) == mark_of(text, "dimension", 2) == (5, 1)
+    assert i.key == "dimension"
+    assert "duplicate key 'dimension'" in i.message
+    assert i.hint == "first given on line 2"
+
+
+def test_duplicate_key_inside_a_body_is_refused(tmp_path, any_parser):
+    # The stock loader would silently keep mass: 5.
+    text = "dimension: 2\nbodies:\n  - name: a\n    mass: 1\n    inertia: 1\n    mass: 5\n"
+    assert yaml.safe_load(text)["bodies"][0]["mass"] == 5
+    i = only(tmp_path / "m.yaml", text)
+    assert (i.line, i.column) == mark_of(text, "mass: 5") == (6, 5)
+    assert i.key == "bodies[0].mass"
+    assert i.hint == "first given on line 4"
+
+
+def test_every_duplicate_key_is_reported_together(tmp_path):
+    text = "dimension: 2\ndimension: 2\n" + BODY + "loads: []\nloads: []\n"
+    found = issues(tmp_path / "m.yaml", text)
+    assert [(i.key, i.line) for i in found] == [("dimension", 2), ("loads", 6)]
+
+
+# -- tags and other YAML features -----------------------------------------------------
+
+def test_python_object_tag_is_refused_and_never_run(tmp_path, any_parser):
+    witness = tmp_path / "pwned"
+    text = f"dimension: 2\nmodel: !!python/object/apply:os.system ['touch {witness}']\n" + BODY
+    i = only(tmp_path / "m.yaml", text)
+    assert (i.line, i.column) == mark_of(text, "!!python")
+    assert i.key == "model"
+    assert "python/object/apply:os.system" in i.message and "not allowed" in i.message
+    assert not witness.exists()
+
+
+@pytest.mark.parametrize("tagged", ["!!python/name:os.system", "!!set {x: null}",
+                                    "!custom 3", "!!python/tuple [1, 2]"])
+def test_other_constructing_tags_are_refused(tmp_path, tagged):
+    text = f"dimension: 2\nmodel: {tagged}\n" + BODY
+    i = only(tmp_path / "m.yaml", text)
+    assert (i.line, i.column) == (2, 8)
+    assert "not allowed" in i.message
+
+
+def test_core_tags_are_accepted(tmp_path):
+    path = tmp_path / "m.yaml"
+    path.write_text("dimension: !!int 2\nmodel: !!str 12\n"
+                    "bodies:\n  - {name: a, mass: !!float 3, inertia: 1}\n")
+    m = mbody.load(path)
+    assert (m.dimension, m.name, m.mass[0]) == (2, "12", 3.0)
+
+
+def test_merge_keys_are_refused(tmp_path):
+    text = ("dimension: 2\nmodel: &b m\nbodies:\n  - {<<: *b, name: a, inertia: 1}\n"
+            "  - {name: b, <<: *b, inertia: 1}\n")
+    found = issues(tmp_path / "m.yaml", text)
+    assert [(i.line, i.column) for i in found] == [mark_of(text, "<<"), mark_of(text, "<<", 2)]
+    assert all("merge keys ('<<') are not supported" in i.message for i in found)
+
+
+def test_complex_and_alias_keys_are_refused(tmp_path, any_parser):
+    text = "dimension: 2\n? [1, 2]\n: 3\n" + BODY
+    i = only(tmp_path / "m.yaml", text)
+    assert "key must be a plain name" in i.message and i.line == 2
+
+
+def test_undefined_alias_is_named(tmp_path):
+    text = "dimension: 2\nmodel: *nowhere\n" + BODY
+    i = only(tmp_path / "m.yaml", text)
+    assert (i.line, i.column) == mark_of(text, "*nowhere")
+    assert "'*nowhere'" in i.message
+
+
+def test_a_small_alias_is_fine(tmp_path):
+    path = tmp_path / "m.yaml"
+    path.write_text("dimension: 3\nbodies:\n"
+                    "  - {name: a, mass: 1, inertia: &J [2, 3, 4]}\n"
+                    "  - {name: b, mass: 1, inertia: *J}\n")
+    m = mbody.load(path)
+    assert m.bodies["b"].inertia.diagonal().tolist() == [2, 3, 4]
+
+
+def test_alias_bomb_is_refused_quickly(tmp_path, any_parser):
+    # "Billion laughs": 9 levels of 9 aliases would expand to 9**9 = 387 million strings.
+    lines = ['l0: &l0 ["lol", "lol", "lol", "lol", "lol", "lol", "lol", "lol", "lol"]']
+    for k in range(1, 10):
+        lines.append(f"l{k}: &l{k} [" + ", ".join([f"*l{k - 1}"] * 9) + "]")
+    text = "\n".join(lines) + "\n"
+    t0 = time.perf_counter()
+    i = only(tmp_path / "bomb.yaml", text)
+    elapsed = time.perf_counter() - t0
+    assert elapsed < 2.0
+    assert "alias" in i.message and str(loader.MAX_ALIAS_NODES) in i.message
+    assert i.line <= 10
+
+
+# -- size, depth, encoding, files -----------------------------------------------------
+
+def test_file_over_max_bytes_is_refused_before_reading(tmp_path):
+    path = tmp_path / "huge.yaml"
+    with open(path, "wb") as f:  # a sparse 200 MiB file: instant to make, slow to parse
+        f.truncate(200 * 2**20)
+    t0 = time.perf_counter()
+    with pytest.raises(ModelError) as err:
+        mbody.load(path)
+    assert time.perf_counter() - t0 < 0.5
+    (i,) = err.value.issues
+    assert i.file == str(path)
+    assert "200.0 MiB" in i.message and "at most 32 MiB" in i.message
+
+
+def test_max_bytes_argument(tmp_path):
+    path = tmp_path / "m.yaml"
+    text = "dimension: 2\n" + BODY + "# padding\n" * 200_000  # about 2 MB of comments
+    path.write_text(text)
+    with pytest.raises(ModelError) as err:
+        mbody.load(path, max_bytes=2**20)
+    assert "at most 1 MiB" in str(err.value)
+    assert mbody.load(path, max_bytes=4 * 2**20).n == 1
+
+
+@pytest.mark.parametrize("nest", ["[" * 100_000 + "]" * 100_000,
+                                  "\n  " + "- " * 100_000 + "x",
+                                  "{a: " * 5000 + "1" + "}" * 5000])
+def test_deep_nesting_is_refused_without_crashing(tmp_path, nest, any_parser):
+    # PyYAML's own composer recurses once per level and overflows the C stack (a
+    # segmentation fault) on the first of these; the loader must answer in one line.
+    text = "dimension: 2\nbodies: " + nest + "\n"
+    t0 = time.perf_counter()
+    i = only(tmp_path / "deep.yaml", text)
+    assert time.perf_counter() - t0 < 2.0
+    assert f"nesting deeper than {loader.MAX_DEPTH} levels" in i.message
+    assert i.key.startswith("bodies")
+    assert i.line in (2, 3)
+
+
+def test_nesting_at_the_limit_is_parsed():
+    depth = loader.MAX_DEPTH - 1
+    doc = loader.load_text("a: " + "[" * depth + "1" + "]" * depth)
+    v = doc.data["a"]
+    for _ in range(depth):
+        v = v[0]
+    assert v == 1
+
+
+@pytest.mark.parametrize("text", ["", "\n\n", "# only a comment\n", "---\n...\n"])
+def test_empty_file(tmp_path, text):
+    found = issues(tmp_path / "m.yaml", text)
+    assert len(found) == 1
+    msg = found[0].message
+    assert "empty" in msg or "expected a model mapping" in msg
+
+
+def test_top_level_must_be_a_mapping(tmp_path):
+    i = only(tmp_path / "m.yaml", "- a\n- b\n")
+    assert (i.line, i.column) == (1, 1)
+    assert i.message == "expected a model mapping, got a list of 2"
+
+
+def test_non_utf8_file_names_the_byte(tmp_path):
+    raw = b"dimension: 2\nmodel: caf\xe9\n" + BODY.encode()
+    i = only(tmp_path / "latin1.yaml", raw)
+    assert (i.line, i.column) == (2, 11)
+    assert "not UTF-8" in i.message and "0xe9" in i.message
+
+
+def test_utf8_with_bom_and_unicode_names(tmp_path):
+    path = tmp_path / "m.yaml"
+    path.write_bytes("\ufeffdimension: 2\nmodel: Schwungrad-Übung\n".encode()
+                     + b"bodies:\n  - {name: r\xc3\xa4d, mass: 1, inertia: 1}\n")
+    m = mbody.load(path)
+    assert m.name == "Schwungrad-Übung" and m.body_names == ("räd",)
+
+
+def test_directory_is_refused(tmp_path):
+    with pytest.raises(ModelError) as err:
+        mbody.load(tmp_path)
+    (i,) = err.value.issues
+    assert i.file == str(tmp_path) and "directory" in i.message
+
+
+def test_missing_file(tmp_path):
+    path = tmp_path / "nope.yaml"
+    with pytest.raises(ModelError) as err:
+        mbody.load(path)
+    assert str(err.value) == f"{path}: no such file"
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root reads everything")
+def test_unreadable_file(tmp_path):
+    path = tmp_path / "locked.yaml"
+    path.write_text("dimension: 2\n" + BODY)
+    path.chmod(0)
+    try:
+        with pytest.raises(ModelError) as err:
+            mbody.load(path)
+        assert "cannot read the file" in str(err.value)
+    finally:
+        path.chmod(0o644)
+
+
+# -- syntax errors --------------------------------------------------------------------
+
+@pytest.mark.parametrize(("text", "where", "words"), [
+    ("dimension: 2\nbodies: [\n  {name: a, mass: 1\n", (4, 1), "flow"),
+    ("dimension: 2\nbodies:\n\t- {name: a}\n", (3, 1), "cannot start any token"),
+    ("dimension: 2\nmodel: a: b\n", (2, 9), "mapping values are not allowed"),
+    ("dimension: 2\nbodies:\n  a: 1\n b: 2\n", (4, 2), "block mapping"),
+    ("dimension: 2\nmodel: \"unclosed\n", (3, 1), "quoted scalar"),
+])
+def test_syntax_errors_name_line_and_column(tmp_path, text, where, words, any_parser):
+    i = only(tmp_path / "m.yaml", text)
+    assert (i.line, i.column) == where
+    assert i.message.startswith("YAML syntax error") and words in i.message
+
+
+def test_syntax_error_says_where_the_unclosed_part_started(tmp_path):
+    text = "dimension: 2\nbodies: [\n  {name: a, mass: 1}\n\n"
+    i = only(tmp_path / "m.yaml", text)
+    assert "started at line 2, column 9" in i.message
+
+
+def test_second_document_is_refused(tmp_path):
+    text = "dimension: 2\n" + BODY + "---\ndimension: 3\n"
+    i = only(tmp_path / "m.yaml", text)
+    assert (i.line, i.column) == mark_of(text, "---")
+    assert "second YAML document" in i.message
+
+
+# -- scalars --------------------------------------------------------------------------
+
+def test_exponent_without_dot_is_a_number(any_parser):
+    # YAML 1.1 reads 1e3 as text; engineers mean a thousand. Quoted, it stays text.
+    data = loader.load_text("a: 1e3\nb: -2.5E-2\nc: '1e3'\nd: 1_000\ne: 0x10\n").data
+    assert data == {"a": 1000.0, "b": -0.025, "c": "1e3", "d": 1000, "e": 16}
+
+
+def test_quoted_number_is_text_where_a_number_is_expected(tmp_path):
+    text = "dimension: 2\nbodies:\n  - {name: a, mass: '1e3', inertia: 1}\n"
+    i = only(tmp_path / "m.yaml", text)
+    assert (i.line, i.column) == mark_of(text, "'1e3'")
+    assert i.message == "expected a number, got the text '1e3'"
+
+
+def test_marks_of_keys_and_values(any_parser):
+    text = "dimension: 3\nbodies:\n  - name: a\n    inertia:\n      - [1, 0, 0]\n"
+    doc = loader.load_text(text)
+    assert doc.key_marks[("bodies", 0, "inertia")] == (4, 5)
+    assert doc.marks[("bodies", 0, "inertia", 0, 2)] == mark_of(text, "0]")
+    assert doc.where(("bodies", 0, "mass")) == (3, 5)  # absent: the enclosing mapping
+
+
+@pytest.mark.parametrize("path", sorted(MODELS.glob("*.yaml")), ids=lambda p: p.name)
+def test_same_values_as_pyyaml_on_shipped_models(path):
+    text = path.read_text()
+    assert loader.load_text(text, str(path)).data == yaml.safe_load(text)
+
+
+def test_loading_10000_bodies_is_fast(tmp_path):
+    body = ("  - {name: b%d, mass: 1.5, inertia: [2, 3, 4], position: [%d, 0, 0], "
+            "angular_velocity: [1, 2, 3], orientation: {quaternion: [1, 0, 0, 0]}}\n")
+    text = "dimension: 3\nbodies:\n" + "".join(body % (i, i) for i in range(10_000))
+    t0 = time.perf_counter()
+    doc = loader.load_text(text)
+    elapsed = time.perf_counter() - t0
+    assert len(doc.data["bodies"]) == 10_000 and doc.marks[("bodies", 9999)] == (10_002, 5)
+    assert elapsed < 5.0  # about 0.4 s on the team's machine; PyYAML's compose takes ~2 s
