@@ -86,3 +86,28 @@ def test_flywheel_10_newton_metre(dimension):
         asm = mbody.assemble(mbody.load(spec))
         assert asm.b == pytest.approx(np.zeros(6), **EXACT)
         assert asm.solve().accelerations == pytest.approx([0, 0, 0, 0, 0, 40.0], **EXACT)
+
+
+# -- the same answers on the shipped practice ladder ---------------------------------------
+
+def test_practice_1_translation():
+    """4 kg crate, 30 N push and 6 N drag through G: a = 24/4 = 6, α = 0."""
+    asm = mbody.assemble(mbody.load(MODELS / "practice_1_translation.yaml"))
+    np.testing.assert_allclose(asm.Q, [24.0, 0.0, 0.0], rtol=0, atol=1e-12)
+    assert asm.solve().accelerations == pytest.approx([6.0, 0.0, 0.0], **EXACT)
+
+
+def test_practice_2_flywheel():
+    """I = 0.25, motor 10 N m, bearing reactions known (Fy carries the weight): α = 40."""
+    asm = mbody.assemble(mbody.load(MODELS / "practice_2_flywheel.yaml"))
+    assert asm.reactions == ["bearing.Fx", "bearing.Fy"]
+    assert asm.solve().accelerations == pytest.approx([0.0, 0.0, 40.0], **EXACT)
+    # without the file's known weight the bearing leaves the wheel falling at g
+    acc = asm.solve(known={"bearing.Fy": 0.0}).accelerations
+    assert acc == pytest.approx([0.0, -9.81, 40.0], **EXACT)
+
+
+def test_practice_3_euler():
+    """I = (2, 3, 4), ω = (1, 2, 3), no torque: ω̇ = (−3, 2, −0.5); the mass plays no part."""
+    asm = mbody.assemble(mbody.load(MODELS / "practice_3_euler.yaml"))
+    assert asm.solve().accelerations == pytest.approx([0, 0, 0, -3.0, 2.0, -0.5], **EXACT)
