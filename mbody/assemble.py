@@ -17,9 +17,10 @@ import numpy as np
 import scipy.sparse as sp
 
 from . import conventions as cv
+from . import kernels
 from .errors import MbodyError, did_you_mean
 from .joints import ReactionColumns, g_matrix, reaction_columns, reaction_wrench
-from .loads import AppliedLoads, applied_loads, gyroscopic
+from .loads import AppliedLoads
 from .model import Model, State
 from .spatial import matvec
 
@@ -40,15 +41,20 @@ def accelerations6(model: Model, rhs6: np.ndarray) -> np.ndarray:
 
 
 def mass_matrix(model: Model) -> sp.spmatrix:
-    """Block-diagonal M as a BSR matrix over the (n, 6, 6) (planar (n, 3, 3)) blocks."""
+    """Block-diagonal M as a BSR matrix over the (n, 6, 6) (planar (n, 3, 3)) blocks.
+
+    Built from index arrays (block i at block row and column i), never from a list of
+    per-body matrices; `Assembly.M` builds it only when first asked for.
+    """
     n = model.n
-    blocks = np.zeros((n, 6, 6))
-    idx = np.arange(3)
-    blocks[:, idx, idx] = model.mass[:, None]
-    blocks[:, 3:, 3:] = model.J
+    k = model.rows_per_body
+    blocks = np.zeros((n, k, k))
     if model.dimension == cv.PLANAR:
-        blocks = blocks[:, cv.PLANAR_SELECT][:, :, cv.PLANAR_SELECT]
-    k = blocks.shape[1]
+        blocks[:, 0, 0] = blocks[:, 1, 1] = model.mass
+        blocks[:, 2, 2] = model.J[:, 2, 2]
+    else:
+        blocks[:, [0, 1, 2], [0, 1, 2]] = model.mass[:, None]
+        blocks[:, 3:, 3:] = model.J
     return sp.bsr_matrix((blocks, np.arange(n), np.arange(n + 1)), shape=(n * k, n * k))
 
 
@@ -114,8 +120,10 @@ class Assembly:
         self.model = model
         self.state = state
         self.loads = loads
+        # (n, 6) per-body rows; `assemble` passes transposed views of (6, n) arrays (the
+        # kernels' layout), so `_Q6s`/`_b6s` below are contiguous rows.
         self._b6 = b6
-        self._Q6 = np.concatenate((loads.W_F, loads.B_M), axis=1)
+        self._Q6 = loads.Q6.T
 
     # -- the stacked system ------------------------------------------------------------
     @property
@@ -198,12 +206,19 @@ class Assembly:
         values = self.reaction_values(known)
         if len(values) < len(self.reactions):
             return self._solve_constrained(values, condition)
-        rhs6 = self._Q6 - self._b6
-        if self.reactions:
+        model = self.model
+        plan = kernels.plan_for(model)
+        extra = None
+        if self.reactions:  # G λ, summed per body on the kernels' sparse path
             lam = np.array([values[r] for r in self.reactions])
-            rhs6 = rhs6 + reaction_wrench(self.model, self.columns, lam)
-        acc = _select(self.model, accelerations6(self.model, rhs6))
-        return Solution(self.coordinates, acc, {r: values[r] for r in self.reactions})
+            t, cols = model.reaction_table, self.columns
+            extra = kernels.sparse_wrench(plan, [
+                (np.concatenate((t.child, t.parent)),
+                 np.concatenate((cols.child6 * lam[:, None], cols.parent6 * lam[:, None])))])
+        acc6 = np.empty((model.n, 6))
+        kernels.solve(plan, self._Q6.T, self._b6.T[3:6], extra, acc6.T)
+        return Solution(self.coordinates, _select(model, acc6),
+                        {r: values[r] for r in self.reactions})
 
     def _solve_constrained(self, values: dict[str, float], condition: bool) -> Solution:
         from .constraints import gamma
@@ -254,12 +269,15 @@ class _LazyBodies(Mapping):
 def assemble(model: Model, state: State | None = None) -> Assembly:
     """The stacked Newton-Euler equations of `model` at `state` (default: its initial state)."""
     state = model.initial if state is None else state
-    R = state.W_R_B
-    loads = applied_loads(model, state, R)
-    b6 = np.zeros((model.n, 6))
-    if model.dimension == cv.SPATIAL:
-        b6[:, 3:] = gyroscopic(model.J, state.omega)
-    return Assembly(model, state, loads, b6)
+    plan = kernels.plan_for(model)
+    frame = kernels.frame_at(model, state.t)
+    sparse = kernels.sparse_wrench(plan, [kernels.load_wrenches(model, plan, frame, state),
+                                          kernels.spring_wrenches(model, state)])
+    Q6 = np.empty((6, model.n))
+    b6 = np.zeros((6, model.n))  # rows 0-2 (Newton) stay 0; planar: all 0
+    kernels.loads_and_gyroscopic(plan, frame, state, sparse, Q6,
+                                 b6[3:6] if model.dimension == cv.SPATIAL else None)
+    return Assembly(model, state, AppliedLoads(model, state, Q6), b6.T)
 
 
 from .constraints import ConstraintJacobian  # noqa: E402  (annotations only)

@@ -136,7 +136,8 @@ class Plan:
     J: np.ndarray
     J_inv: np.ndarray
     chunks: tuple[tuple[int, int], ...]
-    kind: np.ndarray  # per force-table row: 0 world force, 1 body force, 2 world couple, 3 body couple
+    block: int  # the longest chunk (scratch size)
+    kind: np.ndarray  # per load: 0 world force, 1 body force, 2 world couple, 3 body couple
     slot_bodies: tuple[np.ndarray, ...]  # dense offset-force slots: bodies of slot j
     slot_loads: tuple[np.ndarray, ...]  # ... and the force-table rows they hold
     slot_r: tuple[np.ndarray, ...]  # (3, n) application points of slot j (0 elsewhere)
@@ -192,7 +193,7 @@ def build_plan(model: Model) -> Plan:
     return Plan(n, np.asarray(model.mass), 1.0 / np.asarray(model.mass),
                 np.asarray(model.gravity, float), diagonal, _entries(J, diagonal),
                 _entries(np.asarray(model.J_inv), diagonal),
-                tuple((s, min(s + CHUNK, n)) for s in range(0, n, CHUNK)),
+                tuple((s, min(s + CHUNK, n)) for s in range(0, n, CHUNK)), max(1, min(CHUNK, n)),
                 kind, tuple(slot_bodies), tuple(slot_loads), tuple(slot_r),
                 sparse_loads.astype(np.intp), dbf, dwc, dbc)
 
@@ -426,7 +427,7 @@ def accelerations(plan: Plan, frame: LoadFrame, state: State, sparse: Sparse | N
 
     `sparse` (forces, moments of the sparse path and reactions) is added per chunk.
     """
-    sc = scratch(min(CHUNK, max(plan.n, 1)))
+    sc = scratch(plan.block)
     diag = plan.diagonal
     for c, (s, e) in enumerate(plan.chunks):
         L = e - s
@@ -456,28 +457,30 @@ def accelerations(plan: Plan, frame: LoadFrame, state: State, sparse: Sparse | N
 
 
 def loads_and_gyroscopic(plan: Plan, frame: LoadFrame, state: State, sparse: Sparse | None,
-                         Q: np.ndarray, b: np.ndarray) -> None:
-    """Q (6, n) = [W_F; B_M] applied loads and b (3, n) = ω × (J ω), chunk by chunk."""
-    sc = scratch(min(CHUNK, max(plan.n, 1)))
+                         Q: np.ndarray, b: np.ndarray | None) -> None:
+    """Q (6, n) = [W_F; B_M] applied loads and b (3, n) = ω × (J ω) (skipped when b is
+    None), chunk by chunk."""
+    sc = scratch(plan.block)
     diag = plan.diagonal
     for c, (s, e) in enumerate(plan.chunks):
         L = e - s
         q = _rows(state.quaternion, s, e, sc.q)
-        om = _rows(state.omega, s, e, sc.omega)
         M, F, h, tmp = Q[3:6, s:e], Q[0:3, s:e], sc.v[3, :, :L], sc.row[:L]
         moments(plan, frame, q, s, e, M, sc, F)
         if sparse is not None:
             lo, hi = sparse.bounds[c], sparse.bounds[c + 1]
             if hi > lo:
                 Q[:, sparse.bodies[lo:hi]] += sparse.W[:, lo:hi]
-        matvec(plan.J[:, s:e], om, h, tmp, diag)
-        cross(om, h, b[:, s:e], tmp)
+        if b is not None:
+            om = _rows(state.omega, s, e, sc.omega)
+            matvec(plan.J[:, s:e], om, h, tmp, diag)
+            cross(om, h, b[:, s:e], tmp)
 
 
 def solve(plan: Plan, Q: np.ndarray, b: np.ndarray, extra: Sparse | None,
           out: np.ndarray) -> np.ndarray:
     """out (6, n) = [Q_F / m; J⁻¹ (Q_M − b)] plus the `extra` (reaction) wrenches."""
-    sc = scratch(min(CHUNK, max(plan.n, 1)))
+    sc = scratch(plan.block)
     diag = plan.diagonal
     for c, (s, e) in enumerate(plan.chunks):
         L = e - s

@@ -1,5 +1,5 @@
 """Applied loads -> per-body net force (world axes) and moment about the mass centre
-(body axes), vectorised over loads and bodies.
+(body axes), vectorised over loads and bodies (the sums: `mbody.kernels`).
 
 For a force ``W_f`` at the body point ``B_r`` (from the mass centre, body axes):
 
@@ -13,9 +13,11 @@ pulls them together with tension ``T = k (L − L0) + c L̇`` along ``u = (P_b �
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
+from . import kernels
 from .model import Model, State
 from .spatial import cross, matvec, rmatvec
 
@@ -38,17 +40,29 @@ class Contributions:
     couple: np.ndarray
 
 
-@dataclass(frozen=True)
 class AppliedLoads:
     """Net applied loads per body: W_F (n, 3) world axes, B_M (n, 3) body axes about G.
 
     `contributions` lists point forces, couples and spring ends; gravity is m g at each
-    mass centre and is not repeated there.
+    mass centre and is not repeated there. Only diagrams need the per-load list, so it
+    is computed on first access; the sums come from the cache-blocked kernels
+    (`mbody.kernels`) as one (6, n) array `Q6` (rows [W_F; B_M]).
     """
 
-    W_F: np.ndarray
-    B_M: np.ndarray
-    contributions: Contributions
+    def __init__(self, model: Model, state: State, Q6: np.ndarray):
+        self.model, self.state, self.Q6 = model, state, Q6
+
+    @property
+    def W_F(self) -> np.ndarray:
+        return self.Q6[0:3].T
+
+    @property
+    def B_M(self) -> np.ndarray:
+        return self.Q6[3:6].T
+
+    @cached_property
+    def contributions(self) -> Contributions:
+        return contributions(self.model, self.state)
 
 
 def scatter(index: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
@@ -57,9 +71,13 @@ def scatter(index: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
     keep = index >= 0
     if not keep.all():
         index, values = index[keep], values[keep]
-    if len(index):
-        for c in range(3):  # loop over 3 components, not over bodies
-            out[:, c] = np.bincount(index, values[:, c], minlength=n)
+    if not len(index):
+        return out
+    if len(index) == len(np.unique(index)):  # one row per body: a direct write
+        out[index] = values
+        return out
+    for c in range(3):  # loop over 3 components, not over bodies
+        out[:, c] = np.bincount(index, values[:, c], minlength=n)
     return out
 
 
@@ -78,9 +96,23 @@ def point_kinematics(state: State, R: np.ndarray, body: np.ndarray,
 
 
 def applied_loads(model: Model, state: State, R: np.ndarray | None = None) -> AppliedLoads:
-    """Net applied force and moment on every body at `state` (gravity and springs included)."""
+    """Net applied force and moment on every body at `state` (gravity and springs included).
+
+    W_F = Σ W_f + m g (world axes), B_M = Σ B_r × (W_R_Bᵀ W_f) + couples (body axes).
+    `R` is accepted for compatibility and not needed (rotations use the quaternions).
+    """
+    plan = kernels.plan_for(model)
+    frame = kernels.frame_at(model, state.t)
+    sparse = kernels.sparse_wrench(plan, [kernels.load_wrenches(model, plan, frame, state),
+                                          kernels.spring_wrenches(model, state)])
+    Q6 = np.empty((6, model.n))
+    kernels.loads_and_gyroscopic(plan, frame, state, sparse, Q6, None)
+    return AppliedLoads(model, state, Q6)
+
+
+def contributions(model: Model, state: State, R: np.ndarray | None = None) -> Contributions:
+    """Each point force, couple and spring end on its body at `state` (for diagrams)."""
     R = state.W_R_B if R is None else R
-    n = model.n
     ft, sp = model.forces, model.springs
 
     # Point forces and couples.
@@ -115,12 +147,8 @@ def applied_loads(model: Model, state: State, R: np.ndarray | None = None) -> Ap
             Bms.append(cross(Br, rmatvec(Re, sign * f)))
             couples.append(np.zeros(len(end), dtype=bool))
 
-    body = np.concatenate(bodies)
-    contrib = Contributions(body, tuple(names), np.concatenate(Wfs), np.concatenate(Brs),
-                            np.concatenate(Bms), np.concatenate(couples))
-    W_F = scatter(body, contrib.W_f, n) + model.mass[:, None] * model.gravity
-    B_M = scatter(body, contrib.B_m, n)
-    return AppliedLoads(W_F, B_M, contrib)
+    return Contributions(np.concatenate(bodies), tuple(names), np.concatenate(Wfs),
+                         np.concatenate(Brs), np.concatenate(Bms), np.concatenate(couples))
 
 
 def gyroscopic(J: np.ndarray, omega: np.ndarray) -> np.ndarray:
