@@ -111,6 +111,8 @@ class Equation:
         for label, coef in self.reactions.items():
             name = f"({label}={_num(self.known[label])})" if label in self.known else label
             term = _terms([(coef, name)])
+            if not term:  # a coefficient that is rounding noise
+                continue
             if right:
                 term = f"+ {term}" if not term.startswith("-") else f"- {term[1:]}"
             right = f"{right} {term}".strip()
@@ -140,7 +142,7 @@ def _num(x: float) -> str:
 def _terms(pairs: list[tuple[float, str]]) -> str:
     out = ""
     for coef, name in pairs:
-        if coef == 0:
+        if abs(coef) < 1e-12:  # rounding noise from rotations, not a term
             continue
         mag = abs(coef)
         txt = name if mag == 1 else f"{_num(mag)} {name}"
