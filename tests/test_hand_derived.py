@@ -529,3 +529,46 @@ def test_reaction_sign_ground_parent_spatial():
     # ω̇ = (0, 4/2, 8/2.5) = (0, 2, 3.2).
     acc = mbody.assemble(mbody.load(spec)).solve().accelerations
     close(acc, [2.0, 0, 0, 0, 2.0, 3.2])
+
+
+# -- orientation conventions and inertia from a shape ---------------------------------------
+
+@pytest.mark.parametrize(("orientation", "body_x", "body_y"), [
+    # intrinsic ZYX [a, b, c] = Rz(a) Ry(b) Rx(c)
+    ({"euler": ["90 deg", 0, 0], "sequence": "ZYX"}, [0, 1, 0], [-1, 0, 0]),
+    # Ry(90°): x -> (0, 0, −1), y -> y
+    ({"euler": [0, "90 deg", 0], "sequence": "ZYX"}, [0, 0, -1], [0, 1, 0]),
+    # Rz(90°) Ry(90°): x -> Rz(0, 0, −1) = (0, 0, −1); y -> Rz(0, 1, 0) = (−1, 0, 0)
+    ({"euler": ["90 deg", "90 deg", 0]}, [0, 0, -1], [-1, 0, 0]),
+    # extrinsic xyz [c, b, a] is the same rotation as intrinsic ZYX [a, b, c]
+    ({"euler": [0, "90 deg", "90 deg"], "sequence": "xyz"}, [0, 0, -1], [-1, 0, 0]),
+    ({"quaternion": [S2, 0, 0, S2]}, [0, 1, 0], [-1, 0, 0]),
+    ({"quaternion": [2.0, 0, 0, 2.0]}, [0, 1, 0], [-1, 0, 0]),  # normalised (with a warning)
+    ({"matrix": RZ90.tolist()}, [0, 1, 0], [-1, 0, 0]),
+])
+def test_orientation_conventions_turn_body_frame_loads(orientation, body_x, body_y):
+    """A body-frame force along body x (then y) shows up along R e_x (R e_y) in world."""
+    spec = {"dimension": 3, "bodies": [{"name": "b", "mass": 1.0, "inertia": [1, 1, 1],
+                                        "orientation": orientation}],
+            "loads": [{"type": "force", "body": "b", "force": [1.0, 0, 0], "frame": "body"},
+                      {"type": "force", "body": "b", "force": [0, 2.0, 0], "frame": "body"}]}
+    close(mbody.assemble(mbody.load(spec)).Q[:3], np.add(body_x, 2 * np.asarray(body_y)))
+
+
+@pytest.mark.parametrize(("dimension", "shape", "mass", "expected"), [
+    # box [a, b, c]: m/12 (b² + c², a² + c², a² + b²) = (0.05, 0.17, 0.2) for m = 12
+    (3, {"box": [0.4, 0.2, 0.1]}, 12.0, [0.05, 0.17, 0.2]),
+    # cylinder (axis z): m(3r² + L²)/12 = 2(0.03 + 0.36)/12 = 0.065; m r²/2 = 0.01
+    (3, {"cylinder": {"radius": 0.1, "length": 0.6}}, 2.0, [0.065, 0.065, 0.01]),
+    # sphere: 2/5 m r² = 0.4 · 5 · 0.25 = 0.5
+    (3, {"sphere": {"radius": 0.5}}, 5.0, [0.5, 0.5, 0.5]),
+    # planar box [w, h]: m(w² + h²)/12 = 10 · 1.64 / 12
+    (2, {"box": [1.0, 0.8]}, 10.0, [10 * 1.64 / 12]),
+    # planar disc: m r²/2 = 12.5 · 0.04 / 2 = 0.25
+    (2, {"disc": {"radius": 0.2}}, 12.5, [0.25]),
+])
+def test_inertia_from_shape(dimension, shape, mass, expected):
+    spec = {"dimension": dimension, "bodies": [{"name": "b", "mass": mass, "shape": shape}]}
+    M = mbody.assemble(mbody.load(spec)).M.toarray()
+    k = 3 if dimension == 3 else 1
+    close(np.diag(M)[-k:], expected, 1e-14)
