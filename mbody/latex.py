@@ -22,6 +22,8 @@ from .fbd import REACTION, BodyEquations, Equation
 
 MAX_FULL = 12
 """Matrices with more rows or columns than this are shown in block form."""
+TERMS_PER_LINE = 4
+"""Right-hand-side terms per line of a body's equation before it continues below."""
 
 _ACC = {"a_x": "a_{x}", "a_y": "a_{y}", "a_z": "a_{z}", "alpha": r"\alpha",
         "alpha_1": r"\dot{\omega}_{1}", "alpha_2": r"\dot{\omega}_{2}",
@@ -29,7 +31,7 @@ _ACC = {"a_x": "a_{x}", "a_y": "a_{y}", "a_z": "a_{z}", "alpha": r"\alpha",
 _SPECIAL = {"\\": r"\textbackslash{}", "{": r"\{", "}": r"\}", "$": r"\$", "&": r"\&",
             "#": r"\#", "^": r"\textasciicircum{}", "_": r"\_", "%": r"\%",
             "~": r"\textasciitilde{}", "<": r"\textless{}", ">": r"\textgreater{}",
-            "|": r"\textbar{}", '"': r"\textquotedbl{}"}
+            "|": r"\textbar{}", '"': "{''}"}
 
 
 def escape(text: str) -> str:
@@ -69,7 +71,7 @@ def reaction_symbol(label: str) -> str:
 
 
 def _term(coef: float, symbol: str, first: bool) -> str:
-    if coef == 0:
+    if number(coef) == "0":  # zero, or rounding noise from rotations
         return ""
     mag = abs(coef)
     body = symbol if mag == 1 else f"{number(mag)}\\,{symbol}"
@@ -78,18 +80,24 @@ def _term(coef: float, symbol: str, first: bool) -> str:
     return f" {'-' if coef < 0 else '+'} {body}"
 
 
-def equation_latex(eq: Equation) -> str:
-    """One row ``Σ M_rk a_k + b_r &= Q_r + Σ G_rc λ_c`` (``&`` before the equals sign)."""
+def equation_latex(eq: Equation, per_line: int = TERMS_PER_LINE) -> str:
+    """One row ``Σ M_rk a_k + b_r &= Q_r + Σ G_rc λ_c`` (``&`` before the equals sign).
+
+    A right-hand side with many reaction terms continues on further aligned lines,
+    `per_line` terms each, so that a body with many joints stays readable.
+    """
     left = ""
     for name, coef in eq.lhs.items():
         left += _term(coef, _ACC.get(name, escape(name)), not left)
     left = left or "0"
     if eq.gyro != 0 and number(eq.gyro) != "0":
         left += f" {'-' if eq.gyro < 0 else '+'} {number(abs(eq.gyro))}"
-    right = number(eq.rhs) if (number(eq.rhs) != "0" or not eq.reactions) else ""
+    terms = [number(eq.rhs)] if (number(eq.rhs) != "0" or not eq.reactions) else []
     for label, coef in eq.reactions.items():
-        right += _term(coef, reaction_symbol(label), not right)
-    return f"{left} &= {right or '0'}"
+        if term := _term(coef, reaction_symbol(label), not terms):
+            terms.append(term)
+    lines = ["".join(terms[i:i + per_line]) for i in range(0, len(terms), per_line)]
+    return f"{left} &= " + " \\\\\n&\\quad ".join(lines or ["0"])
 
 
 def body_latex(eq: BodyEquations) -> str:
@@ -163,13 +171,14 @@ def _block_form(asm: Assembly, max_full: int) -> str:
     model = asm.model
     names = list(model.body_names)
     k = model.rows_per_body
-    shown = names[:3]
-    blocks = [rf"M_{{\text{{{escape(b)}}}}} = "
-              + _matrix(asm.M[i * k:(i + 1) * k, i * k:(i + 1) * k].toarray())
-              for i, b in enumerate(shown)]
+    shown = names[:2]
+    M = asm.M.tocsr()
     parts = [r"M = \operatorname{diag}(" + ", ".join(
         rf"M_{{\text{{{escape(b)}}}}}" for b in shown)
-        + (r", \dots" if len(names) > len(shown) else "") + r"),\quad " + r",\quad ".join(blocks)]
+        + (r", \dots" if len(names) > len(shown) else "") + ")"]
+    parts += [rf"M_{{\text{{{escape(b)}}}}} = "
+              + _matrix(M[i * k:(i + 1) * k, i * k:(i + 1) * k].toarray())
+              for i, b in enumerate(shown)]
     # G: which body's rows each joint's columns touch (a block pattern, truncated).
     jt = model.reaction_table
     if len(jt.labels):
@@ -191,7 +200,7 @@ def _block_form(asm: Assembly, max_full: int) -> str:
                      + "c" * len(joints) + "} & " + head + r" \\ \hline "
                      + r" \\ ".join(body_rows + more) + r"\end{array}")
     size = (rf"\text{{{len(asm.coordinates)} rows, {len(asm.reactions)} reaction "
-            r"unknowns}}")
+            r"unknowns}")
     return ("\\begin{gathered}\n" + r"M \dot{v} + b = Q + G\lambda,\quad " + size
             + " \\\\\n" + " \\\\\n".join(parts) + "\n\\end{gathered}")
 
@@ -235,7 +244,7 @@ def document(asm: Assembly, title: str | None = None, bodies: Iterable[str] | No
                    + r")$~m/s$^2$ (world).")
     for name in names:
         eq = asm.bodies[name]
-        out += [rf"\section*{{Body \texttt{{{escape(name)}}}}}", free_body_latex(eq),
+        out += [rf"\section*{{Body {escape(name)}}}", free_body_latex(eq),
                 _display(body_latex(eq))]
     if len(names) < model.n:
         out.append(rf"({model.n - len(names)} more bodies not shown.)")
