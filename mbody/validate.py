@@ -481,6 +481,8 @@ def _shape(c: _Checker, path: Path_, value: Any) -> dict[str, Any] | None:
     allowed = SHAPES[c.dim]
     if not c.mapping(path, value, allowed, what="a shape mapping such as {box: [a, b, c]}"):
         return None
+    if any(k not in allowed for k in value):  # already reported, with a did-you-mean
+        return None
     if len(value) != 1:
         c.err(path, f"give exactly one shape, one of: {', '.join(allowed)}")
         return None
