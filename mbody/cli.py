@@ -17,7 +17,7 @@ from . import __version__
 from .commands import EXIT_INPUT, EXIT_INTERNAL, EXIT_OK, EXIT_UNMET
 from .errors import MbodyError, ModelError, UnknownReactionsError
 
-COMMAND_MODULES = ("core", "export", "sim")
+COMMAND_MODULES = ("core", "export", "sim", "draw")
 """Modules of `mbody.commands`; each has `register(subparsers)` adding its commands."""
 
 def build_parser() -> argparse.ArgumentParser:
