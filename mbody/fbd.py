@@ -145,7 +145,7 @@ def _terms(pairs: list[tuple[float, str]]) -> str:
         if abs(coef) < 1e-12:  # rounding noise from rotations, not a term
             continue
         mag = abs(coef)
-        txt = name if mag == 1 else f"{_num(mag)} {name}"
+        txt = name if _num(mag) == "1" else f"{_num(mag)} {name}"  # 0.9999999 is 1
         if not out:
             out = f"-{txt}" if coef < 0 else txt
         else:
