@@ -48,64 +48,81 @@ DENSE_FRACTION = 8
 _mul, _add, _sub = np.multiply, np.add, np.subtract
 
 
-# -- small vector kernels on (3, L) rows ------------------------------------------------
+# -- small vector kernels on "rolled" component rows --------------------------------------
+# A vector field is stored as (5, L) rows [x, y, z, x, y], so that V[1:4] = (y, z, x) and
+# V[2:5] = (z, x, y) are views: a cross product is then 3 numpy calls on (3, L) blocks
+# instead of 9 on single rows (fewer calls = less interpreter overhead per body).
+def roll(V: np.ndarray) -> np.ndarray:
+    """Make (5, L) rows [x, y, z, ., .] rolled: rows 3, 4 = rows 0, 1."""
+    np.copyto(V[3:5], V[0:2])
+    return V
+
+
 def cross(a: np.ndarray, b: np.ndarray, out: np.ndarray, tmp: np.ndarray) -> np.ndarray:
-    """out = a × b for (3, L) component rows; `tmp` is one (L,) scratch row."""
-    _mul(a[1], b[2], out=out[0])
-    _mul(a[2], b[1], out=tmp)
-    _sub(out[0], tmp, out=out[0])
-    _mul(a[2], b[0], out=out[1])
-    _mul(a[0], b[2], out=tmp)
-    _sub(out[1], tmp, out=out[1])
-    _mul(a[0], b[1], out=out[2])
-    _mul(a[1], b[0], out=tmp)
-    _sub(out[2], tmp, out=out[2])
-    return out
+    """out (3, L) = a × b for rolled a, b (5, L); `tmp` is (3, L) scratch."""
+    _mul(a[1:4], b[2:5], out)
+    _mul(a[2:5], b[1:4], tmp)
+    return _sub(out, tmp, out)
 
 
 def cross_add(a: np.ndarray, b: np.ndarray, out: np.ndarray, tmp: np.ndarray,
               sign: float = 1.0) -> np.ndarray:
-    """out += sign (a × b) for (3, L) rows (sign ±1)."""
+    """out (3, L) += sign (a × b) for rolled a, b (sign ±1)."""
     inc, dec = (_add, _sub) if sign > 0 else (_sub, _add)
-    for i, j, k in ((0, 1, 2), (1, 2, 0), (2, 0, 1)):
-        _mul(a[j], b[k], out=tmp)
-        inc(out[i], tmp, out=out[i])
-        _mul(a[k], b[j], out=tmp)
-        dec(out[i], tmp, out=out[i])
-    return out
+    _mul(a[1:4], b[2:5], tmp)
+    inc(out, tmp, out)
+    _mul(a[2:5], b[1:4], tmp)
+    return dec(out, tmp, out)
 
 
 def rotate(w: np.ndarray, u: np.ndarray, v: np.ndarray, out: np.ndarray, t: np.ndarray,
            tmp: np.ndarray, transpose: bool = False) -> np.ndarray:
-    """out = W_R_B v (or W_R_Bᵀ v with `transpose`) for q = (w, u): (L,), (3, L), (3, L).
+    """out[0:3] = W_R_B v (or W_R_Bᵀ v with `transpose`) for q = (w, u).
 
-    W_R_B v = v + w t + u × t with t = 2 u × v; the transpose uses −u.
+    w: (L,); u, v, out, t: rolled (5, L); tmp: (3, L). W_R_B v = v + w t + u × t with
+    t = 2 u × v; the transpose uses −u, i.e. t = 2 v × u and v + w t + t × u.
     """
+    t3, o3 = t[0:3], out[0:3]
     if transpose:
-        cross(v, u, t, tmp)
+        cross(v, u, t3, tmp)
     else:
-        cross(u, v, t, tmp)
-    t *= 2.0
-    _mul(t, w, out=out)
-    out += v
+        cross(u, v, t3, tmp)
+    _mul(t3, 2.0, t3)
+    roll(t)
+    _mul(t3, w, o3)
+    _add(o3, v[0:3], o3)
     if transpose:
-        cross_add(t, u, out, tmp)
+        cross_add(t, u, o3, tmp)
     else:
-        cross_add(u, t, out, tmp)
+        cross_add(u, t, o3, tmp)
     return out
 
 
-def matvec(A: np.ndarray, v: np.ndarray, out: np.ndarray, tmp: np.ndarray,
-           diagonal: bool) -> np.ndarray:
-    """out = A v per body; A is (3, L) diagonal entries or (9, L) row-major entries."""
-    if diagonal:
-        return _mul(A, v, out=out)
+def matvec(A: np.ndarray, v: np.ndarray, out: np.ndarray, p: np.ndarray, tmp: np.ndarray,
+           mode: str) -> np.ndarray:
+    """out (3, L) = A v per body; v and p (scratch) rolled (5, L).
+
+    mode "diag": A (3, L) diagonals. "sym": A (6, L) = [A00, A11, A22, A01, A12, A02], and
+    A v = D∘v + E∘(v_y, v_z, v_x) + P(E∘v) with D the diagonal, E = (A01, A12, A02) and
+    P(p) = (p_z, p_x, p_y). "full": A (9, L) row-major entries, one row at a time.
+    """
+    if mode == "diag":
+        return _mul(A, v[0:3], out)
+    if mode == "sym":
+        E = A[3:6]
+        _mul(A[0:3], v[0:3], out)
+        _mul(E, v[1:4], tmp)
+        _add(out, tmp, out)
+        _mul(E, v[0:3], p[0:3])
+        roll(p)
+        return _add(out, p[2:5], out)
     for i in range(3):
-        _mul(A[3 * i], v[0], out=out[i])
-        _mul(A[3 * i + 1], v[1], out=tmp)
-        out[i] += tmp
-        _mul(A[3 * i + 2], v[2], out=tmp)
-        out[i] += tmp
+        o, t = out[i], tmp[0]
+        _mul(A[3 * i], v[0], o)
+        _mul(A[3 * i + 1], v[1], t)
+        _add(o, t, o)
+        _mul(A[3 * i + 2], v[2], t)
+        _add(o, t, o)
     return out
 
 
@@ -123,16 +140,16 @@ def quat_rotate(q: np.ndarray, v: np.ndarray, transpose: bool = False) -> np.nda
 class Plan:
     """What a model's hot path needs, laid out once (constant in body axes).
 
-    inv_mass: (n,) 1/m. J, J_inv: (3, n) diagonals when every tensor is diagonal
-    (`diagonal`), else (9, n) row-major entries. chunks: [(start, stop)] body blocks.
-    world_offset: (k_w,) indices of world-frame forces applied away from the mass centre.
+    inv_mass: (n,) 1/m. J, J_inv: entries as `matvec` reads them for `mode` ("diag" when
+    every tensor is diagonal, "sym" when every tensor is exactly symmetric, else "full").
+    chunks: [(start, stop)] body blocks. Vector fields are rolled (5, n) rows.
     """
 
     n: int
     mass: np.ndarray
     inv_mass: np.ndarray
     gravity: np.ndarray
-    diagonal: bool
+    mode: str
     J: np.ndarray
     J_inv: np.ndarray
     chunks: tuple[tuple[int, int], ...]
@@ -140,17 +157,25 @@ class Plan:
     kind: np.ndarray  # per load: 0 world force, 1 body force, 2 world couple, 3 body couple
     slot_bodies: tuple[np.ndarray, ...]  # dense offset-force slots: bodies of slot j
     slot_loads: tuple[np.ndarray, ...]  # ... and the force-table rows they hold
-    slot_r: tuple[np.ndarray, ...]  # (3, n) application points of slot j (0 elsewhere)
+    slot_r: tuple[np.ndarray, ...]  # (5, n) application points of slot j (0 elsewhere)
     sparse_loads: np.ndarray  # force-table rows that take the sparse path each step
     dense_body_forces: bool
     dense_world_couples: bool
     dense_body_couples: bool
 
 
-def _entries(J: np.ndarray, diagonal: bool) -> np.ndarray:
-    if diagonal:
+def _entries(J: np.ndarray, mode: str) -> np.ndarray:
+    if mode == "diag":
         return np.ascontiguousarray(np.diagonal(J, axis1=1, axis2=2).T)
+    if mode == "sym":
+        i, j = [0, 1, 2, 0, 1, 0], [0, 1, 2, 1, 2, 2]
+        return np.ascontiguousarray(0.5 * (J[:, i, j] + J[:, j, i]).T)
     return np.ascontiguousarray(J.reshape(-1, 9).T)
+
+
+def rolled(a: np.ndarray) -> np.ndarray:
+    """(k, 3) rows -> rolled (5, k) component rows [x, y, z, x, y]."""
+    return np.ascontiguousarray(np.asarray(a, float).T[[0, 1, 2, 0, 1]])
 
 
 def _distinct(index: np.ndarray) -> int:
@@ -162,7 +187,9 @@ def build_plan(model: Model) -> Plan:
     J = np.asarray(model.J)
     off = J.copy()
     off[:, [0, 1, 2], [0, 1, 2]] = 0.0
-    diagonal = not off.any()
+    # J⁻¹ of an exactly symmetric J is symmetric up to rounding: "sym" averages it out.
+    mode = ("diag" if not off.any() else
+            "sym" if np.array_equal(J, J.transpose(0, 2, 1)) else "full")
     ft = model.forces
     kind = np.where(ft.couple, 2, 0) + ft.in_body.astype(np.intp)
     dense = lambda sel: _distinct(ft.body[sel]) * DENSE_FRACTION >= max(n, 1)  # noqa: E731
@@ -177,8 +204,8 @@ def build_plan(model: Model) -> Plan:
     for j in range(int(rank.max()) + 1 if len(rows) else 0):
         sel = rank == j
         if len(np.unique(body[sel])) * DENSE_FRACTION >= n:
-            r = np.zeros((3, n))
-            r[:, body[sel]] = ft.B_r[rows[sel]].T
+            r = np.zeros((5, n))
+            r[:, body[sel]] = rolled(ft.B_r[rows[sel]])
             slot_bodies.append(body[sel])
             slot_loads.append(rows[sel])
             slot_r.append(r)
@@ -191,8 +218,8 @@ def build_plan(model: Model) -> Plan:
             sparse.append(np.flatnonzero(kind == k))
     sparse_loads = np.sort(np.concatenate(sparse)) if sparse else np.zeros(0, np.intp)
     return Plan(n, np.asarray(model.mass), 1.0 / np.asarray(model.mass),
-                np.asarray(model.gravity, float), diagonal, _entries(J, diagonal),
-                _entries(np.asarray(model.J_inv), diagonal),
+                np.asarray(model.gravity, float), mode, _entries(J, mode),
+                _entries(np.asarray(model.J_inv), mode),
                 tuple((s, min(s + CHUNK, n)) for s in range(0, n, CHUNK)), max(1, min(CHUNK, n)),
                 kind, tuple(slot_bodies), tuple(slot_loads), tuple(slot_r),
                 sparse_loads.astype(np.intp), dbf, dwc, dbc)
@@ -202,10 +229,10 @@ def build_plan(model: Model) -> Plan:
 class LoadFrame:
     """Sums that depend only on the load values (cached while they stay the same array).
 
-    W_F: (3, n) world forces + m g; a_G: W_F / m; B_F: (3, n) body-frame forces to turn
-    into world axes each step (or None); B_M: (3, n) body-frame moments: couples and
-    B_r × f of body-frame forces (or None); W_C: (3, n) world couples (or None);
-    slot_f: (3, n) per offset-force slot.
+    W_F: (3, n) world forces + m g; a_G: W_F / m; B_F: rolled (5, n) body-frame forces to
+    turn into world axes each step (or None); B_M: (3, n) body-frame moments: couples and
+    B_r × f of body-frame forces (or None); W_C: rolled (5, n) world couples (or None);
+    slot_f: rolled (5, n) per offset-force slot.
     """
 
     vector: np.ndarray
@@ -233,7 +260,7 @@ def build_frame(model: Model, plan: Plan, vector: np.ndarray) -> LoadFrame:
     B_F = B_M = W_C = None
     if plan.dense_body_forces and (kind == 1).any():
         s = kind == 1
-        B_F = _sum_rows(n, ft.body[s], vec[s])
+        B_F = roll(np.vstack((_sum_rows(n, ft.body[s], vec[s]), np.empty((2, n)))))
         B_M = _sum_rows(n, ft.body[s], np.cross(ft.B_r[s], vec[s]))
     if plan.dense_body_couples and (kind == 3).any():
         s = kind == 3
@@ -241,11 +268,11 @@ def build_frame(model: Model, plan: Plan, vector: np.ndarray) -> LoadFrame:
         B_M = C if B_M is None else B_M + C
     if plan.dense_world_couples and (kind == 2).any():
         s = kind == 2
-        W_C = _sum_rows(n, ft.body[s], vec[s])
+        W_C = roll(np.vstack((_sum_rows(n, ft.body[s], vec[s]), np.empty((2, n)))))
     slot_f = []
     for bodies, loads in zip(plan.slot_bodies, plan.slot_loads, strict=True):
-        f = np.zeros((3, n))
-        f[:, bodies] = vec[loads].T
+        f = np.zeros((5, n))
+        f[:, bodies] = rolled(vec[loads])
         slot_f.append(f)
     return LoadFrame(vector, W_F, W_F * plan.inv_mass, B_F, B_M, W_C, tuple(slot_f))
 
@@ -309,14 +336,14 @@ def load_wrenches(model: Model, plan: Plan, frame: LoadFrame, state: State
                   ) -> tuple[np.ndarray, np.ndarray]:
     """Per-load wrenches (k, 6) of the loads on the sparse path at `state`."""
     rows = plan.sparse_loads
+    if not len(rows):
+        return rows, np.zeros((0, 6))
     ft = model.forces
     body = ft.body[rows]
     vec = np.asarray(frame.vector, float)[rows]
     kind = plan.kind[rows]
     q = state.quaternion[body]
     W = np.zeros((len(rows), 6))
-    if not len(rows):
-        return body, W
     r = ft.B_r[rows]
     # World-frame forces: their force is already in W_F (frame); only the moment here.
     f = kind == 0
@@ -366,13 +393,22 @@ def spring_wrenches(model: Model, state: State) -> tuple[np.ndarray, np.ndarray]
 
 # -- the chunked passes -------------------------------------------------------------------
 class Scratch:
-    """Preallocated rows for one thread: quaternion (4, C), ω (3, C), vectors (3, C)."""
+    """Preallocated rows for one thread, with the views of each chunk length cached."""
 
     def __init__(self, size: int):
-        self.q = np.empty((4, size))
-        self.omega = np.empty((3, size))
-        self.v = np.empty((6, 3, size))
-        self.row = np.empty(size)
+        self.size = size
+        self.q = np.empty((6, size))  # [w, x, y, z, x, y]
+        self.omega = np.empty((5, size))
+        self.v = np.empty((6, 5, size))
+        self.tmp = np.empty((3, size))
+        self._views: dict[int, tuple] = {}
+
+    def views(self, L: int) -> tuple:
+        """(q, ω, v0..v5, tmp) cut to length L."""
+        if L not in self._views:
+            self._views[L] = (self.q[:, :L], self.omega[:, :L],
+                              *(self.v[i, :, :L] for i in range(6)), self.tmp[:, :L])
+        return self._views[L]
 
 
 _local = threading.local()
@@ -380,45 +416,45 @@ _local = threading.local()
 
 def scratch(size: int) -> Scratch:
     s = getattr(_local, "scratch", None)
-    if s is None or s.row.shape[0] < size:
+    if s is None or s.size < size:
         s = _local.scratch = Scratch(size)
     return s
 
 
-def _rows(a: np.ndarray, s: int, e: int, buf: np.ndarray) -> np.ndarray:
-    """(n, k) AoS slice as (k, L) component rows: a view when already column-major."""
-    if a.strides[0] == a.itemsize:  # Fortran order: columns are contiguous already
-        return a[s:e].T
-    L = e - s
-    np.copyto(buf[:, :L], a[s:e].T)
-    return buf[:, :L]
+def _load(a: np.ndarray, s: int, e: int, buf: np.ndarray, rows: int) -> np.ndarray:
+    """Bodies s:e of an (n, k) array as (k, L) component rows in `buf`, then rolled."""
+    np.copyto(buf[:rows], a[s:e].T)
+    np.copyto(buf[rows:], buf[rows - 3:rows - 1])
+    return buf
 
 
-def moments(plan: Plan, frame: LoadFrame, q: np.ndarray, s: int, e: int, M: np.ndarray,
-            sc: Scratch, F: np.ndarray | None) -> None:
-    """Body-axis applied moments of bodies s:e into M (3, L); world force into F if given.
+def moments(plan: Plan, frame: LoadFrame, w: np.ndarray, u: np.ndarray, s: int, e: int,
+            M: np.ndarray, t: np.ndarray, v: np.ndarray, tmp: np.ndarray) -> None:
+    """Body-axis applied moments of bodies s:e into M (3, L):
 
-    B_M = Σ_slots B_r × (W_R_Bᵀ W_f) + W_R_Bᵀ W_C + (body-frame moments);
-    W_F = (world forces + m g) + W_R_B B_F.
+    B_M = Σ_slots B_r × (W_R_Bᵀ W_f) + W_R_Bᵀ W_C + (body-frame moments).
     """
-    L = e - s
-    w, u = q[0], q[1:4]
-    t, v, tmp = sc.v[0, :, :L], sc.v[1, :, :L], sc.row[:L]
+    first = True
     if frame.B_M is not None:
         np.copyto(M, frame.B_M[:, s:e])
-    else:
-        M.fill(0.0)
+        first = False
     for r, f in zip(plan.slot_r, frame.slot_f, strict=True):
         rotate(w, u, f[:, s:e], v, t, tmp, transpose=True)
-        cross_add(r[:, s:e], v, M, tmp)
+        roll(v)
+        if first:
+            cross(r[:, s:e], v, M, tmp)
+            first = False
+        else:
+            cross_add(r[:, s:e], v, M, tmp)
     if frame.W_C is not None:
         rotate(w, u, frame.W_C[:, s:e], v, t, tmp, transpose=True)
-        M += v
-    if F is not None:
-        np.copyto(F, frame.W_F[:, s:e])
-        if frame.B_F is not None:
-            rotate(w, u, frame.B_F[:, s:e], v, t, tmp)
-            F += v
+        if first:
+            np.copyto(M, v[0:3])
+            first = False
+        else:
+            _add(M, v[0:3], M)
+    if first:
+        M.fill(0.0)
 
 
 def accelerations(plan: Plan, frame: LoadFrame, state: State, sparse: Sparse | None,
@@ -428,19 +464,18 @@ def accelerations(plan: Plan, frame: LoadFrame, state: State, sparse: Sparse | N
     `sparse` (forces, moments of the sparse path and reactions) is added per chunk.
     """
     sc = scratch(plan.block)
-    diag = plan.diagonal
+    mode = plan.mode
     for c, (s, e) in enumerate(plan.chunks):
-        L = e - s
-        q = _rows(state.quaternion, s, e, sc.q)
-        om = _rows(state.omega, s, e, sc.omega)
-        M, h, tmp = sc.v[2, :, :L], sc.v[3, :, :L], sc.row[:L]
+        qb, om, t, v, M, h, p, F, tmp = sc.views(e - s)
+        _load(state.quaternion, s, e, qb, 4)
+        w, u = qb[0], qb[1:6]
         a, wd = out[0:3, s:e], out[3:6, s:e]
-        moments(plan, frame, q, s, e, M, sc, None)
-        if frame.B_F is not None:  # body-frame forces: a += (W_R_B B_F) / m
-            F = sc.v[4, :, :L]
-            rotate(q[0], q[1:4], frame.B_F[:, s:e], F, sc.v[0, :, :L], tmp)
-            _mul(F, plan.inv_mass[s:e], out=F)
-            _add(frame.a_G[:, s:e], F, out=a)
+        M3 = M[0:3]
+        moments(plan, frame, w, u, s, e, M3, t, v, tmp)
+        if frame.B_F is not None:  # body-frame forces: a = a_G + (W_R_B B_F) / m
+            rotate(w, u, frame.B_F[:, s:e], F, t, tmp)
+            _mul(F[0:3], plan.inv_mass[s:e], F[0:3])
+            _add(frame.a_G[:, s:e], F[0:3], a)
         else:
             np.copyto(a, frame.a_G[:, s:e])
         if sparse is not None:
@@ -448,11 +483,14 @@ def accelerations(plan: Plan, frame: LoadFrame, state: State, sparse: Sparse | N
             if hi > lo:
                 b = sparse.bodies[lo:hi]
                 a[:, b - s] += sparse.W[:3, lo:hi] * plan.inv_mass[b]
-                M[:, b - s] += sparse.W[3:, lo:hi]
+                M3[:, b - s] += sparse.W[3:, lo:hi]
         # Euler: J ω̇ = B_M − ω × (J ω)
-        matvec(plan.J[:, s:e], om, h, tmp, diag)
-        cross_add(om, h, M, tmp, sign=-1.0)
-        matvec(plan.J_inv[:, s:e], M, wd, tmp, diag)
+        _load(state.omega, s, e, om, 3)
+        matvec(plan.J[:, s:e], om, h[0:3], p, tmp, mode)
+        roll(h)
+        cross_add(om, h, M3, tmp, sign=-1.0)
+        roll(M)
+        matvec(plan.J_inv[:, s:e], M, wd, p, tmp, mode)
     return out
 
 
@@ -461,19 +499,25 @@ def loads_and_gyroscopic(plan: Plan, frame: LoadFrame, state: State, sparse: Spa
     """Q (6, n) = [W_F; B_M] applied loads and b (3, n) = ω × (J ω) (skipped when b is
     None), chunk by chunk."""
     sc = scratch(plan.block)
-    diag = plan.diagonal
+    mode = plan.mode
     for c, (s, e) in enumerate(plan.chunks):
-        L = e - s
-        q = _rows(state.quaternion, s, e, sc.q)
-        M, F, h, tmp = Q[3:6, s:e], Q[0:3, s:e], sc.v[3, :, :L], sc.row[:L]
-        moments(plan, frame, q, s, e, M, sc, F)
+        qb, om, t, v, M, h, p, F, tmp = sc.views(e - s)
+        _load(state.quaternion, s, e, qb, 4)
+        w, u = qb[0], qb[1:6]
+        moments(plan, frame, w, u, s, e, Q[3:6, s:e], t, v, tmp)
+        if frame.B_F is not None:  # W_F = (world forces + m g) + W_R_B B_F
+            rotate(w, u, frame.B_F[:, s:e], F, t, tmp)
+            _add(frame.W_F[:, s:e], F[0:3], Q[0:3, s:e])
+        else:
+            np.copyto(Q[0:3, s:e], frame.W_F[:, s:e])
         if sparse is not None:
             lo, hi = sparse.bounds[c], sparse.bounds[c + 1]
             if hi > lo:
                 Q[:, sparse.bodies[lo:hi]] += sparse.W[:, lo:hi]
         if b is not None:
-            om = _rows(state.omega, s, e, sc.omega)
-            matvec(plan.J[:, s:e], om, h, tmp, diag)
+            _load(state.omega, s, e, om, 3)
+            matvec(plan.J[:, s:e], om, h[0:3], p, tmp, mode)
+            roll(h)
             cross(om, h, b[:, s:e], tmp)
 
 
@@ -481,22 +525,23 @@ def solve(plan: Plan, Q: np.ndarray, b: np.ndarray, extra: Sparse | None,
           out: np.ndarray) -> np.ndarray:
     """out (6, n) = [Q_F / m; J⁻¹ (Q_M − b)] plus the `extra` (reaction) wrenches."""
     sc = scratch(plan.block)
-    diag = plan.diagonal
+    mode = plan.mode
     for c, (s, e) in enumerate(plan.chunks):
-        L = e - s
-        M, tmp = sc.v[2, :, :L], sc.row[:L]
-        _sub(Q[3:6, s:e], b[:, s:e], out=M)
+        _, _, _, _, M, _, p, F, tmp = sc.views(e - s)
+        M3 = M[0:3]
+        _sub(Q[3:6, s:e], b[:, s:e], M3)
         a = out[0:3, s:e]
         if extra is not None:
-            F = sc.v[4, :, :L]
-            np.copyto(F, Q[0:3, s:e])
+            F3 = F[0:3]
+            np.copyto(F3, Q[0:3, s:e])
             lo, hi = extra.bounds[c], extra.bounds[c + 1]
             if hi > lo:
                 i = extra.bodies[lo:hi] - s
-                F[:, i] += extra.W[:3, lo:hi]
-                M[:, i] += extra.W[3:, lo:hi]
-            _mul(F, plan.inv_mass[s:e], out=a)
+                F3[:, i] += extra.W[:3, lo:hi]
+                M3[:, i] += extra.W[3:, lo:hi]
+            _mul(F3, plan.inv_mass[s:e], a)
         else:
-            _mul(Q[0:3, s:e], plan.inv_mass[s:e], out=a)
-        matvec(plan.J_inv[:, s:e], M, out[3:6, s:e], tmp, diag)
+            _mul(Q[0:3, s:e], plan.inv_mass[s:e], a)
+        roll(M)
+        matvec(plan.J_inv[:, s:e], M, out[3:6, s:e], p, tmp, mode)
     return out
