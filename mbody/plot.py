@@ -79,6 +79,9 @@ def plot_trajectory(traj: Trajectory, bodies: list[str] | None = None) -> Figure
     a.plot(t, T, label="kinetic T")
     if not np.allclose(E, T):
         a.plot(t, E, label="T + V")
+    # From zero: a conserved energy is a flat line, not rounding noise blown up.
+    lo, hi = min(0.0, float(T.min()), float(E.min())), max(float(T.max()), float(E.max()))
+    a.set_ylim(lo - 0.05 * (hi - lo + 1e-300), hi + 0.05 * (hi - lo) + 1e-300)
     a.set_title("energy")
     a.set_ylabel("J")
 

@@ -350,7 +350,7 @@ def summary(traj: Trajectory, path: str | os.PathLike[str] | None = None) -> str
         f"integrator {i['integrator']} (rtol {i['rtol']:g}, atol {i['atol']:g}): "
         f"{i['steps']} steps, {i['evaluations']} evaluations, {i['wall_time_s']:.3g} s",
     ]
-    what = "drift" if i["energy_conserved"] else "change (not conserved: loads do work)"
+    what = "drift" if i["energy_conserved"] else "change (not guaranteed: loads or reactions act)"
     lines.append(f"energy T + V: E(0) = {i['energy_initial']:.6g} J, relative {what} "
                  f"{i['energy_drift']:.2e}")
     what = "drift" if i["angular_momentum_conserved"] else \

@@ -38,7 +38,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                        "drift", description="Plot the angular-velocity components, kinetic "
                        "energy and angular momentum of a saved run over time, and their "
                        "relative drift, in one multi-panel figure.")
-    s.add_argument("run", metavar="RUN.npz", help="a trajectory saved by 'mbody simulate -o'")
+    s.add_argument("trajectory", metavar="RUN.npz", help="a trajectory saved by 'mbody simulate -o'")
     s.add_argument("-o", "--output", required=True, metavar="FILE",
                    help="the figure: .png, .pdf or .svg")
     s.add_argument("--body", action="append", default=None, metavar="NAME",
@@ -67,7 +67,7 @@ def plot(a: argparse.Namespace) -> int:
     from ..plot import save_plot
     from ..trajectory import Trajectory
 
-    traj = Trajectory.load(a.run)
+    traj = Trajectory.load(a.trajectory)
     save_plot(traj, a.output, a.body)
     print(f"wrote {a.output}")
     return EXIT_OK
