@@ -54,6 +54,8 @@ _REQUIRED_HINTS = {
 _ANGLE = re.compile(r"\s*([-+]?[0-9.eE+-]+)\s*(deg|rad)\s*")
 _RATE = re.compile(r"\s*([-+]?[0-9.eE+-]+)\s*(deg/s|rad/s)\s*")
 _TOL = 1e-6
+MAX_MAGNITUDE = 1e100
+"""Largest number accepted: squares and triple products must stay finite in float64."""
 
 
 @dataclass
@@ -120,6 +122,10 @@ class _Checker:
         self.issues: list[Issue] = []
         self.warnings: list[Issue] = []
         self.dim = cv.SPATIAL
+        self.body_names: dict[str, int] = {}
+        """Every body with a valid name, even one with other problems (for references)."""
+        self.joint_types: dict[str, str] = {}
+        """Every joint with a valid name and type, even one with other problems."""
 
     # -- reporting -------------------------------------------------------------------
     def err(self, path: Path_, message: str, hint: str = "", *, key: bool = False) -> None:
@@ -156,8 +162,13 @@ class _Checker:
         except OverflowError:  # an integer with hundreds of digits
             x = math.inf
         if not math.isfinite(x):
-            shown = value if isinstance(value, float) else f"an integer of {len(str(value))} digits"
+            shown = (value if isinstance(value, float)
+                     else f"an integer of {len(str(value))} digits")
             self.err(path, f"expected a finite number, got {shown}")
+            return None
+        if abs(x) > MAX_MAGNITUDE:
+            self.err(path, f"expected a number of magnitude at most {MAX_MAGNITUDE:g}, got "
+                     f"{x:g}", "products of such numbers (r x F, m r^2) would overflow")
             return None
         if positive and x <= 0:
             self.err(path, f"expected a number > 0, got {value}")
@@ -301,7 +312,8 @@ def validate(doc: Document) -> Spec:
         gravity = g if g is not None else gravity
 
     bodies = _bodies(c, data.get("bodies"))
-    names = {b.name: i for i, b in enumerate(bodies)}
+    # A body with a bad mass is still a body: references to it are not problems too.
+    names = c.body_names
     loads = _loads(c, data.get("loads"), names)
     joints = _joints(c, data.get("joints"), names, bodies)
     reaction_expressions: dict[str, Expression] = {}
@@ -328,7 +340,7 @@ def _list(c: _Checker, path: Path_, value: Any, what: str, required: bool) -> li
 
 def _bodies(c: _Checker, value: Any) -> list[BodySpec]:
     out: list[BodySpec] = []
-    seen: dict[str, int] = {}
+    seen: dict[str, int] = c.body_names
     for i, b in enumerate(_list(c, ("bodies",), value, "bodies", True)):
         p: Path_ = ("bodies", i)
         if not c.mapping(p, b, BODY_KEYS, ("name", "mass"), "a body mapping"):
@@ -663,7 +675,7 @@ def _joints(c: _Checker, value: Any, names: dict[str, int],
             seen[name] = i
         typ = None
         other = cv.JOINT_COMPONENTS[cv.PLANAR + cv.SPATIAL - c.dim]
-        if "type" in j and j["type"] in other and j["type"] not in types:
+        if isinstance(j.get("type"), str) and j["type"] in other and j["type"] not in types:
             here, there = ("planar", "spatial") if c.dim == cv.PLANAR else ("spatial", "planar")
             c.err((*p, "type"), f"'{j['type']}' is a {there} joint type; a {here} model "
                   f"(dimension: {c.dim}) has: {', '.join(types)}")
@@ -693,6 +705,8 @@ def _joints(c: _Checker, value: Any, names: dict[str, int],
                 axis2 = _axis(c, (*p, "axis2"), j["axis2"])
         elif typ == "universal":
             c.err(p, "a universal joint needs 'axis2' (the child's axis)")
+        if name is not None and typ is not None:
+            c.joint_types.setdefault(name, typ)
         if axis is not None and axis2 is not None and abs(float(axis @ axis2)) > 1e-6:
             c.err((*p, "axis2"), "a universal joint's axes must be perpendicular",
                   f"axis . axis2 = {float(axis @ axis2):.3g}")
@@ -722,7 +736,9 @@ def _reactions(c: _Checker, value: Any, joints: list[JointSpec],
         c.err(("reactions",), f"expected a mapping of reaction labels to values, got "
               f"{_kind(value)}")
         return {}
-    labels = [f"{j.name}.{k}" for j in joints for k in cv.JOINT_COMPONENTS[c.dim][j.type]]
+    # From every joint with a valid name and type, so that a joint with a bad point does
+    # not turn each of its known reactions into a second problem.
+    labels = [f"{n}.{k}" for n, t in c.joint_types.items() for k in cv.JOINT_COMPONENTS[c.dim][t]]
     out: dict[str, float] = {}
     for label, v in value.items():
         p: Path_ = ("reactions", label)

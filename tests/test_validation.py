@@ -795,3 +795,81 @@ def test_reaction_value_must_be_a_number(model_file):
 def test_reactions_must_be_a_mapping(model_file):
     text = PLANAR + PIN + "reactions: [A.Fx]\n"
     problem(model_file, text, "[A.Fx]", "reactions", "expected a mapping of reaction labels")
+
+
+# == No cascades: one mistake, one message ============================================
+
+def test_a_body_with_a_bad_field_can_still_be_referenced(model_file):
+    text = PLANAR.replace("mass: 10", "mass: -10") + PIN + SPRING
+    problem(model_file, text, "-10", "bodies[0].mass", "expected a number > 0")
+
+
+def test_a_joint_with_a_bad_point_keeps_its_reaction_labels(model_file):
+    text = PLANAR + PIN.replace("at: [0, 0]", "at: [0, x]") + "reactions: {A.Fx: 1}\n"
+    problem(model_file, text, "x]", "joints[0].at[1]", "expected a number, got the text 'x'")
+
+
+def test_an_invalid_dimension_stops_before_vector_checks(model_file):
+    text = PLANAR.replace("dimension: 2", "dimension: 5") + "gravity: [0, -9.81]\n"
+    problem(model_file, text, "5", "dimension", "expected 2 (planar) or 3 (spatial), got the "
+            "number 5")
+
+
+@pytest.mark.parametrize("value", ["[revolute]", "{a: 1}", "3"])
+def test_joint_type_that_is_not_text(model_file, value):
+    text = PLANAR + PIN.replace("type: revolute", f"type: {value}")
+    problem(model_file, text, value, "joints[0].type", "unknown planar joint type")
+
+
+def test_numbers_too_large_to_multiply(model_file):
+    text = PLANAR + "    position: [1e200, 0]\n"
+    i = problem(model_file, text, "1e200", "bodies[0].position[0]",
+                "expected a number of magnitude at most 1e+100, got 1e+200")
+    assert "overflow" in i.hint
+
+
+# == Any damage to a shipped model: a ModelError, never another exception ==============
+
+MODELS = Path(__file__).resolve().parent.parent / "models"
+_JUNK = [None, True, "x", -1, 0, [], {}, [1, 2], [1, 2, 3], [0, 0, 0, 0], {"a": 1},
+         math.nan, "30 deg", 1e300, "ground", [[1, 0], [0, 1]], "revolute", "DELETE"]
+
+
+def _paths(x, p=()):
+    yield p
+    items = x.items() if isinstance(x, dict) else enumerate(x) if isinstance(x, list) else ()
+    for k, v in items:
+        yield from _paths(v, (*p, k))
+
+
+def test_damaged_models_raise_model_error_only():
+    import copy
+    import random
+
+    import yaml
+
+    rng = random.Random(20240)
+    cases = []
+    for f in sorted(MODELS.glob("*.yaml")):
+        base = yaml.safe_load(f.read_text())
+        cases += [(f.name, base, p, v) for p in _paths(base) if p for v in _JUNK]
+    refused = 0
+    for name, base, p, v in rng.sample(cases, min(len(cases), 3000)):
+        d = copy.deepcopy(base)
+        parent = d
+        for k in p[:-1]:
+            parent = parent[k]
+        if v == "DELETE":
+            del parent[p[-1]]
+        else:
+            parent[p[-1]] = copy.deepcopy(v)
+        try:
+            model = mbody.load(d)
+        except ModelError as exc:
+            refused += 1
+            assert exc.issues and all(i.message for i in exc.issues)
+            continue
+        except Exception as exc:  # pragma: no cover - the failure message is the point
+            pytest.fail(f"{name}: setting {p} to {v!r} raised {type(exc).__name__}: {exc}")
+        mbody.assemble(model)  # a model that loads must assemble
+    assert refused > 1000  # most damage is caught: the sample is not all harmless
