@@ -30,7 +30,7 @@ def _energy_momentum(traj: Trajectory) -> tuple[np.ndarray, np.ndarray, np.ndarr
     """(T, E, H, momentum label), from the run's series when present."""
     s = traj.series
     T = s["kinetic_energy"] if "kinetic_energy" in s else traj.kinetic_energy()
-    E = s["energy"] if "energy" in s else T
+    E = s.get("energy", T)
     if "angular_momentum" in s:
         H = s["angular_momentum"]
         kind = traj.info.get("angular_momentum_kind", "about the world origin")

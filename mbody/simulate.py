@@ -219,7 +219,8 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     try:
         import scipy.integrate
 
-        solver = getattr(scipy.integrate, method)(rhs, 0.0, y0, t_end, rtol=rtol, atol=atol, max_step=max_step)
+        solver = getattr(scipy.integrate, method)(rhs, 0.0, y0, t_end, rtol=rtol, atol=atol,
+                                                  max_step=max_step)
         while solver.status == "running":
             msg = solver.step()
             if solver.status == "failed" or not np.all(np.isfinite(solver.y)):

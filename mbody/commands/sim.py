@@ -38,7 +38,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                        "drift", description="Plot the angular-velocity components, kinetic "
                        "energy and angular momentum of a saved run over time, and their "
                        "relative drift, in one multi-panel figure.")
-    s.add_argument("trajectory", metavar="RUN.npz", help="a trajectory saved by 'mbody simulate -o'")
+    s.add_argument("trajectory", metavar="RUN.npz",
+                   help="a trajectory saved by 'mbody simulate -o'")
     s.add_argument("-o", "--output", required=True, metavar="FILE",
                    help="the figure: .png, .pdf or .svg")
     s.add_argument("--body", action="append", default=None, metavar="NAME",

@@ -1,0 +1,258 @@
+"""Simulation against closed forms: torque-free bodies, time-varying loads, spring-damper."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.special import ellipj, ellipkinc
+
+import mbody
+from mbody.cli import main
+from mbody.spatial import quat_to_matrix
+
+MODELS = Path(__file__).resolve().parent.parent / "models"
+
+
+def _model(name: str) -> mbody.Model:
+    return mbody.load(MODELS / f"{name}.yaml")
+
+
+def test_intermediate_axis_matches_jacobi_elliptic_solution():
+    """Torque-free asymmetric body, I1 < I2 < I3, with M² > 2 E I2 (Landau & Lifshitz,
+    Mechanics, §37, eq. 37.10):
+
+        ω1 = sqrt((2E I3 − M²) / (I1 (I3 − I1))) cn τ
+        ω2 = sqrt((2E I3 − M²) / (I2 (I3 − I2))) sn τ
+        ω3 = sqrt((M² − 2E I1) / (I3 (I3 − I1))) dn τ
+        τ = t sqrt((I3 − I2)(M² − 2E I1) / (I1 I2 I3)),
+        k² = (I2 − I1)(2E I3 − M²) / ((I3 − I2)(M² − 2E I1)),
+
+    shifted by τ0 = F(φ0 | k²), φ0 = atan2(sn, cn) at t = 0, to match the initial ω.
+    """
+    model = _model("intermediate_axis_flip")
+    I1, I2, I3 = np.diag(model.J[0])
+    w0 = model.initial.omega[0]
+    E2 = float(np.sum(np.array([I1, I2, I3]) * w0**2))  # 2E
+    M2 = float(np.sum((np.array([I1, I2, I3]) * w0) ** 2))
+    assert I1 < I2 < I3 and M2 > E2 * I2  # the case of the formula
+    A1 = np.sqrt((E2 * I3 - M2) / (I1 * (I3 - I1)))
+    A2 = np.sqrt((E2 * I3 - M2) / (I2 * (I3 - I2)))
+    A3 = np.sqrt((M2 - E2 * I1) / (I3 * (I3 - I1)))
+    rate = np.sqrt((I3 - I2) * (M2 - E2 * I1) / (I1 * I2 * I3))
+    m = (I2 - I1) * (E2 * I3 - M2) / ((I3 - I2) * (M2 - E2 * I1))
+    tau0 = ellipkinc(np.arctan2(w0[1] / A2, w0[0] / A1), m)
+
+    traj = mbody.simulate(model, t_end=10.0, fps=30)
+    sn, cn, dn, _ = ellipj(tau0 + rate * traj.t, m)
+    exact = np.stack((A1 * cn, A2 * sn, A3 * dn), axis=1)
+    w = traj.angular_velocity[:, 0]
+    assert np.abs(exact[0] - w0).max() < 1e-10  # the phase really matches the start
+    assert np.sign(w[:, 1]).min() < 0  # it flipped within the run
+    np.testing.assert_allclose(w, exact, rtol=0, atol=1e-7 * np.abs(w0).max())
+
+
+def test_symmetric_top_torque_free_precession():
+    """I1 = I2: ω1 + i ω2 = a e^{iλt}, λ = (I3 − I1) ω3 / I1 (the body cone, body axes);
+    the symmetry axis cones around the fixed H at |H| / I1 (the space cone), at the
+    constant half-angle atan(I1 a / (I3 ω3))."""
+    model = _model("torque_free_symmetric")
+    I1, _, I3 = np.diag(model.J[0])
+    a, _, w3 = model.initial.omega[0]
+    lam = (I3 - I1) * w3 / I1
+    traj = mbody.simulate(model, t_end=20.0, fps=20)
+    t, w = traj.t, traj.angular_velocity[:, 0]
+    np.testing.assert_allclose(w[:, 0], a * np.cos(lam * t), atol=1e-9)
+    np.testing.assert_allclose(w[:, 1], a * np.sin(lam * t), atol=1e-9)
+    np.testing.assert_allclose(w[:, 2], w3, atol=1e-9)
+
+    H = traj.angular_momentum()[0]
+    h = H / np.linalg.norm(H)
+    e3 = quat_to_matrix(traj.orientation[:, 0])[:, :, 2]  # symmetry axis, world
+    np.testing.assert_allclose(np.degrees(np.arccos(e3 @ h)),
+                               np.degrees(np.arctan2(I1 * a, I3 * w3)), atol=1e-7)
+    # Azimuth of the axis about H: it must grow at |H| / I1.
+    u = np.cross(h, [1.0, 0, 0])
+    u /= np.linalg.norm(u)
+    v = np.cross(h, u)
+    phi = np.unwrap(np.arctan2(e3 @ v, e3 @ u))
+    rate = np.linalg.norm(H) / I1
+    np.testing.assert_allclose(phi - phi[0], rate * t, atol=1e-7)
+    assert rate == pytest.approx(3.00167, abs=1e-5)  # the number in the model's comment
+
+
+@pytest.mark.parametrize("name", ["torque_free_asymmetric", "torque_free_symmetric",
+                                  "intermediate_axis_flip"])
+def test_torque_free_drift_over_100_s(name):
+    traj = mbody.simulate(_model(name), t_end=100.0, fps=10)
+    info = traj.info
+    assert info["energy_conserved"] and info["angular_momentum_conserved"]
+    assert info["energy_drift"] < 1e-8
+    assert info["angular_momentum_drift"] < 1e-8
+    # Recompute independently of the reported figures.
+    T = traj.kinetic_energy()
+    H = traj.angular_momentum()
+    assert np.abs(T / T[0] - 1).max() < 1e-8
+    assert np.linalg.norm(H - H[0], axis=1).max() / np.linalg.norm(H[0]) < 1e-8
+    # Unit quaternions at every output sample.
+    np.testing.assert_allclose(np.linalg.norm(traj.orientation, axis=2), 1.0, atol=1e-15)
+
+
+def test_planar_body_under_time_varying_force_matches_its_integral():
+    """F_x = 50 sin 2t at G, couple 0.5 cos 3t, gravity; m = 2, I_G = 0.1, v0 = (1, 0.5):
+    x = t + 12.5 t − 6.25 sin 2t, y = 0.5 t − 9.81 t²/2, θ = (5/9)(1 − cos 3t)."""
+    traj = mbody.simulate(_model("planar_time_varying_force"), t_end=4.0, fps=25)
+    t = traj.t
+    np.testing.assert_allclose(traj.position[:, 0, 0], t + 12.5 * t - 6.25 * np.sin(2 * t),
+                               atol=1e-8)
+    np.testing.assert_allclose(traj.position[:, 0, 1], 0.5 * t - 9.81 * t**2 / 2, atol=1e-8)
+    np.testing.assert_allclose(traj.orientation[:, 0], 5 / 9 * (1 - np.cos(3 * t)), atol=1e-9)
+    np.testing.assert_allclose(traj.angular_velocity[:, 0], 5 / 3 * np.sin(3 * t), atol=1e-9)
+    np.testing.assert_allclose(traj.velocity[:, 0, 0], 1 + 12.5 * (1 - np.cos(2 * t)),
+                               atol=1e-8)
+    assert traj.position[25, 0, 0] == pytest.approx(7.81689108, abs=1e-8)  # model comment
+
+
+def test_spinning_satellite_with_decaying_thrust_and_spin_up_couple():
+    """Body-frame loads along the spin axis of a symmetric body: v_z = 2.4 (1 − e^{−t/4}),
+    z = 2.4 (t − 4 (1 − e^{−t/4})), ω3 = 2 + (1/30)(t/2 − sin(2at)/(4a)), a = π/10."""
+    traj = mbody.simulate(_model("satellite_thruster"), t_end=10.0, fps=10)
+    t = traj.t
+    a = np.pi / 10
+    np.testing.assert_allclose(traj.velocity[:, 0, 2], 2.4 * (1 - np.exp(-t / 4)), atol=1e-9)
+    np.testing.assert_allclose(traj.position[:, 0, 2], 2.4 * (t - 4 * (1 - np.exp(-t / 4))),
+                               atol=1e-8)
+    np.testing.assert_allclose(traj.angular_velocity[:, 0, 2],
+                               2 + (t / 2 - np.sin(2 * a * t) / (4 * a)) / 30, atol=1e-9)
+    np.testing.assert_allclose(traj.position[:, 0, :2], 0.0, atol=1e-9)
+    # The spin axis stays along world z: the rotation is about z by ∫ω3 dt.
+    R = quat_to_matrix(traj.orientation[:, 0])
+    np.testing.assert_allclose(R[:, :, 2], np.tile([0, 0, 1.0], (len(t), 1)), atol=1e-9)
+
+
+def test_spring_mass_damper_matches_damped_oscillator():
+    """m ü + c u̇ + k u = 0 about the static sag: u = e^{−ζωt}(u0 cos ω_d t +
+    (u̇0 + ζω u0)/ω_d sin ω_d t), ω = sqrt(k/m) = 20, ζ = c / (2 sqrt(k m)) = 0.1."""
+    model = _model("spring_mass_damper")
+    m, k, c, L0, g = 2.0, 800.0, 8.0, 0.5, 9.81
+    y_eq = -(L0 + m * g / k) - 0.05  # the spring ends 0.05 m above the mass centre
+    u0, du0 = -0.6 - y_eq, 0.2
+    wn = np.sqrt(k / m)
+    zeta = c / (2 * np.sqrt(k * m))
+    wd = wn * np.sqrt(1 - zeta**2)
+    traj = mbody.simulate(model, t_end=3.0, fps=100)
+    t = traj.t
+    u = np.exp(-zeta * wn * t) * (u0 * np.cos(wd * t)
+                                  + (du0 + zeta * wn * u0) / wd * np.sin(wd * t))
+    np.testing.assert_allclose(traj.position[:, 0, 1] - y_eq, u, atol=1e-10)
+    np.testing.assert_allclose(traj.position[:, 0, 0], 0.0, atol=1e-12)
+    np.testing.assert_allclose(traj.orientation[:, 0], 0.0, atol=1e-12)
+    # Damped: energy falls, by exactly what the damper dissipated (c ∫ u̇² dt, > 0).
+    E = traj.series["energy"]
+    assert E[-1] < E[0] and not traj.info["energy_conserved"]
+
+
+def test_undamped_spring_conserves_energy():
+    text = (MODELS / "spring_mass_damper.yaml").read_text().replace(
+        "damping: 8 ", "damping: 0 ")
+    model = mbody.loads(text)
+    assert model.springs.damping[0] == 0
+    traj = mbody.simulate(model, t_end=5.0, fps=50)
+    assert traj.info["energy_conserved"]
+    assert traj.info["energy_drift"] < 1e-9
+    V = traj.series["potential_energy"]
+    assert V.max() - V.min() > 0.1  # the spring and gravity potentials really change
+
+
+def test_rotor_precesses_on_its_known_bearing_reactions():
+    """Steady precession: the shaft turns about z at Ω = 0.2 rad/s, horizontal, the mass
+    centre at rest, the spin component ω3 = 200 rad/s constant (model comment)."""
+    model = _model("rotor_gyroscopic_bearings")
+    traj = mbody.simulate(model, t_end=0.5, fps=20)
+    t = traj.t
+    shaft = quat_to_matrix(traj.orientation[:, 0])[:, :, 2]
+    expected = np.stack((np.cos(0.2 * t), np.sin(0.2 * t), 0 * t), axis=1)
+    np.testing.assert_allclose(shaft, expected, atol=1e-10)
+    np.testing.assert_allclose(traj.position[:, 0], 0.0, atol=1e-10)
+    np.testing.assert_allclose(traj.angular_velocity[:, 0, 2], 200.0, rtol=1e-12)
+    np.testing.assert_allclose(np.linalg.norm(traj.angular_velocity[:, 0, :2], axis=1), 0.2,
+                               rtol=1e-9)
+    assert traj.reaction_labels == tuple(model.reactions)
+    np.testing.assert_allclose(traj.reactions[:, 2], 130.1)
+
+
+def test_known_reaction_as_expression_of_time():
+    """A body pushed by a known reaction A.Fx = 3 t (N): x = t³ / (2 m), m = 0.5."""
+    model = mbody.loads("""
+dimension: 3
+bodies: [{name: b, mass: 0.5, inertia: [1, 1, 1]}]
+joints: [{name: A, type: spherical, parent: ground, child: b, at: [0, 0, 0]}]
+reactions: {A.Fx: "3*t", A.Fy: 0, A.Fz: 0}
+""")
+    traj = mbody.simulate(model, t_end=2.0, fps=10)
+    np.testing.assert_allclose(traj.position[:, 0, 0], traj.t**3, atol=1e-10)
+    np.testing.assert_allclose(traj.reactions[:, 0], 3 * traj.t)
+    # The API's `known` overrides the file: a constant 1 N gives x = t².
+    traj = mbody.simulate(model, t_end=2.0, fps=10, known={"A.Fx": 1.0})
+    np.testing.assert_allclose(traj.position[:, 0, 0], traj.t**2, atol=1e-10)
+
+
+def test_unknown_reactions_are_refused():
+    with pytest.raises(mbody.UnknownReactionsError, match="O.Fx"):
+        mbody.simulate(_model("pendulum"), t_end=1.0)
+
+
+def test_pluggable_dynamics_and_samples():
+    model = _model("seed_example_2")
+    calls = []
+
+    def f(model, state):  # constant angular acceleration about body 3, no rotation rates
+        calls.append(state.t)
+        out = np.zeros((model.n, 6))
+        out[:, 5] = 2.0
+        return out
+
+    traj = mbody.simulate(model, t_end=1.0, fps=4, dynamics=f)
+    np.testing.assert_allclose(traj.t, [0, 0.25, 0.5, 0.75, 1.0])
+    np.testing.assert_allclose(traj.angular_velocity[:, 0, 2], 3 + 2 * traj.t, atol=1e-12)
+    assert len(calls) == traj.info["evaluations"] > 0
+    assert not traj.info["energy_conserved"]  # foreign dynamics: nothing is promised
+
+
+def test_fast_planar_wheel_keeps_its_turns():
+    """θ is integrated, not read back from the quaternion: a wheel at 100 rad/s sampled
+    at 10 fps (10 rad per frame) still reports θ = 100 t."""
+    model = mbody.loads("""
+dimension: 2
+bodies: [{name: w, mass: 1, inertia: 0.1, angular_velocity: 100}]
+""")
+    traj = mbody.simulate(model, t_end=1.0, fps=10)
+    np.testing.assert_allclose(traj.orientation[:, 0], 100 * traj.t, atol=1e-9)
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"t_end": -1}, "t_end"), ({"fps": 0}, "fps"), ({"rtol": 0}, "rtol"),
+    ({"method": "dop853"}, "DOP853"),
+])
+def test_bad_arguments(kwargs, match):
+    with pytest.raises(mbody.MbodyError, match=match):
+        mbody.simulate(_model("seed_example_2"), **kwargs)
+
+
+def test_cli_simulate_and_plot(tmp_path, capsys):
+    run = tmp_path / "run.npz"
+    assert main(["simulate", str(MODELS / "torque_free_asymmetric.yaml"), "--t-end", "2",
+                 "--fps", "30", "-o", str(run)]) == 0
+    out = capsys.readouterr().out
+    assert "61 samples" in out and "relative drift" in out and f"wrote {run}" in out
+    traj = mbody.Trajectory.load(run)
+    assert traj.t[-1] == 2.0 and traj.body_names == ("block",)
+    png = tmp_path / "run.png"
+    assert main(["plot", str(run), "-o", str(png)]) == 0
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 20_000
+    assert main(["simulate", str(MODELS / "pendulum.yaml")]) == 1
+    assert "O.Fx" in capsys.readouterr().err
+    assert main(["simulate", str(MODELS / "seed_example_2.yaml"), "--fps", "-3"]) == 2
+    err = capsys.readouterr().err
+    assert "fps" in err and "Traceback" not in err
