@@ -236,7 +236,8 @@ class Assembly:
         acc6, lam_U = system.solve_refined(r6, g_U)
         lam[unknown] = lam_U
         labels = self.reactions
-        solved = tuple(labels[i] for i in system.U)
+        solved = (tuple(labels) if len(system.U) == len(labels)
+                  else tuple(map(labels.__getitem__, system.U.tolist())))
         return Solution(self.coordinates, _select(model, acc6),
                         dict(zip(labels, lam.tolist(), strict=True)), solved,
                         tuple(solved[k] for k in system.fact.redundant if k >= 0),

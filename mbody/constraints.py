@@ -85,35 +85,43 @@ def phi(model: Model, state: State, R: np.ndarray | None = None) -> np.ndarray:
 
 def gamma(model: Model, state: State, cols: ReactionColumns,
           R: np.ndarray | None = None) -> np.ndarray:
-    """(m,) γ = −Ġᵀ v: the right-hand side of Gᵀ v̇ = γ (see module doc)."""
-    R = state.W_R_B if R is None else R
+    """(m,) γ = −Ġᵀ v: the right-hand side of Gᵀ v̇ = γ (see module doc).
+
+    Per joint, with D = V_c(P) − V_p(P): force components γ = −e · (D × ω_p + A),
+    A = ω_c × (ω_c × ρ_c) − ω_p × ṡ; moment components γ = −e · (ω_c × ω_p).
+    """
     t = model.reaction_table
+    jt = model.joint_table
     m = len(t.labels)
     if m == 0:
         return np.zeros(0)
-    Rp, x_p, v_p, w_p = _parent(model, state, R)
-    c = t.child
-    Rc = R[c]
+    on_p = jt.parent >= 0
+    p = np.where(on_p, jt.parent, 0)
+    Rp, Rc = cols.joint_Rp, cols.joint_Rc
+    c = jt.child
     w_c = matvec(Rc, state.omega[c])
-    e = cols.W_e
-    out = np.empty(m)
-    f = t.rot_kind == 0
-    rho = cols.W_P[f] - state.position[c[f]]
-    V_c = state.velocity[c[f]] + cross(w_c[f], rho)
-    s = cols.W_P[f] - x_p[f]
-    V_p = v_p[f] + cross(w_p[f], s)
-    s_dot = V_c - v_p[f]
-    out[f] = -(np.einsum("ij,ij->i", cross(w_p[f], e[f]), V_c - V_p)
-               + np.einsum("ij,ij->i", e[f],
-                           cross(w_c[f], cross(w_c[f], rho)) - cross(w_p[f], s_dot)))
-    mom = (t.rot_kind == 1) | (t.rot_kind == 2)
-    out[mom] = -np.einsum("ij,ij->i", cross(w_p[mom], e[mom]), w_c[mom] - w_p[mom])
-    uni = t.rot_kind == 3
+    w_p = matvec(Rp, state.omega[p])
+    v_p = state.velocity[p]
+    x_p = state.position[p]
+    w_p[~on_p] = 0.0
+    v_p[~on_p] = 0.0
+    x_p[~on_p] = 0.0
+    P = cols.joint_W_P
+    rho = P - state.position[c]
+    V_c = state.velocity[c] + cross(w_c, rho)
+    D = V_c - v_p - cross(w_p, P - x_p)
+    T = cross(D, w_p) + cross(w_c, cross(w_c, rho)) - cross(w_p, V_c - v_p)
+    U = cross(w_c, w_p)
+    j = t.joint
+    TU = np.where((t.axis >= 3)[:, None], U[j], T[j])
+    out = -np.einsum("ij,ij->i", cols.W_e, TU)
+    uni = t.axis == 6
     if uni.any():
-        a = matvec(Rp[uni], t.P_E[uni])
-        b = matvec(Rc[uni], t.C_axis2[uni])
-        e_dot = cross(cross(w_p[uni], a), b) + cross(a, cross(w_c[uni], b))
-        out[uni] = -np.einsum("ij,ij->i", e_dot, w_c[uni] - w_p[uni])
+        ju = j[uni]
+        a = matvec(Rp[ju], jt.P_E3[ju, :, 2])
+        b = matvec(Rc[ju], jt.C_axis2[ju])
+        e_dot = cross(cross(w_p[ju], a), b) + cross(a, cross(w_c[ju], b))
+        out[uni] = -np.einsum("ij,ij->i", e_dot, w_c[ju] - w_p[ju])
     return out
 
 

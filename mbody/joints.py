@@ -33,6 +33,8 @@ class ReactionColumns:
     W_e: (m, 3) its direction, world axes. W_P: (m, 3) joint point, world.
     child6, parent6: (m, 6) the column's entries in the child's and parent's six rows
     (parent entries are zero for ground). is_moment: (m,) bool.
+    Per joint (J): joint_W_P (J, 3) joint points; joint_Rp, joint_Rc (J, 3, 3) the
+    parent's (identity for ground) and child's W_R_B.
     """
 
     W_e: np.ndarray
@@ -40,43 +42,66 @@ class ReactionColumns:
     child6: np.ndarray
     parent6: np.ndarray
     is_moment: np.ndarray
+    joint_W_P: np.ndarray
+    joint_Rp: np.ndarray
+    joint_Rc: np.ndarray
+
+
+def joint_parents(model: Model, R: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per joint: (has a body parent (J,), parent index with ground -> 0, W_R_B of the
+    parent with the identity for ground (J, 3, 3))."""
+    jt = model.joint_table
+    on_p = jt.parent >= 0
+    p = np.where(on_p, jt.parent, 0)
+    Rp = R[p]
+    if not on_p.all():
+        Rp[~on_p] = np.eye(3)
+    return on_p, p, Rp
 
 
 def reaction_columns(model: Model, state: State, R: np.ndarray | None = None) -> ReactionColumns:
     R = state.W_R_B if R is None else R
     t = model.reaction_table
+    jt = model.joint_table
     m = len(t.labels)
     if m == 0:
-        z = np.zeros((0, 3))
-        return ReactionColumns(z, z, np.zeros((0, 6)), np.zeros((0, 6)), np.zeros(0, bool))
-    on_p = t.parent >= 0
-    p = np.where(on_p, t.parent, 0)
-    c = t.child
-    Rp = np.where(on_p[:, None, None], R[p], np.eye(3))
-    Rc = R[c]
-    W_e = matvec(Rp, t.P_E)
+        z, z3 = np.zeros((0, 3)), np.zeros((0, 3, 3))
+        return ReactionColumns(z, z, np.zeros((0, 6)), np.zeros((0, 6)), np.zeros(0, bool),
+                               z, z3, z3)
+    # Per joint: its frame in world axes and in the child's axes, and the joint point.
+    on_p, p, Rp = joint_parents(model, R)
+    Rc = R[jt.child]
+    W_E = Rp @ jt.P_E3
+    B_E_c = np.swapaxes(Rc, 1, 2) @ W_E
+    P = state.position[jt.child] + matvec(Rc, jt.B_r_child)
+    x_p = state.position[p]
+    x_p[~on_p] = 0.0
+    B_r_p = rmatvec(Rp, P - x_p)  # the parent's material point at P, parent axes
+
+    # Per component: pick its axis of the joint frame.
+    j, k = t.joint, t.axis % 3
+    W_e = W_E[j, :, k]
+    B_e_c = B_E_c[j, :, k]
+    B_e_p = jt.P_E3[j, :, k]
     universal = t.axis == 6
     if universal.any():
-        W_a2 = matvec(Rc[universal], t.C_axis2[universal])
-        e = cross(W_e[universal], W_a2)
-        W_e[universal] = e / np.linalg.norm(e, axis=1, keepdims=True)
-    W_P = state.position[c] + matvec(Rc, t.B_r_child)
-    is_moment = t.axis >= 3
-
-    B_e_c = rmatvec(Rc, W_e)
-    B_e_p = rmatvec(Rp, W_e)
-    B_r_p = rmatvec(Rp, W_P - np.where(on_p[:, None], state.position[p], 0.0))
-    child6 = np.zeros((m, 6))
-    parent6 = np.zeros((m, 6))
-    f = ~is_moment
-    child6[f, :3] = W_e[f]
-    child6[f, 3:] = cross(t.B_r_child[f], B_e_c[f])
-    child6[is_moment, 3:] = B_e_c[is_moment]
-    parent6[f, :3] = -W_e[f]
-    parent6[f, 3:] = -cross(B_r_p[f], B_e_p[f])
-    parent6[is_moment, 3:] = -B_e_p[is_moment]
-    parent6[~on_p] = 0.0
-    return ReactionColumns(W_e, W_P, child6, parent6, is_moment)
+        ju = j[universal]
+        a = W_E[ju, :, 2]
+        b = matvec(Rc[ju], jt.C_axis2[ju])
+        e = cross(a, b)
+        e /= np.linalg.norm(e, axis=1, keepdims=True)
+        W_e[universal] = e
+        B_e_c[universal] = rmatvec(Rc[ju], e)
+        B_e_p[universal] = rmatvec(Rp[ju], e)
+    is_moment = (t.axis >= 3)[:, None]
+    child6 = np.empty((m, 6))
+    parent6 = np.empty((m, 6))
+    child6[:, :3] = np.where(is_moment, 0.0, W_e)
+    child6[:, 3:] = np.where(is_moment, B_e_c, cross(jt.B_r_child[j], B_e_c))
+    parent6[:, :3] = -child6[:, :3]
+    parent6[:, 3:] = -np.where(is_moment, B_e_p, cross(B_r_p[j], B_e_p))
+    parent6[~on_p[j]] = 0.0
+    return ReactionColumns(W_e, P[j], child6, parent6, is_moment[:, 0], P, Rp, Rc)
 
 
 def g_matrix(model: Model, cols: ReactionColumns) -> sp.csc_matrix:
@@ -109,9 +134,12 @@ def reaction_wrench(model: Model, cols: ReactionColumns, lam: np.ndarray) -> np.
     """(n, 6) what reactions with values `lam` (m,) put into every body's six rows."""
     t = model.reaction_table
     out = np.zeros((model.n, 6))
-    if len(lam) == 0:
+    nz = np.flatnonzero(lam)
+    if len(nz) == 0:
         return out
-    np.add.at(out, t.child, cols.child6 * lam[:, None])
-    on_p = t.parent >= 0
-    np.add.at(out, t.parent[on_p], cols.parent6[on_p] * lam[on_p, None])
+    for body, six in ((t.child[nz], cols.child6[nz]), (t.parent[nz], cols.parent6[nz])):
+        keep = body >= 0
+        w = six[keep] * lam[nz][keep, None]
+        for r in range(6):  # six rows, not a loop over bodies
+            out[:, r] += np.bincount(body[keep], w[:, r], minlength=model.n)
     return out

@@ -43,6 +43,37 @@ def block_solve(model: Model, body: np.ndarray, g6: np.ndarray) -> np.ndarray:
     return out
 
 
+def _g_and_minv_g(model: Model, parent: np.ndarray, child: np.ndarray, child6: np.ndarray,
+                  parent6: np.ndarray) -> tuple[sp.csc_matrix, sp.csc_matrix]:
+    """G_U and M⁻¹ G_U (6n x mu) built straight in CSC form: each column holds 6 rows of
+    its child and 6 of its parent (none for ground), lower body index first, so the
+    indices come out sorted without any conversion or sort."""
+    mu = len(child)
+    k = np.arange(6)
+    on_p = parent >= 0
+    lo = np.where(on_p, np.minimum(parent, child), child)
+    hi = np.maximum(parent, child)
+    child_first = ~on_p | (child < parent)
+    rows = np.empty((mu, 12), dtype=np.int64)
+    rows[:, :6] = lo[:, None] * 6 + k
+    rows[:, 6:] = hi[:, None] * 6 + k
+    h_c = block_solve(model, child, child6)
+    h_p = block_solve(model, np.where(on_p, parent, 0), parent6)
+    cf = child_first[:, None]
+    g = np.concatenate((np.where(cf, child6, parent6), np.where(cf, parent6, child6)), axis=1)
+    h = np.concatenate((np.where(cf, h_c, h_p), np.where(cf, h_p, h_c)), axis=1)
+    keep = np.ones((mu, 12), dtype=bool)
+    keep[:, 6:] = on_p[:, None]
+    indptr = np.zeros(mu + 1, dtype=np.int64)
+    np.cumsum(np.where(on_p, 12, 6), out=indptr[1:])
+    shape = (6 * model.n, mu)
+    idx = rows[keep]
+    G = sp.csc_matrix((g[keep], idx, indptr), shape=shape)
+    H = sp.csc_matrix((h[keep], idx, indptr), shape=shape)
+    G.has_sorted_indices = H.has_sorted_indices = True
+    return G, H
+
+
 @dataclass
 class Factorisation:
     """S = G_Uᵀ M⁻¹ G_U factorised once; `solve(rhs)` applies (a generalised) S⁻¹."""
@@ -84,22 +115,8 @@ class ConstrainedSystem:
         self.unknown = np.asarray(unknown, dtype=bool)
         U = np.flatnonzero(self.unknown)
         self.U = U
-        mu = len(U)
-        n = model.n
-        on_p = t.parent[U] >= 0
-        # G_U (6n x mu) from each column's child and parent halves.
-        k = np.arange(6)
-        rows = np.concatenate(((t.child[U, None] * 6 + k).ravel(),
-                               (t.parent[U][on_p, None] * 6 + k).ravel()))
-        colidx = np.concatenate((np.repeat(np.arange(mu), 6),
-                                 np.repeat(np.arange(mu)[on_p], 6)))
-        g = np.concatenate((cols.child6[U].ravel(), cols.parent6[U][on_p].ravel()))
-        h = np.concatenate((block_solve(model, t.child[U], cols.child6[U]).ravel(),
-                            block_solve(model, t.parent[U][on_p],
-                                        cols.parent6[U][on_p]).ravel()))
-        shape = (6 * n, mu)
-        self.G = sp.csc_matrix((g, (rows, colidx)), shape=shape)
-        self.H = sp.csc_matrix((h, (rows, colidx)), shape=shape)  # M⁻¹ G_U
+        self.G, self.H = _g_and_minv_g(model, t.parent[U], t.child[U], cols.child6[U],
+                                       cols.parent6[U])
         self.fact = self._factorise((self.G.T @ self.H).tocsr())
 
     # -- factorisation -------------------------------------------------------------------

@@ -205,6 +205,26 @@ class ReactionTable:
     rot_kind: np.ndarray
 
 
+@dataclass(frozen=True)
+class JointTable:
+    """Per joint (J of them), what the reaction table repeats per component.
+
+    parent, child: (J,) body index (-1 = ground); B_r_child, B_r_parent: (J, 3) the joint
+    point in each body's axes (world for ground); P_E3, C_E3: (J, 3, 3) the joint frame
+    fixed in the parent and in the child; C_axis2: (J, 3) a universal joint's child axis.
+    first: (J,) the joint's first column of G (its components are consecutive).
+    """
+
+    parent: np.ndarray
+    child: np.ndarray
+    B_r_child: np.ndarray
+    B_r_parent: np.ndarray
+    P_E3: np.ndarray
+    C_E3: np.ndarray
+    C_axis2: np.ndarray
+    first: np.ndarray
+
+
 @dataclass(frozen=True, eq=False)
 class Model:
     """A validated multibody model: bodies, applied loads and joints, as arrays.
@@ -259,6 +279,14 @@ class Model:
     def reactions(self) -> list[str]:
         """Reaction labels, the column order of G (do not modify the list)."""
         return list(self.reaction_table.labels)
+
+    @cached_property
+    def joint_table(self) -> JointTable:
+        t = self.reaction_table
+        first = np.unique(t.joint, return_index=True)[1] if len(t.joint) else np.zeros(0, int)
+        return JointTable(t.parent[first], t.child[first], t.B_r_child[first],
+                          t.B_r_parent[first], t.P_E3[first], t.C_E3[first],
+                          t.C_axis2[first], first)
 
     @cached_property
     def reaction_index(self) -> dict[str, int]:
