@@ -141,6 +141,7 @@ class _Outline:
     points: np.ndarray  # (k, 3)
     edges: list[tuple[np.ndarray, bool]] = field(default_factory=list)  # ((j, 3), visible)
     size: float = 1.0  # largest extent (m)
+    curved: bool = False  # its silhouette (the hull) is drawn as an edge
 
 
 def _circle(n: int = 72) -> np.ndarray:
@@ -202,24 +203,35 @@ def _outline(fbd: FreeBodyDiagram, eye: np.ndarray) -> _Outline:
         half = v["length"] / 2 if kind == "cylinder" else 0.04 * r
         ring = _circle() * r
         ends = [world(np.column_stack((ring, np.full(len(ring), z)))) for z in (-half, half)]
-        axis = R[:, 2]
-        edges = [(ends[1], True), (ends[0], float(-axis @ eye) > -1e-9 or kind == "disc")]
-        if kind == "disc":
-            edges = [(ends[1], True)]
-        return _Outline(np.vstack(ends), edges, float(max(2 * r, 2 * half)))
-    semi = [v["radius"]] * 3 if kind == "sphere" else list(v)
+        near = 1 if float(R[:, 2] @ eye) >= 0 else 0  # the end face looking at the eye
+        edges = [(ends[near], True)]
+        if kind == "cylinder":  # the far rim shows where the side wall faces the eye
+            W_radial = np.column_stack((ring, np.zeros(len(ring)))) @ R.T
+            edges += _runs(ends[1 - near], W_radial @ eye > 0)
+        return _Outline(np.vstack(ends), edges, float(max(2 * r, 2 * half)), curved=True)
+    semi = np.array([v["radius"]] * 3 if kind == "sphere" else list(v), dtype=float)
     ring = _circle()
-    rings = []
+    edges = []
     for i, j in ((0, 1), (1, 2), (0, 2)):
         B_p = np.zeros((len(ring), 3))
         B_p[:, i], B_p[:, j] = ring[:, 0] * semi[i], ring[:, 1] * semi[j]
-        rings.append(world(B_p))
+        W_normal = (B_p / semi**2) @ R.T  # the surface normal ∝ ∇(pᵀ A p)
+        edges += _runs(world(B_p), W_normal @ eye > 0)
     # the silhouette is the hull of points over the whole surface
     u, w = np.meshgrid(np.linspace(0, np.pi, 19), np.linspace(0, 2 * np.pi, 37))
     surf = np.column_stack(((np.sin(u) * np.cos(w)).ravel() * semi[0],
                             (np.sin(u) * np.sin(w)).ravel() * semi[1],
                             np.cos(u).ravel() * semi[2]))
-    return _Outline(world(surf), [(r_, True) for r_ in rings], float(2 * max(semi)))
+    return _Outline(world(surf), edges, float(2 * semi.max()), curved=True)
+
+
+def _runs(points: np.ndarray, visible: np.ndarray) -> list[tuple[np.ndarray, bool]]:
+    """Split a polyline into stretches that are all visible or all hidden."""
+    cuts = np.flatnonzero(visible[1:] != visible[:-1]) + 1
+    out = []
+    for a, b in zip(np.r_[0, cuts], np.r_[cuts, len(points)], strict=True):
+        out.append((points[a:min(b + 1, len(points))], bool(visible[a])))
+    return out
 
 
 # -- the picture's elements --------------------------------------------------------------
@@ -382,8 +394,11 @@ def draw_fbd(fbd, *, view: str | Sequence[float] | None = "iso", equations: bool
     hull = ConvexHull(hull_pts, qhull_options="QJ")
     ax.add_patch(Polygon(hull_pts[hull.vertices], closed=True, facecolor=BODY_FACE,
                          edgecolor="none", zorder=1, gid="body-outline"))
-    obstacles: list[tuple[np.ndarray, str]] = [(hull_pts[np.r_[hull.vertices,
-                                                               hull.vertices[0]]], "outline")]
+    rim = hull_pts[np.r_[hull.vertices, hull.vertices[0]]]
+    obstacles: list[tuple[np.ndarray, str]] = [(rim, "outline")]
+    if outline.curved:
+        ax.add_line(Line2D(rim[:, 0], rim[:, 1], color=BODY_EDGE, lw=1.3, zorder=2,
+                           gid="body-edge"))
     for pts, visible in outline.edges:
         pp = pts @ P.T
         ax.add_line(Line2D(pp[:, 0], pp[:, 1], color=BODY_EDGE, lw=1.3 if visible else 0.8,
@@ -651,10 +666,14 @@ def _layers(g, roots: list[str]) -> dict[str, tuple[float, float]]:
                         for nd in nodes}
                 nodes.sort(key=bary.__getitem__)
             for k, nd in enumerate(nodes):
-                xs[nd] = (k - (len(nodes) - 1) / 2) * 1.6
-                pos[nd] = (x0 + (width - 1) * 0.8 + xs[nd], -1.35 * dd)
-        x0 += width * 1.6 + 0.6
+                xs[nd] = (k - (len(nodes) - 1) / 2) * 2.4
+                pos[nd] = (x0 + (width - 1) * 1.2 + xs[nd], -1.7 * dd)
+        x0 += width * 2.4 + 0.6
     return pos
+
+
+def _count(k: int, word: str) -> str:
+    return f"{k} {word if k == 1 else word[:-1] + 'ies' if word.endswith('y') else word + 's'}"
 
 
 def draw_graph(model, topo=None) -> Figure:
@@ -669,21 +688,22 @@ def draw_graph(model, topo=None) -> Figure:
             roots.append(min(comp, key=lambda b: model.index[b]))
     pos = _layers(g, roots)
     xy = np.array(list(pos.values()))
-    lo, hi = xy.min(axis=0) - 1.0, xy.max(axis=0) + 1.0
-    w_in = float(np.clip((hi[0] - lo[0]) * 1.15, 5.0, 40.0))
-    h_in = float(np.clip((hi[1] - lo[1]) * 1.15 + 0.6, 3.0, 40.0))
+    lo, hi = xy.min(axis=0) - 0.9, xy.max(axis=0) + 0.9
+    w_in = float(np.clip((hi[0] - lo[0]) * 0.95, 6.5, 40.0))
+    h_in = float(np.clip((hi[1] - lo[1]) * 0.95 + 0.8, 3.0, 40.0))
     fig = Figure(figsize=(w_in, h_in), dpi=100)
     FigureCanvasAgg(fig)
-    ax = fig.add_axes((0.01, 0.01, 0.98, 1 - 0.6 / h_in - 0.01), gid="graph")
+    ax = fig.add_axes((0.01, 0.01, 0.98, 1 - 0.8 / h_in - 0.01), gid="graph")
     ax.set_axis_off()
     ax.set_aspect("equal", adjustable="box")
     _set_limits(ax, lo, hi)
-    head = (f"body/joint graph of {_tex_safe(model.name)}: {model.n} bodies + ground, "
-            f"{len(model.joints)} joints")
+    head = (f"body/joint graph of {_tex_safe(model.name)}: {_count(model.n, 'body')} + "
+            f"ground, {_count(len(model.joints), 'joint')}")
     if topo is not None:
-        head += (f"; {'tree' if topo.is_tree else f'{topo.loops} closed loop(s)'}, "
+        head += (f"; {'a tree' if topo.is_tree else _count(topo.loops, 'closed loop')}, "
                  f"mobility {topo.mobility}")
-    fig.text(0.5, 1 - 0.3 / h_in, head, ha="center", va="center", fontsize=11,
+    head = "\n".join(textwrap.wrap(head, int(w_in * 9)))
+    fig.text(0.5, 1 - 0.4 / h_in, head, ha="center", va="center", fontsize=11,
              weight="bold", gid="title")
 
     groups: dict[tuple[str, str], list] = {}
@@ -701,7 +721,7 @@ def draw_graph(model, topo=None) -> Figure:
                                gid=f"joint:{data['joint']}"))
             mid = 0.25 * pu + 0.5 * ctrl + 0.25 * pv
             r = data["reactions"]
-            ax.text(mid[0], mid[1], f"{_tex_safe(data['joint'])}\n{data['type']}, "
+            ax.text(mid[0], mid[1], f"{_tex_safe(data['joint'])}: {data['type']}\n"
                     f"{r} reaction{'s' if r != 1 else ''}", ha="center", va="center",
                     fontsize=8, zorder=3, gid=f"joint-label:{data['joint']}",
                     bbox=dict(boxstyle="round,pad=0.25", fc="#fff8e1", ec="#c9a227", lw=0.8))
@@ -711,10 +731,9 @@ def draw_graph(model, topo=None) -> Figure:
                                    ec="black", zorder=2, gid="node:ground"))
             ax.text(x, y + 0.28, "ground", ha="center", va="bottom", fontsize=9, zorder=3)
             continue
-        ax.add_patch(Circle((x, y), 0.3, fc="#dbe7f6", ec=COLORS[APPLIED], lw=1.4, zorder=2,
-                            gid=f"node:{node}"))
-        ax.text(x, y, _tex_safe(node), ha="center", va="center", fontsize=9, zorder=3,
-                gid=f"node-label:{node}")
+        ax.text(x, y, _tex_safe(node), ha="center", va="center", fontsize=9.5, zorder=3,
+                gid=f"node:{node}", bbox=dict(boxstyle="round,pad=0.55", fc="#dbe7f6",
+                                              ec=COLORS[APPLIED], lw=1.4))
     return fig
 
 
