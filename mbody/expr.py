@@ -117,13 +117,10 @@ def _tokenise(text: str) -> list[tuple[str, str, int]]:
     i = 0
     while i < len(text):
         m = _TOKEN.match(text, i)
-        if not m:
-            ch = text[i]
-            hint = {"=": "comparisons are not supported", "<": "comparisons are not supported",
-                    ">": "comparisons are not supported", ",": "functions take one argument",
-                    "[": "use ( ) for grouping", "{": "use ( ) for grouping",
-                    ".": "attribute access is not allowed"}.get(ch, "")
-            raise ExpressionError(text, i, f"unexpected character {ch!r}", hint)
+        if not m:  # reported when the parser reaches it, so errors come in reading order
+            out.append(("bad", text[i], i))
+            i += 1
+            continue
         kind = m.lastgroup or ""
         if kind != "ws":
             out.append((kind, m.group(), i))
@@ -141,13 +138,20 @@ class _Parser:
     def __init__(self, text: str, tokens: list[tuple[str, str, int]]):
         self.text, self.tokens, self.i = text, tokens, 0
 
-    def peek(self) -> tuple[str, str, int]:
-        return self.tokens[self.i]
-
     def take(self) -> tuple[str, str, int]:
-        tok = self.tokens[self.i]
+        tok = self.peek()
         self.i += 1
         return tok
+
+    def peek(self) -> tuple[str, str, int]:
+        kind, ch, pos = self.tokens[self.i]
+        if kind == "bad":
+            hint = {"=": "comparisons are not supported", "<": "comparisons are not supported",
+                    ">": "comparisons are not supported", ",": "functions take one argument",
+                    "[": "use ( ) for grouping", "{": "use ( ) for grouping",
+                    ".": "attribute access is not allowed"}.get(ch, "")
+            raise ExpressionError(self.text, pos, f"unexpected character {ch!r}", hint)
+        return self.tokens[self.i]
 
     def error(self, message: str, hint: str = "", pos: int | None = None):
         raise ExpressionError(self.text, self.peek()[2] if pos is None else pos, message, hint)

@@ -194,7 +194,8 @@ class Trajectory:
                     if p.suffix in (".yaml", ".yml") else "not a .npz archive")
             raise TrajectoryFileError(f"{name}: not an mbody trajectory file ({kind})")
         try:
-            with np.load(p, allow_pickle=False) as z:
+            # Open the file here: np.load leaves its own handle open when the zip is bad.
+            with open(p, "rb") as fh, np.load(fh, allow_pickle=False) as z:
                 files = set(z.files)
                 if "format" not in files:
                     raise TrajectoryFileError(

@@ -1,0 +1,145 @@
+"""Trajectory files: round trip, the model carried along, and clear errors for bad files."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import mbody
+from mbody.cli import main
+from mbody.errors import TrajectoryFileError
+from mbody.trajectory import FORMAT, FORMAT_VERSION, Trajectory
+
+MODELS = Path(__file__).resolve().parent.parent / "models"
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory) -> tuple[Trajectory, Path]:
+    traj = mbody.simulate(mbody.load(MODELS / "satellite_thruster.yaml"), t_end=1.0, fps=20)
+    path = tmp_path_factory.mktemp("runs") / "run.npz"
+    traj.save(path)
+    return traj, path
+
+
+def test_round_trip(run):
+    traj, path = run
+    back = Trajectory.load(path)
+    for k in ("t", "position", "velocity", "orientation", "angular_velocity", "reactions",
+              "mass", "inertia", "gravity"):
+        np.testing.assert_array_equal(getattr(back, k), getattr(traj, k))
+    for k in ("body_names", "dimension", "model_name", "model_file", "reaction_labels",
+              "shapes", "colors", "model_yaml"):
+        assert getattr(back, k) == getattr(traj, k), k
+    assert back.info == json.loads(json.dumps(traj.info))
+    assert set(back.series) == {"kinetic_energy", "potential_energy", "energy",
+                                "angular_momentum"}
+    np.testing.assert_array_equal(back.series["energy"], traj.series["energy"])
+    assert back.shapes == ({"cylinder": {"radius": 1.2, "length": 1.5}},)
+
+
+def test_planar_round_trip_and_state(tmp_path):
+    model = mbody.load(MODELS / "planar_time_varying_force.yaml")
+    traj = mbody.simulate(model, t_end=0.5, fps=10)
+    traj.save(tmp_path / "p.npz")
+    back = Trajectory.load(tmp_path / "p.npz")
+    assert back.position.shape == (6, 1, 2) and back.orientation.shape == (6, 1)
+    s = back.state(5)
+    np.testing.assert_allclose(s.position[0, :2], traj.position[5, 0])
+    assert s.t == 0.5 and s.omega[0, 2] == traj.angular_velocity[5, 0]
+
+
+def test_model_travels_with_the_run(run):
+    traj, path = run
+    model = Trajectory.load(path).model()
+    assert model.body_names == ("satellite",) and model.bodies["satellite"].mass == 500
+    assert "300*exp(-t/4)" in traj.model_yaml
+
+
+def test_kinetic_energy_and_momentum_by_hand(run):
+    traj, _ = run
+    k = 10
+    m, J = 500.0, np.diag([400.0, 400, 600])
+    v, w = traj.velocity[k, 0], traj.angular_velocity[k, 0]
+    assert traj.kinetic_energy()[k] == pytest.approx(0.5 * m * v @ v + 0.5 * w @ J @ w,
+                                                     rel=1e-14)
+    from mbody.spatial import quat_to_matrix
+
+    R = quat_to_matrix(traj.orientation[k, 0])
+    H = np.cross(traj.position[k, 0], m * v) + R @ J @ w
+    np.testing.assert_allclose(traj.angular_momentum()[k], H, rtol=1e-13)
+
+
+def test_truncated_file(run, tmp_path):
+    _, path = run
+    data = path.read_bytes()
+    for cut in (10, len(data) // 2, len(data) - 30):
+        bad = tmp_path / f"cut{cut}.npz"
+        bad.write_bytes(data[:cut])
+        with pytest.raises(TrajectoryFileError, match="damaged or truncated"):
+            Trajectory.load(bad)
+
+
+def test_wrong_kinds(run, tmp_path):
+    with pytest.raises(TrajectoryFileError, match="YAML model file"):
+        Trajectory.load(MODELS / "pendulum.yaml")
+    with pytest.raises(TrajectoryFileError, match="no such file"):
+        Trajectory.load(tmp_path / "missing.npz")
+    with pytest.raises(TrajectoryFileError, match="directory"):
+        Trajectory.load(tmp_path)
+    other = tmp_path / "other.npz"
+    np.savez(other, a=np.zeros(3))
+    with pytest.raises(TrajectoryFileError, match="no 'format' entry"):
+        Trajectory.load(other)
+    tagged = tmp_path / "tagged.npz"
+    np.savez(tagged, format=np.array("mbody-assembly"), version=np.array(1))
+    with pytest.raises(TrajectoryFileError, match="'mbody-assembly' file"):
+        Trajectory.load(tagged)
+    newer = tmp_path / "newer.npz"
+    np.savez(newer, format=np.array(FORMAT), version=np.array(FORMAT_VERSION + 1))
+    with pytest.raises(TrajectoryFileError, match="upgrade mbody"):
+        Trajectory.load(newer)
+    partial = tmp_path / "partial.npz"
+    np.savez(partial, format=np.array(FORMAT), version=np.array(FORMAT_VERSION),
+             t=np.zeros(3))
+    with pytest.raises(TrajectoryFileError, match="missing position"):
+        Trajectory.load(partial)
+
+
+def test_inconsistent_shapes(run, tmp_path):
+    _, path = run
+    with np.load(path) as z:
+        data = dict(z)
+    data["position"] = data["position"][:-1]
+    bad = tmp_path / "shapes.npz"
+    np.savez(bad, **data)
+    with pytest.raises(TrajectoryFileError, match="'position' has shape"):
+        Trajectory.load(bad)
+
+
+def test_save_is_atomic(run, tmp_path, monkeypatch):
+    traj, _ = run
+    target = tmp_path / "keep.npz"
+    target.write_bytes(b"old")
+
+    def fail(*a, **k):
+        raise OSError("disk full")
+
+    monkeypatch.setattr(np, "savez_compressed", fail)
+    with pytest.raises(OSError):
+        traj.save(target)
+    assert target.read_bytes() == b"old"
+    assert [p.name for p in tmp_path.iterdir()] == ["keep.npz"]
+
+
+def test_cli_bad_trajectory_exits_2_without_traceback(run, tmp_path, capsys):
+    _, path = run
+    bad = tmp_path / "cut.npz"
+    bad.write_bytes(path.read_bytes()[:100])
+    for f in (bad, MODELS / "pendulum.yaml"):
+        assert main(["plot", str(f), "-o", str(tmp_path / "x.png")]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith("mbody: error: ") and str(f) in err and "Traceback" not in err
+    assert not (tmp_path / "x.png").exists()
