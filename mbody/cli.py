@@ -9,15 +9,16 @@ from __future__ import annotations
 import argparse
 import importlib
 import os
+import re
 import sys
 import traceback
 from collections.abc import Sequence
 
 from . import __version__
 from .commands import EXIT_INPUT, EXIT_INTERNAL, EXIT_OK, EXIT_UNMET
-from .errors import MbodyError, ModelError, UnknownReactionsError
+from .errors import MbodyError, ModelError, UnknownReactionsError, did_you_mean
 
-COMMAND_MODULES = ("core", "export", "sim", "draw")
+COMMAND_MODULES = ("core", "export", "sim", "draw", "animate", "mechanism")
 """Modules of `mbody.commands`; each has `register(subparsers)` adding its commands."""
 
 def build_parser() -> argparse.ArgumentParser:
@@ -33,6 +34,10 @@ def build_parser() -> argparse.ArgumentParser:
 
 class _Parser(argparse.ArgumentParser):
     def error(self, message: str):  # one paragraph, exit 2, as for any bad input
+        bad = re.search(r"invalid choice: '([^']*)' \(choose from (.*)\)", message)
+        if bad:  # argparse of Python 3.11 offers no suggestion for a misspelt command
+            hint = did_you_mean(bad.group(1), re.findall(r"'([^']*)'", bad.group(2)))
+            message += f"; {hint}" if hint else ""
         self.print_usage(sys.stderr)
         sys.stderr.write(f"mbody: error: {message}\n")
         raise SystemExit(EXIT_INPUT)
