@@ -5,6 +5,7 @@
     sol = asm.solve(known={"A.Fx": 0})   # accelerations, aligned with asm.coordinates
 """
 
+from .animate import animate
 from .assemble import Assembly, Solution, assemble
 from .errors import Issue, MbodyError, ModelError, UnknownReactionsError
 from .export import ExportedAssembly, load_export
@@ -20,5 +21,5 @@ __all__ = [
     "FreeBodyDiagram", "load_export",
     "Issue", "Joint", "Load", "MbodyError", "Model", "ModelError", "Solution", "State",
     "Trajectory", "simulate",
-    "UnknownReactionsError", "assemble", "load", "loads",
+    "UnknownReactionsError", "animate", "assemble", "load", "loads",
 ]

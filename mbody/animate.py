@@ -546,10 +546,9 @@ class LiveViewer:
                     raise MbodyError("the meshcat server exited while starting"
                                      + self._server_log())
                 out += chunk
-                for line in out.decode("utf-8", "replace").splitlines():
+                for line in out.decode("utf-8", "replace").split("\n")[:-1]:  # whole lines
                     key, sep, value = line.partition("=")
-                    if sep and key in ("zmq_url", "web_url") and line.endswith(
-                            ("/", tuple("0123456789"))):
+                    if sep and key in ("zmq_url", "web_url"):
                         urls[key] = value.strip()
         return urls
 
@@ -599,16 +598,6 @@ class LiveViewer:
     def wait_for_browser(self, timeout: float = 10.0) -> bool:
         """True once a browser is connected (False after `timeout` s)."""
         return self._request([b"wait"], timeout) is not None
-
-    def capture_png(self, timeout: float = 10.0) -> bytes:
-        """A PNG of the connected browser's view (needs a connected browser)."""
-        import umsgpack
-
-        reply = self._request([b"capture_image", b"", umsgpack.packb({"type": "capture_image"})],
-                              timeout)
-        if reply is None or not reply.startswith(b"\x89PNG"):
-            raise MbodyError("no browser is connected to the live viewer")
-        return reply
 
     def close(self) -> None:
         """Stop the server and release everything; safe to call twice. (meshcat 0.3.2's
@@ -685,15 +674,15 @@ def _is_npz(path: Path) -> bool:
 
 
 def _load_trajectory(path: Path) -> Trajectory:
-    load = getattr(Trajectory, "load", None)
-    if load is None:
-        raise MbodyError("this mbody cannot read trajectory files yet")
-    return load(path)
+    return Trajectory.load(path)  # TrajectoryFileError (an MbodyError) names the problem
 
 
 def _model_of(traj: Trajectory, path: Path) -> Model:
+    """The run's model: from the YAML text it carries, else from the file it names."""
     from .model import load as load_model
 
+    if getattr(traj, "model_yaml", ""):
+        return traj.model()
     if not traj.model_file:
         raise MbodyError(f"{path} does not say which model it came from: pass --model MODEL")
     for where in (Path(traj.model_file), path.parent / traj.model_file):

@@ -107,6 +107,18 @@ def probe(page: str | os.PathLike[str], js: str, *, budget_ms: int = 4000,
     return value
 
 
+def screenshot(url: str, png: str | os.PathLike[str], *, budget_ms: int = 3000,
+               timeout: float = 90.0) -> Path:
+    """Load `url` (a page or a live viewer), let it run `budget_ms` of virtual time, and
+    save an 800x600 PNG of the window."""
+    with tempfile.TemporaryDirectory() as tmp:
+        out = subprocess.run(_cmd(f"--virtual-time-budget={budget_ms}", f"--screenshot={png}",
+                                  url, user_data=tmp), capture_output=True, timeout=timeout)
+    if not Path(png).is_file():
+        raise AssertionError(f"no screenshot (exit {out.returncode}): {out.stderr[-2000:]!r}")
+    return Path(png)
+
+
 def open_url(url: str, user_data: str) -> subprocess.Popen:
     """Start headless Chromium on `url` in its own session (stop it with `close`)."""
     return subprocess.Popen(_cmd("--remote-debugging-port=0", url, user_data=user_data),

@@ -1,0 +1,349 @@
+"""Animation: the scene's keyframes against closed-form motions, the offline page in a real
+browser (pose after seeking, pixels on screen), the live viewer's loopback binding and
+clean shutdown, and bad input."""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import psutil
+import pytest
+
+import mbody
+from mbody.animate import LiveViewer, build_scene, page_html, write_page
+from mbody.errors import MbodyError
+from mbody.trajectory import Trajectory
+
+sys.path.insert(0, str(Path(__file__).parent))
+import chromium  # noqa: E402
+
+needs_browser = pytest.mark.skipif(not chromium.AVAILABLE, reason="no /usr/bin/chromium")
+ROOT = Path(__file__).resolve().parent.parent
+
+SPIN_YAML = """\
+model: spinner
+dimension: 3
+bodies:
+  - {name: brick, mass: 2, shape: {box: [0.4, 0.2, 0.1]}, color: red}
+  - {name: rotor, mass: 1, shape: {cylinder: {radius: 0.1, length: 0.3}},
+     position: [0, 0.5, 0], color: "#00ff00"}
+loads:
+  - {name: push, type: force, body: brick, force: [0, 0, 3], at: [0.2, 0, 0], frame: body}
+"""
+W = 3.0                                   # rad/s about the fixed axis N
+N = np.array([1.0, 1.0, 2.0]) / math.sqrt(6.0)
+V = 0.5                                   # m/s along world x
+
+
+def spin_q(t):
+    """Closed form: constant ω about a fixed axis, q = [cos(ωt/2), sin(ωt/2) N]."""
+    t = np.asarray(t, dtype=float)
+    return np.concatenate([np.cos(W * t / 2)[..., None], np.sin(W * t / 2)[..., None] * N], -1)
+
+
+def rot(q):
+    w, x, y, z = q
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+
+
+@pytest.fixture(scope="module")
+def spinner():
+    model = mbody.loads(SPIN_YAML, "spinner.yaml")
+    t = np.linspace(0.0, 2.0, 61)
+    K = len(t)
+    pos = np.zeros((K, 2, 3))
+    pos[:, 0, 0] = V * t
+    pos[:, 1, 1] = 0.5
+    q = np.zeros((K, 2, 4))
+    q[:, 0] = spin_q(t)
+    q[:, 1, 0] = 1.0
+    traj = Trajectory(t, pos, np.zeros_like(pos), q, np.zeros((K, 2, 3)), ("brick", "rotor"),
+                      3, model_name="spinner", model_yaml=SPIN_YAML)
+    return model, traj
+
+
+PEND_L, PEND_A, PEND_W = 0.5, math.pi / 6, 3.0
+
+
+@pytest.fixture(scope="module")
+def pendulum():
+    model = mbody.load(ROOT / "models" / "pendulum.yaml")
+    t = np.linspace(0.0, 2.0, 81)
+    th = PEND_A * np.cos(PEND_W * t)
+    pos = np.stack([PEND_L * np.sin(th), -PEND_L * np.cos(th)], -1)[:, None, :]
+    traj = Trajectory(t, pos, np.zeros_like(pos), th[:, None], np.zeros((len(t), 1)),
+                      ("rod",), 2, model_name="physical-pendulum")
+    return model, traj
+
+
+def _animation(scene, path):
+    anim = next(c for c in scene.commands if c["type"] == "set_animation")
+    return {tr["name"]: tr for a in anim["animations"] if a["path"] == path
+            for tr in a["clip"]["tracks"]}
+
+
+# -- the scene (no browser) ---------------------------------------------------------------
+
+
+def test_keyframes_are_the_trajectory(spinner):
+    model, traj = spinner
+    scene = build_scene(traj, model)
+    tracks = _animation(scene, scene.paths["brick"])
+    assert tracks[".position"]["times"] == pytest.approx(traj.t.tolist(), abs=0)
+    P = np.reshape(tracks[".position"]["values"], (-1, 3))
+    np.testing.assert_allclose(P[:, 0], V * traj.t, atol=1e-15)
+    Q = np.reshape(tracks[".quaternion"]["values"], (-1, 4))  # three.js order x, y, z, w
+    np.testing.assert_allclose(Q[:, [3, 0, 1, 2]], spin_q(traj.t), atol=1e-15)
+    assert scene.duration == 2.0 and scene.frames == 61
+
+
+def test_cylinder_axis_is_body_z(spinner):
+    """meshcat's cylinder runs along its local y; the shape node must turn y onto z."""
+    model, traj = spinner
+    scene = build_scene(traj, model)
+    cmd = next(c for c in scene.commands if c["type"] == "set_transform"
+               and c["path"] == scene.paths["rotor"] + "/shape")
+    T = np.reshape(cmd["matrix"], (4, 4)).T  # meshcat sends column-major
+    np.testing.assert_allclose(T[:3, :3] @ [0, 1, 0], [0, 0, 1], atol=1e-15)
+    mesh = next(c for c in scene.commands if c["type"] == "set_object"
+                and c["path"] == scene.paths["rotor"] + "/shape/mesh")
+    geom = mesh["object"]["geometries"][0]
+    assert (geom["height"], geom["radiusTop"]) == (0.3, 0.1)
+
+
+def test_inertia_box_when_no_shape():
+    """No shape: the uniform box with the body's inertia, along its principal axes."""
+    model = mbody.load(ROOT / "models" / "seed_example_2.yaml")  # I = (2, 3, 4), m = 1
+    traj = Trajectory(np.array([0.0, 1.0]), np.zeros((2, 1, 3)), np.zeros((2, 1, 3)),
+                      np.tile([1.0, 0, 0, 0], (2, 1, 1)), np.zeros((2, 1, 3)), ("body",), 3)
+    scene = build_scene(traj, model)
+    mesh = next(c for c in scene.commands if c["type"] == "set_object"
+                and c["path"].endswith("/shape/mesh"))
+    a, b, c = mesh["object"]["geometries"][0]["width"], \
+        mesh["object"]["geometries"][0]["height"], mesh["object"]["geometries"][0]["depth"]
+    # I1 = m (b² + c²)/12 etc. for the drawn box
+    np.testing.assert_allclose([(b * b + c * c) / 12, (a * a + c * c) / 12,
+                                (a * a + b * b) / 12], [2, 3, 4], rtol=1e-12)
+
+
+def test_force_arrow_tracks_follow_the_body(spinner):
+    model, traj = spinner
+    scene = build_scene(traj, model, forces=True)
+    tracks = _animation(scene, scene.load_paths["push"])
+    P = np.reshape(tracks[".position"]["values"], (-1, 3))
+    Q = np.reshape(tracks[".quaternion"]["values"], (-1, 4))[:, [3, 0, 1, 2]]
+    for k in (0, 17, 60):
+        R = rot(spin_q(traj.t[k]))
+        np.testing.assert_allclose(P[k], traj.position[k, 0] + R @ [0.2, 0, 0], atol=1e-12)
+        np.testing.assert_allclose(rot(Q[k]) @ [0, 1, 0], R @ [0, 0, 1], atol=1e-12)
+
+
+def test_page_is_self_contained(spinner, tmp_path):
+    model, traj = spinner
+    out = write_page(traj, tmp_path / "run.html", model=model, forces=True)
+    text = out.read_text(encoding="utf-8")
+    links = set(re.findall(r"https?://[^\s\"'<>)]*", text))
+    assert links == {"http://www.w3.org/1999/xhtml"}
+    markup = re.sub(r"<script>.*?</script>", "", text, flags=re.S)  # the HTML outside scripts
+    assert not re.search(r"\b(src|href)\s*=", markup) and "<link" not in markup
+    assert "MeshCat.Viewer" in text and "<title>mbody: spinner</title>" in text
+    assert [p.name for p in tmp_path.iterdir()] == ["run.html"]  # no temp file left
+
+
+def test_bad_colour_and_body(spinner):
+    model, traj = spinner
+    bad = mbody.loads(SPIN_YAML.replace("color: red", "color: blurple"))
+    with pytest.raises(MbodyError, match="'blurple' is not a colour"):
+        build_scene(traj, bad)
+    with pytest.raises(MbodyError, match="unknown body 'brik'.*did you mean 'brick'"):
+        build_scene(traj, model, bodies=["brik"])
+    other = mbody.loads(SPIN_YAML.replace("name: rotor", "name: wheel"))
+    with pytest.raises(MbodyError, match="unknown body 'rotor'.*'spinner' has only"):
+        build_scene(traj, other)
+    with pytest.raises(MbodyError, match="give the model"):
+        mbody.animate(traj, "/tmp/never.html")
+
+
+# -- the page in a real browser -------------------------------------------------------------
+
+
+@needs_browser
+def test_browser_plays_the_spatial_motion(spinner, tmp_path):
+    model, traj = spinner
+    page = write_page(traj, tmp_path / "spin.html", model=model, forces=True)
+    paths = build_scene(traj, model, forces=True)
+    b, arrow = paths.paths["brick"], paths.load_paths["push"]
+    t1, t2 = 1.2345, 0.31  # between keyframes: linear position and slerp are exact here
+    r = chromium.probe(page, f"""
+      var out = {{duration: viewer.animator.duration}};
+      at({t1}); out.b1 = local("{b}"); out.a1 = local("{arrow}");
+      out.red1 = dominant(0, 3, 90); out.s1 = screen("{b}");
+      at({t2}); out.b2 = local("{b}"); out.red2 = dominant(0, 3, 90); out.s2 = screen("{b}");
+      out.green = dominant(1, 3, 90); out.sg = screen("{paths.paths['rotor']}");
+      return out;""")
+    assert r["duration"] == pytest.approx(2.0)
+    for key, t in (("b1", t1), ("b2", t2)):
+        np.testing.assert_allclose(r[key]["p"], [V * t, 0, 0], atol=1e-6)
+        q = np.array(r[key]["q"])[[3, 0, 1, 2]]
+        assert min(np.abs(q - spin_q(t)).max(), np.abs(q + spin_q(t)).max()) < 1e-6
+    # The arrow's foot is on the spinning body, 0.2 m from G; between keyframes it moves
+    # along the chord, at most the sagitta 0.2 (1 − cos(ω Δt / 2)) from the arc.
+    R = rot(spin_q(t1))
+    sag = 0.2 * (1 - math.cos(W * (traj.t[1] - traj.t[0]) / 2))
+    np.testing.assert_allclose(r["a1"]["p"], [V * t1, 0, 0] + R @ [0.2, 0, 0], atol=sag)
+    # The red brick is on the canvas where its mass centre projects, at both times.
+    for red, s in ((r["red1"], r["s1"]), (r["red2"], r["s2"])):
+        assert red["n"] > 400, red
+        assert math.dist(red["c"], s) < 0.05 * red["w"], (red, s)
+    moved = np.subtract(r["red1"]["c"], r["red2"]["c"])
+    np.testing.assert_allclose(moved, np.subtract(r["s1"], r["s2"]), atol=0.03 * 800)
+    assert r["green"]["n"] > 300 and math.dist(r["green"]["c"], r["sg"]) < 40
+
+
+@needs_browser
+def test_browser_planar_is_upright_in_xy(pendulum, tmp_path):
+    model, traj = pendulum
+    page = write_page(traj, tmp_path / "pend.html", model=model)
+    rod = build_scene(traj, model).paths["rod"]
+    k = int(np.searchsorted(traj.t, 0.3))  # a keyframe where θ > 0
+    r = chromium.probe(page, f"""
+      at({traj.t[k]}); var o = local("{rod}");
+      return {{rod: o, s: screen("{rod}"), origin: screen("/meshcat/mbody/origin"),
+               orange: dominant(0, 1.6, 120)}};""")
+    thk = PEND_A * math.cos(PEND_W * traj.t[k])
+    np.testing.assert_allclose(r["rod"]["p"], [PEND_L * math.sin(thk),
+                                               -PEND_L * math.cos(thk), 0], atol=1e-6)
+    np.testing.assert_allclose(r["rod"]["q"], [0, 0, math.sin(thk / 2), math.cos(thk / 2)],
+                               atol=1e-6)
+    # Viewed from +z with y up: the hanging rod's centre is below and (θ > 0) right of
+    # the pivot, and its pixels are around that point.
+    assert thk > 0.3
+    assert r["s"][1] > r["origin"][1] + 50 and r["s"][0] > r["origin"][0] + 5
+    assert r["orange"]["n"] > 400 and math.dist(r["orange"]["c"], r["s"]) < 30
+
+
+# -- the live viewer ---------------------------------------------------------------------
+
+
+def _listening(pid):
+    return [c.laddr for c in psutil.Process(pid).net_connections(kind="inet")
+            if c.status == psutil.CONN_LISTEN]
+
+
+def test_live_cli_binds_loopback_and_stops_on_ctrl_c(spinner, tmp_path):
+    model, traj = spinner
+    run = traj.save(tmp_path / "run.npz")
+    proc = subprocess.Popen([sys.executable, "-m", "mbody.cli", "animate", str(run), "--live"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            cwd=tmp_path)
+    server = None
+    try:
+        line = proc.stdout.readline()
+        assert "127.0.0.1 only" in line, line + proc.stderr.read()
+        url = re.search(r"http://127\.0\.0\.1:(\d+)/static/", line)
+        assert url, line
+        (server,) = psutil.Process(proc.pid).children()
+        addrs = _listening(server.pid)
+        assert len(addrs) == 2  # the websocket/HTTP port and the ZMQ port
+        assert {a.ip for a in addrs} == {"127.0.0.1"}
+        assert int(url.group(1)) in {a.port for a in addrs}
+        proc.send_signal(signal.SIGINT)
+        assert proc.wait(15) == 0
+        assert "viewer stopped" in proc.stderr.read()
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+        proc.stdout.close()
+        proc.stderr.close()
+    assert server is not None and not server.is_running()
+    assert not psutil.Process().children(recursive=True)
+
+
+def test_live_server_dies_with_a_killed_parent(tmp_path):
+    """A SIGKILLed mbody cannot clean up; its server notices and exits by itself."""
+    code = ("from mbody.animate import LiveViewer; v = LiveViewer(); print(v.pid, flush=True);"
+            "import time; time.sleep(60)")
+    proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True)
+    server = psutil.Process(int(proc.stdout.readline()))
+    proc.kill()
+    proc.wait()
+    proc.stdout.close()
+    server.wait(10)  # psutil.TimeoutExpired if it outlives its parent
+    assert not server.is_running()
+
+
+@needs_browser
+def test_live_viewer_shows_the_scene_to_a_browser(spinner, tmp_path):
+    """A browser that connects after the scene was pushed is sent all of it."""
+    from PIL import Image
+
+    model, traj = spinner
+    with LiveViewer() as viewer:
+        pid = viewer.pid
+        viewer.show(build_scene(traj, model))
+        png = chromium.screenshot(viewer.url, tmp_path / "live.png")
+        assert viewer.wait_for_browser(0.5) is False  # the browser has gone again
+    img = np.asarray(Image.open(png).convert("RGB")).astype(int)
+    r, g, b = img[..., 0], img[..., 1], img[..., 2]
+    assert ((r > 90) & (r > 3 * g) & (r > 3 * b)).sum() > 300  # the red brick
+    assert ((g > 90) & (g > 3 * r) & (g > 3 * b)).sum() > 200  # the green rotor
+    assert not psutil.pid_exists(pid)
+
+
+# -- command line --------------------------------------------------------------------------
+
+
+def _cli(*args, cwd):
+    return subprocess.run([sys.executable, "-m", "mbody.cli", *map(str, args)],
+                          capture_output=True, text=True, cwd=cwd, timeout=120)
+
+
+def test_cli_writes_a_page_from_a_run_and_from_a_model(spinner, tmp_path):
+    model, traj = spinner
+    run = traj.save(tmp_path / "run.npz")
+    p = _cli("animate", run, "-o", "out/a.html", "--forces", cwd=tmp_path)
+    assert p.returncode == 0, p.stderr
+    assert "wrote out/a.html" in p.stdout and "2 bodies, 61 frames, 2 s" in p.stdout
+    assert (tmp_path / "out" / "a.html").stat().st_size > 800_000  # the viewer is inlined
+    p = _cli("animate", ROOT / "models" / "seed_example_2.yaml", "--t-end", 1, "--fps", 20,
+             cwd=tmp_path)
+    assert p.returncode == 0, p.stderr
+    assert "wrote seed_example_2.html" in p.stdout and "21 frames, 1 s" in p.stdout
+
+
+@pytest.mark.parametrize("args, message", [
+    (["missing.npz"], "missing.npz: no such file"),
+    (["wrong.npz"], "not an mbody trajectory"),
+    (["run.npz", "--body", "brik"], "unknown body 'brik'"),
+    (["run.npz", "--model", "other.yaml"], "unknown body 'rotor'"),
+    (["run.npz", "--hold", "3"], "--hold only applies with --live"),
+    (["run.npz", "--fps", "0"], "--fps must be > 0"),
+])
+def test_cli_bad_input_exits_2(spinner, tmp_path, args, message):
+    model, traj = spinner
+    traj.save(tmp_path / "run.npz")
+    np.savez(tmp_path / "wrong.npz", a=np.ones(3))
+    (tmp_path / "other.yaml").write_text(SPIN_YAML.replace("name: rotor", "name: wheel"))
+    p = _cli("animate", *args, cwd=tmp_path)
+    assert p.returncode == 2, (p.stdout, p.stderr)
+    assert message in p.stderr and "Traceback" not in p.stderr
+    assert not [f for f in os.listdir(tmp_path) if f.endswith(".html")]
+
+
+def test_api_animate_model_and_trajectory(spinner, tmp_path):
+    model, traj = spinner
+    out = mbody.animate(traj, tmp_path / "a.html", model=model, bodies=["rotor"])
+    assert out == tmp_path / "a.html" and out.stat().st_size > 800_000
+    scene = build_scene(traj, model, bodies=["rotor"])
+    assert list(scene.paths) == ["rotor"] and scene.title == "mbody: spinner"
+    assert page_html(scene).count("<script>") == 2
