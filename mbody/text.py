@@ -23,7 +23,9 @@ def _n(x: float) -> str:
 
 
 def _plural(k: int, word: str) -> str:
-    return f"{k} {word}{'' if k == 1 else 's'}"
+    if k == 1:
+        return f"{k} {word}"
+    return f"{k} {word[:-1]}ies" if word.endswith("y") else f"{k} {word}s"  # body -> bodies
 
 
 def model_summary(model: Model, topo: Topology) -> str:
@@ -91,7 +93,7 @@ def graph_summary(model: Model, topo: Topology) -> str:
     per = 3 if model.dimension == cv.PLANAR else 6
     g = model.graph
     lines = [f"graph: {g.number_of_nodes()} nodes (bodies + ground), "
-             f"{g.number_of_edges()} joint edges; "
+             f"{_plural(g.number_of_edges(), 'joint edge')}; "
              + ("a tree (no closed loops)" if topo.is_tree
                 else f"{_plural(topo.loops, 'closed loop')}")]
     parts = [p for p in topo.parts if p != [cv.GROUND]]

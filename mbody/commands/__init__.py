@@ -7,6 +7,7 @@ paragraph on stderr and a non-zero exit code.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 from ..errors import MbodyError
@@ -28,7 +29,10 @@ def parse_known(pairs: Sequence[str]) -> dict[str, float]:
         if not sep:
             raise MbodyError(f"--known expects LABEL=VALUE (for example A.Fx=3), got {p!r}")
         try:
-            out[label.strip()] = float(value)
+            x = float(value)
         except ValueError:
             raise MbodyError(f"--known {label}: {value!r} is not a number") from None
+        if not math.isfinite(x):
+            raise MbodyError(f"--known {label}: expected a finite number, got {value!r}")
+        out[label.strip()] = x
     return out

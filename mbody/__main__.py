@@ -1,0 +1,7 @@
+"""`python -m mbody ...` runs the `mbody` command."""
+
+import sys
+
+from .cli import main
+
+sys.exit(main())
