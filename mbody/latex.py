@@ -24,6 +24,8 @@ MAX_FULL = 12
 """Matrices with more rows or columns than this are shown in block form."""
 TERMS_PER_LINE = 4
 """Right-hand-side terms per line of a body's equation before it continues below."""
+MAX_BODIES = 200
+"""Body sections in a document unless bodies are chosen (a longer one is not read)."""
 
 _ACC = {"a_x": "a_{x}", "a_y": "a_{y}", "a_z": "a_{z}", "alpha": r"\alpha",
         "alpha_1": r"\dot{\omega}_{1}", "alpha_2": r"\dot{\omega}_{2}",
@@ -206,11 +208,12 @@ def _block_form(asm: Assembly, max_full: int) -> str:
 
 
 def document(asm: Assembly, title: str | None = None, bodies: Iterable[str] | None = None,
-             max_full: int = MAX_FULL) -> str:
+             max_full: int = MAX_FULL, max_bodies: int = MAX_BODIES) -> str:
     """A complete LaTeX document: conventions, each body's free body and Newton-Euler
-    pair, then the stacked system. `bodies` limits the per-body sections."""
+    pair, then the stacked system. `bodies` chooses the per-body sections (default: the
+    first `max_bodies` bodies in stacking order)."""
     model = asm.model
-    names = list(model.body_names if bodies is None else bodies)
+    names = list(model.body_names[:max_bodies] if bodies is None else bodies)
     title = title or f"Newton-Euler equations of {model.name}"
     planar = model.dimension == cv.PLANAR
     rows = ", ".join(cv.PLANAR_ROWS if planar else cv.SPATIAL_ROWS)
@@ -247,7 +250,8 @@ def document(asm: Assembly, title: str | None = None, bodies: Iterable[str] | No
         out += [rf"\section*{{Body {escape(name)}}}", free_body_latex(eq),
                 _display(body_latex(eq))]
     if len(names) < model.n:
-        out.append(rf"({model.n - len(names)} more bodies not shown.)")
+        out.append(rf"({model.n - len(names)} more bodies not shown; choose bodies with "
+                   r"\texttt{--body NAME}.)")
     out += [r"\section*{Stacked system}", _display(stacked_latex(asm, max_full)),
             r"\end{document}", ""]
     return "\n".join(out)

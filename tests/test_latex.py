@@ -196,4 +196,8 @@ def test_document_for_one_body_only():
     asm = _asm(ODD_NAMES)
     text = document(asm, bodies=["link_1"])
     assert r"\section*{Body link\_1}" in text
-    assert text.count(r"\section*{Body ") == 1 and "(2 more bodies not shown.)" in text
+    assert text.count(r"\section*{Body ") == 1 and "(2 more bodies not shown;" in text
+    big = DOC_CASES["spatial_30_bodies"]()
+    text = document(big, max_bodies=5)
+    assert text.count(r"\section*{Body ") == 5 and "(25 more bodies not shown;" in text
+    assert r"\section*{Body b4}" in text and r"\section*{Body b5}" not in text
