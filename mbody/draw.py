@@ -66,6 +66,9 @@ SCALE_NOTE = ("arrow length ∝ 1 + log10(|F| / F_min): each ×10 in force adds 
 
 _UNKNOWN_FORCE, _UNKNOWN_MOMENT = 0.62, 0.82  # of ℓ_max
 _HEAD = 0.085  # arrowhead length, of ℓ_max
+END_ON = 0.2
+"""A spatial arrow whose page length is below END_ON times its 3-D length is drawn end-on:
+a ring with a dot (toward the eye) or a cross (away); its short shaft stays, for tools."""
 
 
 # -- views -----------------------------------------------------------------------------
@@ -246,6 +249,8 @@ class _Arrow:
     tail: np.ndarray  # (2,) page
     vec: np.ndarray  # (2,) page (projected drawn vector); planar couple: (sign, radius)
     arc: np.ndarray | None = None  # planar couple: (k, 2) points
+    length3: float = 0.0  # drawn length in 3-D, before projection
+    toward: float = 0.0  # its component toward the eye (spatial)
     line: Line2D | None = None
 
 
@@ -301,7 +306,7 @@ def _arrows(fbd: FreeBodyDiagram, P: np.ndarray, lmax: float) -> list[_Arrow]:
         tail = P @ tail3
         gid = f"{'couple' if fo.couple else 'arrow'}:{kind}:{fo.label or fo.name}"
         a = _Arrow(gid, kind, _label(fo), COLORS[kind], kind == REACTION, fo.couple,
-                   tail, P @ (ell * d))
+                   tail, P @ (ell * d), length3=ell, toward=float(ell * d @ _eye(P)))
         if fo.couple and planar:
             sign = 1.0 if d[2] >= 0 else -1.0
             key = tuple(np.round(tail, 9))
@@ -452,6 +457,21 @@ def draw_fbd(fbd, *, view: str | Sequence[float] | None = "iso", equations: bool
                 ax.add_patch(Polygon(_head(a.arc[-1], t_end / np.linalg.norm(t_end), head),
                                      color=a.color, zorder=9, gid=a.gid + ":head"))
             anchor, direction = a.arc[-1], a.arc[-1] - a.tail
+        elif np.linalg.norm(a.vec) < END_ON * a.length3:
+            # seen end-on: a dot toward the eye, a cross away from it (two rings: a moment)
+            r = 0.05 * lmax
+            for k in range(2 if a.couple else 1):
+                ax.add_patch(Circle(a.tail, r * (1 + 0.45 * k), fill=False, ec=a.color, lw=1.6,
+                                    zorder=9, gid=a.gid + (":end-on" if k == 0 else ":ring2")))
+            if a.toward > 0:
+                ax.add_patch(Circle(a.tail, 0.3 * r, color=a.color, zorder=9))
+            else:
+                for s_ in (1, -1):
+                    xx = a.tail + 0.7 * r * np.array([[-1, -s_], [1, s_]]) / math.sqrt(2)
+                    ax.add_line(Line2D(xx[:, 0], xx[:, 1], color=a.color, lw=1.4, zorder=9))
+            ring = a.tail + r * (1.5 if a.couple else 1.0) * _circle(24)
+            obstacles.append((ring, a.gid))
+            anchor, direction = a.tail + r * np.array([0.7, 0.7]), np.array([1.0, 0.7])
         else:
             n = np.linalg.norm(a.vec)
             tip = a.tail + a.vec
@@ -564,6 +584,10 @@ def _place_labels(fig, ax, renderer, texts, items, obstacles) -> list[Bbox]:
         if own not in ("axis", "g"):  # beside the shaft, half-way
             mid = -0.5 * np.linalg.norm(to_px(anchor) - to_px(anchor - direction)) / px_per_pt
             cands += [d * mid + nrm * 10, d * mid - nrm * 10]
+        # then a ring of spots further out, for crowded joints
+        for radius in (14.0, 26.0, 40.0):
+            for ang in np.linspace(0, 2 * np.pi, 16, endpoint=False):
+                cands.append(radius * (np.cos(ang) * d + np.sin(ang) * nrm))
         best = None
         for off in cands:
             o = off / (np.linalg.norm(off) or 1.0)
@@ -575,7 +599,7 @@ def _place_labels(fig, ax, renderer, texts, items, obstacles) -> list[Bbox]:
             text.set_ha(ha)
             text.set_va(va)
             bb = text.get_window_extent(renderer).expanded(1.0, 1.0).padded(2 * px_per_pt)
-            score = 0.0
+            score = 0.004 * float(np.linalg.norm(off))  # nearer is better, other things equal
             for pts, tag in samples:
                 inside = np.count_nonzero((pts[:, 0] > bb.x0) & (pts[:, 0] < bb.x1)
                                           & (pts[:, 1] > bb.y0) & (pts[:, 1] < bb.y1))

@@ -1,0 +1,344 @@
+"""Free-body pictures: what the drawing contains (arrows, directions, styles, labels),
+the projection, the log length scale, the graph picture and the fbd/graph commands."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from matplotlib.colors import to_hex
+from matplotlib.figure import Figure
+
+import mbody
+from mbody.cli import main
+from mbody.draw import (
+    COLORS,
+    arrow_lengths,
+    draw_graph,
+    figure_bytes,
+    figure_svg,
+    parse_view,
+    projection,
+    save_figure,
+)
+from mbody.errors import MbodyError
+from mbody.graph import topology
+
+ROOT = Path(__file__).resolve().parent.parent
+MODELS = sorted((ROOT / "models").glob("*.yaml"))
+S3 = 1 / np.sqrt(3)
+
+
+def drawing(fig: Figure):
+    return next(a for a in fig.axes if a.get_gid() == "drawing")
+
+
+def arrows(fig: Figure, prefix: str) -> dict:
+    """gid -> Line2D of the arrow shafts whose gid starts with `prefix`."""
+    return {ln.get_gid(): ln for ln in drawing(fig).lines
+            if (ln.get_gid() or "").startswith(prefix)}
+
+
+def direction(line) -> np.ndarray:
+    xy = line.get_xydata()
+    d = xy[-1] - xy[0]
+    return d / np.linalg.norm(d)
+
+
+def labels(fig: Figure) -> dict[str, str]:
+    return {t.get_gid(): t.get_text() for t in drawing(fig).texts
+            if (t.get_gid() or "").startswith("label:")}
+
+
+def body(model_file: str, name: str, **kw):
+    m = mbody.load(ROOT / "models" / model_file) if not isinstance(model_file, dict) \
+        else mbody.load(model_file)
+    return mbody.assemble(m).bodies[name]
+
+
+def planar_model(loads, joints=(), reactions=None, gravity=True):
+    spec = {"model": "t", "dimension": 2,
+            "bodies": [{"name": "plate", "mass": 2.0, "inertia": 0.1, "position": [1, 2],
+                        "shape": {"box": [0.6, 0.4]}}],
+            "loads": list(loads), "joints": list(joints)}
+    if gravity:
+        spec["gravity"] = [0, -9.81]
+    if reactions:
+        spec["reactions"] = reactions
+    return mbody.load(spec)
+
+
+# -- projection and scale ---------------------------------------------------------------
+def test_named_views_project_world_axes_as_drawn_on_paper():
+    iso = projection("iso")
+    np.testing.assert_allclose(iso @ [1, 0, 0], [-np.sqrt(0.5), -np.sqrt(1 / 6)], atol=1e-12)
+    np.testing.assert_allclose(iso @ [0, 1, 0], [np.sqrt(0.5), -np.sqrt(1 / 6)], atol=1e-12)
+    np.testing.assert_allclose(iso @ [0, 0, 1], [0, np.sqrt(2 / 3)], atol=1e-12)
+    # the isometric eye looks along (1, 1, 1): that direction projects to a point
+    np.testing.assert_allclose(iso @ [S3, S3, S3], [0, 0], atol=1e-12)
+    np.testing.assert_allclose(projection("front"), [[1, 0, 0], [0, 0, 1]], atol=1e-12)
+    np.testing.assert_allclose(projection("top"), [[1, 0, 0], [0, 1, 0]], atol=1e-12)
+    np.testing.assert_allclose(projection("side"), [[0, 1, 0], [0, 0, 1]], atol=1e-12)
+    for v in ("iso", (20, -70), "30,-60"):
+        P = projection(v)
+        np.testing.assert_allclose(P @ P.T, np.eye(2), atol=1e-12)  # orthonormal rows
+
+
+def test_bad_view_is_a_clear_error():
+    with pytest.raises(MbodyError, match="did you mean 'iso'"):
+        parse_view("isso")
+    with pytest.raises(MbodyError, match="ELEV,AZIM"):
+        parse_view("30;40")
+    assert parse_view("30, -60") == (30.0, -60.0)
+
+
+def test_log_lengths_keep_a_1000_to_1_ratio_readable():
+    ell = arrow_lengths([1.0, 10.0, 1000.0, 0.0], 2.0)
+    # 1 + log10(F/F_min): steps 1, 2, 4, scaled so the longest is 2
+    np.testing.assert_allclose(ell, [0.5, 1.0, 2.0, 0.0])
+    np.testing.assert_allclose(arrow_lengths([3.0, 3.0], 1.0), [1.0, 1.0])
+    assert arrow_lengths([], 1.0).shape == (0,)
+
+
+# -- planar diagrams -----------------------------------------------------------------------
+def test_seed_example_1_one_applied_arrow_along_x_at_its_point():
+    eq = body("seed_example_1.yaml", "plate")
+    fig = eq.fbd.draw()
+    assert isinstance(fig, Figure)
+    shafts = arrows(fig, "arrow:")
+    assert list(shafts) == ["arrow:applied:push"]  # no gravity in this model, no joints
+    push = shafts["arrow:applied:push"]
+    np.testing.assert_allclose(direction(push), [1, 0], atol=1e-12)
+    np.testing.assert_allclose(push.get_xydata()[0], [0, -0.4], atol=1e-12)  # at: [0, -0.4]
+    assert push.get_linestyle() == "-"
+    assert to_hex(push.get_color()) == COLORS["applied"]
+    assert labels(fig)["label:applied:push"] == "push 50 N"
+    eqs = next(t for t in fig.texts if t.get_gid() == "equations").get_text()
+    for e in eq.equations:
+        assert str(e) in eqs
+    assert "10 a_x = 50" in eqs and "0.5 alpha = 20" in eqs  # the course's answer
+
+
+def test_pendulum_gravity_and_dashed_reactions_at_the_pin():
+    fig = body("pendulum.yaml", "rod").fbd.draw()
+    grav = arrows(fig, "arrow:gravity:")
+    reac = arrows(fig, "arrow:reaction:")
+    assert list(grav) == ["arrow:gravity:gravity"]
+    np.testing.assert_allclose(direction(grav["arrow:gravity:gravity"]), [0, -1], atol=1e-12)
+    np.testing.assert_allclose(grav["arrow:gravity:gravity"].get_xydata()[0],
+                               [0.25, -0.4330127018922193], atol=1e-12)  # at G
+    assert sorted(reac) == ["arrow:reaction:O.Fx", "arrow:reaction:O.Fy"]
+    np.testing.assert_allclose(direction(reac["arrow:reaction:O.Fx"]), [1, 0], atol=1e-9)
+    np.testing.assert_allclose(direction(reac["arrow:reaction:O.Fy"]), [0, 1], atol=1e-9)
+    for ln in reac.values():
+        np.testing.assert_allclose(ln.get_xydata()[0], [0, 0], atol=1e-9)  # the pin O
+        assert ln.get_linestyle() != "-"  # dashed
+        assert to_hex(ln.get_color()) == COLORS["reaction"]
+        assert to_hex(ln.get_color()) != COLORS["applied"]
+    lab = labels(fig)
+    assert lab["label:reaction:O.Fx"] == "O.Fx" and lab["label:reaction:O.Fy"] == "O.Fy"
+    assert lab["label:gravity:gravity"] == "m g = 19.62 N"
+    legend = " ".join(t.get_text() for a in fig.axes if a.get_legend()
+                      for t in [a.get_legend().get_title(), *a.get_legend().get_texts()])
+    assert "log10" in legend and "reaction" in legend and "gravity" in legend
+
+
+def test_lengths_within_one_picture_follow_the_log_rule():
+    m = planar_model([{"name": "small", "type": "force", "body": "plate", "force": [1, 0]},
+                      {"name": "big", "type": "force", "body": "plate", "force": [0, 1000],
+                       "at": [0.1, 0]}], gravity=False)
+    fig = mbody.assemble(m).bodies["plate"].fbd.draw()
+    sh = arrows(fig, "arrow:applied:")
+    length = {k: np.linalg.norm(np.ptp(v.get_xydata(), axis=0)) for k, v in sh.items()}
+    assert length["arrow:applied:big"] / length["arrow:applied:small"] == pytest.approx(4.0)
+    np.testing.assert_allclose(direction(sh["arrow:applied:big"]), [0, 1], atol=1e-12)
+    assert labels(fig)["label:applied:big"] == "big 1000 N"
+
+
+def test_planar_couples_are_curved_with_the_sense_of_rotation():
+    m = planar_model([{"name": "ccw", "type": "torque", "body": "plate", "torque": 5},
+                      {"name": "cw", "type": "torque", "body": "plate", "torque": -2}])
+    fig = mbody.assemble(m).bodies["plate"].fbd.draw()
+    cps = arrows(fig, "couple:applied:")
+    assert sorted(cps) == ["couple:applied:ccw", "couple:applied:cw"]
+    G = np.array([1.0, 2.0])
+    for gid, sense in (("couple:applied:ccw", 1), ("couple:applied:cw", -1)):
+        xy = cps[gid].get_xydata() - G
+        turn = np.sum(xy[:-1, 0] * xy[1:, 1] - xy[:-1, 1] * xy[1:, 0])  # signed area x 2
+        assert np.sign(turn) == sense
+        radius = np.linalg.norm(xy, axis=1)
+        np.testing.assert_allclose(radius, radius[0], rtol=1e-9)  # an arc about G
+    assert labels(fig)["label:applied:cw"] == "cw 2 N m"
+
+
+def test_known_reactions_show_values_and_zeros_are_listed_not_drawn():
+    m = planar_model([], joints=[{"name": "A", "type": "revolute", "parent": "ground",
+                                  "child": "plate", "at": [1.3, 2]}],
+                     reactions={"A.Fx": 0, "A.Fy": -4})
+    fig = mbody.assemble(m).bodies["plate"].fbd.draw()
+    reac = arrows(fig, "arrow:reaction:")
+    assert list(reac) == ["arrow:reaction:A.Fy"]
+    # drawn in the component's positive direction; the value carries the sign
+    np.testing.assert_allclose(direction(reac["arrow:reaction:A.Fy"]), [0, 1], atol=1e-12)
+    assert labels(fig)["label:reaction:A.Fy"] == "A.Fy = −4 N"
+    note = next(t for t in fig.texts if t.get_gid() == "zero-note").get_text()
+    assert "A.Fx" in note
+
+
+# -- spatial diagrams ------------------------------------------------------------------------
+@pytest.mark.parametrize(("view", "end_on"), [("iso", 0), ("front", 5), ("top", 2),
+                                              ((25.0, -130.0), 0)])
+def test_spatial_arrows_point_along_their_projected_vectors(view, end_on):
+    eq = body("fourbar_spatial.yaml", "coupler")
+    fbd = eq.fbd
+    fig = fbd.draw(view=view)
+    P = projection(view)
+    forces = arrows(fig, "arrow:reaction:")
+    moments = arrows(fig, "couple:reaction:")
+    assert len(forces) == 6 and len(moments) == 4  # two revolutes: Fx Fy Fz Mx My each
+    checked = 0
+    for fo in fbd.forces:
+        gid = ("couple:" if fo.couple else "arrow:") + f"{fo.kind}:{fo.label or fo.name}"
+        line = arrows(fig, gid)[gid]
+        page = P @ fo.W_vector
+        if np.linalg.norm(page) < 1e-6:  # seen end-on in this view
+            continue
+        np.testing.assert_allclose(direction(line), page / np.linalg.norm(page), atol=1e-9)
+        checked += 1
+    # the front view sees gravity and the y components end-on, the top view the z ones
+    assert checked == len(fbd.forces) - end_on
+    gids = [p.get_gid() or "" for p in drawing(fig).patches]
+    # every moment has a double head, or two rings when seen end-on
+    double = {g.split(":")[2] for g in gids if g.endswith((":head2", ":ring2"))}
+    assert double == {"A.Mx", "A.My", "B.Mx", "B.My"}
+    assert sum(g.endswith(":end-on") for g in gids) == end_on
+    lab = labels(fig)
+    assert {lab[f"label:reaction:{c}"] for c in ("A.Fx", "B.Mx")} == {"A.Fx", "B.Mx"}
+
+
+def test_spatial_body_without_shape_is_its_equivalent_box():
+    fbd = body("seed_example_2.yaml", "body").fbd  # inertia (2, 3, 4), no shape
+    fig = fbd.draw(view="top")
+    outline = next(p for p in drawing(fig).patches if p.get_gid() == "body-outline")
+    xy = outline.get_xy()
+    # box edges a² = 6 (I2 + I3 − I1)/m: 30, 18, 6 -> seen from the top: a × b
+    a, b = np.sqrt(6 * 5), np.sqrt(6 * 3)
+    np.testing.assert_allclose(np.ptp(xy, axis=0), [a, b], rtol=1e-6)
+    world = next(a for a in fig.axes if a.get_gid() == "world-axes")
+    assert {ln.get_gid() for ln in world.lines} >= {"world-axis:x", "world-axis:y"}
+    assert {ln.get_gid() for ln in drawing(fig).lines} >= {
+        "body-axis:x", "body-axis:y", "body-axis:z"}
+
+
+def _own_overlaps(fig: Figure) -> list[str]:
+    """Labels whose box is crossed by the arrow they name (display pixels)."""
+    ax = drawing(fig)
+    r = fig.canvas.get_renderer()
+    shafts = {ln.get_gid().split(":", 1)[1]: ln for ln in ax.lines
+              if (ln.get_gid() or "").split(":")[0] in ("arrow", "couple")}
+    bad = []
+    for t in ax.texts:
+        gid = t.get_gid() or ""
+        if not gid.startswith("label:") or gid[6:] not in shafts:
+            continue
+        bb = t.get_window_extent(r)
+        pts = ax.transData.transform(shafts[gid[6:]].get_xydata())
+        s = np.vstack([p + (q - p) * np.linspace(0, 1, 50)[:, None]
+                       for p, q in zip(pts[:-1], pts[1:], strict=True)])
+        if np.any((s[:, 0] > bb.x0) & (s[:, 0] < bb.x1) & (s[:, 1] > bb.y0)
+                  & (s[:, 1] < bb.y1)):
+            bad.append(t.get_text())
+    return bad
+
+
+@pytest.mark.parametrize("path", MODELS, ids=[p.stem for p in MODELS])
+def test_labels_do_not_cross_their_arrows_on_shipped_models(path):
+    m = mbody.load(path)
+    asm = mbody.assemble(m)
+    for name in m.body_names[:6]:
+        fig = asm.bodies[name].fbd.draw()
+        n_arrows = len(arrows(fig, "arrow:")) + len(arrows(fig, "couple:"))
+        drawn = [f for f in asm.bodies[name].fbd.forces
+                 if f.unknown or (f.value != 0 if f.kind == "reaction" else f.magnitude > 0)]
+        assert n_arrows == len(drawn)
+        assert _own_overlaps(fig) == [], (m.name, name)
+
+
+# -- output and the API ---------------------------------------------------------------------
+def test_outputs_svg_png_pdf_and_jupyter(tmp_path):
+    fbd = body("pendulum.yaml", "rod").fbd
+    svg = fbd._repr_svg_()
+    assert svg.startswith("<svg") and svg.rstrip().endswith("</svg>")
+    assert "<?xml" not in svg and "<metadata>" not in svg
+    fig = fbd.draw()
+    assert figure_svg(fig).startswith("<svg")
+    assert figure_bytes(fig, "png")[:8] == b"\x89PNG\r\n\x1a\n"
+    assert figure_bytes(fig, "pdf")[:5] == b"%PDF-"
+    out = save_figure(fig, tmp_path / "rod.png")
+    assert out.read_bytes()[:4] == b"\x89PNG"
+    assert [p.name for p in tmp_path.iterdir()] == ["rod.png"]  # no temporary left behind
+    with pytest.raises(MbodyError, match="format"):
+        save_figure(fig, tmp_path / "rod.gif")
+
+
+def test_drawing_never_imports_pyplot():
+    code = ("import sys, mbody; a = mbody.assemble(mbody.load('models/pendulum.yaml')); "
+            "a.bodies['rod'].fbd.draw(); print('matplotlib.pyplot' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True,
+                         text=True, check=True)
+    assert out.stdout.strip() == "False"
+
+
+def test_graph_picture_has_every_body_and_joint():
+    m = mbody.load(ROOT / "models" / "slider_crank.yaml")
+    fig = draw_graph(m, topology(m))
+    ax = next(a for a in fig.axes if a.get_gid() == "graph")
+    nodes = {t.get_gid() for t in ax.texts if (t.get_gid() or "").startswith("node:")}
+    nodes |= {p.get_gid() for p in ax.patches if (p.get_gid() or "").startswith("node:")}
+    assert nodes == {"node:ground"} | {f"node:{b}" for b in m.body_names}
+    edges = {ln.get_gid() for ln in ax.lines}
+    assert edges == {f"joint:{j.name}" for j in m.joints}
+    text = {t.get_gid(): t.get_text() for t in ax.texts}
+    for j in m.joints:
+        assert text[f"joint-label:{j.name}"] == (f"{j.name}: {j.type}\n"
+                                                 f"{len(j.components)} reactions")
+    title = next(t for t in fig.texts if t.get_gid() == "title").get_text()
+    assert "1 closed loop" in title and "mobility 1" in title
+
+
+# -- commands --------------------------------------------------------------------------------
+def test_fbd_command_writes_one_picture_per_body(tmp_path, capsys):
+    assert main(["fbd", "models/slider_crank.yaml", "-o", str(tmp_path)]) == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "fbd_crank.svg", "fbd_piston.svg", "fbd_rod.svg"]
+    assert (tmp_path / "fbd_rod.svg").read_text().lstrip().startswith("<?xml")
+    assert main(["fbd", "models/heavy_top.yaml", "-o", str(tmp_path), "--body", "top",
+                 "--format", "png", "--view", "front"]) == 0
+    assert (tmp_path / "fbd_top.png").read_bytes()[:4] == b"\x89PNG"
+    assert "fbd_top.png" in capsys.readouterr().out
+
+
+def test_fbd_command_bad_body_and_view_exit_2(tmp_path, capsys):
+    assert main(["fbd", "models/slider_crank.yaml", "-o", str(tmp_path), "--body",
+                 "pistn"]) == 2
+    err = capsys.readouterr().err
+    assert "no body named 'pistn'" in err and "did you mean 'piston'?" in err
+    assert "Traceback" not in err
+    assert main(["fbd", "models/slider_crank.yaml", "-o", str(tmp_path), "--view",
+                 "sideways"]) == 2
+    assert "unknown view 'sideways'" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+    with pytest.raises(SystemExit) as exc:
+        main(["fbd", "models/slider_crank.yaml", "--format", "gif"])
+    assert exc.value.code == 2
+
+
+def test_graph_command(tmp_path, capsys):
+    out = tmp_path / "g.png"
+    assert main(["graph", "models/fourbar_planar.yaml", "-o", str(out)]) == 0
+    assert out.read_bytes()[:4] == b"\x89PNG"
+    assert main(["graph", "models/fourbar_planar.yaml", "-o", str(tmp_path / "g.gif")]) == 2
+    assert ".svg, .png, .pdf" in capsys.readouterr().err
