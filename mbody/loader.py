@@ -56,6 +56,8 @@ _ALLOWED_SCALAR_TAGS = {_TAG + t for t in ("str", "int", "float", "bool", "null"
 _AS_TEXT_TAGS = {_TAG + "timestamp", _TAG + "binary"}
 _NOT_ALLOWED_HINT = "only plain YAML mappings, lists, strings and numbers"
 _CACHE_LIMIT = 20_000
+_RESOLVER_FIRST = frozenset(c for c in yaml.resolver.Resolver.yaml_implicit_resolvers if c)
+"""First characters of every plain scalar PyYAML's resolver may read as non-text."""
 
 
 @dataclass
@@ -314,6 +316,8 @@ class _Builder:
         value = ev.value
         plain = tag is None and ev.implicit[0]
         if plain:
+            if value and value[0] not in _RESOLVER_FIRST:
+                return value  # e.g. a body name: no YAML 1.1 type starts with this letter
             hit = self.cache.get(value, _NOKEY)
             if hit is not _NOKEY:
                 return hit
