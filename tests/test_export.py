@@ -343,3 +343,13 @@ def test_cli_export_json_with_known_value(tmp_path):
     doc = json.loads((tmp_path / "k.json").read_text())
     assert [c["known"] for c in doc["columns"]] == [0.0, None]
     assert doc["state"]["source"] == "the model's initial state (t = 0 s)"
+
+
+def test_cli_export_unwritable_target_is_one_message(tmp_path):
+    (tmp_path / "taken.npz").mkdir()
+    r = _mbody("export", MODELS / "pendulum.yaml", "-o", tmp_path / "taken.npz")
+    assert r.returncode == 2 and "cannot write" in r.stderr and "Is a directory" in r.stderr
+    assert [p.name for p in tmp_path.iterdir()] == ["taken.npz"]  # no temporary file left
+    (tmp_path / "file").write_text("x")
+    r = _mbody("export", MODELS / "pendulum.yaml", "--csv", tmp_path / "file")
+    assert r.returncode == 2 and "exists and is not a folder" in r.stderr

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import sys
 
 from ..errors import MbodyError
@@ -49,10 +50,12 @@ def export(a: argparse.Namespace) -> int:
     exp = exported(asm, parse_known(a.known), source)
     N, m = len(exp.coordinates), len(exp.reactions)
     for out in a.output:
-        print(f"wrote {write_export(exp, out)}")
+        with _writing(out):
+            print(f"wrote {write_export(exp, out)}")
     if a.csv:
-        print(f"wrote {write_csv(exp, a.csv)}/ (M.csv, G.csv, vectors.csv, columns.csv, "
-              "bodies.csv, info.csv)")
+        with _writing(a.csv):
+            print(f"wrote {write_csv(exp, a.csv)}/ (M.csv, G.csv, vectors.csv, columns.csv, "
+                  "bodies.csv, info.csv)")
     print(f"M {N}x{N} ({exp.M.nnz} non-zeros), b {N}, Q {N}, G {N}x{m} "
           f"({exp.G.nnz} non-zeros); state: {exp.state_source}")
     return EXIT_OK
@@ -72,5 +75,15 @@ def latex(asm, target: str, body: str | None = None) -> int:
     if target == "-":
         sys.stdout.write(text)
     else:
-        print(f"wrote {write_atomic(target, text)}")
+        with _writing(target):
+            print(f"wrote {write_atomic(target, text)}")
     return EXIT_OK
+
+
+@contextlib.contextmanager
+def _writing(target: str):
+    """An operating-system error while writing `target` becomes one clear message."""
+    try:
+        yield
+    except OSError as exc:
+        raise MbodyError(f"cannot write {target}: {exc.strerror or exc}") from None
