@@ -525,7 +525,9 @@ def _loads(c: _Checker, value: Any, names: dict[str, int]) -> list[LoadSpec]:
     out: list[LoadSpec] = []
     seen: dict[str, int] = {}
     counters: dict[str, int] = {}
-    for i, ld in enumerate(_list(c, ("loads",), value, "loads", False)):
+    items = _list(c, ("loads",), value, "loads", False)
+    given = {ld["name"] for ld in items if isinstance(ld, dict) and isinstance(ld.get("name"), str)}
+    for i, ld in enumerate(items):
         p: Path_ = ("loads", i)
         if not isinstance(ld, dict):
             c.err(p, f"expected a load mapping, got {_kind(ld)}")
@@ -542,8 +544,11 @@ def _loads(c: _Checker, value: Any, names: dict[str, int]) -> list[LoadSpec]:
         c.mapping(p, ld, LOAD_KEYS[typ], required)
         if "name" in ld:
             name = c.name((*p, "name"), ld["name"], "load")
-        else:
+        else:  # <type><n>, never a name the file gives to another load
             name = f"{typ}{counters[typ]}"
+            while name in given or name in seen:
+                counters[typ] += 1
+                name = f"{typ}{counters[typ]}"
         if name is not None and name in seen:
             c.err((*p, "name"), f"duplicate load name '{name}'",
                   f"first used by loads[{seen[name]}]")

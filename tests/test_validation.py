@@ -580,6 +580,13 @@ def test_generated_load_names(model_file):
     assert [ld.name for ld in m.loads] == ["force1", "torque1", "force2"]
 
 
+def test_generated_names_avoid_names_given_in_the_file(model_file):
+    # The unnamed force would be force1, but a later load is called that.
+    m = ok(model_file, PLANAR + "loads:\n  - {type: force, body: plate, force: [1, 0]}\n"
+           "  - {name: force1, type: force, body: plate, force: [0, 1]}\n")
+    assert [ld.name for ld in m.loads] == ["force2", "force1"]
+
+
 SPRING = "loads:\n  - {type: spring, bodies: [ground, plate], at: [[0, 1], [0, 0]], " \
          "stiffness: 100, rest_length: 0.5, damping: 2}\n"
 
