@@ -325,3 +325,21 @@ def test_help_of_each_command(command, words):
     out = succeeds(command, "--help")
     assert out.startswith(f"usage: mbody {command} ")
     assert "MODEL" in out and words in out
+
+
+# == warnings =========================================================================
+
+QN = ("dimension: 3\nbodies:\n  - {name: a, mass: 1, inertia: [1, 1, 1], "
+      "orientation: {quaternion: [2, 0, 0, 0]}}\n")
+
+
+def test_warnings_go_to_stderr_and_do_not_fail(tmp_path):
+    path = tmp_path / "q.yaml"
+    path.write_text(QN)
+    p = mbody("solve", path)
+    assert p.returncode == 0
+    assert p.stderr == (f"mbody: warning: {path}:3:70: bodies[0].orientation.quaternion: the "
+                        "quaternion has norm 2; it was normalised\n")
+    p = mbody("check", path)  # the summary lists it once, on stdout
+    assert p.returncode == 0 and p.stderr == ""
+    assert p.stdout.count("the quaternion has norm 2") == 1

@@ -15,10 +15,18 @@ from ..errors import MbodyError
 EXIT_OK, EXIT_UNMET, EXIT_INPUT, EXIT_INTERNAL = 0, 1, 2, 70
 
 
-def load_model(path: str):
+def load_model(path: str, *, warn: bool = True):
+    """The validated model at `path`; its warnings (e.g. a quaternion that was normalised)
+    go to stderr, so that a questionable input never passes unseen."""
+    import sys
+
     from ..model import load
 
-    return load(path)
+    model = load(path)
+    if warn:
+        for w in model.warnings:
+            sys.stderr.write(f"mbody: warning: {w}\n")
+    return model
 
 
 def parse_known(pairs: Sequence[str]) -> dict[str, float]:

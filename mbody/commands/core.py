@@ -43,7 +43,7 @@ def check(a: argparse.Namespace) -> int:
     from ..graph import topology
     from ..text import model_summary
 
-    model = load_model(a.model)
+    model = load_model(a.model, warn=False)  # the summary lists the warnings itself
     topo = topology(model, _assemble(model).G if model.reactions else None)
     print(model_summary(model, topo))
     print(f"\nOK: {a.model} is a valid model.")
