@@ -42,15 +42,23 @@ DEFAULT_EULER_SEQUENCE = "ZYX"
 """Intrinsic z-y'-x'' (yaw, pitch, roll), scipy's upper-case convention."""
 
 _REQUIRED_HINTS = {
-    "dimension": "2 for a planar model, 3 for a spatial one",
-    "bodies": "a list of bodies, each with at least name, mass and inertia",
-    "name": "a name without spaces or dots",
-    "mass": "the mass in kg, a number > 0",
-    "type": "the kind of joint or load",
-    "parent": "a body name or ground",
-    "child": "a body name",
-    "at": "the joint point, world coordinates at the initial pose",
+    ("", "dimension"): "2 for a planar model, 3 for a spatial one",
+    ("", "bodies"): "a list of bodies, each with at least name, mass and inertia",
+    ("bodies", "name"): "a name without spaces or dots",
+    ("bodies", "mass"): "the mass in kg, a number > 0",
+    ("loads", "body"): "the name of the body it acts on",
+    ("loads", "force"): "the force components, N",
+    ("loads", "torque"): "the couple, N m",
+    ("loads", "bodies"): "the two ends: [body, body] or [ground, body]",
+    ("loads", "at"): "the two attachment points: body axes, or world for ground",
+    ("loads", "stiffness"): "N/m, a number >= 0",
+    ("joints", "name"): "a name without spaces or dots; reactions are <name>.Fx ...",
+    ("joints", "type"): "the kind of joint, such as revolute",
+    ("joints", "parent"): "a body name or ground",
+    ("joints", "child"): "a body name",
+    ("joints", "at"): "the joint point, world coordinates at the initial pose",
 }
+"""Hints for missing required keys, by (top-level section, key)."""
 _ANGLE = re.compile(r"\s*([-+]?[0-9.eE+-]+)\s*(deg|rad)\s*")
 _RATE = re.compile(r"\s*([-+]?[0-9.eE+-]+)\s*(deg/s|rad/s)\s*")
 _TOL = 1e-6
@@ -149,7 +157,9 @@ class _Checker:
                          key=True)
         for k in required:
             if k not in value:
-                self.err(path, f"missing required key '{k}'", _REQUIRED_HINTS.get(k, ""))
+                section = str(path[0]) if path else ""
+                self.err(path, f"missing required key '{k}'",
+                         _REQUIRED_HINTS.get((section, k), ""))
         return True
 
     def number(self, path: Path_, value: Any, *, positive: bool = False,

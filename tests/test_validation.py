@@ -880,3 +880,18 @@ def test_damaged_models_raise_model_error_only():
             pytest.fail(f"{name}: setting {p} to {v!r} raised {type(exc).__name__}: {exc}")
         mbody.assemble(model)  # a model that loads must assemble
     assert refused > 1000  # most damage is caught: the sample is not all harmless
+
+
+@pytest.mark.parametrize(("section", "text", "needle", "key", "hint"), [
+    ("spring", PLANAR + SPRING.replace("at: [[0, 1], [0, 0]], ", ""), "{type", "at",
+     "the two attachment points: body axes, or world for ground"),
+    ("spring", PLANAR + SPRING.replace("bodies: [ground, plate], ", ""), "{type", "bodies",
+     "the two ends: [body, body] or [ground, body]"),
+    ("joint", PLANAR + PIN.replace("child: plate, ", ""), "{name: A", "child", "a body name"),
+    ("force", PLANAR + "loads:\n  - {type: force, force: [1, 0]}\n", "{type", "body",
+     "the name of the body it acts on"),
+])
+def test_missing_key_hints_fit_their_section(model_file, section, text, needle, key, hint):
+    i = problem(model_file, text, needle, f"{'joints' if section == 'joint' else 'loads'}[0]",
+                f"missing required key '{key}'")
+    assert i.hint == hint
