@@ -69,8 +69,8 @@ def fbd(a: argparse.Namespace) -> int:
     if a.body is not None and a.body not in model.index:
         hint = did_you_mean(a.body, model.body_names)
         raise MbodyError(f"no body named {a.body!r} in {a.model}"
-                         + (f"; {hint}" if hint else "")
-                         + "; bodies: " + ", ".join(model.body_names[:20])
+                         + (f" ({hint})" if hint else "")
+                         + "; its bodies: " + ", ".join(model.body_names[:20])
                          + (" ..." if model.n > 20 else ""))
     if a.dpi <= 0:
         raise MbodyError(f"--dpi must be a positive number of dots per inch, got {a.dpi}")
