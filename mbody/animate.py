@@ -312,6 +312,8 @@ def _arrows(traj: Trajectory, model: Model, pos: np.ndarray, quat: np.ndarray, s
 
     Each arrow node turns +y onto the load's direction; its shaft is scaled along y to
     length L − head and its head sits at the shaft's end, so the head keeps its shape.
+    A force that pushes into its body (f · r < 0, r from G to the point) is drawn ending
+    at its point, so that it stays outside the body; others start at their point.
     L = L_max |f| / max|f| over the run (forces and couples scaled separately).
     """
     from .loads import applied_loads
@@ -355,6 +357,11 @@ def _arrows(traj: Trajectory, model: Model, pos: np.ndarray, quat: np.ndarray, s
             mesh(f"{path}/head/geom/mesh",
                  g.Cylinder(head, radiusTop=0.0, radiusBottom=2.5 * radius), color)
             shaft = np.maximum(L - head, 0.0)
+            if not group:  # a push into the body is drawn with its tip at the point
+                lever = at[:, j] - pos[:, body[j]]
+                tol = 1e-9 * size[:, j] * np.linalg.norm(lever, axis=-1)  # f ⊥ r is not inward
+                inward = np.einsum("ij,ij->i", vec[:, j], lever) < -tol
+                at[inward, j] -= (shaft + head)[inward, None] * d[inward]
             shown_k = (size[:, j] > 0).astype(np.float64)
             ones, zeros = np.ones(K), np.zeros(K)
             out.append(_animation(path, [

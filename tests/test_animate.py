@@ -147,6 +147,24 @@ def test_force_arrow_tracks_follow_the_body(spinner):
         np.testing.assert_allclose(rot(Q[k]) @ [0, 1, 0], R @ [0, 0, 1], atol=1e-12)
 
 
+def test_a_push_into_the_body_ends_at_its_point(spinner):
+    """Thrust at the bottom face pointing up: the arrow's tip touches the point."""
+    model = mbody.loads(SPIN_YAML.replace("at: [0.2, 0, 0]", "at: [0, 0, -0.05]"))
+    _, traj = spinner
+    scene = build_scene(traj, model, forces=True)
+    tracks = _animation(scene, scene.load_paths["push"])
+    P = np.reshape(tracks[".position"]["values"], (-1, 3))
+    head = _animation(scene, scene.load_paths["push"] + "/head")[".position"]["values"]
+    shaft = np.reshape(head, (-1, 3))[:, 1]
+    extent = 2.0 / np.reshape(next(c for c in scene.commands if c["path"] == "/meshcat/mbody"
+                                   and c["type"] == "set_transform")["matrix"], (4, 4))[0, 0]
+    length = shaft + 0.06 * extent  # shaft plus head
+    for k in (0, 33):
+        R = rot(spin_q(traj.t[k]))
+        tip = P[k] + length[k] * (R @ [0, 0, 1])
+        np.testing.assert_allclose(tip, traj.position[k, 0] + R @ [0, 0, -0.05], atol=1e-12)
+
+
 def test_page_is_self_contained(spinner, tmp_path):
     model, traj = spinner
     out = write_page(traj, tmp_path / "run.html", model=model, forces=True)
