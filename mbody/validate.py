@@ -428,7 +428,9 @@ def _inertia(c: _Checker, path: Path_, value: Any) -> np.ndarray | None:
             return None
         scale = float(np.max(np.abs(J))) or 1.0
         if np.max(np.abs(J - J.T)) > _TOL * scale:
-            c.err(path, "the inertia tensor is not symmetric",
+            i, j = np.unravel_index(np.argmax(np.abs(J - J.T)), J.shape)
+            c.err(path, f"the inertia tensor is not symmetric: row {i + 1}, column {j + 1} "
+                  f"is {J[i, j]:g} but row {j + 1}, column {i + 1} is {J[j, i]:g}",
                   "entry (i, j) must equal entry (j, i)")
             return None
         principal = np.linalg.eigvalsh(J)
@@ -467,7 +469,8 @@ def _orientation(c: _Checker, path: Path_, value: Any) -> np.ndarray | None:
         return None
     kind = given[0]
     if "sequence" in value and kind != "euler":
-        c.err((*path, "sequence"), "'sequence' goes with 'euler'", key=True)
+        c.err((*path, "sequence"), "'sequence' goes with 'euler'",
+              "remove it, or give the angles as euler: [a, b, c]", key=True)
     if kind == "quaternion":
         q = c.vector((*path, "quaternion"), value["quaternion"], 4)
         if q is None:
@@ -492,8 +495,12 @@ def _orientation(c: _Checker, path: Path_, value: Any) -> np.ndarray | None:
     R = c.matrix3((*path, "matrix"), value["matrix"])
     if R is None:
         return None
-    if np.max(np.abs(R.T @ R - np.eye(3))) > _TOL or np.linalg.det(R) < 0:
-        c.err((*path, "matrix"), "not a rotation matrix",
+    off, det = float(np.max(np.abs(R.T @ R - np.eye(3)))), float(np.linalg.det(R))
+    if off > _TOL or det < 0:
+        c.err((*path, "matrix"), "not a rotation matrix: "
+              + (f"R^T R differs from I by up to {off:.3g}" if off > _TOL else "")
+              + ("; " if off > _TOL and det < 0 else "")
+              + (f"determinant {det:.3g} (a reflection)" if det < 0 else ""),
               "it must be orthonormal (R^T R = I within 1e-6) with determinant +1")
         return None
     return matrix_to_quat(R)
@@ -704,7 +711,8 @@ def _joints(c: _Checker, value: Any, names: dict[str, int],
                   "put ground as the parent")
             child = None
         if parent is not None and parent == child:
-            c.err((*p, "child"), f"the joint connects '{child}' to itself")
+            c.err((*p, "child"), f"the joint connects '{child}' to itself",
+                  "parent and child must be different bodies (or ground as the parent)")
             child = None
         at = c.vec3((*p, "at"), j["at"]) if "at" in j else None
         axis = axis2 = None
@@ -715,7 +723,8 @@ def _joints(c: _Checker, value: Any, names: dict[str, int],
                   "the slide direction" if typ == "prismatic" else "the rotation axis")
         if "axis2" in j:
             if typ != "universal":
-                c.err((*p, "axis2"), "'axis2' belongs to universal joints", key=True)
+                c.err((*p, "axis2"), "'axis2' belongs to universal joints",
+                      "remove it, or use type: universal", key=True)
             else:
                 axis2 = _axis(c, (*p, "axis2"), j["axis2"])
         elif typ == "universal":
@@ -738,7 +747,7 @@ def _axis(c: _Checker, path: Path_, value: Any) -> np.ndarray | None:
         return None
     n = float(np.linalg.norm(a))
     if n < 1e-12:
-        c.err(path, "the axis is the zero vector")
+        c.err(path, "the axis is the zero vector", "give a direction, such as [0, 0, 1]")
         return None
     return a / n
 

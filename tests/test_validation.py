@@ -309,7 +309,8 @@ def test_inertia_on_the_triangle_boundary_is_accepted(model_file):
 
 def test_inertia_tensor_must_be_symmetric(model_file):
     text = SPATIAL.replace("[2, 3, 4]", "[[2, 0.1, 0], [0, 3, 0], [0, 0, 4]]")
-    i = problem(model_file, text, "[[2", "bodies[0].inertia", "not symmetric")
+    i = problem(model_file, text, "[[2", "bodies[0].inertia", "not symmetric: row 1, column 2 "
+                "is 0.1 but row 2, column 1 is 0")
     assert "(i, j) must equal entry (j, i)" in i.hint
 
 
@@ -464,13 +465,15 @@ def test_rotation_matrix(model_file):
     assert m.initial.W_R_B[0] == pytest.approx(np.array([[0, -1, 0], [1, 0, 0], [0, 0, 1]]))
 
 
-@pytest.mark.parametrize("matrix", ["[[1, 0, 0], [0, 1, 0], [0, 0, 2]]",
-                                    "[[1, 0, 0], [0, 1, 0], [0, 0, -1]]",
-                                    "[[1, 0.1, 0], [0, 1, 0], [0, 0, 1]]"])
-def test_matrix_must_be_a_rotation(model_file, matrix):
+@pytest.mark.parametrize(("matrix", "words"), [
+    ("[[1, 0, 0], [0, 1, 0], [0, 0, 2]]", "R^T R differs from I by up to 3"),
+    ("[[1, 0, 0], [0, 1, 0], [0, 0, -1]]", "determinant -1 (a reflection)"),
+    ("[[1, 0.1, 0], [0, 1, 0], [0, 0, 1]]", "R^T R differs from I by up to 0.1"),
+])
+def test_matrix_must_be_a_rotation(model_file, matrix, words):
     text = SPATIAL + f"    orientation: {{matrix: {matrix}}}\n"
     i = problem(model_file, text, matrix, "bodies[0].orientation.matrix",
-                "not a rotation matrix")
+                "not a rotation matrix: " + words)
     assert "orthonormal" in i.hint and "determinant +1" in i.hint
 
 
@@ -483,7 +486,7 @@ def test_exactly_one_orientation_form(model_file):
 def test_sequence_goes_with_euler(model_file):
     text = SPATIAL + "    orientation: {quaternion: [1, 0, 0, 0], sequence: ZYX}\n"
     problem(model_file, text, "sequence", "bodies[0].orientation.sequence",
-            "'sequence' goes with 'euler'")
+            "'sequence' goes with 'euler'", hint="remove it, or give the angles as euler")
 
 
 def test_misspelt_orientation_form(model_file):
@@ -681,7 +684,8 @@ def test_axis_optional_where_the_type_needs_none(model_file, typ):
 
 def test_zero_axis(model_file):
     text = SPATIAL + HINGE.replace("axis: [0, 0, 1]", "axis: [0, 0, 0]")
-    problem(model_file, text, "[0, 0, 0]}", "joints[0].axis", "the axis is the zero vector")
+    problem(model_file, text, "[0, 0, 0]}", "joints[0].axis", "the axis is the zero vector",
+            hint="give a direction")
 
 
 def test_axis_length_follows_the_dimension(model_file):
@@ -711,7 +715,8 @@ def test_universal_needs_axis2(model_file):
 
 def test_axis2_belongs_to_universal_joints(model_file):
     text = SPATIAL + HINGE.replace("axis: [0, 0, 1]", "axis: [0, 0, 1], axis2: [1, 0, 0]")
-    problem(model_file, text, "axis2", "joints[0].axis2", "'axis2' belongs to universal joints")
+    problem(model_file, text, "axis2", "joints[0].axis2", "'axis2' belongs to universal joints",
+            hint="use type: universal")
 
 
 def test_joint_parent_misspelt(model_file):
@@ -729,7 +734,7 @@ def test_joint_child_misspelt(model_file):
 def test_joint_child_must_not_be_its_parent(model_file):
     text = PLANAR + PIN.replace("parent: ground", "parent: plate")
     problem(model_file, text, "plate, at", "joints[0].child",
-            "the joint connects 'plate' to itself")
+            "the joint connects 'plate' to itself", hint="must be different bodies")
 
 
 def test_joint_child_must_not_be_ground(model_file):
