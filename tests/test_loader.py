@@ -108,6 +108,14 @@ def test_other_constructing_tags_are_refused(tmp_path, tagged):
     assert "not allowed" in i.message
 
 
+def test_tag_shorthand_from_a_directive_is_refused_too(tmp_path, any_parser):
+    text = ("%TAG !py! tag:yaml.org,2002:python/object/apply:\n---\n"
+            "dimension: 2\nmodel: !py!os.system ['true']\n" + BODY)
+    i = only(tmp_path / "m.yaml", text)
+    assert (i.line, i.column) == mark_of(text, "!py!os")
+    assert "'tag:yaml.org,2002:python/object/apply:os.system' is not allowed" in i.message
+
+
 def test_core_tags_are_accepted(tmp_path):
     path = tmp_path / "m.yaml"
     path.write_text("dimension: !!int 2\nmodel: !!str 12\n"
