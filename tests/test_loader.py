@@ -339,3 +339,33 @@ def test_loading_10000_bodies_is_fast(tmp_path):
     elapsed = time.perf_counter() - t0
     assert len(doc.data["bodies"]) == 10_000 and doc.marks[("bodies", 9999)] == (10_002, 5)
     assert elapsed < 5.0  # about 0.4 s on the team's machine; PyYAML's compose takes ~2 s
+
+
+def test_mangled_text_gives_model_errors_only():
+    """Random edits of shipped model files: each loads, or fails with a located ModelError."""
+    import random
+
+    rng = random.Random(7)
+    texts = [p.read_text() for p in sorted(MODELS.glob("*.yaml"))]
+    pieces = list("[]{}:,-'\"#&*!|>%@` \n\t0123456789.eE+ab") + ["deg", "~", "<<: ", ": "]
+    refused = 0
+    for _ in range(1500):
+        t = rng.choice(texts)
+        for _ in range(rng.randint(1, 3)):
+            k = rng.randrange(len(t))
+            op = rng.random()
+            if op < 0.4:
+                t = t[:k] + rng.choice(pieces) + t[k:]
+            elif op < 0.7:
+                t = t[:k] + t[k + rng.randint(1, 5):]
+            else:
+                t = t[:k] + rng.choice(pieces) + t[k + 1:]
+        try:
+            mbody.assemble(mbody.loads(t, "m.yaml"))
+        except ModelError as exc:
+            refused += 1
+            lines = t.count("\n") + 2
+            assert all(i.file == "m.yaml" and 0 <= i.line <= lines for i in exc.issues)
+        except Exception as exc:  # pragma: no cover - the failure message is the point
+            pytest.fail(f"{type(exc).__name__}: {exc} on\n{t}")
+    assert refused > 300
