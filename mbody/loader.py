@@ -137,17 +137,18 @@ def load_file(path: str | os.PathLike[str], max_bytes: int = MAX_BYTES) -> Docum
         raise ModelError([Issue(name, 0, 0, "", f"cannot read the file: {exc.strerror}")]) from None
     if p.is_dir():
         raise ModelError([Issue(name, 0, 0, "", "this is a directory; expected a YAML model file")])
+    more = "mbody.load(path, max_bytes=N) reads more"
     if size > max_bytes:
-        raise ModelError(
-            [Issue(name, 0, 0, "", f"the file is {size / 2**20:.1f} MiB; at most "
-                   f"{max_bytes / 2**20:.3g} MiB is read (pass max_bytes to read more)")]
-        )
+        raise ModelError([Issue(name, 0, 0, "", f"the file is {size / 2**20:.1f} MiB; at most "
+                                f"{max_bytes / 2**20:.3g} MiB is read ({more})")])
     try:
-        raw = p.read_bytes()
+        with open(p, "rb") as f:  # bounded: /dev/zero or a pipe reports size 0
+            raw = f.read(max_bytes + 1)
     except OSError as exc:
         raise ModelError([Issue(name, 0, 0, "", f"cannot read the file: {exc.strerror}")]) from None
     if len(raw) > max_bytes:  # the file grew, or stat() lied (a pipe, /proc)
-        raise ModelError([Issue(name, 0, 0, "", f"the file is larger than {max_bytes} bytes")])
+        raise ModelError([Issue(name, 0, 0, "", f"the file is larger than {max_bytes} bytes, "
+                                f"the most that is read ({more})")])
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as exc:

@@ -369,3 +369,26 @@ def test_mangled_text_gives_model_errors_only():
         except Exception as exc:  # pragma: no cover - the failure message is the point
             pytest.fail(f"{type(exc).__name__}: {exc} on\n{t}")
     assert refused > 300
+
+
+@pytest.mark.skipif(not Path("/dev/zero").exists(), reason="no /dev/zero")
+def test_endless_device_is_read_only_up_to_the_limit():
+    t0 = time.perf_counter()
+    with pytest.raises(ModelError) as err:
+        mbody.load("/dev/zero", max_bytes=2**20)
+    assert time.perf_counter() - t0 < 1.0
+    assert str(err.value).startswith("/dev/zero: the file is larger than 1048576 bytes")
+
+
+def test_model_from_a_pipe(tmp_path):
+    import threading
+
+    fifo = tmp_path / "pipe.yaml"
+    os.mkfifo(fifo)
+    text = (MODELS / "seed_example_1.yaml").read_text()
+    writer = threading.Thread(target=fifo.write_text, args=(text,))
+    writer.start()
+    try:
+        assert mbody.load(fifo).mass.tolist() == [10.0]
+    finally:
+        writer.join(timeout=5)
