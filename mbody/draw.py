@@ -567,14 +567,34 @@ def _equation_lines(fbd: FreeBodyDiagram, planar: bool) -> list[str]:
 
 def _place_labels(fig, ax, renderer, texts, items, obstacles) -> list[Bbox]:
     """Greedy placement: for each label try spots around its anchor (the arrow tip) and
-    keep the one crossing the fewest drawn lines and placed labels, own arrow worst."""
+    keep the one crossing the fewest drawn lines and placed labels, its own arrow worst.
+
+    Works in display pixels; a label's box at a spot follows from its size and alignment
+    (text is never rotated), so each candidate costs a few array operations."""
     to_px = ax.transData.transform
     px_per_pt = fig.dpi / 72.0
     step = 1.5 * px_per_pt
-    samples = [(_sample(to_px(pts), step), tag) for pts, tag in obstacles]
-    placed: list[Bbox] = []
-    axbox = ax.get_window_extent(renderer)
+    pts_list, tags = [], []
+    for pts, tag in obstacles:
+        sp = _sample(to_px(pts), step)
+        pts_list.append(sp)
+        tags += [tag] * len(sp)
+    P = np.vstack(pts_list)
+    tags_arr = np.array(tags, dtype=object)
+    base_w = np.where(tags_arr == "outline", 0.4, 3.0)
+    placed = np.zeros((0, 4))  # x0, y0, x1, y1
+    ax_box = ax.get_window_extent(renderer)
+    pad = 2 * px_per_pt
+    frac = {"left": 0.0, "center": 0.5, "right": 1.0, "bottom": 0.0, "top": 1.0}
     for text, (_, anchor, direction, _, _, own, _) in zip(texts, items, strict=True):
+        text.set_position(anchor)
+        text.set_transform(ax.transData)
+        text.set_ha("left")
+        text.set_va("bottom")
+        ext = text.get_window_extent(renderer)
+        w, h = ext.width, ext.height
+        weights = np.where(tags_arr == own, 8.0, base_w)
+        a_px = to_px(anchor)
         d = np.asarray(direction, dtype=float)
         n = np.linalg.norm(d)
         d = d / n if n > 1e-12 else np.array([1.0, 0.0])
@@ -582,7 +602,7 @@ def _place_labels(fig, ax, renderer, texts, items, obstacles) -> list[Bbox]:
         cands = [d * 5, d * 5 + nrm * 9, d * 5 - nrm * 9, nrm * 10, -nrm * 10, d * 18,
                  d * 5 + nrm * 22, d * 5 - nrm * 22, d * 30 + nrm * 10, d * 30 - nrm * 10]
         if own not in ("axis", "g"):  # beside the shaft, half-way
-            mid = -0.5 * np.linalg.norm(to_px(anchor) - to_px(anchor - direction)) / px_per_pt
+            mid = -0.5 * np.linalg.norm(a_px - to_px(anchor - direction)) / px_per_pt
             cands += [d * mid + nrm * 10, d * mid - nrm * 10]
         # then a ring of spots further out, for crowded joints
         for radius in (14.0, 26.0, 40.0):
@@ -593,41 +613,29 @@ def _place_labels(fig, ax, renderer, texts, items, obstacles) -> list[Bbox]:
             o = off / (np.linalg.norm(off) or 1.0)
             ha = "left" if o[0] > 0.3 else "right" if o[0] < -0.3 else "center"
             va = "bottom" if o[1] > 0.3 else "top" if o[1] < -0.3 else "center"
-            text.set_position(anchor)
-            text.set_transform(offset_copy(ax.transData, fig=fig, x=off[0], y=off[1],
-                                           units="points"))
-            text.set_ha(ha)
-            text.set_va(va)
-            bb = text.get_window_extent(renderer).expanded(1.0, 1.0).padded(2 * px_per_pt)
-            score = 0.004 * float(np.linalg.norm(off))  # nearer is better, other things equal
-            for pts, tag in samples:
-                inside = np.count_nonzero((pts[:, 0] > bb.x0) & (pts[:, 0] < bb.x1)
-                                          & (pts[:, 1] > bb.y0) & (pts[:, 1] < bb.y1))
-                if inside:
-                    w = 8.0 if tag == own else 0.4 if tag == "outline" else 3.0
-                    score += w * inside
-            for pb in placed:
-                ov = _overlap(bb, pb)
-                if ov > 0:
-                    score += 200 + 5 * ov / px_per_pt**2
-            if not (axbox.x0 <= bb.x0 and bb.x1 <= axbox.x1 and axbox.y0 <= bb.y0
-                    and bb.y1 <= axbox.y1):
+            x = a_px[0] + off[0] * px_per_pt - frac[ha] * w
+            y = a_px[1] + off[1] * px_per_pt - frac[va] * h
+            x0, y0, x1, y1 = x - pad, y - pad, x + w + pad, y + h + pad
+            inside = (P[:, 0] > x0) & (P[:, 0] < x1) & (P[:, 1] > y0) & (P[:, 1] < y1)
+            score = 0.004 * float(np.linalg.norm(off))  # nearer is better, all else equal
+            score += float(weights[inside].sum())
+            if len(placed):
+                ow = np.minimum(x1, placed[:, 2]) - np.maximum(x0, placed[:, 0])
+                oh = np.minimum(y1, placed[:, 3]) - np.maximum(y0, placed[:, 1])
+                hit = (ow > 0) & (oh > 0)
+                score += float(np.sum(200 + 5 * ow[hit] * oh[hit] / px_per_pt**2))
+            if not (ax_box.x0 <= x0 and x1 <= ax_box.x1 and ax_box.y0 <= y0
+                    and y1 <= ax_box.y1):
                 score += 2.0  # allowed (limits grow later) but not preferred
             if best is None or score < best[0] - 1e-9:
-                best = (score, off, ha, va, bb)
-        _, off, ha, va, bb = best
+                best = (score, off, ha, va, (x0, y0, x1, y1))
+        _, off, ha, va, box = best
         text.set_transform(offset_copy(ax.transData, fig=fig, x=off[0], y=off[1],
                                        units="points"))
         text.set_ha(ha)
         text.set_va(va)
-        placed.append(bb)
+        placed = np.vstack((placed, box))
     return [t.get_window_extent(renderer) for t in texts]
-
-
-def _overlap(a: Bbox, b: Bbox) -> float:
-    w = min(a.x1, b.x1) - max(a.x0, b.x0)
-    h = min(a.y1, b.y1) - max(a.y0, b.y0)
-    return w * h if w > 0 and h > 0 else 0.0
 
 
 def _world_triad(ax, P: np.ndarray, planar: bool) -> None:
