@@ -58,6 +58,13 @@ def test_assemble_seed_example_1_shows_the_equations():
     assert "stacked: M 3x3, b 3, Q 3, G 3x0" in out
 
 
+def test_assemble_seed_example_2_shows_the_gyroscopic_terms():
+    out = succeeds("assemble", MODELS / "seed_example_2.yaml")
+    # J w_dot + w x (J w) = 0 with J w = (2, 6, 12): w x J w = (6, -6, 2).
+    assert "  2 alpha_1 + 6 = 0\n  3 alpha_2 - 6 = 0\n  4 alpha_3 + 2 = 0\n" in out
+    assert "stacked: M 6x6, b 6, Q 6, G 6x0" in out
+
+
 def test_solve_seed_example_1():
     out = succeeds("solve", MODELS / "seed_example_1.yaml")
     assert re.search(r"plate\s+a_x = 5 m/s\^2\s+a_y = 0 m/s\^2\s+alpha = 40 rad/s\^2", out)
