@@ -100,7 +100,7 @@ def test_model_loads_checks_and_assembles(path: Path, capsys):
 # the shaft precesses, so its bearing points move at 0.05 m/s; all its reactions are
 # given, so mbody never enforces those joints and its simulation is still right.
 # spinning_disc_bearings.yaml is the consistent version (the bearings sit on a frame).
-_INCONSISTENT = {"rotor_gyroscopic_bearings"}
+_INCONSISTENT: set[str] = set()  # rotor_gyroscopic_bearings: now a universal joint at G
 
 
 @pytest.mark.parametrize("path", [
