@@ -47,10 +47,15 @@ class ModelError(MbodyError):
         self.issues = list(issues)
         super().__init__(self._text())
 
+    SHOWN = 50
+    """Most issues written out in the message; `issues` always holds every one."""
+
     def _text(self) -> str:
         n = len(self.issues)
         head = f"{n} problem{'s' if n != 1 else ''} in the model:" if n > 1 else ""
-        body = "\n".join(str(i) for i in self.issues)
+        body = "\n".join(str(i) for i in self.issues[:self.SHOWN])
+        if n > self.SHOWN:
+            body += f"\n... and {n - self.SHOWN} more (fix these first; often they repeat)"
         return f"{head}\n{body}" if head else body
 
 
