@@ -25,7 +25,6 @@ import shutil
 import tempfile
 from collections.abc import Mapping
 from dataclasses import dataclass
-from functools import cached_property
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -36,7 +35,8 @@ import scipy.sparse as sp
 from . import conventions as cv
 from .assemble import Assembly, Solution
 from .atomic import _umask, atomic_path
-from .errors import MbodyError, UnknownReactionsError
+from .constraints import gamma, phi
+from .errors import MbodyError
 from .model import Model, State
 
 FORMAT = "mbody-export"
@@ -58,6 +58,9 @@ class Columns:
     text. W_e: (m, 3) the component's direction (its joint-frame axis) in world axes at
     the exported state. W_P: (m, 3) the joint point, world coordinates (m).
     known: (m,) the reaction value when known, NaN when unknown.
+    gamma: (m,) γ, the velocity-product terms of each joint constraint, so that a motion
+    keeping the joints has Gᵀ v̇ = γ (row c of Gᵀ is column c of G); phi: (m,) the
+    position error of each constraint at the state (0 when the joints are assembled).
     """
 
     labels: np.ndarray
@@ -71,6 +74,8 @@ class Columns:
     W_e: np.ndarray
     W_P: np.ndarray
     known: np.ndarray
+    gamma: np.ndarray
+    phi: np.ndarray
 
     def __len__(self) -> int:
         return len(self.labels)
@@ -82,11 +87,13 @@ class Columns:
             if not len(hits):
                 raise KeyError(f"no reaction column {i!r}")
             i = int(hits[0])
-        out: dict[str, Any] = {k: str(getattr(self, k)[i]) for k in COLUMN_TEXT}
-        out["label"] = out.pop("labels")
+        out: dict[str, Any] = {"label": str(self.labels[i])}
+        out.update({k: str(getattr(self, k)[i]) for k in COLUMN_TEXT[1:]})
         out["frame"] = self.W_e[i].tolist()
         out["point"] = self.W_P[i].tolist()
         out["known"] = None if np.isnan(self.known[i]) else float(self.known[i])
+        out["gamma"] = float(self.gamma[i])
+        out["phi"] = float(self.phi[i])
         return out
 
     def records(self) -> list[dict[str, Any]]:
@@ -136,27 +143,40 @@ class ExportedAssembly:
         N, m = len(self.coordinates), len(self.reactions)
         return {"M": (N, N), "b": (N,), "Q": (N,), "G": (N, m)}
 
-    @cached_property
-    def _lu(self):
+    def solve(self, known: Mapping[str, float] | None = None) -> Solution:
+        """Accelerations, and the reaction components not given (stored values or `known`).
+
+        All known: v̇ = M⁻¹ (Q + G λ − b). Otherwise, with U the unknown components,
+        ``[[M, −G_U], [G_Uᵀ, 0]] [v̇; λ_U] = [Q − b + G_K λ_K; γ_U]`` (the joints of the
+        given components are not enforced), as `mbody.Assembly.solve` does.
+        """
         from scipy.sparse.linalg import splu
 
-        return splu(self.M.tocsc())
-
-    def solve(self, known: Mapping[str, float] | None = None) -> Solution:
-        """v̇ = M⁻¹ (Q + G λ − b) with every reaction known (stored values updated by `known`)."""
         values = self.known
         for label, v in (known or {}).items():
             if label not in self.reactions:
                 raise MbodyError(f"no reaction component {label!r} in this export")
             values[label] = float(v)
-        missing = [r for r in self.reactions if r not in values]
-        if missing:
-            raise UnknownReactionsError(missing)
+        lam = np.array([values.get(r, np.nan) for r in self.reactions], dtype=float)
+        U = np.isnan(lam)
         rhs = self.Q - self.b
-        if self.reactions:
-            rhs = rhs + self.G @ np.array([values[r] for r in self.reactions])
-        acc = self._lu.solve(rhs) if len(rhs) else rhs
-        return Solution(list(self.coordinates), acc, {r: values[r] for r in self.reactions})
+        if len(lam):
+            rhs = rhs + self.G @ np.where(U, 0.0, lam)
+        N, u = len(rhs), int(U.sum())
+        if N == 0:
+            return Solution(list(self.coordinates), rhs, {})
+        GU = self.G[:, np.flatnonzero(U)]
+        K = sp.bmat([[self.M, -GU], [GU.T, None]], format="csc") if u else self.M.tocsc()
+        try:
+            x = splu(K).solve(np.concatenate((rhs, self.columns.gamma[U])))
+        except RuntimeError:  # exactly singular: redundant constraints
+            raise MbodyError("the constrained system is singular (redundant constraints); "
+                             "give some of the reaction values, or use mbody.Assembly.solve, "
+                             "which returns minimum-norm reactions") from None
+        lam[U] = x[N:]
+        return Solution(list(self.coordinates), x[:N],
+                        dict(zip(self.reactions, lam.tolist(), strict=True)),
+                        tuple(r for r, k in zip(self.reactions, U, strict=True) if k))
 
     def differences(self, other: ExportedAssembly) -> list[str]:
         """What differs from `other`, bit for bit ([] when they are identical)."""
@@ -178,7 +198,7 @@ class ExportedAssembly:
             if a.shape != b.shape or not (_same(a.data, b.data) and _same(a.indices, b.indices)
                                           and _same(a.indptr, b.indptr)):
                 out.append(k)
-        for k in (*COLUMN_TEXT, "W_e", "W_P", "known"):
+        for k in (*COLUMN_TEXT, "W_e", "W_P", "known", "gamma", "phi"):
             if not _same(getattr(self.columns, k), getattr(other.columns, k)):
                 out.append(f"columns.{k}")
         return out
@@ -234,6 +254,8 @@ def exported(asm: Assembly, known: Mapping[str, float] | None = None,
         np.array(cols.W_e, dtype=float).reshape(-1, 3),
         np.array(cols.W_P, dtype=float).reshape(-1, 3),
         np.array([values.get(lab, np.nan) for lab in labels], dtype=float),
+        np.array(gamma(model, asm.state, cols), dtype=float).reshape(-1),
+        np.array(phi(model, asm.state), dtype=float).reshape(-1),
     )
     st = asm.state
     state = State(*(np.array(getattr(st, k), dtype=float) for k in
@@ -323,6 +345,7 @@ def _arrays(exp: ExportedAssembly) -> dict[str, Any]:
         "position": exp.state.position, "quaternion": exp.state.quaternion,
         "velocity": exp.state.velocity, "omega": exp.state.omega,
         "column_frame": c.W_e, "column_point": c.W_P, "column_known": c.known,
+        "column_gamma": c.gamma, "column_phi": c.phi,
     }
     for k in COLUMN_TEXT[1:]:
         out[f"column_{k}"] = getattr(c, k)
@@ -458,10 +481,12 @@ def _csv_tables(exp: ExportedAssembly) -> dict[str, Any]:
         [lab, b, q] for lab, b, q in zip(exp.coordinates, exp.b.tolist(), exp.Q.tolist(),
                                          strict=True)]
     head = ["label", "joint", "type", "parent", "child", "component", "kind",
-            "frame_x", "frame_y", "frame_z", "point_x", "point_y", "point_z", "known", "sign"]
+            "frame_x", "frame_y", "frame_z", "point_x", "point_y", "point_z", "known",
+            "gamma", "phi", "sign"]
     columns = [head] + [
         [*(str(getattr(c, k)[i]) for k in COLUMN_TEXT[:-1]), *c.W_e[i].tolist(),
-         *c.W_P[i].tolist(), "" if np.isnan(c.known[i]) else float(c.known[i]), str(c.sign[i])]
+         *c.W_P[i].tolist(), "" if np.isnan(c.known[i]) else float(c.known[i]),
+         float(c.gamma[i]), float(c.phi[i]), str(c.sign[i])]
         for i in range(len(c))]
     bhead = ["name", "mass", *(f"J{i}{j}" for i in (1, 2, 3) for j in (1, 2, 3)),
              "x", "y", "z", "qw", "qx", "qy", "qz", "vx", "vy", "vz", "w1", "w2", "w3"]
@@ -524,7 +549,7 @@ def _build(path: Path, get, M: sp.spmatrix, G: sp.spmatrix) -> ExportedAssembly:
 
     columns = Columns(txt("reactions"), *(txt(f"column_{k}") for k in COLUMN_TEXT[1:]),
                       vec("column_frame", m, 3), vec("column_point", m, 3),
-                      vec("column_known", m))
+                      vec("column_known", m), vec("column_gamma", m), vec("column_phi", m))
     state = State(vec("position", n, 3), vec("quaternion", n, 4), vec("velocity", n, 3),
                   vec("omega", n, 3), float(get("t")))
     N = len(get("coordinates"))
@@ -599,6 +624,7 @@ def from_json(d: dict[str, Any], path: Path | str = "<json>") -> ExportedAssembl
         "column_frame": [c["frame"] for c in cols] or np.zeros((0, 3)),
         "column_point": [c["point"] for c in cols] or np.zeros((0, 3)),
         "column_known": [np.nan if c["known"] is None else c["known"] for c in cols],
+        "column_gamma": [c["gamma"] for c in cols], "column_phi": [c["phi"] for c in cols],
     }
     for k in ("position", "quaternion", "velocity", "omega"):
         flat[k] = [b[k] for b in bodies] or np.zeros((0, 4 if k == "quaternion" else 3))
@@ -653,7 +679,8 @@ def _read_csv(folder: Path) -> ExportedAssembly:
         "omega": floats(bodies, 21, 24),
         "column_frame": floats(cols, 7, 10), "column_point": floats(cols, 10, 13),
         "column_known": [np.nan if r[13] == "" else float(r[13]) for r in cols],
-        "column_sign": [r[14] for r in cols],
+        "column_gamma": [float(r[14]) for r in cols], "column_phi": [float(r[15]) for r in cols],
+        "column_sign": [r[16] for r in cols],
     })
     for i, k in enumerate(COLUMN_TEXT[1:-1], start=1):
         flat[f"column_{k}"] = [r[i] for r in cols]

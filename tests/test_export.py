@@ -96,6 +96,32 @@ def test_reloaded_export_solves_like_the_assembly(tmp_path, fmt):
         assert back.solve().accelerations == pytest.approx(want, rel=1e-12, abs=1e-12)
 
 
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_reloaded_export_solves_for_unknown_reactions(tmp_path, fmt):
+    """[[M, −G_U], [G_Uᵀ, 0]] [v̇; λ_U] = [Q − b + G_K λ_K; γ_U] from the file alone.
+
+    Pendulum about its pin: α = −m g (L/2) sin θ / (I_G + m (L/2)²); double pendulum,
+    slider-crank (moving, so γ ≠ 0) and heavy top agree with `Assembly.solve`.
+    """
+    pend = mbody.load_export(_write(mbody.assemble(MODEL_CASES["pendulum"]),
+                                    tmp_path / "p", fmt))
+    I_O = 2.0 * (0.05**2 + 1.0) / 12 + 2.0 * 0.25
+    sol = pend.solve()
+    assert sol["rod.theta"] == pytest.approx(-2.0 * 9.81 * 0.5 * 0.5 / I_O, rel=1e-12)
+    assert sol.solved == ("O.Fx", "O.Fy")
+    for name in ("double_pendulum", "slider_crank", "heavy_top"):
+        asm = mbody.assemble(mbody.load(MODELS / f"{name}.yaml"))
+        back = mbody.load_export(_write(asm, tmp_path / name, fmt))
+        want, got = asm.solve(), back.solve()
+        scale = np.abs(want.accelerations).max()
+        assert np.abs(got.accelerations - want.accelerations).max() <= 1e-12 * scale
+        for k, v in want.reactions.items():
+            assert got.reactions[k] == pytest.approx(v, rel=1e-10, abs=1e-10 * scale)
+    # A given value replaces the unknown (and its joint is no longer enforced).
+    fall = pend.solve(known={"O.Fx": 0.0, "O.Fy": 0.0})
+    assert fall["rod.y"] == -9.81 and fall["rod.theta"] == 0.0 and fall.solved == ()
+
+
 def test_round_trip_with_state_known_values_and_triplet_csv(tmp_path, monkeypatch):
     """A moved state, --known values and the CSV triplet layout (forced small limit)."""
     model = MODEL_CASES["random_planar"]
@@ -311,6 +337,10 @@ def test_cli_export_at_a_trajectory_sample(tmp_path):
         assert back.G.toarray()[2] == pytest.approx(
             [-0.5 * math.cos(th[2]), -0.5 * math.sin(th[2])], rel=1e-13)
         assert back.state.omega[0, 2] == 0.4
+        # γ = ω² (r · e) for a pin on ground, r from the mass centre to the pin; φ = 0.
+        r = np.array([-0.5 * math.sin(th[2]), 0.5 * math.cos(th[2])])
+        assert back.columns.gamma == pytest.approx(0.16 * r, rel=1e-12)
+        assert back.columns.phi == pytest.approx([0.0, 0.0], abs=1e-15)
 
 
 @pytest.mark.parametrize("args, message", [
