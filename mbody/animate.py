@@ -45,10 +45,14 @@ from .trajectory import Trajectory
 
 ROOT = "/meshcat/mbody"
 """Scene path of the model's frame; bodies are at ROOT/bodies/<name>."""
-PALETTE = ("#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#bcbd22",
+PALETTE = ("#ff7f0e", "#2ca02c", "#9467bd", "#8c564b", "#e377c2", "#bcbd22",
            "#17becf", "#7f7f7f", "#1f77b4")
-"""Default body colours (matplotlib's tab10, blue last: the background is blue)."""
+"""Default body colours (matplotlib's tab10 without its red, which marks joint reactions
+as on the free-body diagrams; blue last: the background is blue)."""
 FORCE_COLOR, COUPLE_COLOR = "#ffd400", "#ff00ff"
+REACTION_COLOR, REACTION_COUPLE_COLOR = "#e8202a", "#8b0a14"
+"""Joint reactions: the red of the free-body diagrams' reaction arrows, a darker red for
+couples, and thinner arrows than applied loads."""
 SCENE_SIZE = 2.0
 """The motion's bounding box is scaled to about this size (m) in the viewer, so that the
 viewer's fixed camera range (near 0.01, far 100) and lights suit any model."""
@@ -193,7 +197,7 @@ def _path_name(name: str) -> str:
 
 
 def build_scene(traj: Trajectory, model: Model, *, forces: bool = False,
-                bodies: Iterable[str] | None = None) -> Scene:
+                bodies: Iterable[str] | None = None, reactions: bool = False) -> Scene:
     """The meshcat commands that draw `model`'s bodies moving along `traj`.
 
     traj: positions (K, n, d) world, orientations (K, n, 4) w-first or (K, n) angles.
@@ -291,6 +295,11 @@ def build_scene(traj: Trajectory, model: Model, *, forces: bool = False,
         arrows, load_paths = _arrows(traj, model, pos, quat, set(idx), times, extent,
                                      set_transform, mesh)
         animations.extend(arrows)
+    if reactions:
+        arrows, reaction_paths = _reaction_arrows(traj, model, times, extent, set_transform,
+                                                  mesh)
+        animations.extend(arrows)
+        load_paths.update(reaction_paths)
 
     cmds.append({"type": "set_animation", "path": "", "animations": animations,
                  "options": {"play": True, "repetitions": math.inf}})
@@ -345,33 +354,89 @@ def _arrows(traj: Trajectory, model: Model, pos: np.ndarray, quat: np.ndarray, s
         scale = L_max / top if top > 0 else 0.0
         color = int((COUPLE_COLOR if group else FORCE_COLOR)[1:], 16)
         for j in np.flatnonzero(sel):
-            L = size[:, j] * scale
-            d = np.divide(vec[:, j], size[:, j, None], out=np.zeros((K, 3)),
-                          where=size[:, j, None] > 0)
-            d[size[:, j] == 0] = [0.0, 1.0, 0.0]
             path = f"{ROOT}/loads/{j}_{_path_name(names[j])}"
             paths.setdefault(names[j], path)
-            set_transform(f"{path}/shaft/geom", _homogeneous(p=[0.0, 0.5, 0.0]))
-            mesh(f"{path}/shaft/geom/mesh", g.Cylinder(1.0, radius), color)
-            set_transform(f"{path}/head/geom", _homogeneous(p=[0.0, head / 2, 0.0]))
-            mesh(f"{path}/head/geom/mesh",
-                 g.Cylinder(head, radiusTop=0.0, radiusBottom=2.5 * radius), color)
-            shaft = np.maximum(L - head, 0.0)
-            if not group:  # a push into the body is drawn with its tip at the point
-                lever = at[:, j] - pos[:, body[j]]
-                tol = 1e-9 * size[:, j] * np.linalg.norm(lever, axis=-1)  # f ⊥ r is not inward
-                inward = np.einsum("ij,ij->i", vec[:, j], lever) < -tol
-                at[inward, j] -= (shaft + head)[inward, None] * d[inward]
-            shown_k = (size[:, j] > 0).astype(np.float64)
-            ones, zeros = np.ones(K), np.zeros(K)
-            out.append(_animation(path, [
-                _track("position", "vector3", times, at[:, j]),
-                _track("quaternion", "quaternion", times, _xyzw(_y_to(d))),
-                _track("scale", "vector3", times, np.stack([shown_k] * 3, axis=-1))]))
-            out.append(_animation(f"{path}/shaft", [
-                _track("scale", "vector3", times, np.stack([ones, shaft, ones], axis=-1))]))
-            out.append(_animation(f"{path}/head", [
-                _track("position", "vector3", times, np.stack([zeros, shaft, zeros], -1))]))
+            lever = None if group else at[:, j] - pos[:, body[j]]
+            out += _arrow(g, path, at[:, j], vec[:, j], size[:, j] * scale, color,
+                          (head, radius), times, set_transform, mesh, lever)
+    return out, paths
+
+
+def _arrow(g, path: str, at: np.ndarray, vec: np.ndarray, L: np.ndarray, color: int,
+           dims: tuple[float, float], times: list[float], set_transform, mesh,
+           lever: np.ndarray | None = None) -> list[dict[str, Any]]:
+    """One arrow's nodes and tracks: (K, 3) foot `at`, direction of `vec`, length L (K,).
+
+    With `lever` (K, 3) (point minus mass centre), a push into the body is drawn with its
+    tip at the point instead of its foot, so that it stays outside the body.
+    """
+    head, radius = dims
+    K = len(times)
+    size = np.linalg.norm(vec, axis=-1)
+    d = np.divide(vec, size[:, None], out=np.zeros((K, 3)), where=size[:, None] > 0)
+    d[size == 0] = [0.0, 1.0, 0.0]
+    set_transform(f"{path}/shaft/geom", _homogeneous(p=[0.0, 0.5, 0.0]))
+    mesh(f"{path}/shaft/geom/mesh", g.Cylinder(1.0, radius), color)
+    set_transform(f"{path}/head/geom", _homogeneous(p=[0.0, head / 2, 0.0]))
+    mesh(f"{path}/head/geom/mesh",
+         g.Cylinder(head, radiusTop=0.0, radiusBottom=2.5 * radius), color)
+    shaft = np.maximum(L - head, 0.0)
+    at = np.array(at, dtype=np.float64)
+    if lever is not None:
+        tol = 1e-9 * size * np.linalg.norm(lever, axis=-1)  # f ⊥ r is not inward
+        inward = np.einsum("ij,ij->i", vec, lever) < -tol
+        at[inward] -= (shaft + head)[inward, None] * d[inward]
+    shown_k = (size > 0).astype(np.float64)
+    ones, zeros = np.ones(K), np.zeros(K)
+    return [
+        _animation(path, [
+            _track("position", "vector3", times, at),
+            _track("quaternion", "quaternion", times, _xyzw(_y_to(d))),
+            _track("scale", "vector3", times, np.stack([shown_k] * 3, axis=-1))]),
+        _animation(f"{path}/shaft", [
+            _track("scale", "vector3", times, np.stack([ones, shaft, ones], axis=-1))]),
+        _animation(f"{path}/head", [
+            _track("position", "vector3", times, np.stack([zeros, shaft, zeros], -1))])]
+
+
+def _reaction_arrows(traj: Trajectory, model: Model, times: list[float], extent: float,
+                     set_transform, mesh):
+    """Each joint's net reaction on its child, per frame: the force at the joint point
+    (R = Σ λ_k e_k over its force components) and its couple (Σ over moment components),
+    dashed-red style of the diagrams (REACTION_COLOR, thinner). The parent gets −R."""
+    from .joints import reaction_columns
+
+    if not len(traj.reaction_labels) or traj.reactions.shape[1] == 0:
+        raise MbodyError("this run holds no joint reactions to draw (a model without "
+                         "joints, or a run saved before reactions were stored)")
+    mc = _meshcat()
+    g = mc.geometry
+    K, J = len(times), len(model.joints)
+    t = model.reaction_table
+    order = [traj.reaction_labels.index(r) for r in model.reactions]
+    F, C, P = np.zeros((K, J, 3)), np.zeros((K, J, 3)), np.zeros((K, J, 3))
+    for k in range(K):  # one vectorised evaluation per frame
+        cols = reaction_columns(model, traj.state(k))
+        w = traj.reactions[k, order][:, None] * cols.W_e
+        for comp_is_moment, acc in ((False, F), (True, C)):
+            sel = cols.is_moment == comp_is_moment
+            for c in range(3):
+                acc[k, :, c] = np.bincount(t.joint[sel], w[sel, c], minlength=J)
+        P[k] = cols.joint_W_P
+    L_max, head, radius = 0.35 * extent, 0.05 * extent, 0.008 * extent
+    out, paths = [], {}
+    for vec, color, kind in ((F, REACTION_COLOR, "force"), (C, REACTION_COUPLE_COLOR, "couple")):
+        size = np.linalg.norm(vec, axis=-1)
+        top = float(size.max()) if size.size else 0.0
+        if top <= 0:
+            continue
+        for jn, joint in enumerate(model.joints):
+            if not np.any(size[:, jn] > 1e-12 * top):
+                continue
+            path = f"{ROOT}/reactions/{_path_name(joint.name)}_{kind}"
+            paths[f"{joint.name} ({kind})"] = path
+            out += _arrow(g, path, P[:, jn], vec[:, jn], size[:, jn] * L_max / top,
+                          int(color[1:], 16), (head, radius), times, set_transform, mesh)
     return out, paths
 
 
@@ -461,9 +526,9 @@ def page_html(scene: Scene, *, extra_js: str = "") -> str:
 
 def write_page(traj: Trajectory, out: str | os.PathLike[str], *, model: Model,
                forces: bool = False, bodies: Iterable[str] | None = None,
-               extra_js: str = "") -> Path:
+               extra_js: str = "", reactions: bool = False) -> Path:
     """Write the offline animation page for `traj` to `out` (atomically); return its path."""
-    scene = build_scene(traj, model, forces=forces, bodies=bodies)
+    scene = build_scene(traj, model, forces=forces, bodies=bodies, reactions=reactions)
     return write_atomic(out, page_html(scene, extra_js=extra_js))
 
 
@@ -712,7 +777,7 @@ def _simulate(model: Model, t_end: float | None, fps: float | None) -> Trajector
 def animate(source, out: str | os.PathLike[str] | None = "run.html", *,
             model: Model | str | os.PathLike[str] | None = None, forces: bool = False,
             live: bool = False, t_end: float | None = None, fps: float | None = None,
-            bodies: Iterable[str] | None = None) -> Path | LiveViewer:
+            bodies: Iterable[str] | None = None, reactions: bool = False) -> Path | LiveViewer:
     """Animate a motion: write a self-contained page, or (live=True) open the live viewer.
 
     source: a `Trajectory` (then give `model`), a `Model` (simulated first, `t_end`/`fps`
@@ -721,7 +786,7 @@ def animate(source, out: str | os.PathLike[str] | None = "run.html", *,
     written; show its `url` in a browser and `close()` it when done).
     """
     traj, mdl = resolve(source, model, t_end=t_end, fps=fps)
-    scene = build_scene(traj, mdl, forces=forces, bodies=bodies)
+    scene = build_scene(traj, mdl, forces=forces, bodies=bodies, reactions=reactions)
     if not live:
         if out is None:
             raise MbodyError("give out= (the page to write) or live=True")

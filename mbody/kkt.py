@@ -29,6 +29,8 @@ from .joints import ReactionColumns
 from .model import Model
 from .spatial import matvec
 
+SMALL_BODIES = 60
+"""Up to this many bodies (and DENSE_LIMIT unknowns) G is held as a dense array."""
 DENSE_LIMIT = 300
 """Up to this many unknown components, S is factorised densely (and checked for rank)."""
 RANK_RTOL = 1e-10
@@ -41,6 +43,24 @@ def block_solve(model: Model, body: np.ndarray, g6: np.ndarray) -> np.ndarray:
     out[:, :3] = g6[:, :3] / model.mass[body, None]
     out[:, 3:] = matvec(model.J_inv[body], g6[:, 3:])
     return out
+
+
+def _g_and_minv_g_dense(model: Model, parent: np.ndarray, child: np.ndarray,
+                        child6: np.ndarray, parent6: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """G_U and M⁻¹ G_U as dense (6n x mu) arrays (for small mechanisms)."""
+    mu = len(child)
+    G = np.zeros((6 * model.n, mu))
+    H = np.zeros((6 * model.n, mu))
+    k = np.arange(6)
+    u = np.arange(mu)[:, None]
+    G[child[:, None] * 6 + k, u] = child6
+    H[child[:, None] * 6 + k, u] = block_solve(model, child, child6)
+    on = parent >= 0
+    if on.any():
+        rows = parent[on, None] * 6 + k
+        G[rows, u[on]] = parent6[on]
+        H[rows, u[on]] = block_solve(model, parent[on], parent6[on])
+    return G, H
 
 
 def _g_and_minv_g(model: Model, parent: np.ndarray, child: np.ndarray, child6: np.ndarray,
@@ -95,8 +115,8 @@ class Factorisation:
         if self.redundant:
             return float("inf")
         S = self._S
-        if self.size <= DENSE_LIMIT:
-            return float(np.linalg.cond(S.toarray(), 1))
+        if not sp.issparse(S):
+            return float(np.linalg.cond(S, 1))
         inv = spla.LinearOperator(S.shape, matvec=self.solve, rmatvec=self.solve,
                                   dtype=float)
         return float(spla.onenormest(S) * spla.onenormest(inv))
@@ -115,9 +135,14 @@ class ConstrainedSystem:
         self.unknown = np.asarray(unknown, dtype=bool)
         U = np.flatnonzero(self.unknown)
         self.U = U
-        self.G, self.H = _g_and_minv_g(model, t.parent[U], t.child[U], cols.child6[U],
-                                       cols.parent6[U])
-        self.fact = self._factorise((self.G.T @ self.H).tocsr())
+        args = (model, t.parent[U], t.child[U], cols.child6[U], cols.parent6[U])
+        if len(U) <= DENSE_LIMIT and model.n <= SMALL_BODIES:
+            # Small mechanisms: dense arrays beat sparse-matrix bookkeeping by far.
+            self.G, self.H = _g_and_minv_g_dense(*args)
+            self.fact = self._dense(self.G.T @ self.H)
+        else:
+            self.G, self.H = _g_and_minv_g(*args)
+            self.fact = self._factorise((self.G.T @ self.H).tocsr())
 
     # -- factorisation -------------------------------------------------------------------
     def _factorise(self, S: sp.csr_matrix) -> Factorisation:
@@ -170,15 +195,15 @@ class ConstrainedSystem:
             return Factorisation("LSQR (rank-deficient, redundant constraints)", mu,
                                  redundant=[-1], _solve=solve, _S=S)
 
-    def _dense(self, S: sp.csr_matrix) -> Factorisation:
-        A = S.toarray()
+    def _dense(self, S) -> Factorisation:
+        A = S.toarray() if sp.issparse(S) else np.asarray(S)
         A = 0.5 * (A + A.T)
         try:  # the usual case: independent constraints, S positive definite
             cf = sla.cho_factor(A, check_finite=False)
             d = np.diag(cf[0]) ** 2
             if d.min() > RANK_RTOL * d.max():
                 return Factorisation("dense Cholesky of the Schur complement", len(A),
-                                     rank=len(A), _S=S,
+                                     rank=len(A), _S=A,
                                      _solve=lambda r: sla.cho_solve(cf, r, check_finite=False))
         except np.linalg.LinAlgError:
             pass
@@ -190,7 +215,7 @@ class ConstrainedSystem:
             cf = sla.cho_factor(A, check_finite=False)
             return Factorisation("dense Cholesky of the Schur complement", len(w), rank=rank,
                                  _solve=lambda r: sla.cho_solve(cf, r, check_finite=False),
-                                 _S=S)
+                                 _S=A)
         # Minimum-norm solution through the pseudo-inverse; the null space of S (= that of
         # G_U) tells which components are not unique.
         Vg, wg = V[:, good], w[good]
@@ -198,7 +223,7 @@ class ConstrainedSystem:
         not_unique = np.flatnonzero(np.linalg.norm(null, axis=1) > 1e-8).tolist()
         return Factorisation("dense pseudo-inverse of the Schur complement (redundant "
                              "constraints)", len(w), redundant=not_unique, rank=rank,
-                             _solve=lambda r: Vg @ ((Vg.T @ r) / wg), _S=S)
+                             _solve=lambda r: Vg @ ((Vg.T @ r) / wg), _S=A)
 
     # -- solving -------------------------------------------------------------------------
     def solve(self, r6: np.ndarray, gamma_U: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -224,7 +249,7 @@ class ConstrainedSystem:
         """Norm-wise relative backward error ‖r‖∞ / (‖K‖∞ ‖x‖∞ + ‖f‖∞) of the KKT system."""
         model = self.model
         r1, r2 = self.residual(r6, gamma_U, acc6, lam)
-        absG = abs(self.G)
+        absG = abs(self.G) if sp.issparse(self.G) else np.abs(self.G)
         rowM = np.concatenate((np.repeat(model.mass[:, None], 3, axis=1),
                                np.abs(model.J).sum(axis=2)), axis=1).ravel()
         normK = max(float(np.max(rowM + np.asarray(absG.sum(axis=1)).ravel(), initial=0.0)),

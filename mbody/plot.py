@@ -55,9 +55,10 @@ def plot_trajectory(traj: Trajectory, bodies: list[str] | None = None) -> Figure
     t = traj.t
     T, E, H, kind = _energy_momentum(traj)
 
-    fig = Figure(figsize=(11, 7.5), layout="constrained")
+    has_reactions = bool(traj.reaction_labels) and traj.reactions.shape[1] > 0
+    fig = Figure(figsize=(11, 10.5 if has_reactions else 7.5), layout="constrained")
     FigureCanvasAgg(fig)
-    ax = fig.subplots(2, 2)
+    ax = fig.subplots(3 if has_reactions else 2, 2)
     title = f"{traj.model_name or 'trajectory'}: {traj.n} bod{'y' if traj.n == 1 else 'ies'}"
     if traj.info:
         title += (f", {traj.info.get('integrator', '')} rtol {traj.info.get('rtol', 0):g}")
@@ -105,12 +106,32 @@ def plot_trajectory(traj: Trajectory, bodies: list[str] | None = None) -> Figure
                  if traj.info.get(key)]
     a.set_title("relative change" + (f" (conserved: {', '.join(conserved)})"
                                       if conserved else " (nothing conserved)"))
+    if has_reactions:
+        _reaction_panels(traj, ax[2, 0], ax[2, 1])
     for a in ax.flat:
         a.set_xlabel("t (s)")
         a.grid(True, alpha=0.3)
         if a.get_legend_handles_labels()[0]:
             a.legend(fontsize="small", ncol=2 if len(a.lines) > 6 else 1)
     return fig
+
+
+MAX_REACTIONS = 12
+"""Reaction components drawn per panel (the first ones in label order)."""
+
+
+def _reaction_panels(traj: Trajectory, forces_ax, moments_ax) -> None:
+    """Reaction components over time: forces (N) on one panel, moments (N m) on the other;
+    each on its joint frame axis, acting +R on the child and −R on the parent."""
+    labels = list(traj.reaction_labels)
+    for ax, moment, unit in ((forces_ax, False, "N"), (moments_ax, True, "N m")):
+        sel = [k for k, lab in enumerate(labels) if lab.split(".", 1)[1].startswith("M") == moment]
+        for k in sel[:MAX_REACTIONS]:
+            ax.plot(traj.t, traj.reactions[:, k], label=labels[k])
+        more = f" (first {MAX_REACTIONS} of {len(sel)})" if len(sel) > MAX_REACTIONS else ""
+        ax.set_title(f"joint reaction {'moments' if moment else 'forces'}, joint axes{more}"
+                     if sel else f"no joint reaction {'moments' if moment else 'forces'}")
+        ax.set_ylabel(unit)
 
 
 def save_plot(traj: Trajectory, path: str | os.PathLike[str], bodies: list[str] | None = None,

@@ -178,7 +178,13 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     K = int(math.floor(t_end * fps + 1e-9)) + 1
     if K > 10_000_000:
         raise MbodyError(f"{K} output samples requested (t_end * fps); at most 10 million")
-    f = dynamics or known_reaction_dynamics(model, known)
+    mechanism = dynamics is None and _has_unknown_reactions(model, known)
+    if mechanism:  # joints with unknown reactions: solved at every step (mbody.mechanism)
+        from .mechanism import constrained_dynamics
+
+        f = constrained_dynamics(model, _numeric_known(model, known))
+    else:
+        f = dynamics or known_reaction_dynamics(model, known)
     n = model.n
     planar = model.dimension == cv.PLANAR
     s0 = model.initial if initial is None else initial
@@ -251,12 +257,21 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     reactions_at = getattr(f, "reactions_at", None)
     lam = (reactions_at(t_eval) if reactions_at is not None and labels
            else np.zeros((K, 0)))
+    joint_info: dict = {}
+    if mechanism:
+        from .mechanism import constraint_drift, reactions_along
+
+        states = [_sample_state(model, x[k], q[k], v[k], w[k], float(t_eval[k]))
+                  for k in range(K)]
+        lam = reactions_along(model, states, _numeric_known(model, known))
+        joint_info = {"joint_stabilisation": f.stabilisation, **constraint_drift(model, states)}
     info = {
         "integrator": method, "rtol": rtol, "atol": atol, "t_end": t_end, "fps": fps,
         "samples": K, "steps": steps, "evaluations": counts["nfev"],
         "wall_time_s": wall, "quaternion_norm_error": q_err,
         "quaternion_handling": "integrated as is; rotation built from q/|q|; output "
                                "samples divided by |q|",
+        **joint_info,
     }
     pose = ((x[..., :2], v[..., :2], Y[:, 13 * n:], w[..., 2]) if planar else (x, v, q, w))
     traj = Trajectory(
@@ -266,7 +281,7 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
         shapes=tuple(model.bodies[b].shape for b in model.body_names),
         colors=tuple(model.bodies[b].color for b in model.body_names),
         gravity=np.array(model.gravity), model_yaml=_model_text(model))
-    series, drift = _drift(model, traj, dynamics is None)
+    series, drift = _drift(model, traj, dynamics is None, ideal_joints=mechanism)
     traj.series.update(series)
     info.update(drift)
     return traj
@@ -300,8 +315,37 @@ def potential_energy(model: Model, traj: Trajectory) -> np.ndarray:
     return V
 
 
-def _drift(model: Model, traj: Trajectory, default_dynamics: bool
-           ) -> tuple[dict[str, np.ndarray], dict]:
+def _has_unknown_reactions(model: Model, known: Mapping[str, float | str] | None) -> bool:
+    given = set(model.known_reactions) | set(getattr(model, "known_expressions", {}))
+    return bool(set(model.reactions) - given - set(known or {}))
+
+
+def _numeric_known(model: Model, known: Mapping[str, float | str] | None
+                   ) -> dict[str, float] | None:
+    """`known` for the constrained path (numbers only; formulas of t go in the file)."""
+    if not known:
+        return None
+    out = {}
+    for label, v in known.items():
+        if label not in model.reaction_index:
+            hint = did_you_mean(label, model.reactions)
+            raise MbodyError(f"no reaction component {label!r} in this model"
+                             + (f"; {hint}" if hint else ""))
+        if isinstance(v, str):
+            raise MbodyError(f"{label}: a known value given as a formula of t is supported "
+                             "for models whose reactions are all known; write it in the "
+                             "model file's 'reactions:' instead")
+        out[label] = float(v)
+    return out
+
+
+def _sample_state(model: Model, x, q, v, w, t: float) -> State:
+    """A sample of the integrated (internal, spatial-form) arrays as a `State`."""
+    return State(x, q, v, w, t)
+
+
+def _drift(model: Model, traj: Trajectory, default_dynamics: bool, *,
+           ideal_joints: bool = False) -> tuple[dict[str, np.ndarray], dict]:
     """Energy and angular-momentum series and their largest relative change.
 
     Energy E = T + V; its change is relative to max(|E(0)|, max T). Angular momentum: about
@@ -316,15 +360,19 @@ def _drift(model: Model, traj: Trajectory, default_dynamics: bool
     e_change = float(np.max(np.abs(E - E[0])) / scale) if scale > 0 else 0.0
 
     sp = model.springs
-    applied = len(model.forces.names) > 0 or bool(model.reactions) or not default_dynamics
-    grounded = bool(np.any((sp.a < 0) | (sp.b < 0))) if len(sp.names) else False
+    # Ideal joints whose reactions are solved do no work (Gᵀ v = 0): energy is conserved.
+    applied = (len(model.forces.names) > 0 or not default_dynamics
+               or (bool(model.reactions) and not ideal_joints)
+               or (ideal_joints and bool(model.known_reactions)))
+    grounded = (bool(np.any((sp.a < 0) | (sp.b < 0))) if len(sp.names) else False) or \
+        any(j.parent == cv.GROUND for j in model.joints)
     damped = bool(np.any(sp.damping > 0)) if len(sp.names) else False
     gravity = bool(np.any(model.gravity))
     energy_conserved = not applied and not damped
     if not applied and not grounded and not gravity:
         H, kind = traj.angular_momentum(), "total, about the world origin"
         h_conserved = True
-    elif not applied and not len(sp.names):
+    elif not applied and not len(sp.names) and not model.joints:
         H, kind = traj.spin_angular_momentum(), "spin, about the mass centres"
         h_conserved = True
     else:
@@ -359,6 +407,10 @@ def summary(traj: Trajectory, path: str | os.PathLike[str] | None = None) -> str
     h0 = np.linalg.norm(i["angular_momentum_initial"])
     lines.append(f"angular momentum ({i['angular_momentum_kind']}): |H(0)| = {h0:.6g} "
                  f"kg m^2/s, relative {what} {i['angular_momentum_drift']:.2e}")
+    if "joint_stabilisation" in i:
+        lines.append(f"joints: reactions solved at every step ({i['joint_stabilisation']}); "
+                     f"largest joint error |phi| {i['joint_position_drift']:.1e}, "
+                     f"|G^T v| {i['joint_velocity_drift']:.1e}")
     if traj.dimension == cv.SPATIAL:
         lines.append(f"quaternion norm error before renormalising: "
                      f"{i['quaternion_norm_error']:.1e}")

@@ -147,6 +147,38 @@ def test_force_arrow_tracks_follow_the_body(spinner):
         np.testing.assert_allclose(rot(Q[k]) @ [0, 1, 0], R @ [0, 0, 1], atol=1e-12)
 
 
+def test_reaction_arrows_show_the_solved_pin_force(tmp_path):
+    """A simulated pendulum: the pin's arrow sits at the pin, points along the stored
+    reaction R = (O.Fx, O.Fy) on the child at every frame, and its shaft length is
+    proportional to |R|; a run without reactions is refused with a clear error."""
+    model = mbody.load("models/pendulum.yaml")
+    traj = mbody.simulate(model, t_end=0.5, fps=20)
+    scene = build_scene(traj, model, reactions=True)
+    path = scene.load_paths["O (force)"]
+    tracks = _animation(scene, path)
+    P = np.reshape(tracks[".position"]["values"], (-1, 3))
+    Q = np.reshape(tracks[".quaternion"]["values"], (-1, 4))[:, [3, 0, 1, 2]]
+    shaft = np.reshape(_animation(scene, path + "/shaft")[".scale"]["values"], (-1, 3))[:, 1]
+    R = traj.reactions[:, [traj.reaction_labels.index("O.Fx"),
+                           traj.reaction_labels.index("O.Fy")]]
+    R3 = np.column_stack((R, np.zeros(len(R))))
+    np.testing.assert_allclose(P, 0.0, atol=1e-9)  # the pin is at the origin
+    for k in range(len(traj.t)):
+        np.testing.assert_allclose(rot(Q[k]) @ [0, 1, 0], R3[k] / np.linalg.norm(R3[k]),
+                                   atol=1e-9)
+    # shaft = c |R| − head (a fixed head): its changes are proportional to |R|'s.
+    mag = np.linalg.norm(R, axis=1)
+    c = (shaft[-1] - shaft[0]) / (mag[-1] - mag[0])
+    np.testing.assert_allclose(np.diff(shaft), c * np.diff(mag), rtol=1e-6, atol=1e-12)
+    assert c > 0
+    mesh = [c for c in scene.commands if c.get("type") == "set_object"
+            and c["path"].endswith(path.strip("/") + "/shaft/geom/mesh")]
+    assert mesh and mesh[0]["object"]["materials"][0]["color"] == 0xE8202A
+    with pytest.raises(MbodyError, match="no joint reactions"):
+        build_scene(mbody.simulate(mbody.load("models/seed_example_2.yaml"), t_end=0.1),
+                    mbody.load("models/seed_example_2.yaml"), reactions=True)
+
+
 def test_a_push_into_the_body_ends_at_its_point(spinner):
     """Thrust at the bottom face pointing up: the arrow's tip touches the point."""
     model = mbody.loads(SPIN_YAML.replace("at: [0.2, 0, 0]", "at: [0, 0, -0.05]"))

@@ -28,6 +28,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="the model of a run file (default: the model file it names)")
     s.add_argument("--forces", action="store_true",
                    help="draw applied forces (yellow) and couples (magenta) as arrows")
+    s.add_argument("--reactions", action="store_true",
+                   help="draw each joint's reaction on its child (red: force at the joint "
+                   "point; dark red: couple)")
     s.add_argument("--body", metavar="NAME", action="append",
                    help="draw only this body (repeatable)")
     s.add_argument("--t-end", type=float, metavar="S", help="simulated time for a MODEL")
@@ -53,7 +56,7 @@ def animate(a: argparse.Namespace) -> int:
         if value is not None and not value > 0:
             raise MbodyError(f"{flag} must be > 0, got {value:g}")
     traj, model = resolve(a.source, a.model, t_end=a.t_end, fps=a.fps)
-    scene = build_scene(traj, model, forces=a.forces, bodies=a.body)
+    scene = build_scene(traj, model, forces=a.forces, bodies=a.body, reactions=a.reactions)
     what = (f"{len(scene.paths)} bod{'y' if len(scene.paths) == 1 else 'ies'}, "
             f"{scene.frames} frames, {scene.duration:g} s")
     out = a.output or (None if a.live else Path(a.source).with_suffix(".html").name)
