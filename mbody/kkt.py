@@ -65,32 +65,26 @@ def _g_and_minv_g_dense(model: Model, parent: np.ndarray, child: np.ndarray,
 
 def _g_and_minv_g(model: Model, parent: np.ndarray, child: np.ndarray, child6: np.ndarray,
                   parent6: np.ndarray) -> tuple[sp.csc_matrix, sp.csc_matrix]:
-    """G_U and M⁻¹ G_U (6n x mu) built straight in CSC form: each column holds 6 rows of
-    its child and 6 of its parent (none for ground), lower body index first, so the
-    indices come out sorted without any conversion or sort."""
+    """G_U and M⁻¹ G_U (6n x mu) built straight in CSC form, 12 entries a column: the
+    child's 6 rows, then the parent's (for ground, zeros placed on the child's rows
+    again: duplicates that add nothing, and no masking or sorting of the arrays)."""
     mu = len(child)
     k = np.arange(6)
-    on_p = parent >= 0
-    lo = np.where(on_p, np.minimum(parent, child), child)
-    hi = np.maximum(parent, child)
-    child_first = ~on_p | (child < parent)
+    p = np.where(parent >= 0, parent, child)
     rows = np.empty((mu, 12), dtype=np.int64)
-    rows[:, :6] = lo[:, None] * 6 + k
-    rows[:, 6:] = hi[:, None] * 6 + k
-    h_c = block_solve(model, child, child6)
-    h_p = block_solve(model, np.where(on_p, parent, 0), parent6)
-    cf = child_first[:, None]
-    g = np.concatenate((np.where(cf, child6, parent6), np.where(cf, parent6, child6)), axis=1)
-    h = np.concatenate((np.where(cf, h_c, h_p), np.where(cf, h_p, h_c)), axis=1)
-    keep = np.ones((mu, 12), dtype=bool)
-    keep[:, 6:] = on_p[:, None]
-    indptr = np.zeros(mu + 1, dtype=np.int64)
-    np.cumsum(np.where(on_p, 12, 6), out=indptr[1:])
+    rows[:, :6] = child[:, None] * 6 + k
+    rows[:, 6:] = p[:, None] * 6 + k
+    g = np.empty((mu, 12))
+    g[:, :6] = child6
+    g[:, 6:] = parent6  # zero for ground
+    h = np.empty((mu, 12))
+    h[:, :6] = block_solve(model, child, child6)
+    h[:, 6:] = block_solve(model, p, parent6)
+    indptr = np.arange(0, 12 * mu + 1, 12, dtype=np.int64)
     shape = (6 * model.n, mu)
-    idx = rows[keep]
-    G = sp.csc_matrix((g[keep], idx, indptr), shape=shape)
-    H = sp.csc_matrix((h[keep], idx, indptr), shape=shape)
-    G.has_sorted_indices = H.has_sorted_indices = True
+    idx = rows.ravel()
+    G = sp.csc_matrix((g.ravel(), idx, indptr), shape=shape)
+    H = sp.csc_matrix((h.ravel(), idx, indptr), shape=shape)
     return G, H
 
 
