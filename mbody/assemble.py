@@ -82,13 +82,25 @@ class Solution:
     condition: float | None = None
     """1-norm condition estimate of the Schur complement Gᵀ M⁻¹ G (when asked for)."""
     method: str = "block-diagonal M"
+    broken_joints: tuple[str, ...] = ()
+    """Enforced constraints that the state breaks (φ ≠ 0 or Gᵀ v ≠ 0), as text."""
+    redundant: int = 0
+    """Number of redundant constraints (unknown components minus the rank of G_U)."""
 
     @property
     def warnings(self) -> list[str]:
         out = []
         if self.not_unique:
-            out.append(f"redundant constraints: the reactions {', '.join(self.not_unique)} "
-                       "are not unique; the minimum-norm values are given")
+            out.append(f"{self.redundant} redundant constraint(s): the reactions "
+                       f"{', '.join(self.not_unique)} share that indeterminacy and are not "
+                       "unique; the minimum-norm values are given")
+        if self.broken_joints:
+            shown = ", ".join(self.broken_joints[:6])
+            more = f" and {len(self.broken_joints) - 6} more" if len(self.broken_joints) > 6 \
+                else ""
+            out.append(f"the state breaks {len(self.broken_joints)} joint constraint(s): "
+                       f"{shown}{more}; the joints hold only from a state that respects them "
+                       "(positions and velocities)")
         if self.residual is not None and self.residual > INCONSISTENT:
             out.append(f"the constraints are inconsistent at this state (relative residual "
                        f"{self.residual:.1e}): the joints are not assembled, or the velocities "
@@ -221,7 +233,7 @@ class Assembly:
                         {r: values[r] for r in self.reactions})
 
     def _solve_constrained(self, values: dict[str, float], condition: bool) -> Solution:
-        from .constraints import gamma
+        from .constraints import gamma, joint_errors
         from .kkt import ConstrainedSystem
 
         model = self.model
@@ -243,7 +255,9 @@ class Assembly:
                         tuple(solved[k] for k in system.fact.redundant if k >= 0),
                         system.backward_error(r6, g_U, acc6, lam_U),
                         system.fact.condition() if condition else None,
-                        system.fact.method)
+                        system.fact.method,
+                        tuple(joint_errors(model, self.state, self.columns, unknown)),
+                        system.fact.size - system.fact.rank)
 
 
 class _LazyBodies(Mapping):

@@ -10,6 +10,33 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import IO
 
+from .errors import MbodyError
+
+
+def ensure_writable(target: str | os.PathLike[str]) -> Path:
+    """Check (before any long work) that `target` can be written: its folder exists or can
+    be made, is a folder, and is writable; `target` itself is not a folder. Missing
+    folders are created. Returns the folder; raises `MbodyError` with the reason."""
+    target = Path(target)
+    folder = target.parent if str(target.parent) else Path(".")
+    if target.is_dir():
+        raise MbodyError(f"cannot write {str(target)!r}: it is a folder; give a file name")
+    for p in (folder, *folder.parents):
+        if p.exists():
+            if not p.is_dir():
+                raise MbodyError(f"cannot write {str(target)!r}: {str(p)!r} is a file, "
+                                 "not a folder")
+            break
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise MbodyError(f"cannot write {str(target)!r}: cannot make the folder "
+                         f"{str(folder)!r} ({exc.strerror or exc})") from None
+    if not os.access(folder, os.W_OK):
+        raise MbodyError(f"cannot write {str(target)!r}: the folder {str(folder)!r} is "
+                         "not writable")
+    return folder
+
 
 @contextlib.contextmanager
 def atomic_path(target: str | os.PathLike[str], suffix: str = "") -> Iterator[Path]:
@@ -19,10 +46,12 @@ def atomic_path(target: str | os.PathLike[str], suffix: str = "") -> Iterator[Pa
     `suffix` keeps the extension for writers that look at it (numpy, scipy.io).
     """
     target = Path(target)
-    folder = target.parent if str(target.parent) else Path(".")
-    folder.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=suffix or target.suffix,
-                               dir=folder)
+    folder = ensure_writable(target)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=suffix or target.suffix,
+                                   dir=folder)
+    except OSError as exc:
+        raise MbodyError(f"cannot write {str(target)!r}: {exc.strerror or exc}") from None
     os.close(fd)
     tmp_path = Path(tmp)
     os.chmod(tmp_path, 0o666 & ~_umask())  # mkstemp makes 0600; give what open() would

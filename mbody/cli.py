@@ -23,7 +23,9 @@ COMMAND_MODULES = ("core", "export", "sim", "draw", "animate", "mechanism")
 
 def build_parser() -> argparse.ArgumentParser:
     p = _Parser(prog="mbody", description="Per-body Newton-Euler equations for multibody "
-                "models: M v_dot + b = Q + G lambda.")
+                "models: M v_dot + b = Q + G lambda.", allow_abbrev=False,
+                epilog="Start with: mbody check MODEL, then mbody assemble MODEL. "
+                "Each command has --help.")
     p.add_argument("--version", action="version", version=f"mbody {__version__}")
     sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
@@ -33,7 +35,14 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 class _Parser(argparse.ArgumentParser):
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("allow_abbrev", False)  # --know must not silently mean --known
+        super().__init__(*args, **kwargs)
+
     def error(self, message: str):  # one paragraph, exit 2, as for any bad input
+        if "required: COMMAND" in message:  # bare `mbody`: show what there is to do
+            self.print_help(sys.stderr)
+            raise SystemExit(EXIT_INPUT)
         bad = re.search(r"invalid choice: '([^']*)' \(choose from (.*)\)", message)
         if bad:  # argparse of Python 3.11 offers no suggestion for a misspelt command
             hint = did_you_mean(bad.group(1), re.findall(r"'([^']*)'", bad.group(2)))

@@ -153,3 +153,36 @@ class ConstraintJacobian:
         """The nonzero entries of one constraint row, by coordinate label."""
         r = self.matrix.getrow(self.rows.index(label)).tocoo()
         return {self.columns[j]: float(v) for j, v in zip(r.col, r.data, strict=True)}
+
+
+JOINT_TOL = 1e-6
+"""Relative size of φ (to the model's extent) and of Gᵀ v (to its largest speed) above
+which a state is said to break a joint."""
+
+
+def joint_errors(model: Model, state: State, cols: ReactionColumns | None = None,
+                 enforced: np.ndarray | None = None) -> list[str]:
+    """The enforced constraints (default: those of unknown reactions) that `state` breaks,
+    as text: position errors φ ≠ 0 and relative velocities Gᵀ v ≠ 0 (see `phi`)."""
+    t = model.reaction_table
+    if not len(t.labels):
+        return []
+    if enforced is None:
+        enforced = np.array([lab not in model.known_reactions for lab in t.labels])
+    from .joints import reaction_columns
+
+    cols = reaction_columns(model, state) if cols is None else cols
+    v6 = np.concatenate((state.velocity, state.omega), axis=1)
+    gtv = np.einsum("ij,ij->i", cols.child6, v6[t.child])
+    on = t.parent >= 0
+    gtv[on] += np.einsum("ij,ij->i", cols.parent6[on], v6[t.parent[on]])
+    ph = phi(model, state)
+    size = float(np.ptp(state.position, axis=0).max()) if model.n > 1 else 0.0
+    size = max(size, float(np.abs(t.B_r_child).max()), 1e-3)
+    speed = max(float(np.abs(v6).max()), 1e-3)
+    out = []
+    for k in np.flatnonzero(enforced & ((np.abs(ph) > JOINT_TOL * size)
+                                        | (np.abs(gtv) > JOINT_TOL * speed))):
+        unit = ("rad", "rad/s") if t.axis[k] >= 3 else ("m", "m/s")
+        out.append(f"{t.labels[k]} (phi {ph[k]:.3g} {unit[0]}, G^T v {gtv[k]:.3g} {unit[1]})")
+    return out

@@ -373,7 +373,7 @@ def draw_fbd(fbd, *, view: str | Sequence[float] | None = "iso", equations: bool
     eq_lines = _equation_lines(fbd, planar) if equations else []
     zeros = [fo.label or fo.name for fo in fbd.forces if not fo.unknown and (
         fo.value == 0 if fo.kind == REACTION else fo.magnitude == 0)]
-    zero_note = textwrap.wrap("known to be zero (not drawn): " + ", ".join(zeros), 110)
+    zero_note = textwrap.wrap("zero at this instant (not drawn): " + ", ".join(zeros), 110)
     h_draw, h_title = 5.6, 0.45
     h_band = 1.25 + 0.17 * len(zero_note) if zeros else 1.25
     h_eq = (0.3 + 0.19 * len(eq_lines)) if eq_lines else 0.0

@@ -264,7 +264,10 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
         states = [_sample_state(model, x[k], q[k], v[k], w[k], float(t_eval[k]))
                   for k in range(K)]
         lam = reactions_along(model, states, _numeric_known(model, known))
-        joint_info = {"joint_stabilisation": f.stabilisation, **constraint_drift(model, states)}
+        from .constraints import joint_errors
+
+        joint_info = {"joint_stabilisation": f.stabilisation, **constraint_drift(model, states),
+                      "initial_joint_errors": joint_errors(model, states[0])}
     info = {
         "integrator": method, "rtol": rtol, "atol": atol, "t_end": t_end, "fps": fps,
         "samples": K, "steps": steps, "evaluations": counts["nfev"],
@@ -405,12 +408,26 @@ def summary(traj: Trajectory, path: str | os.PathLike[str] | None = None) -> str
     what = "drift" if i["angular_momentum_conserved"] else \
         "change (not conserved: external moments)"
     h0 = np.linalg.norm(i["angular_momentum_initial"])
-    lines.append(f"angular momentum ({i['angular_momentum_kind']}): |H(0)| = {h0:.6g} "
-                 f"kg m^2/s, relative {what} {i['angular_momentum_drift']:.2e}")
+    if i["angular_momentum_conserved"]:
+        lines.append(f"angular momentum ({i['angular_momentum_kind']}): |H(0)| = {h0:.6g} "
+                     f"kg m^2/s, relative {what} {i['angular_momentum_drift']:.2e}")
+    else:  # a relative change of something not conserved (and maybe 0 at t = 0) says little
+        lines.append(f"angular momentum ({i['angular_momentum_kind']}): |H(0)| = {h0:.6g} "
+                     "kg m^2/s, not conserved (external moments act)")
+    if i["energy_conserved"] and i["energy_drift"] > 1e-6:
+        lines.append(f"warning: energy should be conserved but drifted {i['energy_drift']:.1e}"
+                     " (relative); check the initial state and the tolerances")
     if "joint_stabilisation" in i:
         lines.append(f"joints: reactions solved at every step ({i['joint_stabilisation']}); "
                      f"largest joint error |phi| {i['joint_position_drift']:.1e}, "
                      f"|G^T v| {i['joint_velocity_drift']:.1e}")
+        broken = i.get("initial_joint_errors") or []
+        if broken:
+            lines.append(f"warning: the initial state breaks {len(broken)} joint "
+                         f"constraint(s): {', '.join(broken[:4])}"
+                         + (" ..." if len(broken) > 4 else "")
+                         + "; the stabilisation pulls the joints together, so energy and "
+                         "the early motion are not those of the model as written")
     if traj.dimension == cv.SPATIAL:
         lines.append(f"quaternion norm error before renormalising: "
                      f"{i['quaternion_norm_error']:.1e}")

@@ -22,6 +22,20 @@ def _n(x: float) -> str:
     return "0" if s in ("-0", "0") else s
 
 
+def _table(header: list[str], rows: list[list[str]], indent: str = "  ") -> list[str]:
+    """Left-aligned columns, each as wide as its longest cell plus two spaces."""
+    widths = [max(len(r[c]) for r in [header, *rows]) for c in range(len(header))]
+    fmt = indent + "  ".join(f"{{:<{w}}}" for w in widths)
+    return [fmt.format(*r).rstrip() for r in [header, *rows]]
+
+
+def _clean(x: np.ndarray, rel: float = 1e-10) -> np.ndarray:
+    """Values below `rel` times the largest one printed as 0: rounding noise, not data."""
+    x = np.asarray(x, dtype=float)
+    top = float(np.max(np.abs(x), initial=0.0))
+    return np.where(np.abs(x) <= rel * top, 0.0, x)
+
+
 def _plural(k: int, word: str) -> str:
     if k == 1:
         return f"{k} {word}"
@@ -96,10 +110,10 @@ def graph_summary(model: Model, topo: Topology) -> str:
              f"{_plural(g.number_of_edges(), 'joint edge')}; "
              + ("a tree (no closed loops)" if topo.is_tree
                 else f"{_plural(topo.loops, 'closed loop')}")]
-    parts = [p for p in topo.parts if p != [cv.GROUND]]
     lines.append(f"  connected parts: {len(topo.parts)}")
-    for p in parts[:10]:
-        lines.append("    " + ", ".join(p[:12]) + (" ..." if len(p) > 12 else ""))
+    for p in topo.parts[:10]:
+        text = ", ".join(p[:12]) + (" ..." if len(p) > 12 else "")
+        lines.append("    " + (text + " (nothing attached)" if p == [cv.GROUND] else text))
     if topo.floating:
         lines.append(f"  attached to nothing ({len(topo.floating)}): "
                      + ", ".join(topo.floating[:12]) + (" ..." if len(topo.floating) > 12 else ""))
@@ -120,23 +134,24 @@ def body_text(eq: BodyEquations, dimension: int) -> str:
     f = eq.fbd
     out = [f"== {eq.body} ==  m {_n(f.mass)} kg, mass centre at {_v(f.W_position, dimension)} m"]
     out.append("free body:")
-    hdr = (f"  {'force':<14}{'kind':<10}{'point (body, m)':<22}{'components (world)':<30}"
-           f"moment about G")
-    out.append(hdr)
+    rows = []
     for fo in f.forces:
         if fo.kind == REACTION:
-            name = fo.label + ("" if fo.value is None else f"={_n(fo.value)}")
-            comp = ("unit " if fo.value is None else "") + _v(
-                fo.W_vector if fo.value is not None else fo.W_vector, dimension)
+            name = fo.label + ("" if fo.value is None else f" = {_n(fo.value)}")
+            comp = ("unit " if fo.value is None else "") + _v(fo.W_vector, dimension)
+        elif fo.couple and dimension == cv.PLANAR:  # a planar couple is a scalar about z
+            name, comp = fo.name, _n(fo.W_vector[2])
         else:
             name, comp = fo.name, _v(fo.W_vector, dimension)
         unit = "N m" if fo.couple else "N"
         point = "-" if fo.couple else _v(fo.B_r, dimension)
         mom = _n(fo.B_moment[2]) if dimension == cv.PLANAR else _v(fo.B_moment, 3)
-        label = "couple" if fo.couple else fo.kind
-        if fo.kind == REACTION:
-            label = "reaction"
-        out.append(f"  {name:<14}{label:<10}{point:<22}{comp + ' ' + unit:<30}{mom}")
+        label = "reaction" if fo.kind == REACTION else "couple" if fo.couple else fo.kind
+        rows.append([name, label, point, f"{comp} {unit}", mom])
+    if f.forces:
+        out += _table(["force", "kind", "point (body axes, m)", "components (world axes)",
+                       "moment about G" + (" (N m)" if dimension == cv.PLANAR
+                                           else " (body axes, N m)")], rows)
     if not f.forces:
         out.append("  (no forces)")
     out.append("Newton (world axes):")
@@ -168,8 +183,9 @@ def solution_text(sol: Solution, model: Model) -> str:
     lines = [f"accelerations of {model.name!r} (Newton rows world axes"
              + (", Euler rows body axes):" if model.dimension == 3 else "):")]
     k = len(rows)
+    acc = _clean(sol.accelerations)
     for i, name in enumerate(model.body_names):
-        vals = sol.accelerations[i * k:(i + 1) * k]
+        vals = acc[i * k:(i + 1) * k]
         lines.append(f"  {name:<14}" + "  ".join(
             f"{cv.ACCELERATION_NAMES[r]} = {_n(v)} {units.get(r, 'rad/s^2')}"
             for r, v in zip(rows, vals, strict=True)))
@@ -177,41 +193,48 @@ def solution_text(sol: Solution, model: Model) -> str:
 
 
 def reaction_table_text(asm: Assembly, sol: Solution) -> str:
-    """Joint, component, frame axis (world), value; then each joint's net force and couple
-    on its child (at the joint point) and on its parent (equal and opposite)."""
+    """Joint, component, its axis (world components at this state), value, status; then
+    each joint's net force and couple on its child (at the joint point) and on its parent
+    (equal and opposite)."""
     model = asm.model
     dim = model.dimension
     if not sol.reactions:
         return ""
     cols = asm.columns
     t = model.reaction_table
-    lines = ["reactions (components along the joint frame axes, world components shown; "
-             "+R on the child, -R on the parent):",
-             f"  {'joint':<10}{'comp':<6}{'axis (world)':<28}{'value':>14}  {'':<8}"]
-    solved = set(sol.solved)
+    lam = _clean(np.array([sol.reactions[r] for r in model.reactions]))
+    solved, not_unique = set(sol.solved), set(sol.not_unique)
+    rows = []
     for c, label in enumerate(model.reactions):
         joint, comp = label.split(".", 1)
         unit = "N m" if cols.is_moment[c] else "N"
-        how = "solved" if label in solved else "given"
-        if label in sol.not_unique:
-            how = "not unique"
-        lines.append(f"  {joint:<10}{comp:<6}{_v(cols.W_e[c], 3):<28}"
-                     f"{_n(sol.reactions[label]):>14} {unit:<4} {how}")
-    lines.append("net joint loads (world axes, at the joint point):")
-    lam = np.array([sol.reactions[r] for r in model.reactions])
-    for jn, j in enumerate(model.joints):
+        status = ("not unique" if label in not_unique else
+                  "solved" if label in solved else "given")
+        rows.append([joint, comp, _v(cols.W_e[c], dim), f"{_n(lam[c])} {unit}", status])
+    lines = ["joint reactions: each component acts along (or about) its joint-frame axis, "
+             "+R on the child and -R on the parent"]
+    lines += _table(["joint", "comp", "axis (world)", "value", "status"], rows)
+    lines.append("net load of each joint at its joint point (world axes):")
+    F_all = np.zeros((len(model.joints), 3))
+    C_all = np.zeros((len(model.joints), 3))
+    for jn in range(len(model.joints)):
         sel = t.joint == jn
-        F = (lam[sel & ~cols.is_moment, None] * cols.W_e[sel & ~cols.is_moment]).sum(axis=0)
-        C = (lam[sel & cols.is_moment, None] * cols.W_e[sel & cols.is_moment]).sum(axis=0)
-        P = cols.W_P[np.flatnonzero(sel)[0]]
+        F_all[jn] = (lam[sel & ~cols.is_moment, None] * cols.W_e[sel & ~cols.is_moment]).sum(0)
+        C_all[jn] = (lam[sel & cols.is_moment, None] * cols.W_e[sel & cols.is_moment]).sum(0)
+    F_all, C_all = _clean(F_all), _clean(C_all)
+    for jn, j in enumerate(model.joints):
+        P = cols.W_P[np.flatnonzero(t.joint == jn)[0]]
+        F, C = F_all[jn], C_all[jn]
         Cs = _n(C[2]) if dim == cv.PLANAR else _v(C, 3)
         mCs = _n(-C[2]) if dim == cv.PLANAR else _v(-C, 3)
         lines.append(f"  {j.name} at {_v(P, dim)}: on child {j.child}: F {_v(F, dim)} N, "
                      f"C {Cs} N m; on parent {j.parent}: F {_v(-F, dim)} N, C {mCs} N m")
     if sol.residual is not None:
-        lines.append(f"solve: {sol.method}; relative backward error {sol.residual:.1e}"
-                     + (f"; condition estimate {sol.condition:.2e}"
-                        if sol.condition is not None else ""))
+        cond = ""
+        if sol.condition is not None:
+            cond = ("; singular (redundant constraints)" if not np.isfinite(sol.condition)
+                    else f"; condition estimate {sol.condition:.2e}")
+        lines.append(f"solve: {sol.method}; relative backward error {sol.residual:.1e}{cond}")
     for w in sol.warnings:
         lines.append(f"warning: {w}")
     return "\n".join(lines)

@@ -378,7 +378,7 @@ def test_cli_export_json_with_known_value(tmp_path):
 def test_cli_export_unwritable_target_is_one_message(tmp_path):
     (tmp_path / "taken.npz").mkdir()
     r = _mbody("export", MODELS / "pendulum.yaml", "-o", tmp_path / "taken.npz")
-    assert r.returncode == 2 and "cannot write" in r.stderr and "Is a directory" in r.stderr
+    assert r.returncode == 2 and "cannot write" in r.stderr and "is a folder" in r.stderr
     assert [p.name for p in tmp_path.iterdir()] == ["taken.npz"]  # no temporary file left
     (tmp_path / "file").write_text("x")
     r = _mbody("export", MODELS / "pendulum.yaml", "--csv", tmp_path / "file")

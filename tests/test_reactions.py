@@ -178,7 +178,10 @@ def test_constrained_solution_satisfies_both_block_rows(seed):
     assert asm.M @ a + asm.b == pytest.approx(asm.Q + asm.G @ lam, rel=1e-9, abs=1e-9)
     assert asm.G.T @ a == pytest.approx(asm.jacobian().gamma, rel=1e-9, abs=1e-9)
     assert sol.residual < 1e-13
-    assert not sol.not_unique and not sol.warnings
+    assert not sol.not_unique and sol.redundant == 0
+    # The random velocities break the joints, and the solution says so by name.
+    assert sol.broken_joints and all("G^T v" in b for b in sol.broken_joints)
+    assert [w for w in sol.warnings if "breaks" in w] == sol.warnings
 
 
 def test_inconsistent_redundant_constraints_are_reported():

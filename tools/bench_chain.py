@@ -40,13 +40,17 @@ def chain_spec(n: int) -> dict:
             "joints": joints}
 
 
-def best(fn, repeat: int) -> float:
+def best(fn, repeat: int, *args) -> float:
     out = float("inf")
     for _ in range(repeat):
         t0 = time.perf_counter()
-        fn()
+        fn(*args)
         out = min(out, time.perf_counter() - t0)
     return out
+
+
+def build_and_solve(model: mbody.Model, state: mbody.State) -> None:
+    mbody.assemble(model, state).solve()
 
 
 def kkt_splu(asm: mbody.Assembly) -> None:
@@ -60,7 +64,7 @@ def kkt_splu(asm: mbody.Assembly) -> None:
 def mujoco_models(n: int, joint_coordinates: bool):
     import mujoco
 
-    inertial = f'<inertial pos="0 0 0" mass="1" diaginertia="1e-3 1e-3 2e-4"/>'
+    inertial = '<inertial pos="0 0 0" mass="1" diaginertia="1e-3 1e-3 2e-4"/>'
     if joint_coordinates:  # nested 1000 deep: built with MjSpec (XML limits nesting)
         spec = mujoco.MjSpec()
         spec.option.gravity = [0, 0, -G0]
@@ -76,7 +80,7 @@ def mujoco_models(n: int, joint_coordinates: bool):
     else:
         body = "".join(f'<body name="l{i}" pos="0 0 {-L * (i + 0.5)}"><freejoint/>{inertial}'
                        "</body>" for i in range(n))
-        eq = f'<connect body1="world" body2="l0" anchor="0 0 0"/>' + "".join(
+        eq = '<connect body1="world" body2="l0" anchor="0 0 0"/>' + "".join(
             f'<connect body1="l{i - 1}" body2="l{i}" anchor="0 0 {-L / 2}"/>'
             for i in range(1, n))
         xml = (f'<mujoco><option gravity="0 0 {-G0}" jacobian="sparse"/><size memory="2G"/>'
@@ -106,18 +110,18 @@ def main() -> None:
     for n in sizes:
         model = mbody.load(chain_spec(n))
         state = model.initial
-        t_mb = best(lambda: mbody.assemble(model, state).solve(), a.repeat) / n
+        t_mb = best(build_and_solve, a.repeat, model, state) / n
         sol = mbody.assemble(model, state).solve(condition=True)
         asm = mbody.assemble(model, state)
-        t_lu = best(lambda: kkt_splu(asm), max(1, a.repeat // 2)) / n
+        t_lu = best(kkt_splu, max(1, a.repeat // 2), asm) / n
         cols = [f"{n:>7} {1e6 * t_mb:8.2f} {1e6 * t_lu:9.2f} {t_lu / t_mb:6.1f}"]
         if have_mj:
             mj, m, d = mujoco_models(n, joint_coordinates=False)
-            t_max = best(lambda: mj.mj_forward(m, d), a.repeat) / n
+            t_max = best(mj.mj_forward, a.repeat, m, d) / n
             cols.append(f"{1e6 * t_max:8.2f} {t_max / t_mb:6.1f}")
             if n <= 1000:
                 mj, m, d = mujoco_models(n, joint_coordinates=True)
-                t_j = best(lambda: mj.mj_forward(m, d), a.repeat) / n
+                t_j = best(mj.mj_forward, a.repeat, m, d) / n
                 cols.append(f"{1e6 * t_j:9.2f} {t_j / t_mb:6.1f}")
             else:
                 cols.append(f"{'-':>9} {'-':>6}")

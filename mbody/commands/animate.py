@@ -55,6 +55,10 @@ def animate(a: argparse.Namespace) -> int:
     for flag, value in (("--t-end", a.t_end), ("--fps", a.fps), ("--hold", a.hold)):
         if value is not None and not value > 0:
             raise MbodyError(f"{flag} must be > 0, got {value:g}")
+    if a.output:  # fail now, not after simulating
+        from ..atomic import ensure_writable
+
+        ensure_writable(a.output)
     traj, model = resolve(a.source, a.model, t_end=a.t_end, fps=a.fps)
     scene = build_scene(traj, model, forces=a.forces, bodies=a.body, reactions=a.reactions)
     what = (f"{len(scene.paths)} bod{'y' if len(scene.paths) == 1 else 'ies'}, "

@@ -28,9 +28,12 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "FILE, or to standard output without FILE")
     s.set_defaults(run=assemble)
 
-    s = sub.add_parser("solve", help="accelerations of every body (reactions known or absent)",
-                       description="Accelerations of every body when no unknown reactions "
-                       "remain (none, or all given in the file or with --known).")
+    s = sub.add_parser("solve", help="accelerations of every body and the unknown reactions",
+                       description="Accelerations of every body. Reaction values given in "
+                       "the file or with --known are applied as loads; the unknown ones are "
+                       "solved together with the accelerations (M v_dot - G lambda = Q - b, "
+                       "G^T v_dot = gamma) and printed as a reaction table, with the backward "
+                       "error, a condition estimate and any redundant constraints named.")
     s.add_argument("model", metavar="MODEL", help="a YAML model file")
     s.add_argument("--known", metavar="LABEL=VALUE", action="append", default=[],
                    help="a known reaction value, e.g. --known A.Fx=3 (repeatable)")
@@ -40,12 +43,19 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def check(a: argparse.Namespace) -> int:
     from ..assemble import assemble as _assemble
+    from ..constraints import joint_errors
     from ..graph import topology
     from ..text import model_summary
 
     model = load_model(a.model, warn=False)  # the summary lists the warnings itself
     topo = topology(model, _assemble(model).G if model.reactions else None)
     print(model_summary(model, topo))
+    broken = joint_errors(model, model.initial)
+    if broken:
+        print(f"warning: the initial state breaks {len(broken)} joint constraint(s): "
+              + ", ".join(broken[:6]) + (" ..." if len(broken) > 6 else "")
+              + "; move or set the bodies' positions and velocities so the joints hold",
+              file=sys.stderr)
     print(f"\nOK: {a.model} is a valid model.")
     return EXIT_OK
 

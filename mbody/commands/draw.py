@@ -111,5 +111,5 @@ def report(a: argparse.Namespace) -> int:
     parse_view(a.view)
     model = load_model(a.model)
     path = write_report(model, a.output, view=a.view)
-    print(f"wrote {path}  ({model.n} bodies)")
+    print(f"wrote {path}  ({model.n} bod{'y' if model.n == 1 else 'ies'})")
     return EXIT_OK

@@ -9,11 +9,14 @@ from . import EXIT_OK, load_model, parse_known
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    s = sub.add_parser("simulate", help="integrate the motion (reactions known or absent)",
+    s = sub.add_parser("simulate", help="integrate the motion (unknown reactions solved "
+                       "each step)",
                        description="Integrate the Newton-Euler equations of MODEL from its "
-                       "initial state (every reaction value known: none, given in the file, "
-                       "or with --known), print the run summary with the drift of energy and "
-                       "angular momentum, and save the trajectory with -o.")
+                       "initial state. Reaction values given in the file or with --known are "
+                       "applied as loads; the unknown ones are solved with the accelerations "
+                       "at every step (joints held by Baumgarte stabilisation) and stored "
+                       "with the run. Prints the run summary with the drift of energy, "
+                       "angular momentum and joints; saves the trajectory with -o.")
     s.add_argument("model", metavar="MODEL", help="a YAML model file")
     s.add_argument("--t-end", type=float, default=10.0, metavar="SECONDS",
                    help="simulated time, s (default 10)")
@@ -53,6 +56,10 @@ def simulate(a: argparse.Namespace) -> int:
     from ..simulate import simulate as _simulate
 
     model = load_model(a.model)
+    if a.output:  # fail now, not after a long integration
+        from ..atomic import ensure_writable
+
+        ensure_writable(a.output)
     traj = _simulate(model, a.t_end, a.fps,
                      rtol=DEFAULT_RTOL if a.rtol is None else a.rtol,
                      atol=DEFAULT_ATOL if a.atol is None else a.atol, method=a.method,
