@@ -95,12 +95,9 @@ class Solution:
                        f"{', '.join(self.not_unique)} share that indeterminacy and are not "
                        "unique; the minimum-norm values are given")
         if self.broken_joints:
-            shown = ", ".join(self.broken_joints[:6])
-            more = f" and {len(self.broken_joints) - 6} more" if len(self.broken_joints) > 6 \
-                else ""
-            out.append(f"the state breaks {len(self.broken_joints)} joint constraint(s): "
-                       f"{shown}{more}; the joints hold only from a state that respects them "
-                       "(positions and velocities)")
+            out.append(f"the state breaks joint constraints: {', '.join(self.broken_joints)}"
+                       "; the joints hold only from a state that respects them (positions "
+                       "and velocities)")
         if self.residual is not None and self.residual > INCONSISTENT:
             out.append(f"the constraints are inconsistent at this state (relative residual "
                        f"{self.residual:.1e}): the joints are not assembled, or the velocities "
@@ -245,7 +242,7 @@ class Assembly:
         r6 = self._Q6 - self._b6 + reaction_wrench(model, self.columns, lam)
         system = ConstrainedSystem(model, self.columns, unknown)
         g_U = gamma(model, self.state, self.columns)[unknown]
-        acc6, lam_U = system.solve_refined(r6, g_U)
+        acc6, lam_U, berr = system.solve_refined(r6, g_U)
         lam[unknown] = lam_U
         labels = self.reactions
         solved = (tuple(labels) if len(system.U) == len(labels)
@@ -253,11 +250,20 @@ class Assembly:
         return Solution(self.coordinates, _select(model, acc6),
                         dict(zip(labels, lam.tolist(), strict=True)), solved,
                         tuple(solved[k] for k in system.fact.redundant if k >= 0),
-                        system.backward_error(r6, g_U, acc6, lam_U),
+                        berr,
                         system.fact.condition() if condition else None,
                         system.fact.method,
-                        tuple(joint_errors(model, self.state, self.columns, unknown)),
+                        tuple(joint_errors(model, self.state, self.columns, unknown,
+                                           gtv=_gtv(system, self.state, len(labels)))),
                         system.fact.size - system.fact.rank)
+
+
+def _gtv(system, state: State, m: int) -> np.ndarray:
+    """(m,) Gᵀ v for the system's (unknown) components, zero for the others."""
+    v6 = np.concatenate((state.velocity, state.omega), axis=1).ravel()
+    out = np.zeros(m)
+    out[system.U] = system.G.T @ v6
+    return out
 
 
 class _LazyBodies(Mapping):

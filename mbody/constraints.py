@@ -161,9 +161,11 @@ which a state is said to break a joint."""
 
 
 def joint_errors(model: Model, state: State, cols: ReactionColumns | None = None,
-                 enforced: np.ndarray | None = None) -> list[str]:
+                 enforced: np.ndarray | None = None, limit: int = 8,
+                 gtv: np.ndarray | None = None) -> list[str]:
     """The enforced constraints (default: those of unknown reactions) that `state` breaks,
-    as text: position errors φ ≠ 0 and relative velocities Gᵀ v ≠ 0 (see `phi`)."""
+    as text: position errors φ ≠ 0 and relative velocities Gᵀ v ≠ 0 (see `phi`). At most
+    `limit` are described; a last entry counts the rest."""
     t = model.reaction_table
     if not len(t.labels):
         return []
@@ -171,18 +173,22 @@ def joint_errors(model: Model, state: State, cols: ReactionColumns | None = None
         enforced = np.array([lab not in model.known_reactions for lab in t.labels])
     from .joints import reaction_columns
 
-    cols = reaction_columns(model, state) if cols is None else cols
     v6 = np.concatenate((state.velocity, state.omega), axis=1)
-    gtv = np.einsum("ij,ij->i", cols.child6, v6[t.child])
-    on = t.parent >= 0
-    gtv[on] += np.einsum("ij,ij->i", cols.parent6[on], v6[t.parent[on]])
+    if gtv is None:  # (m,) Gᵀ v, unless the caller has it already
+        cols = reaction_columns(model, state) if cols is None else cols
+        gtv = np.einsum("ij,ij->i", cols.child6, v6[t.child])
+        on = t.parent >= 0
+        gtv[on] += np.einsum("ij,ij->i", cols.parent6[on], v6[t.parent[on]])
     ph = phi(model, state)
     size = float(np.ptp(state.position, axis=0).max()) if model.n > 1 else 0.0
     size = max(size, float(np.abs(t.B_r_child).max()), 1e-3)
     speed = max(float(np.abs(v6).max()), 1e-3)
     out = []
-    for k in np.flatnonzero(enforced & ((np.abs(ph) > JOINT_TOL * size)
-                                        | (np.abs(gtv) > JOINT_TOL * speed))):
+    broken = np.flatnonzero(enforced & ((np.abs(ph) > JOINT_TOL * size)
+                                        | (np.abs(gtv) > JOINT_TOL * speed)))
+    for k in broken[:limit]:
         unit = ("rad", "rad/s") if t.axis[k] >= 3 else ("m", "m/s")
         out.append(f"{t.labels[k]} (phi {ph[k]:.3g} {unit[0]}, G^T v {gtv[k]:.3g} {unit[1]})")
+    if len(broken) > limit:
+        out.append(f"{len(broken) - limit} more")
     return out

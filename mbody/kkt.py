@@ -239,15 +239,16 @@ class ConstrainedSystem:
         r2 = gamma_U - self.G.T @ acc6.ravel()
         return r1.reshape(-1, 6), r2
 
-    def backward_error(self, r6, gamma_U, acc6, lam) -> float:
-        """Norm-wise relative backward error ‖r‖∞ / (‖K‖∞ ‖x‖∞ + ‖f‖∞) of the KKT system."""
+    def _norm_K(self) -> float:
+        """‖K‖∞ of the KKT matrix [[M, −G_U], [G_Uᵀ, 0]] (row sums of |M| and |G|)."""
         model = self.model
-        r1, r2 = self.residual(r6, gamma_U, acc6, lam)
         absG = abs(self.G) if sp.issparse(self.G) else np.abs(self.G)
         rowM = np.concatenate((np.repeat(model.mass[:, None], 3, axis=1),
                                np.abs(model.J).sum(axis=2)), axis=1).ravel()
-        normK = max(float(np.max(rowM + np.asarray(absG.sum(axis=1)).ravel(), initial=0.0)),
-                    float(np.max(np.asarray(absG.sum(axis=0)).ravel(), initial=0.0)))
+        return max(float(np.max(rowM + np.asarray(absG.sum(axis=1)).ravel(), initial=0.0)),
+                   float(np.max(np.asarray(absG.sum(axis=0)).ravel(), initial=0.0)))
+
+    def _backward(self, r6, gamma_U, acc6, lam, r1, r2, normK: float) -> float:
         normx = max(float(np.max(np.abs(acc6), initial=0.0)),
                     float(np.max(np.abs(lam), initial=0.0)))
         normf = max(float(np.max(np.abs(r6), initial=0.0)),
@@ -256,13 +257,21 @@ class ConstrainedSystem:
         denom = normK * normx + normf
         return res / denom if denom > 0 else res
 
-    def solve_refined(self, r6: np.ndarray, gamma_U: np.ndarray, steps: int = 1):
-        """`solve` plus `steps` rounds of iterative refinement (same factorisation)."""
+    def backward_error(self, r6, gamma_U, acc6, lam) -> float:
+        """Norm-wise relative backward error ‖r‖∞ / (‖K‖∞ ‖x‖∞ + ‖f‖∞) of the KKT system."""
+        r1, r2 = self.residual(r6, gamma_U, acc6, lam)
+        return self._backward(r6, gamma_U, acc6, lam, r1, r2, self._norm_K())
+
+    def solve_refined(self, r6: np.ndarray, gamma_U: np.ndarray, target: float = 1e-15):
+        """`solve`, then one round of iterative refinement (same factorisation) when the
+        backward error is above `target`. Returns (v̇ (n, 6), λ_U, backward error)."""
         acc, lam = self.solve(r6, gamma_U)
-        if self.fact.redundant:
-            return acc, lam
-        for _ in range(steps):
-            r1, r2 = self.residual(r6, gamma_U, acc, lam)
+        normK = self._norm_K()
+        r1, r2 = self.residual(r6, gamma_U, acc, lam)
+        err = self._backward(r6, gamma_U, acc, lam, r1, r2, normK)
+        if err > target and not self.fact.redundant:
             da, dl = self.solve(r1, r2)
             acc, lam = acc + da, lam + dl
-        return acc, lam
+            r1, r2 = self.residual(r6, gamma_U, acc, lam)
+            err = self._backward(r6, gamma_U, acc, lam, r1, r2, normK)
+        return acc, lam, err

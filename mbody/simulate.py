@@ -423,9 +423,8 @@ def summary(traj: Trajectory, path: str | os.PathLike[str] | None = None) -> str
                      f"|G^T v| {i['joint_velocity_drift']:.1e}")
         broken = i.get("initial_joint_errors") or []
         if broken:
-            lines.append(f"warning: the initial state breaks {len(broken)} joint "
-                         f"constraint(s): {', '.join(broken[:4])}"
-                         + (" ..." if len(broken) > 4 else "")
+            lines.append("warning: the initial state breaks joint constraints: "
+                         + ", ".join(broken)
                          + "; the stabilisation pulls the joints together, so energy and "
                          "the early motion are not those of the model as written")
     if traj.dimension == cv.SPATIAL:

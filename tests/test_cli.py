@@ -320,7 +320,10 @@ def test_missing_model_argument():
 
 
 def test_no_command():
-    assert "the following arguments are required: COMMAND" in fails(2)
+    """A bare `mbody` shows the help (every command listed) and exits 2."""
+    err = fails(2)
+    assert "usage: mbody" in err and "Start with: mbody check MODEL" in err
+    assert all(c in err for c in ("check", "assemble", "solve", "simulate", "animate"))
 
 
 @pytest.mark.parametrize(("command", "words"), [

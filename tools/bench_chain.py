@@ -27,12 +27,17 @@ import mbody
 L, G0 = 0.1, 9.81
 
 
+OMEGA = np.array([0.3, -0.2, 0.1])
+"""The chain turns as one rigid body about its top pin (a state its joints allow)."""
+
+
 def chain_spec(n: int) -> dict:
     bodies, joints = [], []
     for i in range(n):
+        x = np.array([0.0, 0.0, -L * (i + 0.5)])
         bodies.append({"name": f"l{i}", "mass": 1.0, "inertia": [1e-3, 1e-3, 2e-4],
-                       "position": [0.0, 0.0, -L * (i + 0.5)],
-                       "angular_velocity": [0.3, -0.2, 0.1]})
+                       "position": x.tolist(), "angular_velocity": OMEGA.tolist(),
+                       "velocity": np.cross(OMEGA, x).tolist()})  # turning as one rigid body
         joints.append({"name": f"j{i}", "type": "spherical",
                        "parent": "ground" if i == 0 else f"l{i - 1}", "child": f"l{i}",
                        "at": [0.0, 0.0, -L * i]})
