@@ -30,56 +30,47 @@ from .model import Model, State
 from .spatial import cross, matvec
 
 
-def _parent(model: Model, state: State, R: np.ndarray):
-    t = model.reaction_table
-    on = t.parent >= 0
-    p = np.where(on, t.parent, 0)
-    Rp = np.where(on[:, None, None], R[p], np.eye(3))
-    x_p = np.where(on[:, None], state.position[p], 0.0)
-    v_p = np.where(on[:, None], state.velocity[p], 0.0)
-    w_p = np.where(on[:, None], matvec(Rp, state.omega[p]), 0.0)
-    return Rp, x_p, v_p, w_p
+def phi(model: Model, state: State, R: np.ndarray | None = None,
+        cols: ReactionColumns | None = None) -> np.ndarray:
+    """(m,) position errors of every reaction component's constraint (see module doc).
 
-
-def phi(model: Model, state: State, R: np.ndarray | None = None) -> np.ndarray:
-    """(m,) position errors of every reaction component's constraint (see module doc)."""
-    R = state.W_R_B if R is None else R
+    Worked out per joint (the joint frames of `cols`, computed when not given), then
+    picked per component.
+    """
     t = model.reaction_table
+    jt = model.joint_table
     m = len(t.labels)
     if m == 0:
         return np.zeros(0)
-    Rp, x_p, _, _ = _parent(model, state, R)
-    Rc = R[t.child]
-    out = np.zeros(m)
-    f = t.rot_kind == 0
-    if f.any():
-        P_c = state.position[t.child[f]] + matvec(Rc[f], t.B_r_child[f])
-        P_p = x_p[f] + matvec(Rp[f], t.B_r_parent[f])
-        e = matvec(Rp[f], t.P_E[f])
-        out[f] = np.einsum("ij,ij->i", e, P_c - P_p)
-    mom = ~f
+    if cols is None:
+        from .joints import reaction_columns
+
+        cols = reaction_columns(model, state, R)
+    Rp, Rc = cols.joint_Rp, cols.joint_Rc
+    on_p = jt.parent >= 0
+    x_p = state.position[np.where(on_p, jt.parent, 0)]
+    x_p[~on_p] = 0.0
+    d = cols.joint_W_P - (x_p + matvec(Rp, jt.B_r_parent))  # child's point − parent's
+    j = t.joint
+    out = np.einsum("ij,ij->i", cols.W_e, d[j])  # forces: e · (P_c − P_p)
+    mom = t.rot_kind > 0
     if mom.any():
-        E_p = Rp[mom] @ t.P_E3[mom]
-        E_c = Rc[mom] @ t.C_E3[mom]
-        R_rel = np.swapaxes(E_p, 1, 2) @ E_c
-        k = t.axis[mom] - 3
-        kind = t.rot_kind[mom]
-        val = np.zeros(mom.sum())
-        tilt = kind == 1  # z_rel = third column of R_rel
-        z = R_rel[tilt, :, 2]
-        val[tilt] = np.where(k[tilt] == 0, -z[:, 1], z[:, 0])
-        lock = kind == 2
-        A = R_rel[lock]
+        jm = np.unique(j[mom])  # joints with moment components
+        R_rel = np.zeros((len(jt.parent), 3, 3))
+        R_rel[jm] = np.swapaxes(Rp[jm] @ jt.P_E3[jm], 1, 2) @ (Rc[jm] @ jt.C_E3[jm])
+        A = R_rel[j]
+        k = t.axis - 3
+        tilt = np.where(k == 0, -A[:, 1, 2], A[:, 0, 2])  # child's z axis in parent frame
         vee = 0.5 * np.stack((A[:, 2, 1] - A[:, 1, 2], A[:, 0, 2] - A[:, 2, 0],
                               A[:, 1, 0] - A[:, 0, 1]), axis=1)
-        val[lock] = vee[np.arange(lock.sum()), k[lock]]
-        uni = kind == 3
+        lock = vee[np.arange(m), np.clip(k, 0, 2)]
+        out = np.where(t.rot_kind == 1, tilt, np.where(t.rot_kind == 2, lock, out))
+        uni = t.rot_kind == 3
         if uni.any():
-            idx = np.flatnonzero(mom)[uni]
-            a = E_p[uni][:, :, 2]
-            b = matvec(Rc[idx], t.C_axis2[idx])
-            val[uni] = -np.einsum("ij,ij->i", a, b)
-        out[mom] = val
+            ju = j[uni]
+            a = matvec(Rp[ju], jt.P_E3[ju, :, 2])
+            b = matvec(Rc[ju], jt.C_axis2[ju])
+            out[uni] = -np.einsum("ij,ij->i", a, b)
     return out
 
 
@@ -179,7 +170,7 @@ def joint_errors(model: Model, state: State, cols: ReactionColumns | None = None
         gtv = np.einsum("ij,ij->i", cols.child6, v6[t.child])
         on = t.parent >= 0
         gtv[on] += np.einsum("ij,ij->i", cols.parent6[on], v6[t.parent[on]])
-    ph = phi(model, state)
+    ph = phi(model, state, cols=cols)
     size = float(np.ptp(state.position, axis=0).max()) if model.n > 1 else 0.0
     size = max(size, float(np.abs(t.B_r_child).max()), 1e-3)
     speed = max(float(np.abs(v6).max()), 1e-3)
