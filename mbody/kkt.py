@@ -39,6 +39,9 @@ RANK_RTOL = 1e-10
 
 def block_solve(model: Model, body: np.ndarray, g6: np.ndarray) -> np.ndarray:
     """M_b⁻¹ g for rows g6 (k, 6) acting on bodies `body` (k,): [g_N / m, J⁻¹ g_E]."""
+    d = model.minv6
+    if d is not None:  # principal axes: M_b⁻¹ is diagonal
+        return g6 * d[body]
     out = np.empty_like(g6)
     out[:, :3] = g6[:, :3] / model.mass[body, None]
     out[:, 3:] = matvec(model.J_inv[body], g6[:, 3:])

@@ -281,6 +281,18 @@ class Model:
         return list(self.reaction_table.labels)
 
     @cached_property
+    def minv6(self) -> np.ndarray | None:
+        """(n, 6) diagonal of M⁻¹ per body [1/m ×3, 1/J11, 1/J22, 1/J33] when every
+        inertia tensor is diagonal in body axes (principal axes given); else None."""
+        off = self.J - np.einsum("nii->ni", self.J)[:, :, None] * np.eye(3)
+        if np.any(off):
+            return None
+        out = np.empty((self.n, 6))
+        out[:, :3] = 1.0 / self.mass[:, None]
+        out[:, 3:] = 1.0 / np.einsum("nii->ni", self.J)
+        return out
+
+    @cached_property
     def joint_table(self) -> JointTable:
         t = self.reaction_table
         first = np.unique(t.joint, return_index=True)[1] if len(t.joint) else np.zeros(0, int)
