@@ -150,13 +150,16 @@ class _Checker:
         if not isinstance(value, dict):
             self.err(path, f"expected {what}, got {_kind(value)}")
             return False
+        meant = set()  # keys a misspelling points at: their "missing" would repeat it
         for k in value:
             if k not in allowed:
+                hint = did_you_mean(k, allowed)
+                if hint:
+                    meant.add(hint.split("'")[1])
                 self.err((*path, k), f"unknown key '{k}'",
-                         did_you_mean(k, allowed) or f"expected one of: {', '.join(allowed)}",
-                         key=True)
+                         hint or f"expected one of: {', '.join(allowed)}", key=True)
         for k in required:
-            if k not in value:
+            if k not in value and k not in meant:
                 section = str(path[0]) if path else ""
                 self.err(path, f"missing required key '{k}'",
                          _REQUIRED_HINTS.get((section, k), ""))

@@ -914,3 +914,16 @@ def test_thousands_of_problems_are_all_kept_but_the_message_stays_readable(model
     assert msg.count("\n") == 1 + ModelError.SHOWN
     assert msg.endswith(f"... and {2000 - ModelError.SHOWN} more (fix these first; often they "
                         "repeat)")
+
+
+def test_a_misspelt_required_key_is_one_problem_not_two(tmp_path):
+    """`mas:` for `mass:` is reported once, as an unknown key pointing at 'mass'; the
+    'missing required key' that follows from it would only repeat the same mistake."""
+    path = tmp_path / "typo.yaml"
+    path.write_text("dimension: 2\nbodies:\n  - name: plate\n    mas: 10\n    inertia: 0.5\n")
+    with pytest.raises(mbody.ModelError) as info:
+        mbody.load(path)
+    issues = info.value.issues
+    assert len(issues) == 1
+    assert (issues[0].line, issues[0].column) == (4, 5)
+    assert "unknown key 'mas'" in issues[0].message and "'mass'" in issues[0].hint
