@@ -262,7 +262,7 @@ def _gtv(system, state: State, m: int) -> np.ndarray:
     """(m,) Gᵀ v for the system's (unknown) components, zero for the others."""
     v6 = np.concatenate((state.velocity, state.omega), axis=1).ravel()
     out = np.zeros(m)
-    out[system.U] = system.G.T @ v6
+    out[system.U] = system.gt(v6)
     return out
 
 

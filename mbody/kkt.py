@@ -17,6 +17,7 @@ reactions are returned and the components that are not unique are named.
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -25,6 +26,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.sparse.csgraph import reverse_cuthill_mckee
 
+from .blockplan import BlockOperators, BlockPlan, make_plan
 from .joints import ReactionColumns
 from .model import Model
 from .spatial import matvec
@@ -91,6 +93,50 @@ def _g_and_minv_g(model: Model, parent: np.ndarray, child: np.ndarray, child6: n
     return G, H
 
 
+_PLANS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _plan(model: Model, unknown: np.ndarray, U: np.ndarray) -> BlockPlan | None:
+    """The block plan of `model` for this set of unknowns, made once and kept with it."""
+    per_model = _PLANS.setdefault(model, {})
+    key = unknown.tobytes()
+    if key not in per_model:
+        per_model[key] = make_plan(model, U)
+    return per_model[key]
+
+
+def _banded(ab: np.ndarray, perm: np.ndarray | None, mu: int) -> Factorisation | None:
+    """Banded Cholesky of S in upper banded storage; None when S is not positive definite
+    (redundant constraints: the general path then finds the minimum-norm reactions)."""
+    bw = ab.shape[0] - 1
+    try:
+        cb = sla.cholesky_banded(ab, lower=False, check_finite=False)
+    except np.linalg.LinAlgError:
+        return None
+    d = cb[bw] ** 2
+    if not d.min() > RANK_RTOL * d.max():
+        return None
+
+    def solve(r, cb=cb, perm=perm):
+        if perm is None:
+            return sla.cho_solve_banded((cb, False), r, check_finite=False)
+        x = np.empty_like(r)
+        x[perm] = sla.cho_solve_banded((cb, False), r[perm], check_finite=False)
+        return x
+
+    def S_matrix() -> sp.csr_matrix:  # S itself, for the condition estimate only
+        upper = sp.dia_matrix((ab, np.arange(bw, -1, -1)), shape=(mu, mu)).tocsr()
+        S = upper + sp.triu(upper, 1).T
+        if perm is None:
+            return S.tocsr()
+        inv = np.empty(mu, dtype=np.intp)
+        inv[perm] = np.arange(mu)
+        return S.tocsr()[inv][:, inv]
+
+    return Factorisation("banded Cholesky of the Schur complement (per-body blocks)", mu,
+                         rank=mu, _solve=solve, _S=S_matrix)
+
+
 @dataclass
 class Factorisation:
     """S = G_Uᵀ M⁻¹ G_U factorised once; `solve(rhs)` applies (a generalised) S⁻¹."""
@@ -111,7 +157,7 @@ class Factorisation:
             return 1.0
         if self.redundant:
             return float("inf")
-        S = self._S
+        S = self._S() if callable(self._S) else self._S
         if not sp.issparse(S):
             return float(np.linalg.cond(S, 1))
         inv = spla.LinearOperator(S.shape, matvec=self.solve, rmatvec=self.solve,
@@ -133,13 +179,47 @@ class ConstrainedSystem:
         U = np.flatnonzero(self.unknown)
         self.U = U
         args = (model, t.parent[U], t.child[U], cols.child6[U], cols.parent6[U])
+        self.blocks = None
         if len(U) <= DENSE_LIMIT and model.n <= SMALL_BODIES:
             # Small mechanisms: dense arrays beat sparse-matrix bookkeeping by far.
             self.G, self.H = _g_and_minv_g_dense(*args)
             self.fact = self._dense(self.G.T @ self.H)
-        else:
-            self.G, self.H = _g_and_minv_g(*args)
-            self.fact = self._factorise((self.G.T @ self.H).tocsr())
+            return
+        if len(U) > DENSE_LIMIT:  # large: per-body blocks and a banded S (mbody.blockplan)
+            plan = _plan(model, self.unknown, U)
+            if plan is not None:
+                blocks = BlockOperators(model, plan, cols.child6[U], cols.parent6[U])
+                fact = _banded(blocks.band(), plan.perm, len(U))
+                if fact is not None:
+                    self.blocks, self.fact = blocks, fact
+                    return
+        self.G, self.H = _g_and_minv_g(*args)
+        self.fact = self._factorise((self.G.T @ self.H).tocsr())
+
+    # -- the products a solve needs, whichever form G_U is held in --------------------------
+    def g(self, lam: np.ndarray) -> np.ndarray:
+        """(6n,) G_U λ."""
+        return self.blocks.G(lam) if self.blocks is not None else self.G @ lam
+
+    def gt(self, x: np.ndarray) -> np.ndarray:
+        """(mu,) G_Uᵀ x for x (6n,) or (n, 6)."""
+        x = np.ravel(x)
+        return self.blocks.GT(x) if self.blocks is not None else self.G.T @ x
+
+    def h(self, lam: np.ndarray) -> np.ndarray:
+        """(6n,) M⁻¹ G_U λ."""
+        return self.blocks.H(lam) if self.blocks is not None else self.H @ lam
+
+    def g_sparse(self) -> sp.csc_matrix:
+        """G_U as a sparse matrix (built on request from the blocks)."""
+        if self.blocks is None:
+            return sp.csc_matrix(self.G)
+        b = self.blocks
+        p = b.plan
+        six = b.Gb[p.inc_body, p.inc_slot]
+        rows = (p.inc_body[:, None] * 6 + np.arange(6)).ravel()
+        return sp.csc_matrix((six.ravel(), (rows, np.repeat(p.inc_u, 6))),
+                             shape=(b.Gb.shape[0] * 6, p.mu))
 
     # -- factorisation -------------------------------------------------------------------
     def _factorise(self, S: sp.csr_matrix) -> Factorisation:
@@ -227,8 +307,8 @@ class ConstrainedSystem:
         """Solve M v̇ − G_U λ = r (n, 6 rows), G_Uᵀ v̇ = γ_U; returns (v̇ (n, 6), λ_U)."""
         model = self.model
         a0 = block_solve(model, np.arange(model.n), r6).ravel()
-        lam = self.fact.solve(gamma_U - self.G.T @ a0)
-        acc = a0 + self.H @ lam
+        lam = self.fact.solve(gamma_U - self.gt(a0))
+        acc = a0 + self.h(lam)
         return acc.reshape(-1, 6), lam
 
     def residual(self, r6: np.ndarray, gamma_U: np.ndarray, acc6: np.ndarray,
@@ -238,18 +318,23 @@ class ConstrainedSystem:
         Ma = np.empty_like(acc6)
         Ma[:, :3] = acc6[:, :3] * model.mass[:, None]
         Ma[:, 3:] = matvec(model.J, acc6[:, 3:])
-        r1 = r6.ravel() - (Ma.ravel() - self.G @ lam)
-        r2 = gamma_U - self.G.T @ acc6.ravel()
+        r1 = r6.ravel() - (Ma.ravel() - self.g(lam))
+        r2 = gamma_U - self.gt(acc6)
         return r1.reshape(-1, 6), r2
 
     def _norm_K(self) -> float:
         """‖K‖∞ of the KKT matrix [[M, −G_U], [G_Uᵀ, 0]] (row sums of |M| and |G|)."""
         model = self.model
-        absG = abs(self.G) if sp.issparse(self.G) else np.abs(self.G)
+        if self.blocks is not None:
+            rowsG, colsG = self.blocks.abs_sums()
+        else:
+            absG = abs(self.G) if sp.issparse(self.G) else np.abs(self.G)
+            rowsG = np.asarray(absG.sum(axis=1)).ravel()
+            colsG = np.asarray(absG.sum(axis=0)).ravel()
         rowM = np.concatenate((np.repeat(model.mass[:, None], 3, axis=1),
                                np.abs(model.J).sum(axis=2)), axis=1).ravel()
-        return max(float(np.max(rowM + np.asarray(absG.sum(axis=1)).ravel(), initial=0.0)),
-                   float(np.max(np.asarray(absG.sum(axis=0)).ravel(), initial=0.0)))
+        return max(float(np.max(rowM + rowsG, initial=0.0)),
+                   float(np.max(colsG, initial=0.0)))
 
     def _backward(self, r6, gamma_U, acc6, lam, r1, r2, normK: float) -> float:
         normx = max(float(np.max(np.abs(acc6), initial=0.0)),

@@ -62,7 +62,7 @@ def constrained_dynamics(model: Model, known: Mapping[str, float] | None = None,
         g = gamma(model, state, cols, R)[unknown]
         if rate:
             v6 = np.concatenate((state.velocity, state.omega), axis=1).ravel()
-            g = g - 2 * rate * (system.G.T @ v6) - rate**2 * phi(model, state, R, cols)[unknown]
+            g = g - 2 * rate * system.gt(v6) - rate**2 * phi(model, state, R, cols)[unknown]
         acc, _ = system.solve(r6, g)
         return acc
 
