@@ -16,6 +16,7 @@ velocity the joint forbids.
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -59,6 +60,33 @@ def joint_parents(model: Model, R: np.ndarray) -> tuple[np.ndarray, np.ndarray, 
     return on_p, p, Rp
 
 
+@dataclass(frozen=True)
+class _Constants:
+    """Per component, what depends on the model only (made once per model)."""
+
+    k: np.ndarray  # joint-frame axis index 0-2
+    is_moment: np.ndarray  # (m, 1) bool
+    any_moment: bool
+    B_r_child: np.ndarray  # (m, 3) joint point on the child, child axes
+    B_e_p: np.ndarray  # (m, 3) the axis fixed in the parent, parent axes
+    ground: np.ndarray  # (m,) bool: parent is ground
+
+
+_CONSTANTS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _constants(model: Model) -> _Constants:
+    c = _CONSTANTS.get(model)
+    if c is None:
+        t, jt = model.reaction_table, model.joint_table
+        j, k = t.joint, t.axis % 3
+        is_moment = (t.axis >= 3)[:, None]
+        c = _Constants(k, is_moment, bool(is_moment.any()), jt.B_r_child[j],
+                       jt.P_E3[j, :, k], t.parent < 0)
+        _CONSTANTS[model] = c
+    return c
+
+
 def reaction_columns(model: Model, state: State, R: np.ndarray | None = None) -> ReactionColumns:
     R = state.W_R_B if R is None else R
     t = model.reaction_table
@@ -79,10 +107,11 @@ def reaction_columns(model: Model, state: State, R: np.ndarray | None = None) ->
     B_r_p = rmatvec(Rp, P - x_p)  # the parent's material point at P, parent axes
 
     # Per component: pick its axis of the joint frame.
-    j, k = t.joint, t.axis % 3
+    const = _constants(model)
+    j, k = t.joint, const.k
     W_e = W_E[j, :, k]
     B_e_c = B_E_c[j, :, k]
-    B_e_p = jt.P_E3[j, :, k]
+    B_e_p = const.B_e_p
     universal = t.axis == 6
     if universal.any():
         ju = j[universal]
@@ -92,15 +121,23 @@ def reaction_columns(model: Model, state: State, R: np.ndarray | None = None) ->
         e /= np.linalg.norm(e, axis=1, keepdims=True)
         W_e[universal] = e
         B_e_c[universal] = rmatvec(Rc[ju], e)
+        B_e_p = B_e_p.copy()
         B_e_p[universal] = rmatvec(Rp[ju], e)
-    is_moment = (t.axis >= 3)[:, None]
+    is_moment = const.is_moment
     child6 = np.empty((m, 6))
     parent6 = np.empty((m, 6))
-    child6[:, :3] = np.where(is_moment, 0.0, W_e)
-    child6[:, 3:] = np.where(is_moment, B_e_c, cross(jt.B_r_child[j], B_e_c))
-    parent6[:, :3] = -child6[:, :3]
-    parent6[:, 3:] = -np.where(is_moment, B_e_p, cross(B_r_p[j], B_e_p))
-    parent6[~on_p[j]] = 0.0
+    if const.any_moment:
+        child6[:, :3] = np.where(is_moment, 0.0, W_e)
+        child6[:, 3:] = np.where(is_moment, B_e_c, cross(const.B_r_child, B_e_c))
+        parent6[:, 3:] = np.where(is_moment, B_e_p, cross(B_r_p[j], B_e_p))
+    else:  # forces only (spherical joints): no selection needed
+        child6[:, :3] = W_e
+        child6[:, 3:] = cross(const.B_r_child, B_e_c)
+        parent6[:, 3:] = cross(B_r_p[j], B_e_p)
+    np.negative(child6[:, :3], out=parent6[:, :3])
+    np.negative(parent6[:, 3:], out=parent6[:, 3:])
+    if const.ground.any():
+        parent6[const.ground] = 0.0
     return ReactionColumns(W_e, P[j], child6, parent6, is_moment[:, 0], P, Rp, Rc)
 
 

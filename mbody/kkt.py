@@ -178,7 +178,10 @@ class ConstrainedSystem:
         self.unknown = np.asarray(unknown, dtype=bool)
         U = np.flatnonzero(self.unknown)
         self.U = U
-        args = (model, t.parent[U], t.child[U], cols.child6[U], cols.parent6[U])
+        if len(U) == len(t.labels):  # every component unknown: no copies
+            args = (model, t.parent, t.child, cols.child6, cols.parent6)
+        else:
+            args = (model, t.parent[U], t.child[U], cols.child6[U], cols.parent6[U])
         self.blocks = None
         if len(U) <= DENSE_LIMIT and model.n <= SMALL_BODIES:
             # Small mechanisms: dense arrays beat sparse-matrix bookkeeping by far.
@@ -188,7 +191,7 @@ class ConstrainedSystem:
         if len(U) > DENSE_LIMIT:  # large: per-body blocks and a banded S (mbody.blockplan)
             plan = _plan(model, self.unknown, U)
             if plan is not None:
-                blocks = BlockOperators(model, plan, cols.child6[U], cols.parent6[U])
+                blocks = BlockOperators(model, plan, args[3], args[4])
                 fact = _banded(blocks.band(), plan.perm, len(U))
                 if fact is not None:
                     self.blocks, self.fact = blocks, fact
