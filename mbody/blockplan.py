@@ -52,6 +52,9 @@ class BlockPlan:
     block_index: np.ndarray
     ab_index: np.ndarray
     perm: np.ndarray | None
+    flat_child: np.ndarray  # (mu,) row of each column's child half in the (n k, 6) blocks
+    flat_parent: np.ndarray  # (q − mu,) the same for the parent halves
+    parent_u: np.ndarray  # (q − mu,) their columns
 
 
 def make_plan(model: Model, U: np.ndarray) -> BlockPlan | None:
@@ -94,8 +97,10 @@ def make_plan(model: Model, U: np.ndarray) -> BlockPlan | None:
     if (bw + 1) * mu > MAX_BAND_ENTRIES:
         return None
     upper = r <= c
+    rows = inc_body * k + inc_slot
     return BlockPlan(mu, k, bw, inc_u, inc_body, inc_slot, inc_parent, slot_col,
-                     flat[upper], (bw + r[upper] - c[upper]) * mu + c[upper], perm)
+                     flat[upper], (bw + r[upper] - c[upper]) * mu + c[upper], perm,
+                     rows[:mu], rows[mu:], inc_u[mu:])
 
 
 class BlockOperators:
@@ -109,11 +114,10 @@ class BlockOperators:
     def __init__(self, model: Model, plan: BlockPlan, child6: np.ndarray,
                  parent6: np.ndarray):
         self.plan = plan
-        n, k, mu = model.n, plan.k, plan.mu
+        n, k = model.n, plan.k
         Gb = np.zeros((n * k, 6))
-        flat = plan.inc_body * k + plan.inc_slot  # child halves first, then parents
-        Gb[flat[:mu]] = child6
-        Gb[flat[mu:]] = parent6[plan.inc_u[mu:]]
+        Gb[plan.flat_child] = child6
+        Gb[plan.flat_parent] = parent6[plan.parent_u]
         Gb = Gb.reshape(n, k, 6)
         d = model.minv6
         if d is not None:
