@@ -58,6 +58,28 @@ def mass_matrix(model: Model) -> sp.spmatrix:
     return sp.bsr_matrix((blocks, np.arange(n), np.arange(n + 1)), shape=(n * k, n * k))
 
 
+class ReactionValues(Mapping):
+    """label -> value of every reaction component (N, or N m for moments), a read-only
+    view of one array in the order of `Assembly.reactions` (made lazily: a chain of
+    10 000 links has 30 000 of them). `array` is that array."""
+
+    def __init__(self, labels: list[str], index: dict[str, int], values: np.ndarray):
+        self._labels, self._index, self.array = labels, index, values
+        self.array.flags.writeable = False
+
+    def __getitem__(self, label: str) -> float:
+        return float(self.array[self._index[label]])
+
+    def __iter__(self):
+        return iter(self._labels)
+
+    def __len__(self) -> int:
+        return len(self._labels)
+
+    def __repr__(self) -> str:
+        return repr(dict(self))
+
+
 INCONSISTENT = 1e-8
 """Relative backward error above which a constrained solve is reported as inconsistent."""
 
@@ -72,7 +94,8 @@ class Solution:
 
     coordinates: list[str]
     accelerations: np.ndarray
-    reactions: dict[str, float]
+    reactions: Mapping[str, float]
+    """label -> value of every reaction component, given or solved (N; N m)."""
     solved: tuple[str, ...] = ()
     """Reaction components solved for (the rest were given)."""
     not_unique: tuple[str, ...] = ()
@@ -248,7 +271,7 @@ class Assembly:
         solved = (tuple(labels) if len(system.U) == len(labels)
                   else tuple(map(labels.__getitem__, system.U.tolist())))
         return Solution(self.coordinates, _select(model, acc6),
-                        dict(zip(labels, lam.tolist(), strict=True)), solved,
+                        ReactionValues(labels, model.reaction_index, lam), solved,
                         tuple(solved[k] for k in system.fact.redundant if k >= 0),
                         berr,
                         system.fact.condition() if condition else None,

@@ -148,11 +148,3 @@ class BlockOperators:
         ab = np.bincount(p.ab_index, S_blocks.ravel()[p.block_index],
                          minlength=(p.bw + 1) * p.mu)
         return ab.reshape(p.bw + 1, p.mu)
-
-    def abs_sums(self) -> tuple[np.ndarray, np.ndarray]:
-        """Row sums (6n,) and column sums (mu,) of |G_U| (for the KKT matrix's norm)."""
-        A = np.abs(self.Gb)
-        rows = A.sum(axis=1).ravel()
-        cols = np.bincount(self.plan.slot_col.ravel(), A.sum(axis=2).ravel(),
-                           minlength=self.plan.mu + 1)[:self.plan.mu]
-        return rows, cols

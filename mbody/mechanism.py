@@ -80,7 +80,8 @@ def reactions_along(model: Model, states: list[State],
     out = np.empty((len(states), len(model.reactions)))
     for k, s in enumerate(states):
         sol = assemble(model, s).solve(known=known)
-        out[k] = np.fromiter(sol.reactions.values(), float, len(model.reactions))
+        arr = getattr(sol.reactions, "array", None)
+        out[k] = arr if arr is not None else [sol.reactions[r] for r in model.reactions]
     return out
 
 

@@ -93,7 +93,7 @@ def solve(a: argparse.Namespace) -> int:
                                   acc[i * rpb:(i + 1) * rpb], strict=True))
                    for i, name in enumerate(model.body_names)}
         json.dump({"model": model.name, "coordinates": sol.coordinates,
-                   "accelerations": acc, "by_body": by_body, "reactions": sol.reactions,
+                   "accelerations": acc, "by_body": by_body, "reactions": dict(sol.reactions),
                    "solved": list(sol.solved), "not_unique": list(sol.not_unique),
                    "backward_error": sol.residual, "condition": sol.condition,
                    "warnings": sol.warnings},
