@@ -264,9 +264,14 @@ class Assembly:
             unknown[k], lam[k] = False, v
         r6 = self._Q6 - self._b6 + reaction_wrench(model, self.columns, lam)
         system = ConstrainedSystem(model, self.columns, unknown)
-        g_U = gamma(model, self.state, self.columns)[unknown]
+        every = len(system.U) == len(lam)  # all unknown: no masked copies
+        g_U = gamma(model, self.state, self.columns)
+        g_U = g_U if every else g_U[unknown]
         acc6, lam_U, berr = system.solve_refined(r6, g_U)
-        lam[unknown] = lam_U
+        if every:
+            lam = lam_U
+        else:
+            lam[unknown] = lam_U
         labels = self.reactions
         solved = (tuple(labels) if len(system.U) == len(labels)
                   else tuple(map(labels.__getitem__, system.U.tolist())))

@@ -102,9 +102,9 @@ def gamma(model: Model, state: State, cols: ReactionColumns,
     V_c = state.velocity[c] + cross(w_c, rho)
     D = V_c - v_p - cross(w_p, P - x_p)
     T = cross(D, w_p) + cross(w_c, cross(w_c, rho)) - cross(w_p, V_c - v_p)
-    U = cross(w_c, w_p)
     j = t.joint
-    TU = np.where((t.axis >= 3)[:, None], U[j], T[j])
+    moment = (t.axis >= 3)[:, None]
+    TU = np.where(moment, cross(w_c, w_p)[j], T[j]) if moment.any() else T[j]
     out = -np.einsum("ij,ij->i", cols.W_e, TU)
     uni = t.axis == 6
     if uni.any():
