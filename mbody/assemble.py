@@ -254,14 +254,10 @@ class Assembly:
 
     def _solve_constrained(self, values: dict[str, float], condition: bool) -> Solution:
         from .constraints import gamma, joint_errors
-        from .kkt import ConstrainedSystem
+        from .kkt import ConstrainedSystem, split_reactions
 
         model = self.model
-        unknown = np.ones(len(self.reactions), dtype=bool)
-        lam = np.zeros(len(self.reactions))
-        for label, v in values.items():  # the given values only: few
-            k = model.reaction_index[label]
-            unknown[k], lam[k] = False, v
+        unknown, lam = split_reactions(model, values)
         r6 = self._Q6 - self._b6 + reaction_wrench(model, self.columns, lam)
         system = ConstrainedSystem(model, self.columns, unknown)
         every = len(system.U) == len(lam)  # all unknown: no masked copies

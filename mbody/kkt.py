@@ -18,6 +18,7 @@ reactions are returned and the components that are not unique are named.
 from __future__ import annotations
 
 import weakref
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -37,6 +38,21 @@ DENSE_LIMIT = 300
 """Up to this many unknown components, S is factorised densely (and checked for rank)."""
 RANK_RTOL = 1e-10
 """Relative tolerance on S's eigenvalues (or pivots) below which a constraint is redundant."""
+
+
+def split_reactions(model: Model, given: Mapping[str, float]) -> tuple[np.ndarray, np.ndarray]:
+    """(unknown (m,) bool, λ (m,) with the given values in place, 0 elsewhere).
+
+    `given` maps reaction labels (already checked) to values; the loop runs over the given
+    values only, which are few.
+    """
+    m = len(model.reactions)
+    unknown = np.ones(m, dtype=bool)
+    lam = np.zeros(m)
+    for label, v in given.items():
+        k = model.reaction_index[label]
+        unknown[k], lam[k] = False, float(v)
+    return unknown, lam
 
 
 def block_solve(model: Model, body: np.ndarray, g6: np.ndarray) -> np.ndarray:

@@ -21,26 +21,12 @@ import numpy as np
 from .assemble import assemble
 from .constraints import gamma, phi
 from .joints import reaction_columns, reaction_wrench
-from .kkt import ConstrainedSystem
+from .kkt import ConstrainedSystem, split_reactions
 from .loads import applied_loads, gyroscopic
 from .model import Model, State
 
 BAUMGARTE_RATE = 20.0
 """α = β in 1/s: joint errors decay with a time constant of 1/20 s."""
-
-
-def _values(model: Model, known: Mapping[str, float] | None, t: float):
-    """(unknown mask (m,), λ with the known values in place (m,))."""
-    values = model.known_reactions_at(t) if hasattr(model, "known_reactions_at") \
-        else dict(model.known_reactions)
-    values.update(known or {})
-    m = len(model.reactions)
-    unknown = np.ones(m, dtype=bool)
-    lam = np.zeros(m)
-    for label, v in values.items():
-        k = model.reaction_index[label]
-        unknown[k], lam[k] = False, float(v)
-    return unknown, lam
 
 
 def constrained_dynamics(model: Model, known: Mapping[str, float] | None = None, *,
@@ -51,7 +37,8 @@ def constrained_dynamics(model: Model, known: Mapping[str, float] | None = None,
     def f(model: Model, state: State) -> np.ndarray:
         R = state.W_R_B
         cols = reaction_columns(model, state, R)
-        unknown, lam = _values(model, known, state.t)
+        unknown, lam = split_reactions(model, {**model.known_reactions_at(state.t),
+                                               **(known or {})})
         loads = applied_loads(model, state, R)
         r6 = np.concatenate((loads.W_F, loads.B_M), axis=1)
         if model.dimension == 3:

@@ -261,8 +261,7 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     if mechanism:
         from .mechanism import constraint_drift, reactions_along
 
-        states = [_sample_state(model, x[k], q[k], v[k], w[k], float(t_eval[k]))
-                  for k in range(K)]
+        states = [State(x[k], q[k], v[k], w[k], float(t_eval[k])) for k in range(K)]
         lam = reactions_along(model, states, _numeric_known(model, known))
         from .constraints import joint_errors
 
@@ -340,11 +339,6 @@ def _numeric_known(model: Model, known: Mapping[str, float | str] | None
                              "model file's 'reactions:' instead")
         out[label] = float(v)
     return out
-
-
-def _sample_state(model: Model, x, q, v, w, t: float) -> State:
-    """A sample of the integrated (internal, spatial-form) arrays as a `State`."""
-    return State(x, q, v, w, t)
 
 
 def _drift(model: Model, traj: Trajectory, default_dynamics: bool, *,

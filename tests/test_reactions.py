@@ -124,22 +124,27 @@ def _advance(state: State, h: float) -> State:
                          quaternion=(rot * step).as_quat(scalar_first=True))
 
 
-@pytest.mark.parametrize("seed", range(6))
-@pytest.mark.parametrize("dim", [2, 3])
-def test_gamma_is_minus_gdot_transpose_v(seed, dim):
-    """d/dt (Gᵀ v) along a path with v̇ = 0 equals −γ (central differences, h = 1e-5)."""
+def _jointed(seed: int, dim: int):
+    """A random model with every joint type of `dim`, its initial state, and that state's
+    velocities stacked in the model's coordinates (planar: rows x, y, θ)."""
     spec = (spatial_model(seed, n=4, n_joints=6, known=False) if dim == 3
             else planar_model(seed, n=4, n_joints=5, known=False))
     model = mbody.load(spec)
     s0 = model.initial
+    sel = np.arange(6) if dim == 3 else np.array([0, 1, 5])
+    return model, s0, np.concatenate((s0.velocity, s0.omega), axis=1)[:, sel].ravel()
+
+
+@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("dim", [2, 3])
+def test_gamma_is_minus_gdot_transpose_v(seed, dim):
+    """d/dt (Gᵀ v) along a path with v̇ = 0 equals −γ (central differences, h = 1e-5)."""
+    model, s0, v = _jointed(seed, dim)
     jac = mbody.assemble(model, s0).jacobian()
     h = 1e-5
-    v6 = np.concatenate((s0.velocity, s0.omega), axis=1)
-    sel = np.arange(6) if dim == 3 else np.array([0, 1, 5])
 
     def gtv(state):
-        G = mbody.assemble(model, state).G
-        return G.T @ v6[:, sel].ravel()
+        return mbody.assemble(model, state).G.T @ v
 
     deriv = (gtv(_advance(s0, h)) - gtv(_advance(s0, -h))) / (2 * h)
     assert deriv == pytest.approx(-jac.gamma, rel=1e-6, abs=1e-6)
@@ -149,16 +154,11 @@ def test_gamma_is_minus_gdot_transpose_v(seed, dim):
 @pytest.mark.parametrize("dim", [2, 3])
 def test_phi_rate_is_g_transpose_v(seed, dim):
     """At the assembled pose φ = 0 and dφ/dt = Gᵀ v for every joint type."""
-    spec = (spatial_model(seed, n=4, n_joints=6, known=False) if dim == 3
-            else planar_model(seed, n=4, n_joints=5, known=False))
-    model = mbody.load(spec)
-    s0 = model.initial
+    model, s0, v = _jointed(seed, dim)
     assert phi(model, s0) == pytest.approx(0.0, abs=1e-12)
     h = 1e-6
     rate = (phi(model, _advance(s0, h)) - phi(model, _advance(s0, -h))) / (2 * h)
-    sel = np.arange(6) if dim == 3 else np.array([0, 1, 5])
-    v6 = np.concatenate((s0.velocity, s0.omega), axis=1)[:, sel].ravel()
-    assert rate == pytest.approx(mbody.assemble(model, s0).G.T @ v6, rel=1e-6, abs=1e-7)
+    assert rate == pytest.approx(mbody.assemble(model, s0).G.T @ v, rel=1e-6, abs=1e-7)
 
 
 @pytest.mark.parametrize("seed", range(4))
