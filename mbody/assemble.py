@@ -22,6 +22,7 @@ from .errors import MbodyError, did_you_mean
 from .joints import ReactionColumns, g_matrix, reaction_columns, reaction_wrench
 from .loads import AppliedLoads
 from .model import Model, State
+from .plan import Unknowns, compiled
 from .spatial import matvec
 
 
@@ -148,14 +149,39 @@ class Assembly:
     its Newton-Euler pair.
     """
 
-    def __init__(self, model: Model, state: State, loads: AppliedLoads, b6: np.ndarray):
+    def __init__(self, model: Model, state: State):
         self.model = model
         self.state = state
-        self.loads = loads
-        # (n, 6) per-body rows; `assemble` passes transposed views of (6, n) arrays (the
-        # kernels' layout), so `_Q6s`/`_b6s` below are contiguous rows.
-        self._b6 = b6
-        self._Q6 = loads.Q6.T
+
+    @cached_property
+    def _loads_and_b6(self) -> tuple[AppliedLoads, np.ndarray]:
+        """Q and b per body, from the numpy kernels: (AppliedLoads with Q6 (6, n) rows
+        [W_F; B_M], b6 (n, 6) [0; ω × J ω]) (planar: b = 0)."""
+        model, state = self.model, self.state
+        plan = model.plan.kernels
+        frame = model.plan.load_frame(state.t)
+        sparse = kernels.sparse_wrench(plan, [
+            kernels.load_wrenches(model, plan, frame, state),
+            kernels.spring_wrenches(model, state)])
+        Q6 = np.empty((6, model.n))
+        b6 = np.zeros((6, model.n))  # rows 0-2 (Newton) stay 0; planar: all 0
+        kernels.loads_and_gyroscopic(plan, frame, state, sparse, Q6,
+                                     b6[3:6] if model.dimension == cv.SPATIAL else None)
+        # (n, 6) transposed views of the kernels' (6, n) layout
+        return AppliedLoads(model, state, Q6), b6.T
+
+    @property
+    def loads(self) -> AppliedLoads:
+        """Net applied loads per body (and, for diagrams, each load's contribution)."""
+        return self._loads_and_b6[0]
+
+    @property
+    def _Q6(self) -> np.ndarray:
+        return self._loads_and_b6[0].Q6.T
+
+    @property
+    def _b6(self) -> np.ndarray:
+        return self._loads_and_b6[1]
 
     # -- the stacked system ------------------------------------------------------------
     @property
@@ -235,59 +261,108 @@ class Assembly:
         joints of known components are not enforced. `condition=True` also estimates the
         condition number of the Schur complement.
         """
-        values = self.reaction_values(known)
-        if len(values) < len(self.reactions):
-            return self._solve_constrained(values, condition)
         model = self.model
-        plan = kernels.plan_for(model)
+        plan = model.plan
+        unknowns = (plan.unknowns(self.reaction_values(known)) if known
+                    else plan.unknowns_at(self.state.t))
+        if not condition and plan.use_compiled():
+            return self._solve_compiled(unknowns)
+        if len(unknowns.U):
+            return self._solve_constrained(unknowns, condition)
+        lam = unknowns.lam
         extra = None
-        if self.reactions:  # G λ, summed per body on the kernels' sparse path
-            lam = np.array([values[r] for r in self.reactions])
+        if len(lam):  # G λ, summed per body on the kernels' sparse path
             t, cols = model.reaction_table, self.columns
-            extra = kernels.sparse_wrench(plan, [
+            extra = kernels.sparse_wrench(plan.kernels, [
                 (np.concatenate((t.child, t.parent)),
                  np.concatenate((cols.child6 * lam[:, None], cols.parent6 * lam[:, None])))])
         acc6 = np.empty((model.n, 6))
-        kernels.solve(plan, self._Q6.T, self._b6.T[3:6], extra, acc6.T)
+        kernels.solve(plan.kernels, self._Q6.T, self._b6.T[3:6], extra, acc6.T)
         return Solution(self.coordinates, _select(model, acc6),
-                        {r: values[r] for r in self.reactions})
+                        dict(zip(self.reactions, lam.tolist(), strict=True)))
 
-    def _solve_constrained(self, values: dict[str, float], condition: bool) -> Solution:
-        from .constraints import gamma, joint_errors
-        from .kkt import ConstrainedSystem, split_reactions
+    def _solve_compiled(self, unknowns: Unknowns) -> Solution:
+        """The compiled path (`mbody.compiled`), the same solve as `_solve_constrained`."""
+        model, plan, state = self.model, self.model.plan, self.state
+        C = compiled()
+        F, I = plan.packed
+        m = len(unknowns.mask)
+        N, o_lam, o_info = C.solve_layout(model.n, m, model.dimension == cv.PLANAR)
+        out = np.empty(o_info + C.INFO)
+        C.solve(F, I, plan.packed_unknowns(unknowns), plan.pack_state(state),
+                plan.load_values(state.t), unknowns.lam, model.dimension == cv.PLANAR, out)
+        info = out[o_info:]
+        labels = self.reactions
+        lam = out[o_lam:o_lam + m]
+        if not len(unknowns.U):
+            return Solution(self.coordinates, out[:N], dict(zip(labels, lam.tolist(),
+                                                                strict=True)))
+        broken = ()
+        if info[2] > 0:  # rare: describe the broken joints with the numpy path
+            from .constraints import joint_errors
+
+            broken = tuple(joint_errors(model, state, self.columns, unknowns.mask,
+                                        gtv=out[o_lam + m:o_lam + 2 * m]))
+        mu, rank = len(unknowns.U), int(info[C.ST_RANK])
+        not_unique: tuple[str, ...] = ()
+        if rank < mu:
+            flags = out[o_lam + 2 * m:o_info]
+            not_unique = tuple(labels[i] for i in np.flatnonzero(flags))
+        return Solution(self.coordinates, out[:N],
+                        ReactionValues(labels, model.reaction_index, lam),
+                        unknowns.labels(labels), not_unique, float(info[C.ST_BERR]), None,
+                        COMPILED_METHOD if rank == mu else COMPILED_REDUNDANT, broken,
+                        mu - rank)
+
+    def constrained(self, unknowns: Unknowns, *, rate: float = 0.0, refine: bool = True):
+        """The numpy path's constrained solve: (v̇ (n, 6), λ (m,), the `ConstrainedSystem`,
+        backward error or None). `rate` > 0 adds Baumgarte's terms to γ
+        (γ − 2 α Gᵀ v − α² φ, `mbody.mechanism`); `refine` makes one round of iterative
+        refinement when the backward error asks for it."""
+        from .constraints import gamma, phi
+        from .joints import constraint_velocity
+        from .kkt import ConstrainedSystem
+
+        model, state, cols = self.model, self.state, self.columns
+        lam = unknowns.lam.copy()
+        r6 = self._Q6 - self._b6 + reaction_wrench(model, cols, lam)
+        system = ConstrainedSystem(model, cols, unknowns)
+        g = gamma(model, state, cols)
+        if rate:
+            g = (g - 2.0 * rate * constraint_velocity(model, cols, state)
+                 - rate * rate * phi(model, state, cols=cols))
+        g_U = g if unknowns.every else g[unknowns.U]
+        berr = None
+        if refine:
+            acc6, lam_U, berr = system.solve_refined(r6, g_U)
+        else:
+            acc6, lam_U = system.solve(r6, g_U)
+        lam[unknowns.U] = lam_U
+        return acc6, lam, system, berr
+
+    def _solve_constrained(self, unknowns: Unknowns, condition: bool) -> Solution:
+        from .constraints import joint_errors
+        from .joints import constraint_velocity
 
         model = self.model
-        unknown, lam = split_reactions(model, values)
-        r6 = self._Q6 - self._b6 + reaction_wrench(model, self.columns, lam)
-        system = ConstrainedSystem(model, self.columns, unknown)
-        every = len(system.U) == len(lam)  # all unknown: no masked copies
-        g_U = gamma(model, self.state, self.columns)
-        g_U = g_U if every else g_U[unknown]
-        acc6, lam_U, berr = system.solve_refined(r6, g_U)
-        if every:
-            lam = lam_U
-        else:
-            lam[unknown] = lam_U
+        acc6, lam, system, berr = self.constrained(unknowns)
         labels = self.reactions
-        solved = (tuple(labels) if len(system.U) == len(labels)
-                  else tuple(map(labels.__getitem__, system.U.tolist())))
+        solved = unknowns.labels(labels)
         return Solution(self.coordinates, _select(model, acc6),
                         ReactionValues(labels, model.reaction_index, lam), solved,
                         tuple(solved[k] for k in system.fact.redundant if k >= 0),
                         berr,
                         system.fact.condition() if condition else None,
                         system.fact.method,
-                        tuple(joint_errors(model, self.state, self.columns, unknown,
-                                           gtv=_gtv(system, self.state, len(labels)))),
+                        tuple(joint_errors(model, self.state, self.columns, unknowns.mask,
+                                           gtv=constraint_velocity(model, self.columns,
+                                                                   self.state))),
                         system.fact.size - system.fact.rank)
 
 
-def _gtv(system, state: State, m: int) -> np.ndarray:
-    """(m,) Gᵀ v for the system's (unknown) components, zero for the others."""
-    v6 = np.concatenate((state.velocity, state.omega), axis=1).ravel()
-    out = np.zeros(m)
-    out[system.U] = system.gt(v6)
-    return out
+COMPILED_METHOD = "banded Cholesky of the Schur complement (compiled)"
+COMPILED_REDUNDANT = ("eigen-decomposition of the Schur complement, minimum-norm reactions "
+                      "(redundant constraints; compiled)")
 
 
 class _LazyBodies(Mapping):
@@ -312,17 +387,11 @@ class _LazyBodies(Mapping):
 
 
 def assemble(model: Model, state: State | None = None) -> Assembly:
-    """The stacked Newton-Euler equations of `model` at `state` (default: its initial state)."""
-    state = model.initial if state is None else state
-    plan = kernels.plan_for(model)
-    frame = kernels.frame_at(model, state.t)
-    sparse = kernels.sparse_wrench(plan, [kernels.load_wrenches(model, plan, frame, state),
-                                          kernels.spring_wrenches(model, state)])
-    Q6 = np.empty((6, model.n))
-    b6 = np.zeros((6, model.n))  # rows 0-2 (Newton) stay 0; planar: all 0
-    kernels.loads_and_gyroscopic(plan, frame, state, sparse, Q6,
-                                 b6[3:6] if model.dimension == cv.SPATIAL else None)
-    return Assembly(model, state, AppliedLoads(model, state, Q6), b6.T)
+    """The stacked Newton-Euler equations of `model` at `state` (default: its initial state).
+
+    Nothing is computed until asked for: `solve()`, `Q`, `b`, `G`, `M`, `bodies`.
+    """
+    return Assembly(model, model.initial if state is None else state)
 
 
 from .constraints import ConstraintJacobian  # noqa: E402  (annotations only)

@@ -162,14 +162,12 @@ def joint_errors(model: Model, state: State, cols: ReactionColumns | None = None
         return []
     if enforced is None:
         enforced = np.array([lab not in model.known_reactions for lab in t.labels])
-    from .joints import reaction_columns
+    from .joints import constraint_velocity, reaction_columns
 
     v6 = np.concatenate((state.velocity, state.omega), axis=1)
+    cols = reaction_columns(model, state) if cols is None else cols
     if gtv is None:  # (m,) Gᵀ v, unless the caller has it already
-        cols = reaction_columns(model, state) if cols is None else cols
-        gtv = np.einsum("ij,ij->i", cols.child6, v6[t.child])
-        on = t.parent >= 0
-        gtv[on] += np.einsum("ij,ij->i", cols.parent6[on], v6[t.parent[on]])
+        gtv = constraint_velocity(model, cols, state)
     ph = phi(model, state, cols=cols)
     size = float(np.ptp(state.position, axis=0).max()) if model.n > 1 else 0.0
     size = max(size, float(np.abs(t.B_r_child).max()), 1e-3)

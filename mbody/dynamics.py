@@ -14,6 +14,8 @@ For integrators, `derivative` returns the time derivative of the packed state
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from . import kernels as k
@@ -72,6 +74,76 @@ def quaternion_rate(quaternion: np.ndarray, omega: np.ndarray) -> np.ndarray:
     out[:, :1] = -0.5 * np.einsum("ij,ij->i", u, omega)[:, None]
     out[:, 1:] = 0.5 * (w * omega + np.cross(u, omega))
     return out
+
+
+Dynamics = Callable[[Model, State], np.ndarray]
+"""f(model, state) -> (n, 6) accelerations [a_G (world, m/s²), ω̇ (body axes, rad/s²)]."""
+
+
+class StateDerivative:
+    """ẏ = f(t, y) for the packed state a simulation integrates,
+
+        y = [x (n, 3) | q (n, 4) | v (n, 3) | ω (n, 3) | θ (n,), planar only]   (flat),
+        ẏ = [v | ½ q ⊗ (0, ω) | a_G | ω̇ | ω_z],
+
+    with the accelerations from `dynamics` (numpy path, a `Dynamics` callable) or, for
+    models `mbody.plan` compiles, from one call of `mbody.compiled.derivative` with the
+    unknown reactions solved and Baumgarte's terms (α = β = `rate`). The rotation is
+    built from q/‖q‖; q itself is integrated as it is. Planar models' out-of-plane rows
+    are set to exactly 0 (rounding would otherwise creep in).
+    """
+
+    def __init__(self, model: Model, dynamics: Dynamics, *, unknowns=None, rate: float = 0.0,
+                 known_at: Callable[[float], np.ndarray] | None = None,
+                 compiled: bool = False):
+        self.model, self.dynamics, self.rate = model, dynamics, rate
+        self.unknowns, self.known_at = unknowns, known_at
+        self.planar = model.dimension == 2
+        n = model.n
+        self.size = 13 * n + (n if self.planar else 0)
+        self._kernel = None
+        # a simulation makes thousands of evaluations: worth the compiled path at once
+        from .plan import JIT_AFTER
+        from .plan import compiled as compiled_module
+
+        if compiled and model.plan.use_compiled(calls=JIT_AFTER):
+            plan = model.plan
+            self._kernel = compiled_module().derivative
+            self._F, self._I = plan.packed
+            self._Iu = plan.packed_unknowns(unknowns)
+
+    @property
+    def compiled(self) -> bool:
+        """Whether evaluations go through the compiled path."""
+        return self._kernel is not None
+
+    def __call__(self, t: float, y: np.ndarray) -> np.ndarray:
+        if self._kernel is not None:
+            out = np.empty(self.size)
+            lam = self.unknowns.lam if self.known_at is None else self.known_at(t)
+            self._kernel(self._F, self._I, self._Iu, y, self.model.plan.load_values(t), lam,
+                         self.rate, self.planar, out)
+            return out
+        return self._numpy(t, y)
+
+    def _numpy(self, t: float, y: np.ndarray) -> np.ndarray:
+        n = self.model.n
+        x = y[:3 * n].reshape(n, 3)
+        q = y[3 * n:7 * n].reshape(n, 4)
+        v = y[7 * n:10 * n].reshape(n, 3)
+        w = y[10 * n:13 * n].reshape(n, 3)
+        qn = q / np.sqrt(np.einsum("ij,ij->i", q, q))[:, None]
+        acc = self.dynamics(self.model, State(x, qn, v, w, t))
+        d = np.empty(self.size)
+        d[:3 * n] = y[7 * n:10 * n]
+        d[3 * n:7 * n] = quaternion_rate(q, w).ravel()
+        d[7 * n:10 * n].reshape(n, 3)[:] = acc[:, :3]
+        d[10 * n:13 * n].reshape(n, 3)[:] = acc[:, 3:]
+        if self.planar:
+            d[7 * n + 2:10 * n:3] = 0.0
+            d[10 * n:13 * n].reshape(n, 3)[:, :2] = 0.0
+            d[13 * n:] = w[:, 2]
+        return d
 
 
 def pack(state: State) -> np.ndarray:

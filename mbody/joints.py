@@ -16,7 +16,6 @@ velocity the joint forbids.
 
 from __future__ import annotations
 
-import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -61,8 +60,8 @@ def joint_parents(model: Model, R: np.ndarray) -> tuple[np.ndarray, np.ndarray, 
 
 
 @dataclass(frozen=True)
-class _Constants:
-    """Per component, what depends on the model only (made once per model)."""
+class ReactionConstants:
+    """Per component, what its column needs of the model only (kept by `model.plan`)."""
 
     k: np.ndarray  # joint-frame axis index 0-2
     is_moment: np.ndarray  # (m, 1) bool
@@ -72,19 +71,13 @@ class _Constants:
     ground: np.ndarray  # (m,) bool: parent is ground
 
 
-_CONSTANTS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
-
-
-def _constants(model: Model) -> _Constants:
-    c = _CONSTANTS.get(model)
-    if c is None:
-        t, jt = model.reaction_table, model.joint_table
-        j, k = t.joint, t.axis % 3
-        is_moment = (t.axis >= 3)[:, None]
-        c = _Constants(k, is_moment, bool(is_moment.any()), jt.B_r_child[j],
-                       jt.P_E3[j, :, k], t.parent < 0)
-        _CONSTANTS[model] = c
-    return c
+def reaction_constants(model: Model) -> ReactionConstants:
+    """The `ReactionConstants` of `model` (use ``model.plan.reaction_constants``)."""
+    t, jt = model.reaction_table, model.joint_table
+    j, k = t.joint, t.axis % 3
+    is_moment = (t.axis >= 3)[:, None]
+    return ReactionConstants(k, is_moment, bool(is_moment.any()), jt.B_r_child[j],
+                             jt.P_E3[j, :, k], t.parent < 0)
 
 
 def reaction_columns(model: Model, state: State, R: np.ndarray | None = None) -> ReactionColumns:
@@ -107,7 +100,7 @@ def reaction_columns(model: Model, state: State, R: np.ndarray | None = None) ->
     B_r_p = rmatvec(Rp, P - x_p)  # the parent's material point at P, parent axes
 
     # Per component: pick its axis of the joint frame.
-    const = _constants(model)
+    const = model.plan.reaction_constants
     j, k = t.joint, const.k
     W_e = W_E[j, :, k]
     B_e_c = B_E_c[j, :, k]
@@ -179,4 +172,15 @@ def reaction_wrench(model: Model, cols: ReactionColumns, lam: np.ndarray) -> np.
         w = six[keep] * lam[nz][keep, None]
         for r in range(6):  # six rows, not a loop over bodies
             out[:, r] += np.bincount(body[keep], w[:, r], minlength=model.n)
+    return out
+
+
+def constraint_velocity(model: Model, cols: ReactionColumns, state: State) -> np.ndarray:
+    """(m,) Gᵀ v: per component, the relative velocity its joint forbids (m/s or rad/s),
+    from the columns at `state` and the bodies' [v (world), ω (body axes)]."""
+    t = model.reaction_table
+    v6 = np.concatenate((state.velocity, state.omega), axis=1)
+    out = np.einsum("ij,ij->i", cols.child6, v6[t.child])
+    on = t.parent >= 0
+    out[on] += np.einsum("ij,ij->i", cols.parent6[on], v6[t.parent[on]])
     return out

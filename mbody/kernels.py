@@ -33,7 +33,6 @@ springs and reaction wrenches; the sparse sums are added chunk by chunk.
 from __future__ import annotations
 
 import threading
-import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -277,29 +276,14 @@ def build_frame(model: Model, plan: Plan, vector: np.ndarray) -> LoadFrame:
     return LoadFrame(vector, W_F, W_F * plan.inv_mass, B_F, B_M, W_C, tuple(slot_f))
 
 
-_plans: weakref.WeakKeyDictionary[Model, tuple[Plan, list]] = weakref.WeakKeyDictionary()
-_lock = threading.Lock()
-
-
 def plan_for(model: Model) -> Plan:
-    """The model's `Plan`, built on first use and kept while the model lives."""
-    entry = _plans.get(model)
-    if entry is None:
-        with _lock:
-            entry = _plans.setdefault(model, (build_plan(model), [None]))
-    return entry[0]
+    """The model's `Plan` (owned by its evaluation plan, `model.plan`)."""
+    return model.plan.kernels
 
 
 def frame_at(model: Model, t: float) -> LoadFrame:
     """The `LoadFrame` for ``model.forces.vector_at(t)`` (rebuilt only if that array changed)."""
-    plan = plan_for(model)
-    cache = _plans[model][1]
-    vec = model.forces.vector_at(t)
-    frame = cache[0]
-    if frame is None or frame.vector is not vec:
-        frame = build_frame(model, plan, vec)
-        cache[0] = frame  # keeps `vec` alive, so its identity stays meaningful
-    return frame
+    return model.plan.load_frame(t)
 
 
 # -- the sparse path ----------------------------------------------------------------------

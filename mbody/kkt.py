@@ -17,8 +17,6 @@ reactions are returned and the components that are not unique are named.
 
 from __future__ import annotations
 
-import weakref
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -27,9 +25,10 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.sparse.csgraph import reverse_cuthill_mckee
 
-from .blockplan import BlockOperators, BlockPlan, make_plan
+from .blockplan import BlockOperators
 from .joints import ReactionColumns
 from .model import Model
+from .plan import Unknowns
 from .spatial import matvec
 
 SMALL_BODIES = 60
@@ -38,21 +37,6 @@ DENSE_LIMIT = 300
 """Up to this many unknown components, S is factorised densely (and checked for rank)."""
 RANK_RTOL = 1e-10
 """Relative tolerance on S's eigenvalues (or pivots) below which a constraint is redundant."""
-
-
-def split_reactions(model: Model, given: Mapping[str, float]) -> tuple[np.ndarray, np.ndarray]:
-    """(unknown (m,) bool, λ (m,) with the given values in place, 0 elsewhere).
-
-    `given` maps reaction labels (already checked) to values; the loop runs over the given
-    values only, which are few.
-    """
-    m = len(model.reactions)
-    unknown = np.ones(m, dtype=bool)
-    lam = np.zeros(m)
-    for label, v in given.items():
-        k = model.reaction_index[label]
-        unknown[k], lam[k] = False, float(v)
-    return unknown, lam
 
 
 def block_solve(model: Model, body: np.ndarray, g6: np.ndarray) -> np.ndarray:
@@ -107,18 +91,6 @@ def _g_and_minv_g(model: Model, parent: np.ndarray, child: np.ndarray, child6: n
     G = sp.csc_matrix((g.ravel(), idx, indptr), shape=shape)
     H = sp.csc_matrix((h.ravel(), idx, indptr), shape=shape)
     return G, H
-
-
-_PLANS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
-
-
-def _plan(model: Model, unknown: np.ndarray, U: np.ndarray) -> BlockPlan | None:
-    """The block plan of `model` for this set of unknowns, made once and kept with it."""
-    per_model = _PLANS.setdefault(model, {})
-    key = unknown.tobytes()
-    if key not in per_model:
-        per_model[key] = make_plan(model, U)
-    return per_model[key]
 
 
 def _banded(ab: np.ndarray, perm: np.ndarray | None, mu: int) -> Factorisation | None:
@@ -184,17 +156,18 @@ class Factorisation:
 class ConstrainedSystem:
     """The constrained system of a model at one state, for a set of unknown components.
 
-    cols: the reaction columns at the state; unknown: (m,) bool mask of unknown components.
+    cols: the reaction columns at the state; unknowns: which components are unknown
+    (`mbody.plan.Unknowns`).
     """
 
-    def __init__(self, model: Model, cols: ReactionColumns, unknown: np.ndarray):
+    def __init__(self, model: Model, cols: ReactionColumns, unknowns: Unknowns):
         self.model = model
         self.cols = cols
         t = model.reaction_table
-        self.unknown = np.asarray(unknown, dtype=bool)
-        U = np.flatnonzero(self.unknown)
+        self.unknown = unknowns.mask
+        U = unknowns.U
         self.U = U
-        if len(U) == len(t.labels):  # every component unknown: no copies
+        if unknowns.every:  # every component unknown: no copies
             args = (model, t.parent, t.child, cols.child6, cols.parent6)
         else:
             args = (model, t.parent[U], t.child[U], cols.child6[U], cols.parent6[U])
@@ -205,7 +178,7 @@ class ConstrainedSystem:
             self.fact = self._dense(self.G.T @ self.H)
             return
         if len(U) > DENSE_LIMIT:  # large: per-body blocks and a banded S (mbody.blockplan)
-            plan = _plan(model, self.unknown, U)
+            plan = model.plan.block_plan(unknowns)
             if plan is not None:
                 blocks = BlockOperators(model, plan, args[3], args[4])
                 fact = _banded(blocks.band(), plan.perm, len(U))

@@ -19,10 +19,8 @@ from collections.abc import Mapping
 import numpy as np
 
 from .assemble import assemble
-from .constraints import gamma, phi
-from .joints import reaction_columns, reaction_wrench
-from .kkt import ConstrainedSystem, split_reactions
-from .loads import applied_loads, gyroscopic
+from .constraints import phi
+from .joints import constraint_velocity, reaction_columns
 from .model import Model, State
 
 BAUMGARTE_RATE = 20.0
@@ -32,29 +30,16 @@ BAUMGARTE_RATE = 20.0
 def constrained_dynamics(model: Model, known: Mapping[str, float] | None = None, *,
                          rate: float = BAUMGARTE_RATE):
     """f(model, state) -> (n, 6) accelerations with the unknown reactions solved each call,
-    stabilised with α = β = `rate` (1/s; 0 turns stabilisation off)."""
+    stabilised with α = β = `rate` (1/s; 0 turns stabilisation off). The numpy path;
+    `mbody.dynamics.StateDerivative` takes the compiled one where it can."""
 
     def f(model: Model, state: State) -> np.ndarray:
-        R = state.W_R_B
-        cols = reaction_columns(model, state, R)
-        unknown, lam = split_reactions(model, {**model.known_reactions_at(state.t),
-                                               **(known or {})})
-        loads = applied_loads(model, state, R)
-        r6 = np.concatenate((loads.W_F, loads.B_M), axis=1)
-        if model.dimension == 3:
-            r6[:, 3:] -= gyroscopic(model.J, state.omega)
-        if (~unknown).any():
-            r6 += reaction_wrench(model, cols, lam)
-        system = ConstrainedSystem(model, cols, unknown)
-        g = gamma(model, state, cols, R)[unknown]
-        if rate:
-            v6 = np.concatenate((state.velocity, state.omega), axis=1).ravel()
-            g = g - 2 * rate * system.gt(v6) - rate**2 * phi(model, state, R, cols)[unknown]
-        acc, _ = system.solve(r6, g)
-        return acc
+        unknowns = model.plan.unknowns_at(state.t, known)
+        return assemble(model, state).constrained(unknowns, rate=rate, refine=False)[0]
 
     f.stabilisation = (f"Baumgarte, alpha = beta = {rate:g} 1/s" if rate  # type: ignore[attr-defined]
                        else "none")
+    f.rate = rate  # type: ignore[attr-defined]
     return f
 
 
@@ -76,16 +61,10 @@ def constraint_drift(model: Model, states: list[State]) -> dict[str, float]:
     """Largest joint position error |φ| (m for forces, rad for moments) and velocity error
     |Gᵀ v| over the samples."""
     pos = vel = 0.0
-    m = len(model.reactions)
-    if m == 0:
+    if not len(model.reactions):
         return {"joint_position_drift": 0.0, "joint_velocity_drift": 0.0}
     for s in states:
-        pos = max(pos, float(np.max(np.abs(phi(model, s)))))
         cols = reaction_columns(model, s)
-        v6 = np.concatenate((s.velocity, s.omega), axis=1)
-        rel = np.einsum("ij,ij->i", cols.child6, v6[model.reaction_table.child])
-        on = model.reaction_table.parent >= 0
-        rel[on] += np.einsum("ij,ij->i", cols.parent6[on],
-                             v6[model.reaction_table.parent[on]])
-        vel = max(vel, float(np.max(np.abs(rel))))
+        pos = max(pos, float(np.max(np.abs(phi(model, s, cols=cols)))))
+        vel = max(vel, float(np.max(np.abs(constraint_velocity(model, cols, s)))))
     return {"joint_position_drift": pos, "joint_velocity_drift": vel}

@@ -310,6 +310,13 @@ class Model:
         return {n: i for i, n in enumerate(self.body_names)}
 
     @cached_property
+    def plan(self):  # -> mbody.plan.ModelPlan: what every evaluation needs, made once
+        """The model's evaluation plan (`mbody.plan.ModelPlan`), made on first use."""
+        from .plan import ModelPlan
+
+        return ModelPlan(self)
+
+    @cached_property
     def graph(self):  # -> networkx.MultiGraph; imported lazily, it is slow to import
         from .graph import body_graph
 

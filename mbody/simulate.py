@@ -26,43 +26,23 @@ import math
 import os
 import sys
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
 
 from . import conventions as cv
+from .dynamics import Dynamics, StateDerivative, accelerations
 from .errors import MbodyError, UnknownReactionsError, did_you_mean
 from .expr import Expression, compile_expression
 from .model import Model, State
 from .spatial import quat_to_matrix
 from .trajectory import Trajectory
 
-Dynamics = Callable[[Model, State], np.ndarray]
-"""f(model, state) -> (n, 6) accelerations [a_G (world, m/s²), ω̇ (body axes, rad/s²)]."""
-
 METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
 """scipy.integrate's step-by-step solvers (imported when a simulation starts)."""
 DEFAULT_RTOL = 1e-10
 DEFAULT_ATOL = 1e-12
-
-
-def _accelerations_fn():
-    """`mbody.dynamics.accelerations` (the fast kernels), else the assembly's own path."""
-    try:
-        from .dynamics import accelerations
-        return accelerations
-    except ImportError:  # pragma: no cover - only before mbody.dynamics existed
-        from .assemble import accelerations6, assemble
-        from .joints import reaction_columns, reaction_wrench
-
-        def accelerations(model: Model, state: State, reactions=None) -> np.ndarray:
-            asm = assemble(model, state)
-            rhs = asm._Q6 - asm._b6
-            if reactions is not None and len(reactions):
-                rhs = rhs + reaction_wrench(model, reaction_columns(model, state), reactions)
-            return accelerations6(model, rhs)
-        return accelerations
 
 
 def known_reaction_dynamics(model: Model, known: Mapping[str, float | str] | None = None
@@ -90,20 +70,23 @@ def known_reaction_dynamics(model: Model, known: Mapping[str, float | str] | Non
     missing = [r for r in labels if r not in values]
     if missing:
         raise UnknownReactionsError(missing)
-    accelerations = _accelerations_fn()
-    if not labels:
-        return lambda model, state: accelerations(model, state, None)
-    base = np.array([values[r] for r in labels])
+    base = np.array([values[r] for r in labels], dtype=float)
     varying = [(labels.index(r), e) for r, e in exprs.items() if not e.constant]
 
-    def f(model: Model, state: State) -> np.ndarray:
-        lam = base
-        if varying:
-            lam = base.copy()
-            for i, e in varying:  # one call per time-varying reaction, not per body
-                lam[i] = e(state.t)
-        return accelerations(model, state, lam)
+    def values_at(t: float) -> np.ndarray:
+        """(m,) the reaction values at time t."""
+        if not varying:
+            return base
+        lam = base.copy()
+        for i, e in varying:  # one call per time-varying reaction, not per body
+            lam[i] = e(t)
+        return lam
 
+    def f(model: Model, state: State) -> np.ndarray:
+        return accelerations(model, state, values_at(state.t) if labels else None)
+
+    f.values_at = values_at  # type: ignore[attr-defined]
+    f.varying = bool(varying)  # type: ignore[attr-defined]
     f.reactions_at = lambda t: _reactions_at(base, varying, t)  # type: ignore[attr-defined]
     return f
 
@@ -115,16 +98,6 @@ def _reactions_at(base: np.ndarray, varying: list[tuple[int, Expression]],
     for i, e in varying:
         out[:, i] = e(t)
     return out
-
-
-def quaternion_rate(q: np.ndarray, omega: np.ndarray) -> np.ndarray:
-    """q̇ = ½ q ⊗ (0, ω): (n, 4) W_R_B quaternions [w, x, y, z], ω (n, 3) body axes."""
-    w, x, y, z = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
-    p, r, s = omega[:, 0], omega[:, 1], omega[:, 2]
-    return 0.5 * np.stack((-x * p - y * r - z * s,
-                           w * p + y * s - z * r,
-                           w * r + z * p - x * s,
-                           w * s + x * r - y * p), axis=1)
 
 
 class _Progress:
@@ -179,12 +152,8 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     if K > 10_000_000:
         raise MbodyError(f"{K} output samples requested (t_end * fps); at most 10 million")
     mechanism = dynamics is None and _has_unknown_reactions(model, known)
-    if mechanism:  # joints with unknown reactions: solved at every step (mbody.mechanism)
-        from .mechanism import constrained_dynamics
-
-        f = constrained_dynamics(model, _numeric_known(model, known))
-    else:
-        f = dynamics or known_reaction_dynamics(model, known)
+    rhs = state_derivative(model, known, dynamics)
+    f = rhs.dynamics
     n = model.n
     planar = model.dimension == cv.PLANAR
     s0 = model.initial if initial is None else initial
@@ -194,28 +163,7 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     y0 = np.concatenate((s0.position.ravel(), s0.quaternion.ravel(), s0.velocity.ravel(),
                          s0.omega.ravel(), theta0))
     size = len(y0)
-    counts = {"nfev": 0}
     bar = _Progress(progress, t_end, model.name or "simulate")
-
-    def rhs(t: float, y: np.ndarray) -> np.ndarray:
-        x = y[:3 * n].reshape(n, 3)
-        q = y[3 * n:7 * n].reshape(n, 4)
-        v = y[7 * n:10 * n].reshape(n, 3)
-        w = y[10 * n:13 * n].reshape(n, 3)
-        qn = q / np.sqrt(np.einsum("ij,ij->i", q, q))[:, None]
-        acc = f(model, State(x, qn, v, w, t))
-        if planar:  # out-of-plane rows are identically zero; keep rounding from creeping in
-            acc = acc.copy()
-            acc[:, 2:5] = 0.0
-        d = np.empty(size)
-        d[:3 * n] = y[7 * n:10 * n]
-        d[3 * n:7 * n] = quaternion_rate(q, w).ravel()
-        d[7 * n:10 * n].reshape(n, 3)[:] = acc[:, :3]
-        d[10 * n:13 * n].reshape(n, 3)[:] = acc[:, 3:]
-        if planar:
-            d[13 * n:] = w[:, 2]
-        counts["nfev"] += 1
-        return d
 
     t_eval = np.arange(K) / fps
     Y = np.empty((K, size))
@@ -269,7 +217,8 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
                       "initial_joint_errors": joint_errors(model, states[0])}
     info = {
         "integrator": method, "rtol": rtol, "atol": atol, "t_end": t_end, "fps": fps,
-        "samples": K, "steps": steps, "evaluations": counts["nfev"],
+        "samples": K, "steps": steps, "evaluations": solver.nfev,
+        "evaluation_path": "compiled" if rhs.compiled else "numpy",
         "wall_time_s": wall, "quaternion_norm_error": q_err,
         "quaternion_handling": "integrated as is; rotation built from q/|q|; output "
                                "samples divided by |q|",
@@ -287,6 +236,32 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     traj.series.update(series)
     info.update(drift)
     return traj
+
+
+def state_derivative(model: Model, known: Mapping[str, float | str] | None = None,
+                     dynamics: Dynamics | None = None) -> StateDerivative:
+    """ẏ = f(t, y), what `simulate` integrates (`mbody.dynamics.StateDerivative`): the
+    unknown reactions solved at every call (Baumgarte-stabilised, `mbody.mechanism`) or
+    every reaction known (`known_reaction_dynamics`), or `dynamics` when given."""
+    plan = model.plan
+    if dynamics is not None:
+        return StateDerivative(model, dynamics)
+    if _has_unknown_reactions(model, known):  # a mechanism: reactions solved every call
+        from .mechanism import constrained_dynamics
+
+        numeric = _numeric_known(model, known)
+        f = constrained_dynamics(model, numeric)
+        known_at = None
+        if model.known_expressions:
+            def known_at(t: float) -> np.ndarray:
+                return plan.unknowns_at(t, numeric).lam
+        return StateDerivative(model, f, unknowns=plan.unknowns_at(0.0, numeric),
+                               rate=f.rate, known_at=known_at, compiled=True)
+    f = known_reaction_dynamics(model, known)
+    labels = model.reactions
+    every = plan.unknowns(dict(zip(labels, f.values_at(0.0).tolist(), strict=True)))
+    return StateDerivative(model, f, unknowns=every,
+                           known_at=f.values_at if f.varying else None, compiled=True)
 
 
 def _model_text(model: Model) -> str:

@@ -421,7 +421,7 @@ def test_block_path_equals_sparse_path_on_large_random_trees(seed, monkeypatch):
     """Above 300 unknowns the Schur complement is built from per-body blocks
     (mbody.blockplan); on a random tree of 120 bodies with full inertia tensors and every
     joint type it gives the same accelerations and reactions as the general sparse path."""
-    import mbody.kkt as kkt
+    import mbody.blockplan as blockplan
 
     types = ("revolute", "prismatic", "cylindrical", "universal", "spherical", "fixed")
     spec = spatial_model(seed, n=120, n_joints=119, n_forces=40, n_torques=10,
@@ -435,8 +435,8 @@ def test_block_path_equals_sparse_path_on_large_random_trees(seed, monkeypatch):
     assert model.minv6 is None  # full inertia tensors: the non-diagonal M⁻¹ branch
     blocks = mbody.assemble(model).solve()
     assert "per-body blocks" in blocks.method
-    monkeypatch.setattr(kkt, "make_plan", lambda model, U: None)
-    kkt._PLANS.clear()
+    monkeypatch.setattr(blockplan, "make_plan", lambda model, U: None)
+    model.plan._blocks.clear()
     general = mbody.assemble(model).solve()
     assert "per-body blocks" not in general.method
     np.testing.assert_allclose(blocks.accelerations, general.accelerations, rtol=1e-9,

@@ -1,0 +1,754 @@
+"""The compiled small-model path: one call evaluates a whole mechanism at one state,
+
+    M v̇ + b = Q + G λ,    Gᵀ v̇ = γ (− 2 α Gᵀ v − α² φ with Baumgarte's terms),
+
+written as plain loops for numba (``njit(cache=True)``): rotations, applied loads and
+springs, gyroscopic terms, reaction columns, γ, φ, Gᵀ v, the Schur complement
+S = G_Uᵀ M⁻¹ G_U in banded storage, its Cholesky factorisation, one round of iterative
+refinement and the backward error, with nothing allocated per body in Python.
+
+The formulas are those of the numpy path (`mbody.kernels`, `mbody.joints`,
+`mbody.constraints`, `mbody.kkt`), which stays the general path (large models, and
+machines without numba); `tests/test_compiled.py` holds both equal on random mechanisms
+of every joint type. Nothing here is imported by ``import mbody``: `mbody.plan` loads
+this module (and numba) only for models that are evaluated many times.
+
+Packing (`pack_model`): numba's dispatcher costs about 0.1 µs per argument, so the model
+is passed as one float and one int array. `F` holds gravity (3), then per body
+[mass, J (9, row-major), J⁻¹ (9)], per point load `B_r` (3), per spring
+[r_a (3), r_b (3), stiffness, rest length, damping], per joint
+[B_r_child (3), B_r_parent (3), C_axis2 (3), P_E3 (9), C_E3 (9)]. `I` holds the sizes
+[n, loads, springs, joints, components], then per load [body, in_body, couple], per
+spring [a, b], per joint [parent, child], per component [joint, axis, rot_kind]
+(see `mbody.model.ReactionTable`). The unknown components' structure for one set of
+unknowns is a third int array (`pack_unknowns`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+# Column offsets of the packed per-item rows (see the module docstring).
+BODY_W, MASS, J0, JINV0 = 19, 0, 1, 10
+SPRING_W, RA, RB, STIFF, REST, DAMP = 9, 0, 3, 6, 7, 8
+JOINT_W, BRC, BRP, CAX2, PE3, CE3 = 27, 0, 3, 6, 9, 18
+HEADER = 5
+RANK_RTOL = 1e-10  # as mbody.kkt.RANK_RTOL
+JOINT_TOL = 1e-6  # as mbody.constraints.JOINT_TOL
+
+# info[] slots written by `solve`
+ST_RANK, ST_BERR, ST_BROKEN, ST_MU = 0, 1, 2, 3
+INFO = 4
+
+
+def pack_model(model) -> tuple[np.ndarray, np.ndarray]:
+    """(F, I): the model's constants as one float and one int array (module docstring)."""
+    n = model.n
+    ft, sp, rt, jt = model.forces, model.springs, model.reaction_table, model.joint_table
+    k, s, nj, m = len(ft.names), len(sp.names), len(jt.parent), len(rt.labels)
+    bodies = np.concatenate((np.asarray(model.mass, float)[:, None],
+                             np.asarray(model.J).reshape(n, 9),
+                             np.asarray(model.J_inv).reshape(n, 9)), axis=1)
+    springs = np.concatenate((sp.r_a, sp.r_b, sp.stiffness[:, None],
+                              sp.rest_length[:, None], sp.damping[:, None]), axis=1)
+    joints = np.concatenate((jt.B_r_child, jt.B_r_parent, jt.C_axis2,
+                             jt.P_E3.reshape(nj, 9), jt.C_E3.reshape(nj, 9)), axis=1)
+    F = np.concatenate((np.asarray(model.gravity, float), bodies.ravel(),
+                        np.asarray(ft.B_r, float).ravel(), springs.ravel(), joints.ravel()))
+    Ii = np.concatenate((
+        [n, k, s, nj, m],
+        np.stack((ft.body, ft.in_body, ft.couple), axis=1).ravel(),
+        np.stack((sp.a, sp.b), axis=1).ravel(),
+        np.stack((jt.parent, jt.child), axis=1).ravel(),
+        np.stack((rt.joint, rt.axis, rt.rot_kind), axis=1).ravel(),
+    )).astype(np.int64)
+    return np.ascontiguousarray(F), Ii
+
+
+def pack_unknowns(model, U: np.ndarray) -> np.ndarray:
+    """The int array describing the unknown components U (in their solve order).
+
+    Layout: [mu, bw, nnz], U (mu), inc_ptr (n + 1), inc (nnz × [position in U, side]):
+    for each body, the unknown components acting on it (side 0 child, 1 parent), so
+    that S = G_Uᵀ M⁻¹ G_U is summed body by body; bw is S's half bandwidth in U's order.
+    """
+    rt = model.reaction_table
+    n, mu = model.n, len(U)
+    pos = np.arange(mu)
+    body = np.concatenate((rt.child[U], rt.parent[U]))
+    side = np.concatenate((np.zeros(mu, np.int64), np.ones(mu, np.int64)))
+    where = np.concatenate((pos, pos))
+    keep = body >= 0
+    body, side, where = body[keep], side[keep], where[keep]
+    order = np.lexsort((where, body))
+    body, side, where = body[order], side[order], where[order]
+    inc_ptr = np.searchsorted(body, np.arange(n + 1))
+    bw = 0
+    for b in range(n):  # per body, at plan time only
+        w = where[inc_ptr[b]:inc_ptr[b + 1]]
+        if len(w):
+            bw = max(bw, int(w.max() - w.min()))
+    inc = np.stack((where, side), axis=1).ravel()
+    return np.concatenate(([mu, bw, len(where)], np.asarray(U), inc_ptr, inc)).astype(np.int64)
+
+
+# -- small vector helpers ------------------------------------------------------------------
+@njit(cache=True, inline="always")
+def _cross(a0, a1, a2, b0, b1, b2):
+    return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+
+
+@njit(cache=True)
+def _rotations(q: np.ndarray) -> np.ndarray:
+    """(n, 3, 3) W_R_B from (n, 4) quaternions [w, x, y, z], normalised first."""
+    n = q.shape[0]
+    R = np.empty((n, 3, 3))
+    for i in range(n):
+        s = 1.0 / np.sqrt(q[i, 0] ** 2 + q[i, 1] ** 2 + q[i, 2] ** 2 + q[i, 3] ** 2)
+        w, x, y, z = q[i, 0] * s, q[i, 1] * s, q[i, 2] * s, q[i, 3] * s
+        xx, yy, zz = x * x, y * y, z * z
+        xy, xz, yz = x * y, x * z, y * z
+        wx, wy, wz = w * x, w * y, w * z
+        R[i, 0, 0] = 1 - 2 * (yy + zz)
+        R[i, 0, 1] = 2 * (xy - wz)
+        R[i, 0, 2] = 2 * (xz + wy)
+        R[i, 1, 0] = 2 * (xy + wz)
+        R[i, 1, 1] = 1 - 2 * (xx + zz)
+        R[i, 1, 2] = 2 * (yz - wx)
+        R[i, 2, 0] = 2 * (xz - wy)
+        R[i, 2, 1] = 2 * (yz + wx)
+        R[i, 2, 2] = 1 - 2 * (xx + yy)
+    return R
+
+
+@njit(cache=True)
+def _unpack(F, I):
+    n, k, s, nj, m = I[0], I[1], I[2], I[3], I[4]
+    o = 3
+    bodies = F[o:o + n * BODY_W].reshape(n, BODY_W)
+    o += n * BODY_W
+    B_r = F[o:o + 3 * k].reshape(k, 3)
+    o += 3 * k
+    springs = F[o:o + s * SPRING_W].reshape(s, SPRING_W)
+    o += s * SPRING_W
+    joints = F[o:o + nj * JOINT_W].reshape(nj, JOINT_W)
+    o = HEADER
+    loads_i = I[o:o + 3 * k].reshape(k, 3)
+    o += 3 * k
+    springs_i = I[o:o + 2 * s].reshape(s, 2)
+    o += 2 * s
+    joints_i = I[o:o + 2 * nj].reshape(nj, 2)
+    o += 2 * nj
+    comps_i = I[o:o + 3 * m].reshape(m, 3)
+    return F[0:3], bodies, B_r, springs, joints, loads_i, springs_i, joints_i, comps_i
+
+
+# -- Q − b ----------------------------------------------------------------------------------
+@njit(cache=True)
+def _net_wrench(gravity, bodies, B_r, springs, loads_i, springs_i, x, R, v, w, fvec, out):
+    """out (n, 6) = Q − b: [W_F (world); B_M − ω × J ω (body axes)] (module doc of kernels)."""
+    n = x.shape[0]
+    for i in range(n):
+        m = bodies[i, MASS]
+        for c in range(3):
+            out[i, c] = m * gravity[c]
+            out[i, 3 + c] = 0.0
+    for j in range(loads_i.shape[0]):
+        b, in_body, couple = loads_i[j, 0], loads_i[j, 1], loads_i[j, 2]
+        f0, f1, f2 = fvec[j, 0], fvec[j, 1], fvec[j, 2]
+        if in_body:  # body-axis components: the world force is R f
+            W0 = R[b, 0, 0] * f0 + R[b, 0, 1] * f1 + R[b, 0, 2] * f2
+            W1 = R[b, 1, 0] * f0 + R[b, 1, 1] * f1 + R[b, 1, 2] * f2
+            W2 = R[b, 2, 0] * f0 + R[b, 2, 1] * f1 + R[b, 2, 2] * f2
+            B0, B1, B2 = f0, f1, f2
+        else:
+            W0, W1, W2 = f0, f1, f2
+            B0 = R[b, 0, 0] * f0 + R[b, 1, 0] * f1 + R[b, 2, 0] * f2
+            B1 = R[b, 0, 1] * f0 + R[b, 1, 1] * f1 + R[b, 2, 1] * f2
+            B2 = R[b, 0, 2] * f0 + R[b, 1, 2] * f1 + R[b, 2, 2] * f2
+        if couple:
+            out[b, 3] += B0
+            out[b, 4] += B1
+            out[b, 5] += B2
+        else:
+            out[b, 0] += W0
+            out[b, 1] += W1
+            out[b, 2] += W2
+            m0, m1, m2 = _cross(B_r[j, 0], B_r[j, 1], B_r[j, 2], B0, B1, B2)
+            out[b, 3] += m0
+            out[b, 4] += m1
+            out[b, 5] += m2
+    for j in range(springs_i.shape[0]):
+        _spring(springs[j], springs_i[j, 0], springs_i[j, 1], x, R, v, w, out)
+    for i in range(n):  # − ω × (J ω)
+        Jm = bodies[i, J0:J0 + 9]
+        w0, w1, w2 = w[i, 0], w[i, 1], w[i, 2]
+        h0 = Jm[0] * w0 + Jm[1] * w1 + Jm[2] * w2
+        h1 = Jm[3] * w0 + Jm[4] * w1 + Jm[5] * w2
+        h2 = Jm[6] * w0 + Jm[7] * w1 + Jm[8] * w2
+        g0, g1, g2 = _cross(w0, w1, w2, h0, h1, h2)
+        out[i, 3] -= g0
+        out[i, 4] -= g1
+        out[i, 5] -= g2
+
+
+@njit(cache=True)
+def _point(body, r, x, R, v, w):
+    """World position and velocity of body point r (body axes); body −1: r is a world
+    point at rest. P = x + R r, V = v + R (ω × r)."""
+    if body < 0:
+        return r[0], r[1], r[2], 0.0, 0.0, 0.0
+    c0, c1, c2 = _cross(w[body, 0], w[body, 1], w[body, 2], r[0], r[1], r[2])
+    P, V = np.empty(3), np.empty(3)
+    for a in range(3):
+        P[a] = x[body, a] + R[body, a, 0] * r[0] + R[body, a, 1] * r[1] + R[body, a, 2] * r[2]
+        V[a] = v[body, a] + R[body, a, 0] * c0 + R[body, a, 1] * c1 + R[body, a, 2] * c2
+    return P[0], P[1], P[2], V[0], V[1], V[2]
+
+
+@njit(cache=True)
+def _spring(row, a, b, x, R, v, w, out):
+    """Spring-damper: T = k (L − L0) + c L̇ along u = (P_b − P_a) / L; +T u on end a,
+    −T u on end b, each with its moment B_r × (W_R_Bᵀ f)."""
+    ra, rb = row[RA:RA + 3], row[RB:RB + 3]
+    pa0, pa1, pa2, va0, va1, va2 = _point(a, ra, x, R, v, w)
+    pb0, pb1, pb2, vb0, vb1, vb2 = _point(b, rb, x, R, v, w)
+    d0, d1, d2 = pb0 - pa0, pb1 - pa1, pb2 - pa2
+    L = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+    u0 = u1 = u2 = 0.0
+    if L > 1e-12:
+        u0, u1, u2 = d0 / L, d1 / L, d2 / L
+    T = row[STIFF] * (L - row[REST]) + row[DAMP] * (
+        u0 * (vb0 - va0) + u1 * (vb1 - va1) + u2 * (vb2 - va2))
+    f = np.array((T * u0, T * u1, T * u2))
+    for end, r, sign in ((a, ra, 1.0), (b, rb, -1.0)):
+        if end >= 0:
+            g0, g1, g2 = sign * f[0], sign * f[1], sign * f[2]
+            out[end, 0] += g0
+            out[end, 1] += g1
+            out[end, 2] += g2
+            B0 = R[end, 0, 0] * g0 + R[end, 1, 0] * g1 + R[end, 2, 0] * g2
+            B1 = R[end, 0, 1] * g0 + R[end, 1, 1] * g1 + R[end, 2, 1] * g2
+            B2 = R[end, 0, 2] * g0 + R[end, 1, 2] * g1 + R[end, 2, 2] * g2
+            m0, m1, m2 = _cross(r[0], r[1], r[2], B0, B1, B2)
+            out[end, 3] += m0
+            out[end, 4] += m1
+            out[end, 5] += m2
+
+
+# -- reaction columns, γ, φ, Gᵀ v -------------------------------------------------------------
+@njit(cache=True)
+def _columns(joints, joints_i, comps_i, x, R, v, w, child6, parent6, gamma, phi, gtv):
+    """Per component: its columns of G (child6, parent6 (m, 6)), γ = −Ġᵀ v, φ and Gᵀ v
+    (formulas in `mbody.joints` and `mbody.constraints`)."""
+    nj, m = joints_i.shape[0], comps_i.shape[0]
+    W_E = np.empty((nj, 3, 3))
+    Rrel = np.empty((nj, 3, 3))
+    P = np.empty((nj, 3))
+    Brp = np.empty((nj, 3))  # the parent's material point at P, parent axes
+    d = np.empty((nj, 3))  # child's joint point − parent's
+    T = np.empty((nj, 3))  # force components: γ = −e · T
+    wc = np.empty((nj, 3))
+    wp = np.empty((nj, 3))
+    Rp = np.empty((3, 3))
+    for j in range(nj):
+        p, c = joints_i[j, 0], joints_i[j, 1]
+        row = joints[j]
+        if p >= 0:
+            Rp[:, :] = R[p]
+        else:
+            Rp[:, :] = 0.0
+            Rp[0, 0] = Rp[1, 1] = Rp[2, 2] = 1.0
+        Rc = R[c]
+        PE, CE = row[PE3:PE3 + 9], row[CE3:CE3 + 9]
+        for a in range(3):
+            for b in range(3):
+                W_E[j, a, b] = Rp[a, 0] * PE[b] + Rp[a, 1] * PE[3 + b] + Rp[a, 2] * PE[6 + b]
+        for a in range(3):
+            P[j, a] = x[c, a] + Rc[a, 0] * row[BRC] + Rc[a, 1] * row[BRC + 1] \
+                + Rc[a, 2] * row[BRC + 2]
+        xp0 = xp1 = xp2 = 0.0
+        vp0 = vp1 = vp2 = 0.0
+        if p >= 0:
+            xp0, xp1, xp2 = x[p, 0], x[p, 1], x[p, 2]
+            vp0, vp1, vp2 = v[p, 0], v[p, 1], v[p, 2]
+        s0, s1, s2 = P[j, 0] - xp0, P[j, 1] - xp1, P[j, 2] - xp2
+        for a in range(3):
+            Brp[j, a] = Rp[0, a] * s0 + Rp[1, a] * s1 + Rp[2, a] * s2
+            d[j, a] = P[j, a] - (
+                (xp0, xp1, xp2)[a] + Rp[a, 0] * row[BRP] + Rp[a, 1] * row[BRP + 1]
+                + Rp[a, 2] * row[BRP + 2])
+            wc[j, a] = Rc[a, 0] * w[c, 0] + Rc[a, 1] * w[c, 1] + Rc[a, 2] * w[c, 2]
+            wp[j, a] = 0.0
+            if p >= 0:
+                wp[j, a] = Rp[a, 0] * w[p, 0] + Rp[a, 1] * w[p, 1] + Rp[a, 2] * w[p, 2]
+        rho0, rho1, rho2 = P[j, 0] - x[c, 0], P[j, 1] - x[c, 1], P[j, 2] - x[c, 2]
+        c0, c1, c2 = _cross(wc[j, 0], wc[j, 1], wc[j, 2], rho0, rho1, rho2)
+        Vc0, Vc1, Vc2 = v[c, 0] + c0, v[c, 1] + c1, v[c, 2] + c2
+        e0, e1, e2 = _cross(wp[j, 0], wp[j, 1], wp[j, 2], s0, s1, s2)
+        D0, D1, D2 = Vc0 - vp0 - e0, Vc1 - vp1 - e1, Vc2 - vp2 - e2
+        t0, t1, t2 = _cross(D0, D1, D2, wp[j, 0], wp[j, 1], wp[j, 2])
+        a0, a1, a2 = _cross(wc[j, 0], wc[j, 1], wc[j, 2], c0, c1, c2)
+        b0, b1, b2 = _cross(wp[j, 0], wp[j, 1], wp[j, 2], Vc0 - vp0, Vc1 - vp1, Vc2 - vp2)
+        T[j, 0], T[j, 1], T[j, 2] = t0 + a0 - b0, t1 + a1 - b1, t2 + a2 - b2
+        # R_rel = (Rp P_E3)ᵀ (Rc C_E3), for the moment components' φ
+        for a in range(3):
+            for b in range(3):
+                acc = 0.0
+                for k in range(3):
+                    ck = Rc[k, 0] * CE[b] + Rc[k, 1] * CE[3 + b] + Rc[k, 2] * CE[6 + b]
+                    acc += W_E[j, k, a] * ck
+                Rrel[j, a, b] = acc
+    for i in range(m):
+        j, axis, rot = comps_i[i, 0], comps_i[i, 1], comps_i[i, 2]
+        p, c = joints_i[j, 0], joints_i[j, 1]
+        kk = axis % 3
+        e0, e1, e2 = W_E[j, 0, kk], W_E[j, 1, kk], W_E[j, 2, kk]
+        row = joints[j]
+        PE = row[PE3:PE3 + 9]
+        Bp0, Bp1, Bp2 = PE[kk], PE[3 + kk], PE[6 + kk]  # axis fixed in the parent
+        if axis == 6:  # universal: e = a × b / |a × b|, a on the parent, b on the child
+            A0, A1, A2 = W_E[j, 0, 2], W_E[j, 1, 2], W_E[j, 2, 2]
+            cx = row[CAX2:CAX2 + 3]
+            b0 = R[c, 0, 0] * cx[0] + R[c, 0, 1] * cx[1] + R[c, 0, 2] * cx[2]
+            b1 = R[c, 1, 0] * cx[0] + R[c, 1, 1] * cx[1] + R[c, 1, 2] * cx[2]
+            b2 = R[c, 2, 0] * cx[0] + R[c, 2, 1] * cx[1] + R[c, 2, 2] * cx[2]
+            e0, e1, e2 = _cross(A0, A1, A2, b0, b1, b2)
+            nrm = np.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+            e0, e1, e2 = e0 / nrm, e1 / nrm, e2 / nrm
+            if p >= 0:
+                Bp0 = R[p, 0, 0] * e0 + R[p, 1, 0] * e1 + R[p, 2, 0] * e2
+                Bp1 = R[p, 0, 1] * e0 + R[p, 1, 1] * e1 + R[p, 2, 1] * e2
+                Bp2 = R[p, 0, 2] * e0 + R[p, 1, 2] * e1 + R[p, 2, 2] * e2
+            else:
+                Bp0, Bp1, Bp2 = e0, e1, e2
+            pa0, pa1, pa2 = _cross(wp[j, 0], wp[j, 1], wp[j, 2], A0, A1, A2)
+            q0, q1, q2 = _cross(pa0, pa1, pa2, b0, b1, b2)
+            cb0, cb1, cb2 = _cross(wc[j, 0], wc[j, 1], wc[j, 2], b0, b1, b2)
+            r0, r1, r2 = _cross(A0, A1, A2, cb0, cb1, cb2)
+            gamma[i] = -((q0 + r0) * (wc[j, 0] - wp[j, 0]) + (q1 + r1) * (wc[j, 1] - wp[j, 1])
+                         + (q2 + r2) * (wc[j, 2] - wp[j, 2]))
+            phi[i] = -(A0 * b0 + A1 * b1 + A2 * b2)
+        Rc = R[c]
+        Bc0 = Rc[0, 0] * e0 + Rc[1, 0] * e1 + Rc[2, 0] * e2
+        Bc1 = Rc[0, 1] * e0 + Rc[1, 1] * e1 + Rc[2, 1] * e2
+        Bc2 = Rc[0, 2] * e0 + Rc[1, 2] * e1 + Rc[2, 2] * e2
+        if axis >= 3:
+            child6[i, 0] = child6[i, 1] = child6[i, 2] = 0.0
+            child6[i, 3], child6[i, 4], child6[i, 5] = Bc0, Bc1, Bc2
+            parent6[i, 3], parent6[i, 4], parent6[i, 5] = -Bp0, -Bp1, -Bp2
+            if axis != 6:
+                k0, k1, k2 = _cross(wc[j, 0], wc[j, 1], wc[j, 2], wp[j, 0], wp[j, 1], wp[j, 2])
+                gamma[i] = -(e0 * k0 + e1 * k1 + e2 * k2)
+                A = Rrel[j]
+                kq = axis - 3
+                if rot == 1:  # tilt of the child's joint z axis in the parent's frame
+                    phi[i] = -A[1, 2] if kq == 0 else A[0, 2]
+                else:  # small-rotation vector ½ vee(R_rel − R_relᵀ)
+                    if kq == 0:
+                        phi[i] = 0.5 * (A[2, 1] - A[1, 2])
+                    elif kq == 1:
+                        phi[i] = 0.5 * (A[0, 2] - A[2, 0])
+                    else:
+                        phi[i] = 0.5 * (A[1, 0] - A[0, 1])
+        else:
+            child6[i, 0], child6[i, 1], child6[i, 2] = e0, e1, e2
+            child6[i, 3], child6[i, 4], child6[i, 5] = _cross(
+                row[BRC], row[BRC + 1], row[BRC + 2], Bc0, Bc1, Bc2)
+            m0, m1, m2 = _cross(Brp[j, 0], Brp[j, 1], Brp[j, 2], Bp0, Bp1, Bp2)
+            parent6[i, 3], parent6[i, 4], parent6[i, 5] = -m0, -m1, -m2
+            gamma[i] = -(e0 * T[j, 0] + e1 * T[j, 1] + e2 * T[j, 2])
+            phi[i] = e0 * d[j, 0] + e1 * d[j, 1] + e2 * d[j, 2]
+        parent6[i, 0], parent6[i, 1], parent6[i, 2] = -child6[i, 0], -child6[i, 1], -child6[i, 2]
+        s = 0.0
+        for a in range(3):
+            s += child6[i, a] * v[c, a] + child6[i, 3 + a] * w[c, a]
+        if p >= 0:
+            for a in range(3):
+                s += parent6[i, a] * v[p, a] + parent6[i, 3 + a] * w[p, a]
+        else:
+            for a in range(6):
+                parent6[i, a] = 0.0
+        gtv[i] = s
+
+
+# -- the constrained solve ---------------------------------------------------------------------
+@njit(cache=True)
+def _minv(bodies, i, g, out):
+    """out (6,) = M_i⁻¹ g (6,): [g_N / m, J⁻¹ g_E]."""
+    m = bodies[i, MASS]
+    Ji = bodies[i, JINV0:JINV0 + 9]
+    out[0], out[1], out[2] = g[0] / m, g[1] / m, g[2] / m
+    for a in range(3):
+        out[3 + a] = Ji[3 * a] * g[3] + Ji[3 * a + 1] * g[4] + Ji[3 * a + 2] * g[5]
+
+
+@njit(cache=True)
+def _side(child6, parent6, comp, side):
+    return child6[comp] if side == 0 else parent6[comp]
+
+
+@njit(cache=True)
+def _gt(U, comps_i, joints_i, child6, parent6, a6, out):
+    """out (mu,) = G_Uᵀ a for per-body rows a6 (n, 6)."""
+    for k in range(U.shape[0]):
+        i = U[k]
+        j = comps_i[i, 0]
+        p, c = joints_i[j, 0], joints_i[j, 1]
+        s = 0.0
+        for r in range(6):
+            s += child6[i, r] * a6[c, r]
+        if p >= 0:
+            for r in range(6):
+                s += parent6[i, r] * a6[p, r]
+        out[k] = s
+
+
+@njit(cache=True)
+def _add_g(U, comps_i, joints_i, child6, parent6, lam, out, sign):
+    """out (n, 6) += sign · G_U λ."""
+    for k in range(U.shape[0]):
+        i = U[k]
+        j = comps_i[i, 0]
+        p, c = joints_i[j, 0], joints_i[j, 1]
+        f = sign * lam[k]
+        for r in range(6):
+            out[c, r] += child6[i, r] * f
+        if p >= 0:
+            for r in range(6):
+                out[p, r] += parent6[i, r] * f
+
+
+@njit(cache=True)
+def _cholesky_band(Sb, bw):
+    """In place: lower banded S (Sb[i, i − j] = S_ij) -> its Cholesky factor L.
+    Returns False when a pivot is not positive or the squared pivots span more than
+    1/RANK_RTOL (redundant constraints: the general path finds minimum-norm reactions)."""
+    mu = Sb.shape[0]
+    dmax, dmin = 0.0, np.inf
+    for i in range(mu):
+        for j in range(max(0, i - bw), i + 1):
+            s = Sb[i, i - j]
+            for k in range(max(0, i - bw), j):
+                s -= Sb[i, i - k] * Sb[j, j - k]
+            if i == j:
+                if not s > 0.0:
+                    return False
+                Sb[i, 0] = np.sqrt(s)
+                dmax, dmin = max(dmax, s), min(dmin, s)
+            else:
+                Sb[i, i - j] = s / Sb[j, 0]
+    return mu == 0 or dmin > RANK_RTOL * dmax
+
+
+@njit(cache=True)
+def _cho_solve_band(Lb, bw, r):
+    """r (mu,) <- S⁻¹ r for S = L Lᵀ in lower banded storage."""
+    mu = Lb.shape[0]
+    for i in range(mu):
+        s = r[i]
+        for k in range(max(0, i - bw), i):
+            s -= Lb[i, i - k] * r[k]
+        r[i] = s / Lb[i, 0]
+    for i in range(mu - 1, -1, -1):
+        s = r[i]
+        for k in range(i + 1, min(mu, i + bw + 1)):
+            s -= Lb[k, k - i] * r[k]
+        r[i] = s / Lb[i, 0]
+
+
+@njit(cache=True)
+def _schur(bodies, child6, parent6, U, inc_ptr, inc, S, banded):
+    """S = G_Uᵀ M⁻¹ G_U summed body by body over the components acting on it: the lower
+    triangle in banded storage (S[i, i − j]) or, with `banded` False, all of it."""
+    h = np.empty(6)
+    for b in range(inc_ptr.shape[0] - 1):
+        for x in range(inc_ptr[b], inc_ptr[b + 1]):
+            kx, sx = inc[x, 0], inc[x, 1]
+            _minv(bodies, b, _side(child6, parent6, U[kx], sx), h)
+            for y in range(inc_ptr[b], inc_ptr[b + 1]):
+                ky, sy = inc[y, 0], inc[y, 1]
+                if ky <= kx:
+                    gy = _side(child6, parent6, U[ky], sy)
+                    s = 0.0
+                    for r in range(6):
+                        s += gy[r] * h[r]
+                    if banded:
+                        S[kx, kx - ky] += s
+                    else:
+                        S[kx, ky] += s
+                        if ky != kx:
+                            S[ky, kx] += s
+
+
+@njit(cache=True)
+def _constrained(bodies, joints_i, comps_i, Iu, child6, parent6, r6, gam, refine, acc, lamU,
+                 nonunique):
+    """Solve M v̇ − G_U λ = r6, G_Uᵀ v̇ = γ_U through S = G_Uᵀ M⁻¹ G_U: banded Cholesky,
+    or, when S is singular (redundant constraints), the minimum-norm λ with `nonunique`
+    (mu,) marking the components the redundancy leaves undetermined. One round of
+    iterative refinement when the backward error exceeds 1e-15 and `refine` (not for
+    redundant constraints). Returns (rank of S, backward error)."""
+    n = r6.shape[0]
+    mu, bw, nnz = Iu[0], Iu[1], Iu[2]
+    U = Iu[3:3 + mu]
+    inc_ptr = Iu[3 + mu:4 + mu + n]
+    inc = Iu[4 + mu + n:4 + mu + n + 2 * nnz].reshape(nnz, 2)
+    for i in range(n):
+        _minv(bodies, i, r6[i], acc[i])
+    nonunique[:] = False
+    if mu == 0:
+        return 0, 0.0
+    Sb = np.zeros((mu, bw + 1))
+    _schur(bodies, child6, parent6, U, inc_ptr, inc, Sb, True)
+    # λ = S⁻¹ (γ − G_Uᵀ M⁻¹ r), v̇ = M⁻¹ (r + G_U λ)
+    _gt(U, comps_i, joints_i, child6, parent6, acc, lamU)
+    for k in range(mu):
+        lamU[k] = gam[k] - lamU[k]
+    rank = mu
+    if _cholesky_band(Sb, bw):
+        _cho_solve_band(Sb, bw, lamU)
+    else:  # redundant constraints: minimum-norm λ through S's eigen-decomposition
+        S = np.zeros((mu, mu))
+        _schur(bodies, child6, parent6, U, inc_ptr, inc, S, False)
+        ev, V = np.linalg.eigh(S)
+        tol = RANK_RTOL * max(ev[mu - 1], 0.0)
+        proj = V.T @ lamU
+        rank = 0
+        for a in range(mu):
+            if ev[a] > tol:
+                proj[a] /= ev[a]
+                rank += 1
+            else:
+                proj[a] = 0.0
+        lamU[:] = V @ proj
+        for k in range(mu):  # a component is not unique where S's null space reaches it
+            s2 = 0.0
+            for a in range(mu):
+                if not ev[a] > tol:
+                    s2 += V[k, a] ** 2
+            nonunique[k] = np.sqrt(s2) > 1e-8
+    rhs = r6.copy()
+    _add_g(U, comps_i, joints_i, child6, parent6, lamU, rhs, 1.0)
+    for i in range(n):
+        _minv(bodies, i, rhs[i], acc[i])
+    # backward error ‖r‖₂ / (‖K‖_F ‖x‖₂ + ‖f‖₂), ‖K‖_F² = ‖M‖_F² + 2 ‖G_U‖_F²
+    nk = 0.0
+    for i in range(n):
+        nk += 3.0 * bodies[i, MASS] ** 2
+        for a in range(9):
+            nk += bodies[i, J0 + a] ** 2
+    for k in range(mu):
+        i = U[k]
+        for r in range(6):
+            nk += 2.0 * child6[i, r] ** 2
+            if joints_i[comps_i[i, 0], 0] >= 0:
+                nk += 2.0 * parent6[i, r] ** 2
+    normK = np.sqrt(nk)
+    r1 = np.empty((n, 6))
+    r2 = np.empty(mu)
+    berr = _residual(bodies, joints_i, comps_i, U, child6, parent6, r6, gam, acc, lamU,
+                     normK, r1, r2)
+    if refine and rank == mu and berr > 1e-15:
+        dacc = np.empty((n, 6))
+        dlam = np.empty(mu)
+        _solve_again(bodies, joints_i, comps_i, U, child6, parent6, Sb, bw, r1, r2, dacc,
+                     dlam)
+        for i in range(n):
+            for r in range(6):
+                acc[i, r] += dacc[i, r]
+        for k in range(mu):
+            lamU[k] += dlam[k]
+        berr = _residual(bodies, joints_i, comps_i, U, child6, parent6, r6, gam, acc, lamU,
+                         normK, r1, r2)
+    return rank, berr
+
+
+@njit(cache=True)
+def _solve_again(bodies, joints_i, comps_i, U, child6, parent6, Lb, bw, r6, gam, acc, lamU):
+    """The same solve with the factor already in hand (for refinement)."""
+    n, mu = r6.shape[0], U.shape[0]
+    for i in range(n):
+        _minv(bodies, i, r6[i], acc[i])
+    _gt(U, comps_i, joints_i, child6, parent6, acc, lamU)
+    for k in range(mu):
+        lamU[k] = gam[k] - lamU[k]
+    _cho_solve_band(Lb, bw, lamU)
+    rhs = r6.copy()
+    _add_g(U, comps_i, joints_i, child6, parent6, lamU, rhs, 1.0)
+    for i in range(n):
+        _minv(bodies, i, rhs[i], acc[i])
+
+
+@njit(cache=True)
+def _residual(bodies, joints_i, comps_i, U, child6, parent6, r6, gam, acc, lamU, normK,
+              r1, r2):
+    """r1 = r6 − (M v̇ − G_U λ), r2 = γ − G_Uᵀ v̇; returns the backward error."""
+    n, mu = r6.shape[0], U.shape[0]
+    for i in range(n):
+        m = bodies[i, MASS]
+        Jm = bodies[i, J0:J0 + 9]
+        for a in range(3):
+            r1[i, a] = r6[i, a] - m * acc[i, a]
+            r1[i, 3 + a] = r6[i, 3 + a] - (Jm[3 * a] * acc[i, 3] + Jm[3 * a + 1] * acc[i, 4]
+                                           + Jm[3 * a + 2] * acc[i, 5])
+    _add_g(U, comps_i, joints_i, child6, parent6, lamU, r1, 1.0)
+    _gt(U, comps_i, joints_i, child6, parent6, acc, r2)
+    res = normx = normf = 0.0
+    for k in range(mu):
+        r2[k] = gam[k] - r2[k]
+        res += r2[k] ** 2
+        normx += lamU[k] ** 2
+        normf += gam[k] ** 2
+    for i in range(n):
+        for r in range(6):
+            res += r1[i, r] ** 2
+            normx += acc[i, r] ** 2
+            normf += r6[i, r] ** 2
+    denom = normK * np.sqrt(normx) + np.sqrt(normf)
+    return np.sqrt(res) / denom if denom > 0 else np.sqrt(res)
+
+
+# -- the two entry points ----------------------------------------------------------------------
+@njit(cache=True)
+def _evaluate(F, I, Iu, x, q, v, w, fvec, lam, rate, refine):
+    """The shared body of `solve` and `derivative` (see there)."""
+    gravity, bodies, B_r, springs, joints, loads_i, springs_i, joints_i, comps_i = _unpack(F, I)
+    n, m = x.shape[0], comps_i.shape[0]
+    mu = Iu[0]
+    U = Iu[3:3 + mu]
+    R = _rotations(q)
+    r6 = np.empty((n, 6))
+    _net_wrench(gravity, bodies, B_r, springs, loads_i, springs_i, x, R, v, w, fvec, r6)
+    child6 = np.empty((m, 6))
+    parent6 = np.empty((m, 6))
+    gamma, phi, gtv = np.empty(m), np.empty(m), np.empty(m)
+    _columns(joints, joints_i, comps_i, x, R, v, w, child6, parent6, gamma, phi, gtv)
+    # known reactions: r6 += G_K λ_K (λ holds 0 on the unknown components)
+    for i in range(m):
+        if lam[i] != 0.0:
+            j = comps_i[i, 0]
+            p, c = joints_i[j, 0], joints_i[j, 1]
+            for r in range(6):
+                r6[c, r] += child6[i, r] * lam[i]
+            if p >= 0:
+                for r in range(6):
+                    r6[p, r] += parent6[i, r] * lam[i]
+    gam = np.empty(mu)
+    for k in range(mu):
+        i = U[k]
+        gam[k] = gamma[i] - 2.0 * rate * gtv[i] - rate * rate * phi[i]
+    acc = np.empty((n, 6))
+    lamU = np.empty(mu)
+    nonunique = np.empty(mu, dtype=np.bool_)
+    rank, berr = _constrained(bodies, joints_i, comps_i, Iu, child6, parent6, r6, gam,
+                              refine, acc, lamU, nonunique)
+    return acc, lamU, phi, gtv, rank, berr, nonunique
+
+
+def solve_layout(n: int, m: int, planar: bool) -> tuple[int, int, int]:
+    """Where `solve` writes into `out`: (N, offset of λ, offset of info); Gᵀ v (m) and
+    the not-unique flags (m) follow λ; info holds `INFO` entries."""
+    N = (3 if planar else 6) * n
+    return N, N, N + 3 * m
+
+
+@njit(cache=True)
+def solve(F, I, Iu, y, fvec, lam, planar, out):
+    """Accelerations and reactions at one state (what `Assembly.solve` returns).
+
+    y: the state packed as [x (n, 3) world | q (n, 4) W_R_B [w, x, y, z] | v (n, 3) world
+    | ω (n, 3) body axes]; fvec: (k, 3) load values; lam: (m,) known reaction values, 0
+    on the unknown components. Writes `out` (`solve_layout`): the accelerations in the
+    model's coordinates (planar [a_x, a_y, α], spatial [a_G world, ω̇ body axes] per
+    body), λ (m,) (the known values, and the solved ones in place), Gᵀ v (m,), 1.0 for
+    each component that redundant constraints leave not unique (m,), and info [rank of
+    S, backward error, number of broken enforced joints, mu].
+    """
+    n = I[0]
+    m = I[4]
+    x = y[0:3 * n].reshape(n, 3)
+    q = y[3 * n:7 * n].reshape(n, 4)
+    v = y[7 * n:10 * n].reshape(n, 3)
+    w = y[10 * n:13 * n].reshape(n, 3)
+    acc, lamU, phi, gtv, rank, berr, nonunique = _evaluate(F, I, Iu, x, q, v, w, fvec, lam,
+                                                           0.0, True)
+    mu = Iu[0]
+    N = (3 if planar else 6) * n
+    for i in range(n):
+        if planar:
+            out[3 * i], out[3 * i + 1], out[3 * i + 2] = acc[i, 0], acc[i, 1], acc[i, 5]
+        else:
+            for r in range(6):
+                out[6 * i + r] = acc[i, r]
+    for i in range(m):
+        out[N + i] = lam[i]
+        out[N + m + i] = gtv[i]
+        out[N + 2 * m + i] = 0.0
+    for k in range(mu):
+        out[N + Iu[3 + k]] = lamU[k]
+        out[N + 2 * m + Iu[3 + k]] = 1.0 if nonunique[k] else 0.0
+    # broken-joint check on the enforced (unknown) components (mbody.constraints.joint_errors)
+    size = 0.0
+    if n > 1:
+        for a in range(3):
+            lo, hi = x[0, a], x[0, a]
+            for i in range(n):
+                lo, hi = min(lo, x[i, a]), max(hi, x[i, a])
+            size = max(size, hi - lo)
+    joints = _unpack(F, I)[4]
+    comps_i = _unpack(F, I)[8]
+    for i in range(m):
+        row = joints[comps_i[i, 0]]
+        for a in range(3):
+            size = max(size, abs(row[BRC + a]))
+    size = max(size, 1e-3)
+    speed = 1e-3
+    for i in range(n):
+        for a in range(3):
+            speed = max(speed, abs(v[i, a]), abs(w[i, a]))
+    broken = 0
+    for k in range(mu):
+        i = Iu[3 + k]
+        if abs(phi[i]) > JOINT_TOL * size or abs(gtv[i]) > JOINT_TOL * speed:
+            broken += 1
+    o = N + 3 * m
+    out[o + ST_RANK] = rank
+    out[o + ST_BERR] = berr
+    out[o + ST_BROKEN] = broken
+    out[o + ST_MU] = mu
+
+
+@njit(cache=True)
+def derivative(F, I, Iu, y, fvec, lam, rate, planar, out):
+    """out = ẏ for the packed state y = [x (3n) | q (4n) | v (3n) | ω (3n) | θ (n, planar)]
+    (see `mbody.simulate`), with the unknown reactions solved and Baumgarte's terms
+    (α = β = `rate`); redundant constraints get the minimum-norm reactions. Returns 0."""
+    n = I[0]
+    x = y[0:3 * n].reshape(n, 3)
+    q = y[3 * n:7 * n].reshape(n, 4)
+    v = y[7 * n:10 * n].reshape(n, 3)
+    w = y[10 * n:13 * n].reshape(n, 3)
+    acc, lamU, phi, gtv, rank, berr, nonunique = _evaluate(F, I, Iu, x, q, v, w, fvec, lam,
+                                                           rate, False)
+    for i in range(n):
+        for a in range(3):
+            out[3 * i + a] = v[i, a]
+            out[7 * n + 3 * i + a] = acc[i, a]
+            out[10 * n + 3 * i + a] = acc[i, 3 + a]
+        # q̇ = ½ q ⊗ (0, ω)
+        qw, qx, qy, qz = q[i, 0], q[i, 1], q[i, 2], q[i, 3]
+        p, r, s = w[i, 0], w[i, 1], w[i, 2]
+        o = 3 * n + 4 * i
+        out[o] = 0.5 * (-qx * p - qy * r - qz * s)
+        out[o + 1] = 0.5 * (qw * p + qy * s - qz * r)
+        out[o + 2] = 0.5 * (qw * r + qz * p - qx * s)
+        out[o + 3] = 0.5 * (qw * s + qx * r - qy * p)
+    if planar:  # out-of-plane rows are identically zero; θ̇ = ω_z
+        for i in range(n):
+            out[7 * n + 3 * i + 2] = 0.0
+            out[10 * n + 3 * i] = 0.0
+            out[10 * n + 3 * i + 1] = 0.0
+            out[13 * n + i] = w[i, 2]
+    return 0
