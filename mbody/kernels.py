@@ -126,8 +126,9 @@ def matvec(A: np.ndarray, v: np.ndarray, out: np.ndarray, p: np.ndarray, tmp: np
 
 
 def quat_rotate(q: np.ndarray, v: np.ndarray, transpose: bool = False) -> np.ndarray:
-    """AoS helper for the sparse paths: (k, 4) quaternions, (k, 3) vectors -> (k, 3)."""
-    w, u = q[:, :1], q[:, 1:]
+    """W_R_B v (or W_R_Bᵀ v) for (..., 4) unit quaternions and (..., 3) vectors: the one
+    quaternion rotation of the numpy path (AoS, for the sparse paths and springs)."""
+    w, u = q[..., :1], q[..., 1:]
     if transpose:
         u = -u
     t = 2.0 * np.cross(u, v)
@@ -342,32 +343,59 @@ def load_wrenches(model: Model, plan: Plan, frame: LoadFrame, state: State
     return body, W
 
 
-def spring_wrenches(model: Model, state: State) -> tuple[np.ndarray, np.ndarray]:
-    """Spring-damper wrenches on both ends: +T u on end a, −T u on end b.
+def spring_ends(model: Model, position: np.ndarray, quaternion: np.ndarray,
+                velocity: np.ndarray | None = None, omega: np.ndarray | None = None
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None]:
+    """World positions P_a, P_b (..., s, 3) of every spring's two ends, and their
+    velocities V_a, V_b when `velocity` and `omega` are given (else None). Arrays may have
+    a leading time axis (..., n, k). An end on ground (index −1) is its fixed world point.
 
-    T = k (L − L0) + c L̇ along u = (P_b − P_a) / L; the moment is B_r × (W_R_Bᵀ f).
+    P = x + W_R_B r,  V = v + W_R_B (ω × r)  (ω in body axes).
     """
+    sp = model.springs
+    out = []
+    for end, r in ((sp.a, sp.r_a), (sp.b, sp.r_b)):
+        on = (end >= 0)[:, None]
+        b = np.where(end >= 0, end, 0)
+        q = quaternion[..., b, :]
+        out.append(np.where(on, position[..., b, :] + quat_rotate(q, r), r))
+    if velocity is None or omega is None:
+        return out[0], out[1], None, None
+    for end, r in ((sp.a, sp.r_a), (sp.b, sp.r_b)):
+        on = (end >= 0)[:, None]
+        b = np.where(end >= 0, end, 0)
+        V = velocity[..., b, :] + quat_rotate(quaternion[..., b, :],
+                                               np.cross(omega[..., b, :], r))
+        out.append(np.where(on, V, 0.0))
+    return out[0], out[1], out[2], out[3]
+
+
+def spring_tension(model: Model, Pa: np.ndarray, Pb: np.ndarray, Va: np.ndarray,
+                   Vb: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(L, u, T): length (s,), unit vector from end a to end b (s, 3) and tension (s,)
+    T = k (L − L0) + c L̇ (N; positive pulls the ends together)."""
+    sp = model.springs
+    d = Pb - Pa
+    L = np.linalg.norm(d, axis=-1)
+    u = np.divide(d, L[..., None], out=np.zeros_like(d), where=L[..., None] > 1e-12)
+    T = sp.stiffness * (L - sp.rest_length) + sp.damping * np.einsum("...i,...i->...", u,
+                                                                     Vb - Va)
+    return L, u, T
+
+
+def spring_wrenches(model: Model, state: State) -> tuple[np.ndarray, np.ndarray]:
+    """Spring-damper wrenches on both ends: +T u on end a, −T u on end b; the moment is
+    B_r × (W_R_Bᵀ f)."""
     sp = model.springs
     k = len(sp.names)
     if not k:
         return np.zeros(0, np.intp), np.zeros((0, 6))
-
-    def point(end: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        on = end >= 0
-        b = np.where(on, end, 0)
-        q = state.quaternion[b]
-        P = np.where(on[:, None], state.position[b] + quat_rotate(q, r), r)
-        V = np.where(on[:, None],
-                     state.velocity[b] + quat_rotate(q, np.cross(state.omega[b], r)), 0.0)
-        return P, V, q
-
-    Pa, Va, qa = point(sp.a, sp.r_a)
-    Pb, Vb, qb = point(sp.b, sp.r_b)
-    d = Pb - Pa
-    L = np.linalg.norm(d, axis=1)
-    u = np.divide(d, L[:, None], out=np.zeros_like(d), where=L[:, None] > 1e-12)
-    T = sp.stiffness * (L - sp.rest_length) + sp.damping * np.einsum("ij,ij->i", u, Vb - Va)
+    Pa, Pb, Va, Vb = spring_ends(model, state.position, state.quaternion, state.velocity,
+                                 state.omega)
+    _, u, T = spring_tension(model, Pa, Pb, Va, Vb)
     f = T[:, None] * u
+    qa = state.quaternion[np.where(sp.a >= 0, sp.a, 0)]
+    qb = state.quaternion[np.where(sp.b >= 0, sp.b, 0)]
     W = np.zeros((2 * k, 6))
     W[:k, :3], W[k:, :3] = f, -f
     W[:k, 3:] = np.cross(sp.r_a, quat_rotate(qa, f, transpose=True))

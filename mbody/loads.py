@@ -81,20 +81,6 @@ def scatter(index: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
     return out
 
 
-def point_kinematics(state: State, R: np.ndarray, body: np.ndarray,
-                     r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """World position and velocity of body points; body −1 means r is a fixed world point.
-
-    P = x + R r,  V = v + R (ω × r)  (ω in body axes).
-    """
-    on = body >= 0
-    b = np.where(on, body, 0)
-    Rb = R[b]
-    P = np.where(on[:, None], state.position[b] + matvec(Rb, r), r)
-    V = np.where(on[:, None], state.velocity[b] + matvec(Rb, cross(state.omega[b], r)), 0.0)
-    return P, V
-
-
 def applied_loads(model: Model, state: State, R: np.ndarray | None = None) -> AppliedLoads:
     """Net applied force and moment on every body at `state` (gravity and springs included).
 
@@ -128,13 +114,9 @@ def contributions(model: Model, state: State, R: np.ndarray | None = None) -> Co
 
     # Spring-dampers: two contributions each, +T u on end a, −T u on end b.
     if len(sp.names):
-        Pa, Va = point_kinematics(state, R, sp.a, sp.r_a)
-        Pb, Vb = point_kinematics(state, R, sp.b, sp.r_b)
-        d = Pb - Pa
-        L = np.linalg.norm(d, axis=1)
-        u = np.divide(d, L[:, None], out=np.zeros_like(d), where=L[:, None] > 1e-12)
-        Ldot = np.einsum("ij,ij->i", u, Vb - Va)
-        T = sp.stiffness * (L - sp.rest_length) + sp.damping * Ldot
+        ends = kernels.spring_ends(model, state.position, state.quaternion, state.velocity,
+                                   state.omega)
+        _, u, T = kernels.spring_tension(model, *ends)
         f = T[:, None] * u
         for end, r, sign in ((sp.a, sp.r_a, 1.0), (sp.b, sp.r_b, -1.0)):
             on = end >= 0

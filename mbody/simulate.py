@@ -36,7 +36,6 @@ from .dynamics import Dynamics, StateDerivative, accelerations
 from .errors import MbodyError, UnknownReactionsError, did_you_mean
 from .expr import Expression, compile_expression
 from .model import Model, State
-from .spatial import quat_to_matrix
 from .trajectory import Trajectory
 
 METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
@@ -279,15 +278,10 @@ def potential_energy(model: Model, traj: Trajectory) -> np.ndarray:
     V = -np.einsum("kni,i,n->k", x, model.gravity, model.mass)
     sp = model.springs
     if len(sp.names):
-        R = quat_to_matrix(q)  # (K, n, 3, 3)
+        from .kernels import spring_ends
 
-        def ends(body: np.ndarray, r: np.ndarray) -> np.ndarray:
-            on = body >= 0
-            b = np.where(on, body, 0)
-            P = x[:, b] + np.einsum("ksij,sj->ksi", R[:, b], r)
-            return np.where(on[None, :, None], P, r[None])
-
-        L = np.linalg.norm(ends(sp.b, sp.r_b) - ends(sp.a, sp.r_a), axis=2)
+        Pa, Pb, _, _ = spring_ends(model, x, q)
+        L = np.linalg.norm(Pb - Pa, axis=2)
         V = V + 0.5 * np.sum(sp.stiffness * (L - sp.rest_length) ** 2, axis=1)
     return V
 
