@@ -3,18 +3,31 @@
     model = mbody.load("models/seed_example_1.yaml")
     asm = mbody.assemble(model)          # M v̇ + b = Q + G λ at the model's state
     sol = asm.solve(known={"A.Fx": 0})   # accelerations, aligned with asm.coordinates
+
+The public names below are imported on first use (PEP 562), so that `import mbody` and
+the `mbody` command load only what they need (scipy, matplotlib, meshcat and networkx
+are slow to import). Submodules are reachable as attributes too (``mbody.dynamics``).
 """
 
-from .animate import animate
-from .assemble import Assembly, Solution, assemble
+import importlib as _importlib
+import sys as _sys
+import types as _types
+
 from .errors import Issue, MbodyError, ModelError, UnknownReactionsError
-from .export import ExportedAssembly, load_export
-from .fbd import BodyEquations, Equation, ForceOnBody, FreeBodyDiagram
-from .model import Body, Joint, Load, Model, State, load, loads
-from .simulate import simulate
-from .trajectory import Trajectory
 
 __version__ = "0.1.0"
+
+_LAZY = {
+    "animate": "animate",
+    "Assembly": "assemble", "Solution": "assemble", "assemble": "assemble",
+    "ExportedAssembly": "export", "load_export": "export",
+    "BodyEquations": "fbd", "Equation": "fbd", "ForceOnBody": "fbd", "FreeBodyDiagram": "fbd",
+    "Body": "model", "Joint": "model", "Load": "model", "Model": "model", "State": "model",
+    "load": "model", "loads": "model",
+    "simulate": "simulate",
+    "Trajectory": "trajectory",
+}
+"""Public name -> the submodule defining it."""
 
 __all__ = [
     "Assembly", "Body", "BodyEquations", "Equation", "ExportedAssembly", "ForceOnBody",
@@ -23,3 +36,37 @@ __all__ = [
     "Trajectory", "simulate",
     "UnknownReactionsError", "animate", "assemble", "load", "loads",
 ]
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        value = getattr(_importlib.import_module(f".{_LAZY[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    if not name.startswith("__"):  # a submodule not imported yet, e.g. mbody.dynamics
+        try:
+            return _importlib.import_module(f".{name}", __name__)
+        except ModuleNotFoundError as exc:
+            if exc.name != f"{__name__}.{name}":
+                raise
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))
+
+
+class _Package(_types.ModuleType):
+    """Keeps the public functions `assemble`, `animate`, `simulate` and `loads` when their
+    namesake submodules are first imported: the import system sets the package attribute
+    of a submodule to the module, which would hide the function (as it did not when every
+    submodule was imported here, before the functions were bound)."""
+
+    def __setattr__(self, name: str, value) -> None:
+        if (name in _LAZY and isinstance(value, _types.ModuleType)
+                and value.__name__ == f"{__name__}.{name}"):
+            return
+        super().__setattr__(name, value)
+
+
+_sys.modules[__name__].__class__ = _Package

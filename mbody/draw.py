@@ -37,7 +37,6 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, Polygon, Rectangle, Wedge
 from matplotlib.transforms import Bbox, offset_copy
-from scipy.spatial import ConvexHull
 
 from . import conventions as cv
 from .atomic import write_atomic
@@ -359,6 +358,8 @@ def draw_fbd(fbd, *, view: str | Sequence[float] | None = "iso", equations: bool
     fbd: a `FreeBodyDiagram` (or a `BodyEquations`). view: spatial bodies only, see
     `projection`. equations: write the body's Newton-Euler pair under the drawing.
     """
+    from scipy.spatial import ConvexHull  # slow to import; `mbody graph` does not need it
+
     if hasattr(fbd, "fbd"):
         fbd = fbd.fbd
     planar = fbd.dimension == cv.PLANAR

@@ -5,24 +5,33 @@ bodies may share several joints). Mobility counts 6 per spatial body (3 per plan
 body) minus the independent constraints: the rank of G, which is also what exposes
 redundant joints (a planar four-bar modelled in 3-D has more reaction components than
 independent constraints).
+
+`topology` needs only the connected parts, found here from the joint list directly:
+networkx (slow to import) is loaded only for `body_graph` (`Model.graph`), and
+scipy.linalg only for a part of G that may be rank-deficient.
 """
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
-import networkx as nx
 import numpy as np
-import scipy.linalg
 
 from . import conventions as cv
 from .model import Model
+
+if TYPE_CHECKING:
+    import networkx as nx
 
 RANK_LIMIT = 1500
 """Largest number of reaction components in one connected part whose rank is computed."""
 
 
 def body_graph(model: Model) -> nx.MultiGraph:
+    import networkx as nx
+
     g = nx.MultiGraph(name=model.name)
     g.add_node(cv.GROUND, ground=True)
     for name in model.body_names:
@@ -64,12 +73,15 @@ class Topology:
 
 def topology(model: Model, G=None) -> Topology:
     """Analyse the model's graph; `G` (the sparse reaction matrix) enables the rank test."""
-    g = model.graph
-    parts = [sorted(c, key=lambda s: (s != cv.GROUND, s)) for c in nx.connected_components(g)]
+    nodes = [cv.GROUND, *model.body_names]
+    edges = [(j.parent, j.child) for j in model.joints]
+    components = _components(nodes, edges)
+    parts = [sorted(c, key=lambda s: (s != cv.GROUND, s)) for c in components]
     parts.sort(key=lambda c: (c[0] != cv.GROUND, c[0]))
-    loops = g.number_of_edges() - g.number_of_nodes() + nx.number_connected_components(g)
-    floating = [b for b in model.body_names if g.degree(b) == 0]
-    grounded = sorted(nx.node_connected_component(g, cv.GROUND) - {cv.GROUND})
+    loops = len(edges) - len(nodes) + len(components)
+    attached = {b for e in edges for b in e}
+    floating = [b for b in model.body_names if b not in attached]
+    grounded = sorted(next(c for c in components if cv.GROUND in c) - {cv.GROUND})
     m = len(model.reactions)
     per_body = 3 if model.dimension == cv.PLANAR else 6
     gruebler = per_body * model.n - m
@@ -82,14 +94,14 @@ def topology(model: Model, G=None) -> Topology:
 
 def _rank(model: Model, G) -> tuple[int | None, list[str]]:
     """Rank of G, part by part (ground removed, so parts share no rows)."""
-    g = model.graph.copy()
-    g.remove_node(cv.GROUND)
+    parts = _components(model.body_names, [(j.parent, j.child) for j in model.joints
+                                           if cv.GROUND not in (j.parent, j.child)])
     t = model.reaction_table
     rpb = model.rows_per_body
     labels = model.reactions
     total, redundant = 0, []
     G = G.tocsc()
-    for part in nx.connected_components(g):
+    for part in parts:
         idx = np.array(sorted(model.index[b] for b in part))
         cols = np.flatnonzero(np.isin(t.child, idx))
         if not len(cols):
@@ -98,6 +110,11 @@ def _rank(model: Model, G) -> tuple[int | None, list[str]]:
             return None, []
         rows = (idx[:, None] * rpb + np.arange(rpb)).ravel()
         A = G[rows][:, cols].toarray()
+        if _clearly_full_column_rank(A):  # what the pivoted QR below would conclude
+            total += A.shape[1]
+            continue
+        import scipy.linalg  # ~0.1 s to import: only for parts that may be rank-deficient
+
         # QR with column pivoting: the columns pivoted past the rank depend on the others.
         _, Rq, piv = scipy.linalg.qr(A, mode="economic", pivoting=True)
         d = np.abs(np.diag(Rq))
@@ -107,3 +124,42 @@ def _rank(model: Model, G) -> tuple[int | None, list[str]]:
         redundant += [labels[cols[k]] for k in piv[r:]]
     order = {lab: i for i, lab in enumerate(labels)}
     return total, sorted(redundant, key=order.__getitem__)
+
+
+FULL_RANK_MARGIN = 1e-8
+"""`_clearly_full_column_rank` needs λ_min(AᵀA) > FULL_RANK_MARGIN ‖A‖_F², i.e. σ_min(A) above
+1e-4 ‖A‖_F: far above the pivoted QR's rank tolerance (‖A‖ max(m, n) ε 10) and above the
+rounding of AᵀA and of its eigenvalues (about n ε ‖A‖_F²)."""
+
+
+def _clearly_full_column_rank(A: np.ndarray) -> bool:
+    """True when A's columns are independent by a wide margin, so that the pivoted QR of
+    `_rank` would find rank = number of columns and no redundant column (every |R_kk| is at
+    least σ_min(A)). False means "not sure" (rank-deficient or nearly so): `_rank` then
+    computes the QR. Needs only numpy, not scipy.linalg, for the common case."""
+    m, n = A.shape
+    if n > m:
+        return False
+    scale = float(np.einsum("ij,ij->", A, A))
+    return 0 < scale < np.inf and float(np.linalg.eigvalsh(A.T @ A)[0]) > FULL_RANK_MARGIN * scale
+
+
+def _components(nodes: Iterable[str], edges: Iterable[tuple[str, str]]) -> list[set[str]]:
+    """Connected components of the graph with these nodes and edges (union-find), as
+    networkx's `connected_components` gives them (node sets; their order is not used)."""
+    root = {n: n for n in nodes}
+
+    def find(n: str) -> str:
+        while root[n] != n:
+            root[n] = root[root[n]]
+            n = root[n]
+        return n
+
+    for a, b in edges:
+        ra, rb = find(a), find(b)
+        if ra != rb:
+            root[rb] = ra
+    out: dict[str, set[str]] = {}
+    for n in root:
+        out.setdefault(find(n), set()).add(n)
+    return list(out.values())

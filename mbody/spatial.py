@@ -7,7 +7,10 @@ Names carry frames: ``W_R_B`` rotates body-axis components into world axes
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial.transform import Rotation
+
+# scipy.spatial.transform is imported inside the two functions using it: it costs about
+# 0.2 s (it pulls in scipy.spatial, scipy.sparse and scipy.special), which every command
+# would pay at start-up otherwise.
 
 
 def quat_to_matrix(q: np.ndarray) -> np.ndarray:
@@ -31,6 +34,8 @@ def quat_to_matrix(q: np.ndarray) -> np.ndarray:
 
 def matrix_to_quat(R: np.ndarray) -> np.ndarray:
     """(..., 3, 3) rotation matrices -> (..., 4) quaternions [w, x, y, z] with w >= 0."""
+    from scipy.spatial.transform import Rotation
+
     R = np.asarray(R, dtype=float)
     q = Rotation.from_matrix(R.reshape(-1, 3, 3)).as_quat(scalar_first=True)
     q *= np.where(q[:, :1] < 0, -1.0, 1.0)
@@ -57,6 +62,8 @@ def euler_to_quat(angles: np.ndarray, sequence: str) -> np.ndarray:
     `sequence` follows scipy: upper case (``ZYX``) is intrinsic (about the turning body
     axes, in order), lower case (``zyx``) is extrinsic (about the fixed world axes).
     """
+    from scipy.spatial.transform import Rotation
+
     q = Rotation.from_euler(sequence, angles).as_quat(scalar_first=True)
     return q if q[0] >= 0 else -q
 

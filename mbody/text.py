@@ -105,9 +105,10 @@ def model_summary(model: Model, topo: Topology) -> str:
 
 def graph_summary(model: Model, topo: Topology) -> str:
     per = 3 if model.dimension == cv.PLANAR else 6
-    g = model.graph
-    lines = [f"graph: {g.number_of_nodes()} nodes (bodies + ground), "
-             f"{_plural(g.number_of_edges(), 'joint edge')}; "
+    # the counts of model.graph's nodes and edges, without building it (networkx is slow
+    # to import)
+    lines = [f"graph: {model.n + 1} nodes (bodies + ground), "
+             f"{_plural(len(model.joints), 'joint edge')}; "
              + ("a tree (no closed loops)" if topo.is_tree
                 else f"{_plural(topo.loops, 'closed loop')}")]
     lines.append(f"  connected parts: {len(topo.parts)}")

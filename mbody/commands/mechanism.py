@@ -6,8 +6,6 @@ import argparse
 import json
 import sys
 
-import numpy as np
-
 from . import EXIT_OK, load_model
 
 
@@ -28,6 +26,8 @@ def _n(x: float) -> str:
 
 
 def jacobian(a: argparse.Namespace) -> int:
+    import numpy as np
+
     from ..assemble import assemble
 
     model = load_model(a.model)
