@@ -148,9 +148,12 @@ class ExportedAssembly:
 
         All known: v̇ = M⁻¹ (Q + G λ − b). Otherwise, with U the unknown components,
         ``[[M, −G_U], [G_Uᵀ, 0]] [v̇; λ_U] = [Q − b + G_K λ_K; γ_U]`` (the joints of the
-        given components are not enforced), as `mbody.Assembly.solve` does.
+        given components are not enforced), solved by the same constrained solver as
+        `mbody.Assembly.solve` (`mbody.kkt.ConstrainedSystem`), from the stored matrices
+        alone: redundant constraints give the minimum-norm reactions, named.
         """
-        from scipy.sparse.linalg import splu
+        from .kkt import ConstrainedSystem, block_solve
+        from .plan import Unknowns
 
         values = self.known
         for label, v in (known or {}).items():
@@ -158,25 +161,29 @@ class ExportedAssembly:
                 raise MbodyError(f"no reaction component {label!r} in this export")
             values[label] = float(v)
         lam = np.array([values.get(r, np.nan) for r in self.reactions], dtype=float)
-        U = np.isnan(lam)
-        rhs = self.Q - self.b
-        if len(lam):
-            rhs = rhs + self.G @ np.where(U, 0.0, lam)
-        N, u = len(rhs), int(U.sum())
-        if N == 0:
-            return Solution(list(self.coordinates), rhs, {})
-        GU = self.G[:, np.flatnonzero(U)]
-        K = sp.bmat([[self.M, -GU], [GU.T, None]], format="csc") if u else self.M.tocsc()
-        try:
-            x = splu(K).solve(np.concatenate((rhs, self.columns.gamma[U])))
-        except RuntimeError:  # exactly singular: redundant constraints
-            raise MbodyError("the constrained system is singular (redundant constraints); "
-                             "give some of the reaction values, or use mbody.Assembly.solve, "
-                             "which returns minimum-norm reactions") from None
-        lam[U] = x[N:]
-        return Solution(list(self.coordinates), x[:N],
-                        dict(zip(self.reactions, lam.tolist(), strict=True)),
-                        tuple(r for r, k in zip(self.reactions, U, strict=True) if k))
+        mask = np.isnan(lam)
+        lam[mask] = 0.0
+        bodies, cols, rows = _solver_view(self)
+        r6 = np.zeros((bodies.n, 6))
+        r6.reshape(-1)[rows] = self.Q - self.b
+        t = bodies.reaction_table
+        for six, body in ((cols.child6, t.child), (cols.parent6, t.parent)):
+            on = body >= 0
+            np.add.at(r6, body[on], six[on] * lam[on, None])
+        unknowns = Unknowns(mask, np.flatnonzero(mask), lam, mask.tobytes())
+        coords = list(self.coordinates)
+        if not len(unknowns.U):
+            acc6 = block_solve(bodies, np.arange(bodies.n), r6)
+            return Solution(coords, acc6.reshape(-1)[rows],
+                            dict(zip(self.reactions, lam.tolist(), strict=True)))
+        system = ConstrainedSystem(bodies, cols, unknowns)
+        acc6, lam_U, berr = system.solve_refined(r6, self.columns.gamma[mask])
+        lam[mask] = lam_U
+        solved = tuple(r for r, k in zip(self.reactions, mask, strict=True) if k)
+        return Solution(coords, acc6.reshape(-1)[rows],
+                        dict(zip(self.reactions, lam.tolist(), strict=True)), solved,
+                        tuple(solved[k] for k in system.fact.redundant if k >= 0), berr,
+                        None, system.fact.method, (), system.fact.size - system.fact.rank)
 
     def differences(self, other: ExportedAssembly) -> list[str]:
         """What differs from `other`, bit for bit ([] when they are identical)."""
@@ -202,6 +209,76 @@ class ExportedAssembly:
             if not _same(getattr(self.columns, k), getattr(other.columns, k)):
                 out.append(f"columns.{k}")
         return out
+
+
+@dataclass(frozen=True)
+class _Bodies:
+    """What the constrained solver reads of a model, rebuilt from an export's matrices:
+    masses (n,), inertia tensors J and J⁻¹ (n, 3, 3), M⁻¹'s diagonal when every J is
+    diagonal (minv6), and the reaction columns' child and parent bodies."""
+
+    n: int
+    mass: np.ndarray
+    J: np.ndarray
+    J_inv: np.ndarray
+    minv6: np.ndarray | None
+    reaction_table: Any
+    plan: Any = None
+
+
+@dataclass(frozen=True)
+class _Parents:
+    child: np.ndarray
+    parent: np.ndarray
+
+
+@dataclass(frozen=True)
+class _Columns:
+    child6: np.ndarray
+    parent6: np.ndarray
+
+
+def _solver_view(exp: ExportedAssembly) -> tuple[_Bodies, _Columns, np.ndarray]:
+    """(bodies, columns, rows): the export in the solver's per-body six-row form, from M
+    and G as stored (so an edited matrix is honoured). rows (N,) places each stored row
+    among the 6 n rows (planar [x, y, θ] are rows 0, 1, 5 of a body)."""
+    n = len(exp.body_names)
+    keep = np.arange(6) if exp.dimension == cv.SPATIAL else cv.PLANAR_SELECT
+    k = len(keep)
+    rows = (np.arange(n)[:, None] * 6 + keep).ravel()
+    M = sp.csr_matrix(exp.M)
+    mass = M.diagonal()[0::k].copy()
+    J = np.zeros((n, 3, 3))
+    if exp.dimension == cv.SPATIAL:
+        base = np.arange(n) * 6 + 3
+        for i in range(3):
+            for j in range(3):
+                J[:, i, j] = np.asarray(M[base + i, base + j]).ravel()
+    else:  # only I_G acts (planar rows); the other two axes are placeholders
+        J[:, 0, 0] = J[:, 1, 1] = J[:, 2, 2] = M.diagonal()[2::3]
+    J_inv = np.linalg.inv(J) if n else J
+    off = J - np.einsum("nii->ni", J)[:, :, None] * np.eye(3)
+    minv6 = None
+    if not np.any(off):
+        minv6 = np.concatenate((np.repeat(1.0 / mass[:, None], 3, axis=1),
+                                1.0 / np.einsum("nii->ni", J)), axis=1)
+    index = {name: i for i, name in enumerate(exp.body_names)}
+    child = np.array([index[str(c)] for c in exp.columns.child], dtype=np.intp)
+    parent = np.array([index.get(str(p), -1) for p in exp.columns.parent], dtype=np.intp)
+    m = len(child)
+    G = sp.csc_matrix(exp.G)
+    child6, parent6 = np.zeros((m, 6)), np.zeros((m, 6))
+    if m:
+        col = np.repeat(np.arange(m), k)
+        child6[:, keep] = np.asarray(G[(child[:, None] * k + np.arange(k)).ravel(), col]
+                                     ).reshape(m, k)
+        on = parent >= 0
+        if on.any():
+            colp = np.repeat(np.arange(m)[on], k)
+            parent6[np.ix_(on, keep)] = np.asarray(
+                G[(parent[on, None] * k + np.arange(k)).ravel(), colp]).reshape(-1, k)
+    bodies = _Bodies(n, mass, J, J_inv, minv6, _Parents(child, parent))
+    return bodies, _Columns(child6, parent6), rows
 
 
 def _same(a: Any, b: Any) -> bool:

@@ -178,7 +178,7 @@ class ConstrainedSystem:
             self.fact = self._dense(self.G.T @ self.H)
             return
         if len(U) > DENSE_LIMIT:  # large: per-body blocks and a banded S (mbody.blockplan)
-            plan = model.plan.block_plan(unknowns)
+            plan = model.plan.block_plan(unknowns) if model.plan is not None else None
             if plan is not None:
                 blocks = BlockOperators(model, plan, args[3], args[4])
                 fact = _banded(blocks.band(), plan.perm, len(U))
