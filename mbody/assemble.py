@@ -12,9 +12,9 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cached_property
+from typing import TYPE_CHECKING
 
 import numpy as np
-import scipy.sparse as sp
 
 from . import conventions as cv
 from . import kernels
@@ -24,6 +24,12 @@ from .loads import AppliedLoads
 from .model import Model, State
 from .plan import Unknowns, compiled
 from .spatial import matvec
+
+if TYPE_CHECKING:
+    import scipy.sparse as sp
+
+    from .constraints import ConstraintJacobian
+    from .fbd import BodyEquations
 
 
 def _select(model: Model, a6: np.ndarray) -> np.ndarray:
@@ -47,6 +53,8 @@ def mass_matrix(model: Model) -> sp.spmatrix:
     Built from index arrays (block i at block row and column i), never from a list of
     per-body matrices; `Assembly.M` builds it only when first asked for.
     """
+    import scipy.sparse as sp
+
     n = model.n
     k = model.rows_per_body
     blocks = np.zeros((n, k, k))
@@ -393,6 +401,3 @@ def assemble(model: Model, state: State | None = None) -> Assembly:
     """
     return Assembly(model, model.initial if state is None else state)
 
-
-from .constraints import ConstraintJacobian  # noqa: E402  (annotations only)
-from .fbd import BodyEquations  # noqa: E402  (type used in annotations only)

@@ -17,13 +17,16 @@ velocity the joint forbids.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-import scipy.sparse as sp
 
 from . import conventions as cv
 from .model import Model, State
 from .spatial import cross, matvec, rmatvec
+
+if TYPE_CHECKING:
+    import scipy.sparse as sp
 
 
 @dataclass(frozen=True)
@@ -136,6 +139,8 @@ def reaction_columns(model: Model, state: State, R: np.ndarray | None = None) ->
 
 def g_matrix(model: Model, cols: ReactionColumns) -> sp.csc_matrix:
     """The sparse G (rows = stacked coordinates, columns = reaction unknowns)."""
+    import scipy.sparse as sp
+
     t = model.reaction_table
     m = len(t.labels)
     rpb = model.rows_per_body

@@ -18,23 +18,34 @@ reactions are returned and the components that are not unique are named.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
-import scipy.linalg as sla
-import scipy.sparse as sp
-import scipy.sparse.linalg as spla
-from scipy.sparse.csgraph import reverse_cuthill_mckee
 
-from .blockplan import BlockOperators
 from .joints import ReactionColumns
 from .model import Model
 from .plan import Unknowns
 from .spatial import matvec
 
+if TYPE_CHECKING:
+    import scipy.sparse as sp
+
+# scipy.sparse and scipy.linalg are imported where a large system needs them: a small
+# mechanism is solved with numpy alone, so `mbody solve` starts without them.
+
+
+def _issparse(a) -> bool:
+    return type(a).__module__.startswith("scipy.sparse")
+
 SMALL_BODIES = 60
 """Up to this many bodies (and DENSE_LIMIT unknowns) G is held as a dense array."""
-DENSE_LIMIT = 300
-"""Up to this many unknown components, S is factorised densely (and checked for rank)."""
+DENSE_LIMIT = 48
+"""Up to this many unknown components, S is factorised densely (and checked for rank);
+above, S is banded (a joint couples only with the joints sharing one of its bodies) and
+a dense factorisation would waste time on zeros."""
+EIGEN_LIMIT = 1200
+"""Up to this many unknowns, a singular S (redundant constraints) is handled by an
+eigen-decomposition that names the components left undetermined; above, by LSQR."""
 RANK_RTOL = 1e-10
 """Relative tolerance on S's eigenvalues (or pivots) below which a constraint is redundant."""
 
@@ -73,6 +84,8 @@ def _g_and_minv_g(model: Model, parent: np.ndarray, child: np.ndarray, child6: n
     """G_U and M⁻¹ G_U (6n x mu) built straight in CSC form, 12 entries a column: the
     child's 6 rows, then the parent's (for ground, zeros placed on the child's rows
     again: duplicates that add nothing, and no masking or sorting of the arrays)."""
+    import scipy.sparse as sp
+
     mu = len(child)
     k = np.arange(6)
     p = np.where(parent >= 0, parent, child)
@@ -96,6 +109,9 @@ def _g_and_minv_g(model: Model, parent: np.ndarray, child: np.ndarray, child6: n
 def _banded(ab: np.ndarray, perm: np.ndarray | None, mu: int) -> Factorisation | None:
     """Banded Cholesky of S in upper banded storage; None when S is not positive definite
     (redundant constraints: the general path then finds the minimum-norm reactions)."""
+    import scipy.linalg as sla
+    import scipy.sparse as sp
+
     bw = ab.shape[0] - 1
     try:
         cb = sla.cholesky_banded(ab, lower=False, check_finite=False)
@@ -146,11 +162,21 @@ class Factorisation:
         if self.redundant:
             return float("inf")
         S = self._S() if callable(self._S) else self._S
-        if not sp.issparse(S):
+        if not _issparse(S):
             return float(np.linalg.cond(S, 1))
+        import scipy.sparse.linalg as spla
+
         inv = spla.LinearOperator(S.shape, matvec=self.solve, rmatvec=self.solve,
                                   dtype=float)
         return float(spla.onenormest(S) * spla.onenormest(inv))
+
+
+def _cholesky_solver(L: np.ndarray):
+    """r -> S⁻¹ r for S = L Lᵀ (dense, small: two triangular solves with numpy)."""
+    def solve(r: np.ndarray) -> np.ndarray:
+        return np.linalg.solve(L.T, np.linalg.solve(L, r))
+
+    return solve
 
 
 class ConstrainedSystem:
@@ -178,6 +204,8 @@ class ConstrainedSystem:
             self.fact = self._dense(self.G.T @ self.H)
             return
         if len(U) > DENSE_LIMIT:  # large: per-body blocks and a banded S (mbody.blockplan)
+            from .blockplan import BlockOperators
+
             plan = model.plan.block_plan(unknowns) if model.plan is not None else None
             if plan is not None:
                 blocks = BlockOperators(model, plan, args[3], args[4])
@@ -204,6 +232,8 @@ class ConstrainedSystem:
 
     def g_sparse(self) -> sp.csc_matrix:
         """G_U as a sparse matrix (built on request from the blocks)."""
+        import scipy.sparse as sp
+
         if self.blocks is None:
             return sp.csc_matrix(self.G)
         b = self.blocks
@@ -215,6 +245,10 @@ class ConstrainedSystem:
 
     # -- factorisation -------------------------------------------------------------------
     def _factorise(self, S: sp.csr_matrix) -> Factorisation:
+        import scipy.linalg as sla
+        import scipy.sparse.linalg as spla
+        from scipy.sparse.csgraph import reverse_cuthill_mckee
+
         mu = S.shape[0]
         if mu == 0:
             return Factorisation("none", 0, _solve=lambda r: r, _S=S)
@@ -251,7 +285,7 @@ class ConstrainedSystem:
                                          rank=mu, _solve=solve, _S=S)
             except np.linalg.LinAlgError:
                 pass
-        if mu <= 4 * DENSE_LIMIT:
+        if mu <= EIGEN_LIMIT:
             return self._dense(S)
         try:
             lu = spla.splu(S.tocsc())
@@ -265,15 +299,14 @@ class ConstrainedSystem:
                                  redundant=[-1], _solve=solve, _S=S)
 
     def _dense(self, S) -> Factorisation:
-        A = S.toarray() if sp.issparse(S) else np.asarray(S)
+        A = S.toarray() if _issparse(S) else np.asarray(S)
         A = 0.5 * (A + A.T)
         try:  # the usual case: independent constraints, S positive definite
-            cf = sla.cho_factor(A, check_finite=False)
-            d = np.diag(cf[0]) ** 2
+            L = np.linalg.cholesky(A)
+            d = np.diag(L) ** 2
             if d.min() > RANK_RTOL * d.max():
                 return Factorisation("dense Cholesky of the Schur complement", len(A),
-                                     rank=len(A), _S=A,
-                                     _solve=lambda r: sla.cho_solve(cf, r, check_finite=False))
+                                     rank=len(A), _S=A, _solve=_cholesky_solver(L))
         except np.linalg.LinAlgError:
             pass
         w, V = np.linalg.eigh(A)
@@ -281,10 +314,8 @@ class ConstrainedSystem:
         good = w > tol
         rank = int(good.sum())
         if rank == len(w):
-            cf = sla.cho_factor(A, check_finite=False)
             return Factorisation("dense Cholesky of the Schur complement", len(w), rank=rank,
-                                 _solve=lambda r: sla.cho_solve(cf, r, check_finite=False),
-                                 _S=A)
+                                 _solve=_cholesky_solver(np.linalg.cholesky(A)), _S=A)
         # Minimum-norm solution through the pseudo-inverse; the null space of S (= that of
         # G_U) tells which components are not unique.
         Vg, wg = V[:, good], w[good]
@@ -320,7 +351,7 @@ class ConstrainedSystem:
         model = self.model
         if self.blocks is not None:
             g = self.blocks.Gb.ravel()
-        elif sp.issparse(self.G):
+        elif _issparse(self.G):
             g = self.G.data
         else:
             g = np.ravel(self.G)
