@@ -42,6 +42,10 @@ METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
 """scipy.integrate's step-by-step solvers (imported when a simulation starts)."""
 DEFAULT_RTOL = 1e-10
 DEFAULT_ATOL = 1e-12
+DEFAULT_MAX_STEPS = 1_000_000
+"""Step budget of a run. The heaviest shipped model needs about 9 300 steps for 10 s (the
+slider-crank that ran away to 700 rad/s, 24 500): a hundred times that, yet a small
+mechanism (about 0.3 ms per step) reaches it in minutes rather than hours."""
 
 
 def known_reaction_dynamics(model: Model, known: Mapping[str, float | str] | None = None
@@ -126,7 +130,8 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
              rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL, method: str = "DOP853",
              known: Mapping[str, float | str] | None = None, progress: bool = False,
              dynamics: Dynamics | None = None, max_step: float = math.inf,
-             initial: State | None = None) -> Trajectory:
+             initial: State | None = None, max_steps: int | None = DEFAULT_MAX_STEPS,
+             max_wall: float | None = None) -> Trajectory:
     """Integrate the motion from `initial` (default the model's state) to `t_end` seconds.
 
     Samples at t = k / fps for k = 0 .. ⌊t_end · fps⌋. `rtol`, `atol`: the integrator's
@@ -134,7 +139,11 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     of `METHODS` (DOP853: explicit Runge-Kutta of order 8 with a 7th-order interpolant).
     `known`: reaction values (numbers or expressions of t) added to the file's.
     `dynamics`: replaces the default accelerations (see `Dynamics`).
-    Returns a `Trajectory` whose `info` holds the run facts and drift figures.
+    `max_steps`, `max_wall`: budgets of integrator steps and of wall-clock seconds (None:
+    no limit); a run that hits one stops with an `MbodyError` saying where and why.
+    Returns a `Trajectory` whose `info` holds the run facts and drift figures, and under
+    ``info["warnings"]`` what looked wrong (a cost that exploded, a spin the frame rate
+    aliases).
     """
     t_end, fps = float(t_end), float(fps)
     if not (math.isfinite(t_end) and t_end > 0):
@@ -147,6 +156,14 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     if method not in METHODS:
         raise MbodyError(f"unknown integrator {method!r}; "
                          + (did_you_mean(method, METHODS) or f"one of {', '.join(METHODS)}"))
+    if max_steps is not None and (isinstance(max_steps, bool) or not isinstance(
+            max_steps, int | np.integer) or max_steps < 1):
+        raise MbodyError(f"max_steps must be a positive whole number of steps or None, "
+                         f"got {max_steps!r}")
+    if max_wall is not None and not (isinstance(max_wall, int | float | np.number)
+                                     and math.isfinite(max_wall) and max_wall > 0):
+        raise MbodyError(f"max_wall must be a positive number of seconds or None, "
+                         f"got {max_wall!r}")
     K = int(math.floor(t_end * fps + 1e-9)) + 1
     if K > 10_000_000:
         raise MbodyError(f"{K} output samples requested (t_end * fps); at most 10 million")
@@ -167,7 +184,8 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     t_eval = np.arange(K) / fps
     Y = np.empty((K, size))
     Y[0] = y0
-    k, steps = 1, 0
+    k, steps, sampling = 1, 0, 0
+    rate = _StepRate(t_end)
     wall = time.perf_counter()
     try:
         import scipy.integrate
@@ -184,10 +202,31 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
                     "or tolerances too tight for double precision?)")
             steps += 1
             j = int(np.searchsorted(t_eval, solver.t, side="right"))
-            if j > k:
+            if j > k:  # DOP853's interpolant costs 3 evaluations here (docs/simulation.md)
+                nfev = solver.nfev
                 Y[k:j] = solver.dense_output()(t_eval[k:j]).T
+                sampling += solver.nfev - nfev
                 k = j
+            rate.step(solver.t, steps)
             bar.update(solver.t)
+            if solver.status == "running":
+                if max_steps is not None and steps >= max_steps:
+                    raise MbodyError(_budget_message(
+                        f"the step budget: {steps} steps (--max-steps {max_steps})",
+                        solver.t, t_end, steps, rate, f"at that rate the whole run needs "
+                        f"about {steps * t_end / solver.t:.2g} steps", "raise --max-steps"))
+                if max_wall is not None:
+                    now = time.perf_counter()
+                    if steps == 1:  # the pace is timed from here: no start-up costs
+                        first = (solver.t, now)
+                    if now - wall > max_wall:
+                        pace = ((now - first[1]) / (solver.t - first[0]) if steps > 1
+                                else (now - wall) / solver.t)
+                        raise MbodyError(_budget_message(
+                            f"the wall-time budget: {now - wall:.3g} s (--max-wall "
+                            f"{max_wall:g})", solver.t, t_end, steps, rate,
+                            f"at that pace the rest of the run takes about "
+                            f"{pace * (t_end - solver.t):.2g} s more", "raise --max-wall"))
     finally:
         bar.close()
     wall = time.perf_counter() - wall
@@ -217,6 +256,7 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     info = {
         "integrator": method, "rtol": rtol, "atol": atol, "t_end": t_end, "fps": fps,
         "samples": K, "steps": steps, "evaluations": solver.nfev,
+        "sampling_evaluations": sampling, "step_rate": rate.figures(steps),
         "evaluation_path": "compiled" if rhs.compiled else "numpy",
         "wall_time_s": wall, "quaternion_norm_error": q_err,
         "quaternion_handling": "integrated as is; rotation built from q/|q|; output "
@@ -234,7 +274,102 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     series, drift = _drift(model, traj, dynamics is None, ideal_joints=mechanism)
     traj.series.update(series)
     info.update(drift)
+    info["warnings"] = [w for w in (rate.warning(), _spin_warning(traj)) if w]
     return traj
+
+
+class _StepRate:
+    """Steps per simulated second, to catch a run whose cost explodes.
+
+    The rate over the first part of the run (until t_end / `WINDOWS`) is the baseline; the
+    rest is cut into windows of the same length, and a window whose rate exceeds `FACTOR`
+    times the baseline (with at least `MIN_STEPS` steps in it, so that a few steps more
+    on a cheap run say nothing) is kept for a warning.
+    """
+
+    WINDOWS, FACTOR, MIN_STEPS = 20, 20.0, 100
+
+    def __init__(self, t_end: float):
+        self.t_end, self.width = t_end, t_end / self.WINDOWS
+        self.start: tuple[float, float] | None = None  # (t, steps per second) until t
+        self.mark = (0.0, 0)  # (t, steps) where the current window began
+        self.next = self.width
+        self.slow: list[tuple[float, float, float]] = []  # (t0, t1, rate) windows
+        self.peak = 0.0
+
+    def step(self, t: float, steps: int) -> None:
+        if t < self.next and t < self.t_end:
+            return
+        t0, n0 = self.mark
+        r = (steps - n0) / (t - t0)
+        if self.start is None:
+            self.start = (t, r)
+        elif r > self.FACTOR * self.start[1] and steps - n0 >= self.MIN_STEPS:
+            self.slow.append((t0, t, r))
+        self.peak = max(self.peak, r)
+        self.mark = (t, steps)
+        self.next = (math.floor(t / self.width) + 1) * self.width
+
+    def figures(self, steps: int) -> dict:
+        """Steps per simulated second: over the first part, the busiest window, overall."""
+        return {"start": float(self.start[1]) if self.start else None,
+                "peak": float(self.peak), "overall": steps / self.t_end}
+
+    def so_far(self, t: float, steps: int) -> str:
+        """'N steps per simulated second so far (M over the first T s)'."""
+        text = f"{steps / t:.4g} steps per simulated second so far"
+        if self.start is not None:
+            text += f" ({self.start[1]:.4g} over the first {self.start[0]:.3g} s"
+            t0, n0 = self.mark
+            if t > t0 and steps > n0:
+                text += f", {(steps - n0) / (t - t0):.4g} since t = {t0:.3g} s"
+            text += ")"
+        return text
+
+    def warning(self) -> str | None:
+        if not self.slow or self.start is None:
+            return None
+        t0, t1, r = max(self.slow, key=lambda w: w[2])
+        t_start, base = self.start
+        return (f"the integration slowed down from t = {self.slow[0][0]:.3g} s: "
+                f"{r:.4g} steps per simulated second at t = {t0:.3g} .. {t1:.3g} s, "
+                f"{r / base:.0f} times the {base:.4g} per second over the first "
+                f"{t_start:.3g} s. Something in the model speeds up or stiffens (a spin-up "
+                "or runaway, a load that varies ever faster, a stiff spring): check the "
+                "motion; a shorter --t-end, a looser --rtol (1e-8), or --method Radau "
+                "for a stiff model cost less")
+
+
+def _budget_message(what: str, t: float, t_end: float, steps: int, rate: _StepRate,
+                    estimate: str, raise_it: str) -> str:
+    """The one paragraph a run stopped by a budget reports."""
+    return (f"the simulation stopped at {what}, at t = {t:.6g} s of {t_end:g} s: "
+            f"{rate.so_far(t, steps)}; {estimate}. No trajectory is kept (rerun with "
+            f"--t-end {t:.3g} to see the motion up to here). To go on: a shorter --t-end, a "
+            "looser --rtol (e.g. 1e-8), a stiff integrator such as --method Radau if the "
+            f"model is stiff (very stiff springs), or {raise_it}.")
+
+
+def _spin_warning(traj: Trajectory) -> str | None:
+    """A body whose spin aliases the frame rate: |ω| / 2π > fps / 2 at a sample."""
+    fps, w = traj.info["fps"], traj.angular_velocity
+    if traj.n == 0 or not len(w):
+        return None
+    rate = np.abs(w) if traj.dimension == cv.PLANAR else np.linalg.norm(w, axis=2)
+    peak = rate.max(axis=0)  # (n,) rad/s
+    fast = [i for i in np.argsort(-peak, kind="stable") if peak[i] / (2 * np.pi) > fps / 2]
+    if not fast:
+        return None
+    listed = ", ".join(f"{traj.body_names[i]} at up to {peak[i]:.4g} rad/s "
+                       f"({peak[i] / (2 * np.pi):.3g} rev/s, at t = "
+                       f"{traj.t[int(np.argmax(rate[:, i]))]:.3g} s)" for i in fast[:3])
+    if len(fast) > 3:
+        listed += f" and {len(fast) - 3} more bod{'y' if len(fast) == 4 else 'ies'}"
+    need = math.ceil(2 * peak[fast[0]] / (2 * np.pi))
+    return (f"spin faster than {fps:g} fps can show: {listed}. A body turning more than "
+            f"half a revolution between frames (|omega| / 2 pi > fps / 2 = {fps / 2:g} "
+            f"rev/s) looks in an animation as if it turned slower or backwards; use "
+            f"--fps {need} or more")
 
 
 def state_derivative(model: Model, known: Mapping[str, float | str] | None = None,
@@ -363,7 +498,10 @@ def summary(traj: Trajectory, path: str | os.PathLike[str] | None = None) -> str
         f"simulated {traj.model_name!r}: {traj.n} bod{'y' if traj.n == 1 else 'ies'}, "
         f"t = 0 .. {i['t_end']:g} s, {i['samples']} samples at {i['fps']:g} fps",
         f"integrator {i['integrator']} (rtol {i['rtol']:g}, atol {i['atol']:g}): "
-        f"{i['steps']} steps, {i['evaluations']} evaluations, {i['wall_time_s']:.3g} s",
+        f"{i['steps']} steps, {i['evaluations']} evaluations"
+        + (f" ({i['sampling_evaluations']} of them for the samples)"
+           if i.get("sampling_evaluations") else "")
+        + f", {i['wall_time_s']:.3g} s",
     ]
     what = "drift" if i["energy_conserved"] else "change (not guaranteed: loads or reactions act)"
     lines.append(f"energy T + V: E(0) = {i['energy_initial']:.6g} J, relative {what} "
@@ -393,6 +531,7 @@ def summary(traj: Trajectory, path: str | os.PathLike[str] | None = None) -> str
     if traj.dimension == cv.SPATIAL:
         lines.append(f"quaternion norm error before renormalising: "
                      f"{i['quaternion_norm_error']:.1e}")
+    lines.extend(f"warning: {w}" for w in i.get("warnings", ()))
     if path is not None:
         lines.append(f"wrote {path}")
     return "\n".join(lines)

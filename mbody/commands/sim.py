@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 
+from ..errors import MbodyError
 from . import EXIT_OK, load_model, parse_known
 
 
@@ -32,6 +34,12 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="integrator: DOP853 (default), RK45, RK23, Radau, BDF, LSODA")
     s.add_argument("--known", metavar="LABEL=VALUE", action="append", default=[],
                    help="a known reaction value, e.g. --known A.Fx=3 (repeatable)")
+    s.add_argument("--max-steps", type=int, default=None, metavar="N",
+                   help="stop with a message after N integrator steps (default 1000000; "
+                   "0: no limit)")
+    s.add_argument("--max-wall", type=float, default=None, metavar="SECONDS",
+                   help="stop with a message after this much wall-clock time (default: no "
+                   "limit)")
     s.add_argument("--progress", action="store_true",
                    help="show the progress bar on stderr even when it is not a terminal")
     s.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
@@ -52,9 +60,16 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def simulate(a: argparse.Namespace) -> int:
-    from ..simulate import DEFAULT_ATOL, DEFAULT_RTOL, summary
+    from ..simulate import DEFAULT_ATOL, DEFAULT_MAX_STEPS, DEFAULT_RTOL, summary
     from ..simulate import simulate as _simulate
 
+    max_steps = DEFAULT_MAX_STEPS if a.max_steps is None else a.max_steps
+    if max_steps < 0:
+        raise MbodyError(f"--max-steps must be a whole number of steps (0: no limit), got "
+                         f"{max_steps}")
+    if a.max_wall is not None and not (a.max_wall > 0 and math.isfinite(a.max_wall)):
+        raise MbodyError(f"--max-wall must be a positive number of seconds, got "
+                         f"{a.max_wall:g}")
     model = load_model(a.model)
     if a.output:  # fail now, not after a long integration
         from ..atomic import ensure_writable
@@ -64,7 +79,8 @@ def simulate(a: argparse.Namespace) -> int:
                      rtol=DEFAULT_RTOL if a.rtol is None else a.rtol,
                      atol=DEFAULT_ATOL if a.atol is None else a.atol, method=a.method,
                      known=parse_known(a.known),
-                     progress=(a.progress or sys.stderr.isatty()) and not a.no_progress)
+                     progress=(a.progress or sys.stderr.isatty()) and not a.no_progress,
+                     max_steps=max_steps or None, max_wall=a.max_wall)
     if a.output:
         traj.save(a.output)
     print(summary(traj, a.output))
