@@ -35,7 +35,6 @@ from __future__ import annotations
 import argparse
 import gc
 import importlib
-import inspect
 import math
 import sys
 import time
@@ -65,10 +64,6 @@ SYSTEMS = (
 """(label, file in models/) of every system in the first table."""
 ACCURACY = ("double pendulum", "heavy top")
 """Tree models used for time to accuracy (their MuJoCo equivalents are exact)."""
-RUNAWAY = {"slider_crank.yaml"}
-"""Models whose 10 s run may run away (the slider-crank with constant loads speeds up to
-about 700 rad/s, and its steps shrink with it): without a `max_wall` or `max_steps` in
-`simulate` to bound the wall time, they run 1 s of simulated time."""
 
 T_SIM = 10.0
 SOLVE_TARGET, SOLVE_STRETCH = 10.0, 3.0   # solve time / mj_forward time
@@ -468,22 +463,8 @@ def time_rhs(model: mbody.Model, repeat: int) -> tuple[float, bool]:
 
 
 def simulate_kwargs(model: mbody.Model, file: str, sim_limit: float) -> tuple[dict, str]:
-    """simulate() arguments for the 10 s run, bounded by --sim-limit: `max_wall` when
-    `simulate` takes it, else `max_steps` (per-step cost from a short run), else (neither)
-    1 s of simulated time for a model that may run away (`RUNAWAY`)."""
-    params = inspect.signature(mbody.simulate).parameters
-    if "max_wall" in params:
-        return {"t_end": T_SIM, "max_wall": sim_limit}, ""
-    if "max_steps" in params:
-        t0 = time.perf_counter()
-        traj = mbody.simulate(model, t_end=0.2)
-        per_step = (time.perf_counter() - t0) / max(1, traj.info["steps"])
-        return {"t_end": T_SIM, "max_steps": max(100, int(sim_limit / per_step))}, ""
-    if file in RUNAWAY:
-        return {"t_end": 1.0}, ("1 s simulated only, not judged: simulate() has no "
-                                "max_steps to bound a runaway (with constant loads this "
-                                "model speeds up to ~700 rad/s)")
-    return {"t_end": T_SIM}, ""
+    """simulate() arguments for the 10 s run, its wall time bounded by --sim-limit."""
+    return {"t_end": T_SIM, "max_wall": sim_limit}, ""
 
 
 def time_simulation(model: mbody.Model, file: str, sim_limit: float):
