@@ -612,6 +612,13 @@ def _residual(bodies, joints_i, comps_i, U, child6, parent6, r6, gam, acc, lamU,
 
 # -- the two entry points ----------------------------------------------------------------------
 @njit(cache=True)
+def _state(y, n):
+    """Views (x, q, v, ω) of the packed state [x (n, 3) | q (n, 4) | v (n, 3) | ω (n, 3) | …]."""
+    return (y[0:3 * n].reshape(n, 3), y[3 * n:7 * n].reshape(n, 4),
+            y[7 * n:10 * n].reshape(n, 3), y[10 * n:13 * n].reshape(n, 3))
+
+
+@njit(cache=True)
 def _evaluate(F, I, Iu, x, q, v, w, fvec, lam, rate, refine):
     """The shared body of `solve` and `derivative` (see there)."""
     gravity, bodies, B_r, springs, joints, loads_i, springs_i, joints_i, comps_i = _unpack(F, I)
@@ -668,10 +675,7 @@ def solve(F, I, Iu, y, fvec, lam, planar, out):
     """
     n = I[0]
     m = I[4]
-    x = y[0:3 * n].reshape(n, 3)
-    q = y[3 * n:7 * n].reshape(n, 4)
-    v = y[7 * n:10 * n].reshape(n, 3)
-    w = y[10 * n:13 * n].reshape(n, 3)
+    x, q, v, w = _state(y, n)
     acc, lamU, phi, gtv, rank, berr, nonunique = _evaluate(F, I, Iu, x, q, v, w, fvec, lam,
                                                            0.0, True)
     mu = Iu[0]
@@ -697,8 +701,8 @@ def solve(F, I, Iu, y, fvec, lam, planar, out):
             for i in range(n):
                 lo, hi = min(lo, x[i, a]), max(hi, x[i, a])
             size = max(size, hi - lo)
-    joints = _unpack(F, I)[4]
-    comps_i = _unpack(F, I)[8]
+    model = _unpack(F, I)
+    joints, comps_i = model[4], model[8]
     for i in range(m):
         row = joints[comps_i[i, 0]]
         for a in range(3):
@@ -726,10 +730,7 @@ def derivative(F, I, Iu, y, fvec, lam, rate, planar, out):
     (see `mbody.simulate`), with the unknown reactions solved and Baumgarte's terms
     (α = β = `rate`); redundant constraints get the minimum-norm reactions. Returns 0."""
     n = I[0]
-    x = y[0:3 * n].reshape(n, 3)
-    q = y[3 * n:7 * n].reshape(n, 4)
-    v = y[7 * n:10 * n].reshape(n, 3)
-    w = y[10 * n:13 * n].reshape(n, 3)
+    x, q, v, w = _state(y, n)
     acc, lamU, phi, gtv, rank, berr, nonunique = _evaluate(F, I, Iu, x, q, v, w, fvec, lam,
                                                            rate, False)
     for i in range(n):

@@ -22,10 +22,8 @@ takes time quadratic in the number of bodies, so its column is measured on at mo
 from __future__ import annotations
 
 import argparse
-import gc
 import sys
 import tempfile
-import time
 from dataclasses import replace
 from pathlib import Path
 
@@ -34,6 +32,10 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 if str(ROOT) not in sys.path:  # run from a checkout without installing
     sys.path.insert(0, str(ROOT))
+if str(ROOT / "tools") not in sys.path:  # tools/timing.py, also when loaded by path
+    sys.path.insert(0, str(ROOT / "tools"))
+
+from timing import best  # noqa: E402
 
 import mbody  # noqa: E402
 from mbody import dynamics  # noqa: E402
@@ -204,23 +206,6 @@ def mujoco_accelerations(m, d) -> np.ndarray:
 
 
 # -- timing ----------------------------------------------------------------------------------
-def best(fn, repeat: int, budget: float = 0.01) -> float:
-    """Best time of one call (s): `repeat` runs, each of as many calls as fill `budget`."""
-    t0 = time.perf_counter()
-    fn()
-    once = time.perf_counter() - t0
-    number = max(1, int(budget / max(once, 1e-9)))
-    times = []
-    gc.disable()
-    try:
-        for _ in range(repeat):
-            t0 = time.perf_counter()
-            for _ in range(number):
-                fn()
-            times.append((time.perf_counter() - t0) / number)
-    finally:
-        gc.enable()
-    return min(times)
 
 
 _mujoco_cache: dict[int, float] = {}

@@ -33,7 +33,6 @@ beside the numbers with PASS/MISS.
 from __future__ import annotations
 
 import argparse
-import gc
 import importlib
 import math
 import sys
@@ -46,6 +45,10 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 if str(ROOT) not in sys.path:  # run from a checkout without installing
     sys.path.insert(0, str(ROOT))
+if str(ROOT / "tools") not in sys.path:  # tools/timing.py, also when loaded by path
+    sys.path.insert(0, str(ROOT / "tools"))
+
+from timing import best  # noqa: E402
 
 import mbody  # noqa: E402
 from mbody import plan as mplan  # noqa: E402
@@ -82,23 +85,6 @@ def load(file: str) -> mbody.Model:
 
 
 # -- timing --------------------------------------------------------------------------------
-def best(fn, repeat: int, budget: float = 0.02) -> float:
-    """Best time of one call (s): `repeat` runs, each of as many calls as fill `budget`."""
-    t0 = time.perf_counter()
-    fn()
-    once = time.perf_counter() - t0
-    number = max(1, int(budget / max(once, 1e-9)))
-    times = []
-    gc.disable()
-    try:
-        for _ in range(repeat):
-            t0 = time.perf_counter()
-            for _ in range(number):
-                fn()
-            times.append((time.perf_counter() - t0) / number)
-    finally:
-        gc.enable()
-    return min(times)
 
 
 def best_once(fn, repeat: int, limit: float = 2.0):
@@ -443,11 +429,11 @@ def time_solve(model: mbody.Model, repeat: int) -> tuple[float, float]:
 
     for _ in range(mplan.JIT_AFTER + 4):  # switch to the compiled path, compile, warm
         solve()
-    t_jit = best(solve, repeat)
+    t_jit = best(solve, repeat, 0.02)
     previous = mplan.set_jit("off")
     try:
         solve()
-        t_np = best(solve, repeat)
+        t_np = best(solve, repeat, 0.02)
     finally:
         mplan.set_jit(previous)
     return t_jit, t_np
@@ -459,7 +445,7 @@ def time_rhs(model: mbody.Model, repeat: int) -> tuple[float, bool]:
     assert len(f(0.0, y)) == len(y), "state layout"
     for _ in range(3):
         f(0.0, y)
-    return best(lambda: f(0.0, y), repeat), bool(f.compiled)
+    return best(lambda: f(0.0, y), repeat, 0.02), bool(f.compiled)
 
 
 def simulate_kwargs(model: mbody.Model, file: str, sim_limit: float) -> tuple[dict, str]:
@@ -494,7 +480,7 @@ def measure(label: str, file: str, repeat: int, sim_limit: float, have_mj: bool)
         eq = mujoco_equivalent(model)
         check = check_equivalent(model, eq)
         m, d = eq.make()
-        mj = best(lambda: mujoco.mj_forward(m, d), repeat)
+        mj = best(lambda: mujoco.mj_forward(m, d), repeat, 0.02)
         vary = eq.loads_vary
     wall, steps, evals, t_done, note = time_simulation(model, file, sim_limit)
     return Row(label, model.n, unknown_count(model), t_jit, t_np, mj, rhs, compiled, wall,
