@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from . import conventions as cv
+from .joints import g_block
 
 if TYPE_CHECKING:
     from .assemble import Assembly
@@ -198,8 +199,8 @@ def body_equations(asm: Assembly, i: int) -> BodyEquations:
     block[:3, :3] = np.eye(3) * model.mass[i]
     block[3:, 3:] = model.J[i]
     block = block[np.ix_(rows, rows)]
-    G = asm.G
-    Gi = G[i * rpb:(i + 1) * rpb].toarray() if G.shape[1] else np.zeros((rpb, 0))
+    # this body's rows of G, dense and without scipy.sparse (`mbody assemble` prints them)
+    Gi = g_block(model, cols, np.array([i]), np.arange(len(asm.reactions)))
     eqs = []
     for r in range(rpb):
         lhs = {acc[k]: float(block[r, k]) for k in range(rpb) if block[r, k] != 0}

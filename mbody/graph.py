@@ -7,8 +7,11 @@ redundant joints (a planar four-bar modelled in 3-D has more reaction components
 independent constraints).
 
 `topology` needs only the connected parts, found here from the joint list directly:
-networkx (slow to import) is loaded only for `body_graph` (`Model.graph`), and
-scipy.linalg only for a part of G that may be rank-deficient.
+networkx (slow to import) is loaded only for `body_graph` (`Model.graph`). The rank test
+works on dense blocks of G, one per connected part; given the reaction columns (as
+`mbody check` does) it builds them with numpy alone, and its pivoted QR is numpy's for a
+part of up to `NUMPY_QR_LIMIT` components (scipy.linalg, ~0.1-0.2 s to import, only for a
+larger part that may be rank-deficient).
 """
 
 from __future__ import annotations
@@ -25,8 +28,18 @@ from .model import Model
 if TYPE_CHECKING:
     import networkx as nx
 
+    from .joints import ReactionColumns
+
 RANK_LIMIT = 1500
 """Largest number of reaction components in one connected part whose rank is computed."""
+
+NUMPY_QR_LIMIT = 120
+"""Largest number of reaction components in one connected part whose pivoted QR is
+`pivoted_qr` (numpy); scipy.linalg.qr above (the same algorithm, LAPACK's ?geqp3, whose
+rounding decides exact ties)."""
+
+PIVOT_TIE = 1e-9
+"""Relative difference below which two remaining column norms tie in `pivoted_qr`."""
 
 
 def body_graph(model: Model) -> nx.MultiGraph:
@@ -71,8 +84,10 @@ class Topology:
         return self.loops == 0
 
 
-def topology(model: Model, G=None) -> Topology:
-    """Analyse the model's graph; `G` (the sparse reaction matrix) enables the rank test."""
+def topology(model: Model, G=None, *, columns: ReactionColumns | None = None) -> Topology:
+    """Analyse the model's graph. `G` (the reaction matrix, sparse or dense) or `columns`
+    (`Assembly.columns`, from which the blocks of G are built without scipy.sparse)
+    enables the rank test."""
     nodes = [cv.GROUND, *model.body_names]
     edges = [(j.parent, j.child) for j in model.joints]
     components = _components(nodes, edges)
@@ -86,21 +101,23 @@ def topology(model: Model, G=None) -> Topology:
     per_body = 3 if model.dimension == cv.PLANAR else 6
     gruebler = per_body * model.n - m
     rank, redundant = (0, []) if m == 0 else (None, [])
-    if G is not None and m:
-        rank, redundant = _rank(model, G)
+    if m and (G is not None or columns is not None):
+        rank, redundant = _rank(model, G, columns)
     mobility = per_body * model.n - (rank if rank is not None else m)
     return Topology(parts, loops, floating, grounded, m, rank, mobility, gruebler, redundant)
 
 
-def _rank(model: Model, G) -> tuple[int | None, list[str]]:
-    """Rank of G, part by part (ground removed, so parts share no rows)."""
+def _rank(model: Model, G, columns: ReactionColumns | None) -> tuple[int | None, list[str]]:
+    """Rank of G, part by part (ground removed, so parts share no rows); G's blocks come
+    from `G` or else from `columns`."""
     parts = _components(model.body_names, [(j.parent, j.child) for j in model.joints
                                            if cv.GROUND not in (j.parent, j.child)])
     t = model.reaction_table
     rpb = model.rows_per_body
     labels = model.reactions
     total, redundant = 0, []
-    G = G.tocsc()
+    if G is not None and hasattr(G, "tocsc"):  # scipy.sparse
+        G = G.tocsc()
     for part in parts:
         idx = np.array(sorted(model.index[b] for b in part))
         cols = np.flatnonzero(np.isin(t.child, idx))
@@ -108,16 +125,26 @@ def _rank(model: Model, G) -> tuple[int | None, list[str]]:
             continue
         if len(cols) > RANK_LIMIT:
             return None, []
-        rows = (idx[:, None] * rpb + np.arange(rpb)).ravel()
-        A = G[rows][:, cols].toarray()
+        if G is None:
+            from .joints import g_block
+
+            A = g_block(model, columns, idx, cols)
+        else:
+            rows = (idx[:, None] * rpb + np.arange(rpb)).ravel()
+            A = (G[rows][:, cols].toarray() if hasattr(G, "toarray")
+                 else np.asarray(G, dtype=float)[np.ix_(rows, cols)])
         if _clearly_full_column_rank(A):  # what the pivoted QR below would conclude
             total += A.shape[1]
             continue
-        import scipy.linalg  # ~0.1 s to import: only for parts that may be rank-deficient
-
         # QR with column pivoting: the columns pivoted past the rank depend on the others.
-        _, Rq, piv = scipy.linalg.qr(A, mode="economic", pivoting=True)
-        d = np.abs(np.diag(Rq))
+        if A.shape[1] <= NUMPY_QR_LIMIT:
+            d, piv = pivoted_qr(A)
+        else:
+            import scipy.linalg  # ~0.1-0.2 s to import: only for large parts
+
+            _, Rq, piv = scipy.linalg.qr(A, mode="economic", pivoting=True)
+            d = np.diag(Rq)
+        d = np.abs(d)
         tol = (d[0] if len(d) else 0.0) * max(A.shape) * np.finfo(float).eps * 10
         r = int(np.sum(d > tol))
         total += r
@@ -142,6 +169,45 @@ def _clearly_full_column_rank(A: np.ndarray) -> bool:
         return False
     scale = float(np.einsum("ij,ij->", A, A))
     return 0 < scale < np.inf and float(np.linalg.eigvalsh(A.T @ A)[0]) > FULL_RANK_MARGIN * scale
+
+
+def pivoted_qr(A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """QR with column pivoting of A (m, n): (diag(R) (min(m, n),), the column order piv).
+
+    Householder QR that moves forward, at each step, the column of largest remaining norm
+    (Businger and Golub; LAPACK's ?geqp3, which scipy.linalg.qr(pivoting=True) calls,
+    is the same algorithm), so that the columns pivoted past the rank are combinations of
+    the others. Remaining norms within `PIVOT_TIE` of the largest are a tie, won by the
+    column first in A: symmetric mechanisms have exact ties, which rounding would
+    otherwise decide (differently from one BLAS build to another). The remaining norms
+    are recomputed at every step, not downdated, so that rounding stays far below
+    `PIVOT_TIE`. Numpy only: for the small blocks of `_rank`, where importing
+    scipy.linalg would cost more than everything else `mbody check` does.
+    """
+    A = np.array(A, dtype=float)
+    m, n = A.shape
+    piv = np.arange(n)
+    d = np.empty(min(m, n))
+    for i in range(len(d)):
+        rest = A[i:, i:]
+        norms = np.sqrt(np.einsum("ij,ij->j", rest, rest))
+        tied = np.flatnonzero(norms >= (1.0 - PIVOT_TIE) * norms.max())
+        p = i + tied[np.argmin(piv[i + tied])]
+        if p != i:
+            A[:, [i, p]] = A[:, [p, i]]
+            piv[[i, p]] = piv[[p, i]]
+        # Householder reflector H = I - tau v vᵀ (v[0] = 1) taking A[i:, i] to (beta, 0, ...)
+        alpha = A[i, i]
+        xnorm = float(np.sqrt(A[i + 1:, i] @ A[i + 1:, i]))
+        if xnorm == 0.0:
+            d[i] = alpha
+            continue
+        beta = -np.copysign(np.hypot(alpha, xnorm), alpha)
+        d[i] = beta
+        if i + 1 < n:
+            v = np.concatenate(([1.0], A[i + 1:, i] / (alpha - beta)))
+            A[i:, i + 1:] -= np.outer(((beta - alpha) / beta) * v, v @ A[i:, i + 1:])
+    return d, piv
 
 
 def _components(nodes: Iterable[str], edges: Iterable[tuple[str, str]]) -> list[set[str]]:

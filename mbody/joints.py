@@ -165,6 +165,27 @@ def g_matrix(model: Model, cols: ReactionColumns) -> sp.csc_matrix:
     return G
 
 
+def g_block(model: Model, cols: ReactionColumns, bodies: np.ndarray,
+            components: np.ndarray) -> np.ndarray:
+    """Dense G[rows of `bodies`, `components`]: the same numbers as
+    ``g_matrix(model, cols)[rows][:, components].toarray()`` without scipy.sparse (for a
+    body's equations and the rank test). `bodies`: body indices, whose rows are stacked in
+    that order; `components`: reaction component indices (the columns, in that order)."""
+    t = model.reaction_table
+    rpb = model.rows_per_body
+    keep = np.arange(6) if model.dimension == cv.SPATIAL else cv.PLANAR_SELECT
+    bodies, components = np.asarray(bodies, dtype=int), np.asarray(components, dtype=int)
+    local = np.full(model.n + 1, -1)  # body index -> its place in `bodies`; ground (-1) -> -1
+    local[bodies] = np.arange(len(bodies))
+    A = np.zeros((len(bodies), len(components), rpb))
+    for owner, six in ((t.child, cols.child6), (t.parent, cols.parent6)):
+        at = local[owner[components]]
+        on = np.flatnonzero(at >= 0)
+        # 0.0 + x: +0.0 where x is -0.0, as a sparse G (which drops zeros) gives
+        A[at[on], on] += six[components[on]][:, keep]
+    return A.transpose(0, 2, 1).reshape(len(bodies) * rpb, len(components))
+
+
 def reaction_wrench(model: Model, cols: ReactionColumns, lam: np.ndarray) -> np.ndarray:
     """(n, 6) what reactions with values `lam` (m,) put into every body's six rows."""
     t = model.reaction_table

@@ -6,11 +6,16 @@ Names carry frames: ``W_R_B`` rotates body-axis components into world axes
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-# scipy.spatial.transform is imported inside the two functions using it: it costs about
-# 0.2 s (it pulls in scipy.spatial, scipy.sparse and scipy.special), which every command
-# would pay at start-up otherwise.
+# Euler angles and rotation matrices are converted here with numpy and the math module,
+# not scipy.spatial.transform: importing that costs about 0.2 s (it pulls in scipy.spatial,
+# scipy.sparse, scipy.linalg and scipy.special), which `mbody check` of any model with an
+# `orientation: {euler: ...}` would pay. Both functions follow scipy's `Rotation`
+# arithmetic step by step (`from_euler`, `from_matrix`) and give the same numbers to the
+# last bit (tests/test_startup.py compares them).
 
 
 def quat_to_matrix(q: np.ndarray) -> np.ndarray:
@@ -33,11 +38,36 @@ def quat_to_matrix(q: np.ndarray) -> np.ndarray:
 
 
 def matrix_to_quat(R: np.ndarray) -> np.ndarray:
-    """(..., 3, 3) rotation matrices -> (..., 4) quaternions [w, x, y, z] with w >= 0."""
-    from scipy.spatial.transform import Rotation
+    """(..., 3, 3) rotation matrices -> (..., 4) quaternions [w, x, y, z] with w >= 0.
 
+    As scipy's ``Rotation.from_matrix``: a matrix that is not orthogonal to 1e-12 is first
+    replaced by the nearest rotation (U Vᵀ of its SVD); then the largest of the diagonal
+    and the trace picks the best-conditioned formula, and the quaternion is normalised.
+    """
     R = np.asarray(R, dtype=float)
-    q = Rotation.from_matrix(R.reshape(-1, 3, 3)).as_quat(scalar_first=True)
+    M = R.reshape(-1, 3, 3).copy()
+    gram = M @ np.swapaxes(M, 1, 2)
+    skew = ~np.all(np.isclose(gram, np.eye(3), rtol=1e-5, atol=1e-12), axis=(1, 2))
+    if skew.any():
+        U, _, Vt = np.linalg.svd(M[skew], full_matrices=False)
+        M[skew] = U @ Vt
+    trace = M[:, 0, 0] + M[:, 1, 1] + M[:, 2, 2]
+    choice = np.argmax(np.stack((M[:, 0, 0], M[:, 1, 1], M[:, 2, 2], trace), axis=-1),
+                       axis=-1)
+    q = np.empty((len(M), 4))  # [x, y, z, w] here, as in scipy
+    for c in range(3):  # a diagonal entry is largest: component c from it
+        s = choice == c
+        m, j, k = M[s], (c + 1) % 3, (c + 2) % 3
+        q[s, c] = 1 - trace[s] + 2 * m[:, c, c]
+        q[s, j] = m[:, j, c] + m[:, c, j]
+        q[s, k] = m[:, k, c] + m[:, c, k]
+        q[s, 3] = m[:, k, j] - m[:, j, k]
+    s = choice == 3  # the trace is largest: w from it
+    m = M[s]
+    q[s] = np.stack((m[:, 2, 1] - m[:, 1, 2], m[:, 0, 2] - m[:, 2, 0],
+                     m[:, 1, 0] - m[:, 0, 1], 1 + trace[s]), axis=-1)
+    q /= np.linalg.norm(q, axis=-1, keepdims=True)
+    q = q[:, [3, 0, 1, 2]]
     q *= np.where(q[:, :1] < 0, -1.0, 1.0)
     return q.reshape(*R.shape[:-2], 4)
 
@@ -57,15 +87,28 @@ def quat_to_planar_angle(q: np.ndarray) -> np.ndarray:
 
 
 def euler_to_quat(angles: np.ndarray, sequence: str) -> np.ndarray:
-    """Euler angles (radians) -> quaternion [w, x, y, z].
+    """Euler angles (radians) -> quaternion [w, x, y, z] with w >= 0.
 
     `sequence` follows scipy: upper case (``ZYX``) is intrinsic (about the turning body
-    axes, in order), lower case (``zyx``) is extrinsic (about the fixed world axes).
+    axes, in order), lower case (``zyx``) is extrinsic (about the fixed world axes). The
+    three elementary rotations are composed as scipy's ``Rotation.from_euler`` does.
     """
-    from scipy.spatial.transform import Rotation
-
-    q = Rotation.from_euler(sequence, angles).as_quat(scalar_first=True)
-    return q if q[0] >= 0 else -q
+    intrinsic = sequence.isupper()
+    q: list[float] = []  # [x, y, z, w], as in scipy
+    for axis, angle in zip(sequence.lower(), np.asarray(angles, dtype=float).reshape(3),
+                           strict=True):
+        e = [0.0, 0.0, 0.0, math.cos(angle / 2.0)]
+        e["xyz".index(axis)] = math.sin(angle / 2.0)
+        if not q:
+            q = e
+            continue
+        p, r = (q, e) if intrinsic else (e, q)  # q = p r
+        q = [p[3] * r[0] + r[3] * p[0] + (p[1] * r[2] - p[2] * r[1]),
+             p[3] * r[1] + r[3] * p[1] + (p[2] * r[0] - p[0] * r[2]),
+             p[3] * r[2] + r[3] * p[2] + (p[0] * r[1] - p[1] * r[0]),
+             p[3] * r[3] - p[0] * r[0] - p[1] * r[1] - p[2] * r[2]]
+    out = np.array([q[3], q[0], q[1], q[2]])
+    return out if out[0] >= 0 else -out
 
 
 def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:

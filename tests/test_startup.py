@@ -3,7 +3,9 @@ they do not need (nothing here is timed; tools/bench_startup.py measures the tim
 
 Each case runs in a fresh interpreter and lists the heavy modules in its `sys.modules`, so
 an eager import reintroduced anywhere on the path (at the top of a module, or in
-`mbody/__init__.py`) fails here.
+`mbody/__init__.py`) fails here. The numpy code that stands in for scipy on that path
+(rotations from Euler angles and matrices, the blocks of G, the pivoted QR of the rank
+test) is compared with scipy at the end.
 """
 
 from __future__ import annotations
@@ -14,15 +16,24 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
+
+import mbody
 
 ROOT = Path(__file__).resolve().parent.parent
 PENDULUM = ROOT / "models" / "pendulum.yaml"
+SHIPPED = sorted((ROOT / "models").glob("*.yaml"))
 
-HEAVY = ("networkx", "matplotlib", "meshcat", "scipy.spatial", "tqdm", "jsonschema",
-         "scipy.integrate")
-"""Slow to import and not needed by check, assemble or solve (of a model without Euler
-angles or rotation matrices, which need scipy.spatial.transform)."""
+HEAVY = ("networkx", "matplotlib", "meshcat", "numba", "scipy.sparse", "scipy.spatial",
+         "scipy.linalg", "tqdm", "jsonschema", "scipy.integrate")
+"""Slow to import and not needed by check, assemble or solve of a shipped model (scipy.linalg
+alone costs 0.1-0.2 s, as much as the whole command)."""
+
+NEVER_AT_IMPORT = ("networkx", "matplotlib", "meshcat", "numba", "scipy.spatial", "tqdm",
+                   "jsonschema", "scipy.integrate")
+"""Not loaded by resolving the public names either (`mbody.ExportedAssembly` is in
+`mbody.export`, which holds scipy.sparse matrices)."""
 
 
 def loaded(code: str, prefixes: tuple[str, ...] = HEAVY) -> list[str]:
@@ -65,6 +76,25 @@ def test_all_three_commands_in_one_process():
     assert loaded(run_commands(*argvs)) == []
 
 
+@pytest.mark.parametrize("path", SHIPPED, ids=lambda p: p.stem)
+def test_shipped_model_commands_load_no_heavy_module(path: Path):
+    """check, assemble and solve of every shipped model (Euler angles, rotation matrices,
+    redundant joints, closed loops), each followed by a look at what it loaded."""
+    code = ("import contextlib, io, json, sys\nimport mbody.cli\nnew = {}\n"
+            f"prefixes = {HEAVY!r}\n")
+    for cmd in ("check", "assemble", "solve"):
+        code += (f"with contextlib.redirect_stdout(io.StringIO()):\n"
+                 f"    assert mbody.cli.main({[cmd, str(path)]!r}) == 0\n"
+                 f"new[{cmd!r}] = sorted(m for m in sys.modules if any(\n"
+                 "    m == p or m.startswith(p + '.') for p in prefixes))\n")
+    code += "print(json.dumps(new))"
+    env = {k: v for k, v in os.environ.items() if k != "MBODY_DEBUG"}
+    p = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True,
+                       text=True, timeout=120)
+    assert p.returncode == 0, p.stderr
+    assert json.loads(p.stdout.splitlines()[-1]) == {"check": [], "assemble": [], "solve": []}
+
+
 def test_public_names_survive_lazy_loading():
     """Every name in `mbody.__all__` resolves; `assemble`, `animate`, `simulate` and `loads`
     stay the functions after their namesake submodules are imported (by a command)."""
@@ -83,4 +113,103 @@ for n in ("animate", "assemble", "simulate", "loads"):
 assert mbody.loads is mbody.model.loads
 assert mbody.dynamics.__name__ == "mbody.dynamics"  # submodules as attributes, on demand
 """.replace("MODEL", repr(str(PENDULUM)))
-    assert loaded(code) == []
+    assert loaded(code, NEVER_AT_IMPORT) == []
+
+
+# -- numpy in place of scipy on the start-up path: the same numbers ---------------------
+
+SEQUENCES = [a + b + c for a in "xyz" for b in "xyz" for c in "xyz" if a != b != c]
+
+
+@pytest.mark.parametrize("sequence", SEQUENCES + [q.upper() for q in SEQUENCES])
+def test_euler_to_quat_is_scipys_to_the_bit(sequence: str):
+    from scipy.spatial.transform import Rotation
+
+    from mbody.spatial import euler_to_quat
+
+    rng = np.random.default_rng(sum(map(ord, sequence)))
+    angles = np.vstack((rng.uniform(-7, 7, (200, 3)),
+                        np.radians(rng.integers(-360, 361, (100, 3))),  # "30 deg" in a file
+                        np.diag([0.5, -1.0, 2.0]), np.zeros((1, 3))))
+    for a in angles:
+        q = Rotation.from_euler(sequence, a).as_quat(scalar_first=True)
+        np.testing.assert_array_equal(euler_to_quat(a, sequence), q if q[0] >= 0 else -q)
+
+
+def test_matrix_to_quat_is_scipys_to_the_bit():
+    from scipy.spatial.transform import Rotation
+
+    from mbody.spatial import matrix_to_quat
+
+    R = Rotation.random(3000, random_state=1).as_matrix()
+    R[::7] = np.round(R[::7], 7)  # typed into a file: off orthogonal, so projected first
+    R[::13] = np.round(R[::13], 3)
+    R[::11] = np.diag([1.0, -1.0, -1.0])  # turned by pi: the trace is not the largest
+    R[::17] = np.eye(3)
+    q = Rotation.from_matrix(R).as_quat(scalar_first=True)
+    q *= np.where(q[:, :1] < 0, -1.0, 1.0)
+    np.testing.assert_array_equal(matrix_to_quat(R), q)
+    np.testing.assert_array_equal(matrix_to_quat(R[5]), q[5])
+    assert matrix_to_quat(R.reshape(30, 100, 3, 3)).shape == (30, 100, 4)
+
+
+@pytest.mark.parametrize("path", [p for p in SHIPPED if mbody.load(p).reactions],
+                         ids=lambda p: p.stem)
+def test_g_block_is_the_sparse_g(path: Path):
+    from mbody.joints import g_block
+
+    model = mbody.load(path)
+    asm = mbody.assemble(model)
+    G = asm.G.toarray()
+    whole = g_block(model, asm.columns, np.arange(model.n), np.arange(len(model.reactions)))
+    np.testing.assert_array_equal(whole, G)
+    assert not np.any(np.signbit(whole) & (whole == 0))  # no -0.0
+    rng = np.random.default_rng(0)
+    bodies = rng.permutation(model.n)[:2]
+    comps = rng.permutation(len(model.reactions))[:5]
+    rows = (bodies[:, None] * model.rows_per_body + np.arange(model.rows_per_body)).ravel()
+    np.testing.assert_array_equal(g_block(model, asm.columns, bodies, comps),
+                                  G[np.ix_(rows, comps)])
+
+
+def _qr_rank(d: np.ndarray, shape: tuple[int, int]) -> int:
+    d = np.abs(d)
+    return int(np.sum(d > (d[0] if len(d) else 0.0) * max(shape) * np.finfo(float).eps * 10))
+
+
+def test_pivoted_qr_is_scipys_without_ties():
+    """Same rank as LAPACK's pivoted QR always; the same pivots where no two remaining
+    column norms tie (random matrices); the columns it keeps span A."""
+    import scipy.linalg
+
+    from mbody.graph import pivoted_qr
+
+    rng = np.random.default_rng(3)
+    for trial in range(400):
+        m, n = rng.integers(1, 40, 2)
+        r = int(rng.integers(1, min(m, n) + 1))
+        A = rng.normal(size=(m, r)) @ rng.normal(size=(r, n)) if trial % 2 else \
+            (rng.integers(-1, 2, (m, r)) @ rng.integers(-1, 2, (r, n))).astype(float)
+        d, piv = pivoted_qr(A)
+        _, R, piv_s = scipy.linalg.qr(A, mode="economic", pivoting=True)
+        rank = _qr_rank(d, A.shape)
+        assert rank == _qr_rank(np.diag(R), A.shape) == np.linalg.matrix_rank(A)
+        assert np.linalg.matrix_rank(A[:, piv[:rank]]) == rank
+        np.testing.assert_allclose(np.abs(d), np.abs(np.diag(R)), atol=1e-12 * np.abs(d[0]))
+        if trial % 2:
+            np.testing.assert_array_equal(piv[:rank], piv_s[:rank])
+
+
+def test_pivoted_qr_breaks_ties_by_column_order():
+    """Equal columns: the first is kept, the later ones are redundant, whatever rounding
+    says (the spatial four-bar's closing pin carries its redundancy)."""
+    from mbody.graph import pivoted_qr, topology
+
+    A = np.array([[1.0, 0.0, 1.0, 0.0], [0.0, 1.0, 0.0, 1.0], [0.0, 0.0, 0.0, 0.0]])
+    d, piv = pivoted_qr(A)
+    assert list(piv[:2]) == [0, 1] and _qr_rank(d, A.shape) == 2
+    model = mbody.load(ROOT / "models" / "fourbar_spatial.yaml")
+    asm = mbody.assemble(model)
+    topo = topology(model, columns=asm.columns)
+    assert topo == topology(model, asm.G) == topology(model, asm.G.toarray())
+    assert (topo.rank, topo.redundant) == (17, ["O4.Fz", "O4.Mx", "O4.My"])
