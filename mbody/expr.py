@@ -274,6 +274,39 @@ def check_finite(expr: Expression, t: float = 0.0) -> str:
             "negative number?)")
 
 
+CHECK_SPAN = 10.0
+"""Span, s, over which `mbody check` samples expressions: simulate's default t_end."""
+MAX_CHECK_SAMPLES = 100_001
+
+
+def check_times(t_end: float) -> np.ndarray:
+    """Times at which an expression is sampled over [0, t_end]: every millisecond, computed
+    as k / 1000 so that times such as 1, 0.1 or 2.5 are hit exactly (1/(t - 1) is infinite
+    only at t = 1 exactly); for long spans a coarser round step (2, 5 or 10 times a power
+    of ten) keeps it within `MAX_CHECK_SAMPLES` points. t_end itself is always included."""
+    step = next(m * 10.0 ** e for e in range(-3, 300) for m in (1, 2, 5)
+                if t_end / (m * 10.0 ** e) <= MAX_CHECK_SAMPLES - 1)
+    k = np.arange(int(t_end / step) + 1, dtype=float)
+    inverse = round(1 / step)  # 1000, 500, 200, ... 2: exact for every step below 1
+    t = k / inverse if step < 1 else k * step
+    t = t[t <= t_end]
+    return t if t[-1] == t_end else np.append(t, t_end)
+
+
+def first_nonfinite(expr: Expression, t_end: float) -> tuple[float, float] | None:
+    """(t, value) of the first sample of [0, t_end] (`check_times`) where `expr` is not
+    finite, or None."""
+    if expr.constant:
+        return None
+    t = check_times(float(t_end))
+    v = expr(t)
+    bad = ~np.isfinite(v)
+    if not bad.any():
+        return None
+    i = int(np.argmax(bad))
+    return float(t[i]), float(v[i])
+
+
 @dataclass(frozen=True)
 class ExpressionTable:
     """Time-varying entries of a (k, c) table of load components.

@@ -18,8 +18,15 @@ import numpy as np
 
 from . import conventions as cv
 from .errors import Issue, ModelError, did_you_mean
-from .expr import Expression, ExpressionError, check_finite, compile_expression
-from .loader import Document, Path_, dotted
+from .expr import (
+    CHECK_SPAN,
+    Expression,
+    ExpressionError,
+    check_finite,
+    compile_expression,
+    first_nonfinite,
+)
+from .loader import Document, Path_, Unrepresentable, dotted
 from .spatial import euler_to_quat, matrix_to_quat, shape_inertia
 
 TOP_KEYS = ("model", "dimension", "gravity", "bodies", "loads", "joints", "reactions",
@@ -64,6 +71,12 @@ _RATE = re.compile(r"\s*([-+]?[0-9.eE+-]+)\s*(deg/s|rad/s)\s*")
 _TOL = 1e-6
 MAX_MAGNITUDE = 1e100
 """Largest number accepted: squares and triple products must stay finite in float64."""
+MIN_MAGNITUDE = 1e-100
+"""Smallest nonzero magnitude accepted: reciprocals (1/m, J^-1) and products of three such
+numbers stay normal doubles (a denormal mass such as 5e-324 has no reciprocal)."""
+MAX_ANGLE = 1e9
+"""Largest angle accepted, rad (about 160 million turns): a double resolves 1e9 to 1e-7
+rad, and sin/cos of a larger number say little about the pose meant."""
 
 
 @dataclass
@@ -167,45 +180,71 @@ class _Checker:
 
     def number(self, path: Path_, value: Any, *, positive: bool = False,
                nonneg: bool = False) -> float | None:
+        if isinstance(value, Unrepresentable):  # 1e400, 1e-400, a 5 000-digit integer
+            self._out_of_range(path, value.shown, value.large)
+            return None
         if isinstance(value, bool) or not isinstance(value, int | float):
             self.err(path, f"expected a number, got {_kind(value)}")
             return None
         try:
             x = float(value)
-        except OverflowError:  # an integer with hundreds of digits
-            x = math.inf
+        except OverflowError:  # an integer with hundreds of digits (from a dictionary)
+            self._out_of_range(path, _show(value), True)
+            return None
         if not math.isfinite(x):
-            shown = (value if isinstance(value, float)
-                     else f"an integer of {len(str(value))} digits")
-            self.err(path, f"expected a finite number, got {shown}")
+            self.err(path, f"expected a finite number, got {x}")
             return None
         if abs(x) > MAX_MAGNITUDE:
-            self.err(path, f"expected a number of magnitude at most {MAX_MAGNITUDE:g}, got "
-                     f"{x:g}", "products of such numbers (r x F, m r^2) would overflow")
+            self._out_of_range(path, _show(value), True)
+            return None
+        if 0 < abs(x) < MIN_MAGNITUDE:
+            self._out_of_range(path, _show(value), False)
             return None
         if positive and x <= 0:
-            self.err(path, f"expected a number > 0, got {value}")
+            self.err(path, f"expected a number > 0, got {_show(value)}")
             return None
         if nonneg and x < 0:
-            self.err(path, f"expected a number >= 0, got {value}")
+            self.err(path, f"expected a number >= 0, got {_show(value)}")
             return None
         return x
 
+    def _out_of_range(self, path: Path_, shown: str, large: bool) -> None:
+        if large:
+            self.err(path, f"expected a number of magnitude at most {MAX_MAGNITUDE:g}, got "
+                     f"{shown}", "products of such numbers (r x F, m r^2) would overflow")
+        else:
+            self.err(path, f"expected 0 or a number of magnitude at least {MIN_MAGNITUDE:g}, "
+                     f"got {shown}", "1/m, the inverse inertia and products of such numbers "
+                     "would leave double precision")
+
     def angle(self, path: Path_, value: Any, rate: bool = False) -> float | None:
+        """An angle (rad, or a string with deg/rad), or with `rate` an angular rate."""
         if isinstance(value, str):
             m = (_RATE if rate else _ANGLE).fullmatch(value)
             unit = "deg/s" if rate else "deg"
             if not m:
                 self.err(path, f"expected a number (radians{'/s' if rate else ''}) or a string "
-                         f"like '30 {unit}', got '{value}'")
+                         f"like '30 {unit}', got '{_show(value)}'")
                 return None
             try:
                 x = float(m.group(1))
             except ValueError:
-                self.err(path, f"'{value}' is not a number followed by a unit")
+                self.err(path, f"'{_show(value)}' is not a number followed by a unit")
                 return None
-            return math.radians(x) if m.group(2).startswith("deg") else x
-        return self.number(path, value)
+            x = self.number(path, Unrepresentable(m.group(1)) if math.isinf(x) else x)
+            if x is None:
+                return None
+            x = math.radians(x) if m.group(2).startswith("deg") else x
+        else:
+            x = self.number(path, value)
+            if x is None:
+                return None
+        if not rate and abs(x) > MAX_ANGLE:
+            self.err(path, f"expected an angle of at most {MAX_ANGLE:g} rad in magnitude, got "
+                     f"{x:g} rad", "a double cannot resolve the pose of a larger angle; "
+                     "reduce it by whole turns")
+            return None
+        return x
 
     def vector(self, path: Path_, value: Any, n: int, *, angles: bool = False,
                rates: bool = False) -> np.ndarray | None:
@@ -248,14 +287,14 @@ class _Checker:
             self.err(path, f"expected a {what} name (text), got {_kind(value)}")
             return None
         if "." in value or any(c.isspace() for c in value):
-            self.err(path, f"the {what} name '{value}' may not contain '.' or spaces",
+            self.err(path, f"the {what} name '{_show(value)}' may not contain '.' or spaces",
                      "reaction labels are written <joint>.<component>")
             return None
         return value
 
     def choice(self, path: Path_, value: Any, choices: tuple[str, ...], what: str) -> str | None:
         if not isinstance(value, str) or value not in choices:
-            self.err(path, f"unknown {what} {value!r}",
+            self.err(path, f"unknown {what} {_quoted(value)}",
                      did_you_mean(value, choices) or f"expected one of: {', '.join(choices)}")
             return None
         return value
@@ -269,7 +308,7 @@ class _Checker:
             self.err(path, "'ground' is not allowed here", "name a body of the model")
             return None
         hint = did_you_mean(value, choices) if isinstance(value, str) else ""
-        self.err(path, f"no body named {value!r}",
+        self.err(path, f"no body named {_quoted(value)}",
                  hint or f"bodies are: {', '.join(choices[:12])}"
                  + (" ..." if len(choices) > 12 else ""))
         return None
@@ -284,15 +323,28 @@ def _kind(value: Any) -> str:
         return "nothing (null)"
     if isinstance(value, bool):
         return f"a boolean ({str(value).lower()})"
-    if isinstance(value, int | float):
-        return f"the number {value}"
+    if isinstance(value, int | float | Unrepresentable):
+        return f"the number {_show(value)}"
     if isinstance(value, str):
-        return f"the text '{value}'"
+        return f"the text '{_show(value)}'"
     if isinstance(value, list):
         return f"a list of {len(value)}"
     if isinstance(value, dict):
         return "a mapping"
     return type(value).__name__
+
+
+def _quoted(value: Any) -> str:
+    """`value` as repr() shows it, cut short (text is quoted, numbers are not)."""
+    return repr(_show(value)) if isinstance(value, str) else _show(value)
+
+
+def _show(value: Any, limit: int = 60) -> str:
+    """`value` for a message: long text cut short, huge integers by their size."""
+    if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 340:
+        return f"an integer of about {int(value.bit_length() * 0.30103) + 1} digits"
+    text = value if isinstance(value, str) else repr(value)
+    return text if len(text) <= limit else text[:limit - 3] + "..."
 
 
 def validate(doc: Document) -> Spec:
@@ -489,7 +541,7 @@ def _orientation(c: _Checker, path: Path_, value: Any) -> np.ndarray | None:
         seq = value.get("sequence", DEFAULT_EULER_SEQUENCE)
         if not (isinstance(seq, str) and len(seq) == 3 and (seq.isupper() or seq.islower())
                 and set(seq.lower()) <= set("xyz") and seq[0] != seq[1] and seq[1] != seq[2]):
-            c.err((*path, "sequence"), f"invalid Euler sequence {seq!r}",
+            c.err((*path, "sequence"), f"invalid Euler sequence {_quoted(seq)}",
                   "three axes such as ZYX (intrinsic, upper case) or zyx (extrinsic, lower "
                   "case), no axis twice in a row")
             return None
@@ -638,6 +690,11 @@ def expression(c: _Checker, path: Path_, text: str) -> Expression | None:
     if problem:
         c.err(path, f"{problem}: \"{text}\"")
         return None
+    bad = first_nonfinite(e, CHECK_SPAN)
+    if bad is not None:
+        c.warn(path, f"the expression \"{text}\" is not finite at t = {bad[0]:g} s ({bad[1]}); "
+               "a simulation cannot go past that time", f"sampled every millisecond from 0 "
+               f"to {CHECK_SPAN:g} s, simulate's default span")
     return e
 
 
@@ -770,7 +827,7 @@ def _reactions(c: _Checker, value: Any, joints: list[JointSpec],
     for label, v in value.items():
         p: Path_ = ("reactions", label)
         if label not in labels:
-            c.err(p, f"no reaction component '{label}'",
+            c.err(p, f"no reaction component '{_show(label)}'",
                   did_you_mean(label, labels)
                   or (f"the model's reaction components are: {', '.join(labels[:12])}"
                       if labels else "the model has no joints"), key=True)
