@@ -353,3 +353,50 @@ def test_warnings_go_to_stderr_and_do_not_fail(tmp_path):
     p = mbody("check", path)  # the summary lists it once, on stdout
     assert p.returncode == 0 and p.stderr == ""
     assert p.stdout.count("the quaternion has norm 2") == 1
+
+
+# == simulate's notice before compiling =================================================
+
+PENDING = ("import mbody\nfrom mbody.commands.sim import compile_pending\n"
+           "for name in ('pendulum', 'torque_free_asymmetric'):\n"
+           "    print(compile_pending(mbody.load(f'models/{name}.yaml'), {}))\n")
+
+
+def test_compile_pending_with_an_empty_numba_cache(tmp_path):
+    """An empty cache (as after an install): the run would compile, for a mechanism and
+    for a free body alike; never with the compiled path off. Nothing is compiled here."""
+    env = {k: v for k, v in os.environ.items() if k not in ("MBODY_DEBUG", "MBODY_JIT")}
+    for jit, expected in (("auto", "True\nTrue\n"), ("0", "False\nFalse\n")):
+        p = subprocess.run([sys.executable, "-c", PENDING], cwd=ROOT, capture_output=True,
+                           text=True, timeout=120,
+                           env={**env, "NUMBA_CACHE_DIR": str(tmp_path), "MBODY_JIT": jit})
+        assert (p.returncode, p.stdout) == (0, expected), p.stderr
+    assert not list(tmp_path.rglob("*.nbi"))
+
+
+def test_compile_pending_is_false_once_compiled():
+    import mbody
+    from mbody.cli import main
+    from mbody.commands.sim import compile_pending
+    from mbody.plan import compiled
+
+    if compiled() is None:
+        pytest.skip("numba is not available")
+    path = str(MODELS / "pendulum.yaml")
+    assert main(["simulate", path, "--t-end", "0.05", "--no-progress"]) == 0  # may compile
+    assert not compile_pending(mbody.load(path), {})
+    assert not compile_pending(mbody.load(MODELS / "torque_free_asymmetric.yaml"), {})
+
+
+@pytest.mark.parametrize("pending", [True, False])
+def test_simulate_says_so_on_stderr_when_it_compiles(monkeypatch, capsys, pending):
+    from mbody.cli import main
+    from mbody.commands import sim
+
+    monkeypatch.setattr(sim, "compile_pending", lambda model, known: pending)
+    assert main(["simulate", str(MODELS / "torque_free_asymmetric.yaml"), "--t-end", "0.1",
+                 "--no-progress"]) == 0
+    out, err = capsys.readouterr()
+    assert err == (sim.COMPILE_NOTICE + "\n" if pending else "")
+    assert "compiling" not in out
+    assert sim.COMPILE_NOTICE.startswith("mbody: compiling the fast path once")
