@@ -365,6 +365,7 @@ PENDING = ("import mbody\nfrom mbody.commands.sim import compile_pending\n"
 def test_compile_pending_with_an_empty_numba_cache(tmp_path):
     """An empty cache (as after an install): the run would compile, for a mechanism and
     for a free body alike; never with the compiled path off. Nothing is compiled here."""
+    pytest.importorskip("numba")
     env = {k: v for k, v in os.environ.items() if k not in ("MBODY_DEBUG", "MBODY_JIT")}
     for jit, expected in (("auto", "True\nTrue\n"), ("0", "False\nFalse\n")):
         p = subprocess.run([sys.executable, "-c", PENDING], cwd=ROOT, capture_output=True,
