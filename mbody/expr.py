@@ -36,6 +36,8 @@ VARIABLE = "t"
 MAX_LENGTH = 1000
 """Longest expression accepted (characters); deeper than this is not a load, it is a bug."""
 MAX_DEPTH = 100
+MAX_NUMBER, MIN_NUMBER = 1e100, 1e-100
+"""The range of a number written in an expression (the model file's range)."""
 
 _TOKEN = re.compile(r"""
     (?P<ws>\s+)
@@ -194,7 +196,13 @@ class _Parser:
     def atom(self, depth: int) -> Node:
         kind, value, pos = self.take()
         if kind == "num":
-            node: Node = ("num", float(value))
+            x = float(value)
+            if math.isinf(x) or x > MAX_NUMBER or (x < MIN_NUMBER and value.lower().partition(
+                    "e")[0].strip("0.") != ""):
+                raise ExpressionError(self.text, pos, f"the number {value} is out of range",
+                                      f"0, or a magnitude from {MIN_NUMBER:g} to "
+                                      f"{MAX_NUMBER:g}, as everywhere in a model")
+            node: Node = ("num", x)
         elif kind == "name":
             if value == VARIABLE:
                 node = ("t",)

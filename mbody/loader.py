@@ -85,6 +85,9 @@ _RADIX = re.compile(r"([-+]?)0([xX][0-9a-fA-F_]+|[oO][0-7_]+|[bB][01_]+)")
 _SEXAGESIMAL = re.compile(r"[-+]?[0-9][0-9_]*(:[0-5]?[0-9])+(\.[0-9_]*)?")
 _UNDERSCORED = re.compile(r"[-+]?[0-9_]*[0-9][0-9_]*(\.[0-9_]*)?([eE][-+]?[0-9]+)?")
 _FIRST = frozenset("0123456789+-.~tTfFnN")
+_NON_PRINTABLE = re.compile("[^\x09\x0a\x0d\x20-\x7e\x85\xa0-\ud7ff\ue000-\ufffd"
+                            "\U00010000-\U0010ffff]")
+"""Characters YAML does not allow in a file (PyYAML's reader refuses them)."""
 """First characters of every plain scalar that is not simply text."""
 
 
@@ -262,6 +265,16 @@ def load_text(text: str, file: str = "<string>") -> Document:
     """Parse YAML text into a `Document`; raise `ModelError` on any YAML-level problem."""
     doc = Document(None, file)
     builder = _Builder(doc)
+    bad = _NON_PRINTABLE.search(text)
+    if bad:  # PyYAML's reader would say so with a character offset, not a line
+        at = bad.start()
+        line = text.count("\n", 0, at) + 1
+        col = at - (text.rfind("\n", 0, at) + 1) + 1
+        what = (f"the character U+{ord(bad.group()):04X}" if not 0xD800 <= ord(bad.group())
+                <= 0xDFFF else "a lone surrogate")
+        raise ModelError([Issue(file, line, col, "", f"{what} is not allowed in a YAML "
+                                "file", "remove it; inside double quotes a control character "
+                                "may be written escaped, such as \\t")])
     loader = _Loader(text)
     try:
         builder.run(loader)

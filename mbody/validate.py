@@ -341,8 +341,10 @@ def _quoted(value: Any) -> str:
 
 def _show(value: Any, limit: int = 60) -> str:
     """`value` for a message: long text cut short, huge integers by their size."""
-    if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 340:
-        return f"an integer of about {int(value.bit_length() * 0.30103) + 1} digits"
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) >= 10**15:
+        if value.bit_length() > 1000:  # beyond a double: its size says enough
+            return f"an integer of about {int(value.bit_length() * 0.30103) + 1} digits"
+        return f"{value:.6g}"
     text = value if isinstance(value, str) else repr(value)
     return text if len(text) <= limit else text[:limit - 3] + "..."
 
@@ -689,6 +691,8 @@ def expression(c: _Checker, path: Path_, text: str) -> Expression | None:
     problem = check_finite(e, 0.0)
     if problem:
         c.err(path, f"{problem}: \"{text}\"")
+        return None
+    if e.constant and c.number(path, e.value) is None:  # "1e60*1e60" is a number too
         return None
     bad = first_nonfinite(e, CHECK_SPAN)
     if bad is not None:
