@@ -42,7 +42,9 @@ def ensure_writable(target: str | os.PathLike[str]) -> Path:
 def atomic_path(target: str | os.PathLike[str], suffix: str = "") -> Iterator[Path]:
     """Yield a temporary path next to `target`; on success rename it onto `target`.
 
-    On any exception the temporary file is removed and `target` is left untouched.
+    On any exception the temporary file is removed and `target` is left untouched; an
+    operating-system error (ENOSPC, EDQUOT, EFBIG, EIO...) becomes one `MbodyError`
+    naming `target`.
     `suffix` keeps the extension for writers that look at it (numpy, scipy.io).
     """
     target = Path(target)
@@ -60,8 +62,13 @@ def atomic_path(target: str | os.PathLike[str], suffix: str = "") -> Iterator[Pa
         with open(tmp_path, "rb+") as fh:
             os.fsync(fh.fileno())
         os.replace(tmp_path, target)
-    except BaseException:
-        tmp_path.unlink(missing_ok=True)
+    except BaseException as exc:
+        with contextlib.suppress(OSError):
+            tmp_path.unlink(missing_ok=True)
+        if isinstance(exc, OSError):  # a full disk, a quota, a file-size limit, I/O
+            raise MbodyError(f"cannot write {str(target)!r}: {exc.strerror or exc}; "
+                             "nothing was written (the temporary file is removed, and "
+                             f"{target.name!r} is as it was)") from None
         raise
 
 
