@@ -26,6 +26,7 @@ import math
 import os
 import sys
 import time
+import warnings
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -34,12 +35,14 @@ import numpy as np
 from . import conventions as cv
 from .dynamics import Dynamics, StateDerivative, accelerations
 from .errors import MbodyError, UnknownReactionsError, did_you_mean
-from .expr import Expression, compile_expression
+from .expr import Expression, check_times, compile_expression, first_nonfinite
 from .model import Model, State
 from .trajectory import Trajectory
 
 METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
 """scipy.integrate's step-by-step solvers (imported when a simulation starts)."""
+IMPLICIT = ("Radau", "BDF", "LSODA")
+"""The methods for stiff problems (LSODA switches to BDF when it finds stiffness)."""
 DEFAULT_RTOL = 1e-10
 DEFAULT_ATOL = 1e-12
 DEFAULT_MAX_STEPS = 1_000_000
@@ -168,6 +171,8 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     if K > 10_000_000:
         raise MbodyError(f"{K} output samples requested (t_end * fps); at most 10 million")
     mechanism = dynamics is None and _has_unknown_reactions(model, known)
+    varying = _varying_expressions(model, known)
+    _check_span(varying, t_end)
     rhs = state_derivative(model, known, dynamics)
     f = rhs.dynamics
     n = model.n
@@ -190,16 +195,37 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     try:
         import scipy.integrate
 
-        solver = getattr(scipy.integrate, method)(rhs, 0.0, y0, t_end, rtol=rtol, atol=atol,
-                                                  max_step=max_step)
+        fun = rhs
+        if method in ("Radau", "BDF"):  # their Jacobian estimate passes strided columns of y
+            def fun(t, y):
+                return rhs(t, np.ascontiguousarray(y))
+        with np.errstate(all="ignore"):  # its first-step norm may overflow: handled below
+            solver = getattr(scipy.integrate, method)(fun, 0.0, y0, t_end, rtol=rtol,
+                                                      atol=atol, max_step=max_step)
+        t_prev, check_at = 0.0, PREDICT_FROM
         while solver.status == "running":
-            msg = solver.step()
+            try:  # overflow in an implicit method's Jacobian estimate is handled below
+                with np.errstate(all="ignore"), warnings.catch_warnings():
+                    if method in IMPLICIT:  # scipy's LinAlgWarning on a singular iteration
+                        warnings.simplefilter("ignore", RuntimeWarning)
+                    msg = solver.step()
+            except (ValueError, np.linalg.LinAlgError) as exc:
+                if method not in IMPLICIT:
+                    raise
+                raise MbodyError(
+                    f"the integrator {method} failed at t = {solver.t:.6g} s: {exc} (its "
+                    "numerical Jacobian broke down, as it can where the state barely "
+                    "changes). Try another stiff integrator (--method "
+                    + " or ".join(m for m in ("LSODA", "BDF") if m != method)
+                    + ") or looser tolerances (e.g. --rtol 1e-6 --atol 1e-9)") from None
             if solver.status == "failed" or not np.all(np.isfinite(solver.y)):
+                culprit = _blame_expression(varying, t_prev, solver.t, solver.step_size)
                 raise MbodyError(
                     f"the integration stopped at t = {solver.t:.6g} s: "
-                    + (msg or "the state is no longer finite")
-                    + " (a load expression undefined there, a body escaping to infinity, "
-                    "or tolerances too tight for double precision?)")
+                    + (culprit or (msg or "the state is no longer finite")
+                       + " (a body escaping to infinity, or tolerances too tight for "
+                       "double precision?)"))
+            t_prev = solver.t
             steps += 1
             j = int(np.searchsorted(t_eval, solver.t, side="right"))
             if j > k:  # DOP853's interpolant costs 3 evaluations here (docs/simulation.md)
@@ -210,6 +236,10 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
             rate.step(solver.t, steps)
             bar.update(solver.t)
             if solver.status == "running":
+                if steps == check_at:  # the whole run's cost, predicted from its start
+                    check_at *= 2
+                    _predict(model, method, solver.t, t_end, steps, rate, max_steps,
+                             max_wall, time.perf_counter() - wall)
                 if max_steps is not None and steps >= max_steps:
                     raise MbodyError(_budget_message(
                         f"the step budget: {steps} steps (--max-steps {max_steps})",
@@ -276,6 +306,146 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     info.update(drift)
     info["warnings"] = [w for w in (rate.warning(), _spin_warning(traj)) if w]
     return traj
+
+
+PREDICT_FROM = 1000
+"""Steps after which (and after twice, four times as many...) a run's total cost is
+predicted from its rate so far."""
+PREDICT_FACTOR = 1.5
+"""A run predicted to need this many times its step or wall-time budget stops at once."""
+SPIN_STEPS_PER_RAD = 50.0
+"""Steps per radian of the fastest initial spin up to which a run's cost is put down to
+that spin (DOP853 at rtol 1e-10 takes about 1.5 steps per radian of a free spin)."""
+
+
+def _predict(model: Model, method: str, t: float, t_end: float, steps: int, rate: _StepRate,
+             max_steps: int | None, max_wall: float | None, elapsed: float) -> None:
+    """Stop now, with the cause and what to do, a run whose pace so far needs more than
+    `PREDICT_FACTOR` times a budget: a very stiff model or a fast spin otherwise takes
+    minutes to reach the budget (hours without one) and ends with nothing."""
+    if t <= 0:
+        return
+    need_steps = steps * t_end / t
+    need_wall = elapsed * t_end / t
+    if max_steps is not None and need_steps > PREDICT_FACTOR * max_steps:
+        over = (f"about {need_steps:.2g} steps, more than {PREDICT_FACTOR:g} times the budget "
+                f"(--max-steps {max_steps})")
+        raise_it = "raise --max-steps"
+    elif max_wall is not None and need_wall > PREDICT_FACTOR * max_wall:
+        over = (f"about {need_wall:.2g} s, more than {PREDICT_FACTOR:g} times the budget "
+                f"(--max-wall {max_wall:g})")
+        raise_it = "raise --max-wall"
+    else:
+        return
+    cause, remedies = _cost_cause(model, steps / t, method)
+    raise MbodyError(
+        f"the simulation was stopped early: after {steps} steps it is at t = {t:.3g} s of "
+        f"{t_end:g} s ({rate.so_far(t, steps)}); at that rate the whole run needs {over}. "
+        f"{cause} To go on: {remedies}, or {raise_it}. No trajectory is kept (rerun with "
+        f"--t-end {t:.3g} to see the motion up to here).")
+
+
+def _cost_cause(model: Model, steps_per_second: float, method: str) -> tuple[str, str]:
+    """Why the steps are short, and what helps: a fast spin (which every integrator must
+    follow), inertias too far apart for double precision (rounding noise that no
+    integrator steps over), or stiffness (which an implicit integrator steps over)."""
+    w = np.linalg.norm(np.asarray(model.initial.omega), axis=1) if model.n else np.zeros(0)
+    i = int(np.argmax(w)) if len(w) else 0
+    spin = float(w[i]) if len(w) else 0.0
+    if spin > 0 and steps_per_second < SPIN_STEPS_PER_RAD * spin:
+        return (f"The steps follow the fastest motion: '{model.body_names[i]}' spins at "
+                f"{spin:.3g} rad/s ({spin / (2 * math.pi):.3g} rev/s), and any integrator "
+                "must take steps shorter than a turn, so a stiff integrator would not help.",
+                "a shorter --t-end (the cost grows with it), a looser --rtol (e.g. 1e-6), "
+                "a slower spin")
+    moments = np.linalg.eigvalsh(np.asarray(model.J)) if model.n else np.ones((1, 3))
+    spread = moments[:, 2] / np.maximum(moments[:, 0], 1e-300)
+    k = int(np.argmax(spread))
+    if spread[k] > INERTIA_SPREAD:
+        return (f"The body '{model.body_names[k]}' has principal moments of inertia from "
+                f"{moments[k, 0]:.3g} to {moments[k, 2]:.3g} kg m^2 (a ratio of "
+                f"{spread[k]:.2g}): its Euler equation divides the rounding errors of the "
+                "large moments by the small one, and the steps shrink to follow that noise; "
+                "no integrator steps over it.",
+                "a realistic smallest moment (a thin rod's m r^2 / 2 with its real radius), "
+                "a shorter --t-end")
+    fastest = f"{spin:.3g} rad/s" if spin > 0 else "none"
+    cause = (f"That is far more steps than the motion explains (the fastest spin at the "
+             f"start: {fastest}): the model is stiff (time scales far apart, such as a very "
+             "stiff spring on a light body)")
+    if method in IMPLICIT:
+        return (cause + f", and even {method} needs short steps.",
+                "a shorter --t-end, a looser --rtol (e.g. 1e-6)")
+    return (cause + ", and an explicit integrator must resolve the fastest of them.",
+            "a stiff integrator (--method LSODA, BDF or Radau), a shorter --t-end")
+
+
+INERTIA_SPREAD = 1e10
+"""Ratio of a body's largest to smallest principal moment beyond which rounding noise
+(relative 1e-16 of the largest, divided by the smallest) is blamed for short steps."""
+
+
+def _varying_expressions(model: Model, known: Mapping[str, float | str] | None
+                         ) -> list[tuple[str, Expression]]:
+    """(what it is, expression) for every load component and known reaction that varies
+    in time, `known` included (compiled here, so a bad one is reported before any work)."""
+    out = []
+    for ld in model.loads:
+        for k, e in sorted(ld.expressions.items()):
+            comp = "" if model.dimension == cv.PLANAR and ld.type == "torque" else \
+                f" {'xyz'[k]}"
+            out.append((f"the load '{ld.name}' ({ld.type}{comp} on {ld.bodies[0]})", e))
+    exprs = dict(model.known_expressions)
+    for label, v in (known or {}).items():
+        if isinstance(v, str):
+            exprs[label] = compile_expression(v)
+        else:
+            exprs.pop(label, None)
+    out += [(f"the known reaction {label}", e) for label, e in exprs.items()
+            if not e.constant]
+    return out
+
+
+def _check_span(varying: list[tuple[str, Expression]], t_end: float) -> None:
+    """Refuse, before any work, a run over a span where a load expression is not finite."""
+    for what, e in varying:
+        bad = first_nonfinite(e, t_end)
+        if bad is not None:
+            t = bad[0]
+            raise MbodyError(
+                f"{what} = \"{e.text}\" is not finite at t = {t:g} s ({bad[1]}), within the "
+                f"simulated span 0 .. {t_end:g} s: the integration could not go past it. "
+                + ("Change the expression (it is sampled every millisecond)." if t == 0 else
+                   f"Change the expression, or simulate a shorter span (--t-end below "
+                   f"{t:g})."))
+
+
+def _blame_expression(varying: list[tuple[str, Expression]], t0: float, t1: float,
+                      h: float | None) -> str:
+    """When the integration fails between t0 and t1: the load expression that is not
+    finite there, or that grows without bound (1/(t - pi) near pi), else ''."""
+    if not varying:
+        return ""
+    w = max(1e-9 * max(1.0, abs(t1)), 100 * (h or 0.0))
+    near = np.union1d(np.linspace(t0, t1 + w, 4001), [t0, t1, np.nextafter(t1, np.inf)])
+    worst = ("", 0.0)
+    for what, e in varying:
+        v = np.abs(e(near))
+        bad = ~np.isfinite(v)
+        if bad.any():
+            k = int(np.argmax(bad))
+            return (f"{what} = \"{e.text}\" is not finite at t = {near[k]:.9g} s "
+                    f"({e(near[k])}): change the expression, or simulate to before that time")
+        earlier = check_times(t0) if t0 > 0 else np.zeros(1)
+        earlier = earlier[earlier < t0 - 1e-3] if t0 > 2e-3 else earlier[:1]
+        before = float(np.max(np.abs(e(earlier))))
+        ratio = float(v.max()) / max(before, 1e-300)
+        if ratio > 1e6 and ratio > worst[1]:
+            k = int(np.argmax(v))
+            worst = (f"{what} = \"{e.text}\" grows without bound near t = {near[k]:.9g} s "
+                     f"(|value| {v[k]:.3g}, {ratio:.2g} times its largest before): change the "
+                     "expression, or simulate to before that time", ratio)
+    return worst[0]
 
 
 class _StepRate:
