@@ -10,7 +10,7 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import IO
 
-from .errors import MbodyError
+from .errors import MbodyError, OutputError
 
 
 def ensure_writable(target: str | os.PathLike[str]) -> Path:
@@ -43,8 +43,8 @@ def atomic_path(target: str | os.PathLike[str], suffix: str = "") -> Iterator[Pa
     """Yield a temporary path next to `target`; on success rename it onto `target`.
 
     On any exception the temporary file is removed and `target` is left untouched; an
-    operating-system error (ENOSPC, EDQUOT, EFBIG, EIO...) becomes one `MbodyError`
-    naming `target`.
+    operating-system error (ENOSPC, EDQUOT, EFBIG, EIO...) becomes one `OutputError`
+    (an `MbodyError` and an `OSError`) naming `target`.
     `suffix` keeps the extension for writers that look at it (numpy, scipy.io).
     """
     target = Path(target)
@@ -66,9 +66,9 @@ def atomic_path(target: str | os.PathLike[str], suffix: str = "") -> Iterator[Pa
         with contextlib.suppress(OSError):
             tmp_path.unlink(missing_ok=True)
         if isinstance(exc, OSError):  # a full disk, a quota, a file-size limit, I/O
-            raise MbodyError(f"cannot write {str(target)!r}: {exc.strerror or exc}; "
-                             "nothing was written (the temporary file is removed, and "
-                             f"{target.name!r} is as it was)") from None
+            raise OutputError(f"cannot write {str(target)!r}: {exc.strerror or exc}; "
+                              "nothing was written (the temporary file is removed, and "
+                              f"{target.name!r} is as it was)", exc, str(target)) from None
         raise
 
 

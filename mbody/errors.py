@@ -72,6 +72,21 @@ class UnknownReactionsError(MbodyError):
         )
 
 
+class OutputError(MbodyError, OSError):
+    """An output could not be written (a full disk, a quota, a file-size limit, an I/O
+    error): one message for the command line, and still an `OSError` (with the cause's
+    errno and strerror, and the target as filename) for code that catches those."""
+
+    def __init__(self, message: str, cause: OSError | None = None, filename=None):
+        super().__init__(message)
+        if cause is not None:
+            self.errno, self.strerror = cause.errno, cause.strerror
+        self.filename = filename
+
+    def __str__(self) -> str:
+        return str(self.args[0])
+
+
 class TrajectoryFileError(MbodyError):
     """A trajectory file is unreadable, truncated or of the wrong kind."""
 

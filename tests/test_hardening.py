@@ -293,6 +293,9 @@ def test_write_errors_from_python_are_model_free_messages(tmp_path, monkeypatch)
                               "was written (the temporary file is removed, and 'x.txt' is as "
                               "it was)")
     assert target.read_text() == "old" and [f.name for f in tmp_path.iterdir()] == ["x.txt"]
+    # ... and still an OSError, for code that catches those
+    assert isinstance(err.value, OSError) and err.value.errno == errno.ENOSPC
+    assert err.value.filename == str(target)
 
 
 # == files that are not files ====================================================================
@@ -477,3 +480,27 @@ def test_a_singularity_between_samples_is_named_when_the_run_stops(tmp_path, cap
                         r"'push' \(force x on p\) = \"1/\(t-pi\)\" grows without bound near "
                         r"t = 3\.14159265 s \(\|value\| \S+, \S+ times its largest before\): "
                         r"change the expression, or simulate to before that time\n", err)
+
+
+# == characters YAML does not allow; numbers inside expressions ==============================
+
+@pytest.mark.parametrize(("text", "where", "what"), [
+    ("dimension: 2\nmodel: a\x00b\n", "2:9", "the character U+0000"),
+    ("dimension: 2\nmodel: \x1b[31mred\n", "2:8", "the character U+001B"),
+])
+def test_characters_yaml_does_not_allow(tmp_path, capsys, text, where, what):
+    code, err = check(tmp_path, capsys, text)
+    assert (code, err) == (2, f"mbody: error: m.yaml:{where}: {what} is not allowed in a YAML "
+                           "file (remove it; inside double quotes a control character may be "
+                           "written escaped, such as \\t)\n")
+
+
+@pytest.mark.parametrize(("expr", "at"), [("1e-320*t", 1), ("2*1e400", 3)])
+def test_numbers_in_expressions_keep_the_range(tmp_path, capsys, expr, at):
+    code, err = check(tmp_path, capsys, SINGULAR.replace("{expr}", expr))
+    number = expr.split("*")[at > 1] if "*" in expr else expr
+    marked = expr[:at - 1] + "|" + expr[at - 1:]
+    assert (code, err) == (2, f"mbody: error: m.yaml:3:52: loads[0].force[0]: invalid "
+                           f"expression: the number {number} is out of range at character "
+                           f"{at} (marked |): \"{marked}\" (0, or a magnitude from 1e-100 to "
+                           "1e+100, as everywhere in a model)\n")

@@ -6,7 +6,7 @@ import argparse
 import contextlib
 import sys
 
-from ..errors import MbodyError
+from ..errors import MbodyError, OutputError
 from . import EXIT_OK, load_model, parse_known
 
 
@@ -85,5 +85,7 @@ def _writing(target: str):
     """An operating-system error while writing `target` becomes one clear message."""
     try:
         yield
+    except OutputError:  # already one message naming the file
+        raise
     except OSError as exc:
         raise MbodyError(f"cannot write {target}: {exc.strerror or exc}") from None
