@@ -4,8 +4,11 @@ target's folder, flush it to disk, then rename it into place (atomic on POSIX)."
 from __future__ import annotations
 
 import contextlib
+import gc
 import os
+import sys
 import tempfile
+import traceback
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import IO
@@ -66,6 +69,7 @@ def atomic_path(target: str | os.PathLike[str], suffix: str = "") -> Iterator[Pa
         with contextlib.suppress(OSError):
             tmp_path.unlink(missing_ok=True)
         if isinstance(exc, OSError):  # a full disk, a quota, a file-size limit, I/O
+            _release(exc)
             raise OutputError(f"cannot write {str(target)!r}: {exc.strerror or exc}; "
                               "nothing was written (the temporary file is removed, and "
                               f"{target.name!r} is as it was)", exc, str(target)) from None
@@ -84,6 +88,26 @@ def write_atomic(target: str | os.PathLike[str], write: Callable[[IO], object] |
         else:
             fh.write(write)
     return Path(target)
+
+
+def _release(exc: BaseException) -> None:
+    """Free, quietly, what the failed writer's frames still hold: numpy < 2's savez keeps a
+    ZipFile on its file, whose __del__ (at exit, the file long closed) would print a
+    traceback after the clean message."""
+    hook = sys.unraisablehook
+    sys.unraisablehook = lambda unraisable: None
+    try:
+        seen: set[int] = set()
+        chain: list[BaseException | None] = [exc]
+        while chain:  # the error, and those raised while its writer was cleaning up
+            e = chain.pop()
+            if e is not None and id(e) not in seen:
+                seen.add(id(e))
+                traceback.clear_frames(e.__traceback__)
+                chain += [e.__context__, e.__cause__]
+        gc.collect()
+    finally:
+        sys.unraisablehook = hook
 
 
 def _umask() -> int:

@@ -36,8 +36,8 @@ VARIABLE = "t"
 MAX_LENGTH = 1000
 """Longest expression accepted (characters); deeper than this is not a load, it is a bug."""
 MAX_DEPTH = 100
-MAX_NUMBER, MIN_NUMBER = 1e100, 1e-100
-"""The range of a number written in an expression (the model file's range)."""
+MAX_NUMBER = 1e100
+"""Largest number written in an expression (the model file's limit)."""
 
 _TOKEN = re.compile(r"""
     (?P<ws>\s+)
@@ -197,11 +197,13 @@ class _Parser:
         kind, value, pos = self.take()
         if kind == "num":
             x = float(value)
-            if math.isinf(x) or x > MAX_NUMBER or (x < MIN_NUMBER and value.lower().partition(
-                    "e")[0].strip("0.") != ""):
+            if math.isinf(x) or x > MAX_NUMBER:
                 raise ExpressionError(self.text, pos, f"the number {value} is out of range",
-                                      f"0, or a magnitude from {MIN_NUMBER:g} to "
-                                      f"{MAX_NUMBER:g}, as everywhere in a model")
+                                      f"at most {MAX_NUMBER:g}, as everywhere in a model")
+            if x == 0 and value.lower().partition("e")[0].strip("0.") != "":
+                raise ExpressionError(self.text, pos, f"the number {value} is below the "
+                                      "smallest double", "it would be read as 0; write 0 if "
+                                      "that is meant")
             node: Node = ("num", x)
         elif kind == "name":
             if value == VARIABLE:

@@ -179,9 +179,11 @@ class _Checker:
         return True
 
     def number(self, path: Path_, value: Any, *, positive: bool = False,
-               nonneg: bool = False) -> float | None:
+               nonneg: bool = False, scale: bool = False) -> float | None:
+        """A finite number within ±`MAX_MAGNITUDE`; with `scale` (a mass or a size, which
+        is divided by) also 0 or at least `MIN_MAGNITUDE` in magnitude."""
         if isinstance(value, Unrepresentable):  # 1e400, 1e-400, a 5 000-digit integer
-            self._out_of_range(path, value.shown, value.large)
+            self._out_of_range(path, value.shown, value.large)  # never silently 0 or inf
             return None
         if isinstance(value, bool) or not isinstance(value, int | float):
             self.err(path, f"expected a number, got {_kind(value)}")
@@ -197,8 +199,8 @@ class _Checker:
         if abs(x) > MAX_MAGNITUDE:
             self._out_of_range(path, _show(value), True)
             return None
-        if 0 < abs(x) < MIN_MAGNITUDE:
-            self._out_of_range(path, _show(value), False)
+        if scale and 0 < abs(x) < MIN_MAGNITUDE:
+            self._too_small(path, _show(value))
             return None
         if positive and x <= 0:
             self.err(path, f"expected a number > 0, got {_show(value)}")
@@ -212,10 +214,13 @@ class _Checker:
         if large:
             self.err(path, f"expected a number of magnitude at most {MAX_MAGNITUDE:g}, got "
                      f"{shown}", "products of such numbers (r x F, m r^2) would overflow")
-        else:
-            self.err(path, f"expected 0 or a number of magnitude at least {MIN_MAGNITUDE:g}, "
-                     f"got {shown}", "1/m, the inverse inertia and products of such numbers "
-                     "would leave double precision")
+        else:  # written in the file: not even a double holds it
+            self.err(path, f"expected a number a double can hold, got {shown}",
+                     "below about 5e-324 it would be read as 0; write 0 if that is meant")
+
+    def _too_small(self, path: Path_, shown: str) -> None:
+        self.err(path, f"expected a magnitude of at least {MIN_MAGNITUDE:g}, got {shown}",
+                 "masses and sizes are divided by; a smaller one would leave double precision")
 
     def angle(self, path: Path_, value: Any, rate: bool = False) -> float | None:
         """An angle (rad, or a string with deg/rad), or with `rate` an angular rate."""
@@ -247,7 +252,7 @@ class _Checker:
         return x
 
     def vector(self, path: Path_, value: Any, n: int, *, angles: bool = False,
-               rates: bool = False) -> np.ndarray | None:
+               rates: bool = False, scale: bool = False) -> np.ndarray | None:
         if not isinstance(value, list):
             self.err(path, f"expected a list of {n} numbers, got {_kind(value)}")
             return None
@@ -259,7 +264,7 @@ class _Checker:
         out = []
         for i, v in enumerate(value):
             x = (self.angle((*path, i), v, rate=rates) if angles or rates
-                 else self.number((*path, i), v))
+                 else self.number((*path, i), v, scale=scale))
             if x is None:
                 return None
             out.append(x)
@@ -421,7 +426,8 @@ def _bodies(c: _Checker, value: Any) -> list[BodySpec]:
                   f"first used by bodies[{seen[name]}]")
         elif name is not None:
             seen[name] = i
-        mass = c.number((*p, "mass"), b.get("mass"), positive=True) if "mass" in b else None
+        mass = (c.number((*p, "mass"), b.get("mass"), positive=True, scale=True)
+                if "mass" in b else None)
         shape = _shape(c, (*p, "shape"), b["shape"]) if "shape" in b else None
         inertia = None
         if "inertia" in b:
@@ -435,6 +441,8 @@ def _bodies(c: _Checker, value: Any) -> list[BodySpec]:
                 I = shape_inertia(shape, mass, c.dim)
                 inertia = (np.diag([I[0] / 2, I[0] / 2, I[0]]) if c.dim == cv.PLANAR
                            else np.diag(I))
+        if inertia is not None:
+            inertia = _reciprocable(c, (*p, "inertia" if "inertia" in b else "shape"), inertia)
         zero = np.zeros(3)
         pos = c.vec3((*p, "position"), b["position"]) if "position" in b else zero
         vel = c.vec3((*p, "velocity"), b["velocity"]) if "velocity" in b else zero
@@ -512,6 +520,19 @@ def _inertia(c: _Checker, path: Path_, value: Any) -> np.ndarray | None:
     return J
 
 
+def _reciprocable(c: _Checker, path: Path_, J: np.ndarray) -> np.ndarray | None:
+    """`J` unless a principal moment is nonzero but below `MIN_MAGNITUDE` (5e-324, or a
+    tiny mass times a tiny shape): its inverse, used in every solve, would overflow."""
+    moments = [J[2, 2]] if c.dim == cv.PLANAR else np.linalg.eigvalsh(J)
+    tiny = [m for m in moments if 0 < abs(m) < MIN_MAGNITUDE]
+    if not tiny:
+        return J
+    c.err(path, f"a moment of inertia of {tiny[0]:.3g} kg m^2 is below "
+          f"{MIN_MAGNITUDE:g}", "its inverse would leave double precision; give a "
+          "realistic value")
+    return None
+
+
 def _fmt(v: np.ndarray) -> str:
     return "(" + ", ".join(f"{x:g}" for x in v) + ")"
 
@@ -576,7 +597,7 @@ def _shape(c: _Checker, path: Path_, value: Any) -> dict[str, Any] | None:
     p = (*path, kind)
     if kind == "box" or kind == "ellipsoid":
         n = c.dim
-        vec = c.vector(p, v, n)
+        vec = c.vector(p, v, n, scale=True)
         if vec is None:
             return None
         if np.any(vec <= 0):
@@ -588,7 +609,7 @@ def _shape(c: _Checker, path: Path_, value: Any) -> dict[str, Any] | None:
         return None
     out = {}
     for k in keys:
-        x = c.number((*p, k), v.get(k), positive=True) if k in v else None
+        x = c.number((*p, k), v.get(k), positive=True, scale=True) if k in v else None
         if x is None:
             return None
         out[k] = x

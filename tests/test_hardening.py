@@ -104,19 +104,33 @@ def test_long_integers_in_other_bases(tmp_path, capsys, prefix, digit, kind):
 # == finite but absurd numbers ===============================================================
 
 @pytest.mark.parametrize(("mass", "inertia", "message"), [
-    ("5e-324", "1", "m.yaml:4:11: bodies[0].mass: expected 0 or a number of magnitude at "
-     "least 1e-100, got 5e-324"),
-    ("1", "5e-324", "m.yaml:5:14: bodies[0].inertia: expected 0 or a number of magnitude at "
-     "least 1e-100, got 5e-324"),
-    ("1", "2.2e-308", "m.yaml:5:14: bodies[0].inertia: expected 0 or a number of magnitude "
-     "at least 1e-100, got 2.2e-308"),
-    ("1e-400", "1", "m.yaml:4:11: bodies[0].mass: expected 0 or a number of magnitude at "
-     "least 1e-100, got 1e-400"),
+    ("5e-324", "1", "m.yaml:4:11: bodies[0].mass: expected a magnitude of at least 1e-100, got "
+     "5e-324 (masses and sizes are divided by; a smaller one would leave double precision)"),
+    ("1", "5e-324", "m.yaml:5:14: bodies[0].inertia: a moment of inertia of 4.94e-324 kg m^2 is "
+     "below 1e-100 (its inverse would leave double precision; give a realistic value)"),
+    ("1", "2.2e-308", "m.yaml:5:14: bodies[0].inertia: a moment of inertia of 2.2e-308 kg m^2 "
+     "is below 1e-100 (its inverse would leave double precision; give a realistic value)"),
+    ("1e-400", "1", "m.yaml:4:11: bodies[0].mass: expected a number a double can hold, got "
+     "1e-400 (below about 5e-324 it would be read as 0; write 0 if that is meant)"),
 ])
 def test_denormal_and_underflowing_numbers(tmp_path, capsys, mass, inertia, message):
     code, err = check(tmp_path, capsys, PLANAR.format(mass=mass, inertia=inertia))
-    assert (code, err) == (2, f"mbody: error: {message} (1/m, the inverse inertia and "
-                           "products of such numbers would leave double precision)\n")
+    assert (code, err) == (2, f"mbody: error: {message}\n")
+
+
+def test_a_tiny_inertia_from_a_shape_is_refused_too(tmp_path, capsys):
+    text = "dimension: 3\nbodies:\n  - {name: a, mass: 1e-60, shape: {sphere: {radius: 1e-30}}}\n"
+    code, err = check(tmp_path, capsys, text)
+    assert (code, err) == (2, "mbody: error: m.yaml:3:35: bodies[0].shape: a moment of inertia "
+                           "of 4e-121 kg m^2 is below 1e-100 (its inverse would leave double "
+                           "precision; give a realistic value)\n")
+
+
+def test_tiny_values_that_are_never_divided_by_are_fine():
+    model = mbody.loads("dimension: 2\nbodies: [{name: a, mass: 1, inertia: 1, "
+                        "velocity: [1e-300, 5e-324], angular_velocity: 1e-200}]\n")
+    assert model.initial.velocity[0, 1] == 5e-324
+    assert mbody.assemble(model).solve().accelerations.tolist() == [0.0, 0.0, 0.0]
 
 
 def test_denormal_spatial_inertia_never_reaches_the_solver(tmp_path, capsys):
@@ -125,9 +139,9 @@ def test_denormal_spatial_inertia_never_reaches_the_solver(tmp_path, capsys):
                     "[0, 1, 0], [0, 0, 1]]}\n")
     code, _, err = run(capsys, "solve", path)
     assert code == 2
-    assert err == (f"mbody: error: {path}:3:35: bodies[0].inertia[0][0]: expected 0 or a "
-                   "number of magnitude at least 1e-100, got 5e-324 (1/m, the inverse inertia "
-                   "and products of such numbers would leave double precision)\n")
+    assert err == (f"mbody: error: {path}:3:33: bodies[0].inertia: a moment of inertia of "
+                   "4.94e-324 kg m^2 is below 1e-100 (its inverse would leave double precision; "
+                   "give a realistic value)\n")
 
 
 @pytest.mark.parametrize(("angle", "message"), [
@@ -161,7 +175,11 @@ def test_the_range_holds_for_dictionaries_too():
                                                 "inertia": 5e-324}]})
     assert [i.message for i in err.value.issues] == [
         "expected a number of magnitude at most 1e+100, got an integer of about 5001 digits",
-        "expected 0 or a number of magnitude at least 1e-100, got 5e-324"]
+        "a moment of inertia of 4.94e-324 kg m^2 is below 1e-100"]
+    with pytest.raises(mbody.ModelError) as err:
+        mbody.load({"dimension": 2, "bodies": [{"name": "a", "mass": 1, "inertia": 5e-324}]})
+    assert [i.message for i in err.value.issues] == [
+        "a moment of inertia of 4.94e-324 kg m^2 is below 1e-100"]
 
 
 # == YAML 1.1 forms: refused with both readings, or read as YAML 1.2 does ===================
@@ -495,12 +513,13 @@ def test_characters_yaml_does_not_allow(tmp_path, capsys, text, where, what):
                            "written escaped, such as \\t)\n")
 
 
-@pytest.mark.parametrize(("expr", "at"), [("1e-320*t", 1), ("2*1e400", 3)])
-def test_numbers_in_expressions_keep_the_range(tmp_path, capsys, expr, at):
+@pytest.mark.parametrize(("expr", "message"), [
+    ("1e-400*t", "the number 1e-400 is below the smallest double at character 1 (marked |): "
+     "\"|1e-400*t\" (it would be read as 0; write 0 if that is meant)"),
+    ("2*1e400", "the number 1e400 is out of range at character 3 (marked |): \"2*|1e400\" "
+     "(at most 1e+100, as everywhere in a model)"),
+])
+def test_numbers_in_expressions_keep_the_range(tmp_path, capsys, expr, message):
     code, err = check(tmp_path, capsys, SINGULAR.replace("{expr}", expr))
-    number = expr.split("*")[at > 1] if "*" in expr else expr
-    marked = expr[:at - 1] + "|" + expr[at - 1:]
     assert (code, err) == (2, f"mbody: error: m.yaml:3:52: loads[0].force[0]: invalid "
-                           f"expression: the number {number} is out of range at character "
-                           f"{at} (marked |): \"{marked}\" (0, or a magnitude from 1e-100 to "
-                           "1e+100, as everywhere in a model)\n")
+                           f"expression: {message}\n")
