@@ -186,7 +186,7 @@ class _Checker:
             self._out_of_range(path, value.shown, value.large)  # never silently 0 or inf
             return None
         if isinstance(value, bool) or not isinstance(value, int | float):
-            self.err(path, f"expected a number, got {_kind(value)}")
+            self.err(path, f"expected a number, got {_kind(value)}", _number_hint(value))
             return None
         try:
             x = float(value)
@@ -229,7 +229,7 @@ class _Checker:
             unit = "deg/s" if rate else "deg"
             if not m:
                 self.err(path, f"expected a number (radians{'/s' if rate else ''}) or a string "
-                         f"like '30 {unit}', got '{_show(value)}'")
+                         f"like '30 {unit}', got '{_show(value)}'", _angle_hint(value, unit))
                 return None
             try:
                 x = float(m.group(1))
@@ -339,6 +339,35 @@ def _kind(value: Any) -> str:
     return type(value).__name__
 
 
+_DECIMAL_COMMA = re.compile(r"\s*([-+]?\d+),(\d+)\s*")
+_WITH_UNIT = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*"
+                        r"([A-Za-zµ°][A-Za-z0-9µ°/^·²³ .-]*)")
+_ANGLE_WORDS = re.compile(r"\s*([-+]?[\d.eE+-]+)\s*(°|degrees?|degs|grad|radians?)(\s*/\s*s)?\s*",
+                          re.IGNORECASE)
+
+
+def _number_hint(value: Any) -> str:
+    """What was probably meant by text where a number goes: '1,5', '1.5 kg'."""
+    if not isinstance(value, str):
+        return ""
+    m = _DECIMAL_COMMA.fullmatch(value)
+    if m:
+        return f"a decimal comma? write {m.group(1)}.{m.group(2)}"
+    m = _WITH_UNIT.fullmatch(value)
+    if m and len(value) < 40:
+        return f"numbers are in SI units, written without the unit: {m.group(1)}"
+    return ""
+
+
+def _angle_hint(value: str, unit: str) -> str:
+    """'30°', '30 degrees' -> write '30 deg'."""
+    m = _ANGLE_WORDS.fullmatch(value)
+    if not m:
+        return _number_hint(value)
+    word = "rad" if m.group(2).lower().startswith("rad") else "deg"
+    return f"write '{m.group(1)} {word}{unit[3:]}'"
+
+
 def _quoted(value: Any) -> str:
     """`value` as repr() shows it, cut short (text is quoted, numbers are not)."""
     return repr(_show(value)) if isinstance(value, str) else _show(value)
@@ -391,8 +420,8 @@ def validate(doc: Document) -> Spec:
     reaction_expressions: dict[str, Expression] = {}
     reactions = _reactions(c, data.get("reactions"), joints, reaction_expressions)
 
-    if c.issues:
-        raise ModelError(c.issues)
+    if c.issues:  # in file order, as an editor goes through them
+        raise ModelError(sorted(c.issues, key=lambda i: i.line))
     return Spec(str(name), doc.file, c.dim, gravity, bodies, loads, joints, reactions,
                 description, c.warnings, reaction_expressions)
 

@@ -523,3 +523,25 @@ def test_numbers_in_expressions_keep_the_range(tmp_path, capsys, expr, message):
     code, err = check(tmp_path, capsys, SINGULAR.replace("{expr}", expr))
     assert (code, err) == (2, f"mbody: error: m.yaml:3:52: loads[0].force[0]: invalid "
                            f"expression: {message}\n")
+
+
+# == what a newcomer types where a number goes ===============================================
+
+@pytest.mark.parametrize(("line", "message"), [
+    ("    mass: 1,5\n", "m.yaml:6:11: bodies[0].mass: expected a number, got the text '1,5' "
+     "(a decimal comma? write 1.5)"),
+    ("    mass: 1.5 kg\n", "m.yaml:6:11: bodies[0].mass: expected a number, got the text "
+     "'1.5 kg' (numbers are in SI units, written without the unit: 1.5)"),
+    ("    angle: 30°\n", "m.yaml:6:12: bodies[0].angle: expected a number (radians) or a string "
+     "like '30 deg', got '30°' (write '30 deg')"),
+    ("    angle: 30 degrees\n", "m.yaml:6:12: bodies[0].angle: expected a number (radians) or "
+     "a string like '30 deg', got '30 degrees' (write '30 deg')"),
+    ("    angular_velocity: 90 degrees/s\n", "m.yaml:6:23: bodies[0].angular_velocity: "
+     "expected a number (radians/s) or a string like '30 deg/s', got '90 degrees/s' (write "
+     "'90 deg/s')"),
+])
+def test_units_and_decimal_commas_get_a_did_you_mean(tmp_path, capsys, line, message):
+    text = ("dimension: 2\nbodies:\n  - name: a\n    inertia: 1\n"
+            + ("    position: [0, 0]\n" if "mass" in line else "    mass: 1\n") + line)
+    code, err = check(tmp_path, capsys, text)
+    assert (code, err) == (2, f"mbody: error: {message}\n")
