@@ -57,6 +57,9 @@ MAX_ALIAS_NODES = 100_000
 """Most nodes that alias expansion may add before the file is refused."""
 MAX_DEPTH = 64
 """Deepest nesting of mappings and sequences accepted."""
+MAX_NODES = 1_000_000
+"""Most keys and values read from one file (each costs a few microseconds and a few
+hundred bytes with its line mark): over three times a 10 000-body model."""
 
 Path_ = tuple[str | int, ...]
 
@@ -480,11 +483,18 @@ class _Builder:
         stack = self.stack
         marks = self.doc.marks
         documents = 0
+        nodes = 0
         while True:
             ev = loader.get_event()
             t = type(ev)
             if t is ScalarEvent or t is MappingStartEvent or t is SequenceStartEvent \
                     or t is AliasEvent:
+                nodes += 1
+                if nodes > MAX_NODES:
+                    limit = f"{MAX_NODES:_}".replace("_", " ")
+                    self._fatal(ev.start_mark, (), f"the file holds more than {limit} values "
+                                "(keys, numbers, lists...), the most that is read (a "
+                                "10 000-body model holds about 300 000)")
                 if stack:
                     f = stack[-1]
                     if f.is_map and f.key is _NOKEY:

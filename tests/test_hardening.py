@@ -545,3 +545,14 @@ def test_units_and_decimal_commas_get_a_did_you_mean(tmp_path, capsys, line, mes
             + ("    position: [0, 0]\n" if "mass" in line else "    mass: 1\n") + line)
     code, err = check(tmp_path, capsys, text)
     assert (code, err) == (2, f"mbody: error: {message}\n")
+
+
+def test_a_file_of_millions_of_values_is_refused_early(tmp_path, capsys):
+    text = ("dimension: 2\nbodies: [{name: a, mass: 1, inertia: 1}]\ngravity: ["
+            + ", ".join(["0"] * 1_100_000) + "]\n")
+    t0 = time.perf_counter()
+    code, err = check(tmp_path, capsys, text)
+    assert time.perf_counter() - t0 < 10
+    assert code == 2 and err.startswith("mbody: error: m.yaml:3:")
+    assert err.endswith(": the file holds more than 1 000 000 values (keys, numbers, lists...), "
+                        "the most that is read (a 10 000-body model holds about 300 000)\n")
