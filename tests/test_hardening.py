@@ -556,3 +556,19 @@ def test_a_file_of_millions_of_values_is_refused_early(tmp_path, capsys):
     assert code == 2 and err.startswith("mbody: error: m.yaml:3:")
     assert err.endswith(": the file holds more than 1 000 000 values (keys, numbers, lists...), "
                         "the most that is read (a 10 000-body model holds about 300 000)\n")
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no named pipes")
+@pytest.mark.parametrize(("args", "what"), [
+    (["plot", "{fifo}", "-o", "{tmp}/x.png"], "a run file written by 'mbody simulate -o "
+     "RUN.npz'"),
+    (["animate", "{fifo}", "-o", "{tmp}/x.html"], "a model (.yaml) or a run file (.npz)"),
+    (["export", str(MODELS / "pendulum.yaml"), "--state", "{fifo}", "-o", "{tmp}/e.json"],
+     "a run file written by 'mbody simulate -o RUN.npz'"),
+])
+def test_run_files_that_are_pipes_are_refused_unopened(tmp_path, capsys, args, what):
+    fifo = tmp_path / "run.npz"
+    os.mkfifo(fifo)
+    code, _, err = run(capsys, *(a.format(fifo=fifo, tmp=tmp_path) for a in args))
+    assert (code, err) == (2, f"mbody: error: {fifo}: this is a named pipe, not a file; "
+                           f"expected {what}\n")

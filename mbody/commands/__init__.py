@@ -29,6 +29,22 @@ def load_model(path: str, *, warn: bool = True):
     return model
 
 
+def regular_file(path: str, what: str) -> None:
+    """Refuse, before anything opens it, a `path` that exists but is not a regular file: a
+    named pipe without a writer would block numpy's open() forever, a device never end."""
+    import os
+    import stat
+
+    try:
+        mode = os.stat(path).st_mode
+    except OSError:
+        return  # missing or unreadable: the reader says so
+    if not stat.S_ISREG(mode):
+        kind = ("a directory" if stat.S_ISDIR(mode) else "a named pipe" if stat.S_ISFIFO(mode)
+                else "a device" if stat.S_ISCHR(mode) or stat.S_ISBLK(mode) else "not a file")
+        raise MbodyError(f"{path}: this is {kind}, not a file; expected {what}")
+
+
 def parse_known(pairs: Sequence[str]) -> dict[str, float]:
     """``["A.Fx=3", ...]`` -> ``{"A.Fx": 3.0}`` (labels are checked later, with hints)."""
     out = {}

@@ -9,7 +9,7 @@ import time
 from pathlib import Path
 
 from ..errors import MbodyError
-from . import EXIT_OK
+from . import EXIT_OK, regular_file
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -59,6 +59,8 @@ def animate(a: argparse.Namespace) -> int:
         from ..atomic import ensure_writable
 
         ensure_writable(a.output)
+    if not a.source.lower().endswith((".yaml", ".yml")):  # a model may come through a pipe
+        regular_file(a.source, "a model (.yaml) or a run file (.npz)")
     traj, model = resolve(a.source, a.model, t_end=a.t_end, fps=a.fps)
     scene = build_scene(traj, model, forces=a.forces, bodies=a.body, reactions=a.reactions)
     what = (f"{len(scene.paths)} bod{'y' if len(scene.paths) == 1 else 'ies'}, "

@@ -7,7 +7,7 @@ import contextlib
 import sys
 
 from ..errors import MbodyError, OutputError
-from . import EXIT_OK, load_model, parse_known
+from . import EXIT_OK, load_model, parse_known, regular_file
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -44,6 +44,7 @@ def export(a: argparse.Namespace) -> int:
         raise MbodyError("--time needs --state RUN (a trajectory file)")
     model = load_model(a.model)
     if a.state:
+        regular_file(a.state, "a run file written by 'mbody simulate -o RUN.npz'")
         asm, source = assembly_from_trajectory(model, a.state, a.time)
     else:
         asm, source = assemble(model), ""

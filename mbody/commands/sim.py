@@ -7,7 +7,7 @@ import math
 import sys
 
 from ..errors import MbodyError
-from . import EXIT_OK, load_model, parse_known
+from . import EXIT_OK, load_model, parse_known, regular_file
 
 COMPILE_NOTICE = ("mbody: compiling the fast path once (about 20 s); later runs start at "
                   "once")
@@ -139,6 +139,7 @@ def plot(a: argparse.Namespace) -> int:
     from ..plot import save_plot
     from ..trajectory import Trajectory
 
+    regular_file(a.trajectory, "a run file written by 'mbody simulate -o RUN.npz'")
     traj = Trajectory.load(a.trajectory)
     save_plot(traj, a.output, a.body)
     print(f"wrote {a.output}")
