@@ -311,6 +311,11 @@ class Assembly:
 
             broken = tuple(joint_errors(model, state, self.columns, unknowns.mask,
                                         gtv=out[o_lam + m:o_lam + 2 * m]))
+        if info[C.ST_SINGULAR]:
+            from .kkt import singular_mass_error
+
+            code = int(info[C.ST_SINGULAR]) - 1
+            raise singular_mass_error(model, code // 6, code % 6)
         mu, rank = len(unknowns.U), int(info[C.ST_RANK])
         not_unique: tuple[str, ...] = ()
         if rank < mu:
@@ -319,7 +324,7 @@ class Assembly:
         return Solution(self.coordinates, out[:N],
                         ReactionValues(labels, model.reaction_index, lam),
                         unknowns.labels(labels), not_unique, float(info[C.ST_BERR]), None,
-                        COMPILED_METHOD if rank == mu else COMPILED_REDUNDANT, broken,
+                        COMPILED_NULL_SPACE if info[C.ST_PATH] else COMPILED_METHOD, broken,
                         mu - rank)
 
     def constrained(self, unknowns: Unknowns, *, rate: float = 0.0, refine: bool = True):
@@ -369,8 +374,8 @@ class Assembly:
 
 
 COMPILED_METHOD = "banded Cholesky of the Schur complement (compiled)"
-COMPILED_REDUNDANT = ("eigen-decomposition of the Schur complement, minimum-norm reactions "
-                      "(redundant constraints; compiled)")
+COMPILED_NULL_SPACE = ("null-space solve on the joints' geometry (SVD of the scaled G_U; "
+                       "compiled)")
 
 
 class _LazyBodies(Mapping):

@@ -34,12 +34,15 @@ BODY_W, MASS, J0, JINV0 = 19, 0, 1, 10
 SPRING_W, RA, RB, STIFF, REST, DAMP = 9, 0, 3, 6, 7, 8
 JOINT_W, BRC, BRP, CAX2, PE3, CE3 = 27, 0, 3, 6, 9, 18
 HEADER = 5
-RANK_RTOL = 1e-10  # as mbody.kkt.RANK_RTOL
 JOINT_TOL = 1e-6  # as mbody.constraints.JOINT_TOL
+# as mbody.nullspace: the robust solve's tolerances
+G_RANK_RTOL, PIVOT_RTOL, SINGULAR_RTOL, REFINE_STEPS = 1e-12, 1e-6, 1e-14, 2
+SPLIT = 134217729.0  # 2**27 + 1, Dekker's splitting constant
 
-# info[] slots written by `solve`
-ST_RANK, ST_BERR, ST_BROKEN, ST_MU = 0, 1, 2, 3
-INFO = 4
+# info[] slots written by `solve`; ST_PATH: 0 Cholesky of S, 1 null-space solve;
+# ST_SINGULAR: 0, or 1 + 6 body + row of a motion without mass or inertia
+ST_RANK, ST_BERR, ST_BROKEN, ST_MU, ST_PATH, ST_SINGULAR = 0, 1, 2, 3, 4, 5
+INFO = 6
 
 
 def pack_model(model) -> tuple[np.ndarray, np.ndarray]:
@@ -423,23 +426,22 @@ def _add_g(U, comps_i, joints_i, child6, parent6, lam, out, sign):
 @njit(cache=True)
 def _cholesky_band(Sb, bw):
     """In place: lower banded S (Sb[i, i − j] = S_ij) -> its Cholesky factor L.
-    Returns False when a pivot is not positive or the squared pivots span more than
-    1/RANK_RTOL (redundant constraints: the general path finds minimum-norm reactions)."""
+    Returns False when a squared pivot keeps no more than PIVOT_RTOL of its diagonal
+    entry (redundant constraints, a position near a singular one, extreme mass ratios:
+    the null-space solve takes over), as `mbody.kkt`."""
     mu = Sb.shape[0]
-    dmax, dmin = 0.0, np.inf
     for i in range(mu):
         for j in range(max(0, i - bw), i + 1):
             s = Sb[i, i - j]
             for k in range(max(0, i - bw), j):
                 s -= Sb[i, i - k] * Sb[j, j - k]
             if i == j:
-                if not s > 0.0:
+                if not s > PIVOT_RTOL * Sb[i, 0]:
                     return False
                 Sb[i, 0] = np.sqrt(s)
-                dmax, dmin = max(dmax, s), min(dmin, s)
             else:
                 Sb[i, i - j] = s / Sb[j, 0]
-    return mu == 0 or dmin > RANK_RTOL * dmax
+    return True
 
 
 @njit(cache=True)
@@ -483,13 +485,14 @@ def _schur(bodies, child6, parent6, U, inc_ptr, inc, S, banded):
 
 
 @njit(cache=True)
-def _constrained(bodies, joints_i, comps_i, Iu, child6, parent6, r6, gam, refine, acc, lamU,
-                 nonunique):
-    """Solve M v̇ − G_U λ = r6, G_Uᵀ v̇ = γ_U through S = G_Uᵀ M⁻¹ G_U: banded Cholesky,
-    or, when S is singular (redundant constraints), the minimum-norm λ with `nonunique`
-    (mu,) marking the components the redundancy leaves undetermined. One round of
-    iterative refinement when the backward error exceeds 1e-15 and `refine` (not for
-    redundant constraints). Returns (rank of S, backward error)."""
+def _constrained(bodies, joints_i, comps_i, Iu, child6, parent6, r6, gam, planar, refine,
+                 acc, lamU, nonunique):
+    """Solve M v̇ − G_U λ = r6, G_Uᵀ v̇ = γ_U through S = G_Uᵀ M⁻¹ G_U: banded Cholesky
+    (one round of iterative refinement when the backward error exceeds 1e-15 and
+    `refine`), or, when its pivots are not trusted, the null-space solve
+    (`_null_space`): minimum-norm λ with `nonunique` (mu,) marking the components that
+    redundant constraints leave undetermined. Returns (rank of G_U, backward error,
+    path: 0 Cholesky / 1 null space, singular-mass code)."""
     n = r6.shape[0]
     mu, bw, nnz = Iu[0], Iu[1], Iu[2]
     U = Iu[3:3 + mu]
@@ -499,40 +502,26 @@ def _constrained(bodies, joints_i, comps_i, Iu, child6, parent6, r6, gam, refine
         _minv(bodies, i, r6[i], acc[i])
     nonunique[:] = False
     if mu == 0:
-        return 0, 0.0
+        return 0, 0.0, 0, 0
     Sb = np.zeros((mu, bw + 1))
     _schur(bodies, child6, parent6, U, inc_ptr, inc, Sb, True)
     # λ = S⁻¹ (γ − G_Uᵀ M⁻¹ r), v̇ = M⁻¹ (r + G_U λ)
     _gt(U, comps_i, joints_i, child6, parent6, acc, lamU)
     for k in range(mu):
         lamU[k] = gam[k] - lamU[k]
-    rank = mu
+    rank, path, singular = mu, 0, 0
     if _cholesky_band(Sb, bw):
         _cho_solve_band(Sb, bw, lamU)
-    else:  # redundant constraints: minimum-norm λ through S's eigen-decomposition
-        S = np.zeros((mu, mu))
-        _schur(bodies, child6, parent6, U, inc_ptr, inc, S, False)
-        ev, V = np.linalg.eigh(S)
-        tol = RANK_RTOL * max(ev[mu - 1], 0.0)
-        proj = V.T @ lamU
-        rank = 0
-        for a in range(mu):
-            if ev[a] > tol:
-                proj[a] /= ev[a]
-                rank += 1
-            else:
-                proj[a] = 0.0
-        lamU[:] = V @ proj
-        for k in range(mu):  # a component is not unique where S's null space reaches it
-            s2 = 0.0
-            for a in range(mu):
-                if not ev[a] > tol:
-                    s2 += V[k, a] ** 2
-            nonunique[k] = np.sqrt(s2) > 1e-8
-    rhs = r6.copy()
-    _add_g(U, comps_i, joints_i, child6, parent6, lamU, rhs, 1.0)
-    for i in range(n):
-        _minv(bodies, i, rhs[i], acc[i])
+        rhs = r6.copy()
+        _add_g(U, comps_i, joints_i, child6, parent6, lamU, rhs, 1.0)
+        for i in range(n):
+            _minv(bodies, i, rhs[i], acc[i])
+    else:
+        path = 1
+        rank, singular = _null_space(bodies, joints_i, comps_i, U, child6, parent6, r6, gam,
+                                     planar, refine, acc, lamU, nonunique)
+        if singular:
+            return rank, 0.0, path, singular
     # backward error ‖r‖₂ / (‖K‖_F ‖x‖₂ + ‖f‖₂), ‖K‖_F² = ‖M‖_F² + 2 ‖G_U‖_F²
     nk = 0.0
     for i in range(n):
@@ -550,7 +539,7 @@ def _constrained(bodies, joints_i, comps_i, Iu, child6, parent6, r6, gam, refine
     r2 = np.empty(mu)
     berr = _residual(bodies, joints_i, comps_i, U, child6, parent6, r6, gam, acc, lamU,
                      normK, r1, r2)
-    if refine and rank == mu and berr > 1e-15:
+    if refine and path == 0 and berr > 1e-15:
         dacc = np.empty((n, 6))
         dlam = np.empty(mu)
         _solve_again(bodies, joints_i, comps_i, U, child6, parent6, Sb, bw, r1, r2, dacc,
@@ -562,7 +551,213 @@ def _constrained(bodies, joints_i, comps_i, Iu, child6, parent6, r6, gam, refine
             lamU[k] += dlam[k]
         berr = _residual(bodies, joints_i, comps_i, U, child6, parent6, r6, gam, acc, lamU,
                          normK, r1, r2)
-    return rank, berr
+    return rank, berr, path, 0
+
+
+@njit(cache=True, inline="always")
+def _dot_add(s, c, a, b):
+    """(s, c) += a b, compensated (TwoProduct by Dekker's split, TwoSum): Ogita, Rump
+    and Oishi's Dot2, for residuals as if computed in twice the working precision."""
+    p = a * b
+    f = SPLIT * a
+    ah = f - (f - a)
+    al = a - ah
+    f = SPLIT * b
+    bh = f - (f - b)
+    bl = b - bh
+    ep = al * bl - (((p - ah * bh) - al * bh) - ah * bl)
+    t = s + p
+    z = t - s
+    es = (s - (t - z)) + (p - z)
+    return t, c + ep + es
+
+
+@njit(cache=True)
+def _null_space(bodies, joints_i, comps_i, U, child6, parent6, r6, gam, planar, refine,
+                acc, lamU, nonunique):
+    """The robust solve on G_U's geometry, as `mbody.nullspace.NullSpaceSolve` (read its
+    docstring): Ĝ = T G_U C⁻¹, its SVD, the reduced mass
+    matrix of the allowed motions, REFINE_STEPS rounds of refinement with compensated
+    residuals (when `refine`), the minimum-norm λ and the not-unique flags. Writes acc
+    (n, 6) and lamU (mu,); returns (rank, singular-mass code or 0)."""
+    n, mu = r6.shape[0], U.shape[0]
+    per = np.array([0, 1, 5]) if planar else np.arange(6)
+    npr = per.shape[0]
+    nr = n * npr
+    # the length scale: the rms moment arm of the reaction forces
+    num, cnt = 0.0, 0
+    for k in range(mu):
+        i = U[k]
+        for side in range(2 if joints_i[comps_i[i, 0], 0] >= 0 else 1):
+            g = child6[i] if side == 0 else parent6[i]
+            f = g[0] ** 2 + g[1] ** 2 + g[2] ** 2
+            m = g[3] ** 2 + g[4] ** 2 + g[5] ** 2
+            if f > 0.0 and m > 0.0:
+                num += m / f
+                cnt += 1
+    inv_l = 1.0 / np.sqrt(num / cnt) if cnt else 1.0
+    T = np.empty(nr)
+    for b in range(n):
+        for a in range(npr):
+            T[b * npr + a] = 1.0 if per[a] < 3 else inv_l
+    A = np.zeros((nr, mu))
+    C = np.ones(mu)
+    for k in range(mu):
+        i = U[k]
+        j = comps_i[i, 0]
+        p, c = joints_i[j, 0], joints_i[j, 1]
+        for a in range(npr):
+            A[c * npr + a, k] += child6[i, per[a]] * T[c * npr + a]
+            if p >= 0:
+                A[p * npr + a, k] += parent6[i, per[a]] * T[p * npr + a]
+        s2 = 0.0
+        for r in range(nr):
+            s2 += A[r, k] ** 2
+        if s2 > 0.0:
+            C[k] = np.sqrt(s2)
+            for r in range(nr):
+                A[r, k] /= C[k]
+    Uf, sv, Vt = np.linalg.svd(A)
+    rank = 0
+    for a in range(sv.shape[0]):
+        if sv[a] > G_RANK_RTOL * sv[0]:
+            rank += 1
+    dof = nr - rank
+    U1 = np.ascontiguousarray(Uf[:, :rank])
+    U2 = np.ascontiguousarray(Uf[:, rank:])
+    V1 = np.ascontiguousarray(Vt[:rank].T)
+    s1 = sv[:rank]
+    # M̂ = T M T per body (npr × npr blocks)
+    Mb = np.zeros((n, npr, npr))
+    for b in range(n):
+        for a in range(npr):
+            for e in range(npr):
+                ra, re = per[a], per[e]
+                if ra < 3 and re < 3:
+                    Mb[b, a, e] = bodies[b, MASS] if ra == re else 0.0
+                elif ra >= 3 and re >= 3:
+                    Mb[b, a, e] = bodies[b, J0 + 3 * (ra - 3) + (re - 3)] * inv_l * inv_l
+    MU2 = np.zeros((nr, dof))
+    for b in range(n):
+        for a in range(npr):
+            for e in range(npr):
+                mbe = Mb[b, a, e]
+                if mbe != 0.0:
+                    for d in range(dof):
+                        MU2[b * npr + a, d] += mbe * U2[b * npr + e, d]
+    red = U2.T @ MU2
+    Lr = np.zeros((dof, dof))
+    for i in range(dof):  # Cholesky, pivots checked against their diagonal entries
+        for j in range(i + 1):
+            t = 0.5 * (red[i, j] + red[j, i])
+            for k in range(j):
+                t -= Lr[i, k] * Lr[j, k]
+            if i == j:
+                if not t > SINGULAR_RTOL * red[i, i]:
+                    w, V = np.linalg.eigh(0.5 * (red + red.T))
+                    motion = U2 @ np.ascontiguousarray(V[:, 0])
+                    kmax = 0
+                    for r in range(nr):
+                        if abs(motion[r]) > abs(motion[kmax]):
+                            kmax = r
+                    return rank, 1 + 6 * (kmax // npr) + per[kmax % npr]
+                Lr[i, i] = np.sqrt(t)
+            else:
+                Lr[i, j] = t / Lr[j, j]
+    rh = np.empty(nr)
+    for b in range(n):
+        for a in range(npr):
+            rh[b * npr + a] = r6[b, per[a]] * T[b * npr + a]
+    gh = np.empty(mu)
+    for k in range(mu):
+        gh[k] = gam[k] / C[k]
+    ah = np.empty(nr)
+    lamh = np.empty(mu)
+    _ns_inner(U1, U2, V1, s1, Mb, Lr, rh, gh, ah, lamh)
+    if refine:
+        r1 = np.empty(nr)
+        r2 = np.empty(mu)
+        da = np.empty(nr)
+        dl = np.empty(mu)
+        for _ in range(REFINE_STEPS):
+            for b in range(n):  # r̂ − M̂ â + Ĝ λ̂, compensated
+                for a in range(npr):
+                    row = b * npr + a
+                    sm, cm = rh[row], 0.0
+                    for e in range(npr):
+                        sm, cm = _dot_add(sm, cm, -Mb[b, a, e], ah[b * npr + e])
+                    for k in range(mu):
+                        if A[row, k] != 0.0:
+                            sm, cm = _dot_add(sm, cm, A[row, k], lamh[k])
+                    r1[row] = sm + cm
+            for k in range(mu):  # γ̂ − Ĝᵀ â
+                sm, cm = gh[k], 0.0
+                for row in range(nr):
+                    if A[row, k] != 0.0:
+                        sm, cm = _dot_add(sm, cm, -A[row, k], ah[row])
+                r2[k] = sm + cm
+            _ns_inner(U1, U2, V1, s1, Mb, Lr, r1, r2, da, dl)
+            for row in range(nr):
+                ah[row] += da[row]
+            for k in range(mu):
+                lamh[k] += dl[k]
+    for k in range(mu):
+        lamU[k] = lamh[k] / C[k]
+    if rank < mu:  # minimum-norm λ in the model's units; name what the null space touches
+        Nn = np.empty((mu, mu - rank))
+        for k in range(mu):
+            for a in range(mu - rank):
+                Nn[k, a] = Vt[rank + a, k] / C[k]
+        Q = np.ascontiguousarray(np.linalg.qr(Nn)[0])
+        proj = Q.T @ lamU
+        lamU -= Q @ proj
+        for k in range(mu):
+            s2 = 0.0
+            for a in range(Q.shape[1]):
+                s2 += Q[k, a] ** 2
+            nonunique[k] = np.sqrt(s2) > 1e-8
+    acc[:, :] = 0.0
+    for b in range(n):
+        for a in range(npr):
+            acc[b, per[a]] = ah[b * npr + a] * T[b * npr + a]
+    return rank, 0
+
+
+@njit(cache=True)
+def _ns_inner(U1, U2, V1, s1, Mb, Lr, rh, gh, ah, lamh):
+    """One solve of M̂ â − Ĝ λ̂ = r̂, Ĝᵀ â = γ̂ with the SVD in hand (`_null_space`)."""
+    n, npr = Mb.shape[0], Mb.shape[1]
+    rank, dof = s1.shape[0], U2.shape[1]
+    c = (V1.T @ gh) / s1
+    u1c = U1 @ c
+    t = rh.copy()
+    for b in range(n):
+        for a in range(npr):
+            for e in range(npr):
+                t[b * npr + a] -= Mb[b, a, e] * u1c[b * npr + e]
+    z = U2.T @ t
+    for i in range(dof):  # Lr Lrᵀ z = U₂ᵀ t
+        s = z[i]
+        for k in range(i):
+            s -= Lr[i, k] * z[k]
+        z[i] = s / Lr[i, i]
+    for i in range(dof - 1, -1, -1):
+        s = z[i]
+        for k in range(i + 1, dof):
+            s -= Lr[k, i] * z[k]
+        z[i] = s / Lr[i, i]
+    ah[:] = u1c + U2 @ z
+    t2 = np.empty(ah.shape[0])
+    for b in range(n):
+        for a in range(npr):
+            s = -rh[b * npr + a]
+            for e in range(npr):
+                s += Mb[b, a, e] * ah[b * npr + e]
+            t2[b * npr + a] = s
+    if rank:
+        lamh[:] = V1 @ ((U1.T @ t2) / s1)
+    else:
+        lamh[:] = 0.0
 
 
 @njit(cache=True)
@@ -619,7 +814,7 @@ def _state(y, n):
 
 
 @njit(cache=True)
-def _evaluate(F, I, Iu, x, q, v, w, fvec, lam, rate, refine):
+def _evaluate(F, I, Iu, x, q, v, w, fvec, lam, rate, refine, planar):
     """The shared body of `solve` and `derivative` (see there)."""
     gravity, bodies, B_r, springs, joints, loads_i, springs_i, joints_i, comps_i = _unpack(F, I)
     n, m = x.shape[0], comps_i.shape[0]
@@ -649,9 +844,9 @@ def _evaluate(F, I, Iu, x, q, v, w, fvec, lam, rate, refine):
     acc = np.empty((n, 6))
     lamU = np.empty(mu)
     nonunique = np.empty(mu, dtype=np.bool_)
-    rank, berr = _constrained(bodies, joints_i, comps_i, Iu, child6, parent6, r6, gam,
-                              refine, acc, lamU, nonunique)
-    return acc, lamU, phi, gtv, rank, berr, nonunique
+    rank, berr, path, singular = _constrained(bodies, joints_i, comps_i, Iu, child6, parent6,
+                                              r6, gam, planar, refine, acc, lamU, nonunique)
+    return acc, lamU, phi, gtv, rank, berr, nonunique, path, singular
 
 
 def solve_layout(n: int, m: int, planar: bool) -> tuple[int, int, int]:
@@ -676,8 +871,8 @@ def solve(F, I, Iu, y, fvec, lam, planar, out):
     n = I[0]
     m = I[4]
     x, q, v, w = _state(y, n)
-    acc, lamU, phi, gtv, rank, berr, nonunique = _evaluate(F, I, Iu, x, q, v, w, fvec, lam,
-                                                           0.0, True)
+    acc, lamU, phi, gtv, rank, berr, nonunique, path, singular = _evaluate(
+        F, I, Iu, x, q, v, w, fvec, lam, 0.0, True, planar)
     mu = Iu[0]
     N = (3 if planar else 6) * n
     for i in range(n):
@@ -722,17 +917,23 @@ def solve(F, I, Iu, y, fvec, lam, planar, out):
     out[o + ST_BERR] = berr
     out[o + ST_BROKEN] = broken
     out[o + ST_MU] = mu
+    out[o + ST_PATH] = path
+    out[o + ST_SINGULAR] = singular
 
 
 @njit(cache=True)
 def derivative(F, I, Iu, y, fvec, lam, rate, planar, out):
     """out = ẏ for the packed state y = [x (3n) | q (4n) | v (3n) | ω (3n) | θ (n, planar)]
     (see `mbody.simulate`), with the unknown reactions solved and Baumgarte's terms
-    (α = β = `rate`); redundant constraints get the minimum-norm reactions. Returns 0."""
+    (α = β = `rate`); redundant constraints get the minimum-norm reactions. Returns 0, or
+    the singular-mass code (info slot ST_SINGULAR of `solve`) when a motion the joints
+    allow carries no mass or inertia (then `out` is not written)."""
     n = I[0]
     x, q, v, w = _state(y, n)
-    acc, lamU, phi, gtv, rank, berr, nonunique = _evaluate(F, I, Iu, x, q, v, w, fvec, lam,
-                                                           rate, False)
+    acc, lamU, phi, gtv, rank, berr, nonunique, path, singular = _evaluate(
+        F, I, Iu, x, q, v, w, fvec, lam, rate, False, planar)
+    if singular:
+        return singular
     for i in range(n):
         for a in range(3):
             out[3 * i + a] = v[i, a]

@@ -121,8 +121,12 @@ class StateDerivative:
         if self._kernel is not None:
             out = np.empty(self.size)
             lam = self.unknowns.lam if self.known_at is None else self.known_at(t)
-            self._kernel(self._F, self._I, self._Iu, y, self.model.plan.load_values(t), lam,
-                         self.rate, self.planar, out)
+            code = self._kernel(self._F, self._I, self._Iu, y, self.model.plan.load_values(t),
+                                lam, self.rate, self.planar, out)
+            if code:
+                from .kkt import singular_mass_error
+
+                raise singular_mass_error(self.model, (code - 1) // 6, (code - 1) % 6)
             return out
         return self._numpy(t, y)
 

@@ -22,8 +22,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .errors import MbodyError
 from .joints import ReactionColumns
 from .model import Model
+from .nullspace import PIVOT_RTOL, NullSpaceSolve, length_scale
 from .plan import Unknowns
 from .spatial import matvec
 
@@ -47,7 +49,18 @@ EIGEN_LIMIT = 1200
 """Up to this many unknowns, a singular S (redundant constraints) is handled by an
 eigen-decomposition that names the components left undetermined; above, by LSQR."""
 RANK_RTOL = 1e-10
-"""Relative tolerance on S's eigenvalues (or pivots) below which a constraint is redundant."""
+"""Relative tolerance on S's eigenvalues below which a constraint is redundant (only for
+systems too large for the null-space solve, `ROBUST_MAX_ROWS`)."""
+ROBUST_MAX_ROWS = 1200
+"""Up to this many rows (6 per body), a Schur complement whose Cholesky pivots are not
+trusted (`mbody.nullspace.PIVOT_RTOL`) hands the system to the null-space solve
+(`mbody.nullspace`); above, to the eigen-decomposition or LSQR of S."""
+
+
+def _trusted(d: np.ndarray, diag: np.ndarray) -> bool:
+    """Every squared Cholesky pivot keeps `PIVOT_RTOL` of its diagonal entry of S (a ratio
+    that does not depend on the units of the columns)."""
+    return bool(np.all(d > PIVOT_RTOL * diag))
 
 
 def block_solve(model: Model, body: np.ndarray, g6: np.ndarray) -> np.ndarray:
@@ -117,8 +130,7 @@ def _banded(ab: np.ndarray, perm: np.ndarray | None, mu: int) -> Factorisation |
         cb = sla.cholesky_banded(ab, lower=False, check_finite=False)
     except np.linalg.LinAlgError:
         return None
-    d = cb[bw] ** 2
-    if not d.min() > RANK_RTOL * d.max():
+    if not _trusted(cb[bw] ** 2, ab[bw]):
         return None
 
     def solve(r, cb=cb, perm=perm):
@@ -171,6 +183,17 @@ class Factorisation:
         return float(spla.onenormest(S) * spla.onenormest(inv))
 
 
+def singular_mass_error(model, body: int, row: int) -> MbodyError:
+    """The error for a motion the joints allow that carries no mass or inertia."""
+    names = getattr(model, "body_names", None)
+    name = names[body] if names is not None else f"#{body}"
+    what = (f"translation along world {'xyz'[row]}" if row < 3
+            else f"rotation about its body {'xyz'[row - 3]} axis")
+    return MbodyError(f"the accelerations are not unique: body {name!r} has no mass or "
+                      f"inertia for the {what}, and no joint constrains that motion; give "
+                      "it mass or inertia there, or a joint that holds it")
+
+
 def _cholesky_solver(L: np.ndarray):
     """r -> S⁻¹ r for S = L Lᵀ (dense, small: two triangular solves with numpy)."""
     def solve(r: np.ndarray) -> np.ndarray:
@@ -198,6 +221,8 @@ class ConstrainedSystem:
         else:
             args = (model, t.parent[U], t.child[U], cols.child6[U], cols.parent6[U])
         self.blocks = None
+        self.robust: NullSpaceSolve | None = None
+        self._arms = args[1], args[3], args[4]  # parent, child6, parent6 of U
         if len(U) <= DENSE_LIMIT and model.n <= SMALL_BODIES:
             # Small mechanisms: dense arrays beat sparse-matrix bookkeeping by far.
             self.G, self.H = _g_and_minv_g_dense(*args)
@@ -271,8 +296,7 @@ class ConstrainedSystem:
             ab[bw + coo.row[up] - coo.col[up], coo.col[up]] = coo.data[up]
             try:
                 cb = sla.cholesky_banded(ab, lower=False, check_finite=False)
-                d = cb[bw] ** 2
-                if d.min() > RANK_RTOL * d.max():
+                if _trusted(cb[bw] ** 2, ab[bw]):
                     def solve(r, cb=cb, perm=perm):
                         if perm is None:
                             return sla.cho_solve_banded((cb, False), r, check_finite=False)
@@ -303,12 +327,13 @@ class ConstrainedSystem:
         A = 0.5 * (A + A.T)
         try:  # the usual case: independent constraints, S positive definite
             L = np.linalg.cholesky(A)
-            d = np.diag(L) ** 2
-            if d.min() > RANK_RTOL * d.max():
+            if _trusted(np.diag(L) ** 2, np.diag(A)):
                 return Factorisation("dense Cholesky of the Schur complement", len(A),
                                      rank=len(A), _S=A, _solve=_cholesky_solver(L))
         except np.linalg.LinAlgError:
             pass
+        if 6 * self.model.n <= ROBUST_MAX_ROWS:
+            return self._null_space(A)
         w, V = np.linalg.eigh(A)
         tol = RANK_RTOL * max(w[-1], 0.0)
         good = w > tol
@@ -325,9 +350,31 @@ class ConstrainedSystem:
                              "constraints)", len(w), redundant=not_unique, rank=rank,
                              _solve=lambda r: Vg @ ((Vg.T @ r) / wg), _S=A)
 
+    def _null_space(self, S: np.ndarray) -> Factorisation:
+        """Hand the system to the robust solve on G_U's geometry (`mbody.nullspace`)."""
+        from .nullspace import SingularMassError
+
+        model = self.model
+        if self.blocks is not None:
+            G = self.g_sparse().toarray()
+        else:
+            G = self.G.toarray() if _issparse(self.G) else np.asarray(self.G)
+        try:
+            self.robust = NullSpaceSolve(G, np.asarray(model.mass, float),
+                                         np.asarray(model.J, float),
+                                         length_scale(*self._arms[1:], self._arms[0]),
+                                         planar=getattr(model, "dimension", 3) == 2)
+        except SingularMassError as e:
+            raise singular_mass_error(model, e.body, e.row) from None
+        rs = self.robust
+        return Factorisation(rs.method, self.robust.mu, redundant=rs.redundant, rank=rs.rank,
+                             _S=S)
+
     # -- solving -------------------------------------------------------------------------
     def solve(self, r6: np.ndarray, gamma_U: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Solve M v̇ − G_U λ = r (n, 6 rows), G_Uᵀ v̇ = γ_U; returns (v̇ (n, 6), λ_U)."""
+        if self.robust is not None:
+            return self.robust.solve(r6, gamma_U, refine=False)
         model = self.model
         a0 = block_solve(model, np.arange(model.n), r6).ravel()
         lam = self.fact.solve(gamma_U - self.gt(a0))
@@ -375,7 +422,11 @@ class ConstrainedSystem:
 
     def solve_refined(self, r6: np.ndarray, gamma_U: np.ndarray, target: float = 1e-15):
         """`solve`, then one round of iterative refinement (same factorisation) when the
-        backward error is above `target`. Returns (v̇ (n, 6), λ_U, backward error)."""
+        backward error is above `target` (the null-space solve refines its own answer, with
+        residuals in extended precision). Returns (v̇ (n, 6), λ_U, backward error)."""
+        if self.robust is not None:
+            acc, lam = self.robust.solve(r6, gamma_U, refine=True)
+            return acc, lam, self.backward_error(r6, gamma_U, acc, lam)
         acc, lam = self.solve(r6, gamma_U)
         normK = self._norm_K()
         r1, r2 = self.residual(r6, gamma_U, acc, lam)
