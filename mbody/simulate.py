@@ -359,11 +359,12 @@ def _cost_cause(model: Model, steps_per_second: float, method: str) -> tuple[str
                 "a shorter --t-end (the cost grows with it), a looser --rtol (e.g. 1e-6), "
                 "a slower spin")
     moments = np.linalg.eigvalsh(np.asarray(model.J)) if model.n else np.ones((1, 3))
-    spread = moments[:, 2] / np.maximum(moments[:, 0], 1e-300)
+    smallest = np.min(np.where(moments > 0, moments, np.inf), axis=1)  # a zero is no scale
+    spread = np.where(np.isfinite(smallest), moments[:, 2] / smallest, 1.0)
     k = int(np.argmax(spread))
     if spread[k] > INERTIA_SPREAD:
         return (f"The body '{model.body_names[k]}' has principal moments of inertia from "
-                f"{moments[k, 0]:.3g} to {moments[k, 2]:.3g} kg m^2 (a ratio of "
+                f"{smallest[k]:.3g} to {moments[k, 2]:.3g} kg m^2 (a ratio of "
                 f"{spread[k]:.2g}): its Euler equation divides the rounding errors of the "
                 "large moments by the small one, and the steps shrink to follow that noise; "
                 "no integrator steps over it.",
