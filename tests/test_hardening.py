@@ -47,6 +47,7 @@ def cli(*args, **kw) -> subprocess.CompletedProcess:
     p = subprocess.run([sys.executable, "-m", "mbody", *map(str, args)], env=env,
                        stderr=subprocess.PIPE, text=True, timeout=120, **kw)
     assert "Traceback" not in p.stderr
+    p.stderr = p.stderr.replace(COMPILE_NOTICE + "\n", "")
     return p
 
 
