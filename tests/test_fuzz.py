@@ -25,6 +25,7 @@ def fuzz():
     module = importlib.util.module_from_spec(spec)
     sys.modules["mbody_fuzz"] = module
     spec.loader.exec_module(module)
+    module.warm_up()
     return module
 
 

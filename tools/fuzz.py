@@ -564,7 +564,22 @@ def verdict(outcomes: list[Outcome]) -> str:
 
 # -- the run: worker processes watched for hangs ---------------------------------------------
 
+def warm_up() -> None:
+    """Compile (or load from numba's cache) the kernels once, before anything is timed: the
+    first simulation of a process may take tens of seconds, which is no hang."""
+    import mbody
+
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+        for name in ("slider_crank", "torque_free_asymmetric", "planar_time_varying_force",
+                     "fourbar_spatial"):
+            with contextlib.suppress(Exception):
+                model = mbody.load(MODELS / f"{name}.yaml")
+                mbody.assemble(model).solve()
+                mbody.simulate(model, t_end=0.01, fps=100)
+
+
 def _worker(seed, indices, heavy_every, hang, results, workdir):
+    warm_up()
     bases = _bases()
     for i in indices:
         results.put(("start", i, os.getpid()))
