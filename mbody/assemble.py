@@ -341,15 +341,18 @@ class Assembly:
         r6 = self._Q6 - self._b6 + reaction_wrench(model, cols, lam)
         system = ConstrainedSystem(model, cols, unknowns)
         g = gamma(model, state, cols)
+        stab_U = None
         if rate:
-            g = (g - 2.0 * rate * constraint_velocity(model, cols, state)
-                 - rate * rate * phi(model, state, cols=cols))
+            stab = (-2.0 * rate * constraint_velocity(model, cols, state)
+                    - rate * rate * phi(model, state, cols=cols))
+            g = g + stab
+            stab_U = stab if unknowns.every else stab[unknowns.U]
         g_U = g if unknowns.every else g[unknowns.U]
         berr = None
         if refine:
             acc6, lam_U, berr = system.solve_refined(r6, g_U)
         else:
-            acc6, lam_U = system.solve(r6, g_U)
+            acc6, lam_U = system.solve(r6, g_U, stab_U)
         lam[unknowns.U] = lam_U
         return acc6, lam, system, berr
 

@@ -36,7 +36,7 @@ JOINT_W, BRC, BRP, CAX2, PE3, CE3 = 27, 0, 3, 6, 9, 18
 HEADER = 5
 JOINT_TOL = 1e-6  # as mbody.constraints.JOINT_TOL
 # as mbody.nullspace: the robust solve's tolerances
-G_RANK_RTOL, PIVOT_RTOL, SINGULAR_RTOL, REFINE_STEPS = 1e-12, 1e-6, 1e-14, 2
+G_RANK_RTOL, PIVOT_RTOL, SINGULAR_RTOL, STAB_RTOL, REFINE_STEPS = 1e-12, 1e-6, 1e-14, 1e-4, 2
 SPLIT = 134217729.0  # 2**27 + 1, Dekker's splitting constant
 
 # info[] slots written by `solve`; ST_PATH: 0 Cholesky of S, 1 null-space solve;
@@ -485,8 +485,8 @@ def _schur(bodies, child6, parent6, U, inc_ptr, inc, S, banded):
 
 
 @njit(cache=True)
-def _constrained(bodies, joints_i, comps_i, Iu, child6, parent6, r6, gam, planar, refine,
-                 acc, lamU, nonunique):
+def _constrained(bodies, joints_i, comps_i, Iu, child6, parent6, r6, gam, stab, planar,
+                 refine, acc, lamU, nonunique):
     """Solve M v̇ − G_U λ = r6, G_Uᵀ v̇ = γ_U through S = G_Uᵀ M⁻¹ G_U: banded Cholesky
     (one round of iterative refinement when the backward error exceeds 1e-15 and
     `refine`), or, when its pivots are not trusted, the null-space solve
@@ -519,7 +519,7 @@ def _constrained(bodies, joints_i, comps_i, Iu, child6, parent6, r6, gam, planar
     else:
         path = 1
         rank, singular = _null_space(bodies, joints_i, comps_i, U, child6, parent6, r6, gam,
-                                     planar, refine, acc, lamU, nonunique)
+                                     stab, planar, refine, acc, lamU, nonunique)
         if singular:
             return rank, 0.0, path, singular
     # backward error ‖r‖₂ / (‖K‖_F ‖x‖₂ + ‖f‖₂), ‖K‖_F² = ‖M‖_F² + 2 ‖G_U‖_F²
@@ -573,8 +573,8 @@ def _dot_add(s, c, a, b):
 
 
 @njit(cache=True)
-def _null_space(bodies, joints_i, comps_i, U, child6, parent6, r6, gam, planar, refine,
-                acc, lamU, nonunique):
+def _null_space(bodies, joints_i, comps_i, U, child6, parent6, r6, gam, stab, planar,
+                refine, acc, lamU, nonunique):
     """The robust solve on G_U's geometry, as `mbody.nullspace.NullSpaceSolve` (read its
     docstring): Ĝ = T G_U C⁻¹, its SVD, the reduced mass
     matrix of the allowed motions, REFINE_STEPS rounds of refinement with compensated
@@ -669,11 +669,14 @@ def _null_space(bodies, joints_i, comps_i, U, child6, parent6, r6, gam, planar, 
         for a in range(npr):
             rh[b * npr + a] = r6[b, per[a]] * T[b * npr + a]
     gh = np.empty(mu)
-    for k in range(mu):
-        gh[k] = gam[k] / C[k]
+    sh = np.empty(mu)
+    for k in range(mu):  # γ's physical part exactly, Baumgarte's part regularised
+        gh[k] = (gam[k] - stab[k]) / C[k]
+        sh[k] = stab[k] / C[k]
     ah = np.empty(nr)
     lamh = np.empty(mu)
-    _ns_inner(U1, U2, V1, s1, Mb, Lr, rh, gh, ah, lamh)
+    reg = STAB_RTOL * sv[0] if sv.shape[0] else 0.0
+    _ns_inner(U1, U2, V1, s1, Mb, Lr, rh, gh, sh, reg, ah, lamh)
     if refine:
         r1 = np.empty(nr)
         r2 = np.empty(mu)
@@ -696,7 +699,8 @@ def _null_space(bodies, joints_i, comps_i, U, child6, parent6, r6, gam, planar, 
                     if A[row, k] != 0.0:
                         sm, cm = _dot_add(sm, cm, -A[row, k], ah[row])
                 r2[k] = sm + cm
-            _ns_inner(U1, U2, V1, s1, Mb, Lr, r1, r2, da, dl)
+            sh[:] = 0.0
+            _ns_inner(U1, U2, V1, s1, Mb, Lr, r1, r2, sh, 0.0, da, dl)
             for row in range(nr):
                 ah[row] += da[row]
             for k in range(mu):
@@ -724,11 +728,12 @@ def _null_space(bodies, joints_i, comps_i, U, child6, parent6, r6, gam, planar, 
 
 
 @njit(cache=True)
-def _ns_inner(U1, U2, V1, s1, Mb, Lr, rh, gh, ah, lamh):
-    """One solve of M̂ â − Ĝ λ̂ = r̂, Ĝᵀ â = γ̂ with the SVD in hand (`_null_space`)."""
+def _ns_inner(U1, U2, V1, s1, Mb, Lr, rh, gh, sh, reg, ah, lamh):
+    """One solve of M̂ â − Ĝ λ̂ = r̂, Ĝᵀ â = γ̂ + ŝ with the SVD in hand (`_null_space`);
+    the stabilisation ŝ through σ / (σ² + reg²) instead of 1 / σ."""
     n, npr = Mb.shape[0], Mb.shape[1]
     rank, dof = s1.shape[0], U2.shape[1]
-    c = (V1.T @ gh) / s1
+    c = (V1.T @ gh) / s1 + (V1.T @ sh) * s1 / (s1 * s1 + reg * reg)
     u1c = U1 @ c
     t = rh.copy()
     for b in range(n):
@@ -838,14 +843,17 @@ def _evaluate(F, I, Iu, x, q, v, w, fvec, lam, rate, refine, planar):
                 for r in range(6):
                     r6[p, r] += parent6[i, r] * lam[i]
     gam = np.empty(mu)
+    stab = np.empty(mu)
     for k in range(mu):
         i = U[k]
-        gam[k] = gamma[i] - 2.0 * rate * gtv[i] - rate * rate * phi[i]
+        stab[k] = -2.0 * rate * gtv[i] - rate * rate * phi[i]
+        gam[k] = gamma[i] + stab[k]
     acc = np.empty((n, 6))
     lamU = np.empty(mu)
     nonunique = np.empty(mu, dtype=np.bool_)
     rank, berr, path, singular = _constrained(bodies, joints_i, comps_i, Iu, child6, parent6,
-                                              r6, gam, planar, refine, acc, lamU, nonunique)
+                                              r6, gam, stab, planar, refine, acc, lamU,
+                                              nonunique)
     return acc, lamU, phi, gtv, rank, berr, nonunique, path, singular
 
 

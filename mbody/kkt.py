@@ -371,10 +371,13 @@ class ConstrainedSystem:
                              _S=S)
 
     # -- solving -------------------------------------------------------------------------
-    def solve(self, r6: np.ndarray, gamma_U: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Solve M v̇ − G_U λ = r (n, 6 rows), G_Uᵀ v̇ = γ_U; returns (v̇ (n, 6), λ_U)."""
+    def solve(self, r6: np.ndarray, gamma_U: np.ndarray, stab: np.ndarray | None = None
+              ) -> tuple[np.ndarray, np.ndarray]:
+        """Solve M v̇ − G_U λ = r (n, 6 rows), G_Uᵀ v̇ = γ_U; returns (v̇ (n, 6), λ_U).
+        `stab`: the part of γ_U that is Baumgarte's stabilisation, which the null-space
+        solve damps near singular positions (`mbody.nullspace.STAB_RTOL`)."""
         if self.robust is not None:
-            return self.robust.solve(r6, gamma_U, refine=False)
+            return self.robust.solve(r6, gamma_U, refine=False, stab=stab)
         model = self.model
         a0 = block_solve(model, np.arange(model.n), r6).ravel()
         lam = self.fact.solve(gamma_U - self.gt(a0))

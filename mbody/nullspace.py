@@ -54,6 +54,11 @@ ones before it, in the kinetic metric); below, this module's solve is used."""
 SINGULAR_RTOL = 1e-14
 """A motion the joints allow whose Cholesky pivot in the reduced mass matrix keeps less
 than this fraction of its diagonal entry carries no mass or inertia (an error)."""
+STAB_RTOL = 1e-4
+"""Baumgarte's stabilisation terms (a numerical correction of drift, not physics) are
+solved through σ / (σ² + (STAB_RTOL σ_max)²) instead of 1 / σ: near a singular position
+they would otherwise be amplified by 1/σ, stiffen the equations and throw a simulation
+onto another branch of the mechanism."""
 REFINE_STEPS = 2
 
 
@@ -129,8 +134,13 @@ class NullSpaceSolve:
         xb = x.reshape(self.n, len(self.per), -1)
         return np.einsum("bij,bjk->bik", self.Mh_blocks, xb).reshape(shape)
 
-    def _inner(self, rh: np.ndarray, gh: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        c = (self.V1.T @ gh) / self.s1
+    def _inner(self, rh: np.ndarray, gh: np.ndarray, sh: np.ndarray | None = None
+               ) -> tuple[np.ndarray, np.ndarray]:
+        s1 = self.s1
+        c = (self.V1.T @ gh) / s1
+        if sh is not None:
+            reg = STAB_RTOL * s1[0] if len(s1) else 0.0
+            c = c + (self.V1.T @ sh) * s1 / (s1 * s1 + reg * reg)
         u1c = self.U1 @ c
         z = self.U2.T @ (rh - self._m(u1c))
         if len(z):
@@ -150,12 +160,17 @@ class NullSpaceSolve:
         r2 = gh.astype(ld) - A.T @ a
         return r1.astype(float), r2.astype(float)
 
-    def solve(self, r6: np.ndarray, gamma_U: np.ndarray, refine: bool = True
-              ) -> tuple[np.ndarray, np.ndarray]:
-        """(v̇ (n, 6), λ_U) for M v̇ − G_U λ_U = r6 (n, 6), G_Uᵀ v̇ = γ_U."""
+    def solve(self, r6: np.ndarray, gamma_U: np.ndarray, refine: bool = True,
+              stab: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """(v̇ (n, 6), λ_U) for M v̇ − G_U λ_U = r6 (n, 6), G_Uᵀ v̇ = γ_U, where `stab`
+        (mu,), when given, is the part of γ_U that is Baumgarte's stabilisation
+        (`STAB_RTOL`)."""
         rh = self.T * np.ravel(r6)[self.rows]
         gh = np.asarray(gamma_U, float) / self.C
-        ah, lamh = self._inner(rh, gh)
+        if stab is None:
+            ah, lamh = self._inner(rh, gh)
+        else:
+            ah, lamh = self._inner(rh, gh - stab / self.C, stab / self.C)
         for _ in range(REFINE_STEPS if refine else 0):
             r1, r2 = self._residual(rh, gh, ah, lamh)
             da, dl = self._inner(r1, r2)
