@@ -1,6 +1,6 @@
 """Structure-aware fuzzer of mbody's inputs: mutated shipped models through the command line.
 
-    python tools/fuzz.py [-n 10000] [--seed 0] [--jobs N] [--heavy-every 25] [--hang 60]
+    python tools/fuzz.py [-n 10000] [--seed 0] [--jobs N] [--heavy-every 5] [--hang 60]
 
 Each mutation (number i of the run, reproducible from --seed and i alone) takes one of the
 shipped models in models/, changes it one to three times in ways that know the model
@@ -544,7 +544,7 @@ def run_case(case: Case, workdir: Path, hang: float) -> list[Outcome]:
                      ["export", p, "-o", str(folder / rng.choice(["e.json", "e.npz",
                                                                   "e.mat"]))],
                      ["jacobian", p]]
-            if rng.random() < 0.3:
+            if rng.random() < 0.5:
                 heavy.append(["fbd", p, "-o", str(folder / "fbd"), "--format", "svg"])
             for command in heavy:
                 code, out, err, esc = run_command(command, hang)
@@ -589,7 +589,7 @@ def _worker(seed, indices, heavy_every, hang, results, workdir):
                                  (CRASH, HANG) else "", outcomes)))
 
 
-def run(n: int, seed: int = 0, jobs: int = 1, heavy_every: int = 25, hang: float = 60.0,
+def run(n: int, seed: int = 0, jobs: int = 1, heavy_every: int = 5, hang: float = 60.0,
         first: int = 0, log=print) -> dict:
     """Run mutations first .. first + n - 1; return the counts and the failures."""
     workdir = tempfile.mkdtemp(prefix="mbody-fuzz.")
@@ -698,9 +698,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
                     help="worker processes (default: one per CPU)")
-    ap.add_argument("--heavy-every", type=int, default=25, metavar="K",
+    ap.add_argument("--heavy-every", type=int, default=5, metavar="K",
                     help="simulate, export, jacobian (and sometimes fbd) every K-th mutation "
-                    "that check accepts (default 25; 0: never)")
+                    "that check accepts (default 5; 0: never)")
     ap.add_argument("--hang", type=float, default=60.0, metavar="SECONDS",
                     help="a mutation without an answer this long is a hang (default 60)")
     ap.add_argument("--only", type=int, metavar="I", help="run mutation I alone, and show it")
