@@ -206,8 +206,8 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
         while solver.status == "running":
             try:  # overflow in an implicit method's Jacobian estimate is handled below
                 with np.errstate(all="ignore"), warnings.catch_warnings():
-                    if method in IMPLICIT:  # scipy's LinAlgWarning on a singular iteration
-                        warnings.simplefilter("ignore", RuntimeWarning)
+                    if method in IMPLICIT:  # LinAlgWarning on a singular iteration,
+                        warnings.simplefilter("ignore")  # LSODA's convergence failures
                     msg = solver.step()
             except (ValueError, np.linalg.LinAlgError) as exc:
                 if method not in IMPLICIT:
