@@ -324,7 +324,7 @@ class Assembly:
         return Solution(self.coordinates, out[:N],
                         ReactionValues(labels, model.reaction_index, lam),
                         unknowns.labels(labels), not_unique, float(info[C.ST_BERR]), None,
-                        COMPILED_NULL_SPACE if info[C.ST_PATH] else COMPILED_METHOD, broken,
+                        COMPILED_METHODS[int(info[C.ST_PATH])], broken,
                         mu - rank)
 
     def constrained(self, unknowns: Unknowns, *, rate: float = 0.0, refine: bool = True):
@@ -379,6 +379,10 @@ class Assembly:
 COMPILED_METHOD = "banded Cholesky of the Schur complement (compiled)"
 COMPILED_NULL_SPACE = ("null-space solve on the joints' geometry (SVD of the scaled G_U; "
                        "compiled)")
+COMPILED_REDUNDANT = ("pivoted Cholesky of the Schur complement, minimum-norm reactions "
+                      "(redundant constraints; compiled)")
+COMPILED_METHODS = (COMPILED_METHOD, COMPILED_NULL_SPACE, COMPILED_REDUNDANT)
+"""The compiled solve's method by its path (info slot ST_PATH)."""
 
 
 class _LazyBodies(Mapping):

@@ -37,6 +37,9 @@ HEADER = 5
 JOINT_TOL = 1e-6  # as mbody.constraints.JOINT_TOL
 # as mbody.nullspace: the robust solve's tolerances
 G_RANK_RTOL, PIVOT_RTOL, SINGULAR_RTOL, STAB_RTOL, REFINE_STEPS = 1e-12, 1e-6, 1e-14, 1e-4, 2
+# exactly redundant columns: G_j − G_I x_j below this (relative, moment rows over the
+# length scale), and a consistent answer (backward error below REDUNDANT_BERR)
+DEPENDENT_RTOL, REDUNDANT_BERR = 1e-10, 1e-13
 SPLIT = 134217729.0  # 2**27 + 1, Dekker's splitting constant
 
 # info[] slots written by `solve`; ST_PATH: 0 Cholesky of S, 1 null-space solve;
@@ -492,7 +495,8 @@ def _constrained(bodies, joints_i, comps_i, Iu, child6, parent6, r6, gam, stab, 
     `refine`), or, when its pivots are not trusted, the null-space solve
     (`_null_space`): minimum-norm λ with `nonunique` (mu,) marking the components that
     redundant constraints leave undetermined. Returns (rank of G_U, backward error,
-    path: 0 Cholesky / 1 null space, singular-mass code)."""
+    path: 0 Cholesky / 1 null space / 2 pivoted Cholesky (redundant), singular-mass
+    code)."""
     n = r6.shape[0]
     mu, bw, nnz = Iu[0], Iu[1], Iu[2]
     U = Iu[3:3 + mu]
@@ -509,20 +513,7 @@ def _constrained(bodies, joints_i, comps_i, Iu, child6, parent6, r6, gam, stab, 
     _gt(U, comps_i, joints_i, child6, parent6, acc, lamU)
     for k in range(mu):
         lamU[k] = gam[k] - lamU[k]
-    rank, path, singular = mu, 0, 0
-    if _cholesky_band(Sb, bw):
-        _cho_solve_band(Sb, bw, lamU)
-        rhs = r6.copy()
-        _add_g(U, comps_i, joints_i, child6, parent6, lamU, rhs, 1.0)
-        for i in range(n):
-            _minv(bodies, i, rhs[i], acc[i])
-    else:
-        path = 1
-        rank, singular = _null_space(bodies, joints_i, comps_i, U, child6, parent6, r6, gam,
-                                     stab, planar, refine, acc, lamU, nonunique)
-        if singular:
-            return rank, 0.0, path, singular
-    # backward error ‖r‖₂ / (‖K‖_F ‖x‖₂ + ‖f‖₂), ‖K‖_F² = ‖M‖_F² + 2 ‖G_U‖_F²
+    # ‖K‖_F² = ‖M‖_F² + 2 ‖G_U‖_F², for the backward error
     nk = 0.0
     for i in range(n):
         nk += 3.0 * bodies[i, MASS] ** 2
@@ -535,6 +526,33 @@ def _constrained(bodies, joints_i, comps_i, Iu, child6, parent6, r6, gam, stab, 
             if joints_i[comps_i[i, 0], 0] >= 0:
                 nk += 2.0 * parent6[i, r] ** 2
     normK = np.sqrt(nk)
+    rank, path, singular = mu, 0, 0
+    if _cholesky_band(Sb, bw):
+        _cho_solve_band(Sb, bw, lamU)
+        rhs = r6.copy()
+        _add_g(U, comps_i, joints_i, child6, parent6, lamU, rhs, 1.0)
+        for i in range(n):
+            _minv(bodies, i, rhs[i], acc[i])
+    else:
+        # exactly redundant joints (the usual reason) are solved on S with pivoting;
+        # anything else, or an inconsistent answer, goes to the null-space solve
+        # (spatial models only: a planar one's robust solve keeps the in-plane rows, and
+        # the pivoted route would answer its out-of-plane rows too, differently)
+        path = 2
+        rank = -1 if planar else _redundant(bodies, joints_i, comps_i, U, inc_ptr, inc,
+                                            child6, parent6, r6, acc, lamU, nonunique)
+        if rank >= 0:
+            r1 = np.empty((n, 6))
+            r2 = np.empty(mu)
+            if _residual(bodies, joints_i, comps_i, U, child6, parent6, r6, gam, acc, lamU,
+                         normK, r1, r2) > REDUNDANT_BERR:
+                rank = -1
+        if rank < 0:
+            path = 1
+            rank, singular = _null_space(bodies, joints_i, comps_i, U, child6, parent6, r6,
+                                         gam, stab, planar, refine, acc, lamU, nonunique)
+            if singular:
+                return rank, 0.0, path, singular
     r1 = np.empty((n, 6))
     r2 = np.empty(mu)
     berr = _residual(bodies, joints_i, comps_i, U, child6, parent6, r6, gam, acc, lamU,
@@ -552,6 +570,133 @@ def _constrained(bodies, joints_i, comps_i, Iu, child6, parent6, r6, gam, stab, 
         berr = _residual(bodies, joints_i, comps_i, U, child6, parent6, r6, gam, acc, lamU,
                          normK, r1, r2)
     return rank, berr, path, 0
+
+
+@njit(cache=True)
+def _redundant(bodies, joints_i, comps_i, U, inc_ptr, inc, child6, parent6, r6, acc, lamU,
+               nonunique):
+    """Exactly redundant joints, fast: S = G_Uᵀ M⁻¹ G_U factorised with pivoting on the
+    pivot's share of its diagonal entry; the columns left with less than PIVOT_RTOL are
+    redundant if G_U's columns themselves (not only M⁻¹-weighted: extreme mass ratios
+    look alike) are combinations x_j of the kept ones. Then λ on the kept columns, the
+    minimum-norm λ through the null space [−X; I], and `nonunique`. lamU holds
+    γ − G_Uᵀ M⁻¹ r on entry, λ on return. Returns the rank, or −1 when the columns are
+    not exactly dependent (the null-space solve takes over)."""
+    n, mu = r6.shape[0], U.shape[0]
+    S = np.zeros((mu, mu))
+    _schur(bodies, child6, parent6, U, inc_ptr, inc, S, False)
+    diag = np.empty(mu)
+    for k in range(mu):
+        diag[k] = S[k, k]
+    perm = np.arange(mu)
+    r = 0
+    for k in range(mu):  # outer-product Cholesky, lower triangle, symmetric pivoting
+        jb, best = -1, PIVOT_RTOL
+        for j in range(k, mu):
+            if diag[perm[j]] > 0.0 and S[j, j] > best * diag[perm[j]]:
+                jb, best = j, S[j, j] / diag[perm[j]]
+        if jb < 0:
+            break
+        if jb != k:
+            for c in range(mu):
+                S[k, c], S[jb, c] = S[jb, c], S[k, c]
+            for c in range(mu):
+                S[c, k], S[c, jb] = S[c, jb], S[c, k]
+            perm[k], perm[jb] = perm[jb], perm[k]
+        d = np.sqrt(S[k, k])
+        S[k, k] = d
+        for i in range(k + 1, mu):
+            S[i, k] /= d
+        for i in range(k + 1, mu):
+            S[k, i] = S[i, k]
+        for j in range(k + 1, mu):  # the whole trailing block: pivoting swaps both halves
+            for i in range(k + 1, mu):
+                S[i, j] -= S[i, k] * S[j, k]
+        r += 1
+    if r == mu or r == 0:
+        return -1
+    nd = mu - r
+    # X (r × nd): L₁₁ᵀ X = L₂₁ᵀ, the kept columns' combinations for the dropped ones
+    X = np.empty((r, nd))
+    for a in range(nd):
+        for i in range(r):
+            X[i, a] = S[r + a, i]
+        for i in range(r - 1, -1, -1):
+            t = X[i, a]
+            for k in range(i + 1, r):
+                t -= S[k, i] * X[k, a]
+            X[i, a] = t / S[i, i]
+    # the length scale, as `_null_space`, for comparing moment rows with force rows
+    num, cnt = 0.0, 0
+    for k in range(mu):
+        i = U[k]
+        for side in range(2 if joints_i[comps_i[i, 0], 0] >= 0 else 1):
+            g = child6[i] if side == 0 else parent6[i]
+            f = g[0] ** 2 + g[1] ** 2 + g[2] ** 2
+            m = g[3] ** 2 + g[4] ** 2 + g[5] ** 2
+            if f > 0.0 and m > 0.0:
+                num += m / f
+                cnt += 1
+    inv_l = 1.0 / np.sqrt(num / cnt) if cnt else 1.0
+    res = np.empty((n, 6))
+    coef = np.zeros(mu)
+    for a in range(nd):  # G_j − G_I x_j = 0 for every dropped column j?
+        coef[:] = 0.0
+        coef[perm[r + a]] = 1.0
+        for i in range(r):
+            coef[perm[i]] = -X[i, a]
+        res[:, :] = 0.0
+        _add_g(U, comps_i, joints_i, child6, parent6, coef, res, 1.0)
+        big, small = 0.0, 0.0
+        for k in range(mu):
+            if coef[k] != 0.0:
+                i = U[k]
+                g2 = 0.0
+                for c in range(6):
+                    w = 1.0 if c < 3 else inv_l
+                    g2 += (child6[i, c] * w) ** 2
+                    if joints_i[comps_i[i, 0], 0] >= 0:
+                        g2 += (parent6[i, c] * w) ** 2
+                big += abs(coef[k]) * np.sqrt(g2)
+        for b in range(n):
+            for c in range(6):
+                small += (res[b, c] * (1.0 if c < 3 else inv_l)) ** 2
+        if not np.sqrt(small) <= DEPENDENT_RTOL * big:
+            return -1
+    # λ on the kept columns (the dropped ones 0), then the minimum-norm λ
+    rhs = np.empty(r)
+    for i in range(r):
+        rhs[i] = lamU[perm[i]]
+    for i in range(r):
+        t = rhs[i]
+        for k in range(i):
+            t -= S[i, k] * rhs[k]
+        rhs[i] = t / S[i, i]
+    for i in range(r - 1, -1, -1):
+        t = rhs[i]
+        for k in range(i + 1, r):
+            t -= S[k, i] * rhs[k]
+        rhs[i] = t / S[i, i]
+    lamU[:] = 0.0
+    for i in range(r):
+        lamU[perm[i]] = rhs[i]
+    Nn = np.zeros((mu, nd))
+    for a in range(nd):
+        Nn[perm[r + a], a] = 1.0
+        for i in range(r):
+            Nn[perm[i], a] = -X[i, a]
+    Q = np.ascontiguousarray(np.linalg.qr(Nn)[0])
+    lamU -= Q @ (Q.T @ lamU)
+    for k in range(mu):
+        s2 = 0.0
+        for a in range(nd):
+            s2 += Q[k, a] ** 2
+        nonunique[k] = np.sqrt(s2) > 1e-8
+    rhs6 = r6.copy()
+    _add_g(U, comps_i, joints_i, child6, parent6, lamU, rhs6, 1.0)
+    for i in range(n):
+        _minv(bodies, i, rhs6[i], acc[i])
+    return r
 
 
 @njit(cache=True, inline="always")
@@ -581,6 +726,7 @@ def _null_space(bodies, joints_i, comps_i, U, child6, parent6, r6, gam, stab, pl
     residuals (when `refine`), the minimum-norm λ and the not-unique flags. Writes acc
     (n, 6) and lamU (mu,); returns (rank, singular-mass code or 0)."""
     n, mu = r6.shape[0], U.shape[0]
+    nonunique[:] = False
     per = np.array([0, 1, 5]) if planar else np.arange(6)
     npr = per.shape[0]
     nr = n * npr
@@ -730,10 +876,11 @@ def _null_space(bodies, joints_i, comps_i, U, child6, parent6, r6, gam, stab, pl
 @njit(cache=True)
 def _ns_inner(U1, U2, V1, s1, Mb, Lr, rh, gh, sh, reg, ah, lamh):
     """One solve of M̂ â − Ĝ λ̂ = r̂, Ĝᵀ â = γ̂ + ŝ with the SVD in hand (`_null_space`);
-    the stabilisation ŝ through σ / (σ² + reg²) instead of 1 / σ."""
+    the stabilisation ŝ through σ³ / (σ⁴ + reg⁴) instead of 1 / σ."""
     n, npr = Mb.shape[0], Mb.shape[1]
     rank, dof = s1.shape[0], U2.shape[1]
-    c = (V1.T @ gh) / s1 + (V1.T @ sh) * s1 / (s1 * s1 + reg * reg)
+    s3 = s1 * s1 * s1
+    c = (V1.T @ gh) / s1 + (V1.T @ sh) * s3 / (s3 * s1 + reg ** 4)
     u1c = U1 @ c
     t = rh.copy()
     for b in range(n):
