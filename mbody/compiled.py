@@ -573,6 +573,23 @@ def _constrained(bodies, joints_i, comps_i, Iu, child6, parent6, r6, gam, stab, 
 
 
 @njit(cache=True)
+def _inv_length(U, comps_i, joints_i, child6, parent6):
+    """1 / the model's length scale: the rms moment arm |r × e| / |e| of the unknown
+    components' force columns, both sides (as `mbody.nullspace.length_scale`)."""
+    num, cnt = 0.0, 0
+    for k in range(U.shape[0]):
+        i = U[k]
+        for side in range(2 if joints_i[comps_i[i, 0], 0] >= 0 else 1):
+            g = child6[i] if side == 0 else parent6[i]
+            f = g[0] ** 2 + g[1] ** 2 + g[2] ** 2
+            m = g[3] ** 2 + g[4] ** 2 + g[5] ** 2
+            if f > 0.0 and m > 0.0:
+                num += m / f
+                cnt += 1
+    return 1.0 / np.sqrt(num / cnt) if cnt else 1.0
+
+
+@njit(cache=True)
 def _redundant(bodies, joints_i, comps_i, U, inc_ptr, inc, child6, parent6, r6, acc, lamU,
                nonunique):
     """Exactly redundant joints, fast: S = G_Uᵀ M⁻¹ G_U factorised with pivoting on the
@@ -626,18 +643,7 @@ def _redundant(bodies, joints_i, comps_i, U, inc_ptr, inc, child6, parent6, r6, 
             for k in range(i + 1, r):
                 t -= S[k, i] * X[k, a]
             X[i, a] = t / S[i, i]
-    # the length scale, as `_null_space`, for comparing moment rows with force rows
-    num, cnt = 0.0, 0
-    for k in range(mu):
-        i = U[k]
-        for side in range(2 if joints_i[comps_i[i, 0], 0] >= 0 else 1):
-            g = child6[i] if side == 0 else parent6[i]
-            f = g[0] ** 2 + g[1] ** 2 + g[2] ** 2
-            m = g[3] ** 2 + g[4] ** 2 + g[5] ** 2
-            if f > 0.0 and m > 0.0:
-                num += m / f
-                cnt += 1
-    inv_l = 1.0 / np.sqrt(num / cnt) if cnt else 1.0
+    inv_l = _inv_length(U, comps_i, joints_i, child6, parent6)
     res = np.empty((n, 6))
     coef = np.zeros(mu)
     for a in range(nd):  # G_j − G_I x_j = 0 for every dropped column j?
@@ -730,18 +736,7 @@ def _null_space(bodies, joints_i, comps_i, U, child6, parent6, r6, gam, stab, pl
     per = np.array([0, 1, 5]) if planar else np.arange(6)
     npr = per.shape[0]
     nr = n * npr
-    # the length scale: the rms moment arm of the reaction forces
-    num, cnt = 0.0, 0
-    for k in range(mu):
-        i = U[k]
-        for side in range(2 if joints_i[comps_i[i, 0], 0] >= 0 else 1):
-            g = child6[i] if side == 0 else parent6[i]
-            f = g[0] ** 2 + g[1] ** 2 + g[2] ** 2
-            m = g[3] ** 2 + g[4] ** 2 + g[5] ** 2
-            if f > 0.0 and m > 0.0:
-                num += m / f
-                cnt += 1
-    inv_l = 1.0 / np.sqrt(num / cnt) if cnt else 1.0
+    inv_l = _inv_length(U, comps_i, joints_i, child6, parent6)
     T = np.empty(nr)
     for b in range(n):
         for a in range(npr):
