@@ -573,6 +573,21 @@ def _constrained(bodies, joints_i, comps_i, Iu, child6, parent6, r6, gam, stab, 
 
 
 @njit(cache=True)
+def _cho_solve_dense(L, r, x):
+    """x (r,) <- (L Lᵀ)⁻¹ x with L the lower triangle of L[:r, :r]."""
+    for i in range(r):
+        t = x[i]
+        for k in range(i):
+            t -= L[i, k] * x[k]
+        x[i] = t / L[i, i]
+    for i in range(r - 1, -1, -1):
+        t = x[i]
+        for k in range(i + 1, r):
+            t -= L[k, i] * x[k]
+        x[i] = t / L[i, i]
+
+
+@njit(cache=True)
 def _inv_length(U, comps_i, joints_i, child6, parent6):
     """1 / the model's length scale: the rms moment arm |r × e| / |e| of the unknown
     components' force columns, both sides (as `mbody.nullspace.length_scale`)."""
@@ -673,16 +688,7 @@ def _redundant(bodies, joints_i, comps_i, U, inc_ptr, inc, child6, parent6, r6, 
     rhs = np.empty(r)
     for i in range(r):
         rhs[i] = lamU[perm[i]]
-    for i in range(r):
-        t = rhs[i]
-        for k in range(i):
-            t -= S[i, k] * rhs[k]
-        rhs[i] = t / S[i, i]
-    for i in range(r - 1, -1, -1):
-        t = rhs[i]
-        for k in range(i + 1, r):
-            t -= S[k, i] * rhs[k]
-        rhs[i] = t / S[i, i]
+    _cho_solve_dense(S, r, rhs)
     lamU[:] = 0.0
     for i in range(r):
         lamU[perm[i]] = rhs[i]
@@ -883,16 +889,7 @@ def _ns_inner(U1, U2, V1, s1, Mb, Lr, rh, gh, sh, reg, ah, lamh):
             for e in range(npr):
                 t[b * npr + a] -= Mb[b, a, e] * u1c[b * npr + e]
     z = U2.T @ t
-    for i in range(dof):  # Lr Lrᵀ z = U₂ᵀ t
-        s = z[i]
-        for k in range(i):
-            s -= Lr[i, k] * z[k]
-        z[i] = s / Lr[i, i]
-    for i in range(dof - 1, -1, -1):
-        s = z[i]
-        for k in range(i + 1, dof):
-            s -= Lr[k, i] * z[k]
-        z[i] = s / Lr[i, i]
+    _cho_solve_dense(Lr, dof, z)  # Lr Lrᵀ z = U₂ᵀ t
     ah[:] = u1c + U2 @ z
     t2 = np.empty(ah.shape[0])
     for b in range(n):
