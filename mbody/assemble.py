@@ -305,17 +305,17 @@ class Assembly:
         if not len(unknowns.U):
             return Solution(self.coordinates, out[:N], dict(zip(labels, lam.tolist(),
                                                                 strict=True)))
-        broken = ()
-        if info[2] > 0:  # rare: describe the broken joints with the numpy path
-            from .constraints import joint_errors
-
-            broken = tuple(joint_errors(model, state, self.columns, unknowns.mask,
-                                        gtv=out[o_lam + m:o_lam + 2 * m]))
         if info[C.ST_SINGULAR]:
             from .kkt import singular_mass_error
 
             code = int(info[C.ST_SINGULAR]) - 1
             raise singular_mass_error(model, code // 6, code % 6)
+        broken = ()
+        if info[C.ST_BROKEN] > 0:  # rare: describe the broken joints with the numpy path
+            from .constraints import joint_errors
+
+            broken = tuple(joint_errors(model, state, self.columns, unknowns.mask,
+                                        gtv=out[o_lam + m:o_lam + 2 * m]))
         mu, rank = len(unknowns.U), int(info[C.ST_RANK])
         not_unique: tuple[str, ...] = ()
         if rank < mu:

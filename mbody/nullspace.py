@@ -41,6 +41,8 @@ then gives the accelerations to about 1e-12). `mbody.compiled` has the same solv
 
 from __future__ import annotations
 
+from functools import cached_property
+
 import numpy as np
 
 RANK_RTOL = 1e-12
@@ -150,15 +152,19 @@ class NullSpaceSolve:
         lamh = self.V1 @ ((self.U1.T @ (self._m(ah) - rh)) / self.s1)
         return ah, lamh
 
+    @cached_property
+    def _extended(self) -> tuple[np.ndarray, np.ndarray]:
+        """Ĝ and M̂'s blocks in extended precision, for the refinement's residuals."""
+        ld = np.longdouble if _EXTENDED else np.float64
+        return self.A.astype(ld), self.Mh_blocks.astype(ld)
+
     def _residual(self, rh, gh, ah, lamh):
         """r̂ − M̂ â + Ĝ λ̂ and γ̂ − Ĝᵀ â, accumulated in extended precision."""
-        ld = np.longdouble if _EXTENDED else np.float64
-        A = self.A.astype(ld)
-        a = ah.astype(ld)
-        Ma = np.einsum("bij,bj->bi", self.Mh_blocks.astype(ld),
-                       a.reshape(self.n, len(self.per))).ravel()
-        r1 = rh.astype(ld) - Ma + A @ lamh.astype(ld)
-        r2 = gh.astype(ld) - A.T @ a
+        A, Mb = self._extended
+        a = ah.astype(A.dtype)
+        Ma = np.einsum("bij,bj->bi", Mb, a.reshape(self.n, len(self.per))).ravel()
+        r1 = rh.astype(A.dtype) - Ma + A @ lamh.astype(A.dtype)
+        r2 = gh.astype(A.dtype) - A.T @ a
         return r1.astype(float), r2.astype(float)
 
     def solve(self, r6: np.ndarray, gamma_U: np.ndarray, refine: bool = True,
