@@ -35,8 +35,14 @@ if TYPE_CHECKING:
 def _select(model: Model, a6: np.ndarray) -> np.ndarray:
     """(n, 6) per-body rows -> flat stacked vector in the model's coordinates."""
     if model.dimension == cv.SPATIAL:
-        return a6.reshape(-1)
-    return a6[:, cv.PLANAR_SELECT].reshape(-1)
+        return _strip(model, a6.reshape(-1))
+    return _strip(model, a6[:, cv.PLANAR_SELECT].reshape(-1))
+
+
+def _strip(model: Model, full: np.ndarray) -> np.ndarray:
+    """The solver's uniform rows (`all_coordinates`) -> the model's `coordinates` (a
+    particle's rotation rows, which carry nothing, dropped)."""
+    return full[model.rows] if model.has_particles else full
 
 
 def accelerations6(model: Model, rhs6: np.ndarray) -> np.ndarray:
@@ -64,7 +70,10 @@ def mass_matrix(model: Model) -> sp.spmatrix:
     else:
         blocks[:, [0, 1, 2], [0, 1, 2]] = model.mass[:, None]
         blocks[:, 3:, 3:] = model.J
-    return sp.bsr_matrix((blocks, np.arange(n), np.arange(n + 1)), shape=(n * k, n * k))
+    M = sp.bsr_matrix((blocks, np.arange(n), np.arange(n + 1)), shape=(n * k, n * k))
+    if model.has_particles:  # a particle's rows are its translations only
+        M = M.tocsr()[model.rows][:, model.rows]
+    return M
 
 
 class ReactionValues(Mapping):
@@ -223,7 +232,8 @@ class Assembly:
 
     @cached_property
     def G(self) -> sp.csc_matrix:
-        return g_matrix(self.model, self.columns)
+        G = g_matrix(self.model, self.columns)
+        return G[self.model.rows] if self.model.has_particles else G
 
     def jacobian(self) -> ConstraintJacobian:
         """The constraint Jacobian Gᵀ (m x N) with labelled rows and columns, plus γ and φ."""
@@ -303,7 +313,8 @@ class Assembly:
         labels = self.reactions
         lam = out[o_lam:o_lam + m]
         if not len(unknowns.U):
-            return Solution(self.coordinates, out[:N], dict(zip(labels, lam.tolist(),
+            return Solution(self.coordinates, _strip(model, out[:N]),
+                            dict(zip(labels, lam.tolist(),
                                                                 strict=True)))
         if info[C.ST_SINGULAR]:
             from .kkt import singular_mass_error
@@ -321,7 +332,7 @@ class Assembly:
         if rank < mu:
             flags = out[o_lam + 2 * m:o_info]
             not_unique = tuple(labels[i] for i in np.flatnonzero(flags))
-        return Solution(self.coordinates, out[:N],
+        return Solution(self.coordinates, _strip(model, out[:N]),
                         ReactionValues(labels, model.reaction_index, lam),
                         unknowns.labels(labels), not_unique, float(info[C.ST_BERR]), None,
                         COMPILED_METHODS[int(info[C.ST_PATH])], broken,

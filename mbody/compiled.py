@@ -17,9 +17,10 @@ Packing (`pack_model`): numba's dispatcher costs about 0.1 µs per argument, so 
 is passed as one float and one int array. `F` holds gravity (3), then per body
 [mass, J (9, row-major), J⁻¹ (9)], per point load `B_r` (3), per spring
 [r_a (3), r_b (3), stiffness, rest length, damping], per joint
-[B_r_child (3), B_r_parent (3), C_axis2 (3), P_E3 (9), C_E3 (9)]. `I` holds the sizes
-[n, loads, springs, joints, components], then per load [body, in_body, couple], per
-spring [a, b], per joint [parent, child], per component [joint, axis, rot_kind]
+[B_r_child (3), B_r_parent (3), C_axis2 (3), P_E3 (9), C_E3 (9), link length]. `I` holds
+the sizes [n, loads, springs, joints, components], then per load [body, in_body, couple],
+per spring [a, b], per joint [parent, child, flags (1 particle link, 2 particle parent)],
+per component [joint, axis, rot_kind]
 (see `mbody.model.ReactionTable`). The unknown components' structure for one set of
 unknowns is a third int array (`pack_unknowns`).
 """
@@ -32,7 +33,8 @@ from numba import njit
 # Column offsets of the packed per-item rows (see the module docstring).
 BODY_W, MASS, J0, JINV0 = 19, 0, 1, 10
 SPRING_W, RA, RB, STIFF, REST, DAMP = 9, 0, 3, 6, 7, 8
-JOINT_W, BRC, BRP, CAX2, PE3, CE3 = 27, 0, 3, 6, 9, 18
+JOINT_W, BRC, BRP, CAX2, PE3, CE3, LLEN = 28, 0, 3, 6, 9, 18, 27
+LINK_AXIS, J_LINK, J_PARTICLE_PARENT = -1, 1, 2  # as mbody.conventions; joint flags
 HEADER = 5
 JOINT_TOL = 1e-6  # as mbody.constraints.JOINT_TOL
 # as mbody.nullspace: the robust solve's tolerances
@@ -59,14 +61,16 @@ def pack_model(model) -> tuple[np.ndarray, np.ndarray]:
     springs = np.concatenate((sp.r_a, sp.r_b, sp.stiffness[:, None],
                               sp.rest_length[:, None], sp.damping[:, None]), axis=1)
     joints = np.concatenate((jt.B_r_child, jt.B_r_parent, jt.C_axis2,
-                             jt.P_E3.reshape(nj, 9), jt.C_E3.reshape(nj, 9)), axis=1)
+                             jt.P_E3.reshape(nj, 9), jt.C_E3.reshape(nj, 9),
+                             jt.length[:, None]), axis=1)
+    flags = J_LINK * jt.link.astype(np.int64) + J_PARTICLE_PARENT * jt.particle_parent
     F = np.concatenate((np.asarray(model.gravity, float), bodies.ravel(),
                         np.asarray(ft.B_r, float).ravel(), springs.ravel(), joints.ravel()))
     Ii = np.concatenate((
         [n, k, s, nj, m],
         np.stack((ft.body, ft.in_body, ft.couple), axis=1).ravel(),
         np.stack((sp.a, sp.b), axis=1).ravel(),
-        np.stack((jt.parent, jt.child), axis=1).ravel(),
+        np.stack((jt.parent, jt.child, flags), axis=1).ravel(),
         np.stack((rt.joint, rt.axis, rt.rot_kind), axis=1).ravel(),
     )).astype(np.int64)
     return np.ascontiguousarray(F), Ii
@@ -144,8 +148,8 @@ def _unpack(F, I):
     o += 3 * k
     springs_i = I[o:o + 2 * s].reshape(s, 2)
     o += 2 * s
-    joints_i = I[o:o + 2 * nj].reshape(nj, 2)
-    o += 2 * nj
+    joints_i = I[o:o + 3 * nj].reshape(nj, 3)
+    o += 3 * nj
     comps_i = I[o:o + 3 * m].reshape(m, 3)
     return F[0:3], bodies, B_r, springs, joints, loads_i, springs_i, joints_i, comps_i
 
@@ -358,6 +362,9 @@ def _columns(joints, joints_i, comps_i, x, R, v, w, child6, parent6, gamma, phi,
                         phi[i] = 0.5 * (A[0, 2] - A[2, 0])
                     else:
                         phi[i] = 0.5 * (A[1, 0] - A[0, 1])
+        elif axis == LINK_AXIS:  # a particle link's tension T (mbody.joints, constraints)
+            _link(row, p, c, x, R, v, w, d[j], wc[j], wp[j], child6[i], parent6[i], gamma, phi,
+                  i)
         else:
             child6[i, 0], child6[i, 1], child6[i, 2] = e0, e1, e2
             child6[i, 3], child6[i, 4], child6[i, 5] = _cross(
@@ -367,6 +374,8 @@ def _columns(joints, joints_i, comps_i, x, R, v, w, child6, parent6, gamma, phi,
             gamma[i] = -(e0 * T[j, 0] + e1 * T[j, 1] + e2 * T[j, 2])
             phi[i] = e0 * d[j, 0] + e1 * d[j, 1] + e2 * d[j, 2]
         parent6[i, 0], parent6[i, 1], parent6[i, 2] = -child6[i, 0], -child6[i, 1], -child6[i, 2]
+        if joints_i[j, 2] & J_PARTICLE_PARENT:  # forces act at the particle: no moment
+            parent6[i, 3] = parent6[i, 4] = parent6[i, 5] = 0.0
         s = 0.0
         for a in range(3):
             s += child6[i, a] * v[c, a] + child6[i, 3 + a] * w[c, a]
@@ -377,6 +386,52 @@ def _columns(joints, joints_i, comps_i, x, R, v, w, child6, parent6, gamma, phi,
             for a in range(6):
                 parent6[i, a] = 0.0
         gtv[i] = s
+
+
+@njit(cache=True)
+def _link(row, p, c, x, R, v, w, dj, wcj, wpj, child6, parent6, gamma, phi, i):
+    """A particle link's column, γ and φ: d = P_c − P_p, u = d / |d|, e = −u (on the
+    child), φ = L − |d|, γ = u · (ω_c×(ω_c×ρ_c) − ω_p×(ω_p×ρ_p)) + (|ḋ|² − (u·ḋ)²) / |d|."""
+    dist = np.sqrt(dj[0] ** 2 + dj[1] ** 2 + dj[2] ** 2)
+    u0, u1, u2 = dj[0] / dist, dj[1] / dist, dj[2] / dist
+    e0, e1, e2 = -u0, -u1, -u2
+    Rc = R[c]
+    Bc0 = Rc[0, 0] * e0 + Rc[1, 0] * e1 + Rc[2, 0] * e2
+    Bc1 = Rc[0, 1] * e0 + Rc[1, 1] * e1 + Rc[2, 1] * e2
+    Bc2 = Rc[0, 2] * e0 + Rc[1, 2] * e1 + Rc[2, 2] * e2
+    child6[0], child6[1], child6[2] = e0, e1, e2
+    child6[3], child6[4], child6[5] = _cross(row[BRC], row[BRC + 1], row[BRC + 2],
+                                             Bc0, Bc1, Bc2)
+    rc0 = Rc[0, 0] * row[BRC] + Rc[0, 1] * row[BRC + 1] + Rc[0, 2] * row[BRC + 2]
+    rc1 = Rc[1, 0] * row[BRC] + Rc[1, 1] * row[BRC + 1] + Rc[1, 2] * row[BRC + 2]
+    rc2 = Rc[2, 0] * row[BRC] + Rc[2, 1] * row[BRC + 1] + Rc[2, 2] * row[BRC + 2]
+    rp0, rp1, rp2 = row[BRP], row[BRP + 1], row[BRP + 2]
+    vp0 = vp1 = vp2 = 0.0
+    if p >= 0:
+        Rp = R[p]
+        Bp0 = Rp[0, 0] * e0 + Rp[1, 0] * e1 + Rp[2, 0] * e2
+        Bp1 = Rp[0, 1] * e0 + Rp[1, 1] * e1 + Rp[2, 1] * e2
+        Bp2 = Rp[0, 2] * e0 + Rp[1, 2] * e1 + Rp[2, 2] * e2
+        m0, m1, m2 = _cross(row[BRP], row[BRP + 1], row[BRP + 2], Bp0, Bp1, Bp2)
+        parent6[3], parent6[4], parent6[5] = -m0, -m1, -m2
+        rp0 = Rp[0, 0] * row[BRP] + Rp[0, 1] * row[BRP + 1] + Rp[0, 2] * row[BRP + 2]
+        rp1 = Rp[1, 0] * row[BRP] + Rp[1, 1] * row[BRP + 1] + Rp[1, 2] * row[BRP + 2]
+        rp2 = Rp[2, 0] * row[BRP] + Rp[2, 1] * row[BRP + 1] + Rp[2, 2] * row[BRP + 2]
+        vp0, vp1, vp2 = v[p, 0], v[p, 1], v[p, 2]
+    else:
+        parent6[3] = parent6[4] = parent6[5] = 0.0
+        rp0 = rp1 = rp2 = 0.0  # ground: P_p is a world point at rest, ω_p = 0
+    k0, k1, k2 = _cross(wcj[0], wcj[1], wcj[2], rc0, rc1, rc2)
+    f0, f1, f2 = _cross(wpj[0], wpj[1], wpj[2], rp0, rp1, rp2)
+    dd0 = v[c, 0] + k0 - vp0 - f0
+    dd1 = v[c, 1] + k1 - vp1 - f1
+    dd2 = v[c, 2] + k2 - vp2 - f2
+    a0, a1, a2 = _cross(wcj[0], wcj[1], wcj[2], k0, k1, k2)
+    b0, b1, b2 = _cross(wpj[0], wpj[1], wpj[2], f0, f1, f2)
+    ud = u0 * dd0 + u1 * dd1 + u2 * dd2
+    gamma[i] = (u0 * (a0 - b0) + u1 * (a1 - b1) + u2 * (a2 - b2)
+                + (dd0 * dd0 + dd1 * dd1 + dd2 * dd2 - ud * ud) / dist)
+    phi[i] = row[LLEN] - dist
 
 
 # -- the constrained solve ---------------------------------------------------------------------

@@ -53,6 +53,8 @@ def phi(model: Model, state: State, R: np.ndarray | None = None,
     d = cols.joint_W_P - (x_p + matvec(Rp, jt.B_r_parent))  # child's point − parent's
     j = t.joint
     out = np.einsum("ij,ij->i", cols.W_e, d[j])  # forces: e · (P_c − P_p)
+    if t.link.any():  # a particle link's T: L − |P_c − P_p| (W_e = −(P_c − P_p) / |…|)
+        out = out + t.length
     mom = t.rot_kind > 0
     if mom.any():
         jm = np.unique(j[mom])  # joints with moment components
@@ -106,6 +108,18 @@ def gamma(model: Model, state: State, cols: ReactionColumns,
     moment = (t.axis >= 3)[:, None]
     TU = np.where(moment, cross(w_c, w_p)[j], T[j]) if moment.any() else T[j]
     out = -np.einsum("ij,ij->i", cols.W_e, TU)
+    if t.link.any():  # particle links: γ = u · (ω_c×(ω_c×ρ_c) − ω_p×(ω_p×ρ_p)) + |ḋ⊥|² / |d|
+        li = np.flatnonzero(t.link)
+        jl = j[li]
+        rho_p = matvec(Rp[jl], jt.B_r_parent[jl])
+        u = -cols.W_e[li]
+        dd = V_c[jl] - v_p[jl] - cross(w_p[jl], rho_p)
+        acc = (cross(w_c[jl], cross(w_c[jl], rho[jl]))
+               - cross(w_p[jl], cross(w_p[jl], rho_p)))
+        dist = np.linalg.norm(P[jl] - x_p[jl] - rho_p, axis=1)
+        ud = np.einsum("ij,ij->i", u, dd)
+        out[li] = (np.einsum("ij,ij->i", u, acc)
+                   + (np.einsum("ij,ij->i", dd, dd) - ud * ud) / dist)
     uni = t.axis == 6
     if uni.any():
         ju = j[uni]

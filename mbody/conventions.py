@@ -47,6 +47,20 @@ JOINT_COMPONENTS: dict[int, dict[str, tuple[str, ...]]] = {
 }
 """Reaction components of each joint type: exactly the relative motions it prevents."""
 
+LINK = "T"
+"""The tension of a particle's link (positive pulls the particle toward the joint point)."""
+LINK_AXIS = -1
+"""`ReactionTable.axis` of a link's tension T (a force along the link, not a frame axis)."""
+
+PARTICLE_COMPONENTS: dict[int, dict[str, dict[str, tuple[str, ...]]]] = {
+    PLANAR: {"revolute": {"pin": ("Fx", "Fy"), "link": (LINK,)}},
+    SPATIAL: {"revolute": {"pin": ("Fx", "Fy", "Fz"), "link": (LINK, "Fz")},
+              "spherical": {"pin": ("Fx", "Fy", "Fz"), "link": (LINK,)}},
+}
+"""Reaction components of a joint with a particle at an end: a pin (joint point at the
+particle) holds its position, a link (joint point away from it) its distance (and, for a
+spatial revolute, its plane ⟂ the axis: Fz); no moments (a particle has no orientation)."""
+
 AXIS_REQUIRED = {
     PLANAR: {"prismatic"},
     SPATIAL: {"revolute", "prismatic", "cylindrical", "universal"},

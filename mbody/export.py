@@ -241,13 +241,20 @@ class _Columns:
 def _solver_view(exp: ExportedAssembly) -> tuple[_Bodies, _Columns, np.ndarray]:
     """(bodies, columns, rows): the export in the solver's per-body six-row form, from M
     and G as stored (so an edited matrix is honoured). rows (N,) places each stored row
-    among the 6 n rows (planar [x, y, θ] are rows 0, 1, 5 of a body)."""
+    among the 6 n rows (planar [x, y, θ] are rows 0, 1, 5 of a body), read from the
+    coordinate labels: a particle has translation rows only (its rotation rows get a
+    placeholder inertia, and nothing acts on them)."""
     n = len(exp.body_names)
-    keep = np.arange(6) if exp.dimension == cv.SPATIAL else cv.PLANAR_SELECT
-    k = len(keep)
-    rows = (np.arange(n)[:, None] * 6 + keep).ravel()
-    M = sp.csr_matrix(exp.M)
-    mass = M.diagonal()[0::k].copy()
+    index = {name: i for i, name in enumerate(exp.body_names)}
+    where = {**{r: k for k, r in enumerate(cv.SPATIAL_ROWS)}, "theta": 5}
+    rows = np.array([6 * index[lab.rsplit(".", 1)[0]] + where[lab.rsplit(".", 1)[1]]
+                     for lab in exp.coordinates], dtype=np.intp).reshape(-1)
+    N6 = 6 * n
+    P = sp.csr_matrix((np.ones(len(rows)), (rows, np.arange(len(rows)))),
+                      shape=(N6, len(rows)))
+    M = (P @ sp.csr_matrix(exp.M) @ P.T).tocsr()
+    diag = M.diagonal()
+    mass = diag[0::6].copy()
     J = np.zeros((n, 3, 3))
     if exp.dimension == cv.SPATIAL:
         base = np.arange(n) * 6 + 3
@@ -255,28 +262,31 @@ def _solver_view(exp: ExportedAssembly) -> tuple[_Bodies, _Columns, np.ndarray]:
             for j in range(3):
                 J[:, i, j] = np.asarray(M[base + i, base + j]).ravel()
     else:  # only I_G acts (planar rows); the other two axes are placeholders
-        J[:, 0, 0] = J[:, 1, 1] = J[:, 2, 2] = M.diagonal()[2::3]
+        J[:, 0, 0] = J[:, 1, 1] = J[:, 2, 2] = diag[5::6]
+    present = np.zeros(N6, dtype=bool)
+    present[rows] = True
+    particle = ~present.reshape(n, 6)[:, 5]
+    J[particle] = mass[particle, None, None] * np.eye(3)  # placeholder, never turned
     J_inv = np.linalg.inv(J) if n else J
     off = J - np.einsum("nii->ni", J)[:, :, None] * np.eye(3)
     minv6 = None
     if not np.any(off):
         minv6 = np.concatenate((np.repeat(1.0 / mass[:, None], 3, axis=1),
                                 1.0 / np.einsum("nii->ni", J)), axis=1)
-    index = {name: i for i, name in enumerate(exp.body_names)}
     child = np.array([index[str(c)] for c in exp.columns.child], dtype=np.intp)
     parent = np.array([index.get(str(p), -1) for p in exp.columns.parent], dtype=np.intp)
     m = len(child)
-    G = sp.csc_matrix(exp.G)
+    G = (P @ sp.csc_matrix(exp.G)).tocsc()
     child6, parent6 = np.zeros((m, 6)), np.zeros((m, 6))
     if m:
-        col = np.repeat(np.arange(m), k)
-        child6[:, keep] = np.asarray(G[(child[:, None] * k + np.arange(k)).ravel(), col]
-                                     ).reshape(m, k)
+        col = np.repeat(np.arange(m), 6)
+        child6[:] = np.asarray(G[(child[:, None] * 6 + np.arange(6)).ravel(), col]
+                               ).reshape(m, 6)
         on = parent >= 0
         if on.any():
-            colp = np.repeat(np.arange(m)[on], k)
-            parent6[np.ix_(on, keep)] = np.asarray(
-                G[(parent[on, None] * k + np.arange(k)).ravel(), colp]).reshape(-1, k)
+            colp = np.repeat(np.arange(m)[on], 6)
+            parent6[on] = np.asarray(
+                G[(parent[on, None] * 6 + np.arange(6)).ravel(), colp]).reshape(-1, 6)
     bodies = _Bodies(n, mass, J, J_inv, minv6, _Parents(child, parent))
     return bodies, _Columns(child6, parent6), rows
 

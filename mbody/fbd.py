@@ -173,6 +173,7 @@ def body_equations(asm: Assembly, i: int) -> BodyEquations:
 
     t = model.reaction_table
     cols = asm.columns
+    particle = bool(model.particle[i])
     known = model.known_reactions_at(asm.state.t)
     side: dict[str, float] = {}
     for c in np.flatnonzero((t.child == i) | (t.parent == i)):
@@ -181,19 +182,23 @@ def body_equations(asm: Assembly, i: int) -> BodyEquations:
         label = t.labels[c]
         value = known.get(label)
         moment = bool(cols.is_moment[c])
-        B_r = R.T @ (cols.W_P[c] - x)
+        W_P = x.copy() if particle else cols.W_P[c].copy()  # forces act at a particle
+        B_r = R.T @ (W_P - x)
         per_unit = sign * cols.W_e[c]
         scale = 1.0 if value is None else value
-        forces.append(ForceOnBody(label, REACTION, moment, B_r, cols.W_P[c].copy(),
+        forces.append(ForceOnBody(label, REACTION, moment, B_r, W_P,
                                   scale * per_unit, scale * six[3:], label, value))
         side[label] = sign
 
-    fbd = FreeBodyDiagram(name, model.dimension, float(model.mass[i]), model.J[i], x.copy(),
+    J = np.zeros((3, 3)) if particle else model.J[i]  # a particle: no rotational inertia
+    fbd = FreeBodyDiagram(name, model.dimension, float(model.mass[i]), J, x.copy(),
                           R.copy(), model.bodies[name].shape, tuple(forces))
 
     rpb = model.rows_per_body
     rows = cv.PLANAR_SELECT if model.dimension == cv.PLANAR else np.arange(6)
     suffixes = cv.PLANAR_ROWS if model.dimension == cv.PLANAR else cv.SPATIAL_ROWS
+    nn = 2 if model.dimension == cv.PLANAR else 3
+    shown = nn if particle else rpb  # a particle: Newton's rows only
     acc = [cv.ACCELERATION_NAMES[s] for s in suffixes]
     block = np.zeros((6, 6))
     block[:3, :3] = np.eye(3) * model.mass[i]
@@ -202,12 +207,12 @@ def body_equations(asm: Assembly, i: int) -> BodyEquations:
     # this body's rows of G, dense and without scipy.sparse (`mbody assemble` prints them)
     Gi = g_block(model, cols, np.array([i]), np.arange(len(asm.reactions)))
     eqs = []
-    for r in range(rpb):
-        lhs = {acc[k]: float(block[r, k]) for k in range(rpb) if block[r, k] != 0}
+    b6, Q6 = asm._b6[i], asm._Q6[i]
+    for r in range(shown):
+        lhs = {acc[k]: float(block[r, k]) for k in range(shown) if block[r, k] != 0}
         reac = {asm.reactions[c]: float(Gi[r, c]) for c in np.flatnonzero(Gi[r])}
-        eqs.append(Equation(f"{name}.{suffixes[r]}", lhs, float(asm.b[i * rpb + r]),
-                            float(asm.Q[i * rpb + r]), reac,
+        eqs.append(Equation(f"{name}.{suffixes[r]}", lhs, float(b6[rows[r]]),
+                            float(Q6[rows[r]]), reac,
                             {k: v for k, v in known.items() if k in reac}))
-    nn = 2 if model.dimension == cv.PLANAR else 3
     fbd = replace(fbd, equations=tuple(eqs))
     return BodyEquations(name, fbd, tuple(eqs[:nn]), tuple(eqs[nn:]))

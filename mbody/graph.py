@@ -98,12 +98,12 @@ def topology(model: Model, G=None, *, columns: ReactionColumns | None = None) ->
     floating = [b for b in model.body_names if b not in attached]
     grounded = sorted(next(c for c in components if cv.GROUND in c) - {cv.GROUND})
     m = len(model.reactions)
-    per_body = 3 if model.dimension == cv.PLANAR else 6
-    gruebler = per_body * model.n - m
+    coords = len(model.coordinates)  # a particle has translations only
+    gruebler = coords - m
     rank, redundant = (0, []) if m == 0 else (None, [])
     if m and (G is not None or columns is not None):
         rank, redundant = _rank(model, G, columns)
-    mobility = per_body * model.n - (rank if rank is not None else m)
+    mobility = coords - (rank if rank is not None else m)
     return Topology(parts, loops, floating, grounded, m, rank, mobility, gruebler, redundant)
 
 
@@ -130,7 +130,8 @@ def _rank(model: Model, G, columns: ReactionColumns | None) -> tuple[int | None,
 
             A = g_block(model, columns, idx, cols)
         else:
-            rows = (idx[:, None] * rpb + np.arange(rpb)).ravel()
+            rows = (np.concatenate([model.body_rows(i) for i in idx]) if model.has_particles
+                    else (idx[:, None] * rpb + np.arange(rpb)).ravel())
             A = (G[rows][:, cols].toarray() if hasattr(G, "toarray")
                  else np.asarray(G, dtype=float)[np.ix_(rows, cols)])
         if _clearly_full_column_rank(A):  # what the pivoted QR below would conclude

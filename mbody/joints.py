@@ -132,6 +132,19 @@ def reaction_columns(model: Model, state: State, R: np.ndarray | None = None) ->
         parent6[:, 3:] = cross(B_r_p[j], B_e_p)
     np.negative(child6[:, :3], out=parent6[:, :3])
     np.negative(parent6[:, 3:], out=parent6[:, 3:])
+    if t.link.any():  # particle links: T along the line from P_c to P_p
+        li = np.flatnonzero(t.link)
+        jl = j[li]
+        P_p = x_p[jl] + matvec(Rp[jl], jt.B_r_parent[jl])
+        d = P[jl] - P_p
+        e = -d / np.linalg.norm(d, axis=1, keepdims=True)
+        W_e[li] = e
+        child6[li, :3] = e
+        child6[li, 3:] = cross(jt.B_r_child[jl], rmatvec(Rc[jl], e))
+        parent6[li, :3] = -e
+        parent6[li, 3:] = -cross(jt.B_r_parent[jl], rmatvec(Rp[jl], e))
+    if t.particle_parent.any():  # a particle turns with nothing: forces act at it
+        parent6[t.particle_parent, 3:] = 0.0
     if const.ground.any():
         parent6[const.ground] = 0.0
     return ReactionColumns(W_e, P[j], child6, parent6, is_moment[:, 0], P, Rp, Rc)

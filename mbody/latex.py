@@ -125,7 +125,8 @@ def free_body_latex(eq: BodyEquations) -> str:
              if x.kind == REACTION and x.value is not None]
     unknown = [f"${reaction_symbol(x.label)}$" for x in f.forces if x.unknown]
     lines = [rf"Mass ${number(f.mass)}$~kg; "
-             + (rf"$I_G = {number(f.inertia[2, 2])}$~kg\,m$^2$." if f.dimension == cv.PLANAR
+             + ("a particle: no rotational inertia, Newton's rows only." if not eq.euler
+                else rf"$I_G = {number(f.inertia[2, 2])}$~kg\,m$^2$." if f.dimension == cv.PLANAR
                 else r"$J = " + _matrix(np.asarray(f.inertia), "pmatrix") + r"$~kg\,m$^2$ "
                 "(body axes).")]
     lines.append(r"Applied forces (known): " + (", ".join(applied) or "none") + ".")
@@ -145,9 +146,8 @@ def _column(items: Iterable[str]) -> str:
 
 
 def _acc_symbols(asm: Assembly) -> list[str]:
-    rows = cv.PLANAR_ROWS if asm.model.dimension == cv.PLANAR else cv.SPATIAL_ROWS
     return [f"{_ACC[cv.ACCELERATION_NAMES[r]]}^{{\\text{{{escape(b)}}}}}"
-            for b in asm.model.body_names for r in rows]
+            for b, r in (c.rsplit(".", 1) for c in asm.coordinates)]
 
 
 def stacked_latex(asm: Assembly, max_full: int = MAX_FULL) -> str:
@@ -178,8 +178,10 @@ def _block_form(asm: Assembly, max_full: int) -> str:
     parts = [r"M = \operatorname{diag}(" + ", ".join(
         rf"M_{{\text{{{escape(b)}}}}}" for b in shown)
         + (r", \dots" if len(names) > len(shown) else "") + ")"]
+    rows = [model.body_rows(i) if model.has_particles else np.arange(i * k, (i + 1) * k)
+            for i in range(len(shown))]
     parts += [rf"M_{{\text{{{escape(b)}}}}} = "
-              + _matrix(M[i * k:(i + 1) * k, i * k:(i + 1) * k].toarray())
+              + _matrix(M[rows[i]][:, rows[i]].toarray())
               for i, b in enumerate(shown)]
     # G: which body's rows each joint's columns touch (a block pattern, truncated).
     jt = model.reaction_table
@@ -233,7 +235,8 @@ def document(asm: Assembly, title: str | None = None, bodies: Iterable[str] | No
         r"\maketitle",
         r"\section*{Conventions}",
         (rf"{'Planar' if planar else 'Spatial'} model, {model.n} "
-         rf"bod{'y' if model.n == 1 else 'ies'}, rows per body: {escape(rows)}. "
+         rf"bod{'y' if model.n == 1 else 'ies'}, rows per body: {escape(rows)}"
+         + (" (a particle: its translations only)" if model.has_particles else "") + ". "
          r"Newton rows are $m\,a_G$ in world axes; Euler rows are "
          + (r"$I_G\,\alpha$ about the mass centre." if planar else
             r"$J\dot{\omega} + \omega\times(J\omega)$ about the mass centre in body axes.")

@@ -81,6 +81,8 @@ class Body:
     inertia: np.ndarray  # (3, 3) body axes about the mass centre, kg m^2 (planar: I_G at [2, 2])
     shape: dict[str, Any] | None
     color: str | None
+    particle: bool = False
+    """A point mass (`inertia: 0`): translation rows only; `inertia` holds a dummy."""
 
     @property
     def I_G(self) -> float:
@@ -119,6 +121,8 @@ class Joint:
     components: tuple[str, ...]
     axis: np.ndarray | None = None
     axis2: np.ndarray | None = None
+    particle_joint: str = ""
+    """With a particle at an end: "pin" or "link" (see docs "Particles"); else ""."""
 
     @property
     def labels(self) -> list[str]:
@@ -189,6 +193,10 @@ class ReactionTable:
     rot_kind: (m,) for moment components: 1 = about an axis ⟂ a free rotation (revolute,
     cylindrical: measured by the tilt of the joint z axis), 2 = all rotation locked
     (fixed, prismatic: small rotation vector), 3 = universal; 0 for forces.
+    link: (m,) True for a particle link's tension T (axis −1): the force along the line
+    from the child's attachment point to the parent's, constraint |P_c − P_p| = L.
+    particle_parent: (m,) True when the parent is a particle (its moment rows stay 0).
+    length: (m,) the link's length L (0 for other components).
     """
 
     labels: tuple[str, ...]
@@ -203,6 +211,9 @@ class ReactionTable:
     P_E3: np.ndarray
     C_E3: np.ndarray
     rot_kind: np.ndarray
+    link: np.ndarray
+    particle_parent: np.ndarray
+    length: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -213,6 +224,8 @@ class JointTable:
     point in each body's axes (world for ground); P_E3, C_E3: (J, 3, 3) the joint frame
     fixed in the parent and in the child; C_axis2: (J, 3) a universal joint's child axis.
     first: (J,) the joint's first column of G (its components are consecutive).
+    link: (J,) a particle link (its first component is T); particle_parent: (J,) the
+    parent is a particle; length: (J,) the link's length (0 otherwise).
     """
 
     parent: np.ndarray
@@ -223,6 +236,9 @@ class JointTable:
     C_E3: np.ndarray
     C_axis2: np.ndarray
     first: np.ndarray
+    link: np.ndarray
+    particle_parent: np.ndarray
+    length: np.ndarray
 
 
 @dataclass(frozen=True, eq=False)
@@ -272,8 +288,44 @@ class Model:
         return cv.rows_per_body(self.dimension)
 
     @cached_property
-    def coordinates(self) -> list[str]:
+    def particle(self) -> np.ndarray:
+        """(n,) True for the point masses (`inertia: 0`)."""
+        return np.array([self.bodies[b].particle for b in self.body_names], dtype=bool)
+
+    @cached_property
+    def has_particles(self) -> bool:
+        return bool(self.particle.any())
+
+    @cached_property
+    def all_coordinates(self) -> list[str]:
+        """The solver's uniform rows: `rows_per_body` per body, particles included."""
         return cv.coordinate_labels(list(self.body_names), self.dimension)
+
+    @cached_property
+    def rows(self) -> np.ndarray:
+        """Indices into `all_coordinates` of the rows shown (`coordinates`): a particle's
+        rotation rows are dropped (they carry nothing: its ω stays 0)."""
+        rpb = self.rows_per_body
+        keep = np.ones((self.n, rpb), dtype=bool)
+        keep[self.particle, cv.rows_per_body(self.dimension) - (1 if self.dimension
+                                                                   == cv.PLANAR else 3):] = False
+        return np.flatnonzero(keep.reshape(-1))
+
+    @cached_property
+    def coordinates(self) -> list[str]:
+        """Row labels of the stacked equations (a particle has translation rows only)."""
+        if not self.has_particles:
+            return self.all_coordinates
+        full = self.all_coordinates
+        return [full[i] for i in self.rows]
+
+    def body_rows(self, i: int) -> np.ndarray:
+        """Indices into `coordinates` of body i's rows."""
+        if not self.has_particles:
+            rpb = self.rows_per_body
+            return np.arange(i * rpb, (i + 1) * rpb)
+        rpb = self.rows_per_body
+        return np.flatnonzero((self.rows >= i * rpb) & (self.rows < (i + 1) * rpb))
 
     @cached_property
     def reactions(self) -> list[str]:
@@ -298,7 +350,8 @@ class Model:
         first = np.unique(t.joint, return_index=True)[1] if len(t.joint) else np.zeros(0, int)
         return JointTable(t.parent[first], t.child[first], t.B_r_child[first],
                           t.B_r_parent[first], t.P_E3[first], t.C_E3[first],
-                          t.C_axis2[first], first)
+                          t.C_axis2[first], first, t.link[first], t.particle_parent[first],
+                          t.length[first])
 
     @cached_property
     def reaction_index(self) -> dict[str, int]:
@@ -358,8 +411,9 @@ def _build(spec: Spec) -> Model:
         _ro(np.array([b.velocity for b in bs]).reshape(n, 3)),
         _ro(np.array([b.omega for b in bs]).reshape(n, 3)),
     )
-    bodies = {b.name: Body(b.name, i, b.mass, _ro(J[i]), b.shape, b.color)
+    bodies = {b.name: Body(b.name, i, b.mass, _ro(J[i]), b.shape, b.color, b.particle)
               for i, b in enumerate(bs)}
+    particle = {b.name for b in bs if b.particle}
 
     loads = tuple(Load(ld.name, ld.type, ld.bodies, ld.vector, ld.frame, ld.at,
                        ld.stiffness, ld.rest_length, ld.damping, dict(ld.expressions))
@@ -391,22 +445,39 @@ def _build(spec: Spec) -> Model:
     joints = []
     rows: dict[str, list] = {k: [] for k in ("labels", "joint", "parent", "child", "axis",
                                               "P_E", "B_r_child", "C_axis2", "B_r_parent",
-                                              "P_E3", "C_E3", "rot_kind")}
+                                              "P_E3", "C_E3", "rot_kind", "link",
+                                              "particle_parent", "length")}
     for jn, js in enumerate(spec.joints):
-        comps = cv.JOINT_COMPONENTS[spec.dimension][js.type]
+        kind = js.particle_joint
+        comps = (cv.PARTICLE_COMPONENTS[spec.dimension][js.type][kind] if kind
+                 else cv.JOINT_COMPONENTS[spec.dimension][js.type])
         W_E0 = (joint_frame_planar(js.axis) if spec.dimension == cv.PLANAR
                 else joint_frame_spatial(js.axis))
         joints.append(Joint(js.name, js.type, js.parent, js.child, _ro(js.at), _ro(W_E0),
-                            comps, js.axis, js.axis2))
+                            comps, js.axis, js.axis2, kind))
         p, c = idx.get(js.parent, -1), idx[js.child]
         P_E = W_E0 if p < 0 else R0[p].T @ W_E0  # joint frame fixed in the parent
         B_r_child = R0[c].T @ (js.at - initial.position[c])
         C_axis2 = R0[c].T @ js.axis2 if js.axis2 is not None else np.zeros(3)
         B_r_parent = js.at if p < 0 else R0[p].T @ (js.at - initial.position[p])
+        # a particle end is attached at the particle itself (no offset, no moment)
+        if js.child in particle:
+            B_r_child = np.zeros(3)
+        if js.parent in particle:
+            B_r_parent = np.zeros(3)
+        length = 0.0
+        if kind == "link":  # attachment points: the particle(s), else the joint point
+            P_c = initial.position[c] + R0[c] @ B_r_child
+            P_p = B_r_parent if p < 0 else initial.position[p] + R0[p] @ B_r_parent
+            length = float(np.linalg.norm(P_c - P_p))
         C_E = R0[c].T @ W_E0
         free_turn = js.type in ("revolute", "cylindrical")
         for comp in comps:
-            k = 6 if comp == "Mt" else cv.COMPONENTS.index(comp)
+            k = (6 if comp == "Mt" else cv.LINK_AXIS if comp == cv.LINK
+                 else cv.COMPONENTS.index(comp))
+            rows["link"].append(k == cv.LINK_AXIS)
+            rows["particle_parent"].append(js.parent in particle)
+            rows["length"].append(length if k == cv.LINK_AXIS else 0.0)
             rows["labels"].append(f"{js.name}.{comp}")
             rows["joint"].append(jn)
             rows["parent"].append(p)
@@ -433,6 +504,9 @@ def _build(spec: Spec) -> Model:
         _ro(np.array(rows["P_E3"]).reshape(-1, 3, 3)),
         _ro(np.array(rows["C_E3"]).reshape(-1, 3, 3)),
         np.array(rows["rot_kind"], dtype=np.intp),
+        np.array(rows["link"], dtype=bool),
+        np.array(rows["particle_parent"], dtype=bool),
+        _ro(np.array(rows["length"], dtype=float)),
     )
     return Model(spec.name, spec.file, spec.dimension, names, _ro(mass), _ro(J), _ro(J_inv),
                  _ro(spec.gravity), initial, bodies, loads, tuple(joints), forces, springs,

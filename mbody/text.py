@@ -57,7 +57,9 @@ def model_summary(model: Model, topo: Topology) -> str:
     shown = model.body_names[:50]
     for name in shown:
         b = model.bodies[name]
-        if dim == cv.PLANAR:
+        if b.particle:
+            inertia = "particle (no rotational inertia)"
+        elif dim == cv.PLANAR:
             inertia = f"I_G {_n(b.I_G)} kg m^2"
         else:
             J = b.inertia
@@ -118,11 +120,17 @@ def graph_summary(model: Model, topo: Topology) -> str:
     if topo.floating:
         lines.append(f"  attached to nothing ({len(topo.floating)}): "
                      + ", ".join(topo.floating[:12]) + (" ..." if len(topo.floating) > 12 else ""))
+    coords = f"{per} x {model.n} bodies"
+    if model.has_particles:
+        k = int(model.particle.sum())
+        coords = (f"{per} x {model.n - k} bodies + {model.dimension} x {k} particle"
+                  + ("s" if k > 1 else "") if k < model.n
+                  else f"{model.dimension} x {k} particle" + ("s" if k > 1 else ""))
     if topo.rank is None:
-        lines.append(f"mobility: {topo.mobility} = {per} x {model.n} bodies - "
+        lines.append(f"mobility: {topo.mobility} = {coords} - "
                      f"{topo.constraints} reaction components (Gruebler; rank not computed)")
     else:
-        lines.append(f"mobility: {topo.mobility} = {per} x {model.n} bodies - {topo.rank} "
+        lines.append(f"mobility: {topo.mobility} = {coords} - {topo.rank} "
                      f"independent constraints ({topo.constraints} reaction components)")
     if topo.redundant:
         lines.append(f"warning: {len(topo.redundant)} redundant constraint(s): "
@@ -157,6 +165,9 @@ def body_text(eq: BodyEquations, dimension: int) -> str:
         out.append("  (no forces)")
     out.append("Newton (world axes):")
     out += [f"  {e}" for e in eq.newton]
+    if not eq.euler:  # a particle: translation only
+        out.append("Euler: none (a particle has no rotation)")
+        return "\n".join(out)
     out.append("Euler (about the mass centre, " + ("z):" if dimension == 2 else "body axes):"))
     out += [f"  {e}" for e in eq.euler]
     return "\n".join(out)
@@ -167,7 +178,8 @@ def assembly_text(asm: Assembly, max_bodies: int = 200) -> str:
     parts = [f"model {model.name!r}: M v_dot + b = Q + G lambda; rows per body: "
              + ", ".join(cv.PLANAR_ROWS if model.dimension == 2 else cv.SPATIAL_ROWS)
              + ("" if model.dimension == 2 else
-                " (Newton in world axes, Euler in body axes)")]
+                " (Newton in world axes, Euler in body axes)")
+             + ("; a particle has translation rows only" if model.has_particles else "")]
     for name in model.body_names[:max_bodies]:
         parts.append(body_text(asm.bodies[name], model.dimension))
     if model.n > max_bodies:
@@ -183,13 +195,12 @@ def solution_text(sol: Solution, model: Model) -> str:
     units = {"x": "m/s^2", "y": "m/s^2", "z": "m/s^2", "theta": "rad/s^2"}
     lines = [f"accelerations of {model.name!r} (Newton rows world axes"
              + (", Euler rows body axes):" if model.dimension == 3 else "):")]
-    k = len(rows)
     acc = _clean(sol.accelerations)
     for i, name in enumerate(model.body_names):
-        vals = acc[i * k:(i + 1) * k]
+        idx = model.body_rows(i)
         lines.append(f"  {name:<14}" + "  ".join(
             f"{cv.ACCELERATION_NAMES[r]} = {_n(v)} {units.get(r, 'rad/s^2')}"
-            for r, v in zip(rows, vals, strict=True)))
+            for r, v in zip(rows[:len(idx)], acc[idx], strict=True)))
     return "\n".join(lines)
 
 

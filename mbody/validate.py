@@ -91,6 +91,8 @@ class BodySpec:
     shape: dict[str, Any] | None
     color: str | None
     line: int
+    particle: bool = False
+    """`inertia: 0`: a point mass (translation only; see docs "Particles")."""
 
 
 @dataclass
@@ -119,6 +121,9 @@ class JointSpec:
     axis: np.ndarray | None
     axis2: np.ndarray | None
     line: int = 0
+    particle_joint: str = ""
+    """With a particle at an end: "pin" (the joint point is at the particle(s)) or "link"
+    (a massless rigid link from the joint point to the particle); "" otherwise."""
 
 
 @dataclass
@@ -147,6 +152,8 @@ class _Checker:
         """Every body with a valid name, even one with other problems (for references)."""
         self.joint_types: dict[str, str] = {}
         """Every joint with a valid name and type, even one with other problems."""
+        self.particles: set[str] = set()
+        """Names of the bodies given `inertia: 0` (point masses)."""
 
     # -- reporting -------------------------------------------------------------------
     def err(self, path: Path_, message: str, hint: str = "", *, key: bool = False) -> None:
@@ -459,7 +466,10 @@ def _bodies(c: _Checker, value: Any) -> list[BodySpec]:
                 if "mass" in b else None)
         shape = _shape(c, (*p, "shape"), b["shape"]) if "shape" in b else None
         inertia = None
-        if "inertia" in b:
+        particle = "inertia" in b and _zero_inertia(b["inertia"])
+        if particle:  # a dummy inertia inside the solver; nothing turns it (docs: Particles)
+            inertia = np.eye(3) * (mass if mass is not None else 1.0)
+        elif "inertia" in b:
             inertia = _inertia(c, (*p, "inertia"), b["inertia"])
         elif "mass" in b:
             if shape is None:
@@ -470,7 +480,7 @@ def _bodies(c: _Checker, value: Any) -> list[BodySpec]:
                 I = shape_inertia(shape, mass, c.dim)
                 inertia = (np.diag([I[0] / 2, I[0] / 2, I[0]]) if c.dim == cv.PLANAR
                            else np.diag(I))
-        if inertia is not None:
+        if inertia is not None and not particle:
             inertia = _reciprocable(c, (*p, "inertia" if "inertia" in b else "shape"), inertia)
         zero = np.zeros(3)
         pos = c.vec3((*p, "position"), b["position"]) if "position" in b else zero
@@ -498,6 +508,8 @@ def _bodies(c: _Checker, value: Any) -> list[BodySpec]:
             if "angular_velocity" in b:
                 w3 = c.vector((*p, "angular_velocity"), b["angular_velocity"], 3, rates=True)
                 omega = w3 if w3 is not None else zero
+        if particle:
+            _particle_pose(c, p, b, q, omega)
         color = b.get("color")
         if color is not None and not isinstance(color, str):
             c.err((*p, "color"), f"expected a colour name or '#rrggbb', got {_kind(color)}")
@@ -505,8 +517,34 @@ def _bodies(c: _Checker, value: Any) -> list[BodySpec]:
         if _missing(name, mass, inertia, pos, vel):
             continue
         out.append(BodySpec(name, mass, inertia, pos, q, vel, omega, shape, color,
-                            c.doc.where(p)[0]))
+                            c.doc.where(p)[0], particle))
+        if particle:
+            c.particles.add(name)
     return out
+
+
+def _particle_pose(c: _Checker, p: Path_, b: dict, q: np.ndarray, omega: np.ndarray) -> None:
+    """A particle (inertia 0) has no orientation and no angular velocity."""
+    hint = "a particle (inertia: 0) has no orientation; remove the key, or give the body an inertia"
+    if np.any(q[1:] != 0.0):
+        key = "angle" if c.dim == cv.PLANAR else "orientation"
+        c.err((*p, key), f"a particle (inertia: 0) cannot have a nonzero {key}", hint)
+    if np.any(omega != 0.0):
+        c.err((*p, "angular_velocity"), "a particle (inertia: 0) cannot have a nonzero "
+              "angular_velocity", hint)
+
+
+def _zero_inertia(value: Any) -> bool:
+    """`inertia: 0` (planar or spatial), [0, 0, 0] or a 3x3 zero matrix: a particle."""
+    def zero(x: Any) -> bool:
+        return (not isinstance(x, bool) and isinstance(x, int | float)
+                and not isinstance(x, Unrepresentable) and x == 0)
+    if zero(value):
+        return True
+    if isinstance(value, list) and len(value) == 3:
+        return all(zero(x) for x in value) or all(
+            isinstance(r, list) and len(r) == 3 and all(zero(x) for x in r) for r in value)
+    return False
 
 
 def _inertia(c: _Checker, path: Path_, value: Any) -> np.ndarray | None:
@@ -692,6 +730,20 @@ def _loads(c: _Checker, value: Any, names: dict[str, int]) -> list[LoadSpec]:
                 vec = (_varying(c, (*p, "torque"), ld["torque"], exprs, _torque)
                        if "torque" in ld else None)
                 at = np.zeros(3)
+            if body in c.particles:
+                if typ == "torque":
+                    c.err((*p, "type"), f"a torque cannot act on the particle '{body}'",
+                          "a particle (inertia: 0) has no rotation; only forces at the "
+                          "particle act on it")
+                    continue
+                if at is not None and np.any(at != 0.0):
+                    c.err((*p, "at"), f"a force on the particle '{body}' acts at the particle",
+                          "remove 'at' (or give [0, 0]): a particle has no extent")
+                    continue
+                if frame == "body":
+                    c.err((*p, "frame"), f"the particle '{body}' has no body axes",
+                          "give the force in world axes (frame: world)")
+                    continue
             if _missing(name, body, frame, vec, at):
                 continue
             out.append(LoadSpec(name, typ, (body,), vec, frame, (at,), line=line,
@@ -716,6 +768,13 @@ def _loads(c: _Checker, value: Any, names: dict[str, int]) -> list[LoadSpec]:
                           "[[..body axes or world for ground..], [..]]")
             else:
                 pts = [c.vec3((*p, "at", k), at[k]) for k in (0, 1)]
+                for k in (0, 1):
+                    if (len(refs) == 2 and refs[k] in c.particles and pts[k] is not None
+                            and np.any(pts[k] != 0.0)):
+                        c.err((*p, "at", k), f"a spring attaches to the particle "
+                              f"'{refs[k]}' at the particle", "give [0, 0] (body axes): a "
+                              "particle has no extent")
+                        pts[k] = None
             k = c.number((*p, "stiffness"), ld["stiffness"], nonneg=True) \
                 if "stiffness" in ld else None
             L0 = c.number((*p, "rest_length"), ld.get("rest_length", 0.0), nonneg=True)
@@ -851,8 +910,48 @@ def _joints(c: _Checker, value: Any, names: dict[str, int],
             continue
         if _missing(name, typ, parent, child, at):
             continue
-        out.append(JointSpec(name, typ, parent, child, at, axis, axis2, c.doc.where(p)[0]))
+        kind = ""
+        if parent in c.particles or child in c.particles:
+            kind = _particle_joint(c, p, typ, parent, child, at, bodies)
+            if kind is None:
+                continue
+        out.append(JointSpec(name, typ, parent, child, at, axis, axis2, c.doc.where(p)[0],
+                             kind))
     return out
+
+
+PARTICLE_JOINTS = {cv.PLANAR: ("revolute",), cv.SPATIAL: ("revolute", "spherical")}
+"""Joint types that may connect a particle (they constrain its position only)."""
+PARTICLE_RTOL = 1e-9
+"""A joint point within this distance (relative to the model's size) of a particle is at
+the particle (a pin); farther, the joint is a rigid link of that length to it."""
+
+
+def _particle_joint(c: _Checker, p: Path_, typ: str, parent: str, child: str,
+                    at: np.ndarray, bodies: list[BodySpec]) -> str | None:
+    """"pin" or "link" for a joint with a particle at an end (docs: Particles), or None
+    after reporting why such a joint is not allowed."""
+    ends = [e for e in (parent, child) if e in c.particles]
+    allowed = PARTICLE_JOINTS[c.dim]
+    if typ not in allowed:
+        c.err((*p, "type"), f"a {typ} joint cannot connect the particle '{ends[0]}': a "
+              "particle (inertia: 0) has no orientation to constrain",
+              f"use {' or '.join(allowed)} (it constrains the particle's position only)")
+        return None
+    pos = {b.name: b.position for b in bodies}
+    if any(e not in pos for e in ends):
+        return None  # a body with problems of its own, already reported
+    scale = max([float(np.abs(at).max())] + [float(np.abs(x).max()) for x in pos.values()])
+    tol = PARTICLE_RTOL * scale
+    at_particle = [e for e in ends if float(np.linalg.norm(at - pos[e])) <= tol]
+    if len(at_particle) == len(ends):
+        return "pin"
+    if len(ends) == 2 and not at_particle:
+        c.err((*p, "at"), f"the joint point of two particles ('{parent}', '{child}') must "
+              "be at one of them", "at one particle: a rigid link to the other; at both: "
+              "a pin")
+        return None
+    return "link"
 
 
 def _axis(c: _Checker, path: Path_, value: Any) -> np.ndarray | None:

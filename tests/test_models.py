@@ -30,8 +30,10 @@ def velocity_vector(model: mbody.Model) -> np.ndarray:
     """The stacked velocity v at the model's initial state (aligned with the rows)."""
     s = model.initial
     if model.dimension == cv.PLANAR:
-        return np.column_stack((s.velocity[:, :2], s.omega[:, 2])).ravel()
-    return np.column_stack((s.velocity, s.omega)).ravel()
+        v = np.column_stack((s.velocity[:, :2], s.omega[:, 2])).ravel()
+    else:
+        v = np.column_stack((s.velocity, s.omega)).ravel()
+    return v[model.rows]  # a particle has translation rows only
 
 
 def Rz(a: float) -> np.ndarray:
@@ -85,7 +87,8 @@ def test_model_loads_checks_and_assembles(path: Path, capsys):
 
     asm = mbody.assemble(model)
     rpb = 3 if model.dimension == cv.PLANAR else 6
-    N = rpb * model.n
+    # a particle (inertia: 0) has translation rows only
+    N = sum(model.dimension if b.particle else rpb for b in model.bodies.values())
     m = sum(len(j.components) for j in model.joints)
     assert asm.M.shape == (N, N) and asm.b.shape == (N,) and asm.Q.shape == (N,)
     assert asm.G.shape == (N, m) and len(asm.reactions) == m

@@ -286,8 +286,9 @@ def test_planar_inertia_is_a_scalar(model_file):
 
 
 def test_planar_inertia_must_be_positive(model_file):
-    text = PLANAR.replace("inertia: 0.5", "inertia: 0")
-    problem(model_file, text, "inertia: »0", "bodies[0].inertia", "expected a number > 0")
+    # (inertia: 0 is a particle, see tests/test_particles.py)
+    text = PLANAR.replace("inertia: 0.5", "inertia: -0.5")
+    problem(model_file, text, "inertia: »-0.5", "bodies[0].inertia", "expected a number > 0")
 
 
 def test_spatial_inertia_is_not_a_scalar(model_file):

@@ -88,10 +88,8 @@ def solve(a: argparse.Namespace) -> int:
     asm = _assemble(model)
     sol = asm.solve(known=parse_known(a.known), condition=True)
     if a.json:
-        rpb = model.rows_per_body
         acc = sol.accelerations.tolist()
-        by_body = {name: dict(zip(model.coordinates[i * rpb:(i + 1) * rpb],
-                                  acc[i * rpb:(i + 1) * rpb], strict=True))
+        by_body = {name: {model.coordinates[r]: acc[r] for r in model.body_rows(i)}
                    for i, name in enumerate(model.body_names)}
         json.dump({"model": model.name, "coordinates": sol.coordinates,
                    "accelerations": acc, "by_body": by_body, "reactions": dict(sol.reactions),
