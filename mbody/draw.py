@@ -146,6 +146,10 @@ class _Outline:
     curved: bool = False  # its silhouette (the hull) is drawn as an edge
 
 
+PARTICLE_DOT = 0.05
+"""Radius (m) of the dot drawn for a particle (`inertia: 0`) without a shape."""
+
+
 def _circle(n: int = 72) -> np.ndarray:
     t = np.linspace(0.0, 2.0 * np.pi, n + 1)
     return np.column_stack((np.cos(t), np.sin(t)))
@@ -155,7 +159,9 @@ def _outline(fbd: FreeBodyDiagram, eye: np.ndarray) -> _Outline:
     x, R = fbd.W_position, fbd.W_R_B
     shape = fbd.shape
     planar = fbd.dimension == cv.PLANAR
-    if shape is None:  # a uniform box with the same principal inertias
+    if shape is None and not np.any(fbd.inertia):  # a particle: a dot
+        kind, v = "sphere", {"radius": PARTICLE_DOT}
+    elif shape is None:  # a uniform box with the same principal inertias
         if planar:
             side = math.sqrt(6.0 * fbd.inertia[2, 2] / fbd.mass)
             kind, v = "box", [side, side]
@@ -390,7 +396,8 @@ def draw_fbd(fbd, *, view: str | Sequence[float] | None = "iso", equations: bool
     ax.set_aspect("equal", adjustable="box")
     ax.set_axis_off()
     name = _tex_safe(fbd.body)
-    props = (f"m = {_fmt(fbd.mass)} kg, I_G = {_fmt(fbd.inertia[2, 2])} kg m²" if planar
+    props = (f"m = {_fmt(fbd.mass)} kg, particle" if not np.any(fbd.inertia)
+             else f"m = {_fmt(fbd.mass)} kg, I_G = {_fmt(fbd.inertia[2, 2])} kg m²" if planar
              else f"m = {_fmt(fbd.mass)} kg, view {_view_name(view)}")
     fig.text(0.5, 1 - 0.25 / H, title or f"Free-body diagram of {name}   ({props})",
              ha="center", va="center", fontsize=12, weight="bold", gid="title")
