@@ -1156,3 +1156,130 @@ def derivative(F, I, Iu, y, fvec, lam, rate, planar, out):
             out[10 * n + 3 * i + 1] = 0.0
             out[13 * n + i] = w[i, 2]
     return 0
+
+
+# -- coordinate projection (mbody.projection) --------------------------------------------------
+@njit(cache=True)
+def _pivot_ratio(Sb, bw):
+    """The smallest ratio of a squared Cholesky pivot of the banded S to its diagonal
+    entry (1 for well separated constraints, ~σ_min² near a singular position); 0 when
+    S is not positive definite. Sb is overwritten."""
+    mu = Sb.shape[0]
+    worst = 1.0
+    for i in range(mu):
+        for j in range(max(0, i - bw), i + 1):
+            s = Sb[i, i - j]
+            for k in range(max(0, i - bw), j):
+                s -= Sb[i, i - k] * Sb[j, j - k]
+            if i == j:
+                if not s > 0.0 or not Sb[i, 0] > 0.0:
+                    return 0.0
+                worst = min(worst, s / Sb[i, 0])
+                Sb[i, 0] = np.sqrt(s)
+            else:
+                Sb[i, i - j] = s / Sb[j, 0]
+    return worst
+
+
+@njit(cache=True)
+def _project_solve(bodies, joints_i, comps_i, Iu, child6, parent6, r6, gam, stab, planar,
+                   robust, d, lamU, nonunique):
+    """The constrained solve of a projection: the null-space solve when `robust` (near a
+    singular position, where S's Cholesky route loses 1/σ² of the accuracy that the
+    projection of the nearly lost direction needs), else `_constrained`. Returns the
+    singular-mass code."""
+    if robust:
+        mu = Iu[0]
+        return _null_space(bodies, joints_i, comps_i, Iu[3:3 + mu], child6, parent6, r6,
+                           gam, stab, planar, True, d, lamU, nonunique)[1]
+    return _constrained(bodies, joints_i, comps_i, Iu, child6, parent6, r6, gam, stab,
+                        planar, True, d, lamU, nonunique)[3]
+
+
+@njit(cache=True)
+def project(F, I, Iu, y, planar, iters, robust_below, info):
+    """Move the packed state y (in place, layout of `derivative`) onto the enforced
+    joints: positions by Gauss-Newton steps M Δ − G_U μ = 0, G_Uᵀ Δ = −φ_U (the smallest
+    move in the kinetic metric; Δ = [Δx world, Δθ body axes], at most `iters` steps, until
+    a step changes nothing), then velocities by the mass-orthogonal projection
+    M Δv − G_U μ = 0, G_Uᵀ Δv = −G_Uᵀ v. info (4,) <- [largest position step (m or rad),
+    largest velocity change (m/s or rad/s), `_pivot_ratio` of S at the starting
+    positions, singular-mass code (0 when none)]. Below a pivot ratio of `robust_below`
+    the solves are the null-space solve (`_project_solve`)."""
+    gravity, bodies, B_r, springs, joints, loads_i, springs_i, joints_i, comps_i = _unpack(F, I)
+    n, m = I[0], comps_i.shape[0]
+    mu, bw, nnz = Iu[0], Iu[1], Iu[2]
+    U = Iu[3:3 + mu]
+    x, q, v, w = _state(y, n)
+    info[0], info[1], info[2], info[3] = 0.0, 0.0, 1.0, 0.0
+    if mu == 0:
+        return
+    child6, parent6 = np.empty((m, 6)), np.empty((m, 6))
+    gamma, phi, gtv = np.empty(m), np.empty(m), np.empty(m)
+    r6 = np.zeros((n, 6))
+    gam, stab = np.empty(mu), np.zeros(mu)
+    d = np.empty((n, 6))
+    lamU = np.empty(mu)
+    nonunique = np.empty(mu, dtype=np.bool_)
+    inc_ptr = Iu[3 + mu:4 + mu + n]
+    inc = Iu[4 + mu + n:4 + mu + n + 2 * nnz].reshape(nnz, 2)
+    robust = False
+    for it in range(iters + 1):
+        R = _rotations(q)
+        _columns(joints, joints_i, comps_i, x, R, v, w, child6, parent6, gamma, phi, gtv)
+        if it == 0:
+            Sb = np.zeros((mu, bw + 1))
+            _schur(bodies, child6, parent6, U, inc_ptr, inc, Sb, True)
+            info[2] = _pivot_ratio(Sb, bw)
+            robust = info[2] < robust_below
+        if it == iters:
+            break
+        for k in range(mu):
+            gam[k] = -phi[U[k]]
+        singular = _project_solve(bodies, joints_i, comps_i, Iu, child6, parent6, r6, gam,
+                                  stab, planar, robust, d, lamU, nonunique)
+        if singular:
+            info[3] = singular
+            return
+        step = 0.0
+        for i in range(n):
+            for a in range(6):
+                step = max(step, abs(d[i, a]))
+        if step == 0.0:
+            break
+        info[0] = max(info[0], step)
+        if planar:  # the in-plane rows only (the others are 0 up to rounding)
+            for i in range(n):
+                d[i, 2], d[i, 3], d[i, 4] = 0.0, 0.0, 0.0
+        for i in range(n):
+            for a in range(3):
+                x[i, a] += d[i, a]
+            # q <- q ⊗ (1, Δθ/2), renormalised (Δθ in body axes, as ω)
+            p0, p1, p2 = 0.5 * d[i, 3], 0.5 * d[i, 4], 0.5 * d[i, 5]
+            qw, qx, qy, qz = q[i, 0], q[i, 1], q[i, 2], q[i, 3]
+            nw = qw - qx * p0 - qy * p1 - qz * p2
+            nx = qx + qw * p0 + qy * p2 - qz * p1
+            ny = qy + qw * p1 + qz * p0 - qx * p2
+            nz = qz + qw * p2 + qx * p1 - qy * p0
+            s = 1.0 / np.sqrt(nw * nw + nx * nx + ny * ny + nz * nz)
+            q[i, 0], q[i, 1], q[i, 2], q[i, 3] = nw * s, nx * s, ny * s, nz * s
+            if planar:
+                y[13 * n + i] += d[i, 5]
+        if step < 1e-15:
+            break
+    for k in range(mu):
+        gam[k] = -gtv[U[k]]
+    singular = _project_solve(bodies, joints_i, comps_i, Iu, child6, parent6, r6, gam, stab,
+                              planar, robust, d, lamU, nonunique)
+    if singular:
+        info[3] = singular
+        return
+    for i in range(n):
+        for a in range(3):
+            v[i, a] += d[i, a]
+            w[i, a] += d[i, 3 + a]
+            info[1] = max(info[1], abs(d[i, a]), abs(d[i, 3 + a]))
+        if planar:
+            v[i, 2] = 0.0
+            w[i, 0] = 0.0
+            w[i, 1] = 0.0

@@ -98,6 +98,11 @@ class StateDerivative:
                  compiled: bool = False):
         self.model, self.dynamics, self.rate = model, dynamics, rate
         self.unknowns, self.known_at = unknowns, known_at
+        self.projection = None
+        """A `mbody.projection.JointProjection`, set by `simulate` for mechanisms."""
+        self.project_stages = False
+        """Evaluate at the projected copy of y (near singular positions, see
+        `mbody.projection`)."""
         self.planar = model.dimension == 2
         n = model.n
         self.size = 13 * n + (n if self.planar else 0)
@@ -118,6 +123,9 @@ class StateDerivative:
         return self._kernel is not None
 
     def __call__(self, t: float, y: np.ndarray) -> np.ndarray:
+        if self.project_stages and self.projection is not None:
+            y = y.copy()
+            self.projection(y, t, iterations=2)
         if self._kernel is not None:
             out = np.empty(self.size)
             lam = self.unknowns.lam if self.known_at is None else self.known_at(t)

@@ -1,5 +1,7 @@
 """Jointed mechanisms in motion: accelerations with the unknown reactions solved at every
-step, joint drift held down by Baumgarte stabilisation, reactions along a trajectory.
+step, joint drift held down by Baumgarte stabilisation (used by the implicit integrators;
+the explicit ones project the state instead, `mbody.projection`), reactions along a
+trajectory.
 
 Integrating ``Gᵀ v̇ = γ`` alone lets the joints drift apart (rounding and truncation
 errors in φ and φ̇ = Gᵀ v are never corrected). Baumgarte's method replaces it by

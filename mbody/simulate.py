@@ -37,6 +37,7 @@ from .dynamics import Dynamics, StateDerivative, accelerations
 from .errors import MbodyError, UnknownReactionsError, did_you_mean
 from .expr import Expression, check_times, compile_expression, first_nonfinite
 from .model import Model, State
+from .projection import STAGE_PIVOT_RTOL
 from .trajectory import Trajectory
 
 METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
@@ -178,30 +179,40 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     n = model.n
     planar = model.dimension == cv.PLANAR
     s0 = model.initial if initial is None else initial
+    projection = None
+    if mechanism and method not in IMPLICIT:
+        # the joints held by projecting the state after every step (mbody.projection);
+        # the implicit methods keep their own history of y, so Baumgarte's terms hold them
+        from .projection import JointProjection
+
+        projection = JointProjection(model, rhs.unknowns, compiled=rhs.compiled)
+        rhs.projection, rhs.rate = projection, 0.0
     # Planar models also integrate θ itself (θ̇ = ω_z): the angle read back from a
     # quaternion is only known modulo 2π, and a fast wheel turns more than π per frame.
     theta0 = 2.0 * np.arctan2(s0.quaternion[:, 3], s0.quaternion[:, 0]) if planar else ()
     y0 = np.concatenate((s0.position.ravel(), s0.quaternion.ravel(), s0.velocity.ravel(),
                          s0.omega.ravel(), theta0))
     size = len(y0)
+    if projection is not None:  # the run starts on the joints
+        _, _, ratio = projection(y0, s0.t)
+        rhs.project_stages = ratio < STAGE_PIVOT_RTOL
     bar = _Progress(progress, t_end, model.name or "simulate")
 
     t_eval = np.arange(K) / fps
     Y = np.empty((K, size))
     Y[0] = y0
-    k, steps, sampling = 1, 0, 0
+    k, steps, sampling, refreshed = 1, 0, 0, 0
     rate = _StepRate(t_end)
     wall = time.perf_counter()
     try:
-        import scipy.integrate
 
         fun = rhs
         if method in ("Radau", "BDF"):  # their Jacobian estimate passes strided columns of y
             def fun(t, y):
                 return rhs(t, np.ascontiguousarray(y))
         with np.errstate(all="ignore"):  # its first-step norm may overflow: handled below
-            solver = getattr(scipy.integrate, method)(fun, 0.0, y0, t_end, rtol=rtol,
-                                                      atol=atol, max_step=max_step)
+            solver = _integrator(method, rhs)(fun, 0.0, y0, t_end, rtol=rtol, atol=atol,
+                                              max_step=max_step)
         t_prev, check_at = 0.0, PREDICT_FROM
         while solver.status == "running":
             try:  # overflow in an implicit method's Jacobian estimate is handled below
@@ -227,12 +238,22 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
                        "double precision?)"))
             t_prev = solver.t
             steps += 1
+            if projection is not None:
+                moved, changed, ratio = projection(solver.y, solver.t)
+                if rhs.project_stages or max(moved, changed) > REFRESH_ATOL * atol:
+                    solver.f = solver.fun(solver.t, solver.y)  # the next step starts here
+                    refreshed += 1
             j = int(np.searchsorted(t_eval, solver.t, side="right"))
             if j > k:  # DOP853's interpolant costs 3 evaluations here (docs/simulation.md)
                 nfev = solver.nfev
                 Y[k:j] = solver.dense_output()(t_eval[k:j]).T
                 sampling += solver.nfev - nfev
+                if projection is not None:  # the samples on the joints too
+                    for i in range(k, j):
+                        projection(Y[i], float(t_eval[i]))
                 k = j
+            if projection is not None:  # for the next step's stages (after the sampling,
+                rhs.project_stages = ratio < STAGE_PIVOT_RTOL  # which used this step's)
             rate.step(solver.t, steps)
             bar.update(solver.t)
             if solver.status == "running":
@@ -281,8 +302,12 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
         lam = reactions_along(model, states, _numeric_known(model, known))
         from .constraints import joint_errors
 
-        joint_info = {"joint_stabilisation": f.stabilisation, **constraint_drift(model, states),
-                      "initial_joint_errors": joint_errors(model, states[0])}
+        held = (PROJECTION_TEXT if projection is not None else
+                f"{f.stabilisation} (the implicit methods keep their own history of the "
+                "state, which a projection would break)")
+        joint_info = {"joint_stabilisation": held, **constraint_drift(model, states),
+                      "initial_joint_errors": joint_errors(model, s0),
+                      "projection_evaluations": refreshed}
     info = {
         "integrator": method, "rtol": rtol, "atol": atol, "t_end": t_end, "fps": fps,
         "samples": K, "steps": steps, "evaluations": solver.nfev,
@@ -308,6 +333,13 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     return traj
 
 
+PROJECTION_TEXT = ("coordinate projection after every step: positions by Gauss-Newton, "
+                   "velocities mass-orthogonal")
+REFRESH_ATOL = 1e-2
+"""A projection that moves the state by more than this fraction of atol restarts the
+next step from the derivative at the projected state (one evaluation); a smaller one is
+left to the integrator's error control."""
+
 PREDICT_FROM = 1000
 """Steps after which (and after twice, four times as many...) a run's total cost is
 predicted from its rate so far."""
@@ -316,6 +348,36 @@ PREDICT_FACTOR = 1.5
 SPIN_STEPS_PER_RAD = 50.0
 """Steps per radian of the fastest initial spin up to which a run's cost is put down to
 that spin (DOP853 at rtol 1e-10 takes about 1.5 steps per radian of a free spin)."""
+
+
+def _integrator(method: str, rhs: StateDerivative):
+    """scipy's integrator class `method`; for a mechanism held by projection, a subclass
+    whose error estimate, near a singular position (``rhs.project_stages``), counts only
+    the part along the joints (`mbody.projection.tangent_error`)."""
+    import scipy.integrate
+
+    base = getattr(scipy.integrate, method)
+    projection = rhs.projection
+    if projection is None:
+        return base
+    from .projection import tangent_error
+
+    class Projected(base):
+        def _estimate_error_norm(self, K, h, scale):
+            if not rhs.project_stages:
+                return super()._estimate_error_norm(K, h, scale)
+            if hasattr(self, "E5"):  # DOP853's two embedded estimates (as scipy combines them)
+                e5 = tangent_error(projection, self.y, K.T @ self.E5) / scale
+                e3 = tangent_error(projection, self.y, K.T @ self.E3) / scale
+                n5, n3 = float(e5 @ e5), float(e3 @ e3)
+                if n5 == 0 and n3 == 0:
+                    return 0.0
+                return abs(h) * n5 / math.sqrt((n5 + 0.01 * n3) * len(scale))
+            e = tangent_error(projection, self.y, (K.T @ self.E) * h) / scale
+            return float(np.linalg.norm(e)) / math.sqrt(len(e))
+
+    Projected.__name__ = base.__name__
+    return Projected
 
 
 def _predict(model: Model, method: str, t: float, t_end: float, steps: int, rate: _StepRate,
@@ -697,8 +759,12 @@ def summary(traj: Trajectory, path: str | os.PathLike[str] | None = None) -> str
         if broken:
             lines.append("warning: the initial state breaks joint constraints: "
                          + ", ".join(broken)
-                         + "; the stabilisation pulls the joints together, so energy and "
-                         "the early motion are not those of the model as written")
+                         + ("; the run starts from the nearest state that keeps them "
+                            "(projected), so energy and the motion are not those of the "
+                            "state as written"
+                            if i["joint_stabilisation"] == PROJECTION_TEXT else
+                            "; the stabilisation pulls the joints together, so energy and "
+                            "the early motion are not those of the model as written"))
     if traj.dimension == cv.SPATIAL:
         lines.append(f"quaternion norm error before renormalising: "
                      f"{i['quaternion_norm_error']:.1e}")

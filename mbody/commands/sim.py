@@ -20,7 +20,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                        description="Integrate the Newton-Euler equations of MODEL from its "
                        "initial state. Reaction values given in the file or with --known are "
                        "applied as loads; the unknown ones are solved with the accelerations "
-                       "at every step (joints held by Baumgarte stabilisation) and stored "
+                       "at every step (joints held by projecting the state onto them after each "
+                       "step) and stored "
                        "with the run. Prints the run summary with the drift of energy, "
                        "angular momentum and joints; saves the trajectory with -o.")
     s.add_argument("model", metavar="MODEL", help="a YAML model file")
