@@ -42,6 +42,7 @@ G_RANK_RTOL, PIVOT_RTOL, SINGULAR_RTOL, STAB_RTOL, REFINE_STEPS = 1e-12, 1e-6, 1
 # exactly redundant columns: G_j − G_I x_j below this (relative, moment rows over the
 # length scale), and a consistent answer (backward error below REDUNDANT_BERR)
 DEPENDENT_RTOL, REDUNDANT_BERR = 1e-10, 1e-13
+DROPPED_RTOL = 1e-13  # as mbody.projection: an exactly redundant constraint's pivot ratio
 SPLIT = 134217729.0  # 2**27 + 1, Dekker's splitting constant
 
 # info[] slots written by `solve`; ST_PATH: 0 Cholesky of S, 1 null-space solve;
@@ -1162,8 +1163,10 @@ def derivative(F, I, Iu, y, fvec, lam, rate, planar, out):
 @njit(cache=True)
 def _pivot_ratio(Sb, bw):
     """The smallest ratio of a squared Cholesky pivot of the banded S to its diagonal
-    entry (1 for well separated constraints, ~σ_min² near a singular position); 0 when
-    S is not positive definite. Sb is overwritten."""
+    entry (1 for well separated constraints, ~σ_min² near a singular position). A column
+    whose ratio is below `DROPPED_RTOL` is an exactly redundant constraint (a spatial
+    four-bar's): it is left out of the factorisation and of the figure, as a pivoted
+    Cholesky would. Sb is overwritten."""
     mu = Sb.shape[0]
     worst = 1.0
     for i in range(mu):
@@ -1172,12 +1175,13 @@ def _pivot_ratio(Sb, bw):
             for k in range(max(0, i - bw), j):
                 s -= Sb[i, i - k] * Sb[j, j - k]
             if i == j:
-                if not s > 0.0 or not Sb[i, 0] > 0.0:
-                    return 0.0
-                worst = min(worst, s / Sb[i, 0])
-                Sb[i, 0] = np.sqrt(s)
+                if not s > DROPPED_RTOL * Sb[i, 0]:
+                    Sb[i, 0] = 0.0
+                else:
+                    worst = min(worst, s / Sb[i, 0])
+                    Sb[i, 0] = np.sqrt(s)
             else:
-                Sb[i, i - j] = s / Sb[j, 0]
+                Sb[i, i - j] = s / Sb[j, 0] if Sb[j, 0] > 0.0 else 0.0
     return worst
 
 
