@@ -151,6 +151,7 @@ class _Checker:
         self.body_names: dict[str, int] = {}
         """Every body with a valid name, even one with other problems (for references)."""
         self.joint_types: dict[str, str] = {}
+        self.particle_joints: dict[str, str] = {}  # joint name -> "pin" or "link"
         """Every joint with a valid name and type, even one with other problems."""
         self.particles: set[str] = set()
         """Names of the bodies given `inertia: 0` (point masses)."""
@@ -915,6 +916,7 @@ def _joints(c: _Checker, value: Any, names: dict[str, int],
             kind = _particle_joint(c, p, typ, parent, child, at, bodies)
             if kind is None:
                 continue
+            c.particle_joints.setdefault(name, kind)
         out.append(JointSpec(name, typ, parent, child, at, axis, axis2, c.doc.where(p)[0],
                              kind))
     return out
@@ -975,7 +977,9 @@ def _reactions(c: _Checker, value: Any, joints: list[JointSpec],
         return {}
     # From every joint with a valid name and type, so that a joint with a bad point does
     # not turn each of its known reactions into a second problem.
-    labels = [f"{n}.{k}" for n, t in c.joint_types.items() for k in cv.JOINT_COMPONENTS[c.dim][t]]
+    labels = [f"{n}.{k}" for n, t in c.joint_types.items()
+              for k in (cv.PARTICLE_COMPONENTS[c.dim][t][c.particle_joints[n]]
+                        if n in c.particle_joints else cv.JOINT_COMPONENTS[c.dim][t])]
     out: dict[str, float] = {}
     for label, v in value.items():
         p: Path_ = ("reactions", label)

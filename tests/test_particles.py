@@ -337,3 +337,17 @@ def test_export_of_a_particle_model_round_trips_and_solves(tmp_path, name):
     assert exp.coordinates == model.coordinates
     sol = exp.solve()
     np.testing.assert_allclose(sol.accelerations, asm.solve().accelerations, atol=1e-12)
+
+
+def test_a_known_reaction_a_link_does_not_have_is_a_clean_error(tmp_path):
+    """A link to a particle has T only: `reactions: {O.Fz: ...}` was a KeyError (fuzz
+    mutation 1023); it is a validation error naming the link's components."""
+    path = tmp_path / "m.yaml"
+    path.write_text("model: sp\ndimension: 3\ngravity: [0, 0, -9.81]\nbodies:\n"
+                    "  - {name: bob, mass: 1.0, inertia: 0, position: [1, 0, 0]}\n"
+                    "joints: [{name: O, type: spherical, parent: ground, child: bob, "
+                    "at: [0, 0, 0]}]\nreactions:\n  O.Fz: 2.0\n")
+    with pytest.raises(mbody.ModelError) as e:
+        mbody.load(path)
+    assert "no reaction component 'O.Fz'" in str(e.value) and "O.T" in str(e.value)
+    assert ":8:3:" in str(e.value)  # the line of O.Fz under reactions:
