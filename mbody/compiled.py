@@ -1186,6 +1186,24 @@ def _pivot_ratio(Sb, bw):
 
 
 @njit(cache=True)
+def _geometric_ratio(bodies, joints_i, comps_i, U, inc_ptr, inc, child6, parent6, bw):
+    """`_pivot_ratio` of Ĝᵀ Ĝ, Ĝ = T G_U with T = diag(1, 1/ℓ) per body (as
+    `mbody.projection.geometric_ratio`): how close the joints are to a singular position,
+    whatever the masses (S = G_Uᵀ M⁻¹ G_U of a slender spatial four-bar has a ratio of
+    1e-3 at every position)."""
+    n = bodies.shape[0]
+    il = _inv_length(U, comps_i, joints_i, child6, parent6)
+    unit = np.zeros((n, bodies.shape[1]))
+    for i in range(n):
+        unit[i, MASS] = 1.0
+        for a in range(3):
+            unit[i, JINV0 + 4 * a] = il * il
+    Sb = np.zeros((U.shape[0], bw + 1))
+    _schur(unit, child6, parent6, U, inc_ptr, inc, Sb, True)
+    return _pivot_ratio(Sb, bw)
+
+
+@njit(cache=True)
 def _project_solve(bodies, joints_i, comps_i, Iu, child6, parent6, r6, gam, stab, planar,
                    robust, d, lamU, nonunique):
     """The constrained solve of a projection: the null-space solve when `robust` (near a
@@ -1207,7 +1225,7 @@ def project(F, I, Iu, y, planar, iters, robust_below, info):
     move in the kinetic metric; Δ = [Δx world, Δθ body axes], at most `iters` steps, until
     a step changes nothing), then velocities by the mass-orthogonal projection
     M Δv − G_U μ = 0, G_Uᵀ Δv = −G_Uᵀ v. info (4,) <- [largest position step (m or rad),
-    largest velocity change (m/s or rad/s), `_pivot_ratio` of S at the starting
+    largest velocity change (m/s or rad/s), `_geometric_ratio` at the starting
     positions, singular-mass code (0 when none)]. Below a pivot ratio of `robust_below`
     the solves are the null-space solve (`_project_solve`)."""
     gravity, bodies, B_r, springs, joints, loads_i, springs_i, joints_i, comps_i = _unpack(F, I)
@@ -1232,9 +1250,8 @@ def project(F, I, Iu, y, planar, iters, robust_below, info):
         R = _rotations(q)
         _columns(joints, joints_i, comps_i, x, R, v, w, child6, parent6, gamma, phi, gtv)
         if it == 0:
-            Sb = np.zeros((mu, bw + 1))
-            _schur(bodies, child6, parent6, U, inc_ptr, inc, Sb, True)
-            info[2] = _pivot_ratio(Sb, bw)
+            info[2] = _geometric_ratio(bodies, joints_i, comps_i, U, inc_ptr, inc, child6,
+                                       parent6, bw)
             robust = info[2] < robust_below
         if it == iters:
             break

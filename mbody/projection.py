@@ -18,10 +18,10 @@ Jacobian loses rank (a chain of parallelogram four-bars lying flat), the drift i
 direction that is about to lose its constraint is invisible in φ (φ is the product of
 the small singular value and the drift) and the index-1 equations amplify it as 1/σ² on
 the way in: the simulation leaves the mechanism's branch. The Gauss-Newton step divides
-φ by the same small σ and so sees and removes that drift. Close to such a position (the
-Schur complement's smallest pivot ratio below `STAGE_PIVOT_RTOL`) the integrator's stage
-states are projected as well before the accelerations are evaluated, so that the stages
-never see the amplified drift (`mbody.dynamics.StateDerivative.project_stages`).
+φ by the same small σ and so sees and removes that drift. Close to such a position
+(`geometric_ratio` below `STAGE_PIVOT_RTOL`) the integrator's stage states are projected
+as well before the accelerations are evaluated, so that the stages never see the
+amplified drift (`mbody.dynamics.StateDerivative.project_stages`).
 """
 
 from __future__ import annotations
@@ -36,16 +36,14 @@ ITERATIONS = 3
 tolerance) one step is enough to close the joints to rounding, the others stop early."""
 STAGE_PIVOT_RTOL = 1e-2
 """Project the stage states of the next step, and count only the error along the joints,
-when the smallest pivot ratio of S = G_Uᵀ M⁻¹ G_U at the accepted state is below this
-(the four-bar chain within about 0.1 rad of flat; with 1e-4 it takes 11 % more steps
-than the exact ODE). A known cost: S mixes masses and lengths, and the spatial
-four-bar's ratio is 1e-3 everywhere with nothing singular about it, so its stages are
-projected all the time (10 s: 5.5 s instead of 1.4 s); a ratio on G_U's scaled geometry
-(as `mbody.nullspace`) would tell the two apart."""
+when `geometric_ratio` at the accepted state is below this (the four-bar chain within
+about 0.1 rad of flat; with 1e-4 it takes 11 % more steps than the exact ODE). The ratio
+is taken on G_U's scaled geometry, not on S = G_Uᵀ M⁻¹ G_U: S mixes in the masses, and a
+slender spatial four-bar's S has a ratio of 1e-3 at every position."""
 
 
 DROPPED_RTOL = 1e-13
-"""A Schur pivot ratio below this is an exactly redundant constraint (a spatial
+"""A pivot ratio below this is an exactly redundant constraint (a spatial
 four-bar's), not a position near a singular one: rounding leaves ~1e-16, a four-bar
 chain 3e-7 rad from flat 1e-13. Such columns are left out of the ratio."""
 
@@ -55,7 +53,7 @@ class JointProjection:
     packed simulation state y (`mbody.dynamics.StateDerivative` layout) onto the joints
     enforced by the unknown reactions `unknowns`, in place. The step is the largest
     Gauss-Newton correction (m or rad), the change the largest velocity correction (m/s or
-    rad/s), the ratio the smallest Schur pivot ratio at the final state (1: far from any
+    rad/s), the ratio `geometric_ratio` at the starting state (1: far from any
     singular position)."""
 
     def __init__(self, model: Model, unknowns: Unknowns, *, compiled: bool):
@@ -113,7 +111,7 @@ class JointProjection:
             return state, cols, system
 
         state, cols, system = system_at()
-        ratio = _pivot_ratio(system)
+        ratio = geometric_ratio(system)
         if ratio < STAGE_PIVOT_RTOL:
             robust = True
             state, cols, system = system_at()
@@ -142,15 +140,21 @@ class JointProjection:
         return moved, change, ratio
 
 
-def _pivot_ratio(system) -> float:
-    """The smallest squared Cholesky pivot of S over its diagonal entry, exactly redundant
-    columns left out (as `mbody.compiled._pivot_ratio`, whose `DROPPED_RTOL` it uses)."""
-    S = getattr(system.fact, "_S", None)
-    S = S() if callable(S) else S
-    if S is None or hasattr(S, "tocsr") or len(np.shape(S)) != 2:
+def geometric_ratio(system) -> float:
+    """How close the joints are to a singular position, whatever the masses: the smallest
+    squared Cholesky pivot of Ĝᵀ Ĝ over its diagonal entry, Ĝ = T G_U with
+    T = diag(1, 1/ℓ) per body (`mbody.nullspace`'s scaling), exactly redundant columns
+    left out (as `mbody.compiled._geometric_ratio`, whose `DROPPED_RTOL` it uses)."""
+    from .nullspace import length_scale
+
+    G = getattr(system, "G", None)
+    if G is None or system.blocks is not None or hasattr(G, "tocsr"):
         return 1.0  # the large models' sparse factorisations: no cheap figure
-    A = np.array(S, dtype=float)
-    A = 0.5 * (A + A.T)
+    parent, child6, parent6 = system._arms
+    G = np.array(G, dtype=float).reshape(-1, 6, G.shape[1])
+    G[:, 3:] /= length_scale(child6, parent6, parent)
+    G = G.reshape(-1, G.shape[2])
+    A = G.T @ G
     mu, worst = len(A), 1.0
     L = np.zeros_like(A)
     for i in range(mu):  # a few dozen columns at most on this path
