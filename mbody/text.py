@@ -207,7 +207,7 @@ def solution_text(sol: Solution, model: Model) -> str:
 def reaction_table_text(asm: Assembly, sol: Solution) -> str:
     """Joint, component, its axis (world components at this state), value, status; then
     each joint's net force and couple on its child (at the joint point) and on its parent
-    (equal and opposite)."""
+    (equal and opposite; a particle link's force at its two ends)."""
     model = asm.model
     dim = model.dimension
     if not sol.reactions:
@@ -239,6 +239,13 @@ def reaction_table_text(asm: Assembly, sol: Solution) -> str:
         F, C = F_all[jn], C_all[jn]
         Cs = _n(C[2]) if dim == cv.PLANAR else _v(C, 3)
         mCs = _n(-C[2]) if dim == cv.PLANAR else _v(-C, 3)
+        first = np.flatnonzero(t.joint == jn)[0]
+        if t.link[first]:  # a rigid link to a particle: its two ends are apart
+            Pp = P + t.length[first] * cols.W_e[first]
+            lines.append(f"  {j.name} (link, {_n(t.length[first])} m): on child {j.child} "
+                         f"at {_v(P, dim)}: F {_v(F, dim)} N; on parent {j.parent} at "
+                         f"{_v(Pp, dim)}: F {_v(-F, dim)} N")
+            continue
         lines.append(f"  {j.name} at {_v(P, dim)}: on child {j.child}: F {_v(F, dim)} N, "
                      f"C {Cs} N m; on parent {j.parent}: F {_v(-F, dim)} N, C {mCs} N m")
     if sol.residual is not None:
