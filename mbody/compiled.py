@@ -1304,3 +1304,212 @@ def project(F, I, Iu, y, planar, iters, robust_below, info):
             v[i, 2] = 0.0
             w[i, 0] = 0.0
             w[i, 1] = 0.0
+
+
+# -- loads given as expressions of time (mbody.expr) -----------------------------------------
+@njit(cache=True, error_model="numpy")
+def _evaluate_program(codes, numbers, start, end, t, stack):
+    """The value at time t of one expression's postfix program (`mbody.expr.Expression.
+    program`, codes `PROGRAM_CODES`); out of a function's domain, inf or nan as numpy
+    gives them."""
+    top = 0
+    for p in range(start, end):
+        c = codes[p]
+        if c == 0:
+            stack[top] = numbers[p]
+            top += 1
+        elif c == 1:
+            stack[top] = t
+            top += 1
+        elif c == 2:
+            stack[top - 1] = -stack[top - 1]
+        elif c <= 7:
+            a, b = stack[top - 2], stack[top - 1]
+            top -= 1
+            if c == 3:
+                stack[top - 1] = a + b
+            elif c == 4:
+                stack[top - 1] = a - b
+            elif c == 5:
+                stack[top - 1] = a * b
+            elif c == 6:
+                stack[top - 1] = a / b
+            else:
+                stack[top - 1] = a ** b
+        else:
+            a = stack[top - 1]
+            if c == 8:
+                stack[top - 1] = np.sin(a)
+            elif c == 9:
+                stack[top - 1] = np.cos(a)
+            elif c == 10:
+                stack[top - 1] = np.tan(a)
+            elif c == 11:
+                stack[top - 1] = np.exp(a)
+            elif c == 12:
+                stack[top - 1] = np.log(a) if a >= 0.0 else np.nan
+            elif c == 13:
+                stack[top - 1] = np.sqrt(a) if a >= 0.0 else np.nan
+            else:
+                stack[top - 1] = abs(a)
+    return stack[0]
+
+
+@njit(cache=True)
+def set_loads(base, rows, cols, which, starts, codes, numbers, t, out):
+    """out (k, 3) <- base with the entries given as expressions (`mbody.expr.
+    ExpressionTable.program`) set to their values at time t (s)."""
+    for i in range(base.shape[0]):
+        for a in range(base.shape[1]):
+            out[i, a] = base[i, a]
+    u = starts.shape[0] - 1
+    if u == 0:
+        return
+    values = np.empty(u)
+    stack = np.empty(codes.shape[0])
+    for e in range(u):
+        values[e] = _evaluate_program(codes, numbers, starts[e], starts[e + 1], t, stack)
+    for k in range(rows.shape[0]):
+        out[rows[k], cols[k]] = values[which[k]]
+
+
+# -- one explicit Runge-Kutta step (mbody.stepping) ------------------------------------------
+@njit(cache=True)
+def rk_attempt(F, I, Iu, y, f, t, h, base, rows, cols, which, starts, codes, numbers, lam,
+               rate, planar, A, B, C, E3, E5, rtol, atol, K, y_new):
+    """One attempted step of an explicit embedded Runge-Kutta pair with `derivative` as
+    the right-hand side, as scipy's `rk_step` and DOP853's error norm compute it: K
+    (stages + 1, size) <- the stages with K[-1] = ẏ(t + h, y_new); y_new <- the solution
+    at t + h. The loads at each stage's time: base (k, 3) with the entries that are
+    expressions of time set (`set_loads`). Returns (error norm, singular-mass code); the
+    code stops the step."""
+    size = y.shape[0]
+    stages = A.shape[0]
+    for i in range(size):
+        K[0, i] = f[i]
+    z = np.empty(size)
+    loads = np.empty(base.shape)
+    for s in range(1, stages):
+        for i in range(size):
+            acc = 0.0
+            for j in range(s):
+                acc += K[j, i] * A[s, j]
+            z[i] = y[i] + acc * h
+        set_loads(base, rows, cols, which, starts, codes, numbers, t + C[s] * h, loads)
+        code = derivative(F, I, Iu, z, loads, lam, rate, planar, K[s])
+        if code:
+            return 0.0, code
+    for i in range(size):
+        acc = 0.0
+        for j in range(stages):
+            acc += K[j, i] * B[j]
+        y_new[i] = y[i] + h * acc
+    set_loads(base, rows, cols, which, starts, codes, numbers, t + h, loads)
+    code = derivative(F, I, Iu, y_new, loads, lam, rate, planar, K[stages])
+    if code:
+        return 0.0, code
+    n5, n3 = 0.0, 0.0
+    for i in range(size):
+        scale = atol + max(abs(y[i]), abs(y_new[i])) * rtol
+        e5, e3 = 0.0, 0.0
+        for j in range(stages + 1):
+            e5 += K[j, i] * E5[j]
+            e3 += K[j, i] * E3[j]
+        e5 /= scale
+        e3 /= scale
+        n5 += e5 * e5
+        n3 += e3 * e3
+    if n5 == 0.0 and n3 == 0.0:
+        return 0.0, 0
+    return abs(h) * n5 / np.sqrt((n5 + 0.01 * n3) * size), 0
+
+
+RUN_T, RUN_H, RUN_T_OLD, RUN_H_OLD, RUN_STEPS, RUN_NFEV, RUN_STATUS, RUN_RATIO, \
+    RUN_REFRESHED = range(9)
+"""Slots of `rk_run`'s `run` array. Status: 0 running (stopped at t_stop, max_steps or
+near a singular position), 1 step too small, 2 singular mass (code in RUN_RATIO)."""
+
+
+@njit(cache=True)
+def rk_run(F, I, Iu, base, rows, cols, which, starts, codes, numbers, lam, rate, planar, A,
+           B, C, E3, E5, rtol, atol, max_step, t_bound, t_stop, max_steps, project_too,
+           robust_below, refresh_tol, y, f, K, y_old, run):
+    """Steps of scipy's embedded Runge-Kutta control (`mbody.stepping`) with `rk_attempt`,
+    each followed, when `project_too`, by the coordinate projection (`project`) and, when
+    it moved the state by more than `refresh_tol`, a fresh ẏ at the projected state. Stops
+    after the first step that reaches t_stop, after `max_steps` steps, or after a step
+    whose `_geometric_ratio` is below `robust_below` (the next steps need the stage
+    projection of the Python path). y, f (ẏ at y), K (last accepted step's stages) and
+    y_old (its starting state) are updated in place; run holds t, h_abs, the last step's
+    start and size, and counters (slots RUN_*)."""
+    stages = A.shape[0]
+    size = y.shape[0]
+    y_new = np.empty(size)
+    pinfo = np.empty(4)
+    loads = np.empty(base.shape)
+    exponent = -1.0 / 8.0  # DOP853's error estimator is of order 7
+    t, h_abs = run[RUN_T], run[RUN_H]
+    direction = 1.0 if t_bound >= t else -1.0
+    run[RUN_STATUS] = 0.0
+    for _ in range(max_steps):
+        min_step = 10.0 * abs(np.nextafter(t, direction * np.inf) - t)
+        if h_abs > max_step:
+            h_abs = max_step
+        elif h_abs < min_step:
+            h_abs = min_step
+        rejected = False
+        while True:
+            if h_abs < min_step:
+                run[RUN_T], run[RUN_H], run[RUN_STATUS] = t, h_abs, 1.0
+                return
+            h = h_abs * direction
+            t_new = t + h
+            if direction * (t_new - t_bound) > 0:
+                t_new = t_bound
+            h = t_new - t
+            h_abs = abs(h)
+            error, code = rk_attempt(F, I, Iu, y, f, t, h, base, rows, cols, which, starts,
+                                     codes, numbers, lam, rate, planar, A, B, C, E3, E5,
+                                     rtol, atol, K, y_new)
+            run[RUN_NFEV] += stages
+            if code:
+                run[RUN_T], run[RUN_H] = t, h_abs
+                run[RUN_STATUS], run[RUN_RATIO] = 2.0, code
+                return
+            if error < 1.0:
+                factor = 10.0 if error == 0.0 else min(10.0, 0.9 * error ** exponent)
+                if rejected:
+                    factor = min(1.0, factor)
+                h_abs *= factor
+                break
+            h_abs *= max(0.2, 0.9 * error ** exponent)
+            rejected = True
+        for i in range(size):
+            y_old[i] = y[i]
+            y[i] = y_new[i]
+            f[i] = K[stages, i]
+        run[RUN_T_OLD], run[RUN_H_OLD] = t, h
+        t = t_new
+        run[RUN_STEPS] += 1.0
+        run[RUN_RATIO] = 1.0
+        if project_too:
+            project(F, I, Iu, y, planar, 3, robust_below, pinfo)
+            if pinfo[3]:
+                run[RUN_T], run[RUN_H] = t, h_abs
+                run[RUN_STATUS], run[RUN_RATIO] = 2.0, pinfo[3]
+                return
+            run[RUN_RATIO] = pinfo[2]
+            if max(pinfo[0], pinfo[1]) > refresh_tol:
+                set_loads(base, rows, cols, which, starts, codes, numbers, t, loads)
+                code = derivative(F, I, Iu, y, loads, lam, rate, planar, f)
+                run[RUN_NFEV] += 1.0
+                run[RUN_REFRESHED] += 1.0
+                if code:
+                    run[RUN_T], run[RUN_H] = t, h_abs
+                    run[RUN_STATUS], run[RUN_RATIO] = 2.0, code
+                    return
+            if pinfo[2] < robust_below:
+                break
+        if direction * (t - t_stop) >= 0.0 or t == t_bound:
+            break
+    run[RUN_T], run[RUN_H] = t, h_abs

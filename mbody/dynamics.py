@@ -116,6 +116,11 @@ class StateDerivative:
             self._kernel = compiled_module().derivative
             self._F, self._I = plan.packed
             self._Iu = plan.packed_unknowns(unknowns)
+            # loads given as expressions of t: evaluated by the compiled path as well
+            self._program = plan.load_program
+            self._varying = model.forces.varying is not None
+            self._loads = plan.constant_loads.copy() if self._varying else plan.constant_loads
+            self._set_loads = compiled_module().set_loads
 
     @property
     def compiled(self) -> bool:
@@ -129,8 +134,11 @@ class StateDerivative:
         if self._kernel is not None:
             out = np.empty(self.size)
             lam = self.unknowns.lam if self.known_at is None else self.known_at(t)
-            code = self._kernel(self._F, self._I, self._Iu, y, self.model.plan.load_values(t),
-                                lam, self.rate, self.planar, out)
+            loads = self._loads
+            if self._varying:
+                self._set_loads(*self._program, t, loads)
+            code = self._kernel(self._F, self._I, self._Iu, y, loads, lam, self.rate,
+                                self.planar, out)
             if code:
                 from .kkt import singular_mass_error
 

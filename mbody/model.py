@@ -154,8 +154,9 @@ class ForceTable:
         evaluated once per call, with numpy.
         """
         if self.varying is None:
-            return self.vector if np.ndim(t) == 0 else np.broadcast_to(
-                self.vector, (*np.shape(t), *self.vector.shape))
+            if isinstance(t, float | int) or np.ndim(t) == 0:
+                return self.vector
+            return np.broadcast_to(self.vector, (*np.shape(t), *self.vector.shape))
         return self.varying.apply(self.vector, t)
 
 

@@ -209,6 +209,18 @@ class ModelPlan:
         ft = self.model.forces
         return self.constant_loads if ft.varying is None else ft.vector_at(t)
 
+    @cached_property
+    def load_program(self) -> tuple[np.ndarray, ...]:
+        """The loads as the compiled path evaluates them at any time (`mbody.compiled.
+        set_loads`): (constant values (k, 3), then `mbody.expr.ExpressionTable.program`,
+        empty when every load is constant)."""
+        varying = self.model.forces.varying
+        if varying is not None:
+            return (self.constant_loads, *varying.program)
+        none = np.zeros(0, dtype=np.int64)
+        return (self.constant_loads, none, none, none, np.zeros(1, dtype=np.int64), none,
+                np.zeros(0))
+
     def packed_unknowns(self, unknowns: Unknowns) -> np.ndarray:
         """The compiled path's structure of these unknowns (ordered for a narrow band)."""
         out = self._packed_unknowns.get(unknowns.key)

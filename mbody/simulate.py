@@ -38,6 +38,7 @@ from .errors import MbodyError, UnknownReactionsError, did_you_mean
 from .expr import Expression, check_times, compile_expression, first_nonfinite
 from .model import Model, State
 from .projection import STAGE_PIVOT_RTOL
+from .stepping import REFRESH_ATOL, integrator
 from .trajectory import Trajectory
 
 METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
@@ -211,24 +212,34 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
             def fun(t, y):
                 return rhs(t, np.ascontiguousarray(y))
         with np.errstate(all="ignore"):  # its first-step norm may overflow: handled below
-            solver = _integrator(method, rhs)(fun, 0.0, y0, t_end, rtol=rtol, atol=atol,
+            solver = integrator(method, rhs)(fun, 0.0, y0, t_end, rtol=rtol, atol=atol,
                                               max_step=max_step)
         t_prev, check_at = 0.0, PREDICT_FROM
+        advance = getattr(solver, "advance", None)  # compiled DOP853 (mbody.stepping)
+        first = None
         while solver.status == "running":
-            try:  # overflow in an implicit method's Jacobian estimate is handled below
-                with np.errstate(all="ignore"), warnings.catch_warnings():
-                    if method in IMPLICIT:  # LinAlgWarning on a singular iteration,
-                        warnings.simplefilter("ignore")  # LSODA's convergence failures
-                    msg = solver.step()
-            except (ValueError, np.linalg.LinAlgError) as exc:
-                if method not in IMPLICIT:
-                    raise
-                raise MbodyError(
-                    f"the integrator {method} failed at t = {solver.t:.6g} s: {exc} (its "
-                    "numerical Jacobian broke down, as it can where the state barely "
-                    "changes). Try another stiff integrator (--method "
-                    + " or ".join(m for m in ("LSODA", "BDF") if m != method)
-                    + ") or looser tolerances (e.g. --rtol 1e-6 --atol 1e-9)") from None
+            ran = None
+            if advance is not None:  # steps up to the next sample in one compiled call
+                limit = min(CHUNK_STEPS, max(1, check_at - steps))
+                if max_steps is not None:
+                    limit = min(limit, max(1, max_steps - steps))
+                ran = advance(float(t_eval[k]) if k < K else t_end, limit)
+                msg = solver.TOO_SMALL_STEP if solver.status == "failed" else None
+            if ran is None:
+                try:  # overflow in an implicit method's Jacobian estimate is handled below
+                    with np.errstate(all="ignore"), warnings.catch_warnings():
+                        if method in IMPLICIT:  # LinAlgWarning on a singular iteration,
+                            warnings.simplefilter("ignore")  # LSODA's convergence failures
+                        msg = solver.step()
+                except (ValueError, np.linalg.LinAlgError) as exc:
+                    if method not in IMPLICIT:
+                        raise
+                    raise MbodyError(
+                        f"the integrator {method} failed at t = {solver.t:.6g} s: {exc} "
+                        "(its numerical Jacobian broke down, as it can where the state "
+                        "barely changes). Try another stiff integrator (--method "
+                        + " or ".join(m for m in ("LSODA", "BDF") if m != method)
+                        + ") or looser tolerances (e.g. --rtol 1e-6 --atol 1e-9)") from None
             if solver.status == "failed" or not np.all(np.isfinite(solver.y)):
                 culprit = _blame_expression(varying, t_prev, solver.t, solver.step_size)
                 raise MbodyError(
@@ -237,8 +248,13 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
                        + " (a body escaping to infinity, or tolerances too tight for "
                        "double precision?)"))
             t_prev = solver.t
-            steps += 1
-            if projection is not None:
+            if ran is not None:  # projected (and refreshed) in the compiled call
+                steps += ran.steps
+                refreshed += ran.refreshed
+                ratio = ran.ratio
+            else:
+                steps += 1
+            if projection is not None and ran is None:
                 moved, changed, ratio = projection(solver.y, solver.t)
                 if rhs.project_stages or max(moved, changed) > REFRESH_ATOL * atol:
                     solver.f = solver.fun(solver.t, solver.y)  # the next step starts here
@@ -257,8 +273,8 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
             rate.step(solver.t, steps)
             bar.update(solver.t)
             if solver.status == "running":
-                if steps == check_at:  # the whole run's cost, predicted from its start
-                    check_at *= 2
+                if steps >= check_at:  # the whole run's cost, predicted from its start
+                    check_at = 2 * steps
                     _predict(model, method, solver.t, t_end, steps, rate, max_steps,
                              max_wall, time.perf_counter() - wall)
                 if max_steps is not None and steps >= max_steps:
@@ -268,10 +284,10 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
                         f"about {steps * t_end / solver.t:.2g} steps", "raise --max-steps"))
                 if max_wall is not None:
                     now = time.perf_counter()
-                    if steps == 1:  # the pace is timed from here: no start-up costs
+                    if first is None:  # the pace is timed from here: no start-up costs
                         first = (solver.t, now)
                     if now - wall > max_wall:
-                        pace = ((now - first[1]) / (solver.t - first[0]) if steps > 1
+                        pace = ((now - first[1]) / (solver.t - first[0]) if solver.t > first[0]
                                 else (now - wall) / solver.t)
                         raise MbodyError(_budget_message(
                             f"the wall-time budget: {now - wall:.3g} s (--max-wall "
@@ -335,10 +351,8 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
 
 PROJECTION_TEXT = ("coordinate projection after every step: positions by Gauss-Newton, "
                    "velocities mass-orthogonal")
-REFRESH_ATOL = 1e-2
-"""A projection that moves the state by more than this fraction of atol restarts the
-next step from the derivative at the projected state (one evaluation); a smaller one is
-left to the integrator's error control."""
+CHUNK_STEPS = 200
+"""Most steps one compiled call takes before the loop looks at its budgets and progress."""
 
 PREDICT_FROM = 1000
 """Steps after which (and after twice, four times as many...) a run's total cost is
@@ -348,36 +362,6 @@ PREDICT_FACTOR = 1.5
 SPIN_STEPS_PER_RAD = 50.0
 """Steps per radian of the fastest initial spin up to which a run's cost is put down to
 that spin (DOP853 at rtol 1e-10 takes about 1.5 steps per radian of a free spin)."""
-
-
-def _integrator(method: str, rhs: StateDerivative):
-    """scipy's integrator class `method`; for a mechanism held by projection, a subclass
-    whose error estimate, near a singular position (``rhs.project_stages``), counts only
-    the part along the joints (`mbody.projection.tangent_error`)."""
-    import scipy.integrate
-
-    base = getattr(scipy.integrate, method)
-    projection = rhs.projection
-    if projection is None:
-        return base
-    from .projection import tangent_error
-
-    class Projected(base):
-        def _estimate_error_norm(self, K, h, scale):
-            if not rhs.project_stages:
-                return super()._estimate_error_norm(K, h, scale)
-            if hasattr(self, "E5"):  # DOP853's two embedded estimates (as scipy combines them)
-                e5 = tangent_error(projection, self.y, K.T @ self.E5) / scale
-                e3 = tangent_error(projection, self.y, K.T @ self.E3) / scale
-                n5, n3 = float(e5 @ e5), float(e3 @ e3)
-                if n5 == 0 and n3 == 0:
-                    return 0.0
-                return abs(h) * n5 / math.sqrt((n5 + 0.01 * n3) * len(scale))
-            e = tangent_error(projection, self.y, (K.T @ self.E) * h) / scale
-            return float(np.linalg.norm(e)) / math.sqrt(len(e))
-
-    Projected.__name__ = base.__name__
-    return Projected
 
 
 def _predict(model: Model, method: str, t: float, t_end: float, steps: int, rate: _StepRate,
