@@ -531,10 +531,14 @@ def _schur(bodies, child6, parent6, U, inc_ptr, inc, S, banded):
             for y in range(inc_ptr[b], inc_ptr[b + 1]):
                 ky, sy = inc[y, 0], inc[y, 1]
                 if ky <= kx:
-                    gy = _side(child6, parent6, U[ky], sy)
+                    iy = U[ky]  # indexed, not a view: this is the innermost loop
                     s = 0.0
-                    for r in range(6):
-                        s += gy[r] * h[r]
+                    if sy == 0:
+                        for r in range(6):
+                            s += child6[iy, r] * h[r]
+                    else:
+                        for r in range(6):
+                            s += parent6[iy, r] * h[r]
                     if banded:
                         S[kx, kx - ky] += s
                     else:
@@ -583,6 +587,7 @@ def _constrained(bodies, joints_i, comps_i, Iu, child6, parent6, r6, gam, stab, 
                 nk += 2.0 * parent6[i, r] ** 2
     normK = np.sqrt(nk)
     rank, path, singular = mu, 0, 0
+    S0 = Sb.copy()  # for the pivoted route when the band has no Cholesky factor
     if _cholesky_band(Sb, bw):
         _cho_solve_band(Sb, bw, lamU)
         rhs = r6.copy()
@@ -595,14 +600,17 @@ def _constrained(bodies, joints_i, comps_i, Iu, child6, parent6, r6, gam, stab, 
         # (spatial models only: a planar one's robust solve keeps the in-plane rows, and
         # the pivoted route would answer its out-of-plane rows too, differently)
         path = 2
-        rank = -1 if planar else _redundant(bodies, joints_i, comps_i, U, inc_ptr, inc,
-                                            child6, parent6, r6, acc, lamU, nonunique)
+        rank = -1 if planar else _redundant(bodies, joints_i, comps_i, U, S0, bw, child6,
+                                            parent6, r6, acc, lamU, nonunique)
         if rank >= 0:
             r1 = np.empty((n, 6))
             r2 = np.empty(mu)
-            if _residual(bodies, joints_i, comps_i, U, child6, parent6, r6, gam, acc, lamU,
-                         normK, r1, r2) > REDUNDANT_BERR:
+            berr = _residual(bodies, joints_i, comps_i, U, child6, parent6, r6, gam, acc,
+                             lamU, normK, r1, r2)
+            if berr > REDUNDANT_BERR:
                 rank = -1
+            else:
+                return rank, berr, path, 0
         if rank < 0:
             path = 1
             rank, singular = _null_space(bodies, joints_i, comps_i, U, child6, parent6, r6,
@@ -661,7 +669,31 @@ def _inv_length(U, comps_i, joints_i, child6, parent6):
 
 
 @njit(cache=True)
-def _redundant(bodies, joints_i, comps_i, U, inc_ptr, inc, child6, parent6, r6, acc, lamU,
+def _orthonormal(A):
+    """An orthonormal basis (columns) of A's column space, A of full column rank with few
+    columns (a null space [−X; I]): modified Gram-Schmidt, each column orthogonalised
+    twice ("twice is enough": orthogonal to rounding, as a Householder QR)."""
+    m, k = A.shape
+    Q = A.copy()
+    for a in range(k):
+        for _ in range(2):
+            for b in range(a):
+                d = 0.0
+                for i in range(m):
+                    d += Q[i, b] * Q[i, a]
+                for i in range(m):
+                    Q[i, a] -= d * Q[i, b]
+        norm = 0.0
+        for i in range(m):
+            norm += Q[i, a] * Q[i, a]
+        norm = np.sqrt(norm)
+        for i in range(m):
+            Q[i, a] /= norm
+    return Q
+
+
+@njit(cache=True)
+def _redundant(bodies, joints_i, comps_i, U, Sb, bw, child6, parent6, r6, acc, lamU,
                nonunique):
     """Exactly redundant joints, fast: S = G_Uᵀ M⁻¹ G_U factorised with pivoting on the
     pivot's share of its diagonal entry; the columns left with less than PIVOT_RTOL are
@@ -669,10 +701,14 @@ def _redundant(bodies, joints_i, comps_i, U, inc_ptr, inc, child6, parent6, r6, 
     look alike) are combinations x_j of the kept ones. Then λ on the kept columns, the
     minimum-norm λ through the null space [−X; I], and `nonunique`. lamU holds
     γ − G_Uᵀ M⁻¹ r on entry, λ on return. Returns the rank, or −1 when the columns are
-    not exactly dependent (the null-space solve takes over)."""
+    not exactly dependent (the null-space solve takes over). Sb: S's lower band (`_schur`,
+    band width bw)."""
     n, mu = r6.shape[0], U.shape[0]
     S = np.zeros((mu, mu))
-    _schur(bodies, child6, parent6, U, inc_ptr, inc, S, False)
+    for i in range(mu):
+        for j in range(max(0, i - bw), i + 1):
+            S[i, j] = Sb[i, i - j]
+            S[j, i] = Sb[i, i - j]
     diag = np.empty(mu)
     for k in range(mu):
         diag[k] = S[k, k]
@@ -753,8 +789,13 @@ def _redundant(bodies, joints_i, comps_i, U, inc_ptr, inc, child6, parent6, r6, 
         Nn[perm[r + a], a] = 1.0
         for i in range(r):
             Nn[perm[i], a] = -X[i, a]
-    Q = np.ascontiguousarray(np.linalg.qr(Nn)[0])
-    lamU -= Q @ (Q.T @ lamU)
+    Q = _orthonormal(Nn)
+    for a in range(nd):  # λ minus its part in the null space
+        s2 = 0.0
+        for k in range(mu):
+            s2 += Q[k, a] * lamU[k]
+        for k in range(mu):
+            lamU[k] -= s2 * Q[k, a]
     for k in range(mu):
         s2 = 0.0
         for a in range(nd):
