@@ -395,7 +395,7 @@ def test_simulate_says_so_on_stderr_when_it_compiles(monkeypatch, capsys, pendin
     from mbody.cli import main
     from mbody.commands import sim
 
-    monkeypatch.setattr(sim, "compile_pending", lambda model, known: pending)
+    monkeypatch.setattr(sim, "compile_pending", lambda model, known, method: pending)
     assert main(["simulate", str(MODELS / "torque_free_asymmetric.yaml"), "--t-end", "0.1",
                  "--no-progress"]) == 0
     out, err = capsys.readouterr()

@@ -81,7 +81,7 @@ def simulate(a: argparse.Namespace) -> int:
 
         ensure_writable(a.output)
     known = parse_known(a.known)
-    if compile_pending(model, known):  # else ~20 s of silence on the first run
+    if compile_pending(model, known, a.method):  # else ~20 s of silence on the first run
         print(COMPILE_NOTICE, file=sys.stderr, flush=True)
     traj = _simulate(model, a.t_end, a.fps,
                      rtol=DEFAULT_RTOL if a.rtol is None else a.rtol,
@@ -95,11 +95,12 @@ def simulate(a: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def compile_pending(model, known) -> bool:
+def compile_pending(model, known, method: str = "DOP853") -> bool:
     """Whether simulating `model` will first compile `mbody.compiled`'s kernels: the
     compiled path serves it (numba importable, `MBODY_JIT` not off, a model it takes) and
     numba's cache holds no machine code for this machine of a kernel the run calls
-    (`derivative`; `solve` too for the reactions of a mechanism). The cache is empty after
+    (`derivative`; `rk_run` for DOP853's compiled runs; `solve` and `project` too for
+    a mechanism's reactions and projection). The cache is empty after
     an install, and stale after numba or mbody/compiled.py changed (it is keyed by the
     numba version and the source file's time stamp and size). Imports numba, as the run
     itself would; never raises (numba's cache layout is not public: on any surprise the
@@ -113,8 +114,10 @@ def compile_pending(model, known) -> bool:
     if C is None:
         return False
     kernels = [C.derivative]
+    if method == "DOP853":
+        kernels.append(C.rk_run)
     if _has_unknown_reactions(model, known):
-        kernels.append(C.solve)
+        kernels += [C.solve, C.project]
     try:
         return not all(_cached(k) for k in kernels)
     except Exception:  # noqa: BLE001 - a guess about numba's internals, never fatal
