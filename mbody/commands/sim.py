@@ -9,7 +9,7 @@ import sys
 from ..errors import MbodyError
 from . import EXIT_OK, load_model, parse_known, regular_file
 
-COMPILE_NOTICE = ("mbody: compiling the fast path once (about 20 s); later runs start at "
+COMPILE_NOTICE = ("mbody: compiling the fast path once (about a minute); later runs start at "
                   "once")
 """What `mbody simulate` says on stderr before a run that compiles the numba kernels."""
 
