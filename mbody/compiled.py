@@ -1523,7 +1523,8 @@ def rk_run(F, I, Iu, base, rows, cols, which, starts, codes, numbers, lam, rate,
                     factor = min(1.0, factor)
                 h_abs *= factor
                 break
-            h_abs *= max(0.2, 0.9 * error ** exponent)
+            shrink = 0.9 * error ** exponent
+            h_abs *= shrink if shrink > 0.2 else 0.2  # nan -> 0.2, as scipy (max(0.2, nan))
             rejected = True
         for i in range(size):
             y_old[i] = y[i]

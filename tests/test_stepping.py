@@ -71,3 +71,30 @@ def test_compiled_load_programs_equal_the_expressions(text):
         compiled().set_loads(base, *table.program, t, out)
         expected = table.apply(base, np.array([t]))[0]
         np.testing.assert_allclose(out, expected, rtol=1e-15, atol=0, equal_nan=True)
+
+
+def test_a_state_that_is_not_finite_stops_the_compiled_run():
+    """A nan error norm shrinks the step as scipy does (Python's max(0.2, nan) is 0.2)
+    until it is too small: the run reports that instead of looping on a nan step."""
+    import scipy.integrate
+
+    from mbody.plan import compiled
+    from mbody.simulate import state_derivative
+
+    c = compiled()
+    model = mbody.load(MODELS / "torque_free_asymmetric.yaml")  # a free body: no solve
+    rhs = state_derivative(model, None, None)
+    assert rhs.compiled
+    s0 = model.initial
+    y = np.concatenate((s0.position.ravel(), s0.quaternion.ravel(), s0.velocity.ravel(),
+                        s0.omega.ravel()))
+    y[7] = np.nan  # a velocity
+    f = rhs(0.0, y)
+    solver = scipy.integrate.DOP853(lambda t, z: z, 0.0, np.zeros(3), 1.0)
+    K = np.empty((solver.n_stages + 1, len(y)))
+    run = np.zeros(9)
+    run[c.RUN_H] = 1e-3
+    c.rk_run(rhs._F, rhs._I, rhs._Iu, *model.plan.load_program, rhs.unknowns.lam, 0.0,
+             False, solver.A, solver.B, solver.C, solver.E3, solver.E5, 1e-10, 1e-12, np.inf,
+             1.0, 1.0, 100, False, 1e-2, 1e-14, y, f, K, np.empty_like(y), run)
+    assert run[c.RUN_STATUS] == 1.0 and run[c.RUN_STEPS] == 0
