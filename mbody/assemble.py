@@ -21,7 +21,7 @@ from . import kernels
 from .errors import MbodyError, did_you_mean
 from .joints import ReactionColumns, g_matrix, reaction_columns, reaction_wrench
 from .loads import AppliedLoads
-from .model import Model, State
+from .model import Model, State, count
 from .plan import Unknowns, compiled
 from .spatial import matvec
 
@@ -169,6 +169,14 @@ class Assembly:
     def __init__(self, model: Model, state: State):
         self.model = model
         self.state = state
+
+    def __repr__(self) -> str:
+        model = self.model
+        unknown = len(model.plan.unknowns_at(self.state.t).U) if model.reactions else 0
+        return (f"<Assembly of {model.name!r} at t = {self.state.t:g} s: "
+                f"{count(model.n, 'body', 'bodies')}, "
+                f"{count(len(model.reactions), 'reaction component')} ({unknown} unknown); "
+                ".solve(), .bodies[name], .M, .b, .Q, .G>")
 
     @cached_property
     def _loads_and_b6(self) -> tuple[AppliedLoads, np.ndarray]:

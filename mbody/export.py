@@ -143,6 +143,11 @@ class ExportedAssembly:
         N, m = len(self.coordinates), len(self.reactions)
         return {"M": (N, N), "b": (N,), "Q": (N,), "G": (N, m)}
 
+    def __repr__(self) -> str:  # the dataclass's would print every matrix
+        N, m = len(self.coordinates), len(self.reactions)
+        return (f"<ExportedAssembly of {self.model!r}: M {N}x{N}, G {N}x{m}; state: "
+                f"{self.state_source}; .solve(), .records()>")
+
     def solve(self, known: Mapping[str, float] | None = None) -> Solution:
         """Accelerations, and the reaction components not given (stored values or `known`).
 

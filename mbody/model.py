@@ -271,6 +271,15 @@ class Model:
     known_expressions: dict[str, Expression] = field(default_factory=dict)
     """Known reaction values that vary in time (label -> expression of t)."""
 
+    def __repr__(self) -> str:  # the dataclass's would print every array (2-9 KB)
+        kind = "planar" if self.dimension == cv.PLANAR else "spatial"
+        bodies = _names(self.body_names)
+        return (f"<Model {self.name!r}: {kind}, {count(self.n, 'body', 'bodies')} "
+                f"({bodies}), {count(len(self.loads), 'load')}, "
+                f"{count(len(self.joints), 'joint')}, "
+                f"{count(len(self.reactions), 'reaction component')}; mbody.assemble(model) "
+                "for its equations>")
+
     def known_reactions_at(self, t: float) -> dict[str, float]:
         """The known reaction values at time `t` (`known_reactions` holds t = 0)."""
         if not self.known_expressions:
@@ -513,3 +522,15 @@ def _build(spec: Spec) -> Model:
                  _ro(spec.gravity), initial, bodies, loads, tuple(joints), forces, springs,
                  table, dict(spec.reactions), spec.description, tuple(spec.warnings),
                  dict(spec.reaction_expressions))
+
+
+def _names(names, most: int = 5) -> str:
+    """The first `most` names, and how many more (for short reprs)."""
+    names = list(names)
+    more = len(names) - most
+    return ", ".join(names[:most]) + (f", … {more} more" if more > 0 else "")
+
+
+def count(k: int, word: str, plural: str = "") -> str:
+    """'1 body', '3 bodies' (for short reprs)."""
+    return f"{k} {word if k == 1 else plural or word + 's'}"

@@ -33,7 +33,7 @@ import numpy as np
 
 from . import conventions as cv
 from .errors import TrajectoryFileError
-from .model import State
+from .model import State, count
 from .spatial import matvec, planar_quat, quat_to_matrix
 
 FORMAT = "mbody-trajectory"
@@ -119,6 +119,14 @@ class Trajectory:
         return self.mass, self.inertia
 
     # -- mechanics ---------------------------------------------------------------------
+    def __repr__(self) -> str:  # the dataclass's would print every array
+        t = self.t
+        span = f"t = {t[0]:g} .. {t[-1]:g} s" if len(t) else "no samples"
+        return (f"<Trajectory of {self.model_name or 'a model'!r}: "
+                f"{count(self.n, 'body', 'bodies')}, {count(len(t), 'sample')}, {span}, "
+                f"{count(len(self.reaction_labels), 'reaction series', 'reaction series')}; "
+                ".state(k), .kinetic_energy(), .save(path)>")
+
     def kinetic_energy(self, per_body: bool = False) -> np.ndarray:
         """T = ½ m vᵀv + ½ ωᵀ J ω: (K,) total, or (K, n) with `per_body`."""
         m, J = self._need_inertia()
