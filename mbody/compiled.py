@@ -483,24 +483,38 @@ def _add_g(U, comps_i, joints_i, child6, parent6, lam, out, sign):
 
 
 @njit(cache=True)
-def _cholesky_band(Sb, bw):
-    """In place: lower banded S (Sb[i, i − j] = S_ij) -> its Cholesky factor L.
-    Returns False when a squared pivot keeps no more than PIVOT_RTOL of its diagonal
-    entry (redundant constraints, a position near a singular one, extreme mass ratios:
-    the null-space solve takes over), as `mbody.kkt`."""
+def _band_cholesky(Sb, bw, rtol, stop):
+    """In place: lower banded S (Sb[i, i − j] = S_ij) -> its Cholesky factor L. A squared
+    pivot that keeps no more than `rtol` of its diagonal entry stops the factorisation
+    (`stop`: returns −1) or leaves its column out (L's column 0, as a pivoted Cholesky
+    would). Returns the smallest ratio of a kept squared pivot to its diagonal entry."""
     mu = Sb.shape[0]
+    worst = 1.0
     for i in range(mu):
         for j in range(max(0, i - bw), i + 1):
             s = Sb[i, i - j]
             for k in range(max(0, i - bw), j):
                 s -= Sb[i, i - k] * Sb[j, j - k]
             if i == j:
-                if not s > PIVOT_RTOL * Sb[i, 0]:
-                    return False
-                Sb[i, 0] = np.sqrt(s)
+                if not s > rtol * Sb[i, 0]:
+                    if stop:
+                        return -1.0
+                    Sb[i, 0] = 0.0
+                else:
+                    worst = min(worst, s / Sb[i, 0])
+                    Sb[i, 0] = np.sqrt(s)
             else:
-                Sb[i, i - j] = s / Sb[j, 0]
-    return True
+                Sb[i, i - j] = s / Sb[j, 0] if Sb[j, 0] > 0.0 else 0.0
+    return worst
+
+
+@njit(cache=True)
+def _cholesky_band(Sb, bw):
+    """In place: lower banded S -> its Cholesky factor L. Returns False when a squared
+    pivot keeps no more than PIVOT_RTOL of its diagonal entry (redundant constraints, a
+    position near a singular one, extreme mass ratios: the null-space solve takes over),
+    as `mbody.kkt`."""
+    return _band_cholesky(Sb, bw, PIVOT_RTOL, True) >= 0.0
 
 
 @njit(cache=True)
@@ -1206,24 +1220,8 @@ def _pivot_ratio(Sb, bw):
     """The smallest ratio of a squared Cholesky pivot of the banded S to its diagonal
     entry (1 for well separated constraints, ~σ_min² near a singular position). A column
     whose ratio is below `DROPPED_RTOL` is an exactly redundant constraint (a spatial
-    four-bar's): it is left out of the factorisation and of the figure, as a pivoted
-    Cholesky would. Sb is overwritten."""
-    mu = Sb.shape[0]
-    worst = 1.0
-    for i in range(mu):
-        for j in range(max(0, i - bw), i + 1):
-            s = Sb[i, i - j]
-            for k in range(max(0, i - bw), j):
-                s -= Sb[i, i - k] * Sb[j, j - k]
-            if i == j:
-                if not s > DROPPED_RTOL * Sb[i, 0]:
-                    Sb[i, 0] = 0.0
-                else:
-                    worst = min(worst, s / Sb[i, 0])
-                    Sb[i, 0] = np.sqrt(s)
-            else:
-                Sb[i, i - j] = s / Sb[j, 0] if Sb[j, 0] > 0.0 else 0.0
-    return worst
+    four-bar's): it is left out, as a pivoted Cholesky would. Sb is overwritten."""
+    return _band_cholesky(Sb, bw, DROPPED_RTOL, False)
 
 
 @njit(cache=True)
