@@ -6,26 +6,36 @@
 
 The public names below are imported on first use (PEP 562), so that `import mbody` and
 the `mbody` command load only what they need (scipy, matplotlib, meshcat and networkx
-are slow to import). Submodules are reachable as attributes too (``mbody.dynamics``).
+are slow to import). Submodules are reachable as attributes too (``mbody.solve.dynamics``).
+
+The package's folders follow the flow: `model` (file -> validated `Model`), `equations`
+(free bodies and the stacked equations), `solve` (accelerations and reactions),
+`simulate`, `present` (text, LaTeX, pictures, report, animation), `io` (exports) and
+`cli` (the command).
 """
 
 import importlib as _importlib
 import sys as _sys
 import types as _types
 
-from .errors import Issue, MbodyError, ModelError, UnknownReactionsError
+from mbody import _moved
+from mbody.errors import Issue, MbodyError, ModelError, UnknownReactionsError
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
+"""The one version string (pyproject.toml reads it from here)."""
 
 _LAZY = {
-    "animate": "animate",
-    "Assembly": "assemble", "Solution": "assemble", "assemble": "assemble",
-    "ExportedAssembly": "export", "load_export": "export",
-    "BodyEquations": "fbd", "Equation": "fbd", "ForceOnBody": "fbd", "FreeBodyDiagram": "fbd",
-    "Body": "model", "Joint": "model", "Load": "model", "Model": "model", "State": "model",
-    "load": "model", "loads": "model",
-    "simulate": "simulate",
-    "Trajectory": "trajectory",
+    "animate": "present.animate",
+    "Assembly": "equations.assemble", "Solution": "equations.assemble",
+    "assemble": "equations.assemble",
+    "ExportedAssembly": "io.export", "load_export": "io.export",
+    "BodyEquations": "equations.fbd", "Equation": "equations.fbd",
+    "ForceOnBody": "equations.fbd", "FreeBodyDiagram": "equations.fbd",
+    "Body": "model.model", "Joint": "model.model", "Load": "model.model",
+    "Model": "model.model", "State": "model.model", "load": "model.model",
+    "loads": "model.model",
+    "simulate": "simulate.simulation",
+    "Trajectory": "simulate.trajectory",
 }
 """Public name -> the submodule defining it."""
 
@@ -40,10 +50,12 @@ __all__ = [
 
 def __getattr__(name: str):
     if name in _LAZY:
-        value = getattr(_importlib.import_module(f".{_LAZY[name]}", __name__), name)
+        value = getattr(_importlib.import_module(f"{__name__}.{_LAZY[name]}"), name)
         globals()[name] = value
         return value
-    if not name.startswith("__"):  # a submodule not imported yet, e.g. mbody.dynamics
+    if name in _moved.MOVED:  # an old flat module path, e.g. mbody.dynamics
+        return _importlib.import_module(f"{__name__}.{name}")
+    if not name.startswith("__"):  # a submodule not imported yet, e.g. mbody.solve
         try:
             return _importlib.import_module(f".{name}", __name__)
         except ModuleNotFoundError as exc:
@@ -63,10 +75,10 @@ class _Package(_types.ModuleType):
     submodule was imported here, before the functions were bound)."""
 
     def __setattr__(self, name: str, value) -> None:
-        if (name in _LAZY and isinstance(value, _types.ModuleType)
-                and value.__name__ == f"{__name__}.{name}"):
+        if name in _LAZY and isinstance(value, _types.ModuleType):
             return
         super().__setattr__(name, value)
 
 
 _sys.modules[__name__].__class__ = _Package
+_moved.install()

@@ -110,3 +110,7 @@ def conventions(dimension: int) -> dict[str, object]:
                        "[w, x, y, z] (w first) of the body-to-world rotation W_R_B",
         "angular_velocity": "planar: theta_dot; spatial: components along body axes",
     }
+
+APPLIED, GRAVITY, REACTION = "applied", "gravity", "reaction"
+"""The kinds of force on a free body (`ForceOnBody.kind`): an applied load, the body's
+weight, a joint reaction."""

@@ -17,9 +17,9 @@ import psutil
 import pytest
 
 import mbody
-from mbody.animate import LiveViewer, build_scene, page_html, write_page
 from mbody.errors import MbodyError
-from mbody.trajectory import Trajectory
+from mbody.present.animate import LiveViewer, build_scene, page_html, write_page
+from mbody.simulate.trajectory import Trajectory
 
 sys.path.insert(0, str(Path(__file__).parent))
 import chromium  # noqa: E402
@@ -321,7 +321,8 @@ def test_live_cli_binds_loopback_and_stops_on_ctrl_c(spinner, tmp_path):
 
 def test_live_server_dies_with_a_killed_parent(tmp_path):
     """A SIGKILLed mbody cannot clean up; its server notices and exits by itself."""
-    code = ("from mbody.animate import LiveViewer; v = LiveViewer(); print(v.pid, flush=True);"
+    code = ("from mbody.present.animate import LiveViewer; v = LiveViewer(); "
+            "print(v.pid, flush=True);"
             "import time; time.sleep(60)")
     proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True)
     server = psutil.Process(int(proc.stdout.readline()))

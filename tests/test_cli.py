@@ -358,7 +358,7 @@ def test_warnings_go_to_stderr_and_do_not_fail(tmp_path):
 
 # == simulate's notice before compiling =================================================
 
-PENDING = ("import mbody\nfrom mbody.commands.sim import compile_pending\n"
+PENDING = ("import mbody\nfrom mbody.cli.sim import compile_pending\n"
            "for name in ('pendulum', 'torque_free_asymmetric'):\n"
            "    print(compile_pending(mbody.load(f'models/{name}.yaml'), {}))\n")
 
@@ -379,8 +379,8 @@ def test_compile_pending_with_an_empty_numba_cache(tmp_path):
 def test_compile_pending_is_false_once_compiled():
     import mbody
     from mbody.cli import main
-    from mbody.commands.sim import compile_pending
-    from mbody.plan import compiled
+    from mbody.cli.sim import compile_pending
+    from mbody.equations.plan import compiled
 
     if compiled() is None:
         pytest.skip("numba is not available")
@@ -392,8 +392,7 @@ def test_compile_pending_is_false_once_compiled():
 
 @pytest.mark.parametrize("pending", [True, False])
 def test_simulate_says_so_on_stderr_when_it_compiles(monkeypatch, capsys, pending):
-    from mbody.cli import main
-    from mbody.commands import sim
+    from mbody.cli import main, sim
 
     monkeypatch.setattr(sim, "compile_pending", lambda model, known, method: pending)
     assert main(["simulate", str(MODELS / "torque_free_asymmetric.yaml"), "--t-end", "0.1",

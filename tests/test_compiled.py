@@ -19,7 +19,7 @@ import pytest
 from randmodels import planar_model, spatial_model
 
 import mbody
-from mbody import plan as planmod
+from mbody.equations import plan as planmod
 from mbody.simulate import state_derivative
 
 pytest.importorskip("numba")
@@ -66,7 +66,7 @@ def tolerance(sol) -> float:
 def condition(model, state=None) -> float:
     """cond(S) from the numpy path; for a singular S, that of its nonzero part (largest
     over smallest eigenvalue kept by the pseudo-inverse)."""
-    from mbody.kkt import RANK_RTOL, ConstrainedSystem
+    from mbody.solve.kkt import RANK_RTOL, ConstrainedSystem
 
     asm = mbody.assemble(model, state)
     sol = asm.solve(condition=True)

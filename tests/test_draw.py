@@ -14,7 +14,9 @@ from matplotlib.figure import Figure
 
 import mbody
 from mbody.cli import main
-from mbody.draw import (
+from mbody.errors import MbodyError
+from mbody.model.graph import topology
+from mbody.present.draw import (
     COLORS,
     arrow_lengths,
     draw_graph,
@@ -24,8 +26,6 @@ from mbody.draw import (
     projection,
     save_figure,
 )
-from mbody.errors import MbodyError
-from mbody.graph import topology
 
 ROOT = Path(__file__).resolve().parent.parent
 MODELS = sorted((ROOT / "models").glob("*.yaml"))

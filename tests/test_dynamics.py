@@ -1,4 +1,4 @@
-"""`mbody.dynamics.accelerations` and the kernels under `assemble`, against an independent
+"""`mbody.solve.dynamics.accelerations` and the kernels under `assemble`, against an independent
 per-body computation (a Python loop over loads with scipy rotations), on seeded random
 models, shipped models and the benchmark's model builder. No timing here."""
 
@@ -15,9 +15,10 @@ from scipy.spatial.transform import Rotation
 
 import mbody
 from mbody import conventions as cv
-from mbody import dynamics, kernels
+from mbody.equations import kernels
 from mbody.errors import MbodyError
 from mbody.model import State
+from mbody.solve import dynamics
 
 ROOT = Path(__file__).resolve().parent.parent
 TOL = 1e-9

@@ -16,8 +16,8 @@ import scipy.sparse as sp
 from randmodels import planar_model, spatial_model
 
 import mbody
-import mbody.export as ex
-from mbody.trajectory import Trajectory
+import mbody.io.export as ex
+from mbody.simulate.trajectory import Trajectory
 
 ROOT = Path(__file__).resolve().parent.parent
 MODELS = ROOT / "models"
@@ -390,7 +390,7 @@ def test_cli_export_unwritable_target_is_one_message(tmp_path):
 def test_export_solves_like_the_assembly(name, tmp_path):
     """One constrained solver: an export solves exactly as the assembly it came from,
     redundant joints included (minimum-norm reactions, the same components named)."""
-    from mbody.plan import set_jit
+    from mbody.equations.plan import set_jit
 
     previous = set_jit("off")
     try:

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import mbody
-from mbody.expr import ExpressionError, ExpressionTable, compile_expression
+from mbody.model.expressions import ExpressionError, ExpressionTable, compile_expression
 
 T = np.linspace(-2.0, 3.0, 11)
 

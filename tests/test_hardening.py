@@ -16,9 +16,9 @@ from pathlib import Path
 import pytest
 
 import mbody
-from mbody import loader
 from mbody.cli import main
-from mbody.commands.sim import COMPILE_NOTICE
+from mbody.cli.sim import COMPILE_NOTICE
+from mbody.model import loader
 
 ROOT = Path(__file__).resolve().parent.parent
 MODELS = ROOT / "models"
@@ -299,7 +299,7 @@ def test_a_file_that_cannot_be_written_leaves_nothing(tmp_path, command, name):
 def test_write_errors_from_python_are_model_free_messages(tmp_path, monkeypatch):
     import errno
 
-    from mbody.atomic import write_atomic
+    from mbody.io.atomic import write_atomic
 
     target = tmp_path / "x.txt"
     target.write_text("old")

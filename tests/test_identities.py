@@ -388,7 +388,7 @@ def _row_of(eq, acc_name: str) -> str:
 
 @pytest.mark.parametrize("spec", _models())
 def test_per_step_path_equals_assembly(spec):
-    """`mbody.dynamics.accelerations` (the simulation's kernel: springs, offsets, couples,
+    """`mbody.solve.dynamics.accelerations` (the simulation's kernel: springs, offsets, couples,
     gravity, reactions) gives the same v̇ as `assemble(...).solve()` at a random state."""
     dynamics = pytest.importorskip("mbody.dynamics")
     d = spec["dimension"]

@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 import mbody
-from mbody import plan as planmod
+from mbody.equations import plan as planmod
 from mbody.simulate import state_derivative
 
 pytest.importorskip("numba")
@@ -137,7 +137,7 @@ def test_mid_size_ladder_is_banded(jit, kind, target):
     b = _bench()
     n_loops = b.loops_for(kind, target)
     model = mbody.load(b.ladder_spec(n_loops, kind))
-    assert len(model.reactions) > 48  # above mbody.kkt.DENSE_LIMIT
+    assert len(model.reactions) > 48  # above mbody.solve.kkt.DENSE_LIMIT
     for mode in ("off", "on"):
         jit(mode)
         sol = mbody.assemble(model).solve()

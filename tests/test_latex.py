@@ -15,7 +15,7 @@ from randmodels import planar_model, spatial_model
 from test_export import ODD_NAMES
 
 import mbody
-from mbody.latex import (
+from mbody.present.latex import (
     body_latex,
     document,
     equation_latex,

@@ -14,8 +14,8 @@ import pytest
 import yaml
 
 import mbody
-from mbody import loader
 from mbody.errors import Issue, ModelError
+from mbody.model import loader
 
 MODELS = Path(__file__).resolve().parent.parent / "models"
 

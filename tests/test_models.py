@@ -15,7 +15,7 @@ import pytest
 import mbody
 from mbody import conventions as cv
 from mbody.cli import main as cli_main
-from mbody.graph import topology
+from mbody.model.graph import topology
 
 MODELS = Path(__file__).resolve().parent.parent / "models"
 ALL = sorted(MODELS.glob("*.yaml"))

@@ -136,7 +136,7 @@ def test_single_body_known_numbers_agree():
 
 @pytest.mark.parametrize("seed", range(3))
 def test_per_step_path_agrees_with_mujoco(seed):
-    """The simulation's per-step kernel (`mbody.dynamics.accelerations`, a separate
+    """The simulation's per-step kernel (`mbody.solve.dynamics.accelerations`, a separate
     implementation of the same loads) against MuJoCo at an arbitrary state."""
     dynamics = pytest.importorskip("mbody.dynamics")
     spec = _free_bodies(80 + seed, 40)

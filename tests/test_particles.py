@@ -15,7 +15,7 @@ import pytest
 from scipy.special import ellipj, ellipk
 
 import mbody
-from mbody import plan as planmod
+from mbody.equations import plan as planmod
 from mbody.model import State
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -349,7 +349,7 @@ def test_cli_on_particle_models(tmp_path, name):
 
 @pytest.mark.parametrize("name", ["point_pendulum", "spherical_pendulum"])
 def test_export_of_a_particle_model_round_trips_and_solves(tmp_path, name):
-    from mbody.export import load_export, write_export
+    from mbody.io.export import load_export, write_export
 
     model = mbody.load(MODELS / f"{name}.yaml")
     asm = mbody.assemble(model)

@@ -11,7 +11,7 @@ from randmodels import planar_model, spatial_model
 from scipy.spatial.transform import Rotation
 
 import mbody
-from mbody.constraints import phi
+from mbody.equations.constraints import phi
 from mbody.model import State
 
 G0 = 9.81
@@ -421,7 +421,7 @@ def test_block_path_equals_sparse_path_on_large_random_trees(seed, monkeypatch):
     """Above 300 unknowns the Schur complement is built from per-body blocks
     (mbody.blockplan); on a random tree of 120 bodies with full inertia tensors and every
     joint type it gives the same accelerations and reactions as the general sparse path."""
-    import mbody.blockplan as blockplan
+    import mbody.solve.blockplan as blockplan
 
     types = ("revolute", "prismatic", "cylindrical", "universal", "spherical", "fixed")
     spec = spatial_model(seed, n=120, n_joints=119, n_forces=40, n_torques=10,

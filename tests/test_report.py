@@ -13,7 +13,7 @@ import pytest
 
 import mbody
 from mbody.cli import main
-from mbody.report import report_html
+from mbody.present.report import report_html
 
 ROOT = Path(__file__).resolve().parent.parent
 CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"

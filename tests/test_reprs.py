@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 import mbody
-from mbody.export import exported
+from mbody.io.export import exported
 
 MODELS = sorted((Path(__file__).resolve().parents[1] / "models").glob("*.yaml"))
 

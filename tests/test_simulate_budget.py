@@ -158,7 +158,7 @@ def test_sampling_evaluations_are_counted():
 
     def f(model, state):
         calls.append(state.t)
-        return mbody.dynamics.accelerations(model, state)
+        return mbody.solve.dynamics.accelerations(model, state)
 
     traj = mbody.simulate(model, t_end=5.0, fps=60, dynamics=f)
     i = traj.info

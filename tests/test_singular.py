@@ -10,8 +10,8 @@ import pytest
 from fourbar_chain import FourbarChain
 
 import mbody
-from mbody import plan as planmod
-from mbody.nullspace import NullSpaceSolve, SingularMassError
+from mbody.equations import plan as planmod
+from mbody.solve.nullspace import NullSpaceSolve, SingularMassError
 
 # Lengths that are powers of two: every crank's joint vectors are then the same numbers,
 # so the data are those of an exact parallelogram and the solve alone is tested (with
@@ -151,7 +151,7 @@ def test_a_motion_without_mass_is_an_error_naming_body_and_direction():
     with pytest.raises(SingularMassError) as e:
         NullSpaceSolve(G, mass, J, 1.0)
     assert (e.value.body, e.value.row) == (1, 5)
-    from mbody.kkt import singular_mass_error
+    from mbody.solve.kkt import singular_mass_error
 
     model = mbody.loads(CHAIN.yaml(0.3))
     msg = str(singular_mass_error(model, 1, 5))
@@ -173,7 +173,7 @@ def _ideal_steps(model, rtol: float, atol: float) -> int:
     own state layout and tolerances: what a solver that the crossings cost nothing takes."""
     import scipy.integrate
 
-    from mbody.dynamics import quaternion_rate
+    from mbody.solve.dynamics import quaternion_rate
 
     n = model.n
 

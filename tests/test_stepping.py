@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import mbody
-from mbody import stepping
+from mbody.simulate import stepping
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 
@@ -36,7 +36,7 @@ def test_compiled_steps_equal_scipys(name, monkeypatch):
 def test_compiled_steps_are_taken(monkeypatch):
     """The compiled run really is what steps the run (so the test above compares two
     different paths): its step counter, read through the kernel's Python entry."""
-    from mbody.plan import compiled
+    from mbody.equations.plan import compiled
 
     c = compiled()
     taken = []
@@ -60,8 +60,8 @@ EXPRESSIONS = ["-4000*exp(-200*t)", "50*sin(2*t) - cos(t)/3", "2^-t", "t^0.5", "
 def test_compiled_load_programs_equal_the_expressions(text):
     """`compiled.set_loads` (the loads inside a compiled step) gives the numbers numpy
     gives, inf and nan included, at times around the awkward ones."""
-    from mbody.expr import ExpressionTable, compile_expression
-    from mbody.plan import compiled
+    from mbody.equations.plan import compiled
+    from mbody.model.expressions import ExpressionTable, compile_expression
 
     e = compile_expression(text)
     table = ExpressionTable.build([(0, 1, e), (1, 2, e)])
@@ -78,7 +78,7 @@ def test_a_state_that_is_not_finite_stops_the_compiled_run():
     until it is too small: the run reports that instead of looping on a nan step."""
     import scipy.integrate
 
-    from mbody.plan import compiled
+    from mbody.equations.plan import compiled
     from mbody.simulate import state_derivative
 
     c = compiled()

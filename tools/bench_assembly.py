@@ -7,7 +7,7 @@ tensor, a rotated pose, a velocity and an angular velocity, one world-frame forc
 at an offset point, and gravity. Columns (nanoseconds per body, best of --repeat runs):
 
 - (a) ``mbody.assemble(model, state).solve()``: the stacked equations, then v̇;
-- (b) ``mbody.dynamics.accelerations(model, state)``: what a simulation calls per step
+- (b) ``mbody.solve.dynamics.accelerations(model, state)``: what a simulation calls per step
   (b, Q and v̇ with M and J⁻¹ kept), and the same with a reused ``out=`` buffer;
 - naive: the same numbers from a per-body Python loop on numpy 3-vectors;
 - MuJoCo: ``mj_forward`` on the same bodies (free joints, same masses, inertias, poses,
@@ -38,8 +38,8 @@ if str(ROOT / "tools") not in sys.path:  # tools/timing.py, also when loaded by 
 from timing import best  # noqa: E402
 
 import mbody  # noqa: E402
-from mbody import dynamics  # noqa: E402
 from mbody.model import Body, ForceTable, Load, Model, State  # noqa: E402
+from mbody.solve import dynamics  # noqa: E402
 
 GRAVITY = np.array([0.0, 0.0, -9.81])
 
@@ -70,7 +70,7 @@ def _unit_quats(rng: np.random.Generator, n: int) -> np.ndarray:
 
 
 def _quat_matrix(q: np.ndarray) -> np.ndarray:
-    from mbody.spatial import quat_to_matrix
+    from mbody.equations.spatial import quat_to_matrix
 
     return quat_to_matrix(q)
 
@@ -169,7 +169,7 @@ def mujoco_setup(model: Model, state: State):
     """
     import mujoco
 
-    from mbody.spatial import quat_to_matrix
+    from mbody.equations.spatial import quat_to_matrix
 
     g = " ".join(repr(float(x)) for x in model.gravity)
     # No geoms and contacts off: nothing but the free bodies' dynamics is computed.

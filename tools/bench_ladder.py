@@ -63,7 +63,7 @@ if str(ROOT / "tools") not in sys.path:  # tools/timing.py, also when loaded by 
 from timing import best  # noqa: E402
 
 import mbody  # noqa: E402
-from mbody import plan as mplan  # noqa: E402
+from mbody.equations import plan as mplan  # noqa: E402
 
 L, D, W, G0 = 0.5, 0.3, 0.02, 9.81
 """Rung length, coupler length (pin spacing), bar thickness (m), gravity (m/s²)."""
@@ -222,7 +222,7 @@ def solve_with(model, state, mode: str):
 
 def condition(model, state) -> float:
     """cond(S) (for a singular S, that of its nonzero part)."""
-    from mbody.kkt import RANK_RTOL, ConstrainedSystem
+    from mbody.solve.kkt import RANK_RTOL, ConstrainedSystem
 
     previous = mplan.set_jit("off")
     try:
@@ -441,7 +441,7 @@ def measure(kind: str, target: int, repeat: int, threads: bool) -> Row:
     funcs = {}
     for mode, tag in (("on", "jit"), ("off", "np")):
         def solve(mode=mode):
-            # the path is chosen per call from mbody.plan.JIT (set_jit's global), set
+            # the path is chosen per call from mbody.equations.plan.JIT (set_jit's global), set
             # here directly: set_jit's parsing would be timed too
             mplan.JIT = mode
             return mbody.assemble(model, state).solve()

@@ -8,7 +8,7 @@ each read from models/. Measured per system (microseconds per call, best of --re
 
 - solve: ``mbody.assemble(model, model.initial).solve()`` (accelerations and every
   unknown reaction), on the compiled path (after warm-up: the plan switches after
-  `mbody.plan.JIT_AFTER` evaluations) and on the numpy path (``set_jit("off")``);
+  `mbody.equations.plan.JIT_AFTER` evaluations) and on the numpy path (``set_jit("off")``);
 - MuJoCo: ``mj_forward`` on an equivalent model built here from the mbody model's numbers
   (masses, inertias, poses, joint points and axes, loads, gravity, initial velocities):
   a tree of hinge, slide and ball joints, one MuJoCo body frame per mbody body at its mass
@@ -51,7 +51,7 @@ if str(ROOT / "tools") not in sys.path:  # tools/timing.py, also when loaded by 
 from timing import best  # noqa: E402
 
 import mbody  # noqa: E402
-from mbody import plan as mplan  # noqa: E402
+from mbody.equations import plan as mplan  # noqa: E402
 
 MODELS = ROOT / "models"
 SYSTEMS = (

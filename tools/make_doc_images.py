@@ -13,8 +13,8 @@ import argparse
 from pathlib import Path
 
 import mbody
-from mbody.draw import draw_graph, save_figure
-from mbody.graph import topology
+from mbody.model.graph import topology
+from mbody.present.draw import draw_graph, save_figure
 
 ROOT = Path(__file__).resolve().parent.parent
 PICTURES = (  # (model file, body, view, output name)

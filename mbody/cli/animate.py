@@ -1,0 +1,92 @@
+"""animate: a self-contained HTML page of the motion, or the live meshcat viewer."""
+
+from __future__ import annotations
+
+import argparse
+import signal
+import sys
+import time
+from pathlib import Path
+
+from mbody.cli.common import EXIT_OK, regular_file
+from mbody.errors import MbodyError
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    s = sub.add_parser(
+        "animate", help="play the motion in meshcat: an offline HTML page or the live viewer",
+        description="Animate SOURCE, a run file (.npz from `mbody simulate`) or a model "
+        "(simulated first). Writes a self-contained page (no server, no network) with "
+        "every body drawn as its shape (or its inertia-equivalent box), a grid, and "
+        "play/pause and time controls. With --live, serves meshcat's viewer on "
+        "127.0.0.1 only until Ctrl-C.")
+    s.add_argument("source", metavar="MODEL|RUN", help="a model (.yaml) or a run (.npz)")
+    s.add_argument("-o", "--output", metavar="HTML",
+                   help="the page to write (default: SOURCE's name with .html; with --live "
+                   "a page is written only if this is given)")
+    s.add_argument("--model", metavar="MODEL",
+                   help="the model of a run file (default: the model file it names)")
+    s.add_argument("--forces", action="store_true",
+                   help="draw applied forces (yellow) and couples (magenta) as arrows")
+    s.add_argument("--reactions", action="store_true",
+                   help="draw each joint's reaction on its child (red: force at the joint "
+                   "point; dark red: couple)")
+    s.add_argument("--body", metavar="NAME", action="append",
+                   help="draw only this body (repeatable)")
+    s.add_argument("--t-end", type=float, metavar="S", help="simulated time for a MODEL")
+    s.add_argument("--fps", type=float, metavar="N", help="frames per second for a MODEL")
+    s.add_argument("--live", action="store_true",
+                   help="serve the live viewer on 127.0.0.1 and print its URL; Ctrl-C stops")
+    s.add_argument("--hold", type=float, metavar="S",
+                   help="with --live: stop after S seconds instead of waiting for Ctrl-C")
+    s.set_defaults(run=animate)
+
+
+def _stop(signum, frame):  # SIGTERM ends the live viewer like Ctrl-C
+    raise KeyboardInterrupt
+
+
+def animate(a: argparse.Namespace) -> int:
+    from mbody.io.atomic import write_atomic
+    from mbody.present.animate import LiveViewer, build_scene, page_html, resolve
+
+    if a.hold is not None and not a.live:
+        raise MbodyError("--hold only applies with --live")
+    for flag, value in (("--t-end", a.t_end), ("--fps", a.fps), ("--hold", a.hold)):
+        if value is not None and not value > 0:
+            raise MbodyError(f"{flag} must be > 0, got {value:g}")
+    if a.output:  # fail now, not after simulating
+        from mbody.io.atomic import ensure_writable
+
+        ensure_writable(a.output)
+    if not a.source.lower().endswith((".yaml", ".yml")):  # a model may come through a pipe
+        regular_file(a.source, "a model (.yaml) or a run file (.npz)")
+    traj, model = resolve(a.source, a.model, t_end=a.t_end, fps=a.fps)
+    scene = build_scene(traj, model, forces=a.forces, bodies=a.body, reactions=a.reactions)
+    what = (f"{len(scene.paths)} bod{'y' if len(scene.paths) == 1 else 'ies'}, "
+            f"{scene.frames} frames, {scene.duration:g} s")
+    out = a.output or (None if a.live else Path(a.source).with_suffix(".html").name)
+    if out:
+        path = write_atomic(out, page_html(scene))
+        print(f"wrote {path} ({path.stat().st_size / 1e6:.1f} MB: {what})")
+    if not a.live:
+        return EXIT_OK
+
+    previous = signal.signal(signal.SIGTERM, _stop)
+    viewer = None
+    try:
+        viewer = LiveViewer()
+        viewer.show(scene)
+        print(f"meshcat viewer (127.0.0.1 only): {viewer.url}  ({what}; Ctrl-C stops it)",
+              flush=True)
+        deadline = time.monotonic() + (a.hold if a.hold is not None else float("inf"))
+        while time.monotonic() < deadline:
+            time.sleep(min(0.2, max(0.0, deadline - time.monotonic())))
+    except KeyboardInterrupt:
+        pass
+    finally:
+        if viewer is not None:
+            viewer.close()
+        signal.signal(signal.SIGTERM, previous)
+    print("viewer stopped", file=sys.stderr)
+    return EXIT_OK

@@ -1,0 +1,169 @@
+"""The `mbody` command: parse arguments, call the API, print. Nothing else lives here.
+
+Exit codes: 0 success; 1 the request cannot be met (e.g. reactions still unknown);
+2 bad input (model file, arguments); 70 an internal error (a bug: please report it).
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import os
+import re
+import stat
+import sys
+import traceback
+from collections.abc import Sequence
+
+from mbody import __version__
+from mbody.cli.common import EXIT_INPUT, EXIT_INTERNAL, EXIT_OK, EXIT_UNMET
+from mbody.errors import MbodyError, ModelError, UnknownReactionsError, did_you_mean
+
+COMMAND_MODULES = ("core", "export", "sim", "draw", "animate", "mechanism")
+"""Modules of `mbody.cli`; each has `register(subparsers)` adding its commands."""
+
+def build_parser() -> argparse.ArgumentParser:
+    p = _Parser(prog="mbody", description="Per-body Newton-Euler equations for multibody "
+                "models: M v_dot + b = Q + G lambda.", allow_abbrev=False,
+                epilog="Start with: mbody check MODEL, then mbody assemble MODEL. "
+                "Each command has --help.")
+    p.add_argument("--version", action="version", version=f"mbody {__version__}")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    sub.required = True
+    for name in COMMAND_MODULES:
+        importlib.import_module(f"mbody.cli.{name}").register(sub)
+    return p
+
+
+class _Parser(argparse.ArgumentParser):
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("allow_abbrev", False)  # --know must not silently mean --known
+        super().__init__(*args, **kwargs)
+
+    def error(self, message: str):  # one paragraph, exit 2, as for any bad input
+        if "required: COMMAND" in message:  # bare `mbody`: show what there is to do
+            self.print_help(sys.stderr)
+            raise SystemExit(EXIT_INPUT)
+        bad = re.search(r"invalid choice: '([^']*)' \(choose from (.*)\)", message)
+        if bad:  # argparse of Python 3.11 offers no suggestion for a misspelt command
+            hint = did_you_mean(bad.group(1), re.findall(r"'([^']*)'", bad.group(2)))
+            message += f"; {hint}" if hint else ""
+        self.print_usage(sys.stderr)
+        sys.stderr.write(f"mbody: error: {message}\n")
+        raise SystemExit(EXIT_INPUT)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    out = _Stdout(sys.stdout)
+    sys.stdout = out
+    try:
+        code = args.run(args)
+        out.flush()  # a full device is reported here, not at exit
+        return code
+    except ModelError as exc:
+        return _error(f"mbody: error: {exc}\n", EXIT_INPUT)
+    except UnknownReactionsError as exc:
+        return _error(f"mbody: cannot solve: {exc}\n", EXIT_UNMET)
+    except StdoutError as exc:
+        out.discard()
+        return _error(f"mbody: error: {exc}\n", EXIT_INPUT)
+    except MbodyError as exc:
+        return _error(f"mbody: error: {exc}\n", EXIT_INPUT)
+    except KeyboardInterrupt:
+        return _error("mbody: interrupted\n", 130)
+    except BrokenPipeError:  # `mbody ... | head`: the reader has all it wanted
+        out.discard(truncate=False)
+        return EXIT_OK
+    except OSError as exc:  # the system refused a read or a write no command foresaw
+        where = f" ({exc.filename})" if exc.filename else ""
+        return _error(f"mbody: error: {exc.strerror or exc}{where}\n", EXIT_INPUT)
+    except Exception as exc:  # a bug: say so in one paragraph, traceback only on request
+        if os.environ.get("MBODY_DEBUG"):
+            traceback.print_exc()
+        return _error(f"mbody: internal error: {type(exc).__name__}: {exc}. This is a bug "
+                      "in mbody; run with MBODY_DEBUG=1 for details and report it.\n",
+                      EXIT_INTERNAL)
+    finally:
+        sys.stdout = out.inner
+
+
+def _error(text: str, code: int) -> int:
+    """Write `text` to stderr (if stderr itself cannot be written, the code still says it)."""
+    try:
+        sys.stderr.write(text)
+        sys.stderr.flush()
+    except (OSError, ValueError):
+        pass
+    return code
+
+
+class StdoutError(MbodyError):
+    """Standard output could not be written (a full disk or device, an I/O error)."""
+
+
+class _Stdout:
+    """sys.stdout during a command: a write that fails becomes one `StdoutError`, and
+    `discard` leaves nothing partial behind where that can be undone (standard output
+    redirected to a regular file is cut back to where the command started writing)."""
+
+    def __init__(self, inner):
+        self.inner = inner
+        self.start: int | None = None
+        try:
+            fd = inner.fileno()
+            inner.flush()
+            st = os.fstat(fd)
+            if stat.S_ISREG(st.st_mode):
+                import fcntl
+
+                appending = fcntl.fcntl(fd, fcntl.F_GETFL) & os.O_APPEND
+                self.start = st.st_size if appending else os.lseek(fd, 0, os.SEEK_CUR)
+        except (AttributeError, OSError, ValueError, ImportError):
+            pass  # not a file descriptor (a test's capture), or no fcntl: nothing to undo
+
+    def write(self, text: str) -> int:
+        try:
+            return self.inner.write(text)
+        except BrokenPipeError:
+            raise
+        except OSError as exc:
+            raise StdoutError(_stdout_message(exc)) from None
+
+    def flush(self) -> None:
+        try:
+            self.inner.flush()
+        except BrokenPipeError:
+            raise
+        except OSError as exc:
+            raise StdoutError(_stdout_message(exc)) from None
+
+    def discard(self, truncate: bool = True) -> None:
+        """Drop what could not be written: cut a regular file back to where this command
+        started, and point the descriptor at /dev/null so that the interpreter's own flush
+        at exit neither fails again nor prints a second message."""
+        try:
+            fd = self.inner.fileno()
+        except (AttributeError, OSError, ValueError):
+            return
+        try:
+            if truncate and self.start is not None:
+                os.ftruncate(fd, self.start)
+            null = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(null, fd)
+            os.close(null)
+        except OSError:
+            pass
+
+    def __getattr__(self, name: str):
+        return getattr(self.inner, name)
+
+
+def _stdout_message(exc: OSError) -> str:
+    return (f"cannot write to standard output: {exc.strerror or exc}; the output is "
+            "incomplete and was discarded")
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

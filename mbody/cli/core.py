@@ -1,0 +1,106 @@
+"""check, assemble, solve: the model, its equations and its accelerations."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+from mbody.cli.common import EXIT_OK, load_model, parse_known
+from mbody.errors import MbodyError
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    s = sub.add_parser("check", help="validate a model and summarise it (graph, mobility)",
+                       description="Validate MODEL and print its bodies, loads, joints, "
+                       "reaction unknowns, body/joint graph and mobility count.")
+    s.add_argument("model", metavar="MODEL", help="a YAML model file")
+    s.set_defaults(run=check)
+
+    s = sub.add_parser("assemble", help="print every body's free body and Newton-Euler pair",
+                       description="For every body: its free-body list and its Newton and "
+                       "Euler equations with numbers filled in and reactions named; then the "
+                       "sizes of the stacked M, b, Q, G.")
+    s.add_argument("model", metavar="MODEL", help="a YAML model file")
+    s.add_argument("--body", metavar="NAME", help="only this body")
+    s.add_argument("--latex", metavar="FILE", nargs="?", const="-",
+                   help="write a LaTeX document (each body's pair, the stacked system) to "
+                   "FILE, or to standard output without FILE")
+    s.set_defaults(run=assemble)
+
+    s = sub.add_parser("solve", help="accelerations of every body and the unknown reactions",
+                       description="Accelerations of every body. Reaction values given in "
+                       "the file or with --known are applied as loads; the unknown ones are "
+                       "solved together with the accelerations (M v_dot - G lambda = Q - b, "
+                       "G^T v_dot = gamma) and printed as a reaction table, with the backward "
+                       "error, a condition estimate and any redundant constraints named.")
+    s.add_argument("model", metavar="MODEL", help="a YAML model file")
+    s.add_argument("--known", metavar="LABEL=VALUE", action="append", default=[],
+                   help="a known reaction value, e.g. --known A.Fx=3 (repeatable)")
+    s.add_argument("--json", action="store_true", help="machine-readable output")
+    s.set_defaults(run=solve)
+
+
+def check(a: argparse.Namespace) -> int:
+    from mbody.equations.assemble import assemble as _assemble
+    from mbody.equations.constraints import joint_errors
+    from mbody.model.graph import topology
+    from mbody.present.text import model_summary
+
+    model = load_model(a.model, warn=False)  # the summary lists the warnings itself
+    # the rank test from G's columns: dense blocks, no scipy.sparse (start-up time)
+    topo = topology(model, columns=_assemble(model).columns if model.reactions else None)
+    print(model_summary(model, topo))
+    broken = joint_errors(model, model.initial)
+    if broken:
+        print("warning: the initial state breaks joint constraints: " + ", ".join(broken)
+              + "; move or set the bodies' positions and velocities so the joints hold",
+              file=sys.stderr)
+    print(f"\nOK: {a.model} is a valid model.")
+    return EXIT_OK
+
+
+def assemble(a: argparse.Namespace) -> int:
+    from mbody.equations.assemble import assemble as _assemble
+    from mbody.present.text import assembly_text, body_text
+
+    model = load_model(a.model)
+    asm = _assemble(model)
+    if a.latex is not None:
+        from mbody.cli.export import latex
+
+        return latex(asm, a.latex, a.body)
+    if a.body:
+        try:
+            print(body_text(asm.bodies[a.body], model.dimension))
+        except KeyError as exc:
+            raise MbodyError(exc.args[0]) from None
+    else:
+        print(assembly_text(asm))
+    return EXIT_OK
+
+
+def solve(a: argparse.Namespace) -> int:
+    from mbody.equations.assemble import assemble as _assemble
+    from mbody.present.text import reaction_table_text, solution_text
+
+    model = load_model(a.model)
+    asm = _assemble(model)
+    sol = asm.solve(known=parse_known(a.known), condition=True)
+    if a.json:
+        acc = sol.accelerations.tolist()
+        by_body = {name: {model.coordinates[r]: acc[r] for r in model.body_rows(i)}
+                   for i, name in enumerate(model.body_names)}
+        json.dump({"model": model.name, "coordinates": sol.coordinates,
+                   "accelerations": acc, "by_body": by_body, "reactions": dict(sol.reactions),
+                   "solved": list(sol.solved), "not_unique": list(sol.not_unique),
+                   "backward_error": sol.residual, "condition": sol.condition,
+                   "warnings": sol.warnings},
+                  sys.stdout, indent=2)
+        print()
+    else:
+        print(solution_text(sol, model))
+        if sol.reactions:
+            print()
+            print(reaction_table_text(asm, sol))
+    return EXIT_OK

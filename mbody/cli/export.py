@@ -1,0 +1,92 @@
+"""export: M, b, Q, G with their label maps to npz / .mat / JSON / CSV; LaTeX for assemble."""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import sys
+
+from mbody.cli.common import EXIT_OK, load_model, parse_known, regular_file
+from mbody.errors import MbodyError, OutputError
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    s = sub.add_parser(
+        "export", help="write M, b, Q, G with row/column labels (npz, .mat, JSON, CSV)",
+        description="Write the stacked equations M v_dot + b = Q + G lambda of MODEL at its "
+        "initial state (or at a sample of a trajectory file) with the label of every row and "
+        "column, each reaction column's joint, bodies, component, direction and sign, the "
+        "body masses and inertias, and the conventions. The format follows the suffix: "
+        ".npz (numpy; reload with mbody.load_export), .mat (MATLAB/Octave; M and G sparse), "
+        ".json (validates against mbody/data/assembly.schema.json); --csv DIR writes tables.")
+    s.add_argument("model", metavar="MODEL", help="a YAML model file")
+    s.add_argument("-o", "--output", metavar="FILE", action="append", default=[],
+                   help="output file ending in .npz, .mat or .json (repeatable)")
+    s.add_argument("--csv", metavar="DIR", help="write CSV tables into this folder")
+    s.add_argument("--state", metavar="RUN", help="take the state from this trajectory file "
+                   "(written by 'mbody simulate -o RUN.npz')")
+    s.add_argument("--time", metavar="T", type=float, help="with --state: use the stored "
+                   "sample nearest to time T in seconds (default: the last sample); samples "
+                   "are not interpolated")
+    s.add_argument("--known", metavar="LABEL=VALUE", action="append", default=[],
+                   help="a known reaction value recorded in the export, e.g. --known A.Fx=3")
+    s.set_defaults(run=export)
+
+
+def export(a: argparse.Namespace) -> int:
+    from mbody.equations.assemble import assemble
+    from mbody.io.export import assembly_from_trajectory, exported, write_csv, write_export
+
+    if not a.output and not a.csv:
+        raise MbodyError("nothing to write: give -o FILE (.npz, .mat or .json) and/or "
+                         "--csv DIR")
+    if a.time is not None and not a.state:
+        raise MbodyError("--time needs --state RUN (a trajectory file)")
+    model = load_model(a.model)
+    if a.state:
+        regular_file(a.state, "a run file written by 'mbody simulate -o RUN.npz'")
+        asm, source = assembly_from_trajectory(model, a.state, a.time)
+    else:
+        asm, source = assemble(model), ""
+    exp = exported(asm, parse_known(a.known), source)
+    N, m = len(exp.coordinates), len(exp.reactions)
+    for out in a.output:
+        with _writing(out):
+            print(f"wrote {write_export(exp, out)}")
+    if a.csv:
+        with _writing(a.csv):
+            print(f"wrote {write_csv(exp, a.csv)}/ (M.csv, G.csv, vectors.csv, columns.csv, "
+                  "bodies.csv, info.csv)")
+    print(f"M {N}x{N} ({exp.M.nnz} non-zeros), b {N}, Q {N}, G {N}x{m} "
+          f"({exp.G.nnz} non-zeros); state: {exp.state_source}")
+    return EXIT_OK
+
+
+def latex(asm, target: str, body: str | None = None) -> int:
+    """`mbody assemble MODEL --latex [FILE]`: the LaTeX document to FILE (or stdout for -)."""
+    from mbody.io.atomic import write_atomic
+    from mbody.present.latex import document
+
+    if body is not None and body not in asm.model.index:
+        try:
+            asm.bodies[body]
+        except KeyError as exc:
+            raise MbodyError(exc.args[0]) from None
+    text = document(asm, bodies=None if body is None else [body])
+    if target == "-":
+        sys.stdout.write(text)
+    else:
+        with _writing(target):
+            print(f"wrote {write_atomic(target, text)}")
+    return EXIT_OK
+
+
+@contextlib.contextmanager
+def _writing(target: str):
+    """An operating-system error while writing `target` becomes one clear message."""
+    try:
+        yield
+    except OutputError:  # already one message naming the file
+        raise
+    except OSError as exc:
+        raise MbodyError(f"cannot write {target}: {exc.strerror or exc}") from None

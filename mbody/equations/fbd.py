@@ -1,0 +1,218 @@
+"""Free-body data and the Newton-Euler pair of one body, as plain data.
+
+A `FreeBodyDiagram` lists every force and couple on one body: applied loads, gravity
+and the reaction components of its joints, each with its point of application and its
+moment about the mass centre. `BodyEquations` pairs it with the body's rows of
+``M v̇ + b = Q + G λ`` written out as `Equation`s. Drawing lives in `draw.py`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from mbody import conventions as cv
+from mbody.conventions import APPLIED, GRAVITY, REACTION
+from mbody.equations.joints import g_block
+
+if TYPE_CHECKING:
+    from mbody.equations.assemble import Assembly
+
+
+
+@dataclass(frozen=True)
+class ForceOnBody:
+    """One force or couple on a body.
+
+    kind: 'applied', 'gravity' or 'reaction'. couple: True for a pure moment.
+    B_r: (3,) point of application from the mass centre, body axes (m).
+    W_point: (3,) the same point, world coordinates (m).
+    W_vector: (3,) the force (N) or couple (N m), world axes; for an unknown reaction,
+    its value per unit of the unknown (the component's direction).
+    B_moment: (3,) moment about the mass centre, body axes (N m); per unit for unknowns.
+    label: the reaction unknown (``A.Fx``); value: its value when known, else None.
+    """
+
+    name: str
+    kind: str
+    couple: bool
+    B_r: np.ndarray
+    W_point: np.ndarray
+    W_vector: np.ndarray
+    B_moment: np.ndarray
+    label: str = ""
+    value: float | None = None
+
+    @property
+    def unknown(self) -> bool:
+        return self.kind == REACTION and self.value is None
+
+    @property
+    def magnitude(self) -> float:
+        """|vector| (for unknown reactions, of the unit direction: 1)."""
+        return float(np.linalg.norm(self.W_vector))
+
+
+@dataclass(frozen=True)
+class FreeBodyDiagram:
+    """Everything acting on one body. `forces` in order: applied, gravity, reactions."""
+
+    body: str
+    dimension: int
+    mass: float
+    inertia: np.ndarray
+    W_position: np.ndarray
+    W_R_B: np.ndarray
+    shape: dict | None
+    forces: tuple[ForceOnBody, ...]
+    equations: tuple[Equation, ...] = ()  # the body's Newton-Euler rows, shown under drawings
+
+    @property
+    def applied(self) -> list[ForceOnBody]:
+        return [f for f in self.forces if f.kind != REACTION]
+
+    @property
+    def reactions(self) -> list[ForceOnBody]:
+        return [f for f in self.forces if f.kind == REACTION]
+
+    def draw(self, **kwargs):
+        """A matplotlib figure of this diagram (see `mbody.draw.draw_fbd`)."""
+        from mbody.present.draw import draw_fbd
+
+        return draw_fbd(self, **kwargs)
+
+    def _repr_svg_(self) -> str:  # Jupyter shows a diagram as a picture
+        from mbody.present.draw import figure_svg
+
+        return figure_svg(self.draw())
+
+
+@dataclass(frozen=True)
+class Equation:
+    """One row of ``M v̇ + b = Q + G λ``: Σ lhs[k]·k + gyro = rhs + Σ coeff·reaction.
+
+    lhs: acceleration name -> coefficient (a row of M); gyro: this row of b; rhs: this
+    row of Q; reactions: label -> coefficient (this row of G); known: label -> value.
+    """
+
+    row: str
+    lhs: dict[str, float]
+    gyro: float
+    rhs: float
+    reactions: dict[str, float]
+    known: dict[str, float] = field(default_factory=dict)
+
+    def __str__(self) -> str:
+        left = _terms([(c, k) for k, c in self.lhs.items()]) or "0"
+        if abs(self.gyro) > 0:
+            left += f" {'-' if self.gyro < 0 else '+'} {_num(abs(self.gyro))}"
+        right = _num(self.rhs) if self.rhs != 0 or not self.reactions else ""
+        for label, coef in self.reactions.items():
+            name = f"({label}={_num(self.known[label])})" if label in self.known else label
+            term = _terms([(coef, name)])
+            if not term:  # a coefficient that is rounding noise
+                continue
+            if right:
+                term = f"+ {term}" if not term.startswith("-") else f"- {term[1:]}"
+            right = f"{right} {term}".strip()
+        return f"{left} = {right or '0'}"
+
+
+@dataclass(frozen=True)
+class BodyEquations:
+    """One body's free-body diagram and its Newton-Euler pair (rows in stacking order)."""
+
+    body: str
+    fbd: FreeBodyDiagram
+    newton: tuple[Equation, ...]
+    euler: tuple[Equation, ...]
+
+    @property
+    def equations(self) -> tuple[Equation, ...]:
+        return self.newton + self.euler
+
+
+def _num(x: float) -> str:
+    x = 0.0 if abs(x) < 1e-12 else x  # rounding noise from rotations
+    s = f"{x:.6g}"
+    return "0" if s in ("-0", "0") else s
+
+
+def _terms(pairs: list[tuple[float, str]]) -> str:
+    out = ""
+    for coef, name in pairs:
+        if abs(coef) < 1e-12:  # rounding noise from rotations, not a term
+            continue
+        mag = abs(coef)
+        txt = name if _num(mag) == "1" else f"{_num(mag)} {name}"  # 0.9999999 is 1
+        if not out:
+            out = f"-{txt}" if coef < 0 else txt
+        else:
+            out += f" {'-' if coef < 0 else '+'} {txt}"
+    return out
+
+
+def body_equations(asm: Assembly, i: int) -> BodyEquations:
+    model, state = asm.model, asm.state
+    name = model.body_names[i]
+    R = state.W_R_B[i]
+    x = state.position[i]
+    forces: list[ForceOnBody] = []
+
+    con = asm.loads.contributions
+    for k in np.flatnonzero(con.body == i):
+        forces.append(ForceOnBody(con.names[k], APPLIED, bool(con.couple[k]), con.B_r[k],
+                                  x + R @ con.B_r[k],
+                                  (R @ con.B_m[k]) if con.couple[k] else con.W_f[k],
+                                  con.B_m[k]))
+    if np.any(model.gravity):
+        forces.append(ForceOnBody("gravity", GRAVITY, False, np.zeros(3), x.copy(),
+                                  model.mass[i] * model.gravity, np.zeros(3)))
+
+    t = model.reaction_table
+    cols = asm.columns
+    particle = bool(model.particle[i])
+    known = model.known_reactions_at(asm.state.t)
+    side: dict[str, float] = {}
+    for c in np.flatnonzero((t.child == i) | (t.parent == i)):
+        sign = 1.0 if t.child[c] == i else -1.0
+        six = cols.child6[c] if sign > 0 else cols.parent6[c]
+        label = t.labels[c]
+        value = known.get(label)
+        moment = bool(cols.is_moment[c])
+        W_P = x.copy() if particle else cols.W_P[c].copy()  # forces act at a particle
+        B_r = R.T @ (W_P - x)
+        per_unit = sign * cols.W_e[c]
+        scale = 1.0 if value is None else value
+        forces.append(ForceOnBody(label, REACTION, moment, B_r, W_P,
+                                  scale * per_unit, scale * six[3:], label, value))
+        side[label] = sign
+
+    J = np.zeros((3, 3)) if particle else model.J[i]  # a particle: no rotational inertia
+    fbd = FreeBodyDiagram(name, model.dimension, float(model.mass[i]), J, x.copy(),
+                          R.copy(), model.bodies[name].shape, tuple(forces))
+
+    rpb = model.rows_per_body
+    rows = cv.PLANAR_SELECT if model.dimension == cv.PLANAR else np.arange(6)
+    suffixes = cv.PLANAR_ROWS if model.dimension == cv.PLANAR else cv.SPATIAL_ROWS
+    nn = 2 if model.dimension == cv.PLANAR else 3
+    shown = nn if particle else rpb  # a particle: Newton's rows only
+    acc = [cv.ACCELERATION_NAMES[s] for s in suffixes]
+    block = np.zeros((6, 6))
+    block[:3, :3] = np.eye(3) * model.mass[i]
+    block[3:, 3:] = model.J[i]
+    block = block[np.ix_(rows, rows)]
+    # this body's rows of G, dense and without scipy.sparse (`mbody assemble` prints them)
+    Gi = g_block(model, cols, np.array([i]), np.arange(len(asm.reactions)))
+    eqs = []
+    b6, Q6 = asm._b6[i], asm._Q6[i]
+    for r in range(shown):
+        lhs = {acc[k]: float(block[r, k]) for k in range(shown) if block[r, k] != 0}
+        reac = {asm.reactions[c]: float(Gi[r, c]) for c in np.flatnonzero(Gi[r])}
+        eqs.append(Equation(f"{name}.{suffixes[r]}", lhs, float(b6[rows[r]]),
+                            float(Q6[rows[r]]), reac,
+                            {k: v for k, v in known.items() if k in reac}))
+    fbd = replace(fbd, equations=tuple(eqs))
+    return BodyEquations(name, fbd, tuple(eqs[:nn]), tuple(eqs[nn:]))

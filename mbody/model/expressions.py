@@ -1,0 +1,455 @@
+"""A small, safe parser for load expressions of time, such as ``"50*sin(2*t)"``.
+
+    expr  := term (('+' | '-') term)*
+    term  := unary (('*' | '/') unary)*
+    unary := ('+' | '-') unary | power
+    power := atom (('^' | '**') unary)?          right-associative, binds tighter than '-'
+    atom  := NUMBER | 't' | 'pi' | FUNC '(' expr ')' | '(' expr ')'
+    FUNC  := sin | cos | tan | exp | log | sqrt | abs
+
+The text is tokenised and parsed once into a tree of tuples; evaluating the tree calls
+only the numpy functions named above, so a model file can never run code (no `eval`,
+no attribute access, no names other than ``t`` and ``pi``). `Expression(t)` accepts a
+scalar or an array of times and returns a value of the same shape (vectorised over t).
+Sub-trees without ``t`` are folded into constants when compiled.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Any
+
+import numpy as np
+
+from mbody.errors import MbodyError
+
+FUNCTIONS: dict[str, Callable[[Any], Any]] = {
+    "sin": np.sin, "cos": np.cos, "tan": np.tan, "exp": np.exp,
+    "log": np.log, "sqrt": np.sqrt, "abs": np.abs,
+}
+"""The functions an expression may call (one argument each; log is the natural log)."""
+CONSTANTS = {"pi": math.pi}
+VARIABLE = "t"
+MAX_LENGTH = 1000
+"""Longest expression accepted (characters); deeper than this is not a load, it is a bug."""
+MAX_DEPTH = 100
+MAX_NUMBER = 1e100
+"""Largest number written in an expression (the model file's limit)."""
+
+_TOKEN = re.compile(r"""
+    (?P<ws>\s+)
+  | (?P<num>(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)
+  | (?P<name>[A-Za-z_][A-Za-z_0-9]*)
+  | (?P<op>\*\*|[-+*/^()])
+""", re.VERBOSE)
+
+
+class ExpressionError(MbodyError):
+    """An expression that cannot be parsed; `position` is the 0-based character index."""
+
+    def __init__(self, text: str, position: int, message: str, hint: str = ""):
+        self.text, self.position, self.reason, self.hint = text, position, message, hint
+        super().__init__(f"{message} at character {position + 1} of {text!r}"
+                         + (f" ({hint})" if hint else ""))
+
+    def caret(self) -> str:
+        """The expression with a caret under the offending character (two lines)."""
+        return f"{self.text}\n{' ' * self.position}^"
+
+
+# A node is ('num', value) | ('t',) | ('neg', a) | (op, a, b) for op in + - * / ^ |
+# ('call', name, a).
+Node = tuple
+
+
+@dataclass(frozen=True)
+class Expression:
+    """A compiled expression of t: call it with a time (scalar or array).
+
+    text: the source; tree: the parsed (constant-folded) tree; constant: True when it
+    does not depend on t (then `value` is its number).
+    """
+
+    text: str
+    tree: Node
+
+    @property
+    def constant(self) -> bool:
+        return self.tree[0] == "num"
+
+    @property
+    def value(self) -> float:
+        return float(self(0.0))
+
+    @cached_property
+    def _scalar(self) -> Callable[[float], float]:
+        return _closure(self.tree)
+
+    @cached_property
+    def program(self) -> tuple[np.ndarray, np.ndarray]:
+        """The tree in postfix order for `mbody.compiled.evaluate_program`: (codes (P,)
+        int64, numbers (P,) float64); `PROGRAM_CODES` names the codes."""
+        codes: list[int] = []
+        numbers: list[float] = []
+
+        def emit(node: Node) -> None:
+            kind = node[0]
+            if kind == "call":
+                emit(node[2])
+                codes.append(PROGRAM_CODES[node[1]])
+            else:
+                for a in node[1:]:
+                    if isinstance(a, tuple):
+                        emit(a)
+                codes.append(PROGRAM_CODES[kind])
+            numbers.append(float(node[1]) if kind == "num" else 0.0)
+
+        emit(self.tree)
+        return np.array(codes, dtype=np.int64), np.array(numbers, dtype=float)
+
+    def at(self, t: float) -> float:
+        """The value at one time t (s): the same number as `self(t)`, about twenty times
+        sooner (a tree of closures over `math`, no numpy calls; what a simulation's
+        right-hand side evaluates thousands of times). Out of the domain of `math` (1/0,
+        log of a negative number, overflow) it falls back to numpy's inf/nan."""
+        try:
+            return self._scalar(t)
+        except (ArithmeticError, ValueError):
+            return self(float(t))
+
+    def __call__(self, t: float | np.ndarray) -> float | np.ndarray:
+        # Out-of-domain values (log(-1), 1/0) become nan/inf; callers check finiteness.
+        with np.errstate(all="ignore"):
+            out = _eval(self.tree, np.asarray(t, dtype=float))
+        return np.broadcast_to(out, np.shape(t)) + 0.0 if np.ndim(t) else float(out)
+
+    def __str__(self) -> str:
+        return self.text
+
+
+def compile_expression(text: str) -> Expression:
+    """Parse `text`; raise `ExpressionError` (with the position) when it is not valid."""
+    if not isinstance(text, str):
+        raise ExpressionError(str(text), 0, "expected an expression as text")
+    if len(text) > MAX_LENGTH:
+        raise ExpressionError(text[:40] + "...", 0,
+                              f"the expression is longer than {MAX_LENGTH} characters")
+    tokens = _tokenise(text)
+    parser = _Parser(text, tokens)
+    tree = parser.expr(0)
+    kind, value, pos = parser.peek()
+    if kind != "end":
+        if value == ")":
+            raise ExpressionError(text, pos, "unmatched ')'")
+        raise ExpressionError(text, pos, f"unexpected {_describe(kind, value)}",
+                              "an operator (+ - * / ^) is missing?" if kind in ("num", "name",
+                                                                              "op") else "")
+    return Expression(text, tree)
+
+
+def _tokenise(text: str) -> list[tuple[str, str, int]]:
+    out = []
+    i = 0
+    while i < len(text):
+        m = _TOKEN.match(text, i)
+        if not m:  # reported when the parser reaches it, so errors come in reading order
+            out.append(("bad", text[i], i))
+            i += 1
+            continue
+        kind = m.lastgroup or ""
+        if kind != "ws":
+            out.append((kind, m.group(), i))
+        i = m.end()
+    out.append(("end", "", len(text)))
+    return out
+
+
+def _describe(kind: str, value: str) -> str:
+    return {"num": f"number {value}", "name": f"name '{value}'", "op": f"'{value}'",
+            "end": "end of the expression"}[kind]
+
+
+class _Parser:
+    def __init__(self, text: str, tokens: list[tuple[str, str, int]]):
+        self.text, self.tokens, self.i = text, tokens, 0
+
+    def take(self) -> tuple[str, str, int]:
+        tok = self.peek()
+        self.i += 1
+        return tok
+
+    def peek(self) -> tuple[str, str, int]:
+        kind, ch, pos = self.tokens[self.i]
+        if kind == "bad":
+            hint = {"=": "comparisons are not supported", "<": "comparisons are not supported",
+                    ">": "comparisons are not supported", ",": "functions take one argument",
+                    "[": "use ( ) for grouping", "{": "use ( ) for grouping",
+                    ".": "attribute access is not allowed"}.get(ch, "")
+            raise ExpressionError(self.text, pos, f"unexpected character {ch!r}", hint)
+        return self.tokens[self.i]
+
+    def error(self, message: str, hint: str = "", pos: int | None = None):
+        raise ExpressionError(self.text, self.peek()[2] if pos is None else pos, message, hint)
+
+    def expr(self, depth: int) -> Node:
+        if depth > MAX_DEPTH:
+            self.error(f"nesting deeper than {MAX_DEPTH} levels")
+        node = self.term(depth)
+        while self.peek()[1] in ("+", "-") and self.peek()[0] == "op":
+            op = self.take()[1]
+            node = _fold((op, node, self.term(depth)))
+        return node
+
+    def term(self, depth: int) -> Node:
+        node = self.unary(depth)
+        while self.peek()[0] == "op" and self.peek()[1] in ("*", "/"):
+            op = self.take()[1]
+            node = _fold((op, node, self.unary(depth)))
+        return node
+
+    def unary(self, depth: int) -> Node:
+        kind, value, _ = self.peek()
+        if kind == "op" and value in ("+", "-"):
+            self.take()
+            if depth > MAX_DEPTH:
+                self.error(f"nesting deeper than {MAX_DEPTH} levels")
+            operand = self.unary(depth + 1)
+            return operand if value == "+" else _fold(("neg", operand))
+        return self.power(depth)
+
+    def power(self, depth: int) -> Node:
+        base = self.atom(depth)
+        kind, value, _ = self.peek()
+        if kind == "op" and value in ("^", "**"):
+            self.take()
+            # -2^2 = -4 and 2^-1 = 0.5, as on paper.
+            return _fold(("^", base, self.unary(depth + 1)))
+        return base
+
+    def atom(self, depth: int) -> Node:
+        kind, value, pos = self.take()
+        if kind == "num":
+            x = float(value)
+            if math.isinf(x) or x > MAX_NUMBER:
+                raise ExpressionError(self.text, pos, f"the number {value} is out of range",
+                                      f"at most {MAX_NUMBER:g}, as everywhere in a model")
+            if x == 0 and value.lower().partition("e")[0].strip("0.") != "":
+                raise ExpressionError(self.text, pos, f"the number {value} is below the "
+                                      "smallest double", "it would be read as 0; write 0 if "
+                                      "that is meant")
+            node: Node = ("num", x)
+        elif kind == "name":
+            if value == VARIABLE:
+                node = ("t",)
+            elif value in CONSTANTS:
+                node = ("num", CONSTANTS[value])
+            elif value in FUNCTIONS:
+                if self.peek()[1] != "(":
+                    self.error(f"'{value}' must be followed by '('", f"write {value}(t)")
+                self.take()
+                arg = self.expr(depth + 1)
+                if self.peek()[1] != ")":
+                    self.error("expected ')'" if self.peek()[0] != "end"
+                               else "missing ')'", f"to close {value}( at character {pos + 1}")
+                self.take()
+                node = _fold(("call", value, arg))
+            else:
+                hint = ("the only variable is t (time, s)" if len(value) == 1 else
+                        "known names: t, pi, " + ", ".join(FUNCTIONS))
+                raise ExpressionError(self.text, pos, f"unknown name '{value}'", hint)
+        elif kind == "op" and value == "(":
+            node = self.expr(depth + 1)
+            if self.peek()[1] != ")":
+                self.error("missing ')'", f"to close '(' at character {pos + 1}")
+            self.take()
+        elif kind == "end":
+            raise ExpressionError(self.text, pos, "the expression ends too early"
+                                  if self.text.strip() else "the expression is empty")
+        else:
+            raise ExpressionError(self.text, pos, f"unexpected {_describe(kind, value)}")
+        # Implicit multiplication ("2t", "2(t+1)", "t sin(t)") is refused: say so.
+        nk, nv, npos = self.peek()
+        if nk in ("num", "name") or (nk == "op" and nv == "("):
+            raise ExpressionError(self.text, npos, f"unexpected {_describe(nk, nv)}",
+                                  "write '*' for multiplication, e.g. 2*t")
+        return node
+
+
+def _fold(node: Node) -> Node:
+    """Replace a node whose operands are all numbers by its value."""
+    args = [a for a in node[1:] if isinstance(a, tuple)]
+    if all(a[0] == "num" for a in args):
+        with np.errstate(all="ignore"):
+            v = float(_eval(node, np.asarray(0.0)))
+        if math.isfinite(v):  # keep 1/0 unfolded so the error surfaces where it is used
+            return ("num", v)
+    return node
+
+
+def _eval(node: Node, t: np.ndarray) -> Any:
+    kind = node[0]
+    if kind == "num":
+        return node[1]
+    if kind == "t":
+        return t
+    if kind == "neg":
+        return -_eval(node[1], t)
+    if kind == "call":
+        return FUNCTIONS[node[1]](_eval(node[2], t))
+    a, b = _eval(node[1], t), _eval(node[2], t)
+    if kind == "+":
+        return a + b
+    if kind == "-":
+        return a - b
+    if kind == "*":
+        return a * b
+    if kind == "/":
+        return np.divide(a, b)
+    return np.power(a, b)
+
+
+PROGRAM_CODES = {"num": 0, "t": 1, "neg": 2, "+": 3, "-": 4, "*": 5, "/": 6, "^": 7,
+                 "sin": 8, "cos": 9, "tan": 10, "exp": 11, "log": 12, "sqrt": 13, "abs": 14}
+"""Operation codes of `Expression.program` (postfix: operands first)."""
+
+_MATH: dict[str, Callable[[float], float]] = {
+    "sin": math.sin, "cos": math.cos, "tan": math.tan, "exp": math.exp,
+    "log": math.log, "sqrt": math.sqrt, "abs": abs,
+}
+_OPS: dict[str, Callable[[float, float], float]] = {
+    "+": float.__add__, "-": float.__sub__, "*": float.__mul__, "/": float.__truediv__,
+    "^": math.pow,
+}
+
+
+def _closure(node: Node) -> Callable[[float], float]:
+    """`_eval` of one scalar time as nested closures (built once per expression). `math`
+    raises where numpy gives inf or nan (1/0, log(-1), (-8)^(1/3), overflow): the caller
+    (`Expression.at`) then asks numpy."""
+    kind = node[0]
+    if kind == "num":
+        value = float(node[1])
+        return lambda t: value
+    if kind == "t":
+        return float
+    if kind == "neg":
+        f = _closure(node[1])
+        return lambda t: -f(t)
+    if kind == "call":
+        fn, f = _MATH[node[1]], _closure(node[2])
+        return lambda t: fn(f(t))
+    op, a, b = _OPS[kind], _closure(node[1]), _closure(node[2])
+    return lambda t: op(a(t), b(t))
+
+
+def check_finite(expr: Expression, t: float = 0.0) -> str:
+    """'' when expr(t) is finite, else a sentence saying what went wrong."""
+    v = expr(t)
+    if math.isfinite(v):
+        return ""
+    return (f"the expression gives {v} at t = {t:g} (division by zero, log or sqrt of a "
+            "negative number?)")
+
+
+CHECK_SPAN = 10.0
+"""Span, s, over which `mbody check` samples expressions: simulate's default t_end."""
+MAX_CHECK_SAMPLES = 100_001
+
+
+def check_times(t_end: float) -> np.ndarray:
+    """Times at which an expression is sampled over [0, t_end]: every millisecond, computed
+    as k / 1000 so that times such as 1, 0.1 or 2.5 are hit exactly (1/(t - 1) is infinite
+    only at t = 1 exactly); for long spans a coarser round step (2, 5 or 10 times a power
+    of ten) keeps it within `MAX_CHECK_SAMPLES` points. t_end itself is always included."""
+    step = next(m * 10.0 ** e for e in range(-3, 300) for m in (1, 2, 5)
+                if t_end / (m * 10.0 ** e) <= MAX_CHECK_SAMPLES - 1)
+    k = np.arange(int(t_end / step) + 1, dtype=float)
+    inverse = round(1 / step)  # 1000, 500, 200, ... 2: exact for every step below 1
+    t = k / inverse if step < 1 else k * step
+    t = t[t <= t_end]
+    return t if t[-1] == t_end else np.append(t, t_end)
+
+
+def first_nonfinite(expr: Expression, t_end: float) -> tuple[float, float] | None:
+    """(t, value) of the first sample of [0, t_end] (`check_times`) where `expr` is not
+    finite, or None."""
+    if expr.constant:
+        return None
+    t = check_times(float(t_end))
+    v = expr(t)
+    bad = ~np.isfinite(v)
+    if not bad.any():
+        return None
+    i = int(np.argmax(bad))
+    return float(t[i]), float(v[i])
+
+
+@dataclass(frozen=True)
+class ExpressionTable:
+    """Time-varying entries of a (k, c) table of load components.
+
+    rows, cols: (e,) where each varying entry sits; which: (e,) index into `exprs`, the
+    distinct compiled expressions (an expression shared by many loads is evaluated once).
+    """
+
+    rows: np.ndarray
+    cols: np.ndarray
+    which: np.ndarray
+    exprs: tuple[Expression, ...]
+
+    @classmethod
+    def build(cls, entries: list[tuple[int, int, Expression]]) -> ExpressionTable | None:
+        """From (row, col, expression) triples; None when there are none."""
+        if not entries:
+            return None
+        index: dict[Node, int] = {}
+        exprs: list[Expression] = []
+        which = []
+        for _, _, e in entries:
+            if e.tree not in index:
+                index[e.tree] = len(exprs)
+                exprs.append(e)
+            which.append(index[e.tree])
+        return cls(np.array([r for r, _, _ in entries], dtype=np.intp),
+                   np.array([c for _, c, _ in entries], dtype=np.intp),
+                   np.array(which, dtype=np.intp), tuple(exprs))
+
+    @cached_property
+    def program(self) -> tuple[np.ndarray, ...]:
+        """The table for `mbody.compiled.set_loads`: (rows, cols, which (e,) int64,
+        starts (u + 1,) int64 offsets of each expression's program in codes, codes (P,)
+        int64, numbers (P,) float64)."""
+        progs = [e.program for e in self.exprs]
+        starts = np.zeros(len(progs) + 1, dtype=np.int64)
+        starts[1:] = np.cumsum([len(c) for c, _ in progs])
+        return (self.rows.astype(np.int64), self.cols.astype(np.int64),
+                self.which.astype(np.int64), starts,
+                np.concatenate([c for c, _ in progs]), np.concatenate([v for _, v in progs]))
+
+    @cached_property
+    def _entries(self) -> tuple[tuple[int, int, int], ...]:
+        """(row, column, expression) per varying entry, as Python ints."""
+        return tuple(zip(self.rows.tolist(), self.cols.tolist(), self.which.tolist(),
+                         strict=True))
+
+    def apply(self, base: np.ndarray, t: float | np.ndarray) -> np.ndarray:
+        """`base` (k, c) with the varying entries set to their values at `t`.
+
+        Scalar t -> (k, c); array t of shape S -> S + (k, c).
+        """
+        if isinstance(t, float | int) or np.ndim(t) == 0:  # a simulation's right-hand side
+            out = np.array(base, dtype=float)
+            t = float(t)
+            vals = [e.at(t) for e in self.exprs]
+            for r, c, w in self._entries:
+                out[r, c] = vals[w]
+            return out
+        t = np.asarray(t, dtype=float)
+        out = np.broadcast_to(base, (*t.shape, *np.shape(base))).copy()
+        vals = np.stack([e(t) for e in self.exprs], axis=-1)  # S + (u,)
+        out[..., self.rows, self.cols] = vals[..., self.which]
+        return out

@@ -1,0 +1,232 @@
+"""The body/joint graph (networkx) and what it says about the model's topology.
+
+Nodes are the bodies and ``ground``; every joint is an edge (a MultiGraph, since two
+bodies may share several joints). Mobility counts 6 per spatial body (3 per planar
+body) minus the independent constraints: the rank of G, which is also what exposes
+redundant joints (a planar four-bar modelled in 3-D has more reaction components than
+independent constraints).
+
+`topology` needs only the connected parts, found here from the joint list directly:
+networkx (slow to import) is loaded only for `body_graph` (`Model.graph`). The rank test
+works on dense blocks of G, one per connected part; given the reaction columns (as
+`mbody check` does) it builds them with numpy alone, and its pivoted QR is numpy's for a
+part of up to `NUMPY_QR_LIMIT` components (scipy.linalg, ~0.1-0.2 s to import, only for a
+larger part that may be rank-deficient).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from mbody import conventions as cv
+from mbody.equations.joints import g_block
+
+if TYPE_CHECKING:
+    import networkx as nx
+
+    from mbody.equations.joints import ReactionColumns
+    from mbody.model.model import Model
+
+RANK_LIMIT = 1500
+"""Largest number of reaction components in one connected part whose rank is computed."""
+
+NUMPY_QR_LIMIT = 120
+"""Largest number of reaction components in one connected part whose pivoted QR is
+`pivoted_qr` (numpy); scipy.linalg.qr above (the same algorithm, LAPACK's ?geqp3, whose
+rounding decides exact ties)."""
+
+PIVOT_TIE = 1e-9
+"""Relative difference below which two remaining column norms tie in `pivoted_qr`."""
+
+
+def body_graph(model: Model) -> nx.MultiGraph:
+    import networkx as nx
+
+    g = nx.MultiGraph(name=model.name)
+    g.add_node(cv.GROUND, ground=True)
+    for name in model.body_names:
+        g.add_node(name, ground=False, mass=float(model.mass[model.index[name]]))
+    for j in model.joints:
+        g.add_edge(j.parent, j.child, key=j.name, joint=j.name, type=j.type,
+                   reactions=len(j.components))
+    return g
+
+
+@dataclass(frozen=True)
+class Topology:
+    """What the graph says: parts, loops, floating bodies and the mobility count.
+
+    parts: connected parts of the graph (ground included as a node), each a sorted list.
+    loops: independent closed loops (cyclomatic number E − V + C).
+    floating: bodies attached to nothing. grounded: bodies connected to ground.
+    constraints: reaction components in all (Grübler's count).
+    rank: independent constraints (None when too large to compute).
+    mobility: degrees of freedom (per-body freedoms minus `rank`, or minus
+    `constraints` when the rank is unknown). redundant: reaction components that are
+    linear combinations of the others (one valid choice among equivalents).
+    """
+
+    parts: list[list[str]]
+    loops: int
+    floating: list[str]
+    grounded: list[str]
+    constraints: int
+    rank: int | None
+    mobility: int
+    gruebler: int
+    redundant: list[str]
+
+    @property
+    def is_tree(self) -> bool:
+        return self.loops == 0
+
+
+def topology(model: Model, G=None, *, columns: ReactionColumns | None = None) -> Topology:
+    """Analyse the model's graph. `G` (the reaction matrix, sparse or dense) or `columns`
+    (`Assembly.columns`, from which the blocks of G are built without scipy.sparse)
+    enables the rank test."""
+    nodes = [cv.GROUND, *model.body_names]
+    edges = [(j.parent, j.child) for j in model.joints]
+    components = _components(nodes, edges)
+    parts = [sorted(c, key=lambda s: (s != cv.GROUND, s)) for c in components]
+    parts.sort(key=lambda c: (c[0] != cv.GROUND, c[0]))
+    loops = len(edges) - len(nodes) + len(components)
+    attached = {b for e in edges for b in e}
+    floating = [b for b in model.body_names if b not in attached]
+    grounded = sorted(next(c for c in components if cv.GROUND in c) - {cv.GROUND})
+    m = len(model.reactions)
+    coords = len(model.coordinates)  # a particle has translations only
+    gruebler = coords - m
+    rank, redundant = (0, []) if m == 0 else (None, [])
+    if m and (G is not None or columns is not None):
+        rank, redundant = _rank(model, G, columns)
+    mobility = coords - (rank if rank is not None else m)
+    return Topology(parts, loops, floating, grounded, m, rank, mobility, gruebler, redundant)
+
+
+def _rank(model: Model, G, columns: ReactionColumns | None) -> tuple[int | None, list[str]]:
+    """Rank of G, part by part (ground removed, so parts share no rows); G's blocks come
+    from `G` or else from `columns`."""
+    parts = _components(model.body_names, [(j.parent, j.child) for j in model.joints
+                                           if cv.GROUND not in (j.parent, j.child)])
+    t = model.reaction_table
+    rpb = model.rows_per_body
+    labels = model.reactions
+    total, redundant = 0, []
+    if G is not None and hasattr(G, "tocsc"):  # scipy.sparse
+        G = G.tocsc()
+    for part in parts:
+        idx = np.array(sorted(model.index[b] for b in part))
+        cols = np.flatnonzero(np.isin(t.child, idx))
+        if not len(cols):
+            continue
+        if len(cols) > RANK_LIMIT:
+            return None, []
+        if G is None:
+
+            A = g_block(model, columns, idx, cols)
+        else:
+            rows = (np.concatenate([model.body_rows(i) for i in idx]) if model.has_particles
+                    else (idx[:, None] * rpb + np.arange(rpb)).ravel())
+            A = (G[rows][:, cols].toarray() if hasattr(G, "toarray")
+                 else np.asarray(G, dtype=float)[np.ix_(rows, cols)])
+        if _clearly_full_column_rank(A):  # what the pivoted QR below would conclude
+            total += A.shape[1]
+            continue
+        # QR with column pivoting: the columns pivoted past the rank depend on the others.
+        if A.shape[1] <= NUMPY_QR_LIMIT:
+            d, piv = pivoted_qr(A)
+        else:
+            import scipy.linalg  # ~0.1-0.2 s to import: only for large parts
+
+            _, Rq, piv = scipy.linalg.qr(A, mode="economic", pivoting=True)
+            d = np.diag(Rq)
+        d = np.abs(d)
+        tol = (d[0] if len(d) else 0.0) * max(A.shape) * np.finfo(float).eps * 10
+        r = int(np.sum(d > tol))
+        total += r
+        redundant += [labels[cols[k]] for k in piv[r:]]
+    order = {lab: i for i, lab in enumerate(labels)}
+    return total, sorted(redundant, key=order.__getitem__)
+
+
+FULL_RANK_MARGIN = 1e-8
+"""`_clearly_full_column_rank` needs λ_min(AᵀA) > FULL_RANK_MARGIN ‖A‖_F², i.e. σ_min(A) above
+1e-4 ‖A‖_F: far above the pivoted QR's rank tolerance (‖A‖ max(m, n) ε 10) and above the
+rounding of AᵀA and of its eigenvalues (about n ε ‖A‖_F²)."""
+
+
+def _clearly_full_column_rank(A: np.ndarray) -> bool:
+    """True when A's columns are independent by a wide margin, so that the pivoted QR of
+    `_rank` would find rank = number of columns and no redundant column (every |R_kk| is at
+    least σ_min(A)). False means "not sure" (rank-deficient or nearly so): `_rank` then
+    computes the QR. Needs only numpy, not scipy.linalg, for the common case."""
+    m, n = A.shape
+    if n > m:
+        return False
+    scale = float(np.einsum("ij,ij->", A, A))
+    return 0 < scale < np.inf and float(np.linalg.eigvalsh(A.T @ A)[0]) > FULL_RANK_MARGIN * scale
+
+
+def pivoted_qr(A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """QR with column pivoting of A (m, n): (diag(R) (min(m, n),), the column order piv).
+
+    Householder QR that moves forward, at each step, the column of largest remaining norm
+    (Businger and Golub; LAPACK's ?geqp3, which scipy.linalg.qr(pivoting=True) calls,
+    is the same algorithm), so that the columns pivoted past the rank are combinations of
+    the others. Remaining norms within `PIVOT_TIE` of the largest are a tie, won by the
+    column first in A: symmetric mechanisms have exact ties, which rounding would
+    otherwise decide (differently from one BLAS build to another). The remaining norms
+    are recomputed at every step, not downdated, so that rounding stays far below
+    `PIVOT_TIE`. Numpy only: for the small blocks of `_rank`, where importing
+    scipy.linalg would cost more than everything else `mbody check` does.
+    """
+    A = np.array(A, dtype=float)
+    m, n = A.shape
+    piv = np.arange(n)
+    d = np.empty(min(m, n))
+    for i in range(len(d)):
+        rest = A[i:, i:]
+        norms = np.sqrt(np.einsum("ij,ij->j", rest, rest))
+        tied = np.flatnonzero(norms >= (1.0 - PIVOT_TIE) * norms.max())
+        p = i + tied[np.argmin(piv[i + tied])]
+        if p != i:
+            A[:, [i, p]] = A[:, [p, i]]
+            piv[[i, p]] = piv[[p, i]]
+        # Householder reflector H = I - tau v vᵀ (v[0] = 1) taking A[i:, i] to (beta, 0, ...)
+        alpha = A[i, i]
+        xnorm = float(np.sqrt(A[i + 1:, i] @ A[i + 1:, i]))
+        if xnorm == 0.0:
+            d[i] = alpha
+            continue
+        beta = -np.copysign(np.hypot(alpha, xnorm), alpha)
+        d[i] = beta
+        if i + 1 < n:
+            v = np.concatenate(([1.0], A[i + 1:, i] / (alpha - beta)))
+            A[i:, i + 1:] -= np.outer(((beta - alpha) / beta) * v, v @ A[i:, i + 1:])
+    return d, piv
+
+
+def _components(nodes: Iterable[str], edges: Iterable[tuple[str, str]]) -> list[set[str]]:
+    """Connected components of the graph with these nodes and edges (union-find), as
+    networkx's `connected_components` gives them (node sets; their order is not used)."""
+    root = {n: n for n in nodes}
+
+    def find(n: str) -> str:
+        while root[n] != n:
+            root[n] = root[root[n]]
+            n = root[n]
+        return n
+
+    for a, b in edges:
+        ra, rb = find(a), find(b)
+        if ra != rb:
+            root[rb] = ra
+    out: dict[str, set[str]] = {}
+    for n in root:
+        out.setdefault(find(n), set()).add(n)
+    return list(out.values())

@@ -1,0 +1,536 @@
+"""`Model` (what the file says, as arrays) and `State` (where the bodies are and how fast).
+
+A `Model` is immutable and holds no state: masses ``(n,)``, inertia tensors ``(n, 3, 3)``
+in body axes, and the loads and joints as tables of index arrays, so that everything
+downstream is vectorised over bodies. Planar bodies are stored as spatial ones in the
+world x-y plane (see `conventions`).
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field, replace
+from functools import cached_property
+from typing import Any
+
+import numpy as np
+
+from mbody import conventions as cv
+from mbody.equations.plan import ModelPlan
+from mbody.equations.spatial import joint_frame_planar, joint_frame_spatial, quat_to_matrix
+from mbody.errors import Issue
+from mbody.model.expressions import Expression, ExpressionTable
+from mbody.model.graph import body_graph
+from mbody.model.loader import Document, load_file, load_text
+from mbody.model.validate import Spec, validate
+
+
+def _ro(a: np.ndarray) -> np.ndarray:
+    a = np.ascontiguousarray(a, dtype=float)
+    a.flags.writeable = False
+    return a
+
+
+@dataclass(frozen=True)
+class State:
+    """Positions and velocities of all bodies; every array has a leading body axis.
+
+    position: (n, 3) mass centres, world frame [m]
+    quaternion: (n, 4) body-to-world rotations W_R_B, [w, x, y, z]
+    velocity: (n, 3) mass-centre velocities, world frame [m/s]
+    omega: (n, 3) angular velocities, body axes [rad/s]
+    t: time [s] (for time-dependent loads)
+    """
+
+    position: np.ndarray
+    quaternion: np.ndarray
+    velocity: np.ndarray
+    omega: np.ndarray
+    t: float = 0.0
+
+    @cached_property
+    def W_R_B(self) -> np.ndarray:
+        """(n, 3, 3) body-to-world rotation matrices."""
+        return quat_to_matrix(self.quaternion)
+
+    def replace(self, **changes: Any) -> State:
+        return replace(self, **changes)
+
+    @classmethod
+    def planar(cls, position: np.ndarray, angle: np.ndarray, velocity: np.ndarray,
+               angular_velocity: np.ndarray, t: float = 0.0) -> State:
+        """A planar state from (n, 2) positions, (n,) angles, (n, 2) velocities, (n,) θ̇."""
+        n = len(angle)
+        pos = np.zeros((n, 3))
+        pos[:, :2] = position
+        vel = np.zeros((n, 3))
+        vel[:, :2] = velocity
+        q = np.zeros((n, 4))
+        q[:, 0] = np.cos(np.asarray(angle) / 2)
+        q[:, 3] = np.sin(np.asarray(angle) / 2)
+        om = np.zeros((n, 3))
+        om[:, 2] = angular_velocity
+        return cls(pos, q, vel, om, t)
+
+
+@dataclass(frozen=True)
+class Body:
+    """One rigid body as given in the file (a read-only view of the model's arrays)."""
+
+    name: str
+    index: int
+    mass: float  # kg
+    inertia: np.ndarray  # (3, 3) body axes about the mass centre, kg m^2 (planar: I_G at [2, 2])
+    shape: dict[str, Any] | None
+    color: str | None
+    particle: bool = False
+    """A point mass (`inertia: 0`): translation rows only; `inertia` holds a dummy."""
+
+    @property
+    def I_G(self) -> float:
+        """Planar moment of inertia about the mass centre (the z-z entry)."""
+        return float(self.inertia[2, 2])
+
+
+@dataclass(frozen=True)
+class Load:
+    """An applied load as given in the file: force, torque or spring."""
+
+    name: str
+    type: str
+    bodies: tuple[str, ...]
+    vector: np.ndarray | None  # force or torque, in `frame`, 3-D
+    frame: str
+    at: tuple[np.ndarray, ...]  # attachment points: body axes (world for ground)
+    stiffness: float = 0.0
+    rest_length: float = 0.0
+    damping: float = 0.0
+    expressions: dict[int, Expression] = field(default_factory=dict)
+    """Components of `vector` that vary in time (3-D index -> expression of t);
+    `vector` holds their values at t = 0."""
+
+
+@dataclass(frozen=True)
+class Joint:
+    """A joint: its reaction components and its frame at the initial pose."""
+
+    name: str
+    type: str
+    parent: str
+    child: str
+    at: np.ndarray  # (3,) world, initial pose
+    W_E0: np.ndarray  # (3, 3) joint frame at the initial pose, axes as columns (world)
+    components: tuple[str, ...]
+    axis: np.ndarray | None = None
+    axis2: np.ndarray | None = None
+    particle_joint: str = ""
+    """With a particle at an end: "pin" or "link" (see docs "Particles"); else ""."""
+
+    @property
+    def labels(self) -> list[str]:
+        return [f"{self.name}.{k}" for k in self.components]
+
+
+@dataclass(frozen=True)
+class ForceTable:
+    """Point forces and couples, one row per load (vectorised application).
+
+    body: (k,) body index; vector: (k, 3) force or torque components in its frame;
+    in_body: (k,) True when the components are in body axes; B_r: (k, 3) point of
+    application from the mass centre, body axes; couple: (k,) True for torques.
+    """
+
+    names: tuple[str, ...]
+    body: np.ndarray
+    vector: np.ndarray
+    in_body: np.ndarray
+    B_r: np.ndarray
+    couple: np.ndarray
+    varying: ExpressionTable | None = None
+    """Entries of `vector` given as expressions of t (None: every load is constant)."""
+
+    def vector_at(self, t: float | np.ndarray) -> np.ndarray:
+        """(k, 3) load components at time `t` (constant loads: `vector` itself).
+
+        An array of times of shape S gives S + (k, 3); each distinct expression is
+        evaluated once per call, with numpy.
+        """
+        if self.varying is None:
+            if isinstance(t, float | int) or np.ndim(t) == 0:
+                return self.vector
+            return np.broadcast_to(self.vector, (*np.shape(t), *self.vector.shape))
+        return self.varying.apply(self.vector, t)
+
+
+@dataclass(frozen=True)
+class SpringTable:
+    """Linear spring-dampers; index -1 is ground (its point is then in world axes).
+
+    a, b: (k,) end bodies; r_a, r_b: (k, 3) attachment points (body axes, world for
+    ground); stiffness, rest_length, damping: (k,).
+    """
+
+    names: tuple[str, ...]
+    a: np.ndarray
+    b: np.ndarray
+    r_a: np.ndarray
+    r_b: np.ndarray
+    stiffness: np.ndarray
+    rest_length: np.ndarray
+    damping: np.ndarray
+
+
+@dataclass(frozen=True)
+class ReactionTable:
+    """One row per reaction unknown (column of G), in label order.
+
+    joint: (m,) joint index; parent, child: (m,) body index (-1 = ground);
+    axis: (m,) 0-2 force along joint axis k, 3-5 moment about joint axis k-3,
+    6 the universal joint's moment about axis × axis2.
+    P_E: (m, 3) the column's joint axis fixed in the parent (body axes; world for ground);
+    B_r_child: (m, 3) the joint point on the child, child body axes;
+    C_axis2: (m, 3) a universal joint's child axis, child body axes (else 0).
+    B_r_parent: (m, 3) the joint point on the parent, parent body axes (world for ground).
+    P_E3, C_E3: (m, 3, 3) the whole joint frame fixed in the parent and in the child
+    (they coincide at the initial pose); used for position-level constraint errors.
+    rot_kind: (m,) for moment components: 1 = about an axis ⟂ a free rotation (revolute,
+    cylindrical: measured by the tilt of the joint z axis), 2 = all rotation locked
+    (fixed, prismatic: small rotation vector), 3 = universal; 0 for forces.
+    link: (m,) True for a particle link's tension T (axis −1): the force along the line
+    from the child's attachment point to the parent's, constraint |P_c − P_p| = L.
+    particle_parent: (m,) True when the parent is a particle (its moment rows stay 0).
+    length: (m,) the link's length L (0 for other components).
+    """
+
+    labels: tuple[str, ...]
+    joint: np.ndarray
+    parent: np.ndarray
+    child: np.ndarray
+    axis: np.ndarray
+    P_E: np.ndarray
+    B_r_child: np.ndarray
+    C_axis2: np.ndarray
+    B_r_parent: np.ndarray
+    P_E3: np.ndarray
+    C_E3: np.ndarray
+    rot_kind: np.ndarray
+    link: np.ndarray
+    particle_parent: np.ndarray
+    length: np.ndarray
+
+
+@dataclass(frozen=True)
+class JointTable:
+    """Per joint (J of them), what the reaction table repeats per component.
+
+    parent, child: (J,) body index (-1 = ground); B_r_child, B_r_parent: (J, 3) the joint
+    point in each body's axes (world for ground); P_E3, C_E3: (J, 3, 3) the joint frame
+    fixed in the parent and in the child; C_axis2: (J, 3) a universal joint's child axis.
+    first: (J,) the joint's first column of G (its components are consecutive).
+    link: (J,) a particle link (its first component is T); particle_parent: (J,) the
+    parent is a particle; length: (J,) the link's length (0 otherwise).
+    """
+
+    parent: np.ndarray
+    child: np.ndarray
+    B_r_child: np.ndarray
+    B_r_parent: np.ndarray
+    P_E3: np.ndarray
+    C_E3: np.ndarray
+    C_axis2: np.ndarray
+    first: np.ndarray
+    link: np.ndarray
+    particle_parent: np.ndarray
+    length: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class Model:
+    """A validated multibody model: bodies, applied loads and joints, as arrays.
+
+    mass: (n,) kg. J: (n, 3, 3) inertia tensors, body axes, about the mass centres.
+    J_inv: (n, 3, 3) their inverses. gravity: (3,) world, m/s^2.
+    """
+
+    name: str
+    file: str
+    dimension: int
+    body_names: tuple[str, ...]
+    mass: np.ndarray
+    J: np.ndarray
+    J_inv: np.ndarray
+    gravity: np.ndarray
+    initial: State
+    bodies: dict[str, Body]
+    loads: tuple[Load, ...]
+    joints: tuple[Joint, ...]
+    forces: ForceTable
+    springs: SpringTable
+    reaction_table: ReactionTable
+    known_reactions: dict[str, float]
+    description: str = ""
+    warnings: tuple[Issue, ...] = field(default_factory=tuple)
+    known_expressions: dict[str, Expression] = field(default_factory=dict)
+    """Known reaction values that vary in time (label -> expression of t)."""
+
+    def __repr__(self) -> str:  # the dataclass's would print every array (2-9 KB)
+        kind = "planar" if self.dimension == cv.PLANAR else "spatial"
+        bodies = _names(self.body_names)
+        return (f"<Model {self.name!r}: {kind}, {count(self.n, 'body', 'bodies')} "
+                f"({bodies}), {count(len(self.loads), 'load')}, "
+                f"{count(len(self.joints), 'joint')}, "
+                f"{count(len(self.reactions), 'reaction component')}; mbody.assemble(model) "
+                "for its equations>")
+
+    def known_reactions_at(self, t: float) -> dict[str, float]:
+        """The known reaction values at time `t` (`known_reactions` holds t = 0)."""
+        if not self.known_expressions:
+            return dict(self.known_reactions)
+        return {**self.known_reactions,
+                **{k: float(e(t)) for k, e in self.known_expressions.items()}}
+
+    # -- sizes and labels --------------------------------------------------------------
+    @property
+    def n(self) -> int:
+        """Number of bodies."""
+        return len(self.body_names)
+
+    @property
+    def rows_per_body(self) -> int:
+        return cv.rows_per_body(self.dimension)
+
+    @cached_property
+    def particle(self) -> np.ndarray:
+        """(n,) True for the point masses (`inertia: 0`)."""
+        return np.array([self.bodies[b].particle for b in self.body_names], dtype=bool)
+
+    @cached_property
+    def has_particles(self) -> bool:
+        return bool(self.particle.any())
+
+    @cached_property
+    def all_coordinates(self) -> list[str]:
+        """The solver's uniform rows: `rows_per_body` per body, particles included."""
+        return cv.coordinate_labels(list(self.body_names), self.dimension)
+
+    @cached_property
+    def rows(self) -> np.ndarray:
+        """Indices into `all_coordinates` of the rows shown (`coordinates`): a particle's
+        rotation rows are dropped (they carry nothing: its ω stays 0)."""
+        rpb = self.rows_per_body
+        keep = np.ones((self.n, rpb), dtype=bool)
+        keep[self.particle, cv.rows_per_body(self.dimension) - (1 if self.dimension
+                                                                   == cv.PLANAR else 3):] = False
+        return np.flatnonzero(keep.reshape(-1))
+
+    @cached_property
+    def coordinates(self) -> list[str]:
+        """Row labels of the stacked equations (a particle has translation rows only)."""
+        if not self.has_particles:
+            return self.all_coordinates
+        full = self.all_coordinates
+        return [full[i] for i in self.rows]
+
+    def body_rows(self, i: int) -> np.ndarray:
+        """Indices into `coordinates` of body i's rows."""
+        if not self.has_particles:
+            rpb = self.rows_per_body
+            return np.arange(i * rpb, (i + 1) * rpb)
+        rpb = self.rows_per_body
+        return np.flatnonzero((self.rows >= i * rpb) & (self.rows < (i + 1) * rpb))
+
+    @cached_property
+    def reactions(self) -> list[str]:
+        """Reaction labels, the column order of G (do not modify the list)."""
+        return list(self.reaction_table.labels)
+
+    @cached_property
+    def minv6(self) -> np.ndarray | None:
+        """(n, 6) diagonal of M⁻¹ per body [1/m ×3, 1/J11, 1/J22, 1/J33] when every
+        inertia tensor is diagonal in body axes (principal axes given); else None."""
+        off = self.J - np.einsum("nii->ni", self.J)[:, :, None] * np.eye(3)
+        if np.any(off):
+            return None
+        out = np.empty((self.n, 6))
+        out[:, :3] = 1.0 / self.mass[:, None]
+        out[:, 3:] = 1.0 / np.einsum("nii->ni", self.J)
+        return out
+
+    @cached_property
+    def joint_table(self) -> JointTable:
+        t = self.reaction_table
+        first = np.unique(t.joint, return_index=True)[1] if len(t.joint) else np.zeros(0, int)
+        return JointTable(t.parent[first], t.child[first], t.B_r_child[first],
+                          t.B_r_parent[first], t.P_E3[first], t.C_E3[first],
+                          t.C_axis2[first], first, t.link[first], t.particle_parent[first],
+                          t.length[first])
+
+    @cached_property
+    def reaction_index(self) -> dict[str, int]:
+        """reaction label -> column of G."""
+        return {r: i for i, r in enumerate(self.reaction_table.labels)}
+
+    @cached_property
+    def index(self) -> dict[str, int]:
+        return {n: i for i, n in enumerate(self.body_names)}
+
+    @cached_property
+    def plan(self):  # -> mbody.plan.ModelPlan: what every evaluation needs, made once
+        """The model's evaluation plan (`mbody.plan.ModelPlan`), made on first use."""
+
+        return ModelPlan(self)
+
+    @cached_property
+    def graph(self):  # -> networkx.MultiGraph; imported lazily, it is slow to import
+
+        return body_graph(self)
+
+    @classmethod
+    def from_spec(cls, spec: Spec) -> Model:
+        return _build(spec)
+
+
+def load(source: str | os.PathLike[str] | dict, *, max_bytes: int | None = None) -> Model:
+    """Read, validate and build a model; raises `mbody.ModelError` listing every problem.
+
+    `source` is a path to a YAML file, or a dict with the same content (for scripts).
+    """
+    if isinstance(source, dict):
+        doc = Document(source, "<dict>")
+    else:
+        doc = load_file(source, **({"max_bytes": max_bytes} if max_bytes else {}))
+    return Model.from_spec(validate(doc))
+
+
+def loads(text: str, file: str = "<string>") -> Model:
+    """Like `load`, from YAML text."""
+    return Model.from_spec(validate(load_text(text, file)))
+
+
+def _build(spec: Spec) -> Model:
+    bs = spec.bodies
+    n = len(bs)
+    names = tuple(b.name for b in bs)
+    idx = {nm: i for i, nm in enumerate(names)}
+    mass = np.array([b.mass for b in bs], dtype=float)
+    J = np.array([b.inertia for b in bs], dtype=float).reshape(n, 3, 3)
+    J_inv = np.linalg.inv(J)
+    initial = State(
+        _ro(np.array([b.position for b in bs]).reshape(n, 3)),
+        _ro(np.array([b.quaternion for b in bs]).reshape(n, 4)),
+        _ro(np.array([b.velocity for b in bs]).reshape(n, 3)),
+        _ro(np.array([b.omega for b in bs]).reshape(n, 3)),
+    )
+    bodies = {b.name: Body(b.name, i, b.mass, _ro(J[i]), b.shape, b.color, b.particle)
+              for i, b in enumerate(bs)}
+    particle = {b.name for b in bs if b.particle}
+
+    loads = tuple(Load(ld.name, ld.type, ld.bodies, ld.vector, ld.frame, ld.at,
+                       ld.stiffness, ld.rest_length, ld.damping, dict(ld.expressions))
+                  for ld in spec.loads)
+    point = [ld for ld in spec.loads if ld.type in ("force", "torque")]
+    forces = ForceTable(
+        tuple(ld.name for ld in point),
+        np.array([idx[ld.bodies[0]] for ld in point], dtype=np.intp),
+        _ro(np.array([ld.vector for ld in point]).reshape(-1, 3)),
+        np.array([ld.frame == "body" for ld in point], dtype=bool),
+        _ro(np.array([ld.at[0] for ld in point]).reshape(-1, 3)),
+        np.array([ld.type == "torque" for ld in point], dtype=bool),
+        ExpressionTable.build([(row, k, e) for row, ld in enumerate(point)
+                               for k, e in ld.expressions.items()]),
+    )
+    sp = [ld for ld in spec.loads if ld.type == "spring"]
+    springs = SpringTable(
+        tuple(ld.name for ld in sp),
+        np.array([idx.get(ld.bodies[0], -1) for ld in sp], dtype=np.intp),
+        np.array([idx.get(ld.bodies[1], -1) for ld in sp], dtype=np.intp),
+        _ro(np.array([ld.at[0] for ld in sp]).reshape(-1, 3)),
+        _ro(np.array([ld.at[1] for ld in sp]).reshape(-1, 3)),
+        _ro(np.array([ld.stiffness for ld in sp], dtype=float)),
+        _ro(np.array([ld.rest_length for ld in sp], dtype=float)),
+        _ro(np.array([ld.damping for ld in sp], dtype=float)),
+    )
+
+    R0 = initial.W_R_B
+    joints = []
+    rows: dict[str, list] = {k: [] for k in ("labels", "joint", "parent", "child", "axis",
+                                              "P_E", "B_r_child", "C_axis2", "B_r_parent",
+                                              "P_E3", "C_E3", "rot_kind", "link",
+                                              "particle_parent", "length")}
+    for jn, js in enumerate(spec.joints):
+        kind = js.particle_joint
+        comps = (cv.PARTICLE_COMPONENTS[spec.dimension][js.type][kind] if kind
+                 else cv.JOINT_COMPONENTS[spec.dimension][js.type])
+        W_E0 = (joint_frame_planar(js.axis) if spec.dimension == cv.PLANAR
+                else joint_frame_spatial(js.axis))
+        joints.append(Joint(js.name, js.type, js.parent, js.child, _ro(js.at), _ro(W_E0),
+                            comps, js.axis, js.axis2, kind))
+        p, c = idx.get(js.parent, -1), idx[js.child]
+        P_E = W_E0 if p < 0 else R0[p].T @ W_E0  # joint frame fixed in the parent
+        B_r_child = R0[c].T @ (js.at - initial.position[c])
+        C_axis2 = R0[c].T @ js.axis2 if js.axis2 is not None else np.zeros(3)
+        B_r_parent = js.at if p < 0 else R0[p].T @ (js.at - initial.position[p])
+        # a particle end is attached at the particle itself (no offset, no moment)
+        if js.child in particle:
+            B_r_child = np.zeros(3)
+        if js.parent in particle:
+            B_r_parent = np.zeros(3)
+        length = 0.0
+        if kind == "link":  # attachment points: the particle(s), else the joint point
+            P_c = initial.position[c] + R0[c] @ B_r_child
+            P_p = B_r_parent if p < 0 else initial.position[p] + R0[p] @ B_r_parent
+            length = float(np.linalg.norm(P_c - P_p))
+        C_E = R0[c].T @ W_E0
+        free_turn = js.type in ("revolute", "cylindrical")
+        for comp in comps:
+            k = (6 if comp == "Mt" else cv.LINK_AXIS if comp == cv.LINK
+                 else cv.COMPONENTS.index(comp))
+            rows["link"].append(k == cv.LINK_AXIS)
+            rows["particle_parent"].append(js.parent in particle)
+            rows["length"].append(length if k == cv.LINK_AXIS else 0.0)
+            rows["labels"].append(f"{js.name}.{comp}")
+            rows["joint"].append(jn)
+            rows["parent"].append(p)
+            rows["child"].append(c)
+            rows["axis"].append(k)
+            # Mt's direction is recomputed from both bodies; store axis (z) for it.
+            rows["P_E"].append(P_E[:, 2] if k == 6 else P_E[:, k % 3])
+            rows["B_r_child"].append(B_r_child)
+            rows["C_axis2"].append(C_axis2)
+            rows["B_r_parent"].append(B_r_parent)
+            rows["P_E3"].append(P_E)
+            rows["C_E3"].append(C_E)
+            rows["rot_kind"].append(0 if k < 3 else 3 if k == 6 else 1 if free_turn else 2)
+    table = ReactionTable(
+        tuple(rows["labels"]),
+        np.array(rows["joint"], dtype=np.intp),
+        np.array(rows["parent"], dtype=np.intp),
+        np.array(rows["child"], dtype=np.intp),
+        np.array(rows["axis"], dtype=np.intp),
+        _ro(np.array(rows["P_E"]).reshape(-1, 3)),
+        _ro(np.array(rows["B_r_child"]).reshape(-1, 3)),
+        _ro(np.array(rows["C_axis2"]).reshape(-1, 3)),
+        _ro(np.array(rows["B_r_parent"]).reshape(-1, 3)),
+        _ro(np.array(rows["P_E3"]).reshape(-1, 3, 3)),
+        _ro(np.array(rows["C_E3"]).reshape(-1, 3, 3)),
+        np.array(rows["rot_kind"], dtype=np.intp),
+        np.array(rows["link"], dtype=bool),
+        np.array(rows["particle_parent"], dtype=bool),
+        _ro(np.array(rows["length"], dtype=float)),
+    )
+    return Model(spec.name, spec.file, spec.dimension, names, _ro(mass), _ro(J), _ro(J_inv),
+                 _ro(spec.gravity), initial, bodies, loads, tuple(joints), forces, springs,
+                 table, dict(spec.reactions), spec.description, tuple(spec.warnings),
+                 dict(spec.reaction_expressions))
+
+
+def _names(names, most: int = 5) -> str:
+    """The first `most` names, and how many more (for short reprs)."""
+    names = list(names)
+    more = len(names) - most
+    return ", ".join(names[:most]) + (f", … {more} more" if more > 0 else "")
+
+
+def count(k: int, word: str, plural: str = "") -> str:
+    """'1 body', '3 bodies' (for short reprs)."""
+    return f"{k} {word if k == 1 else plural or word + 's'}"

@@ -1,0 +1,1002 @@
+"""Every rule of the model-file contract, checked at the boundary.
+
+`validate(doc)` walks the loaded document once, collects every problem as an `Issue`
+with the file, line and column of the offending key or value, and raises one
+`ModelError` listing them all. On success it returns a `Spec`: the file's content
+normalised (defaults filled in, angles in radians, planar vectors padded to 3-D) and
+ready for `Model` to turn into arrays. Hot paths downstream carry no checks.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from mbody import conventions as cv
+from mbody.equations.spatial import euler_to_quat, matrix_to_quat, shape_inertia
+from mbody.errors import Issue, ModelError, did_you_mean
+from mbody.model.expressions import (
+    CHECK_SPAN,
+    Expression,
+    ExpressionError,
+    check_finite,
+    compile_expression,
+    first_nonfinite,
+)
+from mbody.model.loader import Document, Path_, Unrepresentable, dotted
+
+TOP_KEYS = ("model", "dimension", "gravity", "bodies", "loads", "joints", "reactions",
+            "description")
+BODY_KEYS = ("name", "mass", "inertia", "position", "orientation", "angle", "velocity",
+             "angular_velocity", "shape", "color")
+LOAD_KEYS = {
+    "force": ("name", "type", "body", "force", "at", "frame"),
+    "torque": ("name", "type", "body", "torque", "frame"),
+    "spring": ("name", "type", "bodies", "at", "stiffness", "rest_length", "damping"),
+}
+JOINT_KEYS = ("name", "type", "parent", "child", "at", "axis", "axis2")
+ORIENTATION_KEYS = ("quaternion", "euler", "sequence", "matrix")
+SHAPES = {
+    cv.PLANAR: ("box", "disc", "ellipsoid", "sphere", "cylinder"),
+    cv.SPATIAL: ("box", "cylinder", "sphere", "ellipsoid", "disc"),
+}
+FRAMES = ("world", "body")
+DEFAULT_EULER_SEQUENCE = "ZYX"
+"""Intrinsic z-y'-x'' (yaw, pitch, roll), scipy's upper-case convention."""
+
+_REQUIRED_HINTS = {
+    ("", "dimension"): "2 for a planar model, 3 for a spatial one",
+    ("", "bodies"): "a list of bodies, each with at least name, mass and inertia",
+    ("bodies", "name"): "a name without spaces or dots",
+    ("bodies", "mass"): "the mass in kg, a number > 0",
+    ("loads", "body"): "the name of the body it acts on",
+    ("loads", "force"): "the force components, N",
+    ("loads", "torque"): "the couple, N m",
+    ("loads", "bodies"): "the two ends: [body, body] or [ground, body]",
+    ("loads", "at"): "the two attachment points: body axes, or world for ground",
+    ("loads", "stiffness"): "N/m, a number >= 0",
+    ("joints", "name"): "a name without spaces or dots; reactions are <name>.Fx ...",
+    ("joints", "type"): "the kind of joint, such as revolute",
+    ("joints", "parent"): "a body name or ground",
+    ("joints", "child"): "a body name",
+    ("joints", "at"): "the joint point, world coordinates at the initial pose",
+}
+"""Hints for missing required keys, by (top-level section, key)."""
+_ANGLE = re.compile(r"\s*([-+]?[0-9.eE+-]+)\s*(deg|rad)\s*")
+_RATE = re.compile(r"\s*([-+]?[0-9.eE+-]+)\s*(deg/s|rad/s)\s*")
+_TOL = 1e-6
+MAX_MAGNITUDE = 1e100
+"""Largest number accepted: squares and triple products must stay finite in float64."""
+MIN_MAGNITUDE = 1e-100
+"""Smallest nonzero magnitude accepted: reciprocals (1/m, J^-1) and products of three such
+numbers stay normal doubles (a denormal mass such as 5e-324 has no reciprocal)."""
+MAX_ANGLE = 1e9
+"""Largest angle accepted, rad (about 160 million turns): a double resolves 1e9 to 1e-7
+rad, and sin/cos of a larger number say little about the pose meant."""
+
+
+@dataclass
+class BodySpec:
+    name: str
+    mass: float
+    inertia: np.ndarray  # (3, 3) body axes about the mass centre
+    position: np.ndarray  # (3,) world
+    quaternion: np.ndarray  # (4,) w first, body to world
+    velocity: np.ndarray  # (3,) world
+    omega: np.ndarray  # (3,) body axes
+    shape: dict[str, Any] | None
+    color: str | None
+    line: int
+    particle: bool = False
+    """`inertia: 0`: a point mass (translation only; see docs "Particles")."""
+
+
+@dataclass
+class LoadSpec:
+    name: str
+    type: str
+    bodies: tuple[str, ...]
+    vector: np.ndarray | None = None  # force or torque, 3-D
+    frame: str = "world"
+    at: tuple[np.ndarray, ...] = ()  # body axes (world for ground), 3-D
+    stiffness: float = 0.0
+    rest_length: float = 0.0
+    damping: float = 0.0
+    line: int = 0
+    expressions: dict[int, Expression] = field(default_factory=dict)
+    """Time-varying components of `vector`: component index -> expression of t."""
+
+
+@dataclass
+class JointSpec:
+    name: str
+    type: str
+    parent: str
+    child: str
+    at: np.ndarray  # (3,) world, initial pose
+    axis: np.ndarray | None
+    axis2: np.ndarray | None
+    line: int = 0
+    particle_joint: str = ""
+    """With a particle at an end: "pin" (the joint point is at the particle(s)) or "link"
+    (a massless rigid link from the joint point to the particle); "" otherwise."""
+
+
+@dataclass
+class Spec:
+    name: str
+    file: str
+    dimension: int
+    gravity: np.ndarray
+    bodies: list[BodySpec]
+    loads: list[LoadSpec]
+    joints: list[JointSpec]
+    reactions: dict[str, float]
+    description: str = ""
+    warnings: list[Issue] = field(default_factory=list)
+    reaction_expressions: dict[str, Expression] = field(default_factory=dict)
+    """Known reaction values given as expressions of t (their t = 0 value is in reactions)."""
+
+
+class _Checker:
+    def __init__(self, doc: Document):
+        self.doc = doc
+        self.issues: list[Issue] = []
+        self.warnings: list[Issue] = []
+        self.dim = cv.SPATIAL
+        self.body_names: dict[str, int] = {}
+        """Every body with a valid name, even one with other problems (for references)."""
+        self.joint_types: dict[str, str] = {}
+        self.particle_joints: dict[str, str] = {}  # joint name -> "pin" or "link"
+        """Every joint with a valid name and type, even one with other problems."""
+        self.particles: set[str] = set()
+        """Names of the bodies given `inertia: 0` (point masses)."""
+
+    # -- reporting -------------------------------------------------------------------
+    def err(self, path: Path_, message: str, hint: str = "", *, key: bool = False) -> None:
+        line, col = self.doc.where(path, key=key)
+        self.issues.append(Issue(self.doc.file, line, col, dotted(path), message, hint))
+
+    def warn(self, path: Path_, message: str, hint: str = "") -> None:
+        line, col = self.doc.where(path)
+        self.warnings.append(Issue(self.doc.file, line, col, dotted(path), message, hint))
+
+    # -- shapes of values --------------------------------------------------------------
+    def mapping(self, path: Path_, value: Any, allowed: tuple[str, ...],
+                required: tuple[str, ...] = (), what: str = "a mapping") -> bool:
+        if not isinstance(value, dict):
+            self.err(path, f"expected {what}, got {_kind(value)}")
+            return False
+        meant = set()  # keys a misspelling points at: their "missing" would repeat it
+        for k in value:
+            if k not in allowed:
+                hint = did_you_mean(k, allowed)
+                if hint:
+                    meant.add(hint.split("'")[1])
+                self.err((*path, k), f"unknown key '{k}'",
+                         hint or f"expected one of: {', '.join(allowed)}", key=True)
+        for k in required:
+            if k not in value and k not in meant:
+                section = str(path[0]) if path else ""
+                self.err(path, f"missing required key '{k}'",
+                         _REQUIRED_HINTS.get((section, k), ""))
+        return True
+
+    def number(self, path: Path_, value: Any, *, positive: bool = False,
+               nonneg: bool = False, scale: bool = False) -> float | None:
+        """A finite number within ±`MAX_MAGNITUDE`; with `scale` (a mass or a size, which
+        is divided by) also 0 or at least `MIN_MAGNITUDE` in magnitude."""
+        if isinstance(value, Unrepresentable):  # 1e400, 1e-400, a 5 000-digit integer
+            self._out_of_range(path, value.shown, value.large)  # never silently 0 or inf
+            return None
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            self.err(path, f"expected a number, got {_kind(value)}", _number_hint(value))
+            return None
+        try:
+            x = float(value)
+        except OverflowError:  # an integer with hundreds of digits (from a dictionary)
+            self._out_of_range(path, _show(value), True)
+            return None
+        if not math.isfinite(x):
+            self.err(path, f"expected a finite number, got {x}")
+            return None
+        if abs(x) > MAX_MAGNITUDE:
+            self._out_of_range(path, _show(value), True)
+            return None
+        if scale and 0 < abs(x) < MIN_MAGNITUDE:
+            self._too_small(path, _show(value))
+            return None
+        if positive and x <= 0:
+            self.err(path, f"expected a number > 0, got {_show(value)}")
+            return None
+        if nonneg and x < 0:
+            self.err(path, f"expected a number >= 0, got {_show(value)}")
+            return None
+        return x
+
+    def _out_of_range(self, path: Path_, shown: str, large: bool) -> None:
+        if large:
+            self.err(path, f"expected a number of magnitude at most {MAX_MAGNITUDE:g}, got "
+                     f"{shown}", "products of such numbers (r x F, m r^2) would overflow")
+        else:  # written in the file: not even a double holds it
+            self.err(path, f"expected a number a double can hold, got {shown}",
+                     "below about 5e-324 it would be read as 0; write 0 if that is meant")
+
+    def _too_small(self, path: Path_, shown: str) -> None:
+        self.err(path, f"expected a magnitude of at least {MIN_MAGNITUDE:g}, got {shown}",
+                 "masses and sizes are divided by; a smaller one would leave double precision")
+
+    def angle(self, path: Path_, value: Any, rate: bool = False) -> float | None:
+        """An angle (rad, or a string with deg/rad), or with `rate` an angular rate."""
+        if isinstance(value, str):
+            m = (_RATE if rate else _ANGLE).fullmatch(value)
+            unit = "deg/s" if rate else "deg"
+            if not m:
+                self.err(path, f"expected a number (radians{'/s' if rate else ''}) or a string "
+                         f"like '30 {unit}', got '{_show(value)}'", _angle_hint(value, unit))
+                return None
+            try:
+                x = float(m.group(1))
+            except ValueError:
+                self.err(path, f"'{_show(value)}' is not a number followed by a unit")
+                return None
+            x = self.number(path, Unrepresentable(m.group(1)) if math.isinf(x) else x)
+            if x is None:
+                return None
+            x = math.radians(x) if m.group(2).startswith("deg") else x
+        else:
+            x = self.number(path, value)
+            if x is None:
+                return None
+        if not rate and abs(x) > MAX_ANGLE:
+            self.err(path, f"expected an angle of at most {MAX_ANGLE:g} rad in magnitude, got "
+                     f"{x:g} rad", "a double cannot resolve the pose of a larger angle; "
+                     "reduce it by whole turns")
+            return None
+        return x
+
+    def vector(self, path: Path_, value: Any, n: int, *, angles: bool = False,
+               rates: bool = False, scale: bool = False) -> np.ndarray | None:
+        if not isinstance(value, list):
+            self.err(path, f"expected a list of {n} numbers, got {_kind(value)}")
+            return None
+        if len(value) != n:
+            self.err(path, f"expected {n} components, got {len(value)}",
+                     "planar models use 2-D vectors" if n == 2 and len(value) == 3 else
+                     "spatial models use 3-D vectors" if n == 3 and len(value) == 2 else "")
+            return None
+        out = []
+        for i, v in enumerate(value):
+            x = (self.angle((*path, i), v, rate=rates) if angles or rates
+                 else self.number((*path, i), v, scale=scale))
+            if x is None:
+                return None
+            out.append(x)
+        return np.array(out, dtype=float)
+
+    def vec3(self, path: Path_, value: Any, rates: bool = False) -> np.ndarray | None:
+        """A d-vector from the file, returned padded to 3-D (planar z = 0)."""
+        v = self.vector(path, value, self.dim, rates=rates)
+        if v is None:
+            return None
+        return np.append(v, 0.0) if self.dim == cv.PLANAR else v
+
+    def matrix3(self, path: Path_, value: Any) -> np.ndarray | None:
+        if not (isinstance(value, list) and len(value) == 3
+                and all(isinstance(r, list) for r in value)):
+            self.err(path, f"expected a 3x3 matrix (a list of 3 rows), got {_kind(value)}")
+            return None
+        rows = [self.vector((*path, i), r, 3) for i, r in enumerate(value)]
+        if any(r is None for r in rows):
+            return None
+        return np.array(rows)
+
+    def name(self, path: Path_, value: Any, what: str) -> str | None:
+        if not isinstance(value, str) or not value.strip():
+            self.err(path, f"expected a {what} name (text), got {_kind(value)}")
+            return None
+        if "." in value or any(c.isspace() for c in value):
+            self.err(path, f"the {what} name '{_show(value)}' may not contain '.' or spaces",
+                     "reaction labels are written <joint>.<component>")
+            return None
+        return value
+
+    def choice(self, path: Path_, value: Any, choices: tuple[str, ...], what: str) -> str | None:
+        if not isinstance(value, str) or value not in choices:
+            self.err(path, f"unknown {what} {_quoted(value)}",
+                     did_you_mean(value, choices) or f"expected one of: {', '.join(choices)}")
+            return None
+        return value
+
+    def body_ref(self, path: Path_, value: Any, names: dict[str, int],
+                 allow_ground: bool) -> str | None:
+        if isinstance(value, str) and (value in names or allow_ground and value == cv.GROUND):
+            return value  # the common case first: a dict lookup, not a list of every name
+        choices = list(names) + ([cv.GROUND] if allow_ground else [])
+        if value == cv.GROUND and not allow_ground:
+            self.err(path, "'ground' is not allowed here", "name a body of the model")
+            return None
+        hint = did_you_mean(value, choices) if isinstance(value, str) else ""
+        self.err(path, f"no body named {_quoted(value)}",
+                 hint or f"bodies are: {', '.join(choices[:12])}"
+                 + (" ..." if len(choices) > 12 else ""))
+        return None
+
+
+def _missing(*values: Any) -> bool:
+    return any(v is None for v in values)
+
+
+def _kind(value: Any) -> str:
+    if value is None:
+        return "nothing (null)"
+    if isinstance(value, bool):
+        return f"a boolean ({str(value).lower()})"
+    if isinstance(value, int | float | Unrepresentable):
+        return f"the number {_show(value)}"
+    if isinstance(value, str):
+        return f"the text '{_show(value)}'"
+    if isinstance(value, list):
+        return f"a list of {len(value)}"
+    if isinstance(value, dict):
+        return "a mapping"
+    return type(value).__name__
+
+
+_DECIMAL_COMMA = re.compile(r"\s*([-+]?\d+),(\d+)\s*")
+_WITH_UNIT = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*"
+                        r"([A-Za-zµ°][A-Za-z0-9µ°/^·²³ .-]*)")
+_ANGLE_WORDS = re.compile(r"\s*([-+]?[\d.eE+-]+)\s*(°|degrees?|degs|grad|radians?)(\s*/\s*s)?\s*",
+                          re.IGNORECASE)
+
+
+def _number_hint(value: Any) -> str:
+    """What was probably meant by text where a number goes: '1,5', '1.5 kg'."""
+    if not isinstance(value, str):
+        return ""
+    m = _DECIMAL_COMMA.fullmatch(value)
+    if m:
+        return f"a decimal comma? write {m.group(1)}.{m.group(2)}"
+    m = _WITH_UNIT.fullmatch(value)
+    if m and len(value) < 40:
+        return f"numbers are in SI units, written without the unit: {m.group(1)}"
+    return ""
+
+
+def _angle_hint(value: str, unit: str) -> str:
+    """'30°', '30 degrees' -> write '30 deg'."""
+    m = _ANGLE_WORDS.fullmatch(value)
+    if not m:
+        return _number_hint(value)
+    word = "rad" if m.group(2).lower().startswith("rad") else "deg"
+    return f"write '{m.group(1)} {word}{unit[3:]}'"
+
+
+def _quoted(value: Any) -> str:
+    """`value` as repr() shows it, cut short (text is quoted, numbers are not)."""
+    return repr(_show(value)) if isinstance(value, str) else _show(value)
+
+
+def _show(value: Any, limit: int = 60) -> str:
+    """`value` for a message: long text cut short, huge integers by their size."""
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) >= 10**15:
+        if value.bit_length() > 1000:  # beyond a double: its size says enough
+            return f"an integer of about {int(value.bit_length() * 0.30103) + 1} digits"
+        return f"{value:.6g}"
+    text = value if isinstance(value, str) else repr(value)
+    return text if len(text) <= limit else text[:limit - 3] + "..."
+
+
+def validate(doc: Document) -> Spec:
+    """Check `doc` against the contract; return the normalised `Spec` or raise ModelError."""
+    c = _Checker(doc)
+    data = doc.data
+    if not c.mapping((), data, TOP_KEYS, ("dimension", "bodies"), what="a model mapping"):
+        raise ModelError(c.issues)
+
+    dim = data.get("dimension")
+    if dim not in (2, 3) or isinstance(dim, bool):
+        if "dimension" in data:
+            c.err(("dimension",), f"expected 2 (planar) or 3 (spatial), got {_kind(dim)}")
+        # Every vector length depends on the dimension: checking on would only add noise.
+        raise ModelError(c.issues)
+    c.dim = int(dim)
+    name = data.get("model", None)
+    if name is None:
+        name = doc.file.rsplit("/", 1)[-1].removesuffix(".yaml").removesuffix(".yml")
+    elif not isinstance(name, str):
+        c.err(("model",), f"expected the model's name as text, got {_kind(name)}")
+    description = data.get("description", "")
+    if not isinstance(description, str):
+        c.err(("description",), f"expected text, got {_kind(description)}")
+        description = ""
+
+    gravity = np.zeros(3)
+    if data.get("gravity") is not None:
+        g = c.vec3(("gravity",), data["gravity"])
+        gravity = g if g is not None else gravity
+
+    bodies = _bodies(c, data.get("bodies"))
+    # A body with a bad mass is still a body: references to it are not problems too.
+    names = c.body_names
+    loads = _loads(c, data.get("loads"), names)
+    joints = _joints(c, data.get("joints"), names, bodies)
+    reaction_expressions: dict[str, Expression] = {}
+    reactions = _reactions(c, data.get("reactions"), joints, reaction_expressions)
+
+    if c.issues:  # in file order, as an editor goes through them
+        raise ModelError(sorted(c.issues, key=lambda i: i.line))
+    return Spec(str(name), doc.file, c.dim, gravity, bodies, loads, joints, reactions,
+                description, c.warnings, reaction_expressions)
+
+
+def _list(c: _Checker, path: Path_, value: Any, what: str, required: bool) -> list:
+    if value is None:
+        if required and path[-1] in c.doc.data:  # absent: already reported as missing
+            c.err(path, f"expected a list of {what}, got nothing")
+        return []
+    if not isinstance(value, list):
+        c.err(path, f"expected a list of {what}, got {_kind(value)}")
+        return []
+    if required and not value:
+        c.err(path, f"the model needs at least one of the {what}")
+    return value
+
+
+def _bodies(c: _Checker, value: Any) -> list[BodySpec]:
+    out: list[BodySpec] = []
+    seen: dict[str, int] = c.body_names
+    for i, b in enumerate(_list(c, ("bodies",), value, "bodies", True)):
+        p: Path_ = ("bodies", i)
+        if not c.mapping(p, b, BODY_KEYS, ("name", "mass"), "a body mapping"):
+            continue
+        name = c.name((*p, "name"), b.get("name"), "body") if "name" in b else None
+        if name == cv.GROUND:
+            c.err((*p, "name"), "'ground' is reserved for the fixed world frame")
+            name = None
+        if name is not None and name in seen:
+            c.err((*p, "name"), f"duplicate body name '{name}'",
+                  f"first used by bodies[{seen[name]}]")
+        elif name is not None:
+            seen[name] = i
+        mass = (c.number((*p, "mass"), b.get("mass"), positive=True, scale=True)
+                if "mass" in b else None)
+        shape = _shape(c, (*p, "shape"), b["shape"]) if "shape" in b else None
+        inertia = None
+        particle = "inertia" in b and _zero_inertia(b["inertia"])
+        if particle:  # a dummy inertia inside the solver; nothing turns it (docs: Particles)
+            inertia = np.eye(3) * (mass if mass is not None else 1.0)
+        elif "inertia" in b:
+            inertia = _inertia(c, (*p, "inertia"), b["inertia"])
+        elif "mass" in b:
+            if shape is None:
+                if "shape" not in b:
+                    c.err(p, "missing required key 'inertia'",
+                          "give 'inertia', or a 'shape' to use a uniform solid's inertia")
+            elif mass is not None:
+                I = shape_inertia(shape, mass, c.dim)
+                inertia = (np.diag([I[0] / 2, I[0] / 2, I[0]]) if c.dim == cv.PLANAR
+                           else np.diag(I))
+        if inertia is not None and not particle:
+            inertia = _reciprocable(c, (*p, "inertia" if "inertia" in b else "shape"), inertia)
+        zero = np.zeros(3)
+        pos = c.vec3((*p, "position"), b["position"]) if "position" in b else zero
+        vel = c.vec3((*p, "velocity"), b["velocity"]) if "velocity" in b else zero
+        q = np.array([1.0, 0.0, 0.0, 0.0])
+        omega = zero
+        if c.dim == cv.PLANAR:
+            if "orientation" in b:
+                c.err((*p, "orientation"), "planar bodies give their angle with 'angle'",
+                      "write angle: 0.3 or angle: '30 deg'", key=True)
+            if "angle" in b:
+                th = c.angle((*p, "angle"), b["angle"])
+                if th is not None:
+                    q = np.array([math.cos(th / 2), 0.0, 0.0, math.sin(th / 2)])
+            if "angular_velocity" in b:
+                w = c.angle((*p, "angular_velocity"), b["angular_velocity"], rate=True)
+                omega = np.array([0.0, 0.0, w if w is not None else 0.0])
+        else:
+            if "angle" in b:
+                c.err((*p, "angle"), "spatial bodies give their attitude with 'orientation'",
+                      "write orientation: {euler: [0, 0, 0.3], sequence: ZYX}", key=True)
+            if "orientation" in b:
+                qq = _orientation(c, (*p, "orientation"), b["orientation"])
+                q = qq if qq is not None else q
+            if "angular_velocity" in b:
+                w3 = c.vector((*p, "angular_velocity"), b["angular_velocity"], 3, rates=True)
+                omega = w3 if w3 is not None else zero
+        if particle:
+            _particle_pose(c, p, b, q, omega)
+        color = b.get("color")
+        if color is not None and not isinstance(color, str):
+            c.err((*p, "color"), f"expected a colour name or '#rrggbb', got {_kind(color)}")
+            color = None
+        if _missing(name, mass, inertia, pos, vel):
+            continue
+        out.append(BodySpec(name, mass, inertia, pos, q, vel, omega, shape, color,
+                            c.doc.where(p)[0], particle))
+        if particle:
+            c.particles.add(name)
+    return out
+
+
+def _particle_pose(c: _Checker, p: Path_, b: dict, q: np.ndarray, omega: np.ndarray) -> None:
+    """A particle (inertia 0) has no orientation and no angular velocity."""
+    hint = "a particle (inertia: 0) has no orientation; remove the key, or give the body an inertia"
+    if np.any(q[1:] != 0.0):
+        key = "angle" if c.dim == cv.PLANAR else "orientation"
+        c.err((*p, key), f"a particle (inertia: 0) cannot have a nonzero {key}", hint)
+    if np.any(omega != 0.0):
+        c.err((*p, "angular_velocity"), "a particle (inertia: 0) cannot have a nonzero "
+              "angular_velocity", hint)
+
+
+def _zero_inertia(value: Any) -> bool:
+    """`inertia: 0` (planar or spatial), [0, 0, 0] or a 3x3 zero matrix: a particle."""
+    def zero(x: Any) -> bool:
+        return (not isinstance(x, bool) and isinstance(x, int | float)
+                and not isinstance(x, Unrepresentable) and x == 0)
+    if zero(value):
+        return True
+    if isinstance(value, list) and len(value) == 3:
+        return all(zero(x) for x in value) or all(
+            isinstance(r, list) and len(r) == 3 and all(zero(x) for x in r) for r in value)
+    return False
+
+
+def _inertia(c: _Checker, path: Path_, value: Any) -> np.ndarray | None:
+    if c.dim == cv.PLANAR:
+        I = c.number(path, value, positive=True) if not isinstance(value, list) else None
+        if isinstance(value, list):
+            c.err(path, "a planar body's inertia is the scalar I_G about its mass centre "
+                  f"(kg m^2), got {_kind(value)}")
+        return None if I is None else np.diag([I / 2, I / 2, I])
+    if isinstance(value, list) and value and all(isinstance(r, list) for r in value):
+        J = c.matrix3(path, value)
+        if J is None:
+            return None
+        scale = float(np.max(np.abs(J))) or 1.0
+        if np.max(np.abs(J - J.T)) > _TOL * scale:
+            i, j = np.unravel_index(np.argmax(np.abs(J - J.T)), J.shape)
+            c.err(path, f"the inertia tensor is not symmetric: row {i + 1}, column {j + 1} "
+                  f"is {J[i, j]:g} but row {j + 1}, column {i + 1} is {J[j, i]:g}",
+                  "entry (i, j) must equal entry (j, i)")
+            return None
+        principal = np.linalg.eigvalsh(J)
+    else:
+        v = c.vector(path, value, 3) if isinstance(value, list) else None
+        if not isinstance(value, list):
+            c.err(path, "expected principal moments [I1, I2, I3] or a 3x3 inertia tensor, "
+                  f"got {_kind(value)}")
+        if v is None:
+            return None
+        J, principal = np.diag(v), v
+    if np.any(principal <= 0):
+        c.err(path, "the inertia tensor is not positive definite "
+              f"(principal moments {_fmt(principal)})", "every principal moment must be > 0")
+        return None
+    a, b, d = np.sort(principal)
+    if a + b < d * (1 - _TOL):
+        c.err(path, f"the inertia is not physically realisable: the principal moments "
+              f"{_fmt(principal)} break the triangle inequality ({a:g} + {b:g} < {d:g})",
+              "every moment must be <= the sum of the other two")
+        return None
+    return J
+
+
+def _reciprocable(c: _Checker, path: Path_, J: np.ndarray) -> np.ndarray | None:
+    """`J` unless a principal moment is nonzero but below `MIN_MAGNITUDE` (5e-324, or a
+    tiny mass times a tiny shape): its inverse, used in every solve, would overflow."""
+    moments = [J[2, 2]] if c.dim == cv.PLANAR else np.linalg.eigvalsh(J)
+    tiny = [m for m in moments if 0 < abs(m) < MIN_MAGNITUDE]
+    if not tiny:
+        return J
+    c.err(path, f"a moment of inertia of {tiny[0]:.3g} kg m^2 is below "
+          f"{MIN_MAGNITUDE:g}", "its inverse would leave double precision; give a "
+          "realistic value")
+    return None
+
+
+def _fmt(v: np.ndarray) -> str:
+    return "(" + ", ".join(f"{x:g}" for x in v) + ")"
+
+
+def _orientation(c: _Checker, path: Path_, value: Any) -> np.ndarray | None:
+    if not c.mapping(path, value, ORIENTATION_KEYS, what="an orientation mapping"):
+        return None
+    given = [k for k in ("quaternion", "euler", "matrix") if k in value]
+    if len(given) != 1:
+        c.err(path, "give exactly one of 'quaternion', 'euler' or 'matrix'"
+              + (f" (got {', '.join(given)})" if given else ""))
+        return None
+    kind = given[0]
+    if "sequence" in value and kind != "euler":
+        c.err((*path, "sequence"), "'sequence' goes with 'euler'",
+              "remove it, or give the angles as euler: [a, b, c]", key=True)
+    if kind == "quaternion":
+        q = c.vector((*path, "quaternion"), value["quaternion"], 4)
+        if q is None:
+            return None
+        n = float(np.linalg.norm(q))
+        if n < 1e-12:
+            c.err((*path, "quaternion"), "the quaternion is zero", "identity is [1, 0, 0, 0]")
+            return None
+        if abs(n - 1) > 1e-6:
+            c.warn((*path, "quaternion"), f"the quaternion has norm {n:.6g}; it was normalised")
+        return q / n
+    if kind == "euler":
+        seq = value.get("sequence", DEFAULT_EULER_SEQUENCE)
+        if not (isinstance(seq, str) and len(seq) == 3 and (seq.isupper() or seq.islower())
+                and set(seq.lower()) <= set("xyz") and seq[0] != seq[1] and seq[1] != seq[2]):
+            c.err((*path, "sequence"), f"invalid Euler sequence {_quoted(seq)}",
+                  "three axes such as ZYX (intrinsic, upper case) or zyx (extrinsic, lower "
+                  "case), no axis twice in a row")
+            return None
+        ang = c.vector((*path, "euler"), value["euler"], 3, angles=True)
+        return None if ang is None else euler_to_quat(ang, seq)
+    R = c.matrix3((*path, "matrix"), value["matrix"])
+    if R is None:
+        return None
+    off, det = float(np.max(np.abs(R.T @ R - np.eye(3)))), float(np.linalg.det(R))
+    if off > _TOL or det < 0:
+        c.err((*path, "matrix"), "not a rotation matrix: "
+              + (f"R^T R differs from I by up to {off:.3g}" if off > _TOL else "")
+              + ("; " if off > _TOL and det < 0 else "")
+              + (f"determinant {det:.3g} (a reflection)" if det < 0 else ""),
+              "it must be orthonormal (R^T R = I within 1e-6) with determinant +1")
+        return None
+    return matrix_to_quat(R)
+
+
+def _shape(c: _Checker, path: Path_, value: Any) -> dict[str, Any] | None:
+    allowed = SHAPES[c.dim]
+    if not c.mapping(path, value, allowed, what="a shape mapping such as {box: [a, b, c]}"):
+        return None
+    if any(k not in allowed for k in value):  # already reported, with a did-you-mean
+        return None
+    if len(value) != 1:
+        c.err(path, f"give exactly one shape, one of: {', '.join(allowed)}")
+        return None
+    kind, v = next(iter(value.items()))
+    p = (*path, kind)
+    if kind == "box" or kind == "ellipsoid":
+        n = c.dim
+        vec = c.vector(p, v, n, scale=True)
+        if vec is None:
+            return None
+        if np.any(vec <= 0):
+            c.err(p, "every size must be > 0")
+            return None
+        return {kind: [float(x) for x in vec]}
+    keys = ("radius", "length") if kind == "cylinder" else ("radius",)
+    if not c.mapping(p, v, keys, keys, f"a mapping with {' and '.join(keys)}"):
+        return None
+    out = {}
+    for k in keys:
+        x = c.number((*p, k), v.get(k), positive=True, scale=True) if k in v else None
+        if x is None:
+            return None
+        out[k] = x
+    return {kind: out}
+
+
+def _loads(c: _Checker, value: Any, names: dict[str, int]) -> list[LoadSpec]:
+    out: list[LoadSpec] = []
+    seen: dict[str, int] = {}
+    counters: dict[str, int] = {}
+    items = _list(c, ("loads",), value, "loads", False)
+    given = {ld["name"] for ld in items if isinstance(ld, dict) and isinstance(ld.get("name"), str)}
+    for i, ld in enumerate(items):
+        p: Path_ = ("loads", i)
+        if not isinstance(ld, dict):
+            c.err(p, f"expected a load mapping, got {_kind(ld)}")
+            continue
+        if "type" not in ld:
+            c.err(p, "missing required key 'type'", "one of: force, torque, spring")
+            continue
+        typ = c.choice((*p, "type"), ld["type"], tuple(LOAD_KEYS), "load type")
+        if typ is None:
+            continue
+        counters[typ] = counters.get(typ, 0) + 1
+        required = {"force": ("body", "force"), "torque": ("body", "torque"),
+                    "spring": ("bodies", "at", "stiffness")}[typ]
+        c.mapping(p, ld, LOAD_KEYS[typ], required)
+        if "name" in ld:
+            name = c.name((*p, "name"), ld["name"], "load")
+        else:  # <type><n>, never a name the file gives to another load
+            name = f"{typ}{counters[typ]}"
+            while name in given or name in seen:
+                counters[typ] += 1
+                name = f"{typ}{counters[typ]}"
+        if name is not None and name in seen:
+            c.err((*p, "name"), f"duplicate load name '{name}'",
+                  f"first used by loads[{seen[name]}]")
+        elif name is not None:
+            seen[name] = i
+        line = c.doc.where(p)[0]
+        if typ in ("force", "torque"):
+            body = c.body_ref((*p, "body"), ld["body"], names, False) if "body" in ld else None
+            frame = ld.get("frame", "world")
+            frame = c.choice((*p, "frame"), frame, FRAMES, "frame")
+            exprs: dict[int, Expression] = {}
+            if typ == "force":
+                vec = (_varying(c, (*p, "force"), ld["force"], exprs, _Checker.vec3)
+                       if "force" in ld else None)
+                at = c.vec3((*p, "at"), ld["at"]) if "at" in ld else np.zeros(3)
+            else:
+                vec = (_varying(c, (*p, "torque"), ld["torque"], exprs, _torque)
+                       if "torque" in ld else None)
+                at = np.zeros(3)
+            if body in c.particles:
+                if typ == "torque":
+                    c.err((*p, "type"), f"a torque cannot act on the particle '{body}'",
+                          "a particle (inertia: 0) has no rotation; only forces at the "
+                          "particle act on it")
+                    continue
+                if at is not None and np.any(at != 0.0):
+                    c.err((*p, "at"), f"a force on the particle '{body}' acts at the particle",
+                          "remove 'at' (or give [0, 0]): a particle has no extent")
+                    continue
+                if frame == "body":
+                    c.err((*p, "frame"), f"the particle '{body}' has no body axes",
+                          "give the force in world axes (frame: world)")
+                    continue
+            if _missing(name, body, frame, vec, at):
+                continue
+            out.append(LoadSpec(name, typ, (body,), vec, frame, (at,), line=line,
+                                expressions=exprs))
+        else:
+            pair = ld.get("bodies")
+            refs: list[str | None] = []
+            if not (isinstance(pair, list) and len(pair) == 2):
+                if "bodies" in ld:
+                    c.err((*p, "bodies"), f"expected two body names (or ground), got "
+                          f"{_kind(pair)}")
+            else:
+                refs = [c.body_ref((*p, "bodies", k), pair[k], names, True) for k in (0, 1)]
+                if refs[0] is not None and refs[0] == refs[1]:
+                    c.err((*p, "bodies"), "a spring needs two different ends")
+                    refs = []
+            at = ld.get("at")
+            pts: list[np.ndarray | None] = []
+            if not (isinstance(at, list) and len(at) == 2):
+                if "at" in ld:
+                    c.err((*p, "at"), "expected two attachment points "
+                          "[[..body axes or world for ground..], [..]]")
+            else:
+                pts = [c.vec3((*p, "at", k), at[k]) for k in (0, 1)]
+                for k in (0, 1):
+                    if (len(refs) == 2 and refs[k] in c.particles and pts[k] is not None
+                            and np.any(pts[k] != 0.0)):
+                        c.err((*p, "at", k), f"a spring attaches to the particle "
+                              f"'{refs[k]}' at the particle", "give [0, 0] (body axes): a "
+                              "particle has no extent")
+                        pts[k] = None
+            k = c.number((*p, "stiffness"), ld["stiffness"], nonneg=True) \
+                if "stiffness" in ld else None
+            L0 = c.number((*p, "rest_length"), ld.get("rest_length", 0.0), nonneg=True)
+            damping = c.number((*p, "damping"), ld.get("damping", 0.0), nonneg=True)
+            if (len(refs) != 2 or len(pts) != 2
+                    or _missing(name, *refs, *pts, k, L0, damping)):
+                continue
+            out.append(LoadSpec(name, "spring", tuple(refs), None, "world", tuple(pts),
+                                k, L0, damping, line))
+    return out
+
+
+def expression(c: _Checker, path: Path_, text: str) -> Expression | None:
+    """Compile a load expression of t; on error an issue naming the character."""
+    try:
+        e = compile_expression(text)
+    except ExpressionError as exc:
+        pos = exc.position
+        c.err(path, f"invalid expression: {exc.reason} at character {pos + 1} "
+              f"(marked |): \"{exc.text[:pos]}|{exc.text[pos:]}\"",
+              exc.hint or "see docs/expressions.md for the grammar")
+        return None
+    problem = check_finite(e, 0.0)
+    if problem:
+        c.err(path, f"{problem}: \"{text}\"")
+        return None
+    if e.constant and c.number(path, e.value) is None:  # "1e60*1e60" is a number too
+        return None
+    bad = first_nonfinite(e, CHECK_SPAN)
+    if bad is not None:
+        c.warn(path, f"the expression \"{text}\" is not finite at t = {bad[0]:g} s ({bad[1]}); "
+               "a simulation cannot go past that time", f"sampled every millisecond from 0 "
+               f"to {CHECK_SPAN:g} s, simulate's default span")
+    return e
+
+
+def _varying(c: _Checker, path: Path_, value: Any, exprs: dict[int, Expression],
+             read) -> np.ndarray | None:
+    """A load vector (or planar scalar torque) whose components may be expressions of t.
+
+    Each text component is compiled into `exprs` (by 3-D component index) and replaced by
+    its value at t = 0, so the vector is the load at the initial state.
+    """
+    planar_scalar = not isinstance(value, list)
+    if planar_scalar and not (read is _torque and c.dim == cv.PLANAR):
+        return read(c, path, value)  # not a vector: let the reader say what was expected
+    items = [value] if planar_scalar else list(value)
+    found: dict[int, Expression] = {}
+    ok = True
+    for i, v in enumerate(items):
+        if isinstance(v, str):
+            e = expression(c, path if planar_scalar else (*path, i), v)
+            ok = ok and e is not None
+            if e is not None:
+                found[2 if planar_scalar else i] = e
+            items[i] = 0.0
+    if not ok:
+        return None
+    vec = read(c, path, items[0] if planar_scalar else items)
+    if vec is None:
+        return None
+    for k, e in found.items():
+        vec[k] = e.value
+    exprs.update({k: e for k, e in found.items() if not e.constant})  # "2*pi" is a number
+    return vec
+
+
+def _torque(c: _Checker, path: Path_, value: Any) -> np.ndarray | None:
+    if c.dim == cv.PLANAR:
+        if isinstance(value, list):
+            c.err(path, "a planar torque is a scalar (N m about z)", f"got {_kind(value)}")
+            return None
+        t = c.number(path, value)
+        return None if t is None else np.array([0.0, 0.0, t])
+    return c.vector(path, value, 3)
+
+
+def _joints(c: _Checker, value: Any, names: dict[str, int],
+            bodies: list[BodySpec]) -> list[JointSpec]:
+    out: list[JointSpec] = []
+    seen: dict[str, int] = {}
+    types = tuple(cv.JOINT_COMPONENTS[c.dim])
+    for i, j in enumerate(_list(c, ("joints",), value, "joints", False)):
+        p: Path_ = ("joints", i)
+        if not c.mapping(p, j, JOINT_KEYS, ("name", "type", "parent", "child", "at"),
+                         "a joint mapping"):
+            continue
+        name = c.name((*p, "name"), j["name"], "joint") if "name" in j else None
+        if name is not None and name in seen:
+            c.err((*p, "name"), f"duplicate joint name '{name}'",
+                  f"first used by joints[{seen[name]}]")
+        elif name is not None:
+            seen[name] = i
+        typ = None
+        other = cv.JOINT_COMPONENTS[cv.PLANAR + cv.SPATIAL - c.dim]
+        if isinstance(j.get("type"), str) and j["type"] in other and j["type"] not in types:
+            here, there = ("planar", "spatial") if c.dim == cv.PLANAR else ("spatial", "planar")
+            c.err((*p, "type"), f"'{j['type']}' is a {there} joint type; a {here} model "
+                  f"(dimension: {c.dim}) has: {', '.join(types)}")
+        elif "type" in j:
+            typ = c.choice((*p, "type"), j["type"], types,
+                           f"{'planar' if c.dim == 2 else 'spatial'} joint type")
+        parent = c.body_ref((*p, "parent"), j["parent"], names, True) if "parent" in j else None
+        child = c.body_ref((*p, "child"), j["child"], names, True) if "child" in j else None
+        if child == cv.GROUND:
+            c.err((*p, "child"), "the child of a joint must be a body",
+                  "put ground as the parent")
+            child = None
+        if parent is not None and parent == child:
+            c.err((*p, "child"), f"the joint connects '{child}' to itself",
+                  "parent and child must be different bodies (or ground as the parent)")
+            child = None
+        at = c.vec3((*p, "at"), j["at"]) if "at" in j else None
+        axis = axis2 = None
+        if "axis" in j:
+            axis = _axis(c, (*p, "axis"), j["axis"])
+        elif typ in cv.AXIS_REQUIRED[c.dim]:
+            c.err(p, f"a {typ} joint needs an 'axis'",
+                  "the slide direction" if typ == "prismatic" else "the rotation axis")
+        if "axis2" in j:
+            if typ != "universal":
+                c.err((*p, "axis2"), "'axis2' belongs to universal joints",
+                      "remove it, or use type: universal", key=True)
+            else:
+                axis2 = _axis(c, (*p, "axis2"), j["axis2"])
+        elif typ == "universal":
+            c.err(p, "a universal joint needs 'axis2' (the child's axis)")
+        if name is not None and typ is not None:
+            c.joint_types.setdefault(name, typ)
+        if axis is not None and axis2 is not None and abs(float(axis @ axis2)) > 1e-6:
+            c.err((*p, "axis2"), "a universal joint's axes must be perpendicular",
+                  f"axis . axis2 = {float(axis @ axis2):.3g}")
+            continue
+        if _missing(name, typ, parent, child, at):
+            continue
+        kind = ""
+        if parent in c.particles or child in c.particles:
+            kind = _particle_joint(c, p, typ, parent, child, at, bodies)
+            if kind is None:
+                continue
+            c.particle_joints.setdefault(name, kind)
+        out.append(JointSpec(name, typ, parent, child, at, axis, axis2, c.doc.where(p)[0],
+                             kind))
+    return out
+
+
+PARTICLE_JOINTS = {cv.PLANAR: ("revolute",), cv.SPATIAL: ("revolute", "spherical")}
+"""Joint types that may connect a particle (they constrain its position only)."""
+PARTICLE_RTOL = 1e-9
+"""A joint point within this distance (relative to the model's size) of a particle is at
+the particle (a pin); farther, the joint is a rigid link of that length to it."""
+
+
+def _particle_joint(c: _Checker, p: Path_, typ: str, parent: str, child: str,
+                    at: np.ndarray, bodies: list[BodySpec]) -> str | None:
+    """"pin" or "link" for a joint with a particle at an end (docs: Particles), or None
+    after reporting why such a joint is not allowed."""
+    ends = [e for e in (parent, child) if e in c.particles]
+    allowed = PARTICLE_JOINTS[c.dim]
+    if typ not in allowed:
+        c.err((*p, "type"), f"a {typ} joint cannot connect the particle '{ends[0]}': a "
+              "particle (inertia: 0) has no orientation to constrain",
+              f"use {' or '.join(allowed)} (it constrains the particle's position only)")
+        return None
+    pos = {b.name: b.position for b in bodies}
+    if any(e not in pos for e in ends):
+        return None  # a body with problems of its own, already reported
+    scale = max([float(np.abs(at).max())] + [float(np.abs(x).max()) for x in pos.values()])
+    tol = PARTICLE_RTOL * scale
+    at_particle = [e for e in ends if float(np.linalg.norm(at - pos[e])) <= tol]
+    if len(at_particle) == len(ends):
+        return "pin"
+    if len(ends) == 2 and not at_particle:
+        c.err((*p, "at"), f"the joint point of two particles ('{parent}', '{child}') must "
+              "be at one of them", "at one particle: a rigid link to the other; at both: "
+              "a pin")
+        return None
+    return "link"
+
+
+def _axis(c: _Checker, path: Path_, value: Any) -> np.ndarray | None:
+    a = c.vec3(path, value)
+    if a is None:
+        return None
+    n = float(np.linalg.norm(a))
+    if n < 1e-12:
+        c.err(path, "the axis is the zero vector", "give a direction, such as [0, 0, 1]")
+        return None
+    return a / n
+
+
+def _reactions(c: _Checker, value: Any, joints: list[JointSpec],
+               expressions: dict[str, Expression]) -> dict[str, float]:
+    if value is None:
+        return {}
+    if not isinstance(value, dict):
+        c.err(("reactions",), f"expected a mapping of reaction labels to values, got "
+              f"{_kind(value)}")
+        return {}
+    # From every joint with a valid name and type, so that a joint with a bad point does
+    # not turn each of its known reactions into a second problem.
+    labels = [f"{n}.{k}" for n, t in c.joint_types.items()
+              for k in (cv.PARTICLE_COMPONENTS[c.dim][t][c.particle_joints[n]]
+                        if n in c.particle_joints else cv.JOINT_COMPONENTS[c.dim][t])]
+    out: dict[str, float] = {}
+    for label, v in value.items():
+        p: Path_ = ("reactions", label)
+        if label not in labels:
+            c.err(p, f"no reaction component '{_show(label)}'",
+                  did_you_mean(label, labels)
+                  or (f"the model's reaction components are: {', '.join(labels[:12])}"
+                      if labels else "the model has no joints"), key=True)
+            continue
+        if isinstance(v, str):  # a known value that varies in time, e.g. "40*cos(20*t)"
+            e = expression(c, p, v)
+            if e is not None:
+                out[label] = e.value
+                if not e.constant:
+                    expressions[label] = e
+            continue
+        x = c.number(p, v)
+        if x is not None:
+            out[label] = x
+    return out

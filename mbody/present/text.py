@@ -1,0 +1,259 @@
+"""Readable text for models, assemblies and solutions (what the CLI prints)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from mbody import conventions as cv
+from mbody.equations.assemble import Assembly, Solution
+from mbody.equations.fbd import REACTION, BodyEquations
+from mbody.model.graph import Topology
+from mbody.model.model import Model
+
+
+def _v(x: np.ndarray, dim: int) -> str:
+    x = np.asarray(x)[:2] if dim == cv.PLANAR else np.asarray(x)
+    return "(" + ", ".join(_n(v) for v in x) + ")"
+
+
+def _n(x: float) -> str:
+    x = 0.0 if abs(x) < 1e-12 else x  # rounding noise from rotations, e.g. -2.4e-17
+    s = f"{x:.6g}"
+    return "0" if s in ("-0", "0") else s
+
+
+def _table(header: list[str], rows: list[list[str]], indent: str = "  ") -> list[str]:
+    """Left-aligned columns, each as wide as its longest cell plus two spaces."""
+    widths = [max(len(r[c]) for r in [header, *rows]) for c in range(len(header))]
+    fmt = indent + "  ".join(f"{{:<{w}}}" for w in widths)
+    return [fmt.format(*r).rstrip() for r in [header, *rows]]
+
+
+def _clean(x: np.ndarray, rel: float = 1e-10) -> np.ndarray:
+    """Values below `rel` times the largest one printed as 0: rounding noise, not data."""
+    x = np.asarray(x, dtype=float)
+    top = float(np.max(np.abs(x), initial=0.0))
+    return np.where(np.abs(x) <= rel * top, 0.0, x)
+
+
+def _plural(k: int, word: str) -> str:
+    if k == 1:
+        return f"{k} {word}"
+    return f"{k} {word[:-1]}ies" if word.endswith("y") else f"{k} {word}s"  # body -> bodies
+
+
+def model_summary(model: Model, topo: Topology) -> str:
+    dim = model.dimension
+    kind = "planar" if dim == cv.PLANAR else "spatial"
+    out = [f"model {model.name!r}: {kind}, {_plural(model.n, 'body')}, "
+           f"{_plural(len(model.loads), 'load')}, {_plural(len(model.joints), 'joint')}"
+           + (f"  [{model.file}]" if model.file else "")]
+    if model.description:
+        out.append(f"  {model.description.strip()}")
+    if np.any(model.gravity):
+        out.append(f"gravity {_v(model.gravity, dim)} m/s^2 (world)")
+    out.append("")
+    out.append(f"bodies ({model.n}, in stacking order):")
+    shown = model.body_names[:50]
+    for name in shown:
+        b = model.bodies[name]
+        if b.particle:
+            inertia = "particle (no rotational inertia)"
+        elif dim == cv.PLANAR:
+            inertia = f"I_G {_n(b.I_G)} kg m^2"
+        else:
+            J = b.inertia
+            inertia = ("I " + _v(np.diag(J), 3) if np.allclose(J, np.diag(np.diag(J)))
+                       else "I full tensor, principal " + _v(np.linalg.eigvalsh(J), 3))
+            inertia += " kg m^2"
+        out.append(f"  {name:<14} m {_n(b.mass)} kg, {inertia}")
+    if model.n > len(shown):
+        out.append(f"  ... and {model.n - len(shown)} more")
+    if model.loads:
+        out.append(f"loads ({len(model.loads)}):")
+        for ld in model.loads[:50]:
+            if ld.type == "spring":
+                what = (f"spring {ld.bodies[0]} - {ld.bodies[1]}, k {_n(ld.stiffness)} N/m, "
+                        f"rest {_n(ld.rest_length)} m, damping {_n(ld.damping)} N s/m")
+            elif ld.type == "torque":
+                tq = ld.vector[2] if dim == cv.PLANAR else ld.vector
+                what = f"torque on {ld.bodies[0]}: {_n(tq) if dim == 2 else _v(tq, 3)} N m" \
+                    + ("" if dim == 2 else f" ({ld.frame} axes)")
+            else:
+                what = (f"force on {ld.bodies[0]}: {_v(ld.vector, dim)} N ({ld.frame} axes) "
+                        f"at {_v(ld.at[0], dim)} m")
+            if ld.expressions:  # time-varying components: show the formulas, not t = 0
+                what += "; varying: " + ", ".join(
+                    f"{'xyz'[k]} = {e}" for k, e in sorted(ld.expressions.items()))
+            out.append(f"  {ld.name:<14} {what}")
+    if model.joints:
+        out.append(f"joints ({len(model.joints)}):")
+        for j in model.joints[:50]:
+            out.append(f"  {j.name:<14} {j.type} {j.parent} -> {j.child} at {_v(j.at, dim)}: "
+                       + ", ".join(j.labels))
+    unknown = [r for r in model.reactions if r not in model.known_reactions]
+    out.append(f"reaction unknowns ({len(unknown)}): " + (", ".join(unknown[:40]) or "none")
+               + (" ..." if len(unknown) > 40 else ""))
+    if model.known_reactions:
+        out.append("known reactions: " + ", ".join(
+            f"{k} = {model.known_expressions.get(k) or _n(v)}"
+            for k, v in model.known_reactions.items()))
+    out.append("")
+    out.append(graph_summary(model, topo))
+    for w in model.warnings:
+        out.append(f"warning: {w}")
+    return "\n".join(out)
+
+
+def graph_summary(model: Model, topo: Topology) -> str:
+    per = 3 if model.dimension == cv.PLANAR else 6
+    # the counts of model.graph's nodes and edges, without building it (networkx is slow
+    # to import)
+    lines = [f"graph: {model.n + 1} nodes (bodies + ground), "
+             f"{_plural(len(model.joints), 'joint edge')}; "
+             + ("a tree (no closed loops)" if topo.is_tree
+                else f"{_plural(topo.loops, 'closed loop')}")]
+    lines.append(f"  connected parts: {len(topo.parts)}")
+    for p in topo.parts[:10]:
+        text = ", ".join(p[:12]) + (" ..." if len(p) > 12 else "")
+        lines.append("    " + (text + " (nothing attached)" if p == [cv.GROUND] else text))
+    if topo.floating:
+        lines.append(f"  attached to nothing ({len(topo.floating)}): "
+                     + ", ".join(topo.floating[:12]) + (" ..." if len(topo.floating) > 12 else ""))
+    coords = f"{per} x {model.n} bodies"
+    if model.has_particles:
+        k = int(model.particle.sum())
+        coords = (f"{per} x {model.n - k} bodies + {model.dimension} x {k} particle"
+                  + ("s" if k > 1 else "") if k < model.n
+                  else f"{model.dimension} x {k} particle" + ("s" if k > 1 else ""))
+    if topo.rank is None:
+        lines.append(f"mobility: {topo.mobility} = {coords} - "
+                     f"{topo.constraints} reaction components (Gruebler; rank not computed)")
+    else:
+        lines.append(f"mobility: {topo.mobility} = {coords} - {topo.rank} "
+                     f"independent constraints ({topo.constraints} reaction components)")
+    if topo.redundant:
+        lines.append(f"warning: {len(topo.redundant)} redundant constraint(s): "
+                     + ", ".join(topo.redundant)
+                     + " (these reactions are not unique: they depend on the others)")
+    return "\n".join(lines)
+
+
+def body_text(eq: BodyEquations, dimension: int) -> str:
+    f = eq.fbd
+    out = [f"== {eq.body} ==  m {_n(f.mass)} kg, mass centre at {_v(f.W_position, dimension)} m"]
+    out.append("free body:")
+    rows = []
+    for fo in f.forces:
+        if fo.kind == REACTION:
+            name = fo.label + ("" if fo.value is None else f" = {_n(fo.value)}")
+            comp = ("unit " if fo.value is None else "") + _v(fo.W_vector, dimension)
+        elif fo.couple and dimension == cv.PLANAR:  # a planar couple is a scalar about z
+            name, comp = fo.name, _n(fo.W_vector[2])
+        else:
+            name, comp = fo.name, _v(fo.W_vector, dimension)
+        unit = "N m" if fo.couple else "N"
+        point = "-" if fo.couple else _v(fo.B_r, dimension)
+        mom = _n(fo.B_moment[2]) if dimension == cv.PLANAR else _v(fo.B_moment, 3)
+        label = "reaction" if fo.kind == REACTION else "couple" if fo.couple else fo.kind
+        rows.append([name, label, point, f"{comp} {unit}", mom])
+    if f.forces:
+        out += _table(["force", "kind", "point (body axes, m)", "components (world axes)",
+                       "moment about G" + (" (N m)" if dimension == cv.PLANAR
+                                           else " (body axes, N m)")], rows)
+    if not f.forces:
+        out.append("  (no forces)")
+    out.append("Newton (world axes):")
+    out += [f"  {e}" for e in eq.newton]
+    if not eq.euler:  # a particle: translation only
+        out.append("Euler: none (a particle has no rotation)")
+        return "\n".join(out)
+    out.append("Euler (about the mass centre, " + ("z):" if dimension == 2 else "body axes):"))
+    out += [f"  {e}" for e in eq.euler]
+    return "\n".join(out)
+
+
+def assembly_text(asm: Assembly, max_bodies: int = 200) -> str:
+    model = asm.model
+    parts = [f"model {model.name!r}: M v_dot + b = Q + G lambda; rows per body: "
+             + ", ".join(cv.PLANAR_ROWS if model.dimension == 2 else cv.SPATIAL_ROWS)
+             + ("" if model.dimension == 2 else
+                " (Newton in world axes, Euler in body axes)")
+             + ("; a particle has translation rows only" if model.has_particles else "")]
+    for name in model.body_names[:max_bodies]:
+        parts.append(body_text(asm.bodies[name], model.dimension))
+    if model.n > max_bodies:
+        parts.append(f"... {model.n - max_bodies} more bodies (use --body NAME)")
+    sh = asm.shape
+    parts.append("stacked: " + ", ".join(f"{k} {'x'.join(map(str, v))}" for k, v in sh.items())
+                 + f"  (reaction unknowns: {len(asm.reactions)})")
+    return "\n\n".join(parts)
+
+
+def solution_text(sol: Solution, model: Model) -> str:
+    rows = cv.PLANAR_ROWS if model.dimension == 2 else cv.SPATIAL_ROWS
+    units = {"x": "m/s^2", "y": "m/s^2", "z": "m/s^2", "theta": "rad/s^2"}
+    lines = [f"accelerations of {model.name!r} (Newton rows world axes"
+             + (", Euler rows body axes):" if model.dimension == 3 else "):")]
+    acc = _clean(sol.accelerations)
+    for i, name in enumerate(model.body_names):
+        idx = model.body_rows(i)
+        lines.append(f"  {name:<14}" + "  ".join(
+            f"{cv.ACCELERATION_NAMES[r]} = {_n(v)} {units.get(r, 'rad/s^2')}"
+            for r, v in zip(rows[:len(idx)], acc[idx], strict=True)))
+    return "\n".join(lines)
+
+
+def reaction_table_text(asm: Assembly, sol: Solution) -> str:
+    """Joint, component, its axis (world components at this state), value, status; then
+    each joint's net force and couple on its child (at the joint point) and on its parent
+    (equal and opposite; a particle link's force at its two ends)."""
+    model = asm.model
+    dim = model.dimension
+    if not sol.reactions:
+        return ""
+    cols = asm.columns
+    t = model.reaction_table
+    lam = _clean(np.array([sol.reactions[r] for r in model.reactions]))
+    solved, not_unique = set(sol.solved), set(sol.not_unique)
+    rows = []
+    for c, label in enumerate(model.reactions):
+        joint, comp = label.split(".", 1)
+        unit = "N m" if cols.is_moment[c] else "N"
+        status = ("not unique" if label in not_unique else
+                  "solved" if label in solved else "given")
+        rows.append([joint, comp, _v(cols.W_e[c], dim), f"{_n(lam[c])} {unit}", status])
+    lines = ["joint reactions: each component acts along (or about) its joint-frame axis, "
+             "+R on the child and -R on the parent"]
+    lines += _table(["joint", "comp", "axis (world)", "value", "status"], rows)
+    lines.append("net load of each joint at its joint point (world axes):")
+    F_all = np.zeros((len(model.joints), 3))
+    C_all = np.zeros((len(model.joints), 3))
+    for jn in range(len(model.joints)):
+        sel = t.joint == jn
+        F_all[jn] = (lam[sel & ~cols.is_moment, None] * cols.W_e[sel & ~cols.is_moment]).sum(0)
+        C_all[jn] = (lam[sel & cols.is_moment, None] * cols.W_e[sel & cols.is_moment]).sum(0)
+    F_all, C_all = _clean(F_all), _clean(C_all)
+    for jn, j in enumerate(model.joints):
+        P = cols.W_P[np.flatnonzero(t.joint == jn)[0]]
+        F, C = F_all[jn], C_all[jn]
+        Cs = _n(C[2]) if dim == cv.PLANAR else _v(C, 3)
+        mCs = _n(-C[2]) if dim == cv.PLANAR else _v(-C, 3)
+        first = np.flatnonzero(t.joint == jn)[0]
+        if t.link[first]:  # a rigid link to a particle: its two ends are apart
+            Pp = P + t.length[first] * cols.W_e[first]
+            lines.append(f"  {j.name} (link, {_n(t.length[first])} m): on child {j.child} "
+                         f"at {_v(P, dim)}: F {_v(F, dim)} N; on parent {j.parent} at "
+                         f"{_v(Pp, dim)}: F {_v(-F, dim)} N")
+            continue
+        lines.append(f"  {j.name} at {_v(P, dim)}: on child {j.child}: F {_v(F, dim)} N, "
+                     f"C {Cs} N m; on parent {j.parent}: F {_v(-F, dim)} N, C {mCs} N m")
+    if sol.residual is not None:
+        cond = ""
+        if sol.condition is not None:
+            cond = ("; singular (redundant constraints)" if not np.isfinite(sol.condition)
+                    else f"; condition estimate {sol.condition:.2e}")
+        lines.append(f"solve: {sol.method}; relative backward error {sol.residual:.1e}{cond}")
+    for w in sol.warnings:
+        lines.append(f"warning: {w}")
+    return "\n".join(lines)

@@ -1,0 +1,756 @@
+"""`simulate(model, t_end, fps) -> Trajectory`: integrate the Newton-Euler equations
+
+    ẋ = v,   q̇ = ½ q ⊗ (0, ω),   v̇ = a_G,   ω̇ = J⁻¹ (B_M − ω × J ω)     per body,
+
+where (a_G, ω̇) = M⁻¹ (Q + G λ − b) come from the same loads, gyroscopic terms and
+reaction columns as `assemble` (through `mbody.dynamics.accelerations`), with every
+reaction value λ known (absent, given in the file, or passed as `known`).
+
+State: x (n, 3) world, q (n, 4) W_R_B quaternions [w, x, y, z], v (n, 3) world, ω (n, 3)
+body axes, packed as blocks ``[x | q | v | ω]`` (13 n numbers) so that every block is a
+contiguous (n, k) view: the derivative is vectorised over bodies, with no per-body loop.
+
+Quaternions: the exact flow keeps ‖q‖ = 1 (q̇ · q = 0), so q is integrated as it is; the
+rotation used inside the derivative is built from q/‖q‖, and the quaternions stored at the
+output samples are divided by their norms (the largest |‖q‖ − 1| before that is reported
+as ``info['quaternion_norm_error']``). The integrator is never restarted, so the
+renormalisation changes nothing but the stored samples.
+
+Accelerations are pluggable: `dynamics(model, state) -> (n, 6)` rows [a_G world,
+ω̇ body axes]; the default is `known_reaction_dynamics(model, known)`.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+import time
+import warnings
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+
+from mbody import conventions as cv
+from mbody.equations.constraints import joint_errors
+from mbody.equations.kernels import spring_ends
+from mbody.errors import MbodyError, UnknownReactionsError, did_you_mean
+from mbody.model.expressions import Expression, check_times, compile_expression, first_nonfinite
+from mbody.model.model import Model, State
+from mbody.simulate.mechanism import constrained_dynamics, constraint_drift, reactions_along
+from mbody.simulate.projection import STAGE_PIVOT_RTOL, JointProjection
+from mbody.simulate.stepping import REFRESH_ATOL, integrator
+from mbody.simulate.trajectory import Trajectory
+from mbody.solve.dynamics import Dynamics, StateDerivative, accelerations
+
+METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
+"""scipy.integrate's step-by-step solvers (imported when a simulation starts)."""
+IMPLICIT = ("Radau", "BDF", "LSODA")
+"""The methods for stiff problems (LSODA switches to BDF when it finds stiffness)."""
+DEFAULT_RTOL = 1e-10
+DEFAULT_ATOL = 1e-12
+DEFAULT_MAX_STEPS = 1_000_000
+"""Step budget of a run. The heaviest shipped model needs about 9 300 steps for 10 s (the
+slider-crank that ran away to 700 rad/s, 24 500): a hundred times that, yet a small
+mechanism (about 0.3 ms per step) reaches it in minutes rather than hours."""
+
+
+def known_reaction_dynamics(model: Model, known: Mapping[str, float | str] | None = None
+                            ) -> Dynamics:
+    """The default derivative: every reaction value known (file, then `known`), λ(t) applied.
+
+    `known` values are numbers or expressions of t (text, see docs/expressions.md).
+    Raises `UnknownReactionsError` when a reaction component has no value.
+    """
+    labels = model.reactions
+    values: dict[str, float] = dict(model.known_reactions)
+    exprs: dict[str, Expression] = dict(model.known_expressions)
+    for label, v in (known or {}).items():
+        if label not in labels:
+            hint = did_you_mean(label, labels)
+            raise MbodyError(f"no reaction component {label!r} in this model"
+                             + (f"; {hint}" if hint else ""))
+        if isinstance(v, str):
+            e = compile_expression(v)
+            values[label] = e.value
+            exprs[label] = e
+        else:
+            values[label] = float(v)
+            exprs.pop(label, None)
+    missing = [r for r in labels if r not in values]
+    if missing:
+        raise UnknownReactionsError(missing)
+    base = np.array([values[r] for r in labels], dtype=float)
+    varying = [(labels.index(r), e) for r, e in exprs.items() if not e.constant]
+
+    def values_at(t: float) -> np.ndarray:
+        """(m,) the reaction values at time t."""
+        if not varying:
+            return base
+        lam = base.copy()
+        for i, e in varying:  # one call per time-varying reaction, not per body
+            lam[i] = e(t)
+        return lam
+
+    def f(model: Model, state: State) -> np.ndarray:
+        return accelerations(model, state, values_at(state.t) if labels else None)
+
+    f.values_at = values_at  # type: ignore[attr-defined]
+    f.varying = bool(varying)  # type: ignore[attr-defined]
+    f.reactions_at = lambda t: _reactions_at(base, varying, t)  # type: ignore[attr-defined]
+    return f
+
+
+def _reactions_at(base: np.ndarray, varying: list[tuple[int, Expression]],
+                  t: np.ndarray) -> np.ndarray:
+    """(K, m) reaction values at the sample times."""
+    out = np.broadcast_to(base, (len(t), len(base))).copy()
+    for i, e in varying:
+        out[:, i] = e(t)
+    return out
+
+
+class _Progress:
+    """tqdm bar over simulated time on stderr (a no-op when disabled)."""
+
+    def __init__(self, enabled: bool, t_end: float, label: str):
+        self.bar = None
+        if enabled:
+            from tqdm import tqdm
+
+            self.bar = tqdm(total=t_end, unit="s", file=sys.stderr, desc=label, leave=True,
+                            bar_format="{desc}: {percentage:3.0f}%|{bar}| t = {n:.3g} / "
+                            "{total:.3g} s [{elapsed}<{remaining}]")
+        self.t = 0.0
+
+    def update(self, t: float) -> None:
+        if self.bar is not None and t > self.t:
+            self.bar.update(t - self.t)
+            self.t = t
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+
+
+def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
+             rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL, method: str = "DOP853",
+             known: Mapping[str, float | str] | None = None, progress: bool = False,
+             dynamics: Dynamics | None = None, max_step: float = math.inf,
+             initial: State | None = None, max_steps: int | None = DEFAULT_MAX_STEPS,
+             max_wall: float | None = None) -> Trajectory:
+    """Integrate the motion from `initial` (default the model's state) to `t_end` seconds.
+
+    Samples at t = k / fps for k = 0 .. ⌊t_end · fps⌋. `rtol`, `atol`: the integrator's
+    relative and absolute error tolerances per step (per state component); `method`: one
+    of `METHODS` (DOP853: explicit Runge-Kutta of order 8 with a 7th-order interpolant).
+    `known`: reaction values (numbers or expressions of t) added to the file's.
+    `dynamics`: replaces the default accelerations (see `Dynamics`).
+    `max_steps`, `max_wall`: budgets of integrator steps and of wall-clock seconds (None:
+    no limit); a run that hits one stops with an `MbodyError` saying where and why.
+    Returns a `Trajectory` whose `info` holds the run facts and drift figures, and under
+    ``info["warnings"]`` what looked wrong (a cost that exploded, a spin the frame rate
+    aliases).
+    """
+    t_end, fps = float(t_end), float(fps)
+    if not (math.isfinite(t_end) and t_end > 0):
+        raise MbodyError(f"t_end must be a positive number of seconds, got {t_end:g}")
+    if not (math.isfinite(fps) and fps > 0):
+        raise MbodyError(f"fps must be a positive number of samples per second, got {fps:g}")
+    if not (0 < rtol < 1) or not (atol > 0):
+        raise MbodyError(f"tolerances must satisfy 0 < rtol < 1 and atol > 0 "
+                         f"(got rtol={rtol:g}, atol={atol:g})")
+    if method not in METHODS:
+        raise MbodyError(f"unknown integrator {method!r}; "
+                         + (did_you_mean(method, METHODS) or f"one of {', '.join(METHODS)}"))
+    if max_steps is not None and (isinstance(max_steps, bool) or not isinstance(
+            max_steps, int | np.integer) or max_steps < 1):
+        raise MbodyError(f"max_steps must be a positive whole number of steps or None, "
+                         f"got {max_steps!r}")
+    if max_wall is not None and not (isinstance(max_wall, int | float | np.number)
+                                     and math.isfinite(max_wall) and max_wall > 0):
+        raise MbodyError(f"max_wall must be a positive number of seconds or None, "
+                         f"got {max_wall!r}")
+    K = int(math.floor(t_end * fps + 1e-9)) + 1
+    if K > 10_000_000:
+        raise MbodyError(f"{K} output samples requested (t_end * fps); at most 10 million")
+    mechanism = dynamics is None and _has_unknown_reactions(model, known)
+    varying = _varying_expressions(model, known)
+    _check_span(varying, t_end)
+    rhs = state_derivative(model, known, dynamics)
+    f = rhs.dynamics
+    n = model.n
+    planar = model.dimension == cv.PLANAR
+    s0 = model.initial if initial is None else initial
+    projection = None
+    if mechanism and method not in IMPLICIT:
+        # the joints held by projecting the state after every step (mbody.projection);
+        # the implicit methods keep their own history of y, so Baumgarte's terms hold them
+
+        projection = JointProjection(model, rhs.unknowns, compiled=rhs.compiled)
+        rhs.projection, rhs.rate = projection, 0.0
+    # Planar models also integrate θ itself (θ̇ = ω_z): the angle read back from a
+    # quaternion is only known modulo 2π, and a fast wheel turns more than π per frame.
+    theta0 = 2.0 * np.arctan2(s0.quaternion[:, 3], s0.quaternion[:, 0]) if planar else ()
+    y0 = np.concatenate((s0.position.ravel(), s0.quaternion.ravel(), s0.velocity.ravel(),
+                         s0.omega.ravel(), theta0))
+    size = len(y0)
+    if projection is not None:  # the run starts on the joints
+        _, _, ratio = projection(y0, s0.t)
+        rhs.project_stages = ratio < STAGE_PIVOT_RTOL
+    bar = _Progress(progress, t_end, model.name or "simulate")
+
+    t_eval = np.arange(K) / fps
+    Y = np.empty((K, size))
+    Y[0] = y0
+    k, steps, sampling, refreshed = 1, 0, 0, 0
+    rate = _StepRate(t_end)
+    wall = time.perf_counter()
+    try:
+
+        fun = rhs
+        if method in ("Radau", "BDF"):  # their Jacobian estimate passes strided columns of y
+            def fun(t, y):
+                return rhs(t, np.ascontiguousarray(y))
+        with np.errstate(all="ignore"):  # its first-step norm may overflow: handled below
+            solver = integrator(method, rhs)(fun, 0.0, y0, t_end, rtol=rtol, atol=atol,
+                                              max_step=max_step)
+        t_prev, check_at = 0.0, PREDICT_FROM
+        advance = getattr(solver, "advance", None)  # compiled DOP853 (mbody.stepping)
+        first = None
+        while solver.status == "running":
+            ran = None
+            if advance is not None:  # steps up to the next sample in one compiled call
+                limit = min(CHUNK_STEPS, max(1, check_at - steps))
+                if max_steps is not None:
+                    limit = min(limit, max(1, max_steps - steps))
+                ran = advance(float(t_eval[k]) if k < K else t_end, limit)
+                msg = solver.TOO_SMALL_STEP if solver.status == "failed" else None
+            if ran is None:
+                try:  # overflow in an implicit method's Jacobian estimate is handled below
+                    with np.errstate(all="ignore"), warnings.catch_warnings():
+                        if method in IMPLICIT:  # LinAlgWarning on a singular iteration,
+                            warnings.simplefilter("ignore")  # LSODA's convergence failures
+                        msg = solver.step()
+                except (ValueError, np.linalg.LinAlgError) as exc:
+                    if method not in IMPLICIT:
+                        raise
+                    raise MbodyError(
+                        f"the integrator {method} failed at t = {solver.t:.6g} s: {exc} "
+                        "(its numerical Jacobian broke down, as it can where the state "
+                        "barely changes). Try another stiff integrator (--method "
+                        + " or ".join(m for m in ("LSODA", "BDF") if m != method)
+                        + ") or looser tolerances (e.g. --rtol 1e-6 --atol 1e-9)") from None
+            if solver.status == "failed" or not np.all(np.isfinite(solver.y)):
+                culprit = _blame_expression(varying, t_prev, solver.t, solver.step_size)
+                raise MbodyError(
+                    f"the integration stopped at t = {solver.t:.6g} s: "
+                    + (culprit or (msg or "the state is no longer finite")
+                       + " (a body escaping to infinity, or tolerances too tight for "
+                       "double precision?)"))
+            t_prev = solver.t
+            if ran is not None:  # projected (and refreshed) in the compiled call
+                steps += ran.steps
+                refreshed += ran.refreshed
+                ratio = ran.ratio
+            else:
+                steps += 1
+            if projection is not None and ran is None:
+                moved, changed, ratio = projection(solver.y, solver.t)
+                if rhs.project_stages or max(moved, changed) > REFRESH_ATOL * atol:
+                    solver.f = solver.fun(solver.t, solver.y)  # the next step starts here
+                    refreshed += 1
+            j = int(np.searchsorted(t_eval, solver.t, side="right"))
+            if j > k:  # DOP853's interpolant costs 3 evaluations here (docs/simulation.md)
+                nfev = solver.nfev
+                Y[k:j] = solver.dense_output()(t_eval[k:j]).T
+                sampling += solver.nfev - nfev
+                if projection is not None:  # the samples on the joints too
+                    for i in range(k, j):
+                        projection(Y[i], float(t_eval[i]))
+                k = j
+            if projection is not None:  # for the next step's stages (after the sampling,
+                rhs.project_stages = ratio < STAGE_PIVOT_RTOL  # which used this step's)
+            rate.step(solver.t, steps)
+            bar.update(solver.t)
+            if solver.status == "running":
+                if steps >= check_at:  # the whole run's cost, predicted from its start
+                    check_at = 2 * steps
+                    _predict(model, method, solver.t, t_end, steps, rate, max_steps,
+                             max_wall, time.perf_counter() - wall)
+                if max_steps is not None and steps >= max_steps:
+                    raise MbodyError(_budget_message(
+                        f"the step budget: {steps} steps (--max-steps {max_steps})",
+                        solver.t, t_end, steps, rate, f"at that rate the whole run needs "
+                        f"about {steps * t_end / solver.t:.2g} steps", "raise --max-steps"))
+                if max_wall is not None:
+                    now = time.perf_counter()
+                    if first is None:  # the pace is timed from here: no start-up costs
+                        first = (solver.t, now)
+                    if now - wall > max_wall:
+                        pace = ((now - first[1]) / (solver.t - first[0]) if solver.t > first[0]
+                                else (now - wall) / solver.t)
+                        raise MbodyError(_budget_message(
+                            f"the wall-time budget: {now - wall:.3g} s (--max-wall "
+                            f"{max_wall:g})", solver.t, t_end, steps, rate,
+                            f"at that pace the rest of the run takes about "
+                            f"{pace * (t_end - solver.t):.2g} s more", "raise --max-wall"))
+    finally:
+        bar.close()
+    wall = time.perf_counter() - wall
+
+    x = Y[:, :3 * n].reshape(K, n, 3)
+    q = Y[:, 3 * n:7 * n].reshape(K, n, 4)
+    v = Y[:, 7 * n:10 * n].reshape(K, n, 3)
+    w = Y[:, 10 * n:13 * n].reshape(K, n, 3)
+    norm = np.linalg.norm(q, axis=2)
+    q_err = float(np.max(np.abs(norm - 1.0))) if n else 0.0
+    q = q / norm[..., None]
+
+    labels = tuple(model.reactions)
+    reactions_at = getattr(f, "reactions_at", None)
+    lam = (reactions_at(t_eval) if reactions_at is not None and labels
+           else np.zeros((K, 0)))
+    joint_info: dict = {}
+    if mechanism:
+
+        states = [State(x[k], q[k], v[k], w[k], float(t_eval[k])) for k in range(K)]
+        lam = reactions_along(model, states, _numeric_known(model, known))
+
+        held = (PROJECTION_TEXT if projection is not None else
+                f"{f.stabilisation} (the implicit methods keep their own history of the "
+                "state, which a projection would break)")
+        joint_info = {"joint_stabilisation": held, **constraint_drift(model, states),
+                      "initial_joint_errors": joint_errors(model, s0),
+                      "projection_evaluations": refreshed}
+    info = {
+        "integrator": method, "rtol": rtol, "atol": atol, "t_end": t_end, "fps": fps,
+        "samples": K, "steps": steps, "evaluations": solver.nfev,
+        "sampling_evaluations": sampling, "step_rate": rate.figures(steps),
+        "evaluation_path": "compiled" if rhs.compiled else "numpy",
+        "wall_time_s": wall, "quaternion_norm_error": q_err,
+        "quaternion_handling": "integrated as is; rotation built from q/|q|; output "
+                               "samples divided by |q|",
+        **joint_info,
+    }
+    pose = ((x[..., :2], v[..., :2], Y[:, 13 * n:], w[..., 2]) if planar else (x, v, q, w))
+    traj = Trajectory(
+        t_eval, *pose, body_names=model.body_names, dimension=model.dimension,
+        model_name=model.name, model_file=model.file, reaction_labels=labels,
+        reactions=lam, info=info, mass=np.array(model.mass), inertia=np.array(model.J),
+        shapes=tuple(model.bodies[b].shape for b in model.body_names),
+        colors=tuple(model.bodies[b].color for b in model.body_names),
+        gravity=np.array(model.gravity), model_yaml=_model_text(model))
+    series, drift = _drift(model, traj, dynamics is None, ideal_joints=mechanism)
+    traj.series.update(series)
+    info.update(drift)
+    info["warnings"] = [w for w in (rate.warning(), _spin_warning(traj)) if w]
+    return traj
+
+
+PROJECTION_TEXT = ("coordinate projection after every step: positions by Gauss-Newton, "
+                   "velocities mass-orthogonal")
+CHUNK_STEPS = 200
+"""Most steps one compiled call takes before the loop looks at its budgets and progress."""
+
+PREDICT_FROM = 1000
+"""Steps after which (and after twice, four times as many...) a run's total cost is
+predicted from its rate so far."""
+PREDICT_FACTOR = 1.5
+"""A run predicted to need this many times its step or wall-time budget stops at once."""
+SPIN_STEPS_PER_RAD = 50.0
+"""Steps per radian of the fastest initial spin up to which a run's cost is put down to
+that spin (DOP853 at rtol 1e-10 takes about 1.5 steps per radian of a free spin)."""
+
+
+def _predict(model: Model, method: str, t: float, t_end: float, steps: int, rate: _StepRate,
+             max_steps: int | None, max_wall: float | None, elapsed: float) -> None:
+    """Stop now, with the cause and what to do, a run whose pace so far needs more than
+    `PREDICT_FACTOR` times a budget: a very stiff model or a fast spin otherwise takes
+    minutes to reach the budget (hours without one) and ends with nothing."""
+    if t <= 0:
+        return
+    need_steps = steps * t_end / t
+    need_wall = elapsed * t_end / t
+    if max_steps is not None and need_steps > PREDICT_FACTOR * max_steps:
+        over = (f"about {need_steps:.2g} steps, more than {PREDICT_FACTOR:g} times the budget "
+                f"(--max-steps {max_steps})")
+        raise_it = "raise --max-steps"
+    elif max_wall is not None and need_wall > PREDICT_FACTOR * max_wall:
+        over = (f"about {need_wall:.2g} s, more than {PREDICT_FACTOR:g} times the budget "
+                f"(--max-wall {max_wall:g})")
+        raise_it = "raise --max-wall"
+    else:
+        return
+    cause, remedies = _cost_cause(model, steps / t, method)
+    raise MbodyError(
+        f"the simulation was stopped early: after {steps} steps it is at t = {t:.3g} s of "
+        f"{t_end:g} s ({rate.so_far(t, steps)}); at that rate the whole run needs {over}. "
+        f"{cause} To go on: {remedies}, or {raise_it}. No trajectory is kept (rerun with "
+        f"--t-end {t:.3g} to see the motion up to here).")
+
+
+def _cost_cause(model: Model, steps_per_second: float, method: str) -> tuple[str, str]:
+    """Why the steps are short, and what helps: a fast spin (which every integrator must
+    follow), inertias too far apart for double precision (rounding noise that no
+    integrator steps over), or stiffness (which an implicit integrator steps over)."""
+    w = np.linalg.norm(np.asarray(model.initial.omega), axis=1) if model.n else np.zeros(0)
+    i = int(np.argmax(w)) if len(w) else 0
+    spin = float(w[i]) if len(w) else 0.0
+    if spin > 0 and steps_per_second < SPIN_STEPS_PER_RAD * spin:
+        return (f"The steps follow the fastest motion: '{model.body_names[i]}' spins at "
+                f"{spin:.3g} rad/s ({spin / (2 * math.pi):.3g} rev/s), and any integrator "
+                "must take steps shorter than a turn, so a stiff integrator would not help.",
+                "a shorter --t-end (the cost grows with it), a looser --rtol (e.g. 1e-6), "
+                "a slower spin")
+    moments = np.linalg.eigvalsh(np.asarray(model.J)) if model.n else np.ones((1, 3))
+    smallest = np.min(np.where(moments > 0, moments, np.inf), axis=1)  # a zero is no scale
+    spread = np.where(np.isfinite(smallest), moments[:, 2] / smallest, 1.0)
+    k = int(np.argmax(spread))
+    if spread[k] > INERTIA_SPREAD:
+        return (f"The body '{model.body_names[k]}' has principal moments of inertia from "
+                f"{smallest[k]:.3g} to {moments[k, 2]:.3g} kg m^2 (a ratio of "
+                f"{spread[k]:.2g}): its Euler equation divides the rounding errors of the "
+                "large moments by the small one, and the steps shrink to follow that noise; "
+                "no integrator steps over it.",
+                "a realistic smallest moment (a thin rod's m r^2 / 2 with its real radius), "
+                "a shorter --t-end")
+    fastest = f"{spin:.3g} rad/s" if spin > 0 else "none"
+    cause = (f"That is far more steps than the motion explains (the fastest spin at the "
+             f"start: {fastest}): the model is stiff (time scales far apart, such as a very "
+             "stiff spring on a light body)")
+    if method in IMPLICIT:
+        return (cause + f", and even {method} needs short steps.",
+                "a shorter --t-end, a looser --rtol (e.g. 1e-6)")
+    return (cause + ", and an explicit integrator must resolve the fastest of them.",
+            "a stiff integrator (--method LSODA, BDF or Radau), a shorter --t-end")
+
+
+INERTIA_SPREAD = 1e10
+"""Ratio of a body's largest to smallest principal moment beyond which rounding noise
+(relative 1e-16 of the largest, divided by the smallest) is blamed for short steps."""
+
+
+def _varying_expressions(model: Model, known: Mapping[str, float | str] | None
+                         ) -> list[tuple[str, Expression]]:
+    """(what it is, expression) for every load component and known reaction that varies
+    in time, `known` included (compiled here, so a bad one is reported before any work)."""
+    out = []
+    for ld in model.loads:
+        for k, e in sorted(ld.expressions.items()):
+            comp = "" if model.dimension == cv.PLANAR and ld.type == "torque" else \
+                f" {'xyz'[k]}"
+            out.append((f"the load '{ld.name}' ({ld.type}{comp} on {ld.bodies[0]})", e))
+    exprs = dict(model.known_expressions)
+    for label, v in (known or {}).items():
+        if isinstance(v, str):
+            exprs[label] = compile_expression(v)
+        else:
+            exprs.pop(label, None)
+    out += [(f"the known reaction {label}", e) for label, e in exprs.items()
+            if not e.constant]
+    return out
+
+
+def _check_span(varying: list[tuple[str, Expression]], t_end: float) -> None:
+    """Refuse, before any work, a run over a span where a load expression is not finite."""
+    for what, e in varying:
+        bad = first_nonfinite(e, t_end)
+        if bad is not None:
+            t = bad[0]
+            raise MbodyError(
+                f"{what} = \"{e.text}\" is not finite at t = {t:g} s ({bad[1]}), within the "
+                f"simulated span 0 .. {t_end:g} s: the integration could not go past it. "
+                + ("Change the expression (it is sampled every millisecond)." if t == 0 else
+                   f"Change the expression, or simulate a shorter span (--t-end below "
+                   f"{t:g})."))
+
+
+def _blame_expression(varying: list[tuple[str, Expression]], t0: float, t1: float,
+                      h: float | None) -> str:
+    """When the integration fails between t0 and t1: the load expression that is not
+    finite there, or that grows without bound (1/(t - pi) near pi), else ''."""
+    if not varying:
+        return ""
+    w = max(1e-9 * max(1.0, abs(t1)), 100 * (h or 0.0))
+    near = np.union1d(np.linspace(t0, t1 + w, 4001), [t0, t1, np.nextafter(t1, np.inf)])
+    worst = ("", 0.0)
+    for what, e in varying:
+        v = np.abs(e(near))
+        bad = ~np.isfinite(v)
+        if bad.any():
+            k = int(np.argmax(bad))
+            return (f"{what} = \"{e.text}\" is not finite at t = {near[k]:.9g} s "
+                    f"({e(near[k])}): change the expression, or simulate to before that time")
+        earlier = check_times(t0) if t0 > 0 else np.zeros(1)
+        earlier = earlier[earlier < t0 - 1e-3] if t0 > 2e-3 else earlier[:1]
+        before = float(np.max(np.abs(e(earlier))))
+        ratio = float(v.max()) / max(before, 1e-300)
+        if ratio > 1e6 and ratio > worst[1]:
+            k = int(np.argmax(v))
+            worst = (f"{what} = \"{e.text}\" grows without bound near t = {near[k]:.9g} s "
+                     f"(|value| {v[k]:.3g}, {ratio:.2g} times its largest before): change the "
+                     "expression, or simulate to before that time", ratio)
+    return worst[0]
+
+
+class _StepRate:
+    """Steps per simulated second, to catch a run whose cost explodes.
+
+    The rate over the first part of the run (until t_end / `WINDOWS`) is the baseline; the
+    rest is cut into windows of the same length, and a window whose rate exceeds `FACTOR`
+    times the baseline (with at least `MIN_STEPS` steps in it, so that a few steps more
+    on a cheap run say nothing) is kept for a warning.
+    """
+
+    WINDOWS, FACTOR, MIN_STEPS = 20, 20.0, 100
+
+    def __init__(self, t_end: float):
+        self.t_end, self.width = t_end, t_end / self.WINDOWS
+        self.start: tuple[float, float] | None = None  # (t, steps per second) until t
+        self.mark = (0.0, 0)  # (t, steps) where the current window began
+        self.next = self.width
+        self.slow: list[tuple[float, float, float]] = []  # (t0, t1, rate) windows
+        self.peak = 0.0
+
+    def step(self, t: float, steps: int) -> None:
+        if t < self.next and t < self.t_end:
+            return
+        t0, n0 = self.mark
+        r = (steps - n0) / (t - t0)
+        if self.start is None:
+            self.start = (t, r)
+        elif r > self.FACTOR * self.start[1] and steps - n0 >= self.MIN_STEPS:
+            self.slow.append((t0, t, r))
+        self.peak = max(self.peak, r)
+        self.mark = (t, steps)
+        self.next = (math.floor(t / self.width) + 1) * self.width
+
+    def figures(self, steps: int) -> dict:
+        """Steps per simulated second: over the first part, the busiest window, overall."""
+        return {"start": float(self.start[1]) if self.start else None,
+                "peak": float(self.peak), "overall": steps / self.t_end}
+
+    def so_far(self, t: float, steps: int) -> str:
+        """'N steps per simulated second so far (M over the first T s)'."""
+        text = f"{steps / t:.4g} steps per simulated second so far"
+        if self.start is not None:
+            text += f" ({self.start[1]:.4g} over the first {self.start[0]:.3g} s"
+            t0, n0 = self.mark
+            if t > t0 and steps > n0:
+                text += f", {(steps - n0) / (t - t0):.4g} since t = {t0:.3g} s"
+            text += ")"
+        return text
+
+    def warning(self) -> str | None:
+        if not self.slow or self.start is None:
+            return None
+        t0, t1, r = max(self.slow, key=lambda w: w[2])
+        t_start, base = self.start
+        return (f"the integration slowed down from t = {self.slow[0][0]:.3g} s: "
+                f"{r:.4g} steps per simulated second at t = {t0:.3g} .. {t1:.3g} s, "
+                f"{r / base:.0f} times the {base:.4g} per second over the first "
+                f"{t_start:.3g} s. Something in the model speeds up or stiffens (a spin-up "
+                "or runaway, a load that varies ever faster, a stiff spring): check the "
+                "motion; a shorter --t-end, a looser --rtol (1e-8), or --method Radau "
+                "for a stiff model cost less")
+
+
+def _budget_message(what: str, t: float, t_end: float, steps: int, rate: _StepRate,
+                    estimate: str, raise_it: str) -> str:
+    """The one paragraph a run stopped by a budget reports."""
+    return (f"the simulation stopped at {what}, at t = {t:.6g} s of {t_end:g} s: "
+            f"{rate.so_far(t, steps)}; {estimate}. No trajectory is kept (rerun with "
+            f"--t-end {t:.3g} to see the motion up to here). To go on: a shorter --t-end, a "
+            "looser --rtol (e.g. 1e-8), a stiff integrator such as --method Radau if the "
+            f"model is stiff (very stiff springs), or {raise_it}.")
+
+
+def _spin_warning(traj: Trajectory) -> str | None:
+    """A body whose spin aliases the frame rate: |ω| / 2π > fps / 2 at a sample."""
+    fps, w = traj.info["fps"], traj.angular_velocity
+    if traj.n == 0 or not len(w):
+        return None
+    rate = np.abs(w) if traj.dimension == cv.PLANAR else np.linalg.norm(w, axis=2)
+    peak = rate.max(axis=0)  # (n,) rad/s
+    fast = [i for i in np.argsort(-peak, kind="stable") if peak[i] / (2 * np.pi) > fps / 2]
+    if not fast:
+        return None
+    listed = ", ".join(f"{traj.body_names[i]} at up to {peak[i]:.4g} rad/s "
+                       f"({peak[i] / (2 * np.pi):.3g} rev/s, at t = "
+                       f"{traj.t[int(np.argmax(rate[:, i]))]:.3g} s)" for i in fast[:3])
+    if len(fast) > 3:
+        listed += f" and {len(fast) - 3} more bod{'y' if len(fast) == 4 else 'ies'}"
+    need = math.ceil(2 * peak[fast[0]] / (2 * np.pi))
+    return (f"spin faster than {fps:g} fps can show: {listed}. A body turning more than "
+            f"half a revolution between frames (|omega| / 2 pi > fps / 2 = {fps / 2:g} "
+            f"rev/s) looks in an animation as if it turned slower or backwards; use "
+            f"--fps {need} or more")
+
+
+def state_derivative(model: Model, known: Mapping[str, float | str] | None = None,
+                     dynamics: Dynamics | None = None) -> StateDerivative:
+    """ẏ = f(t, y), what `simulate` integrates (`mbody.dynamics.StateDerivative`): the
+    unknown reactions solved at every call (Baumgarte-stabilised, `mbody.mechanism`) or
+    every reaction known (`known_reaction_dynamics`), or `dynamics` when given."""
+    plan = model.plan
+    if dynamics is not None:
+        return StateDerivative(model, dynamics)
+    if _has_unknown_reactions(model, known):  # a mechanism: reactions solved every call
+
+        numeric = _numeric_known(model, known)
+        f = constrained_dynamics(model, numeric)
+        known_at = None
+        if model.known_expressions:
+            def known_at(t: float) -> np.ndarray:
+                return plan.unknowns_at(t, numeric).lam
+        return StateDerivative(model, f, unknowns=plan.unknowns_at(0.0, numeric),
+                               rate=f.rate, known_at=known_at, compiled=True)
+    f = known_reaction_dynamics(model, known)
+    labels = model.reactions
+    every = plan.unknowns(dict(zip(labels, f.values_at(0.0).tolist(), strict=True)))
+    return StateDerivative(model, f, unknowns=every,
+                           known_at=f.values_at if f.varying else None, compiled=True)
+
+
+def _model_text(model: Model) -> str:
+    """The model file's text, when the model came from a readable file."""
+    p = Path(model.file) if model.file and not model.file.startswith("<") else None
+    try:
+        return p.read_text(encoding="utf-8") if p is not None and p.is_file() else ""
+    except (OSError, UnicodeDecodeError):
+        return ""
+
+
+def potential_energy(model: Model, traj: Trajectory) -> np.ndarray:
+    """V = −Σ m g·x + Σ ½ k (L − L0)²: (K,) gravity and spring potential, J."""
+    x, q, _, _ = traj.spatial()
+    V = -np.einsum("kni,i,n->k", x, model.gravity, model.mass)
+    sp = model.springs
+    if len(sp.names):
+
+        Pa, Pb, _, _ = spring_ends(model, x, q)
+        L = np.linalg.norm(Pb - Pa, axis=2)
+        V = V + 0.5 * np.sum(sp.stiffness * (L - sp.rest_length) ** 2, axis=1)
+    return V
+
+
+def _has_unknown_reactions(model: Model, known: Mapping[str, float | str] | None) -> bool:
+    given = set(model.known_reactions) | set(getattr(model, "known_expressions", {}))
+    return bool(set(model.reactions) - given - set(known or {}))
+
+
+def _numeric_known(model: Model, known: Mapping[str, float | str] | None
+                   ) -> dict[str, float] | None:
+    """`known` for the constrained path (numbers only; formulas of t go in the file)."""
+    if not known:
+        return None
+    out = {}
+    for label, v in known.items():
+        if label not in model.reaction_index:
+            hint = did_you_mean(label, model.reactions)
+            raise MbodyError(f"no reaction component {label!r} in this model"
+                             + (f"; {hint}" if hint else ""))
+        if isinstance(v, str):
+            raise MbodyError(f"{label}: a known value given as a formula of t is supported "
+                             "for models whose reactions are all known; write it in the "
+                             "model file's 'reactions:' instead")
+        out[label] = float(v)
+    return out
+
+
+def _drift(model: Model, traj: Trajectory, default_dynamics: bool, *,
+           ideal_joints: bool = False) -> tuple[dict[str, np.ndarray], dict]:
+    """Energy and angular-momentum series and their largest relative change.
+
+    Energy E = T + V; its change is relative to max(|E(0)|, max T). Angular momentum: about
+    the world origin when nothing external acts (gravity-free, no applied loads, no
+    springs to ground, no reactions); with gravity as the only load, the spin momentum
+    Σ W_R_B J ω (gravity has no moment about a mass centre); else it is not conserved.
+    """
+    T = traj.kinetic_energy()
+    V = potential_energy(model, traj)
+    E = T + V
+    scale = max(abs(E[0]), float(np.max(np.abs(T))) if len(T) else 0.0)
+    e_change = float(np.max(np.abs(E - E[0])) / scale) if scale > 0 else 0.0
+
+    sp = model.springs
+    # Ideal joints whose reactions are solved do no work (Gᵀ v = 0): energy is conserved.
+    applied = (len(model.forces.names) > 0 or not default_dynamics
+               or (bool(model.reactions) and not ideal_joints)
+               or (ideal_joints and bool(model.known_reactions)))
+    grounded = (bool(np.any((sp.a < 0) | (sp.b < 0))) if len(sp.names) else False) or \
+        any(j.parent == cv.GROUND for j in model.joints)
+    damped = bool(np.any(sp.damping > 0)) if len(sp.names) else False
+    gravity = bool(np.any(model.gravity))
+    energy_conserved = not applied and not damped
+    if not applied and not grounded and not gravity:
+        H, kind = traj.angular_momentum(), "total, about the world origin"
+        h_conserved = True
+    elif not applied and not len(sp.names) and not model.joints:
+        H, kind = traj.spin_angular_momentum(), "spin, about the mass centres"
+        h_conserved = True
+    else:
+        H, kind = traj.angular_momentum(), "total, about the world origin"
+        h_conserved = False
+    h0 = float(np.linalg.norm(H[0]))
+    h_scale = max(h0, float(np.max(np.linalg.norm(H, axis=1))))
+    h_change = float(np.max(np.linalg.norm(H - H[0], axis=1)) / h_scale) if h_scale > 0 else 0.0
+    series = {"kinetic_energy": T, "potential_energy": V, "energy": E, "angular_momentum": H}
+    return series, {
+        "energy_conserved": energy_conserved, "energy_drift": e_change,
+        "energy_initial": float(E[0]),
+        "angular_momentum_conserved": h_conserved, "angular_momentum_kind": kind,
+        "angular_momentum_drift": h_change, "angular_momentum_initial": H[0].tolist(),
+    }
+
+
+def summary(traj: Trajectory, path: str | os.PathLike[str] | None = None) -> str:
+    """The run in a few lines: integrator, cost, and drift of the conserved quantities."""
+    i = traj.info
+    lines = [
+        f"simulated {traj.model_name!r}: {traj.n} bod{'y' if traj.n == 1 else 'ies'}, "
+        f"t = 0 .. {i['t_end']:g} s, {i['samples']} samples at {i['fps']:g} fps",
+        f"integrator {i['integrator']} (rtol {i['rtol']:g}, atol {i['atol']:g}): "
+        f"{i['steps']} steps, {i['evaluations']} evaluations"
+        + (f" ({i['sampling_evaluations']} of them for the samples)"
+           if i.get("sampling_evaluations") else "")
+        + f", {i['wall_time_s']:.3g} s",
+    ]
+    what = "drift" if i["energy_conserved"] else "change (not guaranteed: loads or reactions act)"
+    lines.append(f"energy T + V: E(0) = {i['energy_initial']:.6g} J, relative {what} "
+                 f"{i['energy_drift']:.2e}")
+    what = "drift" if i["angular_momentum_conserved"] else \
+        "change (not conserved: external moments)"
+    h0 = np.linalg.norm(i["angular_momentum_initial"])
+    if i["angular_momentum_conserved"]:
+        lines.append(f"angular momentum ({i['angular_momentum_kind']}): |H(0)| = {h0:.6g} "
+                     f"kg m^2/s, relative {what} {i['angular_momentum_drift']:.2e}")
+    else:  # a relative change of something not conserved (and maybe 0 at t = 0) says little
+        lines.append(f"angular momentum ({i['angular_momentum_kind']}): |H(0)| = {h0:.6g} "
+                     "kg m^2/s, not conserved (external moments act)")
+    if i["energy_conserved"] and i["energy_drift"] > 1e-6:
+        lines.append(f"warning: energy should be conserved but drifted {i['energy_drift']:.1e}"
+                     " (relative); check the initial state and the tolerances")
+    if "joint_stabilisation" in i:
+        lines.append(f"joints: reactions solved at every step ({i['joint_stabilisation']}); "
+                     f"largest joint error |phi| {i['joint_position_drift']:.1e}, "
+                     f"|G^T v| {i['joint_velocity_drift']:.1e}")
+        broken = i.get("initial_joint_errors") or []
+        if broken:
+            lines.append("warning: the initial state breaks joint constraints: "
+                         + ", ".join(broken)
+                         + ("; the run starts from the nearest state that keeps them "
+                            "(projected), so energy and the motion are not those of the "
+                            "state as written"
+                            if i["joint_stabilisation"] == PROJECTION_TEXT else
+                            "; the stabilisation pulls the joints together, so energy and "
+                            "the early motion are not those of the model as written"))
+    if traj.dimension == cv.SPATIAL:
+        lines.append(f"quaternion norm error before renormalising: "
+                     f"{i['quaternion_norm_error']:.1e}")
+    lines.extend(f"warning: {w}" for w in i.get("warnings", ()))
+    if path is not None:
+        lines.append(f"wrote {path}")
+    return "\n".join(lines)

@@ -1,0 +1,153 @@
+"""Check mbody's import graph: no cycles between its modules, and say where imports hide.
+
+    python tools/check_imports.py [--verbose]
+
+Every ``import`` of an mbody module counts, at module level or inside a function (an
+import inside a function is still a dependency, only a later one); imports under
+``if TYPE_CHECKING:`` do not (they never run). A cycle is printed with the file and line
+of each of its imports, and the exit code is 1.
+
+An import inside a function is kept only where it saves start-up time: the target loads
+a slow library (scipy, matplotlib, networkx, meshcat, numba, tqdm) when imported, or the
+importer is a command module (`mbody.cli`: every command registers its arguments at
+start-up, and must not load what only another command uses). Any other import inside a
+function hides a dependency for nothing: it is listed, and the exit code is 1.
+``--verbose`` lists every import made inside a function, with its reason.
+"""
+
+from __future__ import annotations
+
+import argparse
+import ast
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+import networkx as nx
+
+ROOT = Path(__file__).resolve().parent.parent
+PACKAGE = ROOT / "mbody"
+
+
+SLOW = ("scipy", "matplotlib", "networkx", "meshcat", "numba", "tqdm")
+"""Libraries that take tens to hundreds of milliseconds to import."""
+
+
+@dataclass(frozen=True)
+class Import:
+    source: str  # importing module, dotted
+    target: str  # imported mbody module, dotted
+    line: int
+    in_function: bool
+
+
+def module_name(path: Path) -> str:
+    parts = path.relative_to(ROOT).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def _is_type_checking(node: ast.If) -> bool:
+    t = node.test
+    return (isinstance(t, ast.Name) and t.id == "TYPE_CHECKING") or (
+        isinstance(t, ast.Attribute) and t.attr == "TYPE_CHECKING")
+
+
+def _targets(node: ast.Import | ast.ImportFrom, source: str, is_package: bool,
+             modules: set[str]) -> list[str]:
+    """The mbody modules an import statement loads (the deepest that exists)."""
+    if isinstance(node, ast.Import):
+        names = [a.name for a in node.names]
+    else:
+        base = node.module or ""
+        if node.level:
+            pkg = source.split(".") if is_package else source.split(".")[:-1]
+            pkg = pkg[: len(pkg) - (node.level - 1)]
+            base = ".".join(pkg + ([base] if base else []))
+        names = [f"{base}.{a.name}" if f"{base}.{a.name}" in modules else base
+                 for a in node.names]
+    found = []
+    for name in names:
+        while name and name not in modules:
+            name = name.rpartition(".")[0]
+        if name.startswith("mbody") and name != source:
+            found.append(name)
+    return sorted(set(found))
+
+
+def imports(modules: dict[str, Path], slow: dict[str, bool]) -> list[Import]:
+    """Imports between mbody modules; fills `slow` with the modules that import a slow
+    library at module level themselves."""
+    out = []
+    for source, path in modules.items():
+        tree = ast.parse(path.read_text("utf-8"), str(path))
+        is_package = path.name == "__init__.py"
+
+        def walk(node: ast.AST, in_function: bool, source=source, is_package=is_package):
+            for child in ast.iter_child_nodes(node):
+                if isinstance(child, ast.If) and _is_type_checking(child):
+                    for other in child.orelse:
+                        walk(other, in_function)
+                    continue
+                if isinstance(child, ast.Import | ast.ImportFrom) and not in_function:
+                    names = ([a.name for a in child.names] if isinstance(child, ast.Import)
+                             else [child.module or ""] if not child.level else [])
+                    if any(n.split(".")[0] in SLOW for n in names):
+                        slow[source] = True
+                if isinstance(child, ast.Import | ast.ImportFrom):
+                    for target in _targets(child, source, is_package, set(modules)):
+                        out.append(Import(source, target, child.lineno, in_function))
+                walk(child, in_function or isinstance(
+                    child, ast.FunctionDef | ast.AsyncFunctionDef | ast.Lambda))
+
+        walk(tree, False)
+    return out
+
+
+def _package_of(name: str) -> str:
+    return name.rpartition(".")[0]
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--verbose", action="store_true", help="list imports made in functions")
+    a = p.parse_args(argv)
+    modules = {module_name(f): f for f in sorted(PACKAGE.rglob("*.py"))}
+    direct: dict[str, bool] = {}
+    found = imports(modules, direct)
+    g = nx.DiGraph()
+    g.add_nodes_from(modules)
+    for imp in found:
+        # importing mbody.x.y runs mbody.x's __init__ first: that is not a dependency of
+        # the importer on the package's other modules, so the edge goes to the module only
+        g.add_edge(imp.source, imp.target, at=imp)
+    # the packages' own __init__ files that import nothing of mbody stay out of cycles
+    cycles = sorted(nx.simple_cycles(g), key=len)
+    for cycle in cycles[:20]:
+        print("import cycle:")
+        for src, dst in zip(cycle, cycle[1:] + cycle[:1], strict=True):
+            imp = g.edges[src, dst]["at"]
+            where = " (in a function)" if imp.in_function else ""
+            print(f"  {modules[src].relative_to(ROOT)}:{imp.line}: {src} -> {dst}{where}")
+    eager = nx.DiGraph((i.source, i.target) for i in found if not i.in_function)
+    eager.add_nodes_from(modules)
+    slow = {m for m in modules if any(direct.get(d) for d in nx.descendants(eager, m) | {m})}
+    late = [imp for imp in found if imp.in_function]
+    needless = []
+    for imp in late:
+        if imp.source.startswith("mbody.cli"):
+            why = "a command module"
+        elif imp.target in slow:
+            why = "loads a slow library"
+        else:
+            why = "NEEDLESS"
+            needless.append(imp)
+        if a.verbose or why == "NEEDLESS":
+            print(f"{modules[imp.source].relative_to(ROOT)}:{imp.line}: {imp.source} imports "
+                  f"{imp.target} in a function: {why}")
+    print(f"{len(modules)} modules, {len(found)} imports between them "
+          f"({len(late)} inside functions, {len(needless)} needless), {len(cycles)} cycle(s)")
+    return 1 if cycles or needless else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
