@@ -13,10 +13,20 @@ from dataclasses import dataclass
 
 @dataclass(frozen=True)
 class Issue:
-    """One problem in a model file.
+    """One problem in a model file, located.
 
-    `line` and `column` are 1-based (as editors show them); 0 means "unknown".
-    `key` is the dotted path to the offending entry, e.g. ``bodies[2].inertia``.
+    Parameters
+    ----------
+    file : str
+        The model file's path as given (``<dict>`` or ``<string>`` when not from a file).
+    line, column : int
+        1-based position, as editors show them; 0 when unknown.
+    key : str
+        Dotted path to the offending entry, e.g. ``bodies[2].inertia``.
+    message : str
+        What is wrong and what was expected.
+    hint : str, optional
+        A did-you-mean or a way to fix it.
     """
 
     file: str
@@ -41,7 +51,13 @@ class MbodyError(Exception):
 
 
 class ModelError(MbodyError):
-    """A model file (or model dictionary) is invalid; `issues` lists every problem."""
+    """A model file (or model dictionary) is invalid; `issues` lists every problem.
+
+    Parameters
+    ----------
+    issues : sequence of Issue
+        Every problem found in the file, in file order.
+    """
 
     def __init__(self, issues: Sequence[Issue]):
         self.issues = list(issues)
@@ -60,7 +76,13 @@ class ModelError(MbodyError):
 
 
 class UnknownReactionsError(MbodyError):
-    """Accelerations were asked for while some reaction components are still unknown."""
+    """Accelerations were asked for while some reaction components are still unknown.
+
+    Parameters
+    ----------
+    unknown : sequence of str
+        The labels of the unknown reaction components (``A.Fx``...).
+    """
 
     def __init__(self, unknown: Sequence[str]):
         self.unknown = list(unknown)
