@@ -17,6 +17,7 @@ from randmodels import planar_model, spatial_model
 
 import mbody
 import mbody.io.export as ex
+from mbody.io.export import csvfolder
 from mbody.simulate.trajectory import Trajectory
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -132,7 +133,7 @@ def test_round_trip_with_state_known_values_and_triplet_csv(tmp_path, monkeypatc
     asm = mbody.assemble(model, moved)
     known = {asm.reactions[0]: -3.5, asm.reactions[-1]: 1e-300}
     exp = ex.exported(asm, known, "a test state")
-    monkeypatch.setattr(ex, "CSV_DENSE_LIMIT", 4)
+    monkeypatch.setattr(csvfolder, "CSV_DENSE_LIMIT", 4)
     for fmt in FORMATS:
         back = mbody.load_export(_write(exp, tmp_path / fmt, fmt))
         assert exp.differences(back) == [], fmt
@@ -243,7 +244,8 @@ def _half_then_fail(path, text=b"PK\x03\x04 half a file"):
 def test_a_write_failing_halfway_leaves_no_partial_file(tmp_path, monkeypatch, fmt):
     asm = mbody.assemble(MODEL_CASES["pendulum"])
     target = tmp_path / f"eqs.{fmt}"
-    monkeypatch.setattr(ex, f"_write_{fmt}", lambda exp, path: _half_then_fail(path))
+    module = {"npz": ex.npz, "mat": ex.mat, "json": ex.jsonfile}[fmt]
+    monkeypatch.setattr(module, "write", lambda exp, path: _half_then_fail(path))
     with pytest.raises(OSError, match="No space"):
         ex.write_export(asm, target)
     assert list(tmp_path.iterdir()) == []  # neither the target nor a temporary file
@@ -251,7 +253,7 @@ def test_a_write_failing_halfway_leaves_no_partial_file(tmp_path, monkeypatch, f
     monkeypatch.undo()
     ex.write_export(asm, target)
     before = target.read_bytes()
-    monkeypatch.setattr(ex, f"_write_{fmt}", lambda exp, path: _half_then_fail(path))
+    monkeypatch.setattr(module, "write", lambda exp, path: _half_then_fail(path))
     with pytest.raises(OSError):
         ex.write_export(asm, target)
     assert target.read_bytes() == before
@@ -260,21 +262,21 @@ def test_a_write_failing_halfway_leaves_no_partial_file(tmp_path, monkeypatch, f
 
 def test_a_csv_write_failing_halfway_leaves_no_partial_folder(tmp_path, monkeypatch):
     asm = mbody.assemble(MODEL_CASES["pendulum"])
-    real = ex._matrix_rows
+    real = csvfolder._matrix_rows
 
     def rows_then_fail(A, rows, cols):
         it = real(A, rows, cols)
         yield next(it)
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr(ex, "_matrix_rows", rows_then_fail)
+    monkeypatch.setattr(csvfolder, "_matrix_rows", rows_then_fail)
     with pytest.raises(OSError):
         ex.write_csv(asm, tmp_path / "out")
     assert list(tmp_path.iterdir()) == []
     monkeypatch.undo()
     ex.write_csv(asm, tmp_path / "out")
     before = {p.name: p.read_bytes() for p in (tmp_path / "out").iterdir()}
-    monkeypatch.setattr(ex, "_matrix_rows", rows_then_fail)
+    monkeypatch.setattr(csvfolder, "_matrix_rows", rows_then_fail)
     with pytest.raises(OSError):
         ex.write_csv(mbody.assemble(MODEL_CASES["seed_example_1"]), tmp_path / "out")
     assert {p.name: p.read_bytes() for p in (tmp_path / "out").iterdir()} == before

@@ -5,12 +5,18 @@ from __future__ import annotations
 import argparse
 import contextlib
 import sys
+from collections.abc import Iterator
+from typing import TYPE_CHECKING
 
 from mbody.cli.common import EXIT_OK, load_model, parse_known, regular_file
 from mbody.errors import MbodyError, OutputError
 
+if TYPE_CHECKING:
+    from mbody.equations.assemble import Assembly
+
 
 def register(sub: argparse._SubParsersAction) -> None:
+    """Add the `export` command and its options to the command line's subparsers."""
     s = sub.add_parser(
         "export", help="write M, b, Q, G with row/column labels (npz, .mat, JSON, CSV)",
         description="Write the stacked equations M v_dot + b = Q + G lambda of MODEL at its "
@@ -34,6 +40,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def export(a: argparse.Namespace) -> int:
+    """`mbody export MODEL -o FILE... [--csv DIR]`: write the exports, print their sizes."""
     from mbody.equations.assemble import assemble
     from mbody.io.export import assembly_from_trajectory, exported, write_csv, write_export
 
@@ -62,7 +69,7 @@ def export(a: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def latex(asm, target: str, body: str | None = None) -> int:
+def latex(asm: Assembly, target: str, body: str | None = None) -> int:
     """`mbody assemble MODEL --latex [FILE]`: the LaTeX document to FILE (or stdout for -)."""
     from mbody.io.atomic import write_atomic
     from mbody.present.latex import document
@@ -82,7 +89,7 @@ def latex(asm, target: str, body: str | None = None) -> int:
 
 
 @contextlib.contextmanager
-def _writing(target: str):
+def _writing(target: str) -> Iterator[None]:
     """An operating-system error while writing `target` becomes one clear message."""
     try:
         yield

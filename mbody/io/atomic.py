@@ -6,12 +6,13 @@ from __future__ import annotations
 import contextlib
 import gc
 import os
+import shutil
 import sys
 import tempfile
 import traceback
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import IO
+from typing import IO, Any
 
 from mbody.errors import MbodyError, OutputError
 
@@ -76,18 +77,91 @@ def atomic_path(target: str | os.PathLike[str], suffix: str = "") -> Iterator[Pa
         raise
 
 
-def write_atomic(target: str | os.PathLike[str], write: Callable[[IO], object] | bytes | str,
+def write_atomic(target: str | os.PathLike[str],
+                 write: Callable[[IO[Any]], object] | bytes | str,
                  binary: bool | None = None) -> Path:
-    """Write `write` (bytes, text, or a callable given the open file) atomically."""
+    """Write `write` (bytes, text, or a callable given the open file) atomically.
+
+    Parameters
+    ----------
+    target
+        The file to write.
+    write
+        The content, or a callable that writes it to the open file it is given (text
+        is encoded, and bytes decoded, as UTF-8 when the mode asks for the other).
+    binary
+        Open the file in binary mode; by default, unless `write` is a str.
+
+    Returns
+    -------
+    Path
+        `target`.
+    """
     if binary is None:
         binary = not isinstance(write, str)
-    with atomic_path(target) as tmp, open(tmp, "wb" if binary else "w",
-                                          **({} if binary else {"encoding": "utf-8"})) as fh:
-        if callable(write):
-            write(fh)
+    with atomic_path(target) as tmp:
+        if binary:
+            with open(tmp, "wb") as fb:
+                if callable(write):
+                    write(fb)
+                else:
+                    fb.write(write.encode("utf-8") if isinstance(write, str) else write)
         else:
-            fh.write(write)
+            with open(tmp, "w", encoding="utf-8") as ft:
+                if callable(write):
+                    write(ft)
+                else:
+                    ft.write(write if isinstance(write, str) else write.decode("utf-8"))
     return Path(target)
+
+
+@contextlib.contextmanager
+def atomic_folder(target: str | os.PathLike[str]) -> Iterator[Path]:
+    """Yield a temporary folder next to `target`; on success move its files into `target`.
+
+    A new `target` is the temporary folder renamed (one atomic step). An existing one
+    gets each file renamed in (each file atomic; files of `target` not written are kept),
+    only after every file is complete, so a failed writer changes nothing.
+
+    Parameters
+    ----------
+    target
+        The folder to fill; created with its parents if needed.
+
+    Raises
+    ------
+    MbodyError
+        When `target` exists and is not a folder.
+    OutputError
+        On an operating-system error (a full disk...), naming `target`; the temporary
+        folder is removed.
+    """
+    target = Path(target)
+    if target.exists() and not target.is_dir():
+        raise MbodyError(f"{target}: exists and is not a folder")
+    parent = target.parent if str(target.parent) else Path(".")
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+        tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.", dir=parent))
+    except OSError as exc:
+        raise MbodyError(f"cannot write {str(target)!r}: {exc.strerror or exc}") from None
+    os.chmod(tmp, 0o777 & ~_umask())  # mkdtemp makes 0700; give what mkdir() would
+    try:
+        yield tmp
+        if not target.exists():
+            os.replace(tmp, target)
+        else:
+            for f in sorted(tmp.iterdir()):
+                os.replace(f, target / f.name)
+            tmp.rmdir()
+    except BaseException as exc:
+        shutil.rmtree(tmp, ignore_errors=True)
+        if isinstance(exc, OSError) and not isinstance(exc, OutputError):
+            _release(exc)
+            raise OutputError(f"cannot write {str(target)!r}: {exc.strerror or exc}; the "
+                              "temporary folder is removed, and the target is as it was",
+                              exc, str(target)) from None
+        raise
 
 
 def _release(exc: BaseException) -> None:

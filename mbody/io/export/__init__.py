@@ -1,0 +1,130 @@
+"""Self-describing exports of ``M v̇ + b = Q + G λ``: npz, MATLAB .mat, JSON and CSV.
+
+Every export holds the stacked matrices at one state together with what is needed to
+read them without mbody: the coordinate label of every row, the reaction label of every
+column of G and, per column, its joint, joint type, parent, child, component, direction
+(the joint-frame axis in world axes at that state), joint point and sign rule; the body
+masses, inertia tensors and state; and the conventions (`mbody.conventions.conventions`).
+
+    exp = exported(asm)                 # an `ExportedAssembly` (in memory)
+    write_export(asm, "eqs.npz")        # or .mat / .json; write_csv(asm, "eqs_csv/")
+    back = load_export("eqs.npz")       # the same `ExportedAssembly`, bit for bit
+
+The package: `assembly` (the in-memory export and what every format shares), one module
+per format holding its writer and its reader together (`npz`, `mat`, `jsonfile`,
+`csvfolder`), `sample` (the state at a trajectory sample), and here the choice of format
+by suffix. Floats are written so that they read back exactly.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Mapping
+from pathlib import Path
+from types import ModuleType
+
+from mbody.equations.assemble import Assembly
+from mbody.errors import MbodyError
+from mbody.io.atomic import atomic_path
+from mbody.io.export import csvfolder, jsonfile, mat, npz
+from mbody.io.export.assembly import (
+    COLUMN_TEXT,
+    FORMAT,
+    VERSION,
+    Columns,
+    ExportedAssembly,
+    as_export,
+    exported,
+)
+from mbody.io.export.csvfolder import CSV_DENSE_LIMIT, write_csv
+from mbody.io.export.jsonfile import from_json, schema, to_json
+from mbody.io.export.sample import assembly_from_trajectory, state_at
+
+__all__ = [
+    "COLUMN_TEXT", "CSV_DENSE_LIMIT", "FORMAT", "SUFFIXES", "VERSION", "Columns",
+    "ExportedAssembly", "assembly_from_trajectory", "exported", "from_json", "load_export",
+    "schema", "state_at", "to_json", "write_csv", "write_export",
+]
+
+SUFFIXES = {".npz": "npz", ".mat": "mat", ".json": "json"}
+"""File suffix -> format; a CSV export is a folder (`write_csv`)."""
+
+
+def _module(fmt: str) -> ModuleType:
+    # looked up at each call, so that a format's `write`/`read` patched on its own module
+    # (as the tests do to simulate a full disk) is the one used
+    return {"npz": npz, "mat": mat, "json": jsonfile}[fmt]
+
+
+def write_export(asm: Assembly | ExportedAssembly, path: str | os.PathLike[str],
+                 known: Mapping[str, float] | None = None) -> Path:
+    """Write an export whose format follows the suffix of `path`, atomically.
+
+    Parameters
+    ----------
+    asm
+        An assembly (exported here) or an export.
+    path
+        A file name ending in .npz, .mat or .json.
+    known
+        Reaction values to record as known, with an `Assembly`.
+
+    Returns
+    -------
+    Path
+        `path`.
+
+    Raises
+    ------
+    MbodyError
+        For another suffix; `mbody.errors.OutputError` when the file cannot be written
+        (nothing is left behind, and an existing file is unchanged).
+    """
+    path = Path(path)
+    fmt = SUFFIXES.get(path.suffix.lower())
+    if fmt is None:
+        raise MbodyError(f"{path}: unknown export format {path.suffix or '(no suffix)'!r}; "
+                         "use a name ending in .npz, .mat or .json, or --csv DIR")
+    exp = as_export(asm, known)
+    with atomic_path(path) as tmp:
+        _module(fmt).write(exp, tmp)
+    return path
+
+
+def load_export(path: str | os.PathLike[str]) -> ExportedAssembly:
+    """Reload any export (.npz, .mat, .json file, or a CSV folder) as an `ExportedAssembly`.
+
+    Parameters
+    ----------
+    path
+        The file, or the folder `write_csv` wrote.
+
+    Returns
+    -------
+    ExportedAssembly
+        The export, bit for bit as written.
+
+    Raises
+    ------
+    MbodyError
+        For a missing, unreadable or foreign file.
+    """
+    path = Path(path)
+    reader: Callable[[Path], ExportedAssembly]
+    if path.is_dir():
+        reader = csvfolder.read
+    else:
+        fmt = SUFFIXES.get(path.suffix.lower())
+        if fmt is None:
+            raise MbodyError(f"{path}: not an mbody export (expected .npz, .mat, .json or a "
+                             "CSV folder)")
+        if not path.exists():
+            raise MbodyError(f"{path}: no such file")
+        reader = _module(fmt).read
+    try:
+        return reader(path)
+    except MbodyError:
+        raise
+    except (OSError, ValueError, KeyError, IndexError, TypeError) as exc:
+        raise MbodyError(f"{path}: not a readable mbody export ({type(exc).__name__}: "
+                         f"{exc})") from None

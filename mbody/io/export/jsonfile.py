@@ -1,0 +1,118 @@
+"""The JSON export: one document that validates against the schema shipped with the package
+(`schema()`, mbody/data/assembly.schema.json); sparse matrices as sorted 0-based
+``row, col, value`` triplets, one object per reaction column and per body. Floats are
+written by `json` with the shortest repr that reads back exactly."""
+
+from __future__ import annotations
+
+import json
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+
+from mbody.errors import MbodyError
+from mbody.io.export.assembly import (
+    COLUMN_TEXT,
+    FORMAT,
+    VERSION,
+    ExportedAssembly,
+    build,
+    check_format,
+)
+
+
+def _triplets(A: sp.csc_matrix) -> dict[str, Any]:
+    """CSC as triplets, sorted by column then row (the CSC order itself)."""
+    col = np.repeat(np.arange(A.shape[1]), np.diff(A.indptr))
+    return {"shape": list(A.shape), "row": A.indices.tolist(), "col": col.tolist(),
+            "value": A.data.tolist()}
+
+
+def to_json(exp: ExportedAssembly) -> dict[str, Any]:
+    """The JSON document (validates against `schema()`)."""
+    st = exp.state
+    bodies = [{"name": n, "mass": float(exp.masses[i]), "inertia": exp.inertias[i].tolist(),
+               "position": st.position[i].tolist(), "quaternion": st.quaternion[i].tolist(),
+               "velocity": st.velocity[i].tolist(), "omega": st.omega[i].tolist()}
+              for i, n in enumerate(exp.body_names)]
+    return {
+        "format": FORMAT, "version": VERSION,
+        "model": {"name": exp.model, "file": exp.file, "dimension": exp.dimension},
+        "state": {"t": exp.t, "source": exp.state_source},
+        "conventions": exp.conventions,
+        "coordinates": exp.coordinates, "reactions": exp.reactions,
+        "bodies": bodies, "columns": exp.columns.records(),
+        "M": _triplets(exp.M), "b": exp.b.tolist(), "Q": exp.Q.tolist(), "G": _triplets(exp.G),
+    }
+
+
+def write(exp: ExportedAssembly, path: Path) -> None:
+    """Write `to_json(exp)` to `path`, UTF-8 (not atomic by itself).
+
+    Parameters
+    ----------
+    exp
+        The export to write.
+    path
+        The file to write.
+    """
+    with open(path, "w", encoding="utf-8") as fh:
+        json.dump(to_json(exp), fh, indent=1, allow_nan=False, ensure_ascii=False)
+        fh.write("\n")
+
+
+def schema() -> dict[str, Any]:
+    """The JSON Schema (draft 2020-12) of the JSON export, shipped with the package."""
+    text = resources.files("mbody").joinpath("data/assembly.schema.json").read_text("utf-8")
+    out: dict[str, Any] = json.loads(text)
+    return out
+
+
+def read(path: Path) -> ExportedAssembly:
+    """The `ExportedAssembly` stored in the JSON file `path`."""
+    with open(path, encoding="utf-8") as fh:
+        d = json.load(fh)
+    if not isinstance(d, dict):
+        raise MbodyError(f"{path}: not an mbody export (not a JSON object)")
+    check_format(path, str(d.get("format")), int(d.get("version", 0)))
+    return from_json(d, path)
+
+
+def from_json(d: dict[str, Any], path: Path | str = "<json>") -> ExportedAssembly:
+    """An `ExportedAssembly` from the JSON document `to_json` produces.
+
+    Parameters
+    ----------
+    d
+        The parsed document.
+    path
+        Where it came from, for messages.
+    """
+    bodies, cols = d["bodies"], d["columns"]
+    flat: dict[str, Any] = {
+        "format": d["format"], "version": d["version"], "model": d["model"]["name"],
+        "model_file": d["model"]["file"], "dimension": d["model"]["dimension"],
+        "t": d["state"]["t"], "state_source": d["state"]["source"],
+        "conventions_json": json.dumps(d["conventions"]),
+        "coordinates": d["coordinates"], "reactions": d["reactions"],
+        "body_names": [b["name"] for b in bodies], "masses": [b["mass"] for b in bodies],
+        "inertias": [b["inertia"] for b in bodies] or np.zeros((0, 3, 3)),
+        "b": d["b"], "Q": d["Q"],
+        "column_frame": [c["frame"] for c in cols] or np.zeros((0, 3)),
+        "column_point": [c["point"] for c in cols] or np.zeros((0, 3)),
+        "column_known": [np.nan if c["known"] is None else c["known"] for c in cols],
+        "column_gamma": [c["gamma"] for c in cols], "column_phi": [c["phi"] for c in cols],
+    }
+    for k in ("position", "quaternion", "velocity", "omega"):
+        flat[k] = [b[k] for b in bodies] or np.zeros((0, 4 if k == "quaternion" else 3))
+    for k in COLUMN_TEXT[1:]:
+        flat[f"column_{k}"] = [c[k] for c in cols]
+
+    def mat(t: dict[str, Any]) -> sp.csc_matrix:
+        return sp.csc_matrix((t["value"], (t["row"], t["col"])), shape=tuple(t["shape"]))
+
+    return build(Path(path), flat.__getitem__, mat(d["M"]), mat(d["G"]))
+

@@ -1,0 +1,51 @@
+"""The npz export: numpy arrays under the `flat_arrays` names, each sparse matrix as its
+CSC arrays (``M_data, M_indices, M_indptr, M_shape``) so that one scipy call rebuilds it
+without mbody, and labels as plain string arrays (no pickling)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+
+from mbody.io.export.assembly import ExportedAssembly, build, flat_arrays, text_array
+
+
+def write(exp: ExportedAssembly, path: Path) -> None:
+    """Write `exp` to `path` as a compressed npz (not atomic: `write_export` makes it so).
+
+    Parameters
+    ----------
+    exp
+        The export to write.
+    path
+        The file to write (numpy adds no suffix: the file handle is given).
+    """
+    arrs = flat_arrays(exp)
+    for k in ("coordinates", "reactions", "body_names"):
+        arrs[k] = text_array(arrs[k])
+    for name in ("M", "G"):
+        A = getattr(exp, name)
+        arrs.update({f"{name}_data": A.data, f"{name}_indices": A.indices,
+                     f"{name}_indptr": A.indptr, f"{name}_shape": np.array(A.shape)})
+    arrays: dict[str, Any] = {k: np.asarray(v) for k, v in arrs.items()}
+    with open(path, "wb") as fh:
+        np.savez_compressed(fh, **arrays)
+
+
+def read(path: Path) -> ExportedAssembly:
+    """The `ExportedAssembly` stored in the npz file `path` (never unpickles anything)."""
+    with np.load(path, allow_pickle=False) as z:
+        data = {k: z[k] for k in z.files}
+
+    def get(k: str) -> Any:
+        v = data[k]
+        return v.item() if v.ndim == 0 else v
+
+    def mat(name: str) -> sp.csc_matrix:
+        return sp.csc_matrix((data[f"{name}_data"], data[f"{name}_indices"],
+                              data[f"{name}_indptr"]), shape=tuple(data[f"{name}_shape"]))
+
+    return build(path, get, mat("M"), mat("G"))
