@@ -18,7 +18,7 @@ import pytest
 
 import mbody
 from mbody.errors import MbodyError
-from mbody.present.animate import LiveViewer, build_scene, page_html, write_page
+from mbody.present.animate import LiveViewer, build_scene, pack, page_html, unpack, write_page
 from mbody.simulate.trajectory import Trajectory
 
 sys.path.insert(0, str(Path(__file__).parent))
@@ -98,12 +98,59 @@ def test_keyframes_are_the_trajectory(spinner):
     model, traj = spinner
     scene = build_scene(traj, model)
     tracks = _animation(scene, scene.paths["brick"])
-    assert tracks[".position"]["times"] == pytest.approx(traj.t.tolist(), abs=0)
+    np.testing.assert_array_equal(tracks[".position"]["times"], traj.t - traj.t[0])
     P = np.reshape(tracks[".position"]["values"], (-1, 3))
     np.testing.assert_allclose(P[:, 0], V * traj.t, atol=1e-15)
     Q = np.reshape(tracks[".quaternion"]["values"], (-1, 4))  # three.js order x, y, z, w
     np.testing.assert_allclose(Q[:, [3, 0, 1, 2]], spin_q(traj.t), atol=1e-15)
     assert scene.duration == 2.0 and scene.frames == 61
+
+
+def test_packed_keyframes_are_float32_arrays_of_the_motion(spinner):
+    """The set_animation command goes out with every track as one Float32Array (msgpack
+    ext 0x17) that decodes to the trajectory's numbers rounded to float32, not as
+    per-number floats; the per-number path (typed_arrays=False) still gives float64."""
+    model, traj = spinner
+    scene = build_scene(traj, model, forces=True)
+    cmd = next(c for c in scene.commands if c["type"] == "set_animation")
+    data = pack(cmd)
+    back = unpack(data)
+    tracks = 0
+    for sent, got in zip(cmd["animations"], back["animations"], strict=True):
+        assert got["path"] == sent["path"]
+        for a, b in zip(sent["clip"]["tracks"], got["clip"]["tracks"], strict=True):
+            assert (b["name"], b["type"]) == (a["name"], a["type"])
+            for key in ("times", "values"):
+                assert isinstance(b[key], np.ndarray) and b[key].dtype == np.float32
+                np.testing.assert_array_equal(b[key], np.float32(a[key]))
+                tracks += 1
+    assert tracks == 2 * (2 + 2 + 5)  # 2 bodies x 2 tracks, the arrow's 5 tracks
+    brick = next(a for a in back["animations"] if a["path"] == scene.paths["brick"])
+    P, Q = (tr["values"] for tr in brick["clip"]["tracks"])
+    np.testing.assert_array_equal(P.reshape(-1, 3), np.float32(traj.position[:, 0]))
+    np.testing.assert_array_equal(Q.reshape(-1, 4)[:, [3, 0, 1, 2]],
+                                  np.float32(traj.orientation[:, 0]))
+    np.testing.assert_array_equal(brick["clip"]["tracks"][0]["times"], np.float32(traj.t))
+    # Each times array is one msgpack ext 8 (0xc7, its length, type 0x17): 4 bytes a number.
+    assert 4 * traj.t.size < 256
+    assert data.count(bytes([0xC7, 4 * traj.t.size, 0x17])) == 9
+    old = unpack(pack(cmd, typed_arrays=False))
+    a0 = old["animations"][0]["clip"]["tracks"][0]
+    assert a0["values"] == cmd["animations"][0]["clip"]["tracks"][0]["values"].tolist()
+    assert len(pack(cmd, typed_arrays=False)) > 1.8 * len(data)
+    with pytest.raises(TypeError, match="int64"):
+        pack({"type": "x", "values": np.arange(3)})
+
+
+def test_the_package_keeps_its_public_names():
+    """mbody.present.animate is a package of parts; its names and mbody.animate stay."""
+    import mbody.present.animate as pkg
+
+    for name in ("animate", "build_scene", "page_html", "write_page", "LiveViewer",
+                 "resolve", "Scene", "ROOT", "HOST", "pack", "unpack"):
+        assert name in pkg.__all__ and getattr(pkg, name) is not None, name
+    assert callable(pkg.animate) and mbody.animate is pkg.animate
+    assert pkg.build_scene.__module__ == "mbody.present.animate.scene"
 
 
 def test_cylinder_axis_is_body_z(spinner):

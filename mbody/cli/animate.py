@@ -7,6 +7,7 @@ import signal
 import sys
 import time
 from pathlib import Path
+from types import FrameType
 
 from mbody.cli.common import EXIT_OK, regular_file
 from mbody.errors import MbodyError
@@ -42,7 +43,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.set_defaults(run=animate)
 
 
-def _stop(signum, frame):  # SIGTERM ends the live viewer like Ctrl-C
+def _stop(signum: int, frame: FrameType | None) -> None:  # SIGTERM ends --live like Ctrl-C
     raise KeyboardInterrupt
 
 

@@ -1,0 +1,460 @@
+"""The scene: meshcat commands that draw each body and move it along a `Trajectory`.
+
+Body i is drawn at its pose at every sample k,
+
+    W_x(t_k) = W_r_G,i(t_k) + W_R_B,i(t_k) B_x      (every point B_x of its shape)
+
+as keyframes (position and quaternion tracks, times t_k − t_0 in seconds) that the
+viewer interpolates (linearly for positions, slerp for rotations). Planar bodies live in
+the x-y plane and turn about z. Applied forces and couples (`forces=True`) are arrows:
+a cylinder shaft and a cone head, placed at the point of application, pointing along
+W_f, with length proportional to |W_f| (couples: along the moment vector, at G).
+
+meshcat 0.3.2's Python side breaks under numpy 2 unless it is given float64 arrays and
+Python scalars, so every number handed to it is converted first (`float`, float64 4x4
+matrices). Keyframe tracks bypass it: they are float64 numpy arrays in the commands,
+sent as Float32Arrays (`mbody.present.animate.wire`).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+from types import ModuleType
+from typing import Any
+
+import numpy as np
+
+from mbody import conventions as cv
+from mbody.equations.joints import reaction_columns
+from mbody.equations.loads import applied_loads
+from mbody.equations.spatial import box_equivalent, matvec, planar_quat, quat_to_matrix
+from mbody.errors import MbodyError, did_you_mean
+from mbody.model.model import Body, Model
+from mbody.present.animate.wire import load_meshcat
+from mbody.simulate.trajectory import Trajectory
+
+ROOT = "/meshcat/mbody"
+"""Scene path of the model's frame; bodies are at ROOT/bodies/<name>."""
+PALETTE = ("#ff7f0e", "#2ca02c", "#9467bd", "#8c564b", "#e377c2", "#bcbd22",
+           "#17becf", "#7f7f7f", "#1f77b4")
+"""Default body colours (matplotlib's tab10 without its red, which marks joint reactions
+as on the free-body diagrams; blue last: the background is blue)."""
+FORCE_COLOR, COUPLE_COLOR = "#ffd400", "#ff00ff"
+REACTION_COLOR, REACTION_COUPLE_COLOR = "#e8202a", "#8b0a14"
+"""Joint reactions: the red of the free-body diagrams' reaction arrows, a darker red for
+couples, and thinner arrows than applied loads."""
+SCENE_SIZE = 2.0
+"""The motion's bounding box is scaled to about this size (m) in the viewer, so that the
+viewer's fixed camera range (near 0.01, far 100) and lights suit any model."""
+CAMERA_DISTANCE = 3.4
+
+_HEX = re.compile(r"#[0-9a-fA-F]{6}")
+
+
+@dataclass(frozen=True)
+class Scene:
+    """Lowered meshcat commands (dicts, in order) that build and animate the motion.
+
+    commands: each a dict as meshcat's viewer reads it; keyframe `times` and `values`
+    are flat float64 numpy arrays (packed as Float32Arrays by `wire.pack`).
+    paths: body name -> scene path of its animated node (local pose = W_r_G, W_R_B).
+    duration: seconds of animation (t_end − t_0); t0: the trajectory's first time.
+    load_paths: load (or 'joint (force)', 'joint (couple)') name -> its arrow's path.
+    """
+
+    commands: list[dict[str, Any]]
+    paths: dict[str, str]
+    duration: float
+    t0: float
+    frames: int
+    title: str
+    load_paths: dict[str, str] = field(default_factory=dict)
+
+
+class _Commands:
+    """The command list being built, with meshcat's lowering for objects."""
+
+    def __init__(self, mc: ModuleType):
+        self.mc = mc
+        self.g = mc.geometry
+        self.list: list[dict[str, Any]] = []
+
+    def set_object(self, path: str, obj: Any) -> None:
+        self.list.append(self.mc.commands.SetObject(obj, path=self._path(path)).lower())
+
+    def mesh(self, path: str, geom: Any, color: int, opacity: float = 1.0) -> None:
+        mat = self.g.MeshLambertMaterial(color=int(color), opacity=float(opacity),
+                                         transparent=opacity < 1.0)
+        self.list.append(self.mc.commands.SetObject(geom, mat, path=self._path(path)).lower())
+
+    def set_transform(self, path: str, T: np.ndarray) -> None:
+        # column-major, as three.js Matrix4.fromArray reads it
+        self.list.append({"type": "set_transform", "path": path,
+                          "matrix": np.asarray(T, dtype=np.float64).T.ravel().tolist()})
+
+    def set_property(self, path: str, key: str, value: Any) -> None:
+        self.list.append({"type": "set_property", "path": path, "property": key,
+                          "value": value})
+
+    def _path(self, path: str) -> Any:
+        return self.mc.path.Path(tuple(p for p in path.split("/") if p))
+
+
+def _rot_x(angle: float) -> np.ndarray:
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[1.0, 0, 0], [0, c, -s], [0, s, c]])
+
+
+def _homogeneous(R: np.ndarray | None = None, p: Sequence[float] | np.ndarray | None = None,
+                 scale: float = 1.0) -> np.ndarray:
+    T = np.eye(4, dtype=np.float64)
+    if R is not None:
+        T[:3, :3] = R
+    T[:3, :3] *= scale
+    if p is not None:
+        T[:3, 3] = p
+    return T
+
+
+def _color(value: str | None, i: int) -> int:
+    """A colour name or '#rrggbb' -> 0xRRGGBB (meshcat wants a Python int)."""
+    text = value if value is not None else PALETTE[i % len(PALETTE)]
+    if _HEX.fullmatch(text):  # the palette and most files: no need to load matplotlib
+        return int(text[1:], 16)
+    from matplotlib.colors import to_hex
+
+    try:
+        return int(to_hex(text)[1:], 16)
+    except ValueError:
+        raise MbodyError(f"{text!r} is not a colour: give a name such as 'orange' or "
+                         "'#rrggbb'") from None
+
+
+def _shape(g: ModuleType, body: Body, dimension: int) -> tuple[Any, np.ndarray, np.ndarray]:
+    """meshcat geometry of a body, its fixed transform in body axes, its half-extents.
+
+    meshcat's cylinder axis is its local +y (three.js); turning it by +90° about x puts it
+    along body z, the axis the model format gives cylinders and discs.
+    """
+    to_z = _homogeneous(_rot_x(math.pi / 2))
+    eye = np.eye(4)
+    shape = body.shape
+    if shape is None:  # the uniform box with the body's inertia, along its principal axes
+        if dimension == cv.PLANAR:
+            side = math.sqrt(6.0 * body.I_G / body.mass)
+            return g.Box([side, side, 0.2 * side]), eye, np.array([side, side, 0.2 * side]) / 2
+        moments, axes = np.linalg.eigh(np.asarray(body.inertia, dtype=np.float64))
+        if np.linalg.det(axes) < 0:
+            axes[:, 2] *= -1.0
+        edges = box_equivalent(moments, body.mass)
+        half = np.abs(axes) @ (edges / 2)
+        return g.Box([float(e) for e in edges]), _homogeneous(axes), half
+    kind, v = next(iter(shape.items()))
+    if kind == "box":
+        dims = [float(x) for x in v]
+        if dimension == cv.PLANAR:
+            dims.append(0.2 * min(dims))
+        return g.Box(dims), eye, np.array(dims) / 2
+    if kind == "ellipsoid":
+        radii = [float(x) for x in v]
+        if dimension == cv.PLANAR:
+            radii.append(0.2 * min(radii))
+        return g.Ellipsoid(np.array(radii, dtype=np.float64)), eye, np.array(radii)
+    r = float(v["radius"])
+    if kind == "sphere":
+        return g.Sphere(r), eye, np.full(3, r)
+    length = float(v["length"]) if kind == "cylinder" else 0.1 * r if dimension == 3 else 0.2 * r
+    return g.Cylinder(length, r), to_z, np.array([r, r, length / 2])
+
+
+def _internal(traj: Trajectory) -> tuple[np.ndarray, np.ndarray]:
+    """(K, n, 3) positions and (K, n, 4) quaternions [w, x, y, z], planar ones lifted."""
+    if traj.dimension == cv.PLANAR:
+        K, n = traj.orientation.shape
+        pos = np.zeros((K, n, 3))
+        pos[..., :2] = traj.position
+        return pos, planar_quat(traj.orientation)
+    return np.asarray(traj.position, dtype=np.float64), np.asarray(traj.orientation,
+                                                                    dtype=np.float64)
+
+
+def _xyzw(q: np.ndarray) -> np.ndarray:
+    """[w, x, y, z] -> three.js order [x, y, z, w]."""
+    return np.concatenate([q[..., 1:], q[..., :1]], axis=-1)
+
+
+def _track(name: str, kind: str, times: np.ndarray, values: np.ndarray) -> dict[str, Any]:
+    # three.js KeyframeTrack JSON with flat `times`/`values` (the compact form its
+    # parser accepts); the clip's fps is 1, so times are seconds.
+    return {"name": "." + name, "type": kind, "times": times,
+            "values": np.ascontiguousarray(values, dtype=np.float64).reshape(-1)}
+
+
+def _animation(path: str, tracks: list[dict[str, Any]]) -> dict[str, Any]:
+    return {"path": path, "clip": {"fps": 1, "name": "default", "tracks": tracks}}
+
+
+def _y_to(d: np.ndarray) -> np.ndarray:
+    """(..., 3) unit vectors -> quaternions [w, x, y, z] turning +y onto them."""
+    w = 1.0 + d[..., 1]
+    q = np.stack([w, d[..., 2], np.zeros_like(w), -d[..., 0]], axis=-1)
+    flip = w < 1e-9  # d = −y: half a turn about x
+    q[flip] = [0.0, 1.0, 0.0, 0.0]
+    return q / np.linalg.norm(q, axis=-1, keepdims=True)
+
+
+def _round_up(x: float) -> float:
+    """The smallest of 1, 2, 5 times a power of ten that is >= x (> 0)."""
+    p = 10.0 ** math.floor(math.log10(x))
+    return next(m * p for m in (1.0, 2.0, 5.0, 10.0) if m * p >= x * (1 - 1e-12))
+
+
+def _path_name(name: str) -> str:
+    return name.replace("/", "_") or "_"
+
+
+def build_scene(traj: Trajectory, model: Model, *, forces: bool = False,
+                bodies: Iterable[str] | None = None, reactions: bool = False) -> Scene:
+    """The meshcat commands that draw `model`'s bodies moving along `traj`.
+
+    Parameters
+    ----------
+    traj : Trajectory
+        Positions (K, n, d) world, orientations (K, n, 4) w-first or (K, n) angles.
+    model : Model
+        Supplies each body's shape (or inertia-equivalent box), colour and loads.
+    forces : bool
+        Draw applied forces and couples as arrows.
+    bodies : iterable of str, optional
+        Draw only these (default: all).
+    reactions : bool
+        Draw each joint's reaction force and couple on its child.
+
+    Returns
+    -------
+    Scene
+        The commands in order, with each body's scene path.
+    """
+    traj_names = list(traj.body_names)
+    _check_match(traj, model)
+    shown = list(traj_names if bodies is None else bodies)
+    for name in shown:
+        if name not in traj_names:
+            hint = did_you_mean(name, traj_names)
+            raise MbodyError(f"unknown body {name!r}: the trajectory has "
+                             f"{', '.join(traj_names)}" + (f" ({hint})" if hint else ""))
+    if len(traj.t) < 1:
+        raise MbodyError("the trajectory has no samples")
+    t = np.asarray(traj.t, dtype=np.float64)
+    if np.any(np.diff(t) <= 0):
+        raise MbodyError("the trajectory's times do not increase")
+
+    out = _Commands(load_meshcat())
+    g = out.g
+    pos, quat = _internal(traj)
+    index = {nm: i for i, nm in enumerate(traj_names)}
+    idx = [index[nm] for nm in shown]
+    times = t - t[0]
+    times.setflags(write=False)  # one array shared by every track
+    duration = float(t[-1] - t[0])
+
+    # Geometry first: its size sets the scene's scale.
+    geoms = []
+    for nm in shown:
+        body = model.bodies[nm]
+        geom, T_shape, half = _shape(g, body, traj.dimension)
+        geoms.append((nm, geom, T_shape, half, _color(body.color, body.index)))
+    reach = max(float(np.linalg.norm(h)) for *_, h, _ in geoms)
+    P = pos[:, idx, :].reshape(-1, 3)
+    lo, hi = P.min(axis=0) - reach, P.max(axis=0) + reach
+    extent = float(np.max(hi - lo))
+    centre = (lo + hi) / 2
+    s = SCENE_SIZE / extent
+
+    # The model frame: centred, scaled to SCENE_SIZE; planar x-y plane stood upright
+    # (model y up on screen, the camera on model +z).
+    R_view = _rot_x(math.pi / 2) if traj.dimension == cv.PLANAR else np.eye(3)
+    W_root = _homogeneous(R_view, -s * R_view @ centre, s)
+    out.set_transform(ROOT, W_root)
+
+    # Ground grid in the model's x-y plane: below the motion (spatial), behind the
+    # bodies (planar). meshcat's grid is 40 cells of 0.5; cells of a round size (1, 2 or
+    # 5 times a power of ten) make it 3 to 7.5 times the motion's size. (A much larger
+    # grid, reaching far behind the camera, loses its near lines in software WebGL.)
+    cell = _round_up(3.0 * extent / 40)
+    gz = lo[2] if traj.dimension == cv.SPATIAL else -max(h[2] for *_, h, _ in geoms) - 1e-3
+    gc = [round(centre[0] / cell) * cell, round(centre[1] / cell) * cell, gz]
+    out.set_transform("/Grid", W_root @ _homogeneous(None, gc, cell / 0.5))
+    out.set_property("/Axes", "visible", False)
+    out.set_object(f"{ROOT}/origin", g.triad(float(0.15 * extent)))
+
+    # Camera in meshcat's y-up camera frame: (x, y, z)_world = (x, -z, y)_camera.
+    d = np.array([0.0, -1.0, 0.0]) if traj.dimension == cv.PLANAR else np.array([1, .8, .65])
+    d = CAMERA_DISTANCE * d / np.linalg.norm(d)
+    out.set_property("/Cameras/default/rotated/<object>", "position",
+                     [float(d[0]), float(d[2]), float(-d[1])])
+
+    # Every shown body's keyframes at once, body-major, so each track is a view.
+    P_all = np.ascontiguousarray(pos[:, idx, :].transpose(1, 0, 2))
+    Q_all = np.ascontiguousarray(_xyzw(quat[:, idx, :]).transpose(1, 0, 2))
+    paths: dict[str, str] = {}
+    animations = []
+    for j, (nm, geom, T_shape, half, color) in enumerate(geoms):
+        path = f"{ROOT}/bodies/{_path_name(nm)}"
+        paths[nm] = path
+        out.set_transform(f"{path}/shape", T_shape)
+        out.mesh(f"{path}/shape/mesh", geom, color)
+        out.set_object(f"{path}/axes", g.triad(float(1.3 * np.max(half))))
+        animations.append(_animation(path, [
+            _track("position", "vector3", times, P_all[j]),
+            _track("quaternion", "quaternion", times, Q_all[j])]))
+
+    load_paths: dict[str, str] = {}
+    if forces:
+        arrows, load_paths = _arrows(traj, model, pos, quat, set(idx), times, extent, out)
+        animations.extend(arrows)
+    if reactions:
+        arrows, reaction_paths = _reaction_arrows(traj, model, times, extent, out)
+        animations.extend(arrows)
+        load_paths.update(reaction_paths)
+
+    out.list.append({"type": "set_animation", "path": "", "animations": animations,
+                     "options": {"play": True, "repetitions": math.inf}})
+    title = f"mbody: {model.name or traj.model_name or 'motion'}"
+    return Scene(out.list, paths, duration, float(t[0]), len(t), title, load_paths)
+
+
+def _arrows(traj: Trajectory, model: Model, pos: np.ndarray, quat: np.ndarray,
+            shown: set[int], times: np.ndarray, extent: float, out: _Commands
+            ) -> tuple[list[dict[str, Any]], dict[str, str]]:
+    """Arrows for applied forces (at their points) and couples (at G), per frame.
+
+    Each arrow node turns +y onto the load's direction; its shaft is scaled along y to
+    length L − head and its head sits at the shaft's end, so the head keeps its shape.
+    A force that pushes into its body (f · r < 0, r from G to the point) is drawn ending
+    at its point, so that it stays outside the body; others start at their point.
+    L = L_max |f| / max|f| over the run (forces and couples scaled separately).
+    """
+    K = len(times)
+    f_list, p_list, m_list = [], [], []
+    for k in range(K):  # one vectorised evaluation per frame (loads may depend on t)
+        c = applied_loads(model, traj.state(k)).contributions
+        on = c.body >= 0  # spring ends on ground are not drawn
+        R = quat_to_matrix(quat[k, np.where(on, c.body, 0)])
+        f_list.append(c.W_f)
+        p_list.append(pos[k, np.where(on, c.body, 0)] + matvec(R, c.B_r))
+        m_list.append(matvec(R, c.B_m))
+        couple, body, names = c.couple, c.body, c.names
+    if not K or not len(body):
+        return [], {}
+    W_f, W_p, W_m = np.array(f_list), np.array(p_list), np.array(m_list)
+    vec = np.where(couple[None, :, None], W_m, W_f)
+    at = np.where(couple[None, :, None], pos[:, np.maximum(body, 0)], W_p)
+    size = np.linalg.norm(vec, axis=-1)  # (K, k)
+    L_max, head, radius = 0.35 * extent, 0.06 * extent, 0.012 * extent
+    anims: list[dict[str, Any]] = []
+    paths: dict[str, str] = {}
+    for group in (False, True):
+        sel = (couple == group) & (body >= 0) & np.isin(body, list(shown))
+        top = size[:, sel].max() if sel.any() else 0.0
+        scale = L_max / top if top > 0 else 0.0
+        color = int((COUPLE_COLOR if group else FORCE_COLOR)[1:], 16)
+        for j in np.flatnonzero(sel):
+            path = f"{ROOT}/loads/{j}_{_path_name(names[j])}"
+            paths.setdefault(names[j], path)
+            lever = None if group else at[:, j] - pos[:, body[j]]
+            anims += _arrow(out, path, at[:, j], vec[:, j], size[:, j] * scale, color,
+                            (head, radius), times, lever)
+    return anims, paths
+
+
+def _arrow(out: _Commands, path: str, at: np.ndarray, vec: np.ndarray, L: np.ndarray,
+           color: int, dims: tuple[float, float], times: np.ndarray,
+           lever: np.ndarray | None = None) -> list[dict[str, Any]]:
+    """One arrow's nodes and tracks: (K, 3) foot `at`, direction of `vec`, length L (K,).
+
+    With `lever` (K, 3) (point minus mass centre), a push into the body is drawn with its
+    tip at the point instead of its foot, so that it stays outside the body.
+    """
+    g = out.g
+    head, radius = dims
+    K = len(times)
+    size = np.linalg.norm(vec, axis=-1)
+    d = np.divide(vec, size[:, None], out=np.zeros((K, 3)), where=size[:, None] > 0)
+    d[size == 0] = [0.0, 1.0, 0.0]
+    out.set_transform(f"{path}/shaft/geom", _homogeneous(p=[0.0, 0.5, 0.0]))
+    out.mesh(f"{path}/shaft/geom/mesh", g.Cylinder(1.0, radius), color)
+    out.set_transform(f"{path}/head/geom", _homogeneous(p=[0.0, head / 2, 0.0]))
+    out.mesh(f"{path}/head/geom/mesh",
+             g.Cylinder(head, radiusTop=0.0, radiusBottom=2.5 * radius), color)
+    shaft = np.maximum(L - head, 0.0)
+    at = np.array(at, dtype=np.float64)
+    if lever is not None:
+        tol = 1e-9 * size * np.linalg.norm(lever, axis=-1)  # f ⊥ r is not inward
+        inward = np.einsum("ij,ij->i", vec, lever) < -tol
+        at[inward] -= (shaft + head)[inward, None] * d[inward]
+    shown_k = (size > 0).astype(np.float64)
+    ones, zeros = np.ones(K), np.zeros(K)
+    return [
+        _animation(path, [
+            _track("position", "vector3", times, at),
+            _track("quaternion", "quaternion", times, _xyzw(_y_to(d))),
+            _track("scale", "vector3", times, np.stack([shown_k] * 3, axis=-1))]),
+        _animation(f"{path}/shaft", [
+            _track("scale", "vector3", times, np.stack([ones, shaft, ones], axis=-1))]),
+        _animation(f"{path}/head", [
+            _track("position", "vector3", times, np.stack([zeros, shaft, zeros], -1))])]
+
+
+def _reaction_arrows(traj: Trajectory, model: Model, times: np.ndarray, extent: float,
+                     out: _Commands) -> tuple[list[dict[str, Any]], dict[str, str]]:
+    """Each joint's net reaction on its child, per frame: the force at the joint point
+    (R = Σ λ_k e_k over its force components) and its couple (Σ over moment components),
+    dashed-red style of the diagrams (REACTION_COLOR, thinner). The parent gets −R."""
+    if not len(traj.reaction_labels) or traj.reactions.shape[1] == 0:
+        raise MbodyError("this run holds no joint reactions to draw (a model without "
+                         "joints, or a run saved before reactions were stored)")
+    K, J = len(times), len(model.joints)
+    t = model.reaction_table
+    order = [traj.reaction_labels.index(r) for r in model.reactions]
+    F, C, P = np.zeros((K, J, 3)), np.zeros((K, J, 3)), np.zeros((K, J, 3))
+    for k in range(K):  # one vectorised evaluation per frame
+        cols = reaction_columns(model, traj.state(k))
+        w = traj.reactions[k, order][:, None] * cols.W_e
+        for comp_is_moment, acc in ((False, F), (True, C)):
+            sel = cols.is_moment == comp_is_moment
+            for c in range(3):
+                acc[k, :, c] = np.bincount(t.joint[sel], w[sel, c], minlength=J)
+        P[k] = cols.joint_W_P
+    L_max, head, radius = 0.35 * extent, 0.05 * extent, 0.008 * extent
+    anims: list[dict[str, Any]] = []
+    paths: dict[str, str] = {}
+    for vec, color, kind in ((F, REACTION_COLOR, "force"), (C, REACTION_COUPLE_COLOR, "couple")):
+        size = np.linalg.norm(vec, axis=-1)
+        top = float(size.max()) if size.size else 0.0
+        if top <= 0:
+            continue
+        for jn, joint in enumerate(model.joints):
+            if not np.any(size[:, jn] > 1e-12 * top):
+                continue
+            path = f"{ROOT}/reactions/{_path_name(joint.name)}_{kind}"
+            paths[f"{joint.name} ({kind})"] = path
+            anims += _arrow(out, path, P[:, jn], vec[:, jn], size[:, jn] * L_max / top,
+                            int(color[1:], 16), (head, radius), times)
+    return anims, paths
+
+
+def _check_match(traj: Trajectory, model: Model) -> None:
+    if traj.dimension != model.dimension:
+        raise MbodyError(f"the trajectory is {'planar' if traj.dimension == 2 else 'spatial'}"
+                         f" but model {model.name!r} is "
+                         f"{'planar' if model.dimension == 2 else 'spatial'}")
+    for nm in traj.body_names:
+        if nm not in model.bodies:
+            hint = did_you_mean(nm, model.body_names)
+            raise MbodyError(f"unknown body {nm!r}: the trajectory names it but model "
+                             f"{model.name!r} has only {', '.join(model.body_names)}"
+                             + (f" ({hint})" if hint else ""))
