@@ -3,6 +3,7 @@ the projection, the log length scale, the graph picture and the fbd/graph comman
 
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -20,12 +21,15 @@ from mbody.present.draw import (
     COLORS,
     arrow_lengths,
     draw_graph,
+    fbd_scene,
     figure_bytes,
     figure_svg,
+    graph_scene,
     parse_view,
     projection,
     save_figure,
 )
+from mbody.present.draw.scene import Line
 
 ROOT = Path(__file__).resolve().parent.parent
 MODELS = sorted((ROOT / "models").glob("*.yaml"))
@@ -141,8 +145,8 @@ def test_pendulum_gravity_and_dashed_reactions_at_the_pin():
     lab = labels(fig)
     assert lab["label:reaction:O.Fx"] == "O.Fx" and lab["label:reaction:O.Fy"] == "O.Fy"
     assert lab["label:gravity:gravity"] == "m g = 19.62 N"
-    legend = " ".join(t.get_text() for a in fig.axes if a.get_legend()
-                      for t in [a.get_legend().get_title(), *a.get_legend().get_texts()])
+    legend = " ".join(t.get_text() for t in fig.texts
+                      if (t.get_gid() or "").startswith("legend"))
     assert "log10" in legend and "reaction" in legend and "gravity" in legend
 
 
@@ -342,3 +346,46 @@ def test_graph_command(tmp_path, capsys):
     assert out.read_bytes()[:4] == b"\x89PNG"
     assert main(["graph", "models/fourbar_planar.yaml", "-o", str(tmp_path / "g.gif")]) == 2
     assert ".svg, .png, .pdf" in capsys.readouterr().err
+
+
+# -- the fast SVG path ------------------------------------------------------------------------
+def test_scene_svg_holds_every_arrow_label_and_glyph_it_uses(tmp_path):
+    fbd = body("fourbar_spatial.yaml", "coupler").fbd
+    sc = fbd_scene(fbd)
+    svg = figure_svg(sc, prefix="p1-")
+    assert svg.startswith("<svg") and svg.endswith("</svg>") and "<?xml" not in svg
+    for fo in fbd.forces:
+        tail = f"{fo.kind}:{fo.label or fo.name}"
+        assert f'id="{"couple" if fo.couple else "arrow"}:{tail}"' in svg
+        assert f'id="label:{tail}"' in svg
+    used = set(re.findall(r'xlink:href="#(p1-[^"]+)"', svg))
+    defined = set(re.findall(r'<path id="(p1-[^"]+)"', svg))
+    assert used and used == defined  # every glyph drawn is defined once, nothing more
+    # the same picture as the matplotlib figure: same arrows, same label texts
+    fig = fbd.draw()
+    shafts = {it.gid for p in sc.panels for it in p.items
+              if isinstance(it, Line) and (it.gid or "").startswith(("arrow:", "couple:"))}
+    assert shafts == set(arrows(fig, "arrow:")) | set(arrows(fig, "couple:"))
+    path = save_figure(sc, tmp_path / "c.svg")
+    assert path.read_text().startswith("<?xml")
+
+
+def test_scene_text_width_matches_matplotlib():
+    from matplotlib.font_manager import FontProperties
+    from matplotlib.textpath import text_to_path
+
+    from mbody.present.draw.fonts import layout
+
+    for s in ("A.Fx = −3.463 N", "m g = 19.62 N", "Wave"):
+        w, _, _ = text_to_path.get_text_width_height_descent(
+            s, FontProperties(family=["DejaVu Sans"], size=9), False)
+        assert layout(s, 9).width == pytest.approx(w, rel=0.01)
+
+
+@pytest.mark.parametrize("path", MODELS, ids=[p.stem for p in MODELS])
+def test_every_shipped_model_draws_as_svg(path):
+    m = mbody.load(path)
+    asm = mbody.assemble(m)
+    for name in m.body_names:
+        assert figure_svg(fbd_scene(asm.bodies[name].fbd)).count("<polyline") >= 1
+    assert 'id="node:' in figure_svg(graph_scene(m))

@@ -62,7 +62,7 @@ def _file_name(body: str, taken: set[str]) -> str:
 
 def fbd(a: argparse.Namespace) -> int:
     from mbody.equations.assemble import assemble
-    from mbody.present.draw import draw_fbd, parse_view, save_figure
+    from mbody.present.draw import fbd_scene, parse_view, save_figure
 
     parse_view(a.view)  # a bad view is reported before any work
     model = load_model(a.model)
@@ -76,11 +76,11 @@ def fbd(a: argparse.Namespace) -> int:
         raise MbodyError(f"--dpi must be a positive number of dots per inch, got {a.dpi}")
     asm = assemble(model)
     names = [a.body] if a.body is not None else list(model.body_names)
-    out, taken = Path(a.output), set()
+    out, taken = Path(a.output), set[str]()
     if out.exists() and not out.is_dir():
         raise MbodyError(f"-o {a.output}: not a folder (fbd writes one picture per body)")
     for name in names:
-        fig = draw_fbd(asm.bodies[name].fbd, view=a.view)
+        fig = fbd_scene(asm.bodies[name].fbd, view=a.view)
         path = save_figure(fig, out / f"{_file_name(name, taken)}.{a.format}", a.format,
                            dpi=a.dpi)
         print(f"wrote {path}  (body {name})")
@@ -90,7 +90,7 @@ def fbd(a: argparse.Namespace) -> int:
 def graph(a: argparse.Namespace) -> int:
     from mbody.equations.assemble import assemble
     from mbody.model.graph import topology
-    from mbody.present.draw import FORMATS, draw_graph, save_figure
+    from mbody.present.draw import FORMATS, graph_scene, save_figure
 
     fmt = Path(a.output).suffix.lstrip(".").lower()
     if fmt not in FORMATS:
@@ -98,7 +98,7 @@ def graph(a: argparse.Namespace) -> int:
                          + ", ".join("." + f for f in FORMATS) + " (it sets the format)")
     model = load_model(a.model)
     topo = topology(model, assemble(model).G if model.reactions else None)
-    path = save_figure(draw_graph(model, topo), a.output, fmt)
+    path = save_figure(graph_scene(model, topo), a.output, fmt)
     print(f"wrote {path}  ({model.n} bodies, {len(model.joints)} joints, "
           f"mobility {topo.mobility})")
     return EXIT_OK

@@ -10,6 +10,7 @@ from __future__ import annotations
 import html
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 from mbody import __version__
 from mbody import conventions as cv
@@ -17,6 +18,7 @@ from mbody.equations.assemble import Assembly, assemble
 from mbody.io.atomic import write_atomic
 from mbody.model.graph import topology
 from mbody.model.model import Model
+from mbody.present.draw import fbd_scene, figure_svg, graph_scene
 from mbody.present.text import body_text, model_summary
 
 MAX_BODIES = 200
@@ -50,8 +52,6 @@ def report_html(model: Model, *, asm: Assembly | None = None,
                 view: str | Sequence[float] | None = "iso",
                 max_bodies: int = MAX_BODIES) -> str:
     """The report page as one HTML string (UTF-8, no external resources)."""
-    from mbody.present.draw import draw_fbd, draw_graph, figure_svg
-
     asm = assemble(model) if asm is None else asm
     topo = topology(model, asm.G if model.reactions else None)
     planar = model.dimension == cv.PLANAR
@@ -82,7 +82,7 @@ def report_html(model: Model, *, asm: Assembly | None = None,
                f"<pre>{_e(model_summary(model, topo))}</pre></section>")
 
     out.append('<section id="topology"><h2>Topology</h2><figure>'
-               f"{figure_svg(draw_graph(model, topo))}"
+               f"{figure_svg(graph_scene(model, topo), prefix='graph-')}"
                "<figcaption>Bodies and ground are the nodes; every joint is an edge labelled "
                "with its type and the number of its reaction components.</figcaption>"
                "</figure></section>")
@@ -104,7 +104,7 @@ def report_html(model: Model, *, asm: Assembly | None = None,
 
     for k, name in enumerate(shown):
         eq = asm.bodies[name]
-        svg = figure_svg(draw_fbd(eq.fbd, view=view))
+        svg = figure_svg(fbd_scene(eq.fbd, view=view), prefix=f"b{k}-")
         out.append(f'<section class="body" id="body-{k}"><h2>Body {_e(name)}</h2>'
                    f"<figure>{svg}<figcaption>Free-body diagram of {_e(name)}: applied "
                    "forces solid, gravity at the mass centre, reaction components dashed."
@@ -118,6 +118,6 @@ def report_html(model: Model, *, asm: Assembly | None = None,
     return "\n".join(out)
 
 
-def write_report(model: Model, path: str | Path, **kwargs) -> Path:
+def write_report(model: Model, path: str | Path, **kwargs: Any) -> Path:
     """Write `report_html(model, **kwargs)` to `path` atomically (UTF-8)."""
     return write_atomic(path, report_html(model, **kwargs))

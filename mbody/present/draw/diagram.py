@@ -1,0 +1,318 @@
+"""The free-body diagram of one body as a `Scene`: title, drawing, world axes, legend
+and the body's Newton-Euler pair.
+
+Spatial bodies are drawn in an orthographic projection: a world vector W_v appears as
+``P @ W_v`` with P the (2, 3) matrix of `projection(view)`, so every arrow's direction on
+the page is exactly its projected vector. Planar bodies use the top view (world x
+right, y up). Every element carries a gid (``arrow:<kind>:<name>``,
+``couple:<kind>:<name>``, ``label:<kind>:<name>``, ``body-outline``, ``mass-centre``,
+``equations``...) so that tests and tools can find it.
+"""
+
+from __future__ import annotations
+
+import math
+import textwrap
+from typing import TYPE_CHECKING
+
+import numpy as np
+from scipy.spatial import ConvexHull
+
+from mbody import conventions as cv
+from mbody.conventions import REACTION
+from mbody.present.draw.arrows import HEAD, Arrow, arrows, fmt, head
+from mbody.present.draw.fonts import layout
+from mbody.present.draw.labels import Label, place
+from mbody.present.draw.outline import circle, outline
+from mbody.present.draw.scene import Disc, Line, Panel, Poly, Scene, Text, Wedge
+from mbody.present.draw.style import (
+    AXIS_COLOR,
+    BODY_EDGE,
+    BODY_FACE,
+    COLORS,
+    DASHED,
+    DOTTED,
+    SCALE_NOTE,
+)
+from mbody.present.draw.views import View, eye, projection, view_name
+
+if TYPE_CHECKING:
+    from mbody.equations.fbd import FreeBodyDiagram
+
+END_ON = 0.2
+"""A spatial arrow whose page length is below END_ON times its 3-D length is drawn end-on:
+a ring with a dot (toward the eye) or a cross (away); its short shaft stays, for tools."""
+
+IN = 72.0  # points per inch
+
+
+def fbd_scene(fbd: FreeBodyDiagram, *, view: View = "iso", equations: bool = True,
+              width: float = 8.0, title: str | None = None) -> Scene:
+    """The free-body diagram of one body as a `Scene` (write it with `save_figure` or
+    `figure_svg`, or turn it into a matplotlib figure with `scene_figure`).
+
+    Parameters
+    ----------
+    fbd : FreeBodyDiagram
+        Or a `BodyEquations` (its ``.fbd``).
+    view : str or (float, float)
+        Spatial bodies only, see `projection`.
+    equations : bool
+        Write the body's Newton-Euler pair under the drawing.
+    width : float
+        Picture width (inches).
+    title : str, optional
+        Instead of "Free-body diagram of <body> (...)".
+
+    Returns
+    -------
+    Scene
+    """
+    fbd = getattr(fbd, "fbd", fbd)
+    planar = fbd.dimension == cv.PLANAR
+    P = projection("top" if planar else view)
+    E = eye(P)
+    shape = outline(fbd, E)
+    reach = max([shape.size] + [2 * float(np.linalg.norm(f.B_r)) for f in fbd.forces])
+    lmax = 0.55 * reach
+    arrs = arrows(fbd, P, lmax)
+    hd = HEAD * lmax
+
+    eq_lines = _equation_lines(fbd, planar) if equations else []
+    zeros = [fo.label or fo.name for fo in fbd.forces if not fo.unknown and (
+        fo.value == 0 if fo.kind == REACTION else fo.magnitude == 0)]
+    zero_note = textwrap.wrap("zero at this instant (not drawn): " + ", ".join(zeros), 110)
+    h_draw, h_title = 5.6, 0.45
+    h_band = 1.25 + 0.17 * len(zero_note) if zeros else 1.25
+    h_eq = (0.3 + 0.19 * len(eq_lines)) if eq_lines else 0.0
+    H = h_title + h_draw + h_band + h_eq
+    W = width * IN
+    sc = Scene(W, H * IN)
+
+    def top(y0: float) -> float:  # inches from the top -> points from the bottom
+        return (H - y0) * IN
+
+    name = fbd.body
+    props = (f"m = {fmt(fbd.mass)} kg, particle" if not np.any(fbd.inertia)
+             else f"m = {fmt(fbd.mass)} kg, I_G = {fmt(fbd.inertia[2, 2])} kg m²" if planar
+             else f"m = {fmt(fbd.mass)} kg, view {view_name(view)}")
+    sc.title = title or f"Free-body diagram of {name}   ({props})"
+    sc.root.add(Text(sc.title, np.array([W / 2, top(0.25)]), 12, ha="center", va="center",
+                     weight="bold", gid="title"))
+    ax = sc.panel("drawing", (0.03 * W, top(h_title + h_draw), 0.94 * W, h_draw * IN))
+
+    # body outline, hidden edges dotted
+    hull_pts = shape.points @ P.T
+    hull = ConvexHull(hull_pts, qhull_options="QJ")
+    ax.add(Poly(hull_pts[hull.vertices], BODY_FACE, zorder=1, gid="body-outline"))
+    rim = hull_pts[np.r_[hull.vertices, hull.vertices[0]]]
+    obstacles: list[tuple[np.ndarray, str]] = [(rim, "outline")]
+    if shape.curved:
+        ax.add(Line(rim, BODY_EDGE, 1.3, zorder=2, gid="body-edge"))
+    for pts, visible in shape.edges:
+        pp = pts @ P.T
+        ax.add(Line(pp, BODY_EDGE, 1.3 if visible else 0.8, None if visible else DOTTED,
+                    zorder=2, gid="body-edge"))
+        obstacles.append((pp, "outline"))
+
+    # mass centre G and body axes
+    G = P @ fbd.W_position
+    rg = 0.045 * lmax
+    ax.add(Disc(G, rg, "white", "black", 1.0, zorder=6, gid="mass-centre"))
+    for a0 in (0, 180):
+        ax.add(Wedge(G, rg, a0, a0 + 90, "black", zorder=6))
+    labels: list[Label] = []
+    for k, nm in enumerate("xyz"[:2 if planar else 3]):
+        tip = G + P @ (fbd.W_R_B[:, k] * 0.38 * shape.size)
+        seg = np.array([G, tip])
+        ax.add(Line(seg, AXIS_COLOR, 1.0, zorder=3, gid=f"body-axis:{nm}"))
+        if np.linalg.norm(tip - G) > 1e-9:
+            ax.add(Poly(head(tip, (tip - G) / np.linalg.norm(tip - G), 0.6 * hd), AXIS_COLOR,
+                        zorder=3))
+        obstacles.append((seg, "axis"))
+        labels.append(Label(Text(f"${nm}_B$", tip, 8, AXIS_COLOR, math=True, zorder=10,
+                                 gid=f"label:body-axis:{nm}"), tip, tip - G, "axis"))
+    labels.append(Label(Text("G", G, 9, zorder=10, gid="label:mass-centre"), G,
+                        np.array([-1.0, 1.0]), "g"))
+
+    # joint points and points of application
+    for fo in fbd.forces:
+        if not fo.couple and np.linalg.norm(fo.B_r) > 0:
+            ax.add(Disc(P @ fo.W_point, 0.022 * lmax, "white", COLORS[fo.kind], 1.2, zorder=7,
+                        gid="joint-point" if fo.kind == REACTION else "load-point"))
+
+    for a in arrs:
+        labels.append(_arrow(ax, a, lmax, hd, obstacles))
+
+    # limits: geometry first, then grown until every label fits
+    geo = np.vstack([o[0] for o in obstacles])
+    lo, hi = geo.min(axis=0), geo.max(axis=0)
+    span = max(float((hi - lo).max()), 1e-6)
+    ax.set_limits(lo - 0.18 * span, hi + 0.18 * span)
+    lo, hi = ax.lo.copy(), ax.hi.copy()
+    x0, y0, w, h = ax.rect
+    for _ in range(4):
+        boxes = place(ax, labels, obstacles)
+        if (np.all(boxes[:, 0] >= x0) and np.all(boxes[:, 2] <= x0 + w)
+                and np.all(boxes[:, 1] >= y0) and np.all(boxes[:, 3] <= y0 + h)):
+            break
+        s = ax.scale
+        corners = (np.vstack((boxes[:, :2], boxes[:, 2:])) - ax.rect[:2]) / s + ax.lo
+        lo = np.minimum(lo, corners.min(axis=0))
+        hi = np.maximum(hi, corners.max(axis=0))
+        span = float((hi - lo).max())
+        ax.set_limits(lo - 0.05 * span, hi + 0.05 * span)
+    ax.add(*(lab.text for lab in labels))
+
+    # band: world axes on the left, legend on the right
+    if zeros:
+        sc.root.add(Text("\n".join(zero_note), np.array([0.04 * W, top(h_title + h_draw + 0.04)]),
+                         8.5, COLORS[REACTION], va="top", gid="zero-note"))
+    band = top(h_title + h_draw + h_band)
+    side = 0.9 * 1.25 * IN
+    tri = sc.panel("world-axes", (0.03 * W, band + 0.05 * 1.25 * IN, side, side),
+                   np.array([-1.45, -1.45]), np.array([1.45, 1.45]))
+    _world_triad(tri, P, planar)
+    _legend(sc.root, (0.2 * W, band, 0.78 * W, 1.25 * IN), arrs, planar)
+
+    if eq_lines:
+        sc.root.add(Text("\n".join(eq_lines),
+                         np.array([0.04 * W, top(h_title + h_draw + h_band) - 0.12 * IN]), 9,
+                         va="top", family="mono", gid="equations", linespacing=1.45))
+    return sc
+
+
+def _arrow(ax: Panel, a: Arrow, lmax: float, hd: float,
+           obstacles: list[tuple[np.ndarray, str]]) -> Label:
+    """Draw arrow `a`: a shaft (gid = the arrow's) and a filled head (gid + ':head');
+    returns its label."""
+    dash = DASHED if a.dashed else None
+    pts = a.arc if a.arc is not None else np.array([a.tail, a.tail + a.vec])
+    ax.add(Line(pts, a.color, 2.0, dash, zorder=8, gid=a.gid))
+    obstacles.append((pts, a.gid))
+    if a.arc is not None:
+        if a.vec[1] > 0:
+            t_end = a.arc[-1] - a.arc[-2]
+            ax.add(Poly(head(a.arc[-1], t_end / np.linalg.norm(t_end), hd), a.color, zorder=9,
+                        gid=a.gid + ":head"))
+        anchor, direction = a.arc[-1], a.arc[-1] - a.tail
+    elif np.linalg.norm(a.vec) < END_ON * a.length3:
+        # seen end-on: a dot toward the eye, a cross away from it (two rings: a moment)
+        r = 0.05 * lmax
+        for k in range(2 if a.couple else 1):
+            ax.add(Disc(a.tail, r * (1 + 0.45 * k), None, a.color, 1.6, zorder=9,
+                        gid=a.gid + (":end-on" if k == 0 else ":ring2")))
+        if a.toward > 0:
+            ax.add(Disc(a.tail, 0.3 * r, a.color, zorder=9))
+        else:
+            for s_ in (1, -1):
+                xx = a.tail + 0.7 * r * np.array([[-1, -s_], [1, s_]]) / math.sqrt(2)
+                ax.add(Line(xx, a.color, 1.4, zorder=9))
+        obstacles.append((a.tail + r * (1.5 if a.couple else 1.0) * circle(24), a.gid))
+        anchor, direction = a.tail + r * np.array([0.7, 0.7]), np.array([1.0, 0.7])
+    else:
+        n = np.linalg.norm(a.vec)
+        tip = a.tail + a.vec
+        if n > 1e-9:
+            d = a.vec / n
+            ax.add(Poly(head(tip, d, hd), a.color, zorder=9, gid=a.gid + ":head"))
+            if a.couple:  # a moment: double head
+                ax.add(Poly(head(tip - 0.75 * hd * d, d, hd), a.color, zorder=9,
+                            gid=a.gid + ":head2"))
+            obstacles.append((head(tip, d, hd)[[0, 1, 2, 0]], a.gid))
+        anchor, direction = tip, (a.vec if n > 1e-9 else np.array([1.0, 0.3]))
+    text = Text(a.label, anchor, 9, a.color, zorder=10, gid="label:" + a.gid.split(":", 1)[1])
+    return Label(text, anchor, direction, a.gid)
+
+
+def _equation_lines(fbd: FreeBodyDiagram, planar: bool) -> list[str]:
+    if not fbd.equations:
+        return []
+    nn = 2 if planar else 3
+    lines = ["Newton (world axes):"]
+    for i, e in enumerate(fbd.equations):
+        if i == nn:
+            lines.append("Euler (about G, " + ("z):" if planar else "body axes):"))
+        wrapped = textwrap.wrap(f"{e.row}:  {e}", 96, subsequent_indent="      ",
+                                break_on_hyphens=False)
+        lines += ["  " + w for w in wrapped]
+    return lines
+
+
+def _world_triad(ax: Panel, P: np.ndarray, planar: bool) -> None:
+    ax.add(Text("world", np.array([0.0, -1.42]), 8, "#333333", ha="center", va="bottom"))
+    for k, nm in enumerate("xyz"[:2 if planar else 3]):
+        v = P[:, k] * 0.9
+        n = np.linalg.norm(v)
+        if n < 0.15:  # along the line of sight: ⊙ out of the page, ⊗ into it
+            ax.add(Disc(np.zeros(2), 0.14, None, "black", 1.0),
+                   Text(nm, np.array([0.18, 0.12]), 9))
+            if float(eye(P)[k]) > 0:
+                ax.add(Disc(np.zeros(2), 0.04, "black"))
+            else:
+                for s_ in (1, -1):
+                    ax.add(Line(np.array([[-0.05, -0.05 * s_], [0.05, 0.05 * s_]]), "black"))
+            continue
+        ax.add(Line(np.array([[0, 0], v]), "black", 1.2, gid=f"world-axis:{nm}"),
+               Poly(head(v, v / n, 0.22), "black"),
+               Text(nm, v + 0.3 * v / n, 9, ha="center", va="center"))
+
+
+def _legend(root: Panel, rect: tuple[float, float, float, float], arrs: list[Arrow],
+            planar: bool) -> None:
+    """A framed legend centred in `rect` (points): the scale note, then two columns."""
+    fs = 8.5
+    entries: list[tuple[str, str]] = [
+        ("applied", "applied force (name, |F|)"), ("gravity", "gravity m g at G"),
+        ("reaction", "reaction (unknown name, or known value)")]
+    if any(a.couple for a in arrs):
+        entries.append(("couple", "couple: curved arrow" if planar
+                        else "couple/moment: double head (right-hand rule)"))
+    entries.append(("G", "G mass centre, x_B y_B" + ("" if planar else " z_B") + " body axes"))
+    rows = (len(entries) + 1) // 2
+    cols = [entries[:rows], entries[rows:]]
+    handle, gap, sep = 2.0 * fs, 0.8 * fs, 2.0 * fs
+    col_w = [max(layout(s, fs).width for _, s in c) + handle + gap for c in cols]
+    note = layout(SCALE_NOTE, 8)
+    row_h = layout("lp", fs).height + 0.5 * fs
+    inner_w = max(sum(col_w) + sep, note.width)
+    inner_h = note.height + 0.5 * fs + rows * row_h
+    pad = 0.4 * fs
+    x0 = rect[0] + (rect[2] - inner_w) / 2
+    y_top = rect[1] + (rect[3] + inner_h) / 2
+    cx = x0 + inner_w / 2
+    frame = np.array([[x0 - pad, y_top + pad], [x0 + inner_w + pad, y_top + pad],
+                      [x0 + inner_w + pad, y_top - inner_h - pad],
+                      [x0 - pad, y_top - inner_h - pad]])
+    root.add(Poly(frame, "white", "#cccccc", 0.8, gid="legend", zorder=4),
+             Text(SCALE_NOTE, np.array([cx, y_top]), 8, ha="center", va="top", zorder=5,
+                  gid="legend-title", linespacing=1.2))
+    x = x0 + (inner_w - sum(col_w) - sep) / 2
+    for c, cw in zip(cols, col_w, strict=True):
+        y = y_top - note.height - 0.5 * fs - row_h / 2
+        for key, s in c:
+            h0, h1 = np.array([x, y]), np.array([x + handle, y])
+            if key in COLORS:
+                root.add(Line(np.array([h0, h1]), COLORS[key], 2.0,
+                              DASHED if key == REACTION else None, zorder=5))
+            elif key == "couple":
+                mid = (h0 + h1) / 2
+                if planar:  # a small curved arrow
+                    t = np.linspace(math.radians(-60), math.radians(210), 20)
+                    arc = mid + 4.0 * np.column_stack((np.cos(t), np.sin(t)))
+                    d = arc[-1] - arc[-2]
+                    root.add(Line(arc, "#555555", 1.5, zorder=5),
+                             Poly(head(arc[-1], d / np.linalg.norm(d), 4.0), "#555555",
+                                  zorder=5))
+                else:  # a double head
+                    root.add(Line(np.array([h0, h1]), "#555555", 2.0, zorder=5),
+                             Poly(head(h1, np.array([1.0, 0]), 5.0), "#555555", zorder=5),
+                             Poly(head(h1 - [3.5, 0], np.array([1.0, 0]), 5.0), "#555555",
+                                  zorder=5))
+            else:
+                root.add(Disc((h0 + h1) / 2, 3.0, "white", "black", 1.0, zorder=5))
+            root.add(Text(s, np.array([x + handle + gap, y]), fs, va="center", zorder=5,
+                          gid="legend-entry"))
+            y -= row_h
+        x += cw + sep
+
