@@ -97,7 +97,7 @@ def arrows(fbd: FreeBodyDiagram, P: np.ndarray, lmax: float) -> list[Arrow]:
     planar = fbd.dimension == cv.PLANAR
     forces = list(fbd.forces)
     known = [fo for fo in forces if not fo.unknown]
-    mag = {id(fo): (abs(fo.value) if fo.kind == REACTION else fo.magnitude) for fo in known}
+    mag = {id(fo): (abs(fo.value) if fo.value is not None else fo.magnitude) for fo in known}
     lengths: dict[int, float] = {}
     for couple in (False, True):
         group = [fo for fo in known if fo.couple == couple]

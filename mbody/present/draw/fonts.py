@@ -17,7 +17,7 @@ from functools import lru_cache
 import numpy as np
 from matplotlib import font_manager
 from matplotlib.font_manager import FontProperties
-from matplotlib.ft2font import FT2Font, Kerning, LoadFlags
+from matplotlib.ft2font import FT2Font, GlyphIndexType, Kerning, LoadFlags
 from matplotlib.textpath import text_to_path
 
 UNIT = 100.0
@@ -71,8 +71,8 @@ class _Font:
         k = self.kern.get((left, right))
         if k is None:
             self.ft.set_size(UNIT, 72)
-            k = self.kern[left, right] = self.ft.get_kerning(left, right,
-                                                             Kerning.DEFAULT) / 64.0
+            k = self.kern[left, right] = self.ft.get_kerning(
+                GlyphIndexType(left), GlyphIndexType(right), Kerning.DEFAULT) / 64.0
         return k
 
 

@@ -39,8 +39,8 @@ def sample(points: np.ndarray, step: float) -> np.ndarray:
 
 def _spots(mid: float | None) -> np.ndarray:
     """Candidate offsets (points) as (along, across) the label's direction."""
-    c = [(5, 0), (5, 9), (5, -9), (0, 10), (0, -10), (18, 0), (5, 22), (5, -22), (30, 10),
-         (30, -10)]
+    c: list[tuple[float, float]] = [(5, 0), (5, 9), (5, -9), (0, 10), (0, -10), (18, 0),
+                                    (5, 22), (5, -22), (30, 10), (30, -10)]
     if mid is not None:  # beside the shaft, half-way
         c += [(mid, 10), (mid, -10)]
     ang = np.linspace(0, 2 * np.pi, 16, endpoint=False)
