@@ -81,13 +81,13 @@ def test_stacked_system_large_is_shown_as_blocks():
     assert len(rows) == 8
     pattern = {b: [c == "times" for c in re.findall(r"\\(times|cdot)", cells)]
                for b, cells in rows}
-    t = asm.model.reaction_table
-    for c in range(len(t.labels)):
-        for b in (t.child[c], t.parent[c]):
+    rt = asm.model.reaction_table
+    for c in range(len(rt.labels)):
+        for b in (rt.child[c], rt.parent[c]):
             if b >= 0:
-                assert pattern[f"p{b}"][t.joint[c]]
+                assert pattern[f"p{b}"][rt.joint[c]]
     assert sum(map(sum, pattern.values())) == len(
-        {(int(b), int(j)) for b, j in zip([*t.child, *t.parent], [*t.joint, *t.joint],
+        {(int(b), int(j)) for b, j in zip([*rt.child, *rt.parent], [*rt.joint, *rt.joint],
                                           strict=True) if b >= 0})
 
 

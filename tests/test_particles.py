@@ -20,7 +20,7 @@ from mbody.model import State
 
 ROOT = Path(__file__).resolve().parent.parent
 MODELS = ROOT / "models"
-G = 9.81
+GRAVITY = 9.81
 
 
 @pytest.fixture
@@ -50,7 +50,7 @@ def pendulum_exact(t: np.ndarray, theta0: float, L: float) -> np.ndarray:
     """θ(t) released from rest at θ0 (from the downward vertical):
     sin(θ/2) = k sn(K(k) − ω0 t | k²), k = sin(θ0/2), ω0 = √(g/L) (at t = 0 sn(K) = 1)."""
     k = np.sin(theta0 / 2)
-    sn = ellipj(ellipk(k * k) - np.sqrt(G / L) * t, k * k)[0]
+    sn = ellipj(ellipk(k * k) - np.sqrt(GRAVITY / L) * t, k * k)[0]
     return 2 * np.arcsin(k * sn)
 
 
@@ -81,7 +81,7 @@ def test_point_pendulum_default_tolerances_need_no_more_steps_than_the_exact_ode
     theta0 = 2.0 * np.arctan2(s0.quaternion[:, 3], s0.quaternion[:, 0])
     y0 = np.concatenate((s0.position.ravel(), s0.quaternion.ravel(), s0.velocity.ravel(),
                          s0.omega.ravel(), theta0))
-    g = np.array([0.0, -G, 0.0])
+    g = np.array([0.0, -GRAVITY, 0.0])
 
     def f(t, y):
         r, v = y[:3], y[7:10]  # the pivot O is at the origin
@@ -105,11 +105,11 @@ def test_tension_is_m_g_cos_plus_m_L_thetadot_squared(jit, theta, rate):
     pos = L * np.array([[np.sin(theta), -np.cos(theta)]])
     vel = L * rate * np.array([[np.cos(theta), np.sin(theta)]])
     state = State.planar(pos, np.zeros(1), vel, np.zeros(1))
-    exact = m * (G * np.cos(theta) + L * rate ** 2)
+    exact = m * (GRAVITY * np.cos(theta) + L * rate ** 2)
     for sol in both(jit, model, state):
         assert abs(sol.reactions["O.T"] - exact) <= 1e-12 * abs(exact)
         # a = −g sinθ along the path + centripetal L θ̇² toward the pivot
-        a = (-G * np.sin(theta) * np.array([np.cos(theta), np.sin(theta)])
+        a = (-GRAVITY * np.sin(theta) * np.array([np.cos(theta), np.sin(theta)])
              + L * rate ** 2 * np.array([-np.sin(theta), np.cos(theta)]))
         np.testing.assert_allclose(sol.accelerations, a, rtol=0, atol=1e-12 * 20)
 
@@ -120,7 +120,7 @@ def test_spherical_pendulum_conserves_energy_and_vertical_angular_momentum():
     traj = mbody.simulate(model, 10.0, 100, rtol=1e-12, atol=1e-12)
     x, v = traj.position[:, 0], traj.velocity[:, 0]
     Hz = x[:, 0] * v[:, 1] - x[:, 1] * v[:, 0]
-    E = 0.5 * np.einsum("ij,ij->i", v, v) + G * x[:, 2]
+    E = 0.5 * np.einsum("ij,ij->i", v, v) + GRAVITY * x[:, 2]
     assert np.abs(Hz / Hz[0] - 1).max() < 1e-9
     assert np.abs(E / E[0] - 1).max() < 1e-9
     assert np.abs(np.linalg.norm(x, axis=1) - 1.0).max() < 1e-9
@@ -136,9 +136,9 @@ def test_spherical_pendulum_start():
     assert model.coordinates == ["bob.x", "bob.y", "bob.z"] and model.reactions == ["O.T"]
     sol = mbody.assemble(model).solve()
     c = np.sqrt(0.5)
-    T = G * c + 1.5 ** 2
+    T = GRAVITY * c + 1.5 ** 2
     assert sol.reactions["O.T"] == pytest.approx(T, rel=1e-12)
-    np.testing.assert_allclose(sol.accelerations, [-T * c, 0, T * c - G], atol=1e-12)
+    np.testing.assert_allclose(sol.accelerations, [-T * c, 0, T * c - GRAVITY], atol=1e-12)
 
 
 # -- pins, links, particle parents; the two paths ---------------------------------------------
@@ -169,8 +169,8 @@ def test_particle_pinned_to_the_end_of_a_rod(jit, swap):
     assert asm.M.shape == (5, 5) and asm.G.shape == (5, 4) and asm.Q.shape == (5,)
     np.testing.assert_array_equal(asm.M.toarray(), np.diag([3, 3, 0.25, 2, 2]))
     M_, m, l = 3.0, 2.0, 1.0
-    alpha = -(M_ * l / 2 + m * l) * G / (0.25 + M_ * (l / 2) ** 2 + m * l ** 2)
-    on_bob = np.array([0.0, m * (alpha * l + G)])
+    alpha = -(M_ * l / 2 + m * l) * GRAVITY / (0.25 + M_ * (l / 2) ** 2 + m * l ** 2)
+    on_bob = np.array([0.0, m * (alpha * l + GRAVITY)])
     sign = -1.0 if swap else 1.0  # +R acts on the child
     for sol in both(jit, model):
         np.testing.assert_allclose(sol.accelerations,

@@ -9,7 +9,7 @@ model's masses and inertia tensors) and builds the sparse matrix only when asked
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 from functools import cached_property
 from typing import TYPE_CHECKING
@@ -305,9 +305,9 @@ class Assembly:
         lam = unknowns.lam
         extra = None
         if len(lam):  # G λ, summed per body on the kernels' sparse path
-            t, cols = model.reaction_table, self.columns
+            rt, cols = model.reaction_table, self.columns
             extra = kernels.sparse_wrench(plan.kernels, [
-                (np.concatenate((t.child, t.parent)),
+                (np.concatenate((rt.child, rt.parent)),
                  np.concatenate((cols.child6 * lam[:, None], cols.parent6 * lam[:, None])))])
         acc6 = np.empty((model.n, 6))
         kernels.solve(plan.kernels, self._Q6.T, self._b6.T[3:6], extra, acc6.T)
@@ -332,12 +332,10 @@ class Assembly:
                             dict(zip(labels, lam.tolist(),
                                                                 strict=True)))
         if info[C.ST_SINGULAR]:
-
             code = int(info[C.ST_SINGULAR]) - 1
             raise singular_mass_error(model, code // 6, code % 6)
-        broken = ()
+        broken: tuple[str, ...] = ()
         if info[C.ST_BROKEN] > 0:  # rare: describe the broken joints with the numpy path
-
             broken = tuple(joint_errors(model, state, self.columns, unknowns.mask,
                                         gtv=out[o_lam + m:o_lam + 2 * m]))
         mu, rank = len(unknowns.U), int(info[C.ST_RANK])
@@ -404,13 +402,14 @@ COMPILED_METHODS = (COMPILED_METHOD, COMPILED_NULL_SPACE, COMPILED_REDUNDANT)
 """The compiled solve's method by its path (info slot ST_PATH)."""
 
 
-class _LazyBodies(Mapping):
+class _LazyBodies(Mapping[str, "BodyEquations"]):
     """name -> BodyEquations, built on first access (presentation, not the hot path)."""
 
-    def __init__(self, asm: Assembly, build):
-        self._asm, self._build, self._cache = asm, build, {}
+    def __init__(self, asm: Assembly, build: Callable[[Assembly, int], BodyEquations]):
+        self._asm, self._build = asm, build
+        self._cache: dict[str, BodyEquations] = {}
 
-    def __getitem__(self, name: str):
+    def __getitem__(self, name: str) -> BodyEquations:
         if name not in self._cache:
             if name not in self._asm.model.index:
                 hint = did_you_mean(name, self._asm.model.body_names)
@@ -418,7 +417,7 @@ class _LazyBodies(Mapping):
             self._cache[name] = self._build(self._asm, self._asm.model.index[name])
         return self._cache[name]
 
-    def __iter__(self):
+    def __iter__(self) -> Iterator[str]:
         return iter(self._asm.model.body_names)
 
     def __len__(self) -> int:

@@ -22,12 +22,16 @@ other two levels, vectorised over the m components:
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from mbody.equations.joints import ReactionColumns, constraint_velocity, reaction_columns
 from mbody.equations.spatial import cross, matvec
 from mbody.model.model import Model, State
+
+if TYPE_CHECKING:
+    import scipy.sparse as sp
 
 
 def phi(model: Model, state: State, R: np.ndarray | None = None,
@@ -37,9 +41,9 @@ def phi(model: Model, state: State, R: np.ndarray | None = None,
     Worked out per joint (the joint frames of `cols`, computed when not given), then
     picked per component.
     """
-    t = model.reaction_table
+    rt = model.reaction_table
     jt = model.joint_table
-    m = len(t.labels)
+    m = len(rt.labels)
     if m == 0:
         return np.zeros(0)
     if cols is None:
@@ -50,23 +54,23 @@ def phi(model: Model, state: State, R: np.ndarray | None = None,
     x_p = state.position[np.where(on_p, jt.parent, 0)]
     x_p[~on_p] = 0.0
     d = cols.joint_W_P - (x_p + matvec(Rp, jt.B_r_parent))  # child's point − parent's
-    j = t.joint
+    j = rt.joint
     out = np.einsum("ij,ij->i", cols.W_e, d[j])  # forces: e · (P_c − P_p)
-    if t.link.any():  # a particle link's T: L − |P_c − P_p| (W_e = −(P_c − P_p) / |…|)
-        out = out + t.length
-    mom = t.rot_kind > 0
+    if rt.link.any():  # a particle link's T: L − |P_c − P_p| (W_e = −(P_c − P_p) / |…|)
+        out = out + rt.length
+    mom = rt.rot_kind > 0
     if mom.any():
         jm = np.unique(j[mom])  # joints with moment components
         R_rel = np.zeros((len(jt.parent), 3, 3))
         R_rel[jm] = np.swapaxes(Rp[jm] @ jt.P_E3[jm], 1, 2) @ (Rc[jm] @ jt.C_E3[jm])
         A = R_rel[j]
-        k = t.axis - 3
+        k = rt.axis - 3
         tilt = np.where(k == 0, -A[:, 1, 2], A[:, 0, 2])  # child's z axis in parent frame
         vee = 0.5 * np.stack((A[:, 2, 1] - A[:, 1, 2], A[:, 0, 2] - A[:, 2, 0],
                               A[:, 1, 0] - A[:, 0, 1]), axis=1)
         lock = vee[np.arange(m), np.clip(k, 0, 2)]
-        out = np.where(t.rot_kind == 1, tilt, np.where(t.rot_kind == 2, lock, out))
-        uni = t.rot_kind == 3
+        out = np.where(rt.rot_kind == 1, tilt, np.where(rt.rot_kind == 2, lock, out))
+        uni = rt.rot_kind == 3
         if uni.any():
             ju = j[uni]
             a = matvec(Rp[ju], jt.P_E3[ju, :, 2])
@@ -82,9 +86,9 @@ def gamma(model: Model, state: State, cols: ReactionColumns,
     Per joint, with D = V_c(P) − V_p(P): force components γ = −e · (D × ω_p + A),
     A = ω_c × (ω_c × ρ_c) − ω_p × ṡ; moment components γ = −e · (ω_c × ω_p).
     """
-    t = model.reaction_table
+    rt = model.reaction_table
     jt = model.joint_table
-    m = len(t.labels)
+    m = len(rt.labels)
     if m == 0:
         return np.zeros(0)
     on_p = jt.parent >= 0
@@ -103,12 +107,12 @@ def gamma(model: Model, state: State, cols: ReactionColumns,
     V_c = state.velocity[c] + cross(w_c, rho)
     D = V_c - v_p - cross(w_p, P - x_p)
     T = cross(D, w_p) + cross(w_c, cross(w_c, rho)) - cross(w_p, V_c - v_p)
-    j = t.joint
-    moment = (t.axis >= 3)[:, None]
+    j = rt.joint
+    moment = (rt.axis >= 3)[:, None]
     TU = np.where(moment, cross(w_c, w_p)[j], T[j]) if moment.any() else T[j]
     out = -np.einsum("ij,ij->i", cols.W_e, TU)
-    if t.link.any():  # particle links: γ = u · (ω_c×(ω_c×ρ_c) − ω_p×(ω_p×ρ_p)) + |ḋ⊥|² / |d|
-        li = np.flatnonzero(t.link)
+    if rt.link.any():  # particle links: γ = u · (ω_c×(ω_c×ρ_c) − ω_p×(ω_p×ρ_p)) + |ḋ⊥|² / |d|
+        li = np.flatnonzero(rt.link)
         jl = j[li]
         rho_p = matvec(Rp[jl], jt.B_r_parent[jl])
         u = -cols.W_e[li]
@@ -119,7 +123,7 @@ def gamma(model: Model, state: State, cols: ReactionColumns,
         ud = np.einsum("ij,ij->i", u, dd)
         out[li] = (np.einsum("ij,ij->i", u, acc)
                    + (np.einsum("ij,ij->i", dd, dd) - ud * ud) / dist)
-    uni = t.axis == 6
+    uni = rt.axis == 6
     if uni.any():
         ju = j[uni]
         a = matvec(Rp[ju], jt.P_E3[ju, :, 2])
@@ -140,7 +144,7 @@ class ConstraintJacobian:
     `phi` are the position errors (0 when the joints are assembled).
     """
 
-    matrix: object
+    matrix: sp.csr_matrix
     rows: list[str]
     columns: list[str]
     gamma: np.ndarray
@@ -170,11 +174,11 @@ def joint_errors(model: Model, state: State, cols: ReactionColumns | None = None
     """The enforced constraints (default: those of unknown reactions) that `state` breaks,
     as text: position errors φ ≠ 0 and relative velocities Gᵀ v ≠ 0 (see `phi`). At most
     `limit` are described; a last entry counts the rest."""
-    t = model.reaction_table
-    if not len(t.labels):
+    rt = model.reaction_table
+    if not len(rt.labels):
         return []
     if enforced is None:
-        enforced = np.array([lab not in model.known_reactions for lab in t.labels])
+        enforced = np.array([lab not in model.known_reactions for lab in rt.labels])
 
     v6 = np.concatenate((state.velocity, state.omega), axis=1)
     cols = reaction_columns(model, state) if cols is None else cols
@@ -182,14 +186,14 @@ def joint_errors(model: Model, state: State, cols: ReactionColumns | None = None
         gtv = constraint_velocity(model, cols, state)
     ph = phi(model, state, cols=cols)
     size = float(np.ptp(state.position, axis=0).max()) if model.n > 1 else 0.0
-    size = max(size, float(np.abs(t.B_r_child).max()), 1e-3)
+    size = max(size, float(np.abs(rt.B_r_child).max()), 1e-3)
     speed = max(float(np.abs(v6).max()), 1e-3)
     out = []
     broken = np.flatnonzero(enforced & ((np.abs(ph) > JOINT_TOL * size)
                                         | (np.abs(gtv) > JOINT_TOL * speed)))
     for k in broken[:limit]:
-        unit = ("rad", "rad/s") if t.axis[k] >= 3 else ("m", "m/s")
-        out.append(f"{t.labels[k]} (phi {ph[k]:.3g} {unit[0]}, G^T v {gtv[k]:.3g} {unit[1]})")
+        unit = ("rad", "rad/s") if rt.axis[k] >= 3 else ("m", "m/s")
+        out.append(f"{rt.labels[k]} (phi {ph[k]:.3g} {unit[0]}, G^T v {gtv[k]:.3g} {unit[1]})")
     if len(broken) > limit:
         out.append(f"{len(broken) - limit} more")
     return out

@@ -171,15 +171,15 @@ def body_equations(asm: Assembly, i: int) -> BodyEquations:
         forces.append(ForceOnBody("gravity", GRAVITY, False, np.zeros(3), x.copy(),
                                   model.mass[i] * model.gravity, np.zeros(3)))
 
-    t = model.reaction_table
+    rt = model.reaction_table
     cols = asm.columns
     particle = bool(model.particle[i])
     known = model.known_reactions_at(asm.state.t)
     side: dict[str, float] = {}
-    for c in np.flatnonzero((t.child == i) | (t.parent == i)):
-        sign = 1.0 if t.child[c] == i else -1.0
+    for c in np.flatnonzero((rt.child == i) | (rt.parent == i)):
+        sign = 1.0 if rt.child[c] == i else -1.0
         six = cols.child6[c] if sign > 0 else cols.parent6[c]
-        label = t.labels[c]
+        label = rt.labels[c]
         value = known.get(label)
         moment = bool(cols.is_moment[c])
         W_P = x.copy() if particle else cols.W_P[c].copy()  # forces act at a particle

@@ -77,18 +77,18 @@ class ReactionConstants:
 
 def reaction_constants(model: Model) -> ReactionConstants:
     """The `ReactionConstants` of `model` (use ``model.plan.reaction_constants``)."""
-    t, jt = model.reaction_table, model.joint_table
-    j, k = t.joint, t.axis % 3
-    is_moment = (t.axis >= 3)[:, None]
+    rt, jt = model.reaction_table, model.joint_table
+    j, k = rt.joint, rt.axis % 3
+    is_moment = (rt.axis >= 3)[:, None]
     return ReactionConstants(k, is_moment, bool(is_moment.any()), jt.B_r_child[j],
-                             jt.P_E3[j, :, k], t.parent < 0)
+                             jt.P_E3[j, :, k], rt.parent < 0)
 
 
 def reaction_columns(model: Model, state: State, R: np.ndarray | None = None) -> ReactionColumns:
     R = state.W_R_B if R is None else R
-    t = model.reaction_table
+    rt = model.reaction_table
     jt = model.joint_table
-    m = len(t.labels)
+    m = len(rt.labels)
     if m == 0:
         z, z3 = np.zeros((0, 3)), np.zeros((0, 3, 3))
         return ReactionColumns(z, z, np.zeros((0, 6)), np.zeros((0, 6)), np.zeros(0, bool),
@@ -105,11 +105,11 @@ def reaction_columns(model: Model, state: State, R: np.ndarray | None = None) ->
 
     # Per component: pick its axis of the joint frame.
     const = model.plan.reaction_constants
-    j, k = t.joint, const.k
+    j, k = rt.joint, const.k
     W_e = W_E[j, :, k]
     B_e_c = B_E_c[j, :, k]
     B_e_p = const.B_e_p
-    universal = t.axis == 6
+    universal = rt.axis == 6
     if universal.any():
         ju = j[universal]
         a = W_E[ju, :, 2]
@@ -133,8 +133,8 @@ def reaction_columns(model: Model, state: State, R: np.ndarray | None = None) ->
         parent6[:, 3:] = cross(B_r_p[j], B_e_p)
     np.negative(child6[:, :3], out=parent6[:, :3])
     np.negative(parent6[:, 3:], out=parent6[:, 3:])
-    if t.link.any():  # particle links: T along the line from P_c to P_p
-        li = np.flatnonzero(t.link)
+    if rt.link.any():  # particle links: T along the line from P_c to P_p
+        li = np.flatnonzero(rt.link)
         jl = j[li]
         P_p = x_p[jl] + matvec(Rp[jl], jt.B_r_parent[jl])
         d = P[jl] - P_p
@@ -144,8 +144,8 @@ def reaction_columns(model: Model, state: State, R: np.ndarray | None = None) ->
         child6[li, 3:] = cross(jt.B_r_child[jl], rmatvec(Rc[jl], e))
         parent6[li, :3] = -e
         parent6[li, 3:] = -cross(jt.B_r_parent[jl], rmatvec(Rp[jl], e))
-    if t.particle_parent.any():  # a particle turns with nothing: forces act at it
-        parent6[t.particle_parent, 3:] = 0.0
+    if rt.particle_parent.any():  # a particle turns with nothing: forces act at it
+        parent6[rt.particle_parent, 3:] = 0.0
     if const.ground.any():
         parent6[const.ground] = 0.0
     return ReactionColumns(W_e, P[j], child6, parent6, is_moment[:, 0], P, Rp, Rc)
@@ -155,8 +155,8 @@ def g_matrix(model: Model, cols: ReactionColumns) -> sp.csc_matrix:
     """The sparse G (rows = stacked coordinates, columns = reaction unknowns)."""
     import scipy.sparse as sp
 
-    t = model.reaction_table
-    m = len(t.labels)
+    rt = model.reaction_table
+    m = len(rt.labels)
     rpb = model.rows_per_body
     N = model.n * rpb
     if m == 0:
@@ -164,10 +164,10 @@ def g_matrix(model: Model, cols: ReactionColumns) -> sp.csc_matrix:
     keep = np.arange(6) if model.dimension == cv.SPATIAL else cv.PLANAR_SELECT
     k = len(keep)
     col = np.repeat(np.arange(m), k)
-    rows_c = (t.child[:, None] * rpb + np.arange(k)).ravel()
+    rows_c = (rt.child[:, None] * rpb + np.arange(k)).ravel()
     data_c = cols.child6[:, keep].ravel()
-    on_p = t.parent >= 0
-    rows_p = (t.parent[on_p, None] * rpb + np.arange(k)).ravel()
+    on_p = rt.parent >= 0
+    rows_p = (rt.parent[on_p, None] * rpb + np.arange(k)).ravel()
     data_p = cols.parent6[on_p][:, keep].ravel()
     col_p = np.repeat(np.arange(m)[on_p], k)
     rows = np.concatenate((rows_c, rows_p))
@@ -185,14 +185,14 @@ def g_block(model: Model, cols: ReactionColumns, bodies: np.ndarray,
     ``g_matrix(model, cols)[rows][:, components].toarray()`` without scipy.sparse (for a
     body's equations and the rank test). `bodies`: body indices, whose rows are stacked in
     that order; `components`: reaction component indices (the columns, in that order)."""
-    t = model.reaction_table
+    rt = model.reaction_table
     rpb = model.rows_per_body
     keep = np.arange(6) if model.dimension == cv.SPATIAL else cv.PLANAR_SELECT
     bodies, components = np.asarray(bodies, dtype=int), np.asarray(components, dtype=int)
     local = np.full(model.n + 1, -1)  # body index -> its place in `bodies`; ground (-1) -> -1
     local[bodies] = np.arange(len(bodies))
     A = np.zeros((len(bodies), len(components), rpb))
-    for owner, six in ((t.child, cols.child6), (t.parent, cols.parent6)):
+    for owner, six in ((rt.child, cols.child6), (rt.parent, cols.parent6)):
         at = local[owner[components]]
         on = np.flatnonzero(at >= 0)
         # 0.0 + x: +0.0 where x is -0.0, as a sparse G (which drops zeros) gives
@@ -202,12 +202,12 @@ def g_block(model: Model, cols: ReactionColumns, bodies: np.ndarray,
 
 def reaction_wrench(model: Model, cols: ReactionColumns, lam: np.ndarray) -> np.ndarray:
     """(n, 6) what reactions with values `lam` (m,) put into every body's six rows."""
-    t = model.reaction_table
+    rt = model.reaction_table
     out = np.zeros((model.n, 6))
     nz = np.flatnonzero(lam)
     if len(nz) == 0:
         return out
-    for body, six in ((t.child[nz], cols.child6[nz]), (t.parent[nz], cols.parent6[nz])):
+    for body, six in ((rt.child[nz], cols.child6[nz]), (rt.parent[nz], cols.parent6[nz])):
         keep = body >= 0
         w = six[keep] * lam[nz][keep, None]
         for r in range(6):  # six rows, not a loop over bodies
@@ -218,9 +218,9 @@ def reaction_wrench(model: Model, cols: ReactionColumns, lam: np.ndarray) -> np.
 def constraint_velocity(model: Model, cols: ReactionColumns, state: State) -> np.ndarray:
     """(m,) Gᵀ v: per component, the relative velocity its joint forbids (m/s or rad/s),
     from the columns at `state` and the bodies' [v (world), ω (body axes)]."""
-    t = model.reaction_table
+    rt = model.reaction_table
     v6 = np.concatenate((state.velocity, state.omega), axis=1)
-    out = np.einsum("ij,ij->i", cols.child6, v6[t.child])
-    on = t.parent >= 0
-    out[on] += np.einsum("ij,ij->i", cols.parent6[on], v6[t.parent[on]])
+    out = np.einsum("ij,ij->i", cols.child6, v6[rt.child])
+    on = rt.parent >= 0
+    out[on] += np.einsum("ij,ij->i", cols.parent6[on], v6[rt.parent[on]])
     return out

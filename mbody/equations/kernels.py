@@ -11,8 +11,8 @@ preallocated scratch buffer (``out=``), so the hot loop allocates nothing.
 
 Rotations use the quaternion directly (no ``(n, 3, 3)`` matrices): with q = (w, u),
 
-    W_R_B v  = v + w t + u × t,   t = 2 u × v
-    W_R_Bᵀ v = v + w t + t × u,   t = 2 v × u
+    W_R_B v  = v + w c + u × c,   c = 2 u × v
+    W_R_Bᵀ v = v + w c + c × u,   c = 2 v × u
 
 What depends only on the model and on the load values at time t is computed once and
 cached (`Plan` per model, `LoadFrame` per load-value array):
@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import threading
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple, overload
 
 import numpy as np
 
@@ -77,26 +77,26 @@ def cross_add(a: np.ndarray, b: np.ndarray, out: np.ndarray, tmp: np.ndarray,
     return dec(out, tmp, out)
 
 
-def rotate(w: np.ndarray, u: np.ndarray, v: np.ndarray, out: np.ndarray, t: np.ndarray,
+def rotate(w: np.ndarray, u: np.ndarray, v: np.ndarray, out: np.ndarray, c: np.ndarray,
            tmp: np.ndarray, transpose: bool = False) -> np.ndarray:
     """out[0:3] = W_R_B v (or W_R_Bᵀ v with `transpose`) for q = (w, u).
 
-    w: (L,); u, v, out, t: rolled (5, L); tmp: (3, L). W_R_B v = v + w t + u × t with
-    t = 2 u × v; the transpose uses −u, i.e. t = 2 v × u and v + w t + t × u.
+    w: (L,); u, v, out, c: rolled (5, L) (c: scratch); tmp: (3, L). W_R_B v = v + w c +
+    u × c with c = 2 u × v; the transpose uses −u, i.e. c = 2 v × u and v + w c + c × u.
     """
-    t3, o3 = t[0:3], out[0:3]
+    c3, o3 = c[0:3], out[0:3]
     if transpose:
-        cross(v, u, t3, tmp)
+        cross(v, u, c3, tmp)
     else:
-        cross(u, v, t3, tmp)
-    _mul(t3, 2.0, t3)
-    roll(t)
-    _mul(t3, w, o3)
+        cross(u, v, c3, tmp)
+    _mul(c3, 2.0, c3)
+    roll(c)
+    _mul(c3, w, o3)
     _add(o3, v[0:3], o3)
     if transpose:
-        cross_add(t, u, o3, tmp)
+        cross_add(c, u, o3, tmp)
     else:
-        cross_add(u, t, o3, tmp)
+        cross_add(u, c, o3, tmp)
     return out
 
 
@@ -119,12 +119,12 @@ def matvec(A: np.ndarray, v: np.ndarray, out: np.ndarray, p: np.ndarray, tmp: np
         roll(p)
         return _add(out, p[2:5], out)
     for i in range(3):
-        o, t = out[i], tmp[0]
+        o, term = out[i], tmp[0]
         _mul(A[3 * i], v[0], o)
-        _mul(A[3 * i + 1], v[1], t)
-        _add(o, t, o)
-        _mul(A[3 * i + 2], v[2], t)
-        _add(o, t, o)
+        _mul(A[3 * i + 1], v[1], term)
+        _add(o, term, o)
+        _mul(A[3 * i + 2], v[2], term)
+        _add(o, term, o)
     return out
 
 
@@ -134,8 +134,8 @@ def quat_rotate(q: np.ndarray, v: np.ndarray, transpose: bool = False) -> np.nda
     w, u = q[..., :1], q[..., 1:]
     if transpose:
         u = -u
-    t = 2.0 * np.cross(u, v)
-    return v + w * t + np.cross(u, t)
+    c = 2.0 * np.cross(u, v)
+    return v + w * c + np.cross(u, c)
 
 
 # -- per-model and per-load-value data ---------------------------------------------------
@@ -346,6 +346,14 @@ def load_wrenches(model: Model, plan: Plan, frame: LoadFrame, state: State
     return body, W
 
 
+@overload
+def spring_ends(model: Model, position: np.ndarray, quaternion: np.ndarray,
+                velocity: np.ndarray, omega: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]: ...
+@overload
+def spring_ends(model: Model, position: np.ndarray, quaternion: np.ndarray,
+                velocity: None = None, omega: None = None
+                ) -> tuple[np.ndarray, np.ndarray, None, None]: ...
 def spring_ends(model: Model, position: np.ndarray, quaternion: np.ndarray,
                 velocity: np.ndarray | None = None, omega: np.ndarray | None = None
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None]:
@@ -407,23 +415,45 @@ def spring_wrenches(model: Model, state: State) -> tuple[np.ndarray, np.ndarray]
 
 
 # -- the chunked passes -------------------------------------------------------------------
+class ChunkRows(NamedTuple):
+    """One chunk's scratch rows (views of length L into a thread's `Scratch`). Rolled
+    fields are (5, L) [x, y, z, x, y]."""
+
+    quaternion: np.ndarray  # (6, L) [w, x, y, z, x, y]: u = rows 1:6 is rolled
+    omega: np.ndarray  # rolled ω (body axes)
+    rotate_c: np.ndarray  # rolled: `rotate`'s c = 2 u × v
+    rotated: np.ndarray  # rolled: W_R_Bᵀ of one world load (`moments`)
+    moment: np.ndarray  # rolled: B_M, then B_M − ω × J ω (rolled for the J⁻¹ product)
+    J_omega: np.ndarray  # rolled: h = J ω
+    matvec_p: np.ndarray  # rolled: `matvec`'s scratch p
+    force: np.ndarray  # rolled: W_R_B B_F, or the summed world force (`solve`)
+    tmp: np.ndarray  # (3, L): the cross products' scratch
+
+
+_ROLLED_ROWS = 6  # ChunkRows fields from rotate_c to force, stored as one (6, 5, n) block
+
+
 class Scratch:
     """Preallocated rows for one thread, with the views of each chunk length cached."""
 
     def __init__(self, size: int):
         self.size = size
-        self.q = np.empty((6, size))  # [w, x, y, z, x, y]
+        self.q = np.empty((6, size))
         self.omega = np.empty((5, size))
-        self.v = np.empty((6, 5, size))
+        self.rolled = np.empty((_ROLLED_ROWS, 5, size))
         self.tmp = np.empty((3, size))
-        self._views: dict[int, tuple] = {}
+        self._views: dict[int, ChunkRows] = {}
 
-    def views(self, L: int) -> tuple:
-        """(q, ω, v0..v5, tmp) cut to length L."""
-        if L not in self._views:
-            self._views[L] = (self.q[:, :L], self.omega[:, :L],
-                              *(self.v[i, :, :L] for i in range(6)), self.tmp[:, :L])
-        return self._views[L]
+    def views(self, L: int) -> ChunkRows:
+        """The scratch rows cut to length L."""
+        rows = self._views.get(L)
+        if rows is None:
+            r = self.rolled[:, :, :L]
+            rows = self._views[L] = ChunkRows(
+                quaternion=self.q[:, :L], omega=self.omega[:, :L], rotate_c=r[0],
+                rotated=r[1], moment=r[2], J_omega=r[3], matvec_p=r[4], force=r[5],
+                tmp=self.tmp[:, :L])
+        return rows
 
 
 _local = threading.local()
@@ -444,17 +474,18 @@ def _load(a: np.ndarray, s: int, e: int, buf: np.ndarray, rows: int) -> np.ndarr
 
 
 def moments(plan: Plan, frame: LoadFrame, w: np.ndarray, u: np.ndarray, s: int, e: int,
-            M: np.ndarray, t: np.ndarray, v: np.ndarray, tmp: np.ndarray) -> None:
-    """Body-axis applied moments of bodies s:e into M (3, L):
+            M: np.ndarray, rows: ChunkRows) -> None:
+    """Body-axis applied moments of bodies s:e into M (3, L) (`rows`: the chunk's scratch):
 
     B_M = Σ_slots B_r × (W_R_Bᵀ W_f) + W_R_Bᵀ W_C + (body-frame moments).
     """
+    c, v, tmp = rows.rotate_c, rows.rotated, rows.tmp
     first = True
     if frame.B_M is not None:
         np.copyto(M, frame.B_M[:, s:e])
         first = False
     for r, f in zip(plan.slot_r, frame.slot_f, strict=True):
-        rotate(w, u, f[:, s:e], v, t, tmp, transpose=True)
+        rotate(w, u, f[:, s:e], v, c, tmp, transpose=True)
         roll(v)
         if first:
             cross(r[:, s:e], v, M, tmp)
@@ -462,7 +493,7 @@ def moments(plan: Plan, frame: LoadFrame, w: np.ndarray, u: np.ndarray, s: int, 
         else:
             cross_add(r[:, s:e], v, M, tmp)
     if frame.W_C is not None:
-        rotate(w, u, frame.W_C[:, s:e], v, t, tmp, transpose=True)
+        rotate(w, u, frame.W_C[:, s:e], v, c, tmp, transpose=True)
         if first:
             np.copyto(M, v[0:3])
             first = False
@@ -481,14 +512,16 @@ def accelerations(plan: Plan, frame: LoadFrame, state: State, sparse: Sparse | N
     sc = scratch(plan.block)
     mode = plan.mode
     for c, (s, e) in enumerate(plan.chunks):
-        qb, om, t, v, M, h, p, F, tmp = sc.views(e - s)
-        _load(state.quaternion, s, e, qb, 4)
+        rows = sc.views(e - s)
+        M, F, om, h, p, tmp = (rows.moment, rows.force, rows.omega, rows.J_omega,
+                               rows.matvec_p, rows.tmp)
+        qb = _load(state.quaternion, s, e, rows.quaternion, 4)
         w, u = qb[0], qb[1:6]
         a, wd = out[0:3, s:e], out[3:6, s:e]
         M3 = M[0:3]
-        moments(plan, frame, w, u, s, e, M3, t, v, tmp)
+        moments(plan, frame, w, u, s, e, M3, rows)
         if frame.B_F is not None:  # body-frame forces: a = a_G + (W_R_B B_F) / m
-            rotate(w, u, frame.B_F[:, s:e], F, t, tmp)
+            rotate(w, u, frame.B_F[:, s:e], F, rows.rotate_c, tmp)
             _mul(F[0:3], plan.inv_mass[s:e], F[0:3])
             _add(frame.a_G[:, s:e], F[0:3], a)
         else:
@@ -516,12 +549,13 @@ def loads_and_gyroscopic(plan: Plan, frame: LoadFrame, state: State, sparse: Spa
     sc = scratch(plan.block)
     mode = plan.mode
     for c, (s, e) in enumerate(plan.chunks):
-        qb, om, t, v, M, h, p, F, tmp = sc.views(e - s)
-        _load(state.quaternion, s, e, qb, 4)
+        rows = sc.views(e - s)
+        F, om, h, p, tmp = rows.force, rows.omega, rows.J_omega, rows.matvec_p, rows.tmp
+        qb = _load(state.quaternion, s, e, rows.quaternion, 4)
         w, u = qb[0], qb[1:6]
-        moments(plan, frame, w, u, s, e, Q[3:6, s:e], t, v, tmp)
+        moments(plan, frame, w, u, s, e, Q[3:6, s:e], rows)
         if frame.B_F is not None:  # W_F = (world forces + m g) + W_R_B B_F
-            rotate(w, u, frame.B_F[:, s:e], F, t, tmp)
+            rotate(w, u, frame.B_F[:, s:e], F, rows.rotate_c, tmp)
             _add(frame.W_F[:, s:e], F[0:3], Q[0:3, s:e])
         else:
             np.copyto(Q[0:3, s:e], frame.W_F[:, s:e])
@@ -542,7 +576,8 @@ def solve(plan: Plan, Q: np.ndarray, b: np.ndarray, extra: Sparse | None,
     sc = scratch(plan.block)
     mode = plan.mode
     for c, (s, e) in enumerate(plan.chunks):
-        _, _, _, _, M, _, p, F, tmp = sc.views(e - s)
+        rows = sc.views(e - s)
+        M, F, p, tmp = rows.moment, rows.force, rows.matvec_p, rows.tmp
         M3 = M[0:3]
         _sub(Q[3:6, s:e], b[:, s:e], M3)
         a = out[0:3, s:e]

@@ -32,7 +32,7 @@ import threading
 from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cached_property
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
@@ -84,6 +84,21 @@ def compiled():
                     mod = False
                 _compiled_module = mod
     return _compiled_module or None
+
+
+class LoadProgram(NamedTuple):
+    """The loads as the compiled path evaluates them at any time, in the order of the
+    arguments of `mbody.solve.compiled.set_loads` (and `rk_run`): the constant values,
+    then the time-varying entries (`mbody.model.expressions.ProgramTable`, empty when
+    every load is constant)."""
+
+    base: np.ndarray  # (k, 3) float: the load values, constant entries in place
+    rows: np.ndarray
+    cols: np.ndarray
+    which: np.ndarray
+    starts: np.ndarray
+    codes: np.ndarray
+    numbers: np.ndarray
 
 
 @dataclass(frozen=True, eq=False)
@@ -210,16 +225,17 @@ class ModelPlan:
         return self.constant_loads if ft.varying is None else ft.vector_at(t)
 
     @cached_property
-    def load_program(self) -> tuple[np.ndarray, ...]:
-        """The loads as the compiled path evaluates them at any time (`mbody.compiled.
-        set_loads`): (constant values (k, 3), then `mbody.expr.ExpressionTable.program`,
-        empty when every load is constant)."""
+    def load_program(self) -> LoadProgram:
+        """The loads as the compiled path evaluates them at any time (`LoadProgram`)."""
         varying = self.model.forces.varying
         if varying is not None:
-            return (self.constant_loads, *varying.program)
+            p = varying.program
+            return LoadProgram(self.constant_loads, p.rows, p.cols, p.which, p.starts,
+                               p.codes, p.numbers)
         none = np.zeros(0, dtype=np.int64)
-        return (self.constant_loads, none, none, none, np.zeros(1, dtype=np.int64), none,
-                np.zeros(0))
+        return LoadProgram(self.constant_loads, rows=none, cols=none, which=none,
+                           starts=np.zeros(1, dtype=np.int64), codes=none,
+                           numbers=np.zeros(0))
 
     def packed_unknowns(self, unknowns: Unknowns) -> np.ndarray:
         """The compiled path's structure of these unknowns (ordered for a narrow band)."""

@@ -21,7 +21,7 @@ import re
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Any
+from typing import Any, NamedTuple, overload
 
 import numpy as np
 
@@ -121,7 +121,13 @@ class Expression:
         except (ArithmeticError, ValueError):
             return self(float(t))
 
+    @overload
+    def __call__(self, t: float) -> float: ...
+    @overload
+    def __call__(self, t: np.ndarray) -> np.ndarray: ...
     def __call__(self, t: float | np.ndarray) -> float | np.ndarray:
+        """The value at t: a float for a number (or a 0-d array), an array of t's shape for
+        an array."""
         # Out-of-domain values (log(-1), 1/0) become nan/inf; callers check finiteness.
         with np.errstate(all="ignore"):
             out = _eval(self.tree, np.asarray(t, dtype=float))
@@ -388,6 +394,18 @@ def first_nonfinite(expr: Expression, t_end: float) -> tuple[float, float] | Non
     return float(t[i]), float(v[i])
 
 
+class ProgramTable(NamedTuple):
+    """Time-varying load entries as `mbody.solve.compiled.set_loads` takes them (in this
+    order, after the constant values)."""
+
+    rows: np.ndarray  # (e,) int64: the load (row) of each varying entry
+    cols: np.ndarray  # (e,) int64: its component
+    which: np.ndarray  # (e,) int64: its expression, index into starts
+    starts: np.ndarray  # (u + 1,) int64: each expression's program in codes/numbers
+    codes: np.ndarray  # (P,) int64: operation codes (`PROGRAM_CODES`), postfix
+    numbers: np.ndarray  # (P,) float64: the constants the codes push
+
+
 @dataclass(frozen=True)
 class ExpressionTable:
     """Time-varying entries of a (k, c) table of load components.
@@ -419,16 +437,16 @@ class ExpressionTable:
                    np.array(which, dtype=np.intp), tuple(exprs))
 
     @cached_property
-    def program(self) -> tuple[np.ndarray, ...]:
-        """The table for `mbody.compiled.set_loads`: (rows, cols, which (e,) int64,
-        starts (u + 1,) int64 offsets of each expression's program in codes, codes (P,)
-        int64, numbers (P,) float64)."""
+    def program(self) -> ProgramTable:
+        """The table for `mbody.compiled.set_loads` (`ProgramTable`)."""
         progs = [e.program for e in self.exprs]
         starts = np.zeros(len(progs) + 1, dtype=np.int64)
         starts[1:] = np.cumsum([len(c) for c, _ in progs])
-        return (self.rows.astype(np.int64), self.cols.astype(np.int64),
-                self.which.astype(np.int64), starts,
-                np.concatenate([c for c, _ in progs]), np.concatenate([v for _, v in progs]))
+        return ProgramTable(
+            rows=self.rows.astype(np.int64), cols=self.cols.astype(np.int64),
+            which=self.which.astype(np.int64), starts=starts,
+            codes=np.concatenate([c for c, _ in progs]),
+            numbers=np.concatenate([v for _, v in progs]))
 
     @cached_property
     def _entries(self) -> tuple[tuple[int, int, int], ...]:
@@ -444,9 +462,9 @@ class ExpressionTable:
         if isinstance(t, float | int) or np.ndim(t) == 0:  # a simulation's right-hand side
             out = np.array(base, dtype=float)
             t = float(t)
-            vals = [e.at(t) for e in self.exprs]
+            values = [e.at(t) for e in self.exprs]
             for r, c, w in self._entries:
-                out[r, c] = vals[w]
+                out[r, c] = values[w]
             return out
         t = np.asarray(t, dtype=float)
         out = np.broadcast_to(base, (*t.shape, *np.shape(base))).copy()

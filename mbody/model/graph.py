@@ -101,7 +101,8 @@ def topology(model: Model, G=None, *, columns: ReactionColumns | None = None) ->
     m = len(model.reactions)
     coords = len(model.coordinates)  # a particle has translations only
     gruebler = coords - m
-    rank, redundant = (0, []) if m == 0 else (None, [])
+    rank: int | None = 0 if m == 0 else None
+    redundant: list[str] = []
     if m and (G is not None or columns is not None):
         rank, redundant = _rank(model, G, columns)
     mobility = coords - (rank if rank is not None else m)
@@ -113,7 +114,7 @@ def _rank(model: Model, G, columns: ReactionColumns | None) -> tuple[int | None,
     from `G` or else from `columns`."""
     parts = _components(model.body_names, [(j.parent, j.child) for j in model.joints
                                            if cv.GROUND not in (j.parent, j.child)])
-    t = model.reaction_table
+    rt = model.reaction_table
     rpb = model.rows_per_body
     labels = model.reactions
     total, redundant = 0, []
@@ -121,13 +122,14 @@ def _rank(model: Model, G, columns: ReactionColumns | None) -> tuple[int | None,
         G = G.tocsc()
     for part in parts:
         idx = np.array(sorted(model.index[b] for b in part))
-        cols = np.flatnonzero(np.isin(t.child, idx))
+        cols = np.flatnonzero(np.isin(rt.child, idx))
         if not len(cols):
             continue
         if len(cols) > RANK_LIMIT:
             return None, []
         if G is None:
-
+            if columns is None:  # neither G nor its columns: no rank test (see `topology`)
+                return None, []
             A = g_block(model, columns, idx, cols)
         else:
             rows = (np.concatenate([model.body_rows(i) for i in idx]) if model.has_particles

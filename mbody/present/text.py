@@ -72,15 +72,18 @@ def model_summary(model: Model, topo: Topology) -> str:
     if model.loads:
         out.append(f"loads ({len(model.loads)}):")
         for ld in model.loads[:50]:
+            vec = ld.vector  # a force's or torque's (a spring has none)
             if ld.type == "spring":
                 what = (f"spring {ld.bodies[0]} - {ld.bodies[1]}, k {_n(ld.stiffness)} N/m, "
                         f"rest {_n(ld.rest_length)} m, damping {_n(ld.damping)} N s/m")
+            elif vec is None:  # not given by the loader; named rather than failing
+                what = f"{ld.type} on {ld.bodies[0]}"
             elif ld.type == "torque":
-                tq = ld.vector[2] if dim == cv.PLANAR else ld.vector
-                what = f"torque on {ld.bodies[0]}: {_n(tq) if dim == 2 else _v(tq, 3)} N m" \
-                    + ("" if dim == 2 else f" ({ld.frame} axes)")
+                what = (f"torque on {ld.bodies[0]}: "
+                        + (f"{_n(vec[2])} N m" if dim == cv.PLANAR
+                           else f"{_v(vec, 3)} N m ({ld.frame} axes)"))
             else:
-                what = (f"force on {ld.bodies[0]}: {_v(ld.vector, dim)} N ({ld.frame} axes) "
+                what = (f"force on {ld.bodies[0]}: {_v(vec, dim)} N ({ld.frame} axes) "
                         f"at {_v(ld.at[0], dim)} m")
             if ld.expressions:  # time-varying components: show the formulas, not t = 0
                 what += "; varying: " + ", ".join(
@@ -213,7 +216,7 @@ def reaction_table_text(asm: Assembly, sol: Solution) -> str:
     if not sol.reactions:
         return ""
     cols = asm.columns
-    t = model.reaction_table
+    rt = model.reaction_table
     lam = _clean(np.array([sol.reactions[r] for r in model.reactions]))
     solved, not_unique = set(sol.solved), set(sol.not_unique)
     rows = []
@@ -230,19 +233,19 @@ def reaction_table_text(asm: Assembly, sol: Solution) -> str:
     F_all = np.zeros((len(model.joints), 3))
     C_all = np.zeros((len(model.joints), 3))
     for jn in range(len(model.joints)):
-        sel = t.joint == jn
+        sel = rt.joint == jn
         F_all[jn] = (lam[sel & ~cols.is_moment, None] * cols.W_e[sel & ~cols.is_moment]).sum(0)
         C_all[jn] = (lam[sel & cols.is_moment, None] * cols.W_e[sel & cols.is_moment]).sum(0)
     F_all, C_all = _clean(F_all), _clean(C_all)
     for jn, j in enumerate(model.joints):
-        P = cols.W_P[np.flatnonzero(t.joint == jn)[0]]
+        P = cols.W_P[np.flatnonzero(rt.joint == jn)[0]]
         F, C = F_all[jn], C_all[jn]
         Cs = _n(C[2]) if dim == cv.PLANAR else _v(C, 3)
         mCs = _n(-C[2]) if dim == cv.PLANAR else _v(-C, 3)
-        first = np.flatnonzero(t.joint == jn)[0]
-        if t.link[first]:  # a rigid link to a particle: its two ends are apart
-            Pp = P + t.length[first] * cols.W_e[first]
-            lines.append(f"  {j.name} (link, {_n(t.length[first])} m): on child {j.child} "
+        first = np.flatnonzero(rt.joint == jn)[0]
+        if rt.link[first]:  # a rigid link to a particle: its two ends are apart
+            Pp = P + rt.length[first] * cols.W_e[first]
+            lines.append(f"  {j.name} (link, {_n(rt.length[first])} m): on child {j.child} "
                          f"at {_v(P, dim)}: F {_v(F, dim)} N; on parent {j.parent} at "
                          f"{_v(Pp, dim)}: F {_v(-F, dim)} N")
             continue

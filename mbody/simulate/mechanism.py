@@ -29,20 +29,27 @@ BAUMGARTE_RATE = 20.0
 """α = β in 1/s: joint errors decay with a time constant of 1/20 s."""
 
 
+class ConstrainedDynamics:
+    """f(model, state) -> (n, 6) accelerations with the unknown reactions solved each call
+    (a `mbody.solve.dynamics.Dynamics`), stabilised with α = β = `rate` (1/s; 0 turns
+    stabilisation off); `known`: given reaction values (label -> value)."""
+
+    def __init__(self, known: Mapping[str, float] | None, rate: float):
+        self.known, self.rate = known, rate
+        self.stabilisation = f"Baumgarte, alpha = beta = {rate:g} 1/s" if rate else "none"
+        """How the joints are held, in words (for a trajectory's info)."""
+
+    def __call__(self, model: Model, state: State) -> np.ndarray:
+        unknowns = model.plan.unknowns_at(state.t, self.known)
+        return assemble(model, state).constrained(unknowns, rate=self.rate, refine=False)[0]
+
+
 def constrained_dynamics(model: Model, known: Mapping[str, float] | None = None, *,
-                         rate: float = BAUMGARTE_RATE):
+                         rate: float = BAUMGARTE_RATE) -> ConstrainedDynamics:
     """f(model, state) -> (n, 6) accelerations with the unknown reactions solved each call,
     stabilised with α = β = `rate` (1/s; 0 turns stabilisation off). The numpy path;
     `mbody.dynamics.StateDerivative` takes the compiled one where it can."""
-
-    def f(model: Model, state: State) -> np.ndarray:
-        unknowns = model.plan.unknowns_at(state.t, known)
-        return assemble(model, state).constrained(unknowns, rate=rate, refine=False)[0]
-
-    f.stabilisation = (f"Baumgarte, alpha = beta = {rate:g} 1/s" if rate  # type: ignore[attr-defined]
-                       else "none")
-    f.rate = rate  # type: ignore[attr-defined]
-    return f
+    return ConstrainedDynamics(known, rate)
 
 
 def reactions_along(model: Model, states: list[State],

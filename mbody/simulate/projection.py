@@ -29,7 +29,7 @@ from __future__ import annotations
 import numpy as np
 
 from mbody.equations.constraints import phi
-from mbody.equations.joints import constraint_velocity, reaction_columns
+from mbody.equations.joints import ReactionColumns, constraint_velocity, reaction_columns
 from mbody.equations.plan import Unknowns
 from mbody.equations.plan import compiled as compiled_module
 from mbody.model.model import Model, State
@@ -67,28 +67,26 @@ class JointProjection:
         self.planar = model.dimension == 2
         self._kernel = None
         if compiled:
-
             plan = model.plan
-            self._kernel = compiled_module().project
+            self._compiled = compiled_module()
+            self._kernel = self._compiled.project
             self._F, self._I = plan.packed
             self._Iu = plan.packed_unknowns(unknowns)
-            self._info = np.empty(4)
+            self._info = np.empty(self._compiled.PROJECT_INFO)
 
     def __call__(self, y: np.ndarray, t: float, iterations: int = ITERATIONS
                  ) -> tuple[float, float, float]:
         if self._kernel is not None:
-            info = self._info
+            info, c = self._info, self._compiled
             self._kernel(self._F, self._I, self._Iu, y, self.planar, iterations,
                          STAGE_PIVOT_RTOL, info)
-            if info[3]:
-
-                code = int(info[3])
+            if info[c.PR_SINGULAR]:
+                code = int(info[c.PR_SINGULAR])
                 raise singular_mass_error(self.model, (code - 1) // 6, (code - 1) % 6)
-            return float(info[0]), float(info[1]), float(info[2])
+            return float(info[c.PR_STEP]), float(info[c.PR_VELOCITY]), float(info[c.PR_RATIO])
         return self._numpy(y, t, iterations)
 
     def _numpy(self, y: np.ndarray, t: float, iterations: int) -> tuple[float, float, float]:
-
         model, unknowns, n = self.model, self.unknowns, self.model.n
         U = unknowns.U
         x = y[:3 * n].reshape(n, 3)
@@ -100,14 +98,13 @@ class JointProjection:
 
         robust = False
 
-        def system_at() -> tuple[State, object, ConstrainedSystem]:
+        def system_at() -> tuple[State, ReactionColumns, ConstrainedSystem]:
             qn = q / np.linalg.norm(q, axis=1)[:, None]
             state = State(x, qn, v, w, t)
             cols = reaction_columns(model, state)
             system = ConstrainedSystem(model, cols, unknowns)
             if robust and system.robust is None:  # as the compiled `_project_solve`
-                S = system.fact._S
-                system.fact = system._null_space(S() if callable(S) else S)
+                system.fact = system._null_space(system.fact.matrix())
             return state, cols, system
 
         state, cols, system = system_at()
@@ -140,12 +137,11 @@ class JointProjection:
         return moved, change, ratio
 
 
-def geometric_ratio(system) -> float:
+def geometric_ratio(system: ConstrainedSystem) -> float:
     """How close the joints are to a singular position, whatever the masses: the smallest
     squared Cholesky pivot of Ĝᵀ Ĝ over its diagonal entry, Ĝ = T G_U with
     T = diag(1, 1/ℓ) per body (`mbody.nullspace`'s scaling), exactly redundant columns
     left out (as `mbody.compiled._geometric_ratio`, whose `DROPPED_RTOL` it uses)."""
-
     G = getattr(system, "G", None)
     if G is None or system.blocks is not None or hasattr(G, "tocsr"):
         return 1.0  # the large models' sparse factorisations: no cheap figure
@@ -175,7 +171,6 @@ def tangent_error(projection: JointProjection, y: np.ndarray, e: np.ndarray) -> 
     The rest is removed by the projection after the step whatever its size, so it should
     not shrink the step: near a singular position it is rounding noise amplified by the
     small singular values (`STAGE_PIVOT_RTOL`), and it would stall the integrator."""
-
     n = projection.model.n
     out = e.copy()
     z = y.copy()

@@ -27,7 +27,7 @@ import os
 import sys
 import time
 import warnings
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
 
 import numpy as np
@@ -38,7 +38,12 @@ from mbody.equations.kernels import spring_ends
 from mbody.errors import MbodyError, UnknownReactionsError, did_you_mean
 from mbody.model.expressions import Expression, check_times, compile_expression, first_nonfinite
 from mbody.model.model import Model, State
-from mbody.simulate.mechanism import constrained_dynamics, constraint_drift, reactions_along
+from mbody.simulate.mechanism import (
+    ConstrainedDynamics,
+    constrained_dynamics,
+    constraint_drift,
+    reactions_along,
+)
 from mbody.simulate.projection import STAGE_PIVOT_RTOL, JointProjection
 from mbody.simulate.stepping import REFRESH_ATOL, integrator
 from mbody.simulate.trajectory import Trajectory
@@ -57,7 +62,7 @@ mechanism (about 0.3 ms per step) reaches it in minutes rather than hours."""
 
 
 def known_reaction_dynamics(model: Model, known: Mapping[str, float | str] | None = None
-                            ) -> Dynamics:
+                            ) -> KnownReactionDynamics:
     """The default derivative: every reaction value known (file, then `known`), λ(t) applied.
 
     `known` values are numbers or expressions of t (text, see docs/expressions.md).
@@ -83,32 +88,38 @@ def known_reaction_dynamics(model: Model, known: Mapping[str, float | str] | Non
         raise UnknownReactionsError(missing)
     base = np.array([values[r] for r in labels], dtype=float)
     varying = [(labels.index(r), e) for r, e in exprs.items() if not e.constant]
+    return KnownReactionDynamics(base, varying)
 
-    def values_at(t: float) -> np.ndarray:
+
+class KnownReactionDynamics:
+    """f(model, state) -> (n, 6) accelerations with every reaction value given (a
+    `mbody.solve.dynamics.Dynamics`): `base` (m,) the values in ``model.reactions``
+    order, `expressions` [(index, expression of t)] those that vary in time."""
+
+    def __init__(self, base: np.ndarray, expressions: list[tuple[int, Expression]]):
+        self.base, self.expressions = base, expressions
+        self.varying = bool(expressions)
+        """Whether some reaction value varies in time."""
+
+    def values_at(self, t: float) -> np.ndarray:
         """(m,) the reaction values at time t."""
-        if not varying:
-            return base
-        lam = base.copy()
-        for i, e in varying:  # one call per time-varying reaction, not per body
+        if not self.expressions:
+            return self.base
+        lam = self.base.copy()
+        for i, e in self.expressions:  # one call per time-varying reaction, not per body
             lam[i] = e(t)
         return lam
 
-    def f(model: Model, state: State) -> np.ndarray:
-        return accelerations(model, state, values_at(state.t) if labels else None)
+    def reactions_at(self, t: np.ndarray) -> np.ndarray:
+        """(K, m) reaction values at the sample times t (K,)."""
+        out = np.broadcast_to(self.base, (len(t), len(self.base))).copy()
+        for i, e in self.expressions:
+            out[:, i] = e(t)
+        return out
 
-    f.values_at = values_at  # type: ignore[attr-defined]
-    f.varying = bool(varying)  # type: ignore[attr-defined]
-    f.reactions_at = lambda t: _reactions_at(base, varying, t)  # type: ignore[attr-defined]
-    return f
-
-
-def _reactions_at(base: np.ndarray, varying: list[tuple[int, Expression]],
-                  t: np.ndarray) -> np.ndarray:
-    """(K, m) reaction values at the sample times."""
-    out = np.broadcast_to(base, (len(t), len(base))).copy()
-    for i, e in varying:
-        out[:, i] = e(t)
-    return out
+    def __call__(self, model: Model, state: State) -> np.ndarray:
+        return accelerations(model, state,
+                             self.values_at(state.t) if len(self.base) else None)
 
 
 class _Progress:
@@ -117,7 +128,7 @@ class _Progress:
     def __init__(self, enabled: bool, t_end: float, label: str):
         self.bar = None
         if enabled:
-            from tqdm import tqdm
+            from tqdm import tqdm  # type: ignore[import-untyped]  # tqdm ships no types
 
             self.bar = tqdm(total=t_end, unit="s", file=sys.stderr, desc=label, leave=True,
                             bar_format="{desc}: {percentage:3.0f}%|{bar}| t = {n:.3g} / "
@@ -183,11 +194,10 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     n = model.n
     planar = model.dimension == cv.PLANAR
     s0 = model.initial if initial is None else initial
-    projection = None
-    if mechanism and method not in IMPLICIT:
+    projection: JointProjection | None = None
+    if mechanism and method not in IMPLICIT and rhs.unknowns is not None:
         # the joints held by projecting the state after every step (mbody.projection);
         # the implicit methods keep their own history of y, so Baumgarte's terms hold them
-
         projection = JointProjection(model, rhs.unknowns, compiled=rhs.compiled)
         rhs.projection, rhs.rate = projection, 0.0
     # Planar models also integrate θ itself (θ̇ = ω_z): the angle read back from a
@@ -208,11 +218,12 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     rate = _StepRate(t_end)
     wall = time.perf_counter()
     try:
-
-        fun = rhs
+        fun: Callable[[float, np.ndarray], np.ndarray] = rhs
         if method in ("Radau", "BDF"):  # their Jacobian estimate passes strided columns of y
-            def fun(t, y):
+            def contiguous(t: float, y: np.ndarray) -> np.ndarray:
                 return rhs(t, np.ascontiguousarray(y))
+
+            fun = contiguous
         with np.errstate(all="ignore"):  # its first-step norm may overflow: handled below
             solver = integrator(method, rhs)(fun, 0.0, y0, t_end, rtol=rtol, atol=atol,
                                               max_step=max_step)
@@ -314,12 +325,12 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
            else np.zeros((K, 0)))
     joint_info: dict = {}
     if mechanism:
-
         states = [State(x[k], q[k], v[k], w[k], float(t_eval[k])) for k in range(K)]
         lam = reactions_along(model, states, _numeric_known(model, known))
 
+        stabilisation = f.stabilisation if isinstance(f, ConstrainedDynamics) else "none"
         held = (PROJECTION_TEXT if projection is not None else
-                f"{f.stabilisation} (the implicit methods keep their own history of the "
+                f"{stabilisation} (the implicit methods keep their own history of the "
                 "state, which a projection would break)")
         joint_info = {"joint_stabilisation": held, **constraint_drift(model, states),
                       "initial_joint_errors": joint_errors(model, s0),
@@ -334,7 +345,8 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
                                "samples divided by |q|",
         **joint_info,
     }
-    pose = ((x[..., :2], v[..., :2], Y[:, 13 * n:], w[..., 2]) if planar else (x, v, q, w))
+    pose: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] = (
+        (x[..., :2], v[..., :2], Y[:, 13 * n:], w[..., 2]) if planar else (x, v, q, w))
     traj = Trajectory(
         t_eval, *pose, body_names=model.body_names, dimension=model.dimension,
         model_name=model.name, model_file=model.file, reaction_labels=labels,
@@ -598,20 +610,20 @@ def state_derivative(model: Model, known: Mapping[str, float | str] | None = Non
     if dynamics is not None:
         return StateDerivative(model, dynamics)
     if _has_unknown_reactions(model, known):  # a mechanism: reactions solved every call
-
         numeric = _numeric_known(model, known)
         f = constrained_dynamics(model, numeric)
-        known_at = None
-        if model.known_expressions:
-            def known_at(t: float) -> np.ndarray:
-                return plan.unknowns_at(t, numeric).lam
+
+        def known_values_at(t: float) -> np.ndarray:
+            return plan.unknowns_at(t, numeric).lam
+
         return StateDerivative(model, f, unknowns=plan.unknowns_at(0.0, numeric),
-                               rate=f.rate, known_at=known_at, compiled=True)
-    f = known_reaction_dynamics(model, known)
+                               rate=f.rate, compiled=True,
+                               known_at=known_values_at if model.known_expressions else None)
+    given = known_reaction_dynamics(model, known)
     labels = model.reactions
-    every = plan.unknowns(dict(zip(labels, f.values_at(0.0).tolist(), strict=True)))
-    return StateDerivative(model, f, unknowns=every,
-                           known_at=f.values_at if f.varying else None, compiled=True)
+    every = plan.unknowns(dict(zip(labels, given.values_at(0.0).tolist(), strict=True)))
+    return StateDerivative(model, given, unknowns=every,
+                           known_at=given.values_at if given.varying else None, compiled=True)
 
 
 def _model_text(model: Model) -> str:

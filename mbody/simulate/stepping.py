@@ -20,7 +20,7 @@ Two refinements, each a subclass of the scipy class the user chose:
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -39,12 +39,12 @@ COMPILED_STEPS = True
 tests switch it off to compare with scipy's own steps)."""
 
 
-def integrator(method: str, rhs: StateDerivative):
+def integrator(method: str, rhs: StateDerivative) -> type[Any]:
     """scipy's integrator class `method`, or a subclass refining it for `rhs` (module
     docstring)."""
     import scipy.integrate
 
-    base = getattr(scipy.integrate, method)
+    base: type[Any] = getattr(scipy.integrate, method)  # an OdeSolver subclass
     projection = rhs.projection
     compiled = (COMPILED_STEPS and method == "DOP853" and rhs.compiled
                 and rhs.known_at is None)
@@ -90,15 +90,14 @@ class Advance(NamedTuple):
 def _compiled_run(solver, rhs: StateDerivative, t_stop: float, max_steps: int) -> Advance:
     """Steps by `mbody.compiled.rk_run`; the solver's fields left as scipy's own steps
     leave them (so that its dense output and next `step()` go on from there)."""
-
     c = compiled_module()
     model = rhs.model
-    run = np.zeros(9)
+    run = np.zeros(c.RUN_SIZE)
     run[c.RUN_T], run[c.RUN_H] = solver.t, solver.h_abs
     y, f = solver.y.copy(), solver.f.copy()
     y_old = np.empty_like(y)
     projection = rhs.projection
-    c.rk_run(rhs._F, rhs._I, rhs._Iu, *model.plan.load_program, rhs.unknowns.lam, rhs.rate,
+    c.rk_run(rhs._F, rhs._I, rhs._Iu, *model.plan.load_program, rhs._lam, rhs.rate,
              rhs.planar, solver.A, solver.B, solver.C, solver.E3, solver.E5, solver.rtol,
              solver.atol, solver.max_step, solver.t_bound, t_stop, max_steps,
              projection is not None, STAGE_PIVOT_RTOL, REFRESH_ATOL * solver.atol,
@@ -107,7 +106,6 @@ def _compiled_run(solver, rhs: StateDerivative, t_stop: float, max_steps: int) -
     solver.nfev += int(run[c.RUN_NFEV])
     status = run[c.RUN_STATUS]
     if status == 2.0:
-
         code = int(run[c.RUN_RATIO])
         raise singular_mass_error(model, (code - 1) // 6, (code - 1) % 6)
     solver.h_abs = run[c.RUN_H]

@@ -63,9 +63,9 @@ class BlockPlan:
 def make_plan(model: Model, U: np.ndarray) -> BlockPlan | None:
     """The plan for unknown components U, or None when blocks would be too padded or the
     band too wide (then the general sparse path is used)."""
-    t = model.reaction_table
+    rt = model.reaction_table
     n, mu = model.n, len(U)
-    child, parent = t.child[U], t.parent[U]
+    child, parent = rt.child[U], rt.parent[U]
     on_p = parent >= 0
     inc_u = np.concatenate((np.arange(mu), np.arange(mu)[on_p]))
     inc_body = np.concatenate((child, parent[on_p]))
@@ -118,10 +118,10 @@ class BlockOperators:
                  parent6: np.ndarray):
         self.plan = plan
         n, k = model.n, plan.k
-        Gb = np.zeros((n * k, 6))
-        Gb[plan.flat_child] = child6
-        Gb[plan.flat_parent] = parent6[plan.parent_u]
-        Gb = Gb.reshape(n, k, 6)
+        G_rows = np.zeros((n * k, 6))  # (body, slot) rows, flat
+        G_rows[plan.flat_child] = child6
+        G_rows[plan.flat_parent] = parent6[plan.parent_u]
+        Gb = G_rows.reshape(n, k, 6)
         d = model.minv6
         if d is not None:
             Hb = Gb * d[:, None, :]

@@ -27,6 +27,8 @@ unknowns is a third int array (`pack_unknowns`).
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 
@@ -49,6 +51,10 @@ SPLIT = 134217729.0  # 2**27 + 1, Dekker's splitting constant
 # ST_SINGULAR: 0, or 1 + 6 body + row of a motion without mass or inertia
 ST_RANK, ST_BERR, ST_BROKEN, ST_MU, ST_PATH, ST_SINGULAR = 0, 1, 2, 3, 4, 5
 INFO = 6
+# info[] slots written by `project`: largest position step, largest velocity change,
+# `_geometric_ratio` at the starting positions, singular-mass code (0 when none)
+PR_STEP, PR_VELOCITY, PR_RATIO, PR_SINGULAR = 0, 1, 2, 3
+PROJECT_INFO = 4
 
 
 def pack_model(model) -> tuple[np.ndarray, np.ndarray]:
@@ -133,6 +139,37 @@ def _rotations(q: np.ndarray) -> np.ndarray:
     return R
 
 
+class PackedModel(NamedTuple):
+    """Views of `pack_model`'s (F, I) by item (numba builds and reads it as a plain tuple,
+    with names): per-item rows at the column offsets above."""
+
+    gravity: np.ndarray  # (3,)
+    bodies: np.ndarray  # (n, BODY_W)
+    B_r: np.ndarray  # (loads, 3) application points, body axes
+    springs: np.ndarray  # (springs, SPRING_W)
+    joints: np.ndarray  # (joints, JOINT_W)
+    loads_i: np.ndarray  # (loads, 3) [body, in_body, couple]
+    springs_i: np.ndarray  # (springs, 2) [a, b]
+    joints_i: np.ndarray  # (joints, 3) [parent, child, flags]
+    comps_i: np.ndarray  # (components, 3) [joint, axis, rot_kind]
+
+
+class Evaluation(NamedTuple):
+    """What `_evaluate` returns: accelerations (n, 6) [a_G world, ω̇ body axes], λ_U (mu,),
+    φ and Gᵀ v (m,), rank of G_U, backward error, not-unique flags (mu,), the solve's path
+    and the singular-mass code (see `_constrained`)."""
+
+    acc: np.ndarray
+    lamU: np.ndarray
+    phi: np.ndarray
+    gtv: np.ndarray
+    rank: int
+    berr: float
+    nonunique: np.ndarray
+    path: int
+    singular: int
+
+
 @njit(cache=True)
 def _unpack(F, I):
     n, k, s, nj, m = I[0], I[1], I[2], I[3], I[4]
@@ -152,7 +189,8 @@ def _unpack(F, I):
     joints_i = I[o:o + 3 * nj].reshape(nj, 3)
     o += 3 * nj
     comps_i = I[o:o + 3 * m].reshape(m, 3)
-    return F[0:3], bodies, B_r, springs, joints, loads_i, springs_i, joints_i, comps_i
+    return PackedModel(F[0:3], bodies, B_r, springs, joints, loads_i, springs_i, joints_i,
+                       comps_i)
 
 
 # -- Q − b ----------------------------------------------------------------------------------
@@ -654,15 +692,15 @@ def _constrained(bodies, joints_i, comps_i, Iu, child6, parent6, r6, gam, stab, 
 def _cho_solve_dense(L, r, x):
     """x (r,) <- (L Lᵀ)⁻¹ x with L the lower triangle of L[:r, :r]."""
     for i in range(r):
-        t = x[i]
+        xi = x[i]
         for k in range(i):
-            t -= L[i, k] * x[k]
-        x[i] = t / L[i, i]
+            xi -= L[i, k] * x[k]
+        x[i] = xi / L[i, i]
     for i in range(r - 1, -1, -1):
-        t = x[i]
+        xi = x[i]
         for k in range(i + 1, r):
-            t -= L[k, i] * x[k]
-        x[i] = t / L[i, i]
+            xi -= L[k, i] * x[k]
+        x[i] = xi / L[i, i]
 
 
 @njit(cache=True)
@@ -760,10 +798,10 @@ def _redundant(bodies, joints_i, comps_i, U, Sb, bw, child6, parent6, r6, acc, l
         for i in range(r):
             X[i, a] = S[r + a, i]
         for i in range(r - 1, -1, -1):
-            t = X[i, a]
+            xia = X[i, a]
             for k in range(i + 1, r):
-                t -= S[k, i] * X[k, a]
-            X[i, a] = t / S[i, i]
+                xia -= S[k, i] * X[k, a]
+            X[i, a] = xia / S[i, i]
     inv_l = _inv_length(U, comps_i, joints_i, child6, parent6)
     res = np.empty((n, 6))
     coef = np.zeros(mu)
@@ -834,10 +872,10 @@ def _dot_add(s, c, a, b):
     bh = f - (f - b)
     bl = b - bh
     ep = al * bl - (((p - ah * bh) - al * bh) - ah * bl)
-    t = s + p
-    z = t - s
-    es = (s - (t - z)) + (p - z)
-    return t, c + ep + es
+    total = s + p
+    z = total - s
+    es = (s - (total - z)) + (p - z)
+    return total, c + ep + es
 
 
 @njit(cache=True)
@@ -907,11 +945,11 @@ def _null_space(bodies, joints_i, comps_i, U, child6, parent6, r6, gam, stab, pl
     Lr = np.zeros((dof, dof))
     for i in range(dof):  # Cholesky, pivots checked against their diagonal entries
         for j in range(i + 1):
-            t = 0.5 * (red[i, j] + red[j, i])
+            sij = 0.5 * (red[i, j] + red[j, i])
             for k in range(j):
-                t -= Lr[i, k] * Lr[j, k]
+                sij -= Lr[i, k] * Lr[j, k]
             if i == j:
-                if not t > SINGULAR_RTOL * red[i, i]:
+                if not sij > SINGULAR_RTOL * red[i, i]:
                     w, V = np.linalg.eigh(0.5 * (red + red.T))
                     motion = U2 @ np.ascontiguousarray(V[:, 0])
                     kmax = 0
@@ -919,9 +957,9 @@ def _null_space(bodies, joints_i, comps_i, U, child6, parent6, r6, gam, stab, pl
                         if abs(motion[r]) > abs(motion[kmax]):
                             kmax = r
                     return rank, 1 + 6 * (kmax // npr) + per[kmax % npr]
-                Lr[i, i] = np.sqrt(t)
+                Lr[i, i] = np.sqrt(sij)
             else:
-                Lr[i, j] = t / Lr[j, j]
+                Lr[i, j] = sij / Lr[j, j]
     rh = np.empty(nr)
     for b in range(n):
         for a in range(npr):
@@ -994,13 +1032,13 @@ def _ns_inner(U1, U2, V1, s1, Mb, Lr, rh, gh, sh, reg, ah, lamh):
     s3 = s1 * s1 * s1
     c = (V1.T @ gh) / s1 + (V1.T @ sh) * s3 / (s3 * s1 + reg ** 4)
     u1c = U1 @ c
-    t = rh.copy()
+    rest = rh.copy()  # r̂ − M̂ U₁ c
     for b in range(n):
         for a in range(npr):
             for e in range(npr):
-                t[b * npr + a] -= Mb[b, a, e] * u1c[b * npr + e]
-    z = U2.T @ t
-    _cho_solve_dense(Lr, dof, z)  # Lr Lrᵀ z = U₂ᵀ t
+                rest[b * npr + a] -= Mb[b, a, e] * u1c[b * npr + e]
+    z = U2.T @ rest
+    _cho_solve_dense(Lr, dof, z)  # Lr Lrᵀ z = U₂ᵀ rest
     ah[:] = u1c + U2 @ z
     t2 = np.empty(ah.shape[0])
     for b in range(n):
@@ -1070,18 +1108,20 @@ def _state(y, n):
 
 @njit(cache=True)
 def _evaluate(F, I, Iu, x, q, v, w, fvec, lam, rate, refine, planar):
-    """The shared body of `solve` and `derivative` (see there)."""
-    gravity, bodies, B_r, springs, joints, loads_i, springs_i, joints_i, comps_i = _unpack(F, I)
+    """The shared body of `solve` and `derivative` (see there) -> `Evaluation`."""
+    pm = _unpack(F, I)
+    bodies, joints_i, comps_i = pm.bodies, pm.joints_i, pm.comps_i
     n, m = x.shape[0], comps_i.shape[0]
     mu = Iu[0]
     U = Iu[3:3 + mu]
     R = _rotations(q)
     r6 = np.empty((n, 6))
-    _net_wrench(gravity, bodies, B_r, springs, loads_i, springs_i, x, R, v, w, fvec, r6)
+    _net_wrench(pm.gravity, bodies, pm.B_r, pm.springs, pm.loads_i, pm.springs_i, x, R, v,
+                w, fvec, r6)
     child6 = np.empty((m, 6))
     parent6 = np.empty((m, 6))
     gamma, phi, gtv = np.empty(m), np.empty(m), np.empty(m)
-    _columns(joints, joints_i, comps_i, x, R, v, w, child6, parent6, gamma, phi, gtv)
+    _columns(pm.joints, joints_i, comps_i, x, R, v, w, child6, parent6, gamma, phi, gtv)
     # known reactions: r6 += G_K λ_K (λ holds 0 on the unknown components)
     for i in range(m):
         if lam[i] != 0.0:
@@ -1104,7 +1144,7 @@ def _evaluate(F, I, Iu, x, q, v, w, fvec, lam, rate, refine, planar):
     rank, berr, path, singular = _constrained(bodies, joints_i, comps_i, Iu, child6, parent6,
                                               r6, gam, stab, planar, refine, acc, lamU,
                                               nonunique)
-    return acc, lamU, phi, gtv, rank, berr, nonunique, path, singular
+    return Evaluation(acc, lamU, phi, gtv, rank, berr, nonunique, path, singular)
 
 
 def solve_layout(n: int, m: int, planar: bool) -> tuple[int, int, int]:
@@ -1129,8 +1169,8 @@ def solve(F, I, Iu, y, fvec, lam, planar, out):
     n = I[0]
     m = I[4]
     x, q, v, w = _state(y, n)
-    acc, lamU, phi, gtv, rank, berr, nonunique, path, singular = _evaluate(
-        F, I, Iu, x, q, v, w, fvec, lam, 0.0, True, planar)
+    ev = _evaluate(F, I, Iu, x, q, v, w, fvec, lam, 0.0, True, planar)
+    acc, lamU, phi, gtv = ev.acc, ev.lamU, ev.phi, ev.gtv
     mu = Iu[0]
     N = (3 if planar else 6) * n
     for i in range(n):
@@ -1145,7 +1185,7 @@ def solve(F, I, Iu, y, fvec, lam, planar, out):
         out[N + 2 * m + i] = 0.0
     for k in range(mu):
         out[N + Iu[3 + k]] = lamU[k]
-        out[N + 2 * m + Iu[3 + k]] = 1.0 if nonunique[k] else 0.0
+        out[N + 2 * m + Iu[3 + k]] = 1.0 if ev.nonunique[k] else 0.0
     # broken-joint check on the enforced (unknown) components (mbody.constraints.joint_errors)
     size = 0.0
     if n > 1:
@@ -1154,8 +1194,8 @@ def solve(F, I, Iu, y, fvec, lam, planar, out):
             for i in range(n):
                 lo, hi = min(lo, x[i, a]), max(hi, x[i, a])
             size = max(size, hi - lo)
-    model = _unpack(F, I)
-    joints, comps_i = model[4], model[8]
+    pm = _unpack(F, I)
+    joints, comps_i = pm.joints, pm.comps_i
     for i in range(m):
         row = joints[comps_i[i, 0]]
         for a in range(3):
@@ -1171,12 +1211,12 @@ def solve(F, I, Iu, y, fvec, lam, planar, out):
         if abs(phi[i]) > JOINT_TOL * size or abs(gtv[i]) > JOINT_TOL * speed:
             broken += 1
     o = N + 3 * m
-    out[o + ST_RANK] = rank
-    out[o + ST_BERR] = berr
+    out[o + ST_RANK] = ev.rank
+    out[o + ST_BERR] = ev.berr
     out[o + ST_BROKEN] = broken
     out[o + ST_MU] = mu
-    out[o + ST_PATH] = path
-    out[o + ST_SINGULAR] = singular
+    out[o + ST_PATH] = ev.path
+    out[o + ST_SINGULAR] = ev.singular
 
 
 @njit(cache=True)
@@ -1188,10 +1228,10 @@ def derivative(F, I, Iu, y, fvec, lam, rate, planar, out):
     allow carries no mass or inertia (then `out` is not written)."""
     n = I[0]
     x, q, v, w = _state(y, n)
-    acc, lamU, phi, gtv, rank, berr, nonunique, path, singular = _evaluate(
-        F, I, Iu, x, q, v, w, fvec, lam, rate, False, planar)
-    if singular:
-        return singular
+    ev = _evaluate(F, I, Iu, x, q, v, w, fvec, lam, rate, False, planar)
+    if ev.singular:
+        return ev.singular
+    acc = ev.acc
     for i in range(n):
         for a in range(3):
             out[3 * i + a] = v[i, a]
@@ -1251,10 +1291,12 @@ def _project_solve(bodies, joints_i, comps_i, Iu, child6, parent6, r6, gam, stab
     singular-mass code."""
     if robust:
         mu = Iu[0]
-        return _null_space(bodies, joints_i, comps_i, Iu[3:3 + mu], child6, parent6, r6,
-                           gam, stab, planar, True, d, lamU, nonunique)[1]
-    return _constrained(bodies, joints_i, comps_i, Iu, child6, parent6, r6, gam, stab,
-                        planar, True, d, lamU, nonunique)[3]
+        _, singular = _null_space(bodies, joints_i, comps_i, Iu[3:3 + mu], child6, parent6,
+                                  r6, gam, stab, planar, True, d, lamU, nonunique)
+        return singular
+    _, _, _, singular = _constrained(bodies, joints_i, comps_i, Iu, child6, parent6, r6, gam,
+                                     stab, planar, True, d, lamU, nonunique)
+    return singular
 
 
 @njit(cache=True)
@@ -1263,16 +1305,18 @@ def project(F, I, Iu, y, planar, iters, robust_below, info):
     joints: positions by Gauss-Newton steps M Δ − G_U μ = 0, G_Uᵀ Δ = −φ_U (the smallest
     move in the kinetic metric; Δ = [Δx world, Δθ body axes], at most `iters` steps, until
     a step changes nothing), then velocities by the mass-orthogonal projection
-    M Δv − G_U μ = 0, G_Uᵀ Δv = −G_Uᵀ v. info (4,) <- [largest position step (m or rad),
-    largest velocity change (m/s or rad/s), `_geometric_ratio` at the starting
-    positions, singular-mass code (0 when none)]. Below a pivot ratio of `robust_below`
-    the solves are the null-space solve (`_project_solve`)."""
-    gravity, bodies, B_r, springs, joints, loads_i, springs_i, joints_i, comps_i = _unpack(F, I)
+    M Δv − G_U μ = 0, G_Uᵀ Δv = −G_Uᵀ v. info (PROJECT_INFO,) <- slots PR_STEP (largest
+    position step, m or rad), PR_VELOCITY (largest velocity change, m/s or rad/s),
+    PR_RATIO (`_geometric_ratio` at the starting positions), PR_SINGULAR (singular-mass
+    code, 0 when none). Below a pivot ratio of `robust_below` the solves are the
+    null-space solve (`_project_solve`)."""
+    pm = _unpack(F, I)
+    bodies, joints, joints_i, comps_i = pm.bodies, pm.joints, pm.joints_i, pm.comps_i
     n, m = I[0], comps_i.shape[0]
     mu, bw, nnz = Iu[0], Iu[1], Iu[2]
     U = Iu[3:3 + mu]
     x, q, v, w = _state(y, n)
-    info[0], info[1], info[2], info[3] = 0.0, 0.0, 1.0, 0.0
+    info[PR_STEP], info[PR_VELOCITY], info[PR_RATIO], info[PR_SINGULAR] = 0.0, 0.0, 1.0, 0.0
     if mu == 0:
         return
     child6, parent6 = np.empty((m, 6)), np.empty((m, 6))
@@ -1289,9 +1333,9 @@ def project(F, I, Iu, y, planar, iters, robust_below, info):
         R = _rotations(q)
         _columns(joints, joints_i, comps_i, x, R, v, w, child6, parent6, gamma, phi, gtv)
         if it == 0:
-            info[2] = _geometric_ratio(bodies, joints_i, comps_i, U, inc_ptr, inc, child6,
-                                       parent6, bw)
-            robust = info[2] < robust_below
+            info[PR_RATIO] = _geometric_ratio(bodies, joints_i, comps_i, U, inc_ptr, inc,
+                                              child6, parent6, bw)
+            robust = info[PR_RATIO] < robust_below
         if it == iters:
             break
         for k in range(mu):
@@ -1299,7 +1343,7 @@ def project(F, I, Iu, y, planar, iters, robust_below, info):
         singular = _project_solve(bodies, joints_i, comps_i, Iu, child6, parent6, r6, gam,
                                   stab, planar, robust, d, lamU, nonunique)
         if singular:
-            info[3] = singular
+            info[PR_SINGULAR] = singular
             return
         step = 0.0
         for i in range(n):
@@ -1307,7 +1351,7 @@ def project(F, I, Iu, y, planar, iters, robust_below, info):
                 step = max(step, abs(d[i, a]))
         if step == 0.0:
             break
-        info[0] = max(info[0], step)
+        info[PR_STEP] = max(info[PR_STEP], step)
         if planar:  # the in-plane rows only (the others are 0 up to rounding)
             for i in range(n):
                 d[i, 2], d[i, 3], d[i, 4] = 0.0, 0.0, 0.0
@@ -1332,13 +1376,13 @@ def project(F, I, Iu, y, planar, iters, robust_below, info):
     singular = _project_solve(bodies, joints_i, comps_i, Iu, child6, parent6, r6, gam, stab,
                               planar, robust, d, lamU, nonunique)
     if singular:
-        info[3] = singular
+        info[PR_SINGULAR] = singular
         return
     for i in range(n):
         for a in range(3):
             v[i, a] += d[i, a]
             w[i, a] += d[i, 3 + a]
-            info[1] = max(info[1], abs(d[i, a]), abs(d[i, 3 + a]))
+            info[PR_VELOCITY] = max(info[PR_VELOCITY], abs(d[i, a]), abs(d[i, 3 + a]))
         if planar:
             v[i, 2] = 0.0
             w[i, 0] = 0.0
@@ -1465,8 +1509,10 @@ def rk_attempt(F, I, Iu, y, f, t, h, base, rows, cols, which, starts, codes, num
 
 RUN_T, RUN_H, RUN_T_OLD, RUN_H_OLD, RUN_STEPS, RUN_NFEV, RUN_STATUS, RUN_RATIO, \
     RUN_REFRESHED = range(9)
-"""Slots of `rk_run`'s `run` array. Status: 0 running (stopped at t_stop, max_steps or
-near a singular position), 1 step too small, 2 singular mass (code in RUN_RATIO)."""
+RUN_SIZE = 9
+"""Slots of `rk_run`'s `run` array (RUN_SIZE of them). Status: 0 running (stopped at
+t_stop, max_steps or near a singular position), 1 step too small, 2 singular mass (code
+in RUN_RATIO)."""
 
 
 @njit(cache=True)
@@ -1484,7 +1530,7 @@ def rk_run(F, I, Iu, base, rows, cols, which, starts, codes, numbers, lam, rate,
     stages = A.shape[0]
     size = y.shape[0]
     y_new = np.empty(size)
-    pinfo = np.empty(4)
+    pinfo = np.empty(PROJECT_INFO)
     loads = np.empty(base.shape)
     exponent = -1.0 / 8.0  # DOP853's error estimator is of order 7
     t, h_abs = run[RUN_T], run[RUN_H]
@@ -1534,12 +1580,12 @@ def rk_run(F, I, Iu, base, rows, cols, which, starts, codes, numbers, lam, rate,
         run[RUN_RATIO] = 1.0
         if project_too:
             project(F, I, Iu, y, planar, 3, robust_below, pinfo)
-            if pinfo[3]:
+            if pinfo[PR_SINGULAR]:
                 run[RUN_T], run[RUN_H] = t, h_abs
-                run[RUN_STATUS], run[RUN_RATIO] = 2.0, pinfo[3]
+                run[RUN_STATUS], run[RUN_RATIO] = 2.0, pinfo[PR_SINGULAR]
                 return
-            run[RUN_RATIO] = pinfo[2]
-            if max(pinfo[0], pinfo[1]) > refresh_tol:
+            run[RUN_RATIO] = pinfo[PR_RATIO]
+            if max(pinfo[PR_STEP], pinfo[PR_VELOCITY]) > refresh_tol:
                 set_loads(base, rows, cols, which, starts, codes, numbers, t, loads)
                 code = derivative(F, I, Iu, y, loads, lam, rate, planar, f)
                 run[RUN_NFEV] += 1.0
@@ -1548,7 +1594,7 @@ def rk_run(F, I, Iu, base, rows, cols, which, starts, codes, numbers, lam, rate,
                     run[RUN_T], run[RUN_H] = t, h_abs
                     run[RUN_STATUS], run[RUN_RATIO] = 2.0, code
                     return
-            if pinfo[2] < robust_below:
+            if pinfo[PR_RATIO] < robust_below:
                 break
         if direction * (t - t_stop) >= 0.0 or t == t_bound:
             break

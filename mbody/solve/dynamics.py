@@ -15,6 +15,7 @@ For integrators, `derivative` returns the time derivative of the packed state
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -27,23 +28,27 @@ from mbody.errors import MbodyError
 from mbody.model.model import Model, State
 from mbody.solve.kkt import singular_mass_error
 
+if TYPE_CHECKING:
+    from mbody.equations.plan import Unknowns
+    from mbody.simulate.projection import JointProjection
+
 
 def _reaction_part(model: Model, state: State, reactions: np.ndarray
                    ) -> tuple[np.ndarray, np.ndarray]:
     """(body (2m,), wrench (2m, 6)): G λ split into the child and parent halves."""
-    t = model.reaction_table
+    rt = model.reaction_table
     lam = np.asarray(reactions, dtype=float).reshape(-1)
-    if len(lam) != len(t.labels):
-        raise MbodyError(f"expected {len(t.labels)} reaction values (one per label of "
+    if len(lam) != len(rt.labels):
+        raise MbodyError(f"expected {len(rt.labels)} reaction values (one per label of "
                          f"model.reactions), got {len(lam)}")
     if not len(lam):
         return np.zeros(0, np.intp), np.zeros((0, 6))
     # Rotation matrices only for the bodies the joints touch (n may be large).
-    involved = np.unique(np.concatenate((t.parent[t.parent >= 0], t.child, [0])))
+    involved = np.unique(np.concatenate((rt.parent[rt.parent >= 0], rt.child, [0])))
     R = np.empty((model.n, 3, 3))
     R[involved] = quat_to_matrix(state.quaternion[involved])
     cols = reaction_columns(model, state, R)
-    body = np.concatenate((t.child, t.parent))
+    body = np.concatenate((rt.child, rt.parent))
     W = np.concatenate((cols.child6 * lam[:, None], cols.parent6 * lam[:, None]))
     return body, W
 
@@ -96,12 +101,12 @@ class StateDerivative:
     are set to exactly 0 (rounding would otherwise creep in).
     """
 
-    def __init__(self, model: Model, dynamics: Dynamics, *, unknowns=None, rate: float = 0.0,
-                 known_at: Callable[[float], np.ndarray] | None = None,
+    def __init__(self, model: Model, dynamics: Dynamics, *, unknowns: Unknowns | None = None,
+                 rate: float = 0.0, known_at: Callable[[float], np.ndarray] | None = None,
                  compiled: bool = False):
         self.model, self.dynamics, self.rate = model, dynamics, rate
         self.unknowns, self.known_at = unknowns, known_at
-        self.projection = None
+        self.projection: JointProjection | None = None
         """A `mbody.projection.JointProjection`, set by `simulate` for mechanisms."""
         self.project_stages = False
         """Evaluate at the projected copy of y (near singular positions, see
@@ -111,14 +116,15 @@ class StateDerivative:
         self.size = 13 * n + (n if self.planar else 0)
         self._kernel = None
         # a simulation makes thousands of evaluations: worth the compiled path at once
-
-        if compiled and model.plan.use_compiled(calls=JIT_AFTER):
+        if compiled and unknowns is not None and model.plan.use_compiled(calls=JIT_AFTER):
             plan = model.plan
             self._kernel = compiled_module().derivative
             self._F, self._I = plan.packed
             self._Iu = plan.packed_unknowns(unknowns)
+            self._lam = unknowns.lam  # the given reaction values, 0 on the unknown ones
             # loads given as expressions of t: evaluated by the compiled path as well
-            self._program = plan.load_program
+            # a plain tuple: CPython passes `*t` of an exact tuple without copying it
+            self._program = tuple(plan.load_program)
             self._varying = model.forces.varying is not None
             self._loads = plan.constant_loads.copy() if self._varying else plan.constant_loads
             self._set_loads = compiled_module().set_loads
@@ -134,14 +140,13 @@ class StateDerivative:
             self.projection(y, t, iterations=2)
         if self._kernel is not None:
             out = np.empty(self.size)
-            lam = self.unknowns.lam if self.known_at is None else self.known_at(t)
+            lam = self._lam if self.known_at is None else self.known_at(t)
             loads = self._loads
             if self._varying:
                 self._set_loads(*self._program, t, loads)
             code = self._kernel(self._F, self._I, self._Iu, y, loads, lam, self.rate,
                                 self.planar, out)
             if code:
-
                 raise singular_mass_error(self.model, (code - 1) // 6, (code - 1) % 6)
             return out
         return self._numpy(t, y)

@@ -17,8 +17,9 @@ reactions are returned and the components that are not unique are named.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, TypeGuard
 
 import numpy as np
 
@@ -32,12 +33,20 @@ from mbody.solve.nullspace import PIVOT_RTOL, NullSpaceSolve, SingularMassError,
 if TYPE_CHECKING:
     import scipy.sparse as sp
 
+    from mbody.solve.blockplan import BlockOperators
+
 # scipy.sparse and scipy.linalg are imported where a large system needs them: a small
 # mechanism is solved with numpy alone, so `mbody solve` starts without them.
 
 
-def _issparse(a) -> bool:
+def _issparse(a: object) -> TypeGuard[sp.spmatrix]:
     return type(a).__module__.startswith("scipy.sparse")
+
+
+Solver = Callable[[np.ndarray], np.ndarray]
+"""r -> S⁻¹ r (or a generalised inverse's product)."""
+SchurMatrix = Any
+"""S as a dense array or a scipy.sparse matrix (scipy has no type information here)."""
 
 SMALL_BODIES = 60
 """Up to this many bodies (and DENSE_LIMIT unknowns) G is held as a dense array."""
@@ -161,11 +170,20 @@ class Factorisation:
     size: int
     redundant: list[int] = field(default_factory=list)
     rank: int = 0
-    _solve: object = None
-    _S: sp.spmatrix | None = None
+    _solve: Solver | None = None  # None: the null-space solve answers (`ConstrainedSystem`)
+    _S: SchurMatrix | Callable[[], SchurMatrix] | None = None  # S, or how to build it
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
+        if self._solve is None:
+            raise TypeError(f"{self.method}: solved by the null-space solve, not by S")
         return self._solve(rhs)
+
+    def matrix(self) -> SchurMatrix:
+        """S itself (built on request when only a function that builds it was kept)."""
+        S = self._S() if callable(self._S) else self._S
+        if S is None:
+            raise ValueError(f"{self.method}: S was not kept")
+        return S
 
     def condition(self) -> float:
         """1-norm condition estimate of S (inf when singular)."""
@@ -173,7 +191,7 @@ class Factorisation:
             return 1.0
         if self.redundant:
             return float("inf")
-        S = self._S() if callable(self._S) else self._S
+        S = self.matrix()
         if not _issparse(S):
             return float(np.linalg.cond(S, 1))
         import scipy.sparse.linalg as spla
@@ -194,7 +212,7 @@ def singular_mass_error(model, body: int, row: int) -> MbodyError:
                       "it mass or inertia there, or a joint that holds it")
 
 
-def _cholesky_solver(L: np.ndarray):
+def _cholesky_solver(L: np.ndarray) -> Solver:
     """r -> S⁻¹ r for S = L Lᵀ (dense, small: two triangular solves with numpy)."""
     def solve(r: np.ndarray) -> np.ndarray:
         return np.linalg.solve(L.T, np.linalg.solve(L, r))
@@ -212,15 +230,17 @@ class ConstrainedSystem:
     def __init__(self, model: Model, cols: ReactionColumns, unknowns: Unknowns):
         self.model = model
         self.cols = cols
-        t = model.reaction_table
+        rt = model.reaction_table
         self.unknown = unknowns.mask
         U = unknowns.U
         self.U = U
         if unknowns.every:  # every component unknown: no copies
-            args = (model, t.parent, t.child, cols.child6, cols.parent6)
+            args = (model, rt.parent, rt.child, cols.child6, cols.parent6)
         else:
-            args = (model, t.parent[U], t.child[U], cols.child6[U], cols.parent6[U])
-        self.blocks = None
+            args = (model, rt.parent[U], rt.child[U], cols.child6[U], cols.parent6[U])
+        self.G: np.ndarray | sp.csc_matrix
+        self.H: np.ndarray | sp.csc_matrix
+        self.blocks: BlockOperators | None = None
         self.robust: NullSpaceSolve | None = None
         self._arms = args[1], args[3], args[4]  # parent, child6, parent6 of U
         if len(U) <= DENSE_LIMIT and model.n <= SMALL_BODIES:
@@ -297,7 +317,8 @@ class ConstrainedSystem:
             try:
                 cb = sla.cholesky_banded(ab, lower=False, check_finite=False)
                 if _trusted(cb[bw] ** 2, ab[bw]):
-                    def solve(r, cb=cb, perm=perm):
+                    def banded_solve(r: np.ndarray, cb: np.ndarray = cb,
+                                     perm: np.ndarray | None = perm) -> np.ndarray:
                         if perm is None:
                             return sla.cho_solve_banded((cb, False), r, check_finite=False)
                         x = np.empty_like(r)
@@ -306,7 +327,7 @@ class ConstrainedSystem:
                         return x
 
                     return Factorisation("banded Cholesky of the Schur complement", mu,
-                                         rank=mu, _solve=solve, _S=S)
+                                         rank=mu, _solve=banded_solve, _S=S)
             except np.linalg.LinAlgError:
                 pass
         if mu <= EIGEN_LIMIT:
@@ -316,11 +337,11 @@ class ConstrainedSystem:
             return Factorisation("sparse LU of the Schur complement", mu, rank=mu,
                                  _solve=lu.solve, _S=S)
         except RuntimeError:  # exactly singular: minimum-norm by LSQR
-            def solve(r, S=S):
+            def lsqr_solve(r: np.ndarray, S: SchurMatrix = S) -> np.ndarray:
                 return spla.lsqr(S, r, atol=1e-15, btol=1e-15, iter_lim=20 * mu)[0]
 
             return Factorisation("LSQR (rank-deficient, redundant constraints)", mu,
-                                 redundant=[-1], _solve=solve, _S=S)
+                                 redundant=[-1], _solve=lsqr_solve, _S=S)
 
     def _dense(self, S) -> Factorisation:
         A = S.toarray() if _issparse(S) else np.asarray(S)
@@ -350,9 +371,8 @@ class ConstrainedSystem:
                              "constraints)", len(w), redundant=not_unique, rank=rank,
                              _solve=lambda r: Vg @ ((Vg.T @ r) / wg), _S=A)
 
-    def _null_space(self, S: np.ndarray) -> Factorisation:
+    def _null_space(self, S: SchurMatrix) -> Factorisation:
         """Hand the system to the robust solve on G_U's geometry (`mbody.nullspace`)."""
-
         model = self.model
         if self.blocks is not None:
             G = self.g_sparse().toarray()

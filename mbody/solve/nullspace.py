@@ -125,7 +125,7 @@ class NullSpaceSolve:
         # G_U's null space in the model's λ (C⁻¹ V₂), orthonormal: the not-unique components
         if r < self.mu:
             q, _ = np.linalg.qr(Vt[r:].T / self.C[:, None])
-            self.null = q
+            self.null: np.ndarray | None = q
             self.redundant = np.flatnonzero(np.linalg.norm(q, axis=1) > 1e-8).tolist()
         else:
             self.null = None
