@@ -193,6 +193,58 @@ def test_max_bytes_argument(tmp_path):
     assert mbody.load(path, max_bytes=4 * 2**20).n == 1
 
 
+def test_max_bytes_on_the_command_line(tmp_path, capsys):
+    from mbody.cli import main
+
+    path = tmp_path / "m.yaml"
+    path.write_text("dimension: 2\n" + BODY + "# padding\n" * 1000)  # about 10 kB
+    assert main(["check", str(path), "--max-bytes", "4k"]) == 2
+    err = capsys.readouterr().err
+    assert "at most 0.00391 MiB is read" in err and "--max-bytes N" in err
+    assert main(["check", str(path), "--max-bytes", "1M"]) == 0
+    assert main(["check", str(path), "--max-bytes", "20000"]) == 0
+    assert loader._LIMIT.get() == loader.MAX_BYTES  # set around the command only
+
+
+@pytest.mark.parametrize("text, size", [("100", 100), ("4k", 4096), ("200M", 200 * 2**20),
+                                        ("1.5G", 3 * 2**29), ("2MiB", 2**21)])
+def test_max_bytes_sizes(text, size):
+    from mbody.cli.common import byte_size
+
+    assert byte_size(text) == size
+
+
+@pytest.mark.parametrize("text", ["", "x", "-1", "0", "1T", "1e9"])
+def test_max_bytes_bad_sizes(text, capsys):
+    from mbody.cli import main
+
+    with pytest.raises(SystemExit) as exit_:  # argparse's own exit, one paragraph
+        main(["check", "m.yaml", "--max-bytes", text])
+    assert exit_.value.code == 2
+    assert "--max-bytes: expected a size" in capsys.readouterr().err
+
+
+def test_every_command_that_reads_a_model_takes_max_bytes():
+    from mbody.cli.app import build_parser
+
+    sub = next(a for a in build_parser()._actions if a.dest == "command")
+    readers = [name for name, p in sub.choices.items()
+               if any(a.dest in ("model", "source") for a in p._get_positional_actions())]
+    assert {"check", "assemble", "solve", "simulate", "export", "animate"} <= set(readers)
+    for name in readers:
+        assert "--max-bytes" in sub.choices[name].format_help(), name
+
+
+def test_max_bytes_limit_is_scoped(tmp_path):
+    path = tmp_path / "m.yaml"
+    path.write_text("dimension: 2\n" + BODY + "# padding\n" * 1000)
+    with loader.max_bytes_limit(1000), pytest.raises(ModelError, match="at most"):
+        mbody.load(path)
+    assert mbody.load(path).n == 1
+    with loader.max_bytes_limit(1000):
+        assert mbody.load(path, max_bytes=10**6).n == 1  # the call's own limit wins
+
+
 @pytest.mark.parametrize("nest", ["[" * 100_000 + "]" * 100_000,
                                   "\n  " + "- " * 100_000 + "x",
                                   "{a: " * 5000 + "1" + "}" * 5000])
@@ -393,7 +445,8 @@ def test_endless_pipe_is_read_only_up_to_the_limit(tmp_path):
             mbody.load(fifo, max_bytes=2**20)
         assert time.perf_counter() - t0 < 5.0
         assert str(err.value) == (f"{fifo}: the file is larger than 1048576 bytes, the most "
-                                  "that is read (mbody.load(path, max_bytes=N) reads more)")
+                                  "that is read (--max-bytes N on the command line, or "
+                                      "mbody.load(path, max_bytes=N), reads more)")
     finally:
         writer.kill()
         writer.wait()

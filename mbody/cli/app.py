@@ -16,8 +16,9 @@ import traceback
 from collections.abc import Sequence
 
 from mbody import __version__
-from mbody.cli.common import EXIT_INPUT, EXIT_INTERNAL, EXIT_OK, EXIT_UNMET
+from mbody.cli.common import EXIT_INPUT, EXIT_INTERNAL, EXIT_OK, EXIT_UNMET, byte_size
 from mbody.errors import MbodyError, ModelError, UnknownReactionsError, did_you_mean
+from mbody.model.loader import MAX_BYTES, max_bytes_limit
 
 COMMAND_MODULES = ("core", "export", "sim", "draw", "animate", "mechanism")
 """Modules of `mbody.cli`; each has `register(subparsers)` adding its commands."""
@@ -32,6 +33,12 @@ def build_parser() -> argparse.ArgumentParser:
     sub.required = True
     for name in COMMAND_MODULES:
         importlib.import_module(f"mbody.cli.{name}").register(sub)
+    for command in sub.choices.values():  # every command that reads a model file
+        if any(a.dest in ("model", "source") for a in command._get_positional_actions()):
+            command.add_argument(
+                "--max-bytes", type=byte_size, metavar="SIZE",
+                help=f"largest model file read, in bytes or with a unit (200M, 1G); "
+                f"default {MAX_BYTES // 2**20}M, a guard against reading a wrong file whole")
     return p
 
 
@@ -59,7 +66,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     out = _Stdout(sys.stdout)
     sys.stdout = out
     try:
-        code = args.run(args)
+        with max_bytes_limit(getattr(args, "max_bytes", None)):
+            code = args.run(args)
         out.flush()  # a full device is reported here, not at exit
         return code
     except ModelError as exc:

@@ -17,7 +17,8 @@ EXIT_OK, EXIT_UNMET, EXIT_INPUT, EXIT_INTERNAL = 0, 1, 2, 70
 
 def load_model(path: str, *, warn: bool = True):
     """The validated model at `path`; its warnings (e.g. a quaternion that was normalised)
-    go to stderr, so that a questionable input never passes unseen."""
+    go to stderr, so that a questionable input never passes unseen. The file size limit
+    is the command's ``--max-bytes`` (set around the command by `mbody.cli.app.main`)."""
     import sys
 
     from mbody.model.model import load
@@ -27,6 +28,24 @@ def load_model(path: str, *, warn: bool = True):
         for w in model.warnings:
             sys.stderr.write(f"mbody: warning: {w}\n")
     return model
+
+
+_UNITS = {"": 1, "k": 2**10, "m": 2**20, "g": 2**30}
+
+
+def byte_size(text: str) -> int:
+    """``--max-bytes`` values: bytes, or with a binary unit (``200M``, ``1.5G``, ``64k``)."""
+    import argparse
+    import re
+
+    m = re.fullmatch(r"\s*([0-9]+(?:\.[0-9]*)?)\s*([kKmMgG]?)(?:i?B)?\s*", text)
+    if not m:
+        raise argparse.ArgumentTypeError(f"expected a size in bytes such as 100000000 or "
+                                         f"200M, got {text!r}")
+    size = int(float(m.group(1)) * _UNITS[m.group(2).lower()])
+    if size < 1:
+        raise argparse.ArgumentTypeError(f"expected a size of at least 1 byte, got {text!r}")
+    return size
 
 
 def regular_file(path: str, what: str) -> None:

@@ -28,6 +28,9 @@ import re
 import select
 import stat
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -46,13 +49,36 @@ from yaml.events import (
 
 from mbody.errors import Issue, ModelError
 
-try:  # libyaml keeps line marks and is many times faster than the pure-Python parser
-    _Loader = yaml.CSafeLoader
-except AttributeError:  # pragma: no cover - PyYAML built without libyaml
-    _Loader = yaml.SafeLoader
+# libyaml keeps line marks and is many times faster than the pure-Python parser
+_Loader: type[yaml.SafeLoader] | type[yaml.CSafeLoader] = getattr(
+    yaml, "CSafeLoader", yaml.SafeLoader)
 
 MAX_BYTES = 32 * 1024 * 1024
-"""Largest model file read, in bytes (a 10 000-body model is about 2 MB)."""
+"""Largest model file read by default, in bytes (a 10 000-body model written by
+``yaml.dump`` is about 8 MB). A size limit keeps a mistaken path (a log, a disk image)
+from being read whole; ``mbody.load(path, max_bytes=N)`` or ``--max-bytes N`` on the
+command line reads larger models."""
+_LIMIT: ContextVar[int] = ContextVar("mbody_max_bytes", default=MAX_BYTES)
+
+
+@contextmanager
+def max_bytes_limit(max_bytes: int | None) -> Iterator[None]:
+    """Within the block, files are read up to `max_bytes` unless a call says otherwise.
+
+    The command line's ``--max-bytes`` sets it around a command, so that every model
+    the command reads (also through a run file) gets the same limit.
+
+    Parameters
+    ----------
+    max_bytes : int or None
+        The limit, in bytes; None keeps the current one.
+    """
+    token = _LIMIT.set(max_bytes) if max_bytes is not None else None
+    try:
+        yield
+    finally:
+        if token is not None:
+            _LIMIT.reset(token)
 MAX_ALIAS_NODES = 100_000
 """Most nodes that alias expansion may add before the file is refused."""
 MAX_DEPTH = 64
@@ -327,13 +353,36 @@ FIFO_WAIT = 1.0
 """Seconds a named pipe with no writer is given for one to appear before it is refused."""
 
 
-def load_file(path: str | os.PathLike[str], max_bytes: int = MAX_BYTES) -> Document:
+def load_file(path: str | os.PathLike[str], max_bytes: int | None = None) -> Document:
     """Read and parse a model file, refusing files over `max_bytes` before reading them.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The model file (or a pipe, see `read_file`).
+    max_bytes : int, optional
+        The largest file read (default `MAX_BYTES`, or `max_bytes_limit`'s); a larger
+        one is refused before it is read.
+
+    Returns
+    -------
+    Document
+        The file's values with their line marks.
+    """
+    return load_text(read_file(path, max_bytes), str(path))
+
+
+def read_file(path: str | os.PathLike[str], max_bytes: int | None = None) -> str:
+    """The text of a model file, refusing files over `max_bytes` before reading them.
+
+    `max_bytes` defaults to `MAX_BYTES`, or the limit set by `max_bytes_limit`.
 
     A regular file or a pipe (``/dev/stdin`` fed by ``<`` or ``|``, ``<(command)``, a named
     pipe with a writer) is read; anything else (a directory, a terminal, a device, a
     socket) is refused without reading, so that nothing can block forever.
     """
+    if max_bytes is None:
+        max_bytes = _LIMIT.get()
     p = Path(path)
     name = str(path)
 
@@ -352,7 +401,7 @@ def load_file(path: str | os.PathLike[str], max_bytes: int = MAX_BYTES) -> Docum
     if kind:
         raise refuse(f"this is {kind}, not a file; expected a YAML model file (to read a "
                      "model from a pipe: mbody check /dev/stdin < model.yaml)")
-    more = "mbody.load(path, max_bytes=N) reads more"
+    more = "--max-bytes N on the command line, or mbody.load(path, max_bytes=N), reads more"
     if st.st_size > max_bytes:
         raise refuse(f"the file is {st.st_size / 2**20:.1f} MiB; at most "
                      f"{max_bytes / 2**20:.3g} MiB is read ({more})")
@@ -390,7 +439,7 @@ def load_file(path: str | os.PathLike[str], max_bytes: int = MAX_BYTES) -> Docum
         raise ModelError([Issue(name, line, col, "", f"not UTF-8 text: byte "
                                 f"0x{raw[exc.start]:02x} ({exc.reason}); save the file "
                                 "as UTF-8")]) from None
-    return load_text(text, name)
+    return text
 
 
 def _file_kind(mode: int) -> str:

@@ -20,8 +20,9 @@ from mbody.equations.plan import ModelPlan
 from mbody.equations.spatial import joint_frame_planar, joint_frame_spatial, quat_to_matrix
 from mbody.errors import Issue
 from mbody.model.expressions import Expression, ExpressionTable
+from mbody.model.fast import fast_spec
 from mbody.model.graph import body_graph
-from mbody.model.loader import Document, load_file, load_text
+from mbody.model.loader import Document, load_text, read_file
 from mbody.model.validate import Spec, validate
 
 
@@ -391,39 +392,60 @@ class Model:
 
 
 def load(source: str | os.PathLike[str] | dict, *, max_bytes: int | None = None) -> Model:
-    """Read, validate and build a model; raises `mbody.ModelError` listing every problem.
+    """Read, validate and build a model.
 
-    `source` is a path to a YAML file, or a dict with the same content (for scripts).
+    Parameters
+    ----------
+    source : str, os.PathLike or dict
+        A path to a YAML model file, or a dict with the same content (for scripts).
+    max_bytes : int, optional
+        The largest file read (default `mbody.model.loader.MAX_BYTES`, 32 MiB, or the
+        command line's ``--max-bytes``); a larger file is refused before it is read.
+        Raise it for very large models (a 100 000-body file is about 80 MB).
+
+    Returns
+    -------
+    Model
+
+    Raises
+    ------
+    mbody.ModelError
+        Listing every problem, each with its file, line and column.
     """
     if isinstance(source, dict):
-        doc = Document(source, "<dict>")
-    else:
-        doc = load_file(source, **({"max_bytes": max_bytes} if max_bytes else {}))
-    return Model.from_spec(validate(doc))
+        return Model.from_spec(validate(Document(source, "<dict>")))
+    text = read_file(source, max_bytes)
+    return loads(text, str(source))
 
 
 def loads(text: str, file: str = "<string>") -> Model:
-    """Like `load`, from YAML text."""
-    return Model.from_spec(validate(load_text(text, file)))
+    """Like `load`, from YAML text.
+
+    A large, regular file (block YAML as ``yaml.dump`` writes it) is read and checked in
+    bulk (`mbody.model.fast`); anything that path does not handle, and every file with a
+    problem, goes through the located path, which reports each problem where it is.
+    """
+    spec = fast_spec(text, file)
+    if spec is None:
+        spec = validate(load_text(text, file))
+    return Model.from_spec(spec)
 
 
 def _build(spec: Spec) -> Model:
-    bs = spec.bodies
-    n = len(bs)
-    names = tuple(b.name for b in bs)
+    t = spec.table()
+    n = len(t.names)
+    names = t.names
     idx = {nm: i for i, nm in enumerate(names)}
-    mass = np.array([b.mass for b in bs], dtype=float)
-    J = np.array([b.inertia for b in bs], dtype=float).reshape(n, 3, 3)
+    mass = _ro(t.mass)
+    J = _ro(t.inertia.reshape(n, 3, 3))
     J_inv = np.linalg.inv(J)
-    initial = State(
-        _ro(np.array([b.position for b in bs]).reshape(n, 3)),
-        _ro(np.array([b.quaternion for b in bs]).reshape(n, 4)),
-        _ro(np.array([b.velocity for b in bs]).reshape(n, 3)),
-        _ro(np.array([b.omega for b in bs]).reshape(n, 3)),
-    )
-    bodies = {b.name: Body(b.name, i, b.mass, _ro(J[i]), b.shape, b.color, b.particle)
-              for i, b in enumerate(bs)}
-    particle = {b.name for b in bs if b.particle}
+    initial = State(_ro(t.position.reshape(n, 3)), _ro(t.quaternion.reshape(n, 4)),
+                    _ro(t.velocity.reshape(n, 3)), _ro(t.omega.reshape(n, 3)))
+    # Views of the read-only J: one array, not n small copies.
+    bodies = {nm: Body(nm, i, m, J[i], shape, color, p) for i, (nm, m, shape, color, p)
+              in enumerate(zip(names, mass.tolist(), t.shape, t.color,
+                               t.particle.tolist(), strict=True))}
+    particle = {names[i] for i in np.flatnonzero(t.particle)}
 
     loads = tuple(Load(ld.name, ld.type, ld.bodies, ld.vector, ld.frame, ld.at,
                        ld.stiffness, ld.rest_length, ld.damping, dict(ld.expressions))
@@ -518,7 +540,7 @@ def _build(spec: Spec) -> Model:
         np.array(rows["particle_parent"], dtype=bool),
         _ro(np.array(rows["length"], dtype=float)),
     )
-    return Model(spec.name, spec.file, spec.dimension, names, _ro(mass), _ro(J), _ro(J_inv),
+    return Model(spec.name, spec.file, spec.dimension, names, mass, J, _ro(J_inv),
                  _ro(spec.gravity), initial, bodies, loads, tuple(joints), forces, springs,
                  table, dict(spec.reactions), spec.description, tuple(spec.warnings),
                  dict(spec.reaction_expressions))

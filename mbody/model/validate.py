@@ -127,6 +127,51 @@ class JointSpec:
 
 
 @dataclass
+class BodyTable:
+    """Every body as arrays with a leading body axis (what `Model` is built from).
+
+    mass: (n,) kg; inertia: (n, 3, 3) body axes about the mass centre; position: (n, 3)
+    world; quaternion: (n, 4) w first, body to world; velocity: (n, 3) world; omega:
+    (n, 3) body axes; particle: (n,) point masses; shape, color: per body, or None.
+    """
+
+    names: tuple[str, ...]
+    mass: np.ndarray
+    inertia: np.ndarray
+    position: np.ndarray
+    quaternion: np.ndarray
+    velocity: np.ndarray
+    omega: np.ndarray
+    particle: np.ndarray
+    shape: list[dict[str, Any] | None]
+    color: list[str | None]
+
+    @classmethod
+    def from_specs(cls, bodies: list[BodySpec]) -> BodyTable:
+        """The table of a list of per-body records (the located path's output)."""
+        n = len(bodies)
+
+        def stack(key: str, *shape: int) -> np.ndarray:
+            return np.array([getattr(b, key) for b in bodies], dtype=float).reshape(n, *shape)
+
+        return cls(tuple(b.name for b in bodies), stack("mass"), stack("inertia", 3, 3),
+                   stack("position", 3), stack("quaternion", 4), stack("velocity", 3),
+                   stack("omega", 3), np.array([b.particle for b in bodies], dtype=bool),
+                   [b.shape for b in bodies], [b.color for b in bodies])
+
+
+def quat_norm(q: np.ndarray) -> np.ndarray:
+    """‖q‖ over the last axis, summed in the order w, x, y, z.
+
+    Written out, not ``np.linalg.norm``, so that one quaternion and a stack of them give
+    the same bits: the located path checks one body at a time, the fast path
+    (`mbody.model.fast`) all at once, and both must build the same `Model`.
+    """
+    return np.sqrt(((q[..., 0] * q[..., 0] + q[..., 1] * q[..., 1]) + q[..., 2] * q[..., 2])
+                   + q[..., 3] * q[..., 3])
+
+
+@dataclass
 class Spec:
     name: str
     file: str
@@ -140,9 +185,16 @@ class Spec:
     warnings: list[Issue] = field(default_factory=list)
     reaction_expressions: dict[str, Expression] = field(default_factory=dict)
     """Known reaction values given as expressions of t (their t = 0 value is in reactions)."""
+    body_table: BodyTable | None = None
+    """The bodies as arrays; the fast path gives only this (and `bodies` empty)."""
+
+    def table(self) -> BodyTable:
+        """The bodies as arrays, from `body_table` or else from `bodies`."""
+        return self.body_table if self.body_table is not None else BodyTable.from_specs(
+            self.bodies)
 
 
-class _Checker:
+class Checker:
     def __init__(self, doc: Document):
         self.doc = doc
         self.issues: list[Issue] = []
@@ -240,18 +292,20 @@ class _Checker:
                          f"like '30 {unit}', got '{_show(value)}'", _angle_hint(value, unit))
                 return None
             try:
-                x = float(m.group(1))
+                written = float(m.group(1))
             except ValueError:
                 self.err(path, f"'{_show(value)}' is not a number followed by a unit")
                 return None
-            x = self.number(path, Unrepresentable(m.group(1)) if math.isinf(x) else x)
-            if x is None:
+            y = self.number(path, Unrepresentable(m.group(1)) if math.isinf(written)
+                            else written)
+            if y is None:
                 return None
-            x = math.radians(x) if m.group(2).startswith("deg") else x
+            x = math.radians(y) if m.group(2).startswith("deg") else y
         else:
-            x = self.number(path, value)
-            if x is None:
+            z = self.number(path, value)
+            if z is None:
                 return None
+            x = z
         if not rate and abs(x) > MAX_ANGLE:
             self.err(path, f"expected an angle of at most {MAX_ANGLE:g} rad in magnitude, got "
                      f"{x:g} rad", "a double cannot resolve the pose of a larger angle; "
@@ -327,10 +381,6 @@ class _Checker:
         return None
 
 
-def _missing(*values: Any) -> bool:
-    return any(v is None for v in values)
-
-
 def _kind(value: Any) -> str:
     if value is None:
         return "nothing (null)"
@@ -392,9 +442,39 @@ def _show(value: Any, limit: int = 60) -> str:
 
 
 def validate(doc: Document) -> Spec:
-    """Check `doc` against the contract; return the normalised `Spec` or raise ModelError."""
-    c = _Checker(doc)
+    """Check a loaded document against the contract.
+
+    Parameters
+    ----------
+    doc : Document
+        The file's values with their line marks (`mbody.model.loader.load_text`).
+
+    Returns
+    -------
+    Spec
+        The content normalised: defaults filled in, angles in radians, vectors 3-D.
+
+    Raises
+    ------
+    ModelError
+        Listing every problem found, each with its file, line and column.
+    """
+    c = Checker(doc)
+    name, description, gravity = header(c)
     data = doc.data
+    bodies = _bodies(c, data.get("bodies"))
+    loads, joints, reactions, reaction_expressions = rest(c, bodies, None)
+    return Spec(str(name), doc.file, c.dim, gravity, bodies, loads, joints, reactions,
+                description, c.warnings, reaction_expressions)
+
+
+def header(c: Checker) -> tuple[str, str, np.ndarray]:
+    """Check the top level, set ``c.dim``; return the name, description and gravity.
+
+    Raises `ModelError` at once when the document is not a mapping or the dimension is
+    not 2 or 3 (every vector length depends on it: checking on would only add noise).
+    """
+    data = c.doc.data
     if not c.mapping((), data, TOP_KEYS, ("dimension", "bodies"), what="a model mapping"):
         raise ModelError(c.issues)
 
@@ -407,7 +487,7 @@ def validate(doc: Document) -> Spec:
     c.dim = int(dim)
     name = data.get("model", None)
     if name is None:
-        name = doc.file.rsplit("/", 1)[-1].removesuffix(".yaml").removesuffix(".yml")
+        name = c.doc.file.rsplit("/", 1)[-1].removesuffix(".yaml").removesuffix(".yml")
     elif not isinstance(name, str):
         c.err(("model",), f"expected the model's name as text, got {_kind(name)}")
     description = data.get("description", "")
@@ -419,22 +499,27 @@ def validate(doc: Document) -> Spec:
     if data.get("gravity") is not None:
         g = c.vec3(("gravity",), data["gravity"])
         gravity = g if g is not None else gravity
+    return str(name), description, gravity
 
-    bodies = _bodies(c, data.get("bodies"))
+
+def rest(c: Checker, bodies: list[BodySpec], loads: list[LoadSpec] | None
+         ) -> tuple[list[LoadSpec], list[JointSpec], dict[str, float], dict[str, Expression]]:
+    """Check loads (unless given), joints and reactions, after the bodies (whose names are
+    in ``c.body_names``); raise `ModelError` if anything was found, in file order."""
+    data = c.doc.data
     # A body with a bad mass is still a body: references to it are not problems too.
     names = c.body_names
-    loads = _loads(c, data.get("loads"), names)
+    if loads is None:
+        loads = _loads(c, data.get("loads"), names)
     joints = _joints(c, data.get("joints"), names, bodies)
     reaction_expressions: dict[str, Expression] = {}
     reactions = _reactions(c, data.get("reactions"), joints, reaction_expressions)
-
     if c.issues:  # in file order, as an editor goes through them
         raise ModelError(sorted(c.issues, key=lambda i: i.line))
-    return Spec(str(name), doc.file, c.dim, gravity, bodies, loads, joints, reactions,
-                description, c.warnings, reaction_expressions)
+    return loads, joints, reactions, reaction_expressions
 
 
-def _list(c: _Checker, path: Path_, value: Any, what: str, required: bool) -> list:
+def _list(c: Checker, path: Path_, value: Any, what: str, required: bool) -> list:
     if value is None:
         if required and path[-1] in c.doc.data:  # absent: already reported as missing
             c.err(path, f"expected a list of {what}, got nothing")
@@ -447,7 +532,7 @@ def _list(c: _Checker, path: Path_, value: Any, what: str, required: bool) -> li
     return value
 
 
-def _bodies(c: _Checker, value: Any) -> list[BodySpec]:
+def _bodies(c: Checker, value: Any) -> list[BodySpec]:
     out: list[BodySpec] = []
     seen: dict[str, int] = c.body_names
     for i, b in enumerate(_list(c, ("bodies",), value, "bodies", True)):
@@ -515,7 +600,7 @@ def _bodies(c: _Checker, value: Any) -> list[BodySpec]:
         if color is not None and not isinstance(color, str):
             c.err((*p, "color"), f"expected a colour name or '#rrggbb', got {_kind(color)}")
             color = None
-        if _missing(name, mass, inertia, pos, vel):
+        if name is None or mass is None or inertia is None or pos is None or vel is None:
             continue
         out.append(BodySpec(name, mass, inertia, pos, q, vel, omega, shape, color,
                             c.doc.where(p)[0], particle))
@@ -524,7 +609,7 @@ def _bodies(c: _Checker, value: Any) -> list[BodySpec]:
     return out
 
 
-def _particle_pose(c: _Checker, p: Path_, b: dict, q: np.ndarray, omega: np.ndarray) -> None:
+def _particle_pose(c: Checker, p: Path_, b: dict, q: np.ndarray, omega: np.ndarray) -> None:
     """A particle (inertia 0) has no orientation and no angular velocity."""
     hint = "a particle (inertia: 0) has no orientation; remove the key, or give the body an inertia"
     if np.any(q[1:] != 0.0):
@@ -548,7 +633,7 @@ def _zero_inertia(value: Any) -> bool:
     return False
 
 
-def _inertia(c: _Checker, path: Path_, value: Any) -> np.ndarray | None:
+def _inertia(c: Checker, path: Path_, value: Any) -> np.ndarray | None:
     if c.dim == cv.PLANAR:
         I = c.number(path, value, positive=True) if not isinstance(value, list) else None
         if isinstance(value, list):
@@ -588,7 +673,7 @@ def _inertia(c: _Checker, path: Path_, value: Any) -> np.ndarray | None:
     return J
 
 
-def _reciprocable(c: _Checker, path: Path_, J: np.ndarray) -> np.ndarray | None:
+def _reciprocable(c: Checker, path: Path_, J: np.ndarray) -> np.ndarray | None:
     """`J` unless a principal moment is nonzero but below `MIN_MAGNITUDE` (5e-324, or a
     tiny mass times a tiny shape): its inverse, used in every solve, would overflow."""
     moments = [J[2, 2]] if c.dim == cv.PLANAR else np.linalg.eigvalsh(J)
@@ -605,7 +690,7 @@ def _fmt(v: np.ndarray) -> str:
     return "(" + ", ".join(f"{x:g}" for x in v) + ")"
 
 
-def _orientation(c: _Checker, path: Path_, value: Any) -> np.ndarray | None:
+def _orientation(c: Checker, path: Path_, value: Any) -> np.ndarray | None:
     if not c.mapping(path, value, ORIENTATION_KEYS, what="an orientation mapping"):
         return None
     given = [k for k in ("quaternion", "euler", "matrix") if k in value]
@@ -621,7 +706,7 @@ def _orientation(c: _Checker, path: Path_, value: Any) -> np.ndarray | None:
         q = c.vector((*path, "quaternion"), value["quaternion"], 4)
         if q is None:
             return None
-        n = float(np.linalg.norm(q))
+        n = float(quat_norm(q))
         if n < 1e-12:
             c.err((*path, "quaternion"), "the quaternion is zero", "identity is [1, 0, 0, 0]")
             return None
@@ -652,7 +737,7 @@ def _orientation(c: _Checker, path: Path_, value: Any) -> np.ndarray | None:
     return matrix_to_quat(R)
 
 
-def _shape(c: _Checker, path: Path_, value: Any) -> dict[str, Any] | None:
+def _shape(c: Checker, path: Path_, value: Any) -> dict[str, Any] | None:
     allowed = SHAPES[c.dim]
     if not c.mapping(path, value, allowed, what="a shape mapping such as {box: [a, b, c]}"):
         return None
@@ -684,7 +769,7 @@ def _shape(c: _Checker, path: Path_, value: Any) -> dict[str, Any] | None:
     return {kind: out}
 
 
-def _loads(c: _Checker, value: Any, names: dict[str, int]) -> list[LoadSpec]:
+def _loads(c: Checker, value: Any, names: dict[str, int]) -> list[LoadSpec]:
     out: list[LoadSpec] = []
     seen: dict[str, int] = {}
     counters: dict[str, int] = {}
@@ -724,7 +809,7 @@ def _loads(c: _Checker, value: Any, names: dict[str, int]) -> list[LoadSpec]:
             frame = c.choice((*p, "frame"), frame, FRAMES, "frame")
             exprs: dict[int, Expression] = {}
             if typ == "force":
-                vec = (_varying(c, (*p, "force"), ld["force"], exprs, _Checker.vec3)
+                vec = (_varying(c, (*p, "force"), ld["force"], exprs, Checker.vec3)
                        if "force" in ld else None)
                 at = c.vec3((*p, "at"), ld["at"]) if "at" in ld else np.zeros(3)
             else:
@@ -745,7 +830,7 @@ def _loads(c: _Checker, value: Any, names: dict[str, int]) -> list[LoadSpec]:
                     c.err((*p, "frame"), f"the particle '{body}' has no body axes",
                           "give the force in world axes (frame: world)")
                     continue
-            if _missing(name, body, frame, vec, at):
+            if name is None or body is None or frame is None or vec is None or at is None:
                 continue
             out.append(LoadSpec(name, typ, (body,), vec, frame, (at,), line=line,
                                 expressions=exprs))
@@ -776,19 +861,21 @@ def _loads(c: _Checker, value: Any, names: dict[str, int]) -> list[LoadSpec]:
                               f"'{refs[k]}' at the particle", "give [0, 0] (body axes): a "
                               "particle has no extent")
                         pts[k] = None
-            k = c.number((*p, "stiffness"), ld["stiffness"], nonneg=True) \
+            stiffness = c.number((*p, "stiffness"), ld["stiffness"], nonneg=True) \
                 if "stiffness" in ld else None
             L0 = c.number((*p, "rest_length"), ld.get("rest_length", 0.0), nonneg=True)
             damping = c.number((*p, "damping"), ld.get("damping", 0.0), nonneg=True)
-            if (len(refs) != 2 or len(pts) != 2
-                    or _missing(name, *refs, *pts, k, L0, damping)):
+            ends = [r for r in refs if r is not None]
+            points = [q for q in pts if q is not None]
+            if (len(ends) != 2 or len(points) != 2 or name is None or stiffness is None
+                    or L0 is None or damping is None):
                 continue
-            out.append(LoadSpec(name, "spring", tuple(refs), None, "world", tuple(pts),
-                                k, L0, damping, line))
+            out.append(LoadSpec(name, "spring", tuple(ends), None, "world", tuple(points),
+                                stiffness, L0, damping, line))
     return out
 
 
-def expression(c: _Checker, path: Path_, text: str) -> Expression | None:
+def expression(c: Checker, path: Path_, text: str) -> Expression | None:
     """Compile a load expression of t; on error an issue naming the character."""
     try:
         e = compile_expression(text)
@@ -812,7 +899,7 @@ def expression(c: _Checker, path: Path_, text: str) -> Expression | None:
     return e
 
 
-def _varying(c: _Checker, path: Path_, value: Any, exprs: dict[int, Expression],
+def _varying(c: Checker, path: Path_, value: Any, exprs: dict[int, Expression],
              read) -> np.ndarray | None:
     """A load vector (or planar scalar torque) whose components may be expressions of t.
 
@@ -843,7 +930,7 @@ def _varying(c: _Checker, path: Path_, value: Any, exprs: dict[int, Expression],
     return vec
 
 
-def _torque(c: _Checker, path: Path_, value: Any) -> np.ndarray | None:
+def _torque(c: Checker, path: Path_, value: Any) -> np.ndarray | None:
     if c.dim == cv.PLANAR:
         if isinstance(value, list):
             c.err(path, "a planar torque is a scalar (N m about z)", f"got {_kind(value)}")
@@ -853,7 +940,7 @@ def _torque(c: _Checker, path: Path_, value: Any) -> np.ndarray | None:
     return c.vector(path, value, 3)
 
 
-def _joints(c: _Checker, value: Any, names: dict[str, int],
+def _joints(c: Checker, value: Any, names: dict[str, int],
             bodies: list[BodySpec]) -> list[JointSpec]:
     out: list[JointSpec] = []
     seen: dict[str, int] = {}
@@ -909,13 +996,14 @@ def _joints(c: _Checker, value: Any, names: dict[str, int],
             c.err((*p, "axis2"), "a universal joint's axes must be perpendicular",
                   f"axis . axis2 = {float(axis @ axis2):.3g}")
             continue
-        if _missing(name, typ, parent, child, at):
+        if name is None or typ is None or parent is None or child is None or at is None:
             continue
         kind = ""
         if parent in c.particles or child in c.particles:
-            kind = _particle_joint(c, p, typ, parent, child, at, bodies)
-            if kind is None:
+            found = _particle_joint(c, p, typ, parent, child, at, bodies)
+            if found is None:
                 continue
+            kind = found
             c.particle_joints.setdefault(name, kind)
         out.append(JointSpec(name, typ, parent, child, at, axis, axis2, c.doc.where(p)[0],
                              kind))
@@ -929,7 +1017,7 @@ PARTICLE_RTOL = 1e-9
 the particle (a pin); farther, the joint is a rigid link of that length to it."""
 
 
-def _particle_joint(c: _Checker, p: Path_, typ: str, parent: str, child: str,
+def _particle_joint(c: Checker, p: Path_, typ: str, parent: str, child: str,
                     at: np.ndarray, bodies: list[BodySpec]) -> str | None:
     """"pin" or "link" for a joint with a particle at an end (docs: Particles), or None
     after reporting why such a joint is not allowed."""
@@ -956,7 +1044,7 @@ def _particle_joint(c: _Checker, p: Path_, typ: str, parent: str, child: str,
     return "link"
 
 
-def _axis(c: _Checker, path: Path_, value: Any) -> np.ndarray | None:
+def _axis(c: Checker, path: Path_, value: Any) -> np.ndarray | None:
     a = c.vec3(path, value)
     if a is None:
         return None
@@ -967,7 +1055,7 @@ def _axis(c: _Checker, path: Path_, value: Any) -> np.ndarray | None:
     return a / n
 
 
-def _reactions(c: _Checker, value: Any, joints: list[JointSpec],
+def _reactions(c: Checker, value: Any, joints: list[JointSpec],
                expressions: dict[str, Expression]) -> dict[str, float]:
     if value is None:
         return {}
