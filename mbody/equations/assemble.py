@@ -115,30 +115,48 @@ INCONSISTENT = 1e-8
 class Solution:
     """Accelerations (aligned with `coordinates`) and the reaction values used.
 
-    Spatial rows: a_G in world axes (m/s^2), then ω̇ in body axes (rad/s^2);
-    planar rows: a_x, a_y (m/s^2), α (rad/s^2).
+    What `Assembly.solve` returns; ``solution["rod.w1"]`` reads one acceleration by its
+    coordinate label.
+
+    Parameters
+    ----------
+    coordinates : list of str
+        The row labels, body by body (``Assembly.coordinates``).
+    accelerations : (N,) array
+        v̇ in the order of `coordinates`. Spatial rows: a_G in world axes (m/s^2), then
+        ω̇ in body axes (rad/s^2); planar rows: a_x, a_y (m/s^2), α (rad/s^2).
+    reactions : mapping of str to float
+        label -> value of every reaction component, given or solved (N; N m).
+    solved : tuple of str
+        Reaction components solved for (the rest were given).
+    not_unique : tuple of str
+        Solved components that redundant constraints leave undetermined (minimum norm).
+    residual : float or None
+        Relative backward error of the constrained solve (None when nothing was solved).
+    condition : float or None
+        1-norm condition estimate of the Schur complement Gᵀ M⁻¹ G (when asked for).
+    method : str
+        How the system was solved (``"block-diagonal M"`` when no reaction was unknown).
+    broken_joints : tuple of str
+        Enforced constraints that the state breaks (φ ≠ 0 or Gᵀ v ≠ 0), as text.
+    redundant : int
+        Number of redundant constraints (unknown components minus the rank of G_U).
     """
 
     coordinates: list[str]
     accelerations: np.ndarray
     reactions: Mapping[str, float]
-    """label -> value of every reaction component, given or solved (N; N m)."""
     solved: tuple[str, ...] = ()
-    """Reaction components solved for (the rest were given)."""
     not_unique: tuple[str, ...] = ()
-    """Solved components that redundant constraints leave undetermined (minimum norm)."""
     residual: float | None = None
-    """Relative backward error of the constrained solve (None when nothing was solved)."""
     condition: float | None = None
-    """1-norm condition estimate of the Schur complement Gᵀ M⁻¹ G (when asked for)."""
     method: str = "block-diagonal M"
     broken_joints: tuple[str, ...] = ()
-    """Enforced constraints that the state breaks (φ ≠ 0 or Gᵀ v ≠ 0), as text."""
     redundant: int = 0
-    """Number of redundant constraints (unknown components minus the rank of G_U)."""
 
     @property
     def warnings(self) -> list[str]:
+        """What looks wrong with this solve, as sentences (empty when nothing does)."""
         out = []
         if self.not_unique:
             out.append(f"{self.redundant} redundant constraint(s): the reactions "
@@ -155,6 +173,13 @@ class Solution:
         return out
 
     def as_dict(self) -> dict[str, float]:
+        """The accelerations by coordinate label.
+
+        Returns
+        -------
+        dict of str to float
+            ``{coordinate: acceleration}`` in stacking order (m/s^2 or rad/s^2).
+        """
         return dict(zip(self.coordinates, self.accelerations.tolist(), strict=True))
 
     def __getitem__(self, label: str) -> float:
@@ -172,7 +197,15 @@ class Assembly:
     applied generalised forces; G: (N, m) sparse reaction coupling. N = 3 n (planar) or
     6 n (spatial); m = number of reaction unknowns. `coordinates` labels the rows,
     `reactions` the columns of G. `bodies[name]` gives one body's free-body data and
-    its Newton-Euler pair.
+    its Newton-Euler pair. Made by `assemble`; nothing is computed until asked for.
+
+    Parameters
+    ----------
+    model : Model
+        The model whose equations these are.
+    state : State
+        The state they are written at: positions, orientations, velocities and the time
+        (load values and known reactions that vary in time are taken at ``state.t``).
     """
 
     def __init__(self, model: Model, state: State):
@@ -220,10 +253,12 @@ class Assembly:
     # -- the stacked system ------------------------------------------------------------
     @property
     def coordinates(self) -> list[str]:
+        """Row labels of M, b, Q and G, body by body (``rod.x``, ``rod.w1``...)."""
         return self.model.coordinates
 
     @property
     def reactions(self) -> list[str]:
+        """Column labels of G: every reaction component (``A.Fx``...), known or not."""
         return self.model.reactions
 
     @property
@@ -233,28 +268,40 @@ class Assembly:
 
     @cached_property
     def M(self) -> sp.spmatrix:
+        """(N, N) block-diagonal mass matrix, sparse: m I (kg), then J (body axes, kg m^2)."""
         return mass_matrix(self.model)
 
     @cached_property
     def b(self) -> np.ndarray:
+        """(N,) gyroscopic vector: 0 on Newton rows, ω × J ω on Euler rows (N m)."""
         return _select(self.model, self._b6)
 
     @cached_property
     def Q(self) -> np.ndarray:
+        """(N,) applied generalised forces: net force (world axes, N), moment about G (body
+        axes, N m)."""
         return _select(self.model, self._Q6)
 
     @cached_property
     def columns(self) -> ReactionColumns:
+        """Each reaction component's direction, point and per-body wrench at this state."""
         return reaction_columns(self.model, self.state)
 
     @cached_property
     def G(self) -> sp.csc_matrix:
+        """(N, m) sparse reaction coupling: column c is the wrench of reaction c per unit."""
         G = g_matrix(self.model, self.columns)
         return G[self.model.rows] if self.model.has_particles else G
 
     def jacobian(self) -> ConstraintJacobian:
-        """The constraint Jacobian Gᵀ (m x N) with labelled rows and columns, plus γ and φ."""
+        """The constraint Jacobian Gᵀ (m x N) with labelled rows and columns, plus γ and φ.
 
+        Returns
+        -------
+        ConstraintJacobian
+            Gᵀ (sparse CSR) with rows labelled by `reactions` and columns by `coordinates`;
+            γ, the acceleration-level right-hand side, and φ, the position-level errors.
+        """
         return ConstraintJacobian(self.G.T.tocsr(), list(self.reactions),
                                   list(self.coordinates),
                                   gamma(self.model, self.state, self.columns),
@@ -262,18 +309,35 @@ class Assembly:
 
     @property
     def shape(self) -> dict[str, tuple[int, ...]]:
+        """The shapes of M, b, Q and G by name, without building them."""
         N, m = len(self.coordinates), len(self.reactions)
         return {"M": (N, N), "b": (N,), "Q": (N,), "G": (N, m)}
 
     # -- per body ----------------------------------------------------------------------
     @cached_property
     def bodies(self) -> Mapping[str, BodyEquations]:
-
+        """name -> `BodyEquations` (free body and Newton-Euler pair), built on first access."""
         return _LazyBodies(self, body_equations)
 
     # -- solving -----------------------------------------------------------------------
     def reaction_values(self, known: Mapping[str, float] | None = None) -> dict[str, float]:
-        """The file's known reaction values updated with `known`; labels are checked."""
+        """The file's known reaction values updated with `known`; labels are checked.
+
+        Parameters
+        ----------
+        known : mapping of str to float, optional
+            Reaction values (N; N m) by label, overriding or adding to the file's.
+
+        Returns
+        -------
+        dict of str to float
+            label -> value of every known reaction component, at ``state.t``.
+
+        Raises
+        ------
+        MbodyError
+            A label of `known` is not a reaction component of the model.
+        """
         values = self.model.known_reactions_at(self.state.t)
         labels = self.model.reaction_index
         for label, v in (known or {}).items():
@@ -290,9 +354,22 @@ class Assembly:
 
         With every reaction known (or none): v̇ = M⁻¹ (Q + G λ − b). Otherwise the
         Newton-Euler pairs and the joint constraints are solved together,
-        ``M v̇ − G_U λ_U = Q − b + G_K λ_K``, ``G_Uᵀ v̇ = γ_U`` (see `mbody.kkt`); the
-        joints of known components are not enforced. `condition=True` also estimates the
-        condition number of the Schur complement.
+        ``M v̇ − G_U λ_U = Q − b + G_K λ_K``, ``G_Uᵀ v̇ = γ_U`` (see `mbody.solve.kkt`);
+        the joints of known components are not enforced.
+
+        Parameters
+        ----------
+        known : mapping of str to float, optional
+            Reaction values (N; N m) by label, added to the file's; the rest are solved.
+        condition : bool
+            Also estimate the 1-norm condition number of the Schur complement Gᵀ M⁻¹ G
+            (`Solution.condition`; takes the numpy path).
+
+        Returns
+        -------
+        Solution
+            The accelerations in the order of `coordinates`, every reaction value, and
+            what the solve found (redundant or broken constraints, backward error).
         """
         model = self.model
         plan = model.plan
@@ -315,7 +392,7 @@ class Assembly:
                         dict(zip(self.reactions, lam.tolist(), strict=True)))
 
     def _solve_compiled(self, unknowns: Unknowns) -> Solution:
-        """The compiled path (`mbody.compiled`), the same solve as `_solve_constrained`."""
+        """The compiled path (`mbody.solve.compiled`), the same solve as `_solve_constrained`."""
         model, plan, state = self.model, self.model.plan, self.state
         C = compiled()
         F, I = plan.packed
@@ -350,11 +427,25 @@ class Assembly:
                         mu - rank)
 
     def constrained(self, unknowns: Unknowns, *, rate: float = 0.0, refine: bool = True):
-        """The numpy path's constrained solve: (v̇ (n, 6), λ (m,), the `ConstrainedSystem`,
-        backward error or None). `rate` > 0 adds Baumgarte's terms to γ
-        (γ − 2 α Gᵀ v − α² φ, `mbody.mechanism`); `refine` makes one round of iterative
-        refinement when the backward error asks for it."""
+        """The numpy path's constrained solve.
 
+        Parameters
+        ----------
+        unknowns : Unknowns
+            Which reaction components are solved for, and the values λ of the others.
+        rate : float
+            Baumgarte's α (1/s): > 0 adds his terms to γ (γ − 2 α Gᵀ v − α² φ,
+            `mbody.simulate.mechanism`); 0 leaves γ as it is.
+        refine : bool
+            Make one round of iterative refinement when the backward error asks for it.
+
+        Returns
+        -------
+        tuple
+            (v̇ (n, 6) rows [a_G (world axes, m/s^2), ω̇ (body axes, rad/s^2)], λ (m,) every
+            reaction value (N; N m), the `ConstrainedSystem`, the backward error or None
+            when `refine` is False).
+        """
         model, state, cols = self.model, self.state, self.columns
         lam = unknowns.lam.copy()
         r6 = self._Q6 - self._b6 + reaction_wrench(model, cols, lam)
@@ -428,6 +519,19 @@ def assemble(model: Model, state: State | None = None) -> Assembly:
     """The stacked Newton-Euler equations of `model` at `state` (default: its initial state).
 
     Nothing is computed until asked for: `solve()`, `Q`, `b`, `G`, `M`, `bodies`.
+
+    Parameters
+    ----------
+    model : Model
+        The model, from `load` or `loads`.
+    state : State, optional
+        Positions, orientations, velocities and time to write the equations at (default
+        ``model.initial``, the file's initial state).
+
+    Returns
+    -------
+    Assembly
+        The equations ``M v̇ + b = Q + G λ`` at that state.
     """
     return Assembly(model, model.initial if state is None else state)
 

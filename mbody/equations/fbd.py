@@ -3,7 +3,8 @@
 A `FreeBodyDiagram` lists every force and couple on one body: applied loads, gravity
 and the reaction components of its joints, each with its point of application and its
 moment about the mass centre. `BodyEquations` pairs it with the body's rows of
-``M v̇ + b = Q + G λ`` written out as `Equation`s. Drawing lives in `draw.py`.
+``M v̇ + b = Q + G λ`` written out as `Equation`s. Drawing lives in
+`mbody.present.draw`.
 """
 
 from __future__ import annotations
@@ -26,13 +27,27 @@ if TYPE_CHECKING:
 class ForceOnBody:
     """One force or couple on a body.
 
-    kind: 'applied', 'gravity' or 'reaction'. couple: True for a pure moment.
-    B_r: (3,) point of application from the mass centre, body axes (m).
-    W_point: (3,) the same point, world coordinates (m).
-    W_vector: (3,) the force (N) or couple (N m), world axes; for an unknown reaction,
-    its value per unit of the unknown (the component's direction).
-    B_moment: (3,) moment about the mass centre, body axes (N m); per unit for unknowns.
-    label: the reaction unknown (``A.Fx``); value: its value when known, else None.
+    Parameters
+    ----------
+    name : str
+        The load's name in the model file, ``gravity``, or the reaction's label.
+    kind : str
+        ``'applied'``, ``'gravity'`` or ``'reaction'``.
+    couple : bool
+        True for a pure moment.
+    B_r : (3,) array
+        Point of application from the mass centre, body axes (m).
+    W_point : (3,) array
+        The same point, world coordinates (m).
+    W_vector : (3,) array
+        The force (N) or couple (N m), world axes; for an unknown reaction, its value per
+        unit of the unknown (the component's direction).
+    B_moment : (3,) array
+        Moment about the mass centre, body axes (N m); per unit for unknowns.
+    label : str
+        The reaction unknown (``A.Fx``); empty for applied loads and gravity.
+    value : float or None
+        The reaction's value when known (N; N m), else None.
     """
 
     name: str
@@ -47,6 +62,7 @@ class ForceOnBody:
 
     @property
     def unknown(self) -> bool:
+        """Whether this is a reaction whose value is not known (solved for, or drawn as λ)."""
         return self.kind == REACTION and self.value is None
 
     @property
@@ -57,7 +73,29 @@ class ForceOnBody:
 
 @dataclass(frozen=True)
 class FreeBodyDiagram:
-    """Everything acting on one body. `forces` in order: applied, gravity, reactions."""
+    """Everything acting on one body. `forces` in order: applied, gravity, reactions.
+
+    Parameters
+    ----------
+    body : str
+        The body's name.
+    dimension : int
+        2 (planar) or 3 (spatial).
+    mass : float
+        The body's mass (kg).
+    inertia : (3, 3) array
+        Inertia tensor about the mass centre, body axes (kg m^2); zero for a particle.
+    W_position : (3,) array
+        The mass centre, world coordinates (m).
+    W_R_B : (3, 3) array
+        The body's orientation: body axes -> world axes.
+    shape : dict or None
+        The body's ``shape`` as in the model file (None when not given).
+    forces : tuple of ForceOnBody
+        Every force and couple on the body: applied, gravity, reactions.
+    equations : tuple of Equation
+        The body's Newton-Euler rows, shown under drawings (empty until assembled).
+    """
 
     body: str
     dimension: int
@@ -71,14 +109,28 @@ class FreeBodyDiagram:
 
     @property
     def applied(self) -> list[ForceOnBody]:
+        """The applied loads and gravity on the body (every force but the reactions)."""
         return [f for f in self.forces if f.kind != REACTION]
 
     @property
     def reactions(self) -> list[ForceOnBody]:
+        """The reaction components of the body's joints, known or not."""
         return [f for f in self.forces if f.kind == REACTION]
 
     def draw(self, **kwargs):
-        """A matplotlib figure of this diagram (see `mbody.draw.draw_fbd`)."""
+        """A matplotlib figure of this diagram (see `mbody.present.draw.draw_fbd`).
+
+        Parameters
+        ----------
+        **kwargs
+            Passed to `mbody.present.draw.draw_fbd`: ``view``, ``equations``, ``width``,
+            ``title``.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+            The drawing (Agg canvas).
+        """
         from mbody.present.draw import draw_fbd
 
         return draw_fbd(self, **kwargs)
@@ -93,8 +145,22 @@ class FreeBodyDiagram:
 class Equation:
     """One row of ``M v̇ + b = Q + G λ``: Σ lhs[k]·k + gyro = rhs + Σ coeff·reaction.
 
-    lhs: acceleration name -> coefficient (a row of M); gyro: this row of b; rhs: this
-    row of Q; reactions: label -> coefficient (this row of G); known: label -> value.
+    ``str(equation)`` writes it out in numbers, known reactions with their values.
+
+    Parameters
+    ----------
+    row : str
+        The row's coordinate label (``rod.x``, ``rod.w1``...).
+    lhs : dict of str to float
+        Acceleration name -> coefficient (a row of M: kg, or kg m^2 on Euler rows).
+    gyro : float
+        This row of b (N m; 0 on Newton rows).
+    rhs : float
+        This row of Q (N on Newton rows, N m on Euler rows).
+    reactions : dict of str to float
+        Reaction label -> coefficient (this row of G).
+    known : dict of str to float
+        Reaction label -> value, for the reactions of this row that are known.
     """
 
     row: str
@@ -122,7 +188,20 @@ class Equation:
 
 @dataclass(frozen=True)
 class BodyEquations:
-    """One body's free-body diagram and its Newton-Euler pair (rows in stacking order)."""
+    """One body's free-body diagram and its Newton-Euler pair (rows in stacking order).
+
+    Parameters
+    ----------
+    body : str
+        The body's name.
+    fbd : FreeBodyDiagram
+        Every force and couple on the body.
+    newton : tuple of Equation
+        Newton's rows, m a_G = ΣF, in world axes.
+    euler : tuple of Equation
+        Euler's rows about the mass centre, in body axes (planar: one, about z); none for
+        a particle.
+    """
 
     body: str
     fbd: FreeBodyDiagram
@@ -131,6 +210,7 @@ class BodyEquations:
 
     @property
     def equations(self) -> tuple[Equation, ...]:
+        """Newton's rows then Euler's, in stacking order."""
         return self.newton + self.euler
 
 

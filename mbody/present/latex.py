@@ -87,6 +87,19 @@ def equation_latex(eq: Equation, per_line: int = TERMS_PER_LINE) -> str:
 
     A right-hand side with many reaction terms continues on further aligned lines,
     `per_line` terms each, so that a body with many joints stays readable.
+
+    Parameters
+    ----------
+    eq : Equation
+        One row of a body's Newton-Euler pair (``asm.bodies[name].equations[k]``).
+    per_line : int
+        Right-hand-side terms per line before the equation continues below.
+
+    Returns
+    -------
+    str
+        One or more lines of an ``aligned`` environment (math mode), joined by ``\\\\``;
+        the last has no line end.
     """
     left = ""
     for name, coef in eq.lhs.items():
@@ -107,6 +120,16 @@ def body_latex(eq: BodyEquations) -> str:
 
     Planar: m a_x, m a_y (world axes), then I_G α. Spatial: Newton in world axes, then
     Euler's equations J ω̇ + ω × (J ω) about the mass centre in body axes.
+
+    Parameters
+    ----------
+    eq : BodyEquations
+        One body's equations, ``asm.bodies[name]``.
+
+    Returns
+    -------
+    str
+        ``\\begin{aligned} ... \\end{aligned}``, to put inside display math.
     """
     rows = [r"&\text{Newton (world axes):} \\"]
     rows += [rf"{equation_latex(e)} \\" for e in eq.newton]
@@ -156,6 +179,18 @@ def stacked_latex(asm: Assembly, max_full: int = MAX_FULL) -> str:
     When M has at most `max_full` rows and G at most `max_full` columns, every matrix is
     written out; otherwise M is shown as its first diagonal blocks and G as the pattern
     of non-zero (body, joint) blocks, since a page cannot hold the numbers.
+
+    Parameters
+    ----------
+    asm : Assembly
+        The equations at one state (`assemble`).
+    max_full : int
+        Largest number of rows of M and columns of G written out in full.
+
+    Returns
+    -------
+    str
+        LaTeX for display math (no ``\\[ \\]`` around it).
     """
     N, m = len(asm.coordinates), len(asm.reactions)
     if max(N, m) <= max_full:
@@ -212,8 +247,28 @@ def _block_form(asm: Assembly, max_full: int) -> str:
 def document(asm: Assembly, title: str | None = None, bodies: Iterable[str] | None = None,
              max_full: int = MAX_FULL, max_bodies: int = MAX_BODIES) -> str:
     """A complete LaTeX document: conventions, each body's free body and Newton-Euler
-    pair, then the stacked system. `bodies` chooses the per-body sections (default: the
-    first `max_bodies` bodies in stacking order)."""
+    pair, then the stacked system.
+
+    Parameters
+    ----------
+    asm : Assembly
+        The equations at one state (`assemble`).
+    title : str, optional
+        The document's title (default "Newton-Euler equations of" the model's name).
+    bodies : iterable of str, optional
+        The bodies that get a section, by name (default: the first `max_bodies` bodies in
+        stacking order).
+    max_full : int
+        Largest number of rows of M and columns of G written out in full (see
+        `stacked_latex`).
+    max_bodies : int
+        Most body sections when `bodies` is not given (a longer document is not read).
+
+    Returns
+    -------
+    str
+        The source of an article (amsmath, graphicx) that pdflatex compiles.
+    """
     model = asm.model
     names = list(model.body_names[:max_bodies] if bodies is None else bodies)
     title = title or f"Newton-Euler equations of {model.name}"

@@ -153,16 +153,53 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
              max_wall: float | None = None) -> Trajectory:
     """Integrate the motion from `initial` (default the model's state) to `t_end` seconds.
 
-    Samples at t = k / fps for k = 0 .. ⌊t_end · fps⌋. `rtol`, `atol`: the integrator's
-    relative and absolute error tolerances per step (per state component); `method`: one
-    of `METHODS` (DOP853: explicit Runge-Kutta of order 8 with a 7th-order interpolant).
-    `known`: reaction values (numbers or expressions of t) added to the file's.
-    `dynamics`: replaces the default accelerations (see `Dynamics`).
-    `max_steps`, `max_wall`: budgets of integrator steps and of wall-clock seconds (None:
-    no limit); a run that hits one stops with an `MbodyError` saying where and why.
-    Returns a `Trajectory` whose `info` holds the run facts and drift figures, and under
-    ``info["warnings"]`` what looked wrong (a cost that exploded, a spin the frame rate
-    aliases).
+    Samples at t = k / fps for k = 0 .. ⌊t_end · fps⌋. Reactions not given in the file
+    or in `known` are solved for at every step, the joints held by projection (explicit
+    methods) or Baumgarte's terms (implicit ones).
+
+    Parameters
+    ----------
+    model : Model
+        The model, from `load` or `loads`.
+    t_end : float
+        End of the run (s), > 0.
+    fps : float
+        Samples per second of simulated time (1/s), > 0.
+    rtol, atol : float
+        The integrator's relative and absolute error tolerances per step (per state
+        component); 0 < rtol < 1, atol > 0.
+    method : str
+        One of `METHODS` (DOP853: explicit Runge-Kutta of order 8 with a 7th-order
+        interpolant; Radau, BDF and LSODA for stiff problems).
+    known : mapping of str to float or str, optional
+        Reaction values by label (N; N m), numbers or expressions of t (text, see
+        docs/expressions.md), added to the file's.
+    progress : bool
+        Show a progress bar over simulated time on stderr (tqdm).
+    dynamics : Dynamics, optional
+        Replaces the default accelerations: f(model, state) -> (n, 6) rows [a_G (world,
+        m/s²), ω̇ (body axes, rad/s²)] (see `mbody.solve.dynamics.Dynamics`).
+    max_step : float
+        Longest integrator step (s); unbounded by default.
+    initial : State, optional
+        The state to start from (default ``model.initial``); the run starts at t = 0.
+    max_steps : int or None
+        Budget of integrator steps (None: no limit).
+    max_wall : float or None
+        Budget of wall-clock seconds (None: no limit). A run that hits either budget
+        stops with an `MbodyError` saying where and why.
+
+    Returns
+    -------
+    Trajectory
+        The sampled motion, whose `info` holds the run facts and drift figures, and under
+        ``info["warnings"]`` what looked wrong (a cost that exploded, a spin the frame
+        rate aliases).
+
+    Raises
+    ------
+    MbodyError
+        An argument out of range, an unknown method or reaction label, or a budget hit.
     """
     t_end, fps = float(t_end), float(fps)
     if not (math.isfinite(t_end) and t_end > 0):

@@ -49,6 +49,55 @@ _SERIES = "series/"
 
 @dataclass(frozen=True, eq=False)
 class Trajectory:
+    """The motion of every body over time, as `simulate` returns it.
+
+    Arrays have a leading time axis of K samples and a body axis of n bodies (file order);
+    d = 2 for a planar model, 3 for a spatial one. ``len(trajectory)`` is K.
+
+    Parameters
+    ----------
+    t : (K,) array
+        Sample times (s).
+    position : (K, n, d) array
+        Mass centres, world frame (m).
+    velocity : (K, n, d) array
+        Mass-centre velocities, world frame (m/s).
+    orientation : (K, n, 4) or (K, n) array
+        Spatial: unit quaternions W_R_B, w first; planar: angles about z (rad), unwrapped.
+    angular_velocity : (K, n, 3) or (K, n) array
+        Spatial: body axes (rad/s); planar: about z (rad/s).
+    body_names : tuple of str
+        The bodies' names, in file order.
+    dimension : int
+        2 (planar) or 3 (spatial).
+    model_name : str
+        The model's name.
+    model_file : str
+        The model file's path as given (empty when the model did not come from a file).
+    reaction_labels : tuple of str
+        Labels of the reaction series in `reactions`.
+    reactions : (K, m) array
+        Reaction values by `reaction_labels` (N; N m); empty when none are tracked.
+    info : dict
+        Run facts: integrator, tolerances, energy/momentum/constraint drift, and under
+        ``"warnings"`` what looked wrong.
+    mass : (n,) array or None
+        Masses (kg).
+    inertia : (n, 3, 3) array or None
+        Inertia tensors, body axes, about the mass centres (kg m^2).
+    shapes : tuple of dict or None
+        Each body's `shape` as in the model file (None when not given).
+    colors : tuple of str or None
+        Each body's colour as in the model file (None when not given).
+    gravity : (3,) array
+        Gravity, world axes (m/s^2).
+    model_yaml : str
+        The model file's text (empty when the model did not come from a file).
+    series : dict of str to array
+        Per-sample quantities computed during the run, e.g. ``'energy'`` (K,),
+        ``'potential'`` (K,).
+    """
+
     t: np.ndarray
     position: np.ndarray
     velocity: np.ndarray
@@ -61,30 +110,36 @@ class Trajectory:
     reaction_labels: tuple[str, ...] = ()
     reactions: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
     info: dict = field(default_factory=dict)
-    """Run facts: integrator, tolerances, energy/momentum/constraint drift."""
     mass: np.ndarray | None = None
-    """(n,) kg."""
     inertia: np.ndarray | None = None
-    """(n, 3, 3) inertia tensors, body axes, about the mass centres, kg m^2."""
     shapes: tuple[dict | None, ...] = ()
-    """Each body's `shape` as in the model file (None when not given)."""
     colors: tuple[str | None, ...] = ()
     gravity: np.ndarray = field(default_factory=lambda: np.zeros(3))
-    """(3,) world, m/s^2."""
     model_yaml: str = ""
-    """The model file's text (empty when the model did not come from a file)."""
     series: dict[str, np.ndarray] = field(default_factory=dict)
-    """Per-sample quantities computed during the run, e.g. 'energy' (K,), 'potential' (K,)."""
 
     @property
     def n(self) -> int:
+        """The number of bodies."""
         return len(self.body_names)
 
     def __len__(self) -> int:
         return len(self.t)
 
     def state(self, k: int) -> State:
-        """The `State` (internal spatial form) at sample k."""
+        """The `State` (internal spatial form) at sample k.
+
+        Parameters
+        ----------
+        k : int
+            The sample's index (0 .. K - 1; negative counts from the end).
+
+        Returns
+        -------
+        State
+            Positions, orientations and velocities at ``t[k]``, spatial arrays (planar
+            ones in the x-y plane, turning about z).
+        """
         if self.dimension == cv.PLANAR:
             return State.planar(self.position[k], self.orientation[k], self.velocity[k],
                                 self.angular_velocity[k], float(self.t[k]))
@@ -95,7 +150,31 @@ class Trajectory:
     def from_states(cls, t: np.ndarray, pos3: np.ndarray, quat: np.ndarray, vel3: np.ndarray,
                     omega3: np.ndarray, *, body_names: tuple[str, ...], dimension: int,
                     **kw) -> Trajectory:
-        """Build from internal spatial arrays (K, n, 3|4); planar ones are reduced."""
+        """Build from internal spatial arrays (K, n, 3|4); planar ones are reduced.
+
+        Parameters
+        ----------
+        t : (K,) array
+            Sample times (s).
+        pos3 : (K, n, 3) array
+            Mass centres, world frame (m).
+        quat : (K, n, 4) array
+            Unit quaternions W_R_B, w first.
+        vel3 : (K, n, 3) array
+            Mass-centre velocities, world frame (m/s).
+        omega3 : (K, n, 3) array
+            Angular velocities, body axes (rad/s).
+        body_names : tuple of str
+            The bodies' names, in file order.
+        dimension : int
+            2 (planar: x, y, the angle about z unwrapped over time, ω_z are kept) or 3.
+        **kw
+            The other fields of `Trajectory` (``reactions``, ``info``, ``mass``...).
+
+        Returns
+        -------
+        Trajectory
+        """
         if dimension == cv.PLANAR:
             ang = 2.0 * np.arctan2(quat[..., 3], quat[..., 0])
             return cls(t, pos3[..., :2], vel3[..., :2], np.unwrap(ang, axis=0),
@@ -104,7 +183,15 @@ class Trajectory:
 
     # -- internal spatial form ---------------------------------------------------------
     def spatial(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """(position (K,n,3), quaternion (K,n,4), velocity (K,n,3), ω body (K,n,3))."""
+        """The motion as spatial arrays, whatever the model's dimension.
+
+        Returns
+        -------
+        tuple of 4 arrays
+            (position (K, n, 3) world (m), quaternion W_R_B (K, n, 4) w first, velocity
+            (K, n, 3) world (m/s), ω (K, n, 3) body axes (rad/s)); planar motion padded
+            with z = 0 and turning about z.
+        """
         if self.dimension == cv.SPATIAL:
             return self.position, self.orientation, self.velocity, self.angular_velocity
         K, n = self.orientation.shape
@@ -129,7 +216,23 @@ class Trajectory:
                 ".state(k), .kinetic_energy(), .save(path)>")
 
     def kinetic_energy(self, per_body: bool = False) -> np.ndarray:
-        """T = ½ m vᵀv + ½ ωᵀ J ω: (K,) total, or (K, n) with `per_body`."""
+        """T = ½ m vᵀv + ½ ωᵀ J ω.
+
+        Parameters
+        ----------
+        per_body : bool
+            Return each body's energy rather than the total.
+
+        Returns
+        -------
+        (K,) or (K, n) array
+            The kinetic energy at every sample (J): total, or per body with `per_body`.
+
+        Raises
+        ------
+        TrajectoryFileError
+            The trajectory carries no masses and inertias.
+        """
         m, J = self._need_inertia()
         _, _, v, w = self.spatial()
         T = 0.5 * m * np.einsum("kni,kni->kn", v, v) \
@@ -137,21 +240,42 @@ class Trajectory:
         return T if per_body else T.sum(axis=1)
 
     def spin_angular_momentum(self) -> np.ndarray:
-        """Σ W_R_B J ω: (K, 3) world axes, the bodies' momenta about their mass centres."""
+        """Σ W_R_B J ω: the bodies' angular momenta about their own mass centres.
+
+        Returns
+        -------
+        (K, 3) array
+            The sum over bodies at every sample, world axes (kg m^2/s).
+        """
         m, J = self._need_inertia()
         _, q, _, w = self.spatial()
         return matvec(quat_to_matrix(q), matvec(J, w)).sum(axis=1)
 
     def angular_momentum(self) -> np.ndarray:
-        """H = Σ (x × m v + W_R_B J ω): (K, 3) world axes, about the world origin."""
+        """H = Σ (x × m v + W_R_B J ω): angular momentum about the world origin.
+
+        Returns
+        -------
+        (K, 3) array
+            H at every sample, world axes (kg m^2/s).
+        """
         m, _ = self._need_inertia()
         x, _, v, _ = self.spatial()
         orbital = np.cross(x, m[:, None] * v).sum(axis=1)
         return orbital + self.spin_angular_momentum()
 
     def model(self):
-        """Rebuild the `Model` from the YAML text stored with the run."""
+        """Rebuild the `Model` from the YAML text stored with the run.
 
+        Returns
+        -------
+        Model
+
+        Raises
+        ------
+        TrajectoryFileError
+            The trajectory carries no YAML text (the model did not come from a file).
+        """
         if not self.model_yaml:
             raise TrajectoryFileError("this trajectory does not carry its model's YAML text "
                                       "(the model did not come from a file)")
@@ -159,8 +283,18 @@ class Trajectory:
 
     # -- files -------------------------------------------------------------------------
     def save(self, path: str | os.PathLike[str]) -> Path:
-        """Write one .npz file atomically (temp file + rename); returns the path."""
+        """Write one .npz file atomically (temp file + rename).
 
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The file to write (replaced if it exists).
+
+        Returns
+        -------
+        pathlib.Path
+            `path`.
+        """
         data: dict[str, Any] = {
             "format": np.array(FORMAT), "version": np.array(FORMAT_VERSION),
             "dimension": np.array(self.dimension),
@@ -184,7 +318,24 @@ class Trajectory:
 
     @classmethod
     def load(cls, path: str | os.PathLike[str]) -> Trajectory:
-        """Read a file written by `save`; `TrajectoryFileError` names what is wrong."""
+        """Read a file written by `save`.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            A trajectory ``.npz`` file (format ``mbody-trajectory``, version at most
+            `FORMAT_VERSION`).
+
+        Returns
+        -------
+        Trajectory
+
+        Raises
+        ------
+        TrajectoryFileError
+            Names what is wrong: no such file, another format, a newer version, missing
+            entries, shapes that disagree, a damaged archive.
+        """
         name = str(path)
         p = Path(path)
         if not p.exists():

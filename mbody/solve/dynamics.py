@@ -5,7 +5,7 @@
 with M and J⁻¹ kept (constant in body axes) and no stacked matrices formed. Rows of the
 result are per body ``[a_G (world axes, m/s²), ω̇ (body axes, rad/s²)]`` for planar and
 spatial models alike (a planar body's rows 2-4 are 0). The numeric work is done by the
-cache-blocked kernels in `mbody.kernels`; what depends only on the model (and on the
+cache-blocked kernels in `mbody.equations.kernels`; what depends only on the model (and on the
 load values, while they do not change) is laid out once and cached on the model.
 
 For integrators, `derivative` returns the time derivative of the packed state
@@ -57,11 +57,35 @@ def accelerations(model: Model, state: State, reactions: np.ndarray | None = Non
                   out: np.ndarray | None = None) -> np.ndarray:
     """v̇ = M⁻¹ (Q + G λ − b) per body -> (n, 6) rows [a_G world, ω̇ body axes].
 
-    `reactions`: (m,) values λ of the reaction components, in the order of
-    ``model.reactions`` (None: no reaction forces). Load values are taken at
-    ``state.t`` (``model.forces.vector_at``). `out`: an (n, 6) array to fill (any memory
-    layout); by default a new one is returned whose columns are contiguous (it is the
-    transpose of a (6, n) array), which is the fast layout to write.
+    Every reaction value is given: nothing is solved for (`Assembly.solve` solves for
+    the unknown ones). Load values are taken at ``state.t`` (``model.forces.vector_at``).
+
+    Parameters
+    ----------
+    model : Model
+        The model, from `load` or `loads`.
+    state : State
+        Positions (world, m), orientations, velocities (world, m/s), angular velocities
+        (body axes, rad/s) and time (s).
+    reactions : (m,) array, optional
+        Values λ of the reaction components (N; N m), in the order of
+        ``model.reactions`` (None: no reaction forces).
+    out : (n, 6) array, optional
+        An array to fill (any memory layout); by default a new one is returned whose
+        columns are contiguous (it is the transpose of a (6, n) array), which is the fast
+        layout to write.
+
+    Returns
+    -------
+    (n, 6) array
+        Per body, in file order: a_G, mass-centre acceleration in world axes (m/s²), then
+        ω̇, angular acceleration in body axes (rad/s²); a planar body's rows 2-4 are 0.
+        `out` when given.
+
+    Raises
+    ------
+    MbodyError
+        `reactions` does not have one value per reaction component.
     """
     plan = k.plan_for(model)
     frame = k.frame_at(model, state.t)
