@@ -3,6 +3,7 @@ the projection, the log length scale, the graph picture and the fbd/graph comman
 
 from __future__ import annotations
 
+import io
 import re
 import subprocess
 import sys
@@ -28,6 +29,7 @@ from mbody.present.draw import (
     parse_view,
     projection,
     save_figure,
+    scene_figure,
 )
 from mbody.present.draw.scene import Line
 
@@ -380,6 +382,35 @@ def test_scene_text_width_matches_matplotlib():
         w, _, _ = text_to_path.get_text_width_height_descent(
             s, FontProperties(family=["DejaVu Sans"], size=9), False)
         assert layout(s, 9).width == pytest.approx(w, rel=0.01)
+
+
+def test_scene_text_boxes_match_matplotlib_svg_layout():
+    # multi-line pitch, line box heights, math, alignment: where matplotlib's own SVG
+    # writer puts each text (its layout in matplotlib >= 3.10: line height from the
+    # font's typo metrics, ink centred in each line)
+    from matplotlib.backends.backend_svg import RendererSVG
+
+    from mbody.present.draw.scene import Scene, Text
+    from mbody.present.draw.svg import text_box
+
+    sc = Scene(400, 400)
+    texts = [Text("O.Fx", np.array([200.0, 200.0]), 9),
+             Text("m g = 9.81 N", np.array([200.0, 200.0]), 9, ha="center", va="center"),
+             Text("Newton (world axes):\n  upper.x:  a_x = O.Fx\n  y", np.array([20.0, 380]),
+                  9, va="top", family="mono", linespacing=1.45),
+             Text("A: revolute\n5 reactions", np.array([200.0, 200]), 8, ha="center",
+                  va="center"),
+             Text("$x_B$", np.array([200.0, 200]), 8, math=True, va="bottom"),
+             Text("G", np.array([200.0, 200]), 9, ha="right", va="top", offset=(3, -4)),
+             Text("two\nlines", np.array([200.0, 200]), 9, va="baseline", align="right")]
+    sc.root.add(*texts)
+    fig = scene_figure(sc)
+    fig.dpi = 72
+    renderer = RendererSVG(400, 400, io.StringIO())
+    for t, a in zip(texts, fig.texts, strict=True):
+        e = a.get_window_extent(renderer)
+        x0, y0, w, h = text_box(t, t.xy)
+        assert (x0, y0, w, h) == pytest.approx((e.x0, e.y0, e.width, e.height), abs=0.05), t.s
 
 
 @pytest.mark.parametrize("path", MODELS, ids=[p.stem for p in MODELS])

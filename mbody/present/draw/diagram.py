@@ -121,6 +121,7 @@ def fbd_scene(fbd: FreeBodyDiagram, *, view: View = "iso", equations: bool = Tru
     ax.add(Disc(G, rg, "white", "black", 1.0, zorder=6, gid="mass-centre"))
     for a0 in (0, 180):
         ax.add(Wedge(G, rg, a0, a0 + 90, "black", zorder=6))
+    obstacles.append((G + 1.3 * rg * circle(16), "centre"))  # labels keep off the marker
     labels: list[Label] = []
     for k, nm in enumerate("xyz"[:2 if planar else 3]):
         tip = G + P @ (fbd.W_R_B[:, k] * 0.38 * shape.size)
@@ -286,7 +287,7 @@ def _legend(root: Panel, rect: tuple[float, float, float, float], arrs: list[Arr
                       [x0 - pad, y_top - inner_h - pad]])
     root.add(Poly(frame, "white", "#cccccc", 0.8, gid="legend", zorder=4),
              Text(SCALE_NOTE, np.array([cx, y_top]), 8, ha="center", va="top", zorder=5,
-                  gid="legend-title", linespacing=1.2))
+                  gid="legend-title", linespacing=1.2, align="left"))
     x = x0 + (inner_w - sum(col_w) - sep) / 2
     for c, cw in zip(cols, col_w, strict=True):
         y = y_top - note.height - 0.5 * fs - row_h / 2

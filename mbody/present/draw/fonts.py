@@ -10,6 +10,7 @@ Glyphs are measured at `UNIT` points and scaled to each text's size, as matplotl
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass
 from functools import lru_cache
@@ -47,13 +48,14 @@ class _Font:
         self.prop = FontProperties(family=[family], weight=weight, size=UNIT)
         self.ft: FT2Font = font_manager.get_font(font_manager.findfont(self.prop))
         self.name = _ID.sub("_", self.ft.postscript_name)
-        self.chars: dict[str, tuple[int, float, str]] = {}  # char -> (index, advance, id)
+        # char -> (index, advance, id, ink bottom, ink top; (inf, -inf) without ink)
+        self.chars: dict[str, tuple[int, float, str, float, float]] = {}
         self.kern: dict[tuple[int, int], float] = {}
-        # matplotlib's line metrics: the height and descent of "lp"
-        _, self.lp_h, self.lp_d = text_to_path.get_text_width_height_descent(
-            "lp", self.prop, False)
+        # matplotlib's line height (>= 3.10): linespacing × (ascender + descender) of
+        # the font's OS/2 (else hhea) table, whatever the line holds
+        self.line = _font_height(self.ft)
 
-    def char(self, c: str) -> tuple[int, float, str]:
+    def char(self, c: str) -> tuple[int, float, str, float, float]:
         got = self.chars.get(c)
         if got is None:
             ft = self.ft  # shared with matplotlib: set its size before every use
@@ -64,7 +66,10 @@ class _Font:
             if gid not in GLYPHS:
                 verts, codes = ft.get_path()
                 GLYPHS[gid] = path_data(verts, codes)
-            got = self.chars[c] = (index, g.linearHoriAdvance / 65536.0, gid)
+            x0, y0, x1, y1 = g.bbox  # 26.6 fixed point; all 0 for a glyph without ink
+            lo, hi = (y0 / 64.0, y1 / 64.0) if (x0, y0, x1, y1) != (0, 0, 0, 0) else (
+                math.inf, -math.inf)
+            got = self.chars[c] = (index, g.linearHoriAdvance / 65536.0, gid, lo, hi)
         return got
 
     def kerning(self, left: int, right: int) -> float:
@@ -74,6 +79,29 @@ class _Font:
             k = self.kern[left, right] = self.ft.get_kerning(
                 GlyphIndexType(left), GlyphIndexType(right), Kerning.DEFAULT) / 64.0
         return k
+
+
+def _font_height(ft: FT2Font) -> float:
+    """Ascender + descender (points at UNIT size), as matplotlib's text layout reads
+    them: OS/2 typo metrics, else hhea."""
+    head = ft.get_sfnt_table("head")
+    units = head["unitsPerEm"] if head is not None else 2048
+    os2 = ft.get_sfnt_table("OS/2")
+    if os2 is not None:
+        return (os2["sTypoAscender"] - os2["sTypoDescender"]) * UNIT / units
+    hhea = ft.get_sfnt_table("hhea")
+    if hhea is not None:
+        return (hhea["ascent"] - hhea["descent"]) * UNIT / units
+    return 1.2 * UNIT
+
+
+def _line_box(ink_top: float, ink_bottom: float, line: float) -> tuple[float, float]:
+    """A line's (ascent, descent) in matplotlib's fixed-spacing layout: its ink (top
+    and bottom above the baseline) centred in a box `line` high."""
+    if ink_top < ink_bottom:  # no ink: matplotlib measures 0 high
+        ink_top = ink_bottom = 0.0
+    lead = (line - (ink_top - ink_bottom)) / 2
+    return ink_top + lead, -ink_bottom + lead
 
 
 @lru_cache(maxsize=8)
@@ -129,43 +157,54 @@ def layout(s: str, size: float, *, family: str = "sans", weight: str = "normal",
     Layout
     """
     if math:
-        return _math(s, family, weight, size)
+        return _math(s, family, weight, size, linespacing)
     return _plain(s, family, weight, size, linespacing, align)
 
 
 @lru_cache(maxsize=4096)
 def _plain(s: str, family: str, weight: str, size: float, linespacing: float,
            align: float) -> Layout:
+    """matplotlib's layout of a plain text (`Text._get_layout`, fixed line spacing):
+    each line a box linespacing × the font height high with its ink centred in it,
+    the lines stacked; width from the advances and kerning."""
     f = _font(family, weight)
     k = size / UNIT
-    h, d = f.lp_h, f.lp_d
-    pitch = (h - d) * linespacing
-    lines = s.split("\n")
-    height = (h - d) + (len(lines) - 1) * pitch + d
-    rows: list[tuple[float, list[tuple[str, float, float, float]]]] = []
-    for i, line in enumerate(lines):
-        base = height - (h - d) - i * pitch
-        x, prev = 0.0, -1
+    box = linespacing * f.line
+    rows: list[tuple[float, float, float, list[tuple[str, float]]]] = []
+    for line in s.split("\n"):
+        x, prev, lo, hi = 0.0, -1, math.inf, -math.inf
         row = []
         for c in line:
-            index, adv, gid = f.char(c)
+            index, adv, gid, g_lo, g_hi = f.char(c)
             if prev >= 0:
                 x += f.kerning(prev, index)
-            if not c.isspace():
-                row.append((gid, x * k, base * k, k))
+            if g_lo <= g_hi:
+                row.append((gid, x))
+                lo, hi = min(lo, g_lo), max(hi, g_hi)
             x += adv
             prev = index
-        rows.append((x * k, row))
-    width = max(w for w, _ in rows)
-    glyphs = tuple(((g, x + align * (width - w), y, s) for w, row in rows
-                    for g, x, y, s in row))
-    return Layout(width, height * k, d * k, glyphs)
+        a, d = _line_box(hi, lo, box)
+        rows.append((x, a, d, row))
+    width = max(w for w, _, _, _ in rows)
+    height = sum(a + d for _, a, d, _ in rows)
+    glyphs = []
+    top = height
+    for w, a, d, row in rows:
+        base = top - a
+        dx = align * (width - w)
+        glyphs += [(g, (x + dx) * k, base * k, k) for g, x in row]
+        top -= a + d
+    return Layout(width * k, height * k, rows[-1][2] * k, tuple(glyphs))
 
 
 @lru_cache(maxsize=256)
-def _math(s: str, family: str, weight: str, size: float) -> Layout:
-    prop = _font(family, weight).prop
+def _math(s: str, family: str, weight: str, size: float, linespacing: float) -> Layout:
+    f = _font(family, weight)
+    prop = f.prop
     w, h, d = text_to_path.get_text_width_height_descent(s, prop, True)
+    # its box as matplotlib lays out one line: the formula centred in linespacing ×
+    # the font height
+    a, d_box = _line_box(h - d, -d, linespacing * f.line)
     info, gmap, _ = text_to_path.get_glyphs_mathtext(prop, s)
     k = size / UNIT
     glyphs = []
@@ -174,5 +213,5 @@ def _math(s: str, family: str, weight: str, size: float) -> Layout:
         if gid not in GLYPHS:
             verts, codes = gmap[rep]
             GLYPHS[gid] = path_data(np.asarray(verts), np.asarray(codes))
-        glyphs.append((gid, float(x) * k, (float(y) + d) * k, scale * k))
-    return Layout(w * k, h * k, d * k, tuple(glyphs))
+        glyphs.append((gid, float(x) * k, (float(y) + d_box) * k, scale * k))
+    return Layout(w * k, (a + d_box) * k, d_box * k, tuple(glyphs))

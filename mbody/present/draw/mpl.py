@@ -59,7 +59,7 @@ def _artist(it: Item, fig: Figure, trans: Transform) -> Artist:
     return MplText(t.xy[0], t.xy[1], t.s if t.math else tex_safe(t.s), color=t.color,
                    fontsize=t.size, ha=t.ha, va=t.va, weight=t.weight,
                    family=_FAMILY[t.family], zorder=t.zorder, gid=t.gid, clip_on=False,
-                   bbox=bbox, linespacing=t.linespacing,
+                   bbox=bbox, linespacing=t.linespacing, multialignment=t.align,
                    transform=offset_copy(trans, fig=fig, x=t.offset[0], y=t.offset[1],
                                          units="points"))
 

@@ -10,6 +10,7 @@ for x and y (equal aspect), as a matplotlib Axes with fixed limits would.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Literal
 
 import numpy as np
 
@@ -80,6 +81,8 @@ class Text:
     """A text anchored at xy (data) and moved by `offset` (points), aligned by ha, va.
 
     s is plain text (no TeX) unless `math`, which holds one mathtext formula ``$...$``.
+    `align` places the lines of a multi-line text within its box (left, center, right;
+    None: as ha), as matplotlib's multialignment.
     """
 
     s: str
@@ -96,6 +99,7 @@ class Text:
     zorder: float = 3.0
     box: Box | None = None
     linespacing: float = 1.2
+    align: Literal["left", "center", "right"] | None = None
 
 
 Item = Line | Poly | Disc | Wedge | Text

@@ -24,7 +24,7 @@ def text_box(t: Text, anchor: np.ndarray) -> tuple[float, float, float, float]:
     """(x0, y0, width, height) in points of text `t` whose anchor sits at `anchor`
     (points, offset not yet added)."""
     lay = layout(t.s, t.size, family=t.family, weight=t.weight, math=t.math,
-                 linespacing=t.linespacing, align=_HA[t.ha])
+                 linespacing=t.linespacing)
     x = anchor[0] + t.offset[0] - _HA[t.ha] * lay.width
     if t.va == "baseline":
         y = anchor[1] + t.offset[1] - lay.descent
@@ -95,7 +95,7 @@ class _Writer:
 
     def text(self, p: Panel, t: Text) -> None:
         lay = layout(t.s, t.size, family=t.family, weight=t.weight, math=t.math,
-                     linespacing=t.linespacing, align=_HA[t.ha])
+                     linespacing=t.linespacing, align=_HA[t.align or t.ha])
         x0, y0, w, h = text_box(t, p.to_pt(t.xy))
         o, H = self.out, self.H
         # the string beside its glyphs, as matplotlib writes it: searchable, diffable
