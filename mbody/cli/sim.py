@@ -96,12 +96,12 @@ def simulate(a: argparse.Namespace) -> int:
 
 
 def compile_pending(model, known, method: str = "DOP853") -> bool:
-    """Whether simulating `model` will first compile `mbody.compiled`'s kernels: the
+    """Whether simulating `model` will first compile `mbody.solve.compiled`'s kernels: the
     compiled path serves it (numba importable, `MBODY_JIT` not off, a model it takes) and
     numba's cache holds no machine code for this machine of a kernel the run calls
     (`derivative`; `rk_run` for DOP853's compiled runs; `solve` and `project` too for
     a mechanism's reactions and projection). The cache is empty after
-    an install, and stale after numba or mbody/compiled.py changed (it is keyed by the
+    an install, and stale after numba or mbody/solve/compiled.py changed (it is keyed by the
     numba version and the source file's time stamp and size). Imports numba, as the run
     itself would; never raises (numba's cache layout is not public: on any surprise the
     answer is no, and the run is merely silent while it compiles)."""

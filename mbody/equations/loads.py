@@ -1,5 +1,5 @@
 """Applied loads -> per-body net force (world axes) and moment about the mass centre
-(body axes), vectorised over loads and bodies (the sums: `mbody.kernels`).
+(body axes), vectorised over loads and bodies (the sums: `mbody.equations.kernels`).
 
 For a force ``W_f`` at the body point ``B_r`` (from the mass centre, body axes):
 
@@ -46,7 +46,7 @@ class AppliedLoads:
     `contributions` lists point forces, couples and spring ends; gravity is m g at each
     mass centre and is not repeated there. Only diagrams need the per-load list, so it
     is computed on first access; the sums come from the cache-blocked kernels
-    (`mbody.kernels`) as one (6, n) array `Q6` (rows [W_F; B_M]).
+    (`mbody.equations.kernels`) as one (6, n) array `Q6` (rows [W_F; B_M]).
     """
 
     def __init__(self, model: Model, state: State, Q6: np.ndarray):

@@ -9,13 +9,14 @@ and the choice of the path that evaluates a state.
 - per set of unknown reaction components: which they are, the given values of the others
   (`unknowns`), the per-body block plan of large solves (`block_plan`) and the packed
   structure the compiled path uses;
-- the packed model for the compiled path (`mbody.compiled`), and the decision to use it.
+- the packed model for the compiled path (`mbody.solve.compiled`), and the decision to use it.
 
 Two paths evaluate a state, with the same formulas:
 
-- the numpy path (`mbody.kernels`, `mbody.joints`, `mbody.constraints`, `mbody.kkt`):
-  vectorised over bodies, for large models and one-off evaluations;
-- the compiled path (`mbody.compiled`, numba): one call per state for models of up to
+- the numpy path (`mbody.equations.kernels`, `mbody.equations.joints`,
+  `mbody.equations.constraints`, `mbody.solve.kkt`): vectorised over bodies, for large
+  models and one-off evaluations;
+- the compiled path (`mbody.solve.compiled`, numba): one call per state for models of up to
   `COMPILED_MAX_BODIES` bodies, used once a plan has been evaluated `JIT_AFTER` times
   (or at once by `simulate`). Importing numba and loading its cached machine code takes
   a few tenths of a second, more than a one-off solve costs, so `mbody solve` and
@@ -73,7 +74,7 @@ _compiled_lock = threading.Lock()
 
 
 def compiled():
-    """The `mbody.compiled` module (importing numba), or None when numba is unavailable."""
+    """The `mbody.solve.compiled` module (importing numba), or None when numba is unavailable."""
     global _compiled_module
     if _compiled_module is None:
         with _compiled_lock:
@@ -140,7 +141,7 @@ class ModelPlan:
     # -- the numpy path's model data ------------------------------------------------------------
     @cached_property
     def kernels(self) -> Plan:
-        """The per-body kernels' layout (`mbody.kernels.Plan`)."""
+        """The per-body kernels' layout (`mbody.equations.kernels.Plan`)."""
 
         return build_plan(self.model)
 
@@ -200,7 +201,7 @@ class ModelPlan:
 
     # -- the compiled path ----------------------------------------------------------------------
     def use_compiled(self, calls: int = 1) -> bool:
-        """Whether to evaluate through `mbody.compiled` (counting `calls` evaluations)."""
+        """Whether to evaluate through `mbody.solve.compiled` (counting `calls` evaluations)."""
         self.evaluations += calls
         mode = JIT
         if mode == "off" or self.model.n > COMPILED_MAX_BODIES or self.model.n == 0:
@@ -211,7 +212,7 @@ class ModelPlan:
 
     @cached_property
     def packed(self) -> tuple[np.ndarray, np.ndarray]:
-        """(F, I): the model as the compiled path reads it (`mbody.compiled.pack_model`)."""
+        """(F, I): the model as the compiled path reads it (`mbody.solve.compiled.pack_model`)."""
         return compiled().pack_model(self.model)
 
     @cached_property

@@ -91,7 +91,7 @@ class Expression:
 
     @cached_property
     def program(self) -> tuple[np.ndarray, np.ndarray]:
-        """The tree in postfix order for `mbody.compiled.evaluate_program`: (codes (P,)
+        """The tree in postfix order for `mbody.solve.compiled.evaluate_program`: (codes (P,)
         int64, numbers (P,) float64); `PROGRAM_CODES` names the codes."""
         codes: list[int] = []
         numbers: list[float] = []
@@ -438,7 +438,7 @@ class ExpressionTable:
 
     @cached_property
     def program(self) -> ProgramTable:
-        """The table for `mbody.compiled.set_loads` (`ProgramTable`)."""
+        """The table for `mbody.solve.compiled.set_loads` (`ProgramTable`)."""
         progs = [e.program for e in self.exprs]
         starts = np.zeros(len(progs) + 1, dtype=np.int64)
         starts[1:] = np.cumsum([len(c) for c, _ in progs])

@@ -1,6 +1,6 @@
 """Jointed mechanisms in motion: accelerations with the unknown reactions solved at every
 step, joint drift held down by Baumgarte stabilisation (used by the implicit integrators;
-the explicit ones project the state instead, `mbody.projection`), reactions along a
+the explicit ones project the state instead, `mbody.simulate.projection`), reactions along a
 trajectory.
 
 Integrating ``Gᵀ v̇ = γ`` alone lets the joints drift apart (rounding and truncation
@@ -48,7 +48,7 @@ def constrained_dynamics(model: Model, known: Mapping[str, float] | None = None,
                          rate: float = BAUMGARTE_RATE) -> ConstrainedDynamics:
     """f(model, state) -> (n, 6) accelerations with the unknown reactions solved each call,
     stabilised with α = β = `rate` (1/s; 0 turns stabilisation off). The numpy path;
-    `mbody.dynamics.StateDerivative` takes the compiled one where it can."""
+    `mbody.solve.dynamics.StateDerivative` takes the compiled one where it can."""
     return ConstrainedDynamics(known, rate)
 
 

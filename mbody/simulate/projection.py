@@ -10,7 +10,7 @@ every integrator step the state is moved back:
   G_Uᵀ Δv = −G_Uᵀ v`` (the smallest change of kinetic energy that makes the joints'
   relative velocities vanish).
 
-Both are the constrained solve of `mbody.kkt` / `mbody.compiled` with other right-hand
+Both are the constrained solve of `mbody.solve.kkt` / `mbody.solve.compiled` with other right-hand
 sides, so near a singular position they go through the same robust null-space solve.
 
 Why projection rather than Baumgarte's terms: near a position where the constraint
@@ -21,7 +21,7 @@ the way in: the simulation leaves the mechanism's branch. The Gauss-Newton step 
 φ by the same small σ and so sees and removes that drift. Close to such a position
 (`geometric_ratio` below `STAGE_PIVOT_RTOL`) the integrator's stage states are projected
 as well before the accelerations are evaluated, so that the stages never see the
-amplified drift (`mbody.dynamics.StateDerivative.project_stages`).
+amplified drift (`mbody.solve.dynamics.StateDerivative.project_stages`).
 """
 
 from __future__ import annotations
@@ -56,7 +56,7 @@ chain 3e-7 rad from flat 1e-13. Such columns are left out of the ratio."""
 
 class JointProjection:
     """`projection(y, t) -> (position step, velocity change, pivot ratio)`: moves the
-    packed simulation state y (`mbody.dynamics.StateDerivative` layout) onto the joints
+    packed simulation state y (`mbody.solve.dynamics.StateDerivative` layout) onto the joints
     enforced by the unknown reactions `unknowns`, in place. The step is the largest
     Gauss-Newton correction (m or rad), the change the largest velocity correction (m/s or
     rad/s), the ratio `geometric_ratio` at the starting state (1: far from any
@@ -140,8 +140,8 @@ class JointProjection:
 def geometric_ratio(system: ConstrainedSystem) -> float:
     """How close the joints are to a singular position, whatever the masses: the smallest
     squared Cholesky pivot of Ĝᵀ Ĝ over its diagonal entry, Ĝ = T G_U with
-    T = diag(1, 1/ℓ) per body (`mbody.nullspace`'s scaling), exactly redundant columns
-    left out (as `mbody.compiled._geometric_ratio`, whose `DROPPED_RTOL` it uses)."""
+    T = diag(1, 1/ℓ) per body (`mbody.solve.nullspace`'s scaling), exactly redundant columns
+    left out (as `mbody.solve.compiled._geometric_ratio`, whose `DROPPED_RTOL` it uses)."""
     G = getattr(system, "G", None)
     if G is None or system.blocks is not None or hasattr(G, "tocsr"):
         return 1.0  # the large models' sparse factorisations: no cheap figure

@@ -3,7 +3,7 @@
     ẋ = v,   q̇ = ½ q ⊗ (0, ω),   v̇ = a_G,   ω̇ = J⁻¹ (B_M − ω × J ω)     per body,
 
 where (a_G, ω̇) = M⁻¹ (Q + G λ − b) come from the same loads, gyroscopic terms and
-reaction columns as `assemble` (through `mbody.dynamics.accelerations`), with every
+reaction columns as `assemble` (through `mbody.solve.dynamics.accelerations`), with every
 reaction value λ known (absent, given in the file, or passed as `known`).
 
 State: x (n, 3) world, q (n, 4) W_R_B quaternions [w, x, y, z], v (n, 3) world, ω (n, 3)
@@ -233,7 +233,7 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     s0 = model.initial if initial is None else initial
     projection: JointProjection | None = None
     if mechanism and method not in IMPLICIT and rhs.unknowns is not None:
-        # the joints held by projecting the state after every step (mbody.projection);
+        # the joints held by projecting the state after every step (mbody.simulate.projection);
         # the implicit methods keep their own history of y, so Baumgarte's terms hold them
         projection = JointProjection(model, rhs.unknowns, compiled=rhs.compiled)
         rhs.projection, rhs.rate = projection, 0.0
@@ -265,7 +265,7 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
             solver = integrator(method, rhs)(fun, 0.0, y0, t_end, rtol=rtol, atol=atol,
                                               max_step=max_step)
         t_prev, check_at = 0.0, PREDICT_FROM
-        advance = getattr(solver, "advance", None)  # compiled DOP853 (mbody.stepping)
+        advance = getattr(solver, "advance", None)  # compiled DOP853 (mbody.simulate.stepping)
         first = None
         while solver.status == "running":
             ran = None
@@ -640,8 +640,8 @@ def _spin_warning(traj: Trajectory) -> str | None:
 
 def state_derivative(model: Model, known: Mapping[str, float | str] | None = None,
                      dynamics: Dynamics | None = None) -> StateDerivative:
-    """ẏ = f(t, y), what `simulate` integrates (`mbody.dynamics.StateDerivative`): the
-    unknown reactions solved at every call (Baumgarte-stabilised, `mbody.mechanism`) or
+    """ẏ = f(t, y), what `simulate` integrates (`mbody.solve.dynamics.StateDerivative`): the
+    unknown reactions solved at every call (Baumgarte-stabilised, `mbody.simulate.mechanism`) or
     every reaction known (`known_reaction_dynamics`), or `dynamics` when given."""
     plan = model.plan
     if dynamics is not None:

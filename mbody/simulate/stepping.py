@@ -7,14 +7,14 @@ Two refinements, each a subclass of the scipy class the user chose:
   an evaluation on top of the evaluation itself, and the simulation loop adds its own
   Python per step; on a small mechanism that is several times the physics.
   `Stepper.advance` takes the steps up to the next output sample in one call of
-  `mbody.compiled.rk_run`: scipy's step-size control and DOP853's stages and error norm
+  `mbody.solve.compiled.rk_run`: scipy's step-size control and DOP853's stages and error norm
   (`rk_attempt`), the projection after each step and the loads' expressions of time, all
   compiled. The solver's fields are left as scipy's own steps leave them, so its dense
   output and `step()` go on from there, and the steps are scipy's to rounding
   (`tests/test_stepping.py`).
 - **Error along the joints** (a mechanism held by projection, near a singular position,
   ``rhs.project_stages``): the error estimate counts only the part along the joints
-  (`mbody.projection.tangent_error`); those steps take scipy's path.
+  (`mbody.simulate.projection.tangent_error`); those steps take scipy's path.
 """
 
 from __future__ import annotations
@@ -35,7 +35,7 @@ next step from the derivative at the projected state (one evaluation); a smaller
 left to the next step's error control."""
 
 COMPILED_STEPS = True
-"""Whether DOP853 steps of compiled models go through `mbody.compiled.rk_attempt` (the
+"""Whether DOP853 steps of compiled models go through `mbody.solve.compiled.rk_attempt` (the
 tests switch it off to compare with scipy's own steps)."""
 
 
@@ -80,7 +80,7 @@ def integrator(method: str, rhs: StateDerivative) -> type[Any]:
 
 class Advance(NamedTuple):
     """What one `advance` did: steps taken, fresh derivatives after a projection, and
-    `mbody.projection.geometric_ratio` before the last step's projection (1 without)."""
+    `mbody.simulate.projection.geometric_ratio` before the last step's projection (1 without)."""
 
     steps: int
     refreshed: int
@@ -88,7 +88,7 @@ class Advance(NamedTuple):
 
 
 def _compiled_run(solver, rhs: StateDerivative, t_stop: float, max_steps: int) -> Advance:
-    """Steps by `mbody.compiled.rk_run`; the solver's fields left as scipy's own steps
+    """Steps by `mbody.solve.compiled.rk_run`; the solver's fields left as scipy's own steps
     leave them (so that its dense output and next `step()` go on from there)."""
     c = compiled_module()
     model = rhs.model

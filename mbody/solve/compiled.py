@@ -7,10 +7,10 @@ springs, gyroscopic terms, reaction columns, γ, φ, Gᵀ v, the Schur complemen
 S = G_Uᵀ M⁻¹ G_U in banded storage, its Cholesky factorisation, one round of iterative
 refinement and the backward error, with nothing allocated per body in Python.
 
-The formulas are those of the numpy path (`mbody.kernels`, `mbody.joints`,
-`mbody.constraints`, `mbody.kkt`), which stays the general path (large models, and
+The formulas are those of the numpy path (`mbody.equations.kernels`, `mbody.equations.joints`,
+`mbody.equations.constraints`, `mbody.solve.kkt`), which stays the general path (large models, and
 machines without numba); `tests/test_compiled.py` holds both equal on random mechanisms
-of every joint type. Nothing here is imported by ``import mbody``: `mbody.plan` loads
+of every joint type. Nothing here is imported by ``import mbody``: `mbody.equations.plan` loads
 this module (and numba) only for models that are evaluated many times.
 
 Packing (`pack_model`): numba's dispatcher costs about 0.1 µs per argument, so the model
@@ -38,13 +38,13 @@ SPRING_W, RA, RB, STIFF, REST, DAMP = 9, 0, 3, 6, 7, 8
 JOINT_W, BRC, BRP, CAX2, PE3, CE3, LLEN = 28, 0, 3, 6, 9, 18, 27
 LINK_AXIS, J_LINK, J_PARTICLE_PARENT = -1, 1, 2  # as mbody.conventions; joint flags
 HEADER = 5
-JOINT_TOL = 1e-6  # as mbody.constraints.JOINT_TOL
-# as mbody.nullspace: the robust solve's tolerances
+JOINT_TOL = 1e-6  # as mbody.equations.constraints.JOINT_TOL
+# as mbody.solve.nullspace: the robust solve's tolerances
 G_RANK_RTOL, PIVOT_RTOL, SINGULAR_RTOL, STAB_RTOL, REFINE_STEPS = 1e-12, 1e-6, 1e-14, 1e-4, 2
 # exactly redundant columns: G_j − G_I x_j below this (relative, moment rows over the
 # length scale), and a consistent answer (backward error below REDUNDANT_BERR)
 DEPENDENT_RTOL, REDUNDANT_BERR = 1e-10, 1e-13
-DROPPED_RTOL = 1e-13  # as mbody.projection: an exactly redundant constraint's pivot ratio
+DROPPED_RTOL = 1e-13  # as mbody.simulate.projection: an exactly redundant constraint's pivot ratio
 SPLIT = 134217729.0  # 2**27 + 1, Dekker's splitting constant
 
 # info[] slots written by `solve`; ST_PATH: 0 Cholesky of S, 1 null-space solve;
@@ -290,7 +290,7 @@ def _spring(row, a, b, x, R, v, w, out):
 @njit(cache=True)
 def _columns(joints, joints_i, comps_i, x, R, v, w, child6, parent6, gamma, phi, gtv):
     """Per component: its columns of G (child6, parent6 (m, 6)), γ = −Ġᵀ v, φ and Gᵀ v
-    (formulas in `mbody.joints` and `mbody.constraints`)."""
+    (formulas in `mbody.equations.joints` and `mbody.equations.constraints`)."""
     nj, m = joints_i.shape[0], comps_i.shape[0]
     W_E = np.empty((nj, 3, 3))
     Rrel = np.empty((nj, 3, 3))
@@ -401,7 +401,7 @@ def _columns(joints, joints_i, comps_i, x, R, v, w, child6, parent6, gamma, phi,
                         phi[i] = 0.5 * (A[0, 2] - A[2, 0])
                     else:
                         phi[i] = 0.5 * (A[1, 0] - A[0, 1])
-        elif axis == LINK_AXIS:  # a particle link's tension T (mbody.joints, constraints)
+        elif axis == LINK_AXIS:  # a particle link's tension T (mbody.equations.joints, constraints)
             _link(row, p, c, x, R, v, w, d[j], wc[j], wp[j], child6[i], parent6[i], gamma, phi,
                   i)
         else:
@@ -551,7 +551,7 @@ def _cholesky_band(Sb, bw):
     """In place: lower banded S -> its Cholesky factor L. Returns False when a squared
     pivot keeps no more than PIVOT_RTOL of its diagonal entry (redundant constraints, a
     position near a singular one, extreme mass ratios: the null-space solve takes over),
-    as `mbody.kkt`."""
+    as `mbody.solve.kkt`."""
     return _band_cholesky(Sb, bw, PIVOT_RTOL, True) >= 0.0
 
 
@@ -706,7 +706,7 @@ def _cho_solve_dense(L, r, x):
 @njit(cache=True)
 def _inv_length(U, comps_i, joints_i, child6, parent6):
     """1 / the model's length scale: the rms moment arm |r × e| / |e| of the unknown
-    components' force columns, both sides (as `mbody.nullspace.length_scale`)."""
+    components' force columns, both sides (as `mbody.solve.nullspace.length_scale`)."""
     num, cnt = 0.0, 0
     for k in range(U.shape[0]):
         i = U[k]
@@ -881,7 +881,7 @@ def _dot_add(s, c, a, b):
 @njit(cache=True)
 def _null_space(bodies, joints_i, comps_i, U, child6, parent6, r6, gam, stab, planar,
                 refine, acc, lamU, nonunique):
-    """The robust solve on G_U's geometry, as `mbody.nullspace.NullSpaceSolve` (read its
+    """The robust solve on G_U's geometry, as `mbody.solve.nullspace.NullSpaceSolve` (read its
     docstring): Ĝ = T G_U C⁻¹, its SVD, the reduced mass
     matrix of the allowed motions, REFINE_STEPS rounds of refinement with compensated
     residuals (when `refine`), the minimum-norm λ and the not-unique flags. Writes acc
@@ -1186,7 +1186,8 @@ def solve(F, I, Iu, y, fvec, lam, planar, out):
     for k in range(mu):
         out[N + Iu[3 + k]] = lamU[k]
         out[N + 2 * m + Iu[3 + k]] = 1.0 if ev.nonunique[k] else 0.0
-    # broken-joint check on the enforced (unknown) components (mbody.constraints.joint_errors)
+    # broken-joint check on the enforced (unknown) components
+    # (mbody.equations.constraints.joint_errors)
     size = 0.0
     if n > 1:
         for a in range(3):
@@ -1254,7 +1255,7 @@ def derivative(F, I, Iu, y, fvec, lam, rate, planar, out):
     return 0
 
 
-# -- coordinate projection (mbody.projection) --------------------------------------------------
+# -- coordinate projection (mbody.simulate.projection) -----------------------------------------
 @njit(cache=True)
 def _pivot_ratio(Sb, bw):
     """The smallest ratio of a squared Cholesky pivot of the banded S to its diagonal
@@ -1267,7 +1268,7 @@ def _pivot_ratio(Sb, bw):
 @njit(cache=True)
 def _geometric_ratio(bodies, joints_i, comps_i, U, inc_ptr, inc, child6, parent6, bw):
     """`_pivot_ratio` of Ĝᵀ Ĝ, Ĝ = T G_U with T = diag(1, 1/ℓ) per body (as
-    `mbody.projection.geometric_ratio`): how close the joints are to a singular position,
+    `mbody.simulate.projection.geometric_ratio`): how close the joints are to a singular position,
     whatever the masses (S = G_Uᵀ M⁻¹ G_U of a slender spatial four-bar has a ratio of
     1e-3 at every position)."""
     n = bodies.shape[0]
@@ -1389,10 +1390,10 @@ def project(F, I, Iu, y, planar, iters, robust_below, info):
             w[i, 1] = 0.0
 
 
-# -- loads given as expressions of time (mbody.expr) -----------------------------------------
+# -- loads given as expressions of time (mbody.model.expressions) ------------------------------
 @njit(cache=True, error_model="numpy")
 def _evaluate_program(codes, numbers, start, end, t, stack):
-    """The value at time t of one expression's postfix program (`mbody.expr.Expression.
+    """The value at time t of one expression's postfix program (`mbody.model.expressions.Expression.
     program`, codes `PROGRAM_CODES`); out of a function's domain, inf or nan as numpy
     gives them."""
     top = 0
@@ -1440,7 +1441,7 @@ def _evaluate_program(codes, numbers, start, end, t, stack):
 
 @njit(cache=True)
 def set_loads(base, rows, cols, which, starts, codes, numbers, t, out):
-    """out (k, 3) <- base with the entries given as expressions (`mbody.expr.
+    """out (k, 3) <- base with the entries given as expressions (`mbody.model.expressions.
     ExpressionTable.program`) set to their values at time t (s)."""
     for i in range(base.shape[0]):
         for a in range(base.shape[1]):
@@ -1456,7 +1457,7 @@ def set_loads(base, rows, cols, which, starts, codes, numbers, t, out):
         out[rows[k], cols[k]] = values[which[k]]
 
 
-# -- one explicit Runge-Kutta step (mbody.stepping) ------------------------------------------
+# -- one explicit Runge-Kutta step (mbody.simulate.stepping) -----------------------------------
 @njit(cache=True)
 def rk_attempt(F, I, Iu, y, f, t, h, base, rows, cols, which, starts, codes, numbers, lam,
                rate, planar, A, B, C, E3, E5, rtol, atol, K, y_new):
@@ -1519,7 +1520,7 @@ in RUN_RATIO)."""
 def rk_run(F, I, Iu, base, rows, cols, which, starts, codes, numbers, lam, rate, planar, A,
            B, C, E3, E5, rtol, atol, max_step, t_bound, t_stop, max_steps, project_too,
            robust_below, refresh_tol, y, f, K, y_old, run):
-    """Steps of scipy's embedded Runge-Kutta control (`mbody.stepping`) with `rk_attempt`,
+    """Steps of scipy's embedded Runge-Kutta control (`mbody.simulate.stepping`) with `rk_attempt`,
     each followed, when `project_too`, by the coordinate projection (`project`) and, when
     it moved the state by more than `refresh_tol`, a fresh ẏ at the projected state. Stops
     after the first step that reaches t_stop, after `max_steps` steps, or after a step

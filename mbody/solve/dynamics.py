@@ -119,8 +119,9 @@ class StateDerivative:
         ẏ = [v | ½ q ⊗ (0, ω) | a_G | ω̇ | ω_z],
 
     with the accelerations from `dynamics` (numpy path, a `Dynamics` callable) or, for
-    models `mbody.plan` compiles, from one call of `mbody.compiled.derivative` with the
-    unknown reactions solved and Baumgarte's terms (α = β = `rate`). The rotation is
+    models `mbody.equations.plan` compiles, from one call of
+    `mbody.solve.compiled.derivative` with the unknown reactions solved and Baumgarte's
+    terms (α = β = `rate`). The rotation is
     built from q/‖q‖; q itself is integrated as it is. Planar models' out-of-plane rows
     are set to exactly 0 (rounding would otherwise creep in).
     """
@@ -131,10 +132,10 @@ class StateDerivative:
         self.model, self.dynamics, self.rate = model, dynamics, rate
         self.unknowns, self.known_at = unknowns, known_at
         self.projection: JointProjection | None = None
-        """A `mbody.projection.JointProjection`, set by `simulate` for mechanisms."""
+        """A `mbody.simulate.projection.JointProjection`, set by `simulate` for mechanisms."""
         self.project_stages = False
         """Evaluate at the projected copy of y (near singular positions, see
-        `mbody.projection`)."""
+        `mbody.simulate.projection`)."""
         self.planar = model.dimension == 2
         n = model.n
         self.size = 13 * n + (n if self.planar else 0)

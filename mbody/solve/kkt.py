@@ -62,8 +62,8 @@ RANK_RTOL = 1e-10
 systems too large for the null-space solve, `ROBUST_MAX_ROWS`)."""
 ROBUST_MAX_ROWS = 1200
 """Up to this many rows (6 per body), a Schur complement whose Cholesky pivots are not
-trusted (`mbody.nullspace.PIVOT_RTOL`) hands the system to the null-space solve
-(`mbody.nullspace`); above, to the eigen-decomposition or LSQR of S."""
+trusted (`mbody.solve.nullspace.PIVOT_RTOL`) hands the system to the null-space solve
+(`mbody.solve.nullspace`); above, to the eigen-decomposition or LSQR of S."""
 
 
 def _trusted(d: np.ndarray, diag: np.ndarray) -> bool:
@@ -224,7 +224,7 @@ class ConstrainedSystem:
     """The constrained system of a model at one state, for a set of unknown components.
 
     cols: the reaction columns at the state; unknowns: which components are unknown
-    (`mbody.plan.Unknowns`).
+    (`mbody.equations.plan.Unknowns`).
     """
 
     def __init__(self, model: Model, cols: ReactionColumns, unknowns: Unknowns):
@@ -248,7 +248,7 @@ class ConstrainedSystem:
             self.G, self.H = _g_and_minv_g_dense(*args)
             self.fact = self._dense(self.G.T @ self.H)
             return
-        if len(U) > DENSE_LIMIT:  # large: per-body blocks and a banded S (mbody.blockplan)
+        if len(U) > DENSE_LIMIT:  # large: per-body blocks and a banded S (mbody.solve.blockplan)
             from mbody.solve.blockplan import BlockOperators
 
             plan = model.plan.block_plan(unknowns) if model.plan is not None else None
@@ -372,7 +372,7 @@ class ConstrainedSystem:
                              _solve=lambda r: Vg @ ((Vg.T @ r) / wg), _S=A)
 
     def _null_space(self, S: SchurMatrix) -> Factorisation:
-        """Hand the system to the robust solve on G_U's geometry (`mbody.nullspace`)."""
+        """Hand the system to the robust solve on G_U's geometry (`mbody.solve.nullspace`)."""
         model = self.model
         if self.blocks is not None:
             G = self.g_sparse().toarray()
@@ -394,7 +394,7 @@ class ConstrainedSystem:
               ) -> tuple[np.ndarray, np.ndarray]:
         """Solve M v̇ − G_U λ = r (n, 6 rows), G_Uᵀ v̇ = γ_U; returns (v̇ (n, 6), λ_U).
         `stab`: the part of γ_U that is Baumgarte's stabilisation, which the null-space
-        solve damps near singular positions (`mbody.nullspace.STAB_RTOL`)."""
+        solve damps near singular positions (`mbody.solve.nullspace.STAB_RTOL`)."""
         if self.robust is not None:
             return self.robust.solve(r6, gamma_U, refine=False, stab=stab)
         model = self.model

@@ -1,7 +1,7 @@
 """The robust constrained solve: accelerations from the geometry of the constraints, for
 the states where the Schur complement S = G_Uᵀ M⁻¹ G_U cannot be trusted.
 
-The usual solve (`mbody.kkt`) factorises S. S squares the conditioning of G_U and mixes
+The usual solve (`mbody.solve.kkt`) factorises S. S squares the conditioning of G_U and mixes
 it with the mass ratios, so two kinds of state defeat it:
 
 - positions close to a singular one (a four-bar chain passing its flat position), where
@@ -35,7 +35,7 @@ position G_U keeps its rank and the solve resolves the small singular value; one
 rounds of iterative refinement with residuals in extended precision
 (`numpy.longdouble`) then give the accelerations of the data as given to near machine
 precision, where the data (G_U, γ) are exact (a position 1e-9 rad from a singular one
-then gives the accelerations to about 1e-12). `mbody.compiled` has the same solve
+then gives the accelerations to about 1e-12). `mbody.solve.compiled` has the same solve
 (compensated dot products instead of long doubles).
 """
 
