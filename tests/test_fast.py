@@ -129,6 +129,18 @@ def test_many_chunks_and_layouts(monkeypatch):
     assert check_both(dump(spec))
 
 
+def test_joint_types_and_axes():
+    spec = chain_spec(12)
+    for j, kind in zip(spec["joints"], ["spherical", "fixed", "cylindrical", "prismatic",
+                                          "universal", "universal"], strict=False):
+        j["type"] = kind
+        if kind == "universal":
+            j["axis"], j["axis2"] = [0.0, 0.0, 2.0], [0.0, 1.0, 0.0]
+        if kind == "spherical":
+            del j["axis"]
+    assert check_both(dump(spec))
+
+
 def test_planar_model():
     bodies = [{"name": f"p{i}", "mass": 1 + i, "inertia": 0.5, "position": [i, 0.5],
                "angle": 0.1 * i, "velocity": [0, 1], "angular_velocity": -2}
@@ -197,9 +209,22 @@ def model_texts(draw):
     spec: dict = {"model": "gen", "dimension": dim, "bodies": bodies}
     if loads:
         spec["loads"] = loads
-    if draw(st.booleans()):
-        spec["joints"] = [{"name": "A", "type": "revolute", "parent": "ground", "child": "b0",
-                           "at": [0.0] * dim, **({"axis": [0, 0, 1]} if dim == 3 else {})}]
+    joints = []
+    kinds = (["revolute", "prismatic", "fixed"] if dim == 2 else
+             ["revolute", "prismatic", "cylindrical", "spherical", "fixed", "universal"])
+    for i in range(draw(st.integers(0, 4))):
+        kind = draw(st.sampled_from(kinds))
+        j: dict = {"name": draw(st.sampled_from([f"j{i}", f"j{i}", "j0"])), "type": kind,
+                   "parent": draw(st.sampled_from(["ground", "b0", f"b{i}"])),
+                   "child": f"b{draw(st.integers(0, n))}", "at": draw(vec)}
+        if draw(st.booleans()) or kind in ("prismatic", "universal", "cylindrical"):
+            j["axis"] = draw(st.sampled_from([[0, 0, 1], [1, 0, 0], [0, 0, 0], [1, 1, 0],
+                                              [0.6, 0.8, 0]]))[:dim]
+        if kind == "universal":
+            j["axis2"] = draw(st.sampled_from([[0, 1, 0], [0, 0, 1], [1, 0, 1e-7]]))
+        joints.append(j)
+    if joints:
+        spec["joints"] = joints
     lines = dump(spec).split("\n")
     for _ in range(draw(st.integers(0, 3))):
         i = draw(st.integers(0, len(lines) - 1))
@@ -276,3 +301,27 @@ def test_fast_path_declines_unhandled_forms():
             assert spec is not None
         else:
             assert spec is None, edit
+
+
+@pytest.mark.parametrize("spec", [free_bodies_spec(20), chain_spec(15)], ids=["free", "chain"])
+def test_value_limit_is_the_located_readers(monkeypatch, spec):
+    """The fast path counts keys and values as the located reader does, and refuses (leaves
+    to the located path) exactly the files that reader refuses for their number."""
+    from mbody.model import loader
+
+    text = dump(spec)
+    doc = load_text(text, "m.yaml")
+    count = len(doc.marks) + len(doc.key_marks)
+    monkeypatch.setattr(loader, "MAX_NODES", count)
+    assert check_both(text)
+    monkeypatch.setattr(loader, "MAX_NODES", count - 1)
+    assert fast.fast_spec(text, "m.yaml") is None
+    with pytest.raises(ModelError, match=f"more than {count - 1:_} values".replace("_", " ")):
+        load_text(text, "m.yaml")
+
+
+def test_value_limit_grows_with_the_file():
+    from mbody.model.loader import MAX_NODES, value_limit
+
+    assert value_limit(1000) == value_limit(32 * 2**20) == MAX_NODES
+    assert value_limit(100 * 2**20) == 100 * 2**20 // 8

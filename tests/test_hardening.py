@@ -558,7 +558,7 @@ def test_a_file_of_millions_of_values_is_refused_early(tmp_path, capsys):
     assert time.perf_counter() - t0 < 10
     assert code == 2 and err.startswith("mbody: error: m.yaml:3:")
     assert err.endswith(": the file holds more than 1 000 000 values (keys, numbers, lists...), "
-                        "the most that is read (a 10 000-body model holds about 300 000)\n")
+                        "the most that is read (a 10 000-body model holds about 650 000)\n")
 
 
 @pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no named pipes")

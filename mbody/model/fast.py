@@ -37,7 +37,7 @@ import numpy as np
 
 from mbody import conventions as cv
 from mbody.errors import ModelError
-from mbody.model.loader import load_text
+from mbody.model.loader import load_text, value_limit
 from mbody.model.validate import (
     _TOL,
     FRAMES,
@@ -46,18 +46,20 @@ from mbody.model.validate import (
     MIN_MAGNITUDE,
     BodyTable,
     Checker,
-    LoadSpec,
+    JointSpec,
+    LoadTable,
     Spec,
     header,
     quat_norm,
     rest,
+    vec_norm,
 )
 
 MIN_BYTES = 64 * 1024
 """Smaller texts go straight to the located path: there is nothing to gain."""
 MAX_TEMPLATES = 16
 """Most distinct item layouts in one list; more means a hand-written file."""
-CHUNK = 1 << 20
+CHUNK = 1 << 18
 """Characters of a list read at a time, so that its temporary strings stay small."""
 
 _PLACEHOLDER = "__mbody_fast_"
@@ -74,11 +76,6 @@ _SPECIAL = frozenset(("null", "Null", "NULL", "true", "True", "TRUE", "false", "
                       "FALSE"))
 """Names the pattern above lets through that YAML reads as null or a boolean."""
 _SECTION_END = re.compile(r"\n[^- ]")
-_SLOT = re.compile(r"(: |^ *- (?=\[))([^\n,{}\[\]]*|\[[^\n\[\]]*\])(?=$|, |\})", re.M)
-"""A slot: a value after 'key: ' (block, or in a one-line flow mapping as yaml.dump
-writes a mapping of scalars) or a '- [...]' list item; a flow list of numbers or a plain
-scalar. A slot that is not where YAML sees a whole value leaves a skeleton whose slot
-marker is not a whole value either: `_structure` refuses it."""
 _PRINTABLE = bytes(range(0x20, 0x7f)) + b"\n"
 """Printable ASCII and newlines; anything else (tabs, CR, a BOM...): the located path."""
 _ODD = re.compile(r"[^\n\x20-\x7e]")
@@ -115,7 +112,7 @@ def fast_spec(text: str, file: str) -> Spec | None:
 
 def _spec(text: str, file: str) -> Spec:
     found = []
-    for key in ("bodies", "loads"):
+    for key in ("bodies", "loads", "joints"):
         head = f"\n{key}:\n- "
         at = 0 if text.startswith(head[1:]) else text.find(head) + 1
         if at == 0 and not text.startswith(head[1:]) or text.find(head, at) >= 0:
@@ -143,19 +140,24 @@ def _spec(text: str, file: str) -> Spec:
     if c.issues or c.warnings:
         raise _Bail
     data = doc.data
-    if data.get("bodies") != f"{_PLACEHOLDER}bodies__":
-        raise _Bail  # the cut was not where the located reader sees the list
-    table = _bodies(c, _read_list(text, *sections["bodies"], file))
-    loads = None
-    if "loads" in sections:
-        if data.get("loads") != f"{_PLACEHOLDER}loads__":
-            raise _Bail
-        loads = _loads(c, _read_list(text, *sections["loads"], file))
-    loads, joints, reactions, expressions = rest(c, [], loads)
+    # every key and value counts towards the located reader's limit: the same limit here
+    values = len(doc.marks) + len(doc.key_marks)
+    lists = {}
+    for key in sections:
+        if data.get(key) != f"{_PLACEHOLDER}{key}__":
+            raise _Bail  # the cut was not where the located reader sees the list
+        lists[key], count = _read_list(text, *sections[key], file)
+        values += count
+    if values > value_limit(len(text)):
+        raise _Bail
+    table = _bodies(c, lists["bodies"])
+    point = _loads(c, lists["loads"]) if "loads" in lists else None
+    joints = _joints(c, lists["joints"]) if "joints" in lists else None
+    loads, joints, reactions, expressions = rest(c, [], [] if point else None, joints)
     if c.issues or c.warnings:
         raise _Bail  # warnings need their lines: the located path gives them
     return Spec(name, file, c.dim, gravity, [], loads, joints, reactions, description,
-                [], expressions, table)
+                [], expressions, table, point)
 
 
 # -- reading a list in bulk ---------------------------------------------------------------
@@ -171,63 +173,135 @@ class _Group:
     columns: dict[tuple[Any, ...], Any]
 
 
-def _read_list(text: str, start: int, end: int, file: str) -> list[_Group]:
+def _read_list(text: str, start: int, end: int, file: str) -> tuple[list[_Group], int]:
     """The items of the block list text[start:end] (each starts with '- ' at column 0),
-    grouped by layout, with every slot typed a column at a time."""
+    grouped by layout, with every slot typed a column at a time; and how many keys and
+    values they hold beyond the list itself (as the located reader counts them).
+
+    The list is read a chunk of about `CHUNK` characters at a time, and each chunk's
+    columns are parsed before the next is cut; no string is made per value (a column's
+    bytes are gathered with numpy and parsed by json in one call).
+    """
     layouts: dict[str, int] = {}
     structure: list[dict[tuple[Any, ...], int]] = []
-    raw: list[list[list[str]]] = []  # per layout, per slot: texts, all chunks
+    nodes: list[int] = []  # per layout: keys and values of one item, a flow list as one
+    pieces: list[dict[tuple[Any, ...], list[Any]]] = []  # per layout, per path: chunks
     rows: list[list[int]] = []  # per layout: item indices
     item = 0
     pos = start
     while pos < end:
         stop = end if end - pos <= CHUNK else text.find("\n- ", pos + CHUNK, end) + 1 or end
-        chunk = text[pos:stop]
-        if chunk.encode("ascii").translate(None, _PRINTABLE):
+        data = text[pos:stop].encode("ascii")
+        if data.translate(None, _PRINTABLE):
             raise _Bail  # a tab, a carriage return, a control character
-        parts = _SLOT.split(chunk)
-        values = parts[2::3]
-        parts[2::3] = ["\x00"] * len(values)
-        body = "".join(parts)
+        b = np.frombuffer(data, dtype=np.uint8)
+        s, e = _slots(b)
+        skeleton = b.copy()
+        skeleton[s] = 0  # each value becomes one NUL, its marker
+        inside = np.zeros(len(b) + 1, dtype=np.int8)
+        inside[s + 1] += 1
+        inside[e] -= 1  # no two slots share a start or an end, nor touch (see _slots)
+        body = skeleton[np.cumsum(inside[:-1], dtype=np.int8) == 0].tobytes().decode("ascii")
         # items without the leading '- ' and the newline that ends each one
         skeletons = body[2:-1 if body.endswith("\n") else None].split("\n- ")
         for sk in set(skeletons).difference(layouts):
             if len(layouts) >= MAX_TEMPLATES:
                 raise _Bail
             layouts[sk] = len(layouts)
-            structure.append(_structure(sk, file))
-            raw.append([[] for _ in structure[-1]])
+            paths, count = _structure(sk, file)
+            structure.append(paths)
+            nodes.append(count)
+            pieces.append({path: [] for path in structure[-1]})
             rows.append([])
-        ids = list(map(layouts.__getitem__, skeletons))
-        k = ids[0]
-        width = len(structure[k])
-        if ids.count(k) == len(ids):  # one layout (the usual case): a column is a slice
-            if width * len(ids) != len(values):
-                raise _Bail
-            for slot, col in enumerate(raw[k]):
-                col.extend(values[slot::width])
-            rows[k].extend(range(item, item + len(ids)))
-        else:
-            at = 0
-            for i, k in enumerate(ids, start=item):
-                for slot, col in enumerate(raw[k]):
-                    col.append(values[at + slot])
-                at += len(structure[k])
-                rows[k].append(i)
-            if at != len(values):
-                raise _Bail
-        item += len(ids)
+        ids = np.fromiter(map(layouts.__getitem__, skeletons), dtype=np.intp,
+                          count=len(skeletons))
+        widths = np.array([len(st) for st in structure], dtype=np.intp)[ids]
+        first = np.cumsum(widths) - widths  # each item's first slot
+        if first[-1] + widths[-1] != len(s):
+            raise _Bail
+        for k in np.unique(ids).tolist():
+            mine = np.flatnonzero(ids == k)
+            for path, slot in structure[k].items():
+                at = first[mine] + slot
+                pieces[k][path].append(_column(b, s[at], e[at]))
+            rows[k].extend((mine + item).tolist())
+        item += len(skeletons)
         pos = stop
-    return [_Group(np.array(r, dtype=np.intp),
-                   {path: _column(raw[k][slot]) for path, slot in structure[k].items()})
-            for k, r in enumerate(rows)]
+    groups = [_Group(np.array(r, dtype=np.intp),
+                     {path: _joined(chunks) for path, chunks in pieces[k].items()})
+              for k, r in enumerate(rows)]
+    count = sum(len(g.index) * (nodes[k] + sum(c.shape[1] for c in g.columns.values()
+                                               if isinstance(c, np.ndarray) and c.ndim == 2))
+                for k, g in enumerate(groups))
+    return groups, count
 
 
-def _structure(skeleton: str, file: str) -> dict[tuple[Any, ...], int]:
-    """key path -> slot number of one item layout, parsed by the located loader."""
+def _slots(b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Start and end (exclusive) of every value in the text `b` (bytes), in order.
+
+    A value follows ': ' (in a block mapping, or in a one-line flow mapping as yaml.dump
+    writes a mapping of scalars), or '- ' before '[' on a line indented with spaces
+    only. It is a flow list ('[' to the next ']'), or it runs to the end of the line, the
+    next ', ' or the next '}'. Anything odd (a value that would swallow the next, an
+    empty one, a list that does not close) is `_Bail`; and a slot that is not where YAML
+    sees a whole value leaves a skeleton whose marker is not a whole value: `_structure`
+    refuses it.
+    """
+    n = len(b)
+    space = b == 32
+    after_colon = np.flatnonzero((b[:-1] == 58) & space[1:]) + 2
+    dash = np.flatnonzero((b[:-2] == 45) & space[1:-1] & (b[2:] == 91))
+    newline = np.append(np.flatnonzero(b == 10), n)
+    if len(dash):  # '- [' with only spaces before it on its line
+        line = np.searchsorted(newline, dash)
+        line_start = np.where(line > 0, newline[line - 1] + 1, 0)
+        blanks = np.concatenate(([0], np.cumsum(~space, dtype=np.int32)))
+        dash = dash[blanks[dash] == blanks[line_start]] + 2
+    s = np.sort(np.concatenate((after_colon, dash)))
+    if len(s) == 0 or s[-1] >= n:
+        raise _Bail
+    close = np.append(np.flatnonzero(b == 93) + 1, n + 1)
+    comma = np.append(np.flatnonzero((b[:-1] == 44) & space[1:]), n)
+    brace = np.append(np.flatnonzero(b == 125), n)
+    plain_end = np.minimum(newline[np.searchsorted(newline, s)],
+                           np.minimum(comma[np.searchsorted(comma, s)],
+                                      brace[np.searchsorted(brace, s)]))
+    e = np.where(b[s] == 91, close[np.searchsorted(close, s)], plain_end)
+    if np.any(e <= s) or np.any(e > n) or np.any(e[:-1] > s[1:] - 2):
+        raise _Bail
+    return s, e
+
+
+def _gather(b: np.ndarray, s: np.ndarray, e: np.ndarray, sep: int) -> bytes:
+    """The values b[s[i]:e[i]] (none empty), joined by the byte `sep`."""
+    lengths = e - s
+    out_start = np.cumsum(lengths + 1) - (lengths + 1)  # where value i goes
+    total = int(out_start[-1] + lengths[-1])
+    out = np.full(total, sep, dtype=np.uint8)
+    filled = np.ones(total, dtype=bool)
+    filled[out_start[1:] - 1] = False  # the separators
+    to = np.flatnonzero(filled)
+    out[to] = b[to + np.repeat(s - out_start, lengths)]
+    return out.tobytes()
+
+
+def _joined(chunks: list[Any]) -> Any:
+    """One column from its chunks: all arrays of one width, or all lists of names."""
+    if all(isinstance(c, list) for c in chunks):
+        return [name for c in chunks for name in c]
+    try:
+        return np.concatenate(chunks) if len(chunks) > 1 else chunks[0]
+    except (ValueError, TypeError):  # names in one chunk, numbers in another; widths
+        raise _Bail from None
+
+
+def _structure(skeleton: str, file: str) -> tuple[dict[tuple[Any, ...], int], int]:
+    """key path -> slot number of one item layout, parsed by the located loader; and the
+    item's count of keys and values (a slot as one)."""
     count = iter(range(1 << 30))
     src = "- " + re.sub("\x00", lambda _: f"__mbody_slot_{next(count)}__", skeleton)
-    data = load_text(src, file).data  # a ModelError: the located path reports it
+    doc = load_text(src, file)  # a ModelError: the located path reports it
+    data = doc.data
     if not (isinstance(data, list) and len(data) == 1 and isinstance(data[0], dict)):
         raise _Bail
     out: dict[tuple[Any, ...], int] = {}
@@ -248,44 +322,46 @@ def _structure(skeleton: str, file: str) -> dict[tuple[Any, ...], int]:
     walk((), data[0])
     if sorted(out.values()) != list(range(next(count))):
         raise _Bail  # a slot swallowed by a multi-line value
-    return out
+    return out, len(doc.marks) + len(doc.key_marks) - 1  # not the list around it
 
 
-def _column(texts: list[str]) -> Any:
-    """The values of one slot over many items, typed as the located loader types them:
-    (k, L) floats for flow lists of L numbers, (k,) floats for numbers, else names."""
-    n = len(texts)
-    first = texts[0]
-    if first[:1] == "[":
-        joined = "\x01".join(texts)
-        # each slot is one flat list: '[...]' joined by '\x01', no bracket inside
-        if not (joined.count("[") == n == joined.count("]") and joined[-1] == "]"
-                and joined.count("]\x01[") == n - 1
-                and joined.count(" ") == joined.count(", ")):  # separators as dumped
+def _column(b: np.ndarray, s: np.ndarray, e: np.ndarray) -> Any:
+    """The values b[s[i]:e[i]] of one slot over many items, typed as the located loader
+    types them: (k, L) floats for flow lists of L numbers, (k,) floats for numbers, else
+    a list of names."""
+    n = len(s)
+    first = int(b[s[0]])
+    if first == ord("["):
+        data = _gather(b, s, e, 1)
+        # each value is one flat list: '[...]' joined by '\x01', no bracket inside
+        if not (data.count(b"[") == n == data.count(b"]") and data[-1:] == b"]"
+                and data.count(b"]\x01[") == n - 1
+                and data.count(b" ") == data.count(b", ")):  # separators as dumped
             raise _Bail
-        data = joined.encode("ascii")
-        width = first.count(",") + 1 if first != "[]" else 0
+        width = 0 if e[0] - s[0] == 2 else int(np.count_nonzero(b[s[0]:e[0]] == 44)) + 1
         # each list's length, from its commas: one flat list of numbers for json (nested
         # lists would make a container per item for the garbage collector to trace)
-        b = np.frombuffer(data, dtype=np.uint8)
-        commas = np.concatenate(([0], np.cumsum(b == ord(","))))
-        opens, closes = np.flatnonzero(b == ord("[")), np.flatnonzero(b == ord("]"))
-        if np.any(commas[closes] - commas[opens] != max(width - 1, 0)):
+        c = np.frombuffer(data, dtype=np.uint8)
+        commas = np.add.reduceat((c == ord(",")).view(np.uint8), np.flatnonzero(c == ord("[")),
+                                 dtype=np.intp)
+        if np.any(commas != max(width - 1, 0)):
             raise _Bail
-        flat = _parse(data, b", []\x01", "[" + joined[1:-1].replace("]\x01[", ",") + "]",
+        flat = _parse(data, b", []\x01", b"[" + data[1:-1].replace(b"]\x01[", b",") + b"]",
                       n * width)
         return flat.reshape(n, width)
-    if first[:1] in "0123456789-":
-        joined = ",".join(texts)
-        if joined.count(",") != n - 1:
+    if chr(first) in "0123456789-":
+        data = _gather(b, s, e, ord(","))
+        if data.count(b",") != n - 1:
             raise _Bail
-        return _parse(joined.encode("ascii"), b",", "[" + joined + "]", n)
-    if _NAMES.fullmatch("\n".join(texts)) and _SPECIAL.isdisjoint(texts):
-        return texts
+        return _parse(data, b",", b"[" + data + b"]", n)
+    joined = _gather(b, s, e, ord("\n")).decode("ascii")
+    names = joined.split("\n")
+    if len(names) == n and _NAMES.fullmatch(joined) and _SPECIAL.isdisjoint(names):
+        return names
     raise _Bail
 
 
-def _parse(data: bytes, separators: bytes, as_json: str, n: int) -> np.ndarray:
+def _parse(data: bytes, separators: bytes, as_json: bytes, n: int) -> np.ndarray:
     """The `n` numbers of a column, checked (see `_NUMBER_BYTES`) and parsed by json."""
     if data.translate(None, _NUMBER_BYTES + separators):
         raise _Bail  # text, quotes, true/null...: not numbers only
@@ -429,10 +505,15 @@ LOAD_PATHS = {
 }
 
 
-def _loads(c: Checker, groups: list[_Group]) -> list[LoadSpec]:
+def _loads(c: Checker, groups: list[_Group]) -> LoadTable:
     """Force and torque loads with constant components; `_Bail` for anything else."""
     n = sum(len(g.index) for g in groups)
-    out: list[LoadSpec | None] = [None] * n
+    names_all: list[str] = [""] * n
+    types: list[str] = [""] * n
+    bodies: list[str] = [""] * n
+    frames_all: list[str] = [""] * n
+    vector = np.zeros((n, 3))
+    at_all = np.zeros((n, 3))
     dim = c.dim
     known = c.body_names
     seen: set[str] = set()
@@ -461,10 +542,64 @@ def _loads(c: Checker, groups: list[_Group]) -> list[LoadSpec]:
             else:
                 vec[:] = _numbers(g, ("torque",), 3)
             at = np.zeros_like(vec)
-        for k, nm, b, v, fr, a in zip(g.index.tolist(), names, on, vec, frames, at,
-                                      strict=True):
-            out[k] = LoadSpec(nm, kind, (b,), v, fr, (a,))
+        for k, nm, b, fr in zip(g.index.tolist(), names, on, frames, strict=True):
+            names_all[k], types[k], bodies[k], frames_all[k] = nm, kind, b, fr
+        vector[g.index] = vec
+        at_all[g.index] = at
     if len(seen) != n:
         raise _Bail  # a duplicate load name
-    return [ld for ld in out if ld is not None]
+    return LoadTable(names_all, types, bodies, frames_all, vector, at_all)
 
+
+
+def _joints(c: Checker, groups: list[_Group]) -> list[JointSpec]:
+    """Joints between bodies (no particles in a fast-path model), checked as
+    `validate._joints` checks them; `_Bail` for anything it would refuse."""
+    n = sum(len(g.index) for g in groups)
+    out: list[JointSpec | None] = [None] * n
+    dim = c.dim
+    types = cv.JOINT_COMPONENTS[dim]
+    known = c.body_names
+    seen: set[str] = set()
+    for g in groups:
+        cols = g.columns
+        if not set(cols) <= {("name",), ("type",), ("parent",), ("child",), ("at",),
+                             ("axis",), ("axis2",)}:
+            raise _Bail
+        names, kinds = _names(g, ("name",)), _names(g, ("type",))
+        parents, children = _names(g, ("parent",)), _names(g, ("child",))
+        if not (set(kinds) <= set(types) and all(b in known for b in children)
+                and all(b in known or b == cv.GROUND for b in parents)
+                and all(a != b for a, b in zip(parents, children, strict=True))):
+            raise _Bail
+        seen.update(names)
+        at = _pad3(_numbers(g, ("at",), dim))
+        axes: list[np.ndarray | None] = [None] * len(names)
+        if ("axis",) in cols:
+            axis = _unit(_pad3(_numbers(g, ("axis",), dim)))
+            axes = list(axis)
+        elif not set(kinds).isdisjoint(cv.AXIS_REQUIRED[dim]):
+            raise _Bail
+        axes2: list[np.ndarray | None] = [None] * len(names)
+        if ("axis2",) in cols or "universal" in kinds:
+            if not (("axis2",) in cols and ("axis",) in cols and set(kinds) == {"universal"}):
+                raise _Bail
+            axis2 = _unit(_pad3(_numbers(g, ("axis2",), dim)))
+            if not np.all(np.abs(np.einsum("ij,ij->i", axis, axis2)) <= 0.5e-6):
+                raise _Bail  # perpendicular (with a margin: near the limit, the located path)
+            axes2 = list(axis2)
+        for k, nm, typ, pa, ch, a, ax, ax2 in zip(g.index.tolist(), names, kinds, parents,
+                                                 children, at, axes, axes2, strict=True):
+            out[k] = JointSpec(nm, typ, pa, ch, a, ax, ax2)
+            c.joint_types.setdefault(nm, typ)
+    if len(seen) != n:
+        raise _Bail  # a duplicate joint name
+    return [j for j in out if j is not None]
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    """Rows of `v` normalised as `validate._axis` normalises one; `_Bail` for a zero one."""
+    norm = vec_norm(v)
+    if not np.all(norm >= 1e-12):
+        raise _Bail
+    return v / norm[:, None]

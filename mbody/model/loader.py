@@ -85,7 +85,15 @@ MAX_DEPTH = 64
 """Deepest nesting of mappings and sequences accepted."""
 MAX_NODES = 1_000_000
 """Most keys and values read from one file (each costs a few microseconds and a few
-hundred bytes with its line mark): over three times a 10 000-body model."""
+hundred bytes with its line mark): over 1.5 times a 10 000-body model. A file larger
+than `MAX_BYTES` (read only with a raised size limit) may hold more: `value_limit`."""
+
+
+def value_limit(size: int) -> int:
+    """Most keys and values read from a text of `size` characters: `MAX_NODES`; for a text
+    larger than `MAX_BYTES` (read only when the caller raised the size limit), one per 8
+    characters (a model file written by ``yaml.dump`` holds one per 12 or 13)."""
+    return MAX_NODES if size <= MAX_BYTES else max(MAX_NODES, size // 8)
 
 Path_ = tuple[str | int, ...]
 
@@ -293,7 +301,7 @@ def dotted(path: Path_) -> str:
 def load_text(text: str, file: str = "<string>") -> Document:
     """Parse YAML text into a `Document`; raise `ModelError` on any YAML-level problem."""
     doc = Document(None, file)
-    builder = _Builder(doc)
+    builder = _Builder(doc, value_limit(len(text)))
     bad = _NON_PRINTABLE.search(text)
     if bad:  # PyYAML's reader would say so with a character offset, not a line
         at = bad.start()
@@ -422,8 +430,8 @@ def read_file(path: str | os.PathLike[str], max_bytes: int | None = None) -> str
         else:
             if getattr(os, "O_NONBLOCK", 0):
                 os.set_blocking(fd, True)
-            with os.fdopen(fd, "rb", closefd=False) as f:  # bounded: /proc files say size 0
-                raw = f.read(max_bytes + 1)
+            with os.fdopen(fd, "rb", closefd=False) as f:
+                raw = _read_bounded(f, max_bytes + 1, os.fstat(fd).st_size)
     except OSError as exc:
         raise refuse(f"cannot read the file: {exc.strerror}") from None
     finally:
@@ -440,6 +448,28 @@ def read_file(path: str | os.PathLike[str], max_bytes: int | None = None) -> str
                                 f"0x{raw[exc.start]:02x} ({exc.reason}); save the file "
                                 "as UTF-8")]) from None
     return text
+
+
+def _read_bounded(f: Any, limit: int, size: int) -> bytes:
+    """Up to `limit` bytes of `f`, whose size is said to be `size`.
+
+    ``f.read(limit)`` would allocate `limit` bytes up front (32 MiB for any model); the
+    said size (plus one byte, to see growth) is read first, then any more in chunks,
+    since some files say less than they hold (/proc files say 0).
+    """
+    first = min(limit, size + 1)
+    raw = f.read(first)
+    if len(raw) < first:
+        return raw
+    chunks = [raw]
+    total = len(raw)
+    while total < limit:
+        chunk = f.read(min(1 << 20, limit - total))
+        if not chunk:
+            break
+        chunks.append(chunk)
+        total += len(chunk)
+    return b"".join(chunks)
 
 
 def _file_kind(mode: int) -> str:
@@ -511,8 +541,9 @@ _KEYNODE = object()  # a refused list or mapping used as a key is being read
 
 
 class _Builder:
-    def __init__(self, doc: Document):
+    def __init__(self, doc: Document, max_nodes: int = MAX_NODES):
         self.doc = doc
+        self.max_nodes = max_nodes
         self.issues: list[Issue] = []
         self.anchors: dict[str, tuple[Any, int]] = {}
         self.expanded = 0
@@ -539,11 +570,11 @@ class _Builder:
             if t is ScalarEvent or t is MappingStartEvent or t is SequenceStartEvent \
                     or t is AliasEvent:
                 nodes += 1
-                if nodes > MAX_NODES:
-                    limit = f"{MAX_NODES:_}".replace("_", " ")
+                if nodes > self.max_nodes:
+                    limit = f"{self.max_nodes:_}".replace("_", " ")
                     self._fatal(ev.start_mark, (), f"the file holds more than {limit} values "
                                 "(keys, numbers, lists...), the most that is read (a "
-                                "10 000-body model holds about 300 000)")
+                                "10 000-body model holds about 650 000)")
                 if stack:
                     f = stack[-1]
                     if f.is_map and f.key is _NOKEY:

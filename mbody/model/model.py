@@ -9,7 +9,8 @@ world x-y plane (see `conventions`).
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass, field, replace
+from collections.abc import Iterable
+from dataclasses import dataclass, field, fields, replace
 from functools import cached_property
 from typing import Any
 
@@ -23,7 +24,7 @@ from mbody.model.expressions import Expression, ExpressionTable
 from mbody.model.fast import fast_spec
 from mbody.model.graph import body_graph
 from mbody.model.loader import Document, load_text, read_file
-from mbody.model.validate import Spec, validate
+from mbody.model.validate import LoadSpec, LoadTable, Spec, validate
 
 
 def _ro(a: np.ndarray) -> np.ndarray:
@@ -415,7 +416,9 @@ def load(source: str | os.PathLike[str] | dict, *, max_bytes: int | None = None)
     if isinstance(source, dict):
         return Model.from_spec(validate(Document(source, "<dict>")))
     text = read_file(source, max_bytes)
-    return loads(text, str(source))
+    spec = fast_spec(text, str(source)) or validate(load_text(text, str(source)))
+    del text  # before the arrays are built: the text is the largest thing held
+    return Model.from_spec(spec)
 
 
 def loads(text: str, file: str = "<string>") -> Model:
@@ -442,25 +445,15 @@ def _build(spec: Spec) -> Model:
     initial = State(_ro(t.position.reshape(n, 3)), _ro(t.quaternion.reshape(n, 4)),
                     _ro(t.velocity.reshape(n, 3)), _ro(t.omega.reshape(n, 3)))
     # Views of the read-only J: one array, not n small copies.
-    bodies = {nm: Body(nm, i, m, J[i], shape, color, p) for i, (nm, m, shape, color, p)
-              in enumerate(zip(names, mass.tolist(), t.shape, t.color,
-                               t.particle.tolist(), strict=True))}
+    bodies = dict(zip(names, _records(Body, zip(
+        names, range(n), mass.tolist(), J, t.shape, t.color, t.particle.tolist(),
+        strict=True)), strict=True))
     particle = {names[i] for i in np.flatnonzero(t.particle)}
 
-    loads = tuple(Load(ld.name, ld.type, ld.bodies, ld.vector, ld.frame, ld.at,
-                       ld.stiffness, ld.rest_length, ld.damping, dict(ld.expressions))
-                  for ld in spec.loads)
-    point = [ld for ld in spec.loads if ld.type in ("force", "torque")]
-    forces = ForceTable(
-        tuple(ld.name for ld in point),
-        np.array([idx[ld.bodies[0]] for ld in point], dtype=np.intp),
-        _ro(np.array([ld.vector for ld in point]).reshape(-1, 3)),
-        np.array([ld.frame == "body" for ld in point], dtype=bool),
-        _ro(np.array([ld.at[0] for ld in point]).reshape(-1, 3)),
-        np.array([ld.type == "torque" for ld in point], dtype=bool),
-        ExpressionTable.build([(row, k, e) for row, ld in enumerate(point)
-                               for k, e in ld.expressions.items()]),
-    )
+    if spec.load_table is not None:
+        loads, forces = _point_loads(spec.load_table, idx)
+    else:
+        loads, forces = _loads(spec.loads, idx)
     sp = [ld for ld in spec.loads if ld.type == "spring"]
     springs = SpringTable(
         tuple(ld.name for ld in sp),
@@ -473,77 +466,144 @@ def _build(spec: Spec) -> Model:
         _ro(np.array([ld.damping for ld in sp], dtype=float)),
     )
 
-    R0 = initial.W_R_B
-    joints = []
-    rows: dict[str, list] = {k: [] for k in ("labels", "joint", "parent", "child", "axis",
-                                              "P_E", "B_r_child", "C_axis2", "B_r_parent",
-                                              "P_E3", "C_E3", "rot_kind", "link",
-                                              "particle_parent", "length")}
-    for jn, js in enumerate(spec.joints):
-        kind = js.particle_joint
-        comps = (cv.PARTICLE_COMPONENTS[spec.dimension][js.type][kind] if kind
-                 else cv.JOINT_COMPONENTS[spec.dimension][js.type])
-        W_E0 = (joint_frame_planar(js.axis) if spec.dimension == cv.PLANAR
-                else joint_frame_spatial(js.axis))
-        joints.append(Joint(js.name, js.type, js.parent, js.child, _ro(js.at), _ro(W_E0),
-                            comps, js.axis, js.axis2, kind))
-        p, c = idx.get(js.parent, -1), idx[js.child]
-        P_E = W_E0 if p < 0 else R0[p].T @ W_E0  # joint frame fixed in the parent
-        B_r_child = R0[c].T @ (js.at - initial.position[c])
-        C_axis2 = R0[c].T @ js.axis2 if js.axis2 is not None else np.zeros(3)
-        B_r_parent = js.at if p < 0 else R0[p].T @ (js.at - initial.position[p])
-        # a particle end is attached at the particle itself (no offset, no moment)
-        if js.child in particle:
-            B_r_child = np.zeros(3)
-        if js.parent in particle:
-            B_r_parent = np.zeros(3)
-        length = 0.0
-        if kind == "link":  # attachment points: the particle(s), else the joint point
-            P_c = initial.position[c] + R0[c] @ B_r_child
-            P_p = B_r_parent if p < 0 else initial.position[p] + R0[p] @ B_r_parent
-            length = float(np.linalg.norm(P_c - P_p))
-        C_E = R0[c].T @ W_E0
-        free_turn = js.type in ("revolute", "cylindrical")
-        for comp in comps:
-            k = (6 if comp == "Mt" else cv.LINK_AXIS if comp == cv.LINK
-                 else cv.COMPONENTS.index(comp))
-            rows["link"].append(k == cv.LINK_AXIS)
-            rows["particle_parent"].append(js.parent in particle)
-            rows["length"].append(length if k == cv.LINK_AXIS else 0.0)
-            rows["labels"].append(f"{js.name}.{comp}")
-            rows["joint"].append(jn)
-            rows["parent"].append(p)
-            rows["child"].append(c)
-            rows["axis"].append(k)
-            # Mt's direction is recomputed from both bodies; store axis (z) for it.
-            rows["P_E"].append(P_E[:, 2] if k == 6 else P_E[:, k % 3])
-            rows["B_r_child"].append(B_r_child)
-            rows["C_axis2"].append(C_axis2)
-            rows["B_r_parent"].append(B_r_parent)
-            rows["P_E3"].append(P_E)
-            rows["C_E3"].append(C_E)
-            rows["rot_kind"].append(0 if k < 3 else 3 if k == 6 else 1 if free_turn else 2)
-    table = ReactionTable(
-        tuple(rows["labels"]),
-        np.array(rows["joint"], dtype=np.intp),
-        np.array(rows["parent"], dtype=np.intp),
-        np.array(rows["child"], dtype=np.intp),
-        np.array(rows["axis"], dtype=np.intp),
-        _ro(np.array(rows["P_E"]).reshape(-1, 3)),
-        _ro(np.array(rows["B_r_child"]).reshape(-1, 3)),
-        _ro(np.array(rows["C_axis2"]).reshape(-1, 3)),
-        _ro(np.array(rows["B_r_parent"]).reshape(-1, 3)),
-        _ro(np.array(rows["P_E3"]).reshape(-1, 3, 3)),
-        _ro(np.array(rows["C_E3"]).reshape(-1, 3, 3)),
-        np.array(rows["rot_kind"], dtype=np.intp),
-        np.array(rows["link"], dtype=bool),
-        np.array(rows["particle_parent"], dtype=bool),
-        _ro(np.array(rows["length"], dtype=float)),
-    )
+    joints, table = _joint_tables(spec, idx, initial, particle)
     return Model(spec.name, spec.file, spec.dimension, names, mass, J, _ro(J_inv),
                  _ro(spec.gravity), initial, bodies, loads, tuple(joints), forces, springs,
                  table, dict(spec.reactions), spec.description, tuple(spec.warnings),
                  dict(spec.reaction_expressions))
+
+
+def _loads(specs: list[LoadSpec], idx: dict[str, int]) -> tuple[tuple[Load, ...], ForceTable]:
+    """The loads of the located path, and the force table of its point loads."""
+    loads = tuple(Load(ld.name, ld.type, ld.bodies, ld.vector, ld.frame, ld.at,
+                       ld.stiffness, ld.rest_length, ld.damping, dict(ld.expressions))
+                  for ld in specs)
+    point = [ld for ld in specs if ld.type in ("force", "torque")]
+    forces = ForceTable(
+        tuple(ld.name for ld in point),
+        np.array([idx[ld.bodies[0]] for ld in point], dtype=np.intp),
+        _ro(np.array([ld.vector for ld in point]).reshape(-1, 3)),
+        np.array([ld.frame == "body" for ld in point], dtype=bool),
+        _ro(np.array([ld.at[0] for ld in point]).reshape(-1, 3)),
+        np.array([ld.type == "torque" for ld in point], dtype=bool),
+        ExpressionTable.build([(row, k, e) for row, ld in enumerate(point)
+                               for k, e in ld.expressions.items()]),
+    )
+    return loads, forces
+
+
+def _point_loads(t: LoadTable, idx: dict[str, int]) -> tuple[tuple[Load, ...], ForceTable]:
+    """The fast path's loads (force and torque, constant), and their force table."""
+    vector, at = _ro(t.vector), _ro(t.at)
+    k = len(t.names)
+    loads = tuple(_records(Load, zip(
+        t.names, t.types, [(b,) for b in t.bodies], vector, t.frames, [(a,) for a in at],
+        [0.0] * k, [0.0] * k, [0.0] * k, [{} for _ in range(k)], strict=True)))
+    forces = ForceTable(tuple(t.names), np.array([idx[b] for b in t.bodies], dtype=np.intp),
+                        vector, np.array([f == "body" for f in t.frames], dtype=bool), at,
+                        np.array([typ == "torque" for typ in t.types], dtype=bool),
+                        ExpressionTable.build([]))
+    return loads, forces
+
+
+def _joint_tables(spec: Spec, idx: dict[str, int], initial: State, particle: set[str]
+                  ) -> tuple[tuple[Joint, ...], ReactionTable]:
+    """The joints and their reaction table, computed for all joints at once.
+
+    Per joint: the joint frame W_E0 at the initial pose (one call of the contract's rule
+    per distinct axis), then the frame and the joint point in each body's axes,
+    ``P_E = R_p^T W_E0``, ``B_r = R^T (at - x)``; then one row per reaction component.
+    """
+    js_all = spec.joints
+    nj = len(js_all)
+    planar = spec.dimension == cv.PLANAR
+    frames: dict[bytes | None, np.ndarray] = {}
+
+    def frame(axis: np.ndarray | None) -> np.ndarray:
+        key = None if axis is None else np.asarray(axis, float).tobytes()
+        if key not in frames:
+            frames[key] = joint_frame_planar(axis) if planar else joint_frame_spatial(axis)
+        return frames[key]
+
+    W_E0 = np.array([frame(js.axis) for js in js_all]).reshape(nj, 3, 3)
+    at = np.array([js.at for js in js_all], dtype=float).reshape(nj, 3)
+    p = np.array([idx.get(js.parent, -1) for js in js_all], dtype=np.intp)
+    c = np.array([idx[js.child] for js in js_all], dtype=np.intp)
+    ground = p < 0
+    R0 = initial.W_R_B
+    x0 = initial.position
+    # the world frame stands in for ground: I @ v is v exactly
+    Rp = np.where(ground[:, None, None], np.eye(3), R0[p] if nj else np.zeros((0, 3, 3)))
+    xp = np.where(ground[:, None], 0.0, x0[p] if nj else np.zeros((0, 3)))
+    Rc, xc = R0[c], x0[c]
+    RpT, RcT = Rp.transpose(0, 2, 1), Rc.transpose(0, 2, 1)
+    P_E = RpT @ W_E0  # joint frame fixed in the parent (the world for ground)
+    C_E = RcT @ W_E0
+    B_r_child = (RcT @ (at - xc)[:, :, None])[:, :, 0]
+    B_r_parent = np.where(ground[:, None], at, (RpT @ (at - xp)[:, :, None])[:, :, 0])
+    axis2 = np.array([js.axis2 if js.axis2 is not None else np.zeros(3) for js in js_all],
+                     dtype=float).reshape(nj, 3)
+    C_axis2 = (RcT @ axis2[:, :, None])[:, :, 0]
+    # a particle end is attached at the particle itself (no offset, no moment)
+    p_particle = np.array([js.parent in particle for js in js_all], dtype=bool)
+    c_particle = np.array([js.child in particle for js in js_all], dtype=bool)
+    B_r_child[c_particle] = 0.0
+    B_r_parent[p_particle] = 0.0
+    kinds = [js.particle_joint for js in js_all]
+    link = np.array([k == "link" for k in kinds], dtype=bool)
+    length = np.zeros(nj)
+    if link.any():  # attachment points: the particle(s), else the joint point
+        P_c = xc + (Rc @ B_r_child[:, :, None])[:, :, 0]
+        P_p = np.where(ground[:, None], B_r_parent,
+                       xp + (Rp @ B_r_parent[:, :, None])[:, :, 0])
+        length[link] = np.linalg.norm((P_c - P_p)[link], axis=1)
+
+    comps = [cv.PARTICLE_COMPONENTS[spec.dimension][js.type][k] if k
+             else cv.JOINT_COMPONENTS[spec.dimension][js.type]
+             for js, k in zip(js_all, kinds, strict=True)]
+    ro_at, ro_W = _ro(at), _ro(W_E0)
+    joints = tuple(Joint(js.name, js.type, js.parent, js.child, ro_at[j], ro_W[j], comps[j],
+                         js.axis, js.axis2, kinds[j]) for j, js in enumerate(js_all))
+    counts = np.array([len(cs) for cs in comps], dtype=np.intp)
+    row_joint = np.repeat(np.arange(nj, dtype=np.intp), counts)
+    # Mt's direction is recomputed from both bodies; its column stores axis z.
+    axis = np.array([6 if comp == "Mt" else cv.LINK_AXIS if comp == cv.LINK
+                     else cv.COMPONENTS.index(comp) for cs in comps for comp in cs],
+                    dtype=np.intp)
+    free_turn = np.array([js.type in ("revolute", "cylindrical") for js in js_all],
+                         dtype=bool)[row_joint]
+    rot_kind = np.where(axis < 3, 0, np.where(axis == 6, 3, np.where(free_turn, 1, 2)))
+    column = np.where(axis == 6, 2, axis % 3)
+    table = ReactionTable(
+        tuple(f"{js.name}.{comp}" for js, cs in zip(js_all, comps, strict=True) for comp in cs),
+        row_joint, p[row_joint], c[row_joint], axis,
+        _ro(P_E[row_joint, :, column].reshape(-1, 3)),
+        _ro(B_r_child[row_joint]), _ro(C_axis2[row_joint]), _ro(B_r_parent[row_joint]),
+        _ro(P_E[row_joint]), _ro(C_E[row_joint]), rot_kind.astype(np.intp),
+        axis == cv.LINK_AXIS, p_particle[row_joint],
+        _ro(np.where(axis == cv.LINK_AXIS, length[row_joint], 0.0)),
+    )
+    return joints, table
+
+
+def _records(cls: type, rows: Iterable[tuple[Any, ...]]) -> list[Any]:
+    """Instances of the frozen dataclass `cls`, each from a tuple of all its fields.
+
+    A frozen dataclass's ``__init__`` sets each field through ``object.__setattr__``;
+    filling the instance's ``__dict__`` at once is about 4x faster, which counts for the
+    10^4-10^5 bodies and loads of a large model (2-3 µs each otherwise). The class must
+    take every field from the tuple: no defaults, no ``__post_init__``, no slots.
+    """
+    names = [f.name for f in fields(cls)]
+    if hasattr(cls, "__post_init__") or hasattr(cls, "__slots__"):
+        return [cls(*row) for row in rows]
+    new = object.__new__
+    out = []
+    for row in rows:
+        obj: Any = new(cls)
+        obj.__dict__.update(zip(names, row, strict=True))
+        out.append(obj)
+    return out
 
 
 def _names(names, most: int = 5) -> str:

@@ -160,6 +160,26 @@ class BodyTable:
                    [b.shape for b in bodies], [b.color for b in bodies])
 
 
+@dataclass
+class LoadTable:
+    """Force and torque loads with constant components as arrays, in file order (the
+    fast path gives this instead of a `LoadSpec` each): names, types ('force' or
+    'torque'), body names, frames; vector: (k, 3) components in the frame; at: (k, 3)
+    point of application, body axes."""
+
+    names: list[str]
+    types: list[str]
+    bodies: list[str]
+    frames: list[str]
+    vector: np.ndarray
+    at: np.ndarray
+
+
+def vec_norm(v: np.ndarray) -> np.ndarray:
+    """‖v‖ of 3-vectors over the last axis, summed in the order x, y, z (see `quat_norm`)."""
+    return np.sqrt((v[..., 0] * v[..., 0] + v[..., 1] * v[..., 1]) + v[..., 2] * v[..., 2])
+
+
 def quat_norm(q: np.ndarray) -> np.ndarray:
     """‖q‖ over the last axis, summed in the order w, x, y, z.
 
@@ -187,6 +207,8 @@ class Spec:
     """Known reaction values given as expressions of t (their t = 0 value is in reactions)."""
     body_table: BodyTable | None = None
     """The bodies as arrays; the fast path gives only this (and `bodies` empty)."""
+    load_table: LoadTable | None = None
+    """The fast path's loads (then `loads` is empty): force and torque loads only."""
 
     def table(self) -> BodyTable:
         """The bodies as arrays, from `body_table` or else from `bodies`."""
@@ -502,16 +524,19 @@ def header(c: Checker) -> tuple[str, str, np.ndarray]:
     return str(name), description, gravity
 
 
-def rest(c: Checker, bodies: list[BodySpec], loads: list[LoadSpec] | None
+def rest(c: Checker, bodies: list[BodySpec], loads: list[LoadSpec] | None,
+         joints: list[JointSpec] | None = None
          ) -> tuple[list[LoadSpec], list[JointSpec], dict[str, float], dict[str, Expression]]:
-    """Check loads (unless given), joints and reactions, after the bodies (whose names are
-    in ``c.body_names``); raise `ModelError` if anything was found, in file order."""
+    """Check loads and joints (unless given: the fast path's) and reactions, after the
+    bodies (whose names are in ``c.body_names``); raise `ModelError` if anything was
+    found, in file order."""
     data = c.doc.data
     # A body with a bad mass is still a body: references to it are not problems too.
     names = c.body_names
     if loads is None:
         loads = _loads(c, data.get("loads"), names)
-    joints = _joints(c, data.get("joints"), names, bodies)
+    if joints is None:
+        joints = _joints(c, data.get("joints"), names, bodies)
     reaction_expressions: dict[str, Expression] = {}
     reactions = _reactions(c, data.get("reactions"), joints, reaction_expressions)
     if c.issues:  # in file order, as an editor goes through them
@@ -1048,7 +1073,7 @@ def _axis(c: Checker, path: Path_, value: Any) -> np.ndarray | None:
     a = c.vec3(path, value)
     if a is None:
         return None
-    n = float(np.linalg.norm(a))
+    n = float(vec_norm(a))
     if n < 1e-12:
         c.err(path, "the axis is the zero vector", "give a direction, such as [0, 0, 1]")
         return None
