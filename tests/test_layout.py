@@ -48,3 +48,12 @@ def test_an_old_module_path_is_the_new_module_with_a_warning(old, new):
         module = importlib.import_module(f"mbody.{old}")
     assert module is importlib.import_module(f"mbody.{new}")
     assert module.__spec__.name == f"mbody.{new}"
+
+
+def test_the_public_api_has_numpydoc_docstrings():
+    """Every object docs/reference.md renders documents its parameters and returns
+    (numpydoc's validator), so the generated reference cannot drift from the code."""
+    pytest.importorskip("numpydoc")
+    p = subprocess.run([sys.executable, str(ROOT / "tools" / "check_docstrings.py")],
+                       capture_output=True, text=True, timeout=300, cwd=ROOT)
+    assert p.returncode == 0, p.stdout + p.stderr

@@ -37,11 +37,18 @@ def _ro(a: np.ndarray) -> np.ndarray:
 class State:
     """Positions and velocities of all bodies; every array has a leading body axis.
 
-    position: (n, 3) mass centres, world frame [m]
-    quaternion: (n, 4) body-to-world rotations W_R_B, [w, x, y, z]
-    velocity: (n, 3) mass-centre velocities, world frame [m/s]
-    omega: (n, 3) angular velocities, body axes [rad/s]
-    t: time [s] (for time-dependent loads)
+    Parameters
+    ----------
+    position : (n, 3) array
+        Mass centres, world axes (m).
+    quaternion : (n, 4) array
+        Body-to-world rotations ``W_R_B`` as unit quaternions, ``[w, x, y, z]``.
+    velocity : (n, 3) array
+        Mass-centre velocities, world axes (m/s).
+    omega : (n, 3) array
+        Angular velocities, body axes (rad/s).
+    t : float, optional
+        Time (s), for loads and known reactions that vary in time.
     """
 
     position: np.ndarray
@@ -56,12 +63,41 @@ class State:
         return quat_to_matrix(self.quaternion)
 
     def replace(self, **changes: Any) -> State:
+        """A copy with some fields changed, e.g. ``state.replace(t=1.0)``.
+
+        Parameters
+        ----------
+        **changes
+            Field name -> new value.
+
+        Returns
+        -------
+        State
+        """
         return replace(self, **changes)
 
     @classmethod
     def planar(cls, position: np.ndarray, angle: np.ndarray, velocity: np.ndarray,
                angular_velocity: np.ndarray, t: float = 0.0) -> State:
-        """A planar state from (n, 2) positions, (n,) angles, (n, 2) velocities, (n,) θ̇."""
+        """A planar state: bodies in the world x-y plane, turning about z.
+
+        Parameters
+        ----------
+        position : (n, 2) array
+            Mass centres, world x and y (m).
+        angle : (n,) array
+            Rotation angles about z (rad).
+        velocity : (n, 2) array
+            Mass-centre velocities, world x and y (m/s).
+        angular_velocity : (n,) array
+            θ̇ about z (rad/s).
+        t : float, optional
+            Time (s).
+
+        Returns
+        -------
+        State
+        """
         n = len(angle)
         pos = np.zeros((n, 3))
         pos[:, :2] = position
@@ -77,7 +113,25 @@ class State:
 
 @dataclass(frozen=True)
 class Body:
-    """One rigid body as given in the file (a read-only view of the model's arrays)."""
+    """One rigid body as given in the file (a read-only view of the model's arrays).
+
+    Parameters
+    ----------
+    name : str
+        As in the file.
+    index : int
+        Its place in the stacking order (`Model.body_names`).
+    mass : float
+        kg.
+    inertia : (3, 3) array
+        About the mass centre, body axes (kg m²); planar: I_G at ``[2, 2]``.
+    shape : dict or None
+        The drawing shape from the file (``{box: [...]}``...).
+    color : str or None
+        The drawing colour from the file.
+    particle : bool, optional
+        A point mass (``inertia: 0``): translation rows only; `inertia` holds a dummy.
+    """
 
     name: str
     index: int
@@ -96,7 +150,28 @@ class Body:
 
 @dataclass(frozen=True)
 class Load:
-    """An applied load as given in the file: force, torque or spring."""
+    """An applied load as given in the file: force, torque or spring.
+
+    Parameters
+    ----------
+    name : str
+        As in the file.
+    type : str
+        ``force``, ``torque`` or ``spring``.
+    bodies : tuple of str
+        The body it acts on (a spring: its two ends, ``ground`` allowed).
+    vector : (3,) array or None
+        Force (N) or torque (N m) components in `frame`; None for a spring.
+    frame : str
+        ``world`` or ``body``: the axes `vector` is given in.
+    at : tuple of (3,) arrays
+        Attachment points, body axes from the mass centre (world for ground) (m).
+    stiffness, rest_length, damping : float, optional
+        A spring's k (N/m), rest length (m) and damping (N s/m).
+    expressions : dict, optional
+        Components of `vector` that vary in time (index 0-2 -> expression of t);
+        `vector` holds their values at t = 0.
+    """
 
     name: str
     type: str
@@ -114,7 +189,27 @@ class Load:
 
 @dataclass(frozen=True)
 class Joint:
-    """A joint: its reaction components and its frame at the initial pose."""
+    """A joint: its reaction components and its frame at the initial pose.
+
+    Parameters
+    ----------
+    name : str
+        As in the file; reaction labels are ``<name>.<component>``.
+    type : str
+        ``revolute``, ``prismatic``, ``spherical``, ``universal``, ``fixed``...
+    parent, child : str
+        The bodies it joins (``ground`` for the world).
+    at : (3,) array
+        The joint point at the initial pose, world axes (m).
+    W_E0 : (3, 3) array
+        The joint frame at the initial pose, axes as columns (world).
+    components : tuple of str
+        Its reaction components (``Fx``, ``Fy``, ``Mz``...), the columns of G in order.
+    axis, axis2 : (3,) array, optional
+        The joint's axis (and a universal joint's second axis), where it has one.
+    particle_joint : str, optional
+        With a particle at an end: ``pin`` or ``link`` (docs "Particles"); else "".
+    """
 
     name: str
     type: str
@@ -130,6 +225,7 @@ class Joint:
 
     @property
     def labels(self) -> list[str]:
+        """Its reaction labels, ``<name>.<component>``."""
         return [f"{self.name}.{k}" for k in self.components]
 
 
@@ -250,8 +346,40 @@ class JointTable:
 class Model:
     """A validated multibody model: bodies, applied loads and joints, as arrays.
 
-    mass: (n,) kg. J: (n, 3, 3) inertia tensors, body axes, about the mass centres.
-    J_inv: (n, 3, 3) their inverses. gravity: (3,) world, m/s^2.
+    Made by `mbody.load`; immutable, and holds no state but the file's `initial` one.
+
+    Parameters
+    ----------
+    name, file, description : str
+        The model's name, the file it came from, its description.
+    dimension : int
+        2 (planar) or 3 (spatial).
+    body_names : tuple of str
+        The stacking order (file order).
+    mass : (n,) array
+        kg.
+    J, J_inv : (n, 3, 3) arrays
+        Inertia tensors about the mass centres, body axes (kg m²), and their inverses.
+    gravity : (3,) array
+        World axes (m/s²).
+    initial : State
+        The state written in the file.
+    bodies : dict of str to Body
+        Each body by name.
+    loads : tuple of Load
+        The applied loads, in file order.
+    joints : tuple of Joint
+        The joints, in file order.
+    forces, springs : ForceTable, SpringTable
+        The loads as arrays, for the vectorised sums.
+    reaction_table : ReactionTable
+        One row per reaction component (a column of G), for the vectorised columns.
+    known_reactions : dict of str to float
+        Reaction values given in the file (at t = 0).
+    warnings : tuple of Issue, optional
+        What validation noticed without refusing the file.
+    known_expressions : dict, optional
+        Known reaction values that vary in time (label -> expression of t).
     """
 
     name: str
@@ -285,7 +413,18 @@ class Model:
                 "for its equations>")
 
     def known_reactions_at(self, t: float) -> dict[str, float]:
-        """The known reaction values at time `t` (`known_reactions` holds t = 0)."""
+        """The known reaction values at a time.
+
+        Parameters
+        ----------
+        t : float
+            Time (s); `known_reactions` holds t = 0.
+
+        Returns
+        -------
+        dict of str to float
+            Label -> value (N or N m).
+        """
         if not self.known_expressions:
             return dict(self.known_reactions)
         return {**self.known_reactions,
@@ -299,6 +438,7 @@ class Model:
 
     @property
     def rows_per_body(self) -> int:
+        """Rows of a rigid body in the stacked system: 3 planar, 6 spatial."""
         return cv.rows_per_body(self.dimension)
 
     @cached_property
@@ -308,6 +448,7 @@ class Model:
 
     @cached_property
     def has_particles(self) -> bool:
+        """Whether any body is a point mass (translation rows only)."""
         return bool(self.particle.any())
 
     @cached_property
@@ -334,7 +475,19 @@ class Model:
         return [full[i] for i in self.rows]
 
     def body_rows(self, i: int) -> np.ndarray:
-        """Indices into `coordinates` of body i's rows."""
+        """Where one body's equations are in the stacked system.
+
+        Parameters
+        ----------
+        i : int
+            The body's index (`Model.index`).
+
+        Returns
+        -------
+        (k,) int array
+            Indices into `coordinates` of its rows (3 planar, 6 spatial, fewer for a
+            particle).
+        """
         if not self.has_particles:
             rpb = self.rows_per_body
             return np.arange(i * rpb, (i + 1) * rpb)
@@ -360,6 +513,7 @@ class Model:
 
     @cached_property
     def joint_table(self) -> JointTable:
+        """One row per joint (its first reaction component's row of `reaction_table`)."""
         t = self.reaction_table
         first = np.unique(t.joint, return_index=True)[1] if len(t.joint) else np.zeros(0, int)
         return JointTable(t.parent[first], t.child[first], t.B_r_child[first],
@@ -374,6 +528,7 @@ class Model:
 
     @cached_property
     def index(self) -> dict[str, int]:
+        """Body name -> its index in the stacking order."""
         return {n: i for i, n in enumerate(self.body_names)}
 
     @cached_property
@@ -384,11 +539,23 @@ class Model:
 
     @cached_property
     def graph(self):  # -> networkx.MultiGraph; imported lazily, it is slow to import
+        """The body/joint graph: bodies and ``ground`` as nodes, joints as edges."""
 
         return body_graph(self)
 
     @classmethod
     def from_spec(cls, spec: Spec) -> Model:
+        """Build the arrays from a validated specification (what `load` does last).
+
+        Parameters
+        ----------
+        spec : Spec
+            The output of `mbody.model.validate.validate`.
+
+        Returns
+        -------
+        Model
+        """
         return _build(spec)
 
 
@@ -424,6 +591,19 @@ def load(source: str | os.PathLike[str] | dict, *, max_bytes: int | None = None)
 def loads(text: str, file: str = "<string>") -> Model:
     """Like `load`, from YAML text.
 
+    Parameters
+    ----------
+    text : str
+        The model file's content.
+    file : str, optional
+        The name used in error messages.
+
+    Returns
+    -------
+    Model
+
+    Notes
+    -----
     A large, regular file (block YAML as ``yaml.dump`` writes it) is read and checked in
     bulk (`mbody.model.fast`); anything that path does not handle, and every file with a
     problem, goes through the located path, which reports each problem where it is.
