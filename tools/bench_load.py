@@ -19,7 +19,8 @@ Columns, best of --repeat runs, in one process:
 - ``json.loads`` of the same document as JSON text (a floor for any reader that builds
   Python values), and the ratio mbody/json;
 - peak: the most memory ``mbody.load`` adds, over the file size, measured in a child
-  process (tracemalloc's peak; ru_maxrss's growth, which includes freed-but-kept pages);
+  process: tracemalloc's peak; and rss, the growth of the peak resident set (VmHWM) over
+  a child that does everything but the load (it includes pages freed but kept);
 - MuJoCo: ``mujoco.MjModel.from_xml_string`` of the same free bodies (MJCF, free
   joints, full inertia). Its compiler takes time that grows faster than n, so it is
   timed on at most --mujoco-limit bodies (marked †).
@@ -91,7 +92,11 @@ if how == "tracemalloc":
 else:
     if how == "rss":
         model = mbody.load(path, max_bytes=size + 1)
-    print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024)
+    try:  # ru_maxrss survives exec on Linux: a child of a large parent starts that large
+        with open("/proc/self/status") as f:
+            print(next(int(line.split()[1]) * 1024 for line in f if line.startswith("VmHWM")))
+    except OSError:
+        print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024)
 """
 
 
