@@ -37,22 +37,24 @@ import numpy as np
 
 from mbody import conventions as cv
 from mbody.errors import ModelError
-from mbody.model.loader import load_text, value_limit
-from mbody.model.validate import (
+from mbody.model.checks import (
     _TOL,
-    FRAMES,
     MAX_ANGLE,
     MAX_MAGNITUDE,
     MIN_MAGNITUDE,
-    BodyTable,
     Checker,
+    quat_norm,
+    vec_norm,
+)
+from mbody.model.loader import load_text, value_limit
+from mbody.model.validate import (
+    FRAMES,
+    BodyTable,
     JointSpec,
     LoadTable,
     Spec,
     header,
-    quat_norm,
     rest,
-    vec_norm,
 )
 
 MIN_BYTES = 64 * 1024

@@ -5,12 +5,15 @@ with the file, line and column of the offending key or value, and raises one
 `ModelError` listing them all. On success it returns a `Spec`: the file's content
 normalised (defaults filled in, angles in radians, planar vectors padded to 3-D) and
 ready for `Model` to turn into arrays. Hot paths downstream carry no checks.
+
+The checking primitives (one value: its type, range, length, name, with a did-you-mean)
+are `mbody.model.checks.Checker`'s; this module holds the contract's rules built from
+them: the top level, bodies, loads, joints, known reactions.
 """
 
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -19,6 +22,16 @@ import numpy as np
 from mbody import conventions as cv
 from mbody.equations.spatial import euler_to_quat, matrix_to_quat, shape_inertia
 from mbody.errors import Issue, ModelError, did_you_mean
+from mbody.model.checks import (
+    _TOL,
+    MIN_MAGNITUDE,
+    Checker,
+    _kind,
+    _quoted,
+    _show,
+    quat_norm,
+    vec_norm,
+)
 from mbody.model.expressions import (
     CHECK_SPAN,
     Expression,
@@ -27,7 +40,7 @@ from mbody.model.expressions import (
     compile_expression,
     first_nonfinite,
 )
-from mbody.model.loader import Document, Path_, Unrepresentable, dotted
+from mbody.model.loader import Document, Path_, Unrepresentable
 
 TOP_KEYS = ("model", "dimension", "gravity", "bodies", "loads", "joints", "reactions",
             "description")
@@ -47,36 +60,6 @@ SHAPES = {
 FRAMES = ("world", "body")
 DEFAULT_EULER_SEQUENCE = "ZYX"
 """Intrinsic z-y'-x'' (yaw, pitch, roll), scipy's upper-case convention."""
-
-_REQUIRED_HINTS = {
-    ("", "dimension"): "2 for a planar model, 3 for a spatial one",
-    ("", "bodies"): "a list of bodies, each with at least name, mass and inertia",
-    ("bodies", "name"): "a name without spaces or dots",
-    ("bodies", "mass"): "the mass in kg, a number > 0",
-    ("loads", "body"): "the name of the body it acts on",
-    ("loads", "force"): "the force components, N",
-    ("loads", "torque"): "the couple, N m",
-    ("loads", "bodies"): "the two ends: [body, body] or [ground, body]",
-    ("loads", "at"): "the two attachment points: body axes, or world for ground",
-    ("loads", "stiffness"): "N/m, a number >= 0",
-    ("joints", "name"): "a name without spaces or dots; reactions are <name>.Fx ...",
-    ("joints", "type"): "the kind of joint, such as revolute",
-    ("joints", "parent"): "a body name or ground",
-    ("joints", "child"): "a body name",
-    ("joints", "at"): "the joint point, world coordinates at the initial pose",
-}
-"""Hints for missing required keys, by (top-level section, key)."""
-_ANGLE = re.compile(r"\s*([-+]?[0-9.eE+-]+)\s*(deg|rad)\s*")
-_RATE = re.compile(r"\s*([-+]?[0-9.eE+-]+)\s*(deg/s|rad/s)\s*")
-_TOL = 1e-6
-MAX_MAGNITUDE = 1e100
-"""Largest number accepted: squares and triple products must stay finite in float64."""
-MIN_MAGNITUDE = 1e-100
-"""Smallest nonzero magnitude accepted: reciprocals (1/m, J^-1) and products of three such
-numbers stay normal doubles (a denormal mass such as 5e-324 has no reciprocal)."""
-MAX_ANGLE = 1e9
-"""Largest angle accepted, rad (about 160 million turns): a double resolves 1e9 to 1e-7
-rad, and sin/cos of a larger number say little about the pose meant."""
 
 
 @dataclass
@@ -175,22 +158,6 @@ class LoadTable:
     at: np.ndarray
 
 
-def vec_norm(v: np.ndarray) -> np.ndarray:
-    """‖v‖ of 3-vectors over the last axis, summed in the order x, y, z (see `quat_norm`)."""
-    return np.sqrt((v[..., 0] * v[..., 0] + v[..., 1] * v[..., 1]) + v[..., 2] * v[..., 2])
-
-
-def quat_norm(q: np.ndarray) -> np.ndarray:
-    """‖q‖ over the last axis, summed in the order w, x, y, z.
-
-    Written out, not ``np.linalg.norm``, so that one quaternion and a stack of them give
-    the same bits: the located path checks one body at a time, the fast path
-    (`mbody.model.fast`) all at once, and both must build the same `Model`.
-    """
-    return np.sqrt(((q[..., 0] * q[..., 0] + q[..., 1] * q[..., 1]) + q[..., 2] * q[..., 2])
-                   + q[..., 3] * q[..., 3])
-
-
 @dataclass
 class Spec:
     name: str
@@ -214,253 +181,6 @@ class Spec:
         """The bodies as arrays, from `body_table` or else from `bodies`."""
         return self.body_table if self.body_table is not None else BodyTable.from_specs(
             self.bodies)
-
-
-class Checker:
-    def __init__(self, doc: Document):
-        self.doc = doc
-        self.issues: list[Issue] = []
-        self.warnings: list[Issue] = []
-        self.dim = cv.SPATIAL
-        self.body_names: dict[str, int] = {}
-        """Every body with a valid name, even one with other problems (for references)."""
-        self.joint_types: dict[str, str] = {}
-        self.particle_joints: dict[str, str] = {}  # joint name -> "pin" or "link"
-        """Every joint with a valid name and type, even one with other problems."""
-        self.particles: set[str] = set()
-        """Names of the bodies given `inertia: 0` (point masses)."""
-
-    # -- reporting -------------------------------------------------------------------
-    def err(self, path: Path_, message: str, hint: str = "", *, key: bool = False) -> None:
-        line, col = self.doc.where(path, key=key)
-        self.issues.append(Issue(self.doc.file, line, col, dotted(path), message, hint))
-
-    def warn(self, path: Path_, message: str, hint: str = "") -> None:
-        line, col = self.doc.where(path)
-        self.warnings.append(Issue(self.doc.file, line, col, dotted(path), message, hint))
-
-    # -- shapes of values --------------------------------------------------------------
-    def mapping(self, path: Path_, value: Any, allowed: tuple[str, ...],
-                required: tuple[str, ...] = (), what: str = "a mapping") -> bool:
-        if not isinstance(value, dict):
-            self.err(path, f"expected {what}, got {_kind(value)}")
-            return False
-        meant = set()  # keys a misspelling points at: their "missing" would repeat it
-        for k in value:
-            if k not in allowed:
-                hint = did_you_mean(k, allowed)
-                if hint:
-                    meant.add(hint.split("'")[1])
-                self.err((*path, k), f"unknown key '{k}'",
-                         hint or f"expected one of: {', '.join(allowed)}", key=True)
-        for k in required:
-            if k not in value and k not in meant:
-                section = str(path[0]) if path else ""
-                self.err(path, f"missing required key '{k}'",
-                         _REQUIRED_HINTS.get((section, k), ""))
-        return True
-
-    def number(self, path: Path_, value: Any, *, positive: bool = False,
-               nonneg: bool = False, scale: bool = False) -> float | None:
-        """A finite number within ±`MAX_MAGNITUDE`; with `scale` (a mass or a size, which
-        is divided by) also 0 or at least `MIN_MAGNITUDE` in magnitude."""
-        if isinstance(value, Unrepresentable):  # 1e400, 1e-400, a 5 000-digit integer
-            self._out_of_range(path, value.shown, value.large)  # never silently 0 or inf
-            return None
-        if isinstance(value, bool) or not isinstance(value, int | float):
-            self.err(path, f"expected a number, got {_kind(value)}", _number_hint(value))
-            return None
-        try:
-            x = float(value)
-        except OverflowError:  # an integer with hundreds of digits (from a dictionary)
-            self._out_of_range(path, _show(value), True)
-            return None
-        if not math.isfinite(x):
-            self.err(path, f"expected a finite number, got {x}")
-            return None
-        if abs(x) > MAX_MAGNITUDE:
-            self._out_of_range(path, _show(value), True)
-            return None
-        if scale and 0 < abs(x) < MIN_MAGNITUDE:
-            self._too_small(path, _show(value))
-            return None
-        if positive and x <= 0:
-            self.err(path, f"expected a number > 0, got {_show(value)}")
-            return None
-        if nonneg and x < 0:
-            self.err(path, f"expected a number >= 0, got {_show(value)}")
-            return None
-        return x
-
-    def _out_of_range(self, path: Path_, shown: str, large: bool) -> None:
-        if large:
-            self.err(path, f"expected a number of magnitude at most {MAX_MAGNITUDE:g}, got "
-                     f"{shown}", "products of such numbers (r x F, m r^2) would overflow")
-        else:  # written in the file: not even a double holds it
-            self.err(path, f"expected a number a double can hold, got {shown}",
-                     "below about 5e-324 it would be read as 0; write 0 if that is meant")
-
-    def _too_small(self, path: Path_, shown: str) -> None:
-        self.err(path, f"expected a magnitude of at least {MIN_MAGNITUDE:g}, got {shown}",
-                 "masses and sizes are divided by; a smaller one would leave double precision")
-
-    def angle(self, path: Path_, value: Any, rate: bool = False) -> float | None:
-        """An angle (rad, or a string with deg/rad), or with `rate` an angular rate."""
-        if isinstance(value, str):
-            m = (_RATE if rate else _ANGLE).fullmatch(value)
-            unit = "deg/s" if rate else "deg"
-            if not m:
-                self.err(path, f"expected a number (radians{'/s' if rate else ''}) or a string "
-                         f"like '30 {unit}', got '{_show(value)}'", _angle_hint(value, unit))
-                return None
-            try:
-                written = float(m.group(1))
-            except ValueError:
-                self.err(path, f"'{_show(value)}' is not a number followed by a unit")
-                return None
-            y = self.number(path, Unrepresentable(m.group(1)) if math.isinf(written)
-                            else written)
-            if y is None:
-                return None
-            x = math.radians(y) if m.group(2).startswith("deg") else y
-        else:
-            z = self.number(path, value)
-            if z is None:
-                return None
-            x = z
-        if not rate and abs(x) > MAX_ANGLE:
-            self.err(path, f"expected an angle of at most {MAX_ANGLE:g} rad in magnitude, got "
-                     f"{x:g} rad", "a double cannot resolve the pose of a larger angle; "
-                     "reduce it by whole turns")
-            return None
-        return x
-
-    def vector(self, path: Path_, value: Any, n: int, *, angles: bool = False,
-               rates: bool = False, scale: bool = False) -> np.ndarray | None:
-        if not isinstance(value, list):
-            self.err(path, f"expected a list of {n} numbers, got {_kind(value)}")
-            return None
-        if len(value) != n:
-            self.err(path, f"expected {n} components, got {len(value)}",
-                     "planar models use 2-D vectors" if n == 2 and len(value) == 3 else
-                     "spatial models use 3-D vectors" if n == 3 and len(value) == 2 else "")
-            return None
-        out = []
-        for i, v in enumerate(value):
-            x = (self.angle((*path, i), v, rate=rates) if angles or rates
-                 else self.number((*path, i), v, scale=scale))
-            if x is None:
-                return None
-            out.append(x)
-        return np.array(out, dtype=float)
-
-    def vec3(self, path: Path_, value: Any, rates: bool = False) -> np.ndarray | None:
-        """A d-vector from the file, returned padded to 3-D (planar z = 0)."""
-        v = self.vector(path, value, self.dim, rates=rates)
-        if v is None:
-            return None
-        return np.append(v, 0.0) if self.dim == cv.PLANAR else v
-
-    def matrix3(self, path: Path_, value: Any) -> np.ndarray | None:
-        if not (isinstance(value, list) and len(value) == 3
-                and all(isinstance(r, list) for r in value)):
-            self.err(path, f"expected a 3x3 matrix (a list of 3 rows), got {_kind(value)}")
-            return None
-        rows = [self.vector((*path, i), r, 3) for i, r in enumerate(value)]
-        if any(r is None for r in rows):
-            return None
-        return np.array(rows)
-
-    def name(self, path: Path_, value: Any, what: str) -> str | None:
-        if not isinstance(value, str) or not value.strip():
-            self.err(path, f"expected a {what} name (text), got {_kind(value)}")
-            return None
-        if "." in value or any(c.isspace() for c in value):
-            self.err(path, f"the {what} name '{_show(value)}' may not contain '.' or spaces",
-                     "reaction labels are written <joint>.<component>")
-            return None
-        return value
-
-    def choice(self, path: Path_, value: Any, choices: tuple[str, ...], what: str) -> str | None:
-        if not isinstance(value, str) or value not in choices:
-            self.err(path, f"unknown {what} {_quoted(value)}",
-                     did_you_mean(value, choices) or f"expected one of: {', '.join(choices)}")
-            return None
-        return value
-
-    def body_ref(self, path: Path_, value: Any, names: dict[str, int],
-                 allow_ground: bool) -> str | None:
-        if isinstance(value, str) and (value in names or allow_ground and value == cv.GROUND):
-            return value  # the common case first: a dict lookup, not a list of every name
-        choices = list(names) + ([cv.GROUND] if allow_ground else [])
-        if value == cv.GROUND and not allow_ground:
-            self.err(path, "'ground' is not allowed here", "name a body of the model")
-            return None
-        hint = did_you_mean(value, choices) if isinstance(value, str) else ""
-        self.err(path, f"no body named {_quoted(value)}",
-                 hint or f"bodies are: {', '.join(choices[:12])}"
-                 + (" ..." if len(choices) > 12 else ""))
-        return None
-
-
-def _kind(value: Any) -> str:
-    if value is None:
-        return "nothing (null)"
-    if isinstance(value, bool):
-        return f"a boolean ({str(value).lower()})"
-    if isinstance(value, int | float | Unrepresentable):
-        return f"the number {_show(value)}"
-    if isinstance(value, str):
-        return f"the text '{_show(value)}'"
-    if isinstance(value, list):
-        return f"a list of {len(value)}"
-    if isinstance(value, dict):
-        return "a mapping"
-    return type(value).__name__
-
-
-_DECIMAL_COMMA = re.compile(r"\s*([-+]?\d+),(\d+)\s*")
-_WITH_UNIT = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*"
-                        r"([A-Za-zµ°][A-Za-z0-9µ°/^·²³ .-]*)")
-_ANGLE_WORDS = re.compile(r"\s*([-+]?[\d.eE+-]+)\s*(°|degrees?|degs|grad|radians?)(\s*/\s*s)?\s*",
-                          re.IGNORECASE)
-
-
-def _number_hint(value: Any) -> str:
-    """What was probably meant by text where a number goes: '1,5', '1.5 kg'."""
-    if not isinstance(value, str):
-        return ""
-    m = _DECIMAL_COMMA.fullmatch(value)
-    if m:
-        return f"a decimal comma? write {m.group(1)}.{m.group(2)}"
-    m = _WITH_UNIT.fullmatch(value)
-    if m and len(value) < 40:
-        return f"numbers are in SI units, written without the unit: {m.group(1)}"
-    return ""
-
-
-def _angle_hint(value: str, unit: str) -> str:
-    """'30°', '30 degrees' -> write '30 deg'."""
-    m = _ANGLE_WORDS.fullmatch(value)
-    if not m:
-        return _number_hint(value)
-    word = "rad" if m.group(2).lower().startswith("rad") else "deg"
-    return f"write '{m.group(1)} {word}{unit[3:]}'"
-
-
-def _quoted(value: Any) -> str:
-    """`value` as repr() shows it, cut short (text is quoted, numbers are not)."""
-    return repr(_show(value)) if isinstance(value, str) else _show(value)
-
-
-def _show(value: Any, limit: int = 60) -> str:
-    """`value` for a message: long text cut short, huge integers by their size."""
-    if isinstance(value, int) and not isinstance(value, bool) and abs(value) >= 10**15:
-        if value.bit_length() > 1000:  # beyond a double: its size says enough
-            return f"an integer of about {int(value.bit_length() * 0.30103) + 1} digits"
-        return f"{value:.6g}"
-    text = value if isinstance(value, str) else repr(value)
-    return text if len(text) <= limit else text[:limit - 3] + "..."
 
 
 def validate(doc: Document) -> Spec:
