@@ -380,6 +380,12 @@ def load_file(path: str | os.PathLike[str], max_bytes: int | None = None) -> Doc
     return load_text(read_file(path, max_bytes), str(path))
 
 
+def _size(n: int) -> str:
+    """A file size in MiB, with the exact bytes when under 1 MiB ("0.0 MiB" says nothing)."""
+    mib = f"{n / 2**20:.1f} MiB"
+    return mib if n >= 2**20 else f"{mib} ({n:,} bytes)"
+
+
 def read_file(path: str | os.PathLike[str], max_bytes: int | None = None) -> str:
     """The text of a model file, refusing files over `max_bytes` before reading them.
 
@@ -411,8 +417,9 @@ def read_file(path: str | os.PathLike[str], max_bytes: int | None = None) -> str
                      "model from a pipe: mbody check /dev/stdin < model.yaml)")
     more = "--max-bytes N on the command line, or mbody.load(path, max_bytes=N), reads more"
     if st.st_size > max_bytes:
-        raise refuse(f"the file is {st.st_size / 2**20:.1f} MiB; at most "
-                     f"{max_bytes / 2**20:.3g} MiB is read ({more})")
+        exact = f"{max_bytes:,} bytes; " if max_bytes < 2**20 else ""
+        raise refuse(f"the file is {_size(st.st_size)}; at most "
+                     f"{max_bytes / 2**20:.3g} MiB is read ({exact}{more})")
     try:  # never blocks in open(): a named pipe with no writer would wait forever there
         fd = os.open(p, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
     except OSError as exc:
