@@ -53,15 +53,8 @@ def __getattr__(name: str):
         value = getattr(_importlib.import_module(f"{__name__}.{_LAZY[name]}"), name)
         globals()[name] = value
         return value
-    if name in _moved.MOVED:  # an old flat module path, e.g. mbody.dynamics
-        return _importlib.import_module(f"{__name__}.{name}")
-    if not name.startswith("__"):  # a submodule not imported yet, e.g. mbody.solve
-        try:
-            return _importlib.import_module(f".{name}", __name__)
-        except ModuleNotFoundError as exc:
-            if exc.name != f"{__name__}.{name}":
-                raise
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    # a submodule not imported yet (mbody.solve), or an old flat path (mbody.dynamics)
+    return _moved.submodule(__name__, name)
 
 
 def __dir__() -> list[str]:
