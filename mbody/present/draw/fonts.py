@@ -51,8 +51,9 @@ class _Font:
         # char -> (index, advance, id, ink bottom, ink top; (inf, -inf) without ink)
         self.chars: dict[str, tuple[int, float, str, float, float]] = {}
         self.kern: dict[tuple[int, int], float] = {}
-        # matplotlib's line height (>= 3.10): linespacing × (ascender + descender) of
-        # the font's OS/2 (else hhea) table, whatever the line holds
+        # matplotlib's line height (>= 3.11; 3.10 measured "lp"): linespacing ×
+        # (ascender + descender) of the font's OS/2 (else hhea) table, whatever the line
+        # holds
         self.line = _font_height(self.ft)
 
     def char(self, c: str) -> tuple[int, float, str, float, float]:
