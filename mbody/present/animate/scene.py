@@ -239,10 +239,11 @@ def build_scene(traj: Trajectory, model: Model, *, forces: bool = False,
         The commands in order, with each body's scene path.
     """
     traj_names = list(traj.body_names)
+    index = {nm: i for i, nm in enumerate(traj_names)}
     _check_match(traj, model)
     shown = list(traj_names if bodies is None else bodies)
     for name in shown:
-        if name not in traj_names:
+        if name not in index:
             hint = did_you_mean(name, traj_names)
             raise MbodyError(f"unknown body {name!r}: the trajectory has "
                              f"{', '.join(traj_names)}" + (f" ({hint})" if hint else ""))
@@ -255,7 +256,6 @@ def build_scene(traj: Trajectory, model: Model, *, forces: bool = False,
     out = _Commands(load_meshcat())
     g = out.g
     pos, quat = _internal(traj)
-    index = {nm: i for i, nm in enumerate(traj_names)}
     idx = [index[nm] for nm in shown]
     times = t - t[0]
     times.setflags(write=False)  # one array shared by every track
@@ -419,7 +419,8 @@ def _reaction_arrows(traj: Trajectory, model: Model, times: np.ndarray, extent: 
                          "joints, or a run saved before reactions were stored)")
     K, J = len(times), len(model.joints)
     t = model.reaction_table
-    order = [traj.reaction_labels.index(r) for r in model.reactions]
+    column = {r: i for i, r in enumerate(traj.reaction_labels)}
+    order = [column[r] for r in model.reactions]
     F, C, P = np.zeros((K, J, 3)), np.zeros((K, J, 3)), np.zeros((K, J, 3))
     for k in range(K):  # one vectorised evaluation per frame
         cols = reaction_columns(model, traj.state(k))

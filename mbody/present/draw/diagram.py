@@ -24,7 +24,7 @@ from mbody.present.draw.arrows import HEAD, Arrow, arrows, fmt, head
 from mbody.present.draw.fonts import layout
 from mbody.present.draw.labels import Label, place
 from mbody.present.draw.outline import circle, outline
-from mbody.present.draw.scene import Disc, Line, Panel, Poly, Scene, Text, Wedge
+from mbody.present.draw.scene import IN, Disc, Line, Panel, Poly, Scene, Text, Wedge
 from mbody.present.draw.style import (
     AXIS_COLOR,
     BODY_EDGE,
@@ -43,7 +43,6 @@ END_ON = 0.2
 """A spatial arrow whose page length is below END_ON times its 3-D length is drawn end-on:
 a ring with a dot (toward the eye) or a cross (away); its short shaft stays, for tools."""
 
-IN = 72.0  # points per inch
 
 
 def fbd_scene(fbd: FreeBodyDiagram, *, view: View = "iso", equations: bool = True,

@@ -10,13 +10,13 @@ import numpy as np
 
 from mbody import conventions as cv
 from mbody.conventions import APPLIED
-from mbody.present.draw.scene import Box, Line, Poly, Scene, Text
+from mbody.model.model import count
+from mbody.present.draw.scene import IN, Box, Line, Poly, Scene, Text
 from mbody.present.draw.style import COLORS
 
 if TYPE_CHECKING:
     from mbody.model.model import Model
 
-IN = 72.0
 
 
 def _layers(g: nx.MultiGraph, roots: list[str]) -> dict[str, tuple[float, float]]:
@@ -43,10 +43,6 @@ def _layers(g: nx.MultiGraph, roots: list[str]) -> dict[str, tuple[float, float]
                 pos[nd] = (x0 + (width - 1) * 1.2 + xs[nd], -1.7 * dd)
         x0 += width * 2.4 + 0.6
     return pos
-
-
-def _count(k: int, word: str) -> str:
-    return f"{k} {word if k == 1 else word[:-1] + 'ies' if word.endswith('y') else word + 's'}"
 
 
 def graph_scene(model: Model, topo: Any = None) -> Scene:
@@ -76,10 +72,10 @@ def graph_scene(model: Model, topo: Any = None) -> Scene:
     W, H = w_in * IN, h_in * IN
     sc = Scene(W, H)
     ax = sc.panel("graph", (0.01 * W, 0.01 * H, 0.98 * W, H - 0.8 * IN - 0.01 * H), lo, hi)
-    head = (f"body/joint graph of {model.name}: {_count(model.n, 'body')} + "
-            f"ground, {_count(len(model.joints), 'joint')}")
+    head = (f"body/joint graph of {model.name}: {count(model.n, 'body', 'bodies')} + "
+            f"ground, {count(len(model.joints), 'joint')}")
     if topo is not None:
-        head += (f"; {'a tree' if topo.is_tree else _count(topo.loops, 'closed loop')}, "
+        head += (f"; {'a tree' if topo.is_tree else count(topo.loops, 'closed loop')}, "
                  f"mobility {topo.mobility}")
     sc.title = head
     head = "\n".join(textwrap.wrap(head, int(w_in * 9)))

@@ -23,7 +23,7 @@ from matplotlib.transforms import Affine2D, Transform, offset_copy
 
 from mbody.errors import MbodyError
 from mbody.io.atomic import write_atomic
-from mbody.present.draw.scene import Disc, Item, Line, Poly, Scene, Wedge
+from mbody.present.draw.scene import IN, Disc, Item, Line, Poly, Scene, Wedge
 from mbody.present.draw.style import FORMATS
 from mbody.present.draw.svg import scene_svg
 
@@ -76,7 +76,7 @@ def scene_figure(scene: Scene) -> Figure:
     matplotlib.figure.Figure
     """
     W, H = scene.width, scene.height
-    fig = Figure(figsize=(W / 72, H / 72), dpi=100)
+    fig = Figure(figsize=(W / IN, H / IN), dpi=100)
     FigureCanvasAgg(fig)
     for p in scene.panels:
         x0, y0, w, h = p.rect
@@ -86,7 +86,7 @@ def scene_figure(scene: Scene) -> Figure:
         ax.set_ylim(float(p.lo[1]), float(p.hi[1]))
         for it in p.items:
             ax.add_artist(_artist(it, fig, ax.transData))  # listed in ax.lines, .texts...
-    points = Affine2D().scale(1 / 72) + fig.dpi_scale_trans
+    points = Affine2D().scale(1 / IN) + fig.dpi_scale_trans
     for it in scene.root.items:
         a = _artist(it, fig, points)
         if isinstance(a, MplText):  # in fig.texts, as fig.text() puts them

@@ -14,6 +14,9 @@ from typing import Literal
 
 import numpy as np
 
+IN = 72.0
+"""Points per inch: scenes are sized in points, figures in inches."""
+
 
 @dataclass(slots=True)
 class Line:
