@@ -325,3 +325,17 @@ def test_value_limit_grows_with_the_file():
 
     assert value_limit(1000) == value_limit(32 * 2**20) == MAX_NODES
     assert value_limit(100 * 2**20) == 100 * 2**20 // 8
+
+
+@pytest.mark.parametrize("tiny", ["0." + "0" * 400 + "1", "0." + "0" * 250 + "1e-99"])
+def test_a_number_that_underflows_through_its_zeros_is_refused_by_both_paths(tiny):
+    """A nonzero number below the smallest double is written with no three-digit exponent:
+    the fast path must not read it as 0 where the located path refuses it as too small."""
+    text = dump(free_bodies_spec(300))
+    i = text.index("position: [") + len("position: [")
+    text = text[:i] + tiny + text[text.index(",", i):]
+    assert fast.fast_spec(text, "m.yaml") is None
+    err = located(text)
+    assert isinstance(err, ModelError)
+    (issue,) = err.issues
+    assert "position" in issue.key and "1e+100" not in issue.message, issue.message

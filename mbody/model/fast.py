@@ -73,6 +73,10 @@ rounded conversion). Forms JSON refuses ('+1', '.5', '1.', '010', '1_000') go to
 located path, as do exponents of three digits (which may underflow to 0, or overflow;
 YAML keeps those as unrepresentable) and magnitudes beyond MAX_MAGNITUDE."""
 _EXPONENT_DIGITS = bytes.maketrans(b"123456789E+", b"000000000e-")
+_ZEROS = b"0" * 200
+"""A run of zeros this long goes to the located path: with an exponent of two digits at
+most, a nonzero number underflows to 0 only after some 224 zeros ("0.000...1e-99"), which
+YAML keeps as unrepresentable; repr never writes more than 4."""
 _NAMES = re.compile(r"[A-Za-z][A-Za-z0-9_-]*(?:\n[A-Za-z][A-Za-z0-9_-]*)*")
 _SPECIAL = frozenset(("null", "Null", "NULL", "true", "True", "TRUE", "false", "False",
                       "FALSE"))
@@ -368,7 +372,7 @@ def _parse(data: bytes, separators: bytes, as_json: bytes, n: int) -> np.ndarray
     if data.translate(None, _NUMBER_BYTES + separators):
         raise _Bail  # text, quotes, true/null...: not numbers only
     digits = data.translate(_EXPONENT_DIGITS)
-    if b"e000" in digits or b"e-000" in digits:
+    if b"e000" in digits or b"e-000" in digits or _ZEROS in data:
         raise _Bail
     try:
         values = np.array(json.loads(as_json), dtype=float)

@@ -32,6 +32,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
 from dataclasses import dataclass, field
+from decimal import Decimal
 from pathlib import Path
 from typing import Any
 
@@ -148,8 +149,9 @@ class Unrepresentable:
     @property
     def large(self) -> bool:
         """True beyond the largest double; False for a nonzero value below the smallest."""
-        mantissa, _, exponent = self.text.lower().partition("e")
-        return not exponent or int(exponent) > 0 or mantissa.strip("+-0.") == ""
+        # the decimal exponent of the leading digit, exact at any length ("0.<400 zeros>1"
+        # has no exponent and is tiny); only nonzero values are ever unrepresentable
+        return Decimal(self.text).adjusted() >= 0
 
     def __repr__(self) -> str:
         return self.shown
@@ -359,25 +361,6 @@ def _tab_at(text: str, mark) -> str:
 
 FIFO_WAIT = 1.0
 """Seconds a named pipe with no writer is given for one to appear before it is refused."""
-
-
-def load_file(path: str | os.PathLike[str], max_bytes: int | None = None) -> Document:
-    """Read and parse a model file, refusing files over `max_bytes` before reading them.
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-        The model file (or a pipe, see `read_file`).
-    max_bytes : int, optional
-        The largest file read (default `MAX_BYTES`, or `max_bytes_limit`'s); a larger
-        one is refused before it is read.
-
-    Returns
-    -------
-    Document
-        The file's values with their line marks.
-    """
-    return load_text(read_file(path, max_bytes), str(path))
 
 
 def _size(n: int) -> str:
