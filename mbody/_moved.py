@@ -37,6 +37,9 @@ public names; ``mbody.cli.main`` is still the command's entry point."""
 
 
 class _Alias(importlib.abc.MetaPathFinder, importlib.abc.Loader):
+    def __init__(self) -> None:
+        self._specs: dict[str, importlib.machinery.ModuleSpec | None] = {}
+
     def find_spec(self, fullname, path=None, target=None):
         old = fullname.removeprefix("mbody.")
         if not fullname.startswith("mbody.") or old not in MOVED:
@@ -48,16 +51,21 @@ class _Alias(importlib.abc.MetaPathFinder, importlib.abc.Loader):
         warnings.warn(f"{spec.name} moved to {new}; the old path goes in mbody 0.3",
                       DeprecationWarning, stacklevel=2)
         module = importlib.import_module(new)
-        self._spec = module.__spec__
+        self._specs[spec.name] = module.__spec__
         return module
 
     def exec_module(self, module: ModuleType) -> None:
-        module.__spec__ = self._spec  # the import system set the alias's spec on it
+        # the import system set the alias's spec on the real module: give its own back
+        alias = module.__spec__
+        assert alias is not None  # the import system has just set it
+        module.__spec__ = self._specs.pop(alias.name)
 
 
 def install() -> None:
     if not any(isinstance(f, _Alias) for f in sys.meta_path):
-        sys.meta_path.append(_Alias())
+        # first: a leftover folder of an old checkout (mbody/commands/) must not shadow
+        # an alias as an empty namespace package
+        sys.meta_path.insert(0, _Alias())
 
 
 def submodule(package: str, name: str) -> ModuleType:

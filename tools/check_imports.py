@@ -85,8 +85,9 @@ def imports(modules: dict[str, Path], slow: dict[str, bool]) -> list[Import]:
         def walk(node: ast.AST, in_function: bool, source=source, is_package=is_package):
             for child in ast.iter_child_nodes(node):
                 if isinstance(child, ast.If) and _is_type_checking(child):
-                    for other in child.orelse:
-                        walk(other, in_function)
+                    # the else branch runs: walk its statements themselves, not only
+                    # their children (an import directly under else: is one)
+                    walk(ast.Module(body=child.orelse, type_ignores=[]), in_function)
                     continue
                 if isinstance(child, ast.Import | ast.ImportFrom) and not in_function:
                     names = ([a.name for a in child.names] if isinstance(child, ast.Import)
@@ -103,10 +104,6 @@ def imports(modules: dict[str, Path], slow: dict[str, bool]) -> list[Import]:
     return out
 
 
-def _package_of(name: str) -> str:
-    return name.rpartition(".")[0]
-
-
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--verbose", action="store_true", help="list imports made in functions")
@@ -117,10 +114,9 @@ def main(argv: list[str] | None = None) -> int:
     g = nx.DiGraph()
     g.add_nodes_from(modules)
     for imp in found:
-        # importing mbody.x.y runs mbody.x's __init__ first: that is not a dependency of
-        # the importer on the package's other modules, so the edge goes to the module only
+        # importing mbody.x.y runs mbody.x's __init__ first, but the importer depends on
+        # mbody.x.y only: the edge goes to the module
         g.add_edge(imp.source, imp.target, at=imp)
-    # the packages' own __init__ files that import nothing of mbody stay out of cycles
     cycles = sorted(nx.simple_cycles(g), key=len)
     for cycle in cycles[:20]:
         print("import cycle:")
