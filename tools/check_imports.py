@@ -117,7 +117,12 @@ def main(argv: list[str] | None = None) -> int:
         # importing mbody.x.y runs mbody.x's __init__ first, but the importer depends on
         # mbody.x.y only: the edge goes to the module
         g.add_edge(imp.source, imp.target, at=imp)
-    cycles = sorted(nx.simple_cycles(g), key=len)
+    # one cycle per strongly connected knot names the loop to break; simple_cycles would
+    # list every loop (and on networkx 3.0 cannot rebuild a graph from its edge view)
+    cycles = sorted(
+        ([src for src, _ in nx.find_cycle(g.subgraph(knot))]
+         for knot in nx.strongly_connected_components(g) if len(knot) > 1),
+        key=len)
     for cycle in cycles[:20]:
         print("import cycle:")
         for src, dst in zip(cycle, cycle[1:] + cycle[:1], strict=True):
