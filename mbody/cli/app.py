@@ -20,7 +20,8 @@ from mbody.cli.common import EXIT_INPUT, EXIT_INTERNAL, EXIT_OK, EXIT_UNMET, byt
 from mbody.errors import MbodyError, ModelError, UnknownReactionsError, did_you_mean
 from mbody.model.loader import MAX_BYTES, max_bytes_limit
 
-COMMAND_MODULES = ("core", "export", "sim", "draw", "animate", "mechanism")
+COMMAND_MODULES = (
+    "core", "export", "sim", "draw", "animate", "mechanism", "verify", "interop")
 """Modules of `mbody.cli`; each has `register(subparsers)` adding its commands."""
 
 def build_parser() -> argparse.ArgumentParser:
