@@ -8,7 +8,8 @@ import inside a function is still a dependency, only a later one); imports under
 of each of its imports, and the exit code is 1.
 
 An import inside a function is kept only where it saves start-up time: the target loads
-a slow library (scipy, matplotlib, networkx, meshcat, numba, tqdm) when imported, or the
+a slow library (scipy, matplotlib, networkx, meshcat, numba, tqdm, sympy,
+mujoco, defusedxml, nbformat, nbclient) when imported, or the
 importer is a command module (`mbody.cli`: every command registers its arguments at
 start-up, and must not load what only another command uses). Any other import inside a
 function hides a dependency for nothing: it is listed, and the exit code is 1.
@@ -29,7 +30,8 @@ ROOT = Path(__file__).resolve().parent.parent
 PACKAGE = ROOT / "mbody"
 
 
-SLOW = ("scipy", "matplotlib", "networkx", "meshcat", "numba", "tqdm")
+SLOW = ("scipy", "matplotlib", "networkx", "meshcat", "numba", "tqdm", "sympy", "mujoco",
+        "defusedxml", "nbformat", "nbclient")
 """Libraries that take tens to hundreds of milliseconds to import."""
 
 
