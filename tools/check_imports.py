@@ -131,7 +131,8 @@ def main(argv: list[str] | None = None) -> int:
             imp = g.edges[src, dst]["at"]
             where = " (in a function)" if imp.in_function else ""
             print(f"  {modules[src].relative_to(ROOT)}:{imp.line}: {src} -> {dst}{where}")
-    eager = nx.DiGraph((i.source, i.target) for i in found if not i.in_function)
+    eager = nx.DiGraph()  # networkx 3.0 tries pandas on a generator passed to DiGraph()
+    eager.add_edges_from((i.source, i.target) for i in found if not i.in_function)
     eager.add_nodes_from(modules)
     slow = {m for m in modules if any(direct.get(d) for d in nx.descendants(eager, m) | {m})}
     late = [imp for imp in found if imp.in_function]
