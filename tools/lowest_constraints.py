@@ -1,10 +1,10 @@
 """Print a pip constraints file pinning every dependency of pyproject.toml to its floor.
 
     python tools/lowest_constraints.py [pyproject.toml] > lowest.txt
-    pip install -c lowest.txt -e .
+    pip install -c lowest.txt -e ".[symbolic]"
 
 pip has no "lowest versions" resolution; pinning each ``name>=X`` of
-``[project.dependencies]`` to ``name==X`` gives the oldest install pyproject allows, which
+``[project.dependencies]`` (and of the extras in `EXTRAS`) to ``name==X`` gives the oldest install pyproject allows, which
 .ci/run tests (so that a floor cannot silently stop being true). A dependency without a
 ``>=`` floor is an error: every one must say which oldest version works.
 """
@@ -20,9 +20,16 @@ ROOT = Path(__file__).resolve().parent.parent
 _FLOOR = re.compile(r"^\s*([A-Za-z0-9][A-Za-z0-9._-]*)\s*(\[[^\]]*\])?\s*>=\s*([0-9][^,;\s]*)")
 
 
+EXTRAS = ("symbolic",)
+"""Optional features tested at their floors too (`mbody verify`, `assemble --symbolic`)."""
+
+
 def floors(pyproject: Path = ROOT / "pyproject.toml") -> dict[str, str]:
-    """{name: oldest version} of the project's runtime dependencies."""
-    deps = tomllib.loads(pyproject.read_text())["project"]["dependencies"]
+    """{name: oldest version} of the runtime dependencies and of the `EXTRAS`."""
+    project = tomllib.loads(pyproject.read_text())["project"]
+    deps = list(project["dependencies"])
+    for extra in EXTRAS:
+        deps += project["optional-dependencies"][extra]
     out = {}
     for dep in deps:
         m = _FLOOR.match(dep)
