@@ -29,7 +29,7 @@ def floors(pyproject: Path = ROOT / "pyproject.toml") -> dict[str, str]:
     project = tomllib.loads(pyproject.read_text())["project"]
     deps = list(project["dependencies"])
     for extra in EXTRAS:
-        deps += project["optional-dependencies"][extra]
+        deps += project.get("optional-dependencies", {}).get(extra, [])
     out = {}
     for dep in deps:
         m = _FLOOR.match(dep)
