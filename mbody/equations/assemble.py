@@ -103,8 +103,12 @@ class ReactionValues(Mapping):
     def __len__(self) -> int:
         return len(self._labels)
 
-    def __repr__(self) -> str:
-        return repr(dict(self))
+    def __repr__(self) -> str:  # a dict's when short; a chain's 30 000 values are not
+        full = repr(dict(self)) if len(self) <= 12 else ""
+        if full and len(full) < 300:
+            return full
+        return (f"<ReactionValues: {len(self)} components (N; N m), "
+                f"{', '.join(self._labels[:4])}, ...; [label], dict(it), .array>")
 
 
 INCONSISTENT = 1e-8
@@ -188,6 +192,17 @@ class Solution:
         except ValueError:
             raise KeyError(f"no coordinate {label!r}; "
                            f"{did_you_mean(label, self.coordinates)}") from None
+
+    def __repr__(self) -> str:  # the dataclass's would print every value
+        return (f"<Solution: {count(len(self.coordinates), 'acceleration')}, "
+                f"{count(len(self.reactions), 'reaction component')} ({len(self.solved)} solved)"
+                + (f", {len(self.warnings)} warning(s)" if self.warnings else "")
+                + "; sol[label], .as_dict(), .reactions, .warnings>")
+
+    def _repr_html_(self) -> str:  # notebook display: accelerations and reactions by body
+        from importlib import import_module  # by name: mbody.present.rich imports this module
+
+        return import_module("mbody.present.rich").solution_html(self)
 
 
 class Assembly:
@@ -482,6 +497,16 @@ class Assembly:
                                            gtv=constraint_velocity(model, self.columns,
                                                                    self.state))),
                         system.fact.size - system.fact.rank)
+
+    def _repr_html_(self) -> str:  # notebook display: each body's free body and pair
+        from importlib import import_module  # by name: mbody.present.rich imports this module
+
+        return import_module("mbody.present.rich").assembly_html(self)
+
+    def _repr_latex_(self) -> str:  # the stacked system as display math
+        from importlib import import_module  # by name: mbody.present.rich imports this module
+
+        return import_module("mbody.present.rich").assembly_latex(self)
 
 
 COMPILED_METHOD = "banded Cholesky of the Schur complement (compiled)"

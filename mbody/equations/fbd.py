@@ -83,6 +83,12 @@ class FreeBodyDiagram:
         2 (planar) or 3 (spatial).
     mass : float
         The body's mass (kg).
+    def __repr__(self) -> str:  # the dataclass's would print four arrays
+        what = ("unknown" if self.value is None else f"= {_num(self.value)}"
+                ) if self.kind == REACTION else f"|{_num(self.magnitude)}|"
+        return (f"<ForceOnBody {self.name!r}: {self.kind}{' couple' if self.couple else ''} "
+                f"{what} at {_vec(self.W_point)} m (world); .W_vector, .B_moment>")
+
     inertia : (3, 3) array
         Inertia tensor about the mass centre, body axes (kg m^2); zero for a particle.
     W_position : (3,) array
@@ -153,6 +159,11 @@ class Equation:
         The row's coordinate label (``rod.x``, ``rod.w1``...).
     lhs : dict of str to float
         Acceleration name -> coefficient (a row of M: kg, or kg m^2 on Euler rows).
+    def __repr__(self) -> str:  # the dataclass's would print every force's arrays
+        unknown = sum(f.unknown for f in self.forces)
+        return (f"<FreeBodyDiagram of {self.body!r}: {len(self.applied)} applied, "
+                f"{len(self.reactions)} reaction ({unknown} unknown); .forces, .draw()>")
+
     gyro : float
         This row of b (N m; 0 on Newton rows).
     rhs : float
@@ -198,6 +209,15 @@ class BodyEquations:
         Every force and couple on the body.
     newton : tuple of Equation
         Newton's rows, m a_G = ΣF, in world axes.
+    def __repr__(self) -> str:  # the row written out, cut short for a row of many terms
+        text = str(self)
+        return f"<Equation {self.row}: {text if len(text) < 240 else text[:236] + ' ...'}>"
+
+    def _repr_latex_(self) -> str:  # notebook display as display math
+        from importlib import import_module  # by name: mbody.present.rich imports this module
+
+        return import_module("mbody.present.rich").equation_latex(self)
+
     euler : tuple of Equation
         Euler's rows about the mass centre, in body axes (planar: one, about z); none for
         a particle.
@@ -226,12 +246,37 @@ def _terms(pairs: list[tuple[float, str]]) -> str:
         if abs(coef) < 1e-12:  # rounding noise from rotations, not a term
             continue
         mag = abs(coef)
+    def __repr__(self) -> str:  # the dataclass's would print the diagram's arrays (1-6 KB)
+        unknown = sum(f.unknown for f in self.fbd.forces)
+        return (f"<BodyEquations of {self.body!r}: {len(self.newton)} Newton and "
+                f"{len(self.euler)} Euler rows, {unknown} reaction "
+                f"unknown{'' if unknown == 1 else 's'}; print() it, .fbd, .equations>")
+
+    def __str__(self) -> str:  # the block `mbody assemble` prints
+        from importlib import import_module  # by name: mbody.present.rich imports this module
+
+        return import_module("mbody.present.rich").body_str(self)
+
+    def _repr_html_(self) -> str:  # notebook display: diagram, forces table, the pair
+        from importlib import import_module  # by name: mbody.present.rich imports this module
+
+        return import_module("mbody.present.rich").body_html(self)
+
+    def _repr_latex_(self) -> str:  # the pair as display math
+        from importlib import import_module  # by name: mbody.present.rich imports this module
+
+        return import_module("mbody.present.rich").body_latex(self)
+
         txt = name if _num(mag) == "1" else f"{_num(mag)} {name}"  # 0.9999999 is 1
         if not out:
             out = f"-{txt}" if coef < 0 else txt
         else:
             out += f" {'-' if coef < 0 else '+'} {txt}"
     return out
+
+def _vec(x: np.ndarray) -> str:
+    return "(" + ", ".join(_num(v) for v in x) + ")"
+
 
 
 def body_equations(asm: Assembly, i: int) -> BodyEquations:

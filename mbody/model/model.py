@@ -110,6 +110,10 @@ class State:
         om[:, 2] = angular_velocity
         return cls(pos, q, vel, om, t)
 
+    def __repr__(self) -> str:  # the dataclass's would print four (n, k) arrays
+        return (f"<State of {count(len(self.position), 'body', 'bodies')} at t = {self.t:g} s; "
+                ".position, .quaternion, .velocity, .omega, .replace(t=...)>")
+
 
 @dataclass(frozen=True)
 class Body:
@@ -146,6 +150,12 @@ class Body:
     def I_G(self) -> float:
         """Planar moment of inertia about the mass centre (the z-z entry)."""
         return float(self.inertia[2, 2])
+
+    def __repr__(self) -> str:  # the dataclass's would print the inertia tensor
+        J = "particle" if self.particle else "I " + _vec(np.diag(self.inertia)) + " kg m^2" + (
+            "" if np.count_nonzero(self.inertia - np.diag(np.diag(self.inertia))) == 0
+            else " (and products)")
+        return f"<Body {self.name!r} (#{self.index}): m {self.mass:g} kg, {J}; .inertia, .shape>"
 
 
 @dataclass(frozen=True)
@@ -185,6 +195,16 @@ class Load:
     expressions: dict[int, Expression] = field(default_factory=dict)
     """Components of `vector` that vary in time (3-D index -> expression of t);
     `vector` holds their values at t = 0."""
+
+    def __repr__(self) -> str:  # the dataclass's would print its arrays
+        on = " - ".join(self.bodies)
+        if self.type == "spring":
+            what = f"k {self.stiffness:g} N/m, rest {self.rest_length:g} m"
+        else:
+            unit = "N m" if self.type == "torque" else "N"
+            what = f"{_vec(np.zeros(3) if self.vector is None else self.vector)} {unit} " \
+                   f"({self.frame} axes)" + (", varies in time" if self.expressions else "")
+        return f"<Load {self.name!r}: {self.type} on {on}, {what}>"
 
 
 @dataclass(frozen=True)
@@ -227,6 +247,10 @@ class Joint:
     def labels(self) -> list[str]:
         """Its reaction labels, ``<name>.<component>``."""
         return [f"{self.name}.{k}" for k in self.components]
+
+    def __repr__(self) -> str:  # the dataclass's would print its frame
+        return (f"<Joint {self.name!r}: {self.type}, {self.parent} -> {self.child} at "
+                f"{_vec(self.at)} m; reactions {', '.join(self.labels)}>")
 
 
 @dataclass(frozen=True)
@@ -558,6 +582,11 @@ class Model:
         """
         return _build(spec)
 
+    def _repr_html_(self) -> str:  # notebook display: summary tables and the graph
+        from importlib import import_module  # by name: mbody.present.rich imports this module
+
+        return import_module("mbody.present.rich").model_html(self)
+
 
 def load(source: str | os.PathLike[str] | dict, *, max_bytes: int | None = None) -> Model:
     """Read, validate and build a model.
@@ -796,3 +825,8 @@ def _names(names, most: int = 5) -> str:
 def count(k: int, word: str, plural: str = "") -> str:
     """'1 body', '3 bodies' (for short reprs)."""
     return f"{k} {word if k == 1 else plural or word + 's'}"
+
+
+def _vec(x: np.ndarray) -> str:
+    """'(1, 0, 2.5)' (for short reprs)."""
+    return "(" + ", ".join(f"{0.0 if abs(v) < 1e-12 else v:.4g}" for v in x) + ")"
