@@ -1,0 +1,607 @@
+"""A model as MuJoCo's MJCF: bodies nested along a spanning tree of the joint graph.
+
+Each MuJoCo body frame is the mbody body frame at the initial pose (origin at the mass
+centre, axes = body axes), so ``xipos`` is the mass centre, ``xmat`` is ``W_R_B`` and
+every reference configuration (``qpos0``) is the file's initial pose. A joint of the
+tree sits in its child body (``pos`` = the joint point in the child's axes); a joint
+that closes a loop becomes an equality constraint, which MuJoCo enforces softly.
+
+Joint types: revolute → hinge, prismatic → slide, cylindrical → slide + hinge on one
+axis, spherical → ball, universal → two hinges in the child body (MuJoCo composes a
+body's joints in order: the first axis stays fixed in the parent, the second turns with
+the first and is fixed in the child, which is the universal joint exactly; no massless
+intermediate body is needed, so the equations keep their bodies), fixed → no joint (the
+child is welded by nesting). A body with no joint to the tree's root gets a free joint
+(spatial), or slides along world x, y and a hinge about z (planar; slides only for a
+particle). Planar models are written in 3-D: every planar joint turns about world z or
+slides in the plane, so the motion stays planar.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+
+from mbody import __version__
+from mbody import conventions as cv
+from mbody.equations.spatial import box_equivalent, matrix_to_quat, quat_to_matrix
+from mbody.io.atomic import write_atomic
+from mbody.model.model import Joint, Model, count
+
+PARTICLE_INERTIA = 1e-12
+"""A particle's principal moments in MuJoCo, as a fraction of m ℓ² (ℓ the model's length
+scale): MuJoCo refuses a moving body without rotational inertia. The relative change of
+the accelerations is of this order."""
+
+LOOP_SOLIMP = "0.9999 0.9999 0.001 0.5 2"
+"""Impedance of the loop-closing equality constraints: MuJoCo's stiffest (its default,
+0.9, lets a loop give by about 10 % of the force that holds it together)."""
+
+_TREE_FIRST = {"prismatic": 0, "cylindrical": 0, "universal": 0, "fixed": 1,
+               "revolute": 2, "spherical": 2}
+"""Which joints go into the tree first: those that have no MuJoCo equality constraint
+(prismatic, cylindrical, universal), then fixed (weld), then revolute and spherical,
+whose loop-closing form (connect) is the closest."""
+
+_HEX = re.compile(r"#[0-9a-fA-F]{6}")
+
+
+@dataclass
+class _Tree:
+    """The spanning forest: each body's tree parent and joint, and the loop closures."""
+
+    parent: dict[str, str]  # body -> tree parent (a body or ground)
+    joint: dict[str, Joint | None]  # body -> the joint to its tree parent (None: a root)
+    children: dict[str, list[str]]  # ground or body -> its tree children, in order
+    loops: list[Joint] = field(default_factory=list)
+
+
+def spanning_tree(model: Model) -> _Tree:
+    """The joint tree MuJoCo nests, and the joints left over to close loops.
+
+    Kruskal's rule on the body/joint graph: joints taken in the order of `_TREE_FIRST`
+    (file order within a kind), each kept unless it closes a loop. Bodies reached from
+    ground hang from it; every other connected part hangs from its first body in file
+    order, which gets a free joint.
+
+    Parameters
+    ----------
+    model : Model
+
+    Returns
+    -------
+    _Tree
+    """
+    root = {n: n for n in (cv.GROUND, *model.body_names)}
+
+    def find(n: str) -> str:
+        while root[n] != n:
+            root[n] = root[root[n]]
+            n = root[n]
+        return n
+
+    order = sorted(range(len(model.joints)),
+                   key=lambda k: (_TREE_FIRST.get(model.joints[k].type, 2), k))
+    kept: list[Joint] = []
+    loops: list[Joint] = []
+    for k in order:
+        j = model.joints[k]
+        a, b = find(j.parent), find(j.child)
+        if a == b:
+            loops.append(j)
+        else:
+            root[b] = a
+            kept.append(j)
+    kept.sort(key=model.joints.index)
+    loops.sort(key=model.joints.index)
+    adjacent: dict[str, list[Joint]] = {n: [] for n in root}
+    for j in kept:
+        adjacent[j.parent].append(j)
+        adjacent[j.child].append(j)
+    tree = _Tree({}, {}, {n: [] for n in root}, loops)
+    starts = [cv.GROUND] + list(model.body_names)
+    seen: set[str] = set()
+    for start in starts:
+        if start in seen:
+            continue
+        seen.add(start)
+        if start != cv.GROUND:
+            tree.parent[start], tree.joint[start] = cv.GROUND, None
+            tree.children[cv.GROUND].append(start)
+        queue = [start]
+        while queue:
+            node = queue.pop(0)
+            for j in adjacent[node]:
+                other = j.child if j.parent == node else j.parent
+                if other in seen:
+                    continue
+                seen.add(other)
+                tree.parent[other], tree.joint[other] = node, j
+                tree.children[node].append(other)
+                queue.append(other)
+    return tree
+
+
+@dataclass
+class _Writer:
+    """What `to_mjcf` accumulates: lines of the body tree, the keyframe, the notes."""
+
+    model: Model
+    scale: float
+    lines: list[str] = field(default_factory=list)
+    qpos: list[float] = field(default_factory=list)
+    qvel: list[float] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+    joint_names: set[str] = field(default_factory=set)
+    sites: dict[str, list[str]] = field(default_factory=dict)  # body -> its site lines
+    worst_velocity: float = 0.0
+
+    def name(self, wanted: str) -> str:
+        """A joint name not used yet (MuJoCo wants them unique)."""
+        out, k = wanted, 2
+        while out in self.joint_names:
+            out, k = f"{wanted}~{k}", k + 1
+        self.joint_names.add(out)
+        return out
+
+
+def to_mjcf(model: Model, *, source: str | None = None) -> str:
+    """The model as an MJCF document (MuJoCo's XML), at its initial state.
+
+    Bodies nest along `spanning_tree`; each body frame is the mass centre with the body
+    axes at the initial pose, so MuJoCo's ``qpos0`` is the file's pose. Gravity goes to
+    ``<option>``, shapes to geoms that take no part in contacts, springs to spatial
+    tendons, joints that close loops to ``<equality>`` constraints, the initial state to
+    ``<keyframe><key name="initial">``. What MJCF cannot hold (point forces and couples,
+    known reaction values) is listed in the header comment.
+
+    Parameters
+    ----------
+    model : Model
+    source : str, optional
+        The file named in the header (default: the model's own file).
+
+    Returns
+    -------
+    str
+        The MJCF text.
+    """
+    scale = _length_scale(model)
+    w = _Writer(model, scale)
+    tree = spanning_tree(model)
+    for spring in range(len(model.springs.names)):
+        _spring_sites(w, spring)
+    for child in tree.children[cv.GROUND]:
+        _body(w, tree, child, depth=2)
+    equality = _equalities(w, tree.loops)
+    tendons = _tendons(w)
+    g = model.gravity
+    out = [_header(w, tree, source), f"<mujoco model={quoteattr(model.name)}>",
+           '  <compiler angle="radian" autolimits="true"/>',
+           f'  <option gravity="{_vec(g)}"/>',
+           "  <default>",
+           '    <geom contype="0" conaffinity="0"/>  <!-- shapes only: no contacts -->',
+           "  </default>",
+           "  <worldbody>", *("    " + s for s in w.sites.get(cv.GROUND, [])), *w.lines,
+           "  </worldbody>"]
+    out += equality + tendons
+    out += ["  <keyframe>",
+            f'    <key name="initial" time="0" qpos="{_vec(w.qpos)}" qvel="{_vec(w.qvel)}"/>',
+            "  </keyframe>", "</mujoco>", ""]
+    return "\n".join(out)
+
+
+def write_mjcf(model: Model, path: str | os.PathLike[str], *,
+               source: str | None = None) -> Path:
+    """Write `to_mjcf(model)` to `path` atomically.
+
+    Parameters
+    ----------
+    model : Model
+    path : str or os.PathLike
+        The ``.xml`` file to write (replaced whole, or left as it was on failure).
+    source : str, optional
+        The file named in the header (default: the model's own file).
+
+    Returns
+    -------
+    Path
+        `path`.
+    """
+    return write_atomic(path, to_mjcf(model, source=source))
+
+
+# -- the body tree ----------------------------------------------------------------------
+
+
+def _body(w: _Writer, tree: _Tree, name: str, depth: int) -> None:
+    """Write body `name`, its joints, inertia, shape and sites, then its tree children."""
+    m = w.model
+    i = m.index[name]
+    parent = tree.parent[name]
+    x_c, q_c = m.initial.position[i], m.initial.quaternion[i]
+    if parent == cv.GROUND:
+        pos, quat = x_c, q_c
+    else:
+        p = m.index[parent]
+        R_p = quat_to_matrix(m.initial.quaternion[p])
+        pos = _snap(R_p.T @ (x_c - m.initial.position[p]), w.scale)
+        quat = _quat_mul(_quat_conj(m.initial.quaternion[p]), q_c)
+    pad = "  " * depth
+    w.lines.append(f'{pad}<body name={quoteattr(name)} pos="{_vec(pos)}" quat="{_vec(quat)}">')
+    inner = pad + "  "
+    joint = tree.joint[name]
+    if joint is None:
+        _root_joints(w, name, inner)
+    else:
+        _tree_joint(w, joint, parent, name, inner)
+    w.lines.append(inner + _inertial(m, i, w.scale))
+    geom = _geom(m, i)
+    if geom:
+        w.lines.append(inner + geom)
+    w.lines += [inner + s for s in w.sites.get(name, [])]
+    for child in tree.children[name]:
+        _body(w, tree, child, depth + 1)
+    w.lines.append(f"{pad}</body>")
+
+
+def _root_joints(w: _Writer, name: str, pad: str) -> None:
+    """A body free of the tree's joints: a free joint (spatial), world slides and a hinge
+    about z (planar); a particle gets the slides only (it has no orientation)."""
+    m = w.model
+    i = m.index[name]
+    v = m.initial.velocity[i]
+    planar = m.dimension == cv.PLANAR
+    if not planar and not m.particle[i]:
+        w.lines.append(f"{pad}<freejoint name={quoteattr(w.name(name))}/>")
+        w.qpos += [*m.initial.position[i], *m.initial.quaternion[i]]
+        w.qvel += [*v, *m.initial.omega[i]]
+        return
+    # the slide axes are written in the body's axes (MuJoCo's joint frame), so that they
+    # are world x, y (z) whatever the body's initial attitude
+    R = quat_to_matrix(m.initial.quaternion[i])
+    for k, axis in enumerate("xyz"[:2 if planar else 3]):
+        jn = w.name(f"{name}:{axis}")
+        w.lines.append(f'{pad}<joint name={quoteattr(jn)} type="slide" pos="0 0 0" '
+                       f'axis="{_vec(_snap(R.T[:, k], 1.0))}"/>')
+        w.qpos.append(0.0)
+        w.qvel.append(float(v[k]))
+    if planar and not m.particle[i]:
+        jn = w.name(f"{name}:theta")
+        w.lines.append(f'{pad}<joint name={quoteattr(jn)} type="hinge" pos="0 0 0" '
+                       f'axis="{_vec(_snap(R.T[:, 2], 1.0))}"/>')
+        w.qpos.append(0.0)
+        w.qvel.append(float(m.initial.omega[i, 2]))
+
+
+def _tree_joint(w: _Writer, j: Joint, parent: str, child: str, pad: str) -> None:
+    """The MuJoCo joint(s) of mbody joint `j`, in the tree child `child`, and their
+    keyframe rates (least squares on the file's velocities: exact when they respect the
+    joint)."""
+    m = w.model
+    c = m.index[child]
+    R_c = quat_to_matrix(m.initial.quaternion[c])
+    x_c = m.initial.position[c]
+    P = np.asarray(j.at, dtype=float)
+    B_P = _snap(R_c.T @ (P - x_c), w.scale)
+    particle = bool(m.particle[c])
+    if m.particle[c] and j.particle_joint == "pin":
+        # a particle pinned at its own position moves with its parent: nested, no joint
+        w.notes.append(f"joint {j.name!r} pins the particle {child!r} at its own position: "
+                       "it moves with its parent (no MuJoCo joint)")
+        return
+    planar = m.dimension == cv.PLANAR
+    E = np.asarray(j.W_E0, dtype=float)
+    axis = E[:, 0] if planar and j.type == "prismatic" else E[:, 2]
+    if planar and j.type == "revolute":
+        axis = np.array([0.0, 0.0, 1.0])
+    parts: list[tuple[str, str, np.ndarray]]  # (name, type, world axis)
+    if j.type == "revolute":
+        parts = [(j.name, "hinge", axis)]
+    elif j.type == "prismatic":
+        parts = [(j.name, "slide", axis)]
+    elif j.type == "cylindrical":
+        parts = [(f"{j.name}:slide", "slide", axis), (f"{j.name}:turn", "hinge", axis)]
+    elif j.type == "universal":
+        a1 = np.asarray(j.axis, dtype=float)
+        a2 = np.asarray(j.axis2, dtype=float)
+        a1, a2 = a1 / np.linalg.norm(a1), a2 / np.linalg.norm(a2)
+        if j.child != child:  # the tree runs child → parent: the axes swap roles
+            a1, a2 = a2, a1
+        parts = [(f"{j.name}:axis", "hinge", a1), (f"{j.name}:axis2", "hinge", a2)]
+    elif j.type == "spherical":
+        parts = [(j.name, "ball", np.zeros(3))]
+    else:  # fixed: welded by nesting
+        return
+    columns = []
+    for nm, kind, a in parts:
+        jn = w.name(nm)
+        if kind == "ball":
+            w.lines.append(f'{pad}<joint name={quoteattr(jn)} type="ball" pos="{_vec(B_P)}"/>')
+            w.qpos += [1.0, 0.0, 0.0, 0.0]
+            columns += [_column("hinge", R_c[:, k], P, x_c) for k in range(3)]
+        else:
+            w.lines.append(f'{pad}<joint name={quoteattr(jn)} type="{kind}" '
+                           f'pos="{_vec(B_P)}" axis="{_vec(_snap(R_c.T @ a, 1.0))}"/>')
+            w.qpos.append(0.0)
+            columns.append(_column(kind, a, P, x_c))
+    w.qvel += _rates(w, j, parent, c, np.array(columns).T, particle)
+
+
+def _column(kind: str, a: np.ndarray, P: np.ndarray, x_c: np.ndarray) -> np.ndarray:
+    """(6,) what a unit joint rate gives the child: [ω (world), v of its mass centre]."""
+    if kind == "slide":
+        return np.concatenate((np.zeros(3), a))
+    return np.concatenate((a, np.cross(a, x_c - P)))
+
+
+def _rates(w: _Writer, j: Joint, parent: str, c: int, A: np.ndarray, particle: bool
+           ) -> list[float]:
+    """Joint rates q̇ with A q̇ = the child's motion relative to its tree parent."""
+    m = w.model
+    st = m.initial
+    R_c = quat_to_matrix(st.quaternion[c])
+    x_c = st.position[c]
+    if parent == cv.GROUND:
+        om_p, v_p = np.zeros(3), np.zeros(3)
+    else:
+        p = m.index[parent]
+        om_p = quat_to_matrix(st.quaternion[p]) @ st.omega[p]
+        v_p = st.velocity[p] + np.cross(om_p, x_c - st.position[p])
+    rel = np.concatenate((R_c @ st.omega[c] - om_p, st.velocity[c] - v_p))
+    if particle:  # a particle has no orientation to match: its translation only
+        A, rel = A[3:], rel[3:]
+    rates, *_ = np.linalg.lstsq(A, rel, rcond=None)
+    miss = float(np.linalg.norm(A @ rates - rel))
+    if miss > 1e-9 * max(1.0, float(np.linalg.norm(rel))):
+        w.notes.append(f"the initial velocities break joint {j.name!r} by {miss:.3g} "
+                       "(rad/s, m/s): the keyframe holds the nearest joint rates")
+    return [float(x) for x in rates]
+
+
+def _inertial(m: Model, i: int, scale: float) -> str:
+    mass = float(m.mass[i])
+    if m.particle[i]:
+        d = PARTICLE_INERTIA * mass * scale**2
+        return f'<inertial pos="0 0 0" mass="{_num(mass)}" diaginertia="{_vec([d] * 3)}"/>'
+    J = np.asarray(m.J[i], dtype=float)
+    if not np.any(J - np.diag(np.diag(J))):
+        return (f'<inertial pos="0 0 0" mass="{_num(mass)}" '
+                f'diaginertia="{_vec(np.diag(J))}"/>')
+    full = (J[0, 0], J[1, 1], J[2, 2], J[0, 1], J[0, 2], J[1, 2])
+    return f'<inertial pos="0 0 0" mass="{_num(mass)}" fullinertia="{_vec(full)}"/>'
+
+
+def _geom(m: Model, i: int) -> str:
+    """The body's shape as a geom in body axes (its equivalent box when it has none), as
+    the drawings show it (`mbody.present.draw.outline`)."""
+    body = m.bodies[m.body_names[i]]
+    planar = m.dimension == cv.PLANAR
+    rgba = _rgba(body.color)
+    color = f' rgba="{rgba}"' if rgba else ""
+    shape = body.shape
+    if shape is None:
+        if body.particle:
+            return ""
+        J = np.asarray(body.inertia, dtype=float)
+        if planar:
+            side = math.sqrt(6.0 * J[2, 2] / body.mass)
+            return f'<geom type="box" size="{_vec([side / 2, side / 2, side / 10])}"{color}/>'
+        moments, axes = np.linalg.eigh(J)
+        if np.linalg.det(axes) < 0:
+            axes[:, 2] *= -1.0
+        edges = box_equivalent(moments, body.mass)
+        return (f'<geom type="box" size="{_vec(edges / 2)}" quat="{_vec(_matrix_quat(axes))}"'
+                f"{color}/>")
+    kind, v = next(iter(shape.items()))
+    if kind in ("box", "ellipsoid"):
+        dims = [float(x) for x in v]
+        if planar:
+            dims.append(0.2 * min(dims))
+        size = [d / 2 for d in dims] if kind == "box" else dims
+        return f'<geom type="{kind}" size="{_vec(size)}"{color}/>'
+    r = float(v["radius"])
+    if kind == "sphere":
+        return f'<geom type="sphere" size="{_num(r)}"{color}/>'
+    length = float(v["length"]) if kind == "cylinder" else 0.1 * r if not planar else 0.2 * r
+    return f'<geom type="cylinder" size="{_vec([r, length / 2])}"{color}/>'
+
+
+# -- loops, springs, header -------------------------------------------------------------
+
+
+def _equalities(w: _Writer, loops: list[Joint]) -> list[str]:
+    """Loop-closing joints as equality constraints: revolute and spherical → connect at
+    the joint point (a spatial revolute: a second connect one length scale along its
+    axis, which holds the axis too), fixed → weld; others have no MuJoCo equality."""
+    m = w.model
+    lines = []
+    soft = f'solimp="{LOOP_SOLIMP}"'
+    for j in loops:
+        c = m.index[j.child]
+        R_c = quat_to_matrix(m.initial.quaternion[c])
+        x_c = m.initial.position[c]
+        other = "" if j.parent == cv.GROUND else f" body2={quoteattr(j.parent)}"
+        if j.particle_joint == "link":
+            w.notes.append(f"joint {j.name!r} (a particle's link) closes a loop: MuJoCo has "
+                           "no distance constraint, so it is left out")
+            continue
+        if j.type in ("revolute", "spherical"):
+            points = [np.asarray(j.at, dtype=float)]
+            if j.type == "revolute" and m.dimension == cv.SPATIAL:
+                points.append(points[0] + w.scale * np.asarray(j.W_E0)[:, 2])
+            for k, P in enumerate(points):
+                nm = j.name if k == 0 else f"{j.name}:axis"
+                lines.append(f"    <connect name={quoteattr(nm)} body1={quoteattr(j.child)}"
+                             f'{other} anchor="{_vec(_snap(R_c.T @ (P - x_c), w.scale))}" {soft}/>')
+        elif j.type == "fixed":
+            lines.append(f"    <weld name={quoteattr(j.name)} body1={quoteattr(j.child)}"
+                         f"{other} {soft}/>")
+        else:
+            w.notes.append(f"joint {j.name!r} ({j.type}) closes a loop: MuJoCo has no "
+                           "equality constraint of that kind, so it is left out")
+    if not lines:
+        return []
+    return ["  <!-- Joints that close loops. MuJoCo enforces equality constraints softly",
+            "       (a stiff spring-damper, solref/solimp), not exactly as mbody does:",
+            "       accelerations agree only up to that softness. -->",
+            "  <equality>", *lines, "  </equality>"]
+
+
+def _spring_sites(w: _Writer, k: int) -> None:
+    """The two attachment points of spring `k` as sites in their bodies (world: ground)."""
+    m = w.model
+    sp = m.springs
+    for end, (b, r) in enumerate(((sp.a[k], sp.r_a[k]), (sp.b[k], sp.r_b[k]))):
+        owner = cv.GROUND if b < 0 else m.body_names[b]
+        site = f"{sp.names[k]}:{'ab'[end]}"
+        w.sites.setdefault(owner, []).append(f'<site name={quoteattr(site)} pos="{_vec(r)}"/>')
+
+
+def _tendons(w: _Writer) -> list[str]:
+    """Springs as spatial tendons: tension k (L − L0) + c L̇ between the two sites."""
+    sp = w.model.springs
+    lines = []
+    for k, name in enumerate(sp.names):
+        lines.append(f"    <spatial name={quoteattr(name)} stiffness="
+                     f'"{_num(sp.stiffness[k])}" damping="{_num(sp.damping[k])}" '
+                     f'springlength="{_num(sp.rest_length[k])}">')
+        lines += [f"      <site site={quoteattr(f'{name}:{e}')}/>" for e in "ab"]
+        lines.append("    </spatial>")
+    return ["  <tendon>", *lines, "  </tendon>"] if lines else []
+
+
+def _header(w: _Writer, tree: _Tree, source: str | None) -> str:
+    """The comment at the top: where the file came from and what it leaves out."""
+    m = w.model
+    src = source if source is not None else m.file
+    out = [f"Written by mbody {__version__} (mbody convert) from {src}.",
+           f"Model {m.name!r}: {'planar' if m.dimension == cv.PLANAR else 'spatial'}, "
+           f"{count(m.n, 'body', 'bodies')}, {count(len(m.joints), 'joint')}. Each MuJoCo "
+           "body frame is the mbody body frame (mass centre, body axes) at the initial "
+           "pose; the keyframe 'initial' is the file's state.",
+           ]
+    if m.dimension == cv.PLANAR:
+        out.append("Planar model written in 3-D: bodies in the world x-y plane, joints "
+                   "turning about world z or sliding in the plane.")
+    point = [ld for ld in m.loads if ld.type in ("force", "torque")]
+    if point:
+        out.append("Left out (MJCF has no constant applied loads; apply them at run time "
+                   "through MjData.xfrc_applied, a world force and torque about the body's "
+                   "mass centre):")
+        for ld in point:
+            out.append("  " + _describe_load(ld))
+    if m.known_reactions or m.known_expressions:
+        labels = sorted({*m.known_reactions, *m.known_expressions})
+        out.append("Left out: the known reaction values of the file (" + ", ".join(labels)
+                   + "); MuJoCo enforces every joint and computes all its reactions, which "
+                   "agree with these values only where they are consistent with the joint.")
+    if any(m.particle):
+        out.append(f"Particles (inertia 0) get principal moments {PARTICLE_INERTIA:g} m "
+                   f"l^2 (l = {w.scale:.3g} m): MuJoCo refuses a moving body without "
+                   "rotational inertia.")
+    if tree.loops:
+        out.append("Closed loops: the joints " + ", ".join(repr(j.name) for j in tree.loops)
+                   + " close them and are written as equality constraints, which MuJoCo "
+                   "keeps softly (see <equality>).")
+    out += w.notes
+    text = "\n".join(_wrap(line) for line in out)
+    return "<!--\n" + text.replace("--", "- -") + "\n-->"
+
+
+def _describe_load(ld) -> str:
+    if ld.vector is None:
+        return f"{ld.type} {ld.name!r}"
+    comps = [str(ld.expressions[k]) if k in ld.expressions else _num(float(x))
+             for k, x in enumerate(ld.vector)]
+    where = ("" if ld.type == "torque" else
+             f" at [{', '.join(_num(float(x)) for x in ld.at[0])}] (body axes)")
+    return (f"{ld.type} {ld.name!r} on {ld.bodies[0]!r}: [{', '.join(comps)}] "
+            f"({ld.frame} axes){where}")
+
+
+def _wrap(line: str, width: int = 88) -> str:
+    """`line` broken at spaces into lines of at most `width` characters (comment text)."""
+    lead = line[:len(line) - len(line.lstrip(" "))]
+    indent = lead + "  "
+    out, cur = [], lead
+    for word in line.split():
+        if cur.strip() and len(cur) + 1 + len(word) > width:
+            out.append(cur)
+            cur = indent + word
+        else:
+            cur = f"{cur} {word}" if cur.strip() else cur + word
+    out.append(cur)
+    return "\n".join(out)
+
+
+# -- numbers ----------------------------------------------------------------------------
+
+
+def _length_scale(model: Model) -> float:
+    """A typical length of the model (m): the largest distance from a mass centre to a
+    joint point, else 1."""
+    x = model.initial.position
+    d = [float(np.linalg.norm(np.asarray(j.at) - x[model.index[b]]))
+         for j in model.joints for b in (j.parent, j.child) if b != cv.GROUND]
+    big = max(d, default=0.0)
+    return big if big > 0 else 1.0
+
+
+def _num(x: float) -> str:
+    """Shortest text that reads back as the same double (0 for ±0)."""
+    x = float(x)
+    if x == 0.0:
+        return "0"
+    if x == int(x) and abs(x) < 1e15:
+        return str(int(x))
+    return repr(x)
+
+
+def _snap(v: np.ndarray, size: float) -> np.ndarray:
+    """`v` with the rounding noise of a frame change (|x| < 1e-14 `size`) made 0, for a
+    readable file; the geometry moves by less than that."""
+    return np.where(np.abs(v) < 1e-14 * size, 0.0, v)
+
+
+def _vec(xs) -> str:
+    return " ".join(_num(x) for x in np.asarray(xs, dtype=float).ravel())
+
+
+def _quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    w1, x1, y1, z1 = a
+    w2, x2, y2, z2 = b
+    return np.array([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
+                     w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+                     w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
+                     w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2])
+
+
+def _quat_conj(q: np.ndarray) -> np.ndarray:
+    return np.array([q[0], -q[1], -q[2], -q[3]])
+
+
+def _matrix_quat(R: np.ndarray) -> np.ndarray:
+    return np.asarray(matrix_to_quat(R[None]))[0]
+
+
+def _rgba(color: str | None) -> str:
+    """'#rrggbb' (or a colour name) -> 'r g b 1'; '' when there is none."""
+    if not color:
+        return ""
+    if _HEX.fullmatch(color):
+        rgb = [int(color[k:k + 2], 16) / 255 for k in (1, 3, 5)]
+    else:
+        from matplotlib.colors import to_rgb  # slow to import: only for a named colour
+
+        try:
+            rgb = list(to_rgb(color))
+        except ValueError:
+            return ""
+    return " ".join(f"{c:.4g}" for c in rgb) + " 1"
