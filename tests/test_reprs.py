@@ -31,3 +31,51 @@ def test_trajectory_repr_is_short():
     text = repr(traj)
     assert text == ("<Trajectory of 'double-pendulum': 2 bodies, 11 samples, t = 0 .. 0.5 s, "
                     "4 reaction series; .state(k), .kinetic_energy(), .save(path)>"), text
+
+
+NEXT = {  # what each repr suggests calling next
+    "Solution": "sol[label]", "State": ".replace(", "Body": ".inertia",
+    "Joint": "reactions ", "BodyEquations": "print() it", "FreeBodyDiagram": ".draw()",
+    "ForceOnBody": ".W_vector",
+}
+
+
+@pytest.mark.parametrize("path", MODELS, ids=lambda p: p.stem)
+def test_every_public_object_has_a_short_repr(path):
+    """Under 300 characters on every shipped model, with its name and what to call next
+    (a dataclass's own repr printed every array: 1-6 KB for a body's equations)."""
+    model = mbody.load(path)
+    asm = mbody.assemble(model)
+    sol = asm.solve()
+    first = model.body_names[0]
+    eq = asm.bodies[first]
+    objs = [(sol, "Solution"), (model.initial, "State"), (model.bodies[first], "Body"),
+            (eq, "BodyEquations"), (eq.fbd, "FreeBodyDiagram")]
+    objs += [(f, "ForceOnBody") for f in eq.fbd.forces]
+    objs += [(j, "Joint") for j in model.joints] + [(ld, "Load") for ld in model.loads]
+    objs += [(e, "Equation") for e in eq.equations]
+    for obj, kind in objs:
+        text = repr(obj)
+        assert text.startswith(f"<{kind} ") or text.startswith(f"<{kind}:"), text
+        assert len(text) < 300, (len(text), text)
+        assert NEXT.get(kind, "") in text
+    assert f"'{first}'" in repr(eq) and f"'{first}'" in repr(eq.fbd)
+    assert str(eq.equations[0]) in repr(eq.equations[0])
+    assert len(repr(sol.reactions)) < 300
+
+
+def test_short_reprs_say_the_values():
+    model = mbody.load(MODELS[0].parent / "pendulum.yaml")
+    asm = mbody.assemble(model)
+    assert repr(model.bodies["rod"]) == ("<Body 'rod' (#0): m 2 kg, I (0.08354, 0.08354, "
+                                         "0.1671) kg m^2; .inertia, .shape>")
+    assert repr(model.joints[0]) == ("<Joint 'O': revolute, ground -> rod at (0, 0, 0) m; "
+                                     "reactions O.Fx, O.Fy>")
+    assert repr(asm.bodies["rod"].newton[1]) == "<Equation rod.y: 2 a_y = -19.62 + O.Fy>"
+    assert repr(asm.solve()) == ("<Solution: 3 accelerations, 2 reaction components "
+                                 "(2 solved); sol[label], .as_dict(), .reactions, .warnings>")
+    assert repr(asm.solve().reactions).startswith("{'O.Fx': -6.3678")
+    big = mbody.assemble(mbody.load(MODELS[0].parent / "fourbar_spatial.yaml")).solve()
+    assert repr(big.reactions).startswith("<ReactionValues: 20 components (N; N m), O2.Fx")
+    spring = mbody.load(MODELS[0].parent / "spring_mass_damper.yaml").loads[0]
+    assert repr(spring).startswith(f"<Load {spring.name!r}: spring on ")
