@@ -26,6 +26,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--latex", metavar="FILE", nargs="?", const="-",
                    help="write a LaTeX document (each body's pair, the stacked system) to "
                    "FILE, or to standard output without FILE")
+    s.add_argument("--symbolic", action="store_true",
+                   help="write each body's pair with symbols (m, I_G or I_1, w_1, loads by "
+                   "name, reaction labels) instead of numbers; with --latex, as a LaTeX "
+                   "document (needs sympy: the 'symbolic' extra)")
     s.set_defaults(run=assemble)
 
     s = sub.add_parser("solve", help="accelerations of every body and the unknown reactions",
@@ -66,6 +70,8 @@ def assemble(a: argparse.Namespace) -> int:
 
     model = load_model(a.model)
     asm = _assemble(model)
+    if a.symbolic:
+        return _symbolic(asm, a)
     if a.latex is not None:
         from mbody.cli.export import latex
 
@@ -77,6 +83,31 @@ def assemble(a: argparse.Namespace) -> int:
             raise MbodyError(exc.args[0]) from None
     else:
         print(assembly_text(asm))
+    return EXIT_OK
+
+
+def _symbolic(asm, a: argparse.Namespace) -> int:
+    """`mbody assemble MODEL --symbolic [--body NAME] [--latex [FILE]]`."""
+    from importlib.util import find_spec
+
+    from mbody.io.atomic import write_atomic
+
+    if find_spec("sympy") is None:
+        raise MbodyError("--symbolic needs sympy; install it with: pip install "
+                         "'mbody[symbolic]'")
+    try:
+        sym = asm.symbolic(None if a.body is None else [a.body])
+    except KeyError as exc:
+        raise MbodyError(exc.args[0]) from None
+    if a.latex is None:
+        print(sym.text() if a.body is None else sym.bodies[0].text())
+    elif a.latex == "-":
+        sys.stdout.write(sym.document())
+    else:
+        try:
+            print(f"wrote {write_atomic(a.latex, sym.document())}")
+        except OSError as exc:
+            raise MbodyError(f"cannot write {a.latex}: {exc.strerror or exc}") from None
     return EXIT_OK
 
 

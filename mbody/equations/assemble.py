@@ -30,6 +30,7 @@ from mbody.equations.joints import (
 from mbody.equations.loads import AppliedLoads
 from mbody.equations.plan import Unknowns, compiled
 from mbody.equations.spatial import matvec
+from mbody.equations.symbolic import SymbolicEquations, assembly_symbolic
 from mbody.errors import MbodyError, did_you_mean
 from mbody.model.model import Model, State, count
 from mbody.solve.kkt import ConstrainedSystem, singular_mass_error
@@ -333,6 +334,23 @@ class Assembly:
     def bodies(self) -> Mapping[str, BodyEquations]:
         """name -> `BodyEquations` (free body and Newton-Euler pair), built on first access."""
         return _LazyBodies(self, body_equations)
+
+    def symbolic(self, bodies: list[str] | None = None) -> SymbolicEquations:
+        """Every body's Newton-Euler pair with symbols instead of numbers (m, I_G or I_1,
+        w_1, loads by name, reaction labels), as text and LaTeX; needs sympy.
+
+        Parameters
+        ----------
+        bodies : list of str, optional
+            Only these bodies (default: all, in stacking order).
+
+        Returns
+        -------
+        SymbolicEquations
+            ``text()``, ``latex()``, ``document()``; each body's ``evaluate()`` gives back
+            its rows of M, b, Q and G (see `mbody.equations.symbolic`).
+        """
+        return assembly_symbolic(self, bodies)
 
     # -- solving -----------------------------------------------------------------------
     def reaction_values(self, known: Mapping[str, float] | None = None) -> dict[str, float]:

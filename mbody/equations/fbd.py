@@ -17,9 +17,11 @@ import numpy as np
 from mbody import conventions as cv
 from mbody.conventions import APPLIED, GRAVITY, REACTION
 from mbody.equations.joints import g_block
+from mbody.equations.symbolic import body_symbolic
 
 if TYPE_CHECKING:
     from mbody.equations.assemble import Assembly
+    from mbody.equations.symbolic import SymbolicBody
 
 
 
@@ -234,18 +236,35 @@ class BodyEquations:
         return self.newton + self.euler
 
 
+    assembly : Assembly, optional
+        The assembly these rows come from (what `symbolic` writes out again).
 def _num(x: float) -> str:
     x = 0.0 if abs(x) < 1e-12 else x  # rounding noise from rotations
     s = f"{x:.6g}"
     return "0" if s in ("-0", "0") else s
 
 
+    assembly: Assembly | None = field(default=None, repr=False, compare=False)
 def _terms(pairs: list[tuple[float, str]]) -> str:
     out = ""
     for coef, name in pairs:
         if abs(coef) < 1e-12:  # rounding noise from rotations, not a term
             continue
         mag = abs(coef)
+    def symbolic(self) -> SymbolicBody:
+        """These rows with symbols (m, I_1, w_2, loads by name, reaction labels) instead of
+        numbers; needs sympy (see `mbody.equations.symbolic`).
+
+        Returns
+        -------
+        SymbolicBody
+            Its ``text()`` and ``latex()``; ``evaluate()`` gives back these numbers.
+        """
+        if self.assembly is None:
+            raise ValueError("these equations were made without their assembly; use "
+                             "mbody.assemble(model).bodies[name].symbolic()")
+        return body_symbolic(self.assembly, self.body)
+
     def __repr__(self) -> str:  # the dataclass's would print the diagram's arrays (1-6 KB)
         unknown = sum(f.unknown for f in self.fbd.forces)
         return (f"<BodyEquations of {self.body!r}: {len(self.newton)} Newton and "
@@ -340,4 +359,4 @@ def body_equations(asm: Assembly, i: int) -> BodyEquations:
                             float(Q6[rows[r]]), reac,
                             {k: v for k, v in known.items() if k in reac}))
     fbd = replace(fbd, equations=tuple(eqs))
-    return BodyEquations(name, fbd, tuple(eqs[:nn]), tuple(eqs[nn:]))
+    return BodyEquations(name, fbd, tuple(eqs[:nn]), tuple(eqs[nn:]), asm)
