@@ -18,7 +18,16 @@ import pytest
 
 import mbody
 from mbody.errors import MbodyError
-from mbody.present.animate import LiveViewer, build_scene, pack, page_html, unpack, write_page
+from mbody.present.animate import (
+    FILL,
+    LiveViewer,
+    build_scene,
+    camera_fit,
+    pack,
+    page_html,
+    unpack,
+    write_page,
+)
 from mbody.simulate.trajectory import Trajectory
 
 sys.path.insert(0, str(Path(__file__).parent))
@@ -226,6 +235,61 @@ def test_reaction_arrows_show_the_solved_pin_force(tmp_path):
                     mbody.load("models/seed_example_2.yaml"), reactions=True)
 
 
+def test_gravity_is_drawn_at_each_mass_centre_with_forces(spinner):
+    """--forces draws m g at every G, pointing along g, as long as the largest applied
+    force (the same scale and colour); no gravity, no gravity arrows."""
+    model = mbody.load(ROOT / "models" / "double_pendulum.yaml")
+    traj = double_pendulum_motion()
+    scene = build_scene(traj, model, forces=True)
+    assert sorted(scene.load_paths) == ["gravity (lower)", "gravity (upper)"]
+    extent = 2.0 / np.reshape(next(c for c in scene.commands if c["path"] == "/meshcat/mbody"
+                                   and c["type"] == "set_transform")["matrix"], (4, 4))[0, 0]
+    for i, name in enumerate(("upper", "lower")):
+        path = scene.load_paths[f"gravity ({name})"]
+        tracks = _animation(scene, path)
+        P = np.reshape(tracks[".position"]["values"], (-1, 3))
+        Q = np.reshape(tracks[".quaternion"]["values"], (-1, 4))[:, [3, 0, 1, 2]]
+        np.testing.assert_allclose(P[:, :2], traj.position[:, i], atol=1e-12)
+        for k in (0, 20, 40):
+            np.testing.assert_allclose(rot(Q[k]) @ [0, 1, 0], [0, -1, 0], atol=1e-12)
+        head = np.reshape(_animation(scene, path + "/head")[".position"]["values"], (-1, 3))
+        # equal masses: both at the full length 0.35 extent (shaft + head 0.06 extent)
+        np.testing.assert_allclose(head[:, 1], 0.29 * extent, rtol=1e-12)
+        mesh = [c for c in scene.commands if c.get("type") == "set_object"
+                and c["path"].endswith(path.strip("/") + "/shaft/geom/mesh")]
+        assert mesh[0]["object"]["materials"][0]["color"] == 0xFFD400
+    assert "gravity (upper)" not in build_scene(traj, model).load_paths
+    spin_model, spin_traj = spinner  # no gravity in the file: only the push
+    assert list(build_scene(spin_traj, spin_model, forces=True).load_paths) == ["push"]
+
+
+def test_camera_fit_puts_the_box_at_fill_with_equal_margins():
+    """Projecting the box's corners from the fitted camera: every corner is inside FILL
+    of the view, the binding dimension touches FILL on both sides, for any aspect."""
+    rng = np.random.default_rng(3)
+    lo, hi = -rng.uniform(0.2, 1.0, 3), rng.uniform(0.2, 1.0, 3)
+    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1])
+                        for z in (lo[2], hi[2])])
+    d = np.array([1, 0.8, 0.65]) / np.linalg.norm([1, 0.8, 0.65])
+    fit = camera_fit(corners, d)
+    tan = math.tan(math.radians(37.5))
+    for aspect in (4 / 3, 800 / 457, 0.6):
+        eye, target = fit.position(aspect), fit.target(aspect)
+        back = (eye - target) / np.linalg.norm(eye - target)
+        np.testing.assert_allclose(back, d, atol=1e-12)  # it looks along the direction
+        right = np.cross([0, 0, 1], back)
+        right /= np.linalg.norm(right)
+        up = np.cross(back, right)
+        rel = corners - eye
+        depth = -rel @ back
+        ndc = np.column_stack([rel @ right / (depth * aspect * tan), rel @ up / (depth * tan)])
+        lo_n, hi_n = ndc.min(axis=0), ndc.max(axis=0)
+        assert np.all(hi_n <= FILL + 1e-9) and np.all(lo_n >= -FILL - 1e-9)
+        bind = int(np.argmax(hi_n - lo_n))
+        np.testing.assert_allclose([lo_n[bind], hi_n[bind]], [-FILL, FILL], atol=1e-9)
+        np.testing.assert_allclose(lo_n, -hi_n, atol=1e-9)  # centred in both
+
+
 def test_a_push_into_the_body_ends_at_its_point(spinner):
     """Thrust at the bottom face pointing up: the arrow's tip touches the point."""
     model = mbody.loads(SPIN_YAML.replace("at: [0.2, 0, 0]", "at: [0, 0, -0.05]"))
@@ -326,6 +390,54 @@ def test_browser_planar_is_upright_in_xy(pendulum, tmp_path):
     assert thk > 0.3
     assert r["s"][1] > r["origin"][1] + 50 and r["s"][0] > r["origin"][0] + 5
     assert r["orange"]["n"] > 400 and math.dist(r["orange"]["c"], r["s"]) < 30
+
+
+COVER = """
+  viewer.scene.traverse(function (o) {
+    if (o.type === "LineSegments" || o.type === "Line") o.visible = false; });
+  node("/Grid").visible = false; viewer.set_property(["Background"], "visible", false);
+  var gl = viewer.renderer.getContext(), w = gl.drawingBufferWidth, h = gl.drawingBufferHeight;
+  var px = new Uint8Array(4 * w * h), hit = new Uint8Array(w * h), N = FRAMES;
+  for (var k = 0; k < N; k++) {  // every keyframe
+    at(viewer.animator.duration * k / (N - 1));
+    gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, px);
+    for (var i = 0; i < w * h; i++)
+      if (px[4*i+3] > 0 && (px[4*i] | px[4*i+1] | px[4*i+2]) > 8) hit[i] = 1;
+  }
+  var x0 = w, x1 = -1, y0 = h, y1 = -1;
+  for (var i = 0; i < w * h; i++) if (hit[i]) { var x = i % w, y = Math.floor(i / w);
+    x0 = Math.min(x0, x); x1 = Math.max(x1, x); y0 = Math.min(y0, y); y1 = Math.max(y1, y); }
+  return {w: w, h: h, box: [x0, y0, x1, y1]};
+"""
+
+
+def double_pendulum_motion():
+    """Two 0.5 m rods of models/double_pendulum.yaml swinging (a kinematic motion)."""
+    t = np.linspace(0.0, 2.0, 41)
+    th1, th2 = 0.5 * np.cos(3 * t), 1.2 * np.sin(4 * t)
+    A = 0.5 * np.stack([np.sin(th1), -np.cos(th1)], -1)
+    pos = np.stack([A / 2, A + 0.25 * np.stack([np.sin(th2), -np.cos(th2)], -1)], 1)
+    return Trajectory(t, pos, np.zeros_like(pos), np.stack([th1, th2], -1),
+                      np.zeros((len(t), 2)), ("upper", "lower"), 2,
+                      model_name="double-pendulum")
+
+
+@needs_browser
+@pytest.mark.parametrize("forces", [False, True])
+def test_browser_the_motion_fills_the_view(forces, tmp_path):
+    """The union of the model's pixels over the motion (grid, background and axes hidden)
+    spans FILL = 85 % of the view's height (the binding dimension for a hanging double
+    pendulum), centred, nothing cut off; gravity's arrows are kept in view too. Before
+    the fit it spanned 29 % of the height."""
+    model = mbody.load(ROOT / "models" / "double_pendulum.yaml")
+    page = write_page(double_pendulum_motion(), tmp_path / "dp.html", model=model,
+                      forces=forces)
+    r = chromium.probe(page, COVER.replace("FRAMES", "41"), budget_ms=8000)
+    x0, y0, x1, y1 = r["box"]
+    w, h = r["w"], r["h"]
+    assert (x1 - x0 + 1) / w < FILL < (y1 - y0 + 2) / h < FILL + 0.02, r
+    assert abs((y0 + y1) / 2 - h / 2) < 0.01 * h and abs((x0 + x1) / 2 - w / 2) < 0.1 * w, r
+    assert x0 > 0.02 * w and y0 > 0.02 * h and x1 < 0.98 * w and y1 < 0.98 * h, r
 
 
 # -- the live viewer ---------------------------------------------------------------------
@@ -445,3 +557,20 @@ def test_api_animate_model_and_trajectory(spinner, tmp_path):
     scene = build_scene(traj, model, bodies=["rotor"])
     assert list(scene.paths) == ["rotor"] and scene.title == "mbody: spinner"
     assert page_html(scene).count("<script>") == 2
+
+
+def test_help_states_the_simulation_defaults_and_gravity():
+    """`animate --help` gives --t-end's and --fps's defaults for a model, which are
+    mbody.simulate's, and says --forces draws gravity."""
+    import inspect
+
+    from mbody.cli import animate as cli_animate
+
+    sig = inspect.signature(mbody.simulate).parameters
+    assert (cli_animate.T_END, cli_animate.FPS) == (sig["t_end"].default, sig["fps"].default)
+    p = subprocess.run([sys.executable, "-m", "mbody.cli", "animate", "--help"],
+                       capture_output=True, text=True, timeout=60)
+    text = " ".join(p.stdout.split())
+    assert f"when SOURCE is a model (default {sig['t_end'].default:g};" in text
+    assert f"(default {sig['fps'].default:g})" in text
+    assert "gravity (m g at each mass centre)" in text

@@ -12,6 +12,10 @@ from types import FrameType
 from mbody.cli.common import EXIT_OK, regular_file
 from mbody.errors import MbodyError
 
+T_END, FPS = 10.0, 60.0
+"""`mbody.simulate`'s defaults, which a MODEL is simulated with (tests keep them equal;
+the simulator is not imported at start-up)."""
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     s = sub.add_parser(
@@ -19,7 +23,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         description="Animate SOURCE, a run file (.npz from `mbody simulate`) or a model "
         "(simulated first). Writes a self-contained page (no server, no network) with "
         "every body drawn as its shape (or its inertia-equivalent box), a grid, and "
-        "play/pause and time controls. With --live, serves meshcat's viewer on "
+        "play/pause and time controls; the camera is fitted to the motion (all bodies "
+        "over the whole run, and the arrows drawn), looking along the plane's normal for "
+        "a planar model. With --live, serves meshcat's viewer on "
         "127.0.0.1 only until Ctrl-C.")
     s.add_argument("source", metavar="MODEL|RUN", help="a model (.yaml) or a run (.npz)")
     s.add_argument("-o", "--output", metavar="HTML",
@@ -28,14 +34,18 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--model", metavar="MODEL",
                    help="the model of a run file (default: the model file it names)")
     s.add_argument("--forces", action="store_true",
-                   help="draw applied forces (yellow) and couples (magenta) as arrows")
+                   help="draw applied forces and gravity (m g at each mass centre) in yellow "
+                   "and couples in magenta, as arrows")
     s.add_argument("--reactions", action="store_true",
                    help="draw each joint's reaction on its child (red: force at the joint "
                    "point; dark red: couple)")
     s.add_argument("--body", metavar="NAME", action="append",
                    help="draw only this body (repeatable)")
-    s.add_argument("--t-end", type=float, metavar="S", help="simulated time for a MODEL")
-    s.add_argument("--fps", type=float, metavar="N", help="frames per second for a MODEL")
+    s.add_argument("--t-end", type=float, metavar="S",
+                   help=f"seconds to simulate when SOURCE is a model (default {T_END:g}; "
+                   "a run file plays its own length)")
+    s.add_argument("--fps", type=float, metavar="N",
+                   help=f"frames per second when SOURCE is a model (default {FPS:g})")
     s.add_argument("--live", action="store_true",
                    help="serve the live viewer on 127.0.0.1 and print its URL; Ctrl-C stops")
     s.add_argument("--hold", type=float, metavar="S",

@@ -25,24 +25,28 @@ from mbody.model.model import Model
 from mbody.present.animate.live import HOST, LiveViewer
 from mbody.present.animate.page import page_html, write_page
 from mbody.present.animate.scene import (
-    CAMERA_DISTANCE,
+    CAMERA,
     COUPLE_COLOR,
+    FILL,
     FORCE_COLOR,
     PALETTE,
     REACTION_COLOR,
     REACTION_COUPLE_COLOR,
     ROOT,
     SCENE_SIZE,
+    CameraFit,
     Scene,
     build_scene,
+    camera_fit,
 )
 from mbody.present.animate.source import Source, resolve
 from mbody.present.animate.wire import pack, unpack
 
 __all__ = [
-    "CAMERA_DISTANCE", "COUPLE_COLOR", "FORCE_COLOR", "HOST", "PALETTE", "REACTION_COLOR",
-    "REACTION_COUPLE_COLOR", "ROOT", "SCENE_SIZE", "LiveViewer", "Scene", "Source",
-    "animate", "build_scene", "pack", "page_html", "resolve", "unpack", "write_page",
+    "CAMERA", "FILL", "COUPLE_COLOR", "FORCE_COLOR", "HOST", "PALETTE", "REACTION_COLOR",
+    "REACTION_COUPLE_COLOR", "ROOT", "SCENE_SIZE", "CameraFit", "LiveViewer", "Scene",
+    "Source", "animate", "build_scene", "camera_fit", "pack", "page_html", "resolve",
+    "unpack", "write_page",
 ]
 
 

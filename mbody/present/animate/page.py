@@ -43,7 +43,7 @@ var viewer = new MeshCat.Viewer(document.getElementById("meshcat-pane"));
   for (var i = 0; i < b.length; i++) a[i] = b.charCodeAt(i);
   viewer.handle_command_bytearray(a);
 }});
-(function () {{
+{fit}(function () {{
   var anim = viewer.animator, t0 = {t0}, duration = {duration};
   var play = document.getElementById("mbody-play");
   var slider = document.getElementById("mbody-time");
@@ -98,9 +98,14 @@ def page_html(scene: Scene, *, extra_js: str = "", typed_arrays: bool = True) ->
         f'"{base64.b64encode(pack(c, typed_arrays=typed_arrays)).decode("ascii")}"'
         for c in scene.commands)
     extra = f"<script>\n{extra_js}\n</script>\n" if extra_js else ""
+    fit = ""
+    if scene.camera is not None:  # the window's own aspect, now and after every resize
+        fit = (scene.camera.js() + "viewer.set_3d_pane_size(); fit(viewer);\n"
+               'window.addEventListener("resize", function () { fit(viewer); });\n')
     caption = html.escape(f"{scene.title.removeprefix('mbody: ')} · {scene.frames} frames")
     return _PAGE.format(title=html.escape(scene.title), duration=repr(scene.duration),
-                        t0=repr(scene.t0), caption=caption, js=js, blobs=blobs, extra=extra)
+                        t0=repr(scene.t0), caption=caption, js=js, fit=fit, blobs=blobs,
+                        extra=extra)
 
 
 def write_page(traj: Trajectory, out: str | os.PathLike[str], *, model: Model,

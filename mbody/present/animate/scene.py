@@ -49,7 +49,13 @@ couples, and thinner arrows than applied loads."""
 SCENE_SIZE = 2.0
 """The motion's bounding box is scaled to about this size (m) in the viewer, so that the
 viewer's fixed camera range (near 0.01, far 100) and lights suit any model."""
-CAMERA_DISTANCE = 3.4
+FOV = 75.0
+"""meshcat's camera: a perspective camera with this vertical field of view (degrees)."""
+FILL, ASPECT = 0.85, 4 / 3
+"""The motion's bounding box fills FILL of the view's width or height, whichever binds;
+the live viewer's camera assumes a view ASPECT (width / height) wide, the offline page
+refits it to its window (`CameraFit.js`)."""
+CAMERA = "/Cameras/default/rotated/<object>"
 
 _HEX = re.compile(r"#[0-9a-fA-F]{6}")
 
@@ -72,6 +78,135 @@ class Scene:
     frames: int
     title: str
     load_paths: dict[str, str] = field(default_factory=dict)
+    camera: CameraFit | None = None
+
+
+@dataclass(frozen=True)
+class CameraFit:
+    """Where the camera must be for the motion's bounding box to fill the view.
+
+    basis: (3, 3) rows right, up, back (unit vectors, meshcat world axes, z up); the
+    camera looks along −back with up as its up. points: (8, 3) the box's corners in
+    those axes (x right, y up, z towards the camera), scene units, about the scene's
+    origin.
+
+    With t = tan(fov / 2) FILL, a corner (x, y, z) is in view of a camera at (c_x, c_y,
+    z = D) when |x − c_x| <= (D − z) a t and |y − c_y| <= (D − z) t, a the aspect. Each
+    pair of bounds is tight at D = (A + B) / (2 a t), c_x = (A − B) / 2 with
+    A = max(x + a t z), B = max(−x + a t z) (likewise for y). The larger D wins; then
+    each offset is the one that centres the corners' projections (x − c_x) / (D − z): in
+    perspective a box's near corners look larger, so the camera aims off its centre.
+    """
+
+    basis: np.ndarray
+    points: np.ndarray
+    fov: float = FOV
+    fill: float = FILL
+
+    def solve(self, aspect: float) -> tuple[float, float, float]:
+        """(c_x, c_y, D): the camera's sideways and upward offset and its distance, for a
+        view `aspect` (width / height) wide."""
+        tan = self.fill * math.tan(math.radians(self.fov) / 2)
+        x, y, z = self.points.T
+        D = 0.0
+        for u, k in ((x, aspect * tan), (y, tan)):
+            D = max(D, (float(np.max(u + k * z)) + float(np.max(-u + k * z))) / (2 * k))
+        return _centre(x, D - z), _centre(y, D - z), D
+
+    def target(self, aspect: float) -> np.ndarray:
+        """The orbit target (meshcat world) for a view `aspect` wide."""
+        cx, cy, _ = self.solve(aspect)
+        return cx * self.basis[0] + cy * self.basis[1]
+
+    def position(self, aspect: float) -> np.ndarray:
+        """The camera's position (meshcat world) for a view `aspect` wide."""
+        cx, cy, D = self.solve(aspect)
+        return cx * self.basis[0] + cy * self.basis[1] + D * self.basis[2]
+
+    def shifted(self, offset: np.ndarray) -> CameraFit:
+        """The same fit with the scene moved by `offset` (meshcat world)."""
+        return CameraFit(self.basis, self.points + self.basis @ offset, self.fov, self.fill)
+
+    def js(self) -> str:
+        """JavaScript: a function `fit(viewer)` that aims the camera for the viewer's own
+        aspect (`solve`, in the page's window)."""
+        pts = [[round(float(v), 6) for v in p] for p in self.points]
+        basis = [[float(v) for v in row] for row in self.basis]
+        return (
+            "function fit(viewer) {\n"
+            f"  var pts = {pts}, B = {basis};\n"
+            f"  var t = {self.fill!r} * Math.tan({math.radians(self.fov) / 2!r});\n"
+            "  function reach(i, k) { var A = -Infinity, C = -Infinity;\n"
+            "    pts.forEach(function (p) { A = Math.max(A, p[i] + k * p[2]);\n"
+            "      C = Math.max(C, -p[i] + k * p[2]); });\n"
+            "    return (A + C) / (2 * k); }\n"
+            "  function centre(i, D) { var lo = Infinity, hi = -Infinity;\n"
+            "    pts.forEach(function (p) { lo = Math.min(lo, p[i]); hi = Math.max(hi, p[i]); });\n"
+            "    for (var n = 0; n < 60; n++) {\n"
+            "      var c = (lo + hi) / 2, a = -Infinity, b = Infinity;\n"
+            "      pts.forEach(function (p) { var q = (p[i] - c) / (D - p[2]);\n"
+            "        a = Math.max(a, q); b = Math.min(b, q); });\n"
+            "      if (a + b > 0) lo = c; else hi = c; }\n"
+            "    return (lo + hi) / 2; }\n"
+            "  var D = Math.max(reach(0, viewer.camera.aspect * t), reach(1, t));\n"
+            "  var cx = centre(0, D), cy = centre(1, D), w = [0, 1, 2].map(function (i) {\n"
+            "    return cx * B[0][i] + cy * B[1][i]; });\n"
+            "  // meshcat's camera frame is y up: (x, y, z)_world = (x, -z, y)_camera\n"
+            "  viewer.controls.target.set(w[0], w[2], -w[1]);\n"
+            "  viewer.camera.position.set(w[0] + D * B[2][0], w[2] + D * B[2][2],"
+            " -w[1] - D * B[2][1]);\n"
+            "  viewer.controls.update(); viewer.set_dirty();\n"
+            "}\n")
+
+
+def _centre(u: np.ndarray, e: np.ndarray) -> float:
+    """The offset c for which the projections (u − c) / e (e > 0) are centred on 0:
+    max + min of them falls as c grows, from >= 0 at min(u) to <= 0 at max(u)."""
+    lo, hi = float(np.min(u)), float(np.max(u))
+    for _ in range(60):
+        c = (lo + hi) / 2
+        q = (u - c) / e
+        lo, hi = (c, hi) if q.max() + q.min() > 0 else (lo, c)
+    return (lo + hi) / 2
+
+
+def camera_fit(corners: np.ndarray, direction: np.ndarray) -> CameraFit:
+    """The camera fit for box `corners` (8, 3), seen from unit `direction` (z up).
+
+    Parameters
+    ----------
+    corners : (8, 3) array
+        The bounding box's corners in meshcat world axes.
+    direction : (3,) array
+        Unit vector from the target to the camera; the camera's up is world +z, as
+        meshcat's orbit controls keep it.
+
+    Returns
+    -------
+    CameraFit
+    """
+    back = np.asarray(direction, dtype=np.float64)
+    right = np.cross([0.0, 0.0, 1.0], back)
+    right /= np.linalg.norm(right)
+    basis = np.stack([right, np.cross(back, right), back])
+    return CameraFit(basis, np.asarray(corners, dtype=np.float64) @ basis.T)
+
+
+def _box_corners(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """(8, 3) corners of the box [lo, hi]."""
+    return np.array([[(lo, hi)[i][0], (lo, hi)[j][1], (lo, hi)[k][2]]
+                     for i in (0, 1) for j in (0, 1) for k in (0, 1)], dtype=np.float64)
+
+
+def _motion_box(pos: np.ndarray, quat: np.ndarray, extents: Sequence[_Extent]
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """The world box holding every body's shape at every sample: (lo, hi), each (3,).
+
+    pos (K, n, 3), quat (K, n, 4) w-first; extents: the n bodies' shapes.
+    """
+    R = quat_to_matrix(quat)
+    reach = np.stack([e.reach(R[:, i]) for i, e in enumerate(extents)], axis=1)
+    return (pos - reach).min(axis=(0, 1)), (pos + reach).max(axis=(0, 1))
 
 
 class _Commands:
@@ -81,6 +216,7 @@ class _Commands:
         self.mc = mc
         self.g = mc.geometry
         self.list: list[dict[str, Any]] = []
+        self.bounds: list[tuple[np.ndarray, np.ndarray]] = []  # (lo, hi) of each arrow
 
     def set_object(self, path: str, obj: Any) -> None:
         self.list.append(self.mc.commands.SetObject(obj, path=self._path(path)).lower())
@@ -133,41 +269,71 @@ def _color(value: str | None, i: int) -> int:
                          "'#rrggbb'") from None
 
 
-def _shape(g: ModuleType, body: Body, dimension: int) -> tuple[Any, np.ndarray, np.ndarray]:
-    """meshcat geometry of a body, its fixed transform in body axes, its half-extents.
+@dataclass(frozen=True)
+class _Extent:
+    """A shape for bounding: kind ('box', 'ellipsoid' or 'cylinder' along its z), the
+    rotation from its own axes to body axes, and its half-extents (radii; for a
+    cylinder [r, r, length / 2]) in its own axes."""
+
+    kind: str
+    axes: np.ndarray
+    half: np.ndarray
+
+    def body_half(self) -> np.ndarray:
+        """Half-extents of a box in body axes that holds the shape."""
+        return np.abs(self.axes) @ self.half
+
+    def reach(self, R: np.ndarray) -> np.ndarray:
+        """(K, 3) half-extents along world axes of the shape turned by R (K, 3, 3),
+        exact for each kind: a box spans |R| h, an ellipsoid sqrt(Σ_j (R_ij r_j)²), a
+        cylinder of axis a spans r sqrt(1 − a_i²) + (length / 2) |a_i|."""
+        Rs = R @ self.axes
+        if self.kind == "box":
+            return np.abs(Rs) @ self.half
+        if self.kind == "ellipsoid":
+            return np.sqrt((Rs * Rs) @ (self.half * self.half))
+        a = Rs[..., 2]
+        return (self.half[0] * np.sqrt(np.clip(1.0 - a * a, 0.0, None))
+                + self.half[2] * np.abs(a))
+
+
+def _shape(g: ModuleType, body: Body, dimension: int) -> tuple[Any, np.ndarray, _Extent]:
+    """meshcat geometry of a body, its fixed transform in body axes, its extent.
 
     meshcat's cylinder axis is its local +y (three.js); turning it by +90° about x puts it
     along body z, the axis the model format gives cylinders and discs.
     """
     to_z = _homogeneous(_rot_x(math.pi / 2))
-    eye = np.eye(4)
+    eye, I3 = np.eye(4), np.eye(3)
     shape = body.shape
     if shape is None:  # the uniform box with the body's inertia, along its principal axes
         if dimension == cv.PLANAR:
             side = math.sqrt(6.0 * body.I_G / body.mass)
-            return g.Box([side, side, 0.2 * side]), eye, np.array([side, side, 0.2 * side]) / 2
+            dims = [side, side, 0.2 * side]
+            return g.Box(dims), eye, _Extent("box", I3, np.array(dims) / 2)
         moments, axes = np.linalg.eigh(np.asarray(body.inertia, dtype=np.float64))
         if np.linalg.det(axes) < 0:
             axes[:, 2] *= -1.0
         edges = box_equivalent(moments, body.mass)
-        half = np.abs(axes) @ (edges / 2)
-        return g.Box([float(e) for e in edges]), _homogeneous(axes), half
+        return (g.Box([float(e) for e in edges]), _homogeneous(axes),
+                _Extent("box", axes, np.asarray(edges, dtype=np.float64) / 2))
     kind, v = next(iter(shape.items()))
     if kind == "box":
         dims = [float(x) for x in v]
         if dimension == cv.PLANAR:
             dims.append(0.2 * min(dims))
-        return g.Box(dims), eye, np.array(dims) / 2
+        return g.Box(dims), eye, _Extent("box", I3, np.array(dims) / 2)
     if kind == "ellipsoid":
         radii = [float(x) for x in v]
         if dimension == cv.PLANAR:
             radii.append(0.2 * min(radii))
-        return g.Ellipsoid(np.array(radii, dtype=np.float64)), eye, np.array(radii)
+        return (g.Ellipsoid(np.array(radii, dtype=np.float64)), eye,
+                _Extent("ellipsoid", I3, np.array(radii)))
     r = float(v["radius"])
     if kind == "sphere":
-        return g.Sphere(r), eye, np.full(3, r)
+        return g.Sphere(r), eye, _Extent("ellipsoid", I3, np.full(3, r))
     length = float(v["length"]) if kind == "cylinder" else 0.1 * r if dimension == 3 else 0.2 * r
-    return g.Cylinder(length, r), to_z, np.array([r, r, length / 2])
+    return g.Cylinder(length, r), to_z, _Extent("cylinder", I3, np.array([r, r, length / 2]))
 
 
 def _internal(traj: Trajectory) -> tuple[np.ndarray, np.ndarray]:
@@ -262,40 +428,15 @@ def build_scene(traj: Trajectory, model: Model, *, forces: bool = False,
     duration = float(t[-1] - t[0])
 
     # Geometry first: its size sets the scene's scale.
-    geoms = []
+    geoms, extents = [], []
     for nm in shown:
         body = model.bodies[nm]
-        geom, T_shape, half = _shape(g, body, traj.dimension)
-        geoms.append((nm, geom, T_shape, half, _color(body.color, body.index)))
-    reach = max(float(np.linalg.norm(h)) for *_, h, _ in geoms)
-    P = pos[:, idx, :].reshape(-1, 3)
-    lo, hi = P.min(axis=0) - reach, P.max(axis=0) + reach
+        geom, T_shape, ext = _shape(g, body, traj.dimension)
+        extents.append(ext)
+        geoms.append((nm, geom, T_shape, ext.body_half(), _color(body.color, body.index)))
+    lo, hi = _motion_box(pos[:, idx], quat[:, idx], extents)
     extent = float(np.max(hi - lo))
-    centre = (lo + hi) / 2
-    s = SCENE_SIZE / extent
-
-    # The model frame: centred, scaled to SCENE_SIZE; planar x-y plane stood upright
-    # (model y up on screen, the camera on model +z).
-    R_view = _rot_x(math.pi / 2) if traj.dimension == cv.PLANAR else np.eye(3)
-    W_root = _homogeneous(R_view, -s * R_view @ centre, s)
-    out.set_transform(ROOT, W_root)
-
-    # Ground grid in the model's x-y plane: below the motion (spatial), behind the
-    # bodies (planar). meshcat's grid is 40 cells of 0.5; cells of a round size (1, 2 or
-    # 5 times a power of ten) make it 3 to 7.5 times the motion's size. (A much larger
-    # grid, reaching far behind the camera, loses its near lines in software WebGL.)
-    cell = _round_up(3.0 * extent / 40)
-    gz = lo[2] if traj.dimension == cv.SPATIAL else -max(h[2] for *_, h, _ in geoms) - 1e-3
-    gc = [round(centre[0] / cell) * cell, round(centre[1] / cell) * cell, gz]
-    out.set_transform("/Grid", W_root @ _homogeneous(None, gc, cell / 0.5))
-    out.set_property("/Axes", "visible", False)
-    out.set_object(f"{ROOT}/origin", g.triad(float(0.15 * extent)))
-
-    # Camera in meshcat's y-up camera frame: (x, y, z)_world = (x, -z, y)_camera.
-    d = np.array([0.0, -1.0, 0.0]) if traj.dimension == cv.PLANAR else np.array([1, .8, .65])
-    d = CAMERA_DISTANCE * d / np.linalg.norm(d)
-    out.set_property("/Cameras/default/rotated/<object>", "position",
-                     [float(d[0]), float(d[2]), float(-d[1])])
+    mark = len(out.list)  # the model frame, grid and camera go here once all is drawn
 
     # Every shown body's keyframes at once, body-major, so each track is a view.
     P_all = np.ascontiguousarray(pos[:, idx, :].transpose(1, 0, 2))
@@ -321,16 +462,66 @@ def build_scene(traj: Trajectory, model: Model, *, forces: bool = False,
         animations.extend(arrows)
         load_paths.update(reaction_paths)
 
+
+    # Fit the view to everything drawn: the bodies' box, with the arrows' reach.
+    if out.bounds:
+        lo = np.minimum(lo, np.min([b[0] for b in out.bounds], axis=0))
+        hi = np.maximum(hi, np.max([b[1] for b in out.bounds], axis=0))
+    rest, out.list = out.list[mark:], out.list[:mark]
+    camera = _view(out, traj.dimension, lo, hi, extent,
+                   -max(h[2] for *_, h, _ in geoms) - 1e-3)
+    out.list += rest
+
     out.list.append({"type": "set_animation", "path": "", "animations": animations,
                      "options": {"play": True, "repetitions": math.inf}})
     title = f"mbody: {model.name or traj.model_name or 'motion'}"
-    return Scene(out.list, paths, duration, float(t[0]), len(t), title, load_paths)
+    return Scene(out.list, paths, duration, float(t[0]), len(t), title, load_paths,
+                 camera)
+
+
+def _view(out: _Commands, dimension: int, lo: np.ndarray, hi: np.ndarray,
+          extent: float, behind: float) -> CameraFit:
+    """The model frame's transform, the grid and the camera for the box [lo, hi] (model
+    axes) of all that is drawn; `extent` sets the scale (the bodies' motion), `behind`
+    the planar grid's z."""
+    centre = (lo + hi) / 2
+    s = SCENE_SIZE / extent
+    # The model frame: scaled to SCENE_SIZE, the planar x-y plane stood upright (model y
+    # up on screen, the camera on model +z), and placed so that the orbit target, which
+    # meshcat keeps at the origin, is where the camera fit aims (off the box's centre:
+    # in perspective its near corners look larger).
+    R_view = _rot_x(math.pi / 2) if dimension == cv.PLANAR else np.eye(3)
+    d = np.array([0.0, -1.0, 0.0]) if dimension == cv.PLANAR else np.array([1, .8, .65])
+    camera = camera_fit(s * (_box_corners(lo, hi) - centre) @ R_view.T, d / np.linalg.norm(d))
+    aim = camera.target(ASPECT)
+    camera = camera.shifted(-aim)
+    W_root = _homogeneous(R_view, -s * R_view @ centre - aim, s)
+    out.set_transform(ROOT, W_root)
+
+    # Ground grid in the model's x-y plane: below the motion (spatial), behind the
+    # bodies (planar). meshcat's grid is 40 cells of 0.5; cells of a round size (1, 2 or
+    # 5 times a power of ten) make it 3 to 7.5 times the motion's size. (A much larger
+    # grid, reaching far behind the camera, loses its near lines in software WebGL.)
+    cell = _round_up(3.0 * extent / 40)
+    gz = lo[2] if dimension == cv.SPATIAL else behind
+    gc = [round(centre[0] / cell) * cell, round(centre[1] / cell) * cell, gz]
+    out.set_transform("/Grid", W_root @ _homogeneous(None, gc, cell / 0.5))
+    out.set_property("/Axes", "visible", False)
+    out.set_object(f"{ROOT}/origin", out.g.triad(float(0.15 * extent)))
+
+    # The camera along a fixed direction, at the distance where the box fills FILL of
+    # the view (the page refits it to its window's aspect).
+    p_cam = camera.position(ASPECT)
+    # meshcat's camera sits in a y-up frame: (x, y, z)_world = (x, -z, y)_camera.
+    out.set_property(CAMERA, "position", [float(p_cam[0]), float(p_cam[2]), float(-p_cam[1])])
+    return camera
 
 
 def _arrows(traj: Trajectory, model: Model, pos: np.ndarray, quat: np.ndarray,
             shown: set[int], times: np.ndarray, extent: float, out: _Commands
             ) -> tuple[list[dict[str, Any]], dict[str, str]]:
-    """Arrows for applied forces (at their points) and couples (at G), per frame.
+    """Arrows for applied forces (at their points), gravity (m g at G) and couples (at
+    G), per frame.
 
     Each arrow node turns +y onto the load's direction; its shaft is scaled along y to
     length L − head and its head sits at the shaft's end, so the head keeps its shape.
@@ -348,11 +539,23 @@ def _arrows(traj: Trajectory, model: Model, pos: np.ndarray, quat: np.ndarray,
         p_list.append(pos[k, np.where(on, c.body, 0)] + matvec(R, c.B_r))
         m_list.append(matvec(R, c.B_m))
         couple, body, names = c.couple, c.body, c.names
-    if not K or not len(body):
-        return [], {}
     W_f, W_p, W_m = np.array(f_list), np.array(p_list), np.array(m_list)
     vec = np.where(couple[None, :, None], W_m, W_f)
     at = np.where(couple[None, :, None], pos[:, np.maximum(body, 0)], W_p)
+    names = tuple(names)
+    # Gravity, m g at each mass centre: the free-body diagrams' weight, drawn and scaled
+    # as the other forces are.
+    weight = model.mass[:, None] * np.asarray(model.gravity, dtype=np.float64)[None, :]
+    heavy = np.flatnonzero(np.linalg.norm(weight, axis=1) > 0)
+    if len(heavy):
+        where = [list(traj.body_names).index(model.body_names[i]) for i in heavy]
+        vec = np.concatenate([vec, np.broadcast_to(weight[heavy], (K, len(heavy), 3))], 1)
+        at = np.concatenate([at, pos[:, where]], axis=1)
+        body = np.concatenate([body, where])
+        couple = np.concatenate([couple, np.zeros(len(heavy), dtype=bool)])
+        names += tuple(f"gravity ({model.body_names[i]})" for i in heavy)
+    if not K or not len(body):
+        return [], {}
     size = np.linalg.norm(vec, axis=-1)  # (K, k)
     L_max, head, radius = 0.35 * extent, 0.06 * extent, 0.012 * extent
     anims: list[dict[str, Any]] = []
@@ -397,6 +600,9 @@ def _arrow(out: _Commands, path: str, at: np.ndarray, vec: np.ndarray, L: np.nda
         inward = np.einsum("ij,ij->i", vec, lever) < -tol
         at[inward] -= (shaft + head)[inward, None] * d[inward]
     shown_k = (size > 0).astype(np.float64)
+    if shown_k.any():
+        ends = np.concatenate([at, at + (shaft + head)[:, None] * d])[np.tile(size > 0, 2)]
+        out.bounds.append((ends.min(axis=0), ends.max(axis=0)))
     ones, zeros = np.ones(K), np.zeros(K)
     return [
         _animation(path, [
