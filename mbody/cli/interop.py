@@ -1,9 +1,134 @@
-"""Placeholder: the commands of this group are being written."""
+"""convert: a model between mbody YAML, MuJoCo's MJCF and URDF."""
 
 from __future__ import annotations
 
 import argparse
+import importlib
+import os
+from pathlib import Path
+from typing import Any
+
+from mbody.cli.common import EXIT_OK, load_model, regular_file
+from mbody.errors import MbodyError, did_you_mean
+
+FORMATS = {".yaml": "yaml", ".yml": "yaml", ".xml": "mjcf", ".mjcf": "mjcf", ".urdf": "urdf"}
+"""File extension -> format."""
+WRITTEN = ("yaml", "mjcf")
+"""Formats `mbody convert` writes (URDF is read only)."""
+NAMES = {"yaml": "mbody YAML", "mjcf": "MJCF", "urdf": "URDF"}
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    """Add this group's commands (none yet)."""
+    """Add the `convert` command to the command line's subparsers."""
+    s = sub.add_parser(
+        "convert", help="convert a model between mbody YAML, MJCF (MuJoCo) and URDF",
+        description="Convert SOURCE to OUTPUT; the formats follow the extensions: .yaml "
+        "(mbody), .xml (MuJoCo's MJCF), .urdf (read only). YAML -> MJCF writes the model "
+        "along its joint tree with the initial state as the keyframe 'initial' (closed "
+        "loops as equality constraints, soft in MuJoCo; the file's header lists what MJCF "
+        "cannot hold). MJCF or URDF -> YAML writes an ordinary, readable mbody model whose "
+        "header names its source. YAML -> YAML rewrites a model in the shipped models' "
+        "layout (comments are not kept).")
+    s.add_argument("source", metavar="SOURCE", help="the model to read (.yaml, .xml, .urdf)")
+    s.add_argument("-o", "--output", metavar="OUTPUT", required=True,
+                   help="the file to write (.yaml or .xml)")
+    s.add_argument("--format", choices=WRITTEN, help="the output format, when OUTPUT's "
+                   "extension does not say it")
+    s.add_argument("--from", dest="source_format", choices=tuple(NAMES),
+                   help="the input format, when SOURCE's extension does not say it")
+    s.add_argument("--force", action="store_true", help="replace OUTPUT if it exists")
+    s.set_defaults(run=convert)
+
+
+def convert(a: argparse.Namespace) -> int:
+    """`mbody convert SOURCE -o OUTPUT`: read, convert, write atomically, say what."""
+    from mbody.io.atomic import ensure_writable
+
+    src_format = a.source_format or _format(a.source, "SOURCE", "--from",
+                                            (".yaml", ".xml", ".urdf"))
+    if not a.format and Path(a.output).suffix.lower() == ".urdf":
+        raise MbodyError(f"{a.output}: mbody reads URDF but does not write it; write "
+                         ".yaml (mbody) or .xml (MJCF)")
+    out_format = a.format or _format(a.output, "OUTPUT", "--format", (".yaml", ".xml"))
+    if not os.path.exists(a.source):
+        raise MbodyError(f"{a.source}: no such file")
+    regular_file(a.source, f"a model file ({NAMES[src_format]})")
+    if os.path.exists(a.output):
+        if os.path.samefile(a.source, a.output):
+            raise MbodyError(f"{a.output}: is SOURCE itself; give another OUTPUT")
+        if not a.force:
+            raise MbodyError(f"{a.output}: exists; give --force to replace it, or another "
+                             "OUTPUT")
+    ensure_writable(a.output)
+    if src_format == "yaml":
+        model = load_model(a.source)
+        if out_format == "mjcf":
+            from mbody.io.interop.mjcf_write import write_mjcf
+
+            write_mjcf(model, a.output, source=a.source)
+        else:
+            from mbody.io.interop.yaml_write import write_document
+            from mbody.model.loader import load_text, read_file
+
+            document = load_text(read_file(a.source), a.source).data
+            write_document(document, a.output, source=a.source)
+    else:
+        document = _read(a.source, src_format)
+        model = _model(document, a.source)
+        if out_format == "mjcf":
+            from mbody.io.interop.mjcf_write import write_mjcf
+
+            write_mjcf(model, a.output, source=a.source)
+        else:
+            from mbody.io.interop.yaml_write import write_document
+
+            write_document(document, a.output, source=a.source)
+    print(f"wrote {a.output} ({NAMES[out_format]} of {model.name!r} from "
+          f"{NAMES[src_format]}: {_summary(model)})")
+    if out_format == "mjcf":
+        print("the header comment of the file lists what MJCF cannot hold")
+    return EXIT_OK
+
+
+def _format(path: str, what: str, option: str, choices: tuple[str, ...]) -> str:
+    """The format `path`'s extension names (`FORMATS`; `choices` are the main ones, for
+    the message), or a clear refusal with a did-you-mean."""
+    ext = Path(path).suffix.lower()
+    if ext in FORMATS and FORMATS[ext] in {FORMATS[c] for c in choices}:
+        return FORMATS[ext]
+    hint = did_you_mean(ext, choices) if ext else ""
+    shown = ext or "no extension"
+    listed = ", ".join(choices)
+    raise MbodyError(f"{path}: cannot tell the format of {what} from {shown!r}"
+                     f"{'; ' + hint if hint else ''} (extensions: {listed}; or give "
+                     f"{option})")
+
+
+def _read(path: str, fmt: str) -> dict[str, Any]:
+    """The model document of an MJCF or URDF file (`mbody.io.interop.read_document`)."""
+    try:
+        interop = importlib.import_module("mbody.io.interop")
+    except ImportError:
+        interop = None
+    read = getattr(interop, "read_document", None)
+    if read is None:
+        raise MbodyError(f"{path}: reading {NAMES[fmt]} is not available in this version "
+                         "of mbody (only .yaml models can be converted)")
+    return read(path, format=fmt)
+
+
+def _model(document: dict[str, Any], source: str):
+    """The validated model of a document read from `source` (its issues name it)."""
+    from mbody.model.loader import Document
+    from mbody.model.model import Model
+    from mbody.model.validate import validate
+
+    return Model.from_spec(validate(Document(document, source)))
+
+
+def _summary(model) -> str:
+    from mbody.model.model import count
+
+    kind = "planar" if model.dimension == 2 else "spatial"
+    return (f"{kind}, {count(model.n, 'body', 'bodies')}, {count(len(model.joints), 'joint')}, "
+            f"{count(len(model.loads), 'load')}")
