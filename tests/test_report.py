@@ -81,3 +81,68 @@ def test_report_renders_in_headless_chromium(tmp_path):
     # the page's blue headings rule and the diagrams' colours are there
     blue = (img[..., 2] > 120) & (img[..., 0] < 80)
     assert blue.sum() > 200
+
+
+def _table(page, table_id):
+    """The rows of <table id=table_id> as lists of cell texts (tags stripped)."""
+    m = re.search(rf'<table class="solution" id="{table_id}">(.*?)</table>', page, re.S)
+    assert m, f"no table {table_id}"
+    return [[re.sub(r"<[^>]+>", "", c) for c in re.findall(r"<t[dh]>(.*?)</t[dh]>", row)]
+            for row in re.findall(r"<tr>(.*?)</tr>", m.group(1))]
+
+
+def test_report_shows_the_solved_mechanism_with_units():
+    """The double pendulum released from rest: the angular accelerations of Lagrange's
+    equations (models/double_pendulum.yaml), a_G = α × r at rest, and the four pin
+    reactions solved, each with its unit."""
+    model = mbody.load(ROOT / "models" / "double_pendulum.yaml")
+    page = report_html(model)
+    assert '<a href="#solution">' in page
+    acc = _table(page, "accelerations")
+    assert acc[0] == ["body", "ax (m/s²)", "ay (m/s²)", "α (rad/s²)"]
+    assert [r[0] for r in acc[1:]] == ["upper", "lower"]
+    np.testing.assert_allclose([float(acc[1][3]), float(acc[2][3])], [-7.36215, -10.1432],
+                               rtol=2e-6)
+    # at rest a_G1 = α1 × r_G1 (pivot at the origin), r_G1 = (0.125, -0.216506)
+    np.testing.assert_allclose([float(acc[1][1]), float(acc[1][2])],
+                               [7.36215 * -0.216506, -7.36215 * 0.125], rtol=2e-5)
+    rx = _table(page, "reactions")
+    assert rx[0] == ["reaction", "value", "unit", "status"]
+    assert [r[0] for r in rx[1:]] == ["O.Fx", "O.Fy", "A.Fx", "A.Fy"]
+    assert all(r[2] == "N" and r[3] == "solved" for r in rx[1:])
+    sol = mbody.assemble(model).solve()
+    np.testing.assert_allclose([float(r[1]) for r in rx[1:]],
+                               [sol.reactions[r] for r in model.reactions], rtol=1e-5)
+    # Newton for the lower rod: m a_G2 = A + m g, so A.Fx = 1 * a_x2
+    assert rx[3][1] == acc[2][1]
+
+
+def test_report_reactions_given_and_couples_in_newton_metres():
+    """Given reactions are marked given; moment components are in N·m; a spatial
+    model's columns are world-axis a and body-axis α."""
+    model = mbody.load(ROOT / "models" / "practice_2_flywheel.yaml")
+    rx = _table(report_html(model), "reactions")
+    assert rx[1:] == [["bearing.Fx", "0", "N", "given"], ["bearing.Fy", "122.625", "N", "given"]]
+    acc = _table(report_html(model), "accelerations")
+    assert acc[1] == ["flywheel", "0", "0", "40"]
+    model = mbody.load(ROOT / "models" / "rotor_gyroscopic_bearings.yaml")
+    page = report_html(model)
+    acc = _table(page, "accelerations")
+    assert acc[0][1:] == ["ax (m/s²)", "ay (m/s²)", "az (m/s²)", "α1 (rad/s²)",
+                          "α2 (rad/s²)", "α3 (rad/s²)"]
+    rx = _table(page, "reactions")
+    units = {r[0]: r[2] for r in rx[1:]}
+    asm = mbody.assemble(model)
+    for c, label in enumerate(model.reactions):
+        assert units[label] == ("N·m" if asm.columns.is_moment[c] else "N"), label
+    assert "N·m" in units.values()
+
+
+def test_report_without_joints_has_accelerations_only():
+    model = mbody.load(ROOT / "models" / "practice_1_translation.yaml")
+    page = report_html(model)
+    assert "No joints, so v̇ = M⁻¹ (Q − b)." in page
+    sol = mbody.assemble(model).solve()
+    acc = _table(page, "accelerations")
+    np.testing.assert_allclose([float(v) for v in acc[1][1:]], sol.accelerations, rtol=1e-5)
+    assert 'id="reactions"' not in page

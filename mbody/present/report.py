@@ -1,5 +1,6 @@
 """One self-contained HTML page per model: summary, topology, every body's free-body
-diagram and Newton-Euler pair, and the sizes of the stacked ``M v̇ + b = Q + G λ``.
+diagram and Newton-Euler pair, the sizes of the stacked ``M v̇ + b = Q + G λ``, and its
+solution at the file's state (accelerations by body, reactions by label, with units).
 
 Everything is inline (pictures as SVG elements, styles in the page): it opens offline,
 links to nothing outside itself, and prints as a hand-in.
@@ -12,9 +13,12 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from mbody import __version__
 from mbody import conventions as cv
 from mbody.equations.assemble import Assembly, assemble
+from mbody.errors import MbodyError
 from mbody.io.atomic import write_atomic
 from mbody.model.graph import topology
 from mbody.model.model import Model
@@ -74,7 +78,8 @@ def report_html(model: Model, *, asm: Assembly | None = None,
     out.append("<nav><h2>Contents</h2><ol>"
                '<li><a href="#summary">Model summary</a></li>'
                '<li><a href="#topology">Topology</a></li>'
-               '<li><a href="#stacked">Stacked equations</a></li>')
+               '<li><a href="#stacked">Stacked equations</a></li>'
+               '<li><a href="#solution">Solution at the initial state</a></li>')
     out += [f'<li><a href="#body-{k}">Body {_e(b)}</a></li>' for k, b in enumerate(shown)]
     out.append("</ol></nav>")
 
@@ -102,6 +107,8 @@ def report_html(model: Model, *, asm: Assembly | None = None,
                "</table>"
                f"<p class=\"muted\">Sign rule: {_e(cv.SIGN_RULE)}.</p></section>")
 
+    out.append(_solution_section(asm))
+
     for k, name in enumerate(shown):
         eq = asm.bodies[name]
         svg = figure_svg(fbd_scene(eq.fbd, view=view), prefix=f"b{k}-")
@@ -116,6 +123,72 @@ def report_html(model: Model, *, asm: Assembly | None = None,
         out.append(f"<p>{model.n - len(shown)} more bodies not drawn: {_e(rest)}.</p>")
     out.append("</body></html>")
     return "\n".join(out)
+
+
+_UNITS = {"x": "m/s²", "y": "m/s²", "z": "m/s²"}
+_SYMBOLS = {"x": "a<sub>x</sub>", "y": "a<sub>y</sub>", "z": "a<sub>z</sub>",
+            "w1": "α<sub>1</sub>", "w2": "α<sub>2</sub>", "w3": "α<sub>3</sub>",
+            "theta": "α"}
+
+
+def _num(x: float) -> str:
+    """As `mbody solve` prints numbers: 6 significant digits, rounding noise as 0."""
+    s = f"{0.0 if abs(x) < 1e-12 else x:.6g}"
+    return "0" if s in ("-0", "0") else s
+
+
+def _quiet(x: np.ndarray, rel: float = 1e-10) -> np.ndarray:
+    """Values below `rel` times the largest one shown as 0: rounding noise, not data."""
+    top = float(np.max(np.abs(x), initial=0.0))
+    return np.where(np.abs(x) <= rel * top, 0.0, x)
+
+
+def _solution_section(asm: Assembly) -> str:
+    """The solved accelerations by body and every reaction's value, at the file's state
+    (what `mbody solve` prints), or why the model cannot be solved there."""
+    model = asm.model
+    head = ('<section id="solution"><h2>Solution at the initial state</h2>'
+            f"<p>At t = {_num(asm.state.t)} s, the state written in the file. ")
+    try:
+        sol = asm.solve()
+    except MbodyError as e:
+        return head + f"The equations cannot be solved there: {_e(e)}</p></section>"
+    rows = cv.PLANAR_ROWS if model.dimension == cv.PLANAR else cv.SPATIAL_ROWS
+    unknown = [r for r in asm.reactions if r not in model.known_reactions]
+    out = [head + ("No joints, so v̇ = M⁻¹ (Q − b)." if not asm.reactions else
+                   "Every reaction is given, so v̇ = M⁻¹ (Q − b + G λ)." if not unknown else
+                   f"The {len(unknown)} unknown reaction components are solved with the "
+                   "joints' constraints (the mechanism's accelerations).")
+           + (" Newton rows in world axes, Euler rows in body axes." if len(rows) == 6
+              else "") + "</p>"]
+    acc = _quiet(np.asarray(sol.accelerations, dtype=np.float64))
+    header = "".join(f"<th>{_SYMBOLS[r]} ({_UNITS.get(r, 'rad/s²')})</th>" for r in rows)
+    body_rows = "".join(
+        f"<tr><td>{_e(name)}</td>"
+        + "".join(f"<td>{_num(v)}</td>" for v in acc[model.body_rows(i)]) + "</tr>"
+        for i, name in enumerate(model.body_names))
+    out.append(f'<h3>Accelerations</h3><table class="solution" id="accelerations">'
+               f"<tr><th>body</th>{header}</tr>{body_rows}</table>")
+    if sol.reactions:
+        is_moment = asm.columns.is_moment
+        lam = _quiet(np.array([sol.reactions[r] for r in model.reactions], dtype=np.float64))
+        solved, not_unique = set(sol.solved), set(sol.not_unique)
+        lines = "".join(
+            f"<tr><td>{_e(label)}</td><td>{_num(lam[c])}</td>"
+            f"<td>{'N·m' if is_moment[c] else 'N'}</td><td>"
+            + ("not unique" if label in not_unique else "solved" if label in solved
+               else "given") + "</td></tr>"
+            for c, label in enumerate(model.reactions))
+        out.append('<h3>Joint reactions</h3><p>Each component acts along (or about) its '
+                   "joint-frame axis: +R on the child, −R on the parent.</p>"
+                   '<table class="solution" id="reactions"><tr><th>reaction</th>'
+                   f"<th>value</th><th>unit</th><th>status</th></tr>{lines}</table>")
+    if sol.residual is not None:
+        out.append(f'<p class="muted">Solved by {_e(sol.method)}; relative backward error '
+                   f"{sol.residual:.1e}.</p>")
+    out += [f"<p><strong>Warning:</strong> {_e(w)}</p>" for w in sol.warnings]
+    out.append("</section>")
+    return "".join(out)
 
 
 def write_report(model: Model, path: str | Path, **kwargs: Any) -> Path:
