@@ -36,6 +36,7 @@ _LAZY = {
     "loads": "model.model",
     "simulate": "simulate.simulation",
     "Trajectory": "simulate.trajectory",
+    "verify": "answers.verify",
 }
 """Public name -> the submodule defining it."""
 
@@ -44,7 +45,7 @@ __all__ = [
     "FreeBodyDiagram", "load_export",
     "Issue", "Joint", "Load", "MbodyError", "Model", "ModelError", "Solution", "State",
     "Trajectory", "simulate",
-    "UnknownReactionsError", "animate", "assemble", "load", "loads",
+    "UnknownReactionsError", "animate", "assemble", "load", "loads", "verify",
 ]
 
 

@@ -1,0 +1,515 @@
+"""Which of the course's mistakes turns a body's true row into the student's equation.
+
+Each mistake of the course's misconceptions table is a small change of a true row,
+built here in numbers (`variants`): the gyroscopic part of b dropped; one scalar inertia
+for the tensor; moments about a joint point or the origin with I_G kept and the
+transport term left out; a reaction left out, given the wrong sign, or replaced by a
+number; an applied load (or gravity) left out. The student's row is compared with the
+true rows first, then with each variant in the order of `DIAGNOSES`; the first that
+matches within the tolerance names the mistake. When none does, the closest true row
+and the terms that differ are reported.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from mbody.answers.compare import CONST, Fit, Row, fit, matches, same
+from mbody.answers.rows import BodyRows, MomentPoint, TrueRow
+
+CORRECT = "correct"
+MISSING_GYROSCOPIC_TERM = "missing_gyroscopic_term"
+WRONG_MOMENT_POINT = "wrong_moment_point"
+REACTION_TREATED_AS_KNOWN = "reaction_treated_as_known"
+MISSING_REACTION = "missing_reaction"
+REACTION_SIGN = "reaction_sign"
+SINGLE_INERTIA_IN_SPACE = "single_inertia_in_space"
+MISSING_APPLIED_LOAD = "missing_applied_load"
+NOT_AN_EQUATION = "not_an_equation_of_this_body"
+
+DIAGNOSES = {
+    CORRECT: "equal to one of the body's Newton or Euler rows (up to scale and "
+             "rearrangement)",
+    MISSING_GYROSCOPIC_TERM: "an Euler row without its ω × Iω part",
+    WRONG_MOMENT_POINT: "moments taken about another point (a joint, the origin) with I_G "
+                        "and without the transport term",
+    REACTION_TREATED_AS_KNOWN: "an unknown reaction replaced by a number",
+    MISSING_REACTION: "an unknown reaction left out",
+    REACTION_SIGN: "a reaction with the wrong sign (the third law: −R on the parent)",
+    SINGLE_INERTIA_IN_SPACE: "one scalar inertia where the tensor's principal moments "
+                             "differ",
+    MISSING_APPLIED_LOAD: "an applied force or moment (or gravity) left out",
+    NOT_AN_EQUATION: "none of the above explains it",
+}
+"""The fixed vocabulary of diagnoses, in the order they are tried, with their meaning."""
+
+
+@dataclass(frozen=True)
+class Diagnosis:
+    """What one equation is, compared with its body's rows.
+
+    Parameters
+    ----------
+    diagnosis : str
+        A key of `DIAGNOSES`.
+    expected : str
+        The row it was compared with, as text ('' when there is none to compare with).
+    row : str
+        That row's coordinate label (``rod.theta``), or ''.
+    explanation : str
+        One or two sentences in the course's terms.
+    details : dict
+        What the diagnosis found, for programs: the term, the point, the load, the value
+        used for a reaction...
+    """
+
+    diagnosis: str
+    expected: str
+    row: str
+    explanation: str
+    details: dict = field(default_factory=dict)
+
+
+AXES = "xyz"
+
+
+def describe_row(r: TrueRow, planar: bool) -> str:
+    """The row in words: "Newton's equation along world y (m a_y = ΣF_y)"..."""
+    if not r.euler:
+        a = AXES[r.axis]
+        return f"Newton's equation along world {a} (m a_{a} = ΣF_{a})"
+    if planar:
+        return "the rotational equation about the mass centre (I_G α = ΣM_G)"
+    k = r.axis + 1
+    return f"Euler's equation about body axis {k} ((I α + ω × Iω)_{k} = M_{k})"
+
+
+def diagnose(s: Row, br: BodyRows, tol: float,
+             solved: Callable[[], Mapping[str, float] | None] = lambda: None) -> Diagnosis:
+    """The diagnosis of the student's row `s` against the body's rows.
+
+    Parameters
+    ----------
+    s : Row
+        The student's equation, ``lhs − rhs``, with the model's numbers put in.
+    br : BodyRows
+        The body's true rows and what they are made of.
+    tol : float
+        Relative tolerance on each coefficient (see `mbody.answers.compare`).
+    solved : callable, optional
+        Returns the reactions' values at this state (solved), or None; asked only when
+        a reaction was replaced by a number, to say what its value is.
+
+    Returns
+    -------
+    Diagnosis
+        The first explanation that matches.
+    """
+    return _Diagnoser(s, br, tol, solved).run()
+
+
+class _Diagnoser:
+    def __init__(self, s: Row, br: BodyRows, tol: float,
+                 solved: Callable[[], Mapping[str, float] | None]):
+        self.s, self.br, self.tol, self.solved = s, br, tol, solved
+        self.planar = br.planar
+
+    def run(self) -> Diagnosis:
+        for step in (self.no_unknowns, self.foreign, self.correct, self.gyroscopic,
+                     self.single_inertia, self.moment_point, self.missing_reaction,
+                     self.reaction_sign, self.missing_load, self.treated_as_known):
+            found = step()
+            if found is not None:
+                return found
+        return self.closest()
+
+    # -- helpers -----------------------------------------------------------------------
+    def match(self, t: Row, free: tuple[str, ...] = ()) -> Fit | None:
+        return matches(self.s, t, self.tol, free)
+
+    def words(self, r: TrueRow) -> str:
+        return describe_row(r, self.planar)
+
+    def reaction_words(self, label: str) -> str:
+        joint, side, other = self.br.joints[label]
+        where = "ground" if other == "ground" else f"body {other}"
+        return f"{label} (joint {joint}, between {self.br.body} and {where})"
+
+    # -- the steps -----------------------------------------------------------------------
+    def no_unknowns(self) -> Diagnosis | None:
+        if self.s.unknowns:
+            return None
+        c = self.s.get(CONST)
+        says = ("0 = 0" if c == 0.0 else
+                f"a number equal to another (they differ by {_num(abs(c))})")
+        return Diagnosis(NOT_AN_EQUATION, "", "",
+                         f"Once the model's numbers are put in, this says {says}: it has no "
+                         "acceleration and no unknown reaction in it. A Newton-Euler "
+                         "equation relates the body's accelerations to the forces on it.",
+                         {"unknowns": []})
+
+    def foreign(self) -> Diagnosis | None:
+        accs = {a for r in self.br.rows for a in r.row.unknowns if "." not in a}
+        accs |= {r.acc for r in self.br.rows}
+        mine = set(self.br.joints) | accs
+        other = sorted(self.s.unknowns - mine)
+        if not other:
+            return None
+        label = other[0]
+        if "." in label:
+            why = (f"{label} is a reaction of a joint that does not touch {self.br.body}, so "
+                   f"it is not a force on this body's free-body diagram.")
+        else:
+            why = f"{label} is not an unknown of {self.br.body}."
+        return Diagnosis(NOT_AN_EQUATION, "", "", why + " Draw the free body of "
+                         f"{self.br.body} alone: only its own joints' reactions act on it.",
+                         {"foreign": other})
+
+    def correct(self) -> Diagnosis | None:
+        for r in self.br.rows:
+            f = self.match(r.row)
+            if f is not None:
+                return Diagnosis(CORRECT, r.text, r.label,
+                                 f"This is {self.words(r)}"
+                                 + (", scaled" if abs(abs(f.k) - 1.0) > self.tol else "")
+                                 + (" and rearranged" if f.k < 0 else "") + ".",
+                                 {"scale": f.k})
+        for e in self.br.euler:
+            for p in self.br.points:
+                t = self.br.transport(e, p, keep_acc=True)
+                if self.match(t) is not None:
+                    return Diagnosis(
+                        CORRECT, row_text(t), e.label,
+                        f"These are moments about {_point(p)}, with the transport term "
+                        f"r × m a_G: the same law as {self.words(e)}, taken about another "
+                        "point.", {"point": p.name, "form": "transport"})
+                if p.fixed and self.match(self.br.about_fixed_point(e, p)) is not None:
+                    return Diagnosis(
+                        CORRECT, row_text(self.br.about_fixed_point(e, p)), e.label,
+                        f"These are moments about {_point(p)}, a fixed pivot, with the "
+                        f"inertia about it (I_P = I_G + m d²): {self.words(e)} combined with "
+                        "Newton's through the pivot's kinematics.",
+                        {"point": p.name, "form": "fixed_pivot"})
+        return None
+
+    def gyroscopic(self) -> Diagnosis | None:
+        for e in self.br.euler:
+            if e.gyro == 0.0 or abs(e.gyro) <= 1e-12 * e.row.err(CONST):
+                continue
+            t = e.row.with_term(CONST, e.row.get(CONST) - e.gyro,
+                                e.row.err(CONST) - abs(e.gyro))
+            if self.match(t) is not None:
+                return Diagnosis(
+                    MISSING_GYROSCOPIC_TERM, e.text, e.label,
+                    f"This is {self.words(e)} without its gyroscopic term "
+                    f"{self.gyro_words(e)}. Keep ω × Iω for spatial rotation: it does not "
+                    "vanish unless the motion is planar.",
+                    {"term": "omega x (I omega)", "value": e.gyro})
+        return None
+
+    def gyro_words(self, e: TrueRow) -> str:
+        k = e.axis
+        J, w = self.br.J, self.br.omega
+        i, j = (k + 1) % 3, (k + 2) % 3
+        if np.count_nonzero(J - np.diag(np.diag(J))) == 0:
+            form = (f" = (I_{j + 1} − I_{i + 1}) w_{i + 1} w_{j + 1} = "
+                    f"({_num(J[j, j])} − {_num(J[i, i])})·{_num(w[i])}·{_num(w[j])}")
+        else:
+            form = " (with the full tensor)"
+        return (f"(ω × Iω)_{k + 1}{form} = {_num(e.gyro)} N m, which belongs on the left "
+                "beside I α")
+
+    def single_inertia(self) -> Diagnosis | None:
+        if self.planar:
+            return None
+        J = self.br.J
+        moments = np.linalg.eigvalsh(J)
+        if np.ptp(moments) <= 1e-9 * moments.max():
+            return None  # equal principal moments: one inertia is right
+        for e in self.br.euler:
+            a = e.acc
+            if self.s.get(a) == 0.0:
+                continue
+            coef = {k: v for k, v in e.row.coef.items()
+                    if not (k.startswith("alpha") and k != a)}
+            coef[CONST] = e.row.get(CONST) - e.gyro
+            t = Row(coef, {k: e.row.err(k) for k in coef})
+            f = self.match(t, free=(a,))
+            if f is None:
+                continue
+            used = self.s.get(a) / f.k
+            diagonal = np.count_nonzero(J - np.diag(np.diag(J))) == 0
+            if diagonal and abs(used - J[e.axis, e.axis]) <= self.tol * abs(J[e.axis, e.axis]):
+                continue  # I_k itself: the gyroscopic step speaks for it
+            k = e.axis + 1
+            pm = ", ".join(_num(x) for x in np.diag(J)) if diagonal else \
+                ", ".join(_num(x) for x in moments)
+            return Diagnosis(
+                SINGLE_INERTIA_IN_SPACE, e.text, e.label,
+                f"This treats the body as having one inertia ({_num(used)} kg m²) about every "
+                f"axis, so angular momentum is taken parallel to the spin and ω × Iω vanishes; "
+                f"but its principal moments differ ({pm} kg m²). Use the full tensor: "
+                f"{self.inertia_words(e)}, and keep ω × Iω ({_num(e.gyro)} N m).",
+                {"inertia_used": used, "term": f"I alpha_{k}"})
+        return None
+
+    def inertia_words(self, e: TrueRow) -> str:
+        row = [(k, v) for k, v in e.row.coef.items() if k.startswith("alpha") and v != 0.0]
+        return "(I α)_{} = {}".format(e.axis + 1, " + ".join(f"{_num(v)} {k}" for k, v in row))
+
+    def moment_point(self) -> Diagnosis | None:
+        for e in self.br.euler:
+            for p in self.br.points:
+                t = self.br.transport(e, p, keep_acc=False)
+                if not same(t, e.row, self.tol) and self.match(t) is not None:
+                    transport = self.br.transport(e, p, keep_acc=True)
+                    term = _terms({k: v - e.row.get(k) for k, v in transport.coef.items()
+                                   if k.startswith("a_")})
+                    return Diagnosis(
+                        WRONG_MOMENT_POINT, e.text, e.label,
+                        f"These are moments about {_point(p)}, not about the mass centre, "
+                        f"but with I_G α alone. About a point other than G add the transport "
+                        f"term r × m a_G ({term} on the left), or take moments about G: "
+                        f"{e.text}.", {"point": p.name, "transport_term": term})
+                if p.fixed:
+                    continue
+                t = self.br.about_fixed_point(e, p)
+                if not same(t, e.row, self.tol) and self.match(t) is not None:
+                    return Diagnosis(
+                        WRONG_MOMENT_POINT, e.text, e.label,
+                        f"These are moments about {_point(p)} with the inertia about it, as "
+                        f"for a fixed pivot; but {p.name.split()[-1]} moves, so I_P α = M_P "
+                        f"does not hold there. Take moments about the mass centre: {e.text}.",
+                        {"point": p.name, "form": "moving_pivot"})
+        return None
+
+    def absent(self, r: TrueRow) -> list[str]:
+        """The row's reactions the student's equation does not have."""
+        return sorted(k for k in r.row.unknowns if k in self.br.joints
+                      and self.s.get(k) == 0.0)
+
+    def missing_reaction(self) -> Diagnosis | None:
+        for r in self.br.rows:
+            gone = self.absent(r)
+            if gone and self.match(r.row.without(gone)) is not None:
+                terms = _terms({k: -r.row.get(k) for k in gone})
+                names = ", ".join(self.reaction_words(k) for k in gone)
+                return Diagnosis(
+                    MISSING_REACTION, r.text, r.label,
+                    f"This is {self.words(r)} with the reaction{'s' if len(gone) > 1 else ''} "
+                    f"{names} left out. Every reaction of the body's joints is on its free "
+                    f"body, as an unknown: the right side needs {terms}.",
+                    {"reactions": gone, "term": terms})
+        return None
+
+    def reaction_sign(self) -> Diagnosis | None:
+        for r in self.br.rows:
+            present = [k for k in r.row.unknowns if k in self.br.joints and self.s.get(k) != 0]
+            groups: dict[str, list[str]] = {}
+            for k in present:
+                groups.setdefault(self.br.joints[k][0], []).append(k)
+            trials = [sorted(g) for g in groups.values()] + [[k] for k in sorted(present)]
+            for flip in trials:
+                t = r.row
+                for k in flip:
+                    t = t.with_term(k, -t.get(k), t.err(k))
+                if self.match(t) is None:
+                    continue
+                joint, side, other = self.br.joints[flip[0]]
+                rule = ("the reaction acts on the child as +R and on the parent as −R "
+                        "(Newton's third law)")
+                role = (f"{self.br.body} is the child of joint {joint}, so it feels "
+                        f"+{flip[0]}" if side > 0 else
+                        f"{self.br.body} is the parent of joint {joint}, so it feels "
+                        f"−{flip[0]}")
+                terms = _terms({k: -r.row.get(k) for k in flip})
+                return Diagnosis(
+                    REACTION_SIGN, r.text, r.label,
+                    f"{', '.join(flip)} {'has' if len(flip) == 1 else 'have'} the wrong sign "
+                    f"in {self.words(r)}: {rule}; {role}. The right side should read "
+                    f"{terms}.", {"reactions": flip, "term": terms})
+        return None
+
+    def missing_load(self) -> Diagnosis | None:
+        for r in self.br.rows:
+            shares = list(r.loads)
+            trials = [[x] for x in shares] + ([shares] if len(shares) > 1 else [])
+            for drop in trials:
+                total = sum(x.value for x in drop)
+                t = r.row.with_term(CONST, r.row.get(CONST) + total,
+                                    max(0.0, r.row.err(CONST) - sum(abs(x.value) for x in drop)))
+                if same(t, r.row, self.tol) or self.match(t) is None:
+                    continue
+                what = "; ".join(_load_words(x, r.euler) for x in drop)
+                return Diagnosis(
+                    MISSING_APPLIED_LOAD, r.text, r.label,
+                    f"This is {self.words(r)} with {what} left out. Every applied load "
+                    "(gravity, springs, actuators) is on the free body: " + r.text + ".",
+                    {"loads": [x.name for x in drop], "value": total})
+        return None
+
+    def treated_as_known(self) -> Diagnosis | None:
+        for r in self.br.rows:
+            gone = self.absent(r)
+            if not gone:
+                continue
+            t = r.row.without(gone)
+            f = self.match(t, free=(CONST,))
+            if f is None:
+                continue
+            # the student's constant, brought to the true row's scale, minus the true one
+            extra = self.s.get(CONST) / f.k - r.row.get(CONST)
+            details: dict = {"reactions": gone}
+            if len(gone) == 1:
+                k = gone[0]
+                value = extra / r.row.get(k)
+                details["value_used"] = value
+                text = (f"{self.reaction_words(k)} is replaced by the number {_num(value)}"
+                        f"{' N m' if _is_moment(k) else ' N'}")
+                sol = self.solved()
+                if sol is not None and k in sol:
+                    details["value_solved"] = sol[k]
+                    text += (f" (solved with the joints, it is {_num(sol[k])} at this "
+                             "instant; but it is an output, not an input)")
+            else:
+                text = (f"the reactions {', '.join(gone)} are replaced by numbers (they add "
+                        f"{_num(-extra)} to the right side)")
+            return Diagnosis(
+                REACTION_TREATED_AS_KNOWN, r.text, r.label,
+                f"In {self.words(r)}, {text}. A joint reaction is a constraint force: tag it "
+                f"as an unknown and keep its symbol, {_terms({k: -r.row.get(k) for k in gone})}"
+                " on the right side.", details)
+        return None
+
+    def closest(self) -> Diagnosis:
+        candidates = [(r, r.row, self.words(r), r.text) for r in self.br.rows]
+        if self.s.unknowns & {"a_x", "a_y", "a_z"} and any(
+                k.startswith("alpha") for k in self.s.unknowns):
+            for e in self.br.euler:
+                for p in self.br.points:
+                    t = self.br.transport(e, p, keep_acc=True)
+                    candidates.append((e, t, f"the moment equation about {_point(p)} (with "
+                                       "the transport term r × m a_G)", row_text(t)))
+        best: tuple | None = None
+        for r, t, words, text in candidates:
+            f = self.consensus(t, r.acc)
+            if f is None:
+                continue
+            wrong = f.wrong(self.tol)
+            shared = len(self.s.unknowns & t.unknowns)
+            key = (len(wrong) - shared, len(wrong), f.error)
+            if best is None or key < best[0]:
+                best = (key, r, t, words, text, f, wrong)
+        if best is None:
+            return Diagnosis(NOT_AN_EQUATION, "", "", "This equation shares no term with "
+                             f"any of {self.br.body}'s Newton-Euler rows.", {})
+        _, r, t, words, text, f, wrong = best
+        parts = []
+        for key in wrong[:3]:
+            have, want = self.s.get(key), f.k * t.get(key)
+            name = "the constant" if key == CONST else key
+            if have == 0.0:
+                parts.append(f"{name} is missing (expected {_num(want)})")
+            elif want == 0.0:
+                parts.append(f"{name} does not belong here (you have {_num(have)})")
+            else:
+                parts.append(f"{name} has {_num(have)} where {_num(want)} is expected")
+        more = f", and {len(wrong) - 3} more" if len(wrong) > 3 else ""
+        combo = self.combination()
+        return Diagnosis(
+            NOT_AN_EQUATION, text, r.label,
+            (combo + " " if combo else "")
+            + f"Closest is {words}; with every term on the left side, at your "
+            "equation's scale: " + "; ".join(parts) + more + ".",
+            {"differs": {k: {"have": self.s.get(k), "expected": f.k * t.get(k)}
+                         for k in wrong}})
+
+    def consensus(self, t: Row, acc: str) -> Fit | None:
+        """The fit whose scale most of the student's terms agree with (the row's own
+        acceleration breaking ties), so that the minority of wrong terms stands out."""
+        best: tuple | None = None
+        for key in sorted(self.s.keys & t.keys):
+            k = self.s.get(key) / t.get(key)
+            errors = {}
+            for name in sorted(self.s.keys | t.keys):
+                ref = max(self.s.err(name), abs(k) * t.err(name))
+                diff = abs(self.s.get(name) - k * t.get(name))
+                errors[name] = 0.0 if diff <= 1e-15 * ref else (
+                    diff / ref if ref > 0 else np.inf)
+            fk = Fit(k, max(errors.values(), default=0.0), errors)
+            score = (len(fk.wrong(self.tol)), key != acc, fk.error)
+            if best is None or score < best[0]:
+                best = (score, fk)
+        return best[1] if best is not None else fit(self.s, t)
+
+    def combination(self) -> str:
+        """A sentence when the equation holds but mixes several rows, else ''."""
+        keys = sorted(set().union(*(r.row.keys for r in self.br.rows)) | self.s.keys)
+        A = np.array([[r.row.get(k) for r in self.br.rows] for k in keys])
+        b = np.array([self.s.get(k) for k in keys])
+        if not len(keys) or not np.any(b):
+            return ""
+        x, *_ = np.linalg.lstsq(A, b, rcond=None)
+        t = Row(dict(zip(keys, (A @ x).tolist(), strict=True)),
+                {k: sum(abs(x[j]) * r.row.err(k) for j, r in enumerate(self.br.rows))
+                 for k in keys})
+        if self.match(t) is None:
+            return ""
+        used = [r.label for j, r in enumerate(self.br.rows)
+                if abs(x[j]) > 1e-9 * np.abs(x).max()]
+        return (f"This equation holds (it combines the rows {', '.join(used)}), but it is not "
+                "one of the body's Newton-Euler rows: write each one on its own.")
+
+
+def _is_moment(label: str) -> bool:
+    return label.rpartition(".")[2].startswith("M")
+
+
+def _point(p: MomentPoint) -> str:
+    where = ", ".join(_num(c) for c in (p.W_P if abs(p.W_P[2]) > 0 else p.W_P[:2]))
+    return f"{p.name} ({where})"
+
+
+def _load_words(x, euler: bool) -> str:
+    name = {"gravity": "gravity, m g", "couple": f"the applied couple '{x.name}'",
+            "spring": f"the spring '{x.name}'"}.get(x.kind, f"the applied force '{x.name}'")
+    if euler and x.kind != "couple":
+        return f"the moment of {name} about G ({_num(x.value)} N m)"
+    return f"{name} ({_num(x.value)} {'N m' if euler else 'N'} on this row)"
+
+
+def _num(x: float) -> str:
+    x = float(x)
+    x = 0.0 if abs(x) < 1e-12 else x
+    s = f"{x:.6g}"
+    return "0" if s in ("-0", "0") else s
+
+
+def _terms(coef: Mapping[str, float]) -> str:
+    """``{O.Fx: -0.43, O.Fy: 1}`` -> ``-0.43 O.Fx + O.Fy``."""
+    out = ""
+    for name, c in coef.items():
+        if c == 0.0:
+            continue
+        mag = abs(c)
+        txt = name if _num(mag) == "1" else f"{_num(mag)} {name}"
+        if not out:
+            out = f"-{txt}" if c < 0 else txt
+        else:
+            out += f" {'-' if c < 0 else '+'} {txt}"
+    return out or "0"
+
+
+def row_text(row: Row) -> str:
+    """A row as an equation: accelerations on the left, the rest on the right."""
+    left = {k: v for k, v in row.coef.items() if k != CONST and "." not in k}
+    right = {k: -v for k, v in row.coef.items() if "." in k}
+    const = -row.get(CONST)
+    rhs = _terms(right) if right and any(right.values()) else ""
+    if const != 0.0 or not rhs:
+        rhs = _num(const) + ("" if not rhs else
+                             (" + " + rhs if not rhs.startswith("-") else " - " + rhs[1:]))
+    return f"{_terms(left)} = {rhs}"

@@ -1,0 +1,182 @@
+"""A parsed equation, with the model's numbers put in, as one linear `Row`.
+
+Each sub-expression evaluates to a linear form ``Σ c_k u_k + c_0`` over the unknowns
+(accelerations, reaction labels) carrying, per coefficient, two magnitudes:
+
+- ``err``: first-order bound of the rounding error, in units of the tolerance: a
+  number written in the equation counts with its magnitude, a name of the vocabulary
+  (``m``, ``I_2``, ``w_3``...) with none, since it is exact;
+- ``mag``: the magnitude of every term that made the coefficient, exact or not, so that
+  ``cos(pi/2)`` (6e-17 in floating point) is seen to be zero.
+
+A product of two forms that both hold unknowns, a division by one, or a function of one
+is not a Newton-Euler equation: `NotLinear` says where.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from mbody.answers.compare import CONST, Row
+from mbody.answers.parse import EquationError, Node, ParsedEquation
+from mbody.answers.vocabulary import Vocabulary
+
+
+class NotLinear(Exception):
+    """The equation is not linear in the unknowns; `position` is where, `why` what."""
+
+    def __init__(self, position: int, why: str):
+        super().__init__(why)
+        self.position, self.why = position, why
+
+
+@dataclass
+class _Form:
+    value: dict[str, float] = field(default_factory=dict)  # CONST for the constant
+    err: dict[str, float] = field(default_factory=dict)
+    mag: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def constant(self) -> bool:
+        return all(k == CONST for k in self.value)
+
+    @property
+    def c(self) -> float:
+        return self.value.get(CONST, 0.0)
+
+    @staticmethod
+    def number(v: float, exact: bool) -> _Form:
+        return _Form({CONST: v}, {CONST: 0.0 if exact else abs(v)}, {CONST: abs(v)})
+
+    def add(self, other: _Form, sign: float) -> _Form:
+        out = _Form(dict(self.value), dict(self.err), dict(self.mag))
+        for k, v in other.value.items():
+            out.value[k] = out.value.get(k, 0.0) + sign * v
+            out.err[k] = out.err.get(k, 0.0) + other.err[k]
+            out.mag[k] = out.mag.get(k, 0.0) + other.mag[k]
+        return out
+
+    def times(self, a: float, a_err: float, a_mag: float) -> _Form:
+        """self · a for a constant a (with its own error and magnitude)."""
+        return _Form({k: v * a for k, v in self.value.items()},
+                     {k: abs(v) * a_err + abs(a) * self.err[k] for k, v in self.value.items()},
+                     {k: self.mag[k] * a_mag for k in self.value})
+
+
+def linear_row(eq: ParsedEquation, vocab: Vocabulary) -> Row:
+    """``lhs − rhs`` of `eq` as a `Row` over the body's unknowns.
+
+    Parameters
+    ----------
+    eq : ParsedEquation
+        The parsed equation.
+    vocab : Vocabulary
+        The body's names.
+
+    Returns
+    -------
+    Row
+        The coefficients (rounding noise zeroed) and their error scales.
+
+    Raises
+    ------
+    EquationError
+        A name outside the vocabulary (with a did-you-mean), or a number that cannot be
+        computed (division by zero, square root of a negative number).
+    NotLinear
+        The equation multiplies, divides or takes a function of an unknown.
+    """
+    text = eq.text
+    form = _eval(eq.lhs, vocab, text).add(_eval(eq.rhs, vocab, text), -1.0)
+    row = Row({k: v for k, v in form.value.items()},
+              {k: form.err[k] for k in form.value})
+    return row.cleaned(form.mag)
+
+
+def _eval(node: Node, vocab: Vocabulary, text: str) -> _Form:
+    kind = node[0]
+    if kind == "num":
+        return _Form.number(float(node[1]), exact=False)
+    if kind == "name":
+        try:
+            name = vocab.resolve(node[1])
+        except KeyError as exc:
+            raise EquationError(text, node[2], str(exc.args[0])) from None
+        if name in vocab.values:
+            return _Form.number(vocab.values[name], exact=True)
+        return _Form({name: 1.0}, {name: 0.0}, {name: 1.0})
+    if kind == "neg":
+        inner = _eval(node[1], vocab, text)
+        return _Form({k: -v for k, v in inner.value.items()}, inner.err, inner.mag)
+    if kind == "call":
+        arg = _eval(node[2], vocab, text)
+        if not arg.constant:
+            raise NotLinear(node[3], f"{node[1]}( ) of an unknown ({_names(arg)})")
+        return _call(node[1], arg, text, node[3])
+    a, b = _eval(node[1], vocab, text), _eval(node[2], vocab, text)
+    pos = node[3]
+    if kind == "+":
+        return a.add(b, 1.0)
+    if kind == "-":
+        return a.add(b, -1.0)
+    if kind == "*":
+        if a.constant:
+            return b.times(a.c, a.err.get(CONST, 0.0), a.mag.get(CONST, 0.0))
+        if b.constant:
+            return a.times(b.c, b.err.get(CONST, 0.0), b.mag.get(CONST, 0.0))
+        raise NotLinear(pos, f"a product of unknowns ({_names(a)} times {_names(b)})")
+    if kind == "/":
+        if not b.constant:
+            raise NotLinear(pos, f"a division by an unknown ({_names(b)})")
+        d = b.c
+        if d == 0.0:
+            raise EquationError(text, pos, "division by zero")
+        # d(a/d) = da/d − a dd/d²: the divisor's error counts relative to it
+        rel = b.err.get(CONST, 0.0) / abs(d)
+        return _Form({k: v / d for k, v in a.value.items()},
+                     {k: a.err[k] / abs(d) + abs(v / d) * rel for k, v in a.value.items()},
+                     {k: a.mag[k] / max(abs(d), b.mag.get(CONST, 0.0)) for k in a.value})
+    # power
+    if not b.constant:
+        raise NotLinear(pos, f"a power with an unknown exponent ({_names(b)})")
+    p = b.c
+    if not a.constant:
+        if p == 1.0:
+            return a
+        if p == 0.0:
+            return _Form.number(1.0, exact=True)
+        raise NotLinear(pos, f"a power of an unknown ({_names(a)})")
+    x = a.c
+    try:
+        v = math.pow(x, p)
+    except (OverflowError, ValueError):
+        raise EquationError(text, pos, f"{x:g}^{p:g} cannot be computed") from None
+    err = abs(p * v / x) * a.err.get(CONST, 0.0) if x != 0.0 else 0.0
+    if x > 0.0:
+        err += abs(v * math.log(x)) * b.err.get(CONST, 0.0)
+    mag = math.pow(a.mag.get(CONST, 0.0), p) if a.mag.get(CONST, 0.0) > 0.0 else abs(v)
+    return _Form({CONST: v}, {CONST: err}, {CONST: max(abs(v), mag)})
+
+
+def _call(name: str, arg: _Form, text: str, pos: int) -> _Form:
+    x, ex = arg.c, arg.err.get(CONST, 0.0)
+    if name == "sin":
+        return _Form({CONST: math.sin(x)}, {CONST: abs(math.cos(x)) * ex}, {CONST: 1.0})
+    if name == "cos":
+        return _Form({CONST: math.cos(x)}, {CONST: abs(math.sin(x)) * ex}, {CONST: 1.0})
+    if name == "tan":
+        c = math.cos(x)
+        if abs(c) < 1e-15:
+            raise EquationError(text, pos, f"tan({x:g}) is infinite")
+        return _Form({CONST: math.tan(x)}, {CONST: ex / (c * c)},
+                     {CONST: max(1.0, abs(math.tan(x)))})
+    if x < 0.0:
+        raise EquationError(text, pos, f"the square root of a negative number ({x:g})")
+    v = math.sqrt(x)
+    return _Form({CONST: v}, {CONST: ex / (2 * v) if v > 0 else 0.0},
+                 {CONST: math.sqrt(arg.mag.get(CONST, 0.0))})
+
+
+def _names(form: _Form) -> str:
+    return ", ".join(sorted(k for k in form.value if k != CONST)) or "a number"

@@ -1,0 +1,252 @@
+"""An answers file: a student's equations, one entry per equation, with line marks.
+
+```yaml
+student: A. Student            # optional, free text
+equations:
+  - {body: rod, eq: "2*a_y = O.Fy - 19.62"}
+  - body: rod
+    eq: I_G*alpha = -0.433013*O.Fx - 0.25*O.Fy
+```
+
+The file is read by mbody's own safe YAML loader (`mbody.model.loader`), so every value
+keeps its line and column: a problem with an entry is reported at the entry, and a
+problem inside an equation at its character.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from mbody.errors import Issue, ModelError, did_you_mean
+from mbody.model.loader import Document, dotted, load_text, read_file
+
+TOP_KEYS = ("equations", "student")
+ENTRY_KEYS = ("body", "eq")
+
+
+class AnswersError(ModelError):
+    """An answers file (or answers given in Python) is invalid; `issues` lists every
+    problem with its file, line and column."""
+
+    def _text(self) -> str:
+        n = len(self.issues)
+        body = "\n".join(str(i) for i in self.issues[:self.SHOWN])
+        if n > self.SHOWN:
+            body += f"\n... and {n - self.SHOWN} more"
+        return f"{n} problems in the answers:\n{body}" if n > 1 else body
+
+
+@dataclass(frozen=True)
+class Answer:
+    """One equation of the answers, with where it was written.
+
+    Parameters
+    ----------
+    index : int
+        1-based place in the file.
+    body : str
+        The body it is an equation of.
+    eq : str
+        The equation as written.
+    line, column : int
+        1-based position of the equation's first character in the file (0 when not from
+        a file).
+    key : str
+        Its place in the file: ``equations[2].eq``.
+    body_line, body_column : int
+        1-based position of its body's name (0 when not from a file).
+    """
+
+    index: int
+    body: str
+    eq: str
+    line: int = 0
+    column: int = 0
+    key: str = ""
+    body_line: int = 0
+    body_column: int = 0
+
+
+@dataclass(frozen=True)
+class Answers:
+    """A student's equations in file order.
+
+    Parameters
+    ----------
+    file : str
+        The answers file's path ('<answers>' when given as data).
+    equations : tuple of Answer
+        The equations, in file order.
+    student : str
+        The optional ``student`` line of the file.
+    """
+
+    file: str
+    equations: tuple[Answer, ...]
+    student: str = ""
+
+    def issue(self, a: Answer, message: str, *, position: int | None = None,
+              body: bool = False, hint: str = "") -> Issue:
+        """An `Issue` located at answer `a` (its body, or a character of its equation)."""
+        line, col = a.line, a.column
+        key = a.key
+        if body:
+            line, col = a.body_line, a.body_column
+            key = key.rpartition(".")[0] + ".body"
+        elif position is not None and line:
+            col += position
+        return Issue(self.file, line, col, key, message, hint)
+
+
+def read_answers(path: str | os.PathLike[str]) -> Answers:
+    """Read an answers file.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The YAML file.
+
+    Returns
+    -------
+    Answers
+        Its equations with their line marks.
+
+    Raises
+    ------
+    AnswersError
+        The file is missing, not YAML, or not an answers file; every problem located.
+    """
+    try:
+        text = read_file(path)
+    except ModelError as exc:
+        raise AnswersError([_reword(i) for i in exc.issues]) from None
+    name = str(path)
+    if not text.strip():
+        raise AnswersError([Issue(name, 1, 1, "", "the file is empty; expected a mapping "
+                                  "with 'equations:', a list of {body: NAME, eq: \"...\"}")])
+    try:
+        doc = load_text(text, name)
+    except ModelError as exc:
+        raise AnswersError(exc.issues) from None
+    return _build(doc.data, name, doc, text)
+
+
+def answers_from_data(data: Any, file: str = "<answers>") -> Answers:
+    """Answers given as Python data.
+
+    Parameters
+    ----------
+    data : mapping or sequence
+        ``{"equations": [...]}``, or the list itself; each entry ``{"body": ...,
+        "eq": ...}`` or a pair ``(body, eq)``.
+    file : str
+        The name shown in messages.
+
+    Returns
+    -------
+    Answers
+        The equations (without line marks).
+
+    Raises
+    ------
+    AnswersError
+        An entry without a body or an equation, or of the wrong kind.
+    """
+    if isinstance(data, Sequence) and not isinstance(data, str | bytes):
+        data = {"equations": [{"body": e[0], "eq": e[1]} if isinstance(e, tuple | list)
+                              and len(e) == 2 else e for e in data]}
+    return _build(data, file, None, "")
+
+
+def _reword(issue: Issue) -> Issue:
+    """The loader speaks of model files; an answers file is not one."""
+    msg = issue.message.replace("expected a YAML model file", "expected a YAML answers file")
+    msg = msg.replace("model file", "answers file")
+    return Issue(issue.file, issue.line, issue.column, issue.key, msg, issue.hint)
+
+
+def _build(data: Any, file: str, doc: Document | None, text: str) -> Answers:
+    issues: list[Issue] = []
+
+    def where(path: tuple, key: bool = False) -> tuple[int, int]:
+        return doc.where(path, key=key) if doc is not None else (0, 0)
+
+    def err(path: tuple, message: str, hint: str = "", key: bool = False) -> None:
+        line, col = where(path, key)
+        issues.append(Issue(file, line, col, dotted(path), message, hint))
+
+    if not isinstance(data, Mapping):
+        err((), f"expected a mapping with 'equations:', got {_kind(data)}",
+            "write equations: followed by a list of {body: NAME, eq: \"...\"}")
+        raise AnswersError(issues)
+    for k in data:
+        if k not in TOP_KEYS:
+            hint = did_you_mean(str(k), TOP_KEYS)
+            err((k,), f"unknown key {k!r}; an answers file has {', '.join(TOP_KEYS)}",
+                hint, key=True)
+    student = data.get("student", "")
+    if student is None:
+        student = ""
+    if not isinstance(student, str | int | float):
+        err(("student",), f"expected free text, got {_kind(student)}")
+    entries = data.get("equations")
+    out: list[Answer] = []
+    if entries is None:
+        err((), "no 'equations:' list", "add equations: with one {body: NAME, eq: \"...\"} "
+            "per equation")
+    elif not isinstance(entries, list):
+        err(("equations",), f"expected a list of {{body, eq}} entries, got {_kind(entries)}")
+    elif not entries:
+        err(("equations",), "the list of equations is empty")
+    else:
+        for n, e in enumerate(entries):
+            path: tuple = ("equations", n)
+            if not isinstance(e, Mapping):
+                err(path, f"expected {{body: NAME, eq: \"...\"}}, got {_kind(e)}")
+                continue
+            bad = [k for k in e if k not in ENTRY_KEYS]
+            for k in bad:
+                err((*path, k), f"unknown key {k!r}; an entry has body and eq",
+                    did_you_mean(str(k), ENTRY_KEYS), key=True)
+            body, eq = e.get("body"), e.get("eq")
+            if body is None or eq is None:
+                missing = " and ".join(k for k, v in (("body", body), ("eq", eq)) if v is None)
+                err(path, f"missing {missing}", "each entry is {body: NAME, eq: \"...\"}")
+                continue
+            if not isinstance(body, str):
+                err((*path, "body"), f"expected a body name, got {_kind(body)}")
+                continue
+            if not isinstance(eq, str):
+                err((*path, "eq"), f"expected the equation as text, got {_kind(eq)}",
+                    'quote it: eq: "2*a_y = O.Fy - 19.62"')
+                continue
+            line, col = where((*path, "eq"))
+            col += _quote_offset(text, line, col, eq)
+            out.append(Answer(n + 1, body, eq, line, col, dotted((*path, "eq")),
+                              *where((*path, "body"))))
+    if issues:
+        raise AnswersError(issues)
+    return Answers(file, tuple(out), str(student))
+
+
+def _quote_offset(text: str, line: int, col: int, eq: str) -> int:
+    """Characters between a value's mark and its first character: 1 for a quote."""
+    if not text or not line:
+        return 0
+    lines = text.split("\n")
+    if line > len(lines):
+        return 0
+    row = lines[line - 1][col - 1:]
+    if row[:1] in ("'", '"') and row[1:].startswith(eq[:8]):
+        return 1
+    return 0
+
+
+def _kind(value: Any) -> str:
+    if value is None:
+        return "nothing"
+    return {dict: "a mapping", list: "a list", str: f"the text {value!r}", bool: "a boolean",
+            int: "a number", float: "a number"}.get(type(value), type(value).__name__)

@@ -1,0 +1,276 @@
+"""A small, safe parser for a student's equation, such as ``"2*a_y = O.Fy - 19.62"``.
+
+    equation := expr '=' expr
+    expr     := term (('+' | '-') term)*
+    term     := unary (('*' | '/') unary)*
+    unary    := ('+' | '-') unary | power
+    power    := atom (('^' | '**') unary)?          right-associative, binds tighter than '-'
+    atom     := NUMBER | NAME | FUNC '(' expr ')' | '(' expr ')'
+    FUNC     := sin | cos | tan | sqrt
+
+The text becomes a tree of tuples and nothing else: no `eval`, no `sympify`, no attribute
+access. Names are not looked up here (`mbody.answers.linear` resolves them against the
+body's vocabulary, with a did-you-mean); a reaction label such as ``O.Fy`` or
+``pin-1.Fx`` is one name. Every node keeps the 0-based character position it starts at,
+so that each error can point at its column in the answers file.
+
+A few characters pasted from textbooks are read as what they mean: ``−`` (minus sign)
+as ``-``, ``·`` and ``×`` as ``*``.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+from mbody.errors import MbodyError
+
+FUNCTIONS = ("sin", "cos", "tan", "sqrt")
+"""The functions an equation may call (one argument each; angles in radians)."""
+MAX_LENGTH = 2000
+"""Longest equation accepted (characters)."""
+MAX_DEPTH = 100
+"""Deepest nesting of parentheses and signs."""
+
+_PASTED = str.maketrans({"\u2212": "-", "\u00b7": "*", "\u00d7": "*", "\u22c5": "*"})
+_TOKEN = re.compile(r"""
+    (?P<ws>\s+)
+  | (?P<num>(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)
+  | (?P<name>[^\W\d]\w*(?:\.[^\W\d]\w*)?)
+  | (?P<op>\*\*|[-+*/^()=])
+""", re.VERBOSE)
+
+# A node: ('num', value, pos) | ('name', text, pos) | ('neg', node, pos)
+# | (op, a, b, pos) for op in + - * / ^ | ('call', name, node, pos).
+Node = tuple
+
+
+class EquationError(MbodyError):
+    """An equation that cannot be read; `position` is the 0-based character index.
+
+    Parameters
+    ----------
+    text : str
+        The equation as written.
+    position : int
+        Where the problem is (0-based index into `text`).
+    message : str
+        What is wrong.
+    hint : str, optional
+        A way to fix it, or a did-you-mean.
+    """
+
+    def __init__(self, text: str, position: int, message: str, hint: str = ""):
+        self.text, self.position, self.reason, self.hint = text, position, message, hint
+        super().__init__(f"{message} at character {position + 1} of {text!r}"
+                         + (f" ({hint})" if hint else ""))
+
+
+@dataclass(frozen=True)
+class ParsedEquation:
+    """``lhs = rhs`` as two trees.
+
+    Parameters
+    ----------
+    text : str
+        The equation as written.
+    lhs, rhs : tuple
+        The trees of the two sides (see the module's grammar).
+    """
+
+    text: str
+    lhs: Node
+    rhs: Node
+
+
+def parse_equation(text: str, labels: Iterable[str] = ()) -> ParsedEquation:
+    """Parse ``lhs = rhs``; raise `EquationError` (with the position) when it is not valid.
+
+    Parameters
+    ----------
+    text : str
+        The equation.
+    labels : iterable of str
+        Reaction labels of the model: each is read as one name even where its joint's
+        name holds characters that are operators elsewhere (``pin-1.Fx``).
+
+    Returns
+    -------
+    ParsedEquation
+        The two sides as trees of tuples.
+    """
+    if not isinstance(text, str):
+        raise EquationError(str(text), 0, "expected an equation as text")
+    if len(text) > MAX_LENGTH:
+        raise EquationError(text[:40] + "...", 0,
+                            f"the equation is longer than {MAX_LENGTH} characters")
+    parser = _Parser(text, _tokenise(text, labels))
+    if not text.strip():
+        raise EquationError(text, 0, "the equation is empty",
+                            "write it as left side = right side, e.g. 2*a_y = O.Fy - 19.62")
+    lhs = parser.expr(0)
+    kind, value, pos = parser.peek()
+    if not (kind == "op" and value == "="):
+        if kind == "end":
+            raise EquationError(text, pos, "an equation needs '='",
+                                "write it as left side = right side")
+        parser.unexpected()
+    parser.take()
+    if parser.peek()[0] == "end":
+        raise EquationError(text, parser.peek()[2], "nothing on the right of '='",
+                            "write 0 if the right side is zero")
+    rhs = parser.expr(0)
+    kind, value, pos = parser.peek()
+    if kind == "op" and value == "=":
+        raise EquationError(text, pos, "a second '='", "write one equation per entry")
+    if kind != "end":
+        parser.unexpected()
+    return ParsedEquation(text, lhs, rhs)
+
+
+def _tokenise(text: str, labels: Iterable[str]) -> list[tuple[str, str, int]]:
+    src = text.translate(_PASTED)
+    # longest first, so that A.Fx is never taken for a prefix of AB.Fx
+    known = sorted((lab for lab in labels if not _TOKEN.fullmatch(lab)), key=len,
+                   reverse=True)
+    out = []
+    i = 0
+    while i < len(src):
+        label = next((lab for lab in known if src.startswith(lab, i)
+                      and not src[i + len(lab):i + len(lab) + 1].isalnum()), None)
+        if label is not None and (i == 0 or not (src[i - 1].isalnum() or src[i - 1] == "_")):
+            out.append(("name", label, i))
+            i += len(label)
+            continue
+        m = _TOKEN.match(src, i)
+        if not m:  # reported when the parser reaches it, so errors come in reading order
+            out.append(("bad", src[i], i))
+            i += 1
+            continue
+        kind = m.lastgroup or ""
+        if kind != "ws":
+            out.append((kind, m.group(), i))
+        i = m.end()
+    out.append(("end", "", len(src)))
+    return out
+
+
+def _describe(kind: str, value: str) -> str:
+    return {"num": f"number {value}", "name": f"name '{value}'", "op": f"'{value}'",
+            "end": "end of the equation"}[kind]
+
+
+_BAD_HINTS = {
+    "<": "only equations (=) are checked", ">": "only equations (=) are checked",
+    ",": "functions take one argument", "[": "use ( ) for grouping",
+    "{": "use ( ) for grouping", ".": "a reaction is written <joint>.<component>, e.g. O.Fy",
+    "'": "write derivatives by name: alpha, a_x, w", "\u0307": "write derivatives by "
+    "name: alpha, a_x, w",
+}
+
+
+class _Parser:
+    def __init__(self, text: str, tokens: list[tuple[str, str, int]]):
+        self.text, self.tokens, self.i = text, tokens, 0
+
+    def take(self) -> tuple[str, str, int]:
+        tok = self.peek()
+        self.i += 1
+        return tok
+
+    def peek(self) -> tuple[str, str, int]:
+        kind, ch, pos = self.tokens[self.i]
+        if kind == "bad":
+            raise EquationError(self.text, pos, f"unexpected character {ch!r}",
+                                _BAD_HINTS.get(ch, ""))
+        return self.tokens[self.i]
+
+    def unexpected(self):
+        kind, value, pos = self.peek()
+        if kind == "op" and value == ")":
+            raise EquationError(self.text, pos, "unmatched ')'")
+        raise EquationError(self.text, pos, f"unexpected {_describe(kind, value)}",
+                            "an operator (+ - * / ^) is missing?"
+                            if kind in ("num", "name") else "")
+
+    def expr(self, depth: int) -> Node:
+        if depth > MAX_DEPTH:
+            raise EquationError(self.text, self.peek()[2],
+                                f"nesting deeper than {MAX_DEPTH} levels")
+        node = self.term(depth)
+        while self.peek()[0] == "op" and self.peek()[1] in ("+", "-"):
+            _, op, pos = self.take()
+            node = (op, node, self.term(depth), pos)
+        return node
+
+    def term(self, depth: int) -> Node:
+        node = self.unary(depth)
+        while self.peek()[0] == "op" and self.peek()[1] in ("*", "/"):
+            _, op, pos = self.take()
+            node = (op, node, self.unary(depth), pos)
+        return node
+
+    def unary(self, depth: int) -> Node:
+        kind, value, pos = self.peek()
+        if kind == "op" and value in ("+", "-"):
+            self.take()
+            if depth > MAX_DEPTH:
+                raise EquationError(self.text, pos, f"nesting deeper than {MAX_DEPTH} levels")
+            operand = self.unary(depth + 1)
+            return operand if value == "+" else ("neg", operand, pos)
+        return self.power(depth)
+
+    def power(self, depth: int) -> Node:
+        base = self.atom(depth)
+        kind, value, pos = self.peek()
+        if kind == "op" and value in ("^", "**"):
+            self.take()
+            # -2^2 = -4 and 2^-1 = 0.5, as on paper
+            return ("^", base, self.unary(depth + 1), pos)
+        return base
+
+    def atom(self, depth: int) -> Node:
+        kind, value, pos = self.take()
+        if kind == "num":
+            x = float(value)
+            if not math.isfinite(x) or x > 1e100:
+                raise EquationError(self.text, pos, f"the number {value} is out of range",
+                                    "at most 1e100")
+            node: Node = ("num", x, pos)
+        elif kind == "name" and value in FUNCTIONS:
+            if self.peek()[1] != "(":
+                raise EquationError(self.text, self.peek()[2],
+                                    f"'{value}' must be followed by '('",
+                                    f"write {value}(...)")
+            self.take()
+            arg = self.expr(depth + 1)
+            if self.peek()[1] != ")":
+                raise EquationError(self.text, self.peek()[2], "expected ')'"
+                                    if self.peek()[0] != "end" else "missing ')'",
+                                    f"to close {value}( at character {pos + 1}")
+            self.take()
+            node = ("call", value, arg, pos)
+        elif kind == "name":
+            node = ("name", value, pos)
+        elif kind == "op" and value == "(":
+            node = self.expr(depth + 1)
+            if self.peek()[1] != ")":
+                raise EquationError(self.text, self.peek()[2], "missing ')'",
+                                    f"to close '(' at character {pos + 1}")
+            self.take()
+        elif kind == "end":
+            raise EquationError(self.text, pos, "the equation ends too early")
+        elif kind == "op" and value == "=":
+            raise EquationError(self.text, pos, "nothing on the left of '='"
+                                if pos == self.tokens[0][2] else "unexpected '='",
+                                "write 0 if that side is zero")
+        else:
+            raise EquationError(self.text, pos, f"unexpected {_describe(kind, value)}")
+        # implicit multiplication ("2a_x", "2(O.Fy)", "m g") is refused: say so
+        nk, nv, npos = self.peek()
+        if nk in ("num", "name") or (nk == "op" and nv == "("):
+            raise EquationError(self.text, npos, f"unexpected {_describe(nk, nv)}",
+                                "write '*' for multiplication, e.g. 2*a_x")
+        return node

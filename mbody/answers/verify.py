@@ -1,0 +1,302 @@
+"""``verify(model, answers) -> Verification``: a student's equations checked against
+each body's Newton-Euler pair, every wrong one explained in the course's terms.
+
+    v = mbody.verify("models/pendulum.yaml", "models/answers/pendulum.yaml")
+    print(v)                      # one paragraph per equation, then the rows not covered
+    v.checks[0].diagnosis         # 'correct', 'wrong_moment_point', ...
+    v.to_dict()                   # what `mbody verify --json` prints
+"""
+
+from __future__ import annotations
+
+import os
+import textwrap
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+from mbody.answers.compare import Row
+from mbody.answers.diagnose import CORRECT, DIAGNOSES, NOT_AN_EQUATION, Diagnosis, diagnose
+from mbody.answers.linear import NotLinear, linear_row
+from mbody.answers.load import Answer, Answers, AnswersError, answers_from_data, read_answers
+from mbody.answers.parse import EquationError, parse_equation
+from mbody.answers.rows import BodyRows, body_rows
+from mbody.answers.vocabulary import Vocabulary, vocabulary
+from mbody.equations.assemble import Assembly, assemble
+from mbody.errors import Issue, MbodyError, did_you_mean
+from mbody.model.model import Model, State, load
+
+TOLERANCE = 1e-3
+"""Default relative tolerance on each coefficient: numbers written to about four
+significant figures match."""
+
+
+@dataclass(frozen=True)
+class Check:
+    """The verdict on one equation.
+
+    Parameters
+    ----------
+    index : int
+        1-based place in the answers.
+    body : str
+        The body the equation is for.
+    eq : str
+        The equation as written.
+    line : int
+        Its line in the answers file (0 when not from a file).
+    diagnosis : str
+        One of `mbody.answers.diagnose.DIAGNOSES`.
+    expected : str
+        The row it was compared with, as text ('' when none is close).
+    row : str
+        That row's coordinate label (``rod.theta``), or ''.
+    explanation : str
+        One or two sentences in the course's terms.
+    details : dict
+        What the diagnosis found (the term, the point, the load, a value used...).
+    """
+
+    index: int
+    body: str
+    eq: str
+    line: int
+    diagnosis: str
+    expected: str
+    row: str
+    explanation: str
+    details: dict = field(default_factory=dict)
+
+    @property
+    def correct(self) -> bool:
+        return self.diagnosis == CORRECT
+
+    def to_dict(self) -> dict[str, Any]:
+        """The check as JSON-ready data."""
+        return {"index": self.index, "body": self.body, "eq": self.eq, "line": self.line,
+                "diagnosis": self.diagnosis, "expected": self.expected, "row": self.row,
+                "explanation": self.explanation, "details": _plain(self.details)}
+
+
+@dataclass(frozen=True)
+class Uncovered:
+    """A row of an answered body that no correct equation gave.
+
+    Parameters
+    ----------
+    body : str
+        The body.
+    row : str
+        The row's coordinate label.
+    expected : str
+        The row as text.
+    """
+
+    body: str
+    row: str
+    expected: str
+
+
+@dataclass(frozen=True)
+class Verification:
+    """Every equation's verdict, in file order, and the rows no answer covered.
+
+    Parameters
+    ----------
+    model : str
+        The model's name.
+    model_file : str
+        Its file ('' when built in Python).
+    answers_file : str
+        The answers' file ('<answers>' when given as data).
+    student : str
+        The answers' ``student`` line.
+    tol : float
+        The relative tolerance used.
+    checks : tuple of Check
+        One per equation, in file order.
+    uncovered : tuple of Uncovered
+        Rows of the bodies that have answers, not given by any correct equation.
+    rows : int
+        How many rows those bodies have.
+    """
+
+    model: str
+    model_file: str
+    answers_file: str
+    student: str
+    tol: float
+    checks: tuple[Check, ...]
+    uncovered: tuple[Uncovered, ...]
+    rows: int
+
+    @property
+    def ok(self) -> bool:
+        """Whether every equation is correct."""
+        return all(c.correct for c in self.checks)
+
+    @property
+    def correct(self) -> int:
+        """How many equations are correct."""
+        return sum(c.correct for c in self.checks)
+
+    def to_dict(self) -> dict[str, Any]:
+        """What ``mbody verify --json`` prints."""
+        return {"model": self.model, "model_file": self.model_file,
+                "answers": self.answers_file, "student": self.student, "tol": self.tol,
+                "equations": [c.to_dict() for c in self.checks],
+                "uncovered": [{"body": u.body, "row": u.row, "expected": u.expected}
+                              for u in self.uncovered],
+                "summary": {"equations": len(self.checks), "correct": self.correct,
+                            "rows": self.rows, "uncovered": len(self.uncovered)}}
+
+    def text(self, width: int = 88) -> str:
+        """The report `mbody verify` prints: a paragraph per equation, then the rows
+        not covered, then a one-line summary."""
+        where = f" ({self.model_file})" if self.model_file else ""
+        out = [f"model '{self.model}'{where}; answers {self.answers_file}"
+               + (f" by {self.student}" if self.student else "")
+               + f"; tolerance {self.tol:g} on each coefficient", ""]
+        wrap = textwrap.TextWrapper(width=width, initial_indent="    ",
+                                    subsequent_indent="    ")
+        for c in self.checks:
+            at = f"  (line {c.line})" if c.line else ""
+            out.append(f"[{c.index}] {c.body}: {c.eq}{at}")
+            out.append(f"    {c.diagnosis}" + ("" if c.correct else
+                                               f": {DIAGNOSES[c.diagnosis]}"))
+            if not c.correct and c.expected:
+                out.append(f"    expected ({c.row}): {c.expected}")
+            out.extend(wrap.wrap(c.explanation))
+            out.append("")
+        if self.uncovered:
+            out.append("rows no correct equation gave:")
+            out += [f"    {u.row}: {u.expected}" for u in self.uncovered]
+            out.append("")
+        n = len(self.checks)
+        out.append(f"{self.correct} of {n} equation{'s' if n != 1 else ''} correct; "
+                   f"{self.rows - len(self.uncovered)} of {self.rows} rows covered.")
+        return "\n".join(out)
+
+    def __str__(self) -> str:
+        return self.text()
+
+
+def verify(model: Model | str | os.PathLike[str], answers: Any, *, tol: float = TOLERANCE,
+           state: State | None = None, asm: Assembly | None = None) -> Verification:
+    """Check a student's equations against each body's Newton-Euler pair.
+
+    Parameters
+    ----------
+    model : Model, str or path-like
+        The model, or its file.
+    answers : Answers, str, path-like, mapping or sequence
+        An answers file's path, `Answers`, or the same as data: ``{"equations": [{"body":
+        "rod", "eq": "2*a_y = O.Fy - 19.62"}, ...]}`` or the list itself.
+    tol : float
+        Relative tolerance on each coefficient (numbers written by a student are
+        rounded); default 1e-3.
+    state : State, optional
+        The state the equations are written at (default: the model's initial state).
+    asm : Assembly, optional
+        The model's assembly at that state, when already made.
+
+    Returns
+    -------
+    Verification
+        One `Check` per equation in file order, and the rows no answer covered.
+
+    Raises
+    ------
+    AnswersError
+        The answers are invalid: an unknown body or name (with a did-you-mean), an
+        equation that cannot be read (with its column); every problem at once.
+    """
+    if not (tol > 0.0 and tol < 1.0):
+        raise MbodyError(f"the tolerance must be between 0 and 1 (relative), got {tol!r}")
+    if isinstance(model, str | os.PathLike):
+        model = load(model)
+    sheet = _answers(answers)
+    if asm is None:
+        asm = assemble(model, state)
+    state = asm.state
+    vocab: dict[str, Vocabulary] = {}
+    rows: dict[str, BodyRows] = {}
+    issues: list[Issue] = []
+    parsed: list[tuple[Answer, Row | None, NotLinear | None]] = []
+    for a in sheet.equations:
+        if a.body not in model.index:
+            hint = did_you_mean(a.body, model.body_names)
+            shown = ", ".join(model.body_names[:10]) + (" ..." if model.n > 10 else "")
+            issues.append(sheet.issue(a, f"no body named {a.body!r} in model "
+                                      f"'{model.name}' (its bodies: {shown})",
+                                      body=True, hint=hint))
+            continue
+        if a.body not in vocab:
+            vocab[a.body] = vocabulary(model, state, a.body)
+        try:
+            eq = parse_equation(a.eq, model.reactions)
+            row = linear_row(eq, vocab[a.body])
+            parsed.append((a, row, None))
+        except EquationError as exc:
+            issues.append(sheet.issue(a, exc.reason, position=exc.position, hint=exc.hint))
+        except NotLinear as exc:
+            parsed.append((a, None, exc))
+    if issues:
+        raise AnswersError(issues)
+
+    solved: list[Mapping[str, float] | None] = []
+
+    def reactions() -> Mapping[str, float] | None:
+        if not solved:
+            try:
+                solved.append(dict(asm.solve().reactions))
+            except MbodyError:
+                solved.append(None)
+        return solved[0]
+
+    checks = []
+    for a, student, problem in parsed:
+        if a.body not in rows:
+            rows[a.body] = body_rows(asm, a.body)
+        if student is None:
+            d = _not_linear(a, problem)
+        else:
+            d = diagnose(student, rows[a.body], tol, reactions)
+        checks.append(Check(a.index, a.body, a.eq, a.line, d.diagnosis, d.expected, d.row,
+                            d.explanation, d.details))
+    covered = {c.row for c in checks if c.correct}
+    uncovered = tuple(Uncovered(b, r.label, r.text) for b, br in rows.items()
+                      for r in br.rows if r.label not in covered)
+    return Verification(model.name, model.file or "", sheet.file, sheet.student, tol,
+                        tuple(checks), uncovered, sum(len(br.rows) for br in rows.values()))
+
+
+def _answers(answers: Any) -> Answers:
+    if isinstance(answers, Answers):
+        return answers
+    if isinstance(answers, str | os.PathLike):
+        return read_answers(answers)
+    if isinstance(answers, Mapping | list | tuple):
+        return answers_from_data(answers)
+    raise AnswersError([Issue("<answers>", 0, 0, "", f"expected an answers file or a list "
+                              f"of {{body, eq}} entries, got {type(answers).__name__}")])
+
+
+def _not_linear(a: Answer, problem: NotLinear | None) -> Diagnosis:
+    why = problem.why if problem is not None else "not linear"
+    return Diagnosis(NOT_AN_EQUATION, "", "",
+                     f"This is not linear in the unknowns: it has {why}. The Newton-Euler "
+                     "equations are linear in the accelerations and the reactions; each "
+                     "term is a number (mass, inertia, lever arm) times one of them.",
+                     {"not_linear": why, "position": problem.position + 1 if problem else 0})
+
+
+def _plain(value: Any) -> Any:
+    """numpy scalars and tuples -> JSON types."""
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_plain(v) for v in value]
+    if hasattr(value, "item"):
+        return value.item()
+    return value

@@ -1,0 +1,235 @@
+"""The names a student's equation may use for one body, and what each stands for.
+
+Unknowns (the equation is linear in them):
+
+- ``a_x, a_y`` (spatial also ``a_z``): the mass centre's acceleration, world axes;
+- ``alpha`` (planar) or ``alpha_1, alpha_2, alpha_3`` (spatial, body axes): the angular
+  acceleration;
+- every unknown reaction component by its label (``O.Fy``).
+
+Numbers taken from the model at its state:
+
+- ``m``; planar ``I_G``; spatial ``I_1, I_2, I_3`` (principal moments, when the tensor is
+  diagonal in body axes) and every tensor entry ``I_11, I_12, ... I_33``;
+- ``w`` and ``theta`` (planar) or ``w_1, w_2, w_3`` (spatial, body axes);
+- ``g``, the magnitude of gravity; ``pi``;
+- a reaction whose value the model gives (``reactions:`` in the file), by its label.
+
+Aliases (``omega``, ``ω``, ``α``, ``ax``, ``theta_ddot``...) map onto these names.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from mbody import conventions as cv
+from mbody.errors import did_you_mean
+from mbody.model.model import Model, State
+
+PLANAR_ACCELERATIONS = ("a_x", "a_y", "alpha")
+SPATIAL_ACCELERATIONS = ("a_x", "a_y", "a_z", "alpha_1", "alpha_2", "alpha_3")
+
+_ALIASES_BOTH = {
+    "ax": "a_x", "ay": "a_y", "a_Gx": "a_x", "a_Gy": "a_y", "a_gx": "a_x", "a_gy": "a_y",
+    "x_ddot": "a_x", "y_ddot": "a_y", "mass": "m",
+}
+_ALIASES_PLANAR = {
+    "alpha_z": "alpha", "theta_ddot": "alpha", "thetaddot": "alpha", "α": "alpha",
+    "omega": "w", "omega_z": "w", "w_z": "w", "theta_dot": "w", "thetadot": "w", "ω": "w",
+    "θ": "theta", "I": "I_G", "I_zz": "I_G", "I_z": "I_G",
+}
+_ALIASES_SPATIAL = {
+    "az": "a_z", "a_Gz": "a_z", "a_gz": "a_z", "z_ddot": "a_z",
+    **{f"{a}{k}": f"alpha_{k}" for k in (1, 2, 3)
+       for a in ("alpha", "α_", "α", "wdot_", "w_dot_", "omega_dot_", "omegadot_", "ω_dot_")},
+    **{f"{a}{k}": f"w_{k}" for k in (1, 2, 3) for a in ("w", "omega_", "omega", "ω_", "ω")},
+    **{f"I{k}": f"I_{k}" for k in (1, 2, 3)},
+    **{f"I{j}{k}": f"I_{j}{k}" for j in (1, 2, 3) for k in (1, 2, 3)},
+}
+
+MEANINGS = {
+    "a_x": "mass-centre acceleration along world x (m/s^2)",
+    "a_y": "mass-centre acceleration along world y (m/s^2)",
+    "a_z": "mass-centre acceleration along world z (m/s^2)",
+    "alpha": "angular acceleration, planar (rad/s^2)",
+    "alpha_1": "angular acceleration about body axis 1 (rad/s^2)",
+    "alpha_2": "angular acceleration about body axis 2 (rad/s^2)",
+    "alpha_3": "angular acceleration about body axis 3 (rad/s^2)",
+    "m": "mass (kg)", "I_G": "moment of inertia about the mass centre (kg m^2)",
+    "w": "angular velocity, planar (rad/s)", "theta": "angle, planar (rad)",
+    "g": "magnitude of gravity (m/s^2)", "pi": "3.14159...",
+}
+"""What each fixed name of the vocabulary stands for (docs and error hints)."""
+
+
+@dataclass(frozen=True)
+class Vocabulary:
+    """The names an equation of one body may use.
+
+    Parameters
+    ----------
+    body : str
+        The body's name.
+    dimension : int
+        2 (planar) or 3 (spatial).
+    accelerations : tuple of str
+        The body's acceleration unknowns in row order (a particle's: translations only).
+    reactions : tuple of str
+        Every unknown reaction label of the model (a label of another body's joint is
+        understood, and then reported as not acting on this body).
+    values : dict of str to float
+        Every name that stands for a number of the model at its state.
+    aliases : dict of str to str
+        Other spellings -> the names above.
+    absent : dict of str to str
+        Names that exist for other bodies or models but not here -> why (for the error).
+    """
+
+    body: str
+    dimension: int
+    accelerations: tuple[str, ...]
+    reactions: tuple[str, ...]
+    values: dict[str, float]
+    aliases: dict[str, str] = field(default_factory=dict)
+    absent: dict[str, str] = field(default_factory=dict)
+
+    @property
+    def unknowns(self) -> tuple[str, ...]:
+        """The accelerations, then the unknown reaction labels."""
+        return self.accelerations + self.reactions
+
+    @property
+    def names(self) -> list[str]:
+        """Every name accepted (canonical names first, then aliases)."""
+        return [*self.unknowns, *self.values, *self.aliases]
+
+    def resolve(self, name: str) -> str:
+        """The canonical name of `name`.
+
+        Parameters
+        ----------
+        name : str
+            A name as written in an equation.
+
+        Returns
+        -------
+        str
+            An unknown's name or a key of `values`.
+
+        Raises
+        ------
+        KeyError
+            The name is not in the vocabulary; the message says why, with a
+            did-you-mean over the vocabulary.
+        """
+        name = self.aliases.get(name, name)
+        if name in self.values or name in self._unknown_set:
+            return name
+        if name in self.absent:
+            raise KeyError(self.absent[name])
+        hint = did_you_mean(name, [n for n in self.names if n not in self.absent])
+        what = (f"no reaction component {name!r} in this model" if "." in name else
+                f"unknown name {name!r} for body {self.body!r}")
+        raise KeyError(what + (f"; {hint}" if hint else "")
+                       + f" (the names: {self.summary()})")
+
+    @property
+    def _unknown_set(self) -> frozenset[str]:
+        return frozenset(self.unknowns)
+
+    def summary(self) -> str:
+        """The canonical names in one line (for error messages)."""
+        shown = list(self.accelerations)
+        if self.reactions:
+            shown.append(", ".join(self.reactions[:6]) + (" ..." if len(self.reactions) > 6
+                                                          else ""))
+        shown += [n for n in self.values if "." not in n and n != "pi"]
+        return ", ".join(shown)
+
+
+def vocabulary(model: Model, state: State, body: str) -> Vocabulary:
+    """The vocabulary of `body` at `state`.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    state : State
+        Where the numbers (angular velocity, angle, time-varying known reactions) are
+        taken.
+    body : str
+        A body of the model.
+
+    Returns
+    -------
+    Vocabulary
+        Its unknowns, numbers and aliases.
+    """
+    i = model.index[body]
+    planar = model.dimension == cv.PLANAR
+    particle = bool(model.particle[i])
+    known = model.known_reactions_at(state.t)
+    values: dict[str, float] = {"m": float(model.mass[i]), "pi": float(np.pi)}
+    absent: dict[str, str] = {}
+    gravity = float(np.linalg.norm(model.gravity))
+    if gravity > 0:
+        values["g"] = gravity
+    else:
+        absent["g"] = "this model has no gravity, so 'g' stands for nothing here"
+    aliases = dict(_ALIASES_BOTH)
+    aliases.update(_ALIASES_PLANAR if planar else _ALIASES_SPATIAL)
+    accelerations: tuple[str, ...] = PLANAR_ACCELERATIONS if planar else SPATIAL_ACCELERATIONS
+    J = model.J[i]
+    if planar:
+        values["theta"] = float(_planar_angle(state.W_R_B[i]))
+        absent["a_z"] = "a planar body has no a_z (its rows are x, y and theta)"
+        for k in (1, 2, 3):
+            absent[f"alpha_{k}"] = ("a planar body has one angular acceleration: alpha "
+                                    "(about z)")
+            absent[f"w_{k}"] = "a planar body has one angular velocity: w (about z)"
+            absent[f"I_{k}"] = "a planar body has one moment of inertia: I_G"
+    else:
+        absent["alpha"] = ("a spatial body has three angular accelerations, about its body "
+                           "axes: alpha_1, alpha_2, alpha_3")
+        absent["w"] = ("a spatial body has three angular velocity components, along its "
+                       "body axes: w_1, w_2, w_3")
+        absent["I_G"] = absent["I"] = (
+            "a spatial body has an inertia tensor, not one inertia: I_1, I_2, I_3 (principal "
+            "moments) or its entries I_11 ... I_33")
+    if particle:
+        accelerations = accelerations[:2] if planar else accelerations[:3]
+        why = f"{body} is a particle (inertia 0): it has no rotation rows"
+        for name in ("alpha", "alpha_1", "alpha_2", "alpha_3", "I_G", "I_1", "I_2", "I_3",
+                     "w", "w_1", "w_2", "w_3", "theta"):
+            absent[name] = why
+        values.pop("theta", None)
+    elif planar:
+        values["I_G"] = float(J[2, 2])
+        values["w"] = float(state.omega[i, 2])
+    else:
+        for j in range(3):
+            values[f"w_{j + 1}"] = float(state.omega[i, j])
+            for k in range(3):
+                values[f"I_{j + 1}{k + 1}"] = float(J[j, k])
+        if np.count_nonzero(J - np.diag(np.diag(J))) == 0:
+            for k in range(3):
+                values[f"I_{k + 1}"] = float(J[k, k])
+        else:
+            for k in range(3):
+                absent[f"I_{k + 1}"] = (
+                    f"the inertia tensor of {body} is not diagonal in its body axes, so it "
+                    "has no principal moments along them: use its entries I_11, I_12 ... "
+                    "I_33")
+    reactions = tuple(r for r in model.reactions if r not in known)
+    for label, value in known.items():
+        values[label] = float(value)
+    return Vocabulary(body, model.dimension, tuple(accelerations), reactions, values,
+                      {a: c for a, c in aliases.items() if a not in values},
+                      {n: why for n, why in absent.items() if n not in values})
+
+
+def _planar_angle(W_R_B: np.ndarray) -> float:
+    """θ of a planar body from its rotation about z."""
+    return float(np.arctan2(W_R_B[1, 0], W_R_B[0, 0]))
