@@ -23,6 +23,7 @@ from mbody.equations.symbolic import (  # noqa: E402
     SymbolicBody,
     SymbolicEquations,
     latex_symbol,
+    load_symbols,
 )
 from mbody.model.model import State  # noqa: E402
 
@@ -284,3 +285,24 @@ def test_cli_prints_the_api_text(tmp_path):
     r = _cli("assemble", path, "--symbolic", "--latex", str(out))
     assert r.returncode == 0, r.stderr
     assert out.read_text(encoding="utf-8") == want.document()
+
+
+def test_load_symbols_need_no_sympy_and_match_the_rows():
+    """`load_symbols` (numpy only, for `mbody verify`) gives the symbols and values the
+    rows use."""
+    model = _load("satellite_thrusters.yaml")
+    state = random_state(model, 3)
+    loads = load_symbols(model, state, "spacecraft")
+    body = mbody.assemble(model, state).symbolic()["spacecraft"]
+    assert [s.name for s in loads] == ["F_main_engine_3", "F_rcs_1_1", "F_rcs_2_1"]
+    assert {s.name: s.value for s in loads} == {k: v for k, v in body.values.items()
+                                                if k.startswith("F_")}
+
+
+def test_import_and_numeric_assemble_do_not_load_sympy():
+    code = ("import sys, mbody; a = mbody.assemble(mbody.load('models/pendulum.yaml')); "
+            "str(a.bodies['rod']); a.solve(); print('sympy' in sys.modules)")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                       timeout=120, cwd=ROOT)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip() == "False"

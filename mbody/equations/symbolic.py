@@ -30,6 +30,7 @@ from mbody.equations import kernels
 
 if TYPE_CHECKING:
     from mbody.equations.assemble import Assembly
+    from mbody.model.model import Model, State
 
 INERTIA, GYROSCOPIC, APPLIED, GRAVITY, REACTION = (
     "inertia", "gyroscopic", "applied", "gravity", "reaction")
@@ -512,70 +513,23 @@ def body_symbolic(asm: Assembly, name: str) -> SymbolicBody:
     i = model.index[name]
     planar = model.dimension == cv.PLANAR
     particle = bool(model.particle[i])
-    R = state.W_R_B[i]
     values: dict[str, float] = {"m": float(model.mass[i])}
     definitions: dict[str, str] = {}
     S = sympy.Symbol
 
     # Each symbol's contribution to the body's six rows [F (world); M about G (body)].
     six: dict[str, tuple[np.ndarray, str, tuple[Any, ...]]] = {}
-
-    def add(symbol: str, wrench: np.ndarray, part: str = APPLIED,
-            factors: tuple[Any, ...] | None = None) -> None:
-        if symbol in six:
-            six[symbol][0][:] += wrench
-        else:
-            six[symbol] = (wrench.astype(float), part, factors or (S(symbol),))
-
-    ft = model.forces
-    vec = ft.vector_at(state.t)
-    loads = {load.name: load for load in model.loads}
-    for k in np.flatnonzero(ft.body == i):
-        load = loads[ft.names[k]]
-        couple, in_body = bool(ft.couple[k]), bool(ft.in_body[k])
-        comps = [2] if planar and couple else [0, 1] if planar else [0, 1, 2]
-        for c in comps:
-            if load.vector is not None and load.vector[c] == 0 and c not in load.expressions:
-                continue  # a component the file leaves at 0 is no symbol
-            e = np.zeros(3)
-            e[c] = 1.0
-            suffix = "" if planar and couple else (BODY_AXES if in_body else WORLD_AXES)[c]
-            symbol = f"{'M' if couple else 'F'}_{load.name}" + (f"_{suffix}" if suffix else "")
-            W = np.zeros(6)
-            if couple:
-                W[3:] = e if in_body else R.T @ e
-            else:
-                W[:3] = R @ e if in_body else e
-                W[3:] = np.cross(ft.B_r[k], e if in_body else R.T @ e)
-            add(symbol, W)
-            values[symbol] = float(vec[k, c])
-            if c in load.expressions:
-                definitions[symbol] = str(load.expressions[c])
-
-    sp = model.springs
-    if len(sp.names):
-        Pa, Pb, Va, Vb = kernels.spring_ends(model, state.position, state.quaternion,
-                                             state.velocity, state.omega)
-        L, u, T = kernels.spring_tension(model, Pa, Pb, Va, Vb)
-        Ldot = np.einsum("si,si->s", u, Vb - Va)
-        for s in range(len(sp.names)):
-            for end, r, sign in ((sp.a[s], sp.r_a[s], 1.0), (sp.b[s], sp.r_b[s], -1.0)):
-                if end != i:
-                    continue
-                symbol = f"T_{sp.names[s]}"
-                f = sign * u[s]
-                add(symbol, np.concatenate((f, np.cross(r, R.T @ f))))
-                values[symbol] = float(T[s])
-                definitions[symbol] = (
-                    f"k (L - L0) + c dL/dt = {_num(sp.stiffness[s], 6)}*"
-                    f"({_num(L[s], 6)} - {_num(sp.rest_length[s], 6)}) + "
-                    f"{_num(sp.damping[s], 6)}*({_num(Ldot[s], 6)})")
+    for load in load_symbols(model, state, name):
+        six[load.name] = (load.wrench, APPLIED, (S(load.name),))
+        values[load.name] = load.value
+        if load.definition is not None:
+            definitions[load.name] = load.definition
 
     g = float(np.linalg.norm(model.gravity))
     if g > 0:
         values["g"] = g
-        add("m*g", np.concatenate((model.gravity / g, np.zeros(3))), GRAVITY,
-            (S("m"), S("g")))
+        six["m*g"] = (np.concatenate((model.gravity / g, np.zeros(3))), GRAVITY,
+                      (S("m"), S("g")))
 
     # -- inertia and the gyroscopic term (body axes) -----------------------------------
     J = model.J[i]
@@ -625,6 +579,102 @@ def body_symbolic(asm: Assembly, name: str) -> SymbolicBody:
                 definitions[label] = str(model.known_expressions[label])
     return SymbolicBody(name, model.dimension, form, tuple(rows), values, definitions,
                         float(state.t))
+
+
+@dataclass(frozen=True)
+class LoadSymbol:
+    """One symbol of an applied load on one body (no sympy needed).
+
+    Parameters
+    ----------
+    name : str
+        ``F_<load>_x`` (a force component, world axes), ``F_<load>_1`` (body axes),
+        ``M_<load>_...`` (a couple; planar: ``M_<load>``), ``T_<spring>`` (a tension).
+    wrench : (6,) array
+        What one unit of it puts into the body's rows: force (world axes), then moment
+        about the mass centre (body axes), at the state it was made at.
+    value : float
+        Its value at that state (N; N m).
+    definition : str or None
+        How the value is made, where it varies: the load's expression of t, or the
+        spring's law with its numbers.
+    """
+
+    name: str
+    wrench: np.ndarray
+    value: float
+    definition: str | None = None
+
+
+def load_symbols(model: Model, state: State, body: str) -> list[LoadSymbol]:
+    """The applied-load symbols acting on `body`, with their values at `state`.
+
+    A force's or couple's component the file leaves at 0 (and not an expression of t) is
+    no symbol. A spring with both ends on the body gives one symbol.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    state : State
+        Positions, orientations, velocities and time the values are taken at.
+    body : str
+        A body of the model.
+
+    Returns
+    -------
+    list of LoadSymbol
+        In the file's order of loads; springs last.
+    """
+    i = model.index[body]
+    planar = model.dimension == cv.PLANAR
+    R = state.W_R_B[i]
+    out: dict[str, LoadSymbol] = {}
+
+    def add(symbol: str, wrench: np.ndarray, value: float, definition: str | None) -> None:
+        if symbol in out:  # the other end of a spring on the same body
+            wrench = wrench + out[symbol].wrench
+        out[symbol] = LoadSymbol(symbol, wrench, value, definition)
+
+    ft = model.forces
+    vec = ft.vector_at(state.t)
+    loads = {load.name: load for load in model.loads}
+    for k in np.flatnonzero(ft.body == i):
+        load = loads[ft.names[k]]
+        couple, in_body = bool(ft.couple[k]), bool(ft.in_body[k])
+        for c in [2] if planar and couple else [0, 1] if planar else [0, 1, 2]:
+            if load.vector is not None and load.vector[c] == 0 and c not in load.expressions:
+                continue
+            e = np.zeros(3)
+            e[c] = 1.0
+            suffix = "" if planar and couple else (BODY_AXES if in_body else WORLD_AXES)[c]
+            W = np.zeros(6)
+            if couple:
+                W[3:] = e if in_body else R.T @ e
+            else:
+                W[:3] = R @ e if in_body else e
+                W[3:] = np.cross(ft.B_r[k], e if in_body else R.T @ e)
+            add(f"{'M' if couple else 'F'}_{load.name}" + (f"_{suffix}" if suffix else ""),
+                W, float(vec[k, c]),
+                str(load.expressions[c]) if c in load.expressions else None)
+
+    sp = model.springs
+    if np.any(sp.a == i) or np.any(sp.b == i):
+        Pa, Pb, Va, Vb = kernels.spring_ends(model, state.position, state.quaternion,
+                                             state.velocity, state.omega)
+        L, u, T = kernels.spring_tension(model, Pa, Pb, Va, Vb)
+        Ldot = np.einsum("si,si->s", u, Vb - Va)
+        for s in range(len(sp.names)):
+            for end, r, sign in ((sp.a[s], sp.r_a[s], 1.0), (sp.b[s], sp.r_b[s], -1.0)):
+                if end != i:
+                    continue
+                f = sign * u[s]  # +T u pulls end a towards b, -T u end b towards a
+                add(f"T_{sp.names[s]}", np.concatenate((f, np.cross(r, R.T @ f))),
+                    float(T[s]),
+                    f"k (L - L0) + c dL/dt = {_num(sp.stiffness[s], 6)}*"
+                    f"({_num(L[s], 6)} - {_num(sp.rest_length[s], 6)}) + "
+                    f"{_num(sp.damping[s], 6)}*({_num(Ldot[s], 6)})")
+    return list(out.values())
 
 
 def _inertia_symbols(J: np.ndarray, principal: bool,
