@@ -192,6 +192,32 @@ def test_scipy_loadmat_reads_sparse_matrices_and_label_cells(tmp_path):
     assert whos["M"] == "sparse" and whos["G"] == "sparse" and whos["coordinates"] == "cell"
 
 
+@pytest.mark.parametrize("model", ["double_pendulum.yaml", "pendulum.yaml"])
+def test_loadmat_simplify_cells_gives_labels_as_str(model, tmp_path):
+    """With simplify_cells=True every label list is an array of plain str (a list of one
+    label is squeezed to that str, as docs/exports.md says), the conventions a dict; the
+    documented row/column look-up by label reads the right entry of G."""
+    asm = mbody.assemble(mbody.load(ROOT / "models" / model))
+    path = ex.write_export(asm, tmp_path / "eqs.mat")
+    d = scipy.io.loadmat(path, simplify_cells=True)
+    exp = ex.load_export(path)
+    lists = {"coordinates": asm.coordinates, "reactions": asm.reactions,
+             "body_names": list(asm.model.body_names),
+             "column_joint": [str(v) for v in exp.columns.joint],
+             "column_sign": [str(v) for v in exp.columns.sign]}
+    for key, labels in lists.items():
+        got = np.atleast_1d(d[key]).tolist()
+        assert got == labels and all(type(v) is str for v in got), key
+    if len(asm.model.body_names) == 1:
+        assert d["body_names"] == asm.model.body_names[0]
+    assert isinstance(d["conventions"], dict)
+    assert d["conventions"]["reaction_sign"].startswith("the reaction acts on")
+    assert d["model"] == asm.model.name and d["dimension"] == asm.model.dimension
+    i = list(d["coordinates"]).index(asm.coordinates[-1])
+    j = list(np.atleast_1d(d["reactions"])).index(asm.reactions[-1])
+    assert d["G"][i, j] == asm.G[len(asm.coordinates) - 1, len(asm.reactions) - 1] != 0
+
+
 def test_npz_reloads_with_numpy_and_scipy_alone(tmp_path):
     """The documented one call: scipy.sparse.csc_matrix((data, indices, indptr), shape)."""
     asm = mbody.assemble(MODEL_CASES["random_spatial"])

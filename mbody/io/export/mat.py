@@ -15,7 +15,13 @@ from mbody.io.export.assembly import COLUMN_TEXT, ExportedAssembly, build, flat_
 
 
 def _cell(values: Iterable[Any]) -> np.ndarray:
-    """A MATLAB cell column of strings."""
+    """A MATLAB cell column of strings (an n x 1 cellstr).
+
+    MATLAB and Octave index it with ``strcmp(S.coordinates, 'rod.x')``;
+    ``scipy.io.loadmat(path, simplify_cells=True)`` returns it as an array of str (a list
+    of one label squeezed to that str), plain ``loadmat`` as nested 1 x 1 arrays. A char
+    matrix would pad its rows with spaces in every reader, so labels stay cells.
+    """
     items = [str(v) for v in values]
     out = np.empty((len(items), 1), dtype=object)
     for i, v in enumerate(items):
