@@ -223,34 +223,21 @@ class BodyEquations:
     euler : tuple of Equation
         Euler's rows about the mass centre, in body axes (planar: one, about z); none for
         a particle.
+    assembly : Assembly, optional
+        The assembly these rows come from (what `symbolic` writes out again).
     """
 
     body: str
     fbd: FreeBodyDiagram
     newton: tuple[Equation, ...]
     euler: tuple[Equation, ...]
+    assembly: Assembly | None = field(default=None, repr=False, compare=False)
 
     @property
     def equations(self) -> tuple[Equation, ...]:
         """Newton's rows then Euler's, in stacking order."""
         return self.newton + self.euler
 
-
-    assembly : Assembly, optional
-        The assembly these rows come from (what `symbolic` writes out again).
-def _num(x: float) -> str:
-    x = 0.0 if abs(x) < 1e-12 else x  # rounding noise from rotations
-    s = f"{x:.6g}"
-    return "0" if s in ("-0", "0") else s
-
-
-    assembly: Assembly | None = field(default=None, repr=False, compare=False)
-def _terms(pairs: list[tuple[float, str]]) -> str:
-    out = ""
-    for coef, name in pairs:
-        if abs(coef) < 1e-12:  # rounding noise from rotations, not a term
-            continue
-        mag = abs(coef)
     def symbolic(self) -> SymbolicBody:
         """These rows with symbols (m, I_1, w_2, loads by name, reaction labels) instead of
         numbers; needs sympy (see `mbody.equations.symbolic`).
@@ -265,6 +252,19 @@ def _terms(pairs: list[tuple[float, str]]) -> str:
                              "mbody.assemble(model).bodies[name].symbolic()")
         return body_symbolic(self.assembly, self.body)
 
+
+def _num(x: float) -> str:
+    x = 0.0 if abs(x) < 1e-12 else x  # rounding noise from rotations
+    s = f"{x:.6g}"
+    return "0" if s in ("-0", "0") else s
+
+
+def _terms(pairs: list[tuple[float, str]]) -> str:
+    out = ""
+    for coef, name in pairs:
+        if abs(coef) < 1e-12:  # rounding noise from rotations, not a term
+            continue
+        mag = abs(coef)
     def __repr__(self) -> str:  # the dataclass's would print the diagram's arrays (1-6 KB)
         unknown = sum(f.unknown for f in self.fbd.forces)
         return (f"<BodyEquations of {self.body!r}: {len(self.newton)} Newton and "
