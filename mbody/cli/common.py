@@ -7,23 +7,34 @@ paragraph on stderr and a non-zero exit code.
 
 from __future__ import annotations
 
+import argparse
+import functools
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from contextvars import ContextVar
+from typing import Any
 
 from mbody.errors import MbodyError
 
 EXIT_OK, EXIT_UNMET, EXIT_INPUT, EXIT_INTERNAL = 0, 1, 2, 70
 
 
+_IMPORT: ContextVar[dict[str, Any] | None] = ContextVar("mbody_import_options",
+                                                     default=None)
+"""The command's ``--format``, ``--keyframe``, ``--q``... as `mbody.load` options."""
+
+
 def load_model(path: str, *, warn: bool = True):
     """The validated model at `path`; its warnings (e.g. a quaternion that was normalised)
     go to stderr, so that a questionable input never passes unseen. The file size limit
-    is the command's ``--max-bytes`` (set around the command by `mbody.cli.app.main`)."""
+    is the command's ``--max-bytes`` (set around the command by `mbody.cli.app.main`);
+    the format and an imported model's state are its ``--format``, ``--keyframe``,
+    ``--q``, ``--qd`` and ``--floating-base`` (`add_import_options`)."""
     import sys
 
     from mbody.model.model import load
 
-    model = load(path)
+    model = load(path, **(_IMPORT.get() or {}))
     if warn:
         for w in model.warnings:
             sys.stderr.write(f"mbody: warning: {w}\n")
@@ -78,4 +89,78 @@ def parse_known(pairs: Sequence[str]) -> dict[str, float]:
         if not math.isfinite(x):
             raise MbodyError(f"--known {label}: expected a finite number, got {value!r}")
         out[label.strip()] = x
+    return out
+
+
+def add_import_options(command: argparse.ArgumentParser) -> None:
+    """Give a command that reads a model the options of MJCF and URDF input, and make its
+    handler pass them to `load_model`. A command with its own ``--format`` (``convert``:
+    the output's) reads its input itself and is left as it is."""
+    if "--format" in command._option_string_actions:
+        return
+    g = command.add_argument_group("MJCF and URDF input")
+    g.add_argument("--format", choices=("yaml", "mjcf", "urdf"), help="the model file's "
+                   "format, when its extension (.yaml, .xml, .urdf) does not say it")
+    g.add_argument("--keyframe", metavar="NAME", help="MJCF: the <key> whose qpos and qvel "
+                   "give the state (default: the reference pose, at rest)")
+    g.add_argument("--q", action="append", default=[], metavar="JOINT=VALUE",
+                   help="URDF: a joint's position, rad or m (30deg for degrees); repeatable; "
+                   "other joints at 0")
+    g.add_argument("--qd", action="append", default=[], metavar="JOINT=VALUE",
+                   help="URDF: a joint's rate, rad/s or m/s; repeatable; others at rest")
+    g.add_argument("--floating-base", action="store_true", help="URDF: the root link moves "
+                   "freely (a legged robot) instead of being fixed to the world")
+    run = command.get_default("run")
+    if run is not None:
+        command.set_defaults(run=_with_import_options(run))
+
+
+def _with_import_options(run: Callable[[argparse.Namespace], int]
+                         ) -> Callable[[argparse.Namespace], int]:
+    @functools.wraps(run)
+    def wrapped(a: argparse.Namespace) -> int:
+        token = _IMPORT.set(import_options(a))
+        try:
+            return run(a)
+        finally:
+            _IMPORT.reset(token)
+    return wrapped
+
+
+def import_options(a: argparse.Namespace) -> dict[str, Any]:
+    """The `mbody.load` options given on the command line (only those given)."""
+    out: dict[str, Any] = {}
+    if getattr(a, "format", None):
+        out["format"] = a.format
+    if getattr(a, "keyframe", None) is not None:
+        out["keyframe"] = a.keyframe
+    for flag, key in (("q", "joint_positions"), ("qd", "joint_velocities")):
+        pairs = getattr(a, flag, None) or []
+        if pairs:
+            out[key] = _joint_values(pairs, f"--{flag}", rate=flag == "qd")
+    if getattr(a, "floating_base", False):
+        out["floating_base"] = True
+    return out
+
+
+def _joint_values(pairs: Sequence[str], flag: str, rate: bool) -> dict[str, float]:
+    """``["shoulder=0.5", "elbow=30deg"]`` -> ``{"shoulder": 0.5, "elbow": 0.5236}``."""
+    out = {}
+    unit = "deg/s" if rate else "deg"
+    for p in pairs:
+        name, sep, value = p.partition("=")
+        if not sep or not name.strip():
+            raise MbodyError(f"{flag} expects JOINT=VALUE (for example shoulder=0.5), got "
+                             f"{p!r}")
+        text = value.strip()
+        scale = 1.0
+        if text.endswith(unit):
+            text, scale = text[:-len(unit)], math.pi / 180
+        try:
+            x = float(text) * scale
+        except ValueError:
+            raise MbodyError(f"{flag} {name}: {value!r} is not a number") from None
+        if not math.isfinite(x):
+            raise MbodyError(f"{flag} {name}: expected a finite number, got {value!r}")
+        out[name.strip()] = x
     return out

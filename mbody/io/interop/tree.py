@@ -1,0 +1,456 @@
+"""A kinematic tree (what MJCF and URDF both describe) -> the model-file structure.
+
+Both readers turn their file into `TreeBody`s: a frame placed in its parent's frame,
+the joints that move it (MuJoCo's rules: each joint's anchor and axis in the body's
+frame, applied in order), its mass, mass centre and inertia. This module does the rest
+once for both: forward kinematics from joint positions and velocities (numpy; no
+MuJoCo at run time), the mapping of each body's joints onto one mbody joint, massless
+frames, and the plain values `mbody.model.validate` checks, each with the line and
+column of the XML it came from.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from mbody.errors import Issue, ModelError
+from mbody.io.interop.xmlsource import Element
+from mbody.model.loader import Document, Path_
+
+GROUND = "ground"
+PARALLEL_TOL = 1e-9
+"""Two unit axes whose cross product is smaller than this are parallel; a dot product
+smaller than this, perpendicular; two anchors closer than this (relative to the model's
+size), the same point."""
+
+
+@dataclass
+class TreeJoint:
+    """One joint of a body: MuJoCo's hinge, slide, ball or free.
+
+    `pos` and `axis` are in the body's frame; `ref` is the joint position at which the
+    body sits where the file puts it (MJCF's ``ref``; 0 for URDF).
+    """
+
+    name: str
+    type: str
+    pos: np.ndarray
+    axis: np.ndarray
+    element: Element
+    ref: float = 0.0
+
+
+@dataclass
+class TreeBody:
+    """One body (MJCF ``<body>``, URDF ``<link>``), its frame given in its parent's.
+
+    `com` and `R_inertia` place the inertia frame in the body frame; `inertia` is the
+    3x3 tensor about the mass centre in that frame.
+    """
+
+    name: str
+    parent: int  # index of the parent body, -1 for the world
+    pos: np.ndarray
+    quat: np.ndarray  # w first, body frame in the parent's
+    joints: list[TreeJoint]
+    element: Element
+    mass: float = 0.0
+    com: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    R_inertia: np.ndarray = field(default_factory=lambda: np.eye(3))
+    inertia: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
+    mass_element: Element | None = None
+    """Where the mass was written (``<inertial>``, a geom), for error marks."""
+    shape: dict[str, Any] | None = None
+    fixed_name: str = ""
+    """The name of the fixed joint a body without joints gets (URDF names it)."""
+    fixed_element: Element | None = None
+
+
+@dataclass
+class Loop:
+    """A joint that closes a loop (MJCF ``connect``/``weld``): spherical or fixed."""
+
+    name: str
+    type: str  # "spherical" or "fixed"
+    body1: int  # -1 for the world
+    body2: int
+    anchor: np.ndarray  # in body1's frame ("connect") or body2's ("weld")
+    on_body2: bool
+    element: Element
+
+
+@dataclass
+class ImportedDocument(Document):
+    """A `Document` read from MJCF or URDF, with the import's warnings (as `Issue`s)."""
+
+    warnings: list[Issue] = field(default_factory=list)
+    source_format: str = ""
+
+
+# ---- rotations (w first) ------------------------------------------------------------
+
+def quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Hamilton product a * b."""
+    w1, x1, y1, z1 = a
+    w2, x2, y2, z2 = b
+    return np.array([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
+                     w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+                     w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
+                     w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2])
+
+
+def axis_angle_quat(axis: np.ndarray, angle: float) -> np.ndarray:
+    """The rotation by `angle` about the unit `axis`."""
+    s = math.sin(angle / 2)
+    return np.array([math.cos(angle / 2), axis[0] * s, axis[1] * s, axis[2] * s])
+
+
+def quat_matrix(q: np.ndarray) -> np.ndarray:
+    """Unit quaternion -> rotation matrix."""
+    w, x, y, z = q
+    return np.array([
+        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+
+
+def unit(v: np.ndarray) -> np.ndarray:
+    n = float(np.linalg.norm(v))
+    return v / n if n > 0 else v
+
+
+# ---- the joint coordinates ----------------------------------------------------------
+
+NQ = {"hinge": 1, "slide": 1, "ball": 4, "free": 7}
+NV = {"hinge": 1, "slide": 1, "ball": 3, "free": 6}
+
+
+def joint_order(bodies: list[TreeBody]) -> list[tuple[int, TreeJoint]]:
+    """Every joint as (body index, joint), in the order of qpos and qvel."""
+    return [(i, j) for i, b in enumerate(bodies) for j in b.joints]
+
+
+def qpos0(bodies: list[TreeBody]) -> np.ndarray:
+    """The joint positions at which every body sits where the file puts it (a free
+    joint's body is in the world, so its frame as written is its pose)."""
+    out: list[float] = []
+    for i, j in joint_order(bodies):
+        if j.type in ("hinge", "slide"):
+            out.append(j.ref)
+        elif j.type == "ball":
+            out.extend([1.0, 0.0, 0.0, 0.0])
+        else:
+            out.extend([*bodies[i].pos, *bodies[i].quat])
+    return np.array(out)
+
+
+@dataclass
+class Kinematics:
+    """World poses and velocities of every body at one joint state.
+
+    `pos`, `R`: each body frame's origin and orientation; `omega`: angular velocity and
+    `vel` the origin's velocity, world axes; `anchor`, `axis`: each joint's, world.
+    """
+
+    pos: np.ndarray
+    R: np.ndarray
+    quat: np.ndarray
+    omega: np.ndarray
+    vel: np.ndarray
+    anchor: dict[int, list[np.ndarray]]
+    axis: dict[int, list[np.ndarray]]
+
+
+def forward(bodies: list[TreeBody], qpos: np.ndarray, qvel: np.ndarray,
+            q0: np.ndarray) -> Kinematics:
+    """Forward kinematics as MuJoCo's ``mj_kinematics`` does it, with velocities.
+
+    Bodies come parents first. Each body's frame is placed in its parent's, then its
+    joints act in order: a hinge turns about its anchor by q - ref, a slide moves along
+    its axis by q - ref, a ball turns by its quaternion, a free joint sets the pose.
+    """
+    n = len(bodies)
+    pos = np.zeros((n, 3))
+    quat = np.zeros((n, 4))
+    omega = np.zeros((n, 3))
+    vel = np.zeros((n, 3))
+    anchors: dict[int, list[np.ndarray]] = {}
+    axes: dict[int, list[np.ndarray]] = {}
+    qa = va = 0
+    for i, b in enumerate(bodies):
+        if b.parent < 0:
+            ppos, pq, pw, pv = np.zeros(3), np.array([1.0, 0, 0, 0]), np.zeros(3), np.zeros(3)
+        else:
+            ppos, pq, pw, pv = pos[b.parent], quat[b.parent], omega[b.parent], vel[b.parent]
+        Rp = quat_matrix(pq)
+        xpos = ppos + Rp @ b.pos
+        xquat = quat_mul(pq, b.quat)
+        motions: list[tuple[str, np.ndarray, np.ndarray, np.ndarray]] = []
+        anchors[i], axes[i] = [], []
+        for j in b.joints:
+            if j.type == "free":
+                xpos = qpos[qa:qa + 3].copy()
+                xquat = unit(qpos[qa + 3:qa + 7].copy())
+                anchors[i].append(xpos.copy())
+                axes[i].append(quat_matrix(xquat)[:, 2])
+                motions.append(("free", xpos.copy(), np.zeros(3), qvel[va:va + 6].copy()))
+            else:
+                R = quat_matrix(xquat)
+                xaxis = R @ j.axis
+                xanchor = R @ j.pos + xpos
+                anchors[i].append(xanchor)
+                axes[i].append(xaxis)
+                if j.type == "slide":
+                    xpos = xpos + xaxis * (qpos[qa] - q0[qa])
+                    motions.append(("slide", xanchor, xaxis, qvel[va:va + 1].copy()))
+                else:
+                    if j.type == "ball":
+                        qloc = unit(qpos[qa:qa + 4].copy())
+                        motions.append(("ball", xanchor, xaxis, qvel[va:va + 3].copy()))
+                    else:
+                        qloc = axis_angle_quat(j.axis, qpos[qa] - q0[qa])
+                        motions.append(("hinge", xanchor, xaxis, qvel[va:va + 1].copy()))
+                    xquat = quat_mul(xquat, qloc)
+                    xpos = xanchor - quat_matrix(xquat) @ j.pos
+            qa += NQ[j.type]
+            va += NV[j.type]
+        R = quat_matrix(xquat)
+        w = pw.copy()
+        v = pv + np.cross(pw, xpos - ppos)  # the final origin, carried by the parent
+        for kind, anchor, xaxis, qd in motions:  # each joint's rate, at the final origin
+            if kind == "free":
+                v = qd[:3].copy()
+                w = R @ qd[3:]
+            elif kind == "slide":
+                v = v + xaxis * qd[0]
+            elif kind == "hinge":
+                w = w + xaxis * qd[0]
+                v = v + np.cross(xaxis * qd[0], xpos - anchor)
+            else:  # ball: rates about the body's own axes (MuJoCo's cdof)
+                wb = R @ qd
+                w = w + wb
+                v = v + np.cross(wb, xpos - anchor)
+        pos[i], quat[i], omega[i], vel[i] = xpos, xquat, w, v
+    Rs = np.array([quat_matrix(q) for q in quat]) if n else np.zeros((0, 3, 3))
+    return Kinematics(pos, Rs, quat, omega, vel, anchors, axes)
+
+
+# ---- one mbody joint per body -------------------------------------------------------
+
+@dataclass
+class Mapped:
+    """What a body's joints become: an mbody joint type with its data, or a problem."""
+
+    type: str | None  # revolute, prismatic, universal, spherical, cylindrical, fixed; None: free
+    name: str
+    at: np.ndarray | None = None
+    axis: np.ndarray | None = None
+    axis2: np.ndarray | None = None
+    element: Element | None = None
+
+
+def joint_name(names: list[str]) -> str:
+    """One name for several joints of a body: their common stem (``right_hip_x``,
+    ``right_hip_y``, ``right_hip_z`` -> ``right_hip``), else the names joined by ``+``."""
+    stem = names[0]
+    for n in names[1:]:
+        k = 0
+        while k < min(len(stem), len(n)) and stem[k] == n[k]:
+            k += 1
+        stem = stem[:k]
+    stem = stem.rstrip("_-: ")
+    return stem if len(stem) >= 2 else "+".join(names)
+
+
+def map_joints(b: TreeBody, kin: Kinematics, i: int, scale: float) -> Mapped:
+    """The one mbody joint that is exactly a body's MJCF joints, or a `ModelError`."""
+    js = b.joints
+    anchors, axes = kin.anchor[i], kin.axis[i]
+    if not js:
+        return Mapped("fixed", b.fixed_name or f"{b.name}_fixed", kin.pos[i], None, None,
+                      b.fixed_element or b.element)
+    names = [j.name for j in js]
+    kinds = [j.type for j in js]
+    first = js[0].element
+    if "free" in kinds:
+        if len(js) > 1:
+            raise ModelError([first.issue(
+                f"body '{b.name}' has a free joint and other joints", "a free joint must be "
+                "the body's only joint")])
+        return Mapped(None, names[0])
+    tol = PARALLEL_TOL * max(scale, 1.0)
+    same_point = all(float(np.linalg.norm(a - anchors[0])) <= tol for a in anchors)
+    if len(js) == 1:
+        typ = {"hinge": "revolute", "slide": "prismatic", "ball": "spherical"}[kinds[0]]
+        return Mapped(typ, names[0], anchors[0],
+                      axes[0] if typ != "spherical" else None, None, first)
+    name = joint_name(names)
+    listing = ", ".join(f"{k} '{n}'" for k, n in zip(kinds, names, strict=True))
+    if kinds == ["hinge", "hinge"] and same_point and abs(float(axes[0] @ axes[1])) <= 1e-9:
+        return Mapped("universal", name, anchors[0], axes[0], axes[1], first)
+    if kinds == ["hinge"] * 3 and same_point and abs(float(np.linalg.det(np.array(axes)))) > 1e-6:
+        return Mapped("spherical", name, anchors[0], None, None, first)
+    if sorted(kinds) == ["hinge", "slide"] and float(np.linalg.norm(
+            np.cross(axes[0], axes[1]))) <= 1e-9:
+        h = kinds.index("hinge")
+        return Mapped("cylindrical", name, anchors[h], axes[h], None, first)
+    why = _why_not(kinds, same_point, axes)
+    raise ModelError([first.issue(
+        f"body '{b.name}' has {len(js)} joints ({listing}) that no single mbody joint "
+        f"is exactly: {why}",
+        "mbody has no massless intermediate frames; what composes exactly: two hinges "
+        "through one point with perpendicular axes (universal), three hinges through one "
+        "point (spherical), a hinge and a slide along one axis (cylindrical). Give the "
+        "intermediate frame a body with a mass, or change the joints")])
+
+
+def _why_not(kinds: list[str], same_point: bool, axes: list[np.ndarray]) -> str:
+    if "ball" in kinds:
+        return "a ball joint composes with no other joint"
+    if kinds.count("slide") > 1:
+        return "mbody has no joint with two sliding directions"
+    if "slide" in kinds:
+        return "the slide is not along the hinge's axis"
+    if not same_point:
+        return "their axes do not pass through one point (the anchors differ)"
+    if len(kinds) == 2:
+        return (f"their axes are not perpendicular (axis . axis = "
+                f"{float(axes[0] @ axes[1]):.3g})")
+    return "more than three joints, or three hinges whose axes are coplanar"
+
+
+# ---- the document ---------------------------------------------------------------
+
+class DocBuilder:
+    """Plain model-file values with the XML mark of each, for `mbody.model.validate`."""
+
+    def __init__(self, file: str):
+        self.file = file
+        self.marks: dict[Path_, tuple[int, int]] = {}
+        self.key_marks: dict[Path_, tuple[int, int]] = {}
+
+    def mark(self, path: Path_, e: Element | None, attr: str | None = None) -> None:
+        if e is None:
+            return
+        self.marks[path] = e.where(attr)
+        self.key_marks[path] = e.where(attr)
+
+
+def _floats(v: np.ndarray) -> list[float]:
+    return [float(x) for x in v]
+
+
+def build(name: str, description: str, file: str, bodies: list[TreeBody],
+          qpos: np.ndarray, qvel: np.ndarray, q0: np.ndarray, gravity: np.ndarray,
+          loops: list[Loop], root: Element, fmt: str) -> ImportedDocument:
+    """The model-file values of the tree at joint state (qpos, qvel).
+
+    Bodies without mass that sit welded to their parent (frames: URDF's ``tool0``, a
+    bare MJCF body) are left out, their children joined to the nearest body kept; a body
+    without mass that moves is an error (mbody needs a mass on every moving body).
+    """
+    kin = forward(bodies, qpos, qvel, q0)
+    scale = float(max([1.0] + [float(np.abs(p).max()) for p in kin.pos]))
+    issues: list[Issue] = []
+    kept: dict[int, str] = {}  # tree index -> mbody body name
+    owner: dict[int, int] = {}  # tree index -> kept tree index it is welded into, or -1
+    for i, b in enumerate(bodies):
+        if b.mass > 0:
+            kept[i] = b.name
+            owner[i] = i
+        elif b.joints:
+            e = b.joints[0].element
+            issues.append(e.issue(
+                f"body '{b.name}' has no mass but moves on joint '{b.joints[0].name}'",
+                "mbody needs a mass on every moving body (it has no massless intermediate "
+                "frames): give the body an inertial with a mass, or geoms with one"))
+        else:
+            owner[i] = owner.get(b.parent, -1) if b.parent >= 0 else -1
+    if issues:
+        raise ModelError(issues)
+    if not kept:
+        raise ModelError([Issue(file, root.line, root.column, "", "the model has no body "
+                                "with a mass", "mbody models need at least one")])
+    doc = DocBuilder(file)
+    out_bodies: list[dict[str, Any]] = []
+    out_joints: list[dict[str, Any]] = []
+    for i, b in enumerate(bodies):
+        if i not in kept:
+            continue
+        R = kin.R[i]
+        Rb = R @ b.R_inertia
+        c = kin.pos[i] + R @ b.com
+        v = kin.vel[i] + np.cross(kin.omega[i], c - kin.pos[i])
+        k = len(out_bodies)
+        entry: dict[str, Any] = {
+            "name": b.name, "mass": float(b.mass),
+            "inertia": [[float(x) for x in row] for row in 0.5 * (b.inertia + b.inertia.T)],
+            "position": _floats(c), "orientation": {"matrix": [_floats(r) for r in Rb]},
+            "velocity": _floats(v), "angular_velocity": _floats(Rb.T @ kin.omega[i])}
+        if b.shape is not None:
+            entry["shape"] = b.shape
+        out_bodies.append(entry)
+        p: Path_ = ("bodies", k)
+        doc.mark(p, b.element)
+        doc.mark((*p, "name"), b.element, "name")
+        for key in ("mass", "inertia"):
+            doc.mark((*p, key), b.mass_element or b.element, key if key == "mass" else None)
+        m = map_joints(b, kin, i, scale)
+        if m.type is None:
+            continue
+        parent = _parent_name(bodies, b.parent, owner, kept)
+        jd: dict[str, Any] = {"name": m.name, "type": m.type, "parent": parent,
+                              "child": b.name, "at": _floats(m.at if m.at is not None
+                                                             else kin.pos[i])}
+        if m.axis is not None:
+            jd["axis"] = _floats(m.axis)
+        if m.axis2 is not None:
+            jd["axis2"] = _floats(m.axis2)
+        jp: Path_ = ("joints", len(out_joints))
+        out_joints.append(jd)
+        doc.mark(jp, m.element)
+        for key in jd:
+            doc.mark((*jp, key), m.element, key if key in ("name", "axis", "type") else None)
+    for lp in loops:
+        jd = _loop(lp, bodies, kin, owner, kept)
+        if jd is None:
+            continue
+        jp = ("joints", len(out_joints))
+        out_joints.append(jd)
+        doc.mark(jp, lp.element)
+    data: dict[str, Any] = {"model": name, "description": description, "dimension": 3,
+                            "gravity": _floats(gravity), "bodies": out_bodies}
+    if out_joints:
+        data["joints"] = out_joints
+    doc.marks[()] = (root.line, root.column)
+    for key in ("model", "dimension", "gravity", "bodies", "joints"):
+        doc.marks[(key,)] = (root.line, root.column)
+    return ImportedDocument(data, file, doc.marks, doc.key_marks, source_format=fmt)
+
+
+def _parent_name(bodies: list[TreeBody], parent: int, owner: dict[int, int],
+                 kept: dict[int, str]) -> str:
+    if parent < 0:
+        return GROUND
+    o = owner.get(parent, -1)
+    return kept[o] if o >= 0 else GROUND
+
+
+def _loop(lp: Loop, bodies: list[TreeBody], kin: Kinematics, owner: dict[int, int],
+          kept: dict[int, str]) -> dict[str, Any] | None:
+    b1 = _parent_name(bodies, lp.body1, owner, kept)
+    b2 = _parent_name(bodies, lp.body2, owner, kept)
+    if b2 == GROUND:
+        b1, b2 = b2, b1
+    if b2 == GROUND or b1 == b2:
+        return None
+    on = lp.body2 if lp.on_body2 else lp.body1
+    if on < 0:
+        at = lp.anchor
+    else:
+        at = kin.pos[on] + kin.R[on] @ lp.anchor
+    return {"name": lp.name, "type": lp.type, "parent": b1, "child": b2, "at": _floats(at)}

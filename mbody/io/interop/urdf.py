@@ -1,0 +1,390 @@
+"""URDF -> the model-file structure, located at the XML's lines.
+
+Links with an ``<inertial>`` become bodies (mass centre and inertia frame from its
+``origin``, ``xyz`` and ``rpy``; the tensor's entries as written); joints: revolute and
+continuous -> revolute, prismatic -> prismatic, fixed -> fixed (a link without mass on a
+fixed joint is a frame: left out, its children joined to the body it is fixed to). The
+root link is fixed to the world (its mass belongs to the ground, as Pinocchio reads a
+fixed base) unless ``floating_base`` is set, when it moves freely. Joint limits,
+dynamics, mimic joints and transmissions are listed in one warning.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from mbody.errors import Issue, ModelError, did_you_mean
+from mbody.io.interop.tree import (
+    NV,
+    ImportedDocument,
+    TreeBody,
+    TreeJoint,
+    build,
+    joint_order,
+    qpos0,
+    quat_matrix,
+    unit,
+)
+from mbody.io.interop.xmlsource import MAX_ELEMENTS, Element, parse_xml, read_xml, unknown_name
+
+_ATTRS: dict[str, tuple[str, ...]] = {
+    "robot": ("name", "version", "xmlns:xacro"), "link": ("name", "type"),
+    "inertial": (), "origin": ("xyz", "rpy"), "mass": ("value",),
+    "inertia": ("ixx", "ixy", "ixz", "iyy", "iyz", "izz"), "visual": ("name",),
+    "collision": ("name",), "geometry": (), "box": ("size",),
+    "cylinder": ("radius", "length"), "sphere": ("radius",),
+    "capsule": ("radius", "length"), "mesh": ("filename", "scale"),
+    "material": ("name",), "color": ("rgba",), "texture": ("filename",),
+    "joint": ("name", "type"), "parent": ("link",), "child": ("link",), "axis": ("xyz",),
+    "calibration": ("rising", "falling", "reference_position"),
+    "dynamics": ("damping", "friction"), "limit": ("lower", "upper", "effort", "velocity"),
+    "mimic": ("joint", "multiplier", "offset"),
+    "safety_controller": ("soft_lower_limit", "soft_upper_limit", "k_position",
+                          "k_velocity"),
+}
+"""URDF's attributes per element (ROS's urdf XML specification)."""
+_CHILDREN: dict[str, tuple[str, ...]] = {
+    "robot": ("link", "joint", "material", "transmission", "gazebo", "mujoco"),
+    "link": ("inertial", "visual", "collision"),
+    "inertial": ("origin", "mass", "inertia"),
+    "visual": ("origin", "geometry", "material"), "collision": ("origin", "geometry"),
+    "geometry": ("box", "cylinder", "sphere", "capsule", "mesh"),
+    "material": ("color", "texture"),
+    "joint": ("origin", "parent", "child", "axis", "calibration", "dynamics", "limit",
+              "mimic", "safety_controller"),
+}
+_OPEN = ("transmission", "gazebo", "mujoco")
+"""Elements whose content belongs to other tools; not checked."""
+JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
+
+
+def read_urdf(source: str | Path, *, joint_positions: Mapping[str, float] | None = None,
+              joint_velocities: Mapping[str, float] | None = None,
+              floating_base: bool = False, file: str | None = None) -> ImportedDocument:
+    """Read a URDF model into the plain structure a YAML model file parses to.
+
+    Parameters
+    ----------
+    source : str or Path
+        A path to the ``.urdf`` file, or the XML text itself (starting with ``<``).
+    joint_positions, joint_velocities : mapping of str to float, optional
+        Joint name -> position (rad or m) and rate (rad/s or m/s); every other joint at 0.
+    floating_base : bool, optional
+        The root link moves freely (a legged robot) instead of being fixed to the world
+        (an arm's base, the default).
+    file : str, optional
+        The name used in messages.
+
+    Returns
+    -------
+    ImportedDocument
+
+    Raises
+    ------
+    ModelError
+        Bad XML, an unknown element or attribute (with a did-you-mean), an unknown joint
+        name in `joint_positions`, or what mbody cannot express (a planar joint).
+    """
+    budget = [MAX_ELEMENTS]
+    if isinstance(source, Path) or not str(source).lstrip().startswith("<"):
+        name = str(source) if file is None else file
+        root = read_xml(Path(source), name, budget)
+    else:
+        name = "<string>" if file is None else file
+        root = parse_xml(str(source), name, budget)
+    if root.tag != "robot":
+        hint = ("this is an MJCF file: read it as MJCF (a .xml name, or --format mjcf)"
+                if root.tag == "mujoco" else "a URDF model starts with <robot>")
+        raise ModelError([root.issue(f"expected <robot> as the root element, got "
+                                     f"<{root.tag}>", hint)])
+    issues: list[Issue] = []
+    ignored: list[str] = []
+    _check_names(root, issues, ignored)
+    if issues:
+        raise ModelError(issues)
+    reader = _Reader(root, name)
+    if ignored:
+        reader.notes["elements and attributes outside the URDF specification"] = ignored
+    return reader.read(dict(joint_positions or {}), dict(joint_velocities or {}),
+                                    floating_base)
+
+
+def _check_names(root: Element, issues: list[Issue], ignored: list[str]) -> None:
+    """A name close to one of URDF's is misspelt (an error with a did-you-mean); any
+    other unknown name is a tool's extension (Gazebo's, a vendor's): noted, not read."""
+    stack = [root]
+    while stack:
+        e = stack.pop()
+        if e.tag in _OPEN:
+            continue
+        for a in e.attrib:
+            known = _ATTRS.get(e.tag, ())
+            if a not in known and ":" not in a:
+                if did_you_mean(a, known):
+                    issues.append(unknown_name(e, a, known, f"attribute of <{e.tag}>", a))
+                elif f"{e.tag} {a}" not in ignored:
+                    ignored.append(f"{e.tag} {a}")
+        for c in e.children:
+            kids = _CHILDREN.get(e.tag, ())
+            if c.tag in kids:
+                stack.append(c)
+            elif did_you_mean(c.tag, kids):
+                issues.append(unknown_name(c, c.tag, kids, f"element in <{e.tag}>"))
+            elif f"<{c.tag}> in <{e.tag}>" not in ignored:
+                ignored.append(f"<{c.tag}> in <{e.tag}>")
+    issues.sort(key=lambda i: (i.line, i.column))
+
+
+def rpy_quat(rpy: np.ndarray) -> np.ndarray:
+    """URDF's roll, pitch, yaw (fixed axes x, then y, then z) as a quaternion."""
+    r, p, y = rpy / 2
+    cr, sr, cp, sp, cy, sy = (math.cos(r), math.sin(r), math.cos(p), math.sin(p),
+                              math.cos(y), math.sin(y))
+    return np.array([cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy,
+                     cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy])
+
+
+class _Reader:
+    def __init__(self, root: Element, file: str):
+        self.root, self.file = root, file
+        self.issues: list[Issue] = []
+        self.notes: dict[str, list[str]] = {}
+
+    def note(self, what: str, item: str) -> None:
+        self.notes.setdefault(what, []).append(item)
+
+    def numbers(self, e: Element | None, attr: str, n: int, default: np.ndarray
+                ) -> np.ndarray:
+        if e is None or e.get(attr) is None:
+            return default
+        text = e.get(attr) or ""
+        try:
+            x = np.array([float(t) for t in text.split()])
+        except ValueError:
+            self.issues.append(e.issue(f"'{text}' is not {n} number{'s' if n > 1 else ''}",
+                                       "numbers separated by spaces, such as \"0 0 1\"",
+                                       attr))
+            return default
+        if len(x) != n or not np.all(np.isfinite(x)):
+            self.issues.append(e.issue(f"expected {n} finite number{'s' if n > 1 else ''}, "
+                                       f"got '{text}'", attr=attr))
+            return default
+        return x
+
+    def origin(self, e: Element) -> tuple[np.ndarray, np.ndarray]:
+        o = e.find("origin")
+        xyz = self.numbers(o, "xyz", 3, np.zeros(3))
+        rpy = self.numbers(o, "rpy", 3, np.zeros(3))
+        return xyz, rpy_quat(rpy)
+
+    def read(self, qpos_by_name: dict[str, float], qvel_by_name: dict[str, float],
+             floating: bool) -> ImportedDocument:
+        links = {}
+        for ln in self.root.findall("link"):
+            n = ln.get("name")
+            if not n:
+                self.issues.append(ln.issue("a <link> needs a 'name'"))
+                continue
+            if n in links:
+                self.issues.append(ln.issue(f"duplicate link name '{n}'", attr="name"))
+            links[n] = ln
+        joints_of: dict[str, Element] = {}  # child link -> joint
+        children: dict[str, list[str]] = {}
+        for j in self.root.findall("joint"):
+            jn = j.get("name") or "?"
+            typ = j.get("type")
+            if typ not in JOINT_TYPES:
+                self.issues.append(j.issue(f"unknown joint type '{typ}'", did_you_mean(
+                    typ or "", JOINT_TYPES) or f"expected one of: {', '.join(JOINT_TYPES)}",
+                    "type"))
+                continue
+            parent, child = j.find("parent"), j.find("child")
+            if parent is None or child is None:
+                self.issues.append(j.issue(f"joint '{jn}' needs a <parent> and a <child>"))
+                continue
+            pl, cl = parent.get("link") or "", child.get("link") or ""
+            for el, ln_name in ((parent, pl), (child, cl)):
+                if ln_name not in links:
+                    self.issues.append(el.issue(f"unknown link '{ln_name}'",
+                                                did_you_mean(ln_name, links), "link"))
+            if cl in joints_of:
+                self.issues.append(child.issue(f"link '{cl}' is the child of two joints",
+                                               "URDF describes a tree", "link"))
+            joints_of[cl] = j
+            children.setdefault(pl, []).append(cl)
+        if self.issues:
+            raise ModelError(self.issues)
+        roots = [n for n in links if n not in joints_of]
+        if len(roots) != 1:
+            raise ModelError([self.root.issue(
+                f"expected one root link (a link that is no joint's child), found "
+                f"{len(roots)}" + (f": {', '.join(roots[:5])}" if roots else " (a loop)"))])
+        bodies: list[TreeBody] = []
+        index: dict[str, int] = {}
+        order = [roots[0]]
+        for n in order:  # parents first
+            order.extend(children.get(n, []))
+        for n in order:
+            ln = links[n]
+            j = joints_of.get(n)
+            if j is None:
+                b = TreeBody(_name(n), -1, np.zeros(3), np.array([1.0, 0, 0, 0]), [], ln)
+                self.inertial(b, ln)
+                if floating:
+                    b.joints = [TreeJoint(f"{n}_free", "free", np.zeros(3),
+                                          np.array([0.0, 0, 1]), ln)]
+                elif b.mass > 0:
+                    self.note("the root link is fixed to the world (its mass is part of "
+                              "the ground; floating_base=True lets it move)", n)
+                    b.mass = 0.0
+            else:
+                pos, quat = self.origin(j)
+                parent_link = j.find("parent")
+                assert parent_link is not None
+                b = TreeBody(_name(n), index[parent_link.get("link") or ""], pos, quat,
+                             self.joint(j), ln, fixed_name=j.get("name") or f"{n}_fixed",
+                             fixed_element=j)
+                self.inertial(b, ln)
+            b.shape = self.shape(ln)
+            index[n] = len(bodies)
+            bodies.append(b)
+        for t in ("transmission", "gazebo"):
+            for e in self.root.findall(t):
+                self.note(f"{t}s", e.get("name") or e.get("reference") or t)
+        if self.issues:
+            raise ModelError(self.issues)
+        q0 = qpos0(bodies)
+        qpos, qvel = self.state(bodies, q0, qpos_by_name, qvel_by_name)
+        name = self.root.get("name") or Path(self.file).stem
+        doc = build(name, f"imported from {Path(self.file).name} (URDF)", self.file, bodies,
+                    qpos, qvel, q0, np.array([0.0, 0.0, -9.81]), [], self.root, "urdf")
+        if self.notes:
+            parts = []
+            for what, items in self.notes.items():
+                shown = ", ".join(items[:4]) + (f" and {len(items) - 4} more"
+                                                if len(items) > 4 else "")
+                parts.append(f"{what} ({shown})")
+            doc.warnings.append(Issue(self.file, 0, 0, "", "not imported (mbody models none "
+                                      "of these; the motion computed here leaves them out): "
+                                      + "; ".join(parts)))
+        return doc
+
+    def joint(self, j: Element) -> list[TreeJoint]:
+        typ = j.get("type")
+        name = _name(j.get("name") or "joint")
+        if typ == "fixed":
+            return []
+        if typ in ("floating", "planar"):
+            self.issues.append(j.issue(
+                f"a {typ} joint ('{name}') is not read", "use floating_base=True (--floating"
+                "-base) for a free-floating root link" if typ == "floating" else
+                "mbody has no planar joint", "type"))
+            return []
+        axis = self.numbers(j.find("axis"), "xyz", 3, np.array([1.0, 0, 0]))
+        if np.linalg.norm(axis) < 1e-12:
+            ax = j.find("axis")
+            self.issues.append((ax or j).issue("the joint axis is zero", attr="xyz"))
+            axis = np.array([1.0, 0, 0])
+        lim = j.find("limit")
+        if lim is not None and typ != "continuous":
+            self.note("joint limits", name)
+        dyn = j.find("dynamics")
+        if dyn is not None:
+            for k, what in (("damping", "joint damping"), ("friction", "joint friction")):
+                if float(dyn.get(k, "0") or 0) != 0:
+                    self.note(what, name)
+        if j.find("mimic") is not None:
+            self.note("mimic joints (they move freely here)", name)
+        return [TreeJoint(name, "slide" if typ == "prismatic" else "hinge", np.zeros(3),
+                          unit(axis), j)]
+
+    def inertial(self, b: TreeBody, ln: Element) -> None:
+        i = ln.find("inertial")
+        if i is None:
+            return
+        m = i.find("mass")
+        if m is None:
+            self.issues.append(i.issue("an <inertial> needs a <mass>"))
+            return
+        mass = float(self.numbers(m, "value", 1, np.zeros(1))[0])
+        if mass < 0:
+            self.issues.append(m.issue(f"link '{b.name}': the mass is negative", attr="value"))
+            return
+        xyz, quat = self.origin(i)
+        t = i.find("inertia")
+        J = np.zeros((3, 3))
+        if t is not None:
+            g = {k: float(self.numbers(t, k, 1, np.zeros(1))[0]) for k in _ATTRS["inertia"]}
+            J = np.array([[g["ixx"], g["ixy"], g["ixz"]], [g["ixy"], g["iyy"], g["iyz"]],
+                          [g["ixz"], g["iyz"], g["izz"]]])
+        b.mass, b.com, b.R_inertia, b.inertia = mass, xyz, quat_matrix(quat), J
+        b.mass_element = t if t is not None else m
+
+    def shape(self, ln: Element) -> dict[str, Any] | None:
+        best: tuple[float, dict[str, Any]] | None = None
+        for v in ln.findall("visual") + ln.findall("collision"):
+            g = v.find("geometry")
+            for s in g.children if g is not None else []:
+                try:
+                    if s.tag == "box":
+                        size = [float(x) for x in (s.get("size") or "").split()]
+                        vol, shape = float(np.prod(size)), {"box": size}
+                    elif s.tag in ("cylinder", "capsule"):
+                        r, L = float(s.get("radius") or 0), float(s.get("length") or 0)
+                        L += 2 * r if s.tag == "capsule" else 0
+                        vol, shape = math.pi * r * r * L, {"cylinder": {"radius": r,
+                                                                        "length": L}}
+                    elif s.tag == "sphere":
+                        r = float(s.get("radius") or 0)
+                        vol, shape = r ** 3 * 4, {"sphere": {"radius": r}}
+                    else:
+                        continue
+                except ValueError:
+                    continue
+                if len(shape.get("box", [1, 1, 1])) == 3 and vol > 0 and (
+                        best is None or vol > best[0]):
+                    best = (vol, shape)
+        return best[1] if best else None
+
+    def state(self, bodies: list[TreeBody], q0: np.ndarray, qp: dict[str, float],
+              qv: dict[str, float]) -> tuple[np.ndarray, np.ndarray]:
+        names: dict[str, tuple[int, int]] = {}
+        a = v = 0
+        for _, j in joint_order(bodies):
+            names[j.name] = (a, v)
+            a += 4 if j.type == "ball" else 7 if j.type == "free" else 1
+            v += NV[j.type]
+        qpos, qvel = q0.copy(), np.zeros(v)
+        problems = []
+        for given, target, what in ((qp, qpos, "joint_positions"), (qv, qvel,
+                                                                     "joint_velocities")):
+            for k, x in given.items():
+                where = names.get(k)
+                if where is None or k.endswith("_free"):
+                    hint = did_you_mean(k, [n for n in names if not n.endswith("_free")])
+                    problems.append(Issue(self.file, 0, 0, what, f"no joint named '{k}' moves "
+                                          "in this model", hint))
+                    continue
+                try:
+                    value = float(x)
+                except (TypeError, ValueError):
+                    problems.append(Issue(self.file, 0, 0, f"{what}[{k}]",
+                                          f"expected a number, got {x!r}"))
+                    continue
+                if not math.isfinite(value):
+                    problems.append(Issue(self.file, 0, 0, f"{what}[{k}]",
+                                          "expected a finite number"))
+                    continue
+                target[where[0] if target is qpos else where[1]] = value
+        if problems:
+            raise ModelError(problems)
+        return qpos, qvel
+
+
+def _name(n: str) -> str:
+    return "".join("_" if ch == "." or ch.isspace() else ch for ch in n)
