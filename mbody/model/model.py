@@ -588,17 +588,26 @@ class Model:
         return import_module("mbody.present.rich").model_html(self)
 
 
-def load(source: str | os.PathLike[str] | dict, *, max_bytes: int | None = None) -> Model:
+def load(source: str | os.PathLike[str] | dict, *, max_bytes: int | None = None,
+         format: str | None = None, **options: Any) -> Model:
     """Read, validate and build a model.
 
     Parameters
     ----------
     source : str, os.PathLike or dict
-        A path to a YAML model file, or a dict with the same content (for scripts).
+        A path to a model file: YAML, MJCF (``.xml``) or URDF (``.urdf``); or a dict
+        with a YAML file's content (for scripts).
     max_bytes : int, optional
         The largest file read (default `mbody.model.loader.MAX_BYTES`, 32 MiB, or the
         command line's ``--max-bytes``); a larger file is refused before it is read.
         Raise it for very large models (a 100 000-body file is about 80 MB).
+    format : {"yaml", "mjcf", "urdf"}, optional
+        The file's format, when its extension does not say it.
+    **options
+        The state of an imported model: ``keyframe="name"`` (MJCF; default its
+        reference pose at rest), ``joint_positions={...}``, ``joint_velocities={...}``
+        and ``floating_base=True`` (URDF; default every joint at 0, the root fixed).
+        See `mbody.io.interop.read_document`.
 
     Returns
     -------
@@ -611,6 +620,12 @@ def load(source: str | os.PathLike[str] | dict, *, max_bytes: int | None = None)
     """
     if isinstance(source, dict):
         return Model.from_spec(validate(Document(source, "<dict>")))
+    if format or options or str(source).lower().endswith((".xml", ".mjcf", ".urdf")):
+        from mbody.io.interop import import_spec  # MJCF, URDF: defusedxml, only for them
+
+        spec = import_spec(source, format, max_bytes=max_bytes, **options)
+        if spec is not None:
+            return Model.from_spec(spec)
     text = read_file(source, max_bytes)
     spec = fast_spec(text, str(source)) or validate(load_text(text, str(source)))
     del text  # before the arrays are built: the text is the largest thing held
