@@ -118,7 +118,13 @@ def test_seed_example_1_one_applied_arrow_along_x_at_its_point():
     assert list(shafts) == ["arrow:applied:push"]  # no gravity in this model, no joints
     push = shafts["arrow:applied:push"]
     np.testing.assert_allclose(direction(push), [1, 0], atol=1e-12)
-    np.testing.assert_allclose(push.get_xydata()[0], [0, -0.4], atol=1e-12)  # at: [0, -0.4]
+    # it acts at [0, -0.4], on the plate's lower edge and along it: drawn just below the
+    # edge, not on it, with a dotted leader from the point where it acts to its tail
+    lead = next(ln for ln in drawing(fig).lines if ln.get_gid() == "leader:applied:push")
+    np.testing.assert_allclose(lead.get_xydata()[0], [0, -0.4], atol=1e-12)
+    np.testing.assert_allclose(lead.get_xydata()[1], push.get_xydata()[0], atol=1e-12)
+    assert push.get_xydata()[0, 0] == pytest.approx(0, abs=1e-12)
+    assert -0.45 < push.get_xydata()[0, 1] < -0.4  # a few points below the edge
     assert push.get_linestyle() == "-"
     assert to_hex(push.get_color()) == COLORS["applied"]
     assert labels(fig)["label:applied:push"] == "push 50 N"
@@ -209,7 +215,7 @@ def test_spatial_arrows_point_along_their_projected_vectors(view, end_on):
     for fo in fbd.forces:
         gid = ("couple:" if fo.couple else "arrow:") + f"{fo.kind}:{fo.label or fo.name}"
         line = arrows(fig, gid)[gid]
-        page = P @ fo.W_vector
+        page = P @ (fo.side * fo.W_vector)  # along the joint axis, −R on the parent
         if np.linalg.norm(page) < 1e-6:  # seen end-on in this view
             continue
         np.testing.assert_allclose(direction(line), page / np.linalg.norm(page), atol=1e-9)
@@ -222,7 +228,46 @@ def test_spatial_arrows_point_along_their_projected_vectors(view, end_on):
     assert double == {"A.Mx", "A.My", "B.Mx", "B.My"}
     assert sum(g.endswith(":end-on") for g in gids) == end_on
     lab = labels(fig)
-    assert {lab[f"label:reaction:{c}"] for c in ("A.Fx", "B.Mx")} == {"A.Fx", "B.Mx"}
+    # the coupler is A's child (+R) and B's parent (−R)
+    assert {lab[f"label:reaction:{c}"] for c in ("A.Fx", "B.Mx")} == {"A.Fx", "−B.Mx"}
+
+
+@pytest.mark.parametrize("model_file", ["double_pendulum.yaml", "slider_crank.yaml",
+                                        "fourbar_planar.yaml", "triple_pendulum.yaml"])
+def test_parent_side_reactions_are_labelled_minus_and_agree_with_the_equations(model_file):
+    m = mbody.load(ROOT / "models" / model_file)
+    asm = mbody.assemble(m)
+    parents = {j.name for j in m.joints}
+    seen = 0
+    for name in m.body_names:
+        eq = asm.bodies[name]
+        fig = eq.fbd.draw()
+        lab = labels(fig)
+        for fo in eq.fbd.reactions:
+            if fo.value == 0:
+                continue
+            joint = fo.label.split(".")[0]
+            on_parent = next(j for j in m.joints if j.name == joint).parent == name
+            gid = ("couple:" if fo.couple else "arrow:") + f"reaction:{fo.label}"
+            text = lab["label:" + gid.split(":", 1)[1]]
+            assert text.startswith("−") == on_parent, (name, text)
+            assert text.lstrip("−").split(" ")[0] == fo.label
+            sign = -1.0 if text.startswith("−") else 1.0
+            # label sign × drawn direction = the force per unit of the unknown, which is
+            # the unknown's column of G in this body's rows
+            line = arrows(fig, gid)[gid]
+            if not fo.couple:
+                np.testing.assert_allclose(sign * direction(line), fo.W_vector[:2] / np.linalg.norm(
+                    fo.W_vector[:2]), atol=1e-9)
+                rows = {e.row.split(".")[-1]: e.reactions.get(fo.label, 0.0) for e in eq.newton}
+                np.testing.assert_allclose([rows["x"], rows["y"]], fo.W_vector[:2], atol=1e-9)
+            seen += on_parent
+        # the legend explains the minus exactly when the picture has one
+        legend = " ".join(t.get_text() for t in fig.texts
+                          if (t.get_gid() or "") == "legend-entry")
+        assert ("on the joint's parent" in legend) == any(
+            v.startswith("−") for k, v in lab.items() if k.startswith("label:reaction:"))
+    assert seen > 0 and parents
 
 
 def test_spatial_body_without_shape_is_its_equivalent_box():

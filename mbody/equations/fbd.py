@@ -50,6 +50,9 @@ class ForceOnBody:
         The reaction unknown (``A.Fx``); empty for applied loads and gravity.
     value : float or None
         The reaction's value when known (N; N m), else None.
+    side : int
+        +1 where the reaction acts as +R (on the joint's child), -1 as -R (on its
+        parent, Newton's third law); +1 for applied loads and gravity.
     """
 
     name: str
@@ -61,11 +64,21 @@ class ForceOnBody:
     B_moment: np.ndarray
     label: str = ""
     value: float | None = None
+    side: int = 1
 
     @property
     def unknown(self) -> bool:
         """Whether this is a reaction whose value is not known (solved for, or drawn as λ)."""
         return self.kind == REACTION and self.value is None
+
+    @property
+    def signed_label(self) -> str:
+        """The reaction as it acts on this body: ``A.Fx`` on the child, ``−A.Fx`` on the
+        parent (drawn along the joint axis, as the minus in the parent's equations says);
+        the load's name for applied loads and gravity."""
+        if self.kind != REACTION:
+            return self.name
+        return self.label if self.side > 0 else "−" + self.label
 
     @property
     def magnitude(self) -> float:
@@ -331,7 +344,8 @@ def body_equations(asm: Assembly, i: int) -> BodyEquations:
         per_unit = sign * cols.W_e[c]
         scale = 1.0 if value is None else value
         forces.append(ForceOnBody(label, REACTION, moment, B_r, W_P,
-                                  scale * per_unit, scale * six[3:], label, value))
+                                  scale * per_unit, scale * six[3:], label, value,
+                                  int(sign)))
         side[label] = sign
 
     J = np.zeros((3, 3)) if particle else model.J[i]  # a particle: no rotational inertia

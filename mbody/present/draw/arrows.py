@@ -7,7 +7,8 @@ Arrow length of a force of magnitude F (world units, in the picture):
 so the smallest known force is one step long and every factor of 10 adds a step: a force
 1000 times another is drawn 4 times as long, and both stay readable. Couples use the same
 rule on their own scale (N m); unknown reactions have no magnitude and are drawn at a
-fixed length, dashed, in the reaction colour, in their positive direction.
+fixed length, dashed, in the reaction colour, along their joint axis: labelled A.Fx on
+the joint's child, −A.Fx on its parent (where the reaction acts as −R).
 """
 
 from __future__ import annotations
@@ -31,6 +32,9 @@ UNKNOWN_FORCE, UNKNOWN_MOMENT = 0.62, 0.82
 """Drawn length of an unknown reaction force and moment, of ℓ_max."""
 HEAD = 0.085
 """Arrowhead length, of ℓ_max."""
+END_ON = 0.2
+"""A spatial arrow whose page length is below END_ON times its 3-D length is drawn end-on:
+a ring with a dot (toward the eye) or a cross (away); its short shaft stays, for tools."""
 
 
 def arrow_lengths(magnitudes: Sequence[float], longest: float) -> np.ndarray:
@@ -63,6 +67,7 @@ class Arrow:
     arc: np.ndarray | None = None  # planar couple: (k, 2) points
     length3: float = 0.0  # drawn length in 3-D, before projection
     toward: float = 0.0  # its component toward the eye (spatial)
+    moved_from: np.ndarray | None = None  # (2,) where it acts, when drawn beside it
 
 
 def fmt(x: float) -> str:
@@ -74,19 +79,20 @@ def fmt(x: float) -> str:
 
 def _label(fo: ForceOnBody) -> str:
     unit = "N m" if fo.couple else "N"
-    if fo.kind == REACTION:
-        return fo.label if fo.value is None else f"{fo.label} = {fmt(fo.value)} {unit}"
+    if fo.kind == REACTION:  # −A.Fx on the parent: the value of what the arrow carries
+        name = fo.signed_label
+        return name if fo.value is None else f"{name} = {fmt(fo.side * fo.value)} {unit}"
     if fo.kind == GRAVITY:
         return f"m g = {fmt(fo.magnitude)} N"
     return f"{fo.name} {fmt(fo.magnitude)} {unit}"
 
 
 def _direction(fo: ForceOnBody) -> np.ndarray:
-    """Unit direction drawn: the vector itself, or for a known reaction the positive
-    direction of its component (its value then carries the sign)."""
+    """Unit direction drawn: the vector itself, or for a reaction the positive direction
+    of its joint axis (its label, A.Fx or −A.Fx, and value then carry the sign)."""
     v = np.asarray(fo.W_vector, dtype=float)
-    if fo.kind == REACTION and fo.value is not None and fo.value != 0:
-        v = v / fo.value
+    if fo.kind == REACTION:
+        v = v * fo.side / (fo.value if fo.value else 1.0)
     n = np.linalg.norm(v)
     return v / n if n > 0 else v
 
@@ -127,23 +133,6 @@ def arrows(fbd: FreeBodyDiagram, P: np.ndarray, lmax: float) -> list[Arrow]:
             a.arc = tail + rho * np.column_stack((np.cos(t), np.sin(t)))
             a.vec = np.array([sign, rho])
         out.append(a)
-    # arrows leaving one point along the same page direction (a joint's Mx beside its
-    # Fx, two joints' Fy at one pin) move aside a little, so that each stays visible
-    seen: list[Arrow] = []
-    for a in out:
-        n = np.linalg.norm(a.vec)
-        if a.arc is not None or n == 0:
-            continue
-        d = a.vec / n
-        k = 0
-        for b in seen:
-            e = b.vec / np.linalg.norm(b.vec)
-            if (np.linalg.norm(b.tail - a.tail) < 0.05 * lmax and d @ e > 0
-                    and abs(d[0] * e[1] - d[1] * e[0]) < 0.14):
-                k += 1
-        if k:
-            a.tail = a.tail + 0.07 * k * lmax * np.array([-d[1], d[0]])
-        seen.append(a)
     return out
 
 

@@ -20,11 +20,12 @@ from scipy.spatial import ConvexHull
 
 from mbody import conventions as cv
 from mbody.conventions import REACTION
-from mbody.present.draw.arrows import HEAD, Arrow, arrows, fmt, head
+from mbody.present.draw.arrows import END_ON, HEAD, Arrow, arrows, fmt, head
 from mbody.present.draw.fonts import layout
 from mbody.present.draw.labels import Label, place
 from mbody.present.draw.outline import circle, outline
-from mbody.present.draw.scene import IN, Disc, Line, Panel, Poly, Scene, Text, Wedge
+from mbody.present.draw.scene import IN, Disc, Item, Line, Panel, Poly, Scene, Text, Wedge
+from mbody.present.draw.spacing import separate
 from mbody.present.draw.style import (
     AXIS_COLOR,
     BODY_EDGE,
@@ -39,10 +40,7 @@ from mbody.present.draw.views import View, eye, projection, view_name
 if TYPE_CHECKING:
     from mbody.equations.fbd import FreeBodyDiagram
 
-END_ON = 0.2
-"""A spatial arrow whose page length is below END_ON times its 3-D length is drawn end-on:
-a ring with a dot (toward the eye) or a cross (away); its short shaft stays, for tools."""
-
+__all__ = ["END_ON", "fbd_scene"]
 
 
 def fbd_scene(fbd: FreeBodyDiagram, *, view: View = "iso", equations: bool = True,
@@ -78,7 +76,7 @@ def fbd_scene(fbd: FreeBodyDiagram, *, view: View = "iso", equations: bool = Tru
     hd = HEAD * lmax
 
     eq_lines = _equation_lines(fbd, planar) if equations else []
-    zeros = [fo.label or fo.name for fo in fbd.forces if not fo.unknown and (
+    zeros = [fo.signed_label for fo in fbd.forces if not fo.unknown and (
         fo.value == 0 if fo.kind == REACTION else fo.magnitude == 0)]
     zero_note = textwrap.wrap("zero at this instant (not drawn): " + ", ".join(zeros), 110)
     h_draw, h_title = 5.6, 0.45
@@ -117,52 +115,62 @@ def fbd_scene(fbd: FreeBodyDiagram, *, view: View = "iso", equations: bool = Tru
     # mass centre G and body axes
     G = P @ fbd.W_position
     rg = 0.045 * lmax
-    ax.add(Disc(G, rg, "white", "black", 1.0, zorder=6, gid="mass-centre"))
-    for a0 in (0, 180):
-        ax.add(Wedge(G, rg, a0, a0 + 90, "black", zorder=6))
-    obstacles.append((G + 1.3 * rg * circle(16), "centre"))  # labels keep off the marker
+    _centre_mark(ax, G, rg, zorder=6, gid="mass-centre")
+    obstacles.append((G + 1.3 * rg * circle(16), "mass-centre"))
+    fixed = [o[0] for o in obstacles]  # strokes an arrow must not lie on: outline, axes
     labels: list[Label] = []
     for k, nm in enumerate("xyz"[:2 if planar else 3]):
         tip = G + P @ (fbd.W_R_B[:, k] * 0.38 * shape.size)
         seg = np.array([G, tip])
         ax.add(Line(seg, AXIS_COLOR, 1.0, zorder=3, gid=f"body-axis:{nm}"))
+        tag = f"body-axis:{nm}"
         if np.linalg.norm(tip - G) > 1e-9:
-            ax.add(Poly(head(tip, (tip - G) / np.linalg.norm(tip - G), 0.6 * hd), AXIS_COLOR,
-                        zorder=3))
-        obstacles.append((seg, "axis"))
+            arrowhead = head(tip, (tip - G) / np.linalg.norm(tip - G), 0.6 * hd)
+            ax.add(Poly(arrowhead, AXIS_COLOR, zorder=3, gid=f"body-axis:{nm}:head"))
+            obstacles.append((arrowhead[[0, 1, 2, 0]], tag))
+        obstacles.append((seg, tag))
+        fixed.append(seg)
         labels.append(Label(Text(f"${nm}_B$", tip, 8, AXIS_COLOR, math=True, zorder=10,
-                                 gid=f"label:body-axis:{nm}"), tip, tip - G, "axis"))
+                                 gid=f"label:body-axis:{nm}"), tip, tip - G, tag))
     labels.append(Label(Text("G", G, 9, zorder=10, gid="label:mass-centre"), G,
-                        np.array([-1.0, 1.0]), "g"))
+                        np.array([-1.0, 1.0]), "mass-centre"))
 
     # joint points and points of application
     for fo in fbd.forces:
         if not fo.couple and np.linalg.norm(fo.B_r) > 0:
-            ax.add(Disc(P @ fo.W_point, 0.022 * lmax, "white", COLORS[fo.kind], 1.2, zorder=7,
+            c, r = P @ fo.W_point, 0.022 * lmax
+            ax.add(Disc(c, r, "white", COLORS[fo.kind], 1.2, zorder=7,
                         gid="joint-point" if fo.kind == REACTION else "load-point"))
+            obstacles.append((np.vstack((c + r * circle(12), c)), "point"))
 
-    for a in arrs:
-        labels.append(_arrow(ax, a, lmax, hd, obstacles))
-
-    # limits: geometry first, then grown until every label fits
-    geo = np.vstack([o[0] for o in obstacles])
+    # limits: geometry first, then grown until every label fits; arrows are kept apart
+    # and labels placed again at each scale, both measured in points
+    geo = np.vstack([o[0] for o in obstacles] + [np.array([a.tail, a.tail + a.vec])
+                                                  for a in arrs if a.arc is None]
+                    + [a.arc for a in arrs if a.arc is not None])
     lo, hi = geo.min(axis=0), geo.max(axis=0)
     span = max(float((hi - lo).max()), 1e-6)
     ax.set_limits(lo - 0.18 * span, hi + 0.18 * span)
     lo, hi = ax.lo.copy(), ax.hi.copy()
     x0, y0, w, h = ax.rect
-    for _ in range(4):
-        boxes = place(ax, labels, obstacles)
-        if (np.all(boxes[:, 0] >= x0) and np.all(boxes[:, 2] <= x0 + w)
-                and np.all(boxes[:, 1] >= y0) and np.all(boxes[:, 3] <= y0 + h)):
-            break
+    for attempt in range(5):
+        drawn: list[Item] = []
+        arrow_obstacles: list[tuple[np.ndarray, str]] = []
+        arrow_labels = [_arrow(drawn, a, lmax, hd, arrow_obstacles)
+                        for a in separate(arrs, fixed, ax.scale, G)]
+        every = labels + arrow_labels
+        boxes = place(ax, every, obstacles + arrow_obstacles)
+        if attempt == 4 or (np.all(boxes[:, 0] >= x0) and np.all(boxes[:, 2] <= x0 + w)
+                            and np.all(boxes[:, 1] >= y0) and np.all(boxes[:, 3] <= y0 + h)):
+            break  # the last try keeps its scale: what was placed is what is drawn
         s = ax.scale
         corners = (np.vstack((boxes[:, :2], boxes[:, 2:])) - ax.rect[:2]) / s + ax.lo
         lo = np.minimum(lo, corners.min(axis=0))
         hi = np.maximum(hi, corners.max(axis=0))
         span = float((hi - lo).max())
         ax.set_limits(lo - 0.05 * span, hi + 0.05 * span)
-    ax.add(*(lab.text for lab in labels))
+    ax.add(*drawn)
+    ax.add(*(lab.text for lab in every))
 
     # band: world axes on the left, legend on the right
     if zeros:
@@ -173,7 +181,7 @@ def fbd_scene(fbd: FreeBodyDiagram, *, view: View = "iso", equations: bool = Tru
     tri = sc.panel("world-axes", (0.03 * W, band + 0.05 * 1.25 * IN, side, side),
                    np.array([-1.45, -1.45]), np.array([1.45, 1.45]))
     _world_triad(tri, P, planar)
-    _legend(sc.root, (0.2 * W, band, 0.78 * W, 1.25 * IN), arrs, planar)
+    _legend(sc.root, (0.2 * W, band, 0.78 * W, 1.25 * IN), arrs, planar, hd * ax.scale)
 
     if eq_lines:
         sc.root.add(Text("\n".join(eq_lines),
@@ -182,32 +190,39 @@ def fbd_scene(fbd: FreeBodyDiagram, *, view: View = "iso", equations: bool = Tru
     return sc
 
 
-def _arrow(ax: Panel, a: Arrow, lmax: float, hd: float,
+def _arrow(ax: list[Item], a: Arrow, lmax: float, hd: float,
            obstacles: list[tuple[np.ndarray, str]]) -> Label:
-    """Draw arrow `a`: a shaft (gid = the arrow's) and a filled head (gid + ':head');
-    returns its label."""
+    """Draw arrow `a` into `ax`: a shaft (gid = the arrow's) and a filled head (gid +
+    ':head'); its strokes go to `obstacles`; returns its label."""
     dash = DASHED if a.dashed else None
+    shaft = 0.0  # curved and end-on arrows: no spots half-way along
     pts = a.arc if a.arc is not None else np.array([a.tail, a.tail + a.vec])
-    ax.add(Line(pts, a.color, 2.0, dash, zorder=8, gid=a.gid))
+    ax.append(Line(pts, a.color, 2.0, dash, zorder=8, gid=a.gid))
     obstacles.append((pts, a.gid))
+    if a.moved_from is not None:  # drawn beside its point: a leader back to it
+        lead = np.array([a.moved_from, a.tail])
+        ax.append(Line(lead, a.color, 0.9, DOTTED, zorder=8,
+                       gid="leader:" + a.gid.split(":", 1)[1]))
+        obstacles.append((lead, a.gid))
     if a.arc is not None:
         if a.vec[1] > 0:
             t_end = a.arc[-1] - a.arc[-2]
-            ax.add(Poly(head(a.arc[-1], t_end / np.linalg.norm(t_end), hd), a.color, zorder=9,
-                        gid=a.gid + ":head"))
+            tri = head(a.arc[-1], t_end / np.linalg.norm(t_end), hd)
+            ax.append(Poly(tri, a.color, zorder=9, gid=a.gid + ":head"))
+            obstacles.append((tri[[0, 1, 2, 0]], a.gid))
         anchor, direction = a.arc[-1], a.arc[-1] - a.tail
     elif np.linalg.norm(a.vec) < END_ON * a.length3:
         # seen end-on: a dot toward the eye, a cross away from it (two rings: a moment)
         r = 0.05 * lmax
         for k in range(2 if a.couple else 1):
-            ax.add(Disc(a.tail, r * (1 + 0.45 * k), None, a.color, 1.6, zorder=9,
+            ax.append(Disc(a.tail, r * (1 + 0.45 * k), None, a.color, 1.6, zorder=9,
                         gid=a.gid + (":end-on" if k == 0 else ":ring2")))
         if a.toward > 0:
-            ax.add(Disc(a.tail, 0.3 * r, a.color, zorder=9))
+            ax.append(Disc(a.tail, 0.3 * r, a.color, zorder=9))
         else:
             for s_ in (1, -1):
                 xx = a.tail + 0.7 * r * np.array([[-1, -s_], [1, s_]]) / math.sqrt(2)
-                ax.add(Line(xx, a.color, 1.4, zorder=9))
+                ax.append(Line(xx, a.color, 1.4, zorder=9))
         obstacles.append((a.tail + r * (1.5 if a.couple else 1.0) * circle(24), a.gid))
         anchor, direction = a.tail + r * np.array([0.7, 0.7]), np.array([1.0, 0.7])
     else:
@@ -215,14 +230,16 @@ def _arrow(ax: Panel, a: Arrow, lmax: float, hd: float,
         tip = a.tail + a.vec
         if n > 1e-9:
             d = a.vec / n
-            ax.add(Poly(head(tip, d, hd), a.color, zorder=9, gid=a.gid + ":head"))
+            ax.append(Poly(head(tip, d, hd), a.color, zorder=9, gid=a.gid + ":head"))
             if a.couple:  # a moment: double head
-                ax.add(Poly(head(tip - 0.75 * hd * d, d, hd), a.color, zorder=9,
-                            gid=a.gid + ":head2"))
+                tri2 = head(tip - 0.75 * hd * d, d, hd)
+                ax.append(Poly(tri2, a.color, zorder=9, gid=a.gid + ":head2"))
+                obstacles.append((tri2[[0, 1, 2, 0]], a.gid))
             obstacles.append((head(tip, d, hd)[[0, 1, 2, 0]], a.gid))
         anchor, direction = tip, (a.vec if n > 1e-9 else np.array([1.0, 0.3]))
+        shaft = float(n)
     text = Text(a.label, anchor, 9, a.color, zorder=10, gid="label:" + a.gid.split(":", 1)[1])
-    return Label(text, anchor, direction, a.gid)
+    return Label(text, anchor, direction, a.gid, shaft)
 
 
 def _equation_lines(fbd: FreeBodyDiagram, planar: bool) -> list[str]:
@@ -258,20 +275,32 @@ def _world_triad(ax: Panel, P: np.ndarray, planar: bool) -> None:
                Text(nm, v + 0.3 * v / n, 9, ha="center", va="center"))
 
 
+def _centre_mark(panel: Panel, G: np.ndarray, r: float, zorder: float,
+                 gid: str | None = None) -> None:
+    """The mass centre's symbol: a circle quartered black and white."""
+    panel.add(Disc(G, r, "white", "black", 1.0, zorder=zorder, gid=gid))
+    for a0 in (0, 180):
+        panel.add(Wedge(G, r, a0, a0 + 90, "black", zorder=zorder))
+
+
 def _legend(root: Panel, rect: tuple[float, float, float, float], arrs: list[Arrow],
-            planar: bool) -> None:
-    """A framed legend centred in `rect` (points): the scale note, then two columns."""
+            planar: bool, head_pt: float) -> None:
+    """A framed legend centred in `rect` (points): the scale note, then two columns.
+    Each symbol is drawn as in the picture: arrows with their head, width and dash, the
+    mass centre's quartered circle."""
     fs = 8.5
     entries: list[tuple[str, str]] = [
         ("applied", "applied force (name, |F|)"), ("gravity", "gravity m g at G"),
         ("reaction", "reaction (unknown name, or known value)")]
+    if any(a.kind == REACTION and a.label.startswith("−") for a in arrs):
+        entries.append(("parent", "−A.Fx: on the joint's parent (−R)"))
     if any(a.couple for a in arrs):
         entries.append(("couple", "couple: curved arrow" if planar
                         else "couple/moment: double head (right-hand rule)"))
     entries.append(("G", "G mass centre, x_B y_B" + ("" if planar else " z_B") + " body axes"))
     rows = (len(entries) + 1) // 2
     cols = [entries[:rows], entries[rows:]]
-    handle, gap, sep = 2.0 * fs, 0.8 * fs, 2.0 * fs
+    handle, gap, sep = 2.6 * fs, 0.8 * fs, 2.0 * fs
     # 4 % to spare: png and pdf text (hinted by matplotlib) can run a little wider
     col_w = [1.04 * max(layout(s, fs).width for _, s in c) + handle + gap for c in cols]
     note = layout(SCALE_NOTE, 8)
@@ -288,32 +317,37 @@ def _legend(root: Panel, rect: tuple[float, float, float, float], arrs: list[Arr
     root.add(Poly(frame, "white", "#cccccc", 0.8, gid="legend", zorder=4),
              Text(SCALE_NOTE, np.array([cx, y_top]), 8, ha="center", va="top", zorder=5,
                   gid="legend-title", linespacing=1.2, align="left"))
+    hd = min(max(head_pt, 4.0), 7.0)
+    right = np.array([1.0, 0.0])
     x = x0 + (inner_w - sum(col_w) - sep) / 2
     for c, cw in zip(cols, col_w, strict=True):
         y = y_top - note.height - 0.5 * fs - row_h / 2
         for key, s in c:
             h0, h1 = np.array([x, y]), np.array([x + handle, y])
-            if key in COLORS:
-                root.add(Line(np.array([h0, h1]), COLORS[key], 2.0,
-                              DASHED if key == REACTION else None, zorder=5))
+            gid = f"legend-handle:{key}"
+            if key in COLORS or key == "parent":
+                color = COLORS[REACTION if key == "parent" else key]
+                dash = DASHED if key in (REACTION, "parent") else None
+                root.add(Line(np.array([h0, h1]), color, 2.0, dash, zorder=5, gid=gid),
+                         Poly(head(h1, right, hd), color, zorder=5, gid=gid + ":head"))
             elif key == "couple":
-                mid = (h0 + h1) / 2
-                if planar:  # a small curved arrow
+                color = COLORS["applied"]
+                if planar:  # a curved arrow, as drawn about a point
+                    mid = (h0 + h1) / 2
                     t = np.linspace(math.radians(-60), math.radians(210), 20)
-                    arc = mid + 4.0 * np.column_stack((np.cos(t), np.sin(t)))
+                    arc = mid + 5.0 * np.column_stack((np.cos(t), np.sin(t)))
                     d = arc[-1] - arc[-2]
-                    root.add(Line(arc, "#555555", 1.5, zorder=5),
-                             Poly(head(arc[-1], d / np.linalg.norm(d), 4.0), "#555555",
-                                  zorder=5))
+                    root.add(Line(arc, color, 2.0, zorder=5, gid=gid),
+                             Poly(head(arc[-1], d / np.linalg.norm(d), hd), color,
+                                  zorder=5, gid=gid + ":head"))
                 else:  # a double head
-                    root.add(Line(np.array([h0, h1]), "#555555", 2.0, zorder=5),
-                             Poly(head(h1, np.array([1.0, 0]), 6.5), "#555555", zorder=5),
-                             Poly(head(h1 - [4.5, 0], np.array([1.0, 0]), 6.5), "#555555",
-                                  zorder=5))
+                    root.add(Line(np.array([h0, h1]), color, 2.0, zorder=5, gid=gid),
+                             Poly(head(h1, right, hd), color, zorder=5, gid=gid + ":head"),
+                             Poly(head(h1 - 0.75 * hd * right, right, hd), color, zorder=5,
+                                  gid=gid + ":head2"))
             else:
-                root.add(Disc((h0 + h1) / 2, 3.0, "white", "black", 1.0, zorder=5))
+                _centre_mark(root, (h0 + h1) / 2, 3.5, zorder=5, gid=gid)
             root.add(Text(s, np.array([x + handle + gap, y]), fs, va="center", zorder=5,
                           gid="legend-entry"))
             y -= row_h
         x += cw + sep
-

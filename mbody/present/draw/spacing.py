@@ -1,0 +1,126 @@
+"""Arrows kept apart: an arrow lying on another arrow, on the body's outline or on a body
+axis moves sideways, parallel to itself, by the least number of steps that clears it.
+
+Two reactions at one pin along the same axis (the piston's B.Fy and P.Fy), a force along
+a rod's edge, gravity inside a thin vertical link, a force along x_B: each would hide the
+other stroke. Moving an arrow parallel to itself keeps its direction and label exact;
+the step is a few points, small beside any body, and a dotted leader (drawn by the
+diagram) ties the moved tail to the point where the force acts. Works in points (the
+panel's scale), as a reader sees the picture.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from mbody.present.draw.arrows import Arrow
+
+CLEAR = 5.5
+"""An arrow keeps this far (points) from any parallel stroke it runs beside."""
+STEP = 6.0
+"""Sideways step (points) tried in turn on both sides: ±1, ±2, ... steps."""
+PARALLEL = np.cos(np.radians(12.0))
+"""Strokes within 12° of each other are parallel."""
+RUN = 4.0
+"""A stretch (points) of an arrow beside a parallel stroke that counts as lying on it."""
+
+
+def segments(polylines: list[np.ndarray]) -> np.ndarray:
+    """(k, 2, 2) segments of polylines (data coordinates), zero-length ones dropped."""
+    segs = [np.stack((p[:-1], p[1:]), axis=1) for p in polylines if len(p) > 1]
+    if not segs:
+        return np.zeros((0, 2, 2))
+    s = np.vstack(segs)
+    return s[np.linalg.norm(s[:, 1] - s[:, 0], axis=1) > 1e-12]
+
+
+def _lies_on(a: np.ndarray, b: np.ndarray, clear: float, run: float) -> bool:
+    """Whether segment a (2, 2) runs within `clear` of a parallel segment of b (k, 2, 2)
+    along at least `run` (all in the same units)."""
+    if not len(b):
+        return False
+    da = a[1] - a[0]
+    la = float(np.linalg.norm(da))
+    if la < run:
+        return False
+    ua = da / la
+    db = b[:, 1] - b[:, 0]
+    lb = np.linalg.norm(db, axis=1)
+    par = np.abs(db @ ua) / lb > PARALLEL
+    if not np.any(par):
+        return False
+    b = b[par]
+    # b's ends in a's frame: along (s) and across (n)
+    rel = b - a[0]
+    s = rel @ ua
+    n = rel @ np.array([-ua[1], ua[0]])
+    # a's stretch grown by `clear` at both ends: a stroke that starts just past a's tip
+    # still runs on it
+    lo = np.maximum(np.minimum(s[:, 0], s[:, 1]), -clear)
+    hi = np.minimum(np.maximum(s[:, 0], s[:, 1]), la + clear)
+    # across-distance at the two ends of the shared stretch (b is straight: linear)
+    ds = np.where(np.abs(s[:, 1] - s[:, 0]) > 1e-12, s[:, 1] - s[:, 0], 1.0)
+    n_lo = n[:, 0] + (lo - s[:, 0]) / ds * (n[:, 1] - n[:, 0])
+    n_hi = n[:, 0] + (hi - s[:, 0]) / ds * (n[:, 1] - n[:, 0])
+    # the part of the shared stretch where b is within `clear` across (n is linear in s:
+    # b may cross a at a small angle)
+    span = np.maximum(hi - lo, 1e-12)
+    k = (n_hi - n_lo) / span
+    flat = np.abs(k) < 1e-9
+    k = np.where(flat, 1.0, k)
+    e1, e2 = (-clear - n_lo) / k, (clear - n_lo) / k
+    inside = np.where(flat, np.where(np.abs(n_lo) < clear, span, 0.0),
+                      np.minimum(np.maximum(e1, e2), span) - np.maximum(np.minimum(e1, e2), 0))
+    return bool(np.any((hi - lo > 0) & (inside >= run)))
+
+
+def separate(arrs: list[Arrow], fixed: list[np.ndarray], scale: float, centre: np.ndarray
+             ) -> list[Arrow]:
+    """The arrows, each straight one moved sideways where it would lie on a stroke drawn
+    before it (`fixed` polylines: outline and axes; then the arrows before it).
+
+    Parameters
+    ----------
+    arrs : list of Arrow
+        In drawing order; the first keeps its place where it can.
+    fixed : list of (k, 2) arrays
+        Strokes that stay where they are (data coordinates).
+    scale : float
+        Points per data unit of the panel.
+    centre : (2,) array
+        The mass centre on the page: of two equal moves, the one away from it wins.
+
+    Returns
+    -------
+    list of Arrow
+        New arrows (the given ones are left as they are).
+    """
+    unit = 1.0 / scale  # one point in data units
+    placed = segments(fixed)
+    out: list[Arrow] = []
+    for a in arrs:
+        n = float(np.linalg.norm(a.vec))
+        if a.arc is not None or n < 1e-12:  # an end-on arrow keeps a short shaft: it moves
+            out.append(a)
+            if a.arc is not None:
+                placed = np.vstack((placed, segments([a.arc])))
+            continue
+        d = a.vec / n
+        side = np.array([-d[1], d[0]])
+        seg0 = np.array([a.tail, a.tail + a.vec])
+        away = 1.0 if float((a.tail + 0.5 * a.vec - centre) @ side) >= 0 else -1.0
+        shift = 0.0
+        for k in range(13):  # 0, then ±1, ±2, ... steps, away from G first
+            shift = 0.0 if k == 0 else away * ((k + 1) // 2) * (1 if k % 2 else -1)
+            seg = seg0 + shift * STEP * unit * side
+            if not _lies_on(seg, placed, CLEAR * unit, RUN * unit):
+                break
+        else:
+            shift = 0.0  # nowhere clear: leave it where it acts
+        b = (replace(a, tail=a.tail + shift * STEP * unit * side, moved_from=a.tail)
+             if shift else a)
+        out.append(b)
+        placed = np.vstack((placed, np.array([[b.tail, b.tail + b.vec]])))
+    return out

@@ -1,0 +1,253 @@
+"""Free-body diagrams keep their texts and arrows apart: a measure of overlaps on every
+shipped model, every body, planar and the four named spatial views.
+
+The measure reads a diagram's `Scene` (the primitives as drawn, in points; label boxes
+from the font metrics that also write the SVG), independently of how the labels were
+placed. What counts as an overlap (each pair counted once):
+
+- label / label: their boxes come closer than MARGIN;
+- label / anything drawn in the drawing panel: an arrow's shaft or head (straight or
+  curved), an end-on ring, the body's outline (filled region's rim and every edge,
+  hidden ones too), a body axis and its head, the mass centre marker, a joint point:
+  some point of it lies within MARGIN of the label's box. Its own arrow (or axis, or
+  the marker the label names) only counts when it enters the box itself;
+- arrow / arrow, arrow / outline, arrow / body axis: nearly coincident, i.e. a stretch
+  of at least RUN points of one lies within NEAR points of the other and runs parallel
+  to it (within 10°): two arrows on top of each other, or an arrow drawn along an edge.
+  Shafts and curves count here, not arrowheads or leaders (a head's back edge and the
+  dotted leader of an arrow drawn beside its point are short and crosswise).
+
+Run as a script to print the count per model and view.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.spatial import cKDTree
+
+import mbody
+from mbody.present.draw import fbd_scene
+from mbody.present.draw.scene import Disc, Line, Panel, Poly, Scene, Text
+from mbody.present.draw.svg import text_box
+
+ROOT = Path(__file__).resolve().parent.parent
+MODELS = sorted((ROOT / "models").glob("*.yaml"))
+SPATIAL_VIEWS = ("iso", "front", "top", "side")
+
+MARGIN = 1.0
+"""Clearance (points) a label keeps from other labels and from every stroke."""
+NEAR, RUN = 2.0, 8.0
+"""Two strokes closer than NEAR points and parallel along RUN points coincide."""
+STEP = 1.0
+"""Strokes are measured at points this far apart (points)."""
+
+
+def _sample(xy: np.ndarray, closed: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """Points every STEP along a polyline (points) and the unit tangent at each."""
+    xy = np.asarray(xy, dtype=float)
+    if closed:
+        xy = np.vstack((xy, xy[:1]))
+    pts, tan = [xy[:1]], [np.zeros((1, 2))]
+    for p, q in zip(xy[:-1], xy[1:], strict=True):
+        d = q - p
+        n = float(np.linalg.norm(d))
+        if n < 1e-9:
+            continue
+        k = max(1, int(np.ceil(n / STEP)))
+        t = np.arange(1, k + 1)[:, None] / k
+        pts.append(p + t * d)
+        tan.append(np.repeat((d / n)[None], k, axis=0))
+    if len(pts) > 1:
+        tan[0] = tan[1][:1]
+    return np.vstack(pts), np.vstack(tan)
+
+
+def _circle(c: np.ndarray, r: float) -> np.ndarray:
+    t = np.linspace(0, 2 * np.pi, max(12, int(2 * np.pi * r / STEP)), endpoint=False)
+    return c + r * np.column_stack((np.cos(t), np.sin(t)))
+
+
+class Stroke:
+    """One drawn thing in points: samples along it, tangents, its kind and owner."""
+
+    def __init__(self, name: str, kind: str, pts: np.ndarray, tan: np.ndarray,
+                 disc: tuple[np.ndarray, float] | None = None, head: bool = False) -> None:
+        self.name, self.kind, self.pts, self.tan, self.disc = name, kind, pts, tan, disc
+        self.head = head  # an arrowhead: its back edge crossing a line is no coincidence
+
+
+def _owner(gid: str) -> str:
+    """The arrow, axis or marker a stroke belongs to: its gid without ':head' etc."""
+    parts = gid.split(":")
+    if parts[0] in ("arrow", "couple", "leader"):
+        return ":".join(parts[1:3])
+    if parts[0] == "body-axis":
+        return "body-axis:" + parts[1]
+    return gid
+
+
+def strokes(panel: Panel) -> list[Stroke]:
+    """Every stroke of the drawing panel in points, named by what it belongs to."""
+    out = []
+    for it in panel.items:
+        gid = getattr(it, "gid", None) or ""
+        if isinstance(it, Text) or not gid:
+            continue
+        kind = ("arrow" if gid.startswith(("arrow:", "couple:", "leader:")) else
+                "outline" if gid in ("body-outline", "body-edge") else
+                "axis" if gid.startswith("body-axis:") else
+                "marker" if gid in ("mass-centre", "joint-point", "load-point") else "")
+        if not kind:
+            continue
+        if isinstance(it, Line):
+            pts, tan = _sample(panel.to_pt(it.xy))
+            # a leader ties a moved arrow to its point, across the arrow: like a head,
+            # it crosses what the arrow runs beside
+            out.append(Stroke(_owner(gid), kind, pts, tan, head=gid.startswith("leader:")))
+        elif isinstance(it, Poly):
+            pts, tan = _sample(panel.to_pt(it.xy), closed=True)
+            out.append(Stroke(_owner(gid), kind, pts, tan, head=gid.endswith(
+                (":head", ":head2"))))
+        elif isinstance(it, Disc):
+            c, r = panel.to_pt(it.center), it.r * panel.scale
+            pts, tan = _sample(_circle(c, r), closed=True)
+            out.append(Stroke(_owner(gid), kind, pts, tan, (c, r)))
+    return out
+
+
+def labels(panel: Panel) -> list[tuple[str, np.ndarray]]:
+    """(owner, box x0 y0 x1 y1 in points) of every label in the drawing panel."""
+    out = []
+    for it in panel.items:
+        if isinstance(it, Text) and (it.gid or "").startswith("label:"):
+            x0, y0, w, h = text_box(it, panel.to_pt(it.xy))
+            owner = it.gid[6:]
+            owner = "body-axis:" + owner.split(":")[1] if owner.startswith("body-axis") else owner
+            out.append((owner, np.array([x0, y0, x0 + w, y0 + h])))
+    return out
+
+
+def _hits_box(s: Stroke, box: np.ndarray, margin: float) -> bool:
+    lo, hi = box[:2] - margin, box[2:] + margin
+    if s.disc is not None:  # a filled marker or ring: its whole disc
+        c, r = s.disc
+        return bool(np.linalg.norm(c - np.clip(c, lo, hi)) < r + margin)
+    return bool(np.any(np.all((s.pts > lo) & (s.pts < hi), axis=1)))
+
+
+def _coincide(a: Stroke, b: Stroke) -> bool:
+    """A stretch of RUN points of `a` within NEAR of `b`, parallel to it."""
+    dist, j = cKDTree(b.pts).query(a.pts, distance_upper_bound=NEAR)
+    near = np.isfinite(dist)
+    close = near & (np.abs(np.sum(a.tan * b.tan[np.minimum(j, len(b.pts) - 1)], axis=1))
+                    > np.cos(np.radians(10)))
+    return bool(np.count_nonzero(close) * STEP >= RUN)
+
+
+def overlaps(scene: Scene) -> list[str]:
+    """Every overlap in the drawing panel of `scene`, one line each."""
+    panel = next(p for p in scene.panels if p.gid == "drawing")
+    ss, ls = strokes(panel), labels(panel)
+    found = []
+    for i, (na, a) in enumerate(ls):
+        for nb, b in ls[i + 1:]:
+            if (min(a[2], b[2]) - max(a[0], b[0]) > -MARGIN
+                    and min(a[3], b[3]) - max(a[1], b[1]) > -MARGIN):
+                found.append(f"label {na} / label {nb}")
+        hit = set()
+        for s in ss:
+            own = s.name == na
+            if s.name not in hit and _hits_box(s, a, 0.0 if own else MARGIN):
+                hit.add(s.name)
+                found.append(f"label {na} / {s.kind} {s.name}")
+    # strokes merged per owner (a shaft and its heads are one arrow)
+    merged: dict[tuple[str, str], list[Stroke]] = {}
+    for s in ss:
+        if s.kind in ("arrow", "outline", "axis") and s.disc is None and not s.head:
+            # a body's outline is one thing: its filled rim and its edges
+            merged.setdefault((s.kind, "body" if s.kind == "outline" else s.name),
+                              []).append(s)
+    whole = [Stroke(n, k, np.vstack([s.pts for s in v]), np.vstack([s.tan for s in v]))
+             for (k, n), v in merged.items()]
+    for i, a in enumerate(whole):
+        for b in whole[i + 1:]:
+            if "arrow" not in (a.kind, b.kind) or a.name == b.name:
+                continue
+            if _coincide(a, b) or _coincide(b, a):
+                found.append(f"{a.kind} {a.name} / {b.kind} {b.name} coincide")
+    return found
+
+
+def cases() -> Iterator[tuple[str, str, str]]:
+    """(model file stem, body, view) for every body of every shipped model."""
+    for path in MODELS:
+        m = mbody.load(path)
+        for name in m.body_names:
+            for view in (SPATIAL_VIEWS if m.dimension == 3 else ("top",)):
+                yield path.stem, name, view
+
+
+def scenes(stem: str) -> Iterator[tuple[str, str, Scene]]:
+    m = mbody.load(ROOT / "models" / f"{stem}.yaml")
+    asm = mbody.assemble(m)
+    for name in m.body_names:
+        for view in (SPATIAL_VIEWS if m.dimension == 3 else ("top",)):
+            yield name, view, fbd_scene(asm.bodies[name].fbd, view=view, equations=False)
+
+
+# -- the measure can fail -------------------------------------------------------------------
+def test_measure_sees_labels_on_labels_arrows_on_arrows_and_labels_on_outlines():
+    from mbody.present.draw.scene import Scene
+
+    sc = Scene(200, 200)
+    p = sc.panel("drawing", (0, 0, 200, 200), np.zeros(2), np.array([200.0, 200.0]))
+    p.add(Poly(np.array([[50.0, 50], [150, 50], [150, 60], [50, 60]]), "grey",
+               gid="body-outline"),
+          Line(np.array([[50.0, 100], [120, 100]]), "red", gid="arrow:reaction:A.Fx"),
+          Line(np.array([[52.0, 101.5], [110, 101.5]]), "red", gid="arrow:reaction:B.Fx"),
+          Text("A.Fx", np.array([60.0, 52]), 9, gid="label:reaction:A.Fx"),
+          Text("B.Fx", np.array([64.0, 54]), 9, gid="label:reaction:B.Fx"))
+    found = overlaps(sc)
+    assert "label reaction:A.Fx / label reaction:B.Fx" in found
+    assert "label reaction:A.Fx / outline body-outline" in found
+    assert "arrow reaction:A.Fx / arrow reaction:B.Fx coincide" in found
+    # apart: nothing
+    for t, xy in zip([it for it in p.items if isinstance(it, Text)],
+                     ([10.0, 150], [150, 150]), strict=True):
+        t.xy = np.array(xy)
+    p.items[2].xy = np.array([[52.0, 120], [110, 120]])
+    assert overlaps(sc) == []
+
+
+# -- every shipped picture ------------------------------------------------------------------
+@pytest.mark.parametrize("stem", [p.stem for p in MODELS])
+def test_no_overlaps_on_shipped_models(stem):
+    bad = [f"{name} ({view}): {o}" for name, view, sc in scenes(stem) for o in overlaps(sc)]
+    assert bad == []
+
+
+def main() -> int:
+    total = 0
+    only = set(sys.argv[1:])
+    for path in MODELS:
+        if only and path.stem not in only:
+            continue
+        per = []
+        for name, view, sc in scenes(path.stem):
+            found = overlaps(sc)
+            total += len(found)
+            per.append(f"{name}/{view} {len(found)}")
+            for f in found:
+                print(f"    {path.stem} {name} {view}: {f}")
+        print(f"{path.stem:<28} " + ", ".join(per), flush=True)
+    print("total", total)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
