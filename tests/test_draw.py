@@ -31,7 +31,7 @@ from mbody.present.draw import (
     save_figure,
     scene_figure,
 )
-from mbody.present.draw.scene import Line
+from mbody.present.draw.scene import Line, Text
 
 ROOT = Path(__file__).resolve().parent.parent
 MODELS = sorted((ROOT / "models").glob("*.yaml"))
@@ -465,3 +465,35 @@ def test_every_shipped_model_draws_as_svg(path):
     for name in m.body_names:
         assert figure_svg(fbd_scene(asm.bodies[name].fbd)).count("<polyline") >= 1
     assert 'id="node:' in figure_svg(graph_scene(m))
+
+
+@pytest.mark.parametrize(("model_file", "name"), [("slider_crank.yaml", "piston"),
+                                                  ("slider_crank.yaml", "crank"),
+                                                  ("fourbar_spatial.yaml", "coupler")])
+def test_legend_symbols_are_drawn_as_in_the_picture(model_file, name):
+    from mbody.present.draw.scene import Disc, Poly, Wedge
+
+    sc = fbd_scene(body(model_file, name).fbd)
+    drawing_items = next(p for p in sc.panels if p.gid == "drawing").items
+    root = sc.root.items
+    # the mass centre: a white disc with two black quarters, in the picture and legend
+    for items, gid in ((drawing_items, "mass-centre"), (root, "legend-handle:G")):
+        k = next(i for i, it in enumerate(items) if getattr(it, "gid", None) == gid)
+        disc, w1, w2 = items[k:k + 3]
+        assert isinstance(disc, Disc) and (disc.face, disc.edge) == ("white", "black")
+        assert [(type(w), w.a0, w.a1, w.face) for w in (w1, w2)] == [
+            (Wedge, 0, 90, "black"), (Wedge, 180, 270, "black")]
+    # every kind of arrow: same colour, width and dash as drawn, with a head
+    drawn = [it for it in drawing_items if isinstance(it, Line)
+             and (it.gid or "").startswith("arrow:")]
+    kinds = {it.gid.split(":")[1] for it in drawn}
+    assert "reaction" in kinds
+    for kind in kinds:
+        pic = next(it for it in drawn if it.gid.split(":")[1] == kind)
+        leg = next(it for it in root if getattr(it, "gid", None) == f"legend-handle:{kind}")
+        assert (leg.color, leg.lw, leg.dash) == (pic.color, pic.lw, pic.dash)
+        assert any(isinstance(it, Poly) and it.gid == f"legend-handle:{kind}:head"
+                   and it.face == pic.color for it in root)
+    parent = any(t.s.startswith("−") for t in drawing_items
+                 if isinstance(t, Text) and (t.gid or "").startswith("label:reaction:"))
+    assert any(getattr(it, "gid", None) == "legend-handle:parent" for it in root) == parent
