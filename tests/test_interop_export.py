@@ -23,10 +23,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from randmodels import planar_model, spatial_model
 
 import mbody
 from mbody import conventions as cv
+from mbody.cli.app import main
 from mbody.io.interop.mjcf_write import spanning_tree, to_mjcf
+from mbody.io.interop.yaml_write import dump_document
 from mbody.model import State
 from mbody.model.loader import load_text
 
@@ -47,6 +50,14 @@ def _load(name: str, *, known: bool = True) -> mbody.Model:
     data = load_text((MODELS / name).read_text(), name).data
     data.pop("reactions", None)
     return mbody.load(data)
+
+
+def _random_state(m, d, rng: np.random.Generator) -> None:
+    """Random joint positions and rates in MuJoCo's coordinates (so they respect every
+    joint), from the keyframe."""
+    mujoco.mj_resetDataKeyframe(m, d, 0)
+    d.qvel[:] = rng.normal(scale=2.0, size=m.nv)
+    mujoco.mj_integratePos(m, d.qpos, rng.normal(scale=0.5, size=m.nv), 1.0)
 
 
 def _mujoco(model: mbody.Model):
@@ -139,7 +150,7 @@ def _reaction_wrenches(model: mbody.Model, asm, sol, state: State) -> dict[str, 
         cols = [asm.reactions.index(r) for r in joint.labels]
         rows = model.body_rows(i)
         w = G[np.ix_(rows, cols)] @ lam[cols]
-        R = quat_to_matrix_np(state.quaternion[i])
+        R = _quat_matrix(state.quaternion[i])
         if model.dimension == cv.PLANAR:
             force = np.array([w[0], w[1], 0.0])
             moment = np.array([0.0, 0.0, w[2] if len(w) > 2 else 0.0])
@@ -150,7 +161,7 @@ def _reaction_wrenches(model: mbody.Model, asm, sol, state: State) -> dict[str, 
     return out
 
 
-def quat_to_matrix_np(q: np.ndarray) -> np.ndarray:
+def _quat_matrix(q: np.ndarray) -> np.ndarray:
     w, x, y, z = q
     return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
                      [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
@@ -195,9 +206,7 @@ def test_tree_models_agree_with_mujoco_at_random_states(name):
     m, d = _mujoco(model)
     rng = np.random.default_rng(sum(map(ord, name)))
     for _ in range(3):
-        mujoco.mj_resetDataKeyframe(m, d, 0)
-        d.qvel[:] = rng.normal(scale=2.0, size=m.nv)
-        mujoco.mj_integratePos(m, d.qpos, rng.normal(scale=0.5, size=m.nv), 1.0)
+        _random_state(m, d, rng)
         _forward(model, m, d)
         state = _state(model, m, d)
         asm = mbody.assemble(model, state)
@@ -238,3 +247,172 @@ def test_a_wrong_export_is_caught():
     ours = mbody.assemble(model, _state(model, m, d)).solve().accelerations
     with pytest.raises(AssertionError, match="max relative difference"):
         _compare(ours, _accelerations(model, m, d))
+
+
+JOINT_MIXES = [None, ("spherical", "fixed", "universal", "revolute"),
+               ("cylindrical", "spherical", "prismatic", "fixed")]
+
+
+def _random_trees(kind: str, types, springs: int, count: int = 3, *,
+                  upright: bool = False) -> list[dict]:
+    """The first `count` random models (seeds 0, 1, ...) whose joints form a tree (with
+    `upright`, each joint's child farther from the root than its parent)."""
+    out = []
+    for seed in range(100):
+        if kind == "spatial":
+            spec = spatial_model(seed, 5, n_joints=4, known=False, n_springs=springs,
+                                 joint_types=types)
+        else:
+            spec = planar_model(seed, 5, n_joints=4, known=False, n_springs=springs)
+        tree = spanning_tree(mbody.load(spec))
+        if upright and any(j.child != b for b, j in tree.joint.items() if j is not None):
+            continue
+        if not tree.loops:
+            out.append(spec)
+            if len(out) == count:
+                return out
+    raise AssertionError("too few random trees")
+
+
+@pytest.mark.parametrize("springs", [0, 2])
+@pytest.mark.parametrize("kind, types", [("spatial", t) for t in JOINT_MIXES]
+                         + [("planar", None)])
+def test_random_trees_of_every_joint_type_agree_with_mujoco(kind, types, springs):
+    """Random models (full inertias, rotated bodies, offset forces in world and body
+    axes, couples, gravity, damped springs) whose joints of every type form a tree, some
+    joints running against the tree (the child nearer the root): accelerations and, without
+    springs, every joint's reaction agree with MuJoCo at random states."""
+    reversed_joints = 0
+    for k, spec in enumerate(_random_trees(kind, types, springs)):
+        model = mbody.load(spec)
+        tree = spanning_tree(model)
+        reversed_joints += sum(j.child != b for b, j in tree.joint.items() if j is not None)
+        m, d = _mujoco(model)
+        assert m.ntendon == springs
+        rng = np.random.default_rng(k)
+        for _ in range(2):
+            _random_state(m, d, rng)
+            _forward(model, m, d)
+            state = _state(model, m, d)
+            asm = mbody.assemble(model, state)
+            sol = asm.solve()
+            assert sol.residual < 1e-12  # MuJoCo's state respects every joint
+            _compare(sol.accelerations, _accelerations(model, m, d))
+            if not springs:
+                _check_reactions(model, m, d, asm, sol, state)
+    assert reversed_joints > 0
+
+
+def _dense(x) -> np.ndarray:
+    return x.toarray() if hasattr(x, "toarray") else np.asarray(x, dtype=float)
+
+
+def _same_equations(a: mbody.Model, b: mbody.Model, rtol: float = 0.0) -> None:
+    """M, b, Q, G of both models at their initial states agree (rows and columns matched
+    by label, so a reader may order bodies and joints its own way)."""
+    A, B = mbody.assemble(a), mbody.assemble(b)
+    assert sorted(A.coordinates) == sorted(B.coordinates)
+    assert sorted(A.reactions) == sorted(B.reactions)
+    r = [B.coordinates.index(c) for c in A.coordinates]
+    c = [B.reactions.index(x) for x in A.reactions]
+    pairs = {"M": (_dense(A.M), _dense(B.M)[np.ix_(r, r)]), "b": (A.b, np.asarray(B.b)[r]),
+             "Q": (A.Q, np.asarray(B.Q)[r]), "G": (_dense(A.G), _dense(B.G)[np.ix_(r, c)])}
+    for key, (x, y) in pairs.items():
+        scale = max(1.0, float(np.abs(x).max(initial=0.0)))
+        assert np.abs(np.asarray(x) - y).max(initial=0.0) <= rtol * scale, key
+
+
+@pytest.mark.parametrize("name", ALL)
+def test_yaml_round_trip_is_exact(name):
+    """load → document → dump → load: the same document, so the same equations bit for
+    bit (numbers written as repr floats read back as the same doubles)."""
+    text = (MODELS / name).read_text()
+    document = load_text(text, name).data
+    dumped = dump_document(document, source=f"models/{name}")
+    assert dumped.startswith(f"# Converted by mbody {mbody.__version__} (mbody convert) "
+                             f"from models/{name}.\n")
+    assert load_text(dumped, "dumped").data == document
+    _same_equations(mbody.load(MODELS / name), mbody.loads(dumped))
+
+
+def test_yaml_numbers_and_text_read_back_as_written():
+    document = {"model": "yes", "description": "a: b # c, [d]", "dimension": 3,
+                "gravity": [1e-300, 5e-324, -0.0],
+                "bodies": [{"name": "on", "mass": 0.1 + 0.2, "inertia": [1e22, 2.5e-7, 3],
+                            "orientation": {"euler": ["30 deg", "1e3", 0],
+                                            "sequence": "ZYX"},
+                            "color": "#c0392b"}],
+                "loads": [], "joints": []}
+    text = dump_document(document, source=None)
+    assert "mass: 0.30000000000000004" in text and "1.0e+22" in text
+    assert "name: \"on\"" in text and "model: \"yes\"" in text  # YAML 1.1 booleans quoted
+    assert load_text(text, "t").data == document
+    import yaml  # a YAML 1.1 reader sees the same values
+
+    assert yaml.safe_load(text) == document
+
+
+def test_round_trip_through_mjcf_gives_the_same_equations():
+    """YAML → MJCF → YAML (the MJCF reader) for the models MJCF holds whole: spatial,
+    no point loads, no known reactions, no particles, velocities that respect the joints,
+    every joint's child farther from ground than its parent. Others lose what the header
+    of the MJCF file lists (planar models come back spatial; a joint against the tree
+    comes back with parent and child swapped, so its reactions change sign; a fixed joint
+    comes back named after its child, at the child's mass centre)."""
+    mjcf = pytest.importorskip("mbody.io.interop.mjcf")
+    whole = ["heavy_top.yaml", "intermediate_axis_flip.yaml", "practice_3_euler.yaml",
+             "seed_example_2.yaml", "torque_free_asymmetric.yaml",
+             "torque_free_symmetric.yaml"]
+    models = [mbody.load(MODELS / n) for n in whole]
+    # fixed joints have no MJCF element: their name and point do not come back
+    mixes = [None, ("spherical", "universal", "revolute", "cylindrical")]
+    models += [mbody.load(_moving({**spec, "loads": []}))
+               for t in mixes for spec in _random_trees("spatial", t, 0, count=2, upright=True)]
+    for model in models:
+        document = mjcf.read_mjcf(to_mjcf(model), keyframe="initial")
+        back = mbody.loads(dump_document(document.data, source="exported.xml"))
+        _same_equations(model, back, rtol=1e-12)
+
+
+def _moving(spec: dict) -> dict:
+    """`spec` at its pose with random velocities that respect its joints (MuJoCo's joint
+    rates), so that the keyframe holds them exactly."""
+    model = mbody.load(spec)
+    m, d = _mujoco(model)
+    d.qvel[:] = np.random.default_rng(7).normal(scale=2.0, size=m.nv)
+    mujoco.mj_forward(m, d)
+    state = _state(model, m, d)
+    bodies = [{**b, "velocity": state.velocity[i].tolist(),
+               "angular_velocity": state.omega[i].tolist()}
+              for i, b in enumerate(spec["bodies"])]
+    return {**spec, "bodies": bodies}
+
+
+def test_convert_yaml_to_mjcf_and_yaml(tmp_path, capsys):
+    src = str(MODELS / "slider_crank.yaml")
+    xml, yml = tmp_path / "sc.xml", tmp_path / "sc.yaml"
+    assert main(["convert", src, "-o", str(xml)]) == 0
+    assert "wrote" in capsys.readouterr().out
+    m = mujoco.MjModel.from_xml_path(str(xml))
+    assert (m.nbody, m.njnt, m.neq, m.nkey) == (4, 3, 1, 1)
+    text = xml.read_text()
+    assert "force 'gas' on 'piston': [-4000*exp(-200*t), 0, 0]" in text  # left out, said
+    assert main(["convert", src, "-o", str(yml)]) == 0
+    _same_equations(mbody.load(src), mbody.load(yml))
+    assert yml.read_text().startswith(f"# Converted by mbody {mbody.__version__}")
+
+
+@pytest.mark.parametrize("args, message", [
+    (["-o", "{tmp}/out.ymal"], "did you mean '.yaml'?"),
+    (["-o", "{tmp}/out.urdf"], "does not write it"),
+    (["-o", "{tmp}/exists.xml"], "exists; give --force"),
+    (["-o", "/proc/none/out.xml"], "cannot write"),
+])
+def test_convert_refuses_clearly(tmp_path, capsys, args, message):
+    (tmp_path / "exists.xml").write_text("keep")
+    argv = ["convert", str(MODELS / "pendulum.yaml")] + [a.format(tmp=tmp_path) for a in args]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert message in err and "Traceback" not in err
+    assert (tmp_path / "exists.xml").read_text() == "keep"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["exists.xml"]  # nothing partial

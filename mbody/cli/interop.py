@@ -5,11 +5,12 @@ from __future__ import annotations
 import argparse
 import importlib
 import os
+import sys
 from pathlib import Path
 from typing import Any
 
 from mbody.cli.common import EXIT_OK, load_model, regular_file
-from mbody.errors import MbodyError, did_you_mean
+from mbody.errors import MbodyError, ModelError, did_you_mean
 
 FORMATS = {".yaml": "yaml", ".yml": "yaml", ".xml": "mjcf", ".mjcf": "mjcf", ".urdf": "urdf"}
 """File extension -> format."""
@@ -36,6 +37,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "extension does not say it")
     s.add_argument("--from", dest="source_format", choices=tuple(NAMES),
                    help="the input format, when SOURCE's extension does not say it")
+    s.add_argument("--keyframe", metavar="NAME", help="MJCF input: the keyframe whose "
+                   "qpos/qvel give the initial state (default: 'initial' when the file has "
+                   "it, as mbody's export writes; else the reference pose at rest)")
     s.add_argument("--force", action="store_true", help="replace OUTPUT if it exists")
     s.set_defaults(run=convert)
 
@@ -73,8 +77,11 @@ def convert(a: argparse.Namespace) -> int:
             document = load_text(read_file(a.source), a.source).data
             write_document(document, a.output, source=a.source)
     else:
-        document = _read(a.source, src_format)
+        document = _read(a.source, src_format, a.keyframe)
         model = _model(document, a.source)
+        notes = [str(w) for w in getattr(document, "warnings", ())]
+        for note in notes:
+            sys.stderr.write(f"mbody: warning: {note}\n")
         if out_format == "mjcf":
             from mbody.io.interop.mjcf_write import write_mjcf
 
@@ -82,7 +89,8 @@ def convert(a: argparse.Namespace) -> int:
         else:
             from mbody.io.interop.yaml_write import write_document
 
-            write_document(document, a.output, source=a.source)
+            write_document(getattr(document, "data", document), a.output, source=a.source,
+                           notes=notes)
     print(f"wrote {a.output} ({NAMES[out_format]} of {model.name!r} from "
           f"{NAMES[src_format]}: {_summary(model)})")
     if out_format == "mjcf":
@@ -104,7 +112,7 @@ def _format(path: str, what: str, option: str, choices: tuple[str, ...]) -> str:
                      f"{option})")
 
 
-def _read(path: str, fmt: str) -> dict[str, Any]:
+def _read(path: str, fmt: str, keyframe: str | None) -> Any:
     """The model document of an MJCF or URDF file (`mbody.io.interop.read_document`)."""
     try:
         interop = importlib.import_module("mbody.io.interop")
@@ -114,16 +122,27 @@ def _read(path: str, fmt: str) -> dict[str, Any]:
     if read is None:
         raise MbodyError(f"{path}: reading {NAMES[fmt]} is not available in this version "
                          "of mbody (only .yaml models can be converted)")
-    return read(path, format=fmt)
+    if fmt != "mjcf":
+        return read(path, format=fmt)
+    if keyframe is not None:
+        return read(path, format=fmt, keyframe=keyframe)
+    try:
+        return read(path, format=fmt, keyframe="initial")
+    except ModelError as exc:  # no such keyframe: the reference pose, at rest
+        if not any(i.key == "keyframe" for i in exc.issues):
+            raise
+        return read(path, format=fmt)
 
 
-def _model(document: dict[str, Any], source: str):
+def _model(document: Any, source: str):
     """The validated model of a document read from `source` (its issues name it)."""
     from mbody.model.loader import Document
     from mbody.model.model import Model
     from mbody.model.validate import validate
 
-    return Model.from_spec(validate(Document(document, source)))
+    if not isinstance(document, Document):  # plain data: no lines to point at
+        document = Document(document, source)
+    return Model.from_spec(validate(document))
 
 
 def _summary(model) -> str:

@@ -185,9 +185,6 @@ def to_mjcf(model: Model, *, source: str | None = None) -> str:
     out = [_header(w, tree, source), f"<mujoco model={quoteattr(model.name)}>",
            '  <compiler angle="radian" autolimits="true"/>',
            f'  <option gravity="{_vec(g)}"/>',
-           "  <default>",
-           '    <geom contype="0" conaffinity="0"/>  <!-- shapes only: no contacts -->',
-           "  </default>",
            "  <worldbody>", *("    " + s for s in w.sites.get(cv.GROUND, [])), *w.lines,
            "  </worldbody>"]
     out += equality + tendons
@@ -314,7 +311,8 @@ def _tree_joint(w: _Writer, j: Joint, parent: str, child: str, pad: str) -> None
         a1, a2 = a1 / np.linalg.norm(a1), a2 / np.linalg.norm(a2)
         if j.child != child:  # the tree runs child → parent: the axes swap roles
             a1, a2 = a2, a1
-        parts = [(f"{j.name}:axis", "hinge", a1), (f"{j.name}:axis2", "hinge", a2)]
+        # named <joint>:1, <joint>:2: a reader takes the common stem back as the name
+        parts = [(f"{j.name}:1", "hinge", a1), (f"{j.name}:2", "hinge", a2)]
     elif j.type == "spherical":
         parts = [(j.name, "ball", np.zeros(3))]
     else:  # fixed: welded by nesting
@@ -384,7 +382,8 @@ def _geom(m: Model, i: int) -> str:
     body = m.bodies[m.body_names[i]]
     planar = m.dimension == cv.PLANAR
     rgba = _rgba(body.color)
-    color = f' rgba="{rgba}"' if rgba else ""
+    # shapes are for viewing only: contacts would add forces mbody does not have
+    color = ' contype="0" conaffinity="0"' + (f' rgba="{rgba}"' if rgba else "")
     shape = body.shape
     if shape is None:
         if body.particle:
