@@ -19,6 +19,9 @@ import numpy as np
 
 from mbody.answers.compare import CONST, Fit, Row, fit, matches, same
 from mbody.answers.rows import BodyRows, MomentPoint, TrueRow
+from mbody.answers.text import num as _num
+from mbody.answers.text import row_text
+from mbody.answers.text import terms as _terms
 
 CORRECT = "correct"
 MISSING_GYROSCOPIC_TERM = "missing_gyroscopic_term"
@@ -208,6 +211,24 @@ class _Diagnoser:
                     f"{self.gyro_words(e)}. Keep ω × Iω for spatial rotation: it does not "
                     "vanish unless the motion is planar.",
                     {"term": "omega x (I omega)", "value": e.gyro})
+        if self.planar:
+            return None
+        for e in self.br.euler:
+            for p in self.br.points:
+                if not p.fixed:
+                    continue
+                t = self.br.about_fixed_point(e, p, gyro=False)
+                if same(t, self.br.about_fixed_point(e, p), self.tol) or self.match(t) is None:
+                    continue
+                full = self.br.about_fixed_point(e, p)
+                return Diagnosis(
+                    MISSING_GYROSCOPIC_TERM, row_text(full), e.label,
+                    f"These are moments about {_point(p)}, a fixed pivot, with the inertia "
+                    f"about it, but without the gyroscopic term ω × I_P ω "
+                    f"({_num(t.get(CONST) - full.get(CONST))} N m on the left here). Keep "
+                    "ω × Iω for spatial rotation, about a fixed pivot as about G.",
+                    {"term": "omega x (I_P omega)", "point": p.name,
+                     "value": t.get(CONST) - full.get(CONST)})
         return None
 
     def gyro_words(self, e: TrueRow) -> str:
@@ -244,6 +265,10 @@ class _Diagnoser:
             diagonal = np.count_nonzero(J - np.diag(np.diag(J))) == 0
             if diagonal and abs(used - J[e.axis, e.axis]) <= self.tol * abs(J[e.axis, e.axis]):
                 continue  # I_k itself: the gyroscopic step speaks for it
+            # one of the body's own inertias, not any number that makes the row fit
+            scalars = [*moments, *np.diag(J), float(np.trace(J)) / 3]
+            if not any(abs(used - x) <= self.tol * abs(x) for x in scalars):
+                continue
             k = e.axis + 1
             pm = ", ".join(_num(x) for x in np.diag(J)) if diagonal else \
                 ", ".join(_num(x) for x in moments)
@@ -252,13 +277,14 @@ class _Diagnoser:
                 f"This treats the body as having one inertia ({_num(used)} kg m²) about every "
                 f"axis, so angular momentum is taken parallel to the spin and ω × Iω vanishes; "
                 f"but its principal moments differ ({pm} kg m²). Use the full tensor: "
-                f"{self.inertia_words(e)}, and keep ω × Iω ({_num(e.gyro)} N m).",
+                f"{self.inertia_words(e)}"
+                + (f", and keep ω × Iω ({_num(e.gyro)} N m)." if e.gyro else "."),
                 {"inertia_used": used, "term": f"I alpha_{k}"})
         return None
 
     def inertia_words(self, e: TrueRow) -> str:
-        row = [(k, v) for k, v in e.row.coef.items() if k.startswith("alpha") and v != 0.0]
-        return "(I α)_{} = {}".format(e.axis + 1, " + ".join(f"{_num(v)} {k}" for k, v in row))
+        row = {k: v for k, v in e.row.coef.items() if k.startswith("alpha")}
+        return f"(I α)_{e.axis + 1} = {_terms(row)}"
 
     def moment_point(self) -> Diagnosis | None:
         for e in self.br.euler:
@@ -360,6 +386,8 @@ class _Diagnoser:
             f = self.match(t, free=(CONST,))
             if f is None:
                 continue
+            if len(t.unknowns) == 1 and abs(abs(f.k) - 1.0) > self.tol:
+                continue  # one term fixes no scale: ask that it be written as in the row
             # the student's constant, brought to the true row's scale, minus the true one
             extra = self.s.get(CONST) / f.k - r.row.get(CONST)
             details: dict = {"reactions": gone}
@@ -393,6 +421,13 @@ class _Diagnoser:
                     t = self.br.transport(e, p, keep_acc=True)
                     candidates.append((e, t, f"the moment equation about {_point(p)} (with "
                                        "the transport term r × m a_G)", row_text(t)))
+        if any(k.startswith("alpha") for k in self.s.unknowns):
+            for e in self.br.euler:
+                for p in self.br.points:
+                    if p.fixed:
+                        t = self.br.about_fixed_point(e, p)
+                        candidates.append((e, t, f"the moment equation about the fixed pivot "
+                                           f"{_point(p)} (with I_P = I_G + m d²)", row_text(t)))
         best: tuple | None = None
         for r, t, words, text in candidates:
             f = self.consensus(t, r.acc)
@@ -453,13 +488,13 @@ class _Diagnoser:
         if not len(keys) or not np.any(b):
             return ""
         x, *_ = np.linalg.lstsq(A, b, rcond=None)
+        x[np.abs(x) <= 1e-9 * np.abs(x).max()] = 0.0  # rows it does not use
         t = Row(dict(zip(keys, (A @ x).tolist(), strict=True)),
                 {k: sum(abs(x[j]) * r.row.err(k) for j, r in enumerate(self.br.rows))
                  for k in keys})
         if self.match(t) is None:
             return ""
-        used = [r.label for j, r in enumerate(self.br.rows)
-                if abs(x[j]) > 1e-9 * np.abs(x).max()]
+        used = [r.label for j, r in enumerate(self.br.rows) if x[j] != 0.0]
         return (f"This equation holds (it combines the rows {', '.join(used)}), but it is not "
                 "one of the body's Newton-Euler rows: write each one on its own.")
 
@@ -479,37 +514,3 @@ def _load_words(x, euler: bool) -> str:
     if euler and x.kind != "couple":
         return f"the moment of {name} about G ({_num(x.value)} N m)"
     return f"{name} ({_num(x.value)} {'N m' if euler else 'N'} on this row)"
-
-
-def _num(x: float) -> str:
-    x = float(x)
-    x = 0.0 if abs(x) < 1e-12 else x
-    s = f"{x:.6g}"
-    return "0" if s in ("-0", "0") else s
-
-
-def _terms(coef: Mapping[str, float]) -> str:
-    """``{O.Fx: -0.43, O.Fy: 1}`` -> ``-0.43 O.Fx + O.Fy``."""
-    out = ""
-    for name, c in coef.items():
-        if c == 0.0:
-            continue
-        mag = abs(c)
-        txt = name if _num(mag) == "1" else f"{_num(mag)} {name}"
-        if not out:
-            out = f"-{txt}" if c < 0 else txt
-        else:
-            out += f" {'-' if c < 0 else '+'} {txt}"
-    return out or "0"
-
-
-def row_text(row: Row) -> str:
-    """A row as an equation: accelerations on the left, the rest on the right."""
-    left = {k: v for k, v in row.coef.items() if k != CONST and "." not in k}
-    right = {k: -v for k, v in row.coef.items() if "." in k}
-    const = -row.get(CONST)
-    rhs = _terms(right) if right and any(right.values()) else ""
-    if const != 0.0 or not rhs:
-        rhs = _num(const) + ("" if not rhs else
-                             (" + " + rhs if not rhs.startswith("-") else " - " + rhs[1:]))
-    return f"{_terms(left)} = {rhs}"

@@ -16,6 +16,7 @@ import numpy as np
 
 from mbody import conventions as cv
 from mbody.answers.compare import CONST, Row
+from mbody.answers.text import equation_text
 from mbody.answers.vocabulary import PLANAR_ACCELERATIONS, SPATIAL_ACCELERATIONS
 from mbody.equations.assemble import Assembly
 from mbody.equations.fbd import BodyEquations, Equation
@@ -79,7 +80,8 @@ class TrueRow:
 
     @property
     def text(self) -> str:
-        return str(self.equation)
+        """The row as `mbody assemble` writes it."""
+        return equation_text(self.equation)
 
 
 @dataclass(frozen=True)
@@ -164,10 +166,15 @@ class BodyRows:
                 out = out.plus(n.row if keep_acc else n.row.without([n.acc]), c)
         return out.cleaned(absolute=self.joints)
 
-    def about_fixed_point(self, e: TrueRow, point: MomentPoint) -> Row:
+    def about_fixed_point(self, e: TrueRow, point: MomentPoint, *, gyro: bool = True) -> Row:
         """Moments about a fixed `point` with the inertia about it: the transport row
-        with a_G = ω̇ × d + ω × (ω × d) put in (``I_P α = M_P`` in the plane)."""
+        with a_G = ω̇ × d + ω × (ω × d) put in (``I_P α = M_P`` in the plane). With `gyro`
+        False the velocity terms are left out: ``I_P α = M_P`` in space, without
+        ω × I_P ω."""
         row = self.transport(e, point, keep_acc=True)
+        if not gyro:
+            row = row.with_term(CONST, row.get(CONST) - e.gyro,
+                                max(0.0, row.err(CONST) - abs(e.gyro)))
         d = self.W_x - point.W_P
         R = self.W_R_B
         if self.planar:
@@ -180,12 +187,15 @@ class BodyRows:
             A = -_skew(d) @ R
             a0 = np.cross(w_W, np.cross(w_W, d))
             alphas = SPATIAL_ACCELERATIONS[3:]
+        size = float(np.linalg.norm(d))
+        A = _denoise(A, size)
+        a0 = _denoise(a0, size * float(self.omega @ self.omega)) if gyro else 0.0 * a0
         accs = (PLANAR_ACCELERATIONS if self.planar else SPATIAL_ACCELERATIONS)[:3]
         for j, a in enumerate(accs[: 2 if self.planar else 3]):
             c = row.get(a)
             if c == 0.0:
                 continue
-            sub = {al: float(A[j, k]) for k, al in enumerate(alphas)}
+            sub = {al: float(A[j, k]) for k, al in enumerate(alphas) if A[j, k] != 0.0}
             sub[CONST] = float(a0[j])
             row = row.without([a]).plus(Row.of(sub), c)
         return row.cleaned(absolute=self.joints)
@@ -197,7 +207,12 @@ class BodyRows:
             C = np.zeros((3, 3))
             C[2] = _skew(d)[2]
             return C
-        return self.W_R_B.T @ _skew(d)
+        return _denoise(self.W_R_B.T @ _skew(d), float(np.linalg.norm(d)))
+
+
+def _denoise(a: np.ndarray, size: float) -> np.ndarray:
+    """Entries below 1e-12 of `size` (the lever arm they come from) are rotation noise."""
+    return np.where(np.abs(a) <= 1e-12 * size, 0.0, a)
 
 
 def _skew(v: np.ndarray) -> np.ndarray:

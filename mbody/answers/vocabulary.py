@@ -13,7 +13,9 @@ Numbers taken from the model at its state:
   diagonal in body axes) and every tensor entry ``I_11, I_12, ... I_33``;
 - ``w`` and ``theta`` (planar) or ``w_1, w_2, w_3`` (spatial, body axes);
 - ``g``, the magnitude of gravity; ``pi``;
-- a reaction whose value the model gives (``reactions:`` in the file), by its label.
+- a reaction whose value the model gives (``reactions:`` in the file), by its label;
+- each applied load's components by name, as `mbody assemble --symbolic` writes them
+  (``F_push_x`` world axes, ``F_push_1`` body axes, ``M_motor_3``, ``T_spring``).
 
 Aliases (``omega``, ``ω``, ``α``, ``ax``, ``theta_ddot``...) map onto these names.
 """
@@ -25,6 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from mbody import conventions as cv
+from mbody.equations.symbolic import load_symbols
 from mbody.errors import did_you_mean
 from mbody.model.model import Model, State
 
@@ -225,6 +228,8 @@ def vocabulary(model: Model, state: State, body: str) -> Vocabulary:
     reactions = tuple(r for r in model.reactions if r not in known)
     for label, value in known.items():
         values[label] = float(value)
+    for sym in load_symbols(model, state, body):
+        values.setdefault(sym.name, float(sym.value))
     return Vocabulary(body, model.dimension, tuple(accelerations), reactions, values,
                       {a: c for a, c in aliases.items() if a not in values},
                       {n: why for n, why in absent.items() if n not in values})

@@ -47,6 +47,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.add_argument("-o", "--output", metavar="FILE", default="report.html",
                    help="the page to write (default: report.html)")
     s.add_argument("--view", metavar="VIEW", default="iso", help=VIEW_HELP)
+    s.add_argument("--answers", metavar="FILE", help="a student's equations (a YAML answers "
+                   "file, see mbody verify): shown beside the expected rows")
     s.set_defaults(run=report)
 
 
@@ -110,6 +112,11 @@ def report(a: argparse.Namespace) -> int:
 
     parse_view(a.view)
     model = load_model(a.model)
-    path = write_report(model, a.output, view=a.view)
+    answers = None
+    if a.answers is not None:
+        from mbody.answers.verify import verify
+
+        answers = verify(model, a.answers)
+    path = write_report(model, a.output, view=a.view, answers=answers)
     print(f"wrote {path}  ({model.n} bod{'y' if model.n == 1 else 'ies'})")
     return EXIT_OK

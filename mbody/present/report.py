@@ -11,7 +11,7 @@ from __future__ import annotations
 import html
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -22,8 +22,12 @@ from mbody.errors import MbodyError
 from mbody.io.atomic import write_atomic
 from mbody.model.graph import topology
 from mbody.model.model import Model
+from mbody.present.answers import answers_section
 from mbody.present.draw import fbd_scene, figure_svg, graph_scene
 from mbody.present.text import body_text, model_summary
+
+if TYPE_CHECKING:
+    from mbody.answers.verify import Verification
 
 MAX_BODIES = 200
 """Bodies drawn in one report; larger models list the rest by name."""
@@ -54,8 +58,9 @@ def _e(s: object) -> str:
 
 def report_html(model: Model, *, asm: Assembly | None = None,
                 view: str | Sequence[float] | None = "iso",
-                max_bodies: int = MAX_BODIES) -> str:
-    """The report page as one HTML string (UTF-8, no external resources)."""
+                max_bodies: int = MAX_BODIES, answers: Verification | None = None) -> str:
+    """The report page as one HTML string (UTF-8, no external resources); with `answers`
+    (what `mbody.verify` found), a student's equations beside the expected rows."""
     asm = assemble(model) if asm is None else asm
     topo = topology(model, asm.G if model.reactions else None)
     planar = model.dimension == cv.PLANAR
@@ -79,7 +84,9 @@ def report_html(model: Model, *, asm: Assembly | None = None,
                '<li><a href="#summary">Model summary</a></li>'
                '<li><a href="#topology">Topology</a></li>'
                '<li><a href="#stacked">Stacked equations</a></li>'
-               '<li><a href="#solution">Solution at the initial state</a></li>')
+               '<li><a href="#solution">Solution at the initial state</a></li>'
+               + ('<li><a href="#answers">Your equations</a></li>' if answers is not None
+                  else ""))
     out += [f'<li><a href="#body-{k}">Body {_e(b)}</a></li>' for k, b in enumerate(shown)]
     out.append("</ol></nav>")
 
@@ -108,6 +115,8 @@ def report_html(model: Model, *, asm: Assembly | None = None,
                f"<p class=\"muted\">Sign rule: {_e(cv.SIGN_RULE)}.</p></section>")
 
     out.append(_solution_section(asm))
+    if answers is not None:
+        out.append(answers_section(answers))
 
     for k, name in enumerate(shown):
         eq = asm.bodies[name]

@@ -1,0 +1,65 @@
+"""Rows and terms written out for a student: ``0.167083 alpha = -0.433013 O.Fx - 0.25 O.Fy``.
+
+The same style as `mbody assemble` prints (six significant figures, accelerations and
+the gyroscopic term on the left, loads and reactions on the right, a known reaction with
+its value), written here from the rows' numbers so that the checker's words do not
+depend on another module's printing.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+from mbody.answers.compare import CONST, Row
+from mbody.equations.fbd import Equation
+
+
+def num(x: float) -> str:
+    """A number to six significant figures; rounding noise (below 1e-12) is 0."""
+    x = float(x)
+    x = 0.0 if abs(x) < 1e-12 else x
+    s = f"{x:.6g}"
+    return "0" if s in ("-0", "0") else s
+
+
+def terms(coef: Mapping[str, float]) -> str:
+    """``{O.Fx: -0.43, O.Fy: 1}`` -> ``-0.43 O.Fx + O.Fy`` ('0' when empty)."""
+    out = ""
+    for name, c in coef.items():
+        if num(c) == "0":
+            continue
+        mag = abs(c)
+        txt = name if num(mag) == "1" else f"{num(mag)} {name}"
+        if not out:
+            out = f"-{txt}" if c < 0 else txt
+        else:
+            out += f" {'-' if c < 0 else '+'} {txt}"
+    return out or "0"
+
+
+def _join(head: str, tail: str) -> str:
+    if not head or head == "0":
+        return tail
+    if tail == "0":
+        return head
+    return f"{head} - {tail[1:]}" if tail.startswith("-") else f"{head} + {tail}"
+
+
+def equation_text(eq: Equation) -> str:
+    """One row of the assembly as `mbody assemble` writes it."""
+    left = terms(eq.lhs)
+    if num(eq.gyro) != "0":
+        left = _join(left, num(eq.gyro))
+    right = num(eq.rhs) if num(eq.rhs) != "0" or not eq.reactions else "0"
+    for label, c in eq.reactions.items():
+        name = f"({label}={num(eq.known[label])})" if label in eq.known else label
+        right = _join(right, terms({name: c}))
+    return f"{left} = {right}"
+
+
+def row_text(row: Row) -> str:
+    """A row ``Σ c u + c0 = 0`` as an equation: accelerations left, the rest right."""
+    left = terms({k: v for k, v in row.coef.items() if k != CONST and "." not in k})
+    right = _join(num(-row.get(CONST)), terms({k: -v for k, v in row.coef.items()
+                                                if "." in k}))
+    return f"{left} = {right}"

@@ -1,0 +1,420 @@
+"""`mbody.verify`: every diagnosis on shipped models, planar and spatial.
+
+The student equations below are written by hand from the course's worked examples and
+from the shipped models' free bodies (their numbers are in the model files' comments
+and in `mbody assemble`). Each right equation is also written in other orders, scaled,
+with the vocabulary's symbols and with rounded numbers, and must stay `correct`; each
+wrong one must get its diagnosis, never `correct`.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+
+import pytest
+
+import mbody
+from mbody.answers import DIAGNOSES, AnswersError, verify
+from mbody.answers.compare import CONST, Row, fit
+from mbody.answers.parse import EquationError, parse_equation
+
+ROOT = Path(__file__).resolve().parent.parent
+MODELS = ROOT / "models"
+_CACHE: dict[str, mbody.Model] = {}
+
+
+def model(name: str) -> mbody.Model:
+    if name not in _CACHE:
+        _CACHE[name] = mbody.load(MODELS / f"{name}.yaml")
+    return _CACHE[name]
+
+
+def check(name: str, body: str, eq: str, **kw):
+    """The single check of one equation."""
+    v = verify(model(name), [{"body": body, "eq": eq}], **kw)
+    assert len(v.checks) == 1
+    return v.checks[0]
+
+
+def diagnosis(name: str, body: str, eq: str) -> str:
+    return check(name, body, eq).diagnosis
+
+
+# == correct, however it is written ===================================================
+
+CORRECT = [
+    # worked example 1: m = 10, I_G = 0.5, 50 N along x, 20 N m about G
+    ("seed_example_1", "plate", "10*a_x = 50", "plate.x"),
+    ("seed_example_1", "plate", "a_x = 5", "plate.x"),
+    ("seed_example_1", "plate", "50 - m*a_x = 0", "plate.x"),
+    ("seed_example_1", "plate", "m*a_x = F_push_x", "plate.x"),
+    ("seed_example_1", "plate", "m*a_y = 0", "plate.y"),
+    ("seed_example_1", "plate", "I_G*alpha = 50*0.4", "plate.theta"),
+    ("seed_example_1", "plate", "alpha = 20/I_G", "plate.theta"),
+    ("seed_example_1", "plate", "-2*alpha = -80", "plate.theta"),
+    # worked example 2: I = (2, 3, 4), w = (1, 2, 3): alpha = (-3, 2, -0.5)
+    ("seed_example_2", "body", "I_1*alpha_1 = (I_2 - I_3)*w_2*w_3", "body.w1"),
+    ("seed_example_2", "body", "(I_3 - I_2)*w_2*w_3 + I_1*alpha_1 = 0", "body.w1"),
+    ("seed_example_2", "body", "alpha_1 = -3", "body.w1"),
+    ("seed_example_2", "body", "2.000*alpha_1 + 6.000 = 0", "body.w1"),
+    ("seed_example_2", "body", "alpha_2 = (I_3 - I_1)*w_3*w_1/I_2", "body.w2"),
+    ("seed_example_2", "body", "4*alpha_3 = -2", "body.w3"),
+    ("seed_example_2", "body", "α_3 = (I_1 - I_2)*ω_1*ω_2/I_3", "body.w3"),
+    ("seed_example_2", "body", "m*a_z = 0", "body.z"),
+    # the physical pendulum: m = 2, I_G = 0.167083, G 0.5 m below the pin at 30 deg
+    ("pendulum", "rod", "2*a_y = O.Fy - 19.62", "rod.y"),
+    ("pendulum", "rod", "O.Fy - m*g - m*a_y = 0", "rod.y"),
+    ("pendulum", "rod", "a_y = (O.Fy - 19.62)/2", "rod.y"),
+    ("pendulum", "rod", "-4*a_y = -2*O.Fy + 39.24", "rod.y"),
+    ("pendulum", "rod", "m*a_x = O.Fx", "rod.x"),
+    ("pendulum", "rod", "0.1671*alpha = -0.433*O.Fx - 0.25*O.Fy", "rod.theta"),
+    ("pendulum", "rod", "I_G*alpha = -0.5*cos(theta)*O.Fx - 0.5*sin(theta)*O.Fy",
+     "rod.theta"),
+    # moments about the pin with the transport term, and with the pin's inertia
+    ("pendulum", "rod", "I_G*alpha + 0.433013*m*a_x + 0.25*m*a_y = -m*g*0.25", "rod.theta"),
+    ("pendulum", "rod", "(I_G + m*0.5^2)*alpha = -m*g*0.5*sin(theta)", "rod.theta"),
+    # spatial with reactions and a full tensor
+    ("heavy_top", "top", "m*a_z = pivot.Fz - m*g", "top.z"),
+    ("heavy_top", "top", "0.0008*alpha_1 + 0.0632608 = 0.0469846*pivot.Fy "
+     "+ 0.017101*pivot.Fz", "top.w1"),
+    ("heavy_top", "top", "I_1*alpha_1 + (I_3 - I_2)*w_2*w_3 = 0.0469846*pivot.Fy "
+     "+ 0.017101*pivot.Fz", "top.w1"),
+    ("rotated_full_inertia", "bracket",
+     "I_11*alpha_1 + I_12*alpha_2 + I_13*alpha_3 + 0.232 = 0.743015 + 0.5", "bracket.w1"),
+    ("rotated_full_inertia", "bracket", "3*a_z = 15 - 29.43", "bracket.z"),
+    ("rotor_offset_load", "rotor", "I_2*alpha_2 = (I_3 - I_1)*w_3*w_1", "rotor.w2"),
+    ("double_pendulum", "upper", "m*a_x = O.Fx - A.Fx", "upper.x"),
+    ("double_pendulum", "lower", "a_y = A.Fy - g", "lower.y"),
+    ("spring_mass_damper", "block", "2*a_y = 38.4 - 19.62", "block.y"),
+]
+
+
+@pytest.mark.parametrize("name, body, eq, row", CORRECT)
+def test_a_right_equation_written_any_way_is_correct(name, body, eq, row):
+    c = check(name, body, eq)
+    assert c.diagnosis == "correct", c.explanation
+    assert c.row == row
+
+
+def test_the_heavy_tops_euler_equation_about_its_fixed_pivot_is_correct():
+    # I_P = I_G + m d^2 = 0.0008 + 0.05^2 = 0.0033 about axis 1; the gyroscopic term with
+    # I_P: (I_3 - 0.0033) w_2 w_3; gravity's moment about the pivot m g 0.017101
+    c = check("heavy_top", "top", "0.0033*alpha_1 + (I_3 - 0.0033)*w_2*w_3 = m*g*0.017101")
+    assert c.diagnosis == "correct" and c.details["form"] == "fixed_pivot"
+
+
+# == each mistake of the course's table ===============================================
+
+def test_missing_gyroscopic_term_spatial():
+    c = check("seed_example_2", "body", "I_3*alpha_3 = 0")
+    assert c.diagnosis == "missing_gyroscopic_term"
+    assert c.row == "body.w3" and c.expected == "4 alpha_3 + 2 = 0"
+    assert "(I_2 − I_1) w_1 w_2" in c.explanation and "= 2 N m" in c.explanation
+    assert c.details["value"] == pytest.approx(2.0)
+    assert diagnosis("seed_example_2", "body", "alpha_1 = 0") == "missing_gyroscopic_term"
+    # with reactions and a full tensor
+    assert diagnosis("heavy_top", "top", "0.0008*alpha_1 = 0.0469846*pivot.Fy + "
+                     "0.017101*pivot.Fz") == "missing_gyroscopic_term"
+    assert diagnosis("rotated_full_inertia", "bracket", "0.08*alpha_1 - 0.012*alpha_2 + "
+                     "0.004*alpha_3 = 1.24302") == "missing_gyroscopic_term"
+    # about the fixed pivot: I_P alpha = M_P without w x I_P w
+    c = check("heavy_top", "top", "0.0033*alpha_1 = m*g*0.0171010")
+    assert c.diagnosis == "missing_gyroscopic_term" and c.details["point"] == "joint pivot"
+
+
+def test_single_inertia_in_space():
+    # rotor: principal moments (0.2625, 0.2625, 0.225); the side load's moment -5 N m
+    c = check("rotor_offset_load", "rotor", "I_3*alpha_1 = -5")
+    assert c.diagnosis == "single_inertia_in_space"
+    assert c.details["inertia_used"] == pytest.approx(0.225)
+    assert "0.2625 alpha_1" in c.explanation
+    # the mean of the principal moments, written as a number
+    assert diagnosis("rotor_offset_load", "rotor", "0.25*alpha_1 = -5") == \
+        "single_inertia_in_space"
+    # a full tensor: its I_11 alone, no products of inertia, no gyroscopic term
+    c = check("rotated_full_inertia", "bracket", "0.08*alpha_1 = 0.743015 + 0.5")
+    assert c.diagnosis == "single_inertia_in_space" and c.row == "bracket.w1"
+    # an inertia that is none of the body's is not "single inertia": the moment is wrong
+    assert diagnosis("rotor_offset_load", "rotor", "I_1*alpha_1 = -7") == \
+        "not_an_equation_of_this_body"
+
+
+def test_wrong_moment_point():
+    # pendulum: moments about the pin, m g (L/2) sin 30 = 4.905 N m, with I_G kept
+    c = check("pendulum", "rod", "I_G*alpha = -m*g*0.25")
+    assert c.diagnosis == "wrong_moment_point" and c.details["point"] == "joint O"
+    assert c.expected == "0.167083 alpha = -0.433013 O.Fx - 0.25 O.Fy"
+    assert "0.866025 a_x + 0.5 a_y" in c.details["transport_term"]
+    # the lower rod of the double pendulum about its pin A (which moves)
+    c = check("double_pendulum", "lower", "I_G*alpha = -m*g*0.176777")
+    assert c.diagnosis == "wrong_moment_point" and c.details["point"] == "joint A"
+    # I_A alpha = M_A about the moving pin A: only about a fixed point
+    c = check("double_pendulum", "lower", "(I_G + m*0.25^2)*alpha = -m*g*0.176777")
+    assert c.diagnosis == "wrong_moment_point" and c.details["form"] == "moving_pivot"
+    # spatial: the heavy top about its pivot, gravity's moment m g 0.017101 with I_G
+    c = check("heavy_top", "top", "0.0008*alpha_1 + 0.0632608 = m*g*0.0171010")
+    assert c.diagnosis == "wrong_moment_point" and c.row == "top.w1"
+
+
+def test_reaction_treated_as_known():
+    # the pin force's solved value 15.9435 N (pendulum.yaml) put in as a number
+    c = check("pendulum", "rod", "2*a_y = 15.9435 - 19.62")
+    assert c.diagnosis == "reaction_treated_as_known"
+    assert c.details["reactions"] == ["O.Fy"]
+    assert c.details["value_used"] == pytest.approx(15.9435, rel=1e-6)
+    assert c.details["value_solved"] == pytest.approx(15.9435, abs=1e-4)
+    # the static guess O.Fy = m g
+    c = check("pendulum", "rod", "2*a_y = 0")
+    assert c.diagnosis == "reaction_treated_as_known"
+    assert c.details["value_used"] == pytest.approx(19.62)
+    # spatial: the top's pivot force taken as its weight
+    c = check("heavy_top", "top", "0.0008*alpha_1 + 0.0632608 = 0.0469846*pivot.Fy "
+              "+ 0.017101*9.81")
+    assert c.diagnosis == "reaction_treated_as_known"
+    assert c.details["reactions"] == ["pivot.Fz"]
+    assert c.details["value_used"] == pytest.approx(9.81, rel=1e-5)
+
+
+def test_missing_reaction():
+    c = check("pendulum", "rod", "2*a_y = -19.62")
+    assert c.diagnosis == "missing_reaction" and c.details["reactions"] == ["O.Fy"]
+    # the upper rod of the double pendulum: the lower rod's pull at A forgotten
+    c = check("double_pendulum", "upper", "m*a_x = O.Fx")
+    assert c.diagnosis == "missing_reaction" and c.details["reactions"] == ["A.Fx"]
+    assert c.details["term"] == "-A.Fx"
+    # spatial
+    c = check("heavy_top", "top", "0.0008*alpha_1 + 0.0632608 = 0.0469846*pivot.Fy")
+    assert c.diagnosis == "missing_reaction" and c.details["reactions"] == ["pivot.Fz"]
+
+
+def test_reaction_sign():
+    # upper is the parent of A: it feels -A.Fx (Newton's third law)
+    c = check("double_pendulum", "upper", "m*a_x = O.Fx + A.Fx")
+    assert c.diagnosis == "reaction_sign" and c.details["reactions"] == ["A.Fx"]
+    assert "parent of joint A" in c.explanation
+    c = check("pendulum", "rod", "2*a_y = -O.Fy - 19.62")
+    assert c.diagnosis == "reaction_sign" and "child of joint O" in c.explanation
+    # spatial: both pivot components of the Euler row reversed
+    c = check("heavy_top", "top", "0.0008*alpha_1 + 0.0632608 = -0.0469846*pivot.Fy "
+              "- 0.017101*pivot.Fz")
+    assert c.diagnosis == "reaction_sign"
+    assert c.details["reactions"] == ["pivot.Fy", "pivot.Fz"]
+
+
+def test_missing_applied_load():
+    c = check("seed_example_1", "plate", "0.5*alpha = 0")
+    assert c.diagnosis == "missing_applied_load" and c.details["loads"] == ["push"]
+    assert c.expected == "0.5 alpha = 20"
+    c = check("pendulum", "rod", "2*a_y = O.Fy")
+    assert c.diagnosis == "missing_applied_load" and c.details["loads"] == ["gravity"]
+    c = check("spring_mass_damper", "block", "2*a_y = -19.62")
+    assert c.diagnosis == "missing_applied_load" and c.details["loads"] == ["suspension"]
+    # spatial: gravity, a force, a couple
+    assert check("rotated_full_inertia", "bracket", "3*a_z = 15").details["loads"] == \
+        ["gravity"]
+    assert check("rotor_offset_load", "rotor", "m*a_y = 0").details["loads"] == ["side_load"]
+    c = check("rotated_full_inertia", "bracket",
+              "0.08*alpha_1 - 0.012*alpha_2 + 0.004*alpha_3 + 0.232 = 0.743015")
+    assert c.diagnosis == "missing_applied_load" and c.details["loads"] == ["motor"]
+
+
+def test_not_an_equation_of_this_body():
+    c = check("pendulum", "rod", "2*a_y = 3*O.Fy - 19.62")
+    assert c.diagnosis == "not_an_equation_of_this_body" and c.row == "rod.y"
+    assert "O.Fy has -3 where -1 is expected" in c.explanation
+    # a reaction of a joint the body does not touch
+    c = check("double_pendulum", "lower", "m*a_x = O.Fx + A.Fx")
+    assert c.diagnosis == "not_an_equation_of_this_body" and c.details["foreign"] == ["O.Fx"]
+    # not linear in the unknowns
+    c = check("pendulum", "rod", "alpha*O.Fx = 1")
+    assert c.diagnosis == "not_an_equation_of_this_body" and "product" in c.explanation
+    # no unknown at all
+    assert diagnosis("pendulum", "rod", "m*g = 19.62") == "not_an_equation_of_this_body"
+    # the gyroscopic term with the wrong sign
+    c = check("seed_example_2", "body", "I_1*alpha_1 = (I_3 - I_2)*w_2*w_3")
+    assert c.diagnosis == "not_an_equation_of_this_body" and c.row == "body.w1"
+    # a true equation mixing two rows is not one row
+    c = check("seed_example_1", "plate", "10*a_x + 10*a_y = 50")
+    assert c.diagnosis == "not_an_equation_of_this_body"
+    assert "combines the rows plate.x, plate.y" in c.explanation
+    # moments about the pin with a transport term twice too large
+    c = check("pendulum", "rod", "I_G*alpha + 0.866025*m*a_x + 0.5*m*a_y = -m*g*0.25")
+    assert c.diagnosis == "not_an_equation_of_this_body"
+    assert "a_x has 1.73205 where 0.866025 is expected" in c.explanation
+
+
+WRONG = [
+    ("pendulum", "rod", "2*a_y = O.Fy - 19.82"),           # 1 % off
+    ("pendulum", "rod", "2.02*a_y = O.Fy - 19.62"),
+    ("pendulum", "rod", "0.1671*alpha = -0.4330*O.Fx - 0.26*O.Fy"),
+    ("pendulum", "rod", "I_G*alpha = -0.433013*O.Fx"),
+    ("pendulum", "rod", "I_G*alpha = -0.433013*O.Fx - 0.25*O.Fy + 0.001"),
+    ("seed_example_1", "plate", "0.5*alpha = 19.9"),
+    ("seed_example_1", "plate", "10*a_x = 50 + 0.0001*a_y"),
+    ("seed_example_2", "body", "2*alpha_1 + 6.03 = 0"),       # 0.5 % off
+    ("seed_example_2", "body", "I_1*alpha_1 = 0"),
+    ("heavy_top", "top", "a_x = pivot.Fx + pivot.Fy"),
+    ("rotated_full_inertia", "bracket", "0.08*alpha_1 - 0.012*alpha_2 + 0.232 = 1.24302"),
+]
+
+
+@pytest.mark.parametrize("name, body, eq", WRONG)
+def test_a_wrong_equation_is_never_called_correct(name, body, eq):
+    c = check(name, body, eq)
+    assert c.diagnosis != "correct" and c.diagnosis in DIAGNOSES
+
+
+def test_tolerance_decides_how_rounded_a_number_may_be():
+    eq = "0.167*alpha = -0.433*O.Fx - 0.25*O.Fy"  # I_G 0.167083: 5e-4 off
+    assert check("pendulum", "rod", eq).diagnosis == "correct"
+    assert check("pendulum", "rod", eq, tol=1e-4).diagnosis != "correct"
+    assert check("pendulum", "rod", "0.17*alpha = -0.43*O.Fx - 0.25*O.Fy",
+                 tol=2e-2).diagnosis == "correct"
+
+
+def test_rounding_where_terms_cancel_is_judged_by_the_terms():
+    # 50 - 49.9 is 0.1 N from two rounded numbers, so the net may be off by 0.1 %
+    # of 99.9, far more than 0.1 % of 0.1
+    v = verify(model("seed_example_1"), [{"body": "plate", "eq": "10*a_x = 50.04 - 0.04"}])
+    assert v.checks[0].diagnosis == "correct"
+
+
+# == the whole answers, files, errors =================================================
+
+def test_seed_example_answer_files_end_to_end():
+    v = mbody.verify(MODELS / "seed_example_1.yaml", MODELS / "answers/seed_example_1.yaml")
+    assert [c.diagnosis for c in v.checks] == [
+        "correct", "correct", "correct", "correct", "missing_applied_load",
+        "not_an_equation_of_this_body"]
+    assert v.student == "worked example 1" and not v.ok and v.correct == 4
+    assert v.uncovered == () and v.rows == 3
+    v = mbody.verify(str(MODELS / "seed_example_2.yaml"),
+                     str(MODELS / "answers/seed_example_2.yaml"))
+    assert [c.diagnosis for c in v.checks] == [
+        "correct", "correct", "missing_gyroscopic_term", "correct", "correct"]
+    assert [u.row for u in v.uncovered] == ["body.y", "body.z", "body.w3"]
+    assert v.checks[2].line == 7
+    d = v.to_dict()
+    assert [e["index"] for e in d["equations"]] == [1, 2, 3, 4, 5]
+    assert d["summary"] == {"equations": 5, "correct": 4, "rows": 6, "uncovered": 3}
+    assert "body.w3" in str(v) and "missing_gyroscopic_term" in str(v)
+
+
+def test_every_answer_file_shipped_verifies():
+    for path in sorted((MODELS / "answers").glob("*.yaml")):
+        target = MODELS / path.name
+        v = verify(mbody.load(target), path)
+        assert v.checks and all(c.diagnosis in DIAGNOSES for c in v.checks), path
+
+
+def errors(name: str, text: str, tmp_path) -> list[str]:
+    f = tmp_path / "answers.yaml"
+    f.write_text(text, encoding="utf-8")
+    with pytest.raises(AnswersError) as exc:
+        verify(model(name), f)
+    return [str(i) for i in exc.value.issues]
+
+
+def test_bad_answers_are_reported_with_file_line_column_and_did_you_mean(tmp_path):
+    text = ("equations:\n"
+            "  - {body: rdo, eq: \"2*a_y = O.Fy\"}\n"
+            "  - {body: rod, eq: \"2*a_y = O.Fy - m*gg\"}\n"
+            "  - {body: rod, eq: \"2*a_y = = O.Fy\"}\n"
+            "  - body: rod\n"
+            "    eq: 2*a_y = O.Fz\n"
+            "  - {body: rod, eqn: \"a_x = 0\"}\n")
+    out = errors("pendulum", text, tmp_path)
+    f = str(tmp_path / "answers.yaml")
+    assert out[0].startswith(f"{f}:7:17: equations[4].eqn: unknown key 'eqn'")
+    assert "did you mean 'eq'?" in out[0]
+    out = errors("pendulum", text.replace("eqn", "eq"), tmp_path)
+    assert out[0].startswith(f"{f}:2:12: equations[0].body: no body named 'rdo'")
+    assert "did you mean 'rod'?" in out[0]
+    # columns point at the character: "2*a_y = O.Fy - m*gg" starts at column 22
+    assert out[1].startswith(f"{f}:3:39: equations[1].eq: unknown name 'gg'")
+    assert "did you mean 'g'?" in out[1]
+    assert out[2].startswith(f"{f}:4:30: equations[2].eq: nothing on the left of '='") or \
+        out[2].startswith(f"{f}:4:30: equations[2].eq: unexpected '='")
+    assert out[3].startswith(f"{f}:6:17: equations[3].eq: no reaction component 'O.Fz'")
+    assert "did you mean 'O.Fx'?" in out[3] or "did you mean 'O.Fy'?" in out[3]
+
+
+def test_names_of_the_other_kind_of_body_are_explained(tmp_path):
+    out = errors("seed_example_2", "equations:\n  - {body: body, eq: 'I_G*alpha = 0'}\n",
+                 tmp_path)
+    assert "inertia tensor, not one inertia" in out[0]
+    out = errors("seed_example_1", "equations:\n  - {body: plate, eq: 'I_1*alpha_1 = 0'}\n",
+                 tmp_path)
+    assert "one moment of inertia: I_G" in out[0]
+    out = errors("seed_example_1", "equations:\n  - {body: plate, eq: 'm*a_y = -m*g'}\n",
+                 tmp_path)
+    assert "no gravity" in out[0]
+    out = errors("rotated_full_inertia",
+                 "equations:\n  - {body: bracket, eq: 'I_1*alpha_1 = 0'}\n", tmp_path)
+    assert "not diagonal" in out[0] and "I_11" in out[0]
+
+
+def test_empty_or_malformed_answer_files(tmp_path):
+    assert "empty" in errors("pendulum", "", tmp_path)[0]
+    assert "no 'equations:' list" in errors("pendulum", "student: x\n", tmp_path)[0]
+    assert "empty" in errors("pendulum", "equations: []\n", tmp_path)[0]
+    assert "missing eq" in errors("pendulum", "equations:\n  - {body: rod}\n", tmp_path)[0]
+    assert "YAML syntax error" in errors("pendulum", "equations: [\n", tmp_path)[0]
+    with pytest.raises(AnswersError, match="no such file"):
+        verify(model("pendulum"), tmp_path / "missing.yaml")
+
+
+def test_parser_is_safe_and_points_at_its_errors():
+    with pytest.raises(EquationError) as exc:
+        parse_equation("2a_x = 0")
+    assert exc.value.position == 1 and "'*'" in exc.value.hint
+    for text in ("__import__('os') = 0", "a_x = [0]", "a_x < 0",
+                 "a_x = 0 = 0", "a_x", "= 3", "sin a_x = 0", "(a_x = 0"):
+        with pytest.raises(EquationError):
+            parse_equation(text)
+    # a dotted name is only ever looked up in the vocabulary
+    with pytest.raises(AnswersError, match="no reaction component 'a_x.__class__'"):
+        verify(model("pendulum"), [("rod", "a_x.__class__ = 0")])
+    eq = parse_equation("pin-1.Fx * 2 − 3 · a_x = 0", labels=["pin-1.Fx"])
+    assert eq.lhs[0] == "-" and eq.lhs[1][1][1] == "pin-1.Fx"
+
+
+def test_fit_compares_up_to_scale_with_exact_zeros():
+    t = Row.of({"a_y": 2.0, "O.Fy": -1.0, CONST: 19.62})
+    s = Row({"a_y": -1.0, "O.Fy": 0.5, CONST: -9.81}, {})
+    f = fit(s, t)
+    assert f.k == pytest.approx(-0.5) and f.error == 0.0
+    s = Row({"a_y": 2.0, CONST: 19.62}, {"a_y": 2.0, CONST: 19.62})  # O.Fy left out
+    assert fit(s, t).errors["O.Fy"] >= 0.99
+    assert fit(Row({}, {}), t) is None
+
+
+def test_verify_needs_no_sympy_and_import_mbody_stays_light():
+    import subprocess
+
+    code = ("import sys, mbody; assert 'mbody.answers' not in sys.modules; "
+            "v = mbody.verify('models/seed_example_2.yaml', "
+            "'models/answers/seed_example_2.yaml'); "
+            "print('sympy' in sys.modules, v.correct)")
+    out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True,
+                         text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["False", "4"]
+
+
+def test_report_shows_the_answers_beside_the_expected_rows():
+    from mbody.present.report import report_html
+
+    m = model("pendulum")
+    v = verify(m, [{"body": "rod", "eq": "I_G*alpha = -m*g*0.25"},
+                   {"body": "rod", "eq": "m*a_x = O.Fx"}])
+    page = report_html(m, answers=v)
+    assert '<section id="answers">' in page and 'href="#answers"' in page
+    assert "<code>I_G*alpha = -m*g*0.25</code>" in page
+    assert "wrong_moment_point" in page
+    assert "<code>0.167083 alpha = -0.433013 O.Fx - 0.25 O.Fy</code>" in page
+    assert "Rows no correct equation gave" in page and "rod.y" in page
+    assert 'id="answers"' not in report_html(m)
+    assert not math.isnan(v.tol)
