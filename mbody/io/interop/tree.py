@@ -358,10 +358,17 @@ def build(name: str, description: str, file: str, bodies: list[TreeBody],
     issues: list[Issue] = []
     kept: dict[int, str] = {}  # tree index -> mbody body name
     owner: dict[int, int] = {}  # tree index -> kept tree index it is welded into, or -1
+    floating = -2  # a massless frame with a free joint: its first massive part moves freely
+    free: set[int] = set()
     for i, b in enumerate(bodies):
         if b.mass > 0:
             kept[i] = b.name
             owner[i] = i
+            if not b.joints and b.parent >= 0 and owner.get(b.parent) == floating:
+                owner[b.parent] = i  # URDF's massless root link: the trunk floats
+                free.add(i)
+        elif [j.type for j in b.joints] == ["free"]:
+            owner[i] = floating
         elif b.joints:
             e = b.joints[0].element
             issues.append(e.issue(
@@ -399,7 +406,7 @@ def build(name: str, description: str, file: str, bodies: list[TreeBody],
         doc.mark((*p, "name"), b.element, "name")
         for key in ("mass", "inertia"):
             doc.mark((*p, key), b.mass_element or b.element, key if key == "mass" else None)
-        m = map_joints(b, kin, i, scale)
+        m = map_joints(b, kin, i, scale) if i not in free else Mapped(None, "")
         if m.type is None:
             continue
         parent = _parent_name(bodies, b.parent, owner, kept)
@@ -416,11 +423,11 @@ def build(name: str, description: str, file: str, bodies: list[TreeBody],
         for key in jd:
             doc.mark((*jp, key), m.element, key if key in ("name", "axis", "type") else None)
     for lp in loops:
-        jd = _loop(lp, bodies, kin, owner, kept)
-        if jd is None:
+        loop = _loop(lp, bodies, kin, owner, kept)
+        if loop is None:
             continue
         jp = ("joints", len(out_joints))
-        out_joints.append(jd)
+        out_joints.append(loop)
         doc.mark(jp, lp.element)
     data: dict[str, Any] = {"model": name, "description": description, "dimension": 3,
                             "gravity": _floats(gravity), "bodies": out_bodies}
@@ -437,6 +444,10 @@ def _parent_name(bodies: list[TreeBody], parent: int, owner: dict[int, int],
     if parent < 0:
         return GROUND
     o = owner.get(parent, -1)
+    if o == -2:
+        raise ModelError([bodies[parent].element.issue(
+            f"the free body '{bodies[parent].name}' has no mass", "give it an inertial with a "
+            "mass, or fix a link with a mass to it before its moving children")])
     return kept[o] if o >= 0 else GROUND
 
 

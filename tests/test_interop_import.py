@@ -1,0 +1,429 @@
+"""MJCF and URDF import (mbody.io.interop): cross-checked against MuJoCo, real models from
+installed packages, and bad XML reported like bad YAML.
+
+MuJoCo is the reference, never used by the import itself: each model is loaded by both,
+put in the same random state (MuJoCo's ``qpos``/``qvel`` written into a keyframe, or URDF
+joint values), and compared body by body: the mass centre's acceleration (MuJoCo's
+``mj_objectAcceleration`` plus gravity, after ``mj_rnePostConstraint``), the angular
+acceleration (world axes), and on tree models the joint reactions against ``cfrc_int``
+(what the parent exerts on the body: [moment about ``subtree_com[root]``, force], world).
+Passive forces, armature, actuators and constraints (limits, contacts) are switched off in
+MuJoCo: the import lists them as not imported.
+"""
+
+from __future__ import annotations
+
+import importlib.metadata
+import re
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import mbody
+from mbody.cli.app import main
+from mbody.errors import ModelError
+from mbody.io.interop.mjcf import read_mjcf, solid
+from mbody.io.interop.urdf import read_urdf
+from mbody.io.interop.xmlsource import parse_xml
+from mbody.model.model import Model
+from mbody.model.validate import validate
+
+ROBOTS = Path(__file__).resolve().parent.parent / "models" / "robots"
+RTOL = 1e-9
+
+# ---- helpers ---------------------------------------------------------------------------
+
+
+def _mujoco():
+    return pytest.importorskip("mujoco")
+
+
+def _quiet(m) -> None:
+    """What the import does not model, switched off in MuJoCo."""
+    mj = _mujoco()
+    bits = mj.mjtDisableBit
+    m.opt.disableflags |= (bits.mjDSBL_CONSTRAINT | bits.mjDSBL_SPRING | bits.mjDSBL_DAMPER
+                           | bits.mjDSBL_ACTUATION)
+    m.dof_armature[:] = 0
+
+
+def _random_state(m, d, rng, speed=1.0) -> None:
+    d.qpos[:] = m.qpos0
+    for j in range(m.njnt):
+        a, t = m.jnt_qposadr[j], m.jnt_type[j]
+        if t == 0:  # free
+            q = rng.normal(size=4)
+            d.qpos[a:a + 3] = rng.normal(size=3)
+            d.qpos[a + 3:a + 7] = q / np.linalg.norm(q)
+        elif t == 1:  # ball
+            q = rng.normal(size=4)
+            d.qpos[a:a + 4] = q / np.linalg.norm(q)
+        else:
+            d.qpos[a] = rng.uniform(-1.5, 1.5)
+    d.qvel[:] = rng.normal(size=m.nv) * speed
+
+
+def _with_key(text: str, d) -> str:
+    nums = lambda v: " ".join(repr(float(x)) for x in v)  # noqa: E731
+    key = f'<keyframe><key name="xcheck" qpos="{nums(d.qpos)}" qvel="{nums(d.qvel)}"/></keyframe>'
+    i = text.rindex("</mujoco>")
+    return text[:i] + key + text[i:]
+
+
+def _compare(m, d, model: Model, reactions: bool) -> float:
+    """Largest relative difference between mbody and MuJoCo at the state; asserts it."""
+    mj = _mujoco()
+    mj.mj_forward(m, d)
+    mj.mj_rnePostConstraint(m, d)
+    sol = mbody.assemble(model).solve()
+    acc = sol.accelerations.reshape(model.n, 6)
+    res = np.zeros(6)
+    worst = 0.0
+    R = model.initial.W_R_B
+    for i, name in enumerate(model.body_names):
+        b = mj.mj_name2id(m, mj.mjtObj.mjOBJ_BODY, name)
+        assert b >= 0, name
+        np.testing.assert_allclose(model.initial.position[i], d.xipos[b], atol=1e-12)
+        mj.mj_objectAcceleration(m, d, mj.mjtObj.mjOBJ_BODY, b, res, 0)
+        lin, ang = res[3:] + m.opt.gravity, res[:3]
+        mine = np.concatenate([acc[i, :3], R[i] @ acc[i, 3:]])
+        ref = np.concatenate([lin, ang])
+        scale = max(1.0, float(np.abs(ref).max()))
+        worst = max(worst, float(np.abs(mine - ref).max()) / scale)
+    if reactions:
+        for jt in model.joints:
+            b = mj.mj_name2id(m, mj.mjtObj.mjOBJ_BODY, jt.child)
+            F, M = np.zeros(3), np.zeros(3)
+            for label in jt.labels:
+                comp, value = label.split(".")[-1], sol.reactions[label]
+                if comp == "Mt":
+                    M += value * np.cross(jt.axis, jt.axis2) / np.linalg.norm(
+                        np.cross(jt.axis, jt.axis2))
+                else:
+                    col = jt.W_E0[:, "xyz".index(comp[1])]
+                    (F if comp[0] == "F" else M)[:] += value * col
+            c = d.subtree_com[m.body_rootid[b]]
+            torque = M + np.cross(jt.at - c, F)
+            ref = d.cfrc_int[b]
+            scale = max(1.0, float(np.abs(ref).max()))
+            worst = max(worst, float(np.abs(np.concatenate([torque, F]) - ref).max()) / scale)
+    assert worst < RTOL, worst
+    return worst
+
+
+def _mjcf_check(path: Path, seeds=(0, 1, 2), reactions=True) -> float:
+    mj = _mujoco()
+    text = path.read_text()
+    m = mj.MjModel.from_xml_path(str(path))
+    _quiet(m)
+    d = mj.MjData(m)
+    worst = 0.0
+    for seed in seeds:
+        _random_state(m, d, np.random.default_rng(seed))
+        doc = read_mjcf(_with_key(text, d), keyframe="xcheck", file=str(path))
+        worst = max(worst, _compare(m, d, Model.from_spec(validate(doc)), reactions))
+    return worst
+
+
+def _urdf_mujoco(path: Path, floating: bool):
+    """MuJoCo's own URDF reader, given the file without its meshes."""
+    mj = _mujoco()
+    text = path.read_text()
+    text = re.sub(r"<(visual|collision)\b.*?</\1>", "", text, flags=re.S)
+    text = re.sub(r"(<robot[^>]*>)", r'\1<mujoco><compiler fusestatic="false" '
+                  r'discardvisual="true"/></mujoco>', text, count=1)
+    if not floating:
+        return mj.MjModel.from_xml_string(text)
+    spec = mj.MjSpec.from_string(text)
+    spec.worldbody.first_body().add_freejoint()
+    return spec.compile()
+
+
+def _urdf_check(path: Path, floating=False, seeds=(0, 1)) -> float:
+    mj = _mujoco()
+    m = _urdf_mujoco(path, floating)
+    _quiet(m)
+    d = mj.MjData(m)
+    worst = 0.0
+    for seed in seeds:
+        rng = np.random.default_rng(seed)
+        d.qpos[:] = m.qpos0
+        d.qvel[:] = 0
+        qp, qv = {}, {}
+        for j in range(m.njnt):
+            if m.jnt_type[j] == 0:
+                continue  # the floating base: at the origin, at rest
+            name = mj.mj_id2name(m, mj.mjtObj.mjOBJ_JOINT, j)
+            qp[name], qv[name] = rng.uniform(-1.5, 1.5), rng.normal()
+            d.qpos[m.jnt_qposadr[j]], d.qvel[m.jnt_dofadr[j]] = qp[name], qv[name]
+        doc = read_urdf(path, joint_positions=qp, joint_velocities=qv, floating_base=floating)
+        worst = max(worst, _compare(m, d, Model.from_spec(validate(doc)), reactions=True))
+    return worst
+
+
+def _robot(path: str) -> Path:
+    try:
+        dist = importlib.metadata.distribution("example-robot-data")
+    except importlib.metadata.PackageNotFoundError:
+        pytest.skip("example-robot-data is not installed (pip install example-robot-data)")
+    p = Path(str(dist.locate_file(
+        f"cmeel.prefix/share/example-robot-data/robots/{path}")))
+    if not p.is_file():
+        pytest.skip(f"example-robot-data has no {path}")
+    return p
+
+
+def _suite(name: str) -> Path:
+    dm = pytest.importorskip("dm_control", reason="dm_control is not installed")
+    return Path(dm.__file__).parent / "suite" / f"{name}.xml"
+
+
+# ---- MJCF against MuJoCo -------------------------------------------------------------
+
+def test_two_link_arm_mjcf_agrees_with_mujoco():
+    assert _mjcf_check(ROBOTS / "two_link_arm.xml") < RTOL
+
+
+def test_keyframe_and_reference_pose():
+    model = mbody.load(ROBOTS / "two_link_arm.xml", keyframe="swing")
+    assert model.initial.omega.any()
+    rest = mbody.load(ROBOTS / "two_link_arm.xml")
+    assert not rest.initial.velocity.any() and not rest.initial.omega.any()
+    with pytest.raises(ModelError, match="did you mean 'swing'"):
+        mbody.load(ROBOTS / "two_link_arm.xml", keyframe="swimg")
+    names = [j.name for j in rest.joints]
+    assert names == ["turntable", "shoulder", "elbow"]
+    assert "shoulder.Fx" in mbody.assemble(rest).reactions
+
+
+COMPOSED = """<mujoco model="composed">
+  <compiler angle="radian" eulerseq="zyx"/>
+  <option gravity="0.3 -0.2 -9.81"/>
+  <worldbody>
+    <body name="torso" pos="0 0 1" euler="0.1 0.2 0.3">
+      <freejoint name="root"/>
+      <inertial pos="0.01 0.02 0" mass="5" fullinertia="0.3 0.4 0.5 0.01 -0.02 0.03"/>
+      <body name="upper" pos="0.1 0 0" quat="0.9 0.1 0.3 0.2">
+        <joint name="hip_x" type="hinge" axis="1 0 0" pos="0 0 0.05"/>
+        <joint name="hip_z" type="hinge" axis="0 0 1" pos="0 0 0.05"/>
+        <joint name="hip_y" type="hinge" axis="0 1 0.3" pos="0 0 0.05"/>
+        <geom type="capsule" fromto="0 0 0 0.05 0.01 -0.3" size="0.05"/>
+        <body name="lower" pos="0 0 -0.35" axisangle="0 1 0 0.4">
+          <joint name="knee_a" type="hinge" axis="2 1 1"/>
+          <joint name="knee_b" type="hinge" axis="0 -1 1"/>
+          <geom type="ellipsoid" size="0.05 0.06 0.15" pos="0 0 -0.15" density="800"/>
+          <body name="foot" pos="0 0 -0.3" xyaxes="0 1 0 -1 0 0.2">
+            <joint name="ankle" type="ball" pos="0 0 0.02"/>
+            <geom type="box" size="0.1 0.04 0.02" mass="0.7"/>
+            <geom type="sphere" size="0.03" pos="0.1 0 0"/>
+          </body>
+        </body>
+      </body>
+      <body name="slider" pos="0 0.3 0" zaxis="0 1 1">
+        <joint name="rail" type="slide" axis="0 0 1"/>
+        <joint name="spin" type="hinge" axis="0 0 1" pos="0.01 0 0"/>
+        <geom type="cylinder" size="0.04 0.1"/>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+
+def test_composed_joints_agree_with_mujoco(tmp_path):
+    """Three hinges through one point -> spherical; two perpendicular -> universal; a
+    hinge and a slide along one axis -> cylindrical; ball; free; every orientation form;
+    geoms of every solid shape with mass and density."""
+    path = tmp_path / "composed.xml"
+    path.write_text(COMPOSED)
+    assert _mjcf_check(path) < RTOL
+    model = mbody.load(path)
+    types = {j.name: j.type for j in model.joints}
+    assert types == {"hip": "spherical", "knee": "universal", "ankle": "spherical",
+                     "rail+spin": "cylindrical"}
+
+
+def test_geom_mass_and_inertia_are_mujocos():
+    mj = _mujoco()
+    xml = COMPOSED
+    m = mj.MjModel.from_xml_string(xml)
+    model = Model.from_spec(validate(read_mjcf(xml)))
+    for i, name in enumerate(model.body_names):
+        b = mj.mj_name2id(m, mj.mjtObj.mjOBJ_BODY, name)
+        assert model.mass[i] == pytest.approx(m.body_mass[b], rel=1e-12)
+        principal = np.linalg.eigvalsh(model.J[i])
+        assert principal == pytest.approx(np.sort(m.body_inertia[b]), rel=1e-9)
+    vol, _ = solid("capsule", np.array([0.05, 0.1, 0]))
+    assert vol == pytest.approx(np.pi * 0.05**2 * 0.2 + 4 / 3 * np.pi * 0.05**3)
+
+
+CONNECT = """<mujoco>
+  <worldbody>
+    <body name="a" pos="0 0 1"><joint name="ja" axis="0 1 0"/>
+      <geom type="capsule" fromto="0 0 0 1 0 0" size="0.05"/></body>
+    <body name="b" pos="2 0 1"><joint name="jb" axis="0 1 0"/>
+      <geom type="capsule" fromto="0 0 0 -1 0 0" size="0.05"/></body>
+  </worldbody>
+  <equality><connect name="tie" body1="a" body2="b" anchor="1 0 0"/></equality>
+</mujoco>"""
+
+
+def test_connect_becomes_a_spherical_joint_closing_the_loop():
+    model = Model.from_spec(validate(read_mjcf(CONNECT)))
+    tie = next(j for j in model.joints if j.name == "tie")
+    assert (tie.type, tie.parent, tie.child) == ("spherical", "a", "b")
+    assert tie.at == pytest.approx([1, 0, 1])
+
+
+def test_acrobot_cartpole_from_dm_control_agree_with_mujoco():
+    for name in ("acrobot", "cartpole"):
+        assert _mjcf_check(_suite(name)) < RTOL
+
+
+def test_humanoid_says_which_body_cannot_be_expressed():
+    """dm_control's humanoid composes everything except its ankles (two hinges at two
+    points: a massless frame between them, which mbody has not)."""
+    with pytest.raises(ModelError) as info:
+        mbody.load(_suite("humanoid"))
+    text = str(info.value)
+    assert "body 'right_foot' has 2 joints" in text
+    assert "anchors differ" in text and "humanoid.xml:" in text
+
+
+def test_humanoid_with_ankles_through_one_point_agrees_with_mujoco(tmp_path):
+    """The same model with each ankle's two hinges moved to one point loads and agrees
+    (free root, universal abdomen and shoulders, spherical hips)."""
+    src = _suite("humanoid")
+    shutil.copytree(src.parent / "common", tmp_path / "common")
+    text = src.read_text().replace('pos="0 0 .08" axis="0 1 0"', 'pos="0 0 .04" axis="0 1 0"')
+    path = tmp_path / "humanoid.xml"
+    path.write_text(text.replace('axis="1 0 .5"', 'axis="1 0 0"'))
+    assert _mjcf_check(path, seeds=(0, 1)) < RTOL
+
+
+# ---- URDF against MuJoCo -------------------------------------------------------------
+
+def test_two_link_arm_urdf_agrees_with_mujoco():
+    assert _urdf_check(ROBOTS / "two_link_arm.urdf") < RTOL
+    model = mbody.load(ROBOTS / "two_link_arm.urdf")
+    assert model.body_names == ("base", "upper_arm", "forearm")  # tool: a frame, no mass
+    assert [j.name for j in model.joints] == ["mount", "shoulder", "elbow"]
+
+
+@pytest.mark.parametrize("path, floating", [
+    ("ur_description/urdf/ur5_robot.urdf", False),
+    ("panda_description/urdf/panda.urdf", False),
+    ("solo_description/robots/solo12.urdf", True),
+    ("a1_description/urdf/a1.urdf", True),
+])
+def test_example_robot_data_agrees_with_mujoco(path, floating):
+    assert _urdf_check(_robot(path), floating) < RTOL
+
+
+def test_joint_values_by_name():
+    model = mbody.load(ROBOTS / "two_link_arm.urdf", joint_positions={"shoulder": 0.5},
+                       joint_velocities={"elbow": 2.0})
+    assert model.initial.omega[2] @ model.initial.omega[2] == pytest.approx(4.0)
+    with pytest.raises(ModelError, match="did you mean 'shoulder'"):
+        mbody.load(ROBOTS / "two_link_arm.urdf", joint_positions={"shouldr": 1})
+    with pytest.raises(mbody.MbodyError, match="this model is read as URDF"):
+        mbody.load(ROBOTS / "two_link_arm.urdf", keyframe="swing")
+
+
+def test_not_imported_is_one_warning():
+    model = mbody.load(ROBOTS / "two_link_arm.xml")
+    notes = [w for w in model.warnings if "not imported" in w.message]
+    assert len(notes) == 1
+    for word in ("contacts", "joint damping", "joint limits", "actuators (shoulder_motor)"):
+        assert word in notes[0].message
+
+
+# ---- bad XML -------------------------------------------------------------------------
+
+def _issues(text: str, reader=read_mjcf) -> list[str]:
+    with pytest.raises(ModelError) as info:
+        reader(text, file="bad.xml")
+    return [str(i) for i in info.value.issues]
+
+
+def test_syntax_error_has_line_and_column():
+    (msg,) = _issues("<mujoco>\n  <worldbody>\n    <body name='a'>\n  </worldbody>\n</mujoco>")
+    assert msg.startswith("bad.xml:4:5:") and "mismatched tag" in msg
+
+
+def test_misspelt_element_and_attribute():
+    msgs = _issues('<mujoco>\n <worldbody>\n  <bodi name="a"/>\n  <body nme="b"/>\n'
+                   " </worldbody>\n</mujoco>")
+    assert msgs[0].startswith("bad.xml:3:3:") and "did you mean 'body'" in msgs[0]
+    assert msgs[1].startswith("bad.xml:4:9:") and "did you mean 'name'" in msgs[1]
+    (msg,) = _issues('<robot name="r"><link name="a"><inertail/></link></robot>', read_urdf)
+    assert "did you mean 'inertial'" in msg
+
+
+def test_bad_numbers_angles_and_units():
+    (msg,) = _issues('<mujoco><compiler angle="degrees"/></mujoco>')
+    assert "did you mean 'degree'" in msg
+    (msg,) = _issues('<mujoco><worldbody><body pos="0 0 1m"><geom size="1"/>'
+                     "</body></worldbody></mujoco>")
+    assert "'1m' is not a number" in msg and ":1:" in msg
+    (msg,) = _issues('<mujoco><worldbody><body euler="0 0"><geom size="1"/>'
+                     "</body></worldbody></mujoco>")
+    assert "expected 3 numbers, got 2" in msg
+
+
+def test_entities_and_doctype_are_refused():
+    bomb = ('<?xml version="1.0"?>\n<!DOCTYPE lolz [<!ENTITY lol "lol">'
+            + "".join(f'<!ENTITY lol{i} "{"&lol" + str(i - 1) + ";" if i > 1 else "&lol;"}'
+                      f'{"&lol" + str(i - 1) + ";" if i > 1 else "&lol;"}">'
+                      for i in range(1, 10))
+            + ']>\n<mujoco model="&lol9;"/>')
+    (msg,) = _issues(bomb)
+    assert "document type declaration is not accepted" in msg
+    ext = '<!DOCTYPE r [<!ENTITY x SYSTEM "file:///etc/passwd">]><robot name="&x;"/>'
+    (msg,) = _issues(ext, read_urdf)
+    assert "not accepted" in msg
+    assert parse_xml("<a/>").tag == "a"
+
+
+def test_massless_moving_body_is_an_error():
+    (msg,) = _issues("<mujoco><worldbody><body name='ghost'><joint name='j'/>"
+                     "</body></worldbody></mujoco>")
+    assert "body 'ghost' has no mass but moves on joint 'j'" in msg
+
+
+def test_mesh_mass_is_an_error():
+    (msg,) = _issues("<mujoco><asset><mesh name='m' file='m.stl'/></asset><worldbody>"
+                     "<body name='b'><joint/><geom type='mesh' mesh='m'/></body>"
+                     "</worldbody></mujoco>")
+    assert "takes its mass from a mesh geom" in msg and "<inertial>" in msg
+
+
+# ---- the command line ----------------------------------------------------------------
+
+def test_cli_reads_mjcf_and_urdf(capsys):
+    assert main(["check", str(ROBOTS / "two_link_arm.xml"), "--keyframe", "swing"]) == 0
+    out = capsys.readouterr()
+    assert "imported from two_link_arm.xml (MJCF)" in out.out
+    assert main(["solve", str(ROBOTS / "two_link_arm.urdf"), "--q", "shoulder=30deg",
+                 "--qd", "elbow=1"]) in (0, 1)
+    assert re.search(r"shoulder\s+Fx\s", capsys.readouterr().out)
+
+
+def test_cli_bad_xml_exits_2_without_traceback(tmp_path, capsys):
+    bad = tmp_path / "bad.xml"
+    bad.write_text("<mujoco>\n  <worldbody>\n    <bodi/>\n  </worldbody>\n</mujoco>\n")
+    assert main(["check", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert f"{bad}:3:5:" in err and "did you mean 'body'" in err
+    assert "Traceback" not in err
+    assert main(["check", str(ROBOTS / "two_link_arm.urdf"), "--q", "shoulder"]) == 2
+    assert "JOINT=VALUE" in capsys.readouterr().err
+
+
+def test_format_flag_reads_any_extension(tmp_path, capsys):
+    copy = tmp_path / "arm.model"
+    copy.write_text((ROBOTS / "two_link_arm.urdf").read_text())
+    assert main(["check", str(copy), "--format", "urdf"]) == 0
+    capsys.readouterr()
