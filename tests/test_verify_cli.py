@@ -1,0 +1,88 @@
+"""`mbody verify` and `mbody report --answers`, run as a user runs them."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+from mbody.answers import DIAGNOSES
+
+ROOT = Path(__file__).resolve().parent.parent
+MODELS = ROOT / "models"
+
+
+def mbody(*args: str | Path) -> subprocess.CompletedProcess:
+    env = {k: v for k, v in os.environ.items() if k != "MBODY_DEBUG"}
+    p = subprocess.run([sys.executable, "-m", "mbody", *map(str, args)], cwd=ROOT, env=env,
+                       capture_output=True, text=True, timeout=120)
+    assert "Traceback" not in p.stderr and "Traceback" not in p.stdout, p.stderr
+    return p
+
+
+def test_verify_explains_each_equation_and_exits_1_when_one_is_wrong():
+    p = mbody("verify", MODELS / "seed_example_2.yaml", MODELS / "answers/seed_example_2.yaml")
+    assert p.returncode == 1, p.stderr
+    out = p.stdout
+    assert "[3] body: I_3*alpha_3 = 0  (line 7)\n    missing_gyroscopic_term: " in out
+    assert "    expected (body.w3): 4 alpha_3 + 2 = 0\n" in out
+    assert "rows no correct equation gave:\n    body.y: a_y = 0\n" in out
+    assert out.rstrip().endswith("4 of 5 equations correct; 3 of 6 rows covered.")
+
+
+def test_verify_json_has_one_entry_per_equation_in_file_order(tmp_path):
+    answers = tmp_path / "a.yaml"
+    answers.write_text("equations:\n"
+                       "  - {body: rod, eq: 'I_G*alpha = -m*g*0.25'}\n"
+                       "  - {body: rod, eq: '2*a_y = O.Fy - 19.62'}\n"
+                       "  - {body: rod, eq: '2*a_y = 15.9435 - 19.62'}\n", encoding="utf-8")
+    p = mbody("verify", MODELS / "pendulum.yaml", answers, "--json")
+    assert p.returncode == 1, p.stderr
+    d = json.loads(p.stdout)
+    assert [e["diagnosis"] for e in d["equations"]] == [
+        "wrong_moment_point", "correct", "reaction_treated_as_known"]
+    assert [e["line"] for e in d["equations"]] == [2, 3, 4]
+    assert all(set(e) >= {"diagnosis", "expected", "explanation"} for e in d["equations"])
+    assert all(e["diagnosis"] in DIAGNOSES for e in d["equations"])
+    assert d["equations"][0]["expected"] == "0.167083 alpha = -0.433013 O.Fx - 0.25 O.Fy"
+    assert [u["row"] for u in d["uncovered"]] == ["rod.x", "rod.theta"]
+    assert d["summary"] == {"equations": 3, "correct": 1, "rows": 3, "uncovered": 2}
+
+
+def test_verify_exits_0_when_every_equation_is_correct_and_tol_applies(tmp_path):
+    answers = tmp_path / "a.yaml"
+    answers.write_text("equations:\n  - {body: plate, eq: '0.5*alpha = 20.02'}\n",
+                       encoding="utf-8")
+    p = mbody("verify", MODELS / "seed_example_1.yaml", answers)
+    assert p.returncode == 0, p.stdout + p.stderr
+    assert "1 of 1 equation correct" in p.stdout
+    assert mbody("verify", MODELS / "seed_example_1.yaml", answers, "--tol",
+                 "1e-4").returncode == 1
+    p = mbody("verify", MODELS / "seed_example_1.yaml", answers, "--tol", "2")
+    assert p.returncode == 2 and "between 0 and 1" in p.stderr
+
+
+def test_a_bad_answers_file_is_exit_2_with_file_line_column(tmp_path):
+    answers = tmp_path / "a.yaml"
+    answers.write_text("equations:\n  - {body: rod, eq: '2*a_y = O.Fy - m*gg'}\n"
+                       "  - {body: rdo, eq: 'a_x = 0'}\n", encoding="utf-8")
+    p = mbody("verify", MODELS / "pendulum.yaml", answers)
+    assert p.returncode == 2
+    assert p.stderr.startswith("mbody: error: 2 problems in the answers:\n")
+    assert f"{answers}:2:39: equations[0].eq: unknown name 'gg'" in p.stderr
+    assert f"{answers}:3:12: equations[1].body: no body named 'rdo'" in p.stderr
+    assert "did you mean 'rod'?" in p.stderr
+    p = mbody("verify", MODELS / "pendulum.yaml", tmp_path / "none.yaml")
+    assert p.returncode == 2 and "no such file" in p.stderr
+
+
+def test_report_shows_the_answers(tmp_path):
+    page = tmp_path / "r.html"
+    p = mbody("report", MODELS / "seed_example_2.yaml", "-o", page, "--answers",
+              MODELS / "answers/seed_example_2.yaml")
+    assert p.returncode == 0, p.stderr
+    html = page.read_text(encoding="utf-8")
+    assert '<section id="answers">' in html and "missing_gyroscopic_term" in html
+    assert "<code>I_3*alpha_3 = 0</code>" in html
