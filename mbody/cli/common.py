@@ -94,13 +94,17 @@ def parse_known(pairs: Sequence[str]) -> dict[str, float]:
 
 def add_import_options(command: argparse.ArgumentParser) -> None:
     """Give a command that reads a model the options of MJCF and URDF input, and make its
-    handler pass them to `load_model`. A command with its own ``--format`` (``convert``:
-    the output's) reads its input itself and is left as it is."""
-    if "--format" in command._option_string_actions:
+    handler pass them to `load_model`. A command that has a ``--keyframe`` of its own
+    (``convert``) reads its input itself and is left as it is; where ``--format`` names
+    the output's format (``fbd``, ``export``), the model's is ``--model-format``."""
+    taken = command._option_string_actions
+    if "--keyframe" in taken:
         return
     g = command.add_argument_group("MJCF and URDF input")
-    g.add_argument("--format", choices=("yaml", "mjcf", "urdf"), help="the model file's "
-                   "format, when its extension (.yaml, .xml, .urdf) does not say it")
+    g.add_argument("--model-format" if "--format" in taken else "--format",
+                   dest="model_format", choices=("yaml", "mjcf", "urdf"),
+                   help="the model file's format, when its extension (.yaml, .xml, .urdf) "
+                   "does not say it")
     g.add_argument("--keyframe", metavar="NAME", help="MJCF: the <key> whose qpos and qvel "
                    "give the state (default: the reference pose, at rest)")
     g.add_argument("--q", action="append", default=[], metavar="JOINT=VALUE",
@@ -130,8 +134,8 @@ def _with_import_options(run: Callable[[argparse.Namespace], int]
 def import_options(a: argparse.Namespace) -> dict[str, Any]:
     """The `mbody.load` options given on the command line (only those given)."""
     out: dict[str, Any] = {}
-    if getattr(a, "format", None):
-        out["format"] = a.format
+    if getattr(a, "model_format", None):
+        out["format"] = a.model_format
     if getattr(a, "keyframe", None) is not None:
         out["keyframe"] = a.keyframe
     for flag, key in (("q", "joint_positions"), ("qd", "joint_velocities")):
