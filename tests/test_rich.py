@@ -231,3 +231,14 @@ def test_displays_are_not_loaded_by_import_mbody():
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                        timeout=120, cwd=MODELS.parent)
     assert r.returncode == 0 and r.stdout.strip() == "[]", r.stderr
+
+
+def test_the_docs_show_the_current_solution_display():
+    """docs/notebook.md shows the pendulum's Solution display as real HTML (refreshed by
+    `tools/make_notebook.py --docs`): it must be what the code gives now."""
+    page = (MODELS.parent / "docs" / "notebook.md").read_text(encoding="utf-8")
+    shown = page.split("<!-- solution display (tools/make_notebook.py --docs) -->\n", 1)[1]
+    shown = shown.split("\n<!-- end -->", 1)[0]
+    sol = mbody.assemble(mbody.load(MODELS / "pendulum.yaml")).solve()
+    assert shown == rich.solution_html(sol)
+    assert (MODELS.parent / "docs" / "images" / "notebook_body.png").stat().st_size > 20_000

@@ -2,6 +2,11 @@
 
     python tools/make_notebook.py           # write it
     python tools/make_notebook.py --check   # exit 1 when the stored notebook differs
+    python tools/make_notebook.py --docs    # docs/notebook.md's displays, from this code
+
+``--docs`` puts the pendulum's Solution display (its HTML) between the markers in
+docs/notebook.md and a screenshot of its body display (headless Chromium) in
+docs/images/notebook_body.png.
 
 The notebook is stored without outputs: its diff is the cells' text, it holds no stale
 numbers and no megabyte animation, and `tests/test_notebook.py` runs it top to bottom.
@@ -11,7 +16,9 @@ Cell ids are fixed (``cell-00``...) so that writing it twice gives the same file
 from __future__ import annotations
 
 import argparse
+import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 import nbformat
@@ -19,6 +26,10 @@ from nbformat import v4
 
 ROOT = Path(__file__).resolve().parent.parent
 NOTEBOOK = ROOT / "docs" / "notebooks" / "tutorial.ipynb"
+PAGE = ROOT / "docs" / "notebook.md"
+PICTURE = ROOT / "docs" / "images" / "notebook_body.png"
+BEGIN, END = "<!-- solution display (tools/make_notebook.py --docs) -->", "<!-- end -->"
+CHROMIUM = "/usr/bin/chromium"
 
 CELLS: list[tuple[str, str]] = [
     ("md", """\
@@ -203,11 +214,57 @@ def text() -> str:
     return nbformat.writes(build()) + "\n"
 
 
+def solution_display() -> str:
+    """The pendulum's Solution display, as docs/notebook.md shows it.
+
+    Returns
+    -------
+    str
+    """
+    import mbody
+    from mbody.present.rich import solution_html
+
+    return solution_html(mbody.assemble(mbody.load(ROOT / "models" / "pendulum.yaml")).solve())
+
+
+def write_docs() -> None:
+    """Refresh the Solution display in docs/notebook.md and the body display's picture."""
+    from PIL import Image, ImageChops
+
+    import mbody
+    from mbody.present.rich import body_html
+
+    page = PAGE.read_text(encoding="utf-8")
+    head, rest = page.split(BEGIN, 1)
+    PAGE.write_text(head + BEGIN + "\n" + solution_display() + "\n" + END
+                    + rest.split(END, 1)[1], encoding="utf-8")
+    asm = mbody.assemble(mbody.load(ROOT / "models" / "pendulum.yaml"))
+    with tempfile.TemporaryDirectory() as tmp:
+        html, png = Path(tmp) / "body.html", Path(tmp) / "body.png"
+        html.write_text('<html><head><meta charset="utf-8"/></head><body style="margin:8px">'
+                        + body_html(asm.bodies["rod"]) + "</body></html>", encoding="utf-8")
+        subprocess.run([CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu",
+                        "--hide-scrollbars", "--force-device-scale-factor=1",
+                        "--window-size=760,1500", f"--screenshot={png}", html.as_uri()],
+                       check=True, capture_output=True, timeout=120)
+        img = Image.open(png).convert("RGB")
+        box = ImageChops.difference(img, Image.new("RGB", img.size, "white")).getbbox()
+        assert box is not None, "the screenshot is blank"
+        img = img.crop((0, 0, min(img.width, box[2] + 12), min(img.height, box[3] + 12)))
+        img.save(PICTURE, optimize=True)
+    print(f"wrote {PAGE.relative_to(ROOT)} (Solution display) and {PICTURE.relative_to(ROOT)}")
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--check", action="store_true",
                    help="exit 1 when the stored notebook is not what this script writes")
+    p.add_argument("--docs", action="store_true",
+                   help="refresh the displays docs/notebook.md shows")
     a = p.parse_args(argv)
+    if a.docs:
+        write_docs()
+        return 0
     want = text()
     if a.check:
         same = NOTEBOOK.is_file() and NOTEBOOK.read_text(encoding="utf-8") == want
