@@ -254,6 +254,8 @@ class SymbolicBody:
         in time (``50*sin(2*t)``), a spring's tension, a known reaction.
     t : float
         The time of the state (s).
+    reactions : tuple of str
+        The reaction labels acting on the body, in the order of the columns of G.
     """
 
     body: str
@@ -263,6 +265,7 @@ class SymbolicBody:
     values: dict[str, float]
     definitions: dict[str, str] = field(default_factory=dict)
     t: float = 0.0
+    reactions: tuple[str, ...] = ()
 
     @property
     def newton(self) -> tuple[SymbolicRow, ...]:
@@ -278,9 +281,8 @@ class SymbolicBody:
 
     @property
     def unknowns(self) -> list[str]:
-        """The reaction labels on this body whose values are not known."""
-        seen = dict.fromkeys(t.key for r in self.rows for t in r.terms if t.part == REACTION)
-        return [k for k in seen if k not in self.values]
+        """The reaction labels on this body whose values are not known (column order)."""
+        return [k for k in self.reactions if k not in self.values]
 
     def evaluate(self, values: dict[str, float] | None = None) -> list[RowValues]:
         """Every row's numbers with `values` (default: the model's, `values`) substituted.
@@ -572,13 +574,15 @@ def body_symbolic(asm: Assembly, name: str) -> SymbolicBody:
         rows.append(SymbolicRow(eq.row, tuple(terms)))
 
     known = model.known_reactions_at(state.t)
-    for label in dict.fromkeys(t.key for row in rows for t in row.terms if t.part == REACTION):
+    on = {t.key for row in rows for t in row.terms if t.part == REACTION}
+    labels = tuple(label for label in asm.reactions if label in on)
+    for label in labels:
         if label in known:
             values[label] = known[label]
             if label in model.known_expressions:
                 definitions[label] = str(model.known_expressions[label])
     return SymbolicBody(name, model.dimension, form, tuple(rows), values, definitions,
-                        float(state.t))
+                        float(state.t), labels)
 
 
 @dataclass(frozen=True)
