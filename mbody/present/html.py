@@ -23,6 +23,7 @@ STYLE = (
     ".mbody pre{margin:2px 0 6px 0}"
     ".mbody .warn{color:#a30}"
     ".mbody figure{margin:4px 0}"
+    ".mbody svg{max-width:100%;height:auto}"
 )
 """One style block, scoped to the displays' outer ``div.mbody``."""
 
