@@ -85,6 +85,12 @@ class ForceOnBody:
         """|vector| (for unknown reactions, of the unit direction: 1)."""
         return float(np.linalg.norm(self.W_vector))
 
+    def __repr__(self) -> str:  # the dataclass's would print four arrays
+        what = ("unknown" if self.value is None else f"= {_num(self.value)}"
+                ) if self.kind == REACTION else f"|{_num(self.magnitude)}|"
+        return (f"<ForceOnBody {self.name!r}: {self.kind}{' couple' if self.couple else ''} "
+                f"{what} at {_vec(self.W_point)} m (world); .W_vector, .B_moment>")
+
 
 @dataclass(frozen=True)
 class FreeBodyDiagram:
@@ -98,12 +104,6 @@ class FreeBodyDiagram:
         2 (planar) or 3 (spatial).
     mass : float
         The body's mass (kg).
-    def __repr__(self) -> str:  # the dataclass's would print four arrays
-        what = ("unknown" if self.value is None else f"= {_num(self.value)}"
-                ) if self.kind == REACTION else f"|{_num(self.magnitude)}|"
-        return (f"<ForceOnBody {self.name!r}: {self.kind}{' couple' if self.couple else ''} "
-                f"{what} at {_vec(self.W_point)} m (world); .W_vector, .B_moment>")
-
     inertia : (3, 3) array
         Inertia tensor about the mass centre, body axes (kg m^2); zero for a particle.
     W_position : (3,) array
@@ -161,6 +161,11 @@ class FreeBodyDiagram:
 
         return figure_svg(self.draw())
 
+    def __repr__(self) -> str:  # the dataclass's would print every force's arrays
+        unknown = sum(f.unknown for f in self.forces)
+        return (f"<FreeBodyDiagram of {self.body!r}: {len(self.applied)} applied, "
+                f"{len(self.reactions)} reaction ({unknown} unknown); .forces, .draw()>")
+
 
 @dataclass(frozen=True)
 class Equation:
@@ -174,11 +179,6 @@ class Equation:
         The row's coordinate label (``rod.x``, ``rod.w1``...).
     lhs : dict of str to float
         Acceleration name -> coefficient (a row of M: kg, or kg m^2 on Euler rows).
-    def __repr__(self) -> str:  # the dataclass's would print every force's arrays
-        unknown = sum(f.unknown for f in self.forces)
-        return (f"<FreeBodyDiagram of {self.body!r}: {len(self.applied)} applied, "
-                f"{len(self.reactions)} reaction ({unknown} unknown); .forces, .draw()>")
-
     gyro : float
         This row of b (N m; 0 on Newton rows).
     rhs : float
@@ -211,6 +211,15 @@ class Equation:
             right = f"{right} {term}".strip()
         return f"{left} = {right or '0'}"
 
+    def __repr__(self) -> str:  # the row written out, cut short for a row of many terms
+        text = str(self)
+        return f"<Equation {self.row}: {text if len(text) < 240 else text[:236] + ' ...'}>"
+
+    def _repr_latex_(self) -> str:  # notebook display as display math
+        from importlib import import_module  # by name: mbody.present.rich imports this module
+
+        return import_module("mbody.present.rich").equation_latex(self)
+
 
 @dataclass(frozen=True)
 class BodyEquations:
@@ -224,15 +233,6 @@ class BodyEquations:
         Every force and couple on the body.
     newton : tuple of Equation
         Newton's rows, m a_G = ΣF, in world axes.
-    def __repr__(self) -> str:  # the row written out, cut short for a row of many terms
-        text = str(self)
-        return f"<Equation {self.row}: {text if len(text) < 240 else text[:236] + ' ...'}>"
-
-    def _repr_latex_(self) -> str:  # notebook display as display math
-        from importlib import import_module  # by name: mbody.present.rich imports this module
-
-        return import_module("mbody.present.rich").equation_latex(self)
-
     euler : tuple of Equation
         Euler's rows about the mass centre, in body axes (planar: one, about z); none for
         a particle.
@@ -265,19 +265,6 @@ class BodyEquations:
                              "mbody.assemble(model).bodies[name].symbolic()")
         return body_symbolic(self.assembly, self.body)
 
-
-def _num(x: float) -> str:
-    x = 0.0 if abs(x) < 1e-12 else x  # rounding noise from rotations
-    s = f"{x:.6g}"
-    return "0" if s in ("-0", "0") else s
-
-
-def _terms(pairs: list[tuple[float, str]]) -> str:
-    out = ""
-    for coef, name in pairs:
-        if abs(coef) < 1e-12:  # rounding noise from rotations, not a term
-            continue
-        mag = abs(coef)
     def __repr__(self) -> str:  # the dataclass's would print the diagram's arrays (1-6 KB)
         unknown = sum(f.unknown for f in self.fbd.forces)
         return (f"<BodyEquations of {self.body!r}: {len(self.newton)} Newton and "
@@ -299,16 +286,29 @@ def _terms(pairs: list[tuple[float, str]]) -> str:
 
         return import_module("mbody.present.rich").body_latex(self)
 
+
+def _num(x: float) -> str:
+    x = 0.0 if abs(x) < 1e-12 else x  # rounding noise from rotations
+    s = f"{x:.6g}"
+    return "0" if s in ("-0", "0") else s
+
+
+def _vec(x: np.ndarray) -> str:
+    return "(" + ", ".join(_num(v) for v in x) + ")"
+
+
+def _terms(pairs: list[tuple[float, str]]) -> str:
+    out = ""
+    for coef, name in pairs:
+        if abs(coef) < 1e-12:  # rounding noise from rotations, not a term
+            continue
+        mag = abs(coef)
         txt = name if _num(mag) == "1" else f"{_num(mag)} {name}"  # 0.9999999 is 1
         if not out:
             out = f"-{txt}" if coef < 0 else txt
         else:
             out += f" {'-' if coef < 0 else '+'} {txt}"
     return out
-
-def _vec(x: np.ndarray) -> str:
-    return "(" + ", ".join(_num(v) for v in x) + ")"
-
 
 
 def body_equations(asm: Assembly, i: int) -> BodyEquations:
