@@ -400,7 +400,8 @@ class _Diagnoser:
                 sol = self.solved()
                 if sol is not None and k in sol:
                     details["value_solved"] = sol[k]
-                    text += (f" (solved with the joints, it is {_num(sol[k])} at this "
+                    unit = " N m" if _is_moment(k) else " N"
+                    text += (f" (solved with the joints, it is {_num(sol[k])}{unit} at this "
                              "instant; but it is an output, not an input)")
             else:
                 text = (f"the reactions {', '.join(gone)} are replaced by numbers (they add "
