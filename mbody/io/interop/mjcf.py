@@ -535,7 +535,7 @@ class _Reader:
         m = sum(p[0] for p in parts)
         if m <= MIN_MASS:
             return
-        c = sum(p[0] * p[1] for p in parts) / m
+        c = np.sum([p[0] * p[1] for p in parts], axis=0) / m
         J = np.zeros((3, 3))
         for mi, pi, Ji, _ in parts:
             d = pi - c

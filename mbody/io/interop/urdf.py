@@ -231,8 +231,8 @@ class _Reader:
             order.extend(children.get(n, []))
         for n in order:
             ln = links[n]
-            j = joints_of.get(n)
-            if j is None:
+            joint = joints_of.get(n)
+            if joint is None:
                 b = TreeBody(_name(n), -1, np.zeros(3), np.array([1.0, 0, 0, 0]), [], ln)
                 self.inertial(b, ln)
                 if floating:
@@ -243,12 +243,13 @@ class _Reader:
                               "the ground; floating_base=True lets it move)", n)
                     b.mass = 0.0
             else:
-                pos, quat = self.origin(j)
-                parent_link = j.find("parent")
+                pos, quat = self.origin(joint)
+                parent_link = joint.find("parent")
                 assert parent_link is not None
                 b = TreeBody(_name(n), index[parent_link.get("link") or ""], pos, quat,
-                             self.joint(j), ln, fixed_name=j.get("name") or f"{n}_fixed",
-                             fixed_element=j)
+                             self.joint(joint), ln,
+                             fixed_name=joint.get("name") or f"{n}_fixed",
+                             fixed_element=joint)
                 self.inertial(b, ln)
             b.shape = self.shape(ln)
             index[n] = len(bodies)
@@ -330,6 +331,7 @@ class _Reader:
         for v in ln.findall("visual") + ln.findall("collision"):
             g = v.find("geometry")
             for s in g.children if g is not None else []:
+                shape: dict[str, Any]
                 try:
                     if s.tag == "box":
                         size = [float(x) for x in (s.get("size") or "").split()]
