@@ -36,7 +36,7 @@ def test_trajectory_repr_is_short():
 NEXT = {  # what each repr suggests calling next
     "Solution": "sol[label]", "State": ".replace(", "Body": ".inertia",
     "Joint": "reactions ", "BodyEquations": "print() it", "FreeBodyDiagram": ".draw()",
-    "ForceOnBody": ".W_vector",
+    "ForceOnBody": ".W_vector", "ConstraintJacobian": ".row(label)",
 }
 
 
@@ -54,6 +54,7 @@ def test_every_public_object_has_a_short_repr(path):
     objs += [(f, "ForceOnBody") for f in eq.fbd.forces]
     objs += [(j, "Joint") for j in model.joints] + [(ld, "Load") for ld in model.loads]
     objs += [(e, "Equation") for e in eq.equations]
+    objs += [(asm.jacobian(), "ConstraintJacobian")]
     for obj, kind in objs:
         text = repr(obj)
         assert text.startswith(f"<{kind} ") or text.startswith(f"<{kind}:"), text

@@ -162,6 +162,13 @@ class ConstraintJacobian:
         r = self.matrix.getrow(self.rows.index(label)).tocoo()
         return {self.columns[j]: float(v) for j, v in zip(r.col, r.data, strict=True)}
 
+    def __repr__(self) -> str:  # the dataclass's would print every label and the matrix
+        m, n = self.matrix.shape
+        worst = float(np.abs(self.phi).max()) if self.phi.size else 0.0
+        return (f"<ConstraintJacobian G^T: {m} constraints x {n} coordinates, "
+                f"{self.matrix.nnz} nonzero, max |phi| {worst:.3g}; .row(label), "
+                f".toarray(), .rows, .columns>")
+
 
 JOINT_TOL = 1e-6
 """Relative size of φ (to the model's extent) and of Gᵀ v (to its largest speed) above
