@@ -418,3 +418,62 @@ def test_report_shows_the_answers_beside_the_expected_rows():
     assert "Rows no correct equation gave" in page and "rod.y" in page
     assert 'id="answers"' not in report_html(m)
     assert not math.isnan(v.tol)
+
+
+def _written(row: Row, fmt: str, k: float = 1.0, drop: str = "") -> str:
+    """A row written as a student would: every term, numbers in format `fmt`, = 0."""
+    parts = [f"({format(k * v, fmt)})" + ("" if key == CONST else f"*{key}")
+             for key, v in row.coef.items() if v != 0.0 and key != drop]
+    return " + ".join(parts or ["0"]) + " = 0"
+
+
+def test_every_row_of_every_shipped_model_is_correct_and_none_with_a_term_left_out():
+    from mbody.answers.rows import body_rows
+
+    for path in sorted(MODELS.glob("*.yaml")):
+        m = mbody.load(path)
+        asm = mbody.assemble(m)
+        answers, expect = [], []
+        for b in m.body_names:
+            for r in body_rows(asm, b).rows:
+                if not r.row.unknowns:
+                    continue
+                for fmt, k in (("", 1.0), (".5g", 1.0), (".6g", -3.7)):
+                    answers.append((b, _written(r.row, fmt, k)))
+                    expect.append((True, r.label))
+                for key in sorted(r.row.keys):
+                    answers.append((b, _written(r.row, ".6g", 2.0, drop=key)))
+                    expect.append((False, f"{r.label} without {key}"))
+        if not answers:
+            continue
+        v = verify(m, answers, asm=asm)
+        for c, (ok, what) in zip(v.checks, expect, strict=True):
+            if ok:
+                assert c.correct and c.row == what, (path.name, what, c.explanation)
+            elif c.correct:
+                # only a different, true equation may pass: about a fixed pivot, a row
+                # that says alpha_2 = 0 is the same as I_P alpha_2 = 0 (the heavy top)
+                assert c.details.get("form") == "fixed_pivot", (path.name, what, c.eq)
+
+
+def test_particles_known_reactions_and_loads_that_vary_in_time():
+    # a particle: translation rows only; its link tension O.T
+    assert diagnosis("point_pendulum", "bob", "m*a_y = 0.866025*O.T - m*g") == "correct"
+    assert check("point_pendulum", "bob", "m*a_y = 0.866025*O.T").details["loads"] == \
+        ["gravity"]
+    with pytest.raises(AnswersError, match="particle"):
+        verify(model("point_pendulum"), [("bob", "I_G*alpha = 0")])
+    # a reaction the file gives (fork.Mt = 16 N m) by its label or by its value
+    assert diagnosis("rotor_gyroscopic_bearings", "flywheel",
+                     "0.204167*alpha_1 + 7.83333 = fork.Mt") == "correct"
+    assert diagnosis("rotor_gyroscopic_bearings", "flywheel",
+                     "0.204167*alpha_1 + 7.83333 = 16") == "correct"
+    assert diagnosis("rotor_gyroscopic_bearings", "flywheel",
+                     "0.204167*alpha_1 = 16") == "missing_gyroscopic_term"
+    # a thrust 300 exp(-t/4) N at t = 0, by its name or its law
+    assert diagnosis("satellite_thruster", "satellite", "m*a_z = F_main_engine_3") == \
+        "correct"
+    assert diagnosis("satellite_thruster", "satellite", "m*a_z = 300*exp(-0/4)") == \
+        "correct"
+    with pytest.raises(AnswersError, match="unknown function 'ln'"):
+        verify(model("satellite_thruster"), [("satellite", "m*a_z = ln(2)")])

@@ -34,8 +34,10 @@ class Row:
     coef : dict of str to float
         Unknown name -> coefficient; `CONST` -> the constant term.
     scale : dict of str to float
-        Key -> the sum of the magnitudes of the terms that made the coefficient (at
-        least its absolute value; a key absent from `scale` uses that).
+        Key -> the sum of the magnitudes of the rounded numbers that made the
+        coefficient: its error scale (0 for a coefficient that is exact, such as one
+        written with the vocabulary's names; a key absent from `scale` uses the
+        coefficient's magnitude).
     """
 
     coef: dict[str, float]
@@ -43,14 +45,28 @@ class Row:
 
     @classmethod
     def of(cls, coef: Mapping[str, float], scale: Mapping[str, float] | None = None) -> Row:
-        """A row from coefficients, the scale defaulting to their magnitudes."""
+        """A row from coefficients, the scale defaulting to their magnitudes.
+
+        Parameters
+        ----------
+        coef : mapping of str to float
+            Key -> coefficient.
+        scale : mapping of str to float, optional
+            Key -> error scale, raised to at least the coefficient's magnitude.
+
+        Returns
+        -------
+        Row
+        """
         scale = dict(scale or {})
         return cls(dict(coef), {k: max(abs(v), scale.get(k, 0.0)) for k, v in coef.items()})
 
     def get(self, key: str) -> float:
+        """The coefficient of `key` (0 when absent)."""
         return self.coef.get(key, 0.0)
 
     def err(self, key: str) -> float:
+        """The error scale of `key` (its magnitude when not given)."""
         return self.scale.get(key, abs(self.coef.get(key, 0.0)))
 
     @property
@@ -67,7 +83,20 @@ class Row:
                 absolute: Iterable[str] = ()) -> Row:
         """Coefficients that are rounding noise set to exactly 0: below `NOISE` times
         their scale (or times `magnitude`), or below `NOISE` itself for the keys named in
-        `absolute` (direction cosines and lever arms of the reaction columns)."""
+        `absolute` (direction cosines and lever arms of the reaction columns).
+
+        Parameters
+        ----------
+        magnitude : mapping of str to float, optional
+            Key -> the magnitude of the terms that made it, when larger than its scale.
+        absolute : iterable of str
+            Keys whose noise is judged in absolute terms.
+
+        Returns
+        -------
+        Row
+            The same row, noise set to 0.
+        """
         mag = magnitude or {}
         absolute = set(absolute)
         coef = {}
@@ -79,17 +108,40 @@ class Row:
         return Row(coef, dict(self.scale))
 
     def scaled(self, k: float) -> Row:
+        """k times the row (scales times |k|)."""
         return Row({n: k * v for n, v in self.coef.items()},
                    {n: abs(k) * s for n, s in self.scale.items()})
 
     def without(self, keys: Iterable[str]) -> Row:
-        """The row with the terms of `keys` dropped."""
+        """The row with the terms of `keys` dropped.
+
+        Parameters
+        ----------
+        keys : iterable of str
+            The terms to drop.
+
+        Returns
+        -------
+        Row
+        """
         drop = set(keys)
         return Row({n: v for n, v in self.coef.items() if n not in drop},
                    {n: s for n, s in self.scale.items() if n not in drop})
 
     def plus(self, other: Row, factor: float = 1.0) -> Row:
-        """self + factor·other (scales add as magnitudes)."""
+        """self + factor·other (scales add as magnitudes).
+
+        Parameters
+        ----------
+        other : Row
+            The row added.
+        factor : float
+            Its factor.
+
+        Returns
+        -------
+        Row
+        """
         coef, scale = dict(self.coef), dict(self.scale)
         for n, v in other.coef.items():
             coef[n] = coef.get(n, 0.0) + factor * v
@@ -97,6 +149,7 @@ class Row:
         return Row(coef, scale)
 
     def with_term(self, key: str, value: float, scale: float | None = None) -> Row:
+        """The row with the coefficient of `key` set to `value` (and its scale)."""
         coef, sc = dict(self.coef), dict(self.scale)
         coef[key] = value
         sc[key] = abs(value) if scale is None else max(abs(value), scale)
@@ -123,10 +176,21 @@ class Fit:
     errors: dict[str, float]
 
     def ok(self, tol: float) -> bool:
+        """Whether every key matches within `tol`."""
         return self.error <= tol
 
     def wrong(self, tol: float) -> list[str]:
-        """Keys whose coefficients do not match, worst first."""
+        """Keys whose coefficients do not match, worst first.
+
+        Parameters
+        ----------
+        tol : float
+            The relative tolerance.
+
+        Returns
+        -------
+        list of str
+        """
         bad = [(e, key) for key, e in self.errors.items() if e > tol]
         return [key for _, key in sorted(bad, key=lambda p: (-p[0], p[1]))]
 
@@ -177,13 +241,39 @@ def fit(s: Row, t: Row, free: Iterable[str] = ()) -> Fit | None:
 
 
 def matches(s: Row, t: Row, tol: float, free: Iterable[str] = ()) -> Fit | None:
-    """`fit` when it is within `tol`, else None."""
+    """`fit` when it is within `tol`, else None.
+
+    Parameters
+    ----------
+    s, t : Row
+        The student's row and a true row (or a variant).
+    tol : float
+        Relative tolerance on each coefficient.
+    free : iterable of str
+        Keys left out of the comparison.
+
+    Returns
+    -------
+    Fit or None
+    """
     f = fit(s, t, free)
     return f if f is not None and f.ok(tol) else None
 
 
 def same(a: Row, b: Row, tol: float) -> bool:
-    """Whether two true rows are proportional (a variant that changes nothing)."""
+    """Whether two true rows are proportional (a variant that changes nothing).
+
+    Parameters
+    ----------
+    a, b : Row
+        The rows.
+    tol : float
+        Relative tolerance on each coefficient.
+
+    Returns
+    -------
+    bool
+    """
     f = fit(a, b)
     if f is None:
         return not a.keys and not b.keys

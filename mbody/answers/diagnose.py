@@ -80,7 +80,20 @@ AXES = "xyz"
 
 
 def describe_row(r: TrueRow, planar: bool) -> str:
-    """The row in words: "Newton's equation along world y (m a_y = ΣF_y)"..."""
+    """The row in words: "Newton's equation along world y (m a_y = ΣF_y)"...
+
+    Parameters
+    ----------
+    r : TrueRow
+        One of a body's rows.
+    planar : bool
+        Whether the model is planar.
+
+    Returns
+    -------
+    str
+        The row's name in the course's terms.
+    """
     if not r.euler:
         a = AXES[r.axis]
         return f"Newton's equation along world {a} (m a_{a} = ΣF_{a})"

@@ -171,6 +171,12 @@ def _call(name: str, arg: _Form, text: str, pos: int) -> _Form:
             raise EquationError(text, pos, f"tan({x:g}) is infinite")
         return _Form({CONST: math.tan(x)}, {CONST: ex / (c * c)},
                      {CONST: max(1.0, abs(math.tan(x)))})
+    if name == "exp":
+        try:
+            v = math.exp(x)
+        except OverflowError:
+            raise EquationError(text, pos, f"exp({x:g}) is too large") from None
+        return _Form({CONST: v}, {CONST: v * ex}, {CONST: v})
     if x < 0.0:
         raise EquationError(text, pos, f"the square root of a negative number ({x:g})")
     v = math.sqrt(x)

@@ -28,8 +28,13 @@ ENTRY_KEYS = ("body", "eq")
 
 
 class AnswersError(ModelError):
-    """An answers file (or answers given in Python) is invalid; `issues` lists every
-    problem with its file, line and column."""
+    """An answers file (or answers given in Python) is invalid.
+
+    Parameters
+    ----------
+    issues : sequence of Issue
+        Every problem found, each with its file, line and column.
+    """
 
     def _text(self) -> str:
         n = len(self.issues)
@@ -90,7 +95,26 @@ class Answers:
 
     def issue(self, a: Answer, message: str, *, position: int | None = None,
               body: bool = False, hint: str = "") -> Issue:
-        """An `Issue` located at answer `a` (its body, or a character of its equation)."""
+        """An `Issue` located at answer `a` (its body, or a character of its equation).
+
+        Parameters
+        ----------
+        a : Answer
+            The answer the problem is in.
+        message : str
+            What is wrong.
+        position : int, optional
+            0-based character of the equation where it is.
+        body : bool
+            Point at the answer's body name instead of its equation.
+        hint : str
+            A did-you-mean or a way to fix it.
+
+        Returns
+        -------
+        Issue
+            With this file, line and column.
+        """
         line, col = a.line, a.column
         key = a.key
         if body:

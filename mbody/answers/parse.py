@@ -6,7 +6,7 @@
     unary    := ('+' | '-') unary | power
     power    := atom (('^' | '**') unary)?          right-associative, binds tighter than '-'
     atom     := NUMBER | NAME | FUNC '(' expr ')' | '(' expr ')'
-    FUNC     := sin | cos | tan | sqrt
+    FUNC     := sin | cos | tan | sqrt | exp
 
 The text becomes a tree of tuples and nothing else: no `eval`, no `sympify`, no attribute
 access. Names are not looked up here (`mbody.answers.linear` resolves them against the
@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 from mbody.errors import MbodyError
 
-FUNCTIONS = ("sin", "cos", "tan", "sqrt")
+FUNCTIONS = ("sin", "cos", "tan", "sqrt", "exp")
 """The functions an equation may call (one argument each; angles in radians)."""
 MAX_LENGTH = 2000
 """Longest equation accepted (characters)."""
@@ -253,6 +253,10 @@ class _Parser:
             self.take()
             node = ("call", value, arg, pos)
         elif kind == "name":
+            if self.peek()[0] == "op" and self.peek()[1] == "(":
+                raise EquationError(self.text, pos, f"unknown function '{value}'",
+                                    "the functions are " + ", ".join(FUNCTIONS)
+                                    + "; write '*' for a product, e.g. m*(a_x + 1)")
             node = ("name", value, pos)
         elif kind == "op" and value == "(":
             node = self.expr(depth + 1)

@@ -145,10 +145,12 @@ class BodyRows:
 
     @property
     def newton(self) -> list[TrueRow]:
+        """Newton's rows (world axes)."""
         return [r for r in self.rows if not r.euler]
 
     @property
     def euler(self) -> list[TrueRow]:
+        """Euler's rows (body axes; planar: one)."""
         return [r for r in self.rows if r.euler]
 
     def transport(self, e: TrueRow, point: MomentPoint, *, keep_acc: bool) -> Row:
@@ -157,6 +159,20 @@ class BodyRows:
         ``E + Σ_j C_j N_j`` with C = W_R_Bᵀ [d]×, d = G − P: the Euler row about G plus
         d × (the Newton rows). With `keep_acc` False the transport term d × m a_G is
         dropped (moments about P, but I_G α kept: the course's "wrong point").
+
+        Parameters
+        ----------
+        e : TrueRow
+            One of the body's Euler rows.
+        point : MomentPoint
+            The point moments are taken about.
+        keep_acc : bool
+            Keep the transport term (the correct equation about P) or not.
+
+        Returns
+        -------
+        Row
+            The moment equation about P, along e's axis.
         """
         C = self._lever(point)
         out = e.row
@@ -170,7 +186,22 @@ class BodyRows:
         """Moments about a fixed `point` with the inertia about it: the transport row
         with a_G = ω̇ × d + ω × (ω × d) put in (``I_P α = M_P`` in the plane). With `gyro`
         False the velocity terms are left out: ``I_P α = M_P`` in space, without
-        ω × I_P ω."""
+        ω × I_P ω.
+
+        Parameters
+        ----------
+        e : TrueRow
+            One of the body's Euler rows.
+        point : MomentPoint
+            A point that does not move.
+        gyro : bool
+            Keep the gyroscopic terms about the point.
+
+        Returns
+        -------
+        Row
+            The moment equation about the point with the inertia about it.
+        """
         row = self.transport(e, point, keep_acc=True)
         if not gyro:
             row = row.with_term(CONST, row.get(CONST) - e.gyro,

@@ -15,7 +15,17 @@ from mbody.equations.fbd import Equation
 
 
 def num(x: float) -> str:
-    """A number to six significant figures; rounding noise (below 1e-12) is 0."""
+    """A number to six significant figures; rounding noise (below 1e-12) is 0.
+
+    Parameters
+    ----------
+    x : float
+        The number.
+
+    Returns
+    -------
+    str
+    """
     x = float(x)
     x = 0.0 if abs(x) < 1e-12 else x
     s = f"{x:.6g}"
@@ -23,7 +33,17 @@ def num(x: float) -> str:
 
 
 def terms(coef: Mapping[str, float]) -> str:
-    """``{O.Fx: -0.43, O.Fy: 1}`` -> ``-0.43 O.Fx + O.Fy`` ('0' when empty)."""
+    """``{O.Fx: -0.43, O.Fy: 1}`` -> ``-0.43 O.Fx + O.Fy`` ('0' when empty).
+
+    Parameters
+    ----------
+    coef : mapping of str to float
+        Name -> coefficient, in the order written.
+
+    Returns
+    -------
+    str
+    """
     out = ""
     for name, c in coef.items():
         if num(c) == "0":
@@ -46,7 +66,17 @@ def _join(head: str, tail: str) -> str:
 
 
 def equation_text(eq: Equation) -> str:
-    """One row of the assembly as `mbody assemble` writes it."""
+    """One row of the assembly as `mbody assemble` writes it.
+
+    Parameters
+    ----------
+    eq : Equation
+        A row of a body's Newton-Euler pair.
+
+    Returns
+    -------
+    str
+    """
     left = terms(eq.lhs)
     if num(eq.gyro) != "0":
         left = _join(left, num(eq.gyro))
@@ -58,7 +88,17 @@ def equation_text(eq: Equation) -> str:
 
 
 def row_text(row: Row) -> str:
-    """A row ``Σ c u + c0 = 0`` as an equation: accelerations left, the rest right."""
+    """A row ``Σ c u + c0 = 0`` as an equation: accelerations left, the rest right.
+
+    Parameters
+    ----------
+    row : Row
+        The row.
+
+    Returns
+    -------
+    str
+    """
     left = terms({k: v for k, v in row.coef.items() if k != CONST and "." not in k})
     right = _join(num(-row.get(CONST)), terms({k: -v for k, v in row.coef.items()
                                                 if "." in k}))

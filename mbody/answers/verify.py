@@ -69,10 +69,17 @@ class Check:
 
     @property
     def correct(self) -> bool:
+        """Whether the equation is one of the body's rows."""
         return self.diagnosis == CORRECT
 
     def to_dict(self) -> dict[str, Any]:
-        """The check as JSON-ready data."""
+        """The check as JSON-ready data.
+
+        Returns
+        -------
+        dict
+            index, body, eq, line, diagnosis, expected, row, explanation, details.
+        """
         return {"index": self.index, "body": self.body, "eq": self.eq, "line": self.line,
                 "diagnosis": self.diagnosis, "expected": self.expected, "row": self.row,
                 "explanation": self.explanation, "details": _plain(self.details)}
@@ -141,7 +148,14 @@ class Verification:
         return sum(c.correct for c in self.checks)
 
     def to_dict(self) -> dict[str, Any]:
-        """What ``mbody verify --json`` prints."""
+        """What ``mbody verify --json`` prints.
+
+        Returns
+        -------
+        dict
+            model, model_file, answers, student, tol, equations (one entry per equation,
+            in file order), uncovered (rows), summary (counts).
+        """
         return {"model": self.model, "model_file": self.model_file,
                 "answers": self.answers_file, "student": self.student, "tol": self.tol,
                 "equations": [c.to_dict() for c in self.checks],
@@ -152,7 +166,18 @@ class Verification:
 
     def text(self, width: int = 88) -> str:
         """The report `mbody verify` prints: a paragraph per equation, then the rows
-        not covered, then a one-line summary."""
+        not covered, then a one-line summary.
+
+        Parameters
+        ----------
+        width : int
+            Column at which explanations are wrapped.
+
+        Returns
+        -------
+        str
+            The report (no final newline).
+        """
         where = f" ({self.model_file})" if self.model_file else ""
         out = [f"model '{self.model}'{where}; answers {self.answers_file}"
                + (f" by {self.student}" if self.student else "")

@@ -143,7 +143,12 @@ class Vocabulary:
         return frozenset(self.unknowns)
 
     def summary(self) -> str:
-        """The canonical names in one line (for error messages)."""
+        """The canonical names in one line (for error messages).
+
+        Returns
+        -------
+        str
+        """
         shown = list(self.accelerations)
         if self.reactions:
             shown.append(", ".join(self.reactions[:6]) + (" ..." if len(self.reactions) > 6
