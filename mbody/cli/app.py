@@ -16,7 +16,14 @@ import traceback
 from collections.abc import Sequence
 
 from mbody import __version__
-from mbody.cli.common import EXIT_INPUT, EXIT_INTERNAL, EXIT_OK, EXIT_UNMET, byte_size
+from mbody.cli.common import (
+    EXIT_INPUT,
+    EXIT_INTERNAL,
+    EXIT_OK,
+    EXIT_UNMET,
+    add_import_options,
+    byte_size,
+)
 from mbody.errors import MbodyError, ModelError, UnknownReactionsError, did_you_mean
 from mbody.model.loader import MAX_BYTES, max_bytes_limit
 
@@ -40,6 +47,7 @@ def build_parser() -> argparse.ArgumentParser:
                 "--max-bytes", type=byte_size, metavar="SIZE",
                 help=f"largest model file read, in bytes or with a unit (200M, 1G); "
                 f"default {MAX_BYTES // 2**20}M, a guard against reading a wrong file whole")
+            add_import_options(command)  # --format, --keyframe, --q: MJCF and URDF input
     return p
 
 
