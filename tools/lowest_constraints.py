@@ -21,7 +21,7 @@ _FLOOR = re.compile(r"^\s*([A-Za-z0-9][A-Za-z0-9._-]*)\s*(\[[^\]]*\])?\s*>=\s*([
 
 
 EXTRAS = ("symbolic",)
-"""Optional features tested at their floors too (`mbody verify`, `assemble --symbolic`)."""
+"""Optional features tested at their floors too (`assemble --symbolic`)."""
 
 
 def floors(pyproject: Path = ROOT / "pyproject.toml") -> dict[str, str]:
