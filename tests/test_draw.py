@@ -494,6 +494,12 @@ def test_legend_symbols_are_drawn_as_in_the_picture(model_file, name):
         assert (leg.color, leg.lw, leg.dash) == (pic.color, pic.lw, pic.dash)
         assert any(isinstance(it, Poly) and it.gid == f"legend-handle:{kind}:head"
                    and it.face == pic.color for it in root)
+    couples = [it for it in drawing_items if isinstance(it, Line)
+               and (it.gid or "").startswith("couple:")]
+    leg = [it for it in root if getattr(it, "gid", None) == "legend-handle:couple"]
+    assert len(leg) == (1 if couples else 0)
+    if couples:  # drawn as the picture's first couple
+        assert (leg[0].color, leg[0].dash) == (couples[0].color, couples[0].dash)
     parent = any(t.s.startswith("−") for t in drawing_items
                  if isinstance(t, Text) and (t.gid or "").startswith("label:reaction:"))
     assert any(getattr(it, "gid", None) == "legend-handle:parent" for it in root) == parent

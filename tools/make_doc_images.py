@@ -3,8 +3,10 @@
     python tools/make_doc_images.py            # writes docs/images/*.png
 
 Planar: the slider-crank's piston (gas force 4000 N beside 4.9 N of weight: the log
-length scale at work). Spatial: the heavy top on its pivot, isometric view. And the
-slider-crank's body/joint graph.
+length scale at work; two reactions at one pin drawn side by side) and the upper link
+of the double pendulum (the parent of joint A: its reactions are labelled −A.Fx, −A.Fy).
+Spatial: the heavy top on its pivot, isometric view. And the slider-crank's body/joint
+graph.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ from mbody.present.draw import draw_graph, save_figure
 ROOT = Path(__file__).resolve().parent.parent
 PICTURES = (  # (model file, body, view, output name)
     ("slider_crank.yaml", "piston", "iso", "fbd_planar_piston.png"),
+    ("double_pendulum.yaml", "upper", "iso", "fbd_planar_parent_side.png"),
     ("heavy_top.yaml", "top", "iso", "fbd_spatial_heavy_top.png"),
 )
 

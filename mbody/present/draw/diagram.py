@@ -330,18 +330,19 @@ def _legend(root: Panel, rect: tuple[float, float, float, float], arrs: list[Arr
                 dash = DASHED if key in (REACTION, "parent") else None
                 root.add(Line(np.array([h0, h1]), color, 2.0, dash, zorder=5, gid=gid),
                          Poly(head(h1, right, hd), color, zorder=5, gid=gid + ":head"))
-            elif key == "couple":
-                color = COLORS["applied"]
+            elif key == "couple":  # as the picture's first couple: its colour and dash
+                first = next(a for a in arrs if a.couple)
+                color, dash = first.color, DASHED if first.dashed else None
                 if planar:  # a curved arrow, as drawn about a point
                     mid = (h0 + h1) / 2
                     t = np.linspace(math.radians(-60), math.radians(210), 20)
                     arc = mid + 5.0 * np.column_stack((np.cos(t), np.sin(t)))
                     d = arc[-1] - arc[-2]
-                    root.add(Line(arc, color, 2.0, zorder=5, gid=gid),
+                    root.add(Line(arc, color, 2.0, dash, zorder=5, gid=gid),
                              Poly(head(arc[-1], d / np.linalg.norm(d), hd), color,
                                   zorder=5, gid=gid + ":head"))
                 else:  # a double head
-                    root.add(Line(np.array([h0, h1]), color, 2.0, zorder=5, gid=gid),
+                    root.add(Line(np.array([h0, h1]), color, 2.0, dash, zorder=5, gid=gid),
                              Poly(head(h1, right, hd), color, zorder=5, gid=gid + ":head"),
                              Poly(head(h1 - 0.75 * hd * right, right, hd), color, zorder=5,
                                   gid=gid + ":head2"))
