@@ -10,6 +10,7 @@ so problems keep their file, line and column.
 from __future__ import annotations
 
 import sys
+from dataclasses import fields
 from pathlib import Path
 
 import numpy as np
@@ -54,6 +55,12 @@ def same_bits(a, b) -> bool:
     return a.dtype == b.dtype and a.shape == b.shape and a.tobytes() == b.tobytes()
 
 
+def table_fields(table) -> list[str]:
+    """Every field of a model table, those derived on first use included (the reaction
+    table's per-component frames and points, labels...)."""
+    return [f.name for f in fields(table)] + list(getattr(table, "DERIVED", ()))
+
+
 def assert_same_model(m1: Model, m2: Model) -> None:
     """Every array and label of two models, compared bit for bit (-0.0 differs from 0.0)."""
     assert (m1.name, m1.dimension, m1.body_names) == (m2.name, m2.dimension, m2.body_names)
@@ -67,18 +74,26 @@ def assert_same_model(m1: Model, m2: Model) -> None:
             (c.index, c.mass, c.shape, c.color, c.particle)
         assert same_bits(b.inertia, c.inertia)
     for t1, t2 in ((m1.forces, m2.forces), (m1.springs, m2.springs),
-                   (m1.reaction_table, m2.reaction_table)):
-        for k, v in vars(t1).items():
+                   (m1.reaction_table, m2.reaction_table), (m1.joint_table, m2.joint_table)):
+        for k in table_fields(t1):
+            v = getattr(t1, k)
             if isinstance(v, np.ndarray):
                 assert same_bits(v, getattr(t2, k)), k
-            elif k != "varying":
+            elif k not in ("varying", "per_joint"):
                 assert v == getattr(t2, k), k
     assert len(m1.loads) == len(m2.loads)
     for l1, l2 in zip(m1.loads, m2.loads, strict=True):
         assert (l1.name, l1.type, l1.bodies, l1.frame) == (l2.name, l2.type, l2.bodies, l2.frame)
         assert same_bits(l1.vector, l2.vector)
         assert all(same_bits(a, b) for a, b in zip(l1.at, l2.at, strict=True))
-    assert [j.name for j in m1.joints] == [j.name for j in m2.joints]
+    assert len(m1.joints) == len(m2.joints)
+    for j1, j2 in zip(m1.joints, m2.joints, strict=True):
+        assert (j1.name, j1.type, j1.parent, j1.child, j1.components, j1.particle_joint) == \
+            (j2.name, j2.type, j2.parent, j2.child, j2.components, j2.particle_joint)
+        for k in ("at", "W_E0", "axis", "axis2"):
+            a, b = getattr(j1, k), getattr(j2, k)
+            assert (a is None) == (b is None), k
+            assert a is None or same_bits(a, b), k
     assert m1.known_reactions == m2.known_reactions
     assert m1.warnings == m2.warnings == ()
 

@@ -27,9 +27,11 @@ tests/test_fast.py compares both on generated and perturbed files).
 
 from __future__ import annotations
 
+import bisect
 import json
 import math
 import re
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from typing import Any
 
@@ -49,8 +51,10 @@ from mbody.model.checks import (
 from mbody.model.loader import load_text, value_limit
 from mbody.model.validate import (
     FRAMES,
+    JOINT_KEYS,
+    LOAD_KEYS,
     BodyTable,
-    JointSpec,
+    JointSpecTable,
     LoadTable,
     Spec,
     header,
@@ -72,7 +76,6 @@ integer as int, anything with '.' or an exponent as float, through the same corr
 rounded conversion). Forms JSON refuses ('+1', '.5', '1.', '010', '1_000') go to the
 located path, as do exponents of three digits (which may underflow to 0, or overflow;
 YAML keeps those as unrepresentable) and magnitudes beyond MAX_MAGNITUDE."""
-_EXPONENT_DIGITS = bytes.maketrans(b"123456789E+", b"000000000e-")
 _ZEROS = b"0" * 200
 """A run of zeros this long goes to the located path: with an exponent of two digits at
 most, a nonzero number underflows to 0 only after some 224 zeros ("0.000...1e-99"), which
@@ -81,7 +84,7 @@ _NAMES = re.compile(r"[A-Za-z][A-Za-z0-9_-]*(?:\n[A-Za-z][A-Za-z0-9_-]*)*")
 _SPECIAL = frozenset(("null", "Null", "NULL", "true", "True", "TRUE", "false", "False",
                       "FALSE"))
 """Names the pattern above lets through that YAML reads as null or a boolean."""
-_SECTION_END = re.compile(r"\n[^- ]")
+_SECTION_END = re.compile(r"\n(?=[^- ])")
 _PRINTABLE = bytes(range(0x20, 0x7f)) + b"\n"
 """Printable ASCII and newlines; anything else (tabs, CR, a BOM...): the located path."""
 _ODD = re.compile(r"[^\n\x20-\x7e]")
@@ -117,15 +120,20 @@ def fast_spec(text: str, file: str) -> Spec | None:
 
 
 def _spec(text: str, file: str) -> Spec:
+    # the lines at column 0 that neither start nor continue a list item: one pass
+    tops = [0, *(m.start() + 1 for m in _SECTION_END.finditer(text)), len(text)]
+    heads: dict[str, list[int]] = {}
+    for at in tops[:-1]:
+        for key in ("bodies", "loads", "joints"):
+            if text.startswith(f"{key}:\n- ", at):
+                heads.setdefault(key, []).append(at)
     found = []
-    for key in ("bodies", "loads", "joints"):
-        head = f"\n{key}:\n- "
-        at = 0 if text.startswith(head[1:]) else text.find(head) + 1
-        if at == 0 and not text.startswith(head[1:]) or text.find(head, at) >= 0:
-            continue  # absent, or twice (then the located loader names both lines)
+    for key, where in heads.items():
+        if len(where) > 1:
+            continue  # twice: then the located loader names both lines
+        at = where[0]
         start = at + len(key) + 2  # the list's first '- '
-        m = _SECTION_END.search(text, start)
-        found.append((at, start, m.start() + 1 if m else len(text), key))
+        found.append((at, start, tops[bisect.bisect_right(tops, start)], key))
     found.sort()
     sections: dict[str, tuple[int, int]] = {}
     pieces = []
@@ -148,22 +156,34 @@ def _spec(text: str, file: str) -> Spec:
     data = doc.data
     # every key and value counts towards the located reader's limit: the same limit here
     values = len(doc.marks) + len(doc.key_marks)
-    lists = {}
-    for key in sections:
-        if data.get(key) != f"{_PLACEHOLDER}{key}__":
-            raise _Bail  # the cut was not where the located reader sees the list
-        lists[key], count = _read_list(text, *sections[key], file)
+    if any(data.get(key) != f"{_PLACEHOLDER}{key}__" for key in sections):
+        raise _Bail  # the cut was not where the located reader sees the list
+    limit = value_limit(len(text))
+    table, point, joints = None, None, None
+    # one list at a time, into its table, before the next is read (its columns of names
+    # and numbers are the largest thing made); bodies first: the others name them
+    for key in ("bodies", "loads", "joints"):
+        if key not in sections:
+            continue
+        groups, count = _read_list(text, *sections[key], file, _conversions(key, c))
         values += count
-    if values > value_limit(len(text)):
-        raise _Bail
-    table = _bodies(c, lists["bodies"])
-    point = _loads(c, lists["loads"]) if "loads" in lists else None
-    joints = _joints(c, lists["joints"]) if "joints" in lists else None
-    loads, joints, reactions, expressions = rest(c, [], [] if point else None, joints)
+        if values > limit:
+            raise _Bail
+        if key == "bodies":
+            table = _bodies(c, groups)
+        elif key == "loads":
+            point = _loads(c, groups)
+        else:
+            joints = _joints(c, groups)
+        del groups
+    assert table is not None
+    # a list not cut out above (absent, or written another way) goes through validate
+    loads, joint_list, reactions, expressions = rest(c, [], [] if point else None,
+                                                     [] if joints is not None else None)
     if c.issues or c.warnings:
         raise _Bail  # warnings need their lines: the located path gives them
-    return Spec(name, file, c.dim, gravity, [], loads, joints, reactions, description,
-                [], expressions, table, point)
+    return Spec(name, file, c.dim, gravity, [], loads, joint_list, reactions, description,
+                [], expressions, table, point, joints)
 
 
 # -- reading a list in bulk ---------------------------------------------------------------
@@ -179,20 +199,64 @@ class _Group:
     columns: dict[tuple[Any, ...], Any]
 
 
-def _read_list(text: str, start: int, end: int, file: str) -> tuple[list[_Group], int]:
+Convert = Callable[[list[str]], Any]
+"""What a column of names becomes, chunk by chunk (see `_read_list`)."""
+
+
+def _conversions(key: str, c: Checker) -> dict[tuple[Any, ...], Convert]:
+    """The conversions of the name columns of the list `key`: references to bodies become
+    body indices (ground -1), and types and frames one string per distinct name; a name
+    neither would accept is `_Bail`."""
+    known = c.body_names
+    if key == "loads":
+        return {("body",): _references(known, False),
+                ("type",): _canonical(LOAD_KEYS), ("frame",): _canonical(FRAMES)}
+    if key == "joints":
+        return {("parent",): _references(known, True), ("child",): _references(known, False),
+                ("type",): _canonical(cv.JOINT_COMPONENTS[c.dim])}
+    return {}
+
+
+def _canonical(allowed: Iterable[str]) -> Convert:
+    table = {x: x for x in allowed}
+
+    def convert(names: list[str]) -> list[str]:
+        try:
+            return [table[x] for x in names]
+        except KeyError:
+            raise _Bail from None
+
+    return convert
+
+
+def _references(known: dict[str, int], ground: bool) -> Convert:
+    def convert(names: list[str]) -> np.ndarray:
+        index = np.fromiter((known.get(x, -1) for x in names), dtype=np.intp,
+                            count=len(names))
+        if not all(ground and names[i] == cv.GROUND for i in np.flatnonzero(index < 0)):
+            raise _Bail  # neither a body nor (where allowed) ground
+        return index
+
+    return convert
+
+
+def _read_list(text: str, start: int, end: int, file: str,
+               convert: dict[tuple[Any, ...], Convert] | None = None
+               ) -> tuple[list[_Group], int]:
     """The items of the block list text[start:end] (each starts with '- ' at column 0),
     grouped by layout, with every slot typed a column at a time; and how many keys and
     values they hold beyond the list itself (as the located reader counts them).
 
-    The list is read a chunk of about `CHUNK` characters at a time, and each chunk's
-    columns are parsed before the next is cut; no string is made per value (a column's
-    bytes are gathered with numpy and parsed by json in one call).
+    The list is read a chunk of about `CHUNK` characters at a time. In each chunk, one
+    pass of numpy masks gives the skeletons, every number of every slot in order (parsed
+    by one json call) and every name (split once); no string is made per number. A
+    column of names with a path in `convert` is converted chunk by chunk (to body
+    indices, or to one string per distinct name), so that its strings do not pile up.
     """
     layouts: dict[str, int] = {}
-    structure: list[dict[tuple[Any, ...], int]] = []
-    nodes: list[int] = []  # per layout: keys and values of one item, a flow list as one
+    found: list[_Layout] = []
     pieces: list[dict[tuple[Any, ...], list[Any]]] = []  # per layout, per path: chunks
-    rows: list[list[int]] = []  # per layout: item indices
+    rows: list[list[np.ndarray]] = []  # per layout: item indices, per chunk
     item = 0
     pos = start
     while pos < end:
@@ -200,50 +264,213 @@ def _read_list(text: str, start: int, end: int, file: str) -> tuple[list[_Group]
         data = text[pos:stop].encode("ascii")
         if data.translate(None, _PRINTABLE):
             raise _Bail  # a tab, a carriage return, a control character
-        b = np.frombuffer(data, dtype=np.uint8)
-        s, e = _slots(b)
-        skeleton = b.copy()
-        skeleton[s] = 0  # each value becomes one NUL, its marker
-        inside = np.zeros(len(b) + 1, dtype=np.int8)
-        inside[s + 1] += 1
-        inside[e] -= 1  # no two slots share a start or an end, nor touch (see _slots)
-        body = skeleton[np.cumsum(inside[:-1], dtype=np.int8) == 0].tobytes().decode("ascii")
-        # items without the leading '- ' and the newline that ends each one
-        skeletons = body[2:-1 if body.endswith("\n") else None].split("\n- ")
+        if not data.endswith(b"\n"):
+            data += b"\n"  # every value ends before a byte of its own
+        chunk = _Chunk(np.frombuffer(data, dtype=np.uint8))
+        skeletons = chunk.skeletons()
         for sk in set(skeletons).difference(layouts):
             if len(layouts) >= MAX_TEMPLATES:
                 raise _Bail
             layouts[sk] = len(layouts)
             paths, count = _structure(sk, file)
-            structure.append(paths)
-            nodes.append(count)
-            pieces.append({path: [] for path in structure[-1]})
+            found.append(_Layout(paths, count))
+            pieces.append({path: [] for path in paths})
             rows.append([])
         ids = np.fromiter(map(layouts.__getitem__, skeletons), dtype=np.intp,
                           count=len(skeletons))
-        widths = np.array([len(st) for st in structure], dtype=np.intp)[ids]
-        first = np.cumsum(widths) - widths  # each item's first slot
-        if first[-1] + widths[-1] != len(s):
-            raise _Bail
-        for k in np.unique(ids).tolist():
-            mine = np.flatnonzero(ids == k)
-            for path, slot in structure[k].items():
-                at = first[mine] + slot
-                pieces[k][path].append(_column(b, s[at], e[at]))
-            rows[k].extend((mine + item).tolist())
+        for k, mine, columns in chunk.columns(ids, found):
+            for path, column in columns.items():
+                if convert and path in convert and isinstance(column, list):
+                    column = convert[path](column)
+                pieces[k][path].append(column)
+            rows[k].append(mine + item)
         item += len(skeletons)
         pos = stop
-    groups = [_Group(np.array(r, dtype=np.intp),
-                     {path: _joined(chunks) for path, chunks in pieces[k].items()})
-              for k, r in enumerate(rows)]
-    count = sum(len(g.index) * (nodes[k] + sum(c.shape[1] for c in g.columns.values()
-                                               if isinstance(c, np.ndarray) and c.ndim == 2))
-                for k, g in enumerate(groups))
+    groups = []
+    for k, r in enumerate(rows):
+        columns = {}
+        for path in list(pieces[k]):  # each column's chunks dropped once joined
+            columns[path] = _joined(pieces[k].pop(path))
+        groups.append(_Group(np.concatenate(r) if r else np.zeros(0, dtype=np.intp),
+                             columns))
+    count = sum(len(g.index) * found[k].values for k, g in enumerate(groups))
     return groups, count
 
 
-def _slots(b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Start and end (exclusive) of every value in the text `b` (bytes), in order.
+class _Layout:
+    """One item layout: which key path each slot fills; its slots' kinds and widths (from
+    the first item read with it: every other item must match them)."""
+
+    def __init__(self, paths: dict[tuple[Any, ...], int], nodes: int):
+        self.paths = paths
+        self.nodes = nodes
+        self.slots = len(paths)
+        self.kind: np.ndarray | None = None  # per slot: NUMBER, LIST or NAME
+        self.width: np.ndarray | None = None  # per slot: numbers it holds (a name: 0)
+
+    @property
+    def values(self) -> int:
+        """Keys and values of one item as the located reader counts them (a flow list
+        is one value and each of its items one more)."""
+        assert self.kind is not None and self.width is not None
+        return self.nodes + int(self.width[self.kind == _LIST].sum())
+
+
+_NUMBER, _LIST, _NAME = 0, 1, 2
+_STARTS_NUMBER = np.zeros(256, dtype=bool)
+_STARTS_NUMBER[list(b"0123456789-")] = True
+
+
+class _Chunk:
+    """One chunk of a list (whole items) as bytes, and its slots (see `_slots`)."""
+
+    def __init__(self, b: np.ndarray):
+        self.b = b
+        s, e, commas = _slots(b)
+        self.s, self.e = s, e
+        first = b[s]
+        kind = np.where(first == ord("["), _LIST, np.where(_STARTS_NUMBER[first], _NUMBER,
+                                                            _NAME))
+        self.kind = kind
+        listed = kind == _LIST
+        # Each value's bytes, as a level: 1 for the numbers, 2 for the names, 0 for the
+        # rest (the skeleton). A list keeps what is between its brackets and its ']'; a
+        # number or a name keeps the byte that ends it: those become the separators.
+        lo = np.where(listed, s + 1, s)
+        hi = np.where(listed, e, e + 1)
+        step = np.where(kind == _NAME, 2, 1).astype(np.int8)
+        marks = np.zeros(len(b) + 1, dtype=np.int8)
+        marks[lo] = step  # all distinct: slots do not touch (see _slots)
+        marks[hi] = -step
+        self.level = np.cumsum(marks[:-1], dtype=np.int8)
+        inside = np.searchsorted(commas, e) - np.searchsorted(commas, s)
+        if np.any(inside[kind == _NUMBER]) or np.any(e[listed] - s[listed] < 3):
+            raise _Bail  # '1,5' (text in YAML), or an empty list
+        self.width = np.where(listed, inside + 1, np.where(kind == _NUMBER, 1, 0))
+        self.separated: np.ndarray | None = None
+
+    def skeletons(self) -> list[str]:
+        """Each item's text with every value replaced by one NUL, without its leading
+        '- ' and the newline that ends it."""
+        keep = self.level == 0
+        keep[self.s] = True
+        ends = self.e[self.kind != _LIST]
+        keep[ends] = True
+        skeleton = self.b.copy()
+        skeleton[self.s] = 0
+        body = skeleton[keep].tobytes().decode("ascii")
+        return body[2:-1].split("\n- ")
+
+    def columns(self, ids: np.ndarray, layouts: list[_Layout]
+                ) -> Iterator[tuple[int, np.ndarray, dict[tuple[Any, ...], Any]]]:
+        """Per layout in the chunk: its items (indices in the chunk) and each slot's
+        column: (k, L) floats for flow lists of L numbers, (k,) floats for numbers, a
+        list of names; `_Bail` when an item's slots differ in kind or width from its
+        layout's."""
+        kind, width = self.kind, self.width
+        slots = np.array([lay.slots for lay in layouts], dtype=np.intp)[ids]
+        first = np.cumsum(slots) - slots  # each item's first slot
+        if first[-1] + slots[-1] != len(kind):
+            raise _Bail
+        used = np.unique(ids).tolist()
+        for k in used:
+            lay = layouts[k]
+            mine = np.flatnonzero(ids == k)
+            at = first[mine][:, None] + np.arange(lay.slots)
+            if lay.kind is None:
+                lay.kind, lay.width = kind[at[0]], width[at[0]]
+            if not (np.array_equal(kind[at], np.broadcast_to(lay.kind, at.shape))
+                    and np.array_equal(width[at], np.broadcast_to(lay.width, at.shape))):
+                raise _Bail  # a number where another item has a name, lists of two lengths
+        per_item = np.array([int(lay.width.sum()) if lay.width is not None else 0
+                             for lay in layouts], dtype=np.intp)[ids]
+        numbers = self.numbers(int(per_item.sum()))
+        number_at = np.cumsum(per_item) - per_item  # each item's first number
+        named = np.array([int(np.count_nonzero(lay.kind == _NAME)) if lay.kind is not None
+                          else 0 for lay in layouts], dtype=np.intp)[ids]
+        names = self.names(int(named.sum()))
+        name_at = np.cumsum(named) - named
+        single = len(used) == 1
+        for k in used:
+            lay = layouts[k]
+            assert lay.kind is not None and lay.width is not None
+            mine = np.flatnonzero(ids == k)
+            offset = np.cumsum(lay.width) - lay.width  # each slot's first number
+            name_index = np.cumsum(lay.kind == _NAME) - 1
+            columns: dict[tuple[Any, ...], Any] = {}
+            for path, slot in lay.paths.items():
+                if lay.kind[slot] == _NAME:
+                    if single:
+                        columns[path] = names[int(name_index[slot])::int(named[0])]
+                    else:
+                        columns[path] = [names[i] for i in
+                                         (name_at[mine] + name_index[slot]).tolist()]
+                    continue
+                w = int(lay.width[slot])
+                where = number_at[mine] + offset[slot]
+                if lay.kind[slot] == _LIST:
+                    columns[path] = numbers[where[:, None] + np.arange(w)]
+                else:
+                    columns[path] = numbers[where]
+            yield k, mine, columns
+
+    def _stream(self, level: int, n: int) -> np.ndarray:
+        """The bytes of level `level` (see `__init__`) in order, each value followed by
+        its separator, with one byte to spare in front."""
+        if self.separated is None:
+            separated = self.b.copy()
+            kind, e = self.kind, self.e
+            separated[np.where(kind == _LIST, e - 1, e)[kind != _NAME]] = ord(",")
+            separated[e[kind == _NAME]] = ord("\n")
+            self.separated = separated
+        mask = self.level == level
+        out = np.empty(int(np.count_nonzero(mask)) + 1, dtype=np.uint8)
+        np.compress(mask, self.separated, out=out[1:])
+        return out
+
+    def numbers(self, n: int) -> np.ndarray:
+        """Every number of the chunk, slot after slot, checked (see `_NUMBER_BYTES`) and
+        parsed by json at once."""
+        if n == 0:
+            return np.zeros(0)
+        out = self._stream(1, n)
+        out[0], out[-1] = ord("["), ord("]")  # the last value's separator
+        exponent = np.flatnonzero((out == ord("e")) | (out == ord("E")))
+        if len(exponent):  # three digits (after a sign) may underflow to 0 or overflow
+            digits = exponent + 1 + ((out[exponent + 1] == ord("-"))
+                                     | (out[exponent + 1] == ord("+")))
+            long = np.ones(len(digits), dtype=bool)
+            for k in range(3):
+                at = np.minimum(digits + k, len(out) - 1)
+                long &= (out[at] >= ord("0")) & (out[at] <= ord("9"))
+            if long.any():
+                raise _Bail
+        data = out.tobytes()
+        if data.translate(None, _NUMBER_BYTES + b", []") or _ZEROS in data:
+            raise _Bail  # text, quotes, true/null...: not numbers only; a long run of 0
+        try:
+            values = np.array(json.loads(data), dtype=float)
+        except (ValueError, OverflowError, TypeError):  # not JSON numbers, huge integers
+            raise _Bail from None
+        if values.shape != (n,) or not np.all(np.abs(values) <= MAX_MAGNITUDE):
+            raise _Bail
+        return values
+
+    def names(self, n: int) -> list[str]:
+        """Every name of the chunk, slot after slot (names as `_NAMES`, not read by YAML
+        as anything else)."""
+        if n == 0:
+            return []
+        joined = self._stream(2, n)[1:-1].tobytes().decode("ascii")
+        names = joined.split("\n")
+        if len(names) != n or not _NAMES.fullmatch(joined) or not _SPECIAL.isdisjoint(names):
+            raise _Bail
+        return names
+
+
+def _slots(b: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Start and end (exclusive) of every value in the text `b` (bytes, ending with a
+    newline), in order; and where its commas are.
 
     A value follows ': ' (in a block mapping, or in a one-line flow mapping as yaml.dump
     writes a mapping of scalars), or '- ' before '[' on a line indented with spaces
@@ -254,51 +481,60 @@ def _slots(b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     refuses it.
     """
     n = len(b)
-    space = b == 32
-    after_colon = np.flatnonzero((b[:-1] == 58) & space[1:]) + 2
-    dash = np.flatnonzero((b[:-2] == 45) & space[1:-1] & (b[2:] == 91))
-    newline = np.append(np.flatnonzero(b == 10), n)
+    # one pass over the bytes finds every byte that matters; each kind is picked from those
+    pos = np.flatnonzero((b == 58) | (b == 45) | (b == 10) | (b == 93) | (b == 44)
+                         | (b == 125))
+    at = b[pos]
+    colon = pos[at == 58]
+    after_colon = colon[b[colon + 1] == 32] + 2  # b ends with a newline: colon + 1 < n
+    dash = pos[at == 45]
+    dash = dash[dash < n - 2]
+    dash = dash[(b[dash + 1] == 32) & (b[dash + 2] == 91)]
+    newline = np.append(pos[at == 10], n)
     if len(dash):  # '- [' with only spaces before it on its line
         line = np.searchsorted(newline, dash)
         line_start = np.where(line > 0, newline[line - 1] + 1, 0)
-        blanks = np.concatenate(([0], np.cumsum(~space, dtype=np.int32)))
-        dash = dash[blanks[dash] == blanks[line_start]] + 2
+        indent = dash - line_start
+        before = np.arange(int(indent.sum())) + np.repeat(line_start - (np.cumsum(indent)
+                                                                        - indent), indent)
+        odd = np.repeat(np.arange(len(dash)), indent)[b[before] != 32]
+        keep = np.ones(len(dash), dtype=bool)
+        keep[odd] = False
+        dash = dash[keep] + 2
     s = np.sort(np.concatenate((after_colon, dash)))
     if len(s) == 0 or s[-1] >= n:
         raise _Bail
-    close = np.append(np.flatnonzero(b == 93) + 1, n + 1)
-    comma = np.append(np.flatnonzero((b[:-1] == 44) & space[1:]), n)
-    brace = np.append(np.flatnonzero(b == 125), n)
+    close = np.append(pos[at == 93] + 1, n + 1)
+    commas = pos[at == 44]
+    comma = np.append(commas[b[commas + 1] == 32], n)
+    brace = np.append(pos[at == 125], n)
     plain_end = np.minimum(newline[np.searchsorted(newline, s)],
                            np.minimum(comma[np.searchsorted(comma, s)],
                                       brace[np.searchsorted(brace, s)]))
     e = np.where(b[s] == 91, close[np.searchsorted(close, s)], plain_end)
     if np.any(e <= s) or np.any(e > n) or np.any(e[:-1] > s[1:] - 2):
         raise _Bail
-    return s, e
-
-
-def _gather(b: np.ndarray, s: np.ndarray, e: np.ndarray, sep: int) -> bytes:
-    """The values b[s[i]:e[i]] (none empty), joined by the byte `sep`."""
-    lengths = e - s
-    out_start = np.cumsum(lengths + 1) - (lengths + 1)  # where value i goes
-    total = int(out_start[-1] + lengths[-1])
-    out = np.full(total, sep, dtype=np.uint8)
-    filled = np.ones(total, dtype=bool)
-    filled[out_start[1:] - 1] = False  # the separators
-    to = np.flatnonzero(filled)
-    out[to] = b[to + np.repeat(s - out_start, lengths)]
-    return out.tobytes()
+    return s, e, commas
 
 
 def _joined(chunks: list[Any]) -> Any:
-    """One column from its chunks: all arrays of one width, or all lists of names."""
+    """One column from its chunks (emptying `chunks`, each dropped once copied): all
+    arrays of one type and width, or all lists of names."""
     if all(isinstance(c, list) for c in chunks):
         return [name for c in chunks for name in c]
-    try:
-        return np.concatenate(chunks) if len(chunks) > 1 else chunks[0]
-    except (ValueError, TypeError):  # names in one chunk, numbers in another; widths
-        raise _Bail from None
+    if len(chunks) == 1:
+        return chunks.pop()
+    if not all(isinstance(c, np.ndarray) for c in chunks) or \
+            len({(c.dtype, c.shape[1:]) for c in chunks}) != 1:
+        raise _Bail  # names in one chunk, numbers in another; lists of two lengths
+    out = np.empty((sum(len(c) for c in chunks), *chunks[0].shape[1:]), dtype=chunks[0].dtype)
+    at = 0
+    chunks.reverse()
+    while chunks:
+        c = chunks.pop()
+        out[at:at + len(c)] = c
+        at += len(c)
+    return out
 
 
 def _structure(skeleton: str, file: str) -> tuple[dict[tuple[Any, ...], int], int]:
@@ -331,70 +567,28 @@ def _structure(skeleton: str, file: str) -> tuple[dict[tuple[Any, ...], int], in
     return out, len(doc.marks) + len(doc.key_marks) - 1  # not the list around it
 
 
-def _column(b: np.ndarray, s: np.ndarray, e: np.ndarray) -> Any:
-    """The values b[s[i]:e[i]] of one slot over many items, typed as the located loader
-    types them: (k, L) floats for flow lists of L numbers, (k,) floats for numbers, else
-    a list of names."""
-    n = len(s)
-    first = int(b[s[0]])
-    if first == ord("["):
-        data = _gather(b, s, e, 1)
-        # each value is one flat list: '[...]' joined by '\x01', no bracket inside
-        if not (data.count(b"[") == n == data.count(b"]") and data[-1:] == b"]"
-                and data.count(b"]\x01[") == n - 1
-                and data.count(b" ") == data.count(b", ")):  # separators as dumped
-            raise _Bail
-        width = 0 if e[0] - s[0] == 2 else int(np.count_nonzero(b[s[0]:e[0]] == 44)) + 1
-        # each list's length, from its commas: one flat list of numbers for json (nested
-        # lists would make a container per item for the garbage collector to trace)
-        c = np.frombuffer(data, dtype=np.uint8)
-        commas = np.add.reduceat((c == ord(",")).view(np.uint8), np.flatnonzero(c == ord("[")),
-                                 dtype=np.intp)
-        if np.any(commas != max(width - 1, 0)):
-            raise _Bail
-        flat = _parse(data, b", []\x01", b"[" + data[1:-1].replace(b"]\x01[", b",") + b"]",
-                      n * width)
-        return flat.reshape(n, width)
-    if chr(first) in "0123456789-":
-        data = _gather(b, s, e, ord(","))
-        if data.count(b",") != n - 1:
-            raise _Bail
-        return _parse(data, b",", b"[" + data + b"]", n)
-    joined = _gather(b, s, e, ord("\n")).decode("ascii")
-    names = joined.split("\n")
-    if len(names) == n and _NAMES.fullmatch(joined) and _SPECIAL.isdisjoint(names):
-        return names
-    raise _Bail
-
-
-def _parse(data: bytes, separators: bytes, as_json: bytes, n: int) -> np.ndarray:
-    """The `n` numbers of a column, checked (see `_NUMBER_BYTES`) and parsed by json."""
-    if data.translate(None, _NUMBER_BYTES + separators):
-        raise _Bail  # text, quotes, true/null...: not numbers only
-    digits = data.translate(_EXPONENT_DIGITS)
-    if b"e000" in digits or b"e-000" in digits or _ZEROS in data:
-        raise _Bail
-    try:
-        values = np.array(json.loads(as_json), dtype=float)
-    except (ValueError, OverflowError):  # not JSON numbers, ragged lists, huge integers
-        raise _Bail from None
-    if len(values) != n or not np.all(np.abs(values) <= MAX_MAGNITUDE):
-        raise _Bail
-    return values
-
-
 # -- checking ------------------------------------------------------------------------------
 def _numbers(group: _Group, path: tuple[Any, ...], width: int | None) -> np.ndarray:
-    """A column of `width` numbers per item (None: one number per item)."""
-    col = group.columns.get(path)
+    """A column of `width` numbers per item (None: one number per item), taken from the
+    group (each column is read once: its memory goes as soon as it is used)."""
+    col = group.columns.pop(path, None)
     if not isinstance(col, np.ndarray) or (col.ndim == 1) != (width is None) \
             or (width is not None and col.shape[1] != width):
         raise _Bail
     return col
 
 
+def _bodies_of(group: _Group, path: tuple[Any, ...]) -> np.ndarray:
+    """A column of references to bodies, as body indices (ground -1), taken."""
+    col = group.columns.pop(path, None)
+    if not (isinstance(col, np.ndarray) and col.dtype == np.intp and col.ndim == 1):
+        raise _Bail
+    return col
+
+
 def _names(group: _Group, path: tuple[Any, ...]) -> list[str]:
-    col = group.columns.get(path)
+    """A column of names, taken from the group."""
+    col = group.columns.pop(path, None)
     if not isinstance(col, list):
         raise _Bail
     return col
@@ -505,24 +699,32 @@ def _inertia(g: _Group, planar: bool) -> np.ndarray:
     return J
 
 
-LOAD_PATHS = {
-    "force": {("name",), ("type",), ("body",), ("force",), ("at",), ("frame",)},
-    "torque": {("name",), ("type",), ("body",), ("torque",), ("frame",)},
-}
+LOAD_PATHS = {kind: {(k,) for k in LOAD_KEYS[kind]} for kind in ("force", "torque")}
+"""What a force or torque load may give (no expressions: a number per component)."""
+JOINT_PATHS = {(k,) for k in JOINT_KEYS}
+
+
+def _placed(n: int, parts: list[tuple[np.ndarray, list[Any]]]) -> list[Any]:
+    """One list of `n` values from each group's (indices, values)."""
+    if len(parts) == 1:  # one layout: its items are all the items, in order
+        return list(parts[0][1])
+    out: list[Any] = [None] * n
+    for index, values in parts:
+        for k, v in zip(index.tolist(), values, strict=True):
+            out[k] = v
+    return out
 
 
 def _loads(c: Checker, groups: list[_Group]) -> LoadTable:
     """Force and torque loads with constant components; `_Bail` for anything else."""
     n = sum(len(g.index) for g in groups)
-    names_all: list[str] = [""] * n
-    types: list[str] = [""] * n
-    bodies: list[str] = [""] * n
-    frames_all: list[str] = [""] * n
+    names_all: list[tuple[np.ndarray, list[str]]] = []
+    types_all: list[tuple[np.ndarray, list[str]]] = []
+    frames_all: list[tuple[np.ndarray, list[str]]] = []
+    body = np.zeros(n, dtype=np.intp)
     vector = np.zeros((n, 3))
     at_all = np.zeros((n, 3))
     dim = c.dim
-    known = c.body_names
-    seen: set[str] = set()
     for g in groups:
         cols = g.columns
         kind = "force" if ("force",) in cols else "torque"
@@ -531,76 +733,81 @@ def _loads(c: Checker, groups: list[_Group]) -> LoadTable:
         if any(t != kind for t in _names(g, ("type",))):
             raise _Bail
         names = _names(g, ("name",))
-        on = _names(g, ("body",))
-        if not all(b in known for b in on):
-            raise _Bail
-        seen.update(names)
-        frames = _names(g, ("frame",)) if ("frame",) in cols else ["world"] * len(names)
-        if not set(frames) <= set(FRAMES):
-            raise _Bail
+        k = len(names)
+        body[g.index] = _bodies_of(g, ("body",))
+        frames = _names(g, ("frame",)) if ("frame",) in cols else [FRAMES[0]] * k
         if kind == "force":
             vec = _pad3(_numbers(g, ("force",), dim))
             at = _pad3(_numbers(g, ("at",), dim)) if ("at",) in cols else np.zeros_like(vec)
         else:
-            vec = np.zeros((len(names), 3))
+            vec = np.zeros((k, 3))
             if dim == cv.PLANAR:
                 vec[:, 2] = _numbers(g, ("torque",), None)
             else:
                 vec[:] = _numbers(g, ("torque",), 3)
             at = np.zeros_like(vec)
-        for k, nm, b, fr in zip(g.index.tolist(), names, on, frames, strict=True):
-            names_all[k], types[k], bodies[k], frames_all[k] = nm, kind, b, fr
+        names_all.append((g.index, names))
+        types_all.append((g.index, [kind] * k))
+        frames_all.append((g.index, frames))
         vector[g.index] = vec
         at_all[g.index] = at
-    if len(seen) != n:
+    names_list = _placed(n, names_all)
+    if len(set(names_list)) != n:
         raise _Bail  # a duplicate load name
-    return LoadTable(names_all, types, bodies, frames_all, vector, at_all)
+    return LoadTable(names_list, _placed(n, types_all), body, _placed(n, frames_all), vector,
+                     at_all)
 
 
-
-def _joints(c: Checker, groups: list[_Group]) -> list[JointSpec]:
+def _joints(c: Checker, groups: list[_Group]) -> JointSpecTable:
     """Joints between bodies (no particles in a fast-path model), checked as
     `validate._joints` checks them; `_Bail` for anything it would refuse."""
     n = sum(len(g.index) for g in groups)
-    out: list[JointSpec | None] = [None] * n
     dim = c.dim
-    types = cv.JOINT_COMPONENTS[dim]
-    known = c.body_names
-    seen: set[str] = set()
+    names_all: list[tuple[np.ndarray, list[str]]] = []
+    types_all: list[tuple[np.ndarray, list[str]]] = []
+    parent = np.zeros(n, dtype=np.intp)
+    child = np.zeros(n, dtype=np.intp)
+    at = np.zeros((n, 3))
+    axis = np.zeros((n, 3))
+    axis2 = np.zeros((n, 3))
+    has_axis = np.zeros(n, dtype=bool)
+    has_axis2 = np.zeros(n, dtype=bool)
     for g in groups:
         cols = g.columns
-        if not set(cols) <= {("name",), ("type",), ("parent",), ("child",), ("at",),
-                             ("axis",), ("axis2",)}:
+        if not set(cols) <= JOINT_PATHS:
             raise _Bail
-        names, kinds = _names(g, ("name",)), _names(g, ("type",))
-        parents, children = _names(g, ("parent",)), _names(g, ("child",))
-        if not (set(kinds) <= set(types) and all(b in known for b in children)
-                and all(b in known or b == cv.GROUND for b in parents)
-                and all(a != b for a, b in zip(parents, children, strict=True))):
-            raise _Bail
-        seen.update(names)
-        at = _pad3(_numbers(g, ("at",), dim))
-        axes: list[np.ndarray | None] = [None] * len(names)
-        if ("axis",) in cols:
-            axis = _unit(_pad3(_numbers(g, ("axis",), dim)))
-            axes = list(axis)
+        first, second = ("axis",) in cols, ("axis2",) in cols  # before they are taken
+        names = _names(g, ("name",))
+        kinds = _names(g, ("type",))
+        p, ch = _bodies_of(g, ("parent",)), _bodies_of(g, ("child",))
+        if np.any(p == ch) or np.any(ch < 0):
+            raise _Bail  # a body joined to itself
+        i = g.index
+        parent[i], child[i] = p, ch
+        at[i] = _pad3(_numbers(g, ("at",), dim))
+        if first:
+            axis[i] = _unit(_pad3(_numbers(g, ("axis",), dim)))
+            has_axis[i] = True
         elif not set(kinds).isdisjoint(cv.AXIS_REQUIRED[dim]):
             raise _Bail
-        axes2: list[np.ndarray | None] = [None] * len(names)
-        if ("axis2",) in cols or "universal" in kinds:
-            if not (("axis2",) in cols and ("axis",) in cols and set(kinds) == {"universal"}):
+        if second or "universal" in kinds:
+            if not (first and second and set(kinds) == {"universal"}):
                 raise _Bail
-            axis2 = _unit(_pad3(_numbers(g, ("axis2",), dim)))
-            if not np.all(np.abs(np.einsum("ij,ij->i", axis, axis2)) <= 0.5e-6):
+            unit2 = _unit(_pad3(_numbers(g, ("axis2",), dim)))
+            if not np.all(np.abs(np.einsum("ij,ij->i", axis[i], unit2)) <= 0.5e-6):
                 raise _Bail  # perpendicular (with a margin: near the limit, the located path)
-            axes2 = list(axis2)
-        for k, nm, typ, pa, ch, a, ax, ax2 in zip(g.index.tolist(), names, kinds, parents,
-                                                 children, at, axes, axes2, strict=True):
-            out[k] = JointSpec(nm, typ, pa, ch, a, ax, ax2)
-            c.joint_types.setdefault(nm, typ)
-    if len(seen) != n:
+            axis2[i] = unit2
+            has_axis2[i] = True
+        names_all.append((i, names))
+        types_all.append((i, kinds))
+    names_list = _placed(n, names_all)
+    types_list = _placed(n, types_all)
+    if len(set(names_list)) != n:
         raise _Bail  # a duplicate joint name
-    return [j for j in out if j is not None]
+    if "reactions" in c.doc.data:  # known reactions name their joints' components
+        c.joint_types.update(zip(names_list, types_list, strict=True))
+    return JointSpecTable(names_list, types_list, parent, child, at, axis, has_axis, axis2,
+                          has_axis2, [""] * n)
 
 
 def _unit(v: np.ndarray) -> np.ndarray:

@@ -8,11 +8,12 @@ world x-y plane (see `conventions`).
 
 from __future__ import annotations
 
+import operator
 import os
-from collections.abc import Iterable
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field, fields, replace
 from functools import cached_property
-from typing import Any
+from typing import Any, TypeVar, overload
 
 import numpy as np
 
@@ -24,7 +25,7 @@ from mbody.model.expressions import Expression, ExpressionTable
 from mbody.model.fast import fast_spec
 from mbody.model.graph import body_graph
 from mbody.model.loader import Document, load_text, read_file
-from mbody.model.validate import LoadSpec, LoadTable, Spec, validate
+from mbody.model.validate import JointSpecTable, LoadSpec, LoadTable, Spec, validate
 
 
 def _ro(a: np.ndarray) -> np.ndarray:
@@ -302,13 +303,46 @@ class SpringTable:
     damping: np.ndarray
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
+class JointTable:
+    """One row per joint (J of them), in file order: what every reaction component of
+    a joint shares.
+
+    names: (J,) joint names; parent, child: (J,) body index (-1 = ground); B_r_child,
+    B_r_parent: (J, 3) the joint point in each body's axes (world for ground); P_E3, C_E3:
+    (J, 3, 3) the joint frame fixed in the parent and in the child; C_axis2: (J, 3) a
+    universal joint's child axis (else 0). first: (J,) the joint's first column of G (its
+    components are consecutive). link: (J,) a particle link (its first component is T);
+    particle_parent: (J,) the parent is a particle; length: (J,) the link's length (0
+    otherwise); free_turn: (J,) the joint turns freely about its z axis (revolute,
+    cylindrical).
+    """
+
+    names: tuple[str, ...]
+    parent: np.ndarray
+    child: np.ndarray
+    B_r_child: np.ndarray
+    B_r_parent: np.ndarray
+    P_E3: np.ndarray
+    C_E3: np.ndarray
+    C_axis2: np.ndarray
+    first: np.ndarray
+    link: np.ndarray
+    particle_parent: np.ndarray
+    length: np.ndarray
+    free_turn: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
 class ReactionTable:
     """One row per reaction unknown (column of G), in label order.
 
-    joint: (m,) joint index; parent, child: (m,) body index (-1 = ground);
-    axis: (m,) 0-2 force along joint axis k, 3-5 moment about joint axis k-3,
-    6 the universal joint's moment about axis × axis2.
+    Stored: `per_joint`, the `JointTable`; joint: (m,) joint index; axis: (m,) 0-2 force
+    along joint axis k, 3-5 moment about joint axis k-3, 6 the universal joint's moment
+    about axis × axis2, -1 a particle link's tension T. Everything else is derived from
+    these on first use (a large model's file is read without building them):
+
+    labels: ``<joint>.<component>``; parent, child: (m,) body index (-1 = ground);
     P_E: (m, 3) the column's joint axis fixed in the parent (body axes; world for ground);
     B_r_child: (m, 3) the joint point on the child, child body axes;
     C_axis2: (m, 3) a universal joint's child axis, child body axes (else 0).
@@ -324,46 +358,88 @@ class ReactionTable:
     length: (m,) the link's length L (0 for other components).
     """
 
-    labels: tuple[str, ...]
+    per_joint: JointTable
     joint: np.ndarray
-    parent: np.ndarray
-    child: np.ndarray
     axis: np.ndarray
-    P_E: np.ndarray
-    B_r_child: np.ndarray
-    C_axis2: np.ndarray
-    B_r_parent: np.ndarray
-    P_E3: np.ndarray
-    C_E3: np.ndarray
-    rot_kind: np.ndarray
-    link: np.ndarray
-    particle_parent: np.ndarray
-    length: np.ndarray
+
+    DERIVED = ("labels", "parent", "child", "P_E", "B_r_child", "C_axis2", "B_r_parent",
+               "P_E3", "C_E3", "rot_kind", "link", "particle_parent", "length")
+    """The per-component fields made from `per_joint` on first use."""
+
+    @cached_property
+    def labels(self) -> tuple[str, ...]:
+        """``<joint>.<component>`` per column of G."""
+        names = self.per_joint.names
+        return tuple(f"{names[j]}.{_COMPONENT[a]}"
+                     for j, a in zip(self.joint.tolist(), self.axis.tolist(), strict=True))
+
+    @cached_property
+    def parent(self) -> np.ndarray:
+        """(m,) the parent body's index (-1 = ground)."""
+        return self.per_joint.parent[self.joint]
+
+    @cached_property
+    def child(self) -> np.ndarray:
+        """(m,) the child body's index."""
+        return self.per_joint.child[self.joint]
+
+    @cached_property
+    def P_E(self) -> np.ndarray:
+        """(m, 3) the column's joint axis fixed in the parent."""
+        column = np.where(self.axis == 6, 2, self.axis % 3)  # Mt's column stores axis z
+        return _ro(self.per_joint.P_E3[self.joint, :, column].reshape(-1, 3))
+
+    @cached_property
+    def B_r_child(self) -> np.ndarray:
+        """(m, 3) the joint point on the child, child axes."""
+        return _ro(self.per_joint.B_r_child[self.joint])
+
+    @cached_property
+    def C_axis2(self) -> np.ndarray:
+        """(m, 3) a universal joint's child axis, child axes (else 0)."""
+        return _ro(self.per_joint.C_axis2[self.joint])
+
+    @cached_property
+    def B_r_parent(self) -> np.ndarray:
+        """(m, 3) the joint point on the parent, parent axes (world for ground)."""
+        return _ro(self.per_joint.B_r_parent[self.joint])
+
+    @cached_property
+    def P_E3(self) -> np.ndarray:
+        """(m, 3, 3) the joint frame fixed in the parent."""
+        return _ro(self.per_joint.P_E3[self.joint])
+
+    @cached_property
+    def C_E3(self) -> np.ndarray:
+        """(m, 3, 3) the joint frame fixed in the child."""
+        return _ro(self.per_joint.C_E3[self.joint])
+
+    @cached_property
+    def rot_kind(self) -> np.ndarray:
+        """(m,) 0 force, 1 tilt of a free turn, 2 locked rotation, 3 universal."""
+        a = self.axis
+        free = self.per_joint.free_turn[self.joint]
+        return np.where(a < 3, 0, np.where(a == 6, 3, np.where(free, 1, 2))).astype(np.intp)
+
+    @cached_property
+    def link(self) -> np.ndarray:
+        """(m,) a particle link's tension T."""
+        return self.axis == cv.LINK_AXIS
+
+    @cached_property
+    def particle_parent(self) -> np.ndarray:
+        """(m,) the parent is a particle."""
+        return self.per_joint.particle_parent[self.joint]
+
+    @cached_property
+    def length(self) -> np.ndarray:
+        """(m,) a link's length (0 for other components)."""
+        return _ro(np.where(self.link, self.per_joint.length[self.joint], 0.0))
 
 
-@dataclass(frozen=True)
-class JointTable:
-    """Per joint (J of them), what the reaction table repeats per component.
-
-    parent, child: (J,) body index (-1 = ground); B_r_child, B_r_parent: (J, 3) the joint
-    point in each body's axes (world for ground); P_E3, C_E3: (J, 3, 3) the joint frame
-    fixed in the parent and in the child; C_axis2: (J, 3) a universal joint's child axis.
-    first: (J,) the joint's first column of G (its components are consecutive).
-    link: (J,) a particle link (its first component is T); particle_parent: (J,) the
-    parent is a particle; length: (J,) the link's length (0 otherwise).
-    """
-
-    parent: np.ndarray
-    child: np.ndarray
-    B_r_child: np.ndarray
-    B_r_parent: np.ndarray
-    P_E3: np.ndarray
-    C_E3: np.ndarray
-    C_axis2: np.ndarray
-    first: np.ndarray
-    link: np.ndarray
-    particle_parent: np.ndarray
-    length: np.ndarray
+_COMPONENT = {**dict(enumerate(cv.COMPONENTS)), 6: "Mt", cv.LINK_AXIS: cv.LINK}
+"""Component name of each `ReactionTable.axis` code."""
+_AXIS = {name: code for code, name in _COMPONENT.items()}
 
 
 @dataclass(frozen=True, eq=False)
@@ -388,12 +464,12 @@ class Model:
         World axes (m/s²).
     initial : State
         The state written in the file.
-    bodies : dict of str to Body
-        Each body by name.
-    loads : tuple of Load
+    bodies : mapping of str to Body
+        Each body by name, in the stacking order (each record is made on first use).
+    loads : sequence of Load
         The applied loads, in file order.
-    joints : tuple of Joint
-        The joints, in file order.
+    joints : sequence of Joint
+        The joints, in file order (records made on first use).
     forces, springs : ForceTable, SpringTable
         The loads as arrays, for the vectorised sums.
     reaction_table : ReactionTable
@@ -415,9 +491,9 @@ class Model:
     J_inv: np.ndarray
     gravity: np.ndarray
     initial: State
-    bodies: dict[str, Body]
-    loads: tuple[Load, ...]
-    joints: tuple[Joint, ...]
+    bodies: Mapping[str, Body]
+    loads: Sequence[Load]
+    joints: Sequence[Joint]
     forces: ForceTable
     springs: SpringTable
     reaction_table: ReactionTable
@@ -468,6 +544,8 @@ class Model:
     @cached_property
     def particle(self) -> np.ndarray:
         """(n,) True for the point masses (`inertia: 0`)."""
+        if isinstance(self.bodies, BodyRecords):  # without making every record
+            return self.bodies.particle.copy()
         return np.array([self.bodies[b].particle for b in self.body_names], dtype=bool)
 
     @cached_property
@@ -537,13 +615,8 @@ class Model:
 
     @cached_property
     def joint_table(self) -> JointTable:
-        """One row per joint (its first reaction component's row of `reaction_table`)."""
-        t = self.reaction_table
-        first = np.unique(t.joint, return_index=True)[1] if len(t.joint) else np.zeros(0, int)
-        return JointTable(t.parent[first], t.child[first], t.B_r_child[first],
-                          t.B_r_parent[first], t.P_E3[first], t.C_E3[first],
-                          t.C_axis2[first], first, t.link[first], t.particle_parent[first],
-                          t.length[first])
+        """One row per joint: what its reaction components share (`JointTable`)."""
+        return self.reaction_table.per_joint
 
     @cached_property
     def reaction_index(self) -> dict[str, int]:
@@ -662,20 +735,18 @@ def _build(spec: Spec) -> Model:
     t = spec.table()
     n = len(t.names)
     names = t.names
-    idx = {nm: i for i, nm in enumerate(names)}
+    # name -> index, for the located path's records (the fast path's tables hold indices)
+    idx = {nm: i for i, nm in enumerate(names)} if spec.loads or spec.joints else {}
     mass = _ro(t.mass)
     J = _ro(t.inertia.reshape(n, 3, 3))
     J_inv = np.linalg.inv(J)
     initial = State(_ro(t.position.reshape(n, 3)), _ro(t.quaternion.reshape(n, 4)),
                     _ro(t.velocity.reshape(n, 3)), _ro(t.omega.reshape(n, 3)))
-    # Views of the read-only J: one array, not n small copies.
-    bodies = dict(zip(names, _records(Body, zip(
-        names, range(n), mass.tolist(), J, t.shape, t.color, t.particle.tolist(),
-        strict=True)), strict=True))
-    particle = {names[i] for i in np.flatnonzero(t.particle)}
+    bodies = BodyRecords(names, mass, J, t.shape, t.color, t.particle)
 
+    loads: Sequence[Load]
     if spec.load_table is not None:
-        loads, forces = _point_loads(spec.load_table, idx)
+        loads, forces = _point_loads(spec.load_table, names)
     else:
         loads, forces = _loads(spec.loads, idx)
     sp = [ld for ld in spec.loads if ld.type == "spring"]
@@ -690,9 +761,12 @@ def _build(spec: Spec) -> Model:
         _ro(np.array([ld.damping for ld in sp], dtype=float)),
     )
 
-    joints, table = _joint_tables(spec, idx, initial, particle)
+    js = spec.joint_table
+    if js is None:
+        js = JointSpecTable.from_specs(spec.joints, idx)
+    joints, table = _joint_tables(spec.dimension, js, names, initial, t.particle)
     return Model(spec.name, spec.file, spec.dimension, names, mass, J, _ro(J_inv),
-                 _ro(spec.gravity), initial, bodies, loads, tuple(joints), forces, springs,
+                 _ro(spec.gravity), initial, bodies, loads, joints, forces, springs,
                  table, dict(spec.reactions), spec.description, tuple(spec.warnings),
                  dict(spec.reaction_expressions))
 
@@ -716,64 +790,65 @@ def _loads(specs: list[LoadSpec], idx: dict[str, int]) -> tuple[tuple[Load, ...]
     return loads, forces
 
 
-def _point_loads(t: LoadTable, idx: dict[str, int]) -> tuple[tuple[Load, ...], ForceTable]:
-    """The fast path's loads (force and torque, constant), and their force table."""
+def _point_loads(t: LoadTable, names: tuple[str, ...]) -> tuple[Records[Load], ForceTable]:
+    """The fast path's loads (force and torque, constant): their force table, and their
+    records, made on first use from it."""
     vector, at = _ro(t.vector), _ro(t.at)
-    k = len(t.names)
-    loads = tuple(_records(Load, zip(
-        t.names, t.types, [(b,) for b in t.bodies], vector, t.frames, [(a,) for a in at],
-        [0.0] * k, [0.0] * k, [0.0] * k, [{} for _ in range(k)], strict=True)))
-    forces = ForceTable(tuple(t.names), np.array([idx[b] for b in t.bodies], dtype=np.intp),
-                        vector, np.array([f == "body" for f in t.frames], dtype=bool), at,
+    body = np.asarray(t.body, dtype=np.intp)
+    forces = ForceTable(tuple(t.names), body, vector,
+                        np.array([f == "body" for f in t.frames], dtype=bool), at,
                         np.array([typ == "torque" for typ in t.types], dtype=bool),
                         ExpressionTable.build([]))
-    return loads, forces
+    fields_ = _field_names(Load)
+    load_names, types, frames = forces.names, t.types, t.frames
+
+    def make(i: int) -> Load:
+        return _record(Load, fields_, (load_names[i], types[i], (names[body[i]],), vector[i],
+                                       frames[i], (at[i],), 0.0, 0.0, 0.0, {}))
+
+    return Records(len(load_names), make), forces
 
 
-def _joint_tables(spec: Spec, idx: dict[str, int], initial: State, particle: set[str]
-                  ) -> tuple[tuple[Joint, ...], ReactionTable]:
+_FREE_TURN = ("revolute", "cylindrical")
+"""Joint types whose moment components measure the tilt of the joint z axis."""
+
+
+def _joint_tables(dimension: int, js: JointSpecTable, names: tuple[str, ...],
+                  initial: State, particle: np.ndarray
+                  ) -> tuple[Records[Joint], ReactionTable]:
     """The joints and their reaction table, computed for all joints at once.
 
     Per joint: the joint frame W_E0 at the initial pose (one call of the contract's rule
     per distinct axis), then the frame and the joint point in each body's axes,
-    ``P_E = R_p^T W_E0``, ``B_r = R^T (at - x)``; then one row per reaction component.
+    ``P_E = R_p^T W_E0``, ``B_r = R^T (at - x)``, kept per joint (`JointTable`); the
+    reaction table holds one row per component, each naming its joint and axis, and
+    derives the rest on first use. The `Joint` records are made on first use too.
     """
-    js_all = spec.joints
-    nj = len(js_all)
-    planar = spec.dimension == cv.PLANAR
-    frames: dict[bytes | None, np.ndarray] = {}
-
-    def frame(axis: np.ndarray | None) -> np.ndarray:
-        key = None if axis is None else np.asarray(axis, float).tobytes()
-        if key not in frames:
-            frames[key] = joint_frame_planar(axis) if planar else joint_frame_spatial(axis)
-        return frames[key]
-
-    W_E0 = np.array([frame(js.axis) for js in js_all]).reshape(nj, 3, 3)
-    at = np.array([js.at for js in js_all], dtype=float).reshape(nj, 3)
-    p = np.array([idx.get(js.parent, -1) for js in js_all], dtype=np.intp)
-    c = np.array([idx[js.child] for js in js_all], dtype=np.intp)
+    nj = len(js.names)
+    planar = dimension == cv.PLANAR
+    W_E0 = _ro(_frames(js.axis, js.has_axis, planar))
+    at = _ro(js.at)
+    p, c = js.parent, js.child
     ground = p < 0
-    R0 = initial.W_R_B
+    R0 = quat_to_matrix(initial.quaternion)  # State.W_R_B's values, not kept on the state
     x0 = initial.position
     # the world frame stands in for ground: I @ v is v exactly
     Rp = np.where(ground[:, None, None], np.eye(3), R0[p] if nj else np.zeros((0, 3, 3)))
     xp = np.where(ground[:, None], 0.0, x0[p] if nj else np.zeros((0, 3)))
     Rc, xc = R0[c], x0[c]
+    del R0
     RpT, RcT = Rp.transpose(0, 2, 1), Rc.transpose(0, 2, 1)
     P_E = RpT @ W_E0  # joint frame fixed in the parent (the world for ground)
     C_E = RcT @ W_E0
     B_r_child = (RcT @ (at - xc)[:, :, None])[:, :, 0]
     B_r_parent = np.where(ground[:, None], at, (RpT @ (at - xp)[:, :, None])[:, :, 0])
-    axis2 = np.array([js.axis2 if js.axis2 is not None else np.zeros(3) for js in js_all],
-                     dtype=float).reshape(nj, 3)
-    C_axis2 = (RcT @ axis2[:, :, None])[:, :, 0]
+    C_axis2 = (RcT @ js.axis2[:, :, None])[:, :, 0]
     # a particle end is attached at the particle itself (no offset, no moment)
-    p_particle = np.array([js.parent in particle for js in js_all], dtype=bool)
-    c_particle = np.array([js.child in particle for js in js_all], dtype=bool)
+    p_particle = particle[p] & ~ground
+    c_particle = particle[c]
     B_r_child[c_particle] = 0.0
     B_r_parent[p_particle] = 0.0
-    kinds = [js.particle_joint for js in js_all]
+    kinds = js.particle_joint
     link = np.array([k == "link" for k in kinds], dtype=bool)
     length = np.zeros(nj)
     if link.any():  # attachment points: the particle(s), else the joint point
@@ -781,53 +856,194 @@ def _joint_tables(spec: Spec, idx: dict[str, int], initial: State, particle: set
         P_p = np.where(ground[:, None], B_r_parent,
                        xp + (Rp @ B_r_parent[:, :, None])[:, :, 0])
         length[link] = np.linalg.norm((P_c - P_p)[link], axis=1)
+    del Rp, Rc, RpT, RcT, xp, xc
 
-    comps = [cv.PARTICLE_COMPONENTS[spec.dimension][js.type][k] if k
-             else cv.JOINT_COMPONENTS[spec.dimension][js.type]
-             for js, k in zip(js_all, kinds, strict=True)]
-    ro_at, ro_W = _ro(at), _ro(W_E0)
-    joints = tuple(Joint(js.name, js.type, js.parent, js.child, ro_at[j], ro_W[j], comps[j],
-                         js.axis, js.axis2, kinds[j]) for j, js in enumerate(js_all))
-    counts = np.array([len(cs) for cs in comps], dtype=np.intp)
+    types = js.types
+    by_type = cv.JOINT_COMPONENTS[dimension]
+    comps = ([by_type[typ] for typ in types] if not any(kinds) else
+             [cv.PARTICLE_COMPONENTS[dimension][typ][k] if k else by_type[typ]
+              for typ, k in zip(types, kinds, strict=True)])
+    # the distinct component lists (a few), and each joint's
+    distinct: dict[tuple[str, ...], int] = {}
+    code = np.fromiter((distinct.setdefault(cs, len(distinct)) for cs in comps),
+                       dtype=np.intp, count=nj)
+    axes = np.zeros((max(len(distinct), 1), 7), dtype=np.intp)
+    sizes = np.zeros(len(axes), dtype=np.intp)
+    for cs, k in distinct.items():
+        axes[k, :len(cs)] = [_AXIS[comp] for comp in cs]
+        sizes[k] = len(cs)
+    counts = sizes[code]
+    first = np.cumsum(counts) - counts
     row_joint = np.repeat(np.arange(nj, dtype=np.intp), counts)
-    # Mt's direction is recomputed from both bodies; its column stores axis z.
-    axis = np.array([6 if comp == "Mt" else cv.LINK_AXIS if comp == cv.LINK
-                     else cv.COMPONENTS.index(comp) for cs in comps for comp in cs],
-                    dtype=np.intp)
-    free_turn = np.array([js.type in ("revolute", "cylindrical") for js in js_all],
-                         dtype=bool)[row_joint]
-    rot_kind = np.where(axis < 3, 0, np.where(axis == 6, 3, np.where(free_turn, 1, 2)))
-    column = np.where(axis == 6, 2, axis % 3)
-    table = ReactionTable(
-        tuple(f"{js.name}.{comp}" for js, cs in zip(js_all, comps, strict=True) for comp in cs),
-        row_joint, p[row_joint], c[row_joint], axis,
-        _ro(P_E[row_joint, :, column].reshape(-1, 3)),
-        _ro(B_r_child[row_joint]), _ro(C_axis2[row_joint]), _ro(B_r_parent[row_joint]),
-        _ro(P_E[row_joint]), _ro(C_E[row_joint]), rot_kind.astype(np.intp),
-        axis == cv.LINK_AXIS, p_particle[row_joint],
-        _ro(np.where(axis == cv.LINK_AXIS, length[row_joint], 0.0)),
-    )
-    return joints, table
+    axis = axes[code[row_joint], np.arange(len(row_joint)) - first[row_joint]]
+    free_turn = np.array([typ in _FREE_TURN for typ in types], dtype=bool)
+    per_joint = JointTable(tuple(js.names), p, c, _ro(B_r_child), _ro(B_r_parent),
+                           _ro(P_E), _ro(C_E), _ro(C_axis2), first, link, p_particle,
+                           _ro(length), free_turn)
+    table = ReactionTable(per_joint, row_joint, axis)
+
+    fields_ = _field_names(Joint)
+    axis1 = _ro(js.axis)
+    axis2 = _ro(js.axis2)
+    jnames, parents, children = js.names, p, c
+    has1, has2 = js.has_axis, js.has_axis2
+
+    def make(j: int) -> Joint:
+        pj = int(parents[j])
+        return _record(Joint, fields_, (
+            jnames[j], types[j], names[pj] if pj >= 0 else cv.GROUND, names[children[j]],
+            at[j], W_E0[j], comps[j], axis1[j] if has1[j] else None,
+            axis2[j] if has2[j] else None, kinds[j]))
+
+    return Records(nj, make), table
 
 
-def _records(cls: type, rows: Iterable[tuple[Any, ...]]) -> list[Any]:
-    """Instances of the frozen dataclass `cls`, each from a tuple of all its fields.
+def _frames(axis: np.ndarray, has_axis: np.ndarray, planar: bool) -> np.ndarray:
+    """(k, 3, 3) the joint frame of each axis (None where `has_axis` is False), by the
+    contract's rule, computed once per distinct axis (the same bits, not the same value:
+    -0.0 and 0.0 are two axes)."""
+    k = len(axis)
+    if k == 0:
+        return np.zeros((0, 3, 3))
+    bits = np.ascontiguousarray(axis, dtype=float).view(np.int64)
+    key = np.concatenate((bits, has_axis[:, None].astype(np.int64)), axis=1)
+    distinct, inverse = np.unique(key, axis=0, return_inverse=True)
+    rule = joint_frame_planar if planar else joint_frame_spatial
+    first = np.zeros(len(distinct), dtype=np.intp)
+    first[inverse.ravel()[::-1]] = np.arange(k - 1, -1, -1)  # a joint with each axis
+    frames = np.array([rule(axis[i] if has_axis[i] else None) for i in first.tolist()])
+    return frames.reshape(-1, 3, 3)[inverse.ravel()]
+
+
+def _field_names(cls: type) -> list[str]:
+    return [f.name for f in fields(cls)]
+
+
+def _record(cls: type, names: list[str], row: tuple[Any, ...]) -> Any:
+    """An instance of the frozen dataclass `cls` from a tuple of all its fields.
 
     A frozen dataclass's ``__init__`` sets each field through ``object.__setattr__``;
-    filling the instance's ``__dict__`` at once is about 4x faster, which counts for the
-    10^4-10^5 bodies and loads of a large model (2-3 µs each otherwise). The class must
-    take every field from the tuple: no defaults, no ``__post_init__``, no slots.
+    filling the instance's ``__dict__`` at once is about 4x faster (the class must take
+    every field from the tuple: no ``__post_init__``, no slots).
     """
-    names = [f.name for f in fields(cls)]
-    if hasattr(cls, "__post_init__") or hasattr(cls, "__slots__"):
-        return [cls(*row) for row in rows]
-    new = object.__new__
-    out = []
-    for row in rows:
-        obj: Any = new(cls)
-        obj.__dict__.update(zip(names, row, strict=True))
-        out.append(obj)
-    return out
+    obj: Any = object.__new__(cls)
+    obj.__dict__.update(zip(names, row, strict=True))
+    return obj
+
+
+T = TypeVar("T")
+
+
+class Records(Sequence[T]):
+    """A read-only sequence of records, each made on first use and then kept.
+
+    A large model's file is read without making a record per load or joint (a few
+    hundred bytes and about a microsecond each); the arrays they view are the model's.
+
+    Parameters
+    ----------
+    n : int
+        How many records.
+    make : callable
+        Index -> its record.
+    """
+
+    __slots__ = ("_n", "_make", "_made")
+
+    def __init__(self, n: int, make: Callable[[int], T]):
+        self._n = n
+        self._make = make
+        self._made: list[T | None] = [None] * n
+
+    def __len__(self) -> int:
+        return self._n
+
+    @overload
+    def __getitem__(self, i: int) -> T: ...
+
+    @overload
+    def __getitem__(self, i: slice) -> tuple[T, ...]: ...
+
+    def __getitem__(self, i: int | slice) -> T | tuple[T, ...]:
+        if isinstance(i, slice):
+            return tuple(self[k] for k in range(*i.indices(self._n)))
+        k = operator.index(i)
+        if k < 0:
+            k += self._n
+        if not 0 <= k < self._n:
+            raise IndexError(f"record index {i} out of range ({self._n} records)")
+        made = self._made[k]
+        if made is None:
+            made = self._made[k] = self._make(k)
+        return made
+
+    def __iter__(self) -> Iterator[T]:
+        for k in range(self._n):
+            yield self[k]
+
+    def __repr__(self) -> str:
+        return f"<{self._n} records; made so far: {self._n - self._made.count(None)}>"
+
+
+class BodyRecords(Mapping[str, Body]):
+    """Each body's `Body` record by name, in the stacking order, made on first use.
+
+    Parameters
+    ----------
+    names : tuple of str
+        The stacking order.
+    mass : (n,) array
+    inertia : (n, 3, 3) array
+        Read-only: each record's ``inertia`` is a view of its row.
+    shape, color : list
+        Per body, or None.
+    particle : (n,) bool array
+        The point masses.
+    """
+
+    __slots__ = ("_names", "_mass", "_inertia", "_shape", "_color", "particle", "_index",
+                 "_records")
+
+    def __init__(self, names: tuple[str, ...], mass: np.ndarray, inertia: np.ndarray,
+                 shape: list[dict[str, Any] | None], color: list[str | None],
+                 particle: np.ndarray):
+        self._names = names
+        self._mass = mass
+        self._inertia = inertia
+        self._shape = shape
+        self._color = color
+        self.particle = particle
+        self._index: dict[str, int] | None = None
+        fields_ = _field_names(Body)
+
+        def make(i: int) -> Body:
+            return _record(Body, fields_, (names[i], i, float(mass[i]), inertia[i], shape[i],
+                                           color[i], bool(particle[i])))
+
+        self._records = Records(len(names), make)
+
+    def _where(self, name: object) -> int | None:
+        if self._index is None:
+            self._index = {nm: i for i, nm in enumerate(self._names)}
+        return self._index.get(name) if isinstance(name, str) else None
+
+    def __getitem__(self, name: str) -> Body:
+        i = self._where(name)
+        if i is None:
+            raise KeyError(name)
+        return self._records[i]
+
+    def __contains__(self, name: object) -> bool:
+        return self._where(name) is not None
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._names)
+
+    def __len__(self) -> int:
+        return len(self._names)
+
+    def __repr__(self) -> str:
+        return f"<{count(len(self._names), 'body', 'bodies')}: {_names(self._names)}>"
 
 
 def _names(names, most: int = 5) -> str:

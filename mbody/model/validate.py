@@ -147,15 +147,68 @@ class BodyTable:
 class LoadTable:
     """Force and torque loads with constant components as arrays, in file order (the
     fast path gives this instead of a `LoadSpec` each): names, types ('force' or
-    'torque'), body names, frames; vector: (k, 3) components in the frame; at: (k, 3)
-    point of application, body axes."""
+    'torque'); body: (k,) index of the body it acts on; frames ('world' or 'body');
+    vector: (k, 3) components in the frame; at: (k, 3) point of application, body axes."""
 
     names: list[str]
     types: list[str]
-    bodies: list[str]
+    body: np.ndarray
     frames: list[str]
     vector: np.ndarray
     at: np.ndarray
+
+
+@dataclass
+class JointSpecTable:
+    """Every joint as columns, in file order (what `Model` builds its joint tables from).
+
+    names, types; parent, child: (k,) body indices (-1 = ground); at: (k, 3) the joint
+    point, world, initial pose; axis, axis2: (k, 3) unit axes, zero where `has_axis`,
+    `has_axis2` are False; particle_joint: "pin", "link" or "" per joint.
+    """
+
+    names: list[str]
+    types: list[str]
+    parent: np.ndarray
+    child: np.ndarray
+    at: np.ndarray
+    axis: np.ndarray
+    has_axis: np.ndarray
+    axis2: np.ndarray
+    has_axis2: np.ndarray
+    particle_joint: list[str]
+
+    @classmethod
+    def from_specs(cls, joints: list[JointSpec], index: dict[str, int]) -> JointSpecTable:
+        """The table of a list of per-joint records (the located path's output).
+
+        Parameters
+        ----------
+        joints : list of JointSpec
+            The joints, in file order.
+        index : dict of str to int
+            Body name -> index (ground is absent: -1).
+
+        Returns
+        -------
+        JointSpecTable
+        """
+        k = len(joints)
+        zero = np.zeros(3)
+
+        def stack(vectors: list[np.ndarray | None]) -> np.ndarray:
+            return np.array([zero if v is None else v for v in vectors],
+                            dtype=float).reshape(k, 3)
+
+        axes = [j.axis for j in joints]
+        axes2 = [j.axis2 for j in joints]
+        return cls([j.name for j in joints], [j.type for j in joints],
+                   np.array([index.get(j.parent, -1) for j in joints], dtype=np.intp),
+                   np.array([index[j.child] for j in joints], dtype=np.intp),
+                   stack([j.at for j in joints]), stack(axes),
+                   np.array([a is not None for a in axes], dtype=bool), stack(axes2),
+                   np.array([a is not None for a in axes2], dtype=bool),
+                   [j.particle_joint for j in joints])
 
 
 @dataclass
@@ -176,6 +229,8 @@ class Spec:
     """The bodies as arrays; the fast path gives only this (and `bodies` empty)."""
     load_table: LoadTable | None = None
     """The fast path's loads (then `loads` is empty): force and torque loads only."""
+    joint_table: JointSpecTable | None = None
+    """The fast path's joints (then `joints` is empty)."""
 
     def table(self) -> BodyTable:
         """The bodies as arrays, from `body_table` or else from `bodies`."""
