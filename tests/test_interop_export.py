@@ -28,6 +28,8 @@ from randmodels import planar_model, spatial_model
 import mbody
 from mbody import conventions as cv
 from mbody.cli.app import main
+from mbody.errors import ModelError
+from mbody.io.interop.mjcf import read_mjcf
 from mbody.io.interop.mjcf_write import spanning_tree, to_mjcf
 from mbody.io.interop.yaml_write import dump_document
 from mbody.model import State
@@ -352,26 +354,118 @@ def test_yaml_numbers_and_text_read_back_as_written():
     assert yaml.safe_load(text) == document
 
 
+def _through_mjcf(model: mbody.Model) -> tuple[mbody.Model, str]:
+    """YAML → MJCF (loaded by MuJoCo as written) → the MJCF reader → YAML → model."""
+    xml = to_mjcf(model)
+    mujoco.MjModel.from_xml_string(xml)  # the mbody entries do not stop MuJoCo
+    document = read_mjcf(xml, keyframe="initial")
+    assert not document.warnings  # nothing of the export is left unread
+    return mbody.loads(dump_document(document.data, source="exported.xml")), xml
+
+
+def _same_model(a: mbody.Model, b: mbody.Model) -> None:
+    """The same equations (1e-12) and everything the equations are named by."""
+    _same_equations(a, b, rtol=1e-12)
+    assert b.dimension == a.dimension
+    assert sorted(b.body_names) == sorted(a.body_names)
+    assert [bool(b.particle[b.index[n]]) for n in a.body_names] == list(a.particle)
+    assert {(j.name, j.type, j.parent, j.child) for j in b.joints} == {
+        (j.name, j.type, j.parent, j.child) for j in a.joints}
+    assert [(ld.name, ld.type, ld.bodies) for ld in b.loads] == [
+        (ld.name, ld.type, ld.bodies) for ld in a.loads]
+    assert b.known_reactions == a.known_reactions
+    assert {k: str(e) for k, e in b.known_expressions.items()} == {
+        k: str(e) for k, e in a.known_expressions.items()}
+    for t in (0.0, 0.013):  # loads and known values that vary in time vary alike
+        np.testing.assert_array_equal(b.forces.vector_at(t), a.forces.vector_at(t))
+        assert b.known_reactions_at(t) == a.known_reactions_at(t)
+
+
+@pytest.mark.parametrize("name", ALL)
+def test_every_shipped_model_round_trips_through_mjcf(name):
+    """YAML → MJCF → YAML gives the same M, b, Q, G (rows and columns matched by label)
+    for every shipped model, planar and spatial: the mbody entries of ``<custom>`` bring
+    back the dimension, loads, springs, known reactions, fixed joints, particles and
+    each joint's direction."""
+    model = mbody.load(MODELS / name)
+    back, xml = _through_mjcf(model)
+    _same_model(model, back)
+    assert "<custom>" in xml and xml.count('name="mbody:load:') == len(model.loads)
+
+
+def test_without_the_mbody_entries_the_file_is_plain_mjcf():
+    """The entries are the only source of what MJCF cannot say: a file without them
+    reads as MuJoCo's model (spatial; no point loads; springs are tendons mbody does not
+    read)."""
+    def plain(name: str):
+        xml = to_mjcf(mbody.load(MODELS / name))
+        head, rest = xml.split("  <!-- What MJCF cannot say", 1)
+        return read_mjcf(head + rest.split("  </custom>\n", 1)[1], keyframe="initial")
+
+    doc = plain("gyroscope_gimbals.yaml")
+    assert doc.data["dimension"] == 3 and "loads" not in doc.data
+    spec = _random_trees("spatial", None, 2, count=1)[0]
+    xml = to_mjcf(mbody.load(spec))
+    head, rest = xml.split("  <!-- What MJCF cannot say", 1)
+    doc = read_mjcf(head + rest.split("  </custom>\n", 1)[1], keyframe="initial")
+    assert "tendons (s0, s1)" in doc.warnings[0].message
+    assert "loads" not in doc.data
+    with pytest.raises(ModelError, match="no joint with two sliding directions"):
+        plain("spring_mass_damper.yaml")  # a free planar body: MJCF's x, y slides, z hinge
+
+
+def test_a_round_trip_that_loses_something_is_caught():
+    """The comparison can fail: an entry removed from the file changes the equations."""
+    model = mbody.load(MODELS / "practice_2_flywheel.yaml")
+    xml = to_mjcf(model)
+    line = next(ln for ln in xml.splitlines() if 'name="mbody:reaction:' in ln)
+    document = read_mjcf(xml.replace(line + "\n", ""), keyframe="initial")
+    back = mbody.loads(dump_document(document.data, source="exported.xml"))
+    with pytest.raises(AssertionError):
+        _same_model(model, back)
+
+
+def test_one_letter_joints_and_free_particles_round_trip():
+    """A universal joint 'A' (hinges A:1, A:2) and a cylindrical joint 'C' (C:slide,
+    C:turn) come back named A and C; a free particle of a spatial model, written as three
+    orthogonal slides, comes back a free particle."""
+    spec = {"model": "letters", "dimension": 3, "gravity": [0, 0, -9.81],
+            "bodies": [{"name": "a", "mass": 2, "inertia": [1, 2, 2.5],
+                        "position": [0, 0, -0.5]},
+                       {"name": "c", "mass": 1, "inertia": [0.1, 0.2, 0.25],
+                        "position": [0, 0, -1.5]},
+                       {"name": "p", "mass": 0.5, "inertia": 0, "position": [1, 2, 3],
+                        "velocity": [0.5, -1, 2]}],
+            "loads": [{"name": "push", "type": "force", "body": "p", "force": [1, 2, 3]}],
+            "joints": [{"name": "A", "type": "universal", "parent": "ground", "child": "a",
+                        "at": [0, 0, 0], "axis": [1, 0, 0], "axis2": [0, 1, 0]},
+                       {"name": "C", "type": "cylindrical", "parent": "a", "child": "c",
+                        "at": [0, 0, -1], "axis": [0, 0, 1]}]}
+    model = mbody.load(spec)
+    back, xml = _through_mjcf(model)
+    assert 'name="A:1"' in xml and 'name="C:slide"' in xml and 'name="p:z"' in xml
+    _same_model(model, back)
+    assert sorted(j.name for j in back.joints) == ["A", "C"]
+
+
 def test_round_trip_through_mjcf_gives_the_same_equations():
-    """YAML → MJCF → YAML (the MJCF reader) for the models MJCF holds whole: spatial,
-    no point loads, no known reactions, no particles, velocities that respect the joints,
-    every joint's child farther from ground than its parent. Others lose what the header
-    of the MJCF file lists (planar models come back spatial; a joint against the tree
-    comes back with parent and child swapped, so its reactions change sign; a fixed joint
-    comes back named after its child, at the child's mass centre)."""
-    mjcf = pytest.importorskip("mbody.io.interop.mjcf")
-    whole = ["heavy_top.yaml", "intermediate_axis_flip.yaml", "practice_3_euler.yaml",
-             "seed_example_2.yaml", "torque_free_asymmetric.yaml",
-             "torque_free_symmetric.yaml"]
-    models = [mbody.load(MODELS / n) for n in whole]
-    # fixed joints have no MJCF element: their name and point do not come back
-    mixes = [None, ("spherical", "universal", "revolute", "cylindrical")]
-    models += [mbody.load(_moving({**spec, "loads": []}))
-               for t in mixes for spec in _random_trees("spatial", t, 0, count=2, upright=True)]
-    for model in models:
-        document = mjcf.read_mjcf(to_mjcf(model), keyframe="initial")
-        back = mbody.loads(dump_document(document.data, source="exported.xml"))
-        _same_equations(model, back, rtol=1e-12)
+    """YAML → MJCF → YAML for random trees of every joint type, planar and spatial, with
+    offset forces, couples, damped springs, fixed joints and joints that run against the
+    tree (the child nearer the root): the same equations, names and directions."""
+    mixes = [None, ("spherical", "universal", "revolute", "cylindrical"),
+             ("spherical", "fixed", "universal", "revolute"),
+             ("cylindrical", "spherical", "prismatic", "fixed")]
+    specs = [spec for t in mixes for spec in _random_trees("spatial", t, 2, count=2)]
+    specs += _random_trees("planar", None, 2, count=3)
+    reversed_joints = fixed = 0
+    for spec in specs:
+        model = mbody.load(_moving(spec))
+        tree = spanning_tree(model)
+        reversed_joints += sum(j.child != b for b, j in tree.joint.items() if j is not None)
+        fixed += sum(j.type == "fixed" for j in model.joints)
+        back, _ = _through_mjcf(model)
+        _same_model(model, back)
+    assert reversed_joints > 0 and fixed > 0
 
 
 def _moving(spec: dict) -> dict:
@@ -382,8 +476,10 @@ def _moving(spec: dict) -> dict:
     d.qvel[:] = np.random.default_rng(7).normal(scale=2.0, size=m.nv)
     mujoco.mj_forward(m, d)
     state = _state(model, m, d)
-    bodies = [{**b, "velocity": state.velocity[i].tolist(),
-               "angular_velocity": state.omega[i].tolist()}
+    planar = model.dimension == cv.PLANAR
+    bodies = [{**b, "velocity": state.velocity[i, :2 if planar else 3].tolist(),
+               "angular_velocity": (float(state.omega[i, 2]) if planar
+                                    else state.omega[i].tolist())}
               for i, b in enumerate(spec["bodies"])]
     return {**spec, "bodies": bodies}
 

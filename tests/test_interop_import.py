@@ -25,6 +25,7 @@ import mbody
 from mbody.cli.app import main
 from mbody.errors import ModelError
 from mbody.io.interop.mjcf import read_mjcf, solid
+from mbody.io.interop.tree import joint_name
 from mbody.io.interop.urdf import read_urdf
 from mbody.io.interop.xmlsource import parse_xml
 from mbody.model.model import Model
@@ -338,6 +339,62 @@ def test_not_imported_is_one_warning():
     assert len(notes) == 1
     for word in ("contacts", "joint damping", "joint limits", "actuators (shoulder_motor)"):
         assert word in notes[0].message
+
+
+def _contacts(geoms: str) -> str:
+    """The contacts part of the warning for a model of one body with `geoms` (and a
+    floor), '' when none is listed."""
+    doc = read_mjcf(f"""<mujoco><worldbody><geom name="floor" type="plane" size="1 1 .1"/>
+      <body name="b"><freejoint/>{geoms}</body></worldbody></mujoco>""")
+    notes = " ".join(w.message for w in doc.warnings)
+    found = re.search(r"contacts \(([^)]*)\)", notes)
+    return found.group(1) if found else ""
+
+
+def test_contacts_listed_only_for_geoms_that_can_touch():
+    """MuJoCo tests a pair of geoms of different bodies when (contype1 & conaffinity2)
+    or (contype2 & conaffinity1)."""
+    off = 'contype="0" conaffinity="0"'
+    assert _contacts(f'<geom size=".1" {off}/>') == ""
+    assert _contacts('<geom size=".1"/>') == "world geom 'floor', 1 body geoms collide in MuJoCo"
+    assert _contacts(f'<geom size=".1" {off}/><geom size=".2" pos="1 0 0"/>') == (
+        "world geom 'floor', 1 body geoms collide in MuJoCo")
+    # bits that never meet: type 2 against affinity 1 (the floor's), affinity 0 against
+    # the floor's type 1
+    assert _contacts('<geom size=".1" contype="2" conaffinity="0"/>') == ""
+    # through a default class
+    doc = read_mjcf(f"""<mujoco><default><default class="quiet"><geom {off}/></default>
+      </default><worldbody><body name="b" childclass="quiet"><freejoint/>
+      <geom size=".1"/></body></worldbody></mujoco>""")
+    assert not doc.warnings
+
+
+def test_exported_joint_parts_give_back_any_name():
+    """The export names a universal joint's hinges J:1, J:2 and a cylindrical joint's
+    parts J:slide, J:turn; the stem comes back whatever J is (one letter, a colon)."""
+    assert joint_name(["A:1", "A:2"]) == "A"
+    assert joint_name(["x:slide", "x:turn"]) == "x"
+    assert joint_name(["a:b:1", "a:b:2"]) == "a:b"
+    assert joint_name(["right_hip_x", "right_hip_z", "right_hip_y"]) == "right_hip"
+    assert joint_name(["a", "b"]) == "a+b"
+    assert joint_name(["A:1", "B:2"]) == "A:1+B:2"
+
+
+def test_mbody_entries_that_are_wrong_are_located():
+    base = '<mujoco><custom>{}</custom><worldbody><body name="b"><freejoint/>' \
+           '<inertial mass="1" diaginertia="1 1 1"/></body></worldbody></mujoco>'
+    issues = _issues(base.format('<numeric name="mbody:dimensoin" data="2"/>'))
+    assert issues == ["bad.xml:1:26: <numeric name>: unknown mbody entry kind 'dimensoin' "
+                      "(did you mean 'dimension'?)"]
+    issues = _issues(base.format('<text name="mbody:body:b" data="{inertia: 0}"/>'))
+    assert len(issues) == 1 and "the data is not JSON" in issues[0]
+    issues = _issues(base.format('<text name="mbody:body:c" data=\'{"inertia": 0}\'/>'))
+    assert len(issues) == 1 and "no body 'c'" in issues[0]
+    issues = _issues(base.format('<numeric name="mbody:dimension" data="4"/>'))
+    assert len(issues) == 1 and "must be 2 or 3" in issues[0]
+    # other custom entries are MuJoCo's or another tool's: not read
+    doc = read_mjcf(base.format('<numeric name="other:dimension" data="7"/>'))
+    assert doc.data["dimension"] == 3
 
 
 # ---- bad XML -------------------------------------------------------------------------

@@ -21,6 +21,7 @@ import numpy as np
 
 from mbody.equations.spatial import matrix_to_quat
 from mbody.errors import Issue, ModelError, did_you_mean
+from mbody.io.interop.custom import Custom, read_custom, restore
 from mbody.io.interop.mjcf_schema import SCHEMA
 from mbody.io.interop.tree import (
     NV,
@@ -169,6 +170,8 @@ class _Reader:
         self.defaults: dict[str, dict[str, dict[str, str]]] = {}
         self.default_parent: dict[str, str] = {}
         self.bodies: list[TreeBody] = []
+        self.childclasses: dict[int, str | None] = {}
+        self.world_geoms: list[Element] = []
         self.body_index: dict[str, int] = {}
 
     # -- small readers ---------------------------------------------------------------
@@ -273,6 +276,7 @@ class _Reader:
         worlds = root.findall("worldbody")
         for w in worlds:
             for g in w.findall("geom") if not self.contact_off else ():
+                self.world_geoms.append(g)
                 self.note("contacts", f"world geom '{g.get('name') or g.get('type', '?')}'")
             for c in w.children:
                 if c.tag == "body":
@@ -282,6 +286,7 @@ class _Reader:
                               "write the bodies out in <worldbody>")
         if self.issues:
             raise ModelError(self.issues)
+        self.custom = read_custom(root)
         self.bound_masses()
         loops = self.equality()
         self.others()
@@ -292,12 +297,91 @@ class _Reader:
             qpos, qvel = self.key(keyframe, q0, nv)
         name = root.get("model") or Path(self.file).stem
         doc = build(name, f"imported from {Path(self.file).name} (MJCF)", self.file,
-                    self.bodies, qpos, qvel, q0, gravity, loops, root, "mjcf")
+                    self.bodies, qpos, qvel, q0, gravity, loops, root, "mjcf",
+                    self.free_motions())
+        if self.custom is not None:
+            restore(doc.data, [doc.marks, doc.key_marks], self.custom, self.springs())
         if self.notes:
             doc.warnings.append(Issue(self.file, 0, 0, "", _summary(self.notes)))
         return doc
 
     contact_off = False
+    custom: Custom | None = None
+
+    def free_motions(self) -> frozenset[int]:
+        """Bodies in the world whose joints are exactly a free motion, as the mbody
+        entries say: orthogonal slides along x, y and a hinge about z in a planar model
+        (the slides only for a particle), three orthogonal slides for a spatial particle.
+        MJCF alone cannot say that a body is planar or a particle."""
+        c = self.custom
+        if c is None:
+            return frozenset()
+        out = set()
+        for i, b in enumerate(self.bodies):
+            particle = c.particle(b.name)
+            if c.dimension == 2:
+                want = ["slide", "slide"] + ([] if particle else ["hinge"])
+            elif particle:
+                want = ["slide"] * 3
+            else:
+                continue
+            if b.parent >= 0 or [j.type for j in b.joints] != want:
+                continue
+            A = np.array([j.axis for j in b.joints])
+            if np.allclose(A @ A.T, np.eye(len(A)), rtol=0, atol=1e-12):
+                out.add(i)
+        return frozenset(out)
+
+    def springs(self) -> dict[str, dict[str, Any]]:
+        """The spatial tendons the mbody entries name as springs, as spring loads: two
+        sites, ``stiffness``, ``damping`` and ``springlength``."""
+        c = self.custom
+        assert c is not None
+        wanted = set(c.springs)
+        if not wanted:
+            return {}
+        sites: dict[str, tuple[int, np.ndarray]] = {}
+        for w in self.root.findall("worldbody"):
+            for st in w.findall("site"):
+                sites[st.get("name") or ""] = (-1, self.attr(st, st.attrib, "pos", 3,
+                                                             np.zeros(3)))
+        for i, b in enumerate(self.bodies):
+            for st in b.element.findall("site"):
+                sites[st.get("name") or ""] = (i, self.attr(st, st.attrib, "pos", 3,
+                                                            np.zeros(3)))
+        d = c.dimension
+        out: dict[str, dict[str, Any]] = {}
+        for sec in self.root.findall("tendon"):
+            for t in sec.findall("spatial"):
+                name = t.get("name") or ""
+                if name not in wanted:
+                    continue
+                ends = [st.get("site") or "" for st in t.findall("site")]
+                if len(ends) != 2 or any(e not in sites for e in ends):
+                    self.fail(t, f"the spring '{name}' needs a tendon between two sites")
+                    continue
+                bodies, at = [], []
+                for e in ends:
+                    i, p = sites[e]
+                    if i < 0:
+                        bodies.append("ground")
+                        at.append([float(x) for x in p[:d]])
+                    else:
+                        b = self.bodies[i]
+                        bodies.append(b.name)
+                        at.append([float(x) for x in (b.R_inertia.T @ (p - b.com))[:d]])
+                k = self.attr(t, t.attrib, "stiffness", 1, np.zeros(1))
+                damp = self.attr(t, t.attrib, "damping", 1, np.zeros(1))
+                rest = self.attr(t, t.attrib, "springlength", 2, np.zeros(1), lo=1)
+                out[name] = {"type": "spring", "bodies": bodies, "at": at,
+                             "stiffness": float(k[0]), "rest_length": float(rest[0]),
+                             "damping": float(damp[0])}
+        missing = sorted(wanted - set(out))
+        for entry in (x for x in c.loads if x[0] in missing):
+            self.fail(entry[2], "no spatial tendon of this name holds the spring", attr="name")
+        if self.issues:
+            raise ModelError(self.issues)
+        return out
 
     def compiler(self, c: Element) -> None:
         angle = c.get("angle")
@@ -398,6 +482,7 @@ class _Reader:
         b = TreeBody(name, parent, pos, quat, joints, e)
         self.mass(b, e, childclass)
         index = len(self.bodies)
+        self.childclasses[index] = childclass
         self.bodies.append(b)
         self.body_index[name] = index
         for c in e.children:
@@ -628,18 +713,51 @@ class _Reader:
     def others(self) -> None:
         """Note what changes the motion and is not read."""
         r = self.root
+        springs = set(self.custom.springs) if self.custom is not None else set()
         for tag, what in (("actuator", "actuators"), ("tendon", "tendons"),
                           ("sensor", "sensors")):
             for sec in r.findall(tag):
                 for c in sec.children:
+                    if tag == "tendon" and c.tag == "spatial" and c.get("name") in springs:
+                        continue  # an mbody spring, read as one
                     self.note(what, c.get("name") or c.tag)
         for sec in r.findall("contact"):
             for c in sec.children:
                 self.note("contacts", f"{c.tag} {c.get('name') or ''}".strip())
         if not self.contact_off:
-            n = sum(len(b.element.findall("geom")) for b in self.bodies)
-            if n:
-                self.note("contacts", f"{n} body geoms collide in MuJoCo")
+            self.contacts()
+
+    def contacts(self) -> None:
+        """Keep in the warning only the geoms that can touch another body's geom: MuJoCo
+        tests a pair when (contype1 & conaffinity2) or (contype2 & conaffinity1)."""
+        geoms: list[tuple[Element, int, int, int]] = []  # (geom, body or -1, type, affinity)
+        owners = [(-1, g, None) for g in self.world_geoms] + [
+            (i, g, self.childclasses.get(i)) for i, b in enumerate(self.bodies)
+            for g in b.element.findall("geom")]
+        for i, g, cls in owners:
+            v = self.values(g, cls)
+            bits = [self.attr(g, v, k, 1, np.ones(1)) for k in ("contype", "conaffinity")]
+            geoms.append((g, i, int(bits[0][0]), int(bits[1][0])))
+
+        kinds: dict[tuple[int, int], set[int]] = {}  # (type, affinity) -> their bodies
+        for _, i, ct, ca in geoms:
+            kinds.setdefault((ct, ca), set()).add(i)
+
+        def touches(k: int) -> bool:
+            _, i, ct, ca = geoms[k]
+            return any((ct & ca2 or ct2 & ca) and bool(owners_ - {i})
+                       for (ct2, ca2), owners_ in kinds.items())
+
+        nw = len(self.world_geoms)
+        items = self.notes.get("contacts", [])
+        kept = [item for k, item in enumerate(items[:nw]) if touches(k)] + items[nw:]
+        n = sum(touches(k) for k in range(nw, len(geoms)))
+        if n:
+            kept.append(f"{n} body geoms collide in MuJoCo")
+        if kept:
+            self.notes["contacts"] = kept
+        else:
+            self.notes.pop("contacts", None)
 
     def key(self, keyframe: str, q0: np.ndarray, nv: int) -> tuple[np.ndarray, np.ndarray]:
         keys = [k for kf in self.root.findall("keyframe") for k in kf.findall("key")]

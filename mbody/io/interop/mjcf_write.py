@@ -32,6 +32,7 @@ from mbody import __version__
 from mbody import conventions as cv
 from mbody.equations.spatial import box_equivalent, matrix_to_quat, quat_to_matrix
 from mbody.io.atomic import write_atomic
+from mbody.io.interop.custom import numeric, text
 from mbody.model.model import Joint, Model, count
 
 PARTICLE_INERTIA = 1e-12
@@ -141,6 +142,7 @@ class _Writer:
     joint_names: set[str] = field(default_factory=set)
     sites: dict[str, list[str]] = field(default_factory=dict)  # body -> its site lines
     worst_velocity: float = 0.0
+    native: dict[str, str] = field(default_factory=dict)  # joint -> the body holding it
 
     def name(self, wanted: str) -> str:
         """A joint name not used yet (MuJoCo wants them unique)."""
@@ -187,7 +189,7 @@ def to_mjcf(model: Model, *, source: str | None = None) -> str:
            f'  <option gravity="{_vec(g)}"/>',
            "  <worldbody>", *("    " + s for s in w.sites.get(cv.GROUND, [])), *w.lines,
            "  </worldbody>"]
-    out += equality + tendons
+    out += _custom(w, tree) + equality + tendons
     out += ["  <keyframe>",
             f'    <key name="initial" time="0" qpos="{_vec(w.qpos)}" qvel="{_vec(w.qvel)}"/>',
             "  </keyframe>", "</mujoco>", ""]
@@ -317,6 +319,7 @@ def _tree_joint(w: _Writer, j: Joint, parent: str, child: str, pad: str) -> None
         parts = [(j.name, "ball", np.zeros(3))]
     else:  # fixed: welded by nesting
         return
+    w.native[j.name] = child
     columns = []
     for nm, kind, a in parts:
         jn = w.name(nm)
@@ -451,6 +454,67 @@ def _equalities(w: _Writer, loops: list[Joint]) -> list[str]:
             "       (a stiff spring-damper, solref/solimp), not exactly as mbody does:",
             "       accelerations agree only up to that softness. -->",
             "  <equality>", *lines, "  </equality>"]
+
+
+def _custom(w: _Writer, tree: _Tree) -> list[str]:
+    """The ``mbody:`` entries of ``<custom>`` (`mbody.io.interop.custom`): what the MJCF
+    elements lose, one small entry each, so that the MJCF reader restores the model."""
+    m = w.model
+    d = 2 if m.dimension == cv.PLANAR else 3
+    out = [numeric("dimension", [d])]
+    out += [text(f"body:{name}", {"inertia": 0})
+            for i, name in enumerate(m.body_names) if m.particle[i]]
+    for j in m.joints:
+        holder = w.native.get(j.name)
+        if holder is None:  # no MJCF element is exactly this joint: the whole joint
+            entry: dict = {"type": j.type, "parent": j.parent, "child": j.child,
+                           "at": _floats(j.at[:d])}
+            if j.axis is not None:  # it sets the joint frame, so the reactions' axes
+                entry["axis"] = _floats(np.asarray(j.axis)[:d])
+            if j.axis2 is not None:
+                entry["axis2"] = _floats(j.axis2)
+            out.append(text(f"joint:{j.name}", entry))
+        else:
+            lost: dict = {}
+            if holder != j.child:  # written against the tree: its direction
+                lost = {"parent": j.parent, "child": j.child}
+            if j.axis is not None and j.type in ("spherical", "revolute") and (
+                    j.type == "spherical" or d == 2):
+                # the axis sets the joint frame, hence the reaction components: a ball
+                # has no axis, and a planar hinge turns about z whatever the file's axis
+                lost["axis"] = _floats(np.asarray(j.axis)[:d])
+            if lost:
+                out.append(text(f"joint:{j.name}", lost))
+    for ld in m.loads:
+        out.append(text(f"load:{ld.name}", _load_entry(ld, d)))
+    for label, value in m.known_reactions.items():
+        if label not in m.known_expressions:
+            out.append(numeric(f"reaction:{label}", [value]))
+    out += [text(f"reaction:{label}", str(e)) for label, e in m.known_expressions.items()]
+    return ["  <!-- What MJCF cannot say, for mbody's reader (MuJoCo ignores it): see",
+            "       the mbody documentation, interop, 'The mbody entries'. -->",
+            "  <custom>", *("    " + s for s in out), "  </custom>"]
+
+
+def _load_entry(ld, d: int) -> dict:
+    """A load as the model file writes it (a spring: the tendon of the same name)."""
+    if ld.type == "spring" or ld.vector is None:
+        return {"type": "spring"}
+    comps = [str(ld.expressions[k]) if k in ld.expressions else float(x)
+             for k, x in enumerate(ld.vector)]
+    entry: dict = {"type": ld.type, "body": ld.bodies[0]}
+    if ld.type == "torque":
+        entry["torque"] = comps[2] if d == 2 else comps
+    else:
+        entry["force"] = comps[:d]
+        if ld.at and np.any(np.asarray(ld.at[0])):
+            entry["at"] = _floats(np.asarray(ld.at[0])[:d])
+    entry["frame"] = ld.frame
+    return entry
+
+
+def _floats(v) -> list[float]:
+    return [float(x) for x in np.asarray(v, dtype=float).ravel()]
 
 
 def _spring_sites(w: _Writer, k: int) -> None:

@@ -253,9 +253,22 @@ class Mapped:
     element: Element | None = None
 
 
+EXPORT_SUFFIXES = ({"1", "2"}, {"slide", "turn"})
+"""The suffixes the MJCF export gives the parts of one mbody joint (universal:
+``J:1``, ``J:2``; cylindrical: ``J:slide``, ``J:turn``)."""
+
+
 def joint_name(names: list[str]) -> str:
     """One name for several joints of a body: their common stem (``right_hip_x``,
-    ``right_hip_y``, ``right_hip_z`` -> ``right_hip``), else the names joined by ``+``."""
+    ``right_hip_y``, ``right_hip_z`` -> ``right_hip``), else the names joined by ``+``.
+
+    Parts named as the MJCF export names them (``J:1``, ``J:2``; ``J:slide``,
+    ``J:turn``) give back ``J`` exactly, whatever its length or characters.
+    """
+    stems = {n.rpartition(":")[0] for n in names}
+    if len(stems) == 1 and "" not in stems and \
+            {n.rpartition(":")[2] for n in names} in EXPORT_SUFFIXES:
+        return stems.pop()
     stem = names[0]
     for n in names[1:]:
         k = 0
@@ -346,8 +359,12 @@ def _floats(v: np.ndarray) -> list[float]:
 
 def build(name: str, description: str, file: str, bodies: list[TreeBody],
           qpos: np.ndarray, qvel: np.ndarray, q0: np.ndarray, gravity: np.ndarray,
-          loops: list[Loop], root: Element, fmt: str) -> ImportedDocument:
+          loops: list[Loop], root: Element, fmt: str,
+          free_bodies: frozenset[int] = frozenset()) -> ImportedDocument:
     """The model-file values of the tree at joint state (qpos, qvel).
+
+    `free_bodies` (tree indices) move freely: their joints are known to be exactly a free
+    motion (the slides and hinge the MJCF export writes for a free planar body or particle).
 
     Bodies without mass that sit welded to their parent (frames: URDF's ``tool0``, a
     bare MJCF body) are left out, their children joined to the nearest body kept; a body
@@ -406,7 +423,8 @@ def build(name: str, description: str, file: str, bodies: list[TreeBody],
         doc.mark((*p, "name"), b.element, "name")
         for key in ("mass", "inertia"):
             doc.mark((*p, key), b.mass_element or b.element, key if key == "mass" else None)
-        m = map_joints(b, kin, i, scale) if i not in free else Mapped(None, "")
+        m = (map_joints(b, kin, i, scale) if i not in free and i not in free_bodies
+             else Mapped(None, ""))
         if m.type is None:
             continue
         parent = _parent_name(bodies, b.parent, owner, kept)

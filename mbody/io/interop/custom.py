@@ -1,0 +1,272 @@
+"""What MJCF cannot say about an mbody model, kept in MuJoCo's own ``<custom>`` element.
+
+MuJoCo stores ``<custom><numeric>`` and ``<custom><text>`` entries in the model and
+otherwise ignores them, so a file carrying them loads in MuJoCo unchanged. The export
+(`mbody.io.interop.mjcf_write`) writes one small entry per piece that MJCF's own elements
+lose, each named ``mbody:<kind>[:<key>]``; the import (`mbody.io.interop.mjcf`) reads
+them back and restores what the mbody model had. Bodies, masses, inertias, the joints
+MJCF holds, gravity and the state always come from MJCF's native elements.
+
+========================  ========  ===================================================
+name                      element   data
+========================  ========  ===================================================
+``mbody:dimension``       numeric   2 (planar) or 3 (spatial)
+``mbody:body:B``          text      JSON object of body B's keys MJCF cannot hold:
+                                    ``{"inertia": 0}`` for a particle
+``mbody:joint:J``         text      JSON object. With ``type``: the whole joint J (MJCF
+                                    has no element that is exactly it: fixed joints, a
+                                    particle's pin, joints that close loops). Without:
+                                    the keys that differ from what MJCF says (``parent``
+                                    and ``child`` when the joint runs against the tree)
+``mbody:load:L``          text      JSON object of load L as the model file writes it;
+                                    ``{"type": "spring"}``: the spatial tendon L
+``mbody:reaction:R``      numeric   the known value of reaction component R
+``mbody:reaction:R``      text      the same, an expression of t
+========================  ========  ===================================================
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from typing import Any
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+
+from mbody.errors import Issue, ModelError, did_you_mean
+from mbody.io.interop.xmlsource import Element
+
+PREFIX = "mbody:"
+KINDS = ("dimension", "body", "joint", "load", "reaction")
+
+
+@dataclass
+class Custom:
+    """The ``mbody:`` entries of an MJCF file, each with its element (for messages)."""
+
+    dimension: int = 3
+    bodies: dict[str, tuple[dict[str, Any], Element]] = field(default_factory=dict)
+    joints: dict[str, tuple[dict[str, Any], Element]] = field(default_factory=dict)
+    loads: list[tuple[str, dict[str, Any], Element]] = field(default_factory=list)
+    reactions: dict[str, tuple[float | str, Element]] = field(default_factory=dict)
+
+    def particle(self, body: str) -> bool:
+        """Whether the entries make `body` a particle (``inertia: 0``)."""
+        entry = self.bodies.get(body)
+        return entry is not None and entry[0].get("inertia") == 0
+
+    @property
+    def springs(self) -> list[str]:
+        """The loads that are spatial tendons of the file, by name."""
+        return [n for n, d, _ in self.loads if d.get("type") == "spring"]
+
+
+# -- writing -----------------------------------------------------------------------------
+
+
+def numeric(key: str, values: list[float]) -> str:
+    """A ``<numeric>`` entry (numbers as Python's repr: they read back as the same double)."""
+    data = " ".join(_num(x) for x in values)
+    return f"<numeric name={quoteattr(PREFIX + key)} data=\"{data}\"/>"
+
+
+def text(key: str, value: Any) -> str:
+    """A ``<text>`` entry; mappings as compact JSON (exact for doubles)."""
+    data = value if isinstance(value, str) else json.dumps(value, separators=(", ", ": "))
+    return f"<text name={quoteattr(PREFIX + key)} data={quoteattr(data)}/>"
+
+
+def _num(x: float) -> str:
+    x = float(x)
+    if x == 0.0:
+        return "0"
+    return str(int(x)) if x == int(x) and abs(x) < 1e15 else repr(x)
+
+
+# -- reading -----------------------------------------------------------------------------
+
+
+def read_custom(root: Element) -> Custom | None:
+    """The ``mbody:`` entries of the ``<custom>`` elements of `root`; None when there are
+    none (a plain MJCF file, read as MuJoCo reads it).
+
+    Raises
+    ------
+    ModelError
+        An unknown ``mbody:`` kind, data that is not what the kind holds.
+    """
+    out = Custom()
+    found = False
+    issues: list[Issue] = []
+    for c in root.findall("custom"):
+        for e in c.children:
+            name = e.get("name") or ""
+            if e.tag not in ("numeric", "text") or not name.startswith(PREFIX):
+                continue
+            found = True
+            kind, _, key = name[len(PREFIX):].partition(":")
+            data = e.get("data") or ""
+            if kind not in KINDS:
+                issues.append(e.issue(f"unknown mbody entry kind '{kind}'",
+                                      did_you_mean(kind, KINDS) or
+                                      f"expected mbody:{', mbody:'.join(KINDS)}", "name"))
+                continue
+            if (kind == "dimension") != (key == ""):
+                issues.append(e.issue(f"'{name}': "
+                                      + ("mbody:dimension takes no key" if kind == "dimension"
+                                         else f"mbody:{kind} needs a key (mbody:{kind}:NAME)"),
+                                      attr="name"))
+                continue
+            if e.tag == "numeric":
+                try:
+                    values = [float(t) for t in data.split()]
+                except ValueError:
+                    values = []
+                if len(values) != 1 or kind not in ("dimension", "reaction"):
+                    issues.append(e.issue(f"'{name}': expected one number in a <numeric> "
+                                          "mbody:dimension or mbody:reaction entry",
+                                          attr="data"))
+                    continue
+                if kind == "dimension":
+                    if values[0] not in (2.0, 3.0):
+                        issues.append(e.issue(f"mbody:dimension must be 2 or 3, got "
+                                              f"{data}", attr="data"))
+                    out.dimension = int(values[0])
+                else:
+                    out.reactions[key] = (values[0], e)
+                continue
+            if kind == "reaction":
+                out.reactions[key] = (data, e)
+                continue
+            if kind == "dimension":
+                issues.append(e.issue("mbody:dimension is a <numeric> entry", attr="name"))
+                continue
+            try:
+                value = json.loads(data)
+            except ValueError as exc:
+                issues.append(e.issue(f"'{name}': the data is not JSON ({exc})",
+                                      'such as {"inertia": 0}', "data"))
+                continue
+            if not isinstance(value, dict):
+                issues.append(e.issue(f"'{name}': expected a JSON object", attr="data"))
+                continue
+            if kind == "body":
+                out.bodies[key] = (value, e)
+            elif kind == "joint":
+                out.joints[key] = (value, e)
+            else:
+                out.loads.append((key, value, e))
+    if issues:
+        raise ModelError(issues)
+    return out if found else None
+
+
+def restore(data: dict[str, Any], marks: list[dict[Any, tuple[int, int]]],
+            custom: Custom, springs: dict[str, dict[str, Any]]) -> None:
+    """Give the imported document `data` back what `custom` says (in place).
+
+    `marks` are the document's mark tables (updated for the entries' elements);
+    `springs` the spring loads read from their tendons, by name.
+    """
+    if custom.dimension == 2:
+        _planar(data, custom, marks)
+    issues: list[Issue] = []
+    index = {b["name"]: k for k, b in enumerate(data["bodies"])}
+    for name, (entry, e) in custom.bodies.items():
+        if name not in index:
+            issues.append(e.issue(f"mbody:body:{name}: no body '{name}'",
+                                  did_you_mean(name, index), "name"))
+            continue
+        body = data["bodies"][index[name]]
+        body.update(entry)
+        if entry.get("inertia") == 0:  # a particle has no orientation and no spin
+            for key in ("orientation", "angle", "angular_velocity"):
+                body.pop(key, None)
+    joints: list[tuple[dict[str, Any], Any]] = [
+        (j, _marks_of(marks, ("joints", k))) for k, j in enumerate(data.get("joints", []))]
+    for name, (entry, e) in custom.joints.items():
+        if "type" in entry:
+            ends = {entry.get("parent"), entry.get("child")}
+            joints = [(j, m) for j, m in joints if not (
+                j["name"] in (name, f"{name}:axis") or
+                (j["type"] == "fixed" and j["name"].endswith("_fixed") and
+                 {j["parent"], j["child"]} == ends))]
+            joints.append(({"name": name, **entry}, _element_marks(e)))
+            continue
+        match = [j for j, _ in joints if j["name"] == name]
+        if not match:
+            issues.append(e.issue(f"mbody:joint:{name}: no joint '{name}' in the file",
+                                  did_you_mean(name, [j["name"] for j, _ in joints]),
+                                  "name"))
+            continue
+        j = match[0]
+        if entry.get("parent") == j["child"] and entry.get("child") == j["parent"] and \
+                "axis2" in j:  # the tree ran child -> parent: the axes swap back too
+            j["axis"], j["axis2"] = j["axis2"], j["axis"]
+        j.update(entry)
+    if issues:
+        raise ModelError(issues)
+    if joints:
+        data["joints"] = [j for j, _ in joints]
+        for table in marks:
+            for p in [p for p in table if p[:1] == ("joints",) and len(p) > 1]:
+                del table[p]
+        for k, (_, m) in enumerate(joints):
+            for t, table in enumerate(marks):
+                for sub, where in m[t].items():
+                    table[("joints", k, *sub)] = where
+    loads = []
+    for name, entry, e in custom.loads:
+        loads.append({"name": name, **(springs[name] if entry.get("type") == "spring"
+                                       else entry)})
+        for table in marks:
+            table[("loads", len(loads) - 1)] = e.where("data")
+    if loads:
+        data["loads"] = loads
+    if custom.reactions:
+        data["reactions"] = {label: v for label, (v, _) in custom.reactions.items()}
+        for label, (_, e) in custom.reactions.items():
+            for table in marks:
+                table[("reactions", label)] = e.where("data")
+
+
+def _marks_of(marks: list[dict[Any, tuple[int, int]]], path: tuple[Any, ...]
+              ) -> list[dict[tuple[Any, ...], tuple[int, int]]]:
+    """Each mark table's entries under `path`, keyed by the rest of the path."""
+    n = len(path)
+    return [{p[n:]: w for p, w in table.items() if p[:n] == path} for table in marks]
+
+
+def _element_marks(e: Element) -> list[dict[tuple[Any, ...], tuple[int, int]]]:
+    return [{(): e.where("data")}, {(): e.where("data")}]
+
+
+def _planar(data: dict[str, Any], custom: Custom,
+            marks: list[dict[Any, tuple[int, int]]]) -> None:
+    """A planar model written in 3-D (world x-y plane, turning about z) made planar again:
+    x, y and the angle about z of each body; the scalar inertia about z."""
+    data["dimension"] = 2
+    data["gravity"] = data["gravity"][:2]
+    for k, b in enumerate(data["bodies"]):
+        R = np.array(b.pop("orientation")["matrix"], dtype=float)
+        J = b["inertia"]
+        b["inertia"] = float(J[2][2])
+        b["position"] = b["position"][:2]
+        b["angle"] = float(np.arctan2(R[1, 0], R[0, 0]))
+        b["velocity"] = b["velocity"][:2]
+        b["angular_velocity"] = float(b["angular_velocity"][2])
+        shape = b.get("shape")
+        if shape and ("box" in shape or "ellipsoid" in shape):
+            kind = next(iter(shape))
+            b["shape"] = {kind: shape[kind][:2]}
+        for table in marks:
+            if ("bodies", k, "orientation") in table:
+                table[("bodies", k, "angle")] = table[("bodies", k, "orientation")]
+    for j in data.get("joints", []):
+        j["at"] = j["at"][:2]
+        if j["type"] == "prismatic":
+            j["axis"] = j["axis"][:2]
+        else:
+            j.pop("axis", None)
+            j.pop("axis2", None)
