@@ -51,9 +51,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.set_defaults(run=simulate)
 
     s = sub.add_parser("plot", help="plot a saved run: angular velocity, energy, momentum, "
-                       "drift", description="Plot the angular-velocity components, kinetic "
-                       "energy and angular momentum of a saved run over time, and their "
-                       "relative drift, in one multi-panel figure.")
+                       "drift, joint reactions", description="Plot the angular-velocity "
+                       "components, kinetic energy and angular momentum of a saved run over "
+                       "time, and their relative drift, in one multi-panel figure. A run "
+                       "that stores joint reactions (every run of a model with joints) gets "
+                       "a third row: the reaction force components (N) and moment "
+                       "components (N m) over time, each along its joint-frame axis, +R on "
+                       "the child (the first 12 of each kind).")
     s.add_argument("trajectory", metavar="RUN.npz",
                    help="a trajectory saved by 'mbody simulate -o'")
     s.add_argument("-o", "--output", required=True, metavar="FILE",
