@@ -3,8 +3,8 @@ it shows is the real output.
 
 Convention (docs/*.md): shell examples are ```console blocks. A line starting with `$ ` is
 a command (run with bash from the repository root; it must exit 0, or N when the line ends
-with `  # exits N`); the lines after it, up to the next command or the block's end, are
-exactly what it prints (stdout and stderr together, as a terminal shows them). Only what
+with `  # exits N`; a line ending in `\\` goes on on the next); the lines after it, up to
+the next command or the block's end, are exactly what it prints (stdout and stderr together, as a terminal shows them). Only what
 cannot be the same on every run is left open, and visibly so:
 
 - `…` within a line stands for any text on that line (a time, a size, a path);
@@ -72,10 +72,16 @@ def examples(text: str) -> list[tuple[str, str, int, str]]:
         body = "\n".join(s[indent:] for s in m.group("body").splitlines())
         if m.group("lang") == "console":
             shown: list[str] | None = None
+            going_on = False  # the command's last line ended with a backslash
             for k, s in enumerate(body.splitlines()):
-                if s.startswith("$ "):
+                if going_on:
+                    kind, code, at, said = out[-1]
+                    out[-1] = (kind, code + "\n" + s, at, said)
+                    going_on = s.endswith("\\")
+                elif s.startswith("$ "):
                     shown = []
                     out.append(("console", s[2:], line + k, ""))
+                    going_on = s.endswith("\\")
                 elif shown is not None:
                     kind, code, at, said = out[-1]
                     out[-1] = (kind, code, at, said + s + "\n")
@@ -116,6 +122,8 @@ def test_examples_parser_finds_commands_blocks_outputs_and_exit_codes():
                               ("console", "false  # exits 1", 5, ""),
                               ("python", "a = 1", 10, "")]
     assert int(EXITS.search("false  # exits 1").group(1)) == 1
+    assert examples("```console\n$ echo a \\\n  b\na b\n```\n") == [
+        ("console", "echo a \\\n  b", 2, "a b\n")]
 
 
 def test_output_comparison_is_exact_but_for_marked_gaps():
