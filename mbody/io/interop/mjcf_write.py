@@ -549,22 +549,26 @@ def _header(w: _Writer, tree: _Tree, source: str | None) -> str:
            f"{count(m.n, 'body', 'bodies')}, {count(len(m.joints), 'joint')}. Each MuJoCo "
            "body frame is the mbody body frame (mass centre, body axes) at the initial "
            "pose; the keyframe 'initial' is the file's state.",
+           "What MJCF cannot say (the dimension, loads, known reactions, fixed joints, "
+           "particles, joint directions) is in <custom> as mbody: entries, which MuJoCo "
+           "ignores and mbody's reader restores.",
            ]
     if m.dimension == cv.PLANAR:
         out.append("Planar model written in 3-D: bodies in the world x-y plane, joints "
                    "turning about world z or sliding in the plane.")
     point = [ld for ld in m.loads if ld.type in ("force", "torque")]
     if point:
-        out.append("Left out (MJCF has no constant applied loads; apply them at run time "
-                   "through MjData.xfrc_applied, a world force and torque about the body's "
-                   "mass centre):")
+        out.append("Not applied by MuJoCo (MJCF has no constant applied loads; apply them "
+                   "at run time through MjData.xfrc_applied, a world force and torque "
+                   "about the body's mass centre; mbody reads them back from <custom>):")
         for ld in point:
             out.append("  " + _describe_load(ld))
     if m.known_reactions or m.known_expressions:
         labels = sorted({*m.known_reactions, *m.known_expressions})
-        out.append("Left out: the known reaction values of the file (" + ", ".join(labels)
-                   + "); MuJoCo enforces every joint and computes all its reactions, which "
-                   "agree with these values only where they are consistent with the joint.")
+        out.append("Known reaction values of the file (" + ", ".join(labels) + "): in "
+                   "<custom> for mbody; MuJoCo enforces every joint and computes all its "
+                   "reactions, which agree with these values only where they are "
+                   "consistent with the joint.")
     if any(m.particle):
         out.append(f"Particles (inertia 0) get principal moments {PARTICLE_INERTIA:g} m "
                    f"l^2 (l = {w.scale:.3g} m): MuJoCo refuses a moving body without "
