@@ -567,7 +567,7 @@ def test_help_states_the_simulation_defaults_and_gravity():
     from mbody.cli import animate as cli_animate
 
     sig = inspect.signature(mbody.simulate).parameters
-    assert (cli_animate.T_END, cli_animate.FPS) == (sig["t_end"].default, sig["fps"].default)
+    assert (sig["t_end"].default, sig["fps"].default) == (cli_animate.T_END, cli_animate.FPS)
     p = subprocess.run([sys.executable, "-m", "mbody.cli", "animate", "--help"],
                        capture_output=True, text=True, timeout=60)
     text = " ".join(p.stdout.split())
