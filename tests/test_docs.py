@@ -4,8 +4,9 @@ it shows is the real output.
 Convention (docs/*.md): shell examples are ```console blocks. A line starting with `$ ` is
 a command (run with bash from the repository root; it must exit 0, or N when the line ends
 with `  # exits N`; a line ending in `\\` goes on on the next); the lines after it, up to
-the next command or the block's end, are exactly what it prints (stdout and stderr together, as a terminal shows them). Only what
-cannot be the same on every run is left open, and visibly so:
+the next command or the block's end, are exactly what it prints (stdout and stderr
+together, as a terminal shows them). Only what cannot be the same on every run is left
+open, and visibly so:
 
 - `…` within a line stands for any text on that line (a time, a size, a path);
 - a line that is only `…` stands for any number of lines (output cut short);

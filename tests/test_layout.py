@@ -17,25 +17,51 @@ def test_the_import_graph_has_no_cycles_and_no_needless_late_imports():
     p = subprocess.run([sys.executable, str(ROOT / "tools" / "check_imports.py")],
                        capture_output=True, text=True, timeout=120)
     assert p.returncode == 0, p.stdout + p.stderr
-    assert " 0 needless), 0 cycle(s)" in p.stdout
+    assert " 0 needless, 0 by a string), 0 cycle(s)" in p.stdout
 
 
-def test_the_checker_finds_a_cycle(tmp_path, monkeypatch):
-    """The check can fail: a module importing its importer is reported with both lines."""
+def _planted(tmp_path, monkeypatch, files: dict[str, str]) -> int:
+    """check_imports run on a package of `files` (path -> source) instead of mbody's."""
     sys.path.insert(0, str(ROOT / "tools"))
     try:
         import check_imports
     finally:
         sys.path.remove(str(ROOT / "tools"))
     pkg = tmp_path / "mbody"
-    (pkg / "a").mkdir(parents=True)
-    (pkg / "__init__.py").write_text("")
-    (pkg / "a" / "__init__.py").write_text("")
-    (pkg / "a" / "x.py").write_text("from mbody.a.y import f\n")
-    (pkg / "a" / "y.py").write_text("def f():\n    from mbody.a import x\n    return x\n")
+    for name, text in {"__init__.py": "", **files}.items():
+        (pkg / name).parent.mkdir(parents=True, exist_ok=True)
+        (pkg / name).write_text(text)
     monkeypatch.setattr(check_imports, "ROOT", tmp_path)
     monkeypatch.setattr(check_imports, "PACKAGE", pkg)
-    assert check_imports.main([]) == 1
+    return check_imports.main([])
+
+
+def test_the_checker_finds_a_cycle(tmp_path, monkeypatch, capsys):
+    """The check can fail: a module importing its importer is reported with both lines."""
+    assert _planted(tmp_path, monkeypatch, {
+        "a/__init__.py": "", "a/x.py": "from mbody.a.y import f\n",
+        "a/y.py": "def f():\n    from mbody.a import x\n    return x\n"}) == 1
+    out = capsys.readouterr().out
+    assert "mbody/a/x.py:1: mbody.a.x -> mbody.a.y" in out
+    assert "mbody/a/y.py:2: mbody.a.y -> mbody.a.x (in a function)" in out
+
+
+def test_a_display_hook_may_import_the_presentation_layer(tmp_path, monkeypatch, capsys):
+    """`_repr_html_` importing mbody.present is by design (listed, not a cycle); the same
+    import in another method is a cycle, and an import by a string is refused."""
+    files = {"model.py": "class Model:\n    def _repr_html_(self):\n"
+                         "        from mbody.present import html\n        return html(self)\n",
+             "present.py": "from mbody.model import Model\n\n\ndef html(m): ...\n"}
+    assert _planted(tmp_path, monkeypatch, files) == 0
+    assert "0 cycle(s)" in capsys.readouterr().out
+    files["model.py"] = files["model.py"].replace("_repr_html_", "summary")
+    assert _planted(tmp_path, monkeypatch, files) == 1
+    assert "1 cycle(s)" in capsys.readouterr().out
+    files["model.py"] = ("from importlib import import_module\n\n\nclass Model:\n"
+                         "    def _repr_html_(self):\n"
+                         "        return import_module('mbody.present').html(self)\n")
+    assert _planted(tmp_path, monkeypatch, files) == 1
+    assert "imports mbody.present by a string" in capsys.readouterr().out
 
 
 @pytest.mark.parametrize("old, new", [("dynamics", "solve.dynamics"),

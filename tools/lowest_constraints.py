@@ -4,9 +4,10 @@
     pip install -c lowest.txt -e ".[symbolic]"
 
 pip has no "lowest versions" resolution; pinning each ``name>=X`` of
-``[project.dependencies]`` (and of the extras in `EXTRAS`) to ``name==X`` gives the oldest install pyproject allows, which
-.ci/run tests (so that a floor cannot silently stop being true). A dependency without a
-``>=`` floor is an error: every one must say which oldest version works.
+``[project.dependencies]`` (and of the extras in `EXTRAS`) to ``name==X`` gives the
+oldest install pyproject allows, which .ci/run tests (so that a floor cannot silently
+stop being true). A dependency without a ``>=`` floor is an error: every one must say
+which oldest version works.
 """
 
 from __future__ import annotations

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import importlib
 import os
 import sys
 from pathlib import Path
@@ -114,14 +113,8 @@ def _format(path: str, what: str, option: str, choices: tuple[str, ...]) -> str:
 
 def _read(path: str, fmt: str, keyframe: str | None) -> Any:
     """The model document of an MJCF or URDF file (`mbody.io.interop.read_document`)."""
-    try:
-        interop = importlib.import_module("mbody.io.interop")
-    except ImportError:
-        interop = None
-    read = getattr(interop, "read_document", None)
-    if read is None:
-        raise MbodyError(f"{path}: reading {NAMES[fmt]} is not available in this version "
-                         "of mbody (only .yaml models can be converted)")
+    from mbody.io.interop import read_document as read
+
     if fmt != "mjcf":
         return read(path, format=fmt)
     if keyframe is not None:

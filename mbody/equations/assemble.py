@@ -201,9 +201,9 @@ class Solution:
                 + "; sol[label], .as_dict(), .reactions, .warnings>")
 
     def _repr_html_(self) -> str:  # notebook display: accelerations and reactions by body
-        from importlib import import_module  # by name: mbody.present.rich imports this module
+        from mbody.present.rich import solution_html  # a display hook (tools/check_imports.py)
 
-        return import_module("mbody.present.rich").solution_html(self)
+        return solution_html(self)
 
 
 class Assembly:
@@ -517,14 +517,14 @@ class Assembly:
                         system.fact.size - system.fact.rank)
 
     def _repr_html_(self) -> str:  # notebook display: each body's free body and pair
-        from importlib import import_module  # by name: mbody.present.rich imports this module
+        from mbody.present.rich import assembly_html  # a display hook (tools/check_imports.py)
 
-        return import_module("mbody.present.rich").assembly_html(self)
+        return assembly_html(self)
 
     def _repr_latex_(self) -> str:  # the stacked system as display math
-        from importlib import import_module  # by name: mbody.present.rich imports this module
+        from mbody.present.rich import assembly_latex  # a display hook (tools/check_imports.py)
 
-        return import_module("mbody.present.rich").assembly_latex(self)
+        return assembly_latex(self)
 
 
 COMPILED_METHOD = "banded Cholesky of the Schur complement (compiled)"

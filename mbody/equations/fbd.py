@@ -216,9 +216,9 @@ class Equation:
         return f"<Equation {self.row}: {text if len(text) < 240 else text[:236] + ' ...'}>"
 
     def _repr_latex_(self) -> str:  # notebook display as display math
-        from importlib import import_module  # by name: mbody.present.rich imports this module
+        from mbody.present.rich import equation_latex  # a display hook (tools/check_imports.py)
 
-        return import_module("mbody.present.rich").equation_latex(self)
+        return equation_latex(self)
 
 
 @dataclass(frozen=True)
@@ -272,19 +272,19 @@ class BodyEquations:
                 f"unknown{'' if unknown == 1 else 's'}; print() it, .fbd, .equations>")
 
     def __str__(self) -> str:  # the block `mbody assemble` prints
-        from importlib import import_module  # by name: mbody.present.rich imports this module
+        from mbody.present.rich import body_str  # a display hook (tools/check_imports.py)
 
-        return import_module("mbody.present.rich").body_str(self)
+        return body_str(self)
 
     def _repr_html_(self) -> str:  # notebook display: diagram, forces table, the pair
-        from importlib import import_module  # by name: mbody.present.rich imports this module
+        from mbody.present.rich import body_html  # a display hook (tools/check_imports.py)
 
-        return import_module("mbody.present.rich").body_html(self)
+        return body_html(self)
 
     def _repr_latex_(self) -> str:  # the pair as display math
-        from importlib import import_module  # by name: mbody.present.rich imports this module
+        from mbody.present.rich import body_latex  # a display hook (tools/check_imports.py)
 
-        return import_module("mbody.present.rich").body_latex(self)
+        return body_latex(self)
 
 
 def _num(x: float) -> str:

@@ -216,9 +216,9 @@ class Trajectory:
                 ".state(k), .kinetic_energy(), .save(path)>")
 
     def _repr_html_(self) -> str:  # notebook display: the run's facts and its plots
-        from importlib import import_module  # by name: mbody.present.rich imports this module
+        from mbody.present.rich import trajectory_html  # a display hook (tools/check_imports.py)
 
-        return import_module("mbody.present.rich").trajectory_html(self)
+        return trajectory_html(self)
 
     def kinetic_energy(self, per_body: bool = False) -> np.ndarray:
         """T = ½ m vᵀv + ½ ωᵀ J ω.
