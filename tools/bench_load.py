@@ -9,7 +9,9 @@ Files (written by ``yaml.dump`` with ``CSafeDumper``, ``default_flow_style=None`
   tensor, a rotated pose, a velocity and an angular velocity, and one world-frame force
   at an offset point (tools/bench_assembly.py's model: 800 bytes a body);
 - chain: n spatial bodies in a chain of revolute joints (the first to ground), principal
-  inertias, a torque on every body (its joints go through the located path).
+  inertias, a torque on every body (about 490 bytes a body).
+
+Both take the fast path (mbody/model/fast.py) whole: bodies, loads and joints.
 
 Columns, best of --repeat runs, in one process:
 

@@ -45,6 +45,12 @@ MAX_MAGNITUDE = 1e100
 MIN_MAGNITUDE = 1e-100
 """Smallest nonzero magnitude accepted: reciprocals (1/m, J^-1) and products of three such
 numbers stay normal doubles (a denormal mass such as 5e-324 has no reciprocal)."""
+MIN_NORM = 1e-12
+"""A quaternion or an axis shorter than this is zero: it gives no attitude or direction."""
+UNIT_TOL = 1e-6
+"""A quaternion whose norm differs from 1 by more is normalised with a warning."""
+PERPENDICULAR_TOL = 1e-6
+"""Largest |axis . axis2| of a universal joint's two (unit) axes."""
 MAX_ANGLE = 1e9
 """Largest angle accepted, rad (about 160 million turns): a double resolves 1e9 to 1e-7
 rad, and sin/cos of a larger number say little about the pose meant."""

@@ -44,12 +44,16 @@ from mbody.model.checks import (
     MAX_ANGLE,
     MAX_MAGNITUDE,
     MIN_MAGNITUDE,
+    MIN_NORM,
+    PERPENDICULAR_TOL,
+    UNIT_TOL,
     Checker,
     quat_norm,
     vec_norm,
 )
 from mbody.model.loader import load_text, value_limit
 from mbody.model.validate import (
+    BODY_KEYS,
     FRAMES,
     JOINT_KEYS,
     LOAD_KEYS,
@@ -65,7 +69,7 @@ MIN_BYTES = 64 * 1024
 """Smaller texts go straight to the located path: there is nothing to gain."""
 MAX_TEMPLATES = 16
 """Most distinct item layouts in one list; more means a hand-written file."""
-CHUNK = 1 << 18
+CHUNK = 1 << 17
 """Characters of a list read at a time, so that its temporary strings stay small."""
 
 _PLACEHOLDER = "__mbody_fast_"
@@ -286,6 +290,7 @@ def _read_list(text: str, start: int, end: int, file: str,
             rows[k].append(mine + item)
         item += len(skeletons)
         pos = stop
+        del chunk, data, skeletons, ids  # before the next chunk is cut
     groups = []
     for k, r in enumerate(rows):
         columns = {}
@@ -342,7 +347,7 @@ class _Chunk:
         marks = np.zeros(len(b) + 1, dtype=np.int8)
         marks[lo] = step  # all distinct: slots do not touch (see _slots)
         marks[hi] = -step
-        self.level = np.cumsum(marks[:-1], dtype=np.int8)
+        self.level: np.ndarray | None = np.cumsum(marks[:-1], dtype=np.int8)
         inside = np.searchsorted(commas, e) - np.searchsorted(commas, s)
         if np.any(inside[kind == _NUMBER]) or np.any(e[listed] - s[listed] < 3):
             raise _Bail  # '1,5' (text in YAML), or an empty list
@@ -352,6 +357,7 @@ class _Chunk:
     def skeletons(self) -> list[str]:
         """Each item's text with every value replaced by one NUL, without its leading
         '- ' and the newline that ends it."""
+        assert self.level is not None
         keep = self.level == 0
         keep[self.s] = True
         ends = self.e[self.kind != _LIST]
@@ -372,12 +378,12 @@ class _Chunk:
         first = np.cumsum(slots) - slots  # each item's first slot
         if first[-1] + slots[-1] != len(kind):
             raise _Bail
-        used = np.unique(ids).tolist()
+        used = np.flatnonzero(np.bincount(ids, minlength=len(layouts))).tolist()
         for k in used:
             lay = layouts[k]
             mine = np.flatnonzero(ids == k)
             at = first[mine][:, None] + np.arange(lay.slots)
-            if lay.kind is None:
+            if lay.kind is None or lay.width is None:
                 lay.kind, lay.width = kind[at[0]], width[at[0]]
             if not (np.array_equal(kind[at], np.broadcast_to(lay.kind, at.shape))
                     and np.array_equal(width[at], np.broadcast_to(lay.width, at.shape))):
@@ -390,6 +396,7 @@ class _Chunk:
                           else 0 for lay in layouts], dtype=np.intp)[ids]
         names = self.names(int(named.sum()))
         name_at = np.cumsum(named) - named
+        self.level = self.separated = None  # the bytes are read: let them go
         single = len(used) == 1
         for k in used:
             lay = layouts[k]
@@ -423,6 +430,7 @@ class _Chunk:
             separated[np.where(kind == _LIST, e - 1, e)[kind != _NAME]] = ord(",")
             separated[e[kind == _NAME]] = ord("\n")
             self.separated = separated
+        assert self.level is not None
         mask = self.level == level
         out = np.empty(int(np.count_nonzero(mask)) + 1, dtype=np.uint8)
         np.compress(mask, self.separated, out=out[1:])
@@ -600,6 +608,14 @@ def _pad3(v: np.ndarray) -> np.ndarray:
     return out
 
 
+BODY_PATHS: dict[int, set[tuple[Any, ...]]] = {
+    cv.PLANAR: {(k,) for k in BODY_KEYS if k not in ("orientation", "shape", "color")},
+    cv.SPATIAL: {(k,) for k in BODY_KEYS if k not in ("angle", "orientation", "shape", "color")}
+    | {("inertia", 0), ("inertia", 1), ("inertia", 2), ("orientation", "quaternion")},
+}
+"""What a body may give here: no shape or colour, a spatial attitude as a quaternion."""
+
+
 def _bodies(c: Checker, groups: list[_Group]) -> BodyTable:
     """The body table; `_Bail` unless every body passes every check of `validate`."""
     n = sum(len(g.index) for g in groups)
@@ -613,11 +629,7 @@ def _bodies(c: Checker, groups: list[_Group]) -> BodyTable:
     q = np.zeros((n, 4))
     q[:, 0] = 1.0
     omega = np.zeros((n, 3))
-    allowed = ({("name",), ("mass",), ("inertia",), ("position",), ("velocity",), ("angle",),
-                ("angular_velocity",)} if planar else
-               {("name",), ("mass",), ("inertia",), ("inertia", 0), ("inertia", 1),
-                ("inertia", 2), ("position",), ("velocity",), ("orientation", "quaternion"),
-                ("angular_velocity",)})
+    allowed = BODY_PATHS[dim]
     for g in groups:
         cols = g.columns
         if not set(cols) <= allowed:
@@ -648,7 +660,7 @@ def _bodies(c: Checker, groups: list[_Group]) -> BodyTable:
             if ("orientation", "quaternion") in cols:
                 qq = _numbers(g, ("orientation", "quaternion"), 4)
                 norm = quat_norm(qq)
-                if not np.all(np.abs(norm - 1) <= 1e-6):  # else a warning, or zero
+                if not np.all(np.abs(norm - 1) <= UNIT_TOL):  # else a warning, or zero
                     raise _Bail
                 q[i] = qq / norm[:, None]
             if ("angular_velocity",) in cols:
@@ -794,7 +806,7 @@ def _joints(c: Checker, groups: list[_Group]) -> JointSpecTable:
             if not (first and second and set(kinds) == {"universal"}):
                 raise _Bail
             unit2 = _unit(_pad3(_numbers(g, ("axis2",), dim)))
-            if not np.all(np.abs(np.einsum("ij,ij->i", axis[i], unit2)) <= 0.5e-6):
+            if not np.all(np.abs(np.einsum("ij,ij->i", axis[i], unit2)) <= 0.5 * PERPENDICULAR_TOL):
                 raise _Bail  # perpendicular (with a margin: near the limit, the located path)
             axis2[i] = unit2
             has_axis2[i] = True
@@ -813,6 +825,6 @@ def _joints(c: Checker, groups: list[_Group]) -> JointSpecTable:
 def _unit(v: np.ndarray) -> np.ndarray:
     """Rows of `v` normalised as `validate._axis` normalises one; `_Bail` for a zero one."""
     norm = vec_norm(v)
-    if not np.all(norm >= 1e-12):
+    if not np.all(norm >= MIN_NORM):
         raise _Bail
     return v / norm[:, None]

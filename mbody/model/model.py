@@ -907,12 +907,19 @@ def _frames(axis: np.ndarray, has_axis: np.ndarray, planar: bool) -> np.ndarray:
         return np.zeros((0, 3, 3))
     bits = np.ascontiguousarray(axis, dtype=float).view(np.int64)
     key = np.concatenate((bits, has_axis[:, None].astype(np.int64)), axis=1)
-    distinct, inverse = np.unique(key, axis=0, return_inverse=True)
+    if np.all(key == key[0]):  # one axis for all (a chain...)
+        first, inverse = np.zeros(1, dtype=np.intp), np.zeros(k, dtype=np.intp)
+    else:  # rows sorted, then runs of equal rows (np.unique would import numpy.ma)
+        order = np.lexsort(key.T[::-1])
+        ordered = key[order]
+        new = np.ones(k, dtype=bool)
+        new[1:] = np.any(ordered[1:] != ordered[:-1], axis=1)
+        first = order[new]  # a joint with each axis
+        inverse = np.empty(k, dtype=np.intp)
+        inverse[order] = np.cumsum(new) - 1
     rule = joint_frame_planar if planar else joint_frame_spatial
-    first = np.zeros(len(distinct), dtype=np.intp)
-    first[inverse.ravel()[::-1]] = np.arange(k - 1, -1, -1)  # a joint with each axis
     frames = np.array([rule(axis[i] if has_axis[i] else None) for i in first.tolist()])
-    return frames.reshape(-1, 3, 3)[inverse.ravel()]
+    return frames.reshape(-1, 3, 3)[inverse]
 
 
 def _field_names(cls: type) -> list[str]:

@@ -25,6 +25,9 @@ from mbody.errors import Issue, ModelError, did_you_mean
 from mbody.model.checks import (
     _TOL,
     MIN_MAGNITUDE,
+    MIN_NORM,
+    PERPENDICULAR_TOL,
+    UNIT_TOL,
     Checker,
     _kind,
     _quoted,
@@ -507,10 +510,10 @@ def _orientation(c: Checker, path: Path_, value: Any) -> np.ndarray | None:
         if q is None:
             return None
         n = float(quat_norm(q))
-        if n < 1e-12:
+        if n < MIN_NORM:
             c.err((*path, "quaternion"), "the quaternion is zero", "identity is [1, 0, 0, 0]")
             return None
-        if abs(n - 1) > 1e-6:
+        if abs(n - 1) > UNIT_TOL:
             c.warn((*path, "quaternion"), f"the quaternion has norm {n:.6g}; it was normalised")
         return q / n
     if kind == "euler":
@@ -792,7 +795,7 @@ def _joints(c: Checker, value: Any, names: dict[str, int],
             c.err(p, "a universal joint needs 'axis2' (the child's axis)")
         if name is not None and typ is not None:
             c.joint_types.setdefault(name, typ)
-        if axis is not None and axis2 is not None and abs(float(axis @ axis2)) > 1e-6:
+        if axis is not None and axis2 is not None and abs(float(axis @ axis2)) > PERPENDICULAR_TOL:
             c.err((*p, "axis2"), "a universal joint's axes must be perpendicular",
                   f"axis . axis2 = {float(axis @ axis2):.3g}")
             continue
@@ -849,7 +852,7 @@ def _axis(c: Checker, path: Path_, value: Any) -> np.ndarray | None:
     if a is None:
         return None
     n = float(vec_norm(a))
-    if n < 1e-12:
+    if n < MIN_NORM:
         c.err(path, "the axis is the zero vector", "give a direction, such as [0, 0, 1]")
         return None
     return a / n
