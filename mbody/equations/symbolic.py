@@ -560,6 +560,15 @@ def body_symbolic(asm: Assembly, name: str) -> SymbolicBody:
         gyro[3:] = _minus_gyroscopic(I, w, principal)
 
     # -- the rows: left side, then −b, loads and springs, gravity, reactions ------------
+    # A reaction's noise is judged against its largest coefficient among the body's rows
+    # of the same kind (forces or moments), as a load's: a lever arm of 1e-17 m on a
+    # row where it has no real moment (the heavy top's pivot.Fx about axis 3) is
+    # rounding, not a term; the row's other reactions may all be such noise.
+    reaction_scale: dict[tuple[str, bool], float] = {}
+    for r in range(shown):
+        for label, c in eqs.equations[r].reactions.items():
+            key = (label, rows6[r] >= 3)
+            reaction_scale[key] = max(reaction_scale.get(key, 0.0), abs(c))
     rows: list[SymbolicRow] = []
     for r in range(shown):
         terms = list(left[r]) + gyro[rows6[r]]
@@ -568,9 +577,8 @@ def body_symbolic(asm: Assembly, name: str) -> SymbolicBody:
             if abs(coef) > NOISE * _scale(W, rows6[r]):
                 terms.append(Term(coef, factors, part, symbol))
         eq = eqs.equations[r]
-        scale = max((abs(v) for v in eq.reactions.values()), default=0.0)
         terms += [Term(c, (S(label),), REACTION, label) for label, c in eq.reactions.items()
-                  if abs(c) > NOISE * scale]
+                  if abs(c) > NOISE * reaction_scale[label, rows6[r] >= 3]]
         rows.append(SymbolicRow(eq.row, tuple(terms)))
 
     known = model.known_reactions_at(state.t)
