@@ -79,7 +79,12 @@ def _compare(m, d, model: Model, reactions: bool) -> float:
     mj.mj_forward(m, d)
     mj.mj_rnePostConstraint(m, d)
     sol = mbody.assemble(model).solve()
-    acc = sol.accelerations.reshape(model.n, 6)
+    # 6 rows per body, 3 per particle (no rotation): split at each body's first row
+    rows = np.cumsum([0] + [3 if p else 6 for p in model.particle])
+    assert rows[-1] == sol.accelerations.size
+    # cacc holds -g only when gravity is on (dm_control's finger switches it off)
+    g = (np.zeros(3) if m.opt.disableflags & mj.mjtDisableBit.mjDSBL_GRAVITY
+         else m.opt.gravity)
     res = np.zeros(6)
     worst = 0.0
     R = model.initial.W_R_B
@@ -88,12 +93,16 @@ def _compare(m, d, model: Model, reactions: bool) -> float:
         assert b >= 0, name
         np.testing.assert_allclose(model.initial.position[i], d.xipos[b], atol=1e-12)
         mj.mj_objectAcceleration(m, d, mj.mjtObj.mjOBJ_BODY, b, res, 0)
-        lin, ang = res[3:] + m.opt.gravity, res[:3]
-        mine = np.concatenate([acc[i, :3], R[i] @ acc[i, 3:]])
-        ref = np.concatenate([lin, ang])
+        a = sol.accelerations[rows[i]:rows[i + 1]]
+        if model.particle[i]:  # a point mass: its angular acceleration means nothing
+            mine, ref = a, res[3:] + g
+        else:
+            mine = np.concatenate([a[:3], R[i] @ a[3:]])
+            ref = np.concatenate([res[3:] + g, res[:3]])
         scale = max(1.0, float(np.abs(ref).max()))
         worst = max(worst, float(np.abs(mine - ref).max()) / scale)
     if reactions:
+        parent_of = {jt.child: jt.parent for jt in model.joints}
         for jt in model.joints:
             b = mj.mj_name2id(m, mj.mjtObj.mjOBJ_BODY, jt.child)
             F, M = np.zeros(3), np.zeros(3)
@@ -107,7 +116,15 @@ def _compare(m, d, model: Model, reactions: bool) -> float:
                     (F if comp[0] == "F" else M)[:] += value * col
             c = d.subtree_com[m.body_rootid[b]]
             torque = M + np.cross(jt.at - c, F)
-            ref = d.cfrc_int[b]
+            ref = d.cfrc_int[b].copy()
+            for k in np.flatnonzero(m.body_parentid == b):
+                # cfrc_int carries the subtree; what mbody hangs elsewhere (the children
+                # of a welded point mass hang from the body it is welded to) is taken out
+                kid = mj.mj_id2name(m, mj.mjtObj.mjOBJ_BODY, int(k))
+                if parent_of.get(kid, jt.child) != jt.child or (
+                        kid not in parent_of and model.particle[model.body_names.index(
+                            jt.child)]):
+                    ref -= d.cfrc_int[k]
             scale = max(1.0, float(np.abs(ref).max()))
             worst = max(worst, float(np.abs(np.concatenate([torque, F]) - ref).max()) / scale)
     assert worst < RTOL, worst
@@ -278,9 +295,11 @@ def test_connect_becomes_a_spherical_joint_closing_the_loop():
     assert tie.at == pytest.approx([1, 0, 1])
 
 
-def test_acrobot_cartpole_from_dm_control_agree_with_mujoco():
-    for name in ("acrobot", "cartpole"):
-        assert _mjcf_check(_suite(name)) < RTOL
+@pytest.mark.parametrize("name", ["acrobot", "cartpole", "pendulum", "reacher", "finger",
+                                  "quadruped", "humanoid_CMU"])
+def test_dm_control_suite_agrees_with_mujoco(name):
+    """Every suite model that loads (the finger has gravity switched off)."""
+    assert _mjcf_check(_suite(name), seeds=(0, 1)) < RTOL
 
 
 def test_humanoid_says_which_body_cannot_be_expressed():
@@ -318,9 +337,57 @@ def test_two_link_arm_urdf_agrees_with_mujoco():
     ("panda_description/urdf/panda.urdf", False),
     ("solo_description/robots/solo12.urdf", True),
     ("a1_description/urdf/a1.urdf", True),
+    # point masses welded to a link (contact and sensor links: spherical joints; what is
+    # fixed to them hangs from the link): quadruped, so101, Talos, Baxter
+    ("quadruped_description/urdf/quadruped.urdf", True),
+    ("so_arm_description/urdf/so101.urdf", False),
+    ("talos_data/robots/talos_left_arm.urdf", False),
+    ("baxter_description/urdf/baxter.urdf", False),
+    # massless feet with an inertia: it adds to the lower leg's
+    ("bolt_description/robots/bolt.urdf", True),
+    ("go2_description/urdf/go2.urdf", True),
+    ("g1_description/urdf/g1_29dof_rev_1_0.urdf", True),
+    ("xarm_description/urdf/xarm7.urdf", False),
 ])
 def test_example_robot_data_agrees_with_mujoco(path, floating):
     assert _urdf_check(_robot(path), floating) < RTOL
+
+
+POINTS = """<robot name="points">
+  <link name="arm"><inertial><origin xyz="0.2 0 0"/><mass value="2"/>
+    <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.05" iyz="0" izz="0.05"/></inertial></link>
+  <joint name="tip_fixed" type="fixed"><parent link="arm"/><child link="tip"/>
+    <origin xyz="0.4 0.05 0" rpy="0.3 0.2 0.1"/></joint>
+  <link name="tip"><inertial><mass value="0.3"/>
+    <inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial></link>
+  <joint name="finger_joint" type="revolute"><parent link="tip"/><child link="finger"/>
+    <origin xyz="0.05 0 0"/><axis xyz="0 0 1"/></joint>
+  <link name="finger"><inertial><origin xyz="0.05 0 0"/><mass value="0.2"/>
+    <inertia ixx="0.0001" ixy="0" ixz="0" iyy="0.0004" iyz="0" izz="0.0004"/></inertial>
+  </link>
+  <joint name="pad_fixed" type="fixed"><parent link="finger"/><child link="pad"/>
+    <origin xyz="0.1 0 0" rpy="0 0.5 0"/></joint>
+  <link name="pad"><inertial><mass value="0"/>
+    <inertia ixx="0.0002" ixy="0.00001" ixz="0" iyy="0.0003" iyz="0" izz="0.0004"/>
+  </inertial></link>
+</robot>"""
+
+
+def test_point_masses_and_massless_inertias_are_exact(tmp_path):
+    """A link with a mass and no inertia welded to another (a contact or sensor link)
+    is a particle on a spherical joint (a fixed joint has no orientation to hold), and
+    what is fixed to it hangs from the link it is welded to; a link with an inertia and
+    no mass adds its inertia to the body it is welded to. Both exact: MuJoCo agrees."""
+    path = tmp_path / "points.urdf"
+    path.write_text(POINTS)
+    assert _urdf_check(path, floating=True) < RTOL
+    model = mbody.load(path, floating_base=True)
+    assert model.body_names == ("arm", "tip", "finger")
+    joints = {j.name: (j.type, j.parent, j.child) for j in model.joints}
+    assert joints == {"tip_fixed": ("spherical", "arm", "tip"),
+                      "finger_joint": ("revolute", "arm", "finger")}
+    assert model.particle[1] and not model.particle[2]
+    assert np.linalg.eigvalsh(model.J[2]).sum() == pytest.approx(0.0009 + 0.0009)
 
 
 def test_joint_values_by_name():

@@ -377,6 +377,8 @@ def build(name: str, description: str, file: str, bodies: list[TreeBody],
     owner: dict[int, int] = {}  # tree index -> kept tree index it is welded into, or -1
     floating = -2  # a massless frame with a free joint: its first massive part moves freely
     free: set[int] = set()
+    points: set[int] = set()  # point masses welded to a body: spherical joints
+    extra: dict[int, Any] = {}  # kept tree index -> inertia of massless frames welded to it
     for i, b in enumerate(bodies):
         if b.mass > 0:
             kept[i] = b.name
@@ -384,6 +386,13 @@ def build(name: str, description: str, file: str, bodies: list[TreeBody],
             if not b.joints and b.parent >= 0 and owner.get(b.parent) == floating:
                 owner[b.parent] = i  # URDF's massless root link: the trunk floats
                 free.add(i)
+            elif not b.joints and b.parent >= 0 and not b.inertia.any():
+                # A point mass (mass, no inertia: a URDF contact or sensor link) welded to
+                # its parent: mbody's particle, which has no orientation to weld, so a
+                # spherical joint at the point holds it exactly (its moment is zero). What
+                # is fixed to it is fixed to the body it is welded to.
+                points.add(i)
+                owner[i] = owner.get(b.parent, -1)
         elif [j.type for j in b.joints] == ["free"]:
             owner[i] = floating
         elif b.joints:
@@ -394,6 +403,15 @@ def build(name: str, description: str, file: str, bodies: list[TreeBody],
                 "frames): give the body an inertial with a mass, or geoms with one"))
         else:
             owner[i] = owner.get(b.parent, -1) if b.parent >= 0 else -1
+            o = owner[i]
+            if o >= 0 and b.inertia.any():
+                # A frame with inertia but no mass (bolt's feet) turns with the body it is
+                # welded to: with no mass there is no parallel-axis term, so its tensor
+                # adds to that body's as it is, turned into the body's inertia axes.
+                W = kin.R[i] @ b.R_inertia
+                B = kin.R[o] @ bodies[o].R_inertia
+                T = B.T @ W
+                extra[o] = extra.get(o, 0.0) + T @ b.inertia @ T.T
     if issues:
         raise ModelError(issues)
     if not kept:
@@ -410,11 +428,14 @@ def build(name: str, description: str, file: str, bodies: list[TreeBody],
         c = kin.pos[i] + R @ b.com
         v = kin.vel[i] + np.cross(kin.omega[i], c - kin.pos[i])
         k = len(out_bodies)
+        J = b.inertia + extra.get(i, 0.0)
         entry: dict[str, Any] = {
             "name": b.name, "mass": float(b.mass),
-            "inertia": [[float(x) for x in row] for row in 0.5 * (b.inertia + b.inertia.T)],
+            "inertia": [[float(x) for x in row] for row in 0.5 * (J + J.T)],
             "position": _floats(c), "orientation": {"matrix": [_floats(r) for r in Rb]},
             "velocity": _floats(v), "angular_velocity": _floats(Rb.T @ kin.omega[i])}
+        if not J.any():  # a particle: no orientation, no angular velocity
+            del entry["orientation"], entry["angular_velocity"]
         if b.shape is not None:
             entry["shape"] = b.shape
         out_bodies.append(entry)
@@ -425,6 +446,8 @@ def build(name: str, description: str, file: str, bodies: list[TreeBody],
             doc.mark((*p, key), b.mass_element or b.element, key if key == "mass" else None)
         m = (map_joints(b, kin, i, scale) if i not in free and i not in free_bodies
              else Mapped(None, ""))
+        if i in points:
+            m = Mapped("spherical", m.name, c, None, None, m.element)
         if m.type is None:
             continue
         parent = _parent_name(bodies, b.parent, owner, kept)
