@@ -477,3 +477,48 @@ def test_particles_known_reactions_and_loads_that_vary_in_time():
         "correct"
     with pytest.raises(AnswersError, match="unknown function 'ln'"):
         verify(model("satellite_thruster"), [("satellite", "m*a_z = ln(2)")])
+
+
+# == found in review: what a student tries next =========================================
+def test_time_t_is_a_name_so_a_load_copied_from_symbolic_reads():
+    # `mbody assemble --symbolic` writes M_load = -60*exp(-90*t): copy it as it stands
+    eq = ("I_G*alpha = -60*exp(-90*t) + 0.0176777*O.Fx - 0.0176777*O.Fy "
+          "+ 0.0176777*A.Fx - 0.0176777*A.Fy")
+    assert diagnosis("slider_crank", "crank", eq) == "correct"
+    assert diagnosis("slider_crank", "piston", "m*a_x = -4000*exp(-200*t) + B.Fx") == \
+        "correct"
+
+
+def test_the_closest_row_is_about_the_acceleration_written():
+    # a moment equation with wrong lever arms is compared with the moment row, not with
+    # the Newton row that happens to share two reactions with it
+    c = check("slider_crank", "crank", "I_G*alpha = -60 - 0.025*O.Fy + 0.025*A.Fy")
+    assert c.diagnosis == "not_an_equation_of_this_body" and c.row == "crank.theta"
+    assert "alpha does not belong" not in c.explanation
+
+
+def test_a_moment_of_the_wrong_sign_on_the_child_is_not_blamed_on_the_third_law():
+    c = check("pendulum", "rod", "I_G*alpha = 0.433013*O.Fx + 0.25*O.Fy")
+    assert c.diagnosis == "reaction_sign" and c.details["reactions"] == ["O.Fx", "O.Fy"]
+    assert "r × F" in c.explanation and "so it feels +O.Fx" not in c.explanation
+    # on the parent, the third law is the reason, and r × (−R) is said
+    c = check("slider_crank", "crank", "I_G*alpha = -60 + 0.0176777*O.Fx - 0.0176777*O.Fy "
+              "- 0.0176777*A.Fx + 0.0176777*A.Fy")
+    assert c.diagnosis == "reaction_sign" and "parent of joint A" in c.explanation
+    assert "r × (−R)" in c.explanation
+
+
+@pytest.mark.parametrize("name, body, eq, what, row", [
+    ("pendulum", "rod", "m*a_y = O.Fy + m*g", "gravity", "rod.y"),
+    ("slider_crank", "piston", "m*a_x = B.Fx + 4000", "gas", "piston.x"),
+    ("slider_crank", "piston", "m*a_x = B.Fx - F_gas_x", "gas", "piston.x"),
+    ("seed_example_2", "body", "I_1*alpha_1 = (I_3 - I_2)*w_2*w_3", "omega x (I omega)",
+     "body.w1"),
+    ("seed_example_2", "body", "alpha_1 = 3", "omega x (I omega)", "body.w1"),
+    ("heavy_top", "top", "I_1*alpha_1 = (I_3 - I_2)*w_2*w_3 + 0.0469846*pivot.Fy "
+     "+ 0.017101*pivot.Fz", "omega x (I omega)", "top.w1"),
+])
+def test_a_load_or_the_gyroscopic_term_of_the_wrong_sign_is_named(name, body, eq, what, row):
+    c = check(name, body, eq)
+    assert c.diagnosis == "not_an_equation_of_this_body" and c.row == row
+    assert c.details["wrong_sign"] == what and "of the wrong sign" in c.explanation

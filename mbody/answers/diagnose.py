@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from mbody.answers.compare import CONST, Fit, Row, fit, matches, same
-from mbody.answers.rows import BodyRows, MomentPoint, TrueRow
+from mbody.answers.rows import BodyRows, LoadShare, MomentPoint, TrueRow
 from mbody.answers.text import num as _num
 from mbody.answers.text import row_text
 from mbody.answers.text import terms as _terms
@@ -364,6 +364,15 @@ class _Diagnoser:
                         f"+{flip[0]}" if side > 0 else
                         f"{self.br.body} is the parent of joint {joint}, so it feels "
                         f"−{flip[0]}")
+                if r.euler and side > 0:
+                    # the child feels +R, so a flipped moment is r × F's sign, not the
+                    # third law's (telling it "it feels +R" beside "-0.43 O.Fx" confuses)
+                    rule = (f"the moment of a force about G is r × F, with r from G to "
+                            f"where it acts (joint {joint}), and {self.br.body}, the child "
+                            f"of joint {joint}, feels +R there")
+                    role = "check the lever arm's direction and the order of the cross product"
+                elif r.euler:
+                    role += f", whose moment about G is r × (−R), r from G to joint {joint}"
                 terms = _terms({k: -r.row.get(k) for k in flip})
                 return Diagnosis(
                     REACTION_SIGN, r.text, r.label,
@@ -442,6 +451,9 @@ class _Diagnoser:
                         t = self.br.about_fixed_point(e, p)
                         candidates.append((e, t, f"the moment equation about the fixed pivot "
                                            f"{_point(p)} (with I_P = I_G + m d²)", row_text(t)))
+        flipped = self.wrong_sign()
+        if flipped is not None:
+            return flipped
         best: tuple | None = None
         for r, t, words, text in candidates:
             f = self.consensus(t, r.acc)
@@ -449,7 +461,10 @@ class _Diagnoser:
                 continue
             wrong = f.wrong(self.tol)
             shared = len(self.s.unknowns & t.unknowns)
-            key = (len(wrong) - shared, len(wrong), f.error)
+            # a row about an acceleration the student did not write comes last: an
+            # equation in alpha is a moment equation, however many reactions it shares
+            # with a Newton row
+            key = (r.acc not in self.s.unknowns, len(wrong) - shared, len(wrong), f.error)
             if best is None or key < best[0]:
                 best = (key, r, t, words, text, f, wrong)
         if best is None:
@@ -475,6 +490,32 @@ class _Diagnoser:
             "equation's scale: " + "; ".join(parts) + more + ".",
             {"differs": {k: {"have": self.s.get(k), "expected": f.k * t.get(k)}
                          for k in wrong}})
+
+    def wrong_sign(self) -> Diagnosis | None:
+        """A row with one applied load, gravity or the gyroscopic term of the wrong sign:
+        no mistake of the table, but the commonest slip, so it is named."""
+        for r in self.br.rows:
+            flips: list[tuple[LoadShare | None, float]] = [
+                (x, -2.0 * x.value) for x in r.loads]  # Q's share: −value in lhs − rhs
+            if r.euler and r.gyro != 0.0:
+                flips.append((None, 2.0 * r.gyro))  # b is on the left: +gyro
+            for x, change in flips:
+                t = r.row.with_term(CONST, r.row.get(CONST) - change, r.row.err(CONST))
+                if self.match(t) is None:
+                    continue
+                if x is None:
+                    what = (f"its gyroscopic term of the wrong sign: {self.gyro_words(r)} "
+                            "(on the right side it is −(ω × Iω)); mind the cyclic order "
+                            "1 → 2 → 3")
+                    name = "omega x (I omega)"
+                else:
+                    what = f"{_load_words(x, r.euler)} of the wrong sign"
+                    name = x.name
+                return Diagnosis(
+                    NOT_AN_EQUATION, r.text, r.label,
+                    f"This is {self.words(r)} with {what}. The row reads: {r.text}.",
+                    {"wrong_sign": name})
+        return None
 
     def consensus(self, t: Row, acc: str) -> Fit | None:
         """The fit whose scale most of the student's terms agree with (the row's own

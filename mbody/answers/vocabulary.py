@@ -12,7 +12,7 @@ Numbers taken from the model at its state:
 - ``m``; planar ``I_G``; spatial ``I_1, I_2, I_3`` (principal moments, when the tensor is
   diagonal in body axes) and every tensor entry ``I_11, I_12, ... I_33``;
 - ``w`` and ``theta`` (planar) or ``w_1, w_2, w_3`` (spatial, body axes);
-- ``g``, the magnitude of gravity; ``pi``;
+- ``g``, the magnitude of gravity; ``pi``; ``t``, the time of the state;
 - a reaction whose value the model gives (``reactions:`` in the file), by its label;
 - each applied load's components by name, as `mbody assemble --symbolic` writes them
   (``F_push_x`` world axes, ``F_push_1`` body axes, ``M_motor_3``, ``T_spring``).
@@ -63,6 +63,7 @@ MEANINGS = {
     "m": "mass (kg)", "I_G": "moment of inertia about the mass centre (kg m^2)",
     "w": "angular velocity, planar (rad/s)", "theta": "angle, planar (rad)",
     "g": "magnitude of gravity (m/s^2)", "pi": "3.14159...",
+    "t": "the time of the state the equations are written at (s)",
 }
 """What each fixed name of the vocabulary stands for (docs and error hints)."""
 
@@ -233,6 +234,9 @@ def vocabulary(model: Model, state: State, body: str) -> Vocabulary:
     reactions = tuple(r for r in model.reactions if r not in known)
     for label, value in known.items():
         values[label] = float(value)
+    # the time, so that a load written as `mbody assemble --symbolic` defines it
+    # (M_load = -60*exp(-90*t)) can be copied as it stands
+    values["t"] = float(state.t)
     for sym in load_symbols(model, state, body):
         values.setdefault(sym.name, float(sym.value))
     return Vocabulary(body, model.dimension, tuple(accelerations), reactions, values,
