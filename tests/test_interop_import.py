@@ -348,6 +348,8 @@ def test_two_link_arm_urdf_agrees_with_mujoco():
     ("go2_description/urdf/go2.urdf", True),
     ("g1_description/urdf/g1_29dof_rev_1_0.urdf", True),
     ("xarm_description/urdf/xarm7.urdf", False),
+    # <collision_checking> in its links: an extension, noted
+    ("simple_humanoid_description/urdf/simple_humanoid.urdf", True),
 ])
 def test_example_robot_data_agrees_with_mujoco(path, floating):
     assert _urdf_check(_robot(path), floating) < RTOL
@@ -484,6 +486,52 @@ def test_misspelt_element_and_attribute():
     assert msgs[1].startswith("bad.xml:4:9:") and "did you mean 'name'" in msgs[1]
     (msg,) = _issues('<robot name="r"><link name="a"><inertail/></link></robot>', read_urdf)
     assert "did you mean 'inertial'" in msg
+
+
+ARM = ('<robot name="r"><link name="a"/><joint name="j" type="revolute">'
+       '<parent link="a"/><child link="b"/>{joint}</joint>'
+       '<link name="{child}">{link}<inertial><mass value="1"/>'
+       '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>'
+       '</robot>')
+
+
+def test_urdf_extensions_are_noted_and_typos_refused():
+    """ANYmal's ``<limit command_effort gear_velocity>`` and the simple humanoid's
+    ``<collision_checking>`` are tools' extensions (noted in the warning, the robot
+    loads); a name one edit or very little away from URDF's is a typo (refused)."""
+    text = ARM.format(joint='<limit effort="1" command_effort="2" gear_velocity="3"/>',
+                      child="b", link="<collision_checking/>")
+    doc = read_urdf(text)
+    (note,) = [w.message for w in doc.warnings]
+    for name in ("limit command_effort", "limit gear_velocity",
+                 "<collision_checking> in <link>"):
+        assert name in note
+    for joint, hint in (('<origin rpi="0 0 1"/>', "did you mean 'rpy'"),
+                        ('<orgin xyz="0 0 1"/>', "did you mean 'origin'"),
+                        ('<limit efort="1"/>', "did you mean 'effort'")):
+        (msg,) = _issues(ARM.format(joint=joint, child="b", link=""), read_urdf)
+        assert hint in msg
+
+
+def test_urdf_ground_link_empty_robot_and_a_lone_fixed_link(tmp_path):
+    """asr_twodof's link 'ground' is renamed (with a warning), ur3.urdf (xacro macros
+    only) has no link, hector's quadrotor is one link fixed to the world."""
+    doc = read_urdf(ARM.format(joint="", child="ground", link="").replace(
+        '<child link="b"/>', '<child link="ground"/>'))
+    model = Model.from_spec(validate(doc))
+    assert model.body_names == ("ground_body",)
+    assert "'ground' is named 'ground_body'" in doc.warnings[0].message
+    (msg,) = _issues('<robot name="r"></robot>', read_urdf)
+    assert "has no <link>" in msg and "xacro" in msg
+    (msg,) = _issues('<robot name="r"><link name="a"><inertial><mass value="1"/>'
+                     '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/>'
+                     '</inertial></link></robot>', read_urdf)
+    assert "only link with a mass" in msg and "--floating-base" in msg
+    path = tmp_path / "drone.urdf"
+    path.write_text('<robot name="r"><link name="a"><inertial><mass value="1"/>'
+                    '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/>'
+                    '</inertial></link></robot>')
+    assert mbody.load(path, floating_base=True).body_names == ("a",)
 
 
 def test_bad_numbers_angles_and_units():

@@ -370,6 +370,15 @@ def build(name: str, description: str, file: str, bodies: list[TreeBody],
     bare MJCF body) are left out, their children joined to the nearest body kept; a body
     without mass that moves is an error (mbody needs a mass on every moving body).
     """
+    renamed = []
+    for b in bodies:  # "ground" names the world in mbody: a body so named is renamed
+        if b.name == GROUND:
+            taken = {x.name for x in bodies}
+            b.name = next(f"{GROUND}_{k}" if k else f"{GROUND}_body" for k in range(
+                len(bodies) + 1) if (f"{GROUND}_{k}" if k else f"{GROUND}_body") not in taken)
+            renamed.append(Issue(file, *b.element.where("name"), "", f"the body "
+                                 f"'{GROUND}' is named '{b.name}' here: mbody's '{GROUND}' "
+                                 "is the fixed world frame"))
     kin = forward(bodies, qpos, qvel, q0)
     scale = float(max([1.0] + [float(np.abs(p).max()) for p in kin.pos]))
     issues: list[Issue] = []
@@ -477,7 +486,8 @@ def build(name: str, description: str, file: str, bodies: list[TreeBody],
     doc.marks[()] = (root.line, root.column)
     for key in ("model", "dimension", "gravity", "bodies", "joints"):
         doc.marks[(key,)] = (root.line, root.column)
-    return ImportedDocument(data, file, doc.marks, doc.key_marks, source_format=fmt)
+    return ImportedDocument(data, file, doc.marks, doc.key_marks, warnings=renamed,
+                            source_format=fmt)
 
 
 def _parent_name(bodies: list[TreeBody], parent: int, owner: dict[int, int],

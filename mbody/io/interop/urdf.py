@@ -11,6 +11,7 @@ dynamics, mimic joints and transmissions are listed in one warning.
 
 from __future__ import annotations
 
+import difflib
 import math
 from collections.abc import Mapping
 from pathlib import Path
@@ -114,9 +115,33 @@ def read_urdf(source: str | Path, *, joint_positions: Mapping[str, float] | None
                                     floating_base)
 
 
+TYPO_CUTOFF = 0.8
+"""How alike (difflib's ratio) an unknown URDF name must be to one of URDF's to be taken
+for a misspelling: ``orgin``, ``inertail``, ``nme`` are (0.86 to 0.91), and so is any
+name one edit away (``rpi``: 0.67); the extensions real files carry, ``command_effort``
+(ANYmal), ``gear_velocity``, ``collision_checking`` (0.6 to 0.76), are not."""
+
+
+def _one_edit(a: str, b: str) -> bool:
+    """`a` and `b` differ by one letter changed, added, dropped or two swapped."""
+    if abs(len(a) - len(b)) > 1:
+        return False
+    i = 0
+    while i < min(len(a), len(b)) and a[i] == b[i]:
+        i += 1
+    return (a[i + 1:] == b[i + 1:] or a[i:] == b[i + 1:] or a[i + 1:] == b[i:]
+            or a[i:i + 2] == b[i:i + 2][::-1] and a[i + 2:] == b[i + 2:])
+
+
+def _misspelt(name: str, known: tuple[str, ...]) -> bool:
+    return any(difflib.SequenceMatcher(None, name, k).ratio() >= TYPO_CUTOFF
+               or _one_edit(name, k) for k in known)
+
+
 def _check_names(root: Element, issues: list[Issue], ignored: list[str]) -> None:
-    """A name close to one of URDF's is misspelt (an error with a did-you-mean); any
-    other unknown name is a tool's extension (Gazebo's, a vendor's): noted, not read."""
+    """A name very close to one of URDF's is misspelt (an error with a did-you-mean);
+    any other unknown name is a tool's extension (Gazebo's, a vendor's): noted, not read.
+    """
     stack = [root]
     while stack:
         e = stack.pop()
@@ -125,7 +150,7 @@ def _check_names(root: Element, issues: list[Issue], ignored: list[str]) -> None
         for a in e.attrib:
             known = _ATTRS.get(e.tag, ())
             if a not in known and ":" not in a:
-                if did_you_mean(a, known):
+                if _misspelt(a, known):
                     issues.append(unknown_name(e, a, known, f"attribute of <{e.tag}>", a))
                 elif f"{e.tag} {a}" not in ignored:
                     ignored.append(f"{e.tag} {a}")
@@ -133,7 +158,7 @@ def _check_names(root: Element, issues: list[Issue], ignored: list[str]) -> None
             kids = _CHILDREN.get(e.tag, ())
             if c.tag in kids:
                 stack.append(c)
-            elif did_you_mean(c.tag, kids):
+            elif _misspelt(c.tag, kids):
                 issues.append(unknown_name(c, c.tag, kids, f"element in <{e.tag}>"))
             elif f"<{c.tag}> in <{e.tag}>" not in ignored:
                 ignored.append(f"<{c.tag}> in <{e.tag}>")
@@ -220,6 +245,10 @@ class _Reader:
         if self.issues:
             raise ModelError(self.issues)
         roots = [n for n in links if n not in joints_of]
+        if not links:
+            raise ModelError([self.root.issue(
+                "the robot has no <link>", "a file of xacro macros holds none: run xacro on "
+                "the robot's own .urdf.xacro")])
         if len(roots) != 1:
             raise ModelError([self.root.issue(
                 f"expected one root link (a link that is no joint's child), found "
@@ -242,6 +271,13 @@ class _Reader:
                     self.note("the root link is fixed to the world (its mass is part of "
                               "the ground; floating_base=True lets it move)", n)
                     b.mass = 0.0
+                    if not any(links[c].find("inertial") is not None for c in joints_of):
+                        # nothing else has a mass: a drone's or a free object's one link
+                        raise ModelError([ln.issue(
+                            f"the root link '{n}' is the only link with a mass, and it "
+                            "is fixed to the world (a URDF's root is, unless it floats): "
+                            "nothing moves", "floating_base=True (--floating-base) lets "
+                            "it move freely")])
             else:
                 pos, quat = self.origin(joint)
                 parent_link = joint.find("parent")
