@@ -27,6 +27,7 @@ from mbody.model.validate import validate
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tools"))
 from bench_load import chain_spec, free_bodies_spec  # noqa: E402
+from test_fast import assert_same_model  # noqa: E402
 
 DUMPER = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
 SHIPPED = sorted((ROOT / "models").glob("*.yaml"))
@@ -173,8 +174,6 @@ def test_derived_reaction_table_equals_the_eager_one(name, text, monkeypatch):
 def test_the_generated_files_take_the_fast_path_and_match_the_located_one(monkeypatch):
     """Files a few chunks long (the default chunk size), with loads and joints: both paths
     build the same model (tests/test_fast.py compares every array and record)."""
-    from test_fast import assert_same_model
-
     for spec in (chain_spec(1500), free_bodies_spec(600)):
         text = dump(spec)
         assert len(text) > 3 * fast.CHUNK

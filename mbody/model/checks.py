@@ -72,6 +72,22 @@ def quat_norm(q: np.ndarray) -> np.ndarray:
                    + q[..., 3] * q[..., 3])
 
 
+def asymmetry(J: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """max |J - Jᵀ| of inertia tensors (over the last two axes), and the scale it is
+    judged against: the largest |entry| (1 for a zero tensor). Symmetric means
+    ``asymmetry <= TOL * scale`` (`_TOL`)."""
+    scale = np.abs(J).max(axis=(-2, -1))
+    return np.abs(J - np.swapaxes(J, -2, -1)).max(axis=(-2, -1)), np.where(scale == 0, 1.0,
+                                                                           scale)
+
+
+def realisable(principal: np.ndarray, tol: float = _TOL) -> np.ndarray:
+    """Whether principal moments (over the last axis) meet the triangle inequality: each
+    at most the sum of the other two, within `tol` of the largest."""
+    a, b, d = np.moveaxis(np.sort(principal, axis=-1), -1, 0)
+    return a + b >= d * (1 - tol)
+
+
 class Checker:
     def __init__(self, doc: Document):
         self.doc = doc

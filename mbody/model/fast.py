@@ -48,7 +48,9 @@ from mbody.model.checks import (
     PERPENDICULAR_TOL,
     UNIT_TOL,
     Checker,
+    asymmetry,
     quat_norm,
+    realisable,
     vec_norm,
 )
 from mbody.model.loader import load_text, value_limit
@@ -674,8 +676,9 @@ def _bodies(c: Checker, groups: list[_Group]) -> BodyTable:
 
 
 def _inertia(g: _Group, planar: bool) -> np.ndarray:
-    """(k, 3, 3) inertia tensors of a group, checked as `validate._inertia` and
-    `_reciprocable` check them (with a margin: near a limit, the located path decides)."""
+    """(k, 3, 3) inertia tensors of a group, checked by the rules `validate._inertia` and
+    `_reciprocable` use (`checks.asymmetry`, `checks.realisable`), with a margin: near a
+    limit, the located path decides."""
     cols = g.columns
     k = len(g.index)
     J = np.zeros((k, 3, 3))
@@ -694,9 +697,8 @@ def _inertia(g: _Group, planar: bool) -> np.ndarray:
     else:
         for r in range(3):
             J[:, r] = _numbers(g, ("inertia", r), 3)
-        scale = np.abs(J).max(axis=(1, 2))
-        scale[scale == 0] = 1.0
-        if not np.all(np.abs(J - J.transpose(0, 2, 1)).max(axis=(1, 2)) <= 0.5 * _TOL * scale):
+        off, scale = asymmetry(J)
+        if not np.all(off <= 0.5 * _TOL * scale):  # with a margin, as below
             raise _Bail
         principal = np.linalg.eigvalsh(J)
         # eigvalsh over a stack may differ from one at a time in the last bits (relative
@@ -705,8 +707,7 @@ def _inertia(g: _Group, planar: bool) -> np.ndarray:
             raise _Bail
     if not np.all(principal >= 1e10 * MIN_MAGNITUDE):  # positive definite, reciprocable
         raise _Bail
-    a, b, d = np.sort(principal, axis=1).T
-    if not np.all(a + b >= d * (1 - 0.5 * _TOL)):  # triangle inequality, with a margin
+    if not np.all(realisable(principal, 0.5 * _TOL)):  # with a margin
         raise _Bail
     return J
 

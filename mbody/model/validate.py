@@ -32,7 +32,9 @@ from mbody.model.checks import (
     _kind,
     _quoted,
     _show,
+    asymmetry,
     quat_norm,
+    realisable,
     vec_norm,
 )
 from mbody.model.expressions import (
@@ -447,8 +449,8 @@ def _inertia(c: Checker, path: Path_, value: Any) -> np.ndarray | None:
         J = c.matrix3(path, value)
         if J is None:
             return None
-        scale = float(np.max(np.abs(J))) or 1.0
-        if np.max(np.abs(J - J.T)) > _TOL * scale:
+        off, scale = asymmetry(J)
+        if off > _TOL * scale:
             i, j = np.unravel_index(np.argmax(np.abs(J - J.T)), J.shape)
             c.err(path, f"the inertia tensor is not symmetric: row {i + 1}, column {j + 1} "
                   f"is {J[i, j]:g} but row {j + 1}, column {i + 1} is {J[j, i]:g}",
@@ -468,7 +470,7 @@ def _inertia(c: Checker, path: Path_, value: Any) -> np.ndarray | None:
               f"(principal moments {_fmt(principal)})", "every principal moment must be > 0")
         return None
     a, b, d = np.sort(principal)
-    if a + b < d * (1 - _TOL):
+    if not realisable(principal):
         c.err(path, f"the inertia is not physically realisable: the principal moments "
               f"{_fmt(principal)} break the triangle inequality ({a:g} + {b:g} < {d:g})",
               "every moment must be <= the sum of the other two")
