@@ -534,6 +534,23 @@ def test_urdf_ground_link_empty_robot_and_a_lone_fixed_link(tmp_path):
     assert mbody.load(path, floating_base=True).body_names == ("a",)
 
 
+def test_an_included_files_problems_name_that_file(tmp_path, capsys):
+    """What validation finds in an <include>d file is at that file's line, not the main
+    file's (it named main.xml with parts.xml's line)."""
+    (tmp_path / "main.xml").write_text('<mujoco model="m">\n  <include file="parts.xml"/>\n'
+                                       "</mujoco>\n")
+    (tmp_path / "parts.xml").write_text(
+        '<mujoco>\n  <worldbody>\n    <body name="a">\n      <joint type="hinge"/>\n'
+        '      <inertial pos="0 0 0" mass="1" diaginertia="1 1 5"/>\n    </body>\n'
+        "  </worldbody>\n</mujoco>\n")
+    with pytest.raises(ModelError) as info:
+        mbody.load(tmp_path / "main.xml")
+    (issue,) = info.value.issues
+    assert (Path(issue.file).name, issue.line, issue.column) == ("parts.xml", 5, 7)
+    assert main(["convert", str(tmp_path / "main.xml"), "-o", str(tmp_path / "m.yaml")]) == 2
+    assert "parts.xml:5:7: bodies[0].inertia" in capsys.readouterr().err
+
+
 def test_bad_numbers_angles_and_units():
     (msg,) = _issues('<mujoco><compiler angle="degrees"/></mujoco>')
     assert "did you mean 'degree'" in msg

@@ -129,13 +129,13 @@ def _read(path: str, fmt: str, keyframe: str | None) -> Any:
 
 def _model(document: Any, source: str):
     """The validated model of a document read from `source` (its issues name it)."""
+    from mbody.io.interop.tree import validate_imported
     from mbody.model.loader import Document
     from mbody.model.model import Model
-    from mbody.model.validate import validate
 
     if not isinstance(document, Document):  # plain data: no lines to point at
         document = Document(document, source)
-    return Model.from_spec(validate(document))
+    return Model.from_spec(validate_imported(document))
 
 
 def _summary(model) -> str:

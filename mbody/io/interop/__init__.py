@@ -14,10 +14,10 @@ from typing import Any
 
 from mbody.errors import MbodyError, did_you_mean
 from mbody.io.interop.mjcf import read_mjcf
-from mbody.io.interop.tree import ImportedDocument
+from mbody.io.interop.tree import ImportedDocument, validate_imported
 from mbody.io.interop.urdf import read_urdf
 from mbody.model.loader import max_bytes_limit
-from mbody.model.validate import Spec, validate
+from mbody.model.validate import Spec
 
 FORMATS = ("yaml", "mjcf", "urdf")
 """The model formats `mbody.load` and every command read."""
@@ -125,6 +125,6 @@ def import_spec(path: str | os.PathLike[str], format: str | None = None, *,
         return None
     with max_bytes_limit(max_bytes):
         doc = read_document(path, fmt, **options)
-    spec = validate(doc)
+    spec = validate_imported(doc)
     spec.warnings[:0] = doc.warnings
     return spec

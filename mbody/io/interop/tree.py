@@ -11,6 +11,7 @@ column of the XML it came from.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from typing import Any
@@ -19,7 +20,8 @@ import numpy as np
 
 from mbody.errors import Issue, ModelError
 from mbody.io.interop.xmlsource import Element
-from mbody.model.loader import Document, Path_
+from mbody.model.loader import Document, Path_, dotted
+from mbody.model.validate import Spec, validate
 
 GROUND = "ground"
 PARALLEL_TOL = 1e-9
@@ -89,6 +91,36 @@ class ImportedDocument(Document):
 
     warnings: list[Issue] = field(default_factory=list)
     source_format: str = ""
+    files: dict[str, str] = field(default_factory=dict)
+    """Dotted model path (``bodies[2].inertia``) -> the file its mark's line is in: an
+    ``<include>``d file's own name, not the main file's."""
+
+    def locate(self, issue: Issue) -> Issue:
+        """`issue` naming the file its line is in (validation names the main file)."""
+        key = issue.key
+        while key:
+            if key in self.files:
+                return dataclasses.replace(issue, file=self.files[key])
+            key = key[:max(key.rfind("."), key.rfind("["), 0)]
+        return issue
+
+
+def validate_imported(doc: Document) -> Spec:
+    """`mbody.model.validate` of an imported document, each issue at its own file.
+
+    Raises
+    ------
+    ModelError
+        As `validate`, with an included file's issues naming that file.
+    """
+    if not isinstance(doc, ImportedDocument):
+        return validate(doc)
+    try:
+        spec = validate(doc)
+    except ModelError as exc:
+        raise ModelError([doc.locate(i) for i in exc.issues]) from None
+    spec.warnings[:] = [doc.locate(w) for w in spec.warnings]
+    return spec
 
 
 # ---- rotations (w first) ------------------------------------------------------------
@@ -345,12 +377,14 @@ class DocBuilder:
         self.file = file
         self.marks: dict[Path_, tuple[int, int]] = {}
         self.key_marks: dict[Path_, tuple[int, int]] = {}
+        self.files: dict[str, str] = {}
 
     def mark(self, path: Path_, e: Element | None, attr: str | None = None) -> None:
         if e is None:
             return
         self.marks[path] = e.where(attr)
         self.key_marks[path] = e.where(attr)
+        self.files[dotted(path)] = e.file
 
 
 def _floats(v: np.ndarray) -> list[float]:
@@ -487,7 +521,7 @@ def build(name: str, description: str, file: str, bodies: list[TreeBody],
     for key in ("model", "dimension", "gravity", "bodies", "joints"):
         doc.marks[(key,)] = (root.line, root.column)
     return ImportedDocument(data, file, doc.marks, doc.key_marks, warnings=renamed,
-                            source_format=fmt)
+                            source_format=fmt, files=doc.files)
 
 
 def _parent_name(bodies: list[TreeBody], parent: int, owner: dict[int, int],
