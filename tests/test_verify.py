@@ -522,3 +522,30 @@ def test_a_load_or_the_gyroscopic_term_of_the_wrong_sign_is_named(name, body, eq
     c = check(name, body, eq)
     assert c.diagnosis == "not_an_equation_of_this_body" and c.row == row
     assert c.details["wrong_sign"] == what and "of the wrong sign" in c.explanation
+
+
+def test_textbook_spellings_read_and_unknown_names_get_a_useful_hint(tmp_path):
+    # subscript digits pasted from the course (I₁ω̇₁ = (I₂ − I₃)ω₂ω₃), and ω̇ as omega1_dot
+    assert diagnosis("seed_example_2", "body", "I₁*α₁ = (I₂ − I₃)*ω₂*ω₃") == "correct"
+    assert diagnosis("seed_example_2", "body",
+                     "I_1*omega1_dot = (I_2 - I_3)*omega2*omega3") == "correct"
+    assert diagnosis("seed_example_1", "plate", "I_G*omega_dot = 20") == "correct"
+
+    def error(name, body, eq):
+        return errors(name, f"equations:\n  - {{body: {body}, eq: '{eq}'}}\n", tmp_path)[0]
+
+    # a letter axis on a spatial body's angular quantity: its axes are numbered (w_x
+    # was "did you mean 'w_3'?")
+    for eq in ("I_x*alpha_1 = 0", "I_xx*alpha_1 = 0", "w_x*I_1*alpha_1 = 0",
+               "alpha_x = 0"):
+        out = error("seed_example_2", "body", eq)
+        assert "numbered" in out and "did you mean" not in out, out
+    # a product without '*' ("mg" was "did you mean 'm'?")
+    assert "write m*g" in error("pendulum", "rod", "m*a_y = O.Fy - mg")
+    # the inertia about a pin has no name: I_G + m d² ("I_O" was "did you mean 'I_G'?")
+    assert "I_G + m*d^2" in error("pendulum", "rod", "I_O*alpha = -m*g*0.25")
+    # degrees
+    assert "radians" in error("pendulum", "rod", "I_G*alpha = -0.5*O.Fy*sin(30°)")
+    # suggestions are canonical names, never an alias ("a" was "did you mean 'az'?")
+    out = error("seed_example_2", "body", "a = 0")
+    assert "did you mean 'a_" in out and "'az'" not in out

@@ -168,6 +168,8 @@ _BAD_HINTS = {
     "{": "use ( ) for grouping", ".": "a reaction is written <joint>.<component>, e.g. O.Fy",
     "'": "write derivatives by name: alpha, a_x, w", "\u0307": "write derivatives by "
     "name: alpha, a_x, w",
+    "\u00b0": "angles are in radians: write pi/6 or 30*pi/180 for 30°",
+    ";": "one equation per entry, without ';'",
 }
 
 

@@ -22,6 +22,7 @@ Aliases (``omega``, ``ω``, ``α``, ``ax``, ``theta_ddot``...) map onto these na
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -41,16 +42,27 @@ _ALIASES_BOTH = {
 _ALIASES_PLANAR = {
     "alpha_z": "alpha", "theta_ddot": "alpha", "thetaddot": "alpha", "α": "alpha",
     "omega": "w", "omega_z": "w", "w_z": "w", "theta_dot": "w", "thetadot": "w", "ω": "w",
+    "omega_dot": "alpha", "w_dot": "alpha", "wdot": "alpha", "omegadot": "alpha",
     "θ": "theta", "I": "I_G", "I_zz": "I_G", "I_z": "I_G",
 }
 _ALIASES_SPATIAL = {
     "az": "a_z", "a_Gz": "a_z", "a_gz": "a_z", "z_ddot": "a_z",
     **{f"{a}{k}": f"alpha_{k}" for k in (1, 2, 3)
        for a in ("alpha", "α_", "α", "wdot_", "w_dot_", "omega_dot_", "omegadot_", "ω_dot_")},
+    **{f"{a}{k}{d}": f"alpha_{k}" for k in (1, 2, 3) for a in ("w", "w_", "omega", "omega_")
+       for d in ("dot", "_dot")},
     **{f"{a}{k}": f"w_{k}" for k in (1, 2, 3) for a in ("w", "omega_", "omega", "ω_", "ω")},
     **{f"I{k}": f"I_{k}" for k in (1, 2, 3)},
     **{f"I{j}{k}": f"I_{j}{k}" for j in (1, 2, 3) for k in (1, 2, 3)},
 }
+
+_SUBSCRIPT = re.compile("_?[\u2080-\u2089]+")
+_DIGITS = str.maketrans("\u2080\u2081\u2082\u2083\u2084\u2085\u2086\u2087\u2088\u2089",
+                        "0123456789")
+"""Subscript digits pasted from a textbook (I₁, ω₂) read as I_1, ω_2."""
+_LETTER_AXIS = re.compile(r"(w|omega|ω|alpha|α|w_?dot|omega_?dot|ω_?dot|I)_?([xyz]|[xyz]{2})"
+                          r"(_?dot)?")
+"""Angular names with a letter axis: on a spatial body its axes are numbered."""
 
 MEANINGS = {
     "a_x": "mass-centre acceleration along world x (m/s^2)",
@@ -128,16 +140,43 @@ class Vocabulary:
             The name is not in the vocabulary; the message says why, with a
             did-you-mean over the vocabulary.
         """
+        name = _SUBSCRIPT.sub(lambda mo: "_" + mo.group(0).lstrip("_").translate(_DIGITS),
+                              name)
         name = self.aliases.get(name, name)
         if name in self.values or name in self._unknown_set:
             return name
         if name in self.absent:
             raise KeyError(self.absent[name])
-        hint = did_you_mean(name, [n for n in self.names if n not in self.absent])
+        hint = self._hint(name)
         what = (f"no reaction component {name!r} in this model" if "." in name else
                 f"unknown name {name!r} for body {self.body!r}")
         raise KeyError(what + (f"; {hint}" if hint else "")
                        + f" (the names: {self.summary()})")
+
+    def _hint(self, name: str) -> str:
+        """A way to fix an unknown `name`: a product written without '*', a body axis
+        written as a letter, or the closest name (canonical names first: a suggestion of
+        'az' or 'ω_1' for 'a' or 'M_1' helps no one)."""
+        if self.dimension == cv.SPATIAL and _LETTER_AXIS.fullmatch(name):
+            return ("a spatial body's angular velocity, angular acceleration and inertia are "
+                    "along its body axes, numbered: w_1, w_2, w_3; alpha_1 ...; I_1 ... "
+                    "(tensor entries I_11, I_12 ...); letters x, y, z are world axes (a_x)")
+        for k in range(1, len(name)):
+            a, b = name[:k], name[k:]
+            if a != b and self._known(a) and self._known(b):  # "gg" is a typo of g
+                return f"write {a}*{b}: a product needs '*'"
+        known = [n for n in (*self.unknowns, *self.values) if n not in self.absent]
+        hint = did_you_mean(name, known)
+        if not hint:
+            hint = did_you_mean(name, [a for a in self.aliases if a.isascii()])
+            close = hint.split("'")[1] if hint else ""
+            if close:
+                hint = f"did you mean '{self.aliases[close]}'?"
+        return hint
+
+    def _known(self, name: str) -> bool:
+        name = self.aliases.get(name, name)
+        return name in self.values or name in self._unknown_set
 
     @property
     def _unknown_set(self) -> frozenset[str]:
@@ -231,6 +270,15 @@ def vocabulary(model: Model, state: State, body: str) -> Vocabulary:
                     f"the inertia tensor of {body} is not diagonal in its body axes, so it "
                     "has no principal moments along them: use its entries I_11, I_12 ... "
                     "I_33")
+    for joint in model.joints:
+        if body in (joint.parent, joint.child) and not particle:
+            # I_O for the inertia about a pin: the course writes it I_G + m d²
+            absent.setdefault(f"I_{joint.name}", (
+                f"there is no name for the inertia about joint {joint.name}: write it "
+                f"from I_G, as I_G + m*d^2 with d the distance from G to {joint.name}"
+                if planar else
+                f"there is no name for the inertia about joint {joint.name}: write "
+                "moments about the mass centre, with I_1, I_2, I_3 or I_11 ... I_33"))
     reactions = tuple(r for r in model.reactions if r not in known)
     for label, value in known.items():
         values[label] = float(value)
