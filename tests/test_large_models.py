@@ -10,6 +10,7 @@ links, a particle parent), every joint type, and the benchmark's files, through 
 
 from __future__ import annotations
 
+import re
 import sys
 from pathlib import Path
 
@@ -27,7 +28,7 @@ from mbody.model.validate import validate
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tools"))
 from bench_load import chain_spec, free_bodies_spec  # noqa: E402
-from test_fast import assert_same_model  # noqa: E402
+from test_fast import assert_same_model, check_both, located  # noqa: E402
 
 DUMPER = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
 SHIPPED = sorted((ROOT / "models").glob("*.yaml"))
@@ -234,3 +235,42 @@ def test_a_large_file_is_read_without_its_records():
     assert model.joints._made.count(None) == 2000  # type: ignore[attr-defined]
     assert not set(model.reaction_table.DERIVED) & set(vars(model.reaction_table))
     assert len(model.reactions) == 5 * 2000 and model.reactions[-1] == "j1999.My"
+
+
+def _edit(text: str, pattern: str, new: str, nth: int = 7) -> str:
+    """`text` with the `nth` match of `pattern` (a regex) replaced by `new`."""
+    m = list(re.finditer(pattern, text, re.M))[nth]
+    return text[:m.start()] + new + text[m.end():]
+
+
+CHAIN = dump(chain_spec(40))
+EDITS = {
+    "decimal comma": (r"mass: [0-9.]+", "mass: 1,5", False),
+    "list in a list": (r"position: \[[^\n]*\]", "position: [[1.5, 0.0], 0.0]", False),
+    "widths that make up for each other": (
+        r"mass: [0-9.]+\n  inertia: \[[^\n]*\]\n  position: \[[^\n]*\]",
+        "mass: 1,5\n  inertia: [0.3, 0.2, 0.2]\n  position: [1.5, 0.0]", False),
+    "a bracket too many": (r"velocity: \[[^\n]*\]", "velocity: [0.0, 0.0, 0.0]]", False),
+    "three-digit exponent": (r"position: \[[^\n]*\]", "position: [1.0e+100, 0.0, 0.0]", True),
+    "two-digit exponents": (r"position: \[[^\n]*\]", "position: [1.5e-05, 2E+01, -3e7]", True),
+    "spaces in a list": (r"velocity: \[[^\n]*\]", "velocity: [ 0.0 ,0.0,  0.0 ]", True),
+    "no such body": (r"parent: b[0-9]+", "parent: b4000", False),
+    "ground as a parent": (r"parent: b[0-9]+", "parent: ground", True),
+    "a load on ground": (r"body: b[0-9]+", "body: ground", False),
+    "a joint type of the plane": (r"type: revolute", "type: slider", False),
+}
+
+
+@pytest.mark.parametrize("edit", EDITS, ids=str)
+def test_the_chunk_reader_refuses_what_the_located_path_refuses(edit, monkeypatch):
+    """Each value in its own slot: a value cannot spill into its neighbour, a list cannot
+    nest, and every name must be what the contract allows; a file either path refuses
+    is refused (then the located path reports it), one both accept gives one model."""
+    pattern, new, valid = EDITS[edit]
+    text = _edit(CHAIN, pattern, new)
+    assert text != CHAIN
+    monkeypatch.setattr(fast, "MIN_BYTES", 0)
+    assert isinstance(located(text), Model) == valid
+    # the fast path accepts only what the located path accepts, and builds the same model;
+    # it reads these valid edits itself (a three-digit exponent it leaves to the other)
+    assert check_both(text) == (valid and edit != "three-digit exponent")

@@ -445,6 +445,8 @@ class _Chunk:
             return np.zeros(0)
         out = self._stream(1, n)
         out[0], out[-1] = ord("["), ord("]")  # the last value's separator
+        if np.count_nonzero((out == ord("[")) | (out == ord("]"))) != 2:
+            raise _Bail  # a list in a list ('[1, [2]]'): one flat list of numbers only
         exponent = np.flatnonzero((out == ord("e")) | (out == ord("E")))
         if len(exponent):  # three digits (after a sign) may underflow to 0 or overflow
             digits = exponent + 1 + ((out[exponent + 1] == ord("-"))
