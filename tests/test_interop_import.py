@@ -551,6 +551,21 @@ def test_an_included_files_problems_name_that_file(tmp_path, capsys):
     assert "parts.xml:5:7: bodies[0].inertia" in capsys.readouterr().err
 
 
+def test_planar_root_says_why_and_a_bad_size_is_said_once():
+    """dm_control's walkers slide in two directions: the hint says it is a planar body
+    (giving a frame a mass, the general hint, would change the motion). A geom size of
+    the wrong length is one message (it also said the geom had no volume)."""
+    (msg,) = _issues('<mujoco><worldbody><body name="torso">'
+                     '<joint name="rootx" type="slide" axis="1 0 0"/>'
+                     '<joint name="rootz" type="slide" axis="0 0 1"/>'
+                     '<joint name="rooty" axis="0 1 0"/><geom size="0.1"/>'
+                     "</body></worldbody></mujoco>")
+    assert "move in a plane" in msg and "with a mass" not in msg
+    (msg,) = _issues('<mujoco><worldbody><body name="a"><joint/>'
+                     '<geom size="0.1 0.2 0.3 0.4"/></body></worldbody></mujoco>')
+    assert "expected 1 to 3 numbers, got 4" in msg
+
+
 def test_bad_numbers_angles_and_units():
     (msg,) = _issues('<mujoco><compiler angle="degrees"/></mujoco>')
     assert "did you mean 'degree'" in msg

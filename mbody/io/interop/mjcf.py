@@ -586,9 +586,10 @@ class _Reader:
             group = int(float(v.get("group", "0")))
             if not self.groups[0] <= group <= self.groups[1]:
                 continue
+            seen = len(self.issues)
             frame = self.geom_frame(g, v)
-            if frame is None:
-                continue
+            if frame is None or len(self.issues) > seen:
+                continue  # its size or frame is already reported: no second message
             typ, size, pos, quat = frame
             given = self.attr(g, v, "mass", 1)
             if given is not None and float(given[0]) == 0:

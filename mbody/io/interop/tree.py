@@ -344,13 +344,18 @@ def map_joints(b: TreeBody, kin: Kinematics, i: int, scale: float) -> Mapped:
         h = kinds.index("hinge")
         return Mapped("cylindrical", name, anchors[h], axes[h], None, first)
     why = _why_not(kinds, same_point, axes)
+    hint = ("mbody has no massless intermediate frames; what composes exactly: two hinges "
+            "through one point with perpendicular axes (universal), three hinges through "
+            "one point (spherical), a hinge and a slide along one axis (cylindrical). Give "
+            "the intermediate frame a body with a mass, or change the joints")
+    if kinds.count("slide") == 2 and kinds.count("hinge") <= 1:
+        # dm_control's planar walkers and objects: a mass would change their motion
+        hint = ("two slides (and a hinge) make the body move in a plane; a spatial mbody "
+                "model has no planar joint, and the import reads them as a planar free "
+                "body only in mbody's own planar exports (their mbody:dimension entry)")
     raise ModelError([first.issue(
         f"body '{b.name}' has {len(js)} joints ({listing}) that no single mbody joint "
-        f"is exactly: {why}",
-        "mbody has no massless intermediate frames; what composes exactly: two hinges "
-        "through one point with perpendicular axes (universal), three hinges through one "
-        "point (spherical), a hinge and a slide along one axis (cylindrical). Give the "
-        "intermediate frame a body with a mass, or change the joints")])
+        f"is exactly: {why}", hint)])
 
 
 def _why_not(kinds: list[str], same_point: bool, axes: list[np.ndarray]) -> str:
