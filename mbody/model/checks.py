@@ -73,17 +73,39 @@ def quat_norm(q: np.ndarray) -> np.ndarray:
 
 
 def asymmetry(J: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """max |J - Jᵀ| of inertia tensors (over the last two axes), and the scale it is
-    judged against: the largest |entry| (1 for a zero tensor). Symmetric means
-    ``asymmetry <= TOL * scale`` (`_TOL`)."""
+    """How far inertia tensors are from symmetric, and the scale that is judged against.
+
+    Parameters
+    ----------
+    J : (..., 3, 3) array
+        Inertia tensors.
+
+    Returns
+    -------
+    off, scale : (...) arrays
+        max |J - Jᵀ|, and the largest |entry| (1 for a zero tensor): a tensor is
+        symmetric when ``off <= _TOL * scale``.
+    """
     scale = np.abs(J).max(axis=(-2, -1))
     return np.abs(J - np.swapaxes(J, -2, -1)).max(axis=(-2, -1)), np.where(scale == 0, 1.0,
                                                                            scale)
 
 
 def realisable(principal: np.ndarray, tol: float = _TOL) -> np.ndarray:
-    """Whether principal moments (over the last axis) meet the triangle inequality: each
-    at most the sum of the other two, within `tol` of the largest."""
+    """Whether principal moments meet the triangle inequality (a rigid body's do).
+
+    Parameters
+    ----------
+    principal : (..., 3) array
+        Principal moments of inertia.
+    tol : float, optional
+        Relative slack: each moment may exceed the sum of the other two by `tol` times
+        the largest.
+
+    Returns
+    -------
+    (...) bool array
+    """
     a, b, d = np.moveaxis(np.sort(principal, axis=-1), -1, 0)
     return a + b >= d * (1 - tol)
 

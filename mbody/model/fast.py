@@ -2,19 +2,24 @@
 
 Reading a file through PyYAML's events costs about a microsecond per event from Python,
 and a 10 000-body model has some 500 000 of them. Files that large are nearly always
-written by a program (``yaml.dump``), so their ``bodies:`` and ``loads:`` lists repeat
-one layout per item with different numbers. This module reads such a list in bulk:
+written by a program (``yaml.dump``), so their ``bodies:``, ``loads:`` and ``joints:``
+lists repeat one layout per item with different numbers. This module reads such a list
+in bulk, a chunk of whole items (`CHUNK`) at a time:
 
 1. Each list is cut out of the text; every value written at the end of a line (after
-   ``key: `` or ``- [``) is a *slot*, replaced by a marker. What is left (the item's
-   *skeleton*) is usually the same for every item.
+   ``key: `` or ``- [``, or in a one-line flow mapping) is a *slot*, replaced by a
+   marker. What is left (the item's *skeleton*) is usually the same for every item.
 2. Each distinct skeleton is parsed once by the located loader (`load_text`), with its
    slots numbered, which gives the item's structure: which key path each slot fills.
-3. The slots of all items with that skeleton are typed a column at a time: a flow list
-   of numbers, a number, or a name. One regular expression checks a whole column against
-   the decimal forms both paths read identically; numpy parses its numbers.
+3. Each slot is a flow list of numbers, a number or a name; its kind, and a list's
+   length, must be the same in every item of a layout. All the numbers of a chunk are
+   gathered with numpy masks into one text (each followed by a comma), checked byte by
+   byte against the decimal forms both paths read identically and parsed by one
+   ``json.loads``; all its names are gathered likewise and split once. Columns (every
+   body's ``position``...) are cut from those; names of bodies become body indices.
 4. The columns are checked with numpy against the same rules as `validate` (the rest of
-   the file, small, goes through `validate`'s own functions), and `BodyTable` is filled.
+   the file, small, goes through `validate`'s own functions), and the tables of the
+   `Spec` are filled: `BodyTable`, `LoadTable`, `JointSpecTable`.
 
 Anything else (a comment or an anchor on a value line, a tab, a quoted or non-ASCII
 value, a flow mapping, a number written ``1_000`` or ``.5``, a shape, an Euler angle, a
@@ -72,11 +77,12 @@ MIN_BYTES = 64 * 1024
 MAX_TEMPLATES = 16
 """Most distinct item layouts in one list; more means a hand-written file."""
 CHUNK = 1 << 17
-"""Characters of a list read at a time, so that its temporary strings stay small."""
+"""Characters of a list read at a time (then on to the end of an item): a chunk's
+temporary arrays, some 6 bytes per character, stay small against the file."""
 
 _PLACEHOLDER = "__mbody_fast_"
 _NUMBER_BYTES = b"0123456789.eE+-"
-"""What a column of numbers may hold besides its separators: json.loads then checks each
+"""What the numbers may hold besides their separators: json.loads then checks each
 number against JSON's grammar, whose numbers YAML's core schema reads the same way (an
 integer as int, anything with '.' or an exponent as float, through the same correctly
 rounded conversion). Forms JSON refuses ('+1', '.5', '1.', '010', '1_000') go to the
