@@ -242,3 +242,58 @@ def test_the_docs_show_the_current_solution_display():
     sol = mbody.assemble(mbody.load(MODELS / "pendulum.yaml")).solve()
     assert shown == rich.solution_html(sol)
     assert (MODELS.parent / "docs" / "images" / "notebook_body.png").stat().st_size > 20_000
+
+
+def _force_rows(block: str) -> dict[str, list[str]]:
+    """The free-body rows of a body's text block: name -> [kind, point, components, moment]
+    (columns split on runs of two or more spaces)."""
+    lines = block.splitlines()
+    start = lines.index("free body:") + 2
+    out = {}
+    for line in lines[start:]:
+        if not line.startswith("  "):
+            break
+        cells = re.split(r"\s{2,}", line.strip())
+        out[cells[0]] = cells[1:]
+    return out
+
+
+@pytest.mark.parametrize(("model_file", "body", "parent_rows"), [
+    ("double_pendulum", "upper", {"A.Fx": ("(1, 0)", "0.216506"),
+                                  "A.Fy": ("(0, 1)", "0.125")}),
+    ("slider_crank", "rod", {"B.Fx": ("(1, 0)", "0.0176777"),
+                             "B.Fy": ("(0, 1)", "0.0780224")}),
+    ("fourbar_spatial", "coupler", {"B.Fz": ("(0, 0, 1)", None)})])
+def test_parent_side_rows_read_like_the_picture(model_file, body, parent_rows):
+    """A reaction on the joint's parent (−R) is listed as the picture labels it, −A.Fx,
+    with the unit vector and moment the arrow carries (the +axis): the name times the row
+    is the column of G in the body's equations, which do not change."""
+    asm = mbody.assemble(mbody.load(MODELS / f"{model_file}.yaml"))
+    eq = asm.bodies[body]
+    text_rows = _force_rows(str(eq))
+    html_rows = {r[0]: r[1:] for r in rows(parse(eq._repr_html_()))}
+    for fo in eq.fbd.reactions:
+        child = fo.side > 0
+        assert (fo.label in text_rows) == child and (f"-{fo.label}" in text_rows) != child
+        assert (fo.label in html_rows) == child and (f"−{fo.label}" in html_rows) != child
+        row = text_rows[fo.label if child else f"-{fo.label}"]
+        hrow = html_rows[fo.label if child else f"−{fo.label}"]
+        assert row[2].startswith("unit ") and hrow[2] == row[2]
+        assert hrow[3] == row[3]
+    for label, (unit, moment) in parent_rows.items():
+        row = text_rows[f"-{label}"]
+        assert row[2] == f"unit {unit} N"
+        if moment is not None:
+            assert row[3] == moment
+    # the equations keep their signs: −A.Fx on the upper link is "- A.Fx" in Newton
+    if model_file == "double_pendulum":
+        assert str(eq.newton[0]) == "a_x = O.Fx - A.Fx"
+        assert "- 0.216506 A.Fx" in str(eq.euler[0])
+
+
+def test_a_planar_reaction_couple_is_a_scalar_about_z():
+    """The prismatic joint's P.Mz on the piston: 'unit 1 N m' (about z), not (0, 0)."""
+    eq = mbody.assemble(mbody.load(MODELS / "slider_crank.yaml")).bodies["piston"]
+    assert _force_rows(str(eq))["P.Mz"] == ["reaction", "-", "unit 1 N m", "1"]
+    assert {r[0]: r[1:] for r in rows(parse(eq._repr_html_()))}["P.Mz"] == [
+        "reaction, unknown", "-", "unit 1 N m", "1"]

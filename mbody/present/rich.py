@@ -1,12 +1,12 @@
 """What a notebook shows for mbody's objects: HTML, LaTeX, and a body's text block.
 
 The objects' ``_repr_html_``, ``_repr_latex_`` and ``BodyEquations.__str__`` are thin
-methods that call the functions here. They reach this module by name
-(``importlib.import_module("mbody.present.rich")``): this module imports the modules
-that define those objects (through `mbody.present.text`, `latex`, `plot`, `draw` and
-`animate`), so a plain import back from them would close an import cycle. Nothing here
-runs at ``import mbody``; matplotlib and meshcat are imported by the functions that
-draw, on first display.
+methods that import this module inside the method and call the functions here: this
+module imports the modules that define those objects (through `mbody.present.text`,
+`latex`, `plot`, `draw` and `animate`), so an import at the top of theirs would close an
+import cycle (``tools/check_imports.py`` allows exactly these display methods to import
+the presentation layer). Nothing here runs at ``import mbody``; matplotlib and meshcat
+are imported by the functions that draw, on first display.
 
     model_html(model)        summary tables and the body/joint graph
     assembly_html(asm)       every body (up to MAX_BODIES): free body, equations, unknowns
@@ -193,17 +193,10 @@ def _body_parts(eq: BodyEquations, view: str = "iso") -> list[object]:
     f, dim = eq.fbd, eq.fbd.dimension
     rows = []
     for fo in f.forces:
-        if fo.kind == REACTION:
-            name = fo.label + ("" if fo.value is None else f" = {_n(fo.value)}")
-            what = "reaction, unknown" if fo.value is None else "reaction, given"
-            comp = ("unit " if fo.value is None else "") + _v(fo.W_vector, dim)
-        else:
-            name, what = fo.name, "couple" if fo.couple else fo.kind
-            comp = _n(fo.W_vector[2]) if fo.couple and dim == cv.PLANAR else _v(fo.W_vector,
-                                                                                 dim)
-        unit = "N m" if fo.couple else "N"
-        mom = _n(fo.B_moment[2]) if dim == cv.PLANAR else _v(fo.B_moment, 3)
-        rows.append([name, what, "-" if fo.couple else _v(fo.B_r, dim), f"{comp} {unit}", mom])
+        name, point, comp, mom = text.force_cells(fo, dim, minus="−")  # as drawn
+        what = (("reaction, unknown" if fo.value is None else "reaction, given")
+                if fo.kind == REACTION else "couple" if fo.couple else fo.kind)
+        rows.append([name, what, point, comp, mom])
     unknown = [fo.label for fo in f.forces if fo.unknown]
     applied = [fo.name for fo in f.forces if fo.kind != REACTION]
     lines = ["Newton (world axes):", *(f"  {x}" for x in eq.newton)]
