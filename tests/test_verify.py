@@ -549,3 +549,19 @@ def test_textbook_spellings_read_and_unknown_names_get_a_useful_hint(tmp_path):
     # suggestions are canonical names, never an alias ("a" was "did you mean 'az'?")
     out = error("seed_example_2", "body", "a = 0")
     assert "did you mean 'a_" in out and "'az'" not in out
+
+
+def test_a_reaction_is_said_replaced_by_a_number_only_where_a_number_was_written():
+    # no number at all: the static guess, said as such (not "replaced by the number")
+    for name, body, eq in (("pendulum", "rod", "m*a_y = 0"),
+                           ("heavy_top", "top", "I_1*alpha_1 = 0")):
+        c = check(name, body, eq)
+        assert c.diagnosis == "reaction_treated_as_known"
+        assert "static guess" in c.explanation and "replaced by" not in c.explanation
+    # a number, even one written with names that cancel, is a number
+    c = check("heavy_top", "top", "m*a_z = -m*g + m*g")
+    assert c.diagnosis == "reaction_treated_as_known"
+    assert c.details["value_used"] == pytest.approx(9.81)
+    assert "replaced by the number 9.81 N" in c.explanation
+    c = check("pendulum", "rod", "m*a_y = 19.62 - m*g")
+    assert "replaced by the number 19.62 N" in c.explanation

@@ -417,17 +417,26 @@ class _Diagnoser:
                 k = gone[0]
                 value = extra / r.row.get(k)
                 details["value_used"] = value
-                text = (f"{self.reaction_words(k)} is replaced by the number {_num(value)}"
-                        f"{' N m' if _is_moment(k) else ' N'}")
+                unit = " N m" if _is_moment(k) else " N"
+                text = (f"{self.reaction_words(k)} is replaced by the number {_num(value)}{unit}"
+                        if CONST in self.s.coef else
+                        # nothing written for it: the static guess, the reaction taken as
+                        # what balances the rest of the row
+                        f"{self.reaction_words(k)} is left out as if it balanced the rest "
+                        f"of the row, a static guess ({k} = {_num(value)}{unit})")
                 sol = self.solved()
                 if sol is not None and k in sol:
                     details["value_solved"] = sol[k]
                     unit = " N m" if _is_moment(k) else " N"
                     text += (f" (solved with the joints, it is {_num(sol[k])}{unit} at this "
                              "instant; but it is an output, not an input)")
-            else:
+            elif CONST in self.s.coef:
                 text = (f"the reactions {', '.join(gone)} are replaced by numbers (they add "
                         f"{_num(-extra)} to the right side)")
+            else:
+                text = (f"the reactions {', '.join(gone)} are left out as if they balanced "
+                        f"the rest of the row, a static guess (together {_num(-extra)} on "
+                        "the right side)")
             return Diagnosis(
                 REACTION_TREATED_AS_KNOWN, r.text, r.label,
                 f"In {self.words(r)}, {text}. A joint reaction is a constraint force: tag it "

@@ -89,8 +89,10 @@ def linear_row(eq: ParsedEquation, vocab: Vocabulary) -> Row:
     """
     text = eq.text
     form = _eval(eq.lhs, vocab, text).add(_eval(eq.rhs, vocab, text), -1.0)
-    row = Row({k: v for k, v in form.value.items()},
-              {k: form.err[k] for k in form.value})
+    # the constant's key is kept only when a number was written (even one that cancels,
+    # m*g - m*g): "no number at all" is not "a reaction replaced by a number"
+    keys = [k for k in form.value if k != CONST or form.mag[k] > 0.0]
+    row = Row({k: form.value[k] for k in keys}, {k: form.err[k] for k in keys})
     return row.cleaned(form.mag)
 
 
