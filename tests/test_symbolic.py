@@ -263,7 +263,8 @@ DOCS = ["seed_example_2.yaml", "rotated_full_inertia.yaml", "spring_mass_damper.
 @pytest.mark.skipif(shutil.which("pdflatex") is None,
                     reason="pdflatex not installed (Debian: texlive-latex-base)")
 def test_document_compiles_with_pdflatex(tmp_path):
-    for name in DOCS:
+    # the pages' models first, then every other shipped model
+    for name in DOCS + [p.name for p in ALL if p.name not in DOCS]:
         (tmp_path / "sym.tex").write_text(
             mbody.assemble(_load(name)).symbolic().document(), encoding="utf-8")
         r = subprocess.run(["pdflatex", "-interaction=nonstopmode", "-halt-on-error",
