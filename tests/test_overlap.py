@@ -231,6 +231,35 @@ def test_no_overlaps_on_shipped_models(stem):
     assert bad == []
 
 
+def legend_problems(scene: Scene) -> list[str]:
+    """The legend's frame and texts inside the picture, clear of the world-axes triad."""
+    root = scene.root
+    frame = next(it for it in root.items if getattr(it, "gid", None) == "legend")
+    lo, hi = frame.xy.min(axis=0), frame.xy.max(axis=0)
+    found = []
+    if lo[0] < 0 or hi[0] > scene.width or lo[1] < 0 or hi[1] > scene.height:
+        found.append(f"legend frame {lo.round(1)}..{hi.round(1)} outside the picture "
+                     f"{scene.width:.0f} x {scene.height:.0f}")
+    for it in root.items:
+        if isinstance(it, Text) and it.gid in ("legend-entry", "legend-title"):
+            x0, y0, w, h = text_box(it, it.xy)
+            if x0 < lo[0] or x0 + w > hi[0]:
+                found.append(f"legend text {it.s!r} outside its frame")
+    tri = next(p for p in scene.panels if p.gid == "world-axes")
+    if tri.rect[0] + tri.rect[2] > lo[0]:
+        found.append("legend frame over the world axes")
+    return found
+
+
+@pytest.mark.parametrize("stem", [p.stem for p in MODELS])
+def test_legend_fits_in_the_picture(stem):
+    """Every legend (a spatial one lists the longest entries) inside the picture and its
+    frame, beside the world-axes triad."""
+    bad = [f"{name} ({view}): {o}" for name, view, sc in scenes(stem)
+           for o in legend_problems(sc)]
+    assert bad == []
+
+
 def main() -> int:
     total = 0
     only = set(sys.argv[1:])

@@ -288,7 +288,6 @@ def _legend(root: Panel, rect: tuple[float, float, float, float], arrs: list[Arr
     """A framed legend centred in `rect` (points): the scale note, then two columns.
     Each symbol is drawn as in the picture: arrows with their head, width and dash, the
     mass centre's quartered circle."""
-    fs = 8.5
     entries: list[tuple[str, str]] = [
         ("applied", "applied force (name, |F|)"), ("gravity", "gravity m g at G"),
         ("reaction", "reaction (unknown name, or known value)")]
@@ -300,12 +299,18 @@ def _legend(root: Panel, rect: tuple[float, float, float, float], arrs: list[Arr
     entries.append(("G", "G mass centre, x_B y_B" + ("" if planar else " z_B") + " body axes"))
     rows = (len(entries) + 1) // 2
     cols = [entries[:rows], entries[rows:]]
-    handle, gap, sep = 2.6 * fs, 0.8 * fs, 2.0 * fs
-    # 4 % to spare: png and pdf text (hinted by matplotlib) can run a little wider
-    col_w = [1.04 * max(layout(s, fs).width for _, s in c) + handle + gap for c in cols]
-    note = layout(SCALE_NOTE, 8)
+    fs, fs_note = 8.5, 8.0
+    for _ in range(3):  # a spatial legend's entries are longer: smaller type to fit `rect`
+        handle, gap, sep = 2.6 * fs, 0.8 * fs, 2.0 * fs
+        # 4 % to spare: png and pdf text (hinted by matplotlib) can run a little wider
+        col_w = [1.04 * max(layout(s, fs).width for _, s in c) + handle + gap for c in cols]
+        note = layout(SCALE_NOTE, fs_note)
+        inner_w = max(sum(col_w) + sep, note.width)
+        room = rect[2] - 0.8 * fs  # the frame's padding on both sides
+        if inner_w <= room:
+            break
+        fs, fs_note = fs * 0.98 * room / inner_w, fs_note * 0.98 * room / inner_w
     row_h = layout("lp", fs).height + 0.5 * fs
-    inner_w = max(sum(col_w) + sep, note.width)
     inner_h = note.height + 0.5 * fs + rows * row_h
     pad = 0.4 * fs
     x0 = rect[0] + (rect[2] - inner_w) / 2
@@ -315,7 +320,7 @@ def _legend(root: Panel, rect: tuple[float, float, float, float], arrs: list[Arr
                       [x0 + inner_w + pad, y_top - inner_h - pad],
                       [x0 - pad, y_top - inner_h - pad]])
     root.add(Poly(frame, "white", "#cccccc", 0.8, gid="legend", zorder=4),
-             Text(SCALE_NOTE, np.array([cx, y_top]), 8, ha="center", va="top", zorder=5,
+             Text(SCALE_NOTE, np.array([cx, y_top]), fs_note, ha="center", va="top", zorder=5,
                   gid="legend-title", linespacing=1.2, align="left"))
     hd = min(max(head_pt, 4.0), 7.0)
     right = np.array([1.0, 0.0])
