@@ -565,3 +565,29 @@ def test_a_reaction_is_said_replaced_by_a_number_only_where_a_number_was_written
     assert "replaced by the number 9.81 N" in c.explanation
     c = check("pendulum", "rod", "m*a_y = 19.62 - m*g")
     assert "replaced by the number 19.62 N" in c.explanation
+
+
+def test_no_row_of_a_shipped_model_with_one_term_reversed_or_1_percent_off_is_correct():
+    """Every term of every row of every shipped model, reversed in sign or 1 % off
+    (a row of one term excepted: that is only a scale), is never `correct`, except as
+    the same law about a fixed pivot."""
+    from mbody.answers.rows import body_rows
+
+    for path in sorted(MODELS.glob("*.yaml")):
+        m = mbody.load(path)
+        asm = mbody.assemble(m)
+        answers, what = [], []
+        for b in m.body_names:
+            for r in body_rows(asm, b).rows:
+                if len(r.row.keys) < 2:
+                    continue
+                for key in sorted(r.row.keys):
+                    for factor in (-1.0, 1.01):
+                        row = r.row.with_term(key, r.row.get(key) * factor)
+                        answers.append((b, _written(row, ".6g", 1.0)))
+                        what.append(f"{r.label}: {key} times {factor}")
+        if not answers:
+            continue
+        v = verify(m, answers, asm=asm)
+        for c, w in zip(v.checks, what, strict=True):
+            assert not c.correct or c.details.get("form") == "fixed_pivot", (path.name, w)
