@@ -80,3 +80,18 @@ def test_short_reprs_say_the_values():
     assert repr(big.reactions).startswith("<ReactionValues: 20 components (N; N m), O2.Fx")
     spring = mbody.load(MODELS[0].parent / "spring_mass_damper.yaml").loads[0]
     assert repr(spring).startswith(f"<Load {spring.name!r}: spring on ")
+
+
+def test_a_drawing_scene_has_a_short_repr():
+    """`fbd_scene` and `graph_scene` return a Scene (public in mbody.present.draw): its
+    dataclass repr printed every item of every panel (12 KB for the double pendulum)."""
+    from mbody.present.draw import fbd_scene, graph_scene
+
+    m = mbody.load(MODELS[0].parent / "double_pendulum.yaml")
+    asm = mbody.assemble(m)
+    for sc in (fbd_scene(asm.bodies["upper"].fbd), graph_scene(m)):
+        text = repr(sc)
+        assert len(text) < 300, text
+        assert text.startswith("<Scene ") and "panels" in text and "figure_svg" in text
+        assert all(len(repr(p)) < 300 for p in (sc.root, *sc.panels))
+    assert "Free-body diagram of upper" in repr(fbd_scene(asm.bodies["upper"].fbd))

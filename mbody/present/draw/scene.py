@@ -143,6 +143,11 @@ class Panel:
     def add(self, *items: Item) -> None:
         self.items.extend(items)
 
+    def __repr__(self) -> str:  # the dataclass's printed every item's arrays (kilobytes)
+        x0, y0, w, h = self.rect
+        return (f"<Panel {self.gid!r}: {len(self.items)} items in {w:.0f} x {h:.0f} pt at "
+                f"({x0:.0f}, {y0:.0f}); .items, .to_pt(xy)>")
+
 
 @dataclass(slots=True)
 class Scene:
@@ -166,6 +171,15 @@ class Scene:
                      np.ones(2) if hi is None else np.asarray(hi, dtype=float))
         self.panels.append(p)
         return p
+
+    def __repr__(self) -> str:  # the dataclass's printed every panel's items (12 KB)
+        title = self.title if len(self.title) <= 80 else self.title[:77] + "..."
+        names = ", ".join(str(p.gid) for p in self.panels[:6])
+        more = f" +{len(self.panels) - 6}" if len(self.panels) > 6 else ""
+        n = len(self.panels)
+        return (f"<Scene {title!r}: {self.width:.0f} x {self.height:.0f} pt, {n} panel"
+                f"{'' if n == 1 else 's'} ({names}{more}); figure_svg(scene), "
+                "scene_figure(scene)>")
 
     def find(self, gid: str) -> list[Item]:
         """Items whose gid is `gid` (for tests and tools)."""
