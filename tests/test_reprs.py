@@ -92,6 +92,6 @@ def test_a_drawing_scene_has_a_short_repr():
     for sc in (fbd_scene(asm.bodies["upper"].fbd), graph_scene(m)):
         text = repr(sc)
         assert len(text) < 300, text
-        assert text.startswith("<Scene ") and "panels" in text and "figure_svg" in text
+        assert text.startswith("<Scene ") and " panel" in text and "figure_svg" in text
         assert all(len(repr(p)) < 300 for p in (sc.root, *sc.panels))
     assert "Free-body diagram of upper" in repr(fbd_scene(asm.bodies["upper"].fbd))
