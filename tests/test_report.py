@@ -146,3 +146,15 @@ def test_report_without_joints_has_accelerations_only():
     acc = _table(page, "accelerations")
     np.testing.assert_allclose([float(v) for v in acc[1][1:]], sol.accelerations, rtol=1e-5)
     assert 'id="reactions"' not in page
+
+
+def test_report_help_names_the_solution_section():
+    """`mbody report --help` says the page holds the solved accelerations and reactions."""
+    import subprocess
+    import sys
+
+    r = subprocess.run([sys.executable, "-m", "mbody.cli", "report", "--help"],
+                       capture_output=True, text=True, timeout=120)
+    text = " ".join(r.stdout.split())
+    assert r.returncode == 0
+    assert "accelerations and joint reactions solved at the initial state" in text

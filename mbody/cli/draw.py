@@ -41,8 +41,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 
     s = sub.add_parser("report", help="write one self-contained HTML page for the model",
                        description="One offline HTML page: the model summary, the topology "
-                       "picture, every body's free-body diagram and equations, and the "
-                       "sizes of the stacked M, b, Q, G.")
+                       "picture, the sizes of the stacked M, b, Q, G, the accelerations "
+                       "and joint reactions solved at the initial state (with units), and "
+                       "every body's free-body diagram and equations.")
     s.add_argument("model", metavar="MODEL", help="a YAML model file")
     s.add_argument("-o", "--output", metavar="FILE", default="report.html",
                    help="the page to write (default: report.html)")
