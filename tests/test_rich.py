@@ -297,3 +297,16 @@ def test_a_planar_reaction_couple_is_a_scalar_about_z():
     assert _force_rows(str(eq))["P.Mz"] == ["reaction", "-", "unit 1 N m", "1"]
     assert {r[0]: r[1:] for r in rows(parse(eq._repr_html_()))}["P.Mz"] == [
         "reaction, unknown", "-", "unit 1 N m", "1"]
+
+
+def test_solve_lists_a_planar_reaction_couple_about_z():
+    """`mbody solve`'s reaction table: the prismatic joint's P.Mz turns about z; its axis
+    column said (0, 0), the planar part of (0, 0, 1)."""
+    from mbody.present.text import reaction_table_text
+
+    asm = mbody.assemble(mbody.load(MODELS / "slider_crank.yaml"))
+    lines = reaction_table_text(asm, asm.solve()).splitlines()
+    row = next(line.split() for line in lines if line.split()[:2] == ["P", "Mz"])
+    assert row[2:5] == ["about", "z", "0"] and row[5:] == ["N", "m", "solved"]
+    assert next(line.split() for line in lines if line.split()[:2] == ["P", "Fy"])[2:4] \
+        == ["(0,", "1)"]

@@ -256,7 +256,9 @@ def reaction_table_text(asm: Assembly, sol: Solution) -> str:
         unit = "N m" if cols.is_moment[c] else "N"
         status = ("not unique" if label in not_unique else
                   "solved" if label in solved else "given")
-        rows.append([joint, comp, _v(cols.W_e[c], dim), f"{_n(lam[c])} {unit}", status])
+        # a planar couple turns about z: its axis has no in-plane part to print
+        axis = "about z" if dim == cv.PLANAR and cols.is_moment[c] else _v(cols.W_e[c], dim)
+        rows.append([joint, comp, axis, f"{_n(lam[c])} {unit}", status])
     lines = ["joint reactions: each component acts along (or about) its joint-frame axis, "
              "+R on the child and -R on the parent"]
     lines += _table(["joint", "comp", "axis (world)", "value", "status"], rows)
