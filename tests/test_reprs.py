@@ -9,6 +9,7 @@ import pytest
 
 import mbody
 from mbody.io.export import exported
+from mbody.model.graph import topology
 
 MODELS = sorted((Path(__file__).resolve().parents[1] / "models").glob("*.yaml"))
 
@@ -37,6 +38,9 @@ NEXT = {  # what each repr suggests calling next
     "Solution": "sol[label]", "State": ".replace(", "Body": ".inertia",
     "Joint": "reactions ", "BodyEquations": "print() it", "FreeBodyDiagram": ".draw()",
     "ForceOnBody": ".W_vector", "ConstraintJacobian": ".row(label)",
+    "ReactionTable": ".labels", "JointTable": ".first", "ForceTable": ".vector_at(t)",
+    "SpringTable": ".stiffness", "ReactionColumns": ".W_e", "AppliedLoads": ".W_F",
+    "Topology": ".parts",
 }
 
 
@@ -55,6 +59,10 @@ def test_every_public_object_has_a_short_repr(path):
     objs += [(j, "Joint") for j in model.joints] + [(ld, "Load") for ld in model.loads]
     objs += [(e, "Equation") for e in eq.equations]
     objs += [(asm.jacobian(), "ConstraintJacobian")]
+    objs += [(model.reaction_table, "ReactionTable"), (model.joint_table, "JointTable"),
+             (model.forces, "ForceTable"), (model.springs, "SpringTable"),
+             (asm.columns, "ReactionColumns"), (asm.loads, "AppliedLoads"),
+             (topology(model, columns=asm.columns), "Topology")]
     for obj, kind in objs:
         text = repr(obj)
         assert text.startswith(f"<{kind} ") or text.startswith(f"<{kind}:"), text
@@ -63,6 +71,8 @@ def test_every_public_object_has_a_short_repr(path):
     assert f"'{first}'" in repr(eq) and f"'{first}'" in repr(eq.fbd)
     assert str(eq.equations[0]) in repr(eq.equations[0])
     assert len(repr(sol.reactions)) < 300
+    assert repr(asm.bodies).startswith(f"<bodies of {model.name!r}: '{first}'")
+    assert len(repr(asm.bodies)) < 300
 
 
 def test_short_reprs_say_the_values():

@@ -557,6 +557,11 @@ class _LazyBodies(Mapping[str, "BodyEquations"]):
     def __len__(self) -> int:
         return self._asm.model.n
 
+    def __repr__(self) -> str:  # a Mapping's default names only its class
+        names = list(self._asm.model.body_names)
+        shown = ", ".join(repr(b) for b in names[:6]) + (", ..." if len(names) > 6 else "")
+        return f"<bodies of {self._asm.model.name!r}: {shown}; [name] -> BodyEquations>"
+
 
 def assemble(model: Model, state: State | None = None) -> Assembly:
     """The stacked Newton-Euler equations of `model` at `state` (default: its initial state).

@@ -50,6 +50,11 @@ class ReactionColumns:
     joint_Rp: np.ndarray
     joint_Rc: np.ndarray
 
+    def __repr__(self) -> str:  # the dataclass's would print every array
+        m, moments = len(self.W_e), int(np.count_nonzero(self.is_moment))
+        return (f"<ReactionColumns: {m} columns of G at one state ({m - moments} forces, "
+                f"{moments} moments); .W_e (world), .child6, .parent6>")
+
 
 def joint_parents(model: Model, R: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Per joint: (has a body parent (J,), parent index with ground -> 0, W_R_B of the

@@ -64,6 +64,10 @@ class AppliedLoads:
     def contributions(self) -> Contributions:
         return contributions(self.model, self.state)
 
+    def __repr__(self) -> str:  # the default names only the class and an address
+        return (f"<AppliedLoads on {self.model.n} bodies at t = {self.state.t:g} s: "
+                f".W_F (n, 3) N world, .B_M (n, 3) N m body axes, .contributions>")
+
 
 def scatter(index: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
     """Sum rows of `values` (k, 3) into (n, 3) by body `index`; index −1 (ground) is dropped."""

@@ -84,6 +84,12 @@ class Topology:
     def is_tree(self) -> bool:
         return self.loops == 0
 
+    def __repr__(self) -> str:  # the dataclass's would list every part and body
+        shape = "a tree" if self.is_tree else f"{self.loops} closed loop(s)"
+        return (f"<Topology: {shape}, {len(self.parts)} connected part(s), mobility "
+                f"{self.mobility}, {self.constraints} reaction components "
+                f"({len(self.redundant)} redundant); .parts, .redundant>")
+
 
 def topology(model: Model, G=None, *, columns: ReactionColumns | None = None) -> Topology:
     """Analyse the model's graph. `G` (the reaction matrix, sparse or dense) or `columns`

@@ -284,6 +284,11 @@ class ForceTable:
             return np.broadcast_to(self.vector, (*np.shape(t), *self.vector.shape))
         return self.varying.apply(self.vector, t)
 
+    def __repr__(self) -> str:  # the dataclass's would print every array
+        varying = "" if self.varying is None else ", some varying in t"
+        return (f"<ForceTable: {len(self.names)} point forces and couples{varying}; "
+                f".vector_at(t), .body, .B_r>")
+
 
 @dataclass(frozen=True)
 class SpringTable:
@@ -301,6 +306,9 @@ class SpringTable:
     stiffness: np.ndarray
     rest_length: np.ndarray
     damping: np.ndarray
+
+    def __repr__(self) -> str:  # the dataclass's would print every array
+        return f"<SpringTable: {len(self.names)} spring-dampers; .a, .b, .stiffness>"
 
 
 @dataclass(frozen=True, eq=False)
@@ -331,6 +339,10 @@ class JointTable:
     particle_parent: np.ndarray
     length: np.ndarray
     free_turn: np.ndarray
+
+    def __repr__(self) -> str:  # the dataclass's would print every array
+        return (f"<JointTable: {len(self.names)} joints ({', '.join(self.names[:4])}"
+                f"{', ...' if len(self.names) > 4 else ''}); .parent, .child, .P_E3, .first>")
 
 
 @dataclass(frozen=True, eq=False)
@@ -365,6 +377,10 @@ class ReactionTable:
     DERIVED = ("labels", "parent", "child", "P_E", "B_r_child", "C_axis2", "B_r_parent",
                "P_E3", "C_E3", "rot_kind", "link", "particle_parent", "length")
     """The per-component fields made from `per_joint` on first use."""
+
+    def __repr__(self) -> str:  # the dataclass's would print every array
+        return (f"<ReactionTable: {len(self.joint)} reaction components of "
+                f"{len(self.per_joint.names)} joints; .labels, .joint, .axis, .per_joint>")
 
     @cached_property
     def labels(self) -> tuple[str, ...]:
