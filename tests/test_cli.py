@@ -120,6 +120,15 @@ def test_solve_pendulum_for_its_pin_forces():
     assert data["reactions"]["O.Fy"] == pytest.approx(2 * a_G[1] + 2 * 9.81)
 
 
+def test_solve_keeps_a_long_body_name_apart_from_its_values(tmp_path):
+    """A body name longer than the column (URDF links: panda_rightfinger) is not run into
+    its first value ('panda_rightfingera_x = ...')."""
+    text = (MODELS / "pendulum.yaml").read_text().replace("rod", "a_rather_long_link_name")
+    (tmp_path / "long.yaml").write_text(text)
+    out = succeeds("solve", tmp_path / "long.yaml")
+    assert "  a_rather_long_link_name  a_x = " in out, out
+
+
 def test_assemble_one_body():
     out = succeeds("assemble", MODELS / "pendulum.yaml", "--body", "rod")
     assert out.startswith("== rod ==  m 2 kg, mass centre at (0.25, -0.433013) m")

@@ -230,9 +230,10 @@ def solution_text(sol: Solution, model: Model) -> str:
     lines = [f"accelerations of {model.name!r} (Newton rows world axes"
              + (", Euler rows body axes):" if model.dimension == 3 else "):")]
     acc = _clean(sol.accelerations)
+    width = max(14, *(len(b) + 2 for b in model.body_names))  # a long name keeps its column
     for i, name in enumerate(model.body_names):
         idx = model.body_rows(i)
-        lines.append(f"  {name:<14}" + "  ".join(
+        lines.append(f"  {name:<{width}}" + "  ".join(
             f"{cv.ACCELERATION_NAMES[r]} = {_n(v)} {units.get(r, 'rad/s^2')}"
             for r, v in zip(rows[:len(idx)], acc[idx], strict=True)))
     return "\n".join(lines)
