@@ -193,7 +193,7 @@ def joint_errors(model: Model, state: State, cols: ReactionColumns | None = None
         gtv = constraint_velocity(model, cols, state)
     ph = phi(model, state, cols=cols)
     size = float(np.ptp(state.position, axis=0).max()) if model.n > 1 else 0.0
-    size = max(size, float(np.abs(rt.B_r_child).max()), 1e-3)
+    size = max(size, float(np.abs(model.joint_table.B_r_child).max()), 1e-3)
     speed = max(float(np.abs(v6).max()), 1e-3)
     out = []
     broken = np.flatnonzero(enforced & ((np.abs(ph) > JOINT_TOL * size)
