@@ -259,7 +259,8 @@ def _read_list(text: str, start: int, end: int, file: str,
     grouped by layout, with every slot typed a column at a time; and how many keys and
     values they hold beyond the list itself (as the located reader counts them).
 
-    The list is read a chunk of about `CHUNK` characters at a time. In each chunk, one
+    The list is read a chunk of at most about `CHUNK` characters at a time (a 64th of
+    the text, and at least a quarter of `CHUNK`). In each chunk, one
     pass of numpy masks gives the skeletons, every number of every slot in order (parsed
     by one json call) and every name (split once); no string is made per number. A
     column of names with a path in `convert` is converted chunk by chunk (to body
@@ -271,8 +272,11 @@ def _read_list(text: str, start: int, end: int, file: str,
     rows: list[list[np.ndarray]] = []  # per layout: item indices, per chunk
     item = 0
     pos = start
+    # a smaller chunk for a smaller file: its temporary arrays stay small beside the file
+    chunk_size = min(CHUNK, max(CHUNK // 4, len(text) // 64))
     while pos < end:
-        stop = end if end - pos <= CHUNK else text.find("\n- ", pos + CHUNK, end) + 1 or end
+        stop = (end if end - pos <= chunk_size
+                else text.find("\n- ", pos + chunk_size, end) + 1 or end)
         data = text[pos:stop].encode("ascii")
         if data.translate(None, _PRINTABLE):
             raise _Bail  # a tab, a carriage return, a control character
@@ -613,6 +617,9 @@ def _names(group: _Group, path: tuple[Any, ...]) -> list[str]:
 
 
 def _pad3(v: np.ndarray) -> np.ndarray:
+    """Rows of 2 or 3 numbers as rows of 3 (`v` itself when they are 3 already)."""
+    if v.shape[1] == 3:
+        return v
     out = np.zeros((len(v), 3))
     out[:, :v.shape[1]] = v
     return out
@@ -758,20 +765,16 @@ def _loads(c: Checker, groups: list[_Group]) -> LoadTable:
         body[g.index] = _bodies_of(g, ("body",))
         frames = _names(g, ("frame",)) if ("frame",) in cols else [FRAMES[0]] * k
         if kind == "force":
-            vec = _pad3(_numbers(g, ("force",), dim))
-            at = _pad3(_numbers(g, ("at",), dim)) if ("at",) in cols else np.zeros_like(vec)
+            vector[g.index] = _pad3(_numbers(g, ("force",), dim))
+            if ("at",) in cols:  # else at the mass centre: at_all's zeros
+                at_all[g.index] = _pad3(_numbers(g, ("at",), dim))
+        elif dim == cv.PLANAR:
+            vector[g.index, 2] = _numbers(g, ("torque",), None)
         else:
-            vec = np.zeros((k, 3))
-            if dim == cv.PLANAR:
-                vec[:, 2] = _numbers(g, ("torque",), None)
-            else:
-                vec[:] = _numbers(g, ("torque",), 3)
-            at = np.zeros_like(vec)
+            vector[g.index] = _numbers(g, ("torque",), 3)
         names_all.append((g.index, names))
         types_all.append((g.index, [kind] * k))
         frames_all.append((g.index, frames))
-        vector[g.index] = vec
-        at_all[g.index] = at
     names_list = _placed(n, names_all)
     if len(set(names_list)) != n:
         raise _Bail  # a duplicate load name
