@@ -72,6 +72,27 @@ def matrix_to_quat(R: np.ndarray) -> np.ndarray:
     return q.reshape(*R.shape[:-2], 4)
 
 
+def quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Hamilton product a * b of (..., 4) quaternions [w, x, y, z] (rotation b, then a)."""
+    w1, x1, y1, z1 = np.moveaxis(np.asarray(a, dtype=float), -1, 0)
+    w2, x2, y2, z2 = np.moveaxis(np.asarray(b, dtype=float), -1, 0)
+    return np.stack([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
+                     w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+                     w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
+                     w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2], axis=-1)
+
+
+def quat_conj(q: np.ndarray) -> np.ndarray:
+    """(..., 4) conjugate quaternions: the inverse rotations of unit ones."""
+    return np.asarray(q, dtype=float) * np.array([1.0, -1.0, -1.0, -1.0])
+
+
+def axis_angle_quat(axis: np.ndarray, angle: float) -> np.ndarray:
+    """(4,) the rotation by `angle` (rad) about the unit `axis`."""
+    s = math.sin(angle / 2)
+    return np.array([math.cos(angle / 2), axis[0] * s, axis[1] * s, axis[2] * s])
+
+
 def planar_quat(theta: np.ndarray) -> np.ndarray:
     """(...,) angles about world z -> (..., 4) quaternions [cos θ/2, 0, 0, sin θ/2]."""
     theta = np.asarray(theta, dtype=float)

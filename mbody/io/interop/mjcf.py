@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from mbody.equations.spatial import matrix_to_quat
+from mbody.equations.spatial import axis_angle_quat, matrix_to_quat, quat_mul, quat_to_matrix
 from mbody.errors import Issue, ModelError, did_you_mean
 from mbody.io.interop.custom import Custom, read_custom, restore
 from mbody.io.interop.mjcf_schema import SCHEMA
@@ -29,12 +29,9 @@ from mbody.io.interop.tree import (
     Loop,
     TreeBody,
     TreeJoint,
-    axis_angle_quat,
     build,
     joint_order,
     qpos0,
-    quat_matrix,
-    quat_mul,
     unit,
 )
 from mbody.io.interop.xmlsource import MAX_ELEMENTS, Element, parse_xml, read_xml, unknown_name
@@ -531,7 +528,7 @@ class _Reader:
                 return
             b.mass = float(m[0])
             b.com = self.attr(inertial, v, "pos", 3, np.zeros(3))
-            b.R_inertia = quat_matrix(self.orientation(inertial, v))
+            b.R_inertia = quat_to_matrix(self.orientation(inertial, v))
             b.mass_element = inertial
             if "diaginertia" in v:
                 b.inertia = np.diag(self.attr(inertial, v, "diaginertia", 3, np.zeros(3)))
@@ -613,7 +610,7 @@ class _Reader:
                 continue
             m = float(given[0]) if given is not None else float(
                 self.attr(g, v, "density", 1, np.array([1000.0]))[0]) * vol
-            R = quat_matrix(quat)
+            R = quat_to_matrix(quat)
             parts.append((m, pos, R @ np.diag(I_unit * m) @ R.T, g))
         b.shape = self.shape(e, childclass)
         if not parts:

@@ -30,7 +30,13 @@ import numpy as np
 
 from mbody import __version__
 from mbody import conventions as cv
-from mbody.equations.spatial import box_equivalent, matrix_to_quat, quat_to_matrix
+from mbody.equations.spatial import (
+    box_equivalent,
+    matrix_to_quat,
+    quat_conj,
+    quat_mul,
+    quat_to_matrix,
+)
 from mbody.io.atomic import write_atomic
 from mbody.io.interop.custom import numeric, text
 from mbody.model.model import Joint, Model, count
@@ -231,7 +237,7 @@ def _body(w: _Writer, tree: _Tree, name: str, depth: int) -> None:
         p = m.index[parent]
         R_p = quat_to_matrix(m.initial.quaternion[p])
         pos = _snap(R_p.T @ (x_c - m.initial.position[p]), w.scale)
-        quat = _quat_mul(_quat_conj(m.initial.quaternion[p]), q_c)
+        quat = quat_mul(quat_conj(m.initial.quaternion[p]), q_c)
     pad = "  " * depth
     w.lines.append(f'{pad}<body name={quoteattr(name)} pos="{_vec(pos)}" quat="{_vec(quat)}">')
     inner = pad + "  "
@@ -639,19 +645,6 @@ def _snap(v: np.ndarray, size: float) -> np.ndarray:
 
 def _vec(xs) -> str:
     return " ".join(_num(x) for x in np.asarray(xs, dtype=float).ravel())
-
-
-def _quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    w1, x1, y1, z1 = a
-    w2, x2, y2, z2 = b
-    return np.array([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
-                     w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
-                     w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
-                     w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2])
-
-
-def _quat_conj(q: np.ndarray) -> np.ndarray:
-    return np.array([q[0], -q[1], -q[2], -q[3]])
 
 
 def _matrix_quat(R: np.ndarray) -> np.ndarray:

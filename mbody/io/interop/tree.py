@@ -12,12 +12,12 @@ column of the XML it came from.
 from __future__ import annotations
 
 import dataclasses
-import math
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
+from mbody.equations.spatial import axis_angle_quat, quat_mul, quat_to_matrix
 from mbody.errors import Issue, ModelError
 from mbody.io.interop.xmlsource import Element
 from mbody.model.loader import Document, Path_, dotted
@@ -125,31 +125,6 @@ def validate_imported(doc: Document) -> Spec:
 
 # ---- rotations (w first) ------------------------------------------------------------
 
-def quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Hamilton product a * b."""
-    w1, x1, y1, z1 = a
-    w2, x2, y2, z2 = b
-    return np.array([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
-                     w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
-                     w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
-                     w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2])
-
-
-def axis_angle_quat(axis: np.ndarray, angle: float) -> np.ndarray:
-    """The rotation by `angle` about the unit `axis`."""
-    s = math.sin(angle / 2)
-    return np.array([math.cos(angle / 2), axis[0] * s, axis[1] * s, axis[2] * s])
-
-
-def quat_matrix(q: np.ndarray) -> np.ndarray:
-    """Unit quaternion -> rotation matrix."""
-    w, x, y, z = q
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
-
-
 def unit(v: np.ndarray) -> np.ndarray:
     n = float(np.linalg.norm(v))
     return v / n if n > 0 else v
@@ -218,7 +193,7 @@ def forward(bodies: list[TreeBody], qpos: np.ndarray, qvel: np.ndarray,
             ppos, pq, pw, pv = np.zeros(3), np.array([1.0, 0, 0, 0]), np.zeros(3), np.zeros(3)
         else:
             ppos, pq, pw, pv = pos[b.parent], quat[b.parent], omega[b.parent], vel[b.parent]
-        Rp = quat_matrix(pq)
+        Rp = quat_to_matrix(pq)
         xpos = ppos + Rp @ b.pos
         xquat = quat_mul(pq, b.quat)
         motions: list[tuple[str, np.ndarray, np.ndarray, np.ndarray]] = []
@@ -228,10 +203,10 @@ def forward(bodies: list[TreeBody], qpos: np.ndarray, qvel: np.ndarray,
                 xpos = qpos[qa:qa + 3].copy()
                 xquat = unit(qpos[qa + 3:qa + 7].copy())
                 anchors[i].append(xpos.copy())
-                axes[i].append(quat_matrix(xquat)[:, 2])
+                axes[i].append(quat_to_matrix(xquat)[:, 2])
                 motions.append(("free", xpos.copy(), np.zeros(3), qvel[va:va + 6].copy()))
             else:
-                R = quat_matrix(xquat)
+                R = quat_to_matrix(xquat)
                 xaxis = R @ j.axis
                 xanchor = R @ j.pos + xpos
                 anchors[i].append(xanchor)
@@ -247,10 +222,10 @@ def forward(bodies: list[TreeBody], qpos: np.ndarray, qvel: np.ndarray,
                         qloc = axis_angle_quat(j.axis, qpos[qa] - q0[qa])
                         motions.append(("hinge", xanchor, xaxis, qvel[va:va + 1].copy()))
                     xquat = quat_mul(xquat, qloc)
-                    xpos = xanchor - quat_matrix(xquat) @ j.pos
+                    xpos = xanchor - quat_to_matrix(xquat) @ j.pos
             qa += NQ[j.type]
             va += NV[j.type]
-        R = quat_matrix(xquat)
+        R = quat_to_matrix(xquat)
         w = pw.copy()
         v = pv + np.cross(pw, xpos - ppos)  # the final origin, carried by the parent
         for kind, anchor, xaxis, qd in motions:  # each joint's rate, at the final origin
@@ -267,7 +242,7 @@ def forward(bodies: list[TreeBody], qpos: np.ndarray, qvel: np.ndarray,
                 w = w + wb
                 v = v + np.cross(wb, xpos - anchor)
         pos[i], quat[i], omega[i], vel[i] = xpos, xquat, w, v
-    Rs = np.array([quat_matrix(q) for q in quat]) if n else np.zeros((0, 3, 3))
+    Rs = quat_to_matrix(np.asarray(quat, dtype=float).reshape(-1, 4))
     return Kinematics(pos, Rs, quat, omega, vel, anchors, axes)
 
 

@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from mbody.equations.spatial import quat_to_matrix
 from mbody.errors import Issue, ModelError, did_you_mean
 from mbody.io.interop.tree import (
     NV,
@@ -28,7 +29,6 @@ from mbody.io.interop.tree import (
     build,
     joint_order,
     qpos0,
-    quat_matrix,
     unit,
 )
 from mbody.io.interop.xmlsource import MAX_ELEMENTS, Element, parse_xml, read_xml, unknown_name
@@ -359,7 +359,7 @@ class _Reader:
             g = {k: float(self.numbers(t, k, 1, np.zeros(1))[0]) for k in _ATTRS["inertia"]}
             J = np.array([[g["ixx"], g["ixy"], g["ixz"]], [g["ixy"], g["iyy"], g["iyz"]],
                           [g["ixz"], g["iyz"], g["izz"]]])
-        b.mass, b.com, b.R_inertia, b.inertia = mass, xyz, quat_matrix(quat), J
+        b.mass, b.com, b.R_inertia, b.inertia = mass, xyz, quat_to_matrix(quat), J
         b.mass_element = t if t is not None else m
 
     def shape(self, ln: Element) -> dict[str, Any] | None:
