@@ -26,6 +26,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 
 from mbody.errors import MbodyError
+from mbody.model.expressions import tokenise
 
 FUNCTIONS = ("sin", "cos", "tan", "sqrt", "exp")
 """The functions an equation may call (one argument each; angles in radians)."""
@@ -131,30 +132,10 @@ def parse_equation(text: str, labels: Iterable[str] = ()) -> ParsedEquation:
 
 
 def _tokenise(text: str, labels: Iterable[str]) -> list[tuple[str, str, int]]:
-    src = text.translate(_PASTED)
     # longest first, so that A.Fx is never taken for a prefix of AB.Fx
     known = sorted((lab for lab in labels if not _TOKEN.fullmatch(lab)), key=len,
                    reverse=True)
-    out = []
-    i = 0
-    while i < len(src):
-        label = next((lab for lab in known if src.startswith(lab, i)
-                      and not src[i + len(lab):i + len(lab) + 1].isalnum()), None)
-        if label is not None and (i == 0 or not (src[i - 1].isalnum() or src[i - 1] == "_")):
-            out.append(("name", label, i))
-            i += len(label)
-            continue
-        m = _TOKEN.match(src, i)
-        if not m:  # reported when the parser reaches it, so errors come in reading order
-            out.append(("bad", src[i], i))
-            i += 1
-            continue
-        kind = m.lastgroup or ""
-        if kind != "ws":
-            out.append((kind, m.group(), i))
-        i = m.end()
-    out.append(("end", "", len(src)))
-    return out
+    return tokenise(text.translate(_PASTED), _TOKEN, tuple(known))
 
 
 def _describe(kind: str, value: str) -> str:

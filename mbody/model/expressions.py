@@ -144,7 +144,7 @@ def compile_expression(text: str) -> Expression:
     if len(text) > MAX_LENGTH:
         raise ExpressionError(text[:40] + "...", 0,
                               f"the expression is longer than {MAX_LENGTH} characters")
-    tokens = _tokenise(text)
+    tokens = tokenise(text)
     parser = _Parser(text, tokens)
     tree = parser.expr(0)
     kind, value, pos = parser.peek()
@@ -157,12 +157,26 @@ def compile_expression(text: str) -> Expression:
     return Expression(text, tree)
 
 
-def _tokenise(text: str) -> list[tuple[str, str, int]]:
+def tokenise(text: str, pattern: re.Pattern[str] = _TOKEN,
+             labels: tuple[str, ...] = ()) -> list[tuple[str, str, int]]:
+    """(kind, text, position) tokens of `text` by `pattern`'s named groups, ending with
+    ``("end", "", len(text))``; whitespace is dropped, a character no group matches is a
+    ``"bad"`` token (reported when a parser reaches it, so errors come in reading order).
+
+    `labels`, longest first, are whole names taken before `pattern` is tried (a student's
+    equation names reactions such as ``A.Fx``), where they stand alone.
+    """
     out = []
     i = 0
     while i < len(text):
-        m = _TOKEN.match(text, i)
-        if not m:  # reported when the parser reaches it, so errors come in reading order
+        label = next((lab for lab in labels if text.startswith(lab, i)
+                      and not text[i + len(lab):i + len(lab) + 1].isalnum()), None)
+        if label is not None and (i == 0 or not (text[i - 1].isalnum() or text[i - 1] == "_")):
+            out.append(("name", label, i))
+            i += len(label)
+            continue
+        m = pattern.match(text, i)
+        if not m:
             out.append(("bad", text[i], i))
             i += 1
             continue
