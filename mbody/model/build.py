@@ -1,0 +1,175 @@
+"""A validated specification's loads and joints -> the model's tables and records.
+
+`located_loads` and `point_loads` make the `ForceTable` (and the `Load` records) of the
+located and the fast path; `joint_tables` computes every joint's frame and points in each
+body's axes at once, the `ReactionTable`, and the `Joint` records made on first use.
+`mbody.model.model` puts them together into a `Model`.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from mbody import conventions as cv
+from mbody.equations.spatial import joint_frame_planar, joint_frame_spatial, quat_to_matrix
+from mbody.model.expressions import ExpressionTable
+from mbody.model.records import Joint, Load, Records, field_names, record
+from mbody.model.tables import AXIS_CODE, ForceTable, JointTable, ReactionTable, readonly
+from mbody.model.validate import JointSpecTable, LoadSpec, LoadTable
+
+if TYPE_CHECKING:
+    from mbody.model.model import State
+
+
+def located_loads(specs: list[LoadSpec], idx: dict[str, int]
+                  ) -> tuple[tuple[Load, ...], ForceTable]:
+    """The loads of the located path, and the force table of its point loads."""
+    loads = tuple(Load(ld.name, ld.type, ld.bodies, ld.vector, ld.frame, ld.at,
+                       ld.stiffness, ld.rest_length, ld.damping, dict(ld.expressions))
+                  for ld in specs)
+    point = [ld for ld in specs if ld.type in ("force", "torque")]
+    forces = ForceTable(
+        tuple(ld.name for ld in point),
+        np.array([idx[ld.bodies[0]] for ld in point], dtype=np.intp),
+        readonly(np.array([ld.vector for ld in point]).reshape(-1, 3)),
+        np.array([ld.frame == "body" for ld in point], dtype=bool),
+        readonly(np.array([ld.at[0] for ld in point]).reshape(-1, 3)),
+        np.array([ld.type == "torque" for ld in point], dtype=bool),
+        ExpressionTable.build([(row, k, e) for row, ld in enumerate(point)
+                               for k, e in ld.expressions.items()]),
+    )
+    return loads, forces
+
+
+def point_loads(t: LoadTable, names: tuple[str, ...]) -> tuple[Records[Load], ForceTable]:
+    """The fast path's loads (force and torque, constant): their force table, and their
+    records, made on first use from it."""
+    vector, at = readonly(t.vector), readonly(t.at)
+    body = np.asarray(t.body, dtype=np.intp)
+    forces = ForceTable(tuple(t.names), body, vector,
+                        np.array([f == "body" for f in t.frames], dtype=bool), at,
+                        np.array([typ == "torque" for typ in t.types], dtype=bool),
+                        ExpressionTable.build([]))
+    fields_ = field_names(Load)
+    load_names, types, frames = forces.names, t.types, t.frames
+
+    def make(i: int) -> Load:
+        return record(Load, fields_, (load_names[i], types[i], (names[body[i]],), vector[i],
+                                      frames[i], (at[i],), 0.0, 0.0, 0.0, {}))
+
+    return Records(len(load_names), make), forces
+
+
+_FREE_TURN = ("revolute", "cylindrical")
+"""Joint types whose moment components measure the tilt of the joint z axis."""
+
+
+def joint_tables(dimension: int, js: JointSpecTable, names: tuple[str, ...],
+                  initial: State, particle: np.ndarray
+                  ) -> tuple[Records[Joint], ReactionTable]:
+    """The joints and their reaction table, computed for all joints at once.
+
+    Per joint: the joint frame W_E0 at the initial pose (one call of the contract's rule
+    per distinct axis), then the frame and the joint point in each body's axes,
+    ``P_E = R_p^T W_E0``, ``B_r = R^T (at - x)``, kept per joint (`JointTable`); the
+    reaction table holds one row per component, each naming its joint and axis, and
+    derives the rest on first use. The `Joint` records are made on first use too.
+    """
+    nj = len(js.names)
+    planar = dimension == cv.PLANAR
+    W_E0 = readonly(_frames(js.axis, js.has_axis, planar))
+    at = readonly(js.at)
+    p, c = js.parent, js.child
+    ground = p < 0
+    R0 = quat_to_matrix(initial.quaternion)  # State.W_R_B's values, not kept on the state
+    x0 = initial.position
+    # the world frame stands in for ground: I @ v is v exactly
+    Rp = np.where(ground[:, None, None], np.eye(3), R0[p] if nj else np.zeros((0, 3, 3)))
+    xp = np.where(ground[:, None], 0.0, x0[p] if nj else np.zeros((0, 3)))
+    Rc, xc = R0[c], x0[c]
+    del R0
+    RpT, RcT = Rp.transpose(0, 2, 1), Rc.transpose(0, 2, 1)
+    P_E = RpT @ W_E0  # joint frame fixed in the parent (the world for ground)
+    C_E = RcT @ W_E0
+    B_r_child = (RcT @ (at - xc)[:, :, None])[:, :, 0]
+    B_r_parent = np.where(ground[:, None], at, (RpT @ (at - xp)[:, :, None])[:, :, 0])
+    C_axis2 = (RcT @ js.axis2[:, :, None])[:, :, 0]
+    # a particle end is attached at the particle itself (no offset, no moment)
+    p_particle = particle[p] & ~ground
+    c_particle = particle[c]
+    B_r_child[c_particle] = 0.0
+    B_r_parent[p_particle] = 0.0
+    kinds = js.particle_joint
+    link = np.array([k == "link" for k in kinds], dtype=bool)
+    length = np.zeros(nj)
+    if link.any():  # attachment points: the particle(s), else the joint point
+        P_c = xc + (Rc @ B_r_child[:, :, None])[:, :, 0]
+        P_p = np.where(ground[:, None], B_r_parent,
+                       xp + (Rp @ B_r_parent[:, :, None])[:, :, 0])
+        length[link] = np.linalg.norm((P_c - P_p)[link], axis=1)
+    del Rp, Rc, RpT, RcT, xp, xc
+
+    types = js.types
+    by_type = cv.JOINT_COMPONENTS[dimension]
+    comps = ([by_type[typ] for typ in types] if not any(kinds) else
+             [cv.PARTICLE_COMPONENTS[dimension][typ][k] if k else by_type[typ]
+              for typ, k in zip(types, kinds, strict=True)])
+    # the distinct component lists (a few), and each joint's
+    distinct: dict[tuple[str, ...], int] = {}
+    code = np.fromiter((distinct.setdefault(cs, len(distinct)) for cs in comps),
+                       dtype=np.intp, count=nj)
+    axes = np.zeros((max(len(distinct), 1), 7), dtype=np.intp)
+    sizes = np.zeros(len(axes), dtype=np.intp)
+    for cs, k in distinct.items():
+        axes[k, :len(cs)] = [AXIS_CODE[comp] for comp in cs]
+        sizes[k] = len(cs)
+    counts = sizes[code]
+    first = np.cumsum(counts) - counts
+    row_joint = np.repeat(np.arange(nj, dtype=np.intp), counts)
+    axis = axes[code[row_joint], np.arange(len(row_joint)) - first[row_joint]]
+    free_turn = np.array([typ in _FREE_TURN for typ in types], dtype=bool)
+    per_joint = JointTable(tuple(js.names), p, c, readonly(B_r_child), readonly(B_r_parent),
+                           readonly(P_E), readonly(C_E), readonly(C_axis2), first, link, p_particle,
+                           readonly(length), free_turn)
+    table = ReactionTable(per_joint, row_joint, axis)
+
+    fields_ = field_names(Joint)
+    axis1 = readonly(js.axis)
+    axis2 = readonly(js.axis2)
+    jnames, parents, children = js.names, p, c
+    has1, has2 = js.has_axis, js.has_axis2
+
+    def make(j: int) -> Joint:
+        pj = int(parents[j])
+        return record(Joint, fields_, (
+            jnames[j], types[j], names[pj] if pj >= 0 else cv.GROUND, names[children[j]],
+            at[j], W_E0[j], comps[j], axis1[j] if has1[j] else None,
+            axis2[j] if has2[j] else None, kinds[j]))
+
+    return Records(nj, make), table
+
+
+def _frames(axis: np.ndarray, has_axis: np.ndarray, planar: bool) -> np.ndarray:
+    """(k, 3, 3) the joint frame of each axis (None where `has_axis` is False), by the
+    contract's rule, computed once per distinct axis (the same bits, not the same value:
+    -0.0 and 0.0 are two axes)."""
+    k = len(axis)
+    if k == 0:
+        return np.zeros((0, 3, 3))
+    bits = np.ascontiguousarray(axis, dtype=float).view(np.int64)
+    key = np.concatenate((bits, has_axis[:, None].astype(np.int64)), axis=1)
+    if np.all(key == key[0]):  # one axis for all (a chain...)
+        first, inverse = np.zeros(1, dtype=np.intp), np.zeros(k, dtype=np.intp)
+    else:  # rows sorted, then runs of equal rows (np.unique would import numpy.ma)
+        order = np.lexsort(key.T[::-1])
+        ordered = key[order]
+        new = np.ones(k, dtype=bool)
+        new[1:] = np.any(ordered[1:] != ordered[:-1], axis=1)
+        first = order[new]  # a joint with each axis
+        inverse = np.empty(k, dtype=np.intp)
+        inverse[order] = np.cumsum(new) - 1
+    rule = joint_frame_planar if planar else joint_frame_spatial
+    frames = np.array([rule(axis[i] if has_axis[i] else None) for i in first.tolist()])
+    return frames.reshape(-1, 3, 3)[inverse]
