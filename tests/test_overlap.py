@@ -17,6 +17,15 @@ placed. What counts as an overlap (each pair counted once):
   Shafts and curves count here, not arrowheads or leaders (a head's back edge and the
   dotted leader of an arrow drawn beside its point are short and crosswise).
 
+Two more measures of what a reader needs (`far_labels`, `touching_tips`):
+
+- a label far from what it names: the gap between its box and its own arrow (shaft,
+  heads, end-on ring; not the dotted leader of an arrow drawn beside its point), axis or
+  marker is more than FAR times the label's height, and no label leader
+  (``label-leader:<kind>:<name>``) joins it to that arrow;
+- an arrow's tip touching another stroke: the point of an arrowhead lies within TIP
+  points of the edge of another arrow (shaft or head), of the body's outline or of a body axis.
+
 Run as a script to print the count per model and view.
 """
 
@@ -45,6 +54,11 @@ NEAR, RUN = 2.0, 8.0
 """Two strokes closer than NEAR points and parallel along RUN points coincide."""
 STEP = 1.0
 """Strokes are measured at points this far apart (points)."""
+FAR = 1.5
+"""A label's box keeps within FAR times its height of the arrow (axis, marker) it names."""
+TIP = 2.5
+"""An arrow's tip keeps this far (points) from the edge of every stroke it does not belong
+to (a line's centre less half its width)."""
 
 
 def _sample(xy: np.ndarray, closed: bool = False) -> tuple[np.ndarray, np.ndarray]:
@@ -183,6 +197,87 @@ def overlaps(scene: Scene) -> list[str]:
     return found
 
 
+def _own(gid: str, owner: str) -> bool:
+    """Whether the item `gid` is part of the arrow, axis or marker `owner` (a label's gid
+    without 'label:'), leaders excluded."""
+    if owner.startswith("body-axis") or owner == "mass-centre":
+        return gid == owner or gid.startswith(owner + ":")
+    return any(gid == f"{k}:{owner}" or gid.startswith(f"{k}:{owner}:")
+               for k in ("arrow", "couple"))
+
+
+def _item_points(panel: Panel, it: object) -> tuple[np.ndarray, float]:
+    """Points (in points) along a Line, Poly's rim or Disc's centre, and the Disc's radius
+    to take off a distance measured from those points."""
+    if isinstance(it, Line):
+        return _sample(panel.to_pt(it.xy))[0], 0.0
+    if isinstance(it, Poly):
+        return _sample(panel.to_pt(it.xy), closed=True)[0], 0.0
+    assert isinstance(it, Disc)
+    return panel.to_pt(it.center)[None], it.r * panel.scale
+
+
+def far_labels(scene: Scene) -> list[str]:
+    """Every label of the drawing panel farther than FAR label heights from the arrow,
+    axis or marker it names, without a label leader to it; one line each."""
+    panel = next(p for p in scene.panels if p.gid == "drawing")
+    gids = {getattr(it, "gid", None) or "" for it in panel.items}
+    found = []
+    for it in panel.items:
+        if not (isinstance(it, Text) and (it.gid or "").startswith("label:")):
+            continue
+        owner = it.gid[6:]
+        if "label-leader:" + owner in gids:
+            continue
+        x0, y0, w, h = text_box(it, panel.to_pt(it.xy))
+        gap = np.inf
+        for o in panel.items:
+            if isinstance(o, Text) or not _own(getattr(o, "gid", None) or "", owner):
+                continue
+            pts, r = _item_points(panel, o)
+            dx = np.maximum(np.maximum(x0 - pts[:, 0], pts[:, 0] - x0 - w), 0)
+            dy = np.maximum(np.maximum(y0 - pts[:, 1], pts[:, 1] - y0 - h), 0)
+            gap = min(gap, max(float(np.min(np.hypot(dx, dy))) - r, 0.0))
+        if gap > FAR * h:
+            found.append(f"label {owner} {gap:.0f} pt from its arrow (> {FAR * h:.0f})")
+    return found
+
+
+def _segment_distance(p: np.ndarray, xy: np.ndarray) -> float:
+    """Distance from point p to a polyline xy (k, 2)."""
+    a, b = xy[:-1], xy[1:]
+    d = b - a
+    t = np.clip(np.sum((p - a) * d, axis=1) / np.maximum(np.sum(d * d, axis=1), 1e-18),
+                0, 1)
+    return float(np.min(np.linalg.norm(a + t[:, None] * d - p, axis=1)))
+
+
+def touching_tips(scene: Scene) -> list[str]:
+    """Every arrowhead (of a force or couple) whose point lies within TIP points of an
+    arrow, outline edge or body axis other than its own; one line each."""
+    panel = next(p for p in scene.panels if p.gid == "drawing")
+    others = []
+    for it in panel.items:
+        gid = getattr(it, "gid", None) or ""
+        if isinstance(it, (Line, Poly)) and (
+                gid.startswith(("arrow:", "couple:", "body-axis:"))
+                or gid in ("body-outline", "body-edge")):
+            xy = panel.to_pt(it.xy)
+            others.append((_owner(gid), np.vstack((xy, xy[:1])) if isinstance(it, Poly)
+                           else xy, it.lw / 2))
+    found = []
+    for it in panel.items:
+        gid = getattr(it, "gid", None) or ""
+        if not (isinstance(it, Poly) and gid.startswith(("arrow:", "couple:"))
+                and gid.endswith(":head")):
+            continue
+        tip, me = panel.to_pt(it.xy[0]), _owner(gid)
+        hit = sorted({n for n, xy, half in others
+                      if n != me and _segment_distance(tip, xy) - half < TIP})
+        found += [f"tip of {me} on {n}" for n in hit]
+    return found
+
+
 def cases() -> Iterator[tuple[str, str, str]]:
     """(model file stem, body, view) for every body of every shipped model."""
     for path in MODELS:
@@ -224,10 +319,43 @@ def test_measure_sees_labels_on_labels_arrows_on_arrows_and_labels_on_outlines()
     assert overlaps(sc) == []
 
 
+def test_measure_sees_far_labels_and_touching_tips():
+    sc = Scene(200, 200)
+    p = sc.panel("drawing", (0, 0, 200, 200), np.zeros(2), np.array([200.0, 200.0]))
+    p.add(Line(np.array([[20.0, 100], [80, 100]]), "red", gid="arrow:reaction:A.Fx"),
+          Poly(np.array([[80.0, 100], [72, 103], [72, 97]]), "red",
+               gid="arrow:reaction:A.Fx:head"),
+          Line(np.array([[81.0, 40], [81, 160]]), "green", gid="arrow:gravity:gravity"),
+          Text("A.Fx", np.array([150.0, 150]), 9, gid="label:reaction:A.Fx"),
+          Text("m g", np.array([84.0, 60]), 9, gid="label:gravity:gravity"))
+    assert [f.split(" ")[1] for f in far_labels(sc)] == ["reaction:A.Fx"]
+    assert touching_tips(sc) == ["tip of reaction:A.Fx on gravity:gravity"]
+    p.items[3].xy = np.array([84.0, 104])  # beside its tip
+    p.items[2].xy = np.array([[90.0, 40], [90, 160]])
+    assert far_labels(sc) == [] and touching_tips(sc) == []
+    # a label leader drawn to a far label names its arrow
+    p.items[3].xy = np.array([150.0, 150])
+    p.add(Line(np.array([[80.0, 100], [150, 150]]), "red", gid="label-leader:reaction:A.Fx"))
+    assert far_labels(sc) == []
+
+
 # -- every shipped picture ------------------------------------------------------------------
 @pytest.mark.parametrize("stem", [p.stem for p in MODELS])
 def test_no_overlaps_on_shipped_models(stem):
     bad = [f"{name} ({view}): {o}" for name, view, sc in scenes(stem) for o in overlaps(sc)]
+    assert bad == []
+
+
+@pytest.mark.parametrize("stem", [p.stem for p in MODELS])
+def test_labels_near_their_arrows_on_shipped_models(stem):
+    bad = [f"{name} ({view}): {o}" for name, view, sc in scenes(stem) for o in far_labels(sc)]
+    assert bad == []
+
+
+@pytest.mark.parametrize("stem", [p.stem for p in MODELS])
+def test_no_arrow_tip_touches_another_stroke_on_shipped_models(stem):
+    bad = [f"{name} ({view}): {o}" for name, view, sc in scenes(stem)
+           for o in touching_tips(sc)]
     assert bad == []
 
 
@@ -261,20 +389,20 @@ def test_legend_fits_in_the_picture(stem):
 
 
 def main() -> int:
-    total = 0
+    total = far = tips = 0
     only = set(sys.argv[1:])
     for path in MODELS:
         if only and path.stem not in only:
             continue
         per = []
         for name, view, sc in scenes(path.stem):
-            found = overlaps(sc)
-            total += len(found)
-            per.append(f"{name}/{view} {len(found)}")
-            for f in found:
+            found, fl, tt = overlaps(sc), far_labels(sc), touching_tips(sc)
+            total, far, tips = total + len(found), far + len(fl), tips + len(tt)
+            per.append(f"{name}/{view} {len(found)}/{len(fl)}/{len(tt)}")
+            for f in found + fl + tt:
                 print(f"    {path.stem} {name} {view}: {f}")
         print(f"{path.stem:<28} " + ", ".join(per), flush=True)
-    print("total", total)
+    print("overlaps", total, "far labels", far, "touching tips", tips)
     return 0
 
 

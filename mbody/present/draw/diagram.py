@@ -131,7 +131,8 @@ def fbd_scene(fbd: FreeBodyDiagram, *, view: View = "iso", equations: bool = Tru
         obstacles.append((seg, tag))
         fixed.append(seg)
         labels.append(Label(Text(f"${nm}_B$", tip, 8, AXIS_COLOR, math=True, zorder=10,
-                                 gid=f"label:body-axis:{nm}"), tip, tip - G, tag))
+                                 gid=f"label:body-axis:{nm}"), tip, tip - G, tag,
+                            float(np.linalg.norm(tip - G))))
     labels.append(Label(Text("G", G, 9, zorder=10, gid="label:mass-centre"), G,
                         np.array([-1.0, 1.0]), "mass-centre"))
 
@@ -157,7 +158,7 @@ def fbd_scene(fbd: FreeBodyDiagram, *, view: View = "iso", equations: bool = Tru
         drawn: list[Item] = []
         arrow_obstacles: list[tuple[np.ndarray, str]] = []
         arrow_labels = [_arrow(drawn, a, lmax, hd, arrow_obstacles)
-                        for a in separate(arrs, fixed, ax.scale, G)]
+                        for a in separate(arrs, fixed, ax.scale, G, hd)]
         every = labels + arrow_labels
         boxes = place(ax, every, obstacles + arrow_obstacles)
         if attempt == 4 or (np.all(boxes[:, 0] >= x0) and np.all(boxes[:, 2] <= x0 + w)
@@ -170,6 +171,10 @@ def fbd_scene(fbd: FreeBodyDiagram, *, view: View = "iso", equations: bool = Tru
         span = float((hi - lo).max())
         ax.set_limits(lo - 0.05 * span, hi + 0.05 * span)
     ax.add(*drawn)
+    for lab in every:  # a label placed far from its arrow: a thin line to it
+        if lab.leader is not None:
+            ax.add(Line(lab.leader, lab.text.color, 0.6, zorder=8,
+                        gid="label-leader:" + (lab.text.gid or "label:")[6:]))
     ax.add(*(lab.text for lab in every))
 
     # band: world axes on the left, legend on the right
@@ -203,7 +208,7 @@ def _arrow(ax: list[Item], a: Arrow, lmax: float, hd: float,
         lead = np.array([a.moved_from, a.tail])
         ax.append(Line(lead, a.color, 0.9, DOTTED, zorder=8,
                        gid="leader:" + a.gid.split(":", 1)[1]))
-        obstacles.append((lead, a.gid))
+        obstacles.append((lead, "leader:" + a.gid))
     if a.arc is not None:
         if a.vec[1] > 0:
             t_end = a.arc[-1] - a.arc[-2]

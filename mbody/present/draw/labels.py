@@ -7,6 +7,12 @@ sampled inside it (every drawn line, arrowhead, outline, axis and marker, its ow
 included) and the labels it meets. The first ring with a free spot wins; only if none
 is free anywhere does the least crowded spot win. Works in points, without rendering,
 all spots of one ring of one label at once.
+
+A label names its arrow only if it is near it: a free spot whose box is within NEAR
+label heights of the label's own strokes (its arrow's shaft and heads, its axis, its
+marker) beats any free spot farther out; the first spots tried lie beside the tip and
+all along a straight shaft. A label that finds no free spot near enough gets a leader
+(`Label.leader`, drawn by the diagram): a thin line from its box to its arrow.
 """
 
 from __future__ import annotations
@@ -23,6 +29,8 @@ PAD = 2.5
 STEP = 1.0
 """Strokes are sampled every STEP points (below PAD: a stroke near a box has a sample
 inside its padded box)."""
+NEAR = 1.3
+"""A label's box within NEAR times its height of its own strokes is near them."""
 
 
 @dataclass(slots=True)
@@ -34,7 +42,8 @@ class Label:
     anchor: np.ndarray
     direction: np.ndarray
     own: str
-    shaft: float = 0.0  # a straight arrow's length (data): spots beside it, half-way
+    shaft: float = 0.0  # a straight arrow's length (data): spots beside it, along it
+    leader: np.ndarray | None = None  # (2, 2) data: box to its arrow, when placed far
 
 
 def sample(points: np.ndarray, step: float) -> np.ndarray:
@@ -47,12 +56,14 @@ def sample(points: np.ndarray, step: float) -> np.ndarray:
     return np.vstack((points[:1], inner))
 
 
-def _rings(mid: float | None) -> list[np.ndarray]:
+def _rings(length: float | None) -> list[np.ndarray]:
     """Candidate offsets (points) as (along, across) the label's direction, in groups
-    tried in turn: beyond the tip, then rings farther and farther out."""
+    tried in turn: beyond the tip and beside a straight shaft (`length` points) along
+    it, then rings farther and farther out."""
     first: list[tuple[float, float]] = [(5, 0), (5, 9), (5, -9), (0, 10), (0, -10)]
-    if mid is not None:  # beside the shaft, half-way
-        first += [(mid, 10), (mid, -10)]
+    if length is not None:  # beside the shaft, half-way first, then all along it
+        for f in (0.5, 0.3, 0.7, 0.15, 0.85):
+            first += [(-f * length, 10), (-f * length, -10)]
     groups = [np.array(first, dtype=float)]
     for r, n in ((12.0, 16), (20.0, 24), (30.0, 24), (42.0, 32), (58.0, 32), (78.0, 40),
                  (100.0, 40)):
@@ -77,24 +88,30 @@ def place(panel: Panel, labels: list[Label], obstacles: list[tuple[np.ndarray, s
     """
     pts = [sample(panel.to_pt(xy), STEP) for xy, _ in obstacles]
     P = np.vstack(pts) if pts else np.zeros((0, 2))
+    names = {tag: k for k, tag in enumerate(dict.fromkeys(tag for _, tag in obstacles))}
+    tags = np.repeat(np.array([names[tag] for _, tag in obstacles] or [-1]),
+                     [len(p) for p in pts] or [0])
     x0b, y0b, wb, hb = panel.rect
     placed = np.zeros((0, 4))
     for lab in labels:
         t = lab.text
         t.offset, t.ha, t.va = (0.0, 0.0), "left", "bottom"
+        lab.leader = None
         _, _, w, h = text_box(t, np.zeros(2))
         a_pt = panel.to_pt(lab.anchor)
         d = np.asarray(lab.direction, dtype=float)
         n = np.linalg.norm(d)
         d = d / n if n > 1e-12 else np.array([1.0, 0.0])
         nrm = np.array([-d[1], d[0]])
-        mid = -0.5 * lab.shaft * panel.scale if lab.shaft > 0 else None
+        length = lab.shaft * panel.scale if lab.shaft > 0 else None
+        mine = P[tags == names.get(lab.own, -2)] if len(P) else P
+        near_gap = NEAR * h
         # strokes near enough to matter for this label
         reach = 100.0 + w + h + 2 * PAD
         near = np.all(np.abs(P - a_pt) < reach, axis=1) if len(P) else np.zeros(0, bool)
         Q = P[near]
         best: tuple[float, float, float, float, float, float, float] | None = None
-        for sp in _rings(mid):
+        for g, sp in enumerate(_rings(length)):
             off = sp[:, :1] * d + sp[:, 1:] * nrm  # (c, 2) points
             o = off / np.maximum(np.linalg.norm(off, axis=1, keepdims=True), 1e-12)
             fx = np.where(o[:, 0] > 0.3, 0.0, np.where(o[:, 0] < -0.3, 1.0, 0.5))
@@ -116,17 +133,40 @@ def place(panel: Panel, labels: list[Label], obstacles: list[tuple[np.ndarray, s
                 score += np.sum(np.where(hit, 200 + 5 * ow * oh, 0.0), axis=1)
             outside = (x0 < x0b) | (x1 > x0b + wb) | (y0 < y0b) | (y1 > y0b + hb)
             score += 2.0 * outside  # allowed (limits grow later) but not preferred
+            if len(mine):  # far from its own strokes: worse than any free spot near them
+                score += 2.5 * (_gap(mine, x0 + PAD, y0 + PAD, x1 - PAD, y1 - PAD)
+                                > near_gap)
             k = int(np.argmin(score))  # the first of equal scores, as the spots are ordered
             if best is None or score[k] < best[0]:
                 best = (float(score[k]), float(off[k, 0]), float(off[k, 1]), float(fx[k]),
                         float(fy[k]), float(x0[k]), float(y0[k]))
-            if best[0] < 5.0:  # free (at most outside the panel for now): take it
+            # free and near (at most outside the panel for now): take it; once the near
+            # rings are tried, any free spot
+            if best[0] < 2.5 or (best[0] < 5.0 and g >= 2):
                 break
         assert best is not None
         _, ox, oy, bx, by, bx0, by0 = best
         t.offset = (ox, oy)
         t.ha = "left" if bx == 0 else "right" if bx == 1 else "center"
         t.va = "bottom" if by == 0 else "top" if by == 1 else "center"
-        placed = np.vstack((placed, [bx0, by0, bx0 + w + 2 * PAD, by0 + h + 2 * PAD]))
+        box = np.array([bx0, by0, bx0 + w + 2 * PAD, by0 + h + 2 * PAD])
+        placed = np.vstack((placed, box))
+        if len(mine):
+            lo, hi = box[:2] + PAD, box[2:] - PAD
+            gaps = np.linalg.norm(mine - np.clip(mine, lo, hi), axis=1)
+            j = int(np.argmin(gaps))
+            if gaps[j] > near_gap:  # a thin line from the box to its arrow
+                ends = np.array([np.clip(mine[j], lo, hi), mine[j]])
+                lab.leader = (ends - panel.rect[:2]) / panel.scale + panel.lo
     return placed
+
+
+def _gap(pts: np.ndarray, x0: np.ndarray, y0: np.ndarray, x1: np.ndarray, y1: np.ndarray
+         ) -> np.ndarray:
+    """(c,) distance from each box (x0, y0, x1, y1; each (c,)) to the nearest point."""
+    dx = np.maximum(np.maximum(x0[:, None] - pts[None, :, 0], pts[None, :, 0] - x1[:, None]),
+                    0)
+    dy = np.maximum(np.maximum(y0[:, None] - pts[None, :, 1], pts[None, :, 1] - y1[:, None]),
+                    0)
+    return np.min(np.hypot(dx, dy), axis=1)
 

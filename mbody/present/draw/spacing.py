@@ -7,6 +7,13 @@ other stroke. Moving an arrow parallel to itself keeps its direction and label e
 the step is a few points, small beside any body, and a dotted leader (drawn by the
 diagram) ties the moved tail to the point where the force acts. Works in points (the
 panel's scale), as a reader sees the picture.
+
+An arrow's tip must not touch another stroke either (the crank's O.Fx ending on the
+gravity line): its point keeps TIP points from every stroke placed before it, and no tip
+placed before it lies that near its shaft or head. An unknown reaction, whose length
+says nothing, is first drawn a little shorter (or longer) to clear; any arrow is then
+moved sideways as above. Known forces (applied, gravity) and couples are placed first,
+so that a reaction gives way to them: their lengths and points carry their values.
 """
 
 from __future__ import annotations
@@ -15,7 +22,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from mbody.present.draw.arrows import Arrow
+from mbody.conventions import REACTION
+from mbody.present.draw.arrows import END_ON, Arrow, head
 
 CLEAR = 5.5
 """An arrow keeps this far (points) from any parallel stroke it runs beside."""
@@ -25,6 +33,30 @@ PARALLEL = np.cos(np.radians(12.0))
 """Strokes within 12° of each other are parallel."""
 RUN = 4.0
 """A stretch (points) of an arrow beside a parallel stroke that counts as lying on it."""
+TIP = 5.0
+"""An arrow's tip keeps this far (points) from the centre line of every other stroke."""
+LENGTHS = (1.0, 0.86, 0.72, 1.14)
+"""Lengths (of its own) tried in turn for an unknown reaction at each sideways place."""
+
+
+def _distance(p: np.ndarray, segs: np.ndarray) -> np.ndarray:
+    """Distance from each point p (m, 2) to the nearest of the segments (k, 2, 2)."""
+    if not len(segs) or not len(p):
+        return np.full(len(p), np.inf)
+    a, d = segs[:, 0], segs[:, 1] - segs[:, 0]
+    rel = p[:, None, :] - a[None]  # (m, k, 2)
+    t = np.clip(np.sum(rel * d, axis=2) / np.maximum(np.sum(d * d, axis=1), 1e-18), 0, 1)
+    return np.min(np.linalg.norm(rel - t[..., None] * d, axis=2), axis=1)
+
+
+def _strokes(seg: np.ndarray, d: np.ndarray, hd: float, couple: bool) -> np.ndarray:
+    """The segments an arrow draws: its shaft and its head's (heads') edges."""
+    out = [seg[None]]
+    if hd > 0:
+        for back in ((0.0, 0.75) if couple else (0.0,)):
+            tri = head(seg[1] - back * hd * d, d, hd)
+            out.append(np.stack((tri, tri[[1, 2, 0]]), axis=1))
+    return np.vstack(out)
 
 
 def segments(polylines: list[np.ndarray]) -> np.ndarray:
@@ -76,10 +108,11 @@ def _lies_on(a: np.ndarray, b: np.ndarray, clear: float, run: float) -> bool:
     return bool(np.any((hi - lo > 0) & (inside >= run)))
 
 
-def separate(arrs: list[Arrow], fixed: list[np.ndarray], scale: float, centre: np.ndarray
-             ) -> list[Arrow]:
+def separate(arrs: list[Arrow], fixed: list[np.ndarray], scale: float, centre: np.ndarray,
+             hd: float = 0.0) -> list[Arrow]:
     """The arrows, each straight one moved sideways where it would lie on a stroke drawn
-    before it (`fixed` polylines: outline and axes; then the arrows before it).
+    before it (`fixed` polylines: outline and axes; then the arrows before it), or where
+    its tip would touch one (an unknown reaction first drawn shorter or longer).
 
     Parameters
     ----------
@@ -91,6 +124,8 @@ def separate(arrs: list[Arrow], fixed: list[np.ndarray], scale: float, centre: n
         Points per data unit of the panel.
     centre : (2,) array
         The mass centre on the page: of two equal moves, the one away from it wins.
+    hd : float
+        Arrowhead length (data units); 0: tips are not checked.
 
     Returns
     -------
@@ -99,28 +134,54 @@ def separate(arrs: list[Arrow], fixed: list[np.ndarray], scale: float, centre: n
     """
     unit = 1.0 / scale  # one point in data units
     placed = segments(fixed)
-    out: list[Arrow] = []
-    for a in arrs:
+    near = placed.copy()  # what a tip keeps clear of: strokes and arrowheads
+    tips = np.zeros((0, 2))
+    clear = TIP * unit if hd > 0 else -1.0
+    order = sorted(range(len(arrs)), key=lambda i: arrs[i].kind == REACTION)
+    out: dict[int, Arrow] = {}
+    for i in order:
+        a = arrs[i]
         n = float(np.linalg.norm(a.vec))
         if a.arc is not None or n < 1e-12:  # an end-on arrow keeps a short shaft: it moves
-            out.append(a)
+            out[i] = a
             if a.arc is not None:
                 placed = np.vstack((placed, segments([a.arc])))
+                near = np.vstack((near, segments([a.arc])))
             continue
         d = a.vec / n
         side = np.array([-d[1], d[0]])
-        seg0 = np.array([a.tail, a.tail + a.vec])
+        headed = n >= END_ON * a.length3  # drawn with a head (not end-on)
+        factors = LENGTHS if a.kind == REACTION and headed and hd > 0 else (1.0,)
         away = 1.0 if float((a.tail + 0.5 * a.vec - centre) @ side) >= 0 else -1.0
-        shift = 0.0
+        shift, f = 0.0, 1.0
         for k in range(13):  # 0, then ±1, ±2, ... steps, away from G first
             shift = 0.0 if k == 0 else away * ((k + 1) // 2) * (1 if k % 2 else -1)
-            seg = seg0 + shift * STEP * unit * side
-            if not _lies_on(seg, placed, CLEAR * unit, RUN * unit):
+            t0 = a.tail + shift * STEP * unit * side
+            ok = False
+            for f in factors:
+                seg = np.array([t0, t0 + f * a.vec])
+                if _lies_on(seg, placed, CLEAR * unit, RUN * unit):
+                    continue
+                if headed and clear > 0 and (
+                        _distance(seg[1:], near)[0] < clear
+                        or np.any(_distance(tips, _strokes(seg, d, hd, a.couple)) < clear)):
+                    continue
+                ok = True
+                break
+            if ok:
                 break
         else:
-            shift = 0.0  # nowhere clear: leave it where it acts
+            shift, f = 0.0, 1.0  # nowhere clear: leave it where it acts
         b = (replace(a, tail=a.tail + shift * STEP * unit * side, moved_from=a.tail)
              if shift else a)
-        out.append(b)
-        placed = np.vstack((placed, np.array([[b.tail, b.tail + b.vec]])))
-    return out
+        if f != 1.0:
+            b = replace(b, vec=f * a.vec)
+        out[i] = b
+        seg = np.array([b.tail, b.tail + b.vec])
+        placed = np.vstack((placed, seg[None]))
+        if headed:
+            near = np.vstack((near, _strokes(seg, d, hd, a.couple)))
+            tips = np.vstack((tips, seg[1:]))
+        else:
+            near = np.vstack((near, seg[None]))
+    return [out[i] for i in range(len(arrs))]
