@@ -27,7 +27,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "over the whole run, and the arrows drawn), looking along the plane's normal for "
         "a planar model. With --live, serves meshcat's viewer on "
         "127.0.0.1 only until Ctrl-C.")
-    s.add_argument("source", metavar="MODEL|RUN", help="a model (.yaml) or a run (.npz)")
+    s.add_argument("source", metavar="MODEL|RUN",
+                   help="a model (.yaml, .xml, .urdf) or a run (.npz)")
     s.add_argument("-o", "--output", metavar="HTML",
                    help="the page to write (default: SOURCE's name with .html; with --live "
                    "a page is written only if this is given)")

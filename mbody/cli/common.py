@@ -92,6 +92,10 @@ def parse_known(pairs: Sequence[str]) -> dict[str, float]:
     return out
 
 
+MODEL_HELP = "a model file: mbody YAML, MuJoCo's MJCF (.xml) or URDF (.urdf)"
+"""The MODEL argument's help on every command that reads one."""
+
+
 def add_import_options(command: argparse.ArgumentParser) -> None:
     """Give a command that reads a model the options of MJCF and URDF input, and make its
     handler pass them to `load_model`. A command that has a ``--keyframe`` of its own

@@ -6,7 +6,7 @@ import argparse
 import json
 import sys
 
-from mbody.cli.common import EXIT_OK, load_model, parse_known
+from mbody.cli.common import EXIT_OK, MODEL_HELP, load_model, parse_known
 from mbody.errors import MbodyError
 
 
@@ -14,14 +14,14 @@ def register(sub: argparse._SubParsersAction) -> None:
     s = sub.add_parser("check", help="validate a model and summarise it (graph, mobility)",
                        description="Validate MODEL and print its bodies, loads, joints, "
                        "reaction unknowns, body/joint graph and mobility count.")
-    s.add_argument("model", metavar="MODEL", help="a YAML model file")
+    s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
     s.set_defaults(run=check)
 
     s = sub.add_parser("assemble", help="print every body's free body and Newton-Euler pair",
                        description="For every body: its free-body list and its Newton and "
                        "Euler equations with numbers filled in and reactions named; then the "
                        "sizes of the stacked M, b, Q, G.")
-    s.add_argument("model", metavar="MODEL", help="a YAML model file")
+    s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
     s.add_argument("--body", metavar="NAME", help="only this body")
     s.add_argument("--latex", metavar="FILE", nargs="?", const="-",
                    help="write a LaTeX document (each body's pair, the stacked system) to "
@@ -38,7 +38,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                        "solved together with the accelerations (M v_dot - G lambda = Q - b, "
                        "G^T v_dot = gamma) and printed as a reaction table, with the backward "
                        "error, a condition estimate and any redundant constraints named.")
-    s.add_argument("model", metavar="MODEL", help="a YAML model file")
+    s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
     s.add_argument("--known", metavar="LABEL=VALUE", action="append", default=[],
                    help="a known reaction value, e.g. --known A.Fx=3 (repeatable)")
     s.add_argument("--json", action="store_true", help="machine-readable output")

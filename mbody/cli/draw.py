@@ -7,7 +7,7 @@ import argparse
 import re
 from pathlib import Path
 
-from mbody.cli.common import EXIT_OK, load_model
+from mbody.cli.common import EXIT_OK, MODEL_HELP, load_model
 from mbody.errors import MbodyError, did_you_mean
 
 VIEW_HELP = ("spatial models: iso (default), front, top, side, or ELEV,AZIM in degrees "
@@ -20,7 +20,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                        "outline, mass centre and axes, applied forces, gravity, couples and "
                        "reaction components (dashed), with the body's Newton-Euler pair "
                        "under the drawing. Files are named fbd_<body>.<format>.")
-    s.add_argument("model", metavar="MODEL", help="a YAML model file")
+    s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
     s.add_argument("-o", "--output", metavar="DIR", default=".",
                    help="folder for the pictures (created if missing; default: .)")
     s.add_argument("--body", metavar="NAME", help="only this body")
@@ -33,7 +33,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     s = sub.add_parser("graph", help="draw the body/joint graph",
                        description="Draw the bodies and ground as nodes and every joint as "
                        "an edge labelled with its type and number of reaction components.")
-    s.add_argument("model", metavar="MODEL", help="a YAML model file")
+    s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
     s.add_argument("-o", "--output", metavar="FILE", default="graph.svg",
                    help="picture file; its extension (.svg, .png, .pdf) sets the format "
                    "(default: graph.svg)")
@@ -44,7 +44,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                        "picture, the sizes of the stacked M, b, Q, G, the accelerations "
                        "and joint reactions solved at the initial state (with units), and "
                        "every body's free-body diagram and equations.")
-    s.add_argument("model", metavar="MODEL", help="a YAML model file")
+    s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
     s.add_argument("-o", "--output", metavar="FILE", default="report.html",
                    help="the page to write (default: report.html)")
     s.add_argument("--view", metavar="VIEW", default="iso", help=VIEW_HELP)

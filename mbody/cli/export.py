@@ -8,7 +8,7 @@ import sys
 from collections.abc import Iterator
 from typing import TYPE_CHECKING
 
-from mbody.cli.common import EXIT_OK, load_model, parse_known, regular_file
+from mbody.cli.common import EXIT_OK, MODEL_HELP, load_model, parse_known, regular_file
 from mbody.errors import MbodyError, OutputError
 
 if TYPE_CHECKING:
@@ -25,7 +25,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "body masses and inertias, and the conventions. The format follows the suffix: "
         ".npz (numpy; reload with mbody.load_export), .mat (MATLAB/Octave; M and G sparse), "
         ".json (validates against mbody/data/assembly.schema.json); --csv DIR writes tables.")
-    s.add_argument("model", metavar="MODEL", help="a YAML model file")
+    s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
     s.add_argument("-o", "--output", metavar="FILE", action="append", default=[],
                    help="output file ending in .npz, .mat or .json (repeatable)")
     s.add_argument("--csv", metavar="DIR", help="write CSV tables into this folder")

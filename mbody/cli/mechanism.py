@@ -6,7 +6,7 @@ import argparse
 import json
 import sys
 
-from mbody.cli.common import EXIT_OK, load_model
+from mbody.cli.common import EXIT_OK, MODEL_HELP, load_model
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -15,7 +15,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                        "joints at the model's state: one row per reaction component (the "
                        "constraint it enforces), one column per coordinate, with gamma "
                        "(G^T v_dot = gamma) and the position errors phi.")
-    s.add_argument("model", metavar="MODEL", help="a YAML model file")
+    s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
     s.add_argument("--json", action="store_true", help="machine-readable output")
     s.set_defaults(run=jacobian)
 

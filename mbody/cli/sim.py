@@ -6,7 +6,7 @@ import argparse
 import math
 import sys
 
-from mbody.cli.common import EXIT_OK, load_model, parse_known, regular_file
+from mbody.cli.common import EXIT_OK, MODEL_HELP, load_model, parse_known, regular_file
 from mbody.errors import MbodyError
 
 COMPILE_NOTICE = ("mbody: compiling the fast path once (about a minute); later runs start at "
@@ -24,7 +24,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                        "step) and stored "
                        "with the run. Prints the run summary with the drift of energy, "
                        "angular momentum and joints; saves the trajectory with -o.")
-    s.add_argument("model", metavar="MODEL", help="a YAML model file")
+    s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
     s.add_argument("--t-end", type=float, default=10.0, metavar="SECONDS",
                    help="simulated time, s (default 10)")
     s.add_argument("--fps", type=float, default=60.0,

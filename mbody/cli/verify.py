@@ -7,7 +7,7 @@ import json
 import math
 import sys
 
-from mbody.cli.common import EXIT_OK, EXIT_UNMET, load_model, regular_file
+from mbody.cli.common import EXIT_OK, EXIT_UNMET, MODEL_HELP, load_model, regular_file
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -21,7 +21,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "single_inertia_in_space, missing_applied_load, not_an_equation_of_this_body. "
         "Then list the rows no correct equation gave. Exit code 0 when every equation is "
         "correct, 1 when some are not, 2 for a bad model or answers file.")
-    s.add_argument("model", metavar="MODEL", help="a YAML model file")
+    s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
     s.add_argument("answers", metavar="ANSWERS", help="a YAML answers file")
     s.add_argument("--json", action="store_true",
                    help="machine-readable output: one entry per equation, in file order")
