@@ -591,3 +591,51 @@ def test_no_row_of_a_shipped_model_with_one_term_reversed_or_1_percent_off_is_co
         v = verify(m, answers, asm=asm)
         for c, w in zip(v.checks, what, strict=True):
             assert not c.correct or c.details.get("form") == "fixed_pivot", (path.name, w)
+
+
+DP_SPRING = """\
+model: dp-spring
+dimension: 2
+gravity: [0, -9.81]
+bodies:
+  - {name: upper, mass: 2, shape: {box: [0.04, 0.6]}, angle: 30 deg,
+     position: [0.15, -0.259807621135332]}
+  - {name: lower, mass: 1, inertia: 0.03, position: [0.3, -0.769615242270663],
+     angle: 0, angular_velocity: 2 rad/s, velocity: [0.5, 0]}
+loads:
+  - {name: k1, type: spring, bodies: [ground, lower], at: [[1, -1], [0, -0.25]],
+     stiffness: 50, rest_length: 0.3, damping: 1}
+  - {name: tau, type: torque, body: upper, torque: 1.5}
+joints:
+  - {name: O, type: revolute, parent: ground, child: upper, at: [0, 0]}
+  - {name: A, type: revolute, parent: upper, child: lower,
+     at: [0.3, -0.519615242270663]}
+"""
+
+
+@pytest.fixture(scope="module")
+def dp_spring(tmp_path_factory) -> mbody.Model:
+    path = tmp_path_factory.mktemp("dp") / "dp_spring.yaml"
+    path.write_text(DP_SPRING)
+    return mbody.load(path)
+
+
+def test_reactions_are_treated_as_known_only_when_the_number_is_their_share(dp_spring):
+    def one(eq: str, body: str = "upper"):
+        return verify(dp_spring, [{"body": body, "eq": eq}]).checks[0]
+
+    # upper's Euler row: 0.0602667 alpha = 1.5 - 0.259808 O.Fx - 0.15 O.Fy
+    # - 0.259808 A.Fx - 0.15 A.Fy; solved, the four reactions add -2.65334 N m
+    for eq in ("I_G*alpha = 777", "I_G*alpha = 1.5 + 2.943", "I_G*alpha = 1.5 + 2.6533"):
+        c = one(eq)
+        assert c.diagnosis == "not_an_equation_of_this_body", (eq, c.explanation)
+        assert "Closest is" in c.explanation and "replaced by" not in c.explanation
+    # their solved share, rounded as a student would, and the static guess stay
+    for eq in ("I_G*alpha = 1.5 - 2.6533", "I_G*alpha = -1.1533", "I_G*alpha = 0"):
+        c = one(eq)
+        assert c.diagnosis == "reaction_treated_as_known", (eq, c.explanation)
+    # one reaction: a number that is neither its solved value nor its static guess
+    # (pendulum: O.Fy solved 15.9435 N, static m g = 19.62 N) is not that mistake
+    c = check("pendulum", "rod", "2*a_y = 7 - 19.62")
+    assert c.diagnosis == "not_an_equation_of_this_body", c.explanation
+    assert "replaced by" not in c.explanation

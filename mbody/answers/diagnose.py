@@ -117,7 +117,8 @@ def diagnose(s: Row, br: BodyRows, tol: float,
         Relative tolerance on each coefficient (see `mbody.answers.compare`).
     solved : callable, optional
         Returns the reactions' values at this state (solved), or None; asked only when
-        a reaction was replaced by a number, to say what its value is.
+        reactions may have been replaced by numbers, to tell whether the numbers are
+        their values (else the equation is not that mistake) and to say what they are.
 
     Returns
     -------
@@ -412,6 +413,8 @@ class _Diagnoser:
                 continue  # one term fixes no scale: ask that it be written as in the row
             # the student's constant, brought to the true row's scale, minus the true one
             extra = self.s.get(CONST) / f.k - r.row.get(CONST)
+            if not self.stands_for(r, gone, extra, f.k):
+                continue  # some other number: not these reactions' share of the row
             details: dict = {"reactions": gone}
             if len(gone) == 1:
                 k = gone[0]
@@ -443,6 +446,36 @@ class _Diagnoser:
                 f"as an unknown and keep its symbol, {_terms({k: -r.row.get(k) for k in gone})}"
                 " on the right side.", details)
         return None
+
+    def stands_for(self, r: TrueRow, gone: list[str], extra: float, k: float) -> bool:
+        """Whether `extra`, what the student's constant adds to the row `r` (at its scale)
+        in place of the reactions `gone`, is what those reactions contribute at this
+        state: their solved values, the static guess that they balance the rest of the
+        row (the student's constant 0), or each one's static value from the Newton row
+        it alone carries (``O.Fy = m g``). Within the tolerance on rounded numbers: the
+        student's numbers or the magnitudes of the terms that make the contribution."""
+        own = self.s.err(CONST) / abs(k)
+
+        def near(target: float, size: float) -> bool:
+            ref = max(own, r.row.err(CONST) + size)
+            return abs(extra - target) <= self.tol * ref
+
+        if near(-r.row.get(CONST), abs(r.row.get(CONST))):
+            return True
+        static = {}
+        for n in self.br.rows:
+            held = [x for x in n.row.unknowns if x in self.br.joints]
+            if not n.euler and len(held) == 1 and held[0] in gone:
+                static[held[0]] = -n.row.get(CONST) / n.row.get(held[0])
+        guesses = [static] if len(static) == len(gone) else []
+        sol = self.solved()
+        if sol is not None and all(x in sol for x in gone):
+            guesses.append({x: sol[x] for x in gone})
+        for values in guesses:
+            parts = [r.row.get(x) * values[x] for x in gone]
+            if near(sum(parts), sum(abs(p) for p in parts)):
+                return True
+        return False
 
     def closest(self) -> Diagnosis:
         candidates = [(r, r.row, self.words(r), r.text) for r in self.br.rows]
