@@ -26,11 +26,17 @@ Two more measures of what a reader needs (`far_labels`, `touching_tips`):
 - an arrow's tip touching another stroke: the point of an arrowhead lies within TIP
   points of the edge of another arrow (shaft or head), of the body's outline or of a body axis.
 
-Run as a script to print the count per model and view.
+and how many labels a picture joins to their arrow by a leader (`leaders`): at most
+LEADERS per picture, LEADERS_TOTAL over all, none to a body axis seen end-on (drawn
+as a ring with a dot or a cross beside G).
+
+Run as a script to print the count per model and view (overlaps / far labels /
+touching tips / leaders).
 """
 
 from __future__ import annotations
 
+import functools
 import sys
 from collections.abc import Iterator
 from pathlib import Path
@@ -359,6 +365,92 @@ def test_no_arrow_tip_touches_another_stroke_on_shipped_models(stem):
     assert bad == []
 
 
+LEADERS = 6
+"""At most this many labels of one picture are joined to their arrow by a leader."""
+LEADERS_TOTAL = 64
+"""... and at most this many over all shipped pictures (98 before end-on body axes were
+drawn as rings and labels could sit beside a whole shaft)."""
+
+
+def leaders(scene: Scene) -> list[str]:
+    """The owners (``<kind>:<name>``) of every label leader in the drawing panel."""
+    panel = next(p for p in scene.panels if p.gid == "drawing")
+    return [it.gid[len("label-leader:"):] for it in panel.items
+            if (getattr(it, "gid", None) or "").startswith("label-leader:")]
+
+
+def end_on_axis_problems(fbd: object, view: str, scene: Scene) -> list[str]:
+    """A body axis seen end-on (page length below END_ON of its length) is drawn as a
+    ring with a dot or a cross, its label within FAR label heights, and no leader."""
+    from mbody.present.draw import END_ON
+    from mbody.present.draw.views import eye, projection
+
+    P = projection(view)
+    panel = next(p for p in scene.panels if p.gid == "drawing")
+    gids = [getattr(it, "gid", None) or "" for it in panel.items]
+    found = []
+    for k, nm in enumerate("xyz"):
+        axis = np.asarray(fbd.W_R_B)[:, k]
+        if np.linalg.norm(P @ axis) >= END_ON:
+            continue
+        tag = f"body-axis:{nm}"
+        if f"label-leader:{tag}" in gids:
+            found.append(f"{tag} seen end-on has a leader")
+        if f"{tag}:ring" not in gids:
+            found.append(f"{tag} seen end-on has no ring")
+        mark = f"{tag}:dot" if float(axis @ eye(P)) > 0 else f"{tag}:cross"
+        if mark not in gids:
+            found.append(f"{tag} seen end-on has no {mark.split(':')[-1]}")
+    return found
+
+
+@functools.cache
+def leader_counts(stem: str) -> tuple[tuple[str, str, tuple[str, ...], tuple[str, ...]], ...]:
+    """(body, view, leaders, end-on axis problems) of every picture of a shipped model."""
+    m = mbody.load(ROOT / "models" / f"{stem}.yaml")
+    asm = mbody.assemble(m)
+    out = []
+    for name, view, sc in scenes(stem):
+        bad = (end_on_axis_problems(asm.bodies[name].fbd, view, sc)
+               if m.dimension == 3 else [])
+        out.append((name, view, tuple(leaders(sc)), tuple(bad)))
+    return tuple(out)
+
+
+def test_measure_sees_leaders_and_end_on_axes():
+    sc = Scene(200, 200)
+    p = sc.panel("drawing", (0, 0, 200, 200), np.zeros(2), np.array([200.0, 200.0]))
+    p.add(Line(np.array([[80.0, 100], [150, 150]]), "red", gid="label-leader:reaction:A.Fx"),
+          Line(np.array([[100.0, 100], [100, 100]]), "grey", gid="body-axis:z"),
+          Line(np.array([[100.0, 100], [120, 150]]), "grey", gid="label-leader:body-axis:z"))
+    assert leaders(sc) == ["reaction:A.Fx", "body-axis:z"]
+
+    class Box:  # a body turned so that its z axis points at the eye in the front view
+        W_R_B = np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]])
+
+    assert end_on_axis_problems(Box(), "front", sc) == [
+        "body-axis:z seen end-on has a leader", "body-axis:z seen end-on has no ring",
+        "body-axis:z seen end-on has no dot"]
+    assert end_on_axis_problems(Box(), "top", sc) == [
+        "body-axis:y seen end-on has no ring", "body-axis:y seen end-on has no dot"]
+
+
+@pytest.mark.parametrize("stem", [p.stem for p in MODELS])
+def test_few_label_leaders_and_none_to_an_end_on_axis_on_shipped_models(stem):
+    """A body axis seen end-on is a ring beside G, labelled beside it; a picture has at
+    most LEADERS label leaders."""
+    found = leader_counts(stem)
+    bad = [f"{name} ({view}): {o}" for name, view, _, probs in found for o in probs]
+    bad += [f"{name} ({view}): {len(ls)} leaders > {LEADERS}: {', '.join(ls)}"
+            for name, view, ls, _ in found if len(ls) > LEADERS]
+    assert bad == []
+
+
+def test_label_leaders_over_all_shipped_pictures_within_budget():
+    total = sum(len(ls) for path in MODELS for _, _, ls, _ in leader_counts(path.stem))
+    assert total <= LEADERS_TOTAL
+
+
 def legend_problems(scene: Scene) -> list[str]:
     """The legend's frame and texts inside the picture, clear of the world-axes triad."""
     root = scene.root
@@ -389,7 +481,7 @@ def test_legend_fits_in_the_picture(stem):
 
 
 def main() -> int:
-    total = far = tips = 0
+    total = far = tips = lead = 0
     only = set(sys.argv[1:])
     for path in MODELS:
         if only and path.stem not in only:
@@ -397,12 +489,14 @@ def main() -> int:
         per = []
         for name, view, sc in scenes(path.stem):
             found, fl, tt = overlaps(sc), far_labels(sc), touching_tips(sc)
+            ld = leaders(sc)
             total, far, tips = total + len(found), far + len(fl), tips + len(tt)
-            per.append(f"{name}/{view} {len(found)}/{len(fl)}/{len(tt)}")
-            for f in found + fl + tt:
+            lead += len(ld)
+            per.append(f"{name}/{view} {len(found)}/{len(fl)}/{len(tt)}/{len(ld)}")
+            for f in found + fl + tt + [f"leader to {n}" for n in ld]:
                 print(f"    {path.stem} {name} {view}: {f}")
         print(f"{path.stem:<28} " + ", ".join(per), flush=True)
-    print("overlaps", total, "far labels", far, "touching tips", tips)
+    print("overlaps", total, "far labels", far, "touching tips", tips, "label leaders", lead)
     return 0
 
 

@@ -119,19 +119,41 @@ def fbd_scene(fbd: FreeBodyDiagram, *, view: View = "iso", equations: bool = Tru
     obstacles.append((G + 1.3 * rg * circle(16), "mass-centre"))
     fixed = [o[0] for o in obstacles]  # strokes an arrow must not lie on: outline, axes
     labels: list[Label] = []
-    for k, nm in enumerate("xyz"[:2 if planar else 3]):
-        tip = G + P @ (fbd.W_R_B[:, k] * 0.38 * shape.size)
-        seg = np.array([G, tip])
-        ax.add(Line(seg, AXIS_COLOR, 1.0, zorder=3, gid=f"body-axis:{nm}"))
+    axes3 = [fbd.W_R_B[:, k] * 0.38 * shape.size for k in range(2 if planar else 3)]
+    for k, nm in enumerate("xyz"[:len(axes3)]):
         tag = f"body-axis:{nm}"
+        tip = G + P @ axes3[k]
+        if not planar and np.linalg.norm(tip - G) < END_ON * np.linalg.norm(axes3[k]):
+            # seen end-on: a small ring beside G, a dot toward the eye, a cross away
+            c, r, u = _end_on_axis(G, rg, lmax, [P @ v for v in axes3]
+                                   + [a.vec for a in arrs if a.arc is None
+                                      and np.linalg.norm(a.tail - G) < 2 * rg])
+            # its short shaft stays under G's marker, for tools (as an end-on arrow's)
+            ax.add(Line(np.array([G, tip]), AXIS_COLOR, 1.0, zorder=3, gid=tag),
+                   Disc(c, r, "white", AXIS_COLOR, 1.0, zorder=3, gid=f"{tag}:ring"))
+            if float(fbd.W_R_B[:, k] @ E) > 0:
+                ax.add(Disc(c, 0.3 * r, AXIS_COLOR, zorder=3, gid=f"{tag}:dot"))
+            else:
+                for s_ in (1, -1):
+                    xx = c + 0.7 * r * np.array([[-1, -s_], [1, s_]]) / math.sqrt(2)
+                    ax.add(Line(xx, AXIS_COLOR, 1.0, zorder=3, gid=f"{tag}:cross"))
+            ring = c + r * circle(16)
+            obstacles.append((ring, tag))
+            fixed.append(ring)
+            anchor = c + r * u
+            labels.append(Label(Text(f"${nm}_B$", anchor, 8, AXIS_COLOR, math=True,
+                                     zorder=10, gid=f"label:{tag}"), anchor, u, tag))
+            continue
+        seg = np.array([G, tip])
+        ax.add(Line(seg, AXIS_COLOR, 1.0, zorder=3, gid=tag))
         if np.linalg.norm(tip - G) > 1e-9:
             arrowhead = head(tip, (tip - G) / np.linalg.norm(tip - G), 0.6 * hd)
-            ax.add(Poly(arrowhead, AXIS_COLOR, zorder=3, gid=f"body-axis:{nm}:head"))
+            ax.add(Poly(arrowhead, AXIS_COLOR, zorder=3, gid=f"{tag}:head"))
             obstacles.append((arrowhead[[0, 1, 2, 0]], tag))
         obstacles.append((seg, tag))
         fixed.append(seg)
         labels.append(Label(Text(f"${nm}_B$", tip, 8, AXIS_COLOR, math=True, zorder=10,
-                                 gid=f"label:body-axis:{nm}"), tip, tip - G, tag,
+                                 gid=f"label:{tag}"), tip, tip - G, tag,
                             float(np.linalg.norm(tip - G))))
     labels.append(Label(Text("G", G, 9, zorder=10, gid="label:mass-centre"), G,
                         np.array([-1.0, 1.0]), "mass-centre"))
@@ -245,6 +267,20 @@ def _arrow(ax: list[Item], a: Arrow, lmax: float, hd: float,
         shaft = float(n)
     text = Text(a.label, anchor, 9, a.color, zorder=10, gid="label:" + a.gid.split(":", 1)[1])
     return Label(text, anchor, direction, a.gid, shaft)
+
+
+def _end_on_axis(G: np.ndarray, rg: float, lmax: float, away: list[np.ndarray]
+                 ) -> tuple[np.ndarray, float, np.ndarray]:
+    """Where a body axis seen end-on is drawn: a ring of radius r centred at c beside G's
+    marker (radius rg), in the direction u farthest from the strokes leaving G (`away`:
+    page vectors of the other axes and of the arrows at G); the label goes on along u."""
+    dirs = [v / np.linalg.norm(v) for v in away if np.linalg.norm(v) > 1e-9 * lmax]
+    ang = np.radians(np.arange(0, 360, 15) - 45.0)  # lower right first, on ties
+    cand = np.column_stack((np.cos(ang), np.sin(ang)))
+    worst = np.max(cand @ np.array(dirs).T, axis=1) if dirs else np.zeros(len(cand))
+    u = cand[int(np.argmin(np.round(worst, 6)))]
+    r = 0.04 * lmax
+    return G + (rg + 1.8 * r) * u, r, u
 
 
 def _equation_lines(fbd: FreeBodyDiagram, planar: bool) -> list[str]:

@@ -57,18 +57,23 @@ def sample(points: np.ndarray, step: float) -> np.ndarray:
 
 
 def _rings(length: float | None) -> list[np.ndarray]:
-    """Candidate offsets (points) as (along, across) the label's direction, in groups
-    tried in turn: beyond the tip and beside a straight shaft (`length` points) along
-    it, then rings farther and farther out."""
-    first: list[tuple[float, float]] = [(5, 0), (5, 9), (5, -9), (0, 10), (0, -10)]
-    if length is not None:  # beside the shaft, half-way first, then all along it
-        for f in (0.5, 0.3, 0.7, 0.15, 0.85):
-            first += [(-f * length, 10), (-f * length, -10)]
+    """Candidate spots (points), (c, 4) each: offset along and across the label's
+    direction, and the side the box lies on from that point (along, across), in groups
+    tried in turn: beyond the tip, beside it and beside a straight shaft (`length`
+    points) all along it, then rings farther and farther out."""
+    first: list[tuple[float, float, float, float]] = [
+        (5, 0, 1, 0), (5, 9, 1, 1), (5, -9, 1, -1), (0, 10, 0, 1), (0, -10, 0, -1),
+        (-5, 6, -1, 1), (-5, -6, -1, -1)]
+    if length is not None:  # beside the shaft, half-way first, then all along it: the
+        # box lies to the side (not centred on the shaft)
+        for f in (0.5, 0.3, 0.7, 0.15, 0.85, 0.05, 0.95):
+            first += [(-f * length, 6, 0, 1), (-f * length, -6, 0, -1)]
     groups = [np.array(first, dtype=float)]
     for r, n in ((12.0, 16), (20.0, 24), (30.0, 24), (42.0, 32), (58.0, 32), (78.0, 40),
                  (100.0, 40)):
         ang = np.linspace(0, 2 * np.pi, n, endpoint=False)
-        groups.append(np.column_stack((r * np.cos(ang), r * np.sin(ang))))
+        ring = np.column_stack((r * np.cos(ang), r * np.sin(ang)))
+        groups.append(np.hstack((ring, ring)))
     return groups
 
 
@@ -107,13 +112,14 @@ def place(panel: Panel, labels: list[Label], obstacles: list[tuple[np.ndarray, s
         mine = P[tags == names.get(lab.own, -2)] if len(P) else P
         near_gap = NEAR * h
         # strokes near enough to matter for this label
-        reach = 100.0 + w + h + 2 * PAD
+        reach = 100.0 + w + h + 2 * PAD + (length or 0.0)  # spots along the shaft too
         near = np.all(np.abs(P - a_pt) < reach, axis=1) if len(P) else np.zeros(0, bool)
         Q = P[near]
         best: tuple[float, float, float, float, float, float, float] | None = None
         for g, sp in enumerate(_rings(length)):
-            off = sp[:, :1] * d + sp[:, 1:] * nrm  # (c, 2) points
-            o = off / np.maximum(np.linalg.norm(off, axis=1, keepdims=True), 1e-12)
+            off = sp[:, :1] * d + sp[:, 1:2] * nrm  # (c, 2) points
+            side = sp[:, 2:3] * d + sp[:, 3:4] * nrm
+            o = side / np.maximum(np.linalg.norm(side, axis=1, keepdims=True), 1e-12)
             fx = np.where(o[:, 0] > 0.3, 0.0, np.where(o[:, 0] < -0.3, 1.0, 0.5))
             fy = np.where(o[:, 1] > 0.3, 0.0, np.where(o[:, 1] < -0.3, 1.0, 0.5))
             x0 = a_pt[0] + off[:, 0] - fx * w - PAD
