@@ -279,3 +279,33 @@ def test_cli_simulate_and_plot(tmp_path, capsys):
     assert main(["simulate", str(MODELS / "seed_example_2.yaml"), "--fps", "-3"]) == 2
     err = capsys.readouterr().err
     assert "fps" in err and "Traceback" not in err
+
+
+def _panel_titles(traj: mbody.Trajectory) -> list[str]:
+    from mbody.present.plot import plot_trajectory
+
+    return [a.get_title() for a in plot_trajectory(traj).axes]
+
+
+def test_plot_leaves_out_panels_with_nothing_to_show(tmp_path, capsys):
+    """A planar revolute joint has force components only: the figure has no empty
+    'no joint reaction moments' axes, just the five panels that show something (the
+    lone last one spanning its row); a run without joints keeps its four panels."""
+    import dataclasses
+
+    traj = mbody.simulate(_model("double_pendulum"), t_end=0.2, fps=30)
+    assert traj.reaction_labels and not any(".M" in lab for lab in traj.reaction_labels)
+    titles = _panel_titles(traj)
+    assert len(titles) == 5 and not any(t.startswith("no ") for t in titles)
+    assert titles[-1] == "joint reaction forces, joint axes"
+    run, png = tmp_path / "dp.npz", tmp_path / "dp.png"
+    traj.save(run)
+    assert main(["plot", str(run), "-o", str(png)]) == 0
+    assert capsys.readouterr().out == f"wrote {png}\n"
+    # moments only (forces known): the force panel is the one left out
+    moments = dataclasses.replace(
+        traj, reaction_labels=tuple(lab.replace(".F", ".M") for lab in traj.reaction_labels))
+    titles = _panel_titles(moments)
+    assert len(titles) == 5 and titles[-1] == "joint reaction moments, joint axes"
+    free = mbody.simulate(_model("torque_free_asymmetric"), t_end=0.2, fps=30)
+    assert len(_panel_titles(free)) == 4

@@ -57,7 +57,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                        "that stores joint reactions (every run of a model with joints) gets "
                        "a third row: the reaction force components (N) and moment "
                        "components (N m) over time, each along its joint-frame axis, +R on "
-                       "the child (the first 12 of each kind).")
+                       "the child (the first 12 of each kind; a kind the joints do not have, "
+                       "such as the moments of a planar revolute joint, gets no panel).")
     s.add_argument("trajectory", metavar="RUN.npz",
                    help="a trajectory saved by 'mbody simulate -o'")
     s.add_argument("-o", "--output", required=True, metavar="FILE",

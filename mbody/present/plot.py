@@ -10,9 +10,12 @@ tests); `save_plot` writes it atomically, the format taken from the file's exten
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
+from functools import partial
 from pathlib import Path
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
@@ -46,7 +49,10 @@ def _relative(x: np.ndarray, scale: float) -> np.ndarray:
 
 
 def plot_trajectory(traj: Trajectory, bodies: list[str] | None = None) -> Figure:
-    """A 2 × 2 figure: ω components, energy, angular momentum, relative drift."""
+    """Panels two to a row: ω components, energy, angular momentum, relative drift, and for
+    a run with joint reactions their force and moment components. A panel with nothing to
+    show (no moment components: a planar revolute joint, a spherical one) is left out, not
+    drawn as empty axes; an odd last panel spans its row."""
     names = list(bodies) if bodies else list(traj.body_names[:MAX_BODIES])
     unknown = [b for b in names if b not in traj.body_names]
     if unknown:
@@ -55,17 +61,39 @@ def plot_trajectory(traj: Trajectory, bodies: list[str] | None = None) -> Figure
     t = traj.t
     T, E, H, kind = _energy_momentum(traj)
 
-    has_reactions = bool(traj.reaction_labels) and traj.reactions.shape[1] > 0
-    fig = Figure(figsize=(11, 10.5 if has_reactions else 7.5), layout="constrained")
+    panels: list[Callable[[Axes], None]] = [
+        lambda a: _omega_panel(traj, a, idx, names),
+        lambda a: _energy_panel(t, T, E, a),
+        lambda a: _momentum_panel(traj, H, kind, a),
+        lambda a: _drift_panel(traj, T, E, H, a),
+    ]
+    for moment in (False, True):
+        sel = _reaction_columns(traj, moment)
+        if sel:
+            panels.append(partial(_reaction_panel, traj, moment=moment, sel=sel))
+
+    rows = (len(panels) + 1) // 2
+    fig = Figure(figsize=(11, 1.5 + 3 * rows), layout="constrained")
     FigureCanvasAgg(fig)
-    ax = fig.subplots(3 if has_reactions else 2, 2)
+    grid = fig.add_gridspec(rows, 2)
     title = f"{traj.model_name or 'trajectory'}: {traj.n} bod{'y' if traj.n == 1 else 'ies'}"
     if traj.info:
         title += (f", {traj.info.get('integrator', '')} rtol {traj.info.get('rtol', 0):g}")
     fig.suptitle(title)
+    for k, draw in enumerate(panels):
+        r, c = divmod(k, 2)
+        lone = k == len(panels) - 1 and c == 0
+        a = fig.add_subplot(grid[r, :] if lone else grid[r, c])
+        draw(a)
+        a.set_xlabel("t (s)")
+        a.grid(True, alpha=0.3)
+        if a.get_legend_handles_labels()[0]:
+            a.legend(fontsize="small", ncol=2 if len(a.lines) > 6 else 1)
+    return fig
 
-    a = ax[0, 0]
-    w = traj.angular_velocity
+
+def _omega_panel(traj: Trajectory, a: Axes, idx: list[int], names: list[str]) -> None:
+    t, w = traj.t, traj.angular_velocity
     for i, b in zip(idx, names, strict=True):
         if traj.dimension == cv.PLANAR:
             a.plot(t, w[:, i], label=f"{b} θ̇")
@@ -76,7 +104,8 @@ def plot_trajectory(traj: Trajectory, bodies: list[str] | None = None) -> Figure
     a.set_title("angular velocity, body axes" + shown)
     a.set_ylabel("rad/s")
 
-    a = ax[0, 1]
+
+def _energy_panel(t: np.ndarray, T: np.ndarray, E: np.ndarray, a: Axes) -> None:
     a.plot(t, T, label="kinetic T")
     if not np.allclose(E, T):
         a.plot(t, E, label="T + V")
@@ -86,7 +115,9 @@ def plot_trajectory(traj: Trajectory, bodies: list[str] | None = None) -> Figure
     a.set_title("energy")
     a.set_ylabel("J")
 
-    a = ax[1, 0]
+
+def _momentum_panel(traj: Trajectory, H: np.ndarray, kind: str, a: Axes) -> None:
+    t = traj.t
     if traj.dimension == cv.PLANAR:
         a.plot(t, H[:, 2], label="H_z")
     else:
@@ -96,7 +127,10 @@ def plot_trajectory(traj: Trajectory, bodies: list[str] | None = None) -> Figure
     a.set_title(f"angular momentum, world axes ({kind})")
     a.set_ylabel("kg m²/s")
 
-    a = ax[1, 1]
+
+def _drift_panel(traj: Trajectory, T: np.ndarray, E: np.ndarray, H: np.ndarray,
+                 a: Axes) -> None:
+    t = traj.t
     e_scale = max(abs(float(E[0])), float(np.max(np.abs(T))))
     h_scale = float(np.max(np.linalg.norm(H, axis=1)))
     a.semilogy(t, _relative(E, e_scale), label="energy")
@@ -106,32 +140,29 @@ def plot_trajectory(traj: Trajectory, bodies: list[str] | None = None) -> Figure
                  if traj.info.get(key)]
     a.set_title("relative change" + (f" (conserved: {', '.join(conserved)})"
                                       if conserved else " (nothing conserved)"))
-    if has_reactions:
-        _reaction_panels(traj, ax[2, 0], ax[2, 1])
-    for a in ax.flat:
-        a.set_xlabel("t (s)")
-        a.grid(True, alpha=0.3)
-        if a.get_legend_handles_labels()[0]:
-            a.legend(fontsize="small", ncol=2 if len(a.lines) > 6 else 1)
-    return fig
 
 
 MAX_REACTIONS = 12
 """Reaction components drawn per panel (the first ones in label order)."""
 
 
-def _reaction_panels(traj: Trajectory, forces_ax, moments_ax) -> None:
-    """Reaction components over time: forces (N) on one panel, moments (N m) on the other;
-    each on its joint frame axis, acting +R on the child and −R on the parent."""
+def _reaction_columns(traj: Trajectory, moment: bool) -> list[int]:
+    """Columns of `traj.reactions` holding moment (`M…`) or force components."""
+    if not traj.reaction_labels or traj.reactions.ndim != 2 or traj.reactions.shape[1] == 0:
+        return []
+    return [k for k, lab in enumerate(traj.reaction_labels)
+            if lab.split(".", 1)[-1].startswith("M") == moment]
+
+
+def _reaction_panel(traj: Trajectory, a: Axes, *, moment: bool, sel: list[int]) -> None:
+    """Reaction components over time, forces (N) or moments (N m), each on its joint frame
+    axis, acting +R on the child and −R on the parent."""
     labels = list(traj.reaction_labels)
-    for ax, moment, unit in ((forces_ax, False, "N"), (moments_ax, True, "N m")):
-        sel = [k for k, lab in enumerate(labels) if lab.split(".", 1)[1].startswith("M") == moment]
-        for k in sel[:MAX_REACTIONS]:
-            ax.plot(traj.t, traj.reactions[:, k], label=labels[k])
-        more = f" (first {MAX_REACTIONS} of {len(sel)})" if len(sel) > MAX_REACTIONS else ""
-        ax.set_title(f"joint reaction {'moments' if moment else 'forces'}, joint axes{more}"
-                     if sel else f"no joint reaction {'moments' if moment else 'forces'}")
-        ax.set_ylabel(unit)
+    for k in sel[:MAX_REACTIONS]:
+        a.plot(traj.t, traj.reactions[:, k], label=labels[k])
+    more = f" (first {MAX_REACTIONS} of {len(sel)})" if len(sel) > MAX_REACTIONS else ""
+    a.set_title(f"joint reaction {'moments' if moment else 'forces'}, joint axes{more}")
+    a.set_ylabel("N m" if moment else "N")
 
 
 def save_plot(traj: Trajectory, path: str | os.PathLike[str], bodies: list[str] | None = None,
