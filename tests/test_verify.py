@@ -639,3 +639,25 @@ def test_reactions_are_treated_as_known_only_when_the_number_is_their_share(dp_s
     c = check("pendulum", "rod", "2*a_y = 7 - 19.62")
     assert c.diagnosis == "not_an_equation_of_this_body", c.explanation
     assert "replaced by" not in c.explanation
+
+
+def test_the_names_offered_for_a_body_are_its_own_reactions(tmp_path):
+    def error(body, eq):
+        return errors("double_pendulum", f"equations:\n  - {{body: {body}, eq: '{eq}'}}\n",
+                      tmp_path)[0]
+
+    # lower hangs from A only: O.Fx, O.Fy are not on its free body (they were listed)
+    out = error("lower", "m*a_y = A.Fy - m*gg")
+    names = out.split("(the names: ")[1]
+    assert "A.Fx, A.Fy" in names and "O.F" not in names, out
+    out = error("upper", "m*a_y = O.Fy - m*gg")
+    assert "O.Fx, O.Fy, A.Fx, A.Fy" in out.split("(the names: ")[1], out
+    # a misspelt component of another body's joint: said so, never suggested
+    out = error("lower", "m*a_x = A.Fx + O.Fz")
+    assert "joint O does not act on lower" in out and "did you mean" not in out, out
+    # another body's reaction, spelt right, is a mistake of the free body, not of the
+    # file: a diagnosis that names it as not acting on this body
+    c = check("double_pendulum", "lower", "m*a_x = A.Fx + O.Fx")
+    assert c.diagnosis == "not_an_equation_of_this_body"
+    assert c.details["foreign"] == ["O.Fx"]
+    assert "O.Fx is a reaction of a joint that does not touch lower" in c.explanation

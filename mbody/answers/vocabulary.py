@@ -101,6 +101,10 @@ class Vocabulary:
         Other spellings -> the names above.
     absent : dict of str to str
         Names that exist for other bodies or models but not here -> why (for the error).
+    acting : tuple of str, optional
+        The unknown reaction labels of the joints that touch this body (the ones on its
+        free body): the only ones an error's list of names and suggestions offer.
+        Defaults to `reactions`.
     """
 
     body: str
@@ -110,6 +114,12 @@ class Vocabulary:
     values: dict[str, float]
     aliases: dict[str, str] = field(default_factory=dict)
     absent: dict[str, str] = field(default_factory=dict)
+    acting: tuple[str, ...] | None = None
+
+    @property
+    def own_reactions(self) -> tuple[str, ...]:
+        """The unknown reactions that act on this body (`acting`, else every one)."""
+        return self.reactions if self.acting is None else self.acting
 
     @property
     def unknowns(self) -> tuple[str, ...]:
@@ -148,6 +158,11 @@ class Vocabulary:
         if name in self.absent:
             raise KeyError(self.absent[name])
         hint = self._hint(name)
+        joint = name.partition(".")[0] + "."
+        if "." in name and not hint and any(r.startswith(joint) for r in self.reactions) \
+                and not any(r.startswith(joint) for r in self.own_reactions):
+            hint = (f"joint {joint[:-1]} does not act on {self.body}: its reactions are not "
+                    "on this free body")
         what = (f"no reaction component {name!r} in this model" if "." in name else
                 f"unknown name {name!r} for body {self.body!r}")
         raise KeyError(what + (f"; {hint}" if hint else "")
@@ -165,7 +180,10 @@ class Vocabulary:
             a, b = name[:k], name[k:]
             if a != b and self._known(a) and self._known(b):  # "gg" is a typo of g
                 return f"write {a}*{b}: a product needs '*'"
-        known = [n for n in (*self.unknowns, *self.values) if n not in self.absent]
+        # another body's reactions are understood but never suggested: they are not on
+        # this free body
+        known = [n for n in (*self.accelerations, *self.own_reactions, *self.values)
+                 if n not in self.absent]
         hint = did_you_mean(name, known)
         if not hint:
             hint = did_you_mean(name, [a for a in self.aliases if a.isascii()])
@@ -190,9 +208,9 @@ class Vocabulary:
         str
         """
         shown = list(self.accelerations)
-        if self.reactions:
-            shown.append(", ".join(self.reactions[:6]) + (" ..." if len(self.reactions) > 6
-                                                          else ""))
+        own = self.own_reactions
+        if own:
+            shown.append(", ".join(own[:6]) + (" ..." if len(own) > 6 else ""))
         shown += [n for n in self.values if "." not in n and n != "pi"]
         return ", ".join(shown)
 
@@ -280,6 +298,9 @@ def vocabulary(model: Model, state: State, body: str) -> Vocabulary:
                 f"there is no name for the inertia about joint {joint.name}: write "
                 "moments about the mass centre, with I_1, I_2, I_3 or I_11 ... I_33"))
     reactions = tuple(r for r in model.reactions if r not in known)
+    touching = {label for joint in model.joints if body in (joint.parent, joint.child)
+                for label in joint.labels}
+    acting = tuple(r for r in reactions if r in touching)
     for label, value in known.items():
         values[label] = float(value)
     # the time, so that a load written as `mbody assemble --symbolic` defines it
@@ -289,7 +310,7 @@ def vocabulary(model: Model, state: State, body: str) -> Vocabulary:
         values.setdefault(sym.name, float(sym.value))
     return Vocabulary(body, model.dimension, tuple(accelerations), reactions, values,
                       {a: c for a, c in aliases.items() if a not in values},
-                      {n: why for n, why in absent.items() if n not in values})
+                      {n: why for n, why in absent.items() if n not in values}, acting)
 
 
 def _planar_angle(W_R_B: np.ndarray) -> float:
