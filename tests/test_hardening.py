@@ -535,6 +535,14 @@ def test_numbers_in_expressions_keep_the_range(tmp_path, capsys, expr, message):
      "(a decimal comma? write 1.5)"),
     ("    mass: 1.5 kg\n", "m.yaml:6:11: bodies[0].mass: expected a number, got the text "
      "'1.5 kg' (numbers are in SI units, written without the unit: 1.5)"),
+    ("    mass: 500 g\n", "m.yaml:6:11: bodies[0].mass: expected a number, got the text "
+     "'500 g' (numbers are in SI units, written without the unit: 500 g is 0.5 kg)"),
+    ("    angular_velocity: 60 rpm\n", "m.yaml:6:23: bodies[0].angular_velocity: expected a "
+     "number (radians/s) or a string like '30 deg/s', got '60 rpm' (numbers are in SI units, "
+     "written without the unit: 60 rpm is 6.28319 rad/s)"),
+    ("    mass: 3 stone\n", "m.yaml:6:11: bodies[0].mass: expected a number, got the text "
+     "'3 stone' (numbers are in SI units (kg, m, s, N, rad), written without the unit: "
+     "convert '3 stone' to SI first)"),
     ("    angle: 30°\n", "m.yaml:6:12: bodies[0].angle: expected a number (radians) or a string "
      "like '30 deg', got '30°' (write '30 deg')"),
     ("    angle: 30 degrees\n", "m.yaml:6:12: bodies[0].angle: expected a number (radians) or "
@@ -548,6 +556,17 @@ def test_units_and_decimal_commas_get_a_did_you_mean(tmp_path, capsys, line, mes
             + ("    position: [0, 0]\n" if "mass" in line else "    mass: 1\n") + line)
     code, err = check(tmp_path, capsys, text)
     assert (code, err) == (2, f"mbody: error: {message}\n")
+
+
+@pytest.mark.parametrize(("typ", "name"), [("hinge", "revolute"), ("slide", "prismatic"),
+                                          ("weld", "fixed")])
+def test_another_programs_joint_type_names_mbodys(tmp_path, capsys, typ, name):
+    """MuJoCo's and URDF's names are not close in spelling to mbody's: say which is meant."""
+    text = ("dimension: 2\nbodies: [{name: a, mass: 1, inertia: 1}]\n"
+            f"joints: [{{name: O, type: {typ}, parent: ground, child: a, at: [0, 0]}}]\n")
+    code, err = check(tmp_path, capsys, text)
+    assert (code, err) == (2, f"mbody: error: m.yaml:3:26: joints[0].type: unknown planar "
+                              f"joint type '{typ}' (mbody calls it '{name}')\n")
 
 
 def test_a_file_of_millions_of_values_is_refused_early(tmp_path, capsys):

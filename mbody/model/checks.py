@@ -329,8 +329,37 @@ def _number_hint(value: Any) -> str:
         return f"a decimal comma? write {m.group(1)}.{m.group(2)}"
     m = _WITH_UNIT.fullmatch(value)
     if m and len(value) < 40:
-        return f"numbers are in SI units, written without the unit: {m.group(1)}"
+        number, unit = m.group(1), " ".join(m.group(2).replace("·", " ").split())
+        if unit in _SI_UNITS:
+            return f"numbers are in SI units, written without the unit: {number}"
+        if unit in _TO_SI:
+            factor, si = _TO_SI[unit]
+            return (f"numbers are in SI units, written without the unit: {number} {unit} "
+                    f"is {float(number) * factor:.6g} {si}")
+        return (f"numbers are in SI units (kg, m, s, N, rad), written without the unit: "
+                f"convert {value.strip()!r} to SI first")
     return ""
+
+
+# Units a newcomer writes after a number. An SI one is dropped as it is; a common other
+# one is converted in the hint (its bare number would be off by its factor: 500 g is
+# 0.5, not 500).
+_SI_UNITS = frozenset((
+    "kg", "m", "s", "N", "N m", "Nm", "m/s", "m/s^2", "m/s²", "rad", "rad/s", "rad/s^2",
+    "rad/s²", "kg m^2", "kg m²", "kgm^2", "kgm²", "N/m", "N s/m", "Ns/m", "J", "W", "Pa"))
+_TO_SI: dict[str, tuple[float, str]] = {
+    "g": (1e-3, "kg"), "mg": (1e-6, "kg"), "lb": (0.45359237, "kg"),
+    "lbs": (0.45359237, "kg"), "mm": (1e-3, "m"), "cm": (1e-2, "m"), "km": (1e3, "m"),
+    "in": (0.0254, "m"), "ft": (0.3048, "m"), "ms": (1e-3, "s"), "min": (60.0, "s"),
+    "h": (3600.0, "s"), "kN": (1e3, "N"), "mN": (1e-3, "N"), "N mm": (1e-3, "N m"),
+    "N cm": (1e-2, "N m"), "Nmm": (1e-3, "N m"), "kN m": (1e3, "N m"),
+    "rpm": (2 * math.pi / 60, "rad/s"), "rev/min": (2 * math.pi / 60, "rad/s"),
+    "rev/s": (2 * math.pi, "rad/s"), "rev": (2 * math.pi, "rad"), "Hz": (2 * math.pi, "rad/s"),
+    "km/h": (1 / 3.6, "m/s"), "mm/s": (1e-3, "m/s"), "cm/s": (1e-2, "m/s"),
+    "kg mm^2": (1e-6, "kg m^2"), "kg mm²": (1e-6, "kg m^2"), "kg cm^2": (1e-4, "kg m^2"),
+    "kg cm²": (1e-4, "kg m^2"), "g cm^2": (1e-7, "kg m^2"), "g cm²": (1e-7, "kg m^2"),
+    "N/mm": (1e3, "N/m"),
+}
 
 
 def _angle_hint(value: str, unit: str) -> str:

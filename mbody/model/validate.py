@@ -243,6 +243,14 @@ class Spec:
             self.bodies)
 
 
+_JOINT_SYNONYMS = {
+    "hinge": "revolute", "pin": "revolute", "continuous": "revolute", "slide": "prismatic",
+    "slider": "prismatic", "ball": "spherical", "weld": "fixed", "cardan": "universal",
+    "hooke": "universal",
+}
+"""Other programs' names for mbody's joint types (MuJoCo, URDF, textbooks)."""
+
+
 def validate(doc: Document) -> Spec:
     """Check a loaded document against the contract.
 
@@ -767,6 +775,9 @@ def _joints(c: Checker, value: Any, names: dict[str, int],
             here, there = ("planar", "spatial") if c.dim == cv.PLANAR else ("spatial", "planar")
             c.err((*p, "type"), f"'{j['type']}' is a {there} joint type; a {here} model "
                   f"(dimension: {c.dim}) has: {', '.join(types)}")
+        elif isinstance(j.get("type"), str) and _JOINT_SYNONYMS.get(j["type"]) in types:
+            c.err((*p, "type"), f"unknown {'planar' if c.dim == 2 else 'spatial'} joint type "
+                  f"'{j['type']}'", f"mbody calls it '{_JOINT_SYNONYMS[j['type']]}'")
         elif "type" in j:
             typ = c.choice((*p, "type"), j["type"], types,
                            f"{'planar' if c.dim == 2 else 'spatial'} joint type")
