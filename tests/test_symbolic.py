@@ -95,18 +95,43 @@ def check_reproduces(asm: mbody.Assembly) -> int:
             # the body's rows of the same kind (force or moment) as this one
             kind = [index[x.label] for x in body.rows
                     if (x.label in body_euler) == (row.label in body_euler)]
+            unit = row_units(asm, body.body, r, row.label in body_euler)
             for c, label in enumerate(asm.reactions):
                 if label not in val.reactions and g[c] != 0.0:
                     # left out as rounding noise: tiny beside the reaction's largest
-                    # coefficient on the body's rows of this kind (a 1e-17 m lever arm)
+                    # coefficient on the body's rows of this kind (a 1e-17 m lever arm),
+                    # or beside the largest coefficient of its unit in this row (1.9e-18 m
+                    # next to 0.25 m), or below 1e-12 (as `mbody assemble` prints 0)
                     column = float(np.max(np.abs(G[kind, c])))
-                    assert abs(g[c]) <= 1e-14 * column, (row.label, label, g[c], column)
+                    ref = max(column, unit[label.rpartition(".")[2].startswith("M")])
+                    assert abs(g[c]) < 1e-12 or abs(g[c]) <= 1e-14 * ref, (
+                        row.label, label, g[c], column, ref)
                     continue
                 assert abs(val.reactions.get(label, 0.0) - g[c]) <= TOL * gmax, (row.label,
                                                                                    label)
             assert set(val.reactions) <= set(asm.reactions)
             checked += 1
     return checked
+
+
+def row_units(asm: mbody.Assembly, body: str, r: int, euler: bool) -> dict[bool, float]:
+    """The largest coefficient of each unit in row `r` of the assembly (key: whether the
+    symbol is a moment): the reactions' entries of G and the loads' and gravity's unit
+    wrenches, in an Euler row lever arms (m) for forces, direction cosines for moments."""
+    model = asm.model
+    unit = {False: 0.0, True: 0.0}
+    for c, label in enumerate(asm.reactions):
+        moment = label.rpartition(".")[2].startswith("M")
+        unit[moment] = max(unit[moment], abs(float(asm.G[r, c])))
+    first = min(j for j, c in enumerate(asm.coordinates) if c.startswith(body + "."))
+    six = (np.array([0, 1, 5]) if model.dimension == 2 else np.arange(6))[r - first]
+    for sym in load_symbols(model, asm.state, body):
+        moment = not np.any(sym.wrench[:3])
+        unit[moment] = max(unit[moment], abs(float(sym.wrench[six])))
+    if not euler and np.any(model.gravity):
+        unit[False] = max(unit[False], float(np.max(np.abs(model.gravity)))
+                          / float(np.linalg.norm(model.gravity)))
+    return unit
 
 
 @pytest.mark.parametrize("path", ALL, ids=[p.stem for p in ALL])
@@ -341,3 +366,88 @@ def test_every_symbolic_row_copied_into_an_answers_file_is_correct(path):
     v = verify(model, answers, asm=asm)
     for check, label in zip(v.checks, labels, strict=True):
         assert check.correct and check.row == label, (label, check.eq, check.explanation)
+
+
+# -- rounding noise beside the row's own terms -----------------------------------------
+DP_SPRING = """\
+model: dp-spring
+dimension: 2
+gravity: [0, -9.81]
+bodies:
+  - {name: upper, mass: 2, shape: {box: [0.04, 0.6]}, angle: 30 deg,
+     position: [0.15, -0.259807621135332]}
+  - {name: lower, mass: 1, inertia: 0.03, position: [0.3, -0.769615242270663],
+     angle: 0, angular_velocity: 2 rad/s, velocity: [0.5, 0]}
+loads:
+  - {name: k1, type: spring, bodies: [ground, lower], at: [[1, -1], [0, -0.25]],
+     stiffness: 50, rest_length: 0.3, damping: 1}
+  - {name: tau, type: torque, body: upper, torque: 1.5}
+joints:
+  - {name: O, type: revolute, parent: ground, child: upper, at: [0, 0]}
+  - {name: A, type: revolute, parent: upper, child: lower,
+     at: [0.3, -0.519615242270663]}
+"""
+
+
+def copied_rows_are_correct(model: mbody.Model, asm: mbody.Assembly) -> None:
+    from mbody.answers import verify
+
+    answers, labels = [], []
+    for body in asm.symbolic().bodies:
+        for row in body.rows:
+            for digits in (6, 17):
+                answers.append({"body": body.body, "eq": row.text(digits=digits)})
+                labels.append(row.label)
+    v = verify(model, answers, asm=asm)
+    for check, label in zip(v.checks, labels, strict=True):
+        assert check.correct and check.row == label, (label, check.eq, check.explanation)
+
+
+def test_a_lever_arm_of_1e_18_beside_one_of_a_quarter_metre_is_noise(tmp_path):
+    """A.Fy's only moment on the lower rod is a 1.86e-18 m lever arm (the rod hangs
+    straight down from A): the largest of its kind, so only the row's other lever arms
+    (0.25 m for A.Fx) show it is noise; it was printed as 1.85927e-18*A.Fy."""
+    path = tmp_path / "dp_spring.yaml"
+    path.write_text(DP_SPRING)
+    model = mbody.load(path)
+    asm = mbody.assemble(model)
+    lower = asm.symbolic()["lower"]
+    assert lower.rows[2].text() == "I_G*alpha = 0.249902*T_k1 - 0.25*A.Fx"
+    assert asm.G[asm.coordinates.index("lower.theta"), asm.reactions.index("A.Fy")] != 0.0
+    assert not re.search(r"\de-1\d", lower.text())
+    assert "10^{-" not in lower.latex()
+    assert check_reproduces(asm) == len(model.coordinates)
+    copied_rows_are_correct(model, asm)
+
+
+@pytest.mark.parametrize("q", [{}, {"shoulder_lift_joint": -1.2, "elbow_joint": 1.0}],
+                         ids=["zero", "posed"])
+def test_ur5_rows_print_no_term_the_numeric_rows_print_as_0(q):
+    """example-robot-data's UR5 (docs/robots.md): at q = 0 the upper arm's Euler rows had
+    three reaction terms of 5.9e-13 to 7.1e-13 m (a 4.9e-12 rad misalignment in the file
+    times the elbow's lever arms) that `mbody assemble` prints as 0 and `mbody verify`'s
+    rows do not have; posed, the shoulder's row had a 1.4e-17 m arm."""
+    import importlib.metadata
+
+    try:
+        dist = importlib.metadata.distribution("example-robot-data")
+    except importlib.metadata.PackageNotFoundError:
+        pytest.skip("example-robot-data is not installed")
+    path = Path(str(dist.locate_file("cmeel.prefix/share/example-robot-data/robots/"
+                                     "ur_description/urdf/ur5_robot.urdf")))
+    if not path.is_file():
+        pytest.skip("example-robot-data has no ur5_robot.urdf")
+    model = mbody.load(path, joint_positions=q)
+    asm = mbody.assemble(model)
+    sym = asm.symbolic()
+    for body in sym.bodies:
+        for row in body.rows:
+            assert all(abs(c) >= 1e-12 for c in row.reactions.values()), row.text()
+    arm = sym["upper_arm_link"]
+    if not q:
+        assert "elbow_joint.Fy" not in arm.rows[3].text()  # w1
+        assert "elbow_joint.Fx" not in arm.rows[4].text() + arm.rows[5].text()
+    else:
+        assert not re.search(r"\de-1\d", sym.text()), sym.text()
+    assert check_reproduces(asm) == len(model.coordinates)
+    copied_rows_are_correct(model, asm)

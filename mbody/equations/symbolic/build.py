@@ -28,8 +28,15 @@ if TYPE_CHECKING:
     from mbody.equations.assemble import Assembly
 
 NOISE = 1e-14
-"""A coefficient below this fraction of its symbol's largest coefficient on the body is
-rounding noise (cos 90° = 6e-17) and is left out."""
+"""A coefficient below this fraction of its symbol's largest coefficient on the body's
+rows of the same kind (force or moment), or of the largest coefficient of the same unit
+in its row (in an Euler row the lever arms, m; else the direction cosines), is rounding
+noise (cos 90° = 6e-17; a lever arm of 1.9e-18 m beside one of 0.25 m) and is left out."""
+ARM = 1e-12
+"""A reaction's coefficient (a direction cosine, or a lever arm in m) below this is left
+out as well: the numeric `mbody assemble` prints it as 0 and `mbody verify`'s rows have
+no such term (a UR5 link's 5.9e-13 m, a 4.9e-12 rad misalignment in the file times a
+0.12 m arm), so a printed row copied into an answers file stays correct."""
 
 
 def assembly_symbolic(asm: Assembly, bodies: list[str] | None = None) -> SymbolicEquations:
@@ -132,16 +139,24 @@ def body_symbolic(asm: Assembly, name: str) -> SymbolicBody:
         for label, c in eqs.equations[r].reactions.items():
             key = (label, rows6[r] >= 3)
             reaction_scale[key] = max(reaction_scale.get(key, 0.0), abs(c))
+    # A coefficient that is itself its symbol's largest of its kind (a lever arm of
+    # 1.9e-18 m, the only moment A.Fy has on the row) is judged against the row too: the
+    # largest coefficient of the same unit in it.
+    moment = {symbol: not np.any(W[:3]) for symbol, (W, _, _) in six.items()}
     rows: list[SymbolicRow] = []
     for r in range(shown):
+        eq = eqs.equations[r]
+        unit = row_units(((float(W[rows6[r]]), moment[symbol])
+                          for symbol, (W, _, _) in six.items()),
+                         ((c, is_moment(label)) for label, c in eq.reactions.items()))
         terms = list(left[r]) + gyro[rows6[r]]
         for symbol, (W, part, factors) in six.items():
             coef = float(W[rows6[r]])
-            if abs(coef) > NOISE * _scale(W, rows6[r]):
+            if abs(coef) > NOISE * max(_scale(W, rows6[r]), unit[moment[symbol]]):
                 terms.append(Term(coef, factors, part, symbol))
-        eq = eqs.equations[r]
         terms += [Term(c, (S(label),), REACTION, label) for label, c in eq.reactions.items()
-                  if abs(c) > NOISE * reaction_scale[label, rows6[r] >= 3]]
+                  if abs(c) >= ARM and abs(c) > NOISE * max(
+                      reaction_scale[label, rows6[r] >= 3], unit[is_moment(label)])]
         rows.append(SymbolicRow(eq.row, tuple(terms)))
 
     known = model.known_reactions_at(state.t)
@@ -191,6 +206,33 @@ def _minus_gyroscopic(I: list[list[Any]], w: list[Any], principal: bool) -> list
         out.append([Term(1.0, (w[m], h[k]), GYROSCOPIC, "w x (J*w)"),
                     Term(-1.0, (w[k], h[m]), GYROSCOPIC, "w x (J*w)")])
     return out
+
+
+def is_moment(label: str) -> bool:
+    """Whether a reaction label is a moment component (``A.Mz``, a universal joint's
+    ``U.Mt``), not a force (``A.Fx``, a link's tension ``L.T``)."""
+    return label.rpartition(".")[2].startswith("M")
+
+
+def row_units(*coefficients: Any) -> dict[bool, float]:
+    """The largest coefficient of each unit in one row: key True for the moment symbols'
+    (couples, moment reactions), False for the force symbols' (loads, gravity, force
+    reactions; in an Euler row their lever arms).
+
+    Parameters
+    ----------
+    *coefficients : iterables of (float, bool)
+        Each symbol's coefficient in the row, and whether the symbol is a moment.
+
+    Returns
+    -------
+    dict of bool to float
+    """
+    unit = {False: 0.0, True: 0.0}
+    for group in coefficients:
+        for c, moment in group:
+            unit[moment] = max(unit[moment], abs(c))
+    return unit
 
 
 def _scale(W: np.ndarray, row: int) -> float:
