@@ -309,3 +309,55 @@ def test_plot_leaves_out_panels_with_nothing_to_show(tmp_path, capsys):
     assert len(titles) == 5 and titles[-1] == "joint reaction moments, joint axes"
     free = mbody.simulate(_model("torque_free_asymmetric"), t_end=0.2, fps=30)
     assert len(_panel_titles(free)) == 4
+
+
+SLOW_COMPILE = 2.0
+"""Seconds a patched numba compile takes in the tests below (a real first one: a minute)."""
+
+
+def _first_evaluation_compiles(monkeypatch) -> None:
+    """Make the run's first evaluation compile a numba function slowly, as the first run
+    on a machine compiles `mbody.solve.compiled`'s kernels at their first call (the right-
+    hand side's first evaluation, scipy's at t = 0, and the first compiled steps): numba's
+    own compile, made SLOW_COMPILE seconds longer."""
+    import time
+
+    numba = pytest.importorskip("numba")
+    from mbody.solve.dynamics import StateDerivative
+
+    @numba.njit  # not cached: compiled at its first call, in the run
+    def first(t):
+        return t + 1.0
+
+    compile_ = first._compiler.compile
+
+    def slow_compile(*args, **kwargs):
+        time.sleep(SLOW_COMPILE)
+        return compile_(*args, **kwargs)
+
+    monkeypatch.setattr(first._compiler, "compile", slow_compile)
+    call = StateDerivative.__call__
+
+    def evaluate(self, t, y):
+        first(t)
+        return call(self, t, y)
+
+    monkeypatch.setattr(StateDerivative, "__call__", evaluate)
+
+
+def test_wall_time_leaves_out_the_one_off_compile(monkeypatch):
+    """The summary's time is the integration's; a compile on the way (the first run on a
+    machine) is said apart, not added to it; the next run compiles nothing."""
+    from mbody.simulate.simulation import summary
+
+    _first_evaluation_compiles(monkeypatch)
+    traj = mbody.simulate(_model("torque_free_asymmetric"), t_end=0.5, fps=30)
+    i = traj.info
+    assert i["wall_time_s"] < SLOW_COMPILE  # was 2.5 s: the compile counted as integrating
+    assert SLOW_COMPILE <= i["compile_time_s"] < SLOW_COMPILE + 30
+    assert (f"evaluations ({i['sampling_evaluations']} of them for the samples), "
+            f"{i['wall_time_s']:.3g} s (plus {i['compile_time_s']:.3g} s to compile the fast "
+            "path once)\n") in summary(traj)
+    again = mbody.simulate(_model("torque_free_asymmetric"), t_end=0.5, fps=30)
+    assert again.info["compile_time_s"] == 0 and again.info["wall_time_s"] < SLOW_COMPILE
+    assert "compile" not in summary(again)

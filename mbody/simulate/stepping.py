@@ -20,6 +20,7 @@ Two refinements, each a subclass of the scipy class the user chose:
 from __future__ import annotations
 
 import math
+import sys
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -118,3 +119,45 @@ def _compiled_run(solver, rhs: StateDerivative, t_stop: float, max_steps: int) -
         solver.status = "finished"
     return Advance(steps, int(run[c.RUN_REFRESHED]),
                    float(run[c.RUN_RATIO]) if steps else 1.0)
+
+
+class CompileClock:
+    """The wall time numba spends compiling while this is entered: the time inside its
+    ``numba:compile`` events (numba's event API; a compile nested in another counted once).
+    Loading machine code from numba's cache raises no such event, so a run that loads the
+    cached fast path counts 0 here, and the first run after an install counts the one-off
+    compile of `mbody.solve.compiled`'s kernels (about a minute), which its timing leaves
+    out of the integration's. Numba is not imported here: `watch` starts listening once
+    it is (after `state_derivative` has picked the compiled path); without numba, 0."""
+
+    def __init__(self) -> None:
+        self._listener: Any = None
+
+    def __enter__(self) -> CompileClock:
+        self.watch()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self._listener is not None:  # kept: `seconds` reads it after the run
+            from numba.core import event
+
+            event.unregister("numba:compile", self._listener)
+
+    def watch(self) -> None:
+        """Start listening, if numba is imported and this is not listening yet."""
+        if self._listener is not None or "numba" not in sys.modules:
+            return
+        try:
+            from numba.core import event
+
+            listener = event.TimingListener()
+            event.register("numba:compile", listener)
+        except Exception:  # noqa: BLE001 - numba's event API moved: time nothing, never fail
+            return
+        self._listener = listener
+
+    @property
+    def seconds(self) -> float:
+        """Compiling so far (s), compiles under way not counted."""
+        lis = self._listener
+        return float(lis.duration) if lis is not None and lis.done else 0.0
