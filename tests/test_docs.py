@@ -220,4 +220,6 @@ def test_help_texts_name_what_the_commands_do():
                        capture_output=True, text=True, timeout=60, cwd=ROOT)
     text = " ".join(r.stdout.split())
     assert "joint reactions" in text and "reaction force components (N)" in text
-    assert f"(the first {MAX_REACTIONS} of each kind)" in text
+    assert f"(the first {MAX_REACTIONS} of each kind;" in text
+    assert "a kind the joints do not have, such as the moments of a planar revolute joint, " \
+           "gets no panel)" in text
