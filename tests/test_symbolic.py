@@ -369,24 +369,7 @@ def test_every_symbolic_row_copied_into_an_answers_file_is_correct(path):
 
 
 # -- rounding noise beside the row's own terms -----------------------------------------
-DP_SPRING = """\
-model: dp-spring
-dimension: 2
-gravity: [0, -9.81]
-bodies:
-  - {name: upper, mass: 2, shape: {box: [0.04, 0.6]}, angle: 30 deg,
-     position: [0.15, -0.259807621135332]}
-  - {name: lower, mass: 1, inertia: 0.03, position: [0.3, -0.769615242270663],
-     angle: 0, angular_velocity: 2 rad/s, velocity: [0.5, 0]}
-loads:
-  - {name: k1, type: spring, bodies: [ground, lower], at: [[1, -1], [0, -0.25]],
-     stiffness: 50, rest_length: 0.3, damping: 1}
-  - {name: tau, type: torque, body: upper, torque: 1.5}
-joints:
-  - {name: O, type: revolute, parent: ground, child: upper, at: [0, 0]}
-  - {name: A, type: revolute, parent: upper, child: lower,
-     at: [0.3, -0.519615242270663]}
-"""
+DP_SPRING = (Path(__file__).parent / "dp_spring.yaml").read_text()
 
 
 def copied_rows_are_correct(model: mbody.Model, asm: mbody.Assembly) -> None:
