@@ -155,8 +155,11 @@ def test_a_long_chain_is_shown_in_bounded_size():
     assert len(rows(parse(sol._repr_html_()))) == 2 * (rich.MAX_ROWS + 1)
 
 
-def test_trajectory_display_has_facts_and_plots_and_no_megabyte_animation():
+def test_trajectory_display_has_facts_and_plots_and_no_megabyte_animation(monkeypatch):
+    """With the animation turned off (a light notebook), the display is the facts and the
+    plots; by default it embeds the animation too (the next test)."""
     traj = mbody.simulate(mbody.load(MODELS / "double_pendulum.yaml"), 0.3, 20)
+    monkeypatch.setattr(rich, "EMBED_ANIMATION", False)
     html = traj._repr_html_()
     root = parse(html)
     cells = {r[0]: r[1] for r in rows(root) if len(r) == 2}
@@ -167,7 +170,7 @@ def test_trajectory_display_has_facts_and_plots_and_no_megabyte_animation():
     png = base64.b64decode(img.get("src").removeprefix("data:image/png;base64,"))
     assert png.startswith(b"\x89PNG\r\n\x1a\n") and len(png) > 10_000
     assert not list(root.iter("iframe")) and len(html) < 400_000
-    assert "mbody.present.rich.animation(traj)" in text_of(root)
+    assert "mbody.present.rich.animation(traj, reactions=True)" in text_of(root)
 
 
 def test_animation_embeds_the_offline_page_in_an_iframe():
@@ -180,11 +183,10 @@ def test_animation_embeds_the_offline_page_in_an_iframe():
     page = frame.get("srcdoc")
     assert page.startswith("<!DOCTYPE html>") and "MeshCat.Viewer" in page
     assert "window.mbody_ready = true" in page
-    rich.EMBED_ANIMATION = True
-    try:
-        assert len(list(parse(traj._repr_html_()).iter("iframe"))) == 1
-    finally:
-        rich.EMBED_ANIMATION = False
+    assert rich.EMBED_ANIMATION  # by default a run's display plays it
+    shown = parse(traj._repr_html_())
+    (frame,) = shown.iter("iframe")
+    assert "MeshCat.Viewer" in frame.get("srcdoc") and list(shown.iter("img"))
 
 
 # -- LaTeX ---------------------------------------------------------------------------------------

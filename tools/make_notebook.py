@@ -157,15 +157,17 @@ double_asm"""),
 
 `mbody.simulate(model, t_end, fps)` integrates the motion with the reactions solved at
 every step. (The first simulation after installing mbody compiles its solver with numba,
-about a minute once; later runs load the compiled code.)"""),
+about a minute once; later runs load the compiled code.) A run shows its facts, its plots
+and the motion in 3-D."""),
     ("code", """\
 run = mbody.simulate(double, 1.0, 30)
 run"""),
     ("md", """\
 ## 8. Animate
 
-`animation(run)` plays the run here, in a frame holding the offline page (about 1 MB:
-the 3-D viewer comes with it). `mbody.animate` writes the same page to a file."""),
+`animation(run, reactions=True)` plays the run with the joint reactions drawn as arrows,
+in a frame holding the offline page (about 1 MB: the 3-D viewer comes with it).
+`mbody.animate` writes the same page to a file."""),
     ("code", "animation(run, reactions=True)"),
     ("code", """\
 page = mbody.animate(run, OUT / "double_pendulum.html", model=double)

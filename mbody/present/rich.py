@@ -13,7 +13,7 @@ are imported by the functions that draw, on first display.
     body_html(asm.bodies[b]) one body: diagram, forces (applied / reaction), the pair
     solution_html(sol)       accelerations and reactions by body, with units
     trajectory_html(traj)    run facts and the plots; the 3-D animation with
-                             EMBED_ANIMATION = True, or `animation(traj)` on its own
+                             (EMBED_ANIMATION, on by default), or `animation(traj)`
     *_latex                  the equations as display math for Jupyter
 """
 
@@ -48,10 +48,11 @@ MAX_GRAPH = 60
 """Largest number of bodies whose body/joint graph is drawn in a Model display."""
 PLOT_DPI = 60
 """Resolution of the Trajectory display's plots (PNG, about 80 KB for two bodies)."""
-EMBED_ANIMATION = False
-"""Whether a Trajectory display embeds the 3-D animation. Off by default: the page
-inlines meshcat's viewer (about 0.9 MB) in every display, and so in the notebook file;
-``animation(traj)`` embeds it once where it is wanted."""
+EMBED_ANIMATION = True
+"""Whether a Trajectory display embeds the 3-D animation (a run is shown moving, beside
+its plots). The page inlines meshcat's viewer, about 0.9 MB in every such display and so
+in the saved notebook: set it False for light notebooks, and call ``animation(traj)``
+where a run should play."""
 
 _ids = itertools.count()
 
@@ -383,7 +384,8 @@ def _plot_png(traj: Trajectory) -> Markup:
 
 def trajectory_html(traj: Trajectory) -> str:
     """A Trajectory as HTML: the run's facts, its plots (a PNG: ω, energy, angular
-    momentum, drift, reactions) and, with `EMBED_ANIMATION`, the 3-D animation.
+    momentum, drift, reactions) and, with `EMBED_ANIMATION` (the default), the 3-D
+    animation.
 
     Parameters
     ----------
@@ -417,9 +419,9 @@ def trajectory_html(traj: Trajectory) -> str:
     if EMBED_ANIMATION and traj.model_yaml:
         parts.append(Markup(Animation(traj)._repr_html_()))
     return block(f"Trajectory of {traj.model_name or 'a model'!r}", *parts,
-                 note="next: mbody.present.rich.animation(traj) to play it here (about 1 MB), "
-                      "mbody.animate(traj, 'run.html', model=model) for a page, "
-                      "traj.save('run.npz')")
+                 note="next: mbody.present.rich.animation(traj, reactions=True) for the "
+                      "reaction arrows, mbody.animate(traj, 'run.html', model=model) for a "
+                      "page, traj.save('run.npz')")
 
 
 class Animation:
