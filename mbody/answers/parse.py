@@ -24,16 +24,15 @@ import math
 import re
 from collections.abc import Iterable
 from dataclasses import dataclass
+from typing import Any, NoReturn
 
 from mbody.errors import MbodyError
-from mbody.model.expressions import tokenise
+from mbody.model.expressions import OperatorParser, tokenise
 
 FUNCTIONS = ("sin", "cos", "tan", "sqrt", "exp")
 """The functions an equation may call (one argument each; angles in radians)."""
 MAX_LENGTH = 2000
 """Longest equation accepted (characters)."""
-MAX_DEPTH = 100
-"""Deepest nesting of parentheses and signs."""
 
 _PASTED = str.maketrans({"\u2212": "-", "\u00b7": "*", "\u00d7": "*", "\u22c5": "*"})
 _TOKEN = re.compile(r"""
@@ -138,11 +137,6 @@ def _tokenise(text: str, labels: Iterable[str]) -> list[tuple[str, str, int]]:
     return tokenise(text.translate(_PASTED), _TOKEN, tuple(known))
 
 
-def _describe(kind: str, value: str) -> str:
-    return {"num": f"number {value}", "name": f"name '{value}'", "op": f"'{value}'",
-            "end": "end of the equation"}[kind]
-
-
 _BAD_HINTS = {
     "<": "only equations (=) are checked", ">": "only equations (=) are checked",
     ",": "functions take one argument", "[": "use ( ) for grouping",
@@ -154,65 +148,24 @@ _BAD_HINTS = {
 }
 
 
-class _Parser:
-    def __init__(self, text: str, tokens: list[tuple[str, str, int]]):
-        self.text, self.tokens, self.i = text, tokens, 0
+class _Parser(OperatorParser):
+    WHAT = "equation"
 
-    def take(self) -> tuple[str, str, int]:
-        tok = self.peek()
-        self.i += 1
-        return tok
+    def fail(self, pos: int, message: str, hint: str = "") -> NoReturn:
+        raise EquationError(self.text, pos, message, hint)
 
-    def peek(self) -> tuple[str, str, int]:
-        kind, ch, pos = self.tokens[self.i]
-        if kind == "bad":
-            raise EquationError(self.text, pos, f"unexpected character {ch!r}",
-                                _BAD_HINTS.get(ch, ""))
-        return self.tokens[self.i]
+    def bad_hint(self, ch: str) -> str:
+        return _BAD_HINTS.get(ch, "")
 
-    def unexpected(self):
+    def node(self, op: str, pos: int, *operands: Any) -> Node:
+        return (op, *operands, pos)
+
+    def unexpected(self) -> NoReturn:
         kind, value, pos = self.peek()
         if kind == "op" and value == ")":
-            raise EquationError(self.text, pos, "unmatched ')'")
-        raise EquationError(self.text, pos, f"unexpected {_describe(kind, value)}",
-                            "an operator (+ - * / ^) is missing?"
-                            if kind in ("num", "name") else "")
-
-    def expr(self, depth: int) -> Node:
-        if depth > MAX_DEPTH:
-            raise EquationError(self.text, self.peek()[2],
-                                f"nesting deeper than {MAX_DEPTH} levels")
-        node = self.term(depth)
-        while self.peek()[0] == "op" and self.peek()[1] in ("+", "-"):
-            _, op, pos = self.take()
-            node = (op, node, self.term(depth), pos)
-        return node
-
-    def term(self, depth: int) -> Node:
-        node = self.unary(depth)
-        while self.peek()[0] == "op" and self.peek()[1] in ("*", "/"):
-            _, op, pos = self.take()
-            node = (op, node, self.unary(depth), pos)
-        return node
-
-    def unary(self, depth: int) -> Node:
-        kind, value, pos = self.peek()
-        if kind == "op" and value in ("+", "-"):
-            self.take()
-            if depth > MAX_DEPTH:
-                raise EquationError(self.text, pos, f"nesting deeper than {MAX_DEPTH} levels")
-            operand = self.unary(depth + 1)
-            return operand if value == "+" else ("neg", operand, pos)
-        return self.power(depth)
-
-    def power(self, depth: int) -> Node:
-        base = self.atom(depth)
-        kind, value, pos = self.peek()
-        if kind == "op" and value in ("^", "**"):
-            self.take()
-            # -2^2 = -4 and 2^-1 = 0.5, as on paper
-            return ("^", base, self.unary(depth + 1), pos)
-        return base
+            self.fail(pos, "unmatched ')'")
+        self.fail(pos, f"unexpected {self.describe(kind, value)}",
+                  "an operator (+ - * / ^) is missing?" if kind in ("num", "name") else "")
 
     def atom(self, depth: int) -> Node:
         kind, value, pos = self.take()
@@ -254,10 +207,6 @@ class _Parser:
                                 if pos == self.tokens[0][2] else "unexpected '='",
                                 "write 0 if that side is zero")
         else:
-            raise EquationError(self.text, pos, f"unexpected {_describe(kind, value)}")
-        # implicit multiplication ("2a_x", "2(O.Fy)", "m g") is refused: say so
-        nk, nv, npos = self.peek()
-        if nk in ("num", "name") or (nk == "op" and nv == "("):
-            raise EquationError(self.text, npos, f"unexpected {_describe(nk, nv)}",
-                                "write '*' for multiplication, e.g. 2*a_x")
+            raise EquationError(self.text, pos, f"unexpected {self.describe(kind, value)}")
+        self.no_implicit_product("2*a_x")
         return node

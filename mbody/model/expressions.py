@@ -21,7 +21,7 @@ import re
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Any, NamedTuple, overload
+from typing import Any, NamedTuple, NoReturn, overload
 
 import numpy as np
 
@@ -188,14 +188,37 @@ def tokenise(text: str, pattern: re.Pattern[str] = _TOKEN,
     return out
 
 
-def _describe(kind: str, value: str) -> str:
+def _describe(kind: str, value: str, what: str = "expression") -> str:
     return {"num": f"number {value}", "name": f"name '{value}'", "op": f"'{value}'",
-            "end": "end of the expression"}[kind]
+            "end": f"end of the {what}"}[kind]
 
 
-class _Parser:
+class OperatorParser:
+    """Sums, products, signs and powers over `tokenise`'s tokens, by precedence
+    (``-2^2 = -4``, ``2^-1 = 0.5``, as on paper), nesting bounded by `MAX_DEPTH`.
+
+    The grammar shared by load expressions and a student's equations; a subclass says
+    what an atom is (`atom`), how a node is built (`node`) and which error is raised
+    (`fail`, with `bad_hint` for a character no token matches).
+    """
+
+    WHAT = "expression"
+    """What is parsed, in error messages ("the end of the expression")."""
+
     def __init__(self, text: str, tokens: list[tuple[str, str, int]]):
         self.text, self.tokens, self.i = text, tokens, 0
+
+    def fail(self, pos: int, message: str, hint: str = "") -> NoReturn:
+        raise NotImplementedError
+
+    def node(self, op: str, pos: int, *operands: Any) -> Any:
+        raise NotImplementedError
+
+    def atom(self, depth: int) -> Any:
+        raise NotImplementedError
+
+    def bad_hint(self, ch: str) -> str:
+        return ""
 
     def take(self) -> tuple[str, str, int]:
         tok = self.peek()
@@ -205,50 +228,73 @@ class _Parser:
     def peek(self) -> tuple[str, str, int]:
         kind, ch, pos = self.tokens[self.i]
         if kind == "bad":
-            hint = {"=": "comparisons are not supported", "<": "comparisons are not supported",
-                    ">": "comparisons are not supported", ",": "functions take one argument",
-                    "[": "use ( ) for grouping", "{": "use ( ) for grouping",
-                    ".": "attribute access is not allowed"}.get(ch, "")
-            raise ExpressionError(self.text, pos, f"unexpected character {ch!r}", hint)
+            self.fail(pos, f"unexpected character {ch!r}", self.bad_hint(ch))
         return self.tokens[self.i]
 
-    def error(self, message: str, hint: str = "", pos: int | None = None):
-        raise ExpressionError(self.text, self.peek()[2] if pos is None else pos, message, hint)
+    def describe(self, kind: str, value: str) -> str:
+        return _describe(kind, value, self.WHAT)
 
-    def expr(self, depth: int) -> Node:
+    def no_implicit_product(self, example: str) -> None:
+        """After an atom: "2t", "2(t+1)", "m g" are refused with the '*' they lack."""
+        kind, value, pos = self.peek()
+        if kind in ("num", "name") or (kind == "op" and value == "("):
+            self.fail(pos, f"unexpected {self.describe(kind, value)}",
+                      f"write '*' for multiplication, e.g. {example}")
+
+    def _deeper(self, depth: int, pos: int) -> None:
         if depth > MAX_DEPTH:
-            self.error(f"nesting deeper than {MAX_DEPTH} levels")
+            self.fail(pos, f"nesting deeper than {MAX_DEPTH} levels")
+
+    def expr(self, depth: int) -> Any:
+        self._deeper(depth, self.peek()[2])
         node = self.term(depth)
-        while self.peek()[1] in ("+", "-") and self.peek()[0] == "op":
-            op = self.take()[1]
-            node = _fold((op, node, self.term(depth)))
+        while self.peek()[0] == "op" and self.peek()[1] in ("+", "-"):
+            _, op, pos = self.take()
+            node = self.node(op, pos, node, self.term(depth))
         return node
 
-    def term(self, depth: int) -> Node:
+    def term(self, depth: int) -> Any:
         node = self.unary(depth)
         while self.peek()[0] == "op" and self.peek()[1] in ("*", "/"):
-            op = self.take()[1]
-            node = _fold((op, node, self.unary(depth)))
+            _, op, pos = self.take()
+            node = self.node(op, pos, node, self.unary(depth))
         return node
 
-    def unary(self, depth: int) -> Node:
-        kind, value, _ = self.peek()
+    def unary(self, depth: int) -> Any:
+        kind, value, pos = self.peek()
         if kind == "op" and value in ("+", "-"):
             self.take()
-            if depth > MAX_DEPTH:
-                self.error(f"nesting deeper than {MAX_DEPTH} levels")
+            self._deeper(depth, pos)
             operand = self.unary(depth + 1)
-            return operand if value == "+" else _fold(("neg", operand))
+            return operand if value == "+" else self.node("neg", pos, operand)
         return self.power(depth)
 
-    def power(self, depth: int) -> Node:
+    def power(self, depth: int) -> Any:
         base = self.atom(depth)
-        kind, value, _ = self.peek()
+        kind, value, pos = self.peek()
         if kind == "op" and value in ("^", "**"):
             self.take()
-            # -2^2 = -4 and 2^-1 = 0.5, as on paper.
-            return _fold(("^", base, self.unary(depth + 1)))
+            return self.node("^", pos, base, self.unary(depth + 1))
         return base
+
+
+class _Parser(OperatorParser):
+    _BAD_HINTS = {"=": "comparisons are not supported", "<": "comparisons are not supported",
+                  ">": "comparisons are not supported", ",": "functions take one argument",
+                  "[": "use ( ) for grouping", "{": "use ( ) for grouping",
+                  ".": "attribute access is not allowed"}
+
+    def fail(self, pos: int, message: str, hint: str = "") -> NoReturn:
+        raise ExpressionError(self.text, pos, message, hint)
+
+    def error(self, message: str, hint: str = "") -> NoReturn:
+        self.fail(self.peek()[2], message, hint)
+
+    def bad_hint(self, ch: str) -> str:
+        return self._BAD_HINTS.get(ch, "")
+
+    def node(self, op: str, pos: int, *operands: Any) -> Node:
+        return _fold((op, *operands))
 
     def atom(self, depth: int) -> Node:
         kind, value, pos = self.take()
@@ -291,11 +337,7 @@ class _Parser:
                                   if self.text.strip() else "the expression is empty")
         else:
             raise ExpressionError(self.text, pos, f"unexpected {_describe(kind, value)}")
-        # Implicit multiplication ("2t", "2(t+1)", "t sin(t)") is refused: say so.
-        nk, nv, npos = self.peek()
-        if nk in ("num", "name") or (nk == "op" and nv == "("):
-            raise ExpressionError(self.text, npos, f"unexpected {_describe(nk, nv)}",
-                                  "write '*' for multiplication, e.g. 2*t")
+        self.no_implicit_product("2*t")
         return node
 
 
