@@ -77,18 +77,28 @@ def regular_file(path: str, what: str) -> None:
 
 def parse_known(pairs: Sequence[str]) -> dict[str, float]:
     """``["A.Fx=3", ...]`` -> ``{"A.Fx": 3.0}`` (labels are checked later, with hints)."""
+    return assignments(pairs, "--known", "LABEL=VALUE (for example A.Fx=3)")
+
+
+def assignments(pairs: Sequence[str], flag: str, form: str,
+                degrees: str | None = None) -> dict[str, float]:
+    """``NAME=VALUE`` options -> ``{NAME: value}``; a value ending in `degrees` (``deg``,
+    ``deg/s``) is converted to radians. Anything else is a clear `MbodyError`."""
     out = {}
     for p in pairs:
-        label, sep, value = p.partition("=")
-        if not sep:
-            raise MbodyError(f"--known expects LABEL=VALUE (for example A.Fx=3), got {p!r}")
+        name, sep, value = p.partition("=")
+        if not sep or not name.strip():
+            raise MbodyError(f"{flag} expects {form}, got {p!r}")
+        text, scale = value.strip(), 1.0
+        if degrees and text.endswith(degrees):
+            text, scale = text[:-len(degrees)], math.pi / 180
         try:
-            x = float(value)
+            x = float(text) * scale
         except ValueError:
-            raise MbodyError(f"--known {label}: {value!r} is not a number") from None
+            raise MbodyError(f"{flag} {name}: {value!r} is not a number") from None
         if not math.isfinite(x):
-            raise MbodyError(f"--known {label}: expected a finite number, got {value!r}")
-        out[label.strip()] = x
+            raise MbodyError(f"{flag} {name}: expected a finite number, got {value!r}")
+        out[name.strip()] = x
     return out
 
 
@@ -153,22 +163,5 @@ def import_options(a: argparse.Namespace) -> dict[str, Any]:
 
 def _joint_values(pairs: Sequence[str], flag: str, rate: bool) -> dict[str, float]:
     """``["shoulder=0.5", "elbow=30deg"]`` -> ``{"shoulder": 0.5, "elbow": 0.5236}``."""
-    out = {}
-    unit = "deg/s" if rate else "deg"
-    for p in pairs:
-        name, sep, value = p.partition("=")
-        if not sep or not name.strip():
-            raise MbodyError(f"{flag} expects JOINT=VALUE (for example shoulder=0.5), got "
-                             f"{p!r}")
-        text = value.strip()
-        scale = 1.0
-        if text.endswith(unit):
-            text, scale = text[:-len(unit)], math.pi / 180
-        try:
-            x = float(text) * scale
-        except ValueError:
-            raise MbodyError(f"{flag} {name}: {value!r} is not a number") from None
-        if not math.isfinite(x):
-            raise MbodyError(f"{flag} {name}: expected a finite number, got {value!r}")
-        out[name.strip()] = x
-    return out
+    return assignments(pairs, flag, "JOINT=VALUE (for example shoulder=0.5)",
+                       "deg/s" if rate else "deg")
