@@ -1,0 +1,184 @@
+/* mbody's compiled core: the one numeric path of the physics.
+ *
+ * Everything that evaluates a model at a state is written here once, in plain C99:
+ * rotations, applied loads and springs, the gyroscopic term, each joint constraint
+ * primitive's column of G, phi, G^T v and gamma (time-dependent ones included), the
+ * constrained solve (banded Schur complement, pivoted route for redundant joints,
+ * null-space route near singular positions), the coordinate projection, load and law
+ * expressions of t, and the integrators (DOP853 with dense output). Python packs a model
+ * once (mbody/equations/pack.py) into one float array F and one int64 array I, and the
+ * unknown reaction components of a solve into a third int64 array Iu; the extension
+ * module (module.c) hands those buffers to the functions below. Nothing here knows joint
+ * *types*: a joint type (mbody/joints/) is a list of components, each naming one of the
+ * primitives MB_KIND_* below.
+ *
+ * Conventions (docs/conventions.md): every body is spatial inside the core (a planar body
+ * lives in the world x-y plane, turns about world z; its rows are (x, y, w3) of the six).
+ * Per body six rows [Newton x, y, z in world axes | Euler 1, 2, 3 in body axes].
+ * A reaction acts on the child as +R at the joint point, on the parent as -R.
+ *
+ * Build: compiled with -O2 -ffp-contract=off (no fused multiply-add: results do not
+ * depend on the CPU's instruction set).
+ */
+#ifndef MBODY_KERNEL_H
+#define MBODY_KERNEL_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+/* ---------------------------------------------------------------------------------------
+ * Component kinds: the constraint primitives. Per component, with
+ *   E = (R_p P_E3)          the joint frame fixed in the parent, world axes (R_p = I for
+ *                           ground), e = E[:, axis] its column `axis`,
+ *   P = x_c + R_c B_r_child the child's joint point (world), P_p = x_p + R_p B_r_parent
+ *                           the parent's (for ground: B_r_parent is a world point),
+ *   A = (R_p P_E3)^T (R_c C_E3)   the child's joint frame seen in the parent's,
+ *   h = param1, off = param0, and, when the component has a law l >= 0, f, f', f'' the
+ *   law's value and derivatives at t:
+ *
+ * MB_KIND_FORCE  force along e:   child6 = [e; B_r_c x (R_c^T e)],
+ *                                 parent6 = [-e; -(B_r_p x (R_p^T e))], B_r_p = R_p^T (P - x_p)
+ *                phi = e . (P - P_p) + off,   gamma = -e . T   (T: constraints.py's vector)
+ * MB_KIND_TILT   moment about e, axis in {0, 1}, the joint turning freely about E[:, 2]:
+ *                child6 = [0; R_c^T e], parent6 = [0; -R_p^T e]
+ *                phi = axis == 0 ? -A[1][2] : A[0][2],   gamma = -e . (w_c x w_p)
+ * MB_KIND_LOCK   moment about e, rotation locked: columns as TILT,
+ *                phi = 1/2 vee(A - A^T)[axis],          gamma as TILT
+ * MB_KIND_RIGHT_ANGLE  the universal joint's moment about e = a x b / |a x b|, a = E[:, 2]
+ *                on the parent, b = R_c C_axis2 on the child: columns as TILT with that e,
+ *                phi = -a . b,  gamma = -((w_p x a) x b + a x (w_c x b)) . (w_c - w_p)
+ * MB_KIND_LINK   a particle link's tension T: d = P - P_p, u = d/|d|, e = -u,
+ *                child6 = [e; B_r_c x R_c^T e], parent6 = [-e; -(B_r_parent x R_p^T e)],
+ *                phi = L - |d| (L = the joint's link length),
+ *                gamma = u . (w_c x (w_c x rho_c) - w_p x (w_p x rho_p))
+ *                        + (|d'|^2 - (u . d')^2) / |d|
+ * MB_KIND_TURN   moment about e (rotation about e measured as an angle): columns as TILT,
+ *                phi = wrap(theta + off - f),  theta = atan2(A[j][i], A[i][i]),
+ *                i = (axis + 1) % 3, j = (axis + 2) % 3, wrap to (-pi, pi];
+ *                gamma as TILT.  (Drivers of revolute joints; off: the coordinate's value
+ *                at the file's pose, e.g. a planar child's angle minus its parent's.)
+ * MB_KIND_SCREW  the helical joint's axial wrench along e = E[:, axis]: the FORCE column
+ *                plus -h times the moment column about e (h = pitch / 2 pi, m/rad):
+ *                child6 = [e; B_r_c x R_c^T e - h R_c^T e], parent6 = -(its parent side),
+ *                phi = e . (P - P_p) - h theta~, theta~ the relative turn about e
+ *                (as TURN) taken on the branch nearest e . (P - P_p) / h,
+ *                gamma = gamma_FORCE - h gamma_TILT.
+ *
+ * Time dependence (drivers): a component with a law l >= 0 prescribes its coordinate:
+ * the kernel reports phi - f(t) (TURN: inside the wrap), the residual G^T v - f'(t) where
+ * G^T v is asked for, and gamma + f''(t); so Baumgarte's terms, the projection
+ * (G^T dv = -(G^T v - f')) and the drift figures need nothing else.
+ * ------------------------------------------------------------------------------------- */
+enum {
+    MB_KIND_FORCE = 0,
+    MB_KIND_TILT = 1,
+    MB_KIND_LOCK = 2,
+    MB_KIND_RIGHT_ANGLE = 3,
+    MB_KIND_LINK = 4,
+    MB_KIND_TURN = 5,
+    MB_KIND_SCREW = 6,
+    MB_KINDS = 7
+};
+
+/* ---------------------------------------------------------------------------------------
+ * The packed model (written by mbody/equations/pack.py; module.c checks every size).
+ *
+ * I (int64): header [n, k, s, nj, m, n_expr, n_code, n_varying, n_laws, n_known]
+ *   (MB_I_HEADER entries),
+ *   then per point load (k x 3)   [body, in_body (0/1), couple (0/1)]
+ *   per spring (s x 2)            [a, b]          (-1 = ground)
+ *   per joint (nj x 3)            [parent (-1 = ground), child, flags]
+ *                                 flags: 1 particle link, 2 the parent is a particle
+ *   per component (m x 4)         [joint, kind (MB_KIND_*), axis (0-2), law (-1: none)]
+ *   per varying load entry (n_varying x 3) [load row, component (0-2), expression]
+ *   per law (n_laws x 3)          [expression of f, of f', of f'']
+ *   per known reaction varying in t (n_known x 2) [component, expression]: lam[component]
+ *                                 is that expression's value at t (the caller's lam holds
+ *                                 the constant known values and 0 on unknown components)
+ *   expression starts (n_expr + 1) into the codes, then codes (n_code), postfix
+ *                                 (MB_OP_*: the codes of mbody.model.expressions)
+ * F (float64): gravity (3),
+ *   per body (n x MB_BODY_W)      [mass, J (9, row-major, body axes), J^-1 (9)]
+ *   per point load (k x 6)        [B_r (3, body axes), value (3): the constant value,
+ *                                  varying entries overwritten at t]
+ *   per spring (s x MB_SPRING_W)  [r_a (3), r_b (3), stiffness, rest length, damping]
+ *   per joint (nj x MB_JOINT_W)   [B_r_child (3), B_r_parent (3), C_axis2 (3),
+ *                                  P_E3 (9), C_E3 (9), link length]
+ *   per component (m x 2)         [param0 (off), param1 (h)]
+ *   expression numbers (n_code)   the constants the codes push
+ *
+ * Iu (int64), the unknown components of one solve (pack_unknowns):
+ *   [mu, bw, nnz], U (mu: component indices, in solve order), inc_ptr (n + 1),
+ *   inc (nnz x 2: [position in U, side 0 child / 1 parent]) per body: the unknown
+ *   components acting on it; bw: half bandwidth of S = G_U^T M^-1 G_U in U's order.
+ *
+ * The state y (float64): [x (n x 3) world | q (n x 4) W_R_B, [w, x, y, z] | v (n x 3)
+ * world | w (n x 3) body axes | theta (n), planar models only] (MB_STATE_SIZE).
+ * ------------------------------------------------------------------------------------- */
+enum { MB_I_HEADER = 10, MB_BODY_W = 19, MB_LOAD_W = 6, MB_SPRING_W = 9, MB_JOINT_W = 28,
+       MB_COMP_W = 2 };
+enum { MB_J_LINK = 1, MB_J_PARTICLE_PARENT = 2 };
+enum { MB_OP_NUM = 0, MB_OP_T = 1, MB_OP_NEG = 2, MB_OP_ADD = 3, MB_OP_SUB = 4,
+       MB_OP_MUL = 5, MB_OP_DIV = 6, MB_OP_POW = 7, MB_OP_SIN = 8, MB_OP_COS = 9,
+       MB_OP_TAN = 10, MB_OP_EXP = 11, MB_OP_LOG = 12, MB_OP_SQRT = 13, MB_OP_ABS = 14 };
+#define MB_STATE_SIZE(n, planar) (13 * (n) + ((planar) ? (n) : 0))
+
+typedef struct {
+    int64_t n, k, s, nj, m, n_expr, n_code, n_varying, n_laws, n_known;
+    const double *gravity, *bodies, *loads, *springs, *joints, *comps_f, *numbers;
+    const int64_t *loads_i, *springs_i, *joints_i, *comps_i, *varying, *laws, *starts,
+        *codes, *known;
+    int planar;
+} mb_model;
+
+typedef struct {
+    int64_t mu, bw, nnz;
+    const int64_t *U, *inc_ptr, *inc;
+} mb_unknowns;
+
+/* Views of F and I (no copy); returns 0, or -1 when the sizes do not add up. */
+int mb_model_view(mb_model *md, const double *F, int64_t nF, const int64_t *I, int64_t nI,
+                  int planar);
+int mb_unknowns_view(mb_unknowns *u, const mb_model *md, const int64_t *Iu, int64_t nIu);
+
+/* Scratch memory for evaluations of one (model, unknowns): allocated once, reused. */
+typedef struct mb_work mb_work;
+mb_work *mb_work_new(const mb_model *md, const mb_unknowns *u);
+void mb_work_free(mb_work *w);
+
+/* The value at t of expression e (MB_OP_* program); out of a function's domain inf/nan
+ * as numpy gives them. */
+double mb_expression(const mb_model *md, int64_t e, double t);
+
+/* Q - b per body, out (n x 6): [W_F; B_M - w x J w]; with the load values at t. */
+void mb_net_wrench(const mb_model *md, mb_work *w, double t, const double *y, double *out);
+
+/* Per component (m): child6, parent6 (m x 6), W_e (m x 3) its direction (world),
+ * W_P (m x 3) its point (world), gamma, phi, gtv (G^T v - f', see above) at (t, y). */
+void mb_columns(const mb_model *md, mb_work *w, double t, const double *y, double *child6,
+                double *parent6, double *W_e, double *W_P, double *gamma, double *phi,
+                double *gtv);
+
+/* Status codes: 0, or 1 + 6 body + row of a motion without mass or inertia. */
+
+/* Accelerations and reactions at one state (what Assembly.solve returns): out as
+ * mbody/solve/compiled.solve_layout: accelerations in the model's coordinates,
+ * lambda (m) (known values in place), gtv (m), not-unique flags (m), info
+ * [rank, backward error, broken enforced joints, mu, path, singular code]. */
+void mb_solve(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
+              const double *y, const double *lam, double *out);
+
+/* dy/dt at (t, y) with the unknown reactions solved (Baumgarte alpha = beta = rate when
+ * rate > 0); lam: known reaction values (0 on unknown components). Returns the status. */
+int mb_derivative(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
+                  const double *y, const double *lam, double rate, double *ydot);
+
+/* Move y onto the enforced joints at t, in place: `iters` Gauss-Newton position steps,
+ * then the mass-orthogonal velocity projection (target G^T v = f'(t); with `homogeneous`
+ * the target is G^T v = 0 and laws are ignored: the tangent space, for error estimates).
+ * info[4] <- [largest position step, largest velocity change, geometric ratio at the
+ * start, status]. Null-space solves below a geometric ratio of robust_below. */
+void mb_project(const mb_model *md, const mb_unknowns *u, mb_work *w, double t, double *y,
+                int iters, double robust_below, int homogeneous, double *info);
+
+#endif
