@@ -16,6 +16,17 @@ static struct PyModuleDef module = {
 PyMODINIT_FUNC PyInit__core(void) {
     PyObject *m = PyModule_Create(&module);
     if (m == NULL) return NULL;
-    if (PyModule_AddIntConstant(m, "KINDS", MB_KINDS) < 0) return NULL;
+    /* the constraint primitives (kernel.h), named as mbody.joints reads them */
+    if (PyModule_AddIntConstant(m, "KIND_FORCE", MB_KIND_FORCE) < 0
+        || PyModule_AddIntConstant(m, "KIND_TILT", MB_KIND_TILT) < 0
+        || PyModule_AddIntConstant(m, "KIND_LOCK", MB_KIND_LOCK) < 0
+        || PyModule_AddIntConstant(m, "KIND_RIGHT_ANGLE", MB_KIND_RIGHT_ANGLE) < 0
+        || PyModule_AddIntConstant(m, "KIND_LINK", MB_KIND_LINK) < 0
+        || PyModule_AddIntConstant(m, "KIND_TURN", MB_KIND_TURN) < 0
+        || PyModule_AddIntConstant(m, "KIND_SCREW", MB_KIND_SCREW) < 0
+        || PyModule_AddIntConstant(m, "KINDS", MB_KINDS) < 0) {
+        Py_DECREF(m);
+        return NULL;
+    }
     return m;
 }
