@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from mbody import joint_types
+
 PLANAR, SPATIAL = 2, 3
 
 SPATIAL_ROWS = ("x", "y", "z", "w1", "w2", "w3")
@@ -28,44 +30,32 @@ ACCELERATION_NAMES = {
 """How the unknown acceleration of each row is written in equations."""
 
 COMPONENTS = ("Fx", "Fy", "Fz", "Mx", "My", "Mz")
-"""Reaction component names; index k < 3 is a force along joint axis k, else a moment."""
-
-JOINT_COMPONENTS: dict[int, dict[str, tuple[str, ...]]] = {
-    PLANAR: {
-        "revolute": ("Fx", "Fy"),
-        "prismatic": ("Fy", "Mz"),
-        "fixed": ("Fx", "Fy", "Mz"),
-    },
-    SPATIAL: {
-        "revolute": ("Fx", "Fy", "Fz", "Mx", "My"),
-        "prismatic": ("Fx", "Fy", "Mx", "My", "Mz"),
-        "cylindrical": ("Fx", "Fy", "Mx", "My"),
-        "universal": ("Fx", "Fy", "Fz", "Mt"),
-        "spherical": ("Fx", "Fy", "Fz"),
-        "fixed": ("Fx", "Fy", "Fz", "Mx", "My", "Mz"),
-    },
-}
-"""Reaction components of each joint type: exactly the relative motions it prevents."""
+"""The force and moment components along and about the three joint-frame axes."""
 
 LINK = "T"
 """The tension of a particle's link (positive pulls the particle toward the joint point)."""
 LINK_AXIS = -1
 """`ReactionTable.axis` of a link's tension T (a force along the link, not a frame axis)."""
 
+# Views of the joint-type registry (mbody.joint_types, where each type is defined once),
+# for the exports' conventions data and older callers.
+JOINT_COMPONENTS: dict[int, dict[str, tuple[str, ...]]] = {
+    d: {name: jt.component_names for name, jt in types.items()}
+    for d, types in joint_types.TYPES.items()}
+"""Reaction components of each joint type: exactly the relative motions it prevents."""
+
 PARTICLE_COMPONENTS: dict[int, dict[str, dict[str, tuple[str, ...]]]] = {
-    PLANAR: {"revolute": {"pin": ("Fx", "Fy"), "link": (LINK,)}},
-    SPATIAL: {"revolute": {"pin": ("Fx", "Fy", "Fz"), "link": (LINK, "Fz")},
-              "spherical": {"pin": ("Fx", "Fy", "Fz"), "link": (LINK,)}},
-}
+    d: {name: {k: tuple(c.name for c in cs) for k, cs in jt.particle.items()}
+        for name, jt in types.items() if jt.particle}
+    for d, types in joint_types.TYPES.items()}
 """Reaction components of a joint with a particle at an end: a pin (joint point at the
 particle) holds its position, a link (joint point away from it) its distance (and, for a
 spatial revolute, its plane ⟂ the axis: Fz); no moments (a particle has no orientation)."""
 
 AXIS_REQUIRED = {
-    PLANAR: {"prismatic"},
-    SPATIAL: {"revolute", "prismatic", "cylindrical", "universal"},
-}
-"""Joint types that need an `axis` (universal also needs `axis2`)."""
+    d: {name for name, jt in types.items() if (p := jt.param("axis")) and p.required}
+    for d, types in joint_types.TYPES.items()}
+"""Joint types that need an `axis` (universal also needs `axis2`, helical `pitch`)."""
 
 GROUND = "ground"
 

@@ -15,6 +15,8 @@ import sys
 from pathlib import Path
 
 import numpy as np
+
+from mbody import joint_types
 import pytest
 import yaml
 
@@ -115,7 +117,16 @@ def eager_reaction_table(model: Model) -> dict[str, np.ndarray | tuple[str, ...]
     free_turn = np.array([j.type in ("revolute", "cylindrical") for j in js],
                          dtype=bool)[row_joint]
     column = np.where(axis == 6, 2, axis % 3)
+    registry = [joint_types.joint_type(model.dimension, j.type) for j in js]
+    parts = [t.particle[j.particle_joint] if j.particle_joint else t.components
+             for t, j in zip(registry, js, strict=True)]
     return {
+        "component": np.array([joint_types.COMPONENT_CODE[c.name] for cs in parts
+                               for c in cs], dtype=np.intp),
+        "kind": np.array([c.kind for cs in parts for c in cs], dtype=np.intp),
+        "frame_axis": np.array([c.axis for cs in parts for c in cs], dtype=np.intp),
+        "is_moment": np.array([c.what == joint_types.MOMENT for cs in parts for c in cs],
+                              dtype=bool),
         "labels": tuple(f"{j.name}.{comp}" for j, cs in zip(js, comps, strict=True)
                         for comp in cs),
         "joint": row_joint, "parent": p[row_joint], "child": c[row_joint], "axis": axis,
@@ -138,7 +149,7 @@ def assert_derived_equal_eager(model: Model) -> None:
     rt = model.reaction_table
     assert not set(rt.DERIVED) & set(vars(rt))  # nothing derived before it is asked for
     old = eager_reaction_table(model)
-    assert set(old) == {"joint", "axis", *rt.DERIVED}
+    assert set(old) == {"joint", "component", "kind", "frame_axis", *rt.DERIVED}
     for k, v in old.items():
         if k == "labels":
             assert getattr(rt, k) == v

@@ -666,7 +666,7 @@ def test_unknown_spatial_joint_type_lists_them(model_file):
     i = problem(model_file, text, "bearing", "joints[0].type",
                 "unknown spatial joint type 'bearing'")
     assert i.hint == ("expected one of: revolute, prismatic, cylindrical, universal, "
-                      "spherical, fixed")
+                      "spherical, fixed, helical")
 
 
 @pytest.mark.parametrize("typ", ["revolute", "prismatic", "cylindrical", "universal"])

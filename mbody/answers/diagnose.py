@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from mbody import joint_types
 from mbody.answers.compare import CONST, Fit, Row, fit, matches, same
 from mbody.answers.rows import BodyRows, LoadShare, MomentPoint, TrueRow
 from mbody.answers.text import num as _num
@@ -597,7 +598,7 @@ class _Diagnoser:
 
 
 def _is_moment(label: str) -> bool:
-    return label.rpartition(".")[2].startswith("M")
+    return joint_types.is_moment(label)
 
 
 def _point(p: MomentPoint) -> str:

@@ -15,14 +15,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from mbody import conventions as cv
+from mbody import joint_types
 from mbody.answers.compare import CONST, Row
 from mbody.answers.text import equation_text
 from mbody.answers.vocabulary import PLANAR_ACCELERATIONS, SPATIAL_ACCELERATIONS
 from mbody.equations.assemble import Assembly
 from mbody.equations.fbd import BodyEquations, Equation
 
-FIXED_POINT_JOINTS = {cv.PLANAR: {"revolute", "fixed"},
-                      cv.SPATIAL: {"revolute", "spherical", "universal", "fixed"}}
+FIXED_POINT_JOINTS = {d: {name for name, t in types.items() if t.holds_point}
+                      for d, types in joint_types.TYPES.items()}
 """Joint types that hold their point still when the parent is ground."""
 
 

@@ -13,10 +13,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from mbody import conventions as cv
+from mbody import joint_types
 from mbody.equations.spatial import joint_frame_planar, joint_frame_spatial, quat_to_matrix
+from mbody.joint_types.base import TILT, Component
 from mbody.model.expressions import ExpressionTable
 from mbody.model.records import Joint, Load, Records, field_names, record
-from mbody.model.tables import AXIS_CODE, ForceTable, JointTable, ReactionTable, readonly
+from mbody.model.tables import ForceTable, JointTable, ReactionTable, readonly
 from mbody.model.validate import JointSpecTable, LoadSpec, LoadTable
 
 if TYPE_CHECKING:
@@ -60,10 +62,6 @@ def point_loads(t: LoadTable, names: tuple[str, ...]) -> tuple[Records[Load], Fo
                                       frames[i], (at[i],), 0.0, 0.0, 0.0, {}))
 
     return Records(len(load_names), make), forces
-
-
-_FREE_TURN = ("revolute", "cylindrical")
-"""Joint types whose moment components measure the tilt of the joint z axis."""
 
 
 def joint_tables(dimension: int, js: JointSpecTable, names: tuple[str, ...],
@@ -112,28 +110,32 @@ def joint_tables(dimension: int, js: JointSpecTable, names: tuple[str, ...],
     del Rp, Rc, RpT, RcT, xp, xc
 
     types = js.types
-    by_type = cv.JOINT_COMPONENTS[dimension]
-    comps = ([by_type[typ] for typ in types] if not any(kinds) else
-             [cv.PARTICLE_COMPONENTS[dimension][typ][k] if k else by_type[typ]
+    registry = joint_types.TYPES[dimension]
+    comps = ([registry[typ].components for typ in types] if not any(kinds) else
+             [registry[typ].particle[k] if k else registry[typ].components
               for typ, k in zip(types, kinds, strict=True)])
     # the distinct component lists (a few), and each joint's
-    distinct: dict[tuple[str, ...], int] = {}
+    distinct: dict[tuple[Component, ...], int] = {}
     code = np.fromiter((distinct.setdefault(cs, len(distinct)) for cs in comps),
                        dtype=np.intp, count=nj)
-    axes = np.zeros((max(len(distinct), 1), 7), dtype=np.intp)
-    sizes = np.zeros(len(axes), dtype=np.intp)
+    width = max((len(cs) for cs in distinct), default=1)
+    table_of = np.zeros((3, max(len(distinct), 1), width), dtype=np.intp)  # name, kind, axis
+    sizes = np.zeros(table_of.shape[1], dtype=np.intp)
     for cs, k in distinct.items():
-        axes[k, :len(cs)] = [AXIS_CODE[comp] for comp in cs]
+        table_of[:, k, :len(cs)] = [[joint_types.COMPONENT_CODE[comp.name] for comp in cs],
+                                    [comp.kind for comp in cs], [comp.axis for comp in cs]]
         sizes[k] = len(cs)
     counts = sizes[code]
     first = np.cumsum(counts) - counts
     row_joint = np.repeat(np.arange(nj, dtype=np.intp), counts)
-    axis = axes[code[row_joint], np.arange(len(row_joint)) - first[row_joint]]
-    free_turn = np.array([typ in _FREE_TURN for typ in types], dtype=bool)
+    component, kind, frame_axis = table_of[:, code[row_joint],
+                                           np.arange(len(row_joint)) - first[row_joint]]
+    free_turn = np.array([any(c.kind == TILT for c in registry[typ].components)
+                          for typ in types], dtype=bool)
     per_joint = JointTable(tuple(js.names), p, c, readonly(B_r_child), readonly(B_r_parent),
                            readonly(P_E), readonly(C_E), readonly(C_axis2), first, link, p_particle,
-                           readonly(length), free_turn)
-    table = ReactionTable(per_joint, row_joint, axis)
+                           readonly(length), free_turn, readonly(js.pitch))
+    table = ReactionTable(per_joint, row_joint, component, kind, frame_axis)
 
     fields_ = field_names(Joint)
     axis1 = readonly(js.axis)
@@ -145,7 +147,8 @@ def joint_tables(dimension: int, js: JointSpecTable, names: tuple[str, ...],
         pj = int(parents[j])
         return record(Joint, fields_, (
             jnames[j], types[j], names[pj] if pj >= 0 else cv.GROUND, names[children[j]],
-            at[j], W_E0[j], comps[j], axis1[j] if has1[j] else None,
+            at[j], W_E0[j], tuple(comp.name for comp in comps[j]),
+            axis1[j] if has1[j] else None,
             axis2[j] if has2[j] else None, kinds[j]))
 
     return Records(nj, make), table

@@ -43,6 +43,7 @@ from typing import Any
 import numpy as np
 
 from mbody import conventions as cv
+from mbody import joint_types
 from mbody.errors import ModelError
 from mbody.model.checks import (
     _TOL,
@@ -64,6 +65,7 @@ from mbody.model.validate import (
     FRAMES,
     JOINT_KEYS,
     LOAD_KEYS,
+    PARAM_KEYS,
     BodyTable,
     JointSpecTable,
     LoadTable,
@@ -225,7 +227,7 @@ def _conversions(key: str, c: Checker) -> dict[tuple[Any, ...], Convert]:
                 ("type",): _canonical(LOAD_KEYS), ("frame",): _canonical(FRAMES)}
     if key == "joints":
         return {("parent",): _references(known, True), ("child",): _references(known, False),
-                ("type",): _canonical(cv.JOINT_COMPONENTS[c.dim])}
+                ("type",): _canonical(FAST_TYPES[c.dim])}
     return {}
 
 
@@ -729,7 +731,17 @@ def _inertia(g: _Group, planar: bool) -> np.ndarray:
 
 LOAD_PATHS = {kind: {(k,) for k in LOAD_KEYS[kind]} for kind in ("force", "torque")}
 """What a force or torque load may give (no expressions: a number per component)."""
-JOINT_PATHS = {(k,) for k in JOINT_KEYS}
+FAST_PARAMS = {"axis", "axis2"}
+"""The joint parameters this reader takes; a type with others (a helical joint's pitch)
+goes to the located path."""
+JOINT_PATHS = {(k,) for k in JOINT_KEYS if k not in PARAM_KEYS or k in FAST_PARAMS}
+FAST_TYPES = {d: tuple(name for name, t in types.items()
+                       if {p.name for p in t.params} <= FAST_PARAMS)
+              for d, types in joint_types.TYPES.items()}
+"""The joint types this reader takes (by dimension)."""
+AXIS2_TYPES = {d: {name for name, t in types.items() if t.param("axis2")}
+               for d, types in joint_types.TYPES.items()}
+"""The types that have (and need) a second axis."""
 
 
 def _placed(n: int, parts: list[tuple[np.ndarray, list[Any]]]) -> list[Any]:
@@ -814,8 +826,8 @@ def _joints(c: Checker, groups: list[_Group]) -> JointSpecTable:
             has_axis[i] = True
         elif not set(kinds).isdisjoint(cv.AXIS_REQUIRED[dim]):
             raise _Bail
-        if second or "universal" in kinds:
-            if not (first and second and set(kinds) == {"universal"}):
+        if second or not AXIS2_TYPES[dim].isdisjoint(kinds):
+            if not (first and second and set(kinds) <= AXIS2_TYPES[dim]):
                 raise _Bail
             unit2 = _unit(_pad3(_numbers(g, ("axis2",), dim)))
             if not np.all(np.abs(np.einsum("ij,ij->i", axis[i], unit2)) <= 0.5 * PERPENDICULAR_TOL):
@@ -831,7 +843,7 @@ def _joints(c: Checker, groups: list[_Group]) -> JointSpecTable:
     if "reactions" in c.doc.data:  # known reactions name their joints' components
         c.joint_types.update(zip(names_list, types_list, strict=True))
     return JointSpecTable(names_list, types_list, parent, child, at, axis, has_axis, axis2,
-                          has_axis2, [""] * n)
+                          has_axis2, [""] * n, np.zeros(n))
 
 
 def _unit(v: np.ndarray) -> np.ndarray:

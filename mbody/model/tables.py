@@ -13,6 +13,8 @@ from functools import cached_property
 import numpy as np
 
 from mbody import conventions as cv
+from mbody import joint_types as jt
+from mbody.joint_types import base as jb
 from mbody.model.expressions import ExpressionTable
 
 
@@ -92,7 +94,7 @@ class JointTable:
     components are consecutive). link: (J,) a particle link (its first component is T);
     particle_parent: (J,) the parent is a particle; length: (J,) the link's length (0
     otherwise); free_turn: (J,) the joint turns freely about its z axis (revolute,
-    cylindrical).
+    cylindrical, helical); pitch: (J,) a helical joint's advance per turn (m; else 0).
     """
 
     names: tuple[str, ...]
@@ -108,6 +110,7 @@ class JointTable:
     particle_parent: np.ndarray
     length: np.ndarray
     free_turn: np.ndarray
+    pitch: np.ndarray
 
     def __repr__(self) -> str:  # the dataclass's would print every array
         return (f"<JointTable: {len(self.names)} joints ({', '.join(self.names[:4])}"
@@ -118,10 +121,12 @@ class JointTable:
 class ReactionTable:
     """One row per reaction unknown (column of G), in label order.
 
-    Stored: `per_joint`, the `JointTable`; joint: (m,) joint index; axis: (m,) 0-2 force
-    along joint axis k, 3-5 moment about joint axis k-3, 6 the universal joint's moment
-    about axis × axis2, -1 a particle link's tension T. Everything else is derived from
-    these on first use (a large model's file is read without building them):
+    Stored: `per_joint`, the `JointTable`; joint: (m,) joint index; component: (m,) the
+    component's name as an index into `mbody.joint_types.COMPONENT_NAMES`; kind: (m,) the
+    compiled core's constraint primitive that writes its column (`mbody.joint_types.base`,
+    kernel.h's ``MB_KIND_*``); frame_axis: (m,) the joint-frame axis (0-2) it acts along
+    or about. Everything else is derived from these on first use (a large model's file is
+    read without building them):
 
     labels: ``<joint>.<component>``; parent, child: (m,) body index (-1 = ground);
     P_E: (m, 3) the column's joint axis fixed in the parent (body axes; world for ground);
@@ -130,33 +135,36 @@ class ReactionTable:
     B_r_parent: (m, 3) the joint point on the parent, parent body axes (world for ground).
     P_E3, C_E3: (m, 3, 3) the whole joint frame fixed in the parent and in the child
     (they coincide at the initial pose); used for position-level constraint errors.
-    rot_kind: (m,) for moment components: 1 = about an axis ⟂ a free rotation (revolute,
-    cylindrical: measured by the tilt of the joint z axis), 2 = all rotation locked
-    (fixed, prismatic: small rotation vector), 3 = universal; 0 for forces.
-    link: (m,) True for a particle link's tension T (axis −1): the force along the line
-    from the child's attachment point to the parent's, constraint |P_c − P_p| = L.
-    particle_parent: (m,) True when the parent is a particle (its moment rows stay 0).
-    length: (m,) the link's length L (0 for other components).
+    is_moment: (m,) the value is a moment (N m). link: (m,) True for a particle link's
+    tension T: the force along the line from the child's attachment point to the
+    parent's, constraint |P_c − P_p| = L. particle_parent: (m,) True when the parent is a
+    particle (its moment rows stay 0). length: (m,) the link's length L (0 for other
+    components). axis, rot_kind: the older numeric code of each component (0-2 force
+    along axis k, 3-5 moment about axis k-3, 6 the universal joint's moment, -1 a link's
+    tension; rot_kind 1 tilt of a free turn, 2 locked rotation, 3 universal, 0 forces).
     """
 
     per_joint: JointTable
     joint: np.ndarray
-    axis: np.ndarray
+    component: np.ndarray
+    kind: np.ndarray
+    frame_axis: np.ndarray
 
     DERIVED = ("labels", "parent", "child", "P_E", "B_r_child", "C_axis2", "B_r_parent",
-               "P_E3", "C_E3", "rot_kind", "link", "particle_parent", "length")
+               "P_E3", "C_E3", "is_moment", "axis", "rot_kind", "link", "particle_parent",
+               "length")
     """The per-component fields made from `per_joint` on first use."""
 
     def __repr__(self) -> str:  # the dataclass's would print every array
         return (f"<ReactionTable: {len(self.joint)} reaction components of "
-                f"{len(self.per_joint.names)} joints; .labels, .joint, .axis, .per_joint>")
+                f"{len(self.per_joint.names)} joints; .labels, .joint, .kind, .per_joint>")
 
     @cached_property
     def labels(self) -> tuple[str, ...]:
         """``<joint>.<component>`` per column of G."""
-        names = self.per_joint.names
-        return tuple(f"{names[j]}.{_COMPONENT[a]}"
-                     for j, a in zip(self.joint.tolist(), self.axis.tolist(), strict=True))
+        names, comp = self.per_joint.names, jt.COMPONENT_NAMES
+        return tuple(f"{names[j]}.{comp[c]}"
+                     for j, c in zip(self.joint.tolist(), self.component.tolist(), strict=True))
 
     @cached_property
     def parent(self) -> np.ndarray:
@@ -171,8 +179,7 @@ class ReactionTable:
     @cached_property
     def P_E(self) -> np.ndarray:
         """(m, 3) the column's joint axis fixed in the parent."""
-        column = np.where(self.axis == 6, 2, self.axis % 3)  # Mt's column stores axis z
-        return readonly(self.per_joint.P_E3[self.joint, :, column].reshape(-1, 3))
+        return readonly(self.per_joint.P_E3[self.joint, :, self.frame_axis].reshape(-1, 3))
 
     @cached_property
     def B_r_child(self) -> np.ndarray:
@@ -200,16 +207,31 @@ class ReactionTable:
         return readonly(self.per_joint.C_E3[self.joint])
 
     @cached_property
+    def is_moment(self) -> np.ndarray:
+        """(m,) the component's value is a moment (N m)."""
+        return _MOMENT_CODE[self.component]
+
+    @cached_property
+    def axis(self) -> np.ndarray:
+        """(m,) the older numeric code of each component (class docstring)."""
+        k = self.kind
+        return np.where(k == jb.FORCE_ALONG, self.frame_axis,
+                        np.where(k == jb.RIGHT_ANGLE, 6,
+                                 np.where(k == jb.LINK, cv.LINK_AXIS,
+                                          3 + self.frame_axis))).astype(np.intp)
+
+    @cached_property
     def rot_kind(self) -> np.ndarray:
         """(m,) 0 force, 1 tilt of a free turn, 2 locked rotation, 3 universal."""
-        a = self.axis
-        free = self.per_joint.free_turn[self.joint]
-        return np.where(a < 3, 0, np.where(a == 6, 3, np.where(free, 1, 2))).astype(np.intp)
+        k = self.kind
+        return np.where(k == jb.TILT, 1, np.where(
+            (k == jb.LOCK) | (k == jb.TURN), 2, np.where(k == jb.RIGHT_ANGLE, 3, 0))
+        ).astype(np.intp)
 
     @cached_property
     def link(self) -> np.ndarray:
         """(m,) a particle link's tension T."""
-        return self.axis == cv.LINK_AXIS
+        return self.kind == jb.LINK
 
     @cached_property
     def particle_parent(self) -> np.ndarray:
@@ -222,6 +244,5 @@ class ReactionTable:
         return readonly(np.where(self.link, self.per_joint.length[self.joint], 0.0))
 
 
-_COMPONENT = {**dict(enumerate(cv.COMPONENTS)), 6: "Mt", cv.LINK_AXIS: cv.LINK}
-"""Component name of each `ReactionTable.axis` code."""
-AXIS_CODE = {name: code for code, name in _COMPONENT.items()}
+_MOMENT_CODE = np.array([jt.WHATS[c] == jt.MOMENT for c in jt.COMPONENT_NAMES], dtype=bool)
+"""Per `mbody.joint_types.COMPONENT_NAMES` entry: a moment."""

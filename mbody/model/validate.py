@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from mbody import conventions as cv
+from mbody import joint_types
 from mbody.equations.spatial import euler_to_quat, matrix_to_quat, shape_inertia
 from mbody.errors import Issue, ModelError, did_you_mean
 from mbody.model.checks import (
@@ -56,7 +57,10 @@ LOAD_KEYS = {
     "torque": ("name", "type", "body", "torque", "frame"),
     "spring": ("name", "type", "bodies", "at", "stiffness", "rest_length", "damping"),
 }
-JOINT_KEYS = ("name", "type", "parent", "child", "at", "axis", "axis2")
+PARAM_KEYS = tuple(dict.fromkeys(p.name for types in joint_types.TYPES.values()
+                                 for t in types.values() for p in t.params))
+"""Every joint type's own keys (axis, axis2, pitch...: mbody.joint_types)."""
+JOINT_KEYS = ("name", "type", "parent", "child", "at", *PARAM_KEYS)
 ORIENTATION_KEYS = ("quaternion", "euler", "sequence", "matrix")
 SHAPES = {
     cv.PLANAR: ("box", "disc", "ellipsoid", "sphere", "cylinder"),
@@ -112,6 +116,8 @@ class JointSpec:
     particle_joint: str = ""
     """With a particle at an end: "pin" (the joint point is at the particle(s)) or "link"
     (a massless rigid link from the joint point to the particle); "" otherwise."""
+    pitch: float = 0.0
+    """A helical joint's advance per turn along its axis (m; positive: right-handed)."""
 
 
 @dataclass
@@ -169,7 +175,8 @@ class JointSpecTable:
 
     names, types; parent, child: (k,) body indices (-1 = ground); at: (k, 3) the joint
     point, world, initial pose; axis, axis2: (k, 3) unit axes, zero where `has_axis`,
-    `has_axis2` are False; particle_joint: "pin", "link" or "" per joint.
+    `has_axis2` are False; particle_joint: "pin", "link" or "" per joint; pitch: (k,) a
+    helical joint's advance per turn (m; 0 for other types).
     """
 
     names: list[str]
@@ -182,6 +189,7 @@ class JointSpecTable:
     axis2: np.ndarray
     has_axis2: np.ndarray
     particle_joint: list[str]
+    pitch: np.ndarray
 
     @classmethod
     def from_specs(cls, joints: list[JointSpec], index: dict[str, int]) -> JointSpecTable:
@@ -213,7 +221,8 @@ class JointSpecTable:
                    stack([j.at for j in joints]), stack(axes),
                    np.array([a is not None for a in axes], dtype=bool), stack(axes2),
                    np.array([a is not None for a in axes2], dtype=bool),
-                   [j.particle_joint for j in joints])
+                   [j.particle_joint for j in joints],
+                   np.array([j.pitch for j in joints], dtype=float).reshape(k))
 
 
 @dataclass
@@ -241,14 +250,6 @@ class Spec:
         """The bodies as arrays, from `body_table` or else from `bodies`."""
         return self.body_table if self.body_table is not None else BodyTable.from_specs(
             self.bodies)
-
-
-_JOINT_SYNONYMS = {
-    "hinge": "revolute", "pin": "revolute", "continuous": "revolute", "slide": "prismatic",
-    "slider": "prismatic", "ball": "spherical", "weld": "fixed", "cardan": "universal",
-    "hooke": "universal",
-}
-"""Other programs' names for mbody's joint types (MuJoCo, URDF, textbooks)."""
 
 
 def validate(doc: Document) -> Spec:
@@ -757,7 +758,8 @@ def _joints(c: Checker, value: Any, names: dict[str, int],
             bodies: list[BodySpec]) -> list[JointSpec]:
     out: list[JointSpec] = []
     seen: dict[str, int] = {}
-    types = tuple(cv.JOINT_COMPONENTS[c.dim])
+    types = joint_types.type_names(c.dim)
+    synonyms = joint_types.ALIASES[c.dim]  # other programs' names (hinge, slide, ball...)
     for i, j in enumerate(_list(c, ("joints",), value, "joints", False)):
         p: Path_ = ("joints", i)
         if not c.mapping(p, j, JOINT_KEYS, ("name", "type", "parent", "child", "at"),
@@ -770,14 +772,14 @@ def _joints(c: Checker, value: Any, names: dict[str, int],
         elif name is not None:
             seen[name] = i
         typ = None
-        other = cv.JOINT_COMPONENTS[cv.PLANAR + cv.SPATIAL - c.dim]
+        other = joint_types.type_names(cv.PLANAR + cv.SPATIAL - c.dim)
         if isinstance(j.get("type"), str) and j["type"] in other and j["type"] not in types:
             here, there = ("planar", "spatial") if c.dim == cv.PLANAR else ("spatial", "planar")
             c.err((*p, "type"), f"'{j['type']}' is a {there} joint type; a {here} model "
                   f"(dimension: {c.dim}) has: {', '.join(types)}")
-        elif isinstance(j.get("type"), str) and _JOINT_SYNONYMS.get(j["type"]) in types:
+        elif isinstance(j.get("type"), str) and synonyms.get(j["type"]) in types:
             c.err((*p, "type"), f"unknown {'planar' if c.dim == 2 else 'spatial'} joint type "
-                  f"'{j['type']}'", f"mbody calls it '{_JOINT_SYNONYMS[j['type']]}'")
+                  f"'{j['type']}'", f"mbody calls it '{synonyms[j['type']]}'")
         elif "type" in j:
             typ = c.choice((*p, "type"), j["type"], types,
                            f"{'planar' if c.dim == 2 else 'spatial'} joint type")
@@ -792,26 +794,12 @@ def _joints(c: Checker, value: Any, names: dict[str, int],
                   "parent and child must be different bodies (or ground as the parent)")
             child = None
         at = c.vec3((*p, "at"), j["at"]) if "at" in j else None
-        axis = axis2 = None
-        if "axis" in j:
-            axis = _axis(c, (*p, "axis"), j["axis"])
-        elif typ in cv.AXIS_REQUIRED[c.dim]:
-            c.err(p, f"a {typ} joint needs an 'axis'",
-                  "the slide direction" if typ == "prismatic" else "the rotation axis")
-        if "axis2" in j:
-            if typ != "universal":
-                c.err((*p, "axis2"), "'axis2' belongs to universal joints",
-                      "remove it, or use type: universal", key=True)
-            else:
-                axis2 = _axis(c, (*p, "axis2"), j["axis2"])
-        elif typ == "universal":
-            c.err(p, "a universal joint needs 'axis2' (the child's axis)")
+        params = _joint_params(c, p, j, typ)
+        if params is None:
+            continue
+        axis, axis2, pitch = params
         if name is not None and typ is not None:
             c.joint_types.setdefault(name, typ)
-        if axis is not None and axis2 is not None and abs(float(axis @ axis2)) > PERPENDICULAR_TOL:
-            c.err((*p, "axis2"), "a universal joint's axes must be perpendicular",
-                  f"axis . axis2 = {float(axis @ axis2):.3g}")
-            continue
         if name is None or typ is None or parent is None or child is None or at is None:
             continue
         kind = ""
@@ -822,8 +810,38 @@ def _joints(c: Checker, value: Any, names: dict[str, int],
             kind = found
             c.particle_joints.setdefault(name, kind)
         out.append(JointSpec(name, typ, parent, child, at, axis, axis2, c.doc.where(p)[0],
-                             kind))
+                             kind, pitch))
     return out
+
+
+def _joint_params(c: Checker, p: Path_, j: dict, typ: str | None
+                  ) -> tuple[np.ndarray | None, np.ndarray | None, float] | None:
+    """The joint type's own keys (mbody.joint_types: axis, axis2, pitch), checked: (axis,
+    axis2, pitch), or None when the joint is to be left out (a rule of its type broken)."""
+    jt = joint_types.TYPES[c.dim].get(typ) if typ is not None else None
+    got: dict[str, Any] = {}
+    for key in PARAM_KEYS:
+        prm = jt.param(key) if jt is not None else None
+        if key in j:
+            if jt is not None and prm is None:
+                owners = [t.name for t in joint_types.TYPES[c.dim].values() if t.param(key)]
+                c.err((*p, key), f"'{key}' belongs to {' and '.join(owners) or 'no'} joints",
+                      f"remove it, or use type: {' or '.join(owners)}" if owners else
+                      "remove it", key=True)
+            elif prm is None or prm.what == "direction":
+                got[key] = _axis(c, (*p, key), j[key])
+            else:
+                got[key] = c.number((*p, key), j[key])
+        elif prm is not None and prm.required:
+            article = "an " if key == "axis" else ""  # "needs an 'axis'", "needs 'axis2'"
+            c.err(p, f"a {typ} joint needs {article}'{key}'", prm.meaning)
+    axis, axis2 = got.get("axis"), got.get("axis2")
+    if axis is not None and axis2 is not None and abs(float(axis @ axis2)) > PERPENDICULAR_TOL:
+        c.err((*p, "axis2"), f"a {typ} joint's axes must be perpendicular",
+              f"axis . axis2 = {float(axis @ axis2):.3g}")
+        return None
+    pitch = got.get("pitch")
+    return axis, axis2, float(pitch) if pitch is not None else 0.0
 
 
 PARTICLE_JOINTS = {cv.PLANAR: ("revolute",), cv.SPATIAL: ("revolute", "spherical")}

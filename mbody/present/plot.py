@@ -20,6 +20,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from mbody import conventions as cv
+from mbody import joint_types
 from mbody.errors import MbodyError
 from mbody.io.atomic import atomic_path
 from mbody.simulate.trajectory import Trajectory
@@ -147,11 +148,11 @@ MAX_REACTIONS = 12
 
 
 def _reaction_columns(traj: Trajectory, moment: bool) -> list[int]:
-    """Columns of `traj.reactions` holding moment (`M…`) or force components."""
+    """Columns of `traj.reactions` holding moment (N m) or force (N) components."""
     if not traj.reaction_labels or traj.reactions.ndim != 2 or traj.reactions.shape[1] == 0:
         return []
     return [k for k, lab in enumerate(traj.reaction_labels)
-            if lab.split(".", 1)[-1].startswith("M") == moment]
+            if joint_types.is_moment(lab) == moment]
 
 
 def _reaction_panel(traj: Trajectory, a: Axes, *, moment: bool, sel: list[int]) -> None:

@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from mbody import conventions as cv
+from mbody import joint_types
 from mbody.conventions import REACTION
 from mbody.equations.assemble import assemble
 from mbody.model.graph import topology
@@ -280,8 +281,8 @@ def _clean(x: np.ndarray, rel: float = 1e-10) -> np.ndarray:
 
 
 def _unit(label: str) -> str:
-    """A reaction component's unit: moments (M...) in N m, forces and tensions in N."""
-    return "N m" if label.rsplit(".", 1)[-1].startswith("M") else "N"
+    """A reaction component's unit: moments in N m, forces and tensions in N."""
+    return joint_types.unit(label)
 
 
 def solution_html(sol: Solution) -> str:

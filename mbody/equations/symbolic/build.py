@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from mbody import conventions as cv
+from mbody import joint_types
 from mbody.equations.symbolic.applied import load_symbols
 from mbody.equations.symbolic.rows import SymbolicBody, SymbolicEquations, SymbolicRow
 from mbody.equations.symbolic.terms import (
@@ -210,8 +211,9 @@ def _minus_gyroscopic(I: list[list[Any]], w: list[Any], principal: bool) -> list
 
 def is_moment(label: str) -> bool:
     """Whether a reaction label is a moment component (``A.Mz``, a universal joint's
-    ``U.Mt``), not a force (``A.Fx``, a link's tension ``L.T``)."""
-    return label.rpartition(".")[2].startswith("M")
+    ``U.Mt``), not a force (``A.Fx``, a link's tension ``L.T``, a helical joint's axial
+    wrench ``H.Wz``, whose value is its force): `mbody.joint_types.is_moment`."""
+    return joint_types.is_moment(label)
 
 
 def row_units(*coefficients: Any) -> dict[bool, float]:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from mbody import joint_types
 from mbody.equations.symbolic.terms import BODY_AXES, GYROSCOPIC, WORLD_AXES, Term
 
 if TYPE_CHECKING:
@@ -149,7 +150,7 @@ def inertia_words(form: str) -> str:
 
 def _unit(name: str) -> str:
     if "." in name:  # a reaction label: a force component or a moment
-        return "N m" if name.rpartition(".")[2].startswith("M") else "N"
+        return joint_types.unit(name)
     return _UNITS.get(name.partition("_")[0], "")
 
 

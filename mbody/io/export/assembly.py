@@ -19,6 +19,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from mbody import conventions as cv
+from mbody import joint_types
 from mbody.equations.assemble import Assembly, ReactionColumns, Solution
 from mbody.equations.constraints import gamma, phi
 from mbody.equations.plan import Unknowns
@@ -397,7 +398,7 @@ def exported(asm: Assembly, known: Mapping[str, float] | None = None,
     per = jt[t.joint] if len(t.labels) else np.zeros((0, 4), dtype="<U1")
     labels = list(t.labels)
     component = [lab.split(".", 1)[1] for lab in labels]
-    kind = np.where(cols.is_moment, "moment", "force")
+    kind = np.array([joint_types.what(c) for c in component], dtype=str)
     sign = [f"+{lab} acts on {c} at the joint point, -{lab} on {p}"
             for lab, p, c in zip(labels, per[:, 2], per[:, 3], strict=True)]
     columns = Columns(

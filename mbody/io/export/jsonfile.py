@@ -13,6 +13,8 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
+from mbody import conventions as cv
+from mbody import joint_types
 from mbody.errors import MbodyError
 from mbody.io.export.assembly import (
     COLUMN_TEXT,
@@ -65,9 +67,16 @@ def write(exp: ExportedAssembly, path: Path) -> None:
 
 
 def schema() -> dict[str, Any]:
-    """The JSON Schema (draft 2020-12) of the JSON export, shipped with the package."""
+    """The JSON Schema (draft 2020-12) of the JSON export, shipped with the package, with
+    the joint types and reaction components the registry holds (`mbody.joint_types`: a
+    new type's exports validate without editing the schema file)."""
     text = resources.files("mbody").joinpath("data/assembly.schema.json").read_text("utf-8")
     out: dict[str, Any] = json.loads(text)
+    column = out["properties"]["columns"]["items"]["properties"]
+    column["type"]["enum"] = list(dict.fromkeys(
+        name for d in (cv.PLANAR, cv.SPATIAL) for name in joint_types.type_names(d)))
+    column["component"]["enum"] = list(joint_types.COMPONENT_NAMES)
+    column["kind"]["enum"] = [joint_types.FORCE, joint_types.MOMENT, joint_types.WRENCH]
     return out
 
 
