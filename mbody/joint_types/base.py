@@ -108,13 +108,15 @@ class Motion:
     name: ``angle`` or ``displacement`` (the coordinate's label suffix); what: `ROTATION`,
     `TRANSLATION` or `BALL` (three rotations); axis: the joint-frame axis (0-2) it is
     about or along (`BALL`: -1); on: ``parent`` (the axis fixed in the parent: the joint
-    frame) or ``child`` (a universal joint's second axis, ``axis2``, fixed in the child).
+    frame) or ``child`` (a universal joint's second axis, ``axis2``, fixed in the child);
+    part: the suffix of its MJCF joint's name (``J:slide``) when the type has several.
     """
 
     name: str
     what: str
     axis: int
     on: str = "parent"
+    part: str = ""
 
 
 @dataclass(frozen=True)

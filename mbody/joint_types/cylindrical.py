@@ -18,5 +18,6 @@ SPATIAL_TYPE = JointType(
     name="cylindrical", dimension=SPATIAL,
     summary="the child turns about and slides along `axis`",
     components=(force(0), force(1), tilt(0), tilt(1)),
-    motions=(Motion("displacement", TRANSLATION, 2), Motion("angle", ROTATION, 2)),
+    motions=(Motion("displacement", TRANSLATION, 2, part="slide"),
+             Motion("angle", ROTATION, 2, part="turn")),
     params=(Param("axis", "direction", True, "the axis of rotation and sliding"),))

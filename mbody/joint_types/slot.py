@@ -11,6 +11,7 @@ PLANAR_TYPE = JointType(
     summary="a pin in a slot: the child's pin slides along `axis` (default world x) and "
             "turns freely",
     components=(force(1),),
-    motions=(Motion("displacement", TRANSLATION, 0), Motion("angle", ROTATION, 2)),
+    motions=(Motion("displacement", TRANSLATION, 0, part="slide"),
+             Motion("angle", ROTATION, 2, part="turn")),
     params=(Param("axis", "direction", False, "the slot's direction", (1.0, 0.0, 0.0)),),
     aliases=("pin-in-slot", "pin_slot"))

@@ -28,7 +28,7 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
-from mbody import __version__
+from mbody import __version__, joint_types
 from mbody import conventions as cv
 from mbody.equations.spatial import (
     box_equivalent,
@@ -39,6 +39,7 @@ from mbody.equations.spatial import (
 )
 from mbody.io.atomic import write_atomic
 from mbody.io.interop.custom import numeric, text
+from mbody.joint_types.base import SCREW
 from mbody.model.model import Joint, Model, count
 
 PARTICLE_INERTIA = 1e-12
@@ -50,11 +51,11 @@ LOOP_SOLIMP = "0.9999 0.9999 0.001 0.5 2"
 """Impedance of the loop-closing equality constraints: MuJoCo's stiffest (its default,
 0.9, lets a loop give by about 10 % of the force that holds it together)."""
 
-_TREE_FIRST = {"prismatic": 0, "cylindrical": 0, "universal": 0, "fixed": 1,
-               "revolute": 2, "spherical": 2}
-"""Which joints go into the tree first: those that have no MuJoCo equality constraint
-(prismatic, cylindrical, universal), then fixed (weld), then revolute and spherical,
-whose loop-closing form (connect) is the closest."""
+_TREE_FIRST = {None: 0, "weld": 1, "connect": 2}
+"""Which joints go into the tree first, by the MuJoCo equality that would close a loop
+with them (mbody.joint_types: mjcf_loop): those that have none (prismatic, cylindrical,
+universal...), then fixed (weld), then revolute and spherical, whose loop-closing form
+(connect) is the closest."""
 
 _HEX = re.compile(r"#[0-9a-fA-F]{6}")
 
@@ -94,7 +95,8 @@ def spanning_tree(model: Model) -> _Tree:
         return n
 
     order = sorted(range(len(model.joints)),
-                   key=lambda k: (_TREE_FIRST.get(model.joints[k].type, 2), k))
+                   key=lambda k: (_TREE_FIRST[joint_types.joint_type(
+                       model.dimension, model.joints[k].type).mjcf_loop], k))
     kept: list[Joint] = []
     loops: list[Joint] = []
     for k in order:
@@ -302,28 +304,9 @@ def _tree_joint(w: _Writer, j: Joint, parent: str, child: str, pad: str) -> None
                        "it moves with its parent (no MuJoCo joint)")
         return
     planar = m.dimension == cv.PLANAR
-    E = np.asarray(j.W_E0, dtype=float)
-    axis = E[:, 0] if planar and j.type == "prismatic" else E[:, 2]
-    if planar and j.type == "revolute":
-        axis = np.array([0.0, 0.0, 1.0])
-    parts: list[tuple[str, str, np.ndarray]]  # (name, type, world axis)
-    if j.type == "revolute":
-        parts = [(j.name, "hinge", axis)]
-    elif j.type == "prismatic":
-        parts = [(j.name, "slide", axis)]
-    elif j.type == "cylindrical":
-        parts = [(f"{j.name}:slide", "slide", axis), (f"{j.name}:turn", "hinge", axis)]
-    elif j.type == "universal":
-        a1 = np.asarray(j.axis, dtype=float)
-        a2 = np.asarray(j.axis2, dtype=float)
-        a1, a2 = a1 / np.linalg.norm(a1), a2 / np.linalg.norm(a2)
-        if j.child != child:  # the tree runs child → parent: the axes swap roles
-            a1, a2 = a2, a1
-        # named <joint>:1, <joint>:2: a reader takes the common stem back as the name
-        parts = [(f"{j.name}:1", "hinge", a1), (f"{j.name}:2", "hinge", a2)]
-    elif j.type == "spherical":
-        parts = [(j.name, "ball", np.zeros(3))]
-    else:  # fixed: welded by nesting
+    jtype = joint_types.joint_type(m.dimension, j.type)
+    parts = _parts(j, jtype, planar, child)
+    if not parts:  # fixed: welded by nesting
         return
     w.native[j.name] = child
     columns = []
@@ -339,6 +322,42 @@ def _tree_joint(w: _Writer, j: Joint, parent: str, child: str, pad: str) -> None
             w.qpos.append(0.0)
             columns.append(_column(kind, a, P, x_c))
     w.qvel += _rates(w, j, parent, c, np.array(columns).T, particle)
+
+
+_MJCF_KIND = {joint_types.ROTATION: "hinge", joint_types.TRANSLATION: "slide",
+              joint_types.BALL: "ball"}
+
+
+def _parts(j: Joint, jtype: joint_types.JointType, planar: bool, child: str
+           ) -> list[tuple[str, str, np.ndarray]]:
+    """(name, MJCF joint type, world axis) of each MuJoCo joint that makes up `j`: one per
+    motion its type allows (mbody.joint_types), named ``<joint>:<part>`` when there are
+    several; a screw's rotation is written as a hinge and a slide along one axis (their
+    coupling is an equality, `_screws`)."""
+    E = np.asarray(j.W_E0, dtype=float)
+    motions = list(jtype.motions)
+    screw = any(c.kind == SCREW for c in jtype.components)
+    if screw:  # the rotation and the advance it drags along
+        motions = [joint_types.Motion("displacement", joint_types.TRANSLATION, 2,
+                                      part="slide"),
+                   joint_types.Motion("angle", joint_types.ROTATION, 2, part="turn")]
+    out = []
+    for mo in motions:
+        if mo.what == joint_types.BALL:
+            a = np.zeros(3)
+        elif mo.on == "child":
+            a = np.asarray(j.axis2, dtype=float)
+        elif planar and mo.what == joint_types.ROTATION:
+            a = np.array([0.0, 0.0, 1.0])  # a planar joint turns about world z
+        else:
+            a = E[:, mo.axis] if mo.on == "parent" and mo.axis >= 0 else E[:, 2]
+        a = a / np.linalg.norm(a) if a.any() else a
+        name = f"{j.name}:{mo.part}" if len(motions) > 1 else j.name
+        out.append((name, _MJCF_KIND[mo.what], a))
+    if j.child != child and any(mo.on == "child" for mo in motions):
+        # a universal joint written against the tree (child -> parent): the axes swap roles
+        out = [(out[0][0], "hinge", out[1][2]), (out[1][0], "hinge", out[0][2])]
+    return out
 
 
 def _column(kind: str, a: np.ndarray, P: np.ndarray, x_c: np.ndarray) -> np.ndarray:
@@ -440,15 +459,16 @@ def _equalities(w: _Writer, loops: list[Joint]) -> list[str]:
             w.notes.append(f"joint {j.name!r} (a particle's link) closes a loop: MuJoCo has "
                            "no distance constraint, so it is left out")
             continue
-        if j.type in ("revolute", "spherical"):
+        loop = joint_types.joint_type(m.dimension, j.type).mjcf_loop
+        if loop == "connect":
             points = [np.asarray(j.at, dtype=float)]
-            if j.type == "revolute" and m.dimension == cv.SPATIAL:
+            if j.type == "revolute" and m.dimension == cv.SPATIAL:  # its axis: a 2nd point
                 points.append(points[0] + w.scale * np.asarray(j.W_E0)[:, 2])
             for k, P in enumerate(points):
                 nm = j.name if k == 0 else f"{j.name}:axis"
                 lines.append(f"    <connect name={quoteattr(nm)} body1={quoteattr(j.child)}"
                              f'{other} anchor="{_vec(_snap(R_c.T @ (P - x_c), w.scale))}" {soft}/>')
-        elif j.type == "fixed":
+        elif loop == "weld":
             lines.append(f"    <weld name={quoteattr(j.name)} body1={quoteattr(j.child)}"
                          f"{other} {soft}/>")
         else:
