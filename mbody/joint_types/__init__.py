@@ -29,7 +29,7 @@ from mbody.joint_types.base import (
 __all__ = ["BALL", "FORCE", "MOMENT", "PLANAR", "ROTATION", "SPATIAL", "TRANSLATION",
            "WRENCH", "Component", "JointType", "Motion", "Param", "TYPES", "ALIASES",
            "joint_type", "type_names", "what", "unit", "is_moment", "COMPONENT_NAMES",
-           "COMPONENT_CODE", "WHATS"]
+           "COMPONENT_CODE", "WHATS", "docs_table"]
 
 
 def _collect() -> dict[int, dict[str, JointType]]:
@@ -88,6 +88,19 @@ WHATS = _whats()
 COMPONENT_NAMES = tuple(WHATS)
 """Every component name, in a fixed order: `mbody.model.ReactionTable.component` indexes it."""
 COMPONENT_CODE = {name: k for k, name in enumerate(COMPONENT_NAMES)}
+
+
+def docs_table() -> str:
+    """The joint types and their reaction components as docs/model-format.md shows them
+    (a markdown table; tests/test_joint_types.py holds the page to it)."""
+    rows = ["| type | planar components | spatial components |", "| --- | --- | --- |"]
+    for name in dict.fromkeys((*TYPES[PLANAR], *TYPES[SPATIAL])):
+        cells = []
+        for d in (PLANAR, SPATIAL):
+            jt = TYPES[d].get(name)
+            cells.append(f"`{', '.join(jt.component_names)}`" if jt else "—")
+        rows.append(f"| `{name}` | {cells[0]} | {cells[1]} |")
+    return "\n".join(rows)
 
 
 def what(label: str) -> str:
