@@ -161,6 +161,13 @@ void mb_columns(const mb_model *md, mb_work *w, double t, const double *y, doubl
 
 /* Status codes: 0, or 1 + 6 body + row of a motion without mass or inertia. */
 
+/* Slots of mb_solve's info (MB_INFO of them) and of mb_project's (MB_PROJECT_INFO).
+ * MB_ST_PATH: 0 Cholesky of S, 1 null-space solve, 2 pivoted Cholesky (redundant). */
+enum { MB_ST_RANK = 0, MB_ST_BERR = 1, MB_ST_BROKEN = 2, MB_ST_MU = 3, MB_ST_PATH = 4,
+       MB_ST_SINGULAR = 5, MB_INFO = 6 };
+enum { MB_PR_STEP = 0, MB_PR_VELOCITY = 1, MB_PR_RATIO = 2, MB_PR_SINGULAR = 3,
+       MB_PROJECT_INFO = 4 };
+
 /* Accelerations and reactions at one state (what Assembly.solve returns): out as
  * mbody/solve/compiled.solve_layout: accelerations in the model's coordinates,
  * lambda (m) (known values in place), gtv (m), not-unique flags (m), info
