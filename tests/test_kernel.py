@@ -189,7 +189,7 @@ def test_net_wrench_and_columns_equal_numba(name, model):
         cols, ref = k.columns(t, y), numba_columns(C, k, y)
         for key, a in ref.items():
             # φ at the file's pose is rounding (~1e-16 m): compared on the length scale
-            scale = 1.0 if key == "phi" and seed is None else max(np.max(np.abs(a)), 1e-300)
+            scale = 1.0 if key == "phi" and seed is None else max(np.max(np.abs(a), initial=0.0), 1e-300)
             assert np.max(np.abs(cols[key] - a), initial=0.0) <= 1e-12 * scale, (key, seed)
 
 
@@ -300,7 +300,8 @@ def test_near_singular_and_redundant_equal_numba(theta):
     # both refine with compensated (Dot2) residuals; their SVDs differ (LAPACK's and a
     # one-sided Jacobi), which moves the answer by a few ulps of the refined solution
     check_solve(a, b, N, io, len(model.reactions), 1.0)
-    assert rel(b[:N], chain.accelerations(theta, 1.5).ravel()) <= 1e-9
+    if theta:  # at flat itself the branches meet: the parallel branch's ODE is not it
+        assert rel(b[:N], chain.accelerations(theta, 1.5).ravel()) <= 1e-9
 
 
 # -- against the numpy path ---------------------------------------------------------------------
