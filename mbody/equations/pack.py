@@ -103,7 +103,8 @@ def pack_model(model: Model, extra: Sequence[Component] = ()) -> tuple[np.ndarra
         index = [programs.add(e) for e in vt.exprs]
         varying = np.stack((vt.rows, vt.cols, np.asarray(index, np.int64)[vt.which]),
                            axis=1).astype(np.int64)
-    laws, law_of = [], np.full(m, -1, dtype=np.int64)
+    laws: list[list[int]] = []
+    law_of = np.full(m, -1, dtype=np.int64)
     m0 = m - len(extra)
     for i, c in enumerate(extra):
         if c.law is not None:
