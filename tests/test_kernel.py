@@ -705,3 +705,46 @@ def test_bad_buffers_are_clear_errors():
     with pytest.raises(ValueError, match="Iu does not describe"):
         _core.Unknowns(core, Iu)
     assert _core.solve_layout(2, 3, True) == (6, 6, 15)
+
+
+@pytest.mark.parametrize("dimension", [2, 3])
+def test_more_unknowns_than_rows_equal_numba(dimension):
+    """A bar pinned to the ground twice and a second bar hung from it (redundant: more
+    unknowns than the first bar's rows), through the null-space route (planar) or the
+    pivoted one (spatial), and the null-space projection (its SVD of a wide matrix)."""
+    C = numba()
+    at = [[0, 0], [1, 0], [1, 0]] if dimension == 2 else [[0, 0, 0], [1, 0, 0], [1, 0, 0]]
+    pos = [[0.5, 0], [1.5, 0.2]] if dimension == 2 else [[0.5, 0, 0], [1.5, 0.2, 0]]
+    spec = {"model": "twice", "dimension": dimension,
+            "gravity": [0, -9.81] + ([0] if dimension == 3 else []),
+            "bodies": [{"name": "bar", "mass": 1.0, "inertia": 0.1 if dimension == 2
+                        else [0.01, 0.1, 0.1], "position": pos[0]},
+                       {"name": "arm", "mass": 0.5, "inertia": 0.05 if dimension == 2
+                        else [0.01, 0.05, 0.05], "position": pos[1]}],
+            "joints": [{"name": "O", "type": "revolute", "parent": "ground", "child": "bar",
+                        "at": at[0]},
+                       {"name": "P", "type": "revolute", "parent": "ground", "child": "bar",
+                        "at": at[1]},
+                       {"name": "Q", "type": "revolute", "parent": "bar", "child": "arm",
+                        "at": at[2]}]}
+    if dimension == 3:
+        for j in spec["joints"]:
+            j["axis"] = [0, 0, 1]
+    model = mbody.load(spec)
+    k = Kernel(model)
+    unk = model.plan.file_unknowns
+    cu = k.unknowns(unk.U)
+    y = state_vector(model, model.initial)
+    a, b, N, io = solve_both(C, k, cu, unk.U, unk.lam, 0.0, y)
+    assert b[io + _core.ST_RANK] < unk.U.size
+    check_solve(a, b, N, io, len(model.reactions), k.cond(cu, 0.0, y))
+    F0, I0 = C.pack_model(model)
+    Iu0 = C.pack_unknowns(model, unk.U)
+    moved = state_vector(model, moved_state(model, 3))
+    y0 = y + 1e-3 * (moved - y)
+    ya, yb = y0.copy(), y0.copy()
+    ia, ib = np.zeros(4), np.zeros(4)
+    C.project(F0, I0, Iu0, ya, k.planar, 3, 2.0, ia)
+    cu.project(0.0, yb, 3, 2.0, False, ib)
+    assert ib[_core.PR_SINGULAR] == ia[_core.PR_SINGULAR] == 0
+    assert rel(yb - y0, ya - y0) <= 1e-10
