@@ -748,3 +748,27 @@ def test_more_unknowns_than_rows_equal_numba(dimension):
     cu.project(0.0, yb, 3, 2.0, False, ib)
     assert ib[_core.PR_SINGULAR] == ia[_core.PR_SINGULAR] == 0
     assert rel(yb - y0, ya - y0) <= 1e-10
+
+
+def test_many_unknowns_are_band_ordered_and_equal_numba():
+    """A chain of 16 rods on revolute joints (80 unknowns): pack_unknowns orders them
+    by reverse Cuthill-McKee (S's half band stays that of a chain), the solve as numba's
+    in label order."""
+    C = numba()
+    n = 16
+    bodies = [{"name": f"r{i}", "mass": 1.0 + 0.1 * i, "inertia": [0.01, 0.1, 0.1],
+               "position": [0.5 + i, 0, 0], "angular_velocity": [0, 0.3 * i, 0.5]}
+              for i in range(n)]
+    joints = [{"name": f"J{i}", "type": "revolute", "parent": "ground" if i == 0
+               else f"r{i - 1}", "child": f"r{i}", "at": [float(i), 0, 0],
+               "axis": [0, 1 if i % 2 else 0, 1]} for i in range(n)]
+    model = mbody.load({"model": "chain", "dimension": 3, "gravity": [0, 0, -9.81],
+                        "bodies": bodies, "joints": joints})
+    k = Kernel(model)
+    unk = model.plan.file_unknowns
+    assert unk.U.size == 80
+    cu = k.unknowns(unk.U)
+    assert cu.bw < 10  # two joints' components (5 each) per body, whatever the labels
+    y = state_vector(model, moved_state(model, 1))
+    a, b, N, io = solve_both(C, k, cu, unk.U, unk.lam, 0.3, y)
+    check_solve(a, b, N, io, len(model.reactions), k.cond(cu, 0.3, y))

@@ -60,8 +60,8 @@
  * MB_KIND_SCREW  the helical joint's axial wrench along e = E[:, axis]: the FORCE column
  *                plus -h times the moment column about e (h = pitch / 2 pi, m/rad):
  *                child6 = [e; B_r_c x R_c^T e - h R_c^T e], parent6 = -(its parent side),
- *                phi = e . (P - P_p) - h theta~, theta~ the relative turn about e
- *                (as TURN) taken on the branch nearest e . (P - P_p) / h,
+ *                phi = e . (P - P_p) + off - h theta~, theta~ the relative turn about
+ *                e (as TURN) taken on the branch nearest (e . (P - P_p) + off) / h,
  *                gamma = gamma_FORCE - h gamma_TILT.
  *
  * Time dependence (drivers): a component with a law l >= 0 prescribes its coordinate:
