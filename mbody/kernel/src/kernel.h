@@ -60,8 +60,8 @@
  * MB_KIND_SCREW  the helical joint's axial wrench along e = E[:, axis]: the FORCE column
  *                plus -h times the moment column about e (h = pitch / 2 pi, m/rad):
  *                child6 = [e; B_r_c x R_c^T e - h R_c^T e], parent6 = -(its parent side),
- *                phi = e . (P - P_p) - h theta~, theta~ the relative turn about e
- *                (as TURN) taken on the branch nearest e . (P - P_p) / h,
+ *                phi = e . (P - P_p) + off - h theta~, theta~ the relative turn about
+ *                e (as TURN) taken on the branch nearest (e . (P - P_p) + off) / h,
  *                gamma = gamma_FORCE - h gamma_TILT.
  *
  * Time dependence (drivers): a component with a law l >= 0 prescribes its coordinate:
@@ -160,6 +160,13 @@ void mb_columns(const mb_model *md, mb_work *w, double t, const double *y, doubl
                 double *gtv);
 
 /* Status codes: 0, or 1 + 6 body + row of a motion without mass or inertia. */
+
+/* Slots of mb_solve's info (MB_INFO of them) and of mb_project's (MB_PROJECT_INFO).
+ * MB_ST_PATH: 0 Cholesky of S, 1 null-space solve, 2 pivoted Cholesky (redundant). */
+enum { MB_ST_RANK = 0, MB_ST_BERR = 1, MB_ST_BROKEN = 2, MB_ST_MU = 3, MB_ST_PATH = 4,
+       MB_ST_SINGULAR = 5, MB_INFO = 6 };
+enum { MB_PR_STEP = 0, MB_PR_VELOCITY = 1, MB_PR_RATIO = 2, MB_PR_SINGULAR = 3,
+       MB_PROJECT_INFO = 4 };
 
 /* Accelerations and reactions at one state (what Assembly.solve returns): out as
  * mbody/solve/compiled.solve_layout: accelerations in the model's coordinates,

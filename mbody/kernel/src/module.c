@@ -1,32 +1,571 @@
 /* The Python module mbody.kernel._core: the buffers of the packed model handed to the
- * kernel's functions (kernel.h). */
+ * kernel's functions (kernel.h). Arrays pass through the buffer protocol (no numpy C API):
+ * float64 or int64, C-contiguous, of the size the model implies, else a ValueError. The
+ * calls keep the GIL: each owns scratch memory (mb_work) that is not shared across threads
+ * while it runs. */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
+#include <string.h>
 
-#include "kernel.h"
+#include "internal.h"
+
+/* -- buffers ------------------------------------------------------------------------ */
+
+/* A C-contiguous buffer of 8-byte items of `want` (1 'd' float64, 0 'q' int64); count
+ * items (-1: any). Returns 0, or -1 with a ValueError naming `what`. */
+static int get_buffer(PyObject *obj, Py_buffer *view, int writable, int want_float,
+                      Py_ssize_t count, const char *what) {
+    int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (writable ? PyBUF_WRITABLE : 0);
+    if (PyObject_GetBuffer(obj, view, flags) < 0) {
+        PyErr_Clear();
+        PyErr_Format(PyExc_ValueError,
+                     "%s: expected a C-contiguous%s %s array", what,
+                     writable ? " writable" : "", want_float ? "float64" : "int64");
+        return -1;
+    }
+    const char *f = view->format ? view->format : "B";
+    if (*f == '@' || *f == '=' || *f == '<') f++;
+    int ok = view->itemsize == 8 && f[1] == '\0' &&
+             (want_float ? *f == 'd' : (*f == 'l' || *f == 'q'));
+    if (!ok) {
+        PyErr_Format(PyExc_ValueError, "%s: expected a %s array, got item format '%s'",
+                     what, want_float ? "float64" : "int64", view->format ? view->format : "?");
+        PyBuffer_Release(view);
+        return -1;
+    }
+    if (count >= 0 && view->len / 8 != count) {
+        PyErr_Format(PyExc_ValueError, "%s: expected %zd values, got %zd", what, count,
+                     view->len / 8);
+        PyBuffer_Release(view);
+        return -1;
+    }
+    return 0;
+}
+
+static int get_double(PyObject *obj, double *out, const char *what) {
+    *out = PyFloat_AsDouble(obj);
+    if (*out == -1.0 && PyErr_Occurred()) {
+        PyErr_Format(PyExc_TypeError, "%s: expected a number", what);
+        return -1;
+    }
+    return 0;
+}
+
+static int check_nargs(Py_ssize_t nargs, Py_ssize_t want, const char *name) {
+    if (nargs != want) {
+        PyErr_Format(PyExc_TypeError, "%s() takes %zd arguments (%zd given)", name, want, nargs);
+        return -1;
+    }
+    return 0;
+}
+
+/* -- Model --------------------------------------------------------------------------- */
+
+typedef struct {
+    PyObject_HEAD
+    Py_buffer F, I;
+    int have_F, have_I;
+    mb_model md;
+    mb_work *w;
+} ModelObject;
+
+static void Model_dealloc(ModelObject *self) {
+    mb_work_free(self->w);
+    if (self->have_F) PyBuffer_Release(&self->F);
+    if (self->have_I) PyBuffer_Release(&self->I);
+    Py_TYPE(self)->tp_free((PyObject *)self);
+}
+
+static int Model_init(ModelObject *self, PyObject *args, PyObject *kwds) {
+    static char *kwlist[] = {"F", "I", "planar", NULL};
+    PyObject *F, *I;
+    int planar;
+    if (self->have_F || self->have_I) {
+        PyErr_SetString(PyExc_RuntimeError, "Model is initialised once");
+        return -1;
+    }
+    if (!PyArg_ParseTupleAndKeywords(args, kwds, "OOp", kwlist, &F, &I, &planar)) return -1;
+    if (get_buffer(F, &self->F, 0, 1, -1, "F") < 0) return -1;
+    self->have_F = 1;
+    if (get_buffer(I, &self->I, 0, 0, -1, "I") < 0) return -1;
+    self->have_I = 1;
+    if (mb_model_view(&self->md, self->F.buf, self->F.len / 8, self->I.buf, self->I.len / 8,
+                      planar) < 0) {
+        PyErr_SetString(PyExc_ValueError,
+                        "F and I do not describe a packed model (kernel.h): the sizes in "
+                        "I's header do not add up to the arrays' lengths, or an index is "
+                        "out of range, or an expression's program is malformed");
+        return -1;
+    }
+    self->w = mb_work_new(&self->md, NULL);
+    if (self->w == NULL) {
+        PyErr_NoMemory();
+        return -1;
+    }
+    return 0;
+}
+
+static int model_ready(ModelObject *self) {
+    if (self->w == NULL) {
+        PyErr_SetString(PyExc_RuntimeError, "Model is not initialised");
+        return -1;
+    }
+    return 0;
+}
+
+/* y: the state, MB_STATE_SIZE or (solve, columns, wrenches) 13 n values. */
+static int get_state(const mb_model *md, PyObject *obj, Py_buffer *view, int writable,
+                     int exact) {
+    if (get_buffer(obj, view, writable, 1, -1, "y") < 0) return -1;
+    Py_ssize_t len = view->len / 8, full = MB_STATE_SIZE(md->n, md->planar);
+    if (len != full && (exact || len != 13 * md->n)) {
+        PyErr_Format(PyExc_ValueError, "y: expected %zd values (the packed state), got %zd",
+                     full, len);
+        PyBuffer_Release(view);
+        return -1;
+    }
+    return 0;
+}
+
+PyDoc_STRVAR(net_wrench_doc,
+"net_wrench(t, y, out)\n\nout (n x 6) <- Q - b per body at time t (s) and state y:\n"
+"[W_F (world); B_M - w x J w (body axes)], the loads at t.");
+
+static PyObject *Model_net_wrench(ModelObject *self, PyObject *const *args, Py_ssize_t nargs) {
+    Py_buffer y, out;
+    double t;
+    if (model_ready(self) < 0 || check_nargs(nargs, 3, "net_wrench") < 0 ||
+        get_double(args[0], &t, "t") < 0)
+        return NULL;
+    if (get_state(&self->md, args[1], &y, 0, 0) < 0) return NULL;
+    if (get_buffer(args[2], &out, 1, 1, 6 * self->md.n, "out") < 0) {
+        PyBuffer_Release(&y);
+        return NULL;
+    }
+    mb_net_wrench(&self->md, self->w, t, y.buf, out.buf);
+    PyBuffer_Release(&y);
+    PyBuffer_Release(&out);
+    Py_RETURN_NONE;
+}
+
+PyDoc_STRVAR(load_wrenches_doc,
+"load_wrenches(t, y, out)\n\nout ((k + 2 s) x 7) <- each point load's, then each spring's "
+"end a's and end b's\nshare of net_wrench: [body (-1: ground), W_F (world), B_M (about G, "
+"body axes)].");
+
+static PyObject *Model_load_wrenches(ModelObject *self, PyObject *const *args,
+                                     Py_ssize_t nargs) {
+    Py_buffer y, out;
+    double t;
+    if (model_ready(self) < 0 || check_nargs(nargs, 3, "load_wrenches") < 0 ||
+        get_double(args[0], &t, "t") < 0)
+        return NULL;
+    const mb_model *md = &self->md;
+    if (get_state(md, args[1], &y, 0, 0) < 0) return NULL;
+    if (get_buffer(args[2], &out, 1, 1, 7 * (md->k + 2 * md->s), "out") < 0) {
+        PyBuffer_Release(&y);
+        return NULL;
+    }
+    mb_rotations(md->n, (const double *)y.buf + 3 * md->n, self->w->R);
+    mb_eval_all(md, self->w, t);
+    mb_loads_at(md, self->w);
+    mb_load_wrenches_at(md, self->w, y.buf, out.buf);
+    PyBuffer_Release(&y);
+    PyBuffer_Release(&out);
+    Py_RETURN_NONE;
+}
+
+PyDoc_STRVAR(loads_at_doc,
+"loads_at(t, out)\n\nout (k x 3) <- the point loads' values at time t (constant ones as "
+"packed).");
+
+static PyObject *Model_loads_at(ModelObject *self, PyObject *const *args, Py_ssize_t nargs) {
+    Py_buffer out;
+    double t;
+    if (model_ready(self) < 0 || check_nargs(nargs, 2, "loads_at") < 0 ||
+        get_double(args[0], &t, "t") < 0)
+        return NULL;
+    if (get_buffer(args[1], &out, 1, 1, 3 * self->md.k, "out") < 0) return NULL;
+    mb_eval_all(&self->md, self->w, t);
+    mb_loads_at(&self->md, self->w);
+    memcpy(out.buf, self->w->loads, sizeof(double) * 3 * self->md.k);
+    PyBuffer_Release(&out);
+    Py_RETURN_NONE;
+}
+
+PyDoc_STRVAR(columns_doc,
+"columns(t, y, child6, parent6, W_e, W_P, gamma, phi, gtv)\n\nPer reaction component "
+"(m): its columns of G on the child and the parent (m x 6),\nits direction W_e and point "
+"W_P (m x 3, world), gamma = -G'^T v, phi and\nG^T v (m each); a driven component's phi, "
+"G^T v and gamma are shifted by its\nlaw f, f', f'' at t (kernel.h).");
+
+static PyObject *Model_columns(ModelObject *self, PyObject *const *args, Py_ssize_t nargs) {
+    static const char *names[] = {"child6", "parent6", "W_e", "W_P", "gamma", "phi", "gtv"};
+    static const int width[] = {6, 6, 3, 3, 1, 1, 1};
+    Py_buffer y, b[7];
+    double t;
+    if (model_ready(self) < 0 || check_nargs(nargs, 9, "columns") < 0 ||
+        get_double(args[0], &t, "t") < 0)
+        return NULL;
+    if (get_state(&self->md, args[1], &y, 0, 0) < 0) return NULL;
+    int got = 0;
+    for (; got < 7; got++)
+        if (get_buffer(args[2 + got], &b[got], 1, 1, width[got] * self->md.m, names[got]) < 0)
+            break;
+    if (got == 7)
+        mb_columns(&self->md, self->w, t, y.buf, b[0].buf, b[1].buf, b[2].buf, b[3].buf,
+                   b[4].buf, b[5].buf, b[6].buf);
+    for (int i = 0; i < got; i++) PyBuffer_Release(&b[i]);
+    PyBuffer_Release(&y);
+    if (got < 7) return NULL;
+    Py_RETURN_NONE;
+}
+
+PyDoc_STRVAR(expression_doc,
+"expression(e, t) -> float\n\nThe value at time t of the packed expression e (out of a "
+"function's domain: inf\nor nan, as numpy gives them).");
+
+static PyObject *Model_expression(ModelObject *self, PyObject *const *args, Py_ssize_t nargs) {
+    double t;
+    if (model_ready(self) < 0 || check_nargs(nargs, 2, "expression") < 0) return NULL;
+    Py_ssize_t e = PyLong_AsSsize_t(args[0]);
+    if (e == -1 && PyErr_Occurred()) return NULL;
+    if (get_double(args[1], &t, "t") < 0) return NULL;
+    if (e < 0 || e >= self->md.n_expr) {
+        PyErr_Format(PyExc_IndexError, "expression %zd: the model has %lld", e,
+                     (long long)self->md.n_expr);
+        return NULL;
+    }
+    return PyFloat_FromDouble(mb_expression(&self->md, e, t));
+}
+
+static PyObject *Model_get_int(ModelObject *self, void *which) {
+    const mb_model *md = &self->md;
+    switch ((int)(intptr_t)which) {
+    case 0: return PyLong_FromLongLong(md->n);
+    case 1: return PyLong_FromLongLong(md->m);
+    case 2: return PyLong_FromLongLong(md->k);
+    case 3: return PyLong_FromLongLong(md->s);
+    case 4: return PyBool_FromLong(md->planar);
+    case 5: return PyLong_FromLongLong(MB_STATE_SIZE(md->n, md->planar));
+    default: return PyLong_FromLongLong(md->n_expr);
+    }
+}
+
+static PyGetSetDef Model_getset[] = {
+    {"n", (getter)Model_get_int, NULL, "number of bodies", (void *)0},
+    {"m", (getter)Model_get_int, NULL, "number of reaction components", (void *)1},
+    {"k", (getter)Model_get_int, NULL, "number of point loads", (void *)2},
+    {"s", (getter)Model_get_int, NULL, "number of springs", (void *)3},
+    {"planar", (getter)Model_get_int, NULL, "a planar model", (void *)4},
+    {"state_size", (getter)Model_get_int, NULL, "length of the packed state y", (void *)5},
+    {"n_expr", (getter)Model_get_int, NULL, "number of packed expressions", (void *)6},
+    {NULL, NULL, NULL, NULL, NULL},
+};
+
+static PyMethodDef Model_methods[] = {
+    {"net_wrench", (PyCFunction)(void (*)(void))Model_net_wrench, METH_FASTCALL, net_wrench_doc},
+    {"load_wrenches", (PyCFunction)(void (*)(void))Model_load_wrenches, METH_FASTCALL,
+     load_wrenches_doc},
+    {"loads_at", (PyCFunction)(void (*)(void))Model_loads_at, METH_FASTCALL, loads_at_doc},
+    {"columns", (PyCFunction)(void (*)(void))Model_columns, METH_FASTCALL, columns_doc},
+    {"expression", (PyCFunction)(void (*)(void))Model_expression, METH_FASTCALL, expression_doc},
+    {NULL, NULL, 0, NULL},
+};
+
+PyDoc_STRVAR(Model_doc,
+"Model(F, I, planar)\n\nA packed model (mbody.equations.pack.pack_model: F float64, I "
+"int64, both\nC-contiguous; kernel.h's layout). Keeps both buffers alive; a ValueError when "
+"their\nsizes do not add up or an index is out of range.");
+
+static PyTypeObject ModelType = {
+    PyVarObject_HEAD_INIT(NULL, 0)
+    .tp_name = "mbody.kernel._core.Model",
+    .tp_basicsize = sizeof(ModelObject),
+    .tp_dealloc = (destructor)Model_dealloc,
+    .tp_flags = Py_TPFLAGS_DEFAULT,
+    .tp_doc = Model_doc,
+    .tp_methods = Model_methods,
+    .tp_getset = Model_getset,
+    .tp_init = (initproc)Model_init,
+    .tp_new = PyType_GenericNew,
+};
+
+/* -- Unknowns ------------------------------------------------------------------------ */
+
+typedef struct {
+    PyObject_HEAD
+    ModelObject *model;
+    Py_buffer Iu;
+    int have_Iu;
+    mb_unknowns u;
+    mb_work *w;
+} UnknownsObject;
+
+static void Unknowns_dealloc(UnknownsObject *self) {
+    mb_work_free(self->w);
+    if (self->have_Iu) PyBuffer_Release(&self->Iu);
+    Py_XDECREF(self->model);
+    Py_TYPE(self)->tp_free((PyObject *)self);
+}
+
+static int Unknowns_init(UnknownsObject *self, PyObject *args, PyObject *kwds) {
+    static char *kwlist[] = {"model", "Iu", NULL};
+    PyObject *model, *Iu;
+    if (self->model != NULL) {
+        PyErr_SetString(PyExc_RuntimeError, "Unknowns is initialised once");
+        return -1;
+    }
+    if (!PyArg_ParseTupleAndKeywords(args, kwds, "O!O", kwlist, &ModelType, &model, &Iu))
+        return -1;
+    if (model_ready((ModelObject *)model) < 0) return -1;
+    Py_INCREF(model);
+    self->model = (ModelObject *)model;
+    if (get_buffer(Iu, &self->Iu, 0, 0, -1, "Iu") < 0) return -1;
+    self->have_Iu = 1;
+    if (mb_unknowns_view(&self->u, &self->model->md, self->Iu.buf, self->Iu.len / 8) < 0) {
+        PyErr_SetString(PyExc_ValueError,
+                        "Iu does not describe unknowns of this model (kernel.h): sizes, "
+                        "component indices, the per-body incidence or the band width");
+        return -1;
+    }
+    self->w = mb_work_new(&self->model->md, &self->u);
+    if (self->w == NULL) {
+        PyErr_NoMemory();
+        return -1;
+    }
+    return 0;
+}
+
+static int unknowns_ready(UnknownsObject *self) {
+    if (self->w == NULL) {
+        PyErr_SetString(PyExc_RuntimeError, "Unknowns is not initialised");
+        return -1;
+    }
+    return 0;
+}
+
+PyDoc_STRVAR(solve_doc,
+"solve(t, y, lam, out)\n\nAccelerations and reactions at (t, y) with the unknown "
+"components solved; lam (m):\nthe known values (0 on unknown components). out: "
+"solve_layout(n, m, planar)'s\nlength: accelerations (planar [a_x, a_y, alpha], spatial "
+"[a_G world, w' body\naxes] per body), lambda (m, known values in place), G^T v (m), "
+"not-unique flags (m),\ninfo (INFO: slots ST_*).");
+
+static PyObject *Unknowns_solve(UnknownsObject *self, PyObject *const *args, Py_ssize_t nargs) {
+    Py_buffer y, lam, out;
+    double t;
+    if (unknowns_ready(self) < 0 || check_nargs(nargs, 4, "solve") < 0 ||
+        get_double(args[0], &t, "t") < 0)
+        return NULL;
+    const mb_model *md = &self->model->md;
+    if (get_state(md, args[1], &y, 0, 0) < 0) return NULL;
+    if (get_buffer(args[2], &lam, 0, 1, md->m, "lam") < 0) {
+        PyBuffer_Release(&y);
+        return NULL;
+    }
+    Py_ssize_t N = (md->planar ? 3 : 6) * md->n;
+    if (get_buffer(args[3], &out, 1, 1, N + 3 * md->m + MB_INFO, "out") < 0) {
+        PyBuffer_Release(&y);
+        PyBuffer_Release(&lam);
+        return NULL;
+    }
+    mb_solve(md, &self->u, self->w, t, y.buf, lam.buf, out.buf);
+    PyBuffer_Release(&y);
+    PyBuffer_Release(&lam);
+    PyBuffer_Release(&out);
+    Py_RETURN_NONE;
+}
+
+PyDoc_STRVAR(derivative_doc,
+"derivative(t, y, lam, rate, out) -> int\n\nout <- dy/dt at (t, y) (y: the packed state, "
+"state_size values) with the unknown\nreactions solved and Baumgarte's terms (alpha = beta "
+"= rate); lam: the known values.\nReturns 0, or the singular-mass code 1 + 6 body + row "
+"(then out is not written).");
+
+static PyObject *Unknowns_derivative(UnknownsObject *self, PyObject *const *args,
+                                     Py_ssize_t nargs) {
+    Py_buffer y, lam, out;
+    double t, rate;
+    if (unknowns_ready(self) < 0 || check_nargs(nargs, 5, "derivative") < 0 ||
+        get_double(args[0], &t, "t") < 0 || get_double(args[3], &rate, "rate") < 0)
+        return NULL;
+    const mb_model *md = &self->model->md;
+    if (get_state(md, args[1], &y, 0, 1) < 0) return NULL;
+    if (get_buffer(args[2], &lam, 0, 1, md->m, "lam") < 0) {
+        PyBuffer_Release(&y);
+        return NULL;
+    }
+    if (get_buffer(args[4], &out, 1, 1, MB_STATE_SIZE(md->n, md->planar), "out") < 0) {
+        PyBuffer_Release(&y);
+        PyBuffer_Release(&lam);
+        return NULL;
+    }
+    int status = mb_derivative(md, &self->u, self->w, t, y.buf, lam.buf, rate, out.buf);
+    PyBuffer_Release(&y);
+    PyBuffer_Release(&lam);
+    PyBuffer_Release(&out);
+    return PyLong_FromLong(status);
+}
+
+PyDoc_STRVAR(project_doc,
+"project(t, y, iters, robust_below, homogeneous, info)\n\nMove y (in place) onto the "
+"enforced joints at t: `iters` Gauss-Newton position steps,\nthen the mass-orthogonal "
+"velocity projection (target G^T v = f'(t); with\n`homogeneous` G^T v = 0 and the laws "
+"left out). info (PROJECT_INFO) <- slots PR_*.\nBelow a geometric ratio of robust_below the "
+"solves take the null-space route.");
+
+static PyObject *Unknowns_project(UnknownsObject *self, PyObject *const *args,
+                                  Py_ssize_t nargs) {
+    Py_buffer y, info;
+    double t, robust_below;
+    if (unknowns_ready(self) < 0 || check_nargs(nargs, 6, "project") < 0 ||
+        get_double(args[0], &t, "t") < 0 || get_double(args[3], &robust_below, "robust_below") < 0)
+        return NULL;
+    long iters = PyLong_AsLong(args[2]);
+    if (iters == -1 && PyErr_Occurred()) return NULL;
+    if (iters < 0 || iters > 1000) {
+        PyErr_SetString(PyExc_ValueError, "iters: expected 0 to 1000");
+        return NULL;
+    }
+    int homogeneous = PyObject_IsTrue(args[4]);
+    if (homogeneous < 0) return NULL;
+    const mb_model *md = &self->model->md;
+    if (get_state(md, args[1], &y, 1, 1) < 0) return NULL;
+    if (get_buffer(args[5], &info, 1, 1, MB_PROJECT_INFO, "info") < 0) {
+        PyBuffer_Release(&y);
+        return NULL;
+    }
+    mb_project(md, &self->u, self->w, t, y.buf, (int)iters, robust_below, homogeneous, info.buf);
+    PyBuffer_Release(&y);
+    PyBuffer_Release(&info);
+    Py_RETURN_NONE;
+}
+
+PyDoc_STRVAR(schur_doc,
+"schur(t, y, S_out)\n\nS_out (mu x mu) <- S = G_U^T M^-1 G_U at (t, y), dense, in the "
+"unknowns' order (for a\ncondition estimate).");
+
+static PyObject *Unknowns_schur(UnknownsObject *self, PyObject *const *args, Py_ssize_t nargs) {
+    Py_buffer y, S;
+    double t;
+    if (unknowns_ready(self) < 0 || check_nargs(nargs, 3, "schur") < 0 ||
+        get_double(args[0], &t, "t") < 0)
+        return NULL;
+    const mb_model *md = &self->model->md;
+    mb_work *w = self->w;
+    if (get_state(md, args[1], &y, 0, 0) < 0) return NULL;
+    if (get_buffer(args[2], &S, 1, 1, self->u.mu * self->u.mu, "S_out") < 0) {
+        PyBuffer_Release(&y);
+        return NULL;
+    }
+    mb_rotations(md->n, (const double *)y.buf + 3 * md->n, w->R);
+    mb_eval_all(md, w, t);
+    mb_columns_at(md, w, y.buf, 1, w->child6, w->parent6, NULL, NULL, w->gamma, w->phi, w->gtv);
+    memset(S.buf, 0, sizeof(double) * self->u.mu * self->u.mu);
+    mb_schur(md, &self->u, md->bodies, w->child6, w->parent6, S.buf, 0);
+    PyBuffer_Release(&y);
+    PyBuffer_Release(&S);
+    Py_RETURN_NONE;
+}
+
+static PyObject *Unknowns_get(UnknownsObject *self, void *which) {
+    switch ((int)(intptr_t)which) {
+    case 0: return PyLong_FromLongLong(self->u.mu);
+    case 1: return PyLong_FromLongLong(self->u.bw);
+    default: Py_INCREF(self->model); return (PyObject *)self->model;
+    }
+}
+
+static PyGetSetDef Unknowns_getset[] = {
+    {"mu", (getter)Unknowns_get, NULL, "number of unknown components", (void *)0},
+    {"bw", (getter)Unknowns_get, NULL, "half bandwidth of S in the unknowns' order", (void *)1},
+    {"model", (getter)Unknowns_get, NULL, "the Model", (void *)2},
+    {NULL, NULL, NULL, NULL, NULL},
+};
+
+static PyMethodDef Unknowns_methods[] = {
+    {"solve", (PyCFunction)(void (*)(void))Unknowns_solve, METH_FASTCALL, solve_doc},
+    {"derivative", (PyCFunction)(void (*)(void))Unknowns_derivative, METH_FASTCALL, derivative_doc},
+    {"project", (PyCFunction)(void (*)(void))Unknowns_project, METH_FASTCALL, project_doc},
+    {"schur", (PyCFunction)(void (*)(void))Unknowns_schur, METH_FASTCALL, schur_doc},
+    {NULL, NULL, 0, NULL},
+};
+
+PyDoc_STRVAR(Unknowns_doc,
+"Unknowns(model, Iu)\n\nThe unknown reaction components of one solve "
+"(mbody.equations.pack.pack_unknowns),\nwith the scratch memory of its evaluations "
+"(allocated once). A ValueError when Iu\ndoes not describe unknowns of this model.");
+
+static PyTypeObject UnknownsType = {
+    PyVarObject_HEAD_INIT(NULL, 0)
+    .tp_name = "mbody.kernel._core.Unknowns",
+    .tp_basicsize = sizeof(UnknownsObject),
+    .tp_dealloc = (destructor)Unknowns_dealloc,
+    .tp_flags = Py_TPFLAGS_DEFAULT,
+    .tp_doc = Unknowns_doc,
+    .tp_methods = Unknowns_methods,
+    .tp_getset = Unknowns_getset,
+    .tp_init = (initproc)Unknowns_init,
+    .tp_new = PyType_GenericNew,
+};
+
+/* -- module -------------------------------------------------------------------------- */
+
+PyDoc_STRVAR(solve_layout_doc,
+"solve_layout(n, m, planar) -> (N, lam, info)\n\nWhere Unknowns.solve writes into out: "
+"N accelerations, lambda (m) at offset lam,\nthen G^T v (m) and the not-unique flags (m), "
+"info (INFO values) at offset info.");
+
+static PyObject *solve_layout(PyObject *mod, PyObject *args) {
+    long long n, m;
+    int planar;
+    if (!PyArg_ParseTuple(args, "LLp", &n, &m, &planar)) return NULL;
+    long long N = (planar ? 3 : 6) * n;
+    return Py_BuildValue("(LLL)", N, N, N + 3 * m);
+}
 
 static PyMethodDef methods[] = {
+    {"solve_layout", solve_layout, METH_VARARGS, solve_layout_doc},
     {NULL, NULL, 0, NULL},
 };
 
 static struct PyModuleDef module = {
-    PyModuleDef_HEAD_INIT, "_core", "mbody's compiled core (kernel.h).", -1, methods,
+    PyModuleDef_HEAD_INIT, "_core",
+    "mbody's compiled core (kernel.h): Model, Unknowns, solve_layout and the layout "
+    "constants.", -1, methods, NULL, NULL, NULL, NULL,
 };
 
 PyMODINIT_FUNC PyInit__core(void) {
+    if (PyType_Ready(&ModelType) < 0 || PyType_Ready(&UnknownsType) < 0) return NULL;
     PyObject *m = PyModule_Create(&module);
     if (m == NULL) return NULL;
-    /* the constraint primitives (kernel.h), named as mbody.joints reads them */
-    if (PyModule_AddIntConstant(m, "KIND_FORCE", MB_KIND_FORCE) < 0
-        || PyModule_AddIntConstant(m, "KIND_TILT", MB_KIND_TILT) < 0
-        || PyModule_AddIntConstant(m, "KIND_LOCK", MB_KIND_LOCK) < 0
-        || PyModule_AddIntConstant(m, "KIND_RIGHT_ANGLE", MB_KIND_RIGHT_ANGLE) < 0
-        || PyModule_AddIntConstant(m, "KIND_LINK", MB_KIND_LINK) < 0
-        || PyModule_AddIntConstant(m, "KIND_TURN", MB_KIND_TURN) < 0
-        || PyModule_AddIntConstant(m, "KIND_SCREW", MB_KIND_SCREW) < 0
-        || PyModule_AddIntConstant(m, "KINDS", MB_KINDS) < 0) {
-        Py_DECREF(m);
-        return NULL;
-    }
+    struct { const char *name; long value; } constants[] = {
+        {"KIND_FORCE", MB_KIND_FORCE}, {"KIND_TILT", MB_KIND_TILT}, {"KIND_LOCK", MB_KIND_LOCK},
+        {"KIND_RIGHT_ANGLE", MB_KIND_RIGHT_ANGLE}, {"KIND_LINK", MB_KIND_LINK},
+        {"KIND_TURN", MB_KIND_TURN}, {"KIND_SCREW", MB_KIND_SCREW}, {"KINDS", MB_KINDS},
+        {"I_HEADER", MB_I_HEADER}, {"BODY_W", MB_BODY_W}, {"LOAD_W", MB_LOAD_W},
+        {"SPRING_W", MB_SPRING_W}, {"JOINT_W", MB_JOINT_W}, {"COMP_W", MB_COMP_W},
+        {"J_LINK", MB_J_LINK}, {"J_PARTICLE_PARENT", MB_J_PARTICLE_PARENT},
+        {"OP_NUM", MB_OP_NUM}, {"OP_T", MB_OP_T}, {"OP_NEG", MB_OP_NEG}, {"OP_ADD", MB_OP_ADD},
+        {"OP_SUB", MB_OP_SUB}, {"OP_MUL", MB_OP_MUL}, {"OP_DIV", MB_OP_DIV},
+        {"OP_POW", MB_OP_POW}, {"OP_SIN", MB_OP_SIN}, {"OP_COS", MB_OP_COS},
+        {"OP_TAN", MB_OP_TAN}, {"OP_EXP", MB_OP_EXP}, {"OP_LOG", MB_OP_LOG},
+        {"OP_SQRT", MB_OP_SQRT}, {"OP_ABS", MB_OP_ABS},
+        {"ST_RANK", MB_ST_RANK}, {"ST_BERR", MB_ST_BERR}, {"ST_BROKEN", MB_ST_BROKEN},
+        {"ST_MU", MB_ST_MU}, {"ST_PATH", MB_ST_PATH}, {"ST_SINGULAR", MB_ST_SINGULAR},
+        {"INFO", MB_INFO}, {"PR_STEP", MB_PR_STEP}, {"PR_VELOCITY", MB_PR_VELOCITY},
+        {"PR_RATIO", MB_PR_RATIO}, {"PR_SINGULAR", MB_PR_SINGULAR},
+        {"PROJECT_INFO", MB_PROJECT_INFO},
+    };
+    for (size_t i = 0; i < sizeof(constants) / sizeof(constants[0]); i++)
+        if (PyModule_AddIntConstant(m, constants[i].name, constants[i].value) < 0) goto fail;
+    Py_INCREF(&ModelType);
+    if (PyModule_AddObject(m, "Model", (PyObject *)&ModelType) < 0) goto fail;
+    Py_INCREF(&UnknownsType);
+    if (PyModule_AddObject(m, "Unknowns", (PyObject *)&UnknownsType) < 0) goto fail;
     return m;
+fail:
+    Py_DECREF(m);
+    return NULL;
 }

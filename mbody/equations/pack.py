@@ -1,0 +1,194 @@
+"""A model packed for the compiled core (`mbody.kernel`, layout in ``kernel.h``).
+
+`pack_model(model)` gives the float array F and the int array I that
+``mbody.kernel._core.Model(F, I, planar)`` reads; `pack_unknowns(model, U)` the int
+array of one set of unknown reaction components (``_core.Unknowns(model, Iu)``), ordered
+for a narrow band of S = G_Uᵀ M⁻¹ G_U. Every reaction component is one constraint
+primitive of the core (`component_kind`); expressions of t (time-varying loads and known
+reactions, the laws of driven components) are packed as postfix programs, each distinct
+expression once.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, NamedTuple
+
+import numpy as np
+
+from mbody import conventions as cv
+from mbody.kernel import _core
+
+if TYPE_CHECKING:
+    from mbody.model.expressions import Expression
+    from mbody.model.model import Model
+
+BAND_ORDER_ABOVE = 64
+"""Unknowns beyond this many are put in reverse Cuthill-McKee order (a narrow band of
+S); fewer keep their label order (any order is fast)."""
+
+
+class Component(NamedTuple):
+    """A reaction component beyond the model's own (a driven joint's, for tests until
+    drivers land): one primitive `kind` (``_core.KIND_*``) of joint `joint` about or
+    along the joint frame's `axis`, its offset and screw parameter (kernel.h's param0,
+    param1), and optionally its law (f, f', f'') as expressions of t."""
+
+    joint: int
+    kind: int
+    axis: int
+    off: float = 0.0
+    h: float = 0.0
+    law: tuple[Expression, Expression, Expression] | None = None
+
+
+def component_kind(axis: int, rot_kind: int) -> tuple[int, int]:
+    """(kind, axis) of the core's primitive for a `ReactionTable` component (its axis
+    code and rot_kind). The one place that maps today's component codes; the joint-type
+    registry replaces it."""
+    if axis == cv.LINK_AXIS:
+        return _core.KIND_LINK, 0
+    if axis < 3:
+        return _core.KIND_FORCE, axis
+    if axis == 6:
+        return _core.KIND_RIGHT_ANGLE, 2
+    return (_core.KIND_TILT if rot_kind == 1 else _core.KIND_LOCK), axis - 3
+
+
+class _Programs:
+    """Distinct expressions of t in packing order, each with its index."""
+
+    def __init__(self) -> None:
+        self.exprs: list[Expression] = []
+        self._index: dict[object, int] = {}
+
+    def add(self, e: Expression) -> int:
+        key = e.tree
+        if key not in self._index:
+            self._index[key] = len(self.exprs)
+            self.exprs.append(e)
+        return self._index[key]
+
+    def packed(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(starts (u + 1), codes, numbers)."""
+        progs = [e.program for e in self.exprs]
+        starts = np.zeros(len(progs) + 1, dtype=np.int64)
+        starts[1:] = np.cumsum([len(c) for c, _ in progs])
+        codes = np.concatenate([c for c, _ in progs]) if progs else np.zeros(0, np.int64)
+        numbers = np.concatenate([v for _, v in progs]) if progs else np.zeros(0)
+        return starts, codes.astype(np.int64), numbers.astype(float)
+
+
+def _components(model: Model, extra: Sequence[Component]) -> np.ndarray:
+    """(m, 3) [joint, kind, axis] of the model's components, then the extra ones."""
+    rt = model.reaction_table
+    rows = [(j, *component_kind(a, r)) for j, a, r in
+            zip(rt.joint.tolist(), rt.axis.tolist(), rt.rot_kind.tolist(), strict=True)]
+    rows += [(c.joint, c.kind, c.axis) for c in extra]
+    return np.array(rows, dtype=np.int64).reshape(-1, 3)
+
+
+def pack_model(model: Model, extra: Sequence[Component] = ()) -> tuple[np.ndarray, np.ndarray]:
+    """(F, I): the model's constants as one float64 and one int64 array (kernel.h's
+    layout); `extra` components follow the model's own (indices m, m + 1, ...)."""
+    n = model.n
+    ft, sp, jt = model.forces, model.springs, model.joint_table
+    k, s, nj = len(ft.names), len(sp.names), len(jt.parent)
+    comps = _components(model, extra)
+    m = len(comps)
+    programs = _Programs()
+    varying = np.zeros((0, 3), dtype=np.int64)
+    if ft.varying is not None:
+        vt = ft.varying
+        index = [programs.add(e) for e in vt.exprs]
+        varying = np.stack((vt.rows, vt.cols, np.asarray(index, np.int64)[vt.which]),
+                           axis=1).astype(np.int64)
+    laws: list[list[int]] = []
+    law_of = np.full(m, -1, dtype=np.int64)
+    m0 = m - len(extra)
+    for i, c in enumerate(extra):
+        if c.law is not None:
+            law_of[m0 + i] = len(laws)
+            laws.append([programs.add(e) for e in c.law])
+    known = [(model.reaction_index[label], programs.add(e))
+             for label, e in getattr(model, "known_expressions", {}).items()]
+    starts, codes, numbers = programs.packed()
+    bodies = np.concatenate((np.asarray(model.mass, float)[:, None],
+                             np.asarray(model.J).reshape(n, 9),
+                             np.asarray(model.J_inv).reshape(n, 9)), axis=1)
+    loads = np.concatenate((np.asarray(ft.B_r, float).reshape(k, 3),
+                            np.asarray(ft.vector, float).reshape(k, 3)), axis=1)
+    springs = np.concatenate((sp.r_a, sp.r_b, sp.stiffness[:, None],
+                              sp.rest_length[:, None], sp.damping[:, None]), axis=1)
+    joints = np.concatenate((jt.B_r_child, jt.B_r_parent, jt.C_axis2,
+                             jt.P_E3.reshape(nj, 9), jt.C_E3.reshape(nj, 9),
+                             jt.length[:, None]), axis=1)
+    comps_f = np.zeros((m, 2))
+    for i, c in enumerate(extra):
+        comps_f[m0 + i] = (c.off, c.h)
+    flags = _core.J_LINK * jt.link.astype(np.int64) + _core.J_PARTICLE_PARENT * jt.particle_parent
+    F = np.concatenate((np.asarray(model.gravity, float), bodies.ravel(), loads.ravel(),
+                        springs.ravel(), joints.ravel(), comps_f.ravel(), numbers))
+    Ii = np.concatenate((
+        [n, k, s, nj, m, len(starts) - 1, len(codes), len(varying), len(laws), len(known)],
+        np.stack((ft.body, ft.in_body, ft.couple), axis=1).ravel(),
+        np.stack((sp.a, sp.b), axis=1).ravel(),
+        np.stack((jt.parent, jt.child, flags), axis=1).ravel(),
+        np.concatenate((comps, law_of[:, None]), axis=1).ravel(),
+        varying.ravel(), np.asarray(laws, np.int64).ravel(),
+        np.asarray(known, np.int64).ravel(), starts, codes,
+    )).astype(np.int64)
+    return np.ascontiguousarray(F, dtype=float), np.ascontiguousarray(Ii)
+
+
+def _bodies(model: Model, extra: Sequence[Component]) -> tuple[np.ndarray, np.ndarray]:
+    """(child, parent) body of every component (parent −1: ground)."""
+    jt = model.joint_table
+    joint = _components(model, extra)[:, 0]
+    return jt.child[joint], jt.parent[joint]
+
+
+def band_order(child: np.ndarray, parent: np.ndarray, n: int) -> np.ndarray:
+    """A reverse Cuthill-McKee order of components (coupled when they act on a common
+    body; child/parent their bodies), so that S = G_Uᵀ M⁻¹ G_U has a narrow band."""
+    import scipy.sparse as sp
+    from scipy.sparse.csgraph import reverse_cuthill_mckee
+
+    mu = len(child)
+    body = np.concatenate((child, parent))
+    comp = np.concatenate((np.arange(mu), np.arange(mu)))
+    keep = body >= 0
+    B = sp.csr_matrix((np.ones(int(keep.sum())), (comp[keep], body[keep])), shape=(mu, n))
+    return np.asarray(reverse_cuthill_mckee((B @ B.T).tocsr(), symmetric_mode=True))
+
+
+def pack_unknowns(model: Model, U: np.ndarray, extra: Sequence[Component] = ()) -> np.ndarray:
+    """The int64 array describing the unknown components U (indices into the packed
+    components: the model's, then `extra`), in their solve order (reverse Cuthill-McKee
+    beyond BAND_ORDER_ABOVE of them, else as given).
+
+    Layout: [mu, bw, nnz], U (mu), inc_ptr (n + 1), inc (nnz × [position in U, side]):
+    per body, the unknown components acting on it (side 0 child, 1 parent), so that
+    S is summed body by body; bw is S's half bandwidth in U's order.
+    """
+    child_all, parent_all = _bodies(model, extra)
+    U = np.asarray(U, dtype=np.int64)
+    if len(U) > BAND_ORDER_ABOVE:
+        U = U[band_order(child_all[U], parent_all[U], model.n)]
+    n, mu = model.n, len(U)
+    pos = np.arange(mu)
+    body = np.concatenate((child_all[U], parent_all[U]))
+    side = np.concatenate((np.zeros(mu, np.int64), np.ones(mu, np.int64)))
+    where = np.concatenate((pos, pos))
+    keep = body >= 0
+    body, side, where = body[keep], side[keep], where[keep]
+    order = np.lexsort((where, body))
+    body, side, where = body[order], side[order], where[order]
+    inc_ptr = np.searchsorted(body, np.arange(n + 1))
+    bw = 0
+    for b in range(n):  # per body, at plan time only
+        w = where[inc_ptr[b]:inc_ptr[b + 1]]
+        if len(w):
+            bw = max(bw, int(w.max() - w.min()))
+    inc = np.stack((where, side), axis=1).ravel()
+    return np.concatenate(([mu, bw, len(where)], U, inc_ptr, inc)).astype(np.int64)
