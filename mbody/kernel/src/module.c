@@ -5,6 +5,9 @@
 
 #include "kernel.h"
 
+/* The DOP853 integrator's entry points (dop853_module.c). */
+int mb_dop853_register(PyObject *m);
+
 static PyMethodDef methods[] = {
     {NULL, NULL, 0, NULL},
 };
@@ -17,5 +20,6 @@ PyMODINIT_FUNC PyInit__core(void) {
     PyObject *m = PyModule_Create(&module);
     if (m == NULL) return NULL;
     if (PyModule_AddIntConstant(m, "KINDS", MB_KINDS) < 0) return NULL;
+    if (mb_dop853_register(m) < 0) return NULL;
     return m;
 }
