@@ -113,7 +113,8 @@ int mb_dop853_run(const mb_ode *p, double t_stop, int64_t max_steps, double *sta
 
 /* The dense output of the last accepted step at m times inside it (out: m rows of n),
  * its three extra stages evaluated on the first call after the step. Returns 0, -1
- * without a step to interpolate, or a callback's nonzero code (also in state). */
+ * without a step to interpolate, or MB_DOP_STOPPED when a callback stopped it (its code
+ * in state[MB_DOP_CODE]). */
 int mb_dop853_dense(const mb_ode *p, const double *t, int64_t m, double *out,
                     double *state, double *work);
 
