@@ -525,6 +525,9 @@ static PyObject *solve_layout(PyObject *mod, PyObject *args) {
     return Py_BuildValue("(LLL)", N, N, N + 3 * m);
 }
 
+/* The DOP853 integrator's entry points (dop853_module.c). */
+int mb_dop853_register(PyObject *m);
+
 static PyMethodDef methods[] = {
     {"solve_layout", solve_layout, METH_VARARGS, solve_layout_doc},
     {NULL, NULL, 0, NULL},
@@ -564,6 +567,7 @@ PyMODINIT_FUNC PyInit__core(void) {
     if (PyModule_AddObject(m, "Model", (PyObject *)&ModelType) < 0) goto fail;
     Py_INCREF(&UnknownsType);
     if (PyModule_AddObject(m, "Unknowns", (PyObject *)&UnknownsType) < 0) goto fail;
+    if (mb_dop853_register(m) < 0) goto fail;
     return m;
 fail:
     Py_DECREF(m);

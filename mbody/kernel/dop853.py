@@ -1,0 +1,208 @@
+"""The compiled core's DOP853 integrator (`src/dop853.h`) driven from Python.
+
+`DOP853` steps an ODE y' = f(t, y) with Dormand and Prince's 8(5,3) pair, Hairer, Nørsett
+and Wanner's step-size control and the 7th-order dense output: the same accepted steps
+as ``scipy.integrate.DOP853`` (tests/test_dop853.py). The right-hand side is one of the
+core's built-in test systems (`SYSTEMS`, evaluated in C) or a Python callable (a few
+microseconds an evaluation more). The run's whole state lives in two numpy arrays,
+``state`` (slots ``_core.DOP_*``) and ``work`` (rows of n: y, f, the last step's stages,
+its dense output), which the core reads and writes in place.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+
+import numpy as np
+
+from mbody.kernel import _core
+
+SYSTEMS = {
+    "oscillator": _core.DOP_SYSTEM_OSCILLATOR,  # x'' = -w^2 x; params [w]
+    "van_der_pol": _core.DOP_SYSTEM_VAN_DER_POL,  # x'' = mu (1 - x^2) x' - x; [mu]
+    "arenstorf": _core.DOP_SYSTEM_ARENSTORF,  # restricted three-body problem; [mu]
+    "pendulum": _core.DOP_SYSTEM_PENDULUM,  # theta'' = -(g/L) sin(theta); [g/L]
+}
+"""The core's built-in test systems by name: their state and parameters (src/
+dop853_module.c)."""
+
+STATUS = {_core.DOP_RUNNING: "running", _core.DOP_FINISHED: "finished",
+          _core.DOP_TOO_SMALL: "failed", _core.DOP_STOPPED: "stopped"}
+"""scipy's words for the core's statuses (`stopped`: a callback asked to stop)."""
+
+TOO_SMALL_STEP = "Required step size is less than spacing between numbers."
+"""What a run stopped by the minimal step says (scipy's words)."""
+
+Rhs = Callable[[float, np.ndarray], np.ndarray]
+
+
+class DOP853:
+    """DOP853 from (t0, y0) towards t_bound.
+
+    Parameters
+    ----------
+    rhs : str or callable
+        A name in `SYSTEMS` (with `params`), or f(t, y) -> y' (array of len(y0)).
+    t0, y0, t_bound : float, array, float
+        Start and end of the run (t_bound < t0 integrates backwards).
+    rtol, atol : float; float or array
+        Tolerances per component: the local error of y_i is kept below about
+        atol_i + rtol |y_i|.
+    max_step : float
+        Longest step.
+    first_step : float, optional
+        The first step's size; by default Hairer, Nørsett and Wanner's estimate.
+    project, stage, tangent : callable, optional
+        `project(t, y) -> info` moves y in place after each accepted step and returns
+        up to four numbers: the size of the move (above `refresh` times atol, the next
+        step starts from a fresh f(t, y)), whether the next step is filtered, and two of
+        the caller's own (kept in `info`). In a filtered step each evaluation is made at
+        `stage(t, y)`'s move of a copy of its state, and the error estimates pass through
+        `tangent(t, y, e)` (e mapped in place). See src/dop853.h.
+    """
+
+    def __init__(self, rhs: str | Rhs, t0: float, y0: Sequence[float] | np.ndarray,
+                 t_bound: float, *, rtol: float = 1e-3, atol: float | np.ndarray = 1e-6,
+                 max_step: float = math.inf, first_step: float | None = None,
+                 params: Sequence[float] = (), project: Callable | None = None,
+                 stage: Callable | None = None, tangent: Callable | None = None,
+                 refresh: float = 0.0, filter_first: bool = False):
+        y0 = np.array(y0, dtype=float).ravel()
+        self.n = n = len(y0)
+        atol_vector = np.ndim(atol) > 0
+        self.state = np.zeros(_core.DOP_STATE_SIZE)
+        self.work = np.zeros(_core.dop853_work_size(n))
+        s = self.state
+        s[_core.DOP_RTOL], s[_core.DOP_MAX_STEP], s[_core.DOP_T_BOUND] = rtol, max_step, t_bound
+        s[_core.DOP_ATOL] = 0.0 if atol_vector else float(atol)
+        s[_core.DOP_SAFETY], s[_core.DOP_FAC_MIN], s[_core.DOP_FAC_MAX] = 0.9, 0.2, 10.0
+        s[_core.DOP_REFRESH] = refresh
+        s[_core.DOP_FILTER_NEXT] = float(filter_first)
+        if isinstance(rhs, str):
+            core_rhs: int | Callable = SYSTEMS[rhs]
+        else:
+            fun = rhs
+
+            def core_rhs(t: float, y: memoryview, out: memoryview) -> None:
+                np.frombuffer(out)[:] = fun(t, np.frombuffer(y).copy())
+
+        self.problem = (core_rhs, np.array(params, dtype=float), _project(project),
+                        _stage(stage), _tangent(tangent),
+                        np.array(atol, dtype=float).ravel() if atol_vector else None)
+        _core.dop853_start(self.problem, float(t0), y0, float(first_step or 0.0), s,
+                           self.work)
+
+    def run(self, t_stop: float | None = None, max_steps: int = 1) -> str:
+        """Steps until the first that reaches t_stop (default t_bound), at most
+        max_steps of them; returns `status`."""
+        t_stop = self.state[_core.DOP_T_BOUND] if t_stop is None else t_stop
+        _core.dop853_run(self.problem, float(t_stop), int(max_steps), self.state, self.work)
+        return self.status
+
+    def step(self) -> str | None:
+        """One step (scipy's `OdeSolver.step`): None, or why the run failed."""
+        self.run(max_steps=1)
+        return TOO_SMALL_STEP if self.status == "failed" else None
+
+    def dense(self, t: float | Sequence[float] | np.ndarray) -> np.ndarray:
+        """The last step's dense output at t inside it: (n,) for a number, (len(t), n)
+        for an array (a sample a row)."""
+        times = np.atleast_1d(np.asarray(t, dtype=float)).ravel()
+        out = np.empty((len(times), self.n))
+        _core.dop853_dense(self.problem, times, out, self.state, self.work)
+        return out[0] if np.ndim(t) == 0 else out
+
+    def _row(self, row: int) -> np.ndarray:
+        return self.work[row * self.n:(row + 1) * self.n]
+
+    @property
+    def y(self) -> np.ndarray:
+        """y at `t` (a view of the work array: copy it to keep it)."""
+        return self._row(_core.DOP_W_Y)
+
+    @property
+    def f(self) -> np.ndarray:
+        """y' at (t, y) as the next step starts from it."""
+        return self._row(_core.DOP_W_F)
+
+    @property
+    def y_old(self) -> np.ndarray:
+        """y at the start of the last step."""
+        return self._row(_core.DOP_W_Y_OLD)
+
+    @property
+    def t(self) -> float:
+        return float(self.state[_core.DOP_T])
+
+    @property
+    def t_old(self) -> float:
+        """Start of the last accepted step."""
+        return float(self.state[_core.DOP_T_OLD])
+
+    @property
+    def h_abs(self) -> float:
+        """The next step's size, as proposed."""
+        return float(self.state[_core.DOP_H])
+
+    @property
+    def step_size(self) -> float:
+        """The last accepted step's size (signed)."""
+        return float(self.state[_core.DOP_H_OLD])
+
+    @property
+    def nfev(self) -> int:
+        return int(self.state[_core.DOP_NFEV])
+
+    @property
+    def steps(self) -> int:
+        """Accepted steps."""
+        return int(self.state[_core.DOP_STEPS])
+
+    @property
+    def rejected(self) -> int:
+        return int(self.state[_core.DOP_REJECTED])
+
+    @property
+    def refreshed(self) -> int:
+        """Fresh derivatives after a projection."""
+        return int(self.state[_core.DOP_REFRESHED])
+
+    @property
+    def status(self) -> str:
+        return STATUS[int(self.state[_core.DOP_STATUS])]
+
+    @property
+    def info(self) -> np.ndarray:
+        """The last projection's info."""
+        return self.state[_core.DOP_INFO:_core.DOP_INFO + _core.DOP_PROJECT_INFO].copy()
+
+
+def _project(fn: Callable | None) -> Callable | None:
+    if fn is None:
+        return None
+
+    def project(t: float, y: memoryview, info: memoryview) -> None:
+        values = np.atleast_1d(np.asarray(fn(t, np.frombuffer(y)), dtype=float))
+        out = np.frombuffer(info)
+        out[:] = 0.0
+        out[:len(values)] = values
+    return project
+
+
+def _stage(fn: Callable | None) -> Callable | None:
+    if fn is None:
+        return None
+
+    def stage(t: float, y: memoryview) -> None:
+        fn(t, np.frombuffer(y))
+    return stage
+
+
+def _tangent(fn: Callable | None) -> Callable | None:
+    if fn is None:
+        return None
+
+    def tangent(t: float, y: memoryview, e: memoryview) -> None:
+        fn(t, np.frombuffer(y).copy(), np.frombuffer(e))
+    return tangent

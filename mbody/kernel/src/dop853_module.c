@@ -1,0 +1,422 @@
+/* The Python entry points of the DOP853 integrator (dop853.h), registered into
+ * mbody.kernel._core by mb_dop853_register (called from PyInit__core in module.c).
+ *
+ * A problem is the tuple (rhs, params, project, stage, tangent, atol):
+ *   rhs      an int, one of the built-in test systems below (SYSTEM_*), with its
+ *            parameters `params` (a float64 buffer), or a callable rhs(t, y, ydot)
+ *            writing y'(t, y) into ydot (y, ydot: memoryviews of float64);
+ *   project  None or project(t, y, info) (y, info writable; dop853.h's project);
+ *   stage    None or stage(t, y) (y writable);
+ *   tangent  None or tangent(t, y, e) (e writable);
+ *   atol     None or a float64 buffer of n absolute tolerances.
+ * Python callables cost a few microseconds an evaluation: they are for tests and for
+ * problems without a compiled right-hand side. state and work are float64 buffers of
+ * STATE_SIZE and work_size(n) (caller-owned: numpy arrays).
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+
+#include <math.h>
+
+#include "dop853.h"
+
+/* ---------------------------------------------------------------------------------------
+ * Built-in test systems (plain ODEs with known behaviour), written with the same
+ * operations in the same order as their Python versions in tests/test_dop853.py, so that
+ * both give the same numbers.
+ * ------------------------------------------------------------------------------------- */
+enum { SYSTEM_OSCILLATOR, SYSTEM_VAN_DER_POL, SYSTEM_ARENSTORF, SYSTEM_PENDULUM,
+       SYSTEMS };
+static const int64_t SYSTEM_SIZE[SYSTEMS] = {2, 2, 4, 2};
+static const int64_t SYSTEM_PARAMS[SYSTEMS] = {1, 1, 1, 1};
+
+/* x'' = -w^2 x: y = [x, x'], params [w (rad/s)]. */
+static void oscillator(const double *k, const double *y, double *d) {
+    d[0] = y[1];
+    d[1] = -(k[0] * k[0]) * y[0];
+}
+
+/* x'' = mu (1 - x^2) x' - x: y = [x, x'], params [mu]. */
+static void van_der_pol(const double *k, const double *y, double *d) {
+    d[0] = y[1];
+    d[1] = k[0] * (1.0 - y[0] * y[0]) * y[1] - y[0];
+}
+
+/* The restricted three-body problem in the rotating frame (HNW I, II.0, Arenstorf's
+ * orbits): y = [x, y, x', y'], params [mu (mass ratio)]. */
+static void arenstorf(const double *k, const double *y, double *d) {
+    const double mu = k[0], nu = 1.0 - mu;
+    const double a = y[0] + mu, b = y[0] - nu, y2 = y[1] * y[1];
+    const double ra = a * a + y2, rb = b * b + y2;
+    const double d1 = ra * sqrt(ra), d2 = rb * sqrt(rb);
+    d[0] = y[2];
+    d[1] = y[3];
+    d[2] = y[0] + 2.0 * y[3] - nu * a / d1 - mu * b / d2;
+    d[3] = y[1] - 2.0 * y[2] - nu * y[1] / d1 - mu * y[1] / d2;
+}
+
+/* theta'' = -(g/L) sin(theta): y = [theta, theta'], params [g/L (1/s^2)]. */
+static void pendulum(const double *k, const double *y, double *d) {
+    d[0] = y[1];
+    d[1] = -k[0] * sin(y[0]);
+}
+
+typedef void (*system_fn)(const double *k, const double *y, double *d);
+static const system_fn SYSTEM_FN[SYSTEMS] = {oscillator, van_der_pol, arenstorf, pendulum};
+
+/* ---------------------------------------------------------------------------------------
+ * A problem tuple held for one call.
+ * ------------------------------------------------------------------------------------- */
+typedef struct {
+    int system;        /* SYSTEM_*, or -1: a Python callable */
+    const double *params;
+    PyObject *rhs, *project, *stage, *tangent; /* borrowed */
+    Py_buffer params_view, atol_view;
+    int has_params, has_atol;
+    int64_t n;
+} problem;
+
+enum { PY_ERROR = -1000 }; /* a callback's code: a Python exception is set */
+
+static int system_rhs(void *ctx, double t, const double *y, double *ydot) {
+    const problem *pr = ctx;
+    SYSTEM_FN[pr->system](pr->params, y, ydot);
+    return 0;
+}
+
+static PyObject *view(double *x, int64_t n, int writable) {
+    return PyMemoryView_FromMemory((char *)x, (Py_ssize_t)(n * (int64_t)sizeof(double)),
+                                   writable ? PyBUF_WRITE : PyBUF_READ);
+}
+
+/* Calls fn(t, views...) and returns 0, or PY_ERROR with the exception set. */
+static int call(PyObject *fn, double t, double *a, int wa, double *b, int wb, int64_t nb,
+                int64_t n) {
+    PyObject *va = view(a, n, wa), *vb = b != NULL ? view(b, nb, wb) : NULL;
+    PyObject *tt = PyFloat_FromDouble(t);
+    PyObject *res = NULL;
+    if (va != NULL && tt != NULL && (b == NULL || vb != NULL))
+        res = b != NULL ? PyObject_CallFunctionObjArgs(fn, tt, va, vb, NULL)
+                        : PyObject_CallFunctionObjArgs(fn, tt, va, NULL);
+    Py_XDECREF(va);
+    Py_XDECREF(vb);
+    Py_XDECREF(tt);
+    if (res == NULL) return PY_ERROR;
+    Py_DECREF(res);
+    return 0;
+}
+
+static int python_rhs(void *ctx, double t, const double *y, double *ydot) {
+    const problem *pr = ctx;
+    return call(pr->rhs, t, (double *)y, 0, ydot, 1, pr->n, pr->n);
+}
+
+static int python_project(void *ctx, double t, double *y, double *info) {
+    const problem *pr = ctx;
+    return call(pr->project, t, y, 1, info, 1, MB_DOP_PROJECT_INFO, pr->n);
+}
+
+static int python_stage(void *ctx, double t, double *y) {
+    const problem *pr = ctx;
+    return call(pr->stage, t, y, 1, NULL, 0, 0, pr->n);
+}
+
+static int python_tangent(void *ctx, double t, const double *y, double *e) {
+    const problem *pr = ctx;
+    return call(pr->tangent, t, (double *)y, 0, e, 1, pr->n, pr->n);
+}
+
+/* A C-contiguous float64 buffer of exactly `size` doubles (size < 0: any size). */
+static int get_doubles(PyObject *obj, Py_buffer *b, int writable, Py_ssize_t size,
+                       const char *what) {
+    int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (writable ? PyBUF_WRITABLE : 0);
+    if (PyObject_GetBuffer(obj, b, flags) < 0) return -1;
+    if (b->itemsize != 8 || b->format == NULL || strcmp(b->format, "d") != 0) {
+        PyErr_Format(PyExc_TypeError, "%s: a float64 array is needed", what);
+        PyBuffer_Release(b);
+        return -1;
+    }
+    if (size >= 0 && b->len != size * 8) {
+        PyErr_Format(PyExc_ValueError, "%s: %zd values expected, got %zd", what, size,
+                     b->len / 8);
+        PyBuffer_Release(b);
+        return -1;
+    }
+    return 0;
+}
+
+static void problem_release(problem *pr) {
+    if (pr->has_params) PyBuffer_Release(&pr->params_view);
+    if (pr->has_atol) PyBuffer_Release(&pr->atol_view);
+    pr->has_params = pr->has_atol = 0;
+}
+
+/* Reads the problem tuple into pr and ode; n: the size of y. */
+static int problem_read(PyObject *tuple, int64_t n, problem *pr, mb_ode *ode) {
+    PyObject *rhs, *params, *project, *stage, *tangent, *atol;
+    memset(pr, 0, sizeof(*pr));
+    memset(ode, 0, sizeof(*ode));
+    if (!PyArg_ParseTuple(tuple, "OOOOOO", &rhs, &params, &project, &stage, &tangent,
+                          &atol))
+        return -1;
+    pr->n = ode->n = n;
+    ode->ctx = pr;
+    if (PyLong_Check(rhs)) {
+        long s = PyLong_AsLong(rhs);
+        if (s < 0 || s >= SYSTEMS) {
+            PyErr_Format(PyExc_ValueError, "no built-in system %ld", s);
+            return -1;
+        }
+        if (SYSTEM_SIZE[s] != n) {
+            PyErr_Format(PyExc_ValueError, "built-in system %ld has %lld states, not %lld",
+                         s, (long long)SYSTEM_SIZE[s], (long long)n);
+            return -1;
+        }
+        if (get_doubles(params, &pr->params_view, 0, SYSTEM_PARAMS[s], "params") < 0)
+            return -1;
+        pr->has_params = 1;
+        pr->system = (int)s;
+        pr->params = pr->params_view.buf;
+        ode->rhs = system_rhs;
+    } else if (PyCallable_Check(rhs)) {
+        pr->system = -1;
+        pr->rhs = rhs;
+        ode->rhs = python_rhs;
+    } else {
+        PyErr_SetString(PyExc_TypeError, "rhs: a built-in system number or a callable");
+        return -1;
+    }
+    if (project != Py_None) {
+        pr->project = project;
+        ode->project = python_project;
+    }
+    if (stage != Py_None) {
+        pr->stage = stage;
+        ode->stage = python_stage;
+    }
+    if (tangent != Py_None) {
+        pr->tangent = tangent;
+        ode->tangent = python_tangent;
+    }
+    if (atol != Py_None) {
+        if (get_doubles(atol, &pr->atol_view, 0, n, "atol") < 0) {
+            problem_release(pr);
+            return -1;
+        }
+        pr->has_atol = 1;
+        ode->atol = pr->atol_view.buf;
+    }
+    return 0;
+}
+
+/* The state and work buffers; n from work's size. */
+static int buffers(PyObject *state, PyObject *work, Py_buffer *bs, Py_buffer *bw,
+                   int64_t *n) {
+    if (get_doubles(state, bs, 1, MB_DOP_STATE_SIZE, "state") < 0) return -1;
+    if (get_doubles(work, bw, 1, -1, "work") < 0) {
+        PyBuffer_Release(bs);
+        return -1;
+    }
+    if ((bw->len / 8) % MB_DOP_W_ROWS != 0) {
+        PyErr_Format(PyExc_ValueError, "work: a multiple of %d values expected",
+                     (int)MB_DOP_W_ROWS);
+        PyBuffer_Release(bs);
+        PyBuffer_Release(bw);
+        return -1;
+    }
+    *n = (int64_t)(bw->len / 8) / MB_DOP_W_ROWS;
+    return 0;
+}
+
+/* The status, or NULL when a Python callback raised. */
+static PyObject *status_or_error(int status, const double *state) {
+    if (status == MB_DOP_STOPPED && state[MB_DOP_CODE] == PY_ERROR && PyErr_Occurred())
+        return NULL;
+    return PyLong_FromLong(status);
+}
+
+static PyObject *py_start(PyObject *self, PyObject *args) {
+    PyObject *tuple, *y0, *state, *work;
+    double t0, first_step;
+    if (!PyArg_ParseTuple(args, "O!dOdOO", &PyTuple_Type, &tuple, &t0, &y0, &first_step,
+                          &state, &work))
+        return NULL;
+    Py_buffer bs, bw, by;
+    int64_t n;
+    if (buffers(state, work, &bs, &bw, &n) < 0) return NULL;
+    problem pr;
+    mb_ode ode;
+    PyObject *out = NULL;
+    if (get_doubles(y0, &by, 0, (Py_ssize_t)n, "y0") == 0) {
+        if (problem_read(tuple, n, &pr, &ode) == 0) {
+            int status = mb_dop853_start(&ode, t0, by.buf, first_step, bs.buf, bw.buf);
+            out = status_or_error(status, bs.buf);
+            problem_release(&pr);
+        }
+        PyBuffer_Release(&by);
+    }
+    PyBuffer_Release(&bs);
+    PyBuffer_Release(&bw);
+    return out;
+}
+
+static PyObject *py_run(PyObject *self, PyObject *args) {
+    PyObject *tuple, *state, *work;
+    double t_stop;
+    long long max_steps;
+    if (!PyArg_ParseTuple(args, "O!dLOO", &PyTuple_Type, &tuple, &t_stop, &max_steps,
+                          &state, &work))
+        return NULL;
+    Py_buffer bs, bw;
+    int64_t n;
+    if (buffers(state, work, &bs, &bw, &n) < 0) return NULL;
+    problem pr;
+    mb_ode ode;
+    PyObject *out = NULL;
+    if (problem_read(tuple, n, &pr, &ode) == 0) {
+        int status = mb_dop853_run(&ode, t_stop, (int64_t)max_steps, bs.buf, bw.buf);
+        out = status_or_error(status, bs.buf);
+        problem_release(&pr);
+    }
+    PyBuffer_Release(&bs);
+    PyBuffer_Release(&bw);
+    return out;
+}
+
+static PyObject *py_dense(PyObject *self, PyObject *args) {
+    PyObject *tuple, *times, *result, *state, *work;
+    if (!PyArg_ParseTuple(args, "O!OOOO", &PyTuple_Type, &tuple, &times, &result, &state,
+                          &work))
+        return NULL;
+    Py_buffer bs, bw, bt, bo;
+    int64_t n;
+    if (buffers(state, work, &bs, &bw, &n) < 0) return NULL;
+    problem pr;
+    mb_ode ode;
+    PyObject *out = NULL;
+    if (get_doubles(times, &bt, 0, -1, "t") == 0) {
+        const int64_t m = (int64_t)(bt.len / 8);
+        if (get_doubles(result, &bo, 1, (Py_ssize_t)(m * n), "out") == 0) {
+            if (problem_read(tuple, n, &pr, &ode) == 0) {
+                int code = mb_dop853_dense(&ode, bt.buf, m, bo.buf, bs.buf, bw.buf);
+                if (code == -1)
+                    PyErr_SetString(PyExc_RuntimeError, "no step to interpolate yet");
+                else
+                    out = status_or_error(code, bs.buf);
+                problem_release(&pr);
+            }
+            PyBuffer_Release(&bo);
+        }
+        PyBuffer_Release(&bt);
+    }
+    PyBuffer_Release(&bs);
+    PyBuffer_Release(&bw);
+    return out;
+}
+
+static PyObject *py_system(PyObject *self, PyObject *args) {
+    int s;
+    double t;
+    PyObject *params, *y, *ydot;
+    if (!PyArg_ParseTuple(args, "iOdOO", &s, &params, &t, &y, &ydot)) return NULL;
+    if (s < 0 || s >= SYSTEMS) {
+        PyErr_Format(PyExc_ValueError, "no built-in system %d", s);
+        return NULL;
+    }
+    Py_buffer bp, by, bd;
+    if (get_doubles(params, &bp, 0, SYSTEM_PARAMS[s], "params") < 0) return NULL;
+    PyObject *out = NULL;
+    if (get_doubles(y, &by, 0, SYSTEM_SIZE[s], "y") == 0) {
+        if (get_doubles(ydot, &bd, 1, SYSTEM_SIZE[s], "ydot") == 0) {
+            SYSTEM_FN[s](bp.buf, by.buf, bd.buf);
+            out = Py_NewRef(Py_None);
+            PyBuffer_Release(&bd);
+        }
+        PyBuffer_Release(&by);
+    }
+    PyBuffer_Release(&bp);
+    (void)t;
+    return out;
+}
+
+static PyObject *list_of(const double *x, int n) {
+    PyObject *out = PyList_New(n);
+    if (out == NULL) return NULL;
+    for (int i = 0; i < n; i++) {
+        PyObject *v = PyFloat_FromDouble(x[i]);
+        if (v == NULL) {
+            Py_DECREF(out);
+            return NULL;
+        }
+        PyList_SET_ITEM(out, i, v);
+    }
+    return out;
+}
+
+static PyObject *py_tableau(PyObject *self, PyObject *unused) {
+    double c[16], a[16 * 16], b[12], e5[13], e3[13], d[4 * 16];
+    mb_dop853_tableau(c, a, b, e5, e3, d);
+    return Py_BuildValue("{s:N,s:N,s:N,s:N,s:N,s:N}", "c", list_of(c, 16), "a",
+                         list_of(a, 16 * 16), "b", list_of(b, 12), "e5", list_of(e5, 13),
+                         "e3", list_of(e3, 13), "d", list_of(d, 4 * 16));
+}
+
+static PyObject *py_work_size(PyObject *self, PyObject *arg) {
+    long long n = PyLong_AsLongLong(arg);
+    if (n == -1 && PyErr_Occurred()) return NULL;
+    if (n < 0) {
+        PyErr_SetString(PyExc_ValueError, "n must be >= 0");
+        return NULL;
+    }
+    return PyLong_FromLongLong((long long)mb_dop853_work_size((int64_t)n));
+}
+
+static PyMethodDef dop853_methods[] = {
+    {"dop853_start", py_start, METH_VARARGS,
+     "dop853_start(problem, t0, y0, first_step, state, work) -> status: f(t0, y0) and "
+     "the first step (first_step <= 0: HNW's initial step); the settings in state first."},
+    {"dop853_run", py_run, METH_VARARGS,
+     "dop853_run(problem, t_stop, max_steps, state, work) -> status: steps until the "
+     "first that reaches t_stop, max_steps steps, t_bound or a failure."},
+    {"dop853_dense", py_dense, METH_VARARGS,
+     "dop853_dense(problem, t, out, state, work) -> status: out (len(t), n) <- the "
+     "last step's dense output at the times t."},
+    {"dop853_system", py_system, METH_VARARGS,
+     "dop853_system(number, params, t, y, ydot): a built-in test system's y'."},
+    {"dop853_tableau", py_tableau, METH_NOARGS,
+     "dop853_tableau() -> dict of the coefficients c, a (16 x 16 flat), b, e5, e3, d "
+     "(4 x 16 flat), as the core uses them."},
+    {"dop853_work_size", py_work_size, METH_O,
+     "dop853_work_size(n) -> the size of the work array for n states."},
+    {NULL, NULL, 0, NULL},
+};
+
+int mb_dop853_register(PyObject *m) {
+    if (PyModule_AddFunctions(m, dop853_methods) < 0) return -1;
+    static const struct { const char *name; long value; } constants[] = {
+        {"DOP_STATE_SIZE", MB_DOP_STATE_SIZE}, {"DOP_PROJECT_INFO", MB_DOP_PROJECT_INFO},
+        {"DOP_RTOL", MB_DOP_RTOL}, {"DOP_ATOL", MB_DOP_ATOL},
+        {"DOP_MAX_STEP", MB_DOP_MAX_STEP}, {"DOP_T_BOUND", MB_DOP_T_BOUND},
+        {"DOP_SAFETY", MB_DOP_SAFETY}, {"DOP_FAC_MIN", MB_DOP_FAC_MIN},
+        {"DOP_FAC_MAX", MB_DOP_FAC_MAX}, {"DOP_REFRESH", MB_DOP_REFRESH},
+        {"DOP_T", MB_DOP_T}, {"DOP_H", MB_DOP_H}, {"DOP_DIRECTION", MB_DOP_DIRECTION},
+        {"DOP_T_OLD", MB_DOP_T_OLD}, {"DOP_H_OLD", MB_DOP_H_OLD},
+        {"DOP_STATUS", MB_DOP_STATUS}, {"DOP_CODE", MB_DOP_CODE},
+        {"DOP_STEPS", MB_DOP_STEPS}, {"DOP_REJECTED", MB_DOP_REJECTED},
+        {"DOP_NFEV", MB_DOP_NFEV}, {"DOP_REFRESHED", MB_DOP_REFRESHED},
+        {"DOP_FILTER", MB_DOP_FILTER}, {"DOP_FILTER_NEXT", MB_DOP_FILTER_NEXT},
+        {"DOP_DENSE", MB_DOP_DENSE}, {"DOP_INFO", MB_DOP_INFO},
+        {"DOP_RUNNING", MB_DOP_RUNNING}, {"DOP_FINISHED", MB_DOP_FINISHED},
+        {"DOP_TOO_SMALL", MB_DOP_TOO_SMALL}, {"DOP_STOPPED", MB_DOP_STOPPED},
+        {"DOP_W_Y", MB_DOP_W_Y}, {"DOP_W_F", MB_DOP_W_F}, {"DOP_W_Y_OLD", MB_DOP_W_Y_OLD},
+        {"DOP_W_K", MB_DOP_W_K}, {"DOP_W_DENSE", MB_DOP_W_DENSE},
+        {"DOP_W_ROWS", MB_DOP_W_ROWS}, {"DOP_PY_ERROR", PY_ERROR},
+        {"DOP_SYSTEM_OSCILLATOR", SYSTEM_OSCILLATOR},
+        {"DOP_SYSTEM_VAN_DER_POL", SYSTEM_VAN_DER_POL},
+        {"DOP_SYSTEM_ARENSTORF", SYSTEM_ARENSTORF},
+        {"DOP_SYSTEM_PENDULUM", SYSTEM_PENDULUM},
+    };
+    for (size_t i = 0; i < sizeof(constants) / sizeof(constants[0]); i++)
+        if (PyModule_AddIntConstant(m, constants[i].name, constants[i].value) < 0) return -1;
+    return 0;
+}
