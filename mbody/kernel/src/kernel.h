@@ -153,6 +153,11 @@ double mb_expression(const mb_model *md, int64_t e, double t);
 /* Q - b per body, out (n x 6): [W_F; B_M - w x J w]; with the load values at t. */
 void mb_net_wrench(const mb_model *md, mb_work *w, double t, const double *y, double *out);
 
+/* Q and b apart (what Assembly shows): Q (n x 6) [W_F; B_M], b (n x 6) [0; w x J w];
+ * mb_net_wrench is Q - b from the same terms. */
+void mb_wrench_parts(const mb_model *md, mb_work *w, double t, const double *y, double *Q,
+                     double *b);
+
 /* Per component (m): child6, parent6 (m x 6), W_e (m x 3) its direction (world),
  * W_P (m x 3) its point (world), gamma, phi, gtv (G^T v - f', see above) at (t, y). */
 void mb_columns(const mb_model *md, mb_work *w, double t, const double *y, double *child6,

@@ -60,10 +60,10 @@ static void spring_wrench(const mb_model *md, const mb_work *w, int64_t j, const
     }
 }
 
-/* out (n x 6) = Q - b at y with w->R and w->loads in place. */
-void mb_net_wrench_at(const mb_model *md, mb_work *w, const double *y, double *out) {
+/* out (n x 6) = Q: gravity, point loads and springs [W_F (world); B_M (body axes)], at y
+ * with w->R and w->loads in place. */
+static void applied_at(const mb_model *md, mb_work *w, const double *y, double *out) {
     int64_t n = md->n;
-    const double *om = y + 10 * n;
     for (int64_t i = 0; i < n; i++) {
         double m = md->bodies[MB_BODY_W * i + B_MASS];
         for (int c = 0; c < 3; c++) {
@@ -89,17 +89,41 @@ void mb_net_wrench_at(const mb_model *md, mb_work *w, const double *y, double *o
             o[3] += M[3 * e], o[4] += M[3 * e + 1], o[5] += M[3 * e + 2];
         }
     }
-    for (int64_t i = 0; i < n; i++) { /* - w x (J w) */
-        const double *J = md->bodies + MB_BODY_W * i + B_J;
-        const double *wi = om + 3 * i;
-        double h[3], g[3];
-        h[0] = J[0] * wi[0] + J[1] * wi[1] + J[2] * wi[2];
-        h[1] = J[3] * wi[0] + J[4] * wi[1] + J[5] * wi[2];
-        h[2] = J[6] * wi[0] + J[7] * wi[1] + J[8] * wi[2];
-        mb_cross(wi, h, g);
+}
+
+/* g = w x (J w) of body i (body axes): the gyroscopic term b on its Euler rows. */
+static void gyroscopic(const mb_model *md, const double *y, int64_t i, double *g) {
+    const double *J = md->bodies + MB_BODY_W * i + B_J;
+    const double *wi = y + 10 * md->n + 3 * i;
+    double h[3];
+    h[0] = J[0] * wi[0] + J[1] * wi[1] + J[2] * wi[2];
+    h[1] = J[3] * wi[0] + J[4] * wi[1] + J[5] * wi[2];
+    h[2] = J[6] * wi[0] + J[7] * wi[1] + J[8] * wi[2];
+    mb_cross(wi, h, g);
+}
+
+/* out (n x 6) = Q - b at y with w->R and w->loads in place. */
+void mb_net_wrench_at(const mb_model *md, mb_work *w, const double *y, double *out) {
+    applied_at(md, w, y, out);
+    for (int64_t i = 0; i < md->n; i++) { /* - w x (J w) */
+        double g[3];
+        gyroscopic(md, y, i, g);
         out[6 * i + 3] -= g[0];
         out[6 * i + 4] -= g[1];
         out[6 * i + 5] -= g[2];
+    }
+}
+
+void mb_wrench_parts(const mb_model *md, mb_work *w, double t, const double *y, double *Q,
+                     double *b) {
+    mb_rotations(md->n, y + 3 * md->n, w->R);
+    mb_eval_all(md, w, t);
+    mb_loads_at(md, w);
+    applied_at(md, w, y, Q);
+    for (int64_t i = 0; i < md->n; i++) {
+        double *o = b + 6 * i;
+        o[0] = o[1] = o[2] = 0.0;
+        gyroscopic(md, y, i, o + 3);
     }
 }
 

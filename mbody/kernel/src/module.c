@@ -148,6 +148,34 @@ static PyObject *Model_net_wrench(ModelObject *self, PyObject *const *args, Py_s
     Py_RETURN_NONE;
 }
 
+PyDoc_STRVAR(wrench_parts_doc,
+"wrench_parts(t, y, Q, b)\n\nQ (n x 6) <- the applied loads per body [W_F (world); B_M "
+"(about G, body axes)],\nb (n x 6) <- the gyroscopic term [0; w x J w]; net_wrench is "
+"Q - b.");
+
+static PyObject *Model_wrench_parts(ModelObject *self, PyObject *const *args, Py_ssize_t nargs) {
+    Py_buffer y, Q, b;
+    double t;
+    if (model_ready(self) < 0 || check_nargs(nargs, 4, "wrench_parts") < 0 ||
+        get_double(args[0], &t, "t") < 0)
+        return NULL;
+    if (get_state(&self->md, args[1], &y, 0, 0) < 0) return NULL;
+    if (get_buffer(args[2], &Q, 1, 1, 6 * self->md.n, "Q") < 0) {
+        PyBuffer_Release(&y);
+        return NULL;
+    }
+    if (get_buffer(args[3], &b, 1, 1, 6 * self->md.n, "b") < 0) {
+        PyBuffer_Release(&y);
+        PyBuffer_Release(&Q);
+        return NULL;
+    }
+    mb_wrench_parts(&self->md, self->w, t, y.buf, Q.buf, b.buf);
+    PyBuffer_Release(&y);
+    PyBuffer_Release(&Q);
+    PyBuffer_Release(&b);
+    Py_RETURN_NONE;
+}
+
 PyDoc_STRVAR(load_wrenches_doc,
 "load_wrenches(t, y, out)\n\nout ((k + 2 s) x 7) <- each point load's, then each spring's "
 "end a's and end b's\nshare of net_wrench: [body (-1: ground), W_F (world), B_M (about G, "
@@ -265,6 +293,7 @@ static PyGetSetDef Model_getset[] = {
 
 static PyMethodDef Model_methods[] = {
     {"net_wrench", (PyCFunction)(void (*)(void))Model_net_wrench, METH_FASTCALL, net_wrench_doc},
+    {"wrench_parts", (PyCFunction)(void (*)(void))Model_wrench_parts, METH_FASTCALL, wrench_parts_doc},
     {"load_wrenches", (PyCFunction)(void (*)(void))Model_load_wrenches, METH_FASTCALL,
      load_wrenches_doc},
     {"loads_at", (PyCFunction)(void (*)(void))Model_loads_at, METH_FASTCALL, loads_at_doc},
