@@ -4,9 +4,9 @@
 ``mbody.kernel._core.Model(F, I, planar)`` reads; `pack_unknowns(model, U)` the int
 array of one set of unknown reaction components (``_core.Unknowns(model, Iu)``), ordered
 for a narrow band of S = G_Uᵀ M⁻¹ G_U. Every reaction component is one constraint
-primitive of the core (`component_kind`); expressions of t (time-varying loads and known
-reactions, the laws of driven components) are packed as postfix programs, each distinct
-expression once.
+primitive of the core (its `mbody.joint_types` entry); expressions of t (time-varying
+loads and known reactions, the laws of driven components) are packed as postfix
+programs, each distinct expression once.
 """
 
 from __future__ import annotations
@@ -16,7 +16,6 @@ from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
-from mbody import conventions as cv
 from mbody.kernel import _core
 
 if TYPE_CHECKING:
@@ -40,19 +39,6 @@ class Component(NamedTuple):
     off: float = 0.0
     h: float = 0.0
     law: tuple[Expression, Expression, Expression] | None = None
-
-
-def component_kind(axis: int, rot_kind: int) -> tuple[int, int]:
-    """(kind, axis) of the core's primitive for a `ReactionTable` component (its axis
-    code and rot_kind). The one place that maps today's component codes; the joint-type
-    registry replaces it."""
-    if axis == cv.LINK_AXIS:
-        return _core.KIND_LINK, 0
-    if axis < 3:
-        return _core.KIND_FORCE, axis
-    if axis == 6:
-        return _core.KIND_RIGHT_ANGLE, 2
-    return (_core.KIND_TILT if rot_kind == 1 else _core.KIND_LOCK), axis - 3
 
 
 class _Programs:
@@ -80,12 +66,13 @@ class _Programs:
 
 
 def _components(model: Model, extra: Sequence[Component]) -> np.ndarray:
-    """(m, 3) [joint, kind, axis] of the model's components, then the extra ones."""
+    """(m, 3) [joint, kind, axis] of the model's components (each one's constraint
+    primitive and joint-frame axis, from its type in `mbody.joint_types`), then the extra
+    ones."""
     rt = model.reaction_table
-    rows = [(j, *component_kind(a, r)) for j, a, r in
-            zip(rt.joint.tolist(), rt.axis.tolist(), rt.rot_kind.tolist(), strict=True)]
-    rows += [(c.joint, c.kind, c.axis) for c in extra]
-    return np.array(rows, dtype=np.int64).reshape(-1, 3)
+    own = np.stack((rt.joint, rt.kind, rt.frame_axis), axis=1).astype(np.int64)
+    more = np.array([(c.joint, c.kind, c.axis) for c in extra], dtype=np.int64).reshape(-1, 3)
+    return np.concatenate((own, more))
 
 
 def pack_model(model: Model, extra: Sequence[Component] = ()) -> tuple[np.ndarray, np.ndarray]:
@@ -124,6 +111,8 @@ def pack_model(model: Model, extra: Sequence[Component] = ()) -> tuple[np.ndarra
                              jt.P_E3.reshape(nj, 9), jt.C_E3.reshape(nj, 9),
                              jt.length[:, None]), axis=1)
     comps_f = np.zeros((m, 2))
+    screw = np.flatnonzero(comps[:m0, 1] == _core.KIND_SCREW)  # h = pitch / 2 pi
+    comps_f[screw, 1] = jt.pitch[comps[screw, 0]] / (2.0 * np.pi)
     for i, c in enumerate(extra):
         comps_f[m0 + i] = (c.off, c.h)
     flags = _core.J_LINK * jt.link.astype(np.int64) + _core.J_PARTICLE_PARENT * jt.particle_parent

@@ -82,6 +82,7 @@ void mb_known_at(const mb_model *md, const mb_work *w, const double *lam, double
 /* loads.c */
 void mb_net_wrench_at(const mb_model *md, mb_work *w, const double *y, double *out);
 void mb_load_wrenches_at(const mb_model *md, mb_work *w, const double *y, double *out);
+void mb_springs_at(const mb_model *md, mb_work *w, const double *y, double *out);
 
 /* joints.c: columns at y into the given buffers (W_e, W_P may be NULL); with `laws`
  * 0 the laws are left out (the homogeneous constraints). Needs w->R and w->evals. */

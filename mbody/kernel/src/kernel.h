@@ -158,6 +158,11 @@ void mb_net_wrench(const mb_model *md, mb_work *w, double t, const double *y, do
 void mb_wrench_parts(const mb_model *md, mb_work *w, double t, const double *y, double *Q,
                      double *b);
 
+/* Each spring-damper's state at (t, y): out (s x 6) [L, L', T, u (3)]: its length (m),
+ * its rate (m/s), its tension T = k (L - L0) + c L' (N) and its direction u, world axes,
+ * from end a to end b (the same numbers its wrench is made of). */
+void mb_springs(const mb_model *md, mb_work *w, double t, const double *y, double *out);
+
 /* Per component (m): child6, parent6 (m x 6), W_e (m x 3) its direction (world),
  * W_P (m x 3) its point (world), gamma, phi, gtv (G^T v - f', see above) at (t, y). */
 void mb_columns(const mb_model *md, mb_work *w, double t, const double *y, double *child6,

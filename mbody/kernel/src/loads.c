@@ -27,24 +27,37 @@ static int load_wrench(const mb_model *md, const mb_work *w, int64_t j, double *
     return 1;
 }
 
-/* Spring j: T = k (L - L0) + c L' along u = (P_b - P_a) / L; +T u on end a, -T u on
- * end b, each with its moment B_r x (W_R_B^T f). W, M (2 x 3): ends a and b. */
-static void spring_wrench(const mb_model *md, const mb_work *w, int64_t j, const double *y,
-                          double *W, double *M) {
+/* Spring j's state: its length L, rate L', tension T = k (L - L0) + c L' and direction
+ * u = (P_b - P_a) / L (0 when the ends meet): out [L, L', T, u (3)]. */
+static void spring_state(const mb_model *md, const mb_work *w, int64_t j, const double *y,
+                         double *out) {
     int64_t n = md->n;
     const double *x = y, *v = y + 7 * n, *om = y + 10 * n;
     const double *row = md->springs + MB_SPRING_W * j;
-    int64_t ends[2] = {md->springs_i[2 * j], md->springs_i[2 * j + 1]};
     double Pa[3], Va[3], Pb[3], Vb[3];
-    mb_body_point(ends[0], row + S_RA, x, w->R, v, om, Pa, Va);
-    mb_body_point(ends[1], row + S_RB, x, w->R, v, om, Pb, Vb);
+    mb_body_point(md->springs_i[2 * j], row + S_RA, x, w->R, v, om, Pa, Va);
+    mb_body_point(md->springs_i[2 * j + 1], row + S_RB, x, w->R, v, om, Pb, Vb);
     double d0 = Pb[0] - Pa[0], d1 = Pb[1] - Pa[1], d2 = Pb[2] - Pa[2];
     double L = sqrt(d0 * d0 + d1 * d1 + d2 * d2);
     double u0 = 0.0, u1 = 0.0, u2 = 0.0;
     if (L > 1e-12) u0 = d0 / L, u1 = d1 / L, u2 = d2 / L;
-    double T = row[S_STIFF] * (L - row[S_REST]) +
-               row[S_DAMP] * (u0 * (Vb[0] - Va[0]) + u1 * (Vb[1] - Va[1]) + u2 * (Vb[2] - Va[2]));
-    double f[3] = {T * u0, T * u1, T * u2};
+    double Ldot = u0 * (Vb[0] - Va[0]) + u1 * (Vb[1] - Va[1]) + u2 * (Vb[2] - Va[2]);
+    out[0] = L;
+    out[1] = Ldot;
+    out[2] = row[S_STIFF] * (L - row[S_REST]) + row[S_DAMP] * Ldot;
+    out[3] = u0, out[4] = u1, out[5] = u2;
+}
+
+/* Spring j: T = k (L - L0) + c L' along u = (P_b - P_a) / L; +T u on end a, -T u on
+ * end b, each with its moment B_r x (W_R_B^T f). W, M (2 x 3): ends a and b. */
+static void spring_wrench(const mb_model *md, const mb_work *w, int64_t j, const double *y,
+                          double *W, double *M) {
+    const double *row = md->springs + MB_SPRING_W * j;
+    int64_t ends[2] = {md->springs_i[2 * j], md->springs_i[2 * j + 1]};
+    double st[6];
+    spring_state(md, w, j, y, st);
+    double T = st[2];
+    double f[3] = {T * st[3], T * st[4], T * st[5]};
     for (int e = 0; e < 2; e++) {
         double sign = e == 0 ? 1.0 : -1.0;
         double *g = W + 3 * e;
@@ -58,6 +71,11 @@ static void spring_wrench(const mb_model *md, const mb_work *w, int64_t j, const
         for (int a = 0; a < 3; a++) B[a] = Rb[a] * g[0] + Rb[3 + a] * g[1] + Rb[6 + a] * g[2];
         mb_cross(row + (e == 0 ? S_RA : S_RB), B, M + 3 * e);
     }
+}
+
+/* out (s x 6): each spring's [L, L', T, u (3)] at y with w->R in place. */
+void mb_springs_at(const mb_model *md, mb_work *w, const double *y, double *out) {
+    for (int64_t j = 0; j < md->s; j++) spring_state(md, w, j, y, out + 6 * j);
 }
 
 /* out (n x 6) = Q: gravity, point loads and springs [W_F (world); B_M (body axes)], at y
@@ -152,4 +170,10 @@ void mb_net_wrench(const mb_model *md, mb_work *w, double t, const double *y, do
     mb_eval_all(md, w, t);
     mb_loads_at(md, w);
     mb_net_wrench_at(md, w, y, out);
+}
+
+void mb_springs(const mb_model *md, mb_work *w, double t, const double *y, double *out) {
+    mb_rotations(md->n, y + 3 * md->n, w->R);
+    (void)t; /* a spring's law does not depend on t; kept for a uniform signature */
+    mb_springs_at(md, w, y, out);
 }

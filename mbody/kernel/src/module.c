@@ -176,6 +176,28 @@ static PyObject *Model_wrench_parts(ModelObject *self, PyObject *const *args, Py
     Py_RETURN_NONE;
 }
 
+PyDoc_STRVAR(springs_doc,
+"springs(t, y, out)\n\nout (s x 6) <- each spring-damper's [L (m), L' (m/s), T (N), u (3)] "
+"at state y:\nits length, rate, tension k (L - L0) + c L' and unit direction from end a "
+"to end b (world).");
+
+static PyObject *Model_springs(ModelObject *self, PyObject *const *args, Py_ssize_t nargs) {
+    Py_buffer y, out;
+    double t;
+    if (model_ready(self) < 0 || check_nargs(nargs, 3, "springs") < 0 ||
+        get_double(args[0], &t, "t") < 0)
+        return NULL;
+    if (get_state(&self->md, args[1], &y, 0, 0) < 0) return NULL;
+    if (get_buffer(args[2], &out, 1, 1, 6 * self->md.s, "out") < 0) {
+        PyBuffer_Release(&y);
+        return NULL;
+    }
+    mb_springs(&self->md, self->w, t, y.buf, out.buf);
+    PyBuffer_Release(&y);
+    PyBuffer_Release(&out);
+    Py_RETURN_NONE;
+}
+
 PyDoc_STRVAR(load_wrenches_doc,
 "load_wrenches(t, y, out)\n\nout ((k + 2 s) x 7) <- each point load's, then each spring's "
 "end a's and end b's\nshare of net_wrench: [body (-1: ground), W_F (world), B_M (about G, "
@@ -294,6 +316,7 @@ static PyGetSetDef Model_getset[] = {
 static PyMethodDef Model_methods[] = {
     {"net_wrench", (PyCFunction)(void (*)(void))Model_net_wrench, METH_FASTCALL, net_wrench_doc},
     {"wrench_parts", (PyCFunction)(void (*)(void))Model_wrench_parts, METH_FASTCALL, wrench_parts_doc},
+    {"springs", (PyCFunction)(void (*)(void))Model_springs, METH_FASTCALL, springs_doc},
     {"load_wrenches", (PyCFunction)(void (*)(void))Model_load_wrenches, METH_FASTCALL,
      load_wrenches_doc},
     {"loads_at", (PyCFunction)(void (*)(void))Model_loads_at, METH_FASTCALL, loads_at_doc},
