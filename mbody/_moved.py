@@ -19,9 +19,7 @@ MOVED = {
     "graph": "model.graph",
     "spatial": "equations.spatial", "loads": "equations.loads", "joints": "equations.joints",
     "constraints": "equations.constraints", "fbd": "equations.fbd",
-    "assemble": "equations.assemble", "kernels": "equations.kernels", "plan": "equations.plan",
-    "blockplan": "solve.blockplan", "kkt": "solve.kkt", "nullspace": "solve.nullspace",
-    "dynamics": "solve.dynamics", "compiled": "solve.compiled",
+    "assemble": "equations.assemble", "dynamics": "solve.dynamics",
     "mechanism": "simulate.mechanism", "projection": "simulate.projection",
     "stepping": "simulate.stepping", "trajectory": "simulate.trajectory",
     "text": "present.text", "latex": "present.latex", "draw": "present.draw",
@@ -33,7 +31,9 @@ MOVED = {
 }
 """Old path under mbody -> new path under mbody (release 0.2; the aliases go in 0.3).
 ``mbody.model`` and ``mbody.simulate`` are packages now that export the old modules'
-public names; ``mbody.cli.main`` is still the command's entry point."""
+public names; ``mbody.cli.main`` is still the command's entry point. The numeric modules
+that the compiled core replaced (``kernels``, ``plan``, ``blockplan``, ``kkt``,
+``nullspace``, ``compiled``) are gone, not moved: see docs/codebase.md."""
 
 
 class _Alias(importlib.abc.MetaPathFinder, importlib.abc.Loader):

@@ -15,7 +15,6 @@ from scipy.spatial.transform import Rotation
 
 import mbody
 from mbody import conventions as cv
-from mbody.equations import kernels
 from mbody.errors import MbodyError
 from mbody.model import State
 from mbody.solve import dynamics
@@ -120,27 +119,12 @@ def _known(asm) -> np.ndarray:
     return np.array([values[r] for r in asm.reactions])
 
 
-# Kernel configurations: the default; tiny chunks (many blocks, sparse sums split across
-# them); and every load group forced onto the sparse path, or onto the dense one.
-CONFIGS = [(None, None), (3, None), (2, 10**9), (5, 1)]
-
-
-@pytest.fixture(params=CONFIGS, ids=["default", "chunks3", "sparse", "dense"])
-def config(request, monkeypatch):
-    chunk, frac = request.param
-    if chunk is not None:
-        monkeypatch.setattr(kernels, "CHUNK", chunk)
-    if frac is not None:
-        monkeypatch.setattr(kernels, "DENSE_FRACTION", frac)
-    return request.param
-
-
 @pytest.mark.parametrize("seed", range(6))
 @pytest.mark.parametrize("kind", ["spatial", "planar"])
-def test_matches_reference_on_random_models(seed, kind, config):
+def test_matches_reference_on_random_models(seed, kind):
     d = (rm.spatial_model(seed, n=7, n_forces=14, n_torques=6, n_springs=3)
          if kind == "spatial" else rm.planar_model(seed, n=6, n_forces=9, n_springs=3))
-    model = mbody.load(d)  # a fresh model: plans are built under this config
+    model = mbody.load(d)
     for state in (model.initial, random_state(model, seed + 100)):
         asm = mbody.assemble(model, state)
         lam = _known(asm)
@@ -167,13 +151,12 @@ def test_no_reactions_means_zero_reaction_forces():
 
 
 def test_diagonal_and_asymmetric_inertia_storage():
-    """Principal-axis bodies use the diagonal kernel; a tensor that is symmetric only to
-    the validator's tolerance uses the general 3×3 one. Both match the reference."""
+    """Principal-axis bodies and a tensor that is symmetric only to the validator's
+    tolerance both match the reference."""
     d = rm.spatial_model(4, n=4, n_joints=0)
     for b in d["bodies"]:
         b["inertia"] = rm._f(rm.box_principal(np.random.default_rng(1), b["mass"]))
     model = mbody.load(d)
-    assert kernels.plan_for(model).mode == "diag"
     state = random_state(model, 4)
     np.testing.assert_allclose(dynamics.accelerations(model, state),
                                reference_accelerations(model, state), rtol=TOL, atol=TOL)
@@ -182,7 +165,6 @@ def test_diagonal_and_asymmetric_inertia_storage():
     J[0, 1] += 1e-9 * np.abs(J).max()
     d["bodies"][0]["inertia"] = [rm._f(r) for r in J]
     model = mbody.load(d)
-    assert kernels.plan_for(model).mode == "full"
     state = random_state(model, 5)
     np.testing.assert_allclose(dynamics.accelerations(model, state),
                                reference_accelerations(model, state), rtol=TOL, atol=TOL)

@@ -418,17 +418,11 @@ def test_cli_export_unwritable_target_is_one_message(tmp_path):
 def test_export_solves_like_the_assembly(name, tmp_path):
     """One constrained solver: an export solves exactly as the assembly it came from,
     redundant joints included (minimum-norm reactions, the same components named)."""
-    from mbody.equations.plan import set_jit
-
-    previous = set_jit("off")
-    try:
-        model = mbody.load(Path(__file__).resolve().parent.parent / "models" / f"{name}.yaml")
-        asm = mbody.assemble(model)
-        want = asm.solve()
-        ex.write_export(asm, tmp_path / "eqs.npz")
-        got = mbody.load_export(tmp_path / "eqs.npz").solve()
-    finally:
-        set_jit(previous)
+    model = mbody.load(Path(__file__).resolve().parent.parent / "models" / f"{name}.yaml")
+    asm = mbody.assemble(model)
+    want = asm.solve()
+    ex.write_export(asm, tmp_path / "eqs.npz")
+    got = mbody.load_export(tmp_path / "eqs.npz").solve()
     assert got.solved == want.solved and got.not_unique == want.not_unique
     assert got.redundant == want.redundant
     np.testing.assert_allclose(got.accelerations, want.accelerations, rtol=1e-12,

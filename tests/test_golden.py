@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_kernel import ALL
+from golden_models import all_models
 
 import mbody
 from mbody.equations.workspace import workspace
@@ -21,6 +21,7 @@ from mbody.kernel import _core
 GOLDEN = Path(__file__).resolve().parent / "data" / "golden.npz"
 EPS = np.finfo(float).eps
 DATA = np.load(GOLDEN)
+ALL = all_models()
 CASES = [(name, model, tag) for name, model in ALL for tag in ("file", "moved")
          if f"{name}/{tag}/y" in DATA]
 

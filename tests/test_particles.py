@@ -15,7 +15,6 @@ import pytest
 from scipy.special import ellipj, ellipk
 
 import mbody
-from mbody.equations import plan as planmod
 from mbody.model import State
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -23,21 +22,10 @@ MODELS = ROOT / "models"
 GRAVITY = 9.81
 
 
-@pytest.fixture
-def jit():
-    previous = planmod.JIT
-    yield planmod.set_jit
-    planmod.set_jit(previous)
-
-
-def both(jit, model, state=None):
-    """(numpy solution, compiled solution) at the same state."""
-    jit("off")
-    a = mbody.assemble(model, state).solve()
-    jit("on")
-    b = mbody.assemble(model, state).solve()
-    assert "compiled" in b.method and "compiled" not in a.method
-    return a, b
+def both(model, state=None):
+    """The solution at the state (one compiled core: once the numpy and the numba path,
+    held equal here; today's results are tests/test_golden.py)."""
+    return (mbody.assemble(model, state).solve(),)
 
 
 def rel(a, b) -> float:
@@ -99,14 +87,14 @@ def test_point_pendulum_default_tolerances_need_no_more_steps_than_the_exact_ode
 
 
 @pytest.mark.parametrize("theta, rate", [(0.7, 1.3), (-2.5, -0.4), (0.0, 3.0)])
-def test_tension_is_m_g_cos_plus_m_L_thetadot_squared(jit, theta, rate):
+def test_tension_is_m_g_cos_plus_m_L_thetadot_squared(theta, rate):
     model = mbody.load(MODELS / "point_pendulum.yaml")
     L, m = 1.0, 1.0
     pos = L * np.array([[np.sin(theta), -np.cos(theta)]])
     vel = L * rate * np.array([[np.cos(theta), np.sin(theta)]])
     state = State.planar(pos, np.zeros(1), vel, np.zeros(1))
     exact = m * (GRAVITY * np.cos(theta) + L * rate ** 2)
-    for sol in both(jit, model, state):
+    for sol in both(model, state):
         assert abs(sol.reactions["O.T"] - exact) <= 1e-12 * abs(exact)
         # a = −g sinθ along the path + centripetal L θ̇² toward the pivot
         a = (-GRAVITY * np.sin(theta) * np.array([np.cos(theta), np.sin(theta)])
@@ -156,7 +144,7 @@ joints:
 
 
 @pytest.mark.parametrize("swap", [False, True])
-def test_particle_pinned_to_the_end_of_a_rod(jit, swap):
+def test_particle_pinned_to_the_end_of_a_rod(swap):
     """A horizontal rod (M 3 kg, l 1 m, I_G 0.25) pinned at one end, a 2 kg particle pinned
     at the other, released from rest: one rigid pendulum with I_O = I_G + M (l/2)² + m l²,
     α = −(M l/2 + m l) g / I_O; the pin's force on the bob is m (a − g), a = (0, α l)."""
@@ -172,7 +160,7 @@ def test_particle_pinned_to_the_end_of_a_rod(jit, swap):
     alpha = -(M_ * l / 2 + m * l) * GRAVITY / (0.25 + M_ * (l / 2) ** 2 + m * l ** 2)
     on_bob = np.array([0.0, m * (alpha * l + GRAVITY)])
     sign = -1.0 if swap else 1.0  # +R acts on the child
-    for sol in both(jit, model):
+    for sol in both(model):
         np.testing.assert_allclose(sol.accelerations,
                                    [0, alpha * l / 2, alpha, 0, alpha * l], atol=1e-12)
         np.testing.assert_allclose([sol.reactions["B.Fx"], sol.reactions["B.Fy"]],
@@ -217,7 +205,7 @@ def test_link_components():
 
 
 @pytest.mark.parametrize("text", [DOUBLE, SPATIAL_LINK], ids=["double", "spatial_link"])
-def test_numpy_and_compiled_paths_agree_on_links(jit, text):
+def test_links_solve_cleanly_along_a_run(text):
     model = mbody.loads(text)
     rng = np.random.default_rng(3)
     states = [model.initial]
@@ -225,11 +213,8 @@ def test_numpy_and_compiled_paths_agree_on_links(jit, text):
         traj = mbody.simulate(model, rng.uniform(0.05, 0.5), 50)
         states.append(traj.state(len(traj.t) - 1))
     for state in states:
-        a, b = both(jit, model, state)
-        assert rel(a.accelerations, b.accelerations) < 1e-12
-        assert rel(a.reactions.array if hasattr(a.reactions, "array")
-                   else list(a.reactions.values()), b.reactions.array) < 1e-12
-        assert not a.warnings and not b.warnings
+        (a,) = both(model, state)
+        assert np.all(np.isfinite(a.accelerations)) and not a.warnings
 
 
 @pytest.mark.parametrize("text", [DOUBLE, SPATIAL_LINK], ids=["double", "spatial_link"])

@@ -25,7 +25,7 @@ sys.path.insert(0, str(ROOT / "tests"))
 
 import mbody  # noqa: E402
 from mbody.solve import compiled as C  # noqa: E402
-from test_kernel import ALL, moved_state, state_vector  # noqa: E402
+from golden_models import all_models, moved_state, state_vector  # noqa: E402
 
 
 def record(model: mbody.Model, state: mbody.State) -> dict[str, np.ndarray]:
@@ -71,7 +71,8 @@ def record(model: mbody.Model, state: mbody.State) -> dict[str, np.ndarray]:
 
 def main() -> None:
     data: dict[str, np.ndarray] = {}
-    for name, model in ALL:
+    models = all_models()
+    for name, model in models:
         for tag, state in (("file", model.initial), ("moved", moved_state(model, 1))):
             try:
                 rec = record(model, state)
@@ -86,7 +87,7 @@ def main() -> None:
     out = ROOT / "tests" / "data" / "golden.npz"
     out.parent.mkdir(exist_ok=True)
     np.savez_compressed(out, **data)
-    print(f"{out}: {len(ALL)} models, {out.stat().st_size / 1024:.0f} KB, from {commit[:10]}")
+    print(f"{out}: {len(models)} models, {out.stat().st_size / 1024:.0f} KB, from {commit[:10]}")
 
 
 if __name__ == "__main__":

@@ -2,8 +2,9 @@
 
 `spatial` (rotations and frame helpers), `loads` (applied loads -> net force and moment),
 `joints` (reaction components -> the columns of G), `constraints` (Gᵀ, φ and γ),
-`kernels` (the vectorised per-body sums), `plan` (what depends only on the model, made
-once), `fbd` (one body's free body and equations as data) and `assemble` (the `Assembly`).
+`pack` and `workspace` (a model packed for the compiled core, `mbody.kernel`, which
+computes all of these), `solution` (what a solve returns), `fbd` (one body's free body
+and equations as data) and `assemble` (the `Assembly`).
 """
 
 from mbody._moved import submodule as _submodule

@@ -10,36 +10,36 @@ model's masses and inertia tensors) and builds the sparse matrix only when asked
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator, Mapping
-from dataclasses import dataclass
 from functools import cached_property
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from mbody import conventions as cv
-from mbody.equations import kernels
-from mbody.equations.constraints import ConstraintJacobian, gamma, joint_errors, phi
+from mbody.equations.constraints import ConstraintJacobian, joint_errors
 from mbody.equations.fbd import body_equations
-from mbody.equations.joints import (
-    ReactionColumns,
-    constraint_velocity,
-    g_matrix,
-    reaction_columns,
-    reaction_wrench,
+from mbody.equations.joints import ReactionColumns, g_matrix, reaction_columns
+from mbody.equations.loads import AppliedLoads, wrench_parts
+from mbody.equations.solution import (
+    INCONSISTENT,
+    METHODS,
+    ReactionValues,
+    Solution,
+    singular_mass_error,
 )
-from mbody.equations.loads import AppliedLoads
-from mbody.equations.plan import Unknowns, compiled
-from mbody.equations.spatial import matvec
 from mbody.equations.symbolic import SymbolicEquations, assembly_symbolic
+from mbody.equations.workspace import Unknowns, workspace
 from mbody.errors import MbodyError, did_you_mean
+from mbody.kernel import _core
 from mbody.model.model import Model, State, count
-from mbody.solve.kkt import ConstrainedSystem, singular_mass_error
 
 if TYPE_CHECKING:
     import scipy.sparse as sp
 
-    from mbody.equations.constraints import ConstraintJacobian
     from mbody.equations.fbd import BodyEquations
+
+__all__ = ["INCONSISTENT", "Assembly", "ReactionValues", "Solution", "assemble", "mass_matrix",
+           "singular_mass_error", "solve_state"]
 
 
 def _select(model: Model, a6: np.ndarray) -> np.ndarray:
@@ -53,14 +53,6 @@ def _strip(model: Model, full: np.ndarray) -> np.ndarray:
     """The solver's uniform rows (`all_coordinates`) -> the model's `coordinates` (a
     particle's rotation rows, which carry nothing, dropped)."""
     return full[model.rows] if model.has_particles else full
-
-
-def accelerations6(model: Model, rhs6: np.ndarray) -> np.ndarray:
-    """Block solve of M v̇ = rhs: (n, 6) -> (n, 6) [a_G (world), ω̇ (body axes)]."""
-    out = np.empty_like(rhs6)
-    out[:, :3] = rhs6[:, :3] / model.mass[:, None]
-    out[:, 3:] = matvec(model.J_inv, rhs6[:, 3:])
-    return out
 
 
 def mass_matrix(model: Model) -> sp.spmatrix:
@@ -84,126 +76,6 @@ def mass_matrix(model: Model) -> sp.spmatrix:
     if model.has_particles:  # a particle's rows are its translations only
         M = M.tocsr()[model.rows][:, model.rows]
     return M
-
-
-class ReactionValues(Mapping):
-    """label -> value of every reaction component (N, or N m for moments), a read-only
-    view of one array in the order of `Assembly.reactions` (made lazily: a chain of
-    10 000 links has 30 000 of them). `array` is that array."""
-
-    def __init__(self, labels: list[str], index: dict[str, int], values: np.ndarray):
-        self._labels, self._index, self.array = labels, index, values
-        self.array.flags.writeable = False
-
-    def __getitem__(self, label: str) -> float:
-        return float(self.array[self._index[label]])
-
-    def __iter__(self):
-        return iter(self._labels)
-
-    def __len__(self) -> int:
-        return len(self._labels)
-
-    def __repr__(self) -> str:  # a dict's when short; a chain's 30 000 values are not
-        full = repr(dict(self)) if len(self) <= 12 else ""
-        if full and len(full) < 300:
-            return full
-        return (f"<ReactionValues: {len(self)} components (N; N m), "
-                f"{', '.join(self._labels[:4])}, ...; [label], dict(it), .array>")
-
-
-INCONSISTENT = 1e-8
-"""Relative backward error above which a constrained solve is reported as inconsistent."""
-
-
-@dataclass(frozen=True)
-class Solution:
-    """Accelerations (aligned with `coordinates`) and the reaction values used.
-
-    What `Assembly.solve` returns; ``solution["rod.w1"]`` reads one acceleration by its
-    coordinate label.
-
-    Parameters
-    ----------
-    coordinates : list of str
-        The row labels, body by body (``Assembly.coordinates``).
-    accelerations : (N,) array
-        v̇ in the order of `coordinates`. Spatial rows: a_G in world axes (m/s^2), then
-        ω̇ in body axes (rad/s^2); planar rows: a_x, a_y (m/s^2), α (rad/s^2).
-    reactions : mapping of str to float
-        label -> value of every reaction component, given or solved (N; N m).
-    solved : tuple of str
-        Reaction components solved for (the rest were given).
-    not_unique : tuple of str
-        Solved components that redundant constraints leave undetermined (minimum norm).
-    residual : float or None
-        Relative backward error of the constrained solve (None when nothing was solved).
-    condition : float or None
-        1-norm condition estimate of the Schur complement Gᵀ M⁻¹ G (when asked for).
-    method : str
-        How the system was solved (``"block-diagonal M"`` when no reaction was unknown).
-    broken_joints : tuple of str
-        Enforced constraints that the state breaks (φ ≠ 0 or Gᵀ v ≠ 0), as text.
-    redundant : int
-        Number of redundant constraints (unknown components minus the rank of G_U).
-    """
-
-    coordinates: list[str]
-    accelerations: np.ndarray
-    reactions: Mapping[str, float]
-    solved: tuple[str, ...] = ()
-    not_unique: tuple[str, ...] = ()
-    residual: float | None = None
-    condition: float | None = None
-    method: str = "block-diagonal M"
-    broken_joints: tuple[str, ...] = ()
-    redundant: int = 0
-
-    @property
-    def warnings(self) -> list[str]:
-        """What looks wrong with this solve, as sentences (empty when nothing does)."""
-        out = []
-        if self.not_unique:
-            out.append(f"{self.redundant} redundant constraint(s): the reactions "
-                       f"{', '.join(self.not_unique)} share that indeterminacy and are not "
-                       "unique; the minimum-norm values are given")
-        if self.broken_joints:
-            out.append(f"the state breaks joint constraints: {', '.join(self.broken_joints)}"
-                       "; the joints hold only from a state that respects them (positions "
-                       "and velocities)")
-        if self.residual is not None and self.residual > INCONSISTENT:
-            out.append(f"the constraints are inconsistent at this state (relative residual "
-                       f"{self.residual:.1e}): the joints are not assembled, or the velocities "
-                       "break them; the least-squares accelerations are given")
-        return out
-
-    def as_dict(self) -> dict[str, float]:
-        """The accelerations by coordinate label.
-
-        Returns
-        -------
-        dict of str to float
-            ``{coordinate: acceleration}`` in stacking order (m/s^2 or rad/s^2).
-        """
-        return dict(zip(self.coordinates, self.accelerations.tolist(), strict=True))
-
-    def __getitem__(self, label: str) -> float:
-        try:
-            return float(self.accelerations[self.coordinates.index(label)])
-        except ValueError:
-            raise KeyError(f"no coordinate {label!r}; "
-                           f"{did_you_mean(label, self.coordinates)}") from None
-
-    def __repr__(self) -> str:  # the dataclass's would print every value
-        return (f"<Solution: {count(len(self.coordinates), 'acceleration')}, "
-                f"{count(len(self.reactions), 'reaction component')} ({len(self.solved)} solved)"
-                + (f", {len(self.warnings)} warning(s)" if self.warnings else "")
-                + "; sol[label], .as_dict(), .reactions, .warnings>")
-
-    def _repr_html_(self) -> str:  # notebook display: accelerations and reactions by body
-        from mbody.present.rich import solution_html  # a display hook (tools/check_imports.py)
-
-        return solution_html(self)
 
 
 class Assembly:
@@ -230,7 +102,7 @@ class Assembly:
 
     def __repr__(self) -> str:
         model = self.model
-        unknown = len(model.plan.unknowns_at(self.state.t).U) if model.reactions else 0
+        unknown = len(workspace(model).unknowns_at(self.state.t).U) if model.reactions else 0
         return (f"<Assembly of {model.name!r} at t = {self.state.t:g} s: "
                 f"{count(model.n, 'body', 'bodies')}, "
                 f"{count(len(model.reactions), 'reaction component')} ({unknown} unknown); "
@@ -238,20 +110,12 @@ class Assembly:
 
     @cached_property
     def _loads_and_b6(self) -> tuple[AppliedLoads, np.ndarray]:
-        """Q and b per body, from the numpy kernels: (AppliedLoads with Q6 (6, n) rows
+        """Q and b per body from the compiled core: (AppliedLoads with Q6 (6, n) rows
         [W_F; B_M], b6 (n, 6) [0; ω × J ω]) (planar: b = 0)."""
-        model, state = self.model, self.state
-        plan = model.plan.kernels
-        frame = model.plan.load_frame(state.t)
-        sparse = kernels.sparse_wrench(plan, [
-            kernels.load_wrenches(model, plan, frame, state),
-            kernels.spring_wrenches(model, state)])
-        Q6 = np.empty((6, model.n))
-        b6 = np.zeros((6, model.n))  # rows 0-2 (Newton) stay 0; planar: all 0
-        kernels.loads_and_gyroscopic(plan, frame, state, sparse, Q6,
-                                     b6[3:6] if model.dimension == cv.SPATIAL else None)
-        # (n, 6) transposed views of the kernels' (6, n) layout
-        return AppliedLoads(model, state, Q6), b6.T
+        Q6, b6 = wrench_parts(self.model, self.state)
+        if self.model.dimension == cv.PLANAR:
+            b6[:] = 0.0  # a planar body turns about its principal axis z: ω × J ω = 0
+        return AppliedLoads(self.model, self.state, Q6.T), b6
 
     @property
     def loads(self) -> AppliedLoads:
@@ -318,10 +182,9 @@ class Assembly:
             Gᵀ (sparse CSR) with rows labelled by `reactions` and columns by `coordinates`;
             γ, the acceleration-level right-hand side, and φ, the position-level errors.
         """
+        cols = self.columns
         return ConstraintJacobian(self.G.T.tocsr(), list(self.reactions),
-                                  list(self.coordinates),
-                                  gamma(self.model, self.state, self.columns),
-                                  phi(self.model, self.state))
+                                  list(self.coordinates), cols.gamma, cols.phi)
 
     @property
     def shape(self) -> dict[str, tuple[int, ...]]:
@@ -404,117 +267,11 @@ class Assembly:
             The accelerations in the order of `coordinates`, every reaction value, and
             what the solve found (redundant or broken constraints, backward error).
         """
-        model = self.model
-        plan = model.plan
-        unknowns = (plan.unknowns(self.reaction_values(known)) if known
-                    else plan.unknowns_at(self.state.t))
-        if not condition and plan.use_compiled():
-            return self._solve_compiled(unknowns)
-        if len(unknowns.U):
-            return self._solve_constrained(unknowns, condition)
-        lam = unknowns.lam
-        extra = None
-        if len(lam):  # G λ, summed per body on the kernels' sparse path
-            rt, cols = model.reaction_table, self.columns
-            extra = kernels.sparse_wrench(plan.kernels, [
-                (np.concatenate((rt.child, rt.parent)),
-                 np.concatenate((cols.child6 * lam[:, None], cols.parent6 * lam[:, None])))])
-        acc6 = np.empty((model.n, 6))
-        kernels.solve(plan.kernels, self._Q6.T, self._b6.T[3:6], extra, acc6.T)
-        return Solution(self.coordinates, _select(model, acc6),
-                        dict(zip(self.reactions, lam.tolist(), strict=True)))
-
-    def _solve_compiled(self, unknowns: Unknowns) -> Solution:
-        """The compiled path (`mbody.solve.compiled`), the same solve as `_solve_constrained`."""
-        model, plan, state = self.model, self.model.plan, self.state
-        C = compiled()
-        F, I = plan.packed
-        m = len(unknowns.mask)
-        N, o_lam, o_info = C.solve_layout(model.n, m, model.dimension == cv.PLANAR)
-        out = np.empty(o_info + C.INFO)
-        C.solve(F, I, plan.packed_unknowns(unknowns), plan.pack_state(state),
-                plan.load_values(state.t), unknowns.lam, model.dimension == cv.PLANAR, out)
-        info = out[o_info:]
-        labels = self.reactions
-        lam = out[o_lam:o_lam + m]
-        if not len(unknowns.U):
-            return Solution(self.coordinates, _strip(model, out[:N]),
-                            dict(zip(labels, lam.tolist(),
-                                                                strict=True)))
-        if info[C.ST_SINGULAR]:
-            code = int(info[C.ST_SINGULAR]) - 1
-            raise singular_mass_error(model, code // 6, code % 6)
-        broken: tuple[str, ...] = ()
-        if info[C.ST_BROKEN] > 0:  # rare: describe the broken joints with the numpy path
-            broken = tuple(joint_errors(model, state, self.columns, unknowns.mask,
-                                        gtv=out[o_lam + m:o_lam + 2 * m]))
-        mu, rank = len(unknowns.U), int(info[C.ST_RANK])
-        not_unique: tuple[str, ...] = ()
-        if rank < mu:
-            flags = out[o_lam + 2 * m:o_info]
-            not_unique = tuple(labels[i] for i in np.flatnonzero(flags))
-        return Solution(self.coordinates, _strip(model, out[:N]),
-                        ReactionValues(labels, model.reaction_index, lam),
-                        unknowns.labels(labels), not_unique, float(info[C.ST_BERR]), None,
-                        COMPILED_METHODS[int(info[C.ST_PATH])], broken,
-                        mu - rank)
-
-    def constrained(self, unknowns: Unknowns, *, rate: float = 0.0, refine: bool = True):
-        """The numpy path's constrained solve.
-
-        Parameters
-        ----------
-        unknowns : Unknowns
-            Which reaction components are solved for, and the values λ of the others.
-        rate : float
-            Baumgarte's α (1/s): > 0 adds his terms to γ (γ − 2 α Gᵀ v − α² φ,
-            `mbody.simulate.mechanism`); 0 leaves γ as it is.
-        refine : bool
-            Make one round of iterative refinement when the backward error asks for it.
-
-        Returns
-        -------
-        tuple
-            (v̇ (n, 6) rows [a_G (world axes, m/s^2), ω̇ (body axes, rad/s^2)], λ (m,) every
-            reaction value (N; N m), the `ConstrainedSystem`, the backward error or None
-            when `refine` is False).
-        """
-        model, state, cols = self.model, self.state, self.columns
-        lam = unknowns.lam.copy()
-        r6 = self._Q6 - self._b6 + reaction_wrench(model, cols, lam)
-        system = ConstrainedSystem(model, cols, unknowns)
-        g = gamma(model, state, cols)
-        stab_U = None
-        if rate:
-            stab = (-2.0 * rate * constraint_velocity(model, cols, state)
-                    - rate * rate * phi(model, state, cols=cols))
-            g = g + stab
-            stab_U = stab if unknowns.every else stab[unknowns.U]
-        g_U = g if unknowns.every else g[unknowns.U]
-        berr = None
-        if refine:
-            acc6, lam_U, berr = system.solve_refined(r6, g_U)
-        else:
-            acc6, lam_U = system.solve(r6, g_U, stab_U)
-        lam[unknowns.U] = lam_U
-        return acc6, lam, system, berr
-
-    def _solve_constrained(self, unknowns: Unknowns, condition: bool) -> Solution:
-
-        model = self.model
-        acc6, lam, system, berr = self.constrained(unknowns)
-        labels = self.reactions
-        solved = unknowns.labels(labels)
-        return Solution(self.coordinates, _select(model, acc6),
-                        ReactionValues(labels, model.reaction_index, lam), solved,
-                        tuple(solved[k] for k in system.fact.redundant if k >= 0),
-                        berr,
-                        system.fact.condition() if condition else None,
-                        system.fact.method,
-                        tuple(joint_errors(model, self.state, self.columns, unknowns.mask,
-                                           gtv=constraint_velocity(model, self.columns,
-                                                                   self.state))),
-                        system.fact.size - system.fact.rank)
+        ws = workspace(self.model)
+        unknowns = (ws.unknowns(self.reaction_values(known)) if known
+                    else ws.unknowns_at(self.state.t))
+        return solve_state(self.model, self.state, unknowns, condition=condition,
+                           columns=lambda: self.columns)
 
     def _repr_html_(self) -> str:  # notebook display: each body's free body and pair
         from mbody.present.rich import assembly_html  # a display hook (tools/check_imports.py)
@@ -525,15 +282,6 @@ class Assembly:
         from mbody.present.rich import assembly_latex  # a display hook (tools/check_imports.py)
 
         return assembly_latex(self)
-
-
-COMPILED_METHOD = "banded Cholesky of the Schur complement (compiled)"
-COMPILED_NULL_SPACE = ("null-space solve on the joints' geometry (SVD of the scaled G_U; "
-                       "compiled)")
-COMPILED_REDUNDANT = ("pivoted Cholesky of the Schur complement, minimum-norm reactions "
-                      "(redundant constraints; compiled)")
-COMPILED_METHODS = (COMPILED_METHOD, COMPILED_NULL_SPACE, COMPILED_REDUNDANT)
-"""The compiled solve's method by its path (info slot ST_PATH)."""
 
 
 class _LazyBodies(Mapping[str, "BodyEquations"]):
@@ -561,6 +309,84 @@ class _LazyBodies(Mapping[str, "BodyEquations"]):
         names = list(self._asm.model.body_names)
         shown = ", ".join(repr(b) for b in names[:6]) + (", ..." if len(names) > 6 else "")
         return f"<bodies of {self._asm.model.name!r}: {shown}; [name] -> BodyEquations>"
+
+
+def solve_state(model: Model, state: State, unknowns: Unknowns, *, condition: bool = False,
+                columns: Callable[[], ReactionColumns] | None = None) -> Solution:
+    """The accelerations and the unknown reactions at `state`, by the compiled core:
+    ``M v̇ − G_U λ_U = Q − b + G_K λ_K``, ``G_Uᵀ v̇ = γ_U`` (the Schur complement
+    S = G_Uᵀ M⁻¹ G_U by banded Cholesky; exactly redundant joints by a pivoted Cholesky
+    with the minimum-norm reactions; near a singular position the null-space solve on
+    the joints' geometry). `columns` gives the reaction columns at `state` when a broken
+    joint must be described or a large S's condition estimated (made only then)."""
+    ws = workspace(model)
+    solver = ws.solver(unknowns)
+    planar = model.dimension == cv.PLANAR
+    m = len(unknowns.mask)
+    N, o_lam, o_info = _core.solve_layout(model.n, m, planar)
+    out = np.empty(o_info + _core.INFO)
+    t = float(state.t)
+    y = ws.pack_state(state)
+    solver.solve(t, y, unknowns.lam, out)
+    info = out[o_info:]
+    labels = model.reactions
+    acc = out[:N][model.rows] if model.has_particles else out[:N]
+    lam = out[o_lam:o_lam + m]
+    if not len(unknowns.U):
+        return Solution(model.coordinates, acc, ReactionValues(labels, model.reaction_index,
+                                                                lam))
+    if info[_core.ST_SINGULAR]:
+        code = int(info[_core.ST_SINGULAR]) - 1
+        raise singular_mass_error(model, code // 6, code % 6)
+    broken: tuple[str, ...] = ()
+    if info[_core.ST_BROKEN] > 0:  # rare: describe the broken joints
+        cols = columns() if columns is not None else reaction_columns(model, state)
+        broken = tuple(joint_errors(model, state, cols, unknowns.mask,
+                                    gtv=out[o_lam + m:o_lam + 2 * m]))
+    mu, rank = len(unknowns.U), int(info[_core.ST_RANK])
+    not_unique: tuple[str, ...] = ()
+    if rank < mu:
+        flags = out[o_lam + 2 * m:o_info]
+        not_unique = tuple(labels[i] for i in np.flatnonzero(flags))
+    cond = None
+    if condition:
+        cond = _condition(model, state, unknowns, solver, y, rank, columns)
+    return Solution(model.coordinates, acc, ReactionValues(labels, model.reaction_index, lam),
+                    unknowns.labels(labels), not_unique, float(info[_core.ST_BERR]), cond,
+                    METHODS[int(info[_core.ST_PATH])], broken, mu - rank)
+
+
+DENSE_CONDITION = 2000
+"""Up to this many unknown components the condition of S is computed from S itself
+(formed dense by the core); above, estimated (Hager and Higham's 1-norm estimator on the
+sparse S and its LU factors)."""
+
+
+def _condition(model: Model, state: State, unknowns: Unknowns, solver: _core.Unknowns,
+               y: np.ndarray, rank: int, columns: Callable[[], ReactionColumns] | None
+               ) -> float:
+    """The 1-norm condition number of S = G_Uᵀ M⁻¹ G_U (inf when redundant constraints
+    make it singular)."""
+    mu = len(unknowns.U)
+    if rank < mu:
+        return float("inf")
+    if mu <= DENSE_CONDITION:
+        S = np.empty((mu, mu))
+        solver.schur(float(state.t), y, S)
+        return float(np.linalg.cond(S, 1))
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spla
+
+    cols = columns() if columns is not None else reaction_columns(model, state)
+    G = g_matrix(model, cols).tocsc()[:, unknowns.U]  # the model's uniform rows
+    M = mass_matrix(model)
+    if model.has_particles:  # a particle's rows are its translations only
+        G = G[model.rows]
+    S = (G.T @ sp.csc_matrix(spla.spsolve(M.tocsc(), G))).tocsc()
+    lu = spla.splu(S)
+    inverse = spla.LinearOperator(S.shape, matvec=lu.solve,
+                                  rmatvec=lambda r: lu.solve(r, trans="T"), dtype=float)
+    return float(spla.onenormest(S) * spla.onenormest(inverse))
 
 
 def assemble(model: Model, state: State | None = None) -> Assembly:

@@ -1,5 +1,6 @@
 """Applied loads -> per-body net force (world axes) and moment about the mass centre
-(body axes), vectorised over loads and bodies (the sums: `mbody.equations.kernels`).
+(body axes), and each load's own share for diagrams: both from the compiled core
+(`mbody.kernel`, loads.c: one function per load and per spring end).
 
 For a force ``W_f`` at the body point ``B_r`` (from the mass centre, body axes):
 
@@ -17,8 +18,7 @@ from functools import cached_property
 
 import numpy as np
 
-from mbody.equations import kernels
-from mbody.equations.spatial import cross, matvec, rmatvec
+from mbody.equations.workspace import workspace
 from mbody.model.model import Model, State
 
 
@@ -45,8 +45,7 @@ class AppliedLoads:
 
     `contributions` lists point forces, couples and spring ends; gravity is m g at each
     mass centre and is not repeated there. Only diagrams need the per-load list, so it
-    is computed on first access; the sums come from the cache-blocked kernels
-    (`mbody.equations.kernels`) as one (6, n) array `Q6` (rows [W_F; B_M]).
+    is computed on first access; the sums are one (6, n) array `Q6` (rows [W_F; B_M]).
     """
 
     def __init__(self, model: Model, state: State, Q6: np.ndarray):
@@ -69,74 +68,46 @@ class AppliedLoads:
                 f".W_F (n, 3) N world, .B_M (n, 3) N m body axes, .contributions>")
 
 
-def scatter(index: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
-    """Sum rows of `values` (k, 3) into (n, 3) by body `index`; index −1 (ground) is dropped."""
-    out = np.zeros((n, 3))
-    keep = index >= 0
-    if not keep.all():
-        index, values = index[keep], values[keep]
-    if not len(index):
-        return out
-    if len(index) == len(np.unique(index)):  # one row per body: a direct write
-        out[index] = values
-        return out
-    for c in range(3):  # loop over 3 components, not over bodies
-        out[:, c] = np.bincount(index, values[:, c], minlength=n)
-    return out
+def wrench_parts(model: Model, state: State) -> tuple[np.ndarray, np.ndarray]:
+    """(Q6, b6), each (n, 6): the applied loads per body [W_F (world, N); B_M (about G,
+    body axes, N m)] with gravity and springs, and the gyroscopic term [0; ω × J ω]."""
+    ws = workspace(model)
+    Q6, b6 = np.empty((model.n, 6)), np.empty((model.n, 6))
+    ws.core.wrench_parts(float(state.t), ws.pack_state(state), Q6, b6)
+    return Q6, b6
+
+
+def spring_states(model: Model, state: State
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Each spring-damper's (L, L̇, T, u): length (m), its rate (m/s), tension
+    T = k (L − L0) + c L̇ (N) and unit direction from end a to end b (s, 3) (world), from
+    the compiled core (the numbers its wrench is made of)."""
+    ws = workspace(model)
+    rows = np.empty((len(model.springs.names), 6))
+    ws.core.springs(float(state.t), ws.pack_state(state), rows)
+    return rows[:, 0], rows[:, 1], rows[:, 2], rows[:, 3:6]
 
 
 def applied_loads(model: Model, state: State, R: np.ndarray | None = None) -> AppliedLoads:
     """Net applied force and moment on every body at `state` (gravity and springs included).
 
     W_F = Σ W_f + m g (world axes), B_M = Σ B_r × (W_R_Bᵀ W_f) + couples (body axes).
-    `R` is accepted for compatibility and not needed (rotations use the quaternions).
+    `R` is accepted for compatibility and not needed.
     """
-    plan = kernels.plan_for(model)
-    frame = kernels.frame_at(model, state.t)
-    sparse = kernels.sparse_wrench(plan, [kernels.load_wrenches(model, plan, frame, state),
-                                          kernels.spring_wrenches(model, state)])
-    Q6 = np.empty((6, model.n))
-    kernels.loads_and_gyroscopic(plan, frame, state, sparse, Q6, None)
-    return AppliedLoads(model, state, Q6)
+    return AppliedLoads(model, state, wrench_parts(model, state)[0].T)
 
 
 def contributions(model: Model, state: State, R: np.ndarray | None = None) -> Contributions:
     """Each point force, couple and spring end on its body at `state` (for diagrams)."""
-    R = state.W_R_B if R is None else R
+    ws = workspace(model)
     ft, sp = model.forces, model.springs
-
-    # Point forces and couples.
-    Rf = R[ft.body]
-    vec = ft.vector_at(state.t)
-    W_vec = np.where(ft.in_body[:, None], matvec(Rf, vec), vec)
-    B_vec = np.where(ft.in_body[:, None], vec, rmatvec(Rf, vec))
-    couple = ft.couple[:, None]
-    W_f = np.where(couple, 0.0, W_vec)
-    B_m = np.where(couple, B_vec, cross(ft.B_r, B_vec))
-    bodies, names = [ft.body], list(ft.names)
-    Wfs, Brs, Bms, couples = [W_f], [ft.B_r], [B_m], [ft.couple]
-
-    # Spring-dampers: two contributions each, +T u on end a, −T u on end b.
-    if len(sp.names):
-        ends = kernels.spring_ends(model, state.position, state.quaternion, state.velocity,
-                                   state.omega)
-        _, u, T = kernels.spring_tension(model, *ends)
-        f = T[:, None] * u
-        for end, r, sign in ((sp.a, sp.r_a, 1.0), (sp.b, sp.r_b, -1.0)):
-            on = end >= 0
-            Re = R[np.where(on, end, 0)]
-            Br = np.where(on[:, None], r, 0.0)
-            bodies.append(end)
-            names.extend(sp.names)
-            Wfs.append(sign * f)
-            Brs.append(Br)
-            Bms.append(cross(Br, rmatvec(Re, sign * f)))
-            couples.append(np.zeros(len(end), dtype=bool))
-
-    return Contributions(np.concatenate(bodies), tuple(names), np.concatenate(Wfs),
-                         np.concatenate(Brs), np.concatenate(Bms), np.concatenate(couples))
-
-
-def gyroscopic(J: np.ndarray, omega: np.ndarray) -> np.ndarray:
-    """ω × (J ω) for (n, 3, 3) inertia tensors and (n, 3) angular velocities, body axes."""
-    return cross(omega, matvec(J, omega))
+    k, s = len(ft.names), len(sp.names)
+    rows = np.empty((k + 2 * s, 7))  # [body, W_F (3), B_M (3)] per load, spring end a, b
+    ws.core.load_wrenches(float(state.t), ws.pack_state(state), rows)
+    body = rows[:, 0].astype(np.intp)
+    B_r = np.concatenate((ft.B_r, np.where((sp.a >= 0)[:, None], sp.r_a, 0.0),
+                          np.where((sp.b >= 0)[:, None], sp.r_b, 0.0)))
+    order = np.concatenate((np.arange(k), k + 2 * np.arange(s), k + 2 * np.arange(s) + 1))
+    return Contributions(body[order], (*ft.names, *sp.names, *sp.names), rows[order, 1:4],
+                         B_r, rows[order, 4:7],
+                         np.concatenate((ft.couple, np.zeros(2 * s, dtype=bool))))

@@ -154,17 +154,24 @@ def band_order(child: np.ndarray, parent: np.ndarray, n: int) -> np.ndarray:
 def pack_unknowns(model: Model, U: np.ndarray, extra: Sequence[Component] = ()) -> np.ndarray:
     """The int64 array describing the unknown components U (indices into the packed
     components: the model's, then `extra`), in their solve order (reverse Cuthill-McKee
-    beyond BAND_ORDER_ABOVE of them, else as given).
+    beyond BAND_ORDER_ABOVE of them, else as given): see `pack_unknowns_of`."""
+    child_all, parent_all = _bodies(model, extra)
+    return pack_unknowns_of(child_all, parent_all, model.n, U)
+
+
+def pack_unknowns_of(child_all: np.ndarray, parent_all: np.ndarray, n: int, U: np.ndarray
+                     ) -> np.ndarray:
+    """The unknowns array of components U, given every component's child and parent body
+    (parent −1: ground) and the number of bodies n.
 
     Layout: [mu, bw, nnz], U (mu), inc_ptr (n + 1), inc (nnz × [position in U, side]):
     per body, the unknown components acting on it (side 0 child, 1 parent), so that
     S is summed body by body; bw is S's half bandwidth in U's order.
     """
-    child_all, parent_all = _bodies(model, extra)
     U = np.asarray(U, dtype=np.int64)
     if len(U) > BAND_ORDER_ABOVE:
-        U = U[band_order(child_all[U], parent_all[U], model.n)]
-    n, mu = model.n, len(U)
+        U = U[band_order(child_all[U], parent_all[U], n)]
+    mu = len(U)
     pos = np.arange(mu)
     body = np.concatenate((child_all[U], parent_all[U]))
     side = np.concatenate((np.zeros(mu, np.int64), np.ones(mu, np.int64)))
@@ -181,3 +188,20 @@ def pack_unknowns(model: Model, U: np.ndarray, extra: Sequence[Component] = ()) 
             bw = max(bw, int(w.max() - w.min()))
     inc = np.stack((where, side), axis=1).ravel()
     return np.concatenate(([mu, bw, len(where)], U, inc_ptr, inc)).astype(np.int64)
+
+
+def pack_columns_model(mass: np.ndarray, J: np.ndarray, J_inv: np.ndarray,
+                       parent: np.ndarray, child: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(F, I) of a system known only by its matrices (an export): n bodies with these
+    masses and inertia tensors, and one component per column of G acting on its child and
+    parent body, with no geometry (the columns are given to ``Unknowns.solve_given``)."""
+    n, m = len(mass), len(child)
+    bodies = np.concatenate((np.asarray(mass, float)[:, None], np.asarray(J).reshape(n, 9),
+                             np.asarray(J_inv).reshape(n, 9)), axis=1)
+    F = np.concatenate((np.zeros(3), bodies.ravel(), np.zeros(m * (_core.JOINT_W + 2))))
+    joints = np.stack((parent, child, np.zeros(m, np.int64)), axis=1)
+    comps = np.stack((np.arange(m), np.full(m, _core.KIND_FORCE), np.zeros(m, np.int64),
+                      np.full(m, -1)), axis=1)
+    Ii = np.concatenate(([n, 0, 0, m, m, 0, 0, 0, 0, 0], joints.ravel(), comps.ravel(),
+                         [0])).astype(np.int64)
+    return np.ascontiguousarray(F, dtype=float), Ii

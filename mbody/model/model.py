@@ -21,7 +21,6 @@ from typing import Any
 import numpy as np
 
 from mbody import conventions as cv
-from mbody.equations.plan import ModelPlan
 from mbody.equations.spatial import quat_to_matrix
 from mbody.errors import Issue
 from mbody.model.build import joint_tables, located_loads, point_loads
@@ -305,12 +304,6 @@ class Model:
     def index(self) -> dict[str, int]:
         """Body name -> its index in the stacking order."""
         return {n: i for i, n in enumerate(self.body_names)}
-
-    @cached_property
-    def plan(self):  # -> mbody.plan.ModelPlan: what every evaluation needs, made once
-        """The model's evaluation plan (`mbody.plan.ModelPlan`), made on first use."""
-
-        return ModelPlan(self)
 
     @cached_property
     def graph(self):  # -> networkx.MultiGraph; imported lazily, it is slow to import

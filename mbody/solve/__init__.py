@@ -1,9 +1,6 @@
-"""Accelerations and unknown reactions from the stacked equations.
-
-`dynamics` (v̇ at one state when no reaction is unknown), `kkt` (the constrained system:
-Schur complement, or the KKT matrix when it is rank deficient), `nullspace` (the robust
-route near singular positions), `blockplan` (the Schur complement from per-body blocks)
-and `compiled` (the numba path that does all of it for small models in one call).
+"""States found by solving: the accelerations of a simulation's right-hand side
+(`dynamics`); every solve itself is the compiled core's (`mbody.kernel`), reached
+through `mbody.equations.workspace`.
 """
 
 from mbody._moved import submodule as _submodule

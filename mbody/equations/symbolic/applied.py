@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from mbody import conventions as cv
-from mbody.equations import kernels
+from mbody.equations.loads import spring_states
 from mbody.equations.symbolic.printing import num
 from mbody.equations.symbolic.terms import BODY_AXES, WORLD_AXES
 
@@ -101,10 +101,7 @@ def load_symbols(model: Model, state: State, body: str) -> list[LoadSymbol]:
 
     sp = model.springs
     if np.any(sp.a == i) or np.any(sp.b == i):
-        Pa, Pb, Va, Vb = kernels.spring_ends(model, state.position, state.quaternion,
-                                             state.velocity, state.omega)
-        L, u, T = kernels.spring_tension(model, Pa, Pb, Va, Vb)
-        Ldot = np.einsum("si,si->s", u, Vb - Va)
+        L, Ldot, T, u = spring_states(model, state)
         for s in range(len(sp.names)):
             for end, r, sign in ((sp.a[s], sp.r_a[s], 1.0), (sp.b[s], sp.r_b[s], -1.0)):
                 if end != i:

@@ -13,19 +13,20 @@ import json
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, cast
+from types import SimpleNamespace
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
 
 from mbody import conventions as cv
 from mbody import joint_types
-from mbody.equations.assemble import Assembly, ReactionColumns, Solution
-from mbody.equations.constraints import gamma, phi
-from mbody.equations.plan import Unknowns
+from mbody.equations.assemble import Assembly, Solution
+from mbody.equations.pack import pack_columns_model, pack_unknowns_of
+from mbody.equations.solution import METHODS, singular_mass_error
 from mbody.errors import MbodyError
+from mbody.kernel import _core
 from mbody.model.model import Model, State
-from mbody.solve.kkt import ConstrainedSystem, block_solve
 
 FORMAT = "mbody-export"
 """The format tag every export carries; a reader refuses any other."""
@@ -187,8 +188,9 @@ class ExportedAssembly:
         All known: v̇ = M⁻¹ (Q + G λ − b). Otherwise, with U the unknown components,
         ``[[M, −G_U], [G_Uᵀ, 0]] [v̇; λ_U] = [Q − b + G_K λ_K; γ_U]`` (the joints of the
         given components are not enforced), solved by the same constrained solver as
-        `mbody.Assembly.solve` (`mbody.kkt.ConstrainedSystem`), from the stored matrices
-        alone: redundant constraints give the minimum-norm reactions, named.
+        `mbody.Assembly.solve` (the compiled core's, with the stored columns of G given
+        to it), from the stored matrices alone: redundant constraints give the
+        minimum-norm reactions, named.
         """
 
         values = self.known
@@ -200,29 +202,41 @@ class ExportedAssembly:
         mask = np.isnan(lam)
         lam[mask] = 0.0
         bodies, cols, rows = _solver_view(self)
-        # The solver reads only the fields `_Bodies` and `_Columns` rebuild from the file
-        # (see there): they stand in for the `Model` and `ReactionColumns` it is typed with.
-        as_model = cast(Model, bodies)
         r6 = np.zeros((bodies.n, 6))
         r6.reshape(-1)[rows] = self.Q - self.b
         t = bodies.reaction_table
         for six, body in ((cols.child6, t.child), (cols.parent6, t.parent)):
             on = body >= 0
             np.add.at(r6, body[on], six[on] * lam[on, None])
-        unknowns = Unknowns(mask, np.flatnonzero(mask), lam, mask.tobytes())
+        U = np.flatnonzero(mask)
+        mu = len(U)
+        F, I = pack_columns_model(bodies.mass, bodies.J, bodies.J_inv, t.parent, t.child)
+        core = _core.Model(F, I, self.dimension == cv.PLANAR)
+        solver = _core.Unknowns(core, pack_unknowns_of(t.child, t.parent, bodies.n, U))
+        out = np.empty(6 * bodies.n + 2 * mu + _core.INFO)
+        solver.solve_given(r6, np.ascontiguousarray(cols.child6),
+                           np.ascontiguousarray(cols.parent6),
+                           np.ascontiguousarray(self.columns.gamma[U]), out)
+        acc6 = out[:6 * bodies.n]
+        info = out[6 * bodies.n + 2 * mu:]
         coords = list(self.coordinates)
-        if not len(unknowns.U):
-            acc6 = block_solve(as_model, np.arange(bodies.n), r6)
-            return Solution(coords, acc6.reshape(-1)[rows],
+        if info[_core.ST_SINGULAR]:
+            code = int(info[_core.ST_SINGULAR]) - 1
+            raise singular_mass_error(SimpleNamespace(body_names=self.body_names),
+                                      code // 6, code % 6)
+        lam[U] = out[6 * bodies.n:6 * bodies.n + mu]
+        if not mu:
+            return Solution(coords, acc6[rows],
                             dict(zip(self.reactions, lam.tolist(), strict=True)))
-        system = ConstrainedSystem(as_model, cast(ReactionColumns, cols), unknowns)
-        acc6, lam_U, berr = system.solve_refined(r6, self.columns.gamma[mask])
-        lam[mask] = lam_U
-        solved = tuple(r for r, k in zip(self.reactions, mask, strict=True) if k)
-        return Solution(coords, acc6.reshape(-1)[rows],
+        flags = out[6 * bodies.n + mu:6 * bodies.n + 2 * mu]
+        solved = tuple(self.reactions[k] for k in U.tolist())
+        rank = int(info[_core.ST_RANK])
+        return Solution(coords, acc6[rows],
                         dict(zip(self.reactions, lam.tolist(), strict=True)), solved,
-                        tuple(solved[k] for k in system.fact.redundant if k >= 0), berr,
-                        None, system.fact.method, (), system.fact.size - system.fact.rank)
+                        tuple(self.reactions[k] for k, f in zip(U.tolist(), flags, strict=True)
+                              if f and rank < mu),
+                        float(info[_core.ST_BERR]), None, METHODS[int(info[_core.ST_PATH])],
+                        (), mu - rank)
 
     def differences(self, other: ExportedAssembly) -> list[str]:
         """What differs from `other`, bit for bit.
@@ -407,8 +421,8 @@ def exported(asm: Assembly, known: Mapping[str, float] | None = None,
         np.array(cols.W_e, dtype=float).reshape(-1, 3),
         np.array(cols.W_P, dtype=float).reshape(-1, 3),
         np.array([values.get(lab, np.nan) for lab in labels], dtype=float),
-        np.array(gamma(model, asm.state, cols), dtype=float).reshape(-1),
-        np.array(phi(model, asm.state), dtype=float).reshape(-1),
+        np.array(cols.gamma, dtype=float).reshape(-1),
+        np.array(cols.phi, dtype=float).reshape(-1),
     )
     st = asm.state
     state = State(np.array(st.position, dtype=float), np.array(st.quaternion, dtype=float),

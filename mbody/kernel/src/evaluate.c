@@ -124,3 +124,32 @@ int mb_derivative(const mb_model *md, const mb_unknowns *u, mb_work *w, double t
         }
     return 0;
 }
+
+void mb_solve_given(const mb_model *md, const mb_unknowns *u, mb_work *w, const double *r6,
+                    const double *child6, const double *parent6, const double *gam,
+                    double *out) {
+    int64_t n = md->n, m = md->m, mu = u->mu;
+    memcpy(w->r6, r6, sizeof(double) * 6 * n);
+    memcpy(w->child6, child6, sizeof(double) * 6 * m);
+    memcpy(w->parent6, parent6, sizeof(double) * 6 * m);
+    for (int64_t k = 0; k < mu; k++) {
+        w->gam[k] = gam[k];
+        w->stab[k] = 0.0;
+    }
+    int64_t rank;
+    double berr;
+    int path;
+    int singular = mb_constrained(md, u, w, 1, &rank, &berr, &path);
+    memcpy(out, w->acc, sizeof(double) * 6 * n);
+    for (int64_t k = 0; k < mu; k++) {
+        out[6 * n + k] = w->lamU[k];
+        out[6 * n + mu + k] = w->nonunique[k] ? 1.0 : 0.0;
+    }
+    double *info = out + 6 * n + 2 * mu;
+    info[MB_ST_RANK] = (double)rank;
+    info[MB_ST_BERR] = berr;
+    info[MB_ST_BROKEN] = 0.0;
+    info[MB_ST_MU] = (double)mu;
+    info[MB_ST_PATH] = (double)path;
+    info[MB_ST_SINGULAR] = (double)singular;
+}

@@ -185,6 +185,14 @@ enum { MB_PR_STEP = 0, MB_PR_VELOCITY = 1, MB_PR_RATIO = 2, MB_PR_SINGULAR = 3,
 void mb_solve(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
               const double *y, const double *lam, double *out);
 
+/* The same constrained solve with the columns of G (m x 6, child and parent sides), the
+ * right-hand side r6 (n x 6: Q - b + G_K lam_K) and gamma_U (mu) given, not computed
+ * (an exported system's stored matrices): out [acc (n x 6) | lam_U (mu) | not-unique
+ * flags (mu) | info (MB_INFO)]. */
+void mb_solve_given(const mb_model *md, const mb_unknowns *u, mb_work *w, const double *r6,
+                    const double *child6, const double *parent6, const double *gam,
+                    double *out);
+
 /* dy/dt at (t, y) with the unknown reactions solved (Baumgarte alpha = beta = rate when
  * rate > 0); lam: known reaction values (0 on unknown components). Returns the status. */
 int mb_derivative(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,

@@ -429,6 +429,41 @@ static PyObject *Unknowns_solve(UnknownsObject *self, PyObject *const *args, Py_
     Py_RETURN_NONE;
 }
 
+PyDoc_STRVAR(solve_given_doc,
+"solve_given(r6, child6, parent6, gamma_U, out)\n\nThe constrained solve with G's "
+"columns (m x 6 each side), the right-hand side r6\n(n x 6: Q - b + G_K lam_K) and "
+"gamma of the unknowns (mu) given: out [acc (n x 6) |\nlam_U (mu) | not-unique flags (mu) "
+"| info (INFO)].");
+
+static PyObject *Unknowns_solve_given(UnknownsObject *self, PyObject *const *args,
+                                      Py_ssize_t nargs) {
+    Py_buffer r6, c6, p6, gam, out;
+    if (unknowns_ready(self) < 0 || check_nargs(nargs, 5, "solve_given") < 0) return NULL;
+    const mb_model *md = &self->model->md;
+    Py_ssize_t n = md->n, m = md->m, mu = self->u.mu;
+    if (get_buffer(args[0], &r6, 0, 1, 6 * n, "r6") < 0) return NULL;
+    if (get_buffer(args[1], &c6, 0, 1, 6 * m, "child6") < 0) goto r6_;
+    if (get_buffer(args[2], &p6, 0, 1, 6 * m, "parent6") < 0) goto c6_;
+    if (get_buffer(args[3], &gam, 0, 1, mu, "gamma_U") < 0) goto p6_;
+    if (get_buffer(args[4], &out, 1, 1, 6 * n + 2 * mu + MB_INFO, "out") < 0) goto gam_;
+    mb_solve_given(md, &self->u, self->w, r6.buf, c6.buf, p6.buf, gam.buf, out.buf);
+    PyBuffer_Release(&out);
+    PyBuffer_Release(&gam);
+    PyBuffer_Release(&p6);
+    PyBuffer_Release(&c6);
+    PyBuffer_Release(&r6);
+    Py_RETURN_NONE;
+gam_:
+    PyBuffer_Release(&gam);
+p6_:
+    PyBuffer_Release(&p6);
+c6_:
+    PyBuffer_Release(&c6);
+r6_:
+    PyBuffer_Release(&r6);
+    return NULL;
+}
+
 PyDoc_STRVAR(derivative_doc,
 "derivative(t, y, lam, rate, out) -> int\n\nout <- dy/dt at (t, y) (y: the packed state, "
 "state_size values) with the unknown\nreactions solved and Baumgarte's terms (alpha = beta "
@@ -538,6 +573,8 @@ static PyGetSetDef Unknowns_getset[] = {
 
 static PyMethodDef Unknowns_methods[] = {
     {"solve", (PyCFunction)(void (*)(void))Unknowns_solve, METH_FASTCALL, solve_doc},
+    {"solve_given", (PyCFunction)(void (*)(void))Unknowns_solve_given, METH_FASTCALL,
+     solve_given_doc},
     {"derivative", (PyCFunction)(void (*)(void))Unknowns_derivative, METH_FASTCALL, derivative_doc},
     {"project", (PyCFunction)(void (*)(void))Unknowns_project, METH_FASTCALL, project_doc},
     {"schur", (PyCFunction)(void (*)(void))Unknowns_schur, METH_FASTCALL, schur_doc},

@@ -1,0 +1,154 @@
+"""What a solve returns: `Solution` (accelerations, every reaction value, what the solve
+found) and the reaction values as a read-only mapping; the names of the compiled core's
+solve routes; the error for a motion that carries no mass.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from mbody.errors import MbodyError, did_you_mean
+from mbody.model.model import count
+
+
+class ReactionValues(Mapping):
+    """label -> value of every reaction component (N, or N m for moments), a read-only
+    view of one array in the order of `Assembly.reactions` (made lazily: a chain of
+    10 000 links has 30 000 of them). `array` is that array."""
+
+    def __init__(self, labels: list[str], index: dict[str, int], values: np.ndarray):
+        self._labels, self._index, self.array = labels, index, values
+        self.array.flags.writeable = False
+
+    def __getitem__(self, label: str) -> float:
+        return float(self.array[self._index[label]])
+
+    def __iter__(self):
+        return iter(self._labels)
+
+    def __len__(self) -> int:
+        return len(self._labels)
+
+    def __repr__(self) -> str:  # a dict's when short; a chain's 30 000 values are not
+        full = repr(dict(self)) if len(self) <= 12 else ""
+        if full and len(full) < 300:
+            return full
+        return (f"<ReactionValues: {len(self)} components (N; N m), "
+                f"{', '.join(self._labels[:4])}, ...; [label], dict(it), .array>")
+
+
+INCONSISTENT = 1e-8
+"""Relative backward error above which a constrained solve is reported as inconsistent."""
+
+
+@dataclass(frozen=True)
+class Solution:
+    """Accelerations (aligned with `coordinates`) and the reaction values used.
+
+    What `Assembly.solve` returns; ``solution["rod.w1"]`` reads one acceleration by its
+    coordinate label.
+
+    Parameters
+    ----------
+    coordinates : list of str
+        The row labels, body by body (``Assembly.coordinates``).
+    accelerations : (N,) array
+        v̇ in the order of `coordinates`. Spatial rows: a_G in world axes (m/s^2), then
+        ω̇ in body axes (rad/s^2); planar rows: a_x, a_y (m/s^2), α (rad/s^2).
+    reactions : mapping of str to float
+        label -> value of every reaction component, given or solved (N; N m).
+    solved : tuple of str
+        Reaction components solved for (the rest were given).
+    not_unique : tuple of str
+        Solved components that redundant constraints leave undetermined (minimum norm).
+    residual : float or None
+        Relative backward error of the constrained solve (None when nothing was solved).
+    condition : float or None
+        1-norm condition estimate of the Schur complement Gᵀ M⁻¹ G (when asked for).
+    method : str
+        How the system was solved (``"block-diagonal M"`` when no reaction was unknown).
+    broken_joints : tuple of str
+        Enforced constraints that the state breaks (φ ≠ 0 or Gᵀ v ≠ 0), as text.
+    redundant : int
+        Number of redundant constraints (unknown components minus the rank of G_U).
+    """
+
+    coordinates: list[str]
+    accelerations: np.ndarray
+    reactions: Mapping[str, float]
+    solved: tuple[str, ...] = ()
+    not_unique: tuple[str, ...] = ()
+    residual: float | None = None
+    condition: float | None = None
+    method: str = "block-diagonal M"
+    broken_joints: tuple[str, ...] = ()
+    redundant: int = 0
+
+    @property
+    def warnings(self) -> list[str]:
+        """What looks wrong with this solve, as sentences (empty when nothing does)."""
+        out = []
+        if self.not_unique:
+            out.append(f"{self.redundant} redundant constraint(s): the reactions "
+                       f"{', '.join(self.not_unique)} share that indeterminacy and are not "
+                       "unique; the minimum-norm values are given")
+        if self.broken_joints:
+            out.append(f"the state breaks joint constraints: {', '.join(self.broken_joints)}"
+                       "; the joints hold only from a state that respects them (positions "
+                       "and velocities)")
+        if self.residual is not None and self.residual > INCONSISTENT:
+            out.append(f"the constraints are inconsistent at this state (relative residual "
+                       f"{self.residual:.1e}): the joints are not assembled, or the velocities "
+                       "break them; the least-squares accelerations are given")
+        return out
+
+    def as_dict(self) -> dict[str, float]:
+        """The accelerations by coordinate label.
+
+        Returns
+        -------
+        dict of str to float
+            ``{coordinate: acceleration}`` in stacking order (m/s^2 or rad/s^2).
+        """
+        return dict(zip(self.coordinates, self.accelerations.tolist(), strict=True))
+
+    def __getitem__(self, label: str) -> float:
+        try:
+            return float(self.accelerations[self.coordinates.index(label)])
+        except ValueError:
+            raise KeyError(f"no coordinate {label!r}; "
+                           f"{did_you_mean(label, self.coordinates)}") from None
+
+    def __repr__(self) -> str:  # the dataclass's would print every value
+        return (f"<Solution: {count(len(self.coordinates), 'acceleration')}, "
+                f"{count(len(self.reactions), 'reaction component')} ({len(self.solved)} solved)"
+                + (f", {len(self.warnings)} warning(s)" if self.warnings else "")
+                + "; sol[label], .as_dict(), .reactions, .warnings>")
+
+    def _repr_html_(self) -> str:  # notebook display: accelerations and reactions by body
+        from mbody.present.rich import solution_html  # a display hook (tools/check_imports.py)
+
+        return solution_html(self)
+
+
+METHODS = (
+    "banded Cholesky of the Schur complement",
+    "null-space solve on the joints' geometry (SVD of the scaled G_U)",
+    "pivoted Cholesky of the Schur complement, minimum-norm reactions (redundant "
+    "constraints)",
+)
+"""How the compiled core solved, by its route (info slot ST_PATH of `mbody.kernel`)."""
+
+
+def singular_mass_error(model, body: int, row: int) -> MbodyError:
+    """The error for a motion the joints allow that carries no mass or inertia."""
+    names = getattr(model, "body_names", None)
+    name = names[body] if names is not None else f"#{body}"
+    what = (f"translation along world {'xyz'[row]}" if row < 3
+            else f"rotation about its body {'xyz'[row - 3]} axis")
+    return MbodyError(f"the accelerations are not unique: body {name!r} has no mass or "
+                      f"inertia for the {what}, and no joint constrains that motion; give "
+                      "it mass or inertia there, or a joint that holds it")
