@@ -386,10 +386,11 @@ def test_compile_pending_with_an_empty_numba_cache(tmp_path):
 
 
 def test_compile_pending_is_false_once_compiled():
+    from mbody.equations.plan import compiled
+
     import mbody
     from mbody.cli import main
     from mbody.cli.sim import compile_pending
-    from mbody.equations.plan import compiled
 
     if compiled() is None:
         pytest.skip("numba is not available")

@@ -15,13 +15,12 @@ import sys
 from pathlib import Path
 
 import numpy as np
-
-from mbody import joint_types
 import pytest
 import yaml
 
 import mbody
 from mbody import conventions as cv
+from mbody import joint_types
 from mbody.model import fast
 from mbody.model.loader import load_text
 from mbody.model.model import BodyRecords, Model, Records

@@ -61,6 +61,7 @@ def test_compiled_load_programs_equal_the_expressions(text):
     """`compiled.set_loads` (the loads inside a compiled step) gives the numbers numpy
     gives, inf and nan included, at times around the awkward ones."""
     from mbody.equations.plan import compiled
+
     from mbody.model.expressions import ExpressionTable, compile_expression
 
     e = compile_expression(text)
@@ -77,8 +78,8 @@ def test_a_state_that_is_not_finite_stops_the_compiled_run():
     """A nan error norm shrinks the step as scipy does (Python's max(0.2, nan) is 0.2)
     until it is too small: the run reports that instead of looping on a nan step."""
     import scipy.integrate
-
     from mbody.equations.plan import compiled
+
     from mbody.simulate import state_derivative
 
     c = compiled()

@@ -23,9 +23,10 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tests"))
 
+from golden_models import all_models, moved_state, state_vector  # noqa: E402
+
 import mbody  # noqa: E402
 from mbody.solve import compiled as C  # noqa: E402
-from golden_models import all_models, moved_state, state_vector  # noqa: E402
 
 
 def record(model: mbody.Model, state: mbody.State) -> dict[str, np.ndarray]:

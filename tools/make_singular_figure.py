@@ -27,10 +27,10 @@ import matplotlib  # noqa: E402
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from fourbar_chain import FourbarChain  # noqa: E402
+from mbody.solve.kkt import ConstrainedSystem, block_solve  # noqa: E402
 
 import mbody  # noqa: E402
 from mbody.equations.constraints import gamma  # noqa: E402
-from mbody.solve.kkt import ConstrainedSystem, block_solve  # noqa: E402
 
 CHAIN = FourbarChain(crank=0.25, spacing=0.5, width=0.03125)
 
