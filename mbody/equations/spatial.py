@@ -218,3 +218,12 @@ def box_equivalent(J_principal: np.ndarray, mass: float) -> np.ndarray:
     I1, I2, I3 = J_principal
     sq = 6.0 / mass * np.array([I2 + I3 - I1, I1 + I3 - I2, I1 + I2 - I3])
     return np.sqrt(np.maximum(sq, 1e-12))
+
+
+def quaternion_rate(quaternion: np.ndarray, omega: np.ndarray) -> np.ndarray:
+    """q̇ = ½ q ⊗ (0, ω) for W_R_B quaternions (n, 4) [w, x, y, z] and ω (n, 3) body axes."""
+    w, u = quaternion[:, :1], quaternion[:, 1:]
+    out = np.empty_like(quaternion, dtype=float)
+    out[:, :1] = -0.5 * np.einsum("ij,ij->i", u, omega)[:, None]
+    out[:, 1:] = 0.5 * (w * omega + np.cross(u, omega))
+    return out

@@ -24,6 +24,7 @@ import numpy as np
 
 from mbody import conventions as cv
 from mbody.equations.pack import pack_model, pack_unknowns
+from mbody.equations.spatial import quaternion_rate
 from mbody.kernel import _core
 
 if TYPE_CHECKING:
@@ -109,17 +110,79 @@ class Workspace:
         return self.unknowns(given)
 
     def solver(self, unknowns: Unknowns) -> _core.Unknowns:
-        """The core's `Unknowns` for this set (its S's band order and scratch), made once."""
+        """The core's `Unknowns` for this set (its S's band order and scratch, and the rank
+        its constraints have at the mechanism's generic configurations), made once."""
         out = self._solvers.get(unknowns.key)
         if out is None:
             with self._lock:
                 out = self._solvers.get(unknowns.key)
                 if out is None:
                     out = _core.Unknowns(self.core, pack_unknowns(self.model, unknowns.U))
+                    out.set_generic_rank(self._generic_rank(unknowns, out))
                     self._solvers[unknowns.key] = out
         return out
 
+    def _generic_rank(self, unknowns: Unknowns, solver: _core.Unknowns) -> int:
+        """The rank of G_U at the mechanism's generic configurations, decided on its
+        geometry: the rank at the file's pose and, when that is short of full, at a
+        second assembled configuration a small step along a motion the joints allow (a
+        random one: generic with probability one); the larger. A mechanism redundant at
+        every configuration (Bricard's) keeps its deficiency there; one that is singular
+        only at its file's pose (a four-bar chain drawn flat) does not."""
+        mu = len(unknowns.U)
+        y0 = self.state_vector(self.model.initial)
+        r0 = self._rank_at(solver, unknowns, y0)
+        if r0 >= mu:
+            return mu
+        n = self.model.n
+        rng = np.random.default_rng(0)
+        info = np.empty(_core.PROJECT_INFO)
+        y = y0.copy()
+        y[7 * n:13 * n] = rng.standard_normal(6 * n)  # a random motion ...
+        if self.planar:
+            y[7 * n:10 * n].reshape(n, 3)[:, 2] = 0.0
+            y[10 * n:13 * n].reshape(n, 3)[:, :2] = 0.0
+        solver.project(0.0, y, 0, 0.0, 1, info)  # ... the joints allow (velocities only)
+        v, w = y[7 * n:10 * n].reshape(n, 3), y[10 * n:13 * n].reshape(n, 3)
+        speed = max(float(np.abs(v).max()), float(np.abs(w).max()) * self._size(), 1e-300)
+        dt = 1e-3 * self._size() / speed  # a step of a thousandth of the model's size
+        y1 = y0.copy()
+        y1[:3 * n] += dt * v.ravel()
+        q = y1[3 * n:7 * n].reshape(n, 4)
+        q += dt * quaternion_rate(q, w)
+        q /= np.linalg.norm(q, axis=1, keepdims=True)
+        if self.planar:
+            y1[13 * n:] += dt * w[:, 2]
+        solver.project(0.0, y1, 10, 0.0, 1, info)  # back onto the joints
+        if info[_core.PR_SINGULAR]:
+            return r0
+        return max(r0, self._rank_at(solver, unknowns, y1))
+
+    def _rank_at(self, solver: _core.Unknowns, unknowns: Unknowns, y: np.ndarray) -> int:
+        m = len(unknowns.mask)
+        N, _, o_info = _core.solve_layout(self.model.n, m, self.planar)
+        out = np.empty(o_info + _core.INFO)
+        solver.solve(0.0, y, unknowns.lam, out)
+        if out[o_info + _core.ST_SINGULAR]:
+            return len(unknowns.U)  # no rank to learn from here: assume none lost
+        return int(out[o_info + _core.ST_RANK])
+
+    def _size(self) -> float:
+        """The model's length scale: the spread of its mass centres and joint points."""
+        model = self.model
+        pts = np.concatenate((model.initial.position, model.joint_table.B_r_child))
+        return max(float(np.ptp(pts, axis=0).max()) if len(pts) else 0.0, 1e-3)
+
     # -- states ---------------------------------------------------------------------------
+    def state_vector(self, state: State) -> np.ndarray:
+        """The full packed state a simulation integrates: [x | q | v | ω | θ (planar)]."""
+        parts = [state.position.ravel(), state.quaternion.ravel(), state.velocity.ravel(),
+                 state.omega.ravel()]
+        if self.planar:
+            q = state.quaternion
+            parts.append(2.0 * np.arctan2(q[:, 3], q[:, 0]))
+        return np.concatenate(parts)
+
     def pack_state(self, state: State) -> np.ndarray:
         """[x | q | v | ω] flat (13 n,), a fresh C array (the core's state layout, less the
         planar angles, which evaluations do not read)."""

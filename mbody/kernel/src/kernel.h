@@ -134,7 +134,15 @@ typedef struct {
 typedef struct {
     int64_t mu, bw, nnz;
     const int64_t *U, *inc_ptr, *inc;
+    /* The rank G_U has at the mechanism's generic configurations (mu when it is not
+     * redundant there; set by the caller after a look at two assembled configurations,
+     * mbody/equations/workspace.py). Off the configuration manifold by a distance d a
+     * redundant mechanism's G_U gains singular values of about d: the solve keeps this
+     * rank whenever the singular values beyond it are below MB_GENERIC_GAP of the largest,
+     * so that rounding and integration error never make a redundant loop rigid. */
+    int64_t generic_rank;
 } mb_unknowns;
+#define MB_GENERIC_GAP 1e-4
 
 /* Views of F and I (no copy); returns 0, or -1 when the sizes do not add up. */
 int mb_model_view(mb_model *md, const double *F, int64_t nF, const int64_t *I, int64_t nI,

@@ -429,6 +429,29 @@ static PyObject *Unknowns_solve(UnknownsObject *self, PyObject *const *args, Py_
     Py_RETURN_NONE;
 }
 
+PyDoc_STRVAR(set_generic_rank_doc,
+"set_generic_rank(rank)\n\nThe rank G_U has at the mechanism's generic configurations "
+"(kernel.h: mb_unknowns.generic_rank);\nmu (the default) for a mechanism that is not "
+"redundant there.");
+
+static PyObject *Unknowns_set_generic_rank(UnknownsObject *self, PyObject *arg) {
+    if (unknowns_ready(self) < 0) return NULL;
+    long long r = PyLong_AsLongLong(arg);
+    if (r == -1 && PyErr_Occurred()) return NULL;
+    if (r < 0 || r > self->u.mu) {
+        PyErr_Format(PyExc_ValueError, "generic rank %lld is not between 0 and mu = %lld", r,
+                     (long long)self->u.mu);
+        return NULL;
+    }
+    self->u.generic_rank = (int64_t)r;
+    Py_RETURN_NONE;
+}
+
+static PyObject *Unknowns_get_generic_rank(UnknownsObject *self, void *closure) {
+    (void)closure;
+    return PyLong_FromLongLong((long long)self->u.generic_rank);
+}
+
 PyDoc_STRVAR(solve_given_doc,
 "solve_given(r6, child6, parent6, gamma_U, out)\n\nThe constrained solve with G's "
 "columns (m x 6 each side), the right-hand side r6\n(n x 6: Q - b + G_K lam_K) and "
@@ -568,11 +591,14 @@ static PyGetSetDef Unknowns_getset[] = {
     {"mu", (getter)Unknowns_get, NULL, "number of unknown components", (void *)0},
     {"bw", (getter)Unknowns_get, NULL, "half bandwidth of S in the unknowns' order", (void *)1},
     {"model", (getter)Unknowns_get, NULL, "the Model", (void *)2},
+    {"generic_rank", (getter)Unknowns_get_generic_rank, NULL,
+     "the rank G_U has at generic configurations (set_generic_rank)", NULL},
     {NULL, NULL, NULL, NULL, NULL},
 };
 
 static PyMethodDef Unknowns_methods[] = {
     {"solve", (PyCFunction)(void (*)(void))Unknowns_solve, METH_FASTCALL, solve_doc},
+    {"set_generic_rank", (PyCFunction)Unknowns_set_generic_rank, METH_O, set_generic_rank_doc},
     {"solve_given", (PyCFunction)(void (*)(void))Unknowns_solve_given, METH_FASTCALL,
      solve_given_doc},
     {"derivative", (PyCFunction)(void (*)(void))Unknowns_derivative, METH_FASTCALL, derivative_doc},

@@ -105,6 +105,10 @@ int mb_null_space(const mb_model *md, const mb_unknowns *u, mb_work *w, int refi
     int64_t rank = 0;
     for (int64_t a = 0; a < pmin; a++)
         if (s->sv[a] > G_RANK_RTOL * s->sv[0]) rank++;
+    /* a redundant mechanism off its manifold: the extra singular values are the
+     * distance, not constraints (mb_unknowns.generic_rank) */
+    if (rank > u->generic_rank && s->sv[u->generic_rank] <= MB_GENERIC_GAP * s->sv[0])
+        rank = u->generic_rank;
     int64_t dof = nr - rank;
     *rank_out = rank;
     /* U1 = Uf[:, :rank] (stride pmin); U2 (nr x dof) its complement. U1 is copied to a

@@ -22,7 +22,10 @@ static double geometric_ratio(const mb_model *md, const mb_unknowns *u, mb_work 
     }
     memset(w->Sb, 0, sizeof(double) * mu * W);
     mb_schur(md, u, w->unit, w->child6, w->parent6, w->Sb, 1);
-    return mb_band_cholesky(w->Sb, mu, u->bw, DROPPED_RTOL, 0);
+    /* a redundant mechanism (generic_rank < mu): its redundant columns' pivots are the
+     * squared distance off the manifold, up to MB_GENERIC_GAP^2: left out too */
+    double drop = u->generic_rank < mu ? MB_GENERIC_GAP * MB_GENERIC_GAP : DROPPED_RTOL;
+    return mb_band_cholesky(w->Sb, mu, u->bw, drop, 0);
 }
 
 /* The solve of one projection step (w->gam set, w->r6 and w->stab 0). */

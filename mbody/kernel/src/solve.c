@@ -371,7 +371,8 @@ int mb_constrained(const mb_model *md, const mb_unknowns *u, mb_work *w, int ref
     int64_t rank = mu;
     int path = 0;
     memcpy(w->S0, w->Sb, sizeof(double) * mu * W);
-    if (mb_band_cholesky(w->Sb, mu, bw, PIVOT_RTOL, 1) >= 0.0) {
+    /* a mechanism redundant at its generic configurations never has a trusted S */
+    if (u->generic_rank == mu && mb_band_cholesky(w->Sb, mu, bw, PIVOT_RTOL, 1) >= 0.0) {
         cho_solve_band(w->Sb, mu, bw, lamU);
         memcpy(w->rhs, w->r6, sizeof(double) * 6 * n);
         mb_add_g(md, u, w->child6, w->parent6, lamU, w->rhs, 1.0);

@@ -98,6 +98,7 @@ int mb_model_view(mb_model *md, const double *F, int64_t nF, const int64_t *I, i
 int mb_unknowns_view(mb_unknowns *u, const mb_model *md, const int64_t *Iu, int64_t nIu) {
     if (nIu < 3) return -1;
     u->mu = Iu[0], u->bw = Iu[1], u->nnz = Iu[2];
+    u->generic_rank = u->mu;
     if (u->mu < 0 || u->mu > md->m || u->bw < 0 || u->nnz < 0 || u->nnz > 2 * u->mu)
         return -1;
     if (nIu != 3 + u->mu + md->n + 1 + 2 * u->nnz) return -1;
