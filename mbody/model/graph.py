@@ -17,7 +17,7 @@ larger part that may be rank-deficient).
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -68,6 +68,9 @@ class Topology:
     mobility: degrees of freedom (per-body freedoms minus `rank`, or minus
     `constraints` when the rank is unknown). redundant: reaction components that are
     linear combinations of the others (one valid choice among equivalents).
+    indeterminate: one group per indeterminacy (a self-stress: reaction values that
+    balance each other and leave every body alone), naming every component it involves,
+    whose values the equations therefore do not fix.
     """
 
     parts: list[list[str]]
@@ -79,6 +82,7 @@ class Topology:
     mobility: int
     gruebler: int
     redundant: list[str]
+    indeterminate: list[tuple[str, ...]] = field(default_factory=list)
 
     @property
     def is_tree(self) -> bool:
@@ -109,21 +113,25 @@ def topology(model: Model, G=None, *, columns: ReactionColumns | None = None) ->
     gruebler = coords - m
     rank: int | None = 0 if m == 0 else None
     redundant: list[str] = []
+    groups: list[tuple[str, ...]] = []
     if m and (G is not None or columns is not None):
-        rank, redundant = _rank(model, G, columns)
+        rank, redundant, groups = _rank(model, G, columns)
     mobility = coords - (rank if rank is not None else m)
-    return Topology(parts, loops, floating, grounded, m, rank, mobility, gruebler, redundant)
+    return Topology(parts, loops, floating, grounded, m, rank, mobility, gruebler, redundant,
+                    groups)
 
 
-def _rank(model: Model, G, columns: ReactionColumns | None) -> tuple[int | None, list[str]]:
-    """Rank of G, part by part (ground removed, so parts share no rows); G's blocks come
+def _rank(model: Model, G, columns: ReactionColumns | None
+          ) -> tuple[int | None, list[str], list[tuple[str, ...]]]:
+    """Rank of G, part by part (ground removed, so parts share no rows), the columns past
+    the rank, and the components of each indeterminacy (`self_stresses`); G's blocks come
     from `G` or else from `columns`."""
     parts = _components(model.body_names, [(j.parent, j.child) for j in model.joints
                                            if cv.GROUND not in (j.parent, j.child)])
     rt = model.reaction_table
     rpb = model.rows_per_body
     labels = model.reactions
-    total, redundant = 0, []
+    total, redundant, groups = 0, [], []
     if G is not None and hasattr(G, "tocsc"):  # scipy.sparse
         G = G.tocsc()
     for part in parts:
@@ -132,10 +140,10 @@ def _rank(model: Model, G, columns: ReactionColumns | None) -> tuple[int | None,
         if not len(cols):
             continue
         if len(cols) > RANK_LIMIT:
-            return None, []
+            return None, [], []
         if G is None:
             if columns is None:  # neither G nor its columns: no rank test (see `topology`)
-                return None, []
+                return None, [], []
             A = g_block(model, columns, idx, cols)
         else:
             rows = (np.concatenate([model.body_rows(i) for i in idx]) if model.has_particles
@@ -158,8 +166,42 @@ def _rank(model: Model, G, columns: ReactionColumns | None) -> tuple[int | None,
         r = int(np.sum(d > tol))
         total += r
         redundant += [labels[cols[k]] for k in piv[r:]]
+        groups += [tuple(labels[cols[k]] for k in g) for g in self_stresses(A, A.shape[1] - r)]
     order = {lab: i for i, lab in enumerate(labels)}
-    return total, sorted(redundant, key=order.__getitem__)
+    return total, sorted(redundant, key=order.__getitem__), groups
+
+
+SELF_STRESS_TOL = 1e-8
+"""A component belongs to an indeterminacy when its share of the (unit) self-stress is
+above this: as the solve flags components that are not unique."""
+
+
+def self_stresses(A: np.ndarray, d: int) -> list[list[int]]:
+    """The columns each of the d independent self-stresses of A involves (λ ≠ 0 with
+    A λ = 0: reaction values that put nothing into any body), as groups of column
+    indices. The null space's basis is put in reduced row echelon form with the largest
+    entry of each column as pivot, so that each basis vector involves as few components
+    as any basis allows (for d = 1, every component the self-stress touches)."""
+    if d <= 0:
+        return []
+    scale = np.abs(A).max(axis=0)
+    scale[scale == 0] = 1.0
+    _, _, Vt = np.linalg.svd(A / scale, full_matrices=True)  # columns on one scale
+    N = Vt[A.shape[1] - d:].copy()  # (d, n): rows span the null space
+    for i in range(d):  # reduced row echelon form, pivoting on the largest entry
+        rest = N[i:]
+        k = int(np.argmax(np.abs(rest).max(axis=0)))
+        r = i + int(np.argmax(np.abs(rest[:, k])))
+        N[[i, r]] = N[[r, i]]
+        N[i] /= N[i, k]
+        for j in range(d):
+            if j != i:
+                N[j] -= N[j, k] * N[i]
+    out = []
+    for row in N:
+        big = np.abs(row).max()
+        out.append([int(c) for c in np.flatnonzero(np.abs(row) > SELF_STRESS_TOL * big)])
+    return out
 
 
 FULL_RANK_MARGIN = 1e-8

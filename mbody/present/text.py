@@ -136,10 +136,21 @@ def graph_summary(model: Model, topo: Topology) -> str:
         lines.append(f"mobility: {topo.mobility} = {coords} - {topo.rank} "
                      f"independent constraints ({topo.constraints} reaction components)")
     if topo.redundant:
-        lines.append(f"warning: {len(topo.redundant)} redundant constraint(s): "
-                     + ", ".join(topo.redundant)
-                     + " (these reactions are not unique: they depend on the others)")
+        lines.append(redundancy_warning(len(topo.redundant), topo.indeterminate))
     return "\n".join(lines)
+
+
+def redundancy_warning(count: int, groups: list[tuple[str, ...]]) -> str:
+    """What `check` says of redundant constraints: how many, and the components of each
+    indeterminacy (all of them, not one arbitrary member: their values are not unique)."""
+    head = f"warning: {count} redundant constraint{'s' if count != 1 else ''}: "
+    if len(groups) == 1:
+        return (head + f"the reactions {', '.join(groups[0])} (all {len(groups[0])}) share "
+                "one indeterminacy (a self-stress, which loads no body): their values are "
+                "not unique")
+    listed = "; ".join("{" + ", ".join(g) + "}" for g in groups)
+    return (head + f"{len(groups)} indeterminacies (self-stresses, which load no body), "
+            f"each shared by the reactions in braces: {listed}; their values are not unique")
 
 
 def force_cells(fo: ForceOnBody, dimension: int, minus: str = "-") -> list[str]:
