@@ -93,6 +93,11 @@ def pack_model(model: Model, extra: Sequence[Component] = ()) -> tuple[np.ndarra
     laws: list[list[int]] = []
     law_of = np.full(m, -1, dtype=np.int64)
     m0 = m - len(extra)
+    drivers = getattr(model, "drivers", None)
+    first_driver = m0 - (len(drivers) if drivers is not None else 0)
+    for i, law in enumerate(drivers.laws if drivers is not None else ()):
+        law_of[first_driver + i] = len(laws)
+        laws.append([programs.add(e) for e in law])
     for i, c in enumerate(extra):
         if c.law is not None:
             law_of[m0 + i] = len(laws)
@@ -113,6 +118,8 @@ def pack_model(model: Model, extra: Sequence[Component] = ()) -> tuple[np.ndarra
     comps_f = np.zeros((m, 2))
     screw = np.flatnonzero(comps[:m0, 1] == _core.KIND_SCREW)  # h = pitch / 2 pi
     comps_f[screw, 1] = jt.pitch[comps[screw, 0]] / (2.0 * np.pi)
+    if drivers is not None:  # a driven coordinate's value at the file's pose (param0)
+        comps_f[first_driver:m0, 0] = drivers.offset
     for i, c in enumerate(extra):
         comps_f[m0 + i] = (c.off, c.h)
     flags = _core.J_LINK * jt.link.astype(np.int64) + _core.J_PARTICLE_PARENT * jt.particle_parent

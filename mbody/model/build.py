@@ -16,6 +16,7 @@ from mbody import conventions as cv
 from mbody import joint_types
 from mbody.equations.spatial import joint_frame_planar, joint_frame_spatial, quat_to_matrix
 from mbody.joint_types.base import TILT, Component
+from mbody.model.drivers import DriverTable
 from mbody.model.expressions import ExpressionTable
 from mbody.model.records import Joint, Load, Records, field_names, record
 from mbody.model.tables import ForceTable, JointTable, ReactionTable, readonly
@@ -65,7 +66,7 @@ def point_loads(t: LoadTable, names: tuple[str, ...]) -> tuple[Records[Load], Fo
 
 
 def joint_tables(dimension: int, js: JointSpecTable, names: tuple[str, ...],
-                  initial: State, particle: np.ndarray
+                  initial: State, particle: np.ndarray, drivers: DriverTable | None = None
                   ) -> tuple[Records[Joint], ReactionTable]:
     """The joints and their reaction table, computed for all joints at once.
 
@@ -135,7 +136,14 @@ def joint_tables(dimension: int, js: JointSpecTable, names: tuple[str, ...],
     per_joint = JointTable(tuple(js.names), p, c, readonly(B_r_child), readonly(B_r_parent),
                            readonly(P_E), readonly(C_E), readonly(C_axis2), first, link, p_particle,
                            readonly(length), free_turn, readonly(js.pitch))
-    table = ReactionTable(per_joint, row_joint, component, kind, frame_axis)
+    if drivers is not None and len(drivers):  # the drivers' efforts: last components
+        row_joint = np.concatenate((row_joint, drivers.joint))
+        component = np.concatenate((component, [joint_types.COMPONENT_CODE[c]
+                                                for c in drivers.component]))
+        kind = np.concatenate((kind, drivers.kind))
+        frame_axis = np.concatenate((frame_axis, drivers.axis))
+    table = ReactionTable(per_joint, row_joint, component, kind, frame_axis,
+                          drivers.names if drivers is not None else ())
 
     fields_ = field_names(Joint)
     axis1 = readonly(js.axis)

@@ -192,12 +192,12 @@ def _spec(text: str, file: str) -> Spec:
         del groups
     assert table is not None
     # a list not cut out above (absent, or written another way) goes through validate
-    loads, joint_list, reactions, expressions = rest(c, [], [] if point else None,
-                                                     [] if joints is not None else None)
+    loads, joint_list, reactions, expressions, drivers = rest(
+        c, [], [] if point else None, [] if joints is not None else None)
     if c.issues or c.warnings:
         raise _Bail  # warnings need their lines: the located path gives them
     return Spec(name, file, c.dim, gravity, [], loads, joint_list, reactions, description,
-                [], expressions, table, point, joints)
+                [], expressions, table, point, joints, drivers)
 
 
 # -- reading a list in bulk ---------------------------------------------------------------
@@ -840,7 +840,7 @@ def _joints(c: Checker, groups: list[_Group]) -> JointSpecTable:
     types_list = _placed(n, types_all)
     if len(set(names_list)) != n:
         raise _Bail  # a duplicate joint name
-    if "reactions" in c.doc.data:  # known reactions name their joints' components
+    if "reactions" in c.doc.data or "drivers" in c.doc.data:  # they name joints
         c.joint_types.update(zip(names_list, types_list, strict=True))
     return JointSpecTable(names_list, types_list, parent, child, at, axis, has_axis, axis2,
                           has_axis2, [""] * n, np.zeros(n))

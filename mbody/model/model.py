@@ -24,6 +24,7 @@ from mbody import conventions as cv
 from mbody.equations.spatial import quat_to_matrix
 from mbody.errors import Issue
 from mbody.model.build import joint_tables, located_loads, point_loads
+from mbody.model.drivers import DriverTable, driver_table
 from mbody.model.expressions import Expression
 from mbody.model.fast import fast_spec
 from mbody.model.graph import body_graph
@@ -157,6 +158,8 @@ class Model:
         What validation noticed without refusing the file.
     known_expressions : dict, optional
         Known reaction values that vary in time (label -> expression of t).
+    drivers : DriverTable, optional
+        Joint coordinates prescribed as functions of time, whose efforts are unknowns.
     """
 
     name: str
@@ -179,6 +182,9 @@ class Model:
     warnings: tuple[Issue, ...] = field(default_factory=tuple)
     known_expressions: dict[str, Expression] = field(default_factory=dict)
     """Known reaction values that vary in time (label -> expression of t)."""
+    drivers: DriverTable | None = None
+    """Joint coordinates prescribed in time (`mbody.model.drivers`); their efforts are the
+    last components of `reaction_table` (labels ``<driver>.M`` or ``.F``)."""
 
     def __repr__(self) -> str:  # the dataclass's would print every array (2-9 KB)
         kind = "planar" if self.dimension == cv.PLANAR else "spatial"
@@ -435,8 +441,12 @@ def _build(spec: Spec) -> Model:
     js = spec.joint_table
     if js is None:
         js = JointSpecTable.from_specs(spec.joints, idx)
-    joints, table = joint_tables(spec.dimension, js, names, initial, t.particle)
+    q = initial.quaternion  # a planar body's angle about z, for its drivers' offsets
+    drivers = driver_table(spec.drivers, {nm: j for j, nm in enumerate(js.names)},
+                           spec.dimension, (js.parent, js.child),
+                           2.0 * np.arctan2(q[:, 3], q[:, 0]))
+    joints, table = joint_tables(spec.dimension, js, names, initial, t.particle, drivers)
     return Model(spec.name, spec.file, spec.dimension, names, mass, J, readonly(J_inv),
                  readonly(spec.gravity), initial, bodies, loads, joints, forces, springs,
                  table, dict(spec.reactions), spec.description, tuple(spec.warnings),
-                 dict(spec.reaction_expressions))
+                 dict(spec.reaction_expressions), drivers)

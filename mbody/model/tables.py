@@ -149,6 +149,9 @@ class ReactionTable:
     component: np.ndarray
     kind: np.ndarray
     frame_axis: np.ndarray
+    driver_names: tuple[str, ...] = ()
+    """The drivers whose efforts are the last len(driver_names) components (labelled
+    ``<driver>.M`` or ``.F``; their `joint` is the joint they drive)."""
 
     DERIVED = ("labels", "parent", "child", "P_E", "B_r_child", "C_axis2", "B_r_parent",
                "P_E3", "C_E3", "is_moment", "axis", "rot_kind", "link", "particle_parent",
@@ -163,8 +166,10 @@ class ReactionTable:
     def labels(self) -> tuple[str, ...]:
         """``<joint>.<component>`` per column of G."""
         names, comp = self.per_joint.names, jt.COMPONENT_NAMES
-        return tuple(f"{names[j]}.{comp[c]}"
-                     for j, c in zip(self.joint.tolist(), self.component.tolist(), strict=True))
+        k = len(self.joint) - len(self.driver_names)
+        owner = [names[j] for j in self.joint[:k].tolist()] + list(self.driver_names)
+        return tuple(f"{o}.{comp[c]}"
+                     for o, c in zip(owner, self.component.tolist(), strict=True))
 
     @cached_property
     def parent(self) -> np.ndarray:

@@ -38,6 +38,7 @@ from mbody.model.checks import (
     realisable,
     vec_norm,
 )
+from mbody.model.drivers import DriverSpec, read_drivers
 from mbody.model.expressions import (
     CHECK_SPAN,
     Expression,
@@ -49,7 +50,7 @@ from mbody.model.expressions import (
 from mbody.model.loader import Document, Path_, Unrepresentable
 
 TOP_KEYS = ("model", "dimension", "gravity", "bodies", "loads", "joints", "reactions",
-            "description")
+            "drivers", "description")
 BODY_KEYS = ("name", "mass", "inertia", "position", "orientation", "angle", "velocity",
              "angular_velocity", "shape", "color")
 LOAD_KEYS = {
@@ -245,6 +246,8 @@ class Spec:
     """The fast path's loads (then `loads` is empty): force and torque loads only."""
     joint_table: JointSpecTable | None = None
     """The fast path's joints (then `joints` is empty)."""
+    drivers: list[DriverSpec] = field(default_factory=list)
+    """Joint coordinates prescribed in time (`mbody.model.drivers`)."""
 
     def table(self) -> BodyTable:
         """The bodies as arrays, from `body_table` or else from `bodies`."""
@@ -274,9 +277,9 @@ def validate(doc: Document) -> Spec:
     name, description, gravity = header(c)
     data = doc.data
     bodies = _bodies(c, data.get("bodies"))
-    loads, joints, reactions, reaction_expressions = rest(c, bodies, None)
+    loads, joints, reactions, reaction_expressions, drivers = rest(c, bodies, None)
     return Spec(str(name), doc.file, c.dim, gravity, bodies, loads, joints, reactions,
-                description, c.warnings, reaction_expressions)
+                description, c.warnings, reaction_expressions, drivers=drivers)
 
 
 def header(c: Checker) -> tuple[str, str, np.ndarray]:
@@ -315,10 +318,11 @@ def header(c: Checker) -> tuple[str, str, np.ndarray]:
 
 def rest(c: Checker, bodies: list[BodySpec], loads: list[LoadSpec] | None,
          joints: list[JointSpec] | None = None
-         ) -> tuple[list[LoadSpec], list[JointSpec], dict[str, float], dict[str, Expression]]:
-    """Check loads and joints (unless given: the fast path's) and reactions, after the
-    bodies (whose names are in ``c.body_names``); raise `ModelError` if anything was
-    found, in file order."""
+         ) -> tuple[list[LoadSpec], list[JointSpec], dict[str, float], dict[str, Expression],
+                    list[DriverSpec]]:
+    """Check loads and joints (unless given: the fast path's), reactions and drivers,
+    after the bodies (whose names are in ``c.body_names``); raise `ModelError` if
+    anything was found, in file order."""
     data = c.doc.data
     # A body with a bad mass is still a body: references to it are not problems too.
     names = c.body_names
@@ -328,9 +332,10 @@ def rest(c: Checker, bodies: list[BodySpec], loads: list[LoadSpec] | None,
         joints = _joints(c, data.get("joints"), names, bodies)
     reaction_expressions: dict[str, Expression] = {}
     reactions = _reactions(c, data.get("reactions"), joints, reaction_expressions)
+    drivers = read_drivers(c, data.get("drivers"), c.joint_types)
     if c.issues:  # in file order, as an editor goes through them
         raise ModelError(sorted(c.issues, key=lambda i: i.line))
-    return loads, joints, reactions, reaction_expressions
+    return loads, joints, reactions, reaction_expressions, drivers
 
 
 def _list(c: Checker, path: Path_, value: Any, what: str, required: bool) -> list:
