@@ -61,11 +61,13 @@ PARTICLE_COMPONENTS: dict[int, dict[str, dict[str, tuple[str, ...]]]] = {
 particle) holds its position, a link (joint point away from it) its distance (and, for a
 spatial revolute, its plane ⟂ the axis: Fz); no moments (a particle has no orientation)."""
 
-AXIS_REQUIRED = {
-    PLANAR: {"prismatic"},
+AXIS_REQUIRED: dict[int, set[str]] = {
+    PLANAR: set(),
     SPATIAL: {"revolute", "prismatic", "cylindrical", "universal"},
 }
-"""Joint types that need an `axis` (universal also needs `axis2`)."""
+"""Joint types that need an `axis` (universal also needs `axis2`). None in a planar model:
+a prismatic without one slides along world x (its joint frame's rule), as the model-file
+reference says."""
 
 GROUND = "ground"
 
