@@ -55,7 +55,9 @@ spatial revolute, its plane ⟂ the axis: Fz); no moments (a particle has no ori
 AXIS_REQUIRED = {
     d: {name for name, jt in types.items() if (p := jt.param("axis")) and p.required}
     for d, types in joint_types.TYPES.items()}
-"""Joint types that need an `axis` (universal also needs `axis2`, helical `pitch`)."""
+"""Joint types that need an `axis` (universal also needs `axis2`, helical `pitch`). None
+in a planar model: a prismatic (or a slot) without one slides along world x (its joint
+frame's rule), as the model-file reference says."""
 
 GROUND = "ground"
 

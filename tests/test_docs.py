@@ -11,7 +11,12 @@ open, and visibly so:
 - `…` within a line stands for any text on that line (a time, a size, a path);
 - a line that is only `…` stands for any number of lines (output cut short);
 - a wall-clock duration in the output (`0.42 s`, `12 ms` after "in", "took" or "wall")
-  compares as `…`, and trailing spaces and blank lines at the end are ignored.
+  compares as `…`, and trailing spaces and blank lines at the end are ignored;
+- a number printed in full (13 significant digits or more: a float's repr, as JSON, CSV
+  and MJCF output print them) compares as a number, not as text: its last digits are the
+  rounding of the machine's BLAS kernel and maths library (OpenBLAS picks its kernels by
+  CPU: the slider-crank's `crank.y` is 129.67690442594736 with AVX2 kernels,
+  129.6769044259477 with AVX-512 ones). See `rounding_tolerance` for the bound.
 
 Python examples are ```python blocks, run in order in one namespace per page, from the
 repository root. Within a page, console lines and Python blocks run in document order, so
@@ -98,20 +103,76 @@ def _lines(text: str) -> list[str]:
     return lines
 
 
-def _line_pattern(shown: str) -> re.Pattern[str]:
-    return re.compile(".*?".join(re.escape(p) for p in shown.split(ELLIPSIS)) + r"\Z", re.S)
+NUMBER = re.compile(r"(?<![\w.])[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?(?![\w.])")
+ANY_NUMBER = r"([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)"
+FULL_DIGITS = 13
+"""A number shown with at least this many significant digits is a float printed in full
+(repr gives 15 to 17; a display rounded for reading gives 6 or fewer)."""
+CONDITION = re.compile(r"(?:\"condition\": |condition estimate )(\d[\d.]*(?:e[-+]?\d+)?)")
+UNIT_ROUNDOFF = 2.0 ** -53
+MAX_UNKNOWNS = 64
+"""More unknowns than any model a page computes with has (the error bound's n)."""
+
+
+def _printed_in_full(token: str) -> bool:
+    mantissa = re.split(r"[eE]", token.lstrip("+-"))[0].replace(".", "").lstrip("0")
+    return len(mantissa) >= FULL_DIGITS
+
+
+def rounding_tolerance(shown: str, real: str) -> float:
+    """How far a number printed in full may be from the page's, in absolute terms.
+
+    Two backward-stable computations of the same x (the page's machine and this one,
+    differing in the BLAS kernel's order of operations) each lie within κ·n·u·‖x‖∞ of the
+    exact answer (u = 2⁻⁵³ the unit roundoff, n the number of unknowns, κ the problem's
+    condition number), so they differ by at most 2·κ·n·u·‖x‖∞. Here n = `MAX_UNKNOWNS`,
+    κ the condition estimate the command itself prints (`"condition": 3485`, `condition
+    estimate 5.16e+00`; 1 for outputs that solve nothing: an evaluation's error is a few
+    roundings of its largest term), and ‖x‖∞ the largest number the page shows for that
+    output: a component's rounding is relative to the vector it was computed with (the
+    slider-crank's piston.y is 1.7e-13 on one machine and -5.5e-14 on another, beside
+    accelerations of 3.2e4)."""
+    kappa = max([float(k) for k in CONDITION.findall(real)] + [1.0])
+    scale = max([abs(float(m)) for m in NUMBER.findall(shown)] + [0.0])
+    return 2.0 * kappa * MAX_UNKNOWNS * UNIT_ROUNDOFF * scale
+
+
+def _line_pattern(shown: str) -> tuple[re.Pattern[str], list[float]]:
+    """The line as a pattern (`…` any text, each number printed in full any number) and
+    the numbers printed in full, in order."""
+    parts: list[str] = []
+    full: list[float] = []
+    for k, piece in enumerate(shown.split(ELLIPSIS)):
+        if k:
+            parts.append(".*?")
+        at = 0
+        for m in NUMBER.finditer(piece):
+            if _printed_in_full(m.group()):
+                parts.append(re.escape(piece[at:m.start()]) + ANY_NUMBER)
+                full.append(float(m.group()))
+                at = m.end()
+        parts.append(re.escape(piece[at:]))
+    return re.compile("".join(parts) + r"\Z", re.S), full
+
+
+def _line_matches(shown: str, real: str, tol: float) -> bool:
+    pattern, full = _line_pattern(shown)
+    m = pattern.match(real)
+    return m is not None and all(abs(float(got) - want) <= tol
+                                 for got, want in zip(m.groups(), full, strict=True))
 
 
 def output_matches(shown: str, real: str) -> bool:
     """Whether `real` output is what the docs show (`shown`), under the module's rules."""
     want, got = _lines(shown), _lines(real)
+    tol = rounding_tolerance(shown, real)
 
     def match(i: int, j: int) -> bool:
         if i == len(want):
             return j == len(got)
         if want[i] == ELLIPSIS:  # any number of lines
             return any(match(i + 1, k) for k in range(j, len(got) + 1))
-        return j < len(got) and bool(_line_pattern(want[i]).match(got[j])) and match(i + 1, j + 1)
+        return j < len(got) and _line_matches(want[i], got[j], tol) and match(i + 1, j + 1)
 
     return match(0, 0)
 
@@ -140,6 +201,30 @@ def test_output_comparison_is_exact_but_for_marked_gaps():
     assert output_matches("done in 0.31 s\n", "done in 1.5 s\n")  # a wall-clock time
     assert not output_matches("t_end 0.31 s\n", "t_end 1.5 s\n")  # a simulated one
     assert output_matches("", "") and not output_matches("", "something\n")
+
+
+def test_numbers_printed_in_full_compare_within_their_rounding():
+    # the slider-crank's JSON on AVX2 (the page) and AVX-512 (another machine) kernels
+    page = ('"crank.y": 129.67690442594736,\n"theta": 32009.64448135288,\n'
+            '"y": 1.723066134218243e-13\n')
+    other = ('"crank.y": 129.6769044259477,\n"theta": 32009.644481352996,\n'
+             '"y": -5.5067062021407764e-14\n')
+    assert output_matches(page, other + '"condition": 3485.0030456706745\n') is False  # a line more
+    assert output_matches(page + "…\n", other + '"condition": 3485.0030456706745\n')
+    assert output_matches(page, other)  # κ = 1: 2·64·u·32009 = 4.5e-10 > 1.2e-10 apart
+    # a change of the physics (the 11th digit) is not rounding
+    assert not output_matches('"crank.y": 129.67690442594736\n', '"crank.y": 129.67690442694736\n')
+    # rounding is relative to the largest number of the output, not to each number
+    assert rounding_tolerance("x 129.67690442594736 y 1.0\n", "") == pytest.approx(
+        2 * 64 * 2.0 ** -53 * 129.67690442594736)
+    assert rounding_tolerance("a 2.0\n", '"condition": 1e3') == pytest.approx(
+        2 * 64 * 2.0 ** -53 * 2e3)
+    # the text around the numbers still compares exactly; short numbers as text
+    assert not output_matches('"crank.y": 129.67690442594736\n', '"crank.x": 129.67690442594736\n')
+    assert not output_matches("a_x = -3.1839 m/s^2\n", "a_x = -3.18391 m/s^2\n")
+    assert output_matches('pos="0.0176776695296637 0.0176776695296637 0"\n',
+                          'pos="0.017677669529663688 0.0176776695296637 0"\n')
+    assert not output_matches('pos="0.0176776695296637 0"\n', 'pos="0.0176776695296637 1"\n')
 
 
 def test_mkdocs_build_strict_has_no_warnings(tmp_path):

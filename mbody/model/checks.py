@@ -54,6 +54,12 @@ PERPENDICULAR_TOL = 1e-6
 MAX_ANGLE = 1e9
 """Largest angle accepted, rad (about 160 million turns): a double resolves 1e9 to 1e-7
 rad, and sin/cos of a larger number say little about the pose meant."""
+BARE_ANGLE_LIMIT = 2.0 * math.pi
+"""A bare number (no unit) as an angle of a pose beyond this many radians, one turn, is
+read as radians with a warning (did you mean degrees?): no pose needs more than a turn,
+while 45 or 90 is what a student who thinks in degrees writes. Angular velocities are
+never warned about (a wheel spins at 100 rad/s), and a bare 5 meant as degrees cannot be
+told from 5 rad."""
 
 
 def vec_norm(v: np.ndarray) -> np.ndarray:
@@ -227,6 +233,10 @@ class Checker:
                      f"{x:g} rad", "a double cannot resolve the pose of a larger angle; "
                      "reduce it by whole turns")
             return None
+        if not rate and not isinstance(value, str) and abs(x) > BARE_ANGLE_LIMIT:
+            self.warn(path, f"the angle {_show(value)} is read as {_show(value)} rad, "
+                      f"{abs(x) / (2 * math.pi):.3g} turns (a number without a unit is in "
+                      "radians)", f"did you mean '{_show(value)} deg'?")
         return x
 
     def vector(self, path: Path_, value: Any, n: int, *, angles: bool = False,

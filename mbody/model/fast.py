@@ -47,7 +47,7 @@ from mbody import joint_types
 from mbody.errors import ModelError
 from mbody.model.checks import (
     _TOL,
-    MAX_ANGLE,
+    BARE_ANGLE_LIMIT,
     MAX_MAGNITUDE,
     MIN_MAGNITUDE,
     MIN_NORM,
@@ -70,7 +70,9 @@ from mbody.model.validate import (
     JointSpecTable,
     LoadTable,
     Spec,
+    far_joint_points,
     header,
+    reach_of_bodies,
     rest,
 )
 
@@ -196,6 +198,10 @@ def _spec(text: str, file: str) -> Spec:
         c, [], [] if point else None, [] if joints is not None else None)
     if c.issues or c.warnings:
         raise _Bail  # warnings need their lines: the located path gives them
+    if joints is not None and np.any(far_joint_points(
+            joints.at, joints.parent, joints.child, table.position,
+            reach_of_bodies(table.mass, table.inertia, c.dim == cv.PLANAR))):
+        raise _Bail  # the located path warns (validate._far_joint_points)
     return Spec(name, file, c.dim, gravity, [], loads, joint_list, reactions, description,
                 [], expressions, table, point, joints, drivers)
 
@@ -668,8 +674,8 @@ def _bodies(c: Checker, groups: list[_Group]) -> BodyTable:
         if planar:
             if ("angle",) in cols:
                 th = _numbers(g, ("angle",), None)
-                if not np.all(np.abs(th) <= MAX_ANGLE):
-                    raise _Bail
+                if not np.all(np.abs(th) <= BARE_ANGLE_LIMIT):
+                    raise _Bail  # refused beyond MAX_ANGLE, else warned about (degrees?)
                 # math.cos, as the located path: numpy's may differ in the last bit
                 q[i, 0] = [math.cos(t / 2) for t in th.tolist()]
                 q[i, 3] = [math.sin(t / 2) for t in th.tolist()]

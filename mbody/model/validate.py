@@ -278,6 +278,8 @@ def validate(doc: Document) -> Spec:
     data = doc.data
     bodies = _bodies(c, data.get("bodies"))
     loads, joints, reactions, reaction_expressions, drivers = rest(c, bodies, None)
+    if not getattr(doc, "source_format", ""):  # what a person wrote (docstring of the check)
+        _far_joint_points(c, bodies, joints)
     return Spec(str(name), doc.file, c.dim, gravity, bodies, loads, joints, reactions,
                 description, c.warnings, reaction_expressions, drivers=drivers)
 
@@ -847,6 +849,110 @@ def _joint_params(c: Checker, p: Path_, j: dict, typ: str | None
         return None
     pitch = got.get("pitch")
     return axis, axis2, float(pitch) if pitch is not None else 0.0
+
+
+JOINT_REACH_GYRATION = 4.0
+"""A joint point farther than this many radii of gyration ρ from a body's mass centre is
+beyond the body (ρ² = I_G/m in the plane, (I1 + I2 + I3)/2m in space: the mean squared
+distance of its mass from the mass centre). No point of a uniform convex body is that far:
+a rod's ends are at √3 ρ = 1.7 ρ, a slender triangle's apex at 2.8 ρ, a slender cone's,
+the extreme, at 3.9 ρ."""
+JOINT_REACH_SHAPE = 2.0
+"""A body with a shape reaches at least this many times its shape's farthest point from
+the mass centre (an axle or a light arm a shape leaves out stays within it)."""
+
+
+def shape_extent(shape: dict[str, Any], planar: bool) -> float:
+    """The distance from the mass centre (m) of a shape's farthest point (in the plane,
+    for a planar model): a box's half-diagonal, a cylinder's rim..."""
+    kind, v = next(iter(shape.items()))
+    if kind == "box":
+        return 0.5 * math.hypot(*v)
+    if kind == "ellipsoid":
+        return float(max(v))
+    if kind == "cylinder" and not planar:  # seen end-on in the plane: a disc
+        return math.hypot(v["radius"], 0.5 * v["length"])
+    return float(v["radius"])  # sphere, disc, a planar cylinder
+
+
+def body_reach(mass: float, inertia: np.ndarray, shape: dict[str, Any] | None,
+               planar: bool) -> tuple[float, str]:
+    """How far from its mass centre (m) a joint point may lie on a body of this mass,
+    inertia (body axes, about the mass centre) and shape, and on what that rests:
+    `JOINT_REACH_GYRATION` radii of gyration, or `JOINT_REACH_SHAPE` times the shape's
+    extent when that is farther."""
+    reach = float(reach_of_bodies(np.array([mass]), inertia[None], planar)[0])
+    basis = f"{JOINT_REACH_GYRATION:g} radii of gyration"
+    if shape is not None:
+        drawn = JOINT_REACH_SHAPE * shape_extent(shape, planar)
+        if drawn > reach:
+            reach, basis = drawn, f"{JOINT_REACH_SHAPE:g} times its shape's extent"
+    return reach, basis
+
+
+def reach_of_bodies(mass: np.ndarray, inertia: np.ndarray, planar: bool) -> np.ndarray:
+    """(n,) `body_reach` of bodies without a shape, at once: `JOINT_REACH_GYRATION` radii
+    of gyration."""
+    rho2 = (inertia[:, 2, 2] if planar else np.trace(inertia, axis1=1, axis2=2) / 2.0) / mass
+    return JOINT_REACH_GYRATION * np.sqrt(np.maximum(rho2, 0.0))
+
+
+def far_joint_points(at: np.ndarray, parent: np.ndarray, child: np.ndarray,
+                     position: np.ndarray, reach: np.ndarray) -> np.ndarray:
+    """(k,) whether each joint's point `at` (k, 3, world) lies beyond the reach of every
+    body it joins: `parent`, `child` (k,) body indices into `position` (n, 3, mass centres,
+    world) and `reach` (n,), or -1 for an end not counted (ground, a particle). A joint
+    with no end counted is never far."""
+    far = np.ones(len(at), dtype=bool)
+    counted = np.zeros(len(at), dtype=bool)
+    for end in (parent, child):
+        has = end >= 0
+        i = np.where(has, end, 0)
+        d = np.linalg.norm(at - position[i], axis=1) if len(at) else np.zeros(0)
+        far &= ~has | (d > reach[i])
+        counted |= has
+    return far & counted
+
+
+def _far_joint_points(c: Checker, bodies: list[BodySpec], joints: list[JointSpec]) -> None:
+    """Warn where a joint's point lies beyond every body it joins (`body_reach`): a point
+    given in a body's axes instead of the world's, in mm, with a sign or a body's position
+    wrong. Ground and particles are not counted (a joint to a particle away from it is a
+    light link). Only for files a person writes: an MJCF or URDF reader puts each joint at
+    its anchor, and a robot link's inertia is what its CAD gave (Baxter's gripper base
+    has its joint 390 radii of gyration away)."""
+    if not joints:
+        return
+    planar = c.dim == cv.PLANAR
+    index = {b.name: k for k, b in enumerate(bodies)}
+    reach = [body_reach(b.mass, b.inertia, b.shape, planar) for b in bodies]
+
+    def counted(name: str) -> int:
+        k = index.get(name, -1)
+        return -1 if k < 0 or bodies[k].particle else k
+
+    parent = np.array([counted(j.parent) for j in joints], dtype=np.intp)
+    child = np.array([counted(j.child) for j in joints], dtype=np.intp)
+    far = far_joint_points(np.array([j.at for j in joints]), parent, child,
+                           np.array([b.position for b in bodies]).reshape(-1, 3),
+                           np.array([r for r, _ in reach]))
+    where = {j.get("name"): i for i, j in enumerate(c.doc.data.get("joints") or [])
+             if isinstance(j, dict)}
+    for j, p, ch, is_far in zip(joints, parent.tolist(), child.tolist(), far.tolist(),
+                                strict=True):
+        if not is_far:
+            continue
+        ends = [k for k in (p, ch) if k >= 0]
+        parts = [f"{float(np.linalg.norm(j.at - bodies[k].position)):.4g} m from the mass "
+                 f"centre of '{bodies[k].name}' (beyond {reach[k][0]:.3g} m, {reach[k][1]})"
+                 for k in ends]
+        shown = ", ".join(f"{x:g}" for x in (j.at[:2] if planar else j.at))
+        c.warn(("joints", where.get(j.name, 0), "at"),
+               f"the joint point ({shown}) lies off "
+               f"{'the body' if len(ends) == 1 else 'both bodies'} it joins: "
+               + " and ".join(parts),
+               "'at' is in world coordinates, where the bodies meet at the pose the file "
+               "gives them; check it and the bodies' positions and angles")
 
 
 PARTICLE_JOINTS = {cv.PLANAR: ("revolute",), cv.SPATIAL: ("revolute", "spherical")}

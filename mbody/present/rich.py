@@ -34,6 +34,7 @@ from mbody.model.model import count
 from mbody.present import latex, text
 from mbody.present.animate import build_scene, page_html
 from mbody.present.html import Markup, block, table, tag
+from mbody.simulate.simulation import conserved_lines
 
 if TYPE_CHECKING:
     from mbody.equations.assemble import Assembly, Solution
@@ -405,11 +406,10 @@ def trajectory_html(traj: Trajectory) -> str:
     if "integrator" in info:
         facts.append(["integrator", f"{info['integrator']}, rtol {info.get('rtol', '?')}, "
                                     f"{info.get('steps', '?')} steps"])
-    for key, what in (("energy_drift", "energy drift (relative)"),
-                      ("joint_position_drift", "joint position drift (m)"),
-                      ("angular_momentum_drift", "angular momentum drift (relative)")):
-        if isinstance(info.get(key), float):
-            facts.append([what, f"{info[key]:.2e}"])
+    # a drift figure where the model conserves the quantity, else why it does not
+    facts += [[what, said] for what, said in conserved_lines(info)]
+    if isinstance(info.get("joint_position_drift"), float):
+        facts.append(["joint position drift (m)", f"{info['joint_position_drift']:.2e}"])
     if traj.reaction_labels:
         facts.append(["reaction series", ", ".join(traj.reaction_labels[:20])
                       + (" ..." if len(traj.reaction_labels) > 20 else "")])

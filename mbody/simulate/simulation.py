@@ -35,6 +35,7 @@ import numpy as np
 from mbody import conventions as cv
 from mbody.equations.constraints import joint_errors
 from mbody.equations.kernels import spring_ends
+from mbody.equations.spatial import matvec, quat_to_matrix
 from mbody.errors import MbodyError, UnknownReactionsError, did_you_mean
 from mbody.model.expressions import Expression, check_times, compile_expression, first_nonfinite
 from mbody.model.model import Model, State
@@ -404,7 +405,7 @@ def _simulate(model: Model, t_end: float, fps: float, rtol: float, atol: float, 
         shapes=tuple(model.bodies[b].shape for b in model.body_names),
         colors=tuple(model.bodies[b].color for b in model.body_names),
         gravity=np.array(model.gravity), model_yaml=_model_text(model))
-    series, drift = _drift(model, traj, dynamics is None, ideal_joints=mechanism)
+    series, drift = _drift(model, traj, dynamics is None, ideal_joints=mechanism, known=known)
     traj.series.update(series)
     info.update(drift)
     info["compile_time_s"] = clock.seconds  # the whole call's, reactions' kernels included
@@ -723,50 +724,159 @@ def _numeric_known(model: Model, known: Mapping[str, float | str] | None
     return out
 
 
-def _drift(model: Model, traj: Trajectory, default_dynamics: bool, *,
-           ideal_joints: bool = False) -> tuple[dict[str, np.ndarray], dict]:
-    """Energy and angular-momentum series and their largest relative change.
+def _named(names: list[str], most: int = 3) -> str:
+    shown = ", ".join(names[:most])
+    return shown + (f" and {len(names) - most} more" if len(names) > most else "")
 
-    Energy E = T + V; its change is relative to max(|E(0)|, max T). Angular momentum: about
-    the world origin when nothing external acts (gravity-free, no applied loads, no
-    springs to ground, no reactions); with gravity as the only load, the spin momentum
-    Σ W_R_B J ω (gravity has no moment about a mass centre); else it is not conserved.
-    """
+
+def conservation(model: Model, default_dynamics: bool = True, ideal_joints: bool = False,
+                 known: Mapping[str, float | str] | None = None) -> dict[str, str]:
+    """What keeps each quantity from being conserved in this model: for ``energy``,
+    ``momentum`` (linear) and ``angular_momentum``, the reasons ("" when it is conserved);
+    ``angular_momentum_kind`` says about which point.
+
+    Energy E = T + V (gravity, springs) is conserved when nothing else does work: no
+    applied forces or torques (their potential is not in V), no dampers, no reaction
+    values given (solved reactions of ideal joints do no work), mbody's own dynamics.
+    Linear momentum Σ m v: no external force (gravity, applied forces, springs or joints
+    to ground; a couple and forces between bodies leave it). Angular momentum: about the
+    world origin when nothing external acts; with uniform gravity as the only external
+    load, about the mass centres (each body's spin, when nothing joins the bodies) or
+    about the system's mass centre (gravity has no moment about it). `ideal_joints`: the
+    unknown reactions are solved (a mechanism); `known`: reaction values given besides the
+    file's."""
+    sp = model.springs
+    forces = model.forces
+    loads = list(forces.names)
+    pushes = [nm for nm, c in zip(forces.names, forces.couple.tolist(), strict=True)
+              if not c]
+    springs = list(sp.names)
+    grounded_springs = [nm for nm, a, b in zip(sp.names, sp.a.tolist(), sp.b.tolist(),
+                                               strict=True) if a < 0 or b < 0]
+    dampers = [nm for nm, c in zip(sp.names, sp.damping.tolist(), strict=True) if c > 0]
+    grounded_joints = [j.name for j in model.joints if j.parent == cv.GROUND]
+    gravity = bool(np.any(model.gravity))
+    own = [] if default_dynamics else ["the dynamics are the caller's"]
+
+    energy = list(own)
+    if loads:
+        energy.append(f"applied loads do work: {_named(loads)}")
+    if dampers:
+        energy.append(f"dampers dissipate: {_named(dampers)}")
+    given = list(model.known_reactions) if ideal_joints else list(model.reactions)
+    given += [k for k in known or {} if k not in given]
+    if given:  # solved reactions of ideal joints do no work (Gᵀ v = 0); given ones may
+        energy.append(f"given reaction values act as loads: {_named(given)}")
+
+    external = list(own)
+    if gravity:
+        external.append("gravity")
+    if pushes:
+        external.append(f"applied forces: {_named(pushes)}")
+    if grounded_springs:
+        external.append(f"springs to ground: {_named(grounded_springs)}")
+    if grounded_joints:
+        external.append(f"joints to ground: {_named(grounded_joints)}")
+
+    moments = [r for r in external if r != "gravity"]
+    couples = [nm for nm in loads if nm not in pushes]
+    if couples:
+        moments.append(f"applied couples: {_named(couples)}")
+    turning: list[str] = []
+    if not moments and not gravity:
+        kind = "total, about the world origin"
+    elif not moments and not springs and not model.joints:
+        kind = "spin, about the mass centres"
+    elif not moments:
+        kind = "total, about the system's mass centre"
+    else:
+        kind = "total, about the world origin"
+        turning = (["gravity"] if gravity else []) + moments
+    return {"energy": "; ".join(energy), "momentum": "; ".join(external),
+            "angular_momentum": "; ".join(turning), "angular_momentum_kind": kind}
+
+
+def _change(series: np.ndarray, terms: np.ndarray) -> float:
+    """max over the samples of |x(t) − x(0)|, relative to the largest sum of the
+    magnitudes of the terms x is the sum of (K, n, 3): what its rounding is relative to,
+    and not 0 when the sum is (two bodies spinning against each other: H = 0); 0 when
+    every term is."""
+    scale = float(np.max(np.linalg.norm(terms, axis=2).sum(axis=1))) if terms.size else 0.0
+    if scale <= 0:
+        return 0.0
+    return float(np.max(np.linalg.norm(series - series[0], axis=1)) / scale)
+
+
+def _drift(model: Model, traj: Trajectory, default_dynamics: bool, *,
+           ideal_joints: bool = False, known: Mapping[str, float | str] | None = None
+           ) -> tuple[dict[str, np.ndarray], dict]:
+    """Energy, linear and angular momentum: their series, largest relative change, and
+    whether the model conserves them (`conservation`, with its reasons when not).
+
+    Energy E = T + V; its change is relative to max(|E(0)|, max T). Linear momentum
+    p = Σ m v and angular momentum H = Σ (r × m v + W_R_B J ω) (r and v from the world
+    origin, or from the system's mass centre; spin only: Σ W_R_B J ω): relative to the
+    largest sum of their terms' magnitudes (`_change`)."""
+    why = conservation(model, default_dynamics, ideal_joints, known)
     T = traj.kinetic_energy()
     V = potential_energy(model, traj)
     E = T + V
     scale = max(abs(E[0]), float(np.max(np.abs(T))) if len(T) else 0.0)
     e_change = float(np.max(np.abs(E - E[0])) / scale) if scale > 0 else 0.0
 
-    sp = model.springs
-    # Ideal joints whose reactions are solved do no work (Gᵀ v = 0): energy is conserved.
-    applied = (len(model.forces.names) > 0 or not default_dynamics
-               or (bool(model.reactions) and not ideal_joints)
-               or (ideal_joints and bool(model.known_reactions)))
-    grounded = (bool(np.any((sp.a < 0) | (sp.b < 0))) if len(sp.names) else False) or \
-        any(j.parent == cv.GROUND for j in model.joints)
-    damped = bool(np.any(sp.damping > 0)) if len(sp.names) else False
-    gravity = bool(np.any(model.gravity))
-    energy_conserved = not applied and not damped
-    if not applied and not grounded and not gravity:
-        H, kind = traj.angular_momentum(), "total, about the world origin"
-        h_conserved = True
-    elif not applied and not len(sp.names) and not model.joints:
-        H, kind = traj.spin_angular_momentum(), "spin, about the mass centres"
-        h_conserved = True
+    mass = np.asarray(model.mass, dtype=float)
+    x, q, v, w = traj.spatial()
+    mv = mass[:, None] * v  # (K, n, 3) each body's momentum
+    p = mv.sum(axis=1)
+    spin = matvec(quat_to_matrix(q), matvec(np.asarray(model.J, dtype=float), w))
+    kind = why["angular_momentum_kind"]
+    if kind.startswith("spin"):
+        terms = spin
     else:
-        H, kind = traj.angular_momentum(), "total, about the world origin"
-        h_conserved = False
-    h0 = float(np.linalg.norm(H[0]))
-    h_scale = max(h0, float(np.max(np.linalg.norm(H, axis=1))))
-    h_change = float(np.max(np.linalg.norm(H - H[0], axis=1)) / h_scale) if h_scale > 0 else 0.0
+        r, u = x, v
+        if kind.endswith("system's mass centre"):
+            M = float(mass.sum())
+            r = x - (np.einsum("n,kni->ki", mass, x) / M)[:, None]
+            u = v - (p / M)[:, None]
+        terms = np.concatenate((np.cross(r, mass[:, None] * u), spin), axis=1)
+    H = terms.sum(axis=1)
     series = {"kinetic_energy": T, "potential_energy": V, "energy": E, "angular_momentum": H}
     return series, {
-        "energy_conserved": energy_conserved, "energy_drift": e_change,
-        "energy_initial": float(E[0]),
-        "angular_momentum_conserved": h_conserved, "angular_momentum_kind": kind,
-        "angular_momentum_drift": h_change, "angular_momentum_initial": H[0].tolist(),
+        "energy_conserved": not why["energy"], "energy_drift": e_change,
+        "energy_initial": float(E[0]), "energy_not_conserved": why["energy"],
+        "momentum_conserved": not why["momentum"], "momentum_drift": _change(p, mv),
+        "momentum_initial": p[0].tolist(), "momentum_not_conserved": why["momentum"],
+        "angular_momentum_conserved": not why["angular_momentum"],
+        "angular_momentum_kind": kind,
+        "angular_momentum_drift": _change(H, terms), "angular_momentum_initial": H[0].tolist(),
+        "angular_momentum_not_conserved": why["angular_momentum"],
     }
+
+
+def conserved_lines(info: Mapping) -> list[tuple[str, str]]:
+    """(quantity, what the run says of it) for energy, linear and angular momentum: the
+    relative drift where the model conserves it, else "not conserved here (reason)"; for
+    the summary and the notebook's table (runs saved before the reasons were kept say
+    "not conserved here" alone)."""
+    out = []
+    for key, what, unit in (("energy", "energy T + V", "J"),
+                            ("momentum", "linear momentum", "kg m/s"),
+                            ("angular_momentum", "angular momentum", "kg m^2/s")):
+        if f"{key}_drift" not in info:
+            continue
+        if key == "angular_momentum":
+            what += f" ({info.get('angular_momentum_kind', 'about the world origin')})"
+        if info.get(f"{key}_conserved"):
+            first = info.get(f"{key}_initial")
+            start = (f"E(0) = {first:.6g} J" if key == "energy" else
+                     f"|{'p' if key == 'momentum' else 'H'}(0)| = "
+                     f"{float(np.linalg.norm(first)):.6g} {unit}") if first is not None else ""
+            out.append((what, (start + ", " if start else "")
+                        + f"relative drift {info[f'{key}_drift']:.2e}"))
+        else:
+            reason = info.get(f"{key}_not_conserved", "")
+            out.append((what, "not conserved here" + (f" ({reason})" if reason else "")))
+    return out
 
 
 def summary(traj: Trajectory, path: str | os.PathLike[str] | None = None) -> str:
@@ -783,18 +893,9 @@ def summary(traj: Trajectory, path: str | os.PathLike[str] | None = None) -> str
         + (f" (plus {i['compile_time_s']:.3g} s to compile the fast path once)"
            if i.get("compile_time_s") else ""),
     ]
-    what = "drift" if i["energy_conserved"] else "change (not guaranteed: loads or reactions act)"
-    lines.append(f"energy T + V: E(0) = {i['energy_initial']:.6g} J, relative {what} "
-                 f"{i['energy_drift']:.2e}")
-    what = "drift" if i["angular_momentum_conserved"] else \
-        "change (not conserved: external moments)"
-    h0 = np.linalg.norm(i["angular_momentum_initial"])
-    if i["angular_momentum_conserved"]:
-        lines.append(f"angular momentum ({i['angular_momentum_kind']}): |H(0)| = {h0:.6g} "
-                     f"kg m^2/s, relative {what} {i['angular_momentum_drift']:.2e}")
-    else:  # a relative change of something not conserved (and maybe 0 at t = 0) says little
-        lines.append(f"angular momentum ({i['angular_momentum_kind']}): |H(0)| = {h0:.6g} "
-                     "kg m^2/s, not conserved (external moments act)")
+    # a drift figure only for what the model conserves: the relative change of anything
+    # else (a motor's work, gravity's moment) is physics, not an error
+    lines.extend(f"{what}: {said}" for what, said in conserved_lines(i))
     if i["energy_conserved"] and i["energy_drift"] > 1e-6:
         lines.append(f"warning: energy should be conserved but drifted {i['energy_drift']:.1e}"
                      " (relative); check the initial state and the tolerances")
