@@ -54,7 +54,7 @@ def test_the_core_gives_todays_results(name, model, tag):
     y, t = g["y"], float(g["t"])
     tol = max(1e-12, 10.0 * float(g["cond"]) * EPS)
     state = state_of(model, y, t)
-    n, m = model.n, len(model.reactions)
+    m = len(model.reactions)
     N = int(g["N"])
     old = g["solve"]
     # the solve, through the public API
