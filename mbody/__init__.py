@@ -32,8 +32,8 @@ _LAZY = {
     "BodyEquations": "equations.fbd", "Equation": "equations.fbd",
     "ForceOnBody": "equations.fbd", "FreeBodyDiagram": "equations.fbd",
     "Body": "model.model", "Joint": "model.model", "Load": "model.model",
-    "Model": "model.model", "State": "model.model", "load": "model.model",
-    "loads": "model.model",
+    "Model": "model.model", "State": "model.model", "load": "loading",
+    "loads": "loading", "kinematics": "solve.kinematics",
     "simulate": "simulate.simulation",
     "Trajectory": "simulate.trajectory",
     "verify": "answers.verify",
@@ -45,7 +45,7 @@ __all__ = [
     "FreeBodyDiagram", "load_export",
     "Issue", "Joint", "Load", "MbodyError", "Model", "ModelError", "Solution", "State",
     "Trajectory", "simulate",
-    "UnknownReactionsError", "animate", "assemble", "load", "loads", "verify",
+    "UnknownReactionsError", "animate", "assemble", "kinematics", "load", "loads", "verify",
 ]
 
 

@@ -32,7 +32,7 @@ def load_model(path: str, *, warn: bool = True):
     ``--q``, ``--qd`` and ``--floating-base`` (`add_import_options`)."""
     import sys
 
-    from mbody.model.model import load
+    from mbody.loading import load
 
     model = load(path, **(_IMPORT.get() or {}))
     if warn:

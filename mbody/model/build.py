@@ -94,6 +94,10 @@ def joint_tables(dimension: int, js: JointSpecTable, names: tuple[str, ...],
     C_E = RcT @ W_E0
     B_r_child = (RcT @ (at - xc)[:, :, None])[:, :, 0]
     B_r_parent = np.where(ground[:, None], at, (RpT @ (at - xp)[:, :, None])[:, :, 0])
+    if js.body_points is not None and js.body_points.any():  # the file gives them
+        on = js.body_points
+        B_r_child[on] = js.at_child[on]
+        B_r_parent[on] = js.at_parent[on]
     C_axis2 = (RcT @ js.axis2[:, :, None])[:, :, 0]
     # a particle end is attached at the particle itself (no offset, no moment)
     p_particle = particle[p] & ~ground
@@ -135,7 +139,9 @@ def joint_tables(dimension: int, js: JointSpecTable, names: tuple[str, ...],
                           for typ in types], dtype=bool)
     per_joint = JointTable(tuple(js.names), p, c, readonly(B_r_child), readonly(B_r_parent),
                            readonly(P_E), readonly(C_E), readonly(C_axis2), first, link, p_particle,
-                           readonly(length), free_turn, readonly(js.pitch))
+                           readonly(length), free_turn, readonly(js.pitch),
+                           np.zeros(nj, dtype=bool) if js.body_points is None
+                           else np.asarray(js.body_points, dtype=bool))
     if drivers is not None and len(drivers):  # the drivers' efforts: last components
         row_joint = np.concatenate((row_joint, drivers.joint))
         component = np.concatenate((component, [joint_types.COMPONENT_CODE[c]

@@ -174,7 +174,7 @@ def _law(c: Checker, p: Path_, d: dict, key: str, motion: joint_types.Motion
             c.err((*p, key), f"invalid law: {exc.reason} in \"{value}\"",
                   exc.hint or "an expression of t: see docs/expressions.md")
             return None, None
-        return e, None
+        return Expression(value, e.tree), None  # shown as written (deg and all)
     x = c.number((*p, key), value)
     return (compile_expression(repr(float(x))) if x is not None else None), None
 

@@ -185,6 +185,10 @@ class Model:
     drivers: DriverTable | None = None
     """Joint coordinates prescribed in time (`mbody.model.drivers`); their efforts are the
     last components of `reaction_table` (labels ``<driver>.M`` or ``.F``)."""
+    file_state: State | None = None
+    """The state the file wrote when `initial` is the assembled one (`mbody.load` moves the
+    bodies onto their joints and drivers when the file gives joint points per body or
+    drivers: `mbody.solve.kinematics.assembled`); None when `initial` is the file's."""
 
     def __repr__(self) -> str:  # the dataclass's would print every array (2-9 KB)
         kind = "planar" if self.dimension == cv.PLANAR else "spatial"

@@ -111,6 +111,8 @@ class JointTable:
     length: np.ndarray
     free_turn: np.ndarray
     pitch: np.ndarray
+    body_points: np.ndarray
+    """(J,) the file gives the joint's point on each body (not one world point)."""
 
     def __repr__(self) -> str:  # the dataclass's would print every array
         return (f"<JointTable: {len(self.names)} joints ({', '.join(self.names[:4])}"

@@ -21,7 +21,7 @@ import numpy as np
 
 from mbody import conventions as cv
 from mbody import joint_types
-from mbody.equations.spatial import euler_to_quat, matrix_to_quat, shape_inertia
+from mbody.equations.spatial import euler_to_quat, matrix_to_quat, quat_to_matrix, shape_inertia
 from mbody.errors import Issue, ModelError, did_you_mean
 from mbody.model.checks import (
     _TOL,
@@ -119,6 +119,10 @@ class JointSpec:
     (a massless rigid link from the joint point to the particle); "" otherwise."""
     pitch: float = 0.0
     """A helical joint's advance per turn along its axis (m; positive: right-handed)."""
+    body_points: tuple[np.ndarray, np.ndarray] | None = None
+    """The joint's point on each body, when the file gives them (``at: [[parent point],
+    [child point]]``): the parent's in its axes from its mass centre (world for ground),
+    the child's in its axes; `at` is then the child's point at the file's pose."""
 
 
 @dataclass
@@ -177,7 +181,9 @@ class JointSpecTable:
     names, types; parent, child: (k,) body indices (-1 = ground); at: (k, 3) the joint
     point, world, initial pose; axis, axis2: (k, 3) unit axes, zero where `has_axis`,
     `has_axis2` are False; particle_joint: "pin", "link" or "" per joint; pitch: (k,) a
-    helical joint's advance per turn (m; 0 for other types).
+    helical joint's advance per turn (m; 0 for other types); body_points: (k,) the file
+    gives the joint's point on each body (then at_parent, at_child (k, 3) hold them, in
+    the parent's axes or the world for ground, and in the child's axes; else zeros).
     """
 
     names: list[str]
@@ -191,6 +197,9 @@ class JointSpecTable:
     has_axis2: np.ndarray
     particle_joint: list[str]
     pitch: np.ndarray
+    body_points: np.ndarray | None = None
+    at_parent: np.ndarray | None = None
+    at_child: np.ndarray | None = None
 
     @classmethod
     def from_specs(cls, joints: list[JointSpec], index: dict[str, int]) -> JointSpecTable:
@@ -223,7 +232,10 @@ class JointSpecTable:
                    np.array([a is not None for a in axes], dtype=bool), stack(axes2),
                    np.array([a is not None for a in axes2], dtype=bool),
                    [j.particle_joint for j in joints],
-                   np.array([j.pitch for j in joints], dtype=float).reshape(k))
+                   np.array([j.pitch for j in joints], dtype=float).reshape(k),
+                   np.array([j.body_points is not None for j in joints], dtype=bool),
+                   stack([j.body_points[0] if j.body_points else None for j in joints]),
+                   stack([j.body_points[1] if j.body_points else None for j in joints]))
 
 
 @dataclass
@@ -800,7 +812,8 @@ def _joints(c: Checker, value: Any, names: dict[str, int],
             c.err((*p, "child"), f"the joint connects '{child}' to itself",
                   "parent and child must be different bodies (or ground as the parent)")
             child = None
-        at = c.vec3((*p, "at"), j["at"]) if "at" in j else None
+        at, points = (_joint_at(c, p, j["at"], parent, child, bodies) if "at" in j
+                      else (None, None))
         params = _joint_params(c, p, j, typ)
         if params is None:
             continue
@@ -817,8 +830,26 @@ def _joints(c: Checker, value: Any, names: dict[str, int],
             kind = found
             c.particle_joints.setdefault(name, kind)
         out.append(JointSpec(name, typ, parent, child, at, axis, axis2, c.doc.where(p)[0],
-                             kind, pitch))
+                             kind, pitch, points))
     return out
+
+
+def _joint_at(c: Checker, p: Path_, value: Any, parent: str | None, child: str | None,
+              bodies: list[BodySpec]
+              ) -> tuple[np.ndarray | None, tuple[np.ndarray, np.ndarray] | None]:
+    """(the joint point in world coordinates at the file's pose, or None; the points on
+    each body when the file gives them: ``at: [[parent point], [child point]]``, each in
+    its body's axes from the mass centre, world coordinates for ground)."""
+    if not (isinstance(value, list) and len(value) == 2
+            and all(isinstance(v, list) for v in value)):
+        return c.vec3((*p, "at"), value), None
+    rp = c.vec3((*p, "at", 0), value[0])
+    rc = c.vec3((*p, "at", 1), value[1])
+    pose = {b.name: b for b in bodies}
+    if rp is None or rc is None or child not in pose:
+        return None, None
+    b = pose[child]  # where the child's point is at the file's pose
+    return b.position + quat_to_matrix(b.quaternion) @ rc, (rp, rc)
 
 
 def _joint_params(c: Checker, p: Path_, j: dict, typ: str | None

@@ -91,9 +91,23 @@ def model_summary(model: Model, topo: Topology) -> str:
             out.append(f"  {ld.name:<14} {what}")
     if model.joints:
         out.append(f"joints ({len(model.joints)}):")
-        for j in model.joints[:50]:
-            out.append(f"  {j.name:<14} {j.type} {j.parent} -> {j.child} at {_v(j.at, dim)}: "
+        jt = model.joint_table
+        for k, j in enumerate(model.joints[:50]):
+            if jt.body_points[k]:  # the file gives the point on each body
+                where = (f"{_v(jt.B_r_parent[k], dim)} on {j.parent}, "
+                         f"{_v(jt.B_r_child[k], dim)} on {j.child}")
+            else:
+                where = _v(j.at, dim)
+            out.append(f"  {j.name:<14} {j.type} {j.parent} -> {j.child} at {where}: "
                        + ", ".join(j.labels))
+    drivers = model.drivers
+    if drivers is not None and len(drivers):
+        out.append(f"drivers ({len(drivers)}):")
+        for name, j, (law, _, _), label in zip(drivers.names, drivers.joint.tolist(),
+                                                drivers.laws, drivers.labels, strict=True):
+            unit = "rad" if label.endswith(".M") else "m"
+            out.append(f"  {name:<14} {model.joints[j].name}: {law.text} ({unit}, t in s); "
+                       f"effort {label}")
     unknown = [r for r in model.reactions if r not in model.known_reactions]
     out.append(f"reaction unknowns ({len(unknown)}): " + (", ".join(unknown[:40]) or "none")
                + (" ..." if len(unknown) > 40 else ""))
@@ -101,11 +115,28 @@ def model_summary(model: Model, topo: Topology) -> str:
         out.append("known reactions: " + ", ".join(
             f"{k} = {model.known_expressions.get(k) or _n(v)}"
             for k, v in model.known_reactions.items()))
+    if model.file_state is not None:  # assembled at load (joint points per body, drivers)
+        moved = assembly_moves(model)
+        out.append("assembled pose (every joint and driver holds at t = 0): "
+                   + ("; ".join(moved) if moved else "the file's pose already did"))
     out.append("")
     out.append(graph_summary(model, topo))
     for w in model.warnings:
         out.append(f"warning: {w}")
     return "\n".join(out)
+
+
+def assembly_moves(model: Model) -> list[str]:
+    """How far each body moved from the file's pose to the assembled one, in words."""
+    before = model.file_state
+    if before is None:
+        return []
+    d = np.linalg.norm(model.initial.position - before.position, axis=1)
+    dot = np.abs(np.einsum("ij,ij->i", before.quaternion, model.initial.quaternion))
+    turned = np.degrees(2.0 * np.arccos(dot.clip(0.0, 1.0)))
+    return [f"{name} moved {dk * 1e3:.3g} mm, turned {ak:.3g} deg"
+            for name, dk, ak in zip(model.body_names, d.tolist(), turned.tolist(), strict=True)
+            if dk > 1e-12 or ak > 1e-10]
 
 
 def graph_summary(model: Model, topo: Topology) -> str:

@@ -7,8 +7,8 @@ from pathlib import Path
 
 import mbody
 from mbody.errors import MbodyError
+from mbody.loading import load as load_model
 from mbody.model.model import Model
-from mbody.model.model import load as load_model
 from mbody.simulate.trajectory import Trajectory
 
 Source = Trajectory | Model | str | os.PathLike[str]

@@ -1,0 +1,142 @@
+"""Kinematic analysis: the positions and velocities that close every joint and driver.
+
+A mechanism with drivers (joint coordinates prescribed in time) is moved by them; one
+whose joint points are given on each body (``at: [[parent point], [child point]]``) has
+a file pose that need only be close. Both need the configuration where every constraint
+holds at a time t:
+
+    φ(q, t) = 0          (position: Newton–Raphson from a start, on its branch)
+    Gᵀ v = f′(t)          (velocity: the smallest change of kinetic energy that keeps them)
+
+Each Newton step is the compiled core's coordinate projection (`mbody.kernel`,
+project.c): M Δ − G μ = 0, Gᵀ Δ = −φ, the least move in the kinetic metric, so the
+solution found is the one nearest the start (the file's pose, or the previous instant's
+solution along a run: its branch). The accelerations follow from the constraint
+equations with the forces, `mbody.assemble(model, state).solve()`: for a fully driven
+mechanism they are the motion the drivers impose, and the reactions with the drivers'
+efforts are what it takes (kinetostatics).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from mbody.equations.joints import reaction_columns
+from mbody.equations.workspace import workspace
+from mbody.errors import MbodyError
+from mbody.kernel import _core
+from mbody.model.model import Model, State
+
+NEWTON_STEPS = 60
+"""Newton steps at most (one is usually enough from an integrator's step; a few from a
+file's rough pose; more only near a dead centre, where the steps shrink)."""
+CLOSE_RTOL = 1e-12
+"""The joints hold when every position error is below this, relative to the model's
+size (angles: absolute, rad)."""
+
+
+class KinematicsError(MbodyError):
+    """The joints and drivers cannot all hold at a time: a loop that cannot close (a
+    driver past a dead centre, links too short), named with its distance left."""
+
+
+def kinematics(model: Model, t: float = 0.0, *, start: State | None = None) -> State:
+    """The positions and velocities that close every joint and driver at time `t`.
+
+    Parameters
+    ----------
+    model : Model
+        The model, with its drivers (if any).
+    t : float
+        Time (s): the drivers' laws are taken there.
+    start : State, optional
+        Where Newton's method starts (default: the file's state); its branch is the one
+        found, and its velocities are the ones kept as far as the joints allow.
+
+    Returns
+    -------
+    State
+        At time `t`: every joint and driver holds at position and velocity level.
+
+    Raises
+    ------
+    KinematicsError
+        The loops cannot close at `t` (which joints, the drivers' values, the distance
+        left).
+    """
+    ws = workspace(model)
+    state = model.initial if start is None else start
+    unknowns = ws.unknowns({})  # every joint and driver holds
+    solver = ws.solver(unknowns)
+    y = ws.state_vector(state.replace(t=t))
+    info = np.empty(_core.PROJECT_INFO)
+    size = _size(model)
+    moved = np.inf
+    for _ in range(NEWTON_STEPS):
+        solver.project(t, y, 1, 1e-2, 0, info)
+        if info[_core.PR_SINGULAR]:
+            code = int(info[_core.PR_SINGULAR]) - 1
+            body = model.body_names[code // 6]
+            raise KinematicsError(f"the position analysis at t = {t:g} s cannot move body "
+                                  f"{body!r}: its motion carries no mass")
+        moved = float(info[_core.PR_STEP])
+        if moved <= CLOSE_RTOL * size:
+            break
+    out = _state(model, y, t)
+    cols = reaction_columns(model, out)
+    scale = np.where(model.reaction_table.is_moment, 1.0, size)
+    bad = np.flatnonzero(np.abs(cols.phi) > 1e3 * CLOSE_RTOL * scale)
+    if len(bad) or not np.isfinite(y).all():
+        raise KinematicsError(_cannot_close(model, t, cols.phi, bad, moved))
+    return out
+
+
+def _state(model: Model, y: np.ndarray, t: float) -> State:
+    n = model.n
+    q = y[3 * n:7 * n].reshape(n, 4)
+    return State(y[:3 * n].reshape(n, 3).copy(), q / np.linalg.norm(q, axis=1)[:, None],
+                 y[7 * n:10 * n].reshape(n, 3).copy(), y[10 * n:13 * n].reshape(n, 3).copy(),
+                 float(t))
+
+
+def _size(model: Model) -> float:
+    """The model's length scale: the spread of its mass centres, its joints' arms."""
+    pts = model.initial.position
+    spread = float(np.ptp(pts, axis=0).max()) if model.n > 1 else 0.0
+    arms = float(np.abs(model.joint_table.B_r_child).max()) if len(model.joints) else 0.0
+    return max(spread, arms, 1e-3)
+
+
+def _cannot_close(model: Model, t: float, phi: np.ndarray, bad: np.ndarray,
+                  step: float) -> str:
+    rt = model.reaction_table
+    labels = rt.labels
+    worst = bad[np.argsort(-np.abs(phi[bad]))][:6]
+    left = ", ".join(f"{labels[k]} {phi[k]:.3g} {'rad' if rt.is_moment[k] else 'm'}"
+                     for k in worst)
+    drivers = model.drivers
+    at = ""
+    if drivers is not None and len(drivers):
+        values = [f"{name} = {float(law[0](t)):.6g} {'rad' if c == 'M' else 'm'}"
+                  for name, law, c in zip(drivers.names, drivers.laws, drivers.component,
+                                          strict=True)]
+        at = f" with {', '.join(values)}"
+    return (f"the joints cannot all close at t = {t:g} s{at}: the distance left is {left}"
+            f" (Newton's last step {step:.3g}); a driver may be past a dead centre, or the "
+            "links cannot reach")
+
+
+def assembled(model: Model) -> Model:
+    """The model with its initial state moved onto its joints and drivers at t = 0 when
+    the file asks for it: joint points given on each body, or drivers (whose laws at 0
+    may differ from the file's pose). Otherwise `model` itself: a model written with
+    world joint points is where the file puts it (`check` warns when it breaks a joint).
+    The file's own state is kept as `model.file_state`."""
+    needs = (model.drivers is not None and len(model.drivers) > 0) or bool(
+        model.joint_table.body_points.any())
+    if not needs or not len(model.reactions):
+        return model
+    state = kinematics(model, 0.0)
+    return dataclasses.replace(model, initial=state, file_state=model.initial)
