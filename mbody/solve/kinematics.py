@@ -25,7 +25,7 @@ import numpy as np
 
 from mbody.equations.joints import reaction_columns
 from mbody.equations.workspace import workspace
-from mbody.errors import MbodyError
+from mbody.errors import Issue, MbodyError, ModelError
 from mbody.kernel import _core
 from mbody.model.model import Model, State
 
@@ -128,6 +128,45 @@ def _cannot_close(model: Model, t: float, phi: np.ndarray, bad: np.ndarray,
             "links cannot reach")
 
 
+def check_drivers(model: Model) -> None:
+    """Refuse more drivers than the mechanism has degrees of freedom, or a driver of a
+    motion the joints already fix: each driver must add one independent constraint to
+    the joints' (a `ModelError` at the drivers' entries in the file)."""
+    drivers = model.drivers
+    if drivers is None or not len(drivers):
+        return
+    m = len(model.reactions)
+    k = len(drivers)
+    if m > 3000:  # a dense rank test would be slow: trust the file
+        return
+    G = np.asarray(mbody_assembly_G(model))
+    joints = np.linalg.matrix_rank(G[:, :m - k], tol=None) if m > k else 0
+    every = np.linalg.matrix_rank(G, tol=None)
+    if every - joints == k:
+        return
+    dof = len(model.coordinates) - joints
+    if k > dof:
+        line, col = drivers.where[dof] if dof < k else drivers.where[-1]
+        raise ModelError([Issue(model.file, line, col, f"drivers[{dof}]",
+                                f"{k} drivers for {dof} degree(s) of freedom: the joints "
+                                f"leave the mechanism {dof} way(s) to move, and each driver "
+                                "prescribes one",
+                                f"keep at most {dof} driver(s); the others' coordinates "
+                                "follow from the joints")])
+    line, col = drivers.where[-1]
+    raise ModelError([Issue(model.file, line, col, f"drivers[{k - 1}]",
+                            f"driver '{drivers.names[-1]}' adds no independent constraint: "
+                            "its coordinate is already fixed by the joints and the other "
+                            "drivers", "drive another joint, or remove it")])
+
+
+def mbody_assembly_G(model: Model) -> np.ndarray:
+    """G at the file's pose, dense (rows: the model's coordinates)."""
+    from mbody.equations.assemble import assemble
+
+    return assemble(model, model.initial).G.toarray()
+
+
 def assembled(model: Model) -> Model:
     """The model with its initial state moved onto its joints and drivers at t = 0 when
     the file asks for it: joint points given on each body, or drivers (whose laws at 0
@@ -138,5 +177,6 @@ def assembled(model: Model) -> Model:
         model.joint_table.body_points.any())
     if not needs or not len(model.reactions):
         return model
+    check_drivers(model)
     state = kinematics(model, 0.0)
     return dataclasses.replace(model, initial=state, file_state=model.initial)
