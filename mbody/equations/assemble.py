@@ -320,21 +320,20 @@ def solve_state(model: Model, state: State, unknowns: Unknowns, *, condition: bo
     the joints' geometry). `columns` gives the reaction columns at `state` when a broken
     joint must be described or a large S's condition estimated (made only then)."""
     ws = workspace(model)
-    solver = ws.solver(unknowns)
-    planar = model.dimension == cv.PLANAR
-    m = len(unknowns.mask)
-    N, o_lam, o_info = _core.solve_layout(model.n, m, planar)
-    out = np.empty(o_info + _core.INFO)
-    t = float(state.t)
+    plan = ws.solve_plan(unknowns)
+    out = np.empty(plan.o_info + _core.INFO)
     y = ws.pack_state(state)
-    solver.solve(t, y, unknowns.lam, out)
-    info = out[o_info:]
+    plan.solver.solve(state.t, y, unknowns.lam, out)
+    N, o_lam, o_info = plan.N, plan.o_lam, plan.o_info
+    m = (o_info - o_lam) // 3  # λ, Gᵀv and the not-unique flags, m each
     labels = model.reactions
-    acc = out[:N][model.rows] if model.has_particles else out[:N]
+    acc = out[:N] if plan.rows is None else out[:N][plan.rows]
     lam = out[o_lam:o_lam + m]
-    if not len(unknowns.U):
-        return Solution(model.coordinates, acc, ReactionValues(labels, model.reaction_index,
-                                                                lam))
+    reactions = ReactionValues(labels, model.reaction_index, lam)
+    mu = len(unknowns.U)
+    if not mu:
+        return Solution(model.coordinates, acc, reactions)
+    info = out[o_info:]
     if info[_core.ST_SINGULAR]:
         code = int(info[_core.ST_SINGULAR]) - 1
         raise singular_mass_error(model, code // 6, code % 6)
@@ -343,17 +342,17 @@ def solve_state(model: Model, state: State, unknowns: Unknowns, *, condition: bo
         cols = columns() if columns is not None else reaction_columns(model, state)
         broken = tuple(joint_errors(model, state, cols, unknowns.mask,
                                     gtv=out[o_lam + m:o_lam + 2 * m]))
-    mu, rank = len(unknowns.U), int(info[_core.ST_RANK])
+    rank = int(info[_core.ST_RANK])
     not_unique: tuple[str, ...] = ()
     if rank < mu:
         flags = out[o_lam + 2 * m:o_info]
         not_unique = tuple(labels[i] for i in np.flatnonzero(flags))
     cond = None
     if condition:
-        cond = _condition(model, state, unknowns, solver, y, rank, columns)
-    return Solution(model.coordinates, acc, ReactionValues(labels, model.reaction_index, lam),
-                    unknowns.labels(labels), not_unique, float(info[_core.ST_BERR]), cond,
-                    METHODS[int(info[_core.ST_PATH])], broken, mu - rank)
+        cond = _condition(model, state, unknowns, plan.solver, y, rank, columns)
+    return Solution(model.coordinates, acc, reactions, plan.labels, not_unique,
+                    float(info[_core.ST_BERR]), cond, METHODS[int(info[_core.ST_PATH])],
+                    broken, mu - rank)
 
 
 DENSE_CONDITION = 2000

@@ -18,7 +18,7 @@ import weakref
 from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cached_property
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
@@ -56,6 +56,19 @@ class Unknowns:
         return tuple(map(labels.__getitem__, self.U.tolist()))
 
 
+class SolvePlan(NamedTuple):
+    """One set of unknowns' solve, laid out: the core's solver; where `Unknowns.solve`
+    writes (N accelerations, λ at o_lam, info at o_info); the unknowns' labels; the rows
+    a model with particles keeps (None: all)."""
+
+    solver: _core.Unknowns
+    N: int
+    o_lam: int
+    o_info: int
+    labels: tuple[str, ...]
+    rows: np.ndarray | None
+
+
 class Workspace:
     """A model packed for the compiled core, and the core's objects for it (module doc).
 
@@ -65,12 +78,20 @@ class Workspace:
     """
 
     def __init__(self, model: Model):
-        self.model = model
+        self._model = weakref.ref(model)  # the workspace goes with the model, not after
         self.planar = model.dimension == cv.PLANAR
         F, I = pack_model(model)
         self.core = _core.Model(F, I, self.planar)
         self._solvers: dict[bytes, _core.Unknowns] = {}
+        self._plans: dict[bytes, SolvePlan] = {}
         self._lock = threading.Lock()
+
+    @property
+    def model(self) -> Model:
+        model = self._model()
+        if model is None:  # pragma: no cover - a workspace is reached through its model
+            raise ReferenceError("the workspace's model is gone")
+        return model
 
     def __repr__(self) -> str:
         return (f"<Workspace of {self.model.name!r}: {len(self._solvers)} set(s) of unknowns "
@@ -121,6 +142,19 @@ class Workspace:
                     out.set_generic_rank(self._generic_rank(unknowns, out))
                     self._solvers[unknowns.key] = out
         return out
+
+    def solve_plan(self, unknowns: Unknowns) -> SolvePlan:
+        """What one solve with these unknowns needs besides the state (made once)."""
+        plan = self._plans.get(unknowns.key)
+        if plan is None:
+            model = self.model
+            m = len(unknowns.mask)
+            N, o_lam, o_info = _core.solve_layout(model.n, m, self.planar)
+            plan = SolvePlan(self.solver(unknowns), N, o_lam, o_info,
+                             unknowns.labels(model.reactions),
+                             model.rows if model.has_particles else None)
+            self._plans[unknowns.key] = plan
+        return plan
 
     def _generic_rank(self, unknowns: Unknowns, solver: _core.Unknowns) -> int:
         """The rank of G_U at the mechanism's generic configurations, decided on its
@@ -184,23 +218,35 @@ class Workspace:
         return np.concatenate(parts)
 
     def pack_state(self, state: State) -> np.ndarray:
-        """[x | q | v | ω] flat (13 n,), a fresh C array (the core's state layout, less the
-        planar angles, which evaluations do not read)."""
-        return np.concatenate((state.position.ravel(), state.quaternion.ravel(),
-                               state.velocity.ravel(), state.omega.ravel()))
+        """[x | q | v | ω] flat (13 n,), a C array (the core's state layout, less the planar
+        angles, which evaluations do not read). Kept with a state whose arrays are all
+        read-only (a model's initial state): it cannot change, so it is packed once."""
+        packed = state.__dict__.get("_packed")
+        if packed is not None:
+            return packed
+        y = np.concatenate((state.position.ravel(), state.quaternion.ravel(),
+                            state.velocity.ravel(), state.omega.ravel()))
+        if not (state.position.flags.writeable or state.quaternion.flags.writeable
+                or state.velocity.flags.writeable or state.omega.flags.writeable):
+            y.flags.writeable = False
+            state.__dict__["_packed"] = y  # a frozen dataclass: its __dict__ holds caches
+        return y
 
 
-_WORKSPACES: weakref.WeakKeyDictionary[Model, Workspace] = weakref.WeakKeyDictionary()
+_WORKSPACES: dict[int, Workspace] = {}
+"""id(model) -> its workspace; an entry goes with its model (weakref.finalize). A plain
+dict: a lookup per evaluation, where a WeakKeyDictionary's costs a microsecond."""
 _LOCK = threading.Lock()
 
 
 def workspace(model: Model) -> Workspace:
     """The model's `Workspace`, made on first use and kept while the model lives."""
-    ws = _WORKSPACES.get(model)
-    if ws is None:
+    ws = _WORKSPACES.get(id(model))
+    if ws is None or ws._model() is not model:
         with _LOCK:
-            ws = _WORKSPACES.get(model)
-            if ws is None:
+            ws = _WORKSPACES.get(id(model))
+            if ws is None or ws._model() is not model:
                 ws = Workspace(model)
-                _WORKSPACES[model] = ws
+                _WORKSPACES[id(model)] = ws
+                weakref.finalize(model, _WORKSPACES.pop, id(model), None)
     return ws
