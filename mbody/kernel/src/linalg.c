@@ -15,6 +15,16 @@
  * are applied to the columns of V (cols vectors of length cols, V = I on entry). */
 static void jacobi_columns(double *B, int64_t len, int64_t cols, double *V) {
     double tol = DBL_EPSILON * sqrt((double)len);
+    /* A column whose norm is rounding beside the largest (a rank-deficient A's) has no
+     * direction to make orthogonal: rotating it against the others only stirs rounding,
+     * for every sweep up to MAX_SWEEPS. Such pairs count as done. */
+    double top = 0.0;
+    for (int64_t c = 0; c < cols; c++) {
+        double s2 = 0.0;
+        for (int64_t i = 0; i < len; i++) s2 += B[c * len + i] * B[c * len + i];
+        if (s2 > top) top = s2;
+    }
+    double negligible = DBL_EPSILON * DBL_EPSILON * top;
     for (int sweep = 0; sweep < MAX_SWEEPS; sweep++) {
         int rotated = 0;
         for (int64_t p = 0; p < cols - 1; p++) {
@@ -27,6 +37,7 @@ static void jacobi_columns(double *B, int64_t len, int64_t cols, double *V) {
                     gamma += bp[i] * bq[i];
                 }
                 if (gamma == 0.0 || fabs(gamma) <= tol * sqrt(alpha) * sqrt(beta)) continue;
+                if (alpha <= negligible || beta <= negligible) continue;
                 rotated = 1;
                 double zeta = (beta - alpha) / (2.0 * gamma);
                 double t = (zeta >= 0.0 ? 1.0 : -1.0) / (fabs(zeta) + sqrt(1.0 + zeta * zeta));
