@@ -631,3 +631,108 @@ def test_format_flag_reads_any_extension(tmp_path, capsys):
     copy.write_text((ROBOTS / "two_link_arm.urdf").read_text())
     assert main(["check", str(copy), "--format", "urdf"]) == 0
     capsys.readouterr()
+
+
+# ---- every number and keyword read, checked (exit 2, never 70) -------------------------
+
+BODY = ('<mujoco>{top}<worldbody><body {body}><joint {joint}/><geom size="0.1" {geom}/>'
+        "</body></worldbody>{end}</mujoco>")
+
+
+def _mjcf(top="", body="", joint="", geom="", end="") -> str:
+    return BODY.format(top=top, body=body, joint=joint, geom=geom, end=end)
+
+
+BAD_MJCF = [
+    (_mjcf(top='<option density="0 0 0"/>'), "<option density>", "expected 1 number, got 3"),
+    (_mjcf(top='<option wind="a b c"/>'), "<option wind>", "'a' is not a number"),
+    (_mjcf(top='<option wind="1 2"/>'), "<option wind>", "expected 3 numbers, got 2"),
+    (_mjcf(top='<option viscosity="1e400"/>'), "<option viscosity>", "'1e400' is too large"),
+    (_mjcf(body='gravcomp="1 1"'), "<body gravcomp>", "expected 1 number, got 2"),
+    (_mjcf(geom='group="nan"'), "<geom group>", "'nan' is not a whole number"),
+    (_mjcf(geom='group="1e400"'), "<geom group>", "'1e400' is not a whole number"),
+    (_mjcf(geom='group="3000000000"'), "<geom group>", "outside the integers MuJoCo reads"),
+    (_mjcf(geom='contype="1.5"'), "<geom contype>", "'1.5' is not a whole number"),
+    (_mjcf(top='<compiler inertiagrouprange="0 1.5"/>'), "<compiler inertiagrouprange>",
+     "'1.5' is not a whole number"),
+    (_mjcf(joint='damping="1e"'), "<joint damping>", "'1e' is not a number"),
+    (_mjcf(joint='damping="1 2 3 4"'), "<joint damping>", "expected 1 to 3 numbers, got 4"),
+    (_mjcf(joint='range="1"'), "<joint range>", "expected 2 numbers, got 1"),
+    (_mjcf(geom='mass="1_000"'), "<geom mass>", "'1_000' is not a number"),
+    (_mjcf(body='pos="0,0,1"'), "<body pos>", "separate numbers with spaces"),
+    (_mjcf(end='<keyframe><key qvel="x"/></keyframe>'), "<key qvel>", "'x' is not a number"),
+    (_mjcf(body='mocap="yes"'), "<body mocap>", "'yes' is not a value of 'mocap'"),
+    (_mjcf(joint='limited="yes"'), "<joint limited>", "'yes' is not a value of 'limited'"),
+    (_mjcf(geom='shellinertia="True"'), "<geom shellinertia>", "did you mean 'true'"),
+    (_mjcf(top='<option><flag gravity="off"/></option>'), "<flag gravity>",
+     "expected disable or enable"),
+    (_mjcf(top='<compiler balanceinertia="1"/>'), "<compiler balanceinertia>",
+     "'1' is not a value of 'balanceinertia'"),
+]
+
+
+@pytest.mark.parametrize("xml, key, said", BAD_MJCF)
+def test_every_mjcf_number_and_keyword_is_checked(xml, key, said, tmp_path, capsys):
+    """Bare float() and int(float()) reads ended in exit 70 (`<option density="0 0 0">`,
+    `wind="a b c"`, `gravcomp="1 1"`, `group="nan"` or `"1e400"`): each is now one
+    located message, exit 2, where MuJoCo refuses the value too."""
+    path = tmp_path / "m.xml"
+    path.write_text(xml)
+    assert main(["check", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert re.search(rf"^mbody: error: {re.escape(str(path))}:1:\d+: {re.escape(key)}: ", err)
+    assert said in err and "Traceback" not in err and "internal error" not in err
+    mj = _mujoco()
+    with pytest.raises(ValueError):
+        mj.MjModel.from_xml_string(xml)
+
+
+@pytest.mark.parametrize("xml", [
+    _mjcf(top='<option density="1.2" viscosity="0.1" wind="0 1 0"/>'),
+    _mjcf(body='gravcomp="0.5"', joint='damping="1 0.5" stiffness="2 1 0.1"'),
+    _mjcf(geom='group="3" contype="0" conaffinity="-1"'),
+    _mjcf(body='pos="0x1p-1 0 +.5"', joint='axis=" 0\t1\n 0 "'),
+    _mjcf(joint='range=""', geom='pos=""'),
+])
+def test_values_mujoco_reads_are_read(xml):
+    """What MuJoCo 4 accepts loads: fluid options and gravity compensation (noted),
+    damping and stiffness as polynomials (up to three coefficients), C's hexadecimal
+    numbers, any blanks around numbers, an empty value (as if not given)."""
+    mj = _mujoco()
+    mj.MjModel.from_xml_string(xml)
+    model = Model.from_spec(validate(read_mjcf(xml)))
+    assert model.body_names == ("body1",)
+
+
+def test_a_class_value_is_reported_at_the_class(tmp_path):
+    (msg,) = _issues('<mujoco>\n<default>\n  <geom group="x"/>\n</default>\n<worldbody>\n'
+                     '<body><joint/><geom size="0.1"/></body>\n</worldbody>\n</mujoco>')
+    assert msg.startswith("bad.xml:3:9: <geom group>: 'x' is not a whole number")
+
+
+@pytest.mark.parametrize("joint, link, key, said", [
+    ('<dynamics damping="1e"/>', "", "<dynamics damping>", "'1e' is not a number"),
+    ('<dynamics friction="inf"/>', "", "<dynamics friction>", "'inf' is not a finite number"),
+    ('<origin xyz="1 2"/>', "", "<origin xyz>", "expected 3 numbers, got 2"),
+    ('<axis xyz="0 0 1e999"/>', "", "<axis xyz>", "too large for a number"),
+    ("", '<visual><geometry><sphere radius="x"/></geometry></visual>', "<sphere radius>",
+     "'x' is not a number"),
+    ("", '<visual><geometry><box size="1 1"/></geometry></visual>', "<box size>",
+     "expected 3 numbers, got 2"),
+])
+def test_every_urdf_number_is_checked(joint, link, key, said, tmp_path, capsys):
+    path = tmp_path / "r.urdf"
+    path.write_text(ARM.format(joint=joint, child="b", link=link))
+    assert main(["check", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert re.search(rf"^mbody: error: {re.escape(str(path))}:1:\d+: {re.escape(key)}: ", err)
+    assert said in err and "Traceback" not in err
+
+
+def test_an_mbody_entry_number_is_checked():
+    base = ('<mujoco><worldbody><body name="a"><joint/><geom size="0.1"/></body>'
+            '</worldbody><custom>{}</custom></mujoco>')
+    (msg,) = _issues(base.format('<numeric name="mbody:dimension" data="inf"/>'))
+    assert "'inf' is not a finite number" in msg
+    (msg,) = _issues(base.format('<numeric name="mbody:body:a" data="1"/>'))
+    assert "a <numeric> entry holds mbody:dimension or mbody:reaction" in msg

@@ -35,6 +35,7 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 from mbody.errors import Issue, ModelError, did_you_mean
+from mbody.io.interop.attrvalues import read_numbers
 from mbody.io.interop.xmlsource import Element
 
 PREFIX = "mbody:"
@@ -119,22 +120,22 @@ def read_custom(root: Element) -> Custom | None:
                                       attr="name"))
                 continue
             if e.tag == "numeric":
-                try:
-                    values = [float(t) for t in data.split()]
-                except ValueError:
-                    values = []
-                if len(values) != 1 or kind not in ("dimension", "reaction"):
-                    issues.append(e.issue(f"'{name}': expected one number in a <numeric> "
-                                          "mbody:dimension or mbody:reaction entry",
-                                          attr="data"))
+                if kind not in ("dimension", "reaction"):
+                    issues.append(e.issue(f"'{name}': a <numeric> entry holds "
+                                          "mbody:dimension or mbody:reaction",
+                                          "other entries are <text>", attr="name"))
+                    continue
+                values = read_numbers(e, "data", data, issues, count=1, hexadecimal=True)
+                if values is None:
                     continue
                 if kind == "dimension":
                     if values[0] not in (2.0, 3.0):
                         issues.append(e.issue(f"mbody:dimension must be 2 or 3, got "
-                                              f"{data}", attr="data"))
+                                              f"{values[0]:g}", attr="data"))
+                        continue
                     out.dimension = int(values[0])
                 else:
-                    out.reactions[key] = (values[0], e)
+                    out.reactions[key] = (float(values[0]), e)
                 continue
             if kind == "reaction":
                 out.reactions[key] = (data, e)
