@@ -736,3 +736,50 @@ def test_an_mbody_entry_number_is_checked():
     assert "'inf' is not a finite number" in msg
     (msg,) = _issues(base.format('<numeric name="mbody:body:a" data="1"/>'))
     assert "a <numeric> entry holds mbody:dimension or mbody:reaction" in msg
+
+
+# ---- reading: marks found in one pass; included files bounded together ----------------
+
+def test_attribute_marks_with_angle_brackets_and_wide_characters():
+    """Each attribute's line and column, found by reading each tag once (the search up
+    to the first '>' stopped inside a value, and took time with the square of it)."""
+    text = ("<root a='1>2' b=\"x\"\n"
+            '  c="é>é"\tdd="4"><kid e="5"/>é<kid f="6"/></root>')
+    root = parse_xml(text)
+    first, second = text.split("\n")
+
+    def at(line: str, what: str) -> int:  # 1-based column, in characters
+        return line.index(what) + 1
+
+    assert root.attr_marks == {"a": (1, at(first, "a=")), "b": (1, at(first, "b=")),
+                               "c": (2, at(second, "c=")), "dd": (2, at(second, "dd="))}
+    assert root.attr_marks["dd"] == (2, 11)
+    kids = root.findall("kid")
+    assert kids[0].attr_marks == {"e": (2, at(second, "e="))}
+    assert kids[1].attr_marks == {"f": (2, at(second, "f="))} == {"f": (2, 36)}
+    assert (kids[1].line, kids[1].column) == (2, at(second, "<kid f"))
+
+
+def test_included_files_are_bounded_together(tmp_path, capsys, monkeypatch):
+    """100 includes of one 30 MB file took 3.8 GB, then 'out of memory': the bytes read
+    over all included files are bounded (MAX_INCLUDED_BYTES, 64 MiB; lowered here), and
+    the include that passes the bound is named at its line."""
+    from mbody.io.interop import mjcf_source
+
+    part = tmp_path / "part.xml"
+    part.write_text("<mujoco><custom>" + '<text name="t" data="x"/>' * 160
+                    + "</custom></mujoco>")
+    monkeypatch.setattr(mjcf_source, "MAX_INCLUDED_BYTES", 3 * part.stat().st_size)
+    main_file = tmp_path / "main.xml"
+    main_file.write_text('<mujoco model="m">\n' + '  <include file="part.xml"/>\n' * 4
+                         + '  <worldbody><body><joint/><geom size="0.1"/></body></worldbody>'
+                         "\n</mujoco>\n")
+    assert main(["check", str(main_file)]) == 2
+    err = capsys.readouterr().err
+    assert re.search(rf"^mbody: error: {re.escape(str(main_file))}:5:12: <include file>: "
+                     r"including 'part.xml' brings the included files to 15\.\d KiB "
+                     r"together \(include number 4\); at most 11\.\d KiB of included "
+                     "files is read for one model", err), err
+    main_file.write_text(main_file.read_text().replace('  <include file="part.xml"/>\n',
+                                                       "", 1))
+    assert main(["check", str(main_file)]) == 0

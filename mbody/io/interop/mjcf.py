@@ -29,7 +29,7 @@ from mbody.io.interop.attrvalues import BOOLEAN
 from mbody.io.interop.custom import Custom, read_custom, restore
 from mbody.io.interop.mjcf_compiler import z_to_quat
 from mbody.io.interop.mjcf_geoms import GEOM_TYPES, MIN_MASS, Geoms, solid
-from mbody.io.interop.mjcf_source import MAX_INCLUDES, check_names, expand_includes
+from mbody.io.interop.mjcf_source import MAX_INCLUDES, Included, check_names, expand_includes
 from mbody.io.interop.mjcf_state import state
 from mbody.io.interop.tree import ImportedDocument, Loop, TreeBody, TreeJoint, build, unit
 from mbody.io.interop.xmlsource import MAX_ELEMENTS, Element, parse_xml, read_xml
@@ -80,7 +80,7 @@ def read_mjcf(source: str | Path, *, keyframe: str | None = None,
                 if root.tag == "robot" else "an MJCF model starts with <mujoco>")
         raise ModelError([root.issue(f"expected <mujoco> as the root element, got "
                                      f"<{root.tag}>", hint)])
-    expand_includes(root, base, budget, [0])
+    expand_includes(root, base, budget, Included())
     issues: list[Issue] = []
     check_names(root, "mujoco", issues)
     if issues:

@@ -143,26 +143,35 @@ def _check_names(root: Element, issues: list[Issue], ignored: list[str]) -> None
     """A name very close to one of URDF's is misspelt (an error with a did-you-mean);
     any other unknown name is a tool's extension (Gazebo's, a vendor's): noted, not read.
     """
+    noted = set(ignored)  # (the list keeps file order; the set answers 'seen?' at once)
+
+    def note(what: str) -> None:
+        if what not in noted:
+            noted.add(what)
+            ignored.append(what)
+
     stack = [root]
     while stack:
         e = stack.pop()
         if e.tag in _OPEN:
             continue
+        known = _ATTRS.get(e.tag, ())
         for a in e.attrib:
-            known = _ATTRS.get(e.tag, ())
             if a not in known and ":" not in a:
                 if _misspelt(a, known):
-                    issues.append(unknown_name(e, a, known, f"attribute of <{e.tag}>", a))
-                elif f"{e.tag} {a}" not in ignored:
-                    ignored.append(f"{e.tag} {a}")
+                    issues.append(unknown_name(e, a, known, f"attribute of <{e.tag}>", a,
+                                               len(issues) < ModelError.SHOWN))
+                else:
+                    note(f"{e.tag} {a}")
+        kids = _CHILDREN.get(e.tag, ())
         for c in e.children:
-            kids = _CHILDREN.get(e.tag, ())
             if c.tag in kids:
                 stack.append(c)
             elif _misspelt(c.tag, kids):
-                issues.append(unknown_name(c, c.tag, kids, f"element in <{e.tag}>"))
-            elif f"<{c.tag}> in <{e.tag}>" not in ignored:
-                ignored.append(f"<{c.tag}> in <{e.tag}>")
+                issues.append(unknown_name(c, c.tag, kids, f"element in <{e.tag}>",
+                                           hint=len(issues) < ModelError.SHOWN))
+            else:
+                note(f"<{c.tag}> in <{e.tag}>")
     issues.sort(key=lambda i: (i.line, i.column))
 
 
