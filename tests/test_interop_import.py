@@ -783,3 +783,22 @@ def test_included_files_are_bounded_together(tmp_path, capsys, monkeypatch):
     main_file.write_text(main_file.read_text().replace('  <include file="part.xml"/>\n',
                                                        "", 1))
     assert main(["check", str(main_file)]) == 0
+
+
+def test_a_value_with_line_breaks_stays_on_its_line(tmp_path, capsys):
+    """Found by tools/fuzz_xml.py: a joint type written with &#10; split the message into
+    lines that looked like problems without a place; the break is written as \\n."""
+    path = tmp_path / "m.xml"
+    path.write_text(_mjcf(joint='type="1&#9;2&#10;3"'))
+    assert main(["check", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "unknown joint type '1\t2\\n3'" in err
+
+
+@pytest.mark.parametrize("key", ["²", "9" * 5000])
+def test_a_keyframe_index_that_is_no_number_is_a_name(key, capsys):
+    """'²' is a digit to str.isdigit but not to int(); 5000 digits are past int()'s
+    limit: both were exit 70."""
+    assert main(["check", str(ROBOTS / "two_link_arm.xml"), "--keyframe", key]) == 2
+    err = capsys.readouterr().err
+    assert "no keyframe named" in err and "(the file has: swing)" in err and len(err) < 300

@@ -280,3 +280,13 @@ def test_the_shipped_arms_masses_are_mujocos():
     for i, name in enumerate(model.body_names):
         b = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, name)
         assert model.mass[i] == pytest.approx(m.body_mass[b], rel=1e-12)
+
+
+def test_inertiafromgeom_true_keeps_the_inertial_of_a_body_without_geoms():
+    """Found by tools/fuzz_xml.py: with inertiafromgeom="true", a body whose geoms give
+    no mass keeps its <inertial> in MuJoCo (mbody gave it no mass, then boundmass's)."""
+    xml = ('<mujoco><compiler inertiafromgeom="true" boundmass="0.1"/><worldbody>'
+           '<body name="b"><joint axis="0 1 0"/><inertial pos="0.1 0 0" mass="3.7" '
+           'diaginertia="0.07 0.08 0.06"/></body></worldbody></mujoco>')
+    _agree(xml)
+    assert _ours(xml)[0] == pytest.approx(3.7)

@@ -2,9 +2,11 @@
 
 Every number of MJCF and URDF goes through `read_numbers`: each token must be a number
 in C's syntax (``strtod``: a decimal, or in MJCF a hexadecimal ``0x1.8p3``; no ``1_000``,
-no ``1,5``, no unit), finite, within a double's range (``1e400`` is not), a whole number
-within a C ``int`` where the attribute is an integer (``group``, ``contype``), and the
-attribute must hold as many numbers as it takes. A problem is an `Issue` at the line and
+no ``1,5``, no unit), finite, within a double's range (``1e400`` is not) and within the
+magnitudes mbody reads in any model (1e100, `mbody.model.checks.MAX_MAGNITUDE`: their
+products would overflow), a whole number within a C ``int`` where the attribute is an
+integer (``group``, ``contype``), and the attribute must hold as many numbers as it
+takes. A problem is an `Issue` at the line and
 column of the attribute where the value was written (a ``<default>`` class's, when the
 value comes from there), saying what was found and what was expected, so a bad number
 is a clean error (exit 2), never an internal one. Reading is linear in the value's length.
@@ -20,6 +22,7 @@ import numpy as np
 
 from mbody.errors import Issue, did_you_mean
 from mbody.io.interop.xmlsource import Element
+from mbody.model.checks import MAX_MAGNITUDE
 
 INT_MIN, INT_MAX = -2**31, 2**31 - 1
 """The range of a C ``int``: MuJoCo's integer attributes (``group``, ``contype``)."""
@@ -73,6 +76,9 @@ def _number(token: str, attr: str, integer: bool, hexadecimal: bool
         return 0.0, f"'{_shown(token)}' is not a number", hint
     if math.isinf(x):
         return 0.0, f"'{_shown(token)}' is too large for a number (beyond 1.8e308)", ""
+    if abs(x) > MAX_MAGNITUDE:
+        return 0.0, (f"'{_shown(token)}' is beyond the magnitudes mbody reads (at most "
+                     f"{MAX_MAGNITUDE:g}: products of larger numbers overflow)"), ""
     return x, "", ""
 
 

@@ -94,30 +94,35 @@ class Geoms(Compiler):
                           "put the plane in <worldbody>", "type" if "type" in g.attrib
                           else None)
         inertial = e.find("inertial")
-        if inertial is not None and self.inertiafromgeom != "true":
-            iv = inertial.attrib
-            m = self.attr(inertial, iv, "mass", 1)
-            if m is None:
-                self.fail(inertial, "an <inertial> needs a 'mass'")
-                return
-            b.mass = float(m[0])
-            b.com = self.attr(inertial, iv, "pos", 3, np.zeros(3))
-            b.R_inertia = quat_to_matrix(self.orientation(inertial, iv))
-            b.mass_element = inertial
-            if "diaginertia" in iv:
-                b.inertia = np.diag(self.attr(inertial, iv, "diaginertia", 3, np.zeros(3)))
-            elif "fullinertia" in iv:
-                f = self.attr(inertial, iv, "fullinertia", 6, np.zeros(6))
-                b.inertia = np.array([[f[0], f[3], f[4]], [f[3], f[1], f[5]],
-                                      [f[4], f[5], f[2]]])
-            else:
-                self.fail(inertial, "an <inertial> needs 'diaginertia' or 'fullinertia'")
-            b.shape = self.shape(e, childclass)
+        b.shape = self.shape(e, childclass)
+        if self.inertiafromgeom == "true" or (self.inertiafromgeom == "auto" and
+                                               inertial is None):
+            self.geom_mass(b, e, childclass)
+            if b.mass_element is not None:
+                return  # (with inertiafromgeom="true" and no geom of mass, MuJoCo keeps
+                # the <inertial>)
+        if inertial is not None:
+            self.inertial(b, inertial)
+
+    def inertial(self, b: TreeBody, inertial: Element) -> None:
+        """`b`'s mass, mass centre and inertia from its ``<inertial>``."""
+        iv = inertial.attrib
+        m = self.attr(inertial, iv, "mass", 1)
+        if m is None:
+            self.fail(inertial, "an <inertial> needs a 'mass'")
             return
-        if self.inertiafromgeom == "false":
-            b.shape = self.shape(e, childclass)
-            return
-        self.geom_mass(b, e, childclass)
+        b.mass = float(m[0])
+        b.com = self.attr(inertial, iv, "pos", 3, np.zeros(3))
+        b.R_inertia = quat_to_matrix(self.orientation(inertial, iv))
+        b.mass_element = inertial
+        if "diaginertia" in iv:
+            b.inertia = np.diag(self.attr(inertial, iv, "diaginertia", 3, np.zeros(3)))
+        elif "fullinertia" in iv:
+            f = self.attr(inertial, iv, "fullinertia", 6, np.zeros(6))
+            b.inertia = np.array([[f[0], f[3], f[4]], [f[3], f[1], f[5]],
+                                  [f[4], f[5], f[2]]])
+        else:
+            self.fail(inertial, "an <inertial> needs 'diaginertia' or 'fullinertia'")
 
     def geoms(self, e: Element, childclass: str | None) -> list[tuple[Element, Values]]:
         return [(g, self.values(g, childclass)) for g in e.findall("geom")]
@@ -216,7 +221,6 @@ class Geoms(Compiler):
             part = self.geom_part(b, geom)
             if part is not None:
                 parts.append(part)
-        b.shape = self.shape(e, childclass)
         if not parts:
             return
         m = sum(p[0] for p in parts)

@@ -51,15 +51,24 @@ def key(r: Compiler, root: Element, keyframe: str, q0: np.ndarray, nv: int
     names = [k.get("name") or str(i) for i, k in enumerate(keys)]
     if keyframe in names:
         k = keys[names.index(keyframe)]
-    elif keyframe.isdigit() and int(keyframe) < len(keys):
-        k = keys[int(keyframe)]
+    elif _index(keyframe) < len(keys):
+        k = keys[_index(keyframe)]
     else:
+        shown = keyframe if len(keyframe) <= 40 else keyframe[:40] + "..."
         hint = did_you_mean(keyframe, names) or (
             f"the file has: {', '.join(names)}" if names else "the file has no keyframe")
         raise ModelError([Issue(r.file, 0, 0, "keyframe",
-                                f"no keyframe named '{keyframe}'", hint)])
+                                f"no keyframe named '{shown}'", hint)])
     qpos, qvel = values(r, k, q0, nv)
     if r.issues:
         raise ModelError(r.issues)
     return qpos, qvel
 
+
+
+def _index(text: str) -> int:
+    """`text` read as a key's index (0-based, ASCII digits), or a number past any key."""
+    digits = text.lstrip("0") or "0"
+    if text.isascii() and text.isdigit() and len(digits) <= 9:
+        return int(digits)
+    return 10**9

@@ -12,6 +12,7 @@ dynamics, mimic joints and transmissions are listed in one warning.
 from __future__ import annotations
 
 import difflib
+import functools
 import math
 from collections.abc import Mapping
 from pathlib import Path
@@ -134,9 +135,17 @@ def _one_edit(a: str, b: str) -> bool:
             or a[i:i + 2] == b[i:i + 2][::-1] and a[i + 2:] == b[i + 2:])
 
 
+@functools.lru_cache(maxsize=4096)
 def _misspelt(name: str, known: tuple[str, ...]) -> bool:
-    return any(difflib.SequenceMatcher(None, name, k).ratio() >= TYPO_CUTOFF
-               or _one_edit(name, k) for k in known)
+    return any(_one_edit(name, k) or _alike(name, k) for k in known)
+
+
+def _alike(a: str, b: str) -> bool:
+    """difflib's ratio of `a` and `b` is at least TYPO_CUTOFF (its cheap upper bounds
+    first, as get_close_matches does: most names are ruled out by their lengths)."""
+    m = difflib.SequenceMatcher(None, a, b)
+    return (m.real_quick_ratio() >= TYPO_CUTOFF and m.quick_ratio() >= TYPO_CUTOFF
+            and m.ratio() >= TYPO_CUTOFF)
 
 
 def _check_names(root: Element, issues: list[Issue], ignored: list[str]) -> None:

@@ -68,7 +68,7 @@ class Element:
         """An `Issue` located at this element (or at its attribute `attr`)."""
         line, col = self.where(attr)
         key = f"<{self.tag}{' ' + attr if attr else ''}>"
-        return Issue(self.file, line, col, key, message, hint)
+        return Issue(self.file, line, col, key, one_line(message), one_line(hint))
 
     def iter(self, tag: str | None = None) -> Iterator[Element]:
         """This element and every descendant (depth first), or those named `tag`."""
@@ -282,4 +282,15 @@ def unknown_name(e: Element, name: str, known: Iterable[str], what: str,
             said = f"expected one of: {', '.join(choices)}" if choices else f"no {what} here"
     line, col = e.where(attr)
     key = f"<{e.tag}>" if attr is None else f"<{e.tag} {attr}>"
-    return Issue(e.file, line, col, key, f"unknown {what} '{name}'", said)
+    return Issue(e.file, line, col, key, one_line(f"unknown {what} '{name}'"), one_line(said))
+
+
+_BREAKS = str.maketrans({"\n": "\\n", "\r": "\\r", "\x0b": "\\v", "\x0c": "\\f",
+                         "\x1c": "\\x1c", "\x1d": "\\x1d", "\x1e": "\\x1e",
+                         "\x85": "\\x85", "\u2028": "\\u2028", "\u2029": "\\u2029"})
+
+
+def one_line(text: str) -> str:
+    """`text` with its line breaks written as escapes: a value quoted in a message (a
+    name written with ``&#10;``) must not start a line that looks like another problem."""
+    return text.translate(_BREAKS)
