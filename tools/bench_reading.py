@@ -1,11 +1,12 @@
 """Reading time against input size, for inputs whose reading once grew with the square of
 their size: time per MB that stays flat as the size doubles is linear reading.
 
-    python tools/bench_reading.py [--sizes 0.25,0.5,1,2] [--repeat 2] [--only NAME]
+    python tools/bench_reading.py [--sizes 0.25,0.5,1,2] [--repeat 2] [--limit 30]
+                                  [--only NAME]
 
 Each case is one entry of `CASES`: a name and a generator that makes an input of about
 the size asked (in bytes) and says how it is read (`Input`). To add a case (another
-format, another reader), append an entry: the table follows.
+format, another reader), append an entry: the table shows it too.
 
 The cases (issue 22):
 
@@ -25,14 +26,17 @@ The cases (issue 22):
 Every input is read whole, as ``mbody check`` reads it (`mbody.load`: read, check,
 build), in this process; an input mbody refuses (the many attributes are unknown ones)
 is timed up to its error. Columns: the input's size, the best time of --repeat runs
-(tools/timing.py), the time per MB, and that figure over the smallest size's (a
-constant ratio is linear; a quadratic one doubles with each doubling).
+(tools/timing.py), the time per MB, that figure over the smallest size's (a constant
+ratio is linear; a quadratic one doubles with each doubling), and the growth exponent
+from the size before (1 linear, 2 quadratic). A read longer than --limit seconds ends
+its case.
 """
 
 from __future__ import annotations
 
 import argparse
 import contextlib
+import math
 import sys
 import tempfile
 from collections.abc import Callable
@@ -148,6 +152,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--sizes", default="0.25,0.5,1,2",
                     help="input sizes in MB, comma-separated (default 0.25,0.5,1,2)")
     ap.add_argument("--repeat", type=int, default=2, help="runs per size; the best counts")
+    ap.add_argument("--limit", type=float, default=30.0, metavar="SECONDS",
+                    help="a read longer than this ends its case: the larger sizes would "
+                    "take minutes if it is not linear (default 30)")
     ap.add_argument("--only", help="run the cases whose name contains this text")
     a = ap.parse_args(argv)
     sizes = [int(float(s) * MB) for s in a.sizes.split(",")]
@@ -158,14 +165,23 @@ def main(argv: list[str] | None = None) -> int:
     with tempfile.TemporaryDirectory(prefix="mbody-bench-reading.") as tmp:
         for name, make in cases:
             print(f"{name}\n  {'size (MB)':>10} {'time (s)':>10} {'s per MB':>10} "
-                  f"{'vs smallest':>12}")
-            first = None
+                  f"{'vs smallest':>12} {'growth':>7}")
+            first = last = None
             for size in sizes:
                 n, seconds = measure(make, size, a.repeat, Path(tmp))
                 per = seconds / (n / MB)
                 first = per if first is None else first
-                print(f"  {n / MB:10.2f} {seconds:10.3f} {per:10.3f} {per / first:12.2f}",
-                      flush=True)
+                growth = (f"{math.log(seconds / last[1]) / math.log(n / last[0]):7.2f}"
+                          if last and seconds > 0 and last[1] > 0 and n != last[0]
+                          else "      -")
+                print(f"  {n / MB:10.2f} {seconds:10.3f} {per:10.3f} {per / first:12.2f} "
+                      f"{growth}", flush=True)
+                last = (n, seconds)
+                if seconds > a.limit:
+                    print(f"  (stopped: {seconds:.0f} s > --limit)")
+                    break
+    print("growth: log(t2/t1) / log(n2/n1) from the size before (1 linear, 2 quadratic; "
+          "small sizes are noisy)")
     return 0
 
 

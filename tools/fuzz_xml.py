@@ -700,9 +700,15 @@ def _body_differs(model, i: int, m, d, b: int) -> str:
         return ""
     R = model.initial.W_R_B[i]
     axes = d.ximat[b].reshape(3, 3)
-    A = axes.T @ (R @ model.J[i] @ R.T) @ axes  # mbody's tensor in MuJoCo's axes
     moments = m.body_inertia[b]
     top, spread = float(moments.max()), float(moments.max() - moments.min())
+    if model.dimension == 2:  # a planar body has a moment about z only
+        ours = float((R @ model.J[i] @ R.T)[2, 2])
+        theirs = float((axes @ np.diag(moments) @ axes.T)[2, 2])
+        if abs(ours - theirs) > 1.5e-6 * spread + MASS_RTOL * top + 1e-12:
+            return f"moment about z {ours!r} in mbody, {theirs!r} in MuJoCo"
+        return ""
+    A = axes.T @ (R @ model.J[i] @ R.T) @ axes  # mbody's tensor in MuJoCo's axes
     off = A - np.diag(np.diag(A))
     if (np.abs(np.diag(A) - moments).max() > MASS_RTOL * top + 1e-12
             or np.abs(off).max() > 1.5e-6 * spread + MASS_RTOL * top + 1e-12):
