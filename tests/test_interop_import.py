@@ -802,3 +802,33 @@ def test_a_keyframe_index_that_is_no_number_is_a_name(key, capsys):
     assert main(["check", str(ROBOTS / "two_link_arm.xml"), "--keyframe", key]) == 2
     err = capsys.readouterr().err
     assert "no keyframe named" in err and "(the file has: swing)" in err and len(err) < 300
+
+
+def test_a_planar_model_out_of_its_plane_is_refused(tmp_path, capsys):
+    """Found by tools/fuzz_xml.py: an exported planar model (mbody:dimension 2) whose body
+    was moved to z = -1e9 loaded with the z dropped; now each body and joint out of the
+    x-y plane is named at its line."""
+    from mbody.io.interop.mjcf_write import to_mjcf
+
+    text = to_mjcf(mbody.load(ROBOTS.parent / "triple_pendulum.yaml"))
+    path = tmp_path / "m.xml"
+    path.write_text(text)
+    assert main(["check", str(path)]) == 0
+    capsys.readouterr()
+    lines = text.split("\n")
+    (k,) = [i for i, line in enumerate(lines) if '<body name="lower"' in line]
+    lines[k] = re.sub(r'pos="([^ ]+) ([^ ]+) ([^"]+)"', r'pos="\1 \2 -1e9"', lines[k])
+    path.write_text("\n".join(lines))
+    assert main(["check", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert f"{path}:{k + 1}:" in err and "says the model moves in the world x-y plane, " \
+        "but body 'lower' is at z = -1e+09" in err and "joint 'B' is at z" in err
+
+
+def test_an_include_whose_name_is_too_long_is_located(tmp_path, capsys):
+    path = tmp_path / "m.xml"
+    path.write_text('<mujoco>\n  <include file="' + "x" * 5000 + '"/>\n</mujoco>\n')
+    assert main(["check", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"mbody: error: {path}:2:12: <include file>: cannot read the "
+                          "included file 'xxx") and "File name too long" in err

@@ -290,3 +290,12 @@ def test_inertiafromgeom_true_keeps_the_inertial_of_a_body_without_geoms():
            'diaginertia="0.07 0.08 0.06"/></body></worldbody></mujoco>')
     _agree(xml)
     assert _ours(xml)[0] == pytest.approx(3.7)
+
+
+def test_settotalmass_scales_as_mujoco_bounds_it():
+    """Found by tools/fuzz_xml.py: MuJoCo's scale is at least mjMINVAL (1e-15), so
+    settotalmass="1e-20" leaves a one-body model 1e-15 kg heavy, not 1e-20."""
+    xml = _doc('<geom type="sphere" size="0.1" mass="1"/>',
+               compiler='<compiler settotalmass="1e-20"/>')
+    assert _theirs(xml)[0] == pytest.approx(1e-15)
+    _agree(xml)

@@ -26,7 +26,7 @@ import numpy as np
 
 from mbody.errors import Issue, ModelError, did_you_mean
 from mbody.io.interop.attrvalues import BOOLEAN
-from mbody.io.interop.custom import Custom, read_custom, restore
+from mbody.io.interop.custom import Custom, planar_issues, read_custom, restore
 from mbody.io.interop.mjcf_compiler import z_to_quat
 from mbody.io.interop.mjcf_geoms import GEOM_TYPES, MIN_MASS, Geoms, solid
 from mbody.io.interop.mjcf_source import MAX_INCLUDES, Included, check_names, expand_includes
@@ -154,6 +154,9 @@ class _Reader(Geoms):
                     self.bodies, qpos, qvel, q0, gravity, loops, root, "mjcf",
                     self.free_motions())
         if self.custom is not None:
+            off_plane = planar_issues(doc, self.custom)
+            if off_plane:
+                raise ModelError(off_plane)
             restore(doc.data, [doc.marks, doc.key_marks], self.custom, self.springs())
         if self.notes:
             doc.warnings.append(Issue(self.file, 0, 0, "", _summary(self.notes)))

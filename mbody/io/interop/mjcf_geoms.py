@@ -319,13 +319,12 @@ class Geoms(Compiler):
             if self.boundinertia > 0 and b.mass > 0:
                 w, V = np.linalg.eigh(b.inertia)
                 b.inertia = V @ np.diag(np.maximum(w, self.boundinertia)) @ V.T
-        if self.settotalmass > 0:
+        if self.settotalmass > 0:  # MuJoCo's mj_setTotalmass, its scale bounded below
             total = sum(b.mass for b in bodies)
-            if total > 0:
-                k = self.settotalmass / total
-                for b in bodies:
-                    b.mass *= k
-                    b.inertia = b.inertia * k
+            k = max(MIN_MASS, self.settotalmass / max(MIN_MASS, total))
+            for b in bodies:
+                b.mass *= k
+                b.inertia = b.inertia * k
 
 
 def solid(typ: str, size: np.ndarray, shell: bool = False, mass: float = 1.0

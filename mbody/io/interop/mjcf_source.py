@@ -48,11 +48,25 @@ def expand_includes(e: Element, base: Path, budget: list[int], included: Include
         if str(path) in chain:
             raise ModelError([c.issue(f"'{rel}' includes itself (through "
                                       f"{' -> '.join(chain)})", attr="file")])
-        if not path.is_file():
-            raise ModelError([c.issue(f"the included file '{rel}' does not exist",
-                                      f"looked for {path}", attr="file")])
-        _count(c, rel, included, path.stat().st_size)  # refused before it is read
-        text = read_file(path)
+        try:
+            if not path.is_file():
+                raise ModelError([c.issue(f"the included file '{_short(rel)}' does not "
+                                          "exist", f"looked for {_short(str(path))}",
+                                          attr="file")])
+            size = path.stat().st_size
+        except OSError as exc:  # a name too long, a folder that cannot be read...
+            raise ModelError([c.issue(f"cannot read the included file '{_short(rel)}': "
+                                      f"{exc.strerror}", attr="file")]) from None
+        _count(c, rel, included, size)  # refused before it is read
+        try:
+            text = read_file(path)
+        except ModelError as exc:  # too large, unreadable...: said at the include
+            (problem,) = exc.issues
+            if problem.line:  # (not UTF-8: at its own place in the included file)
+                raise
+            why = problem.message.removeprefix("cannot read the file: ")
+            raise ModelError([c.issue(f"cannot read the included file '{_short(rel)}': "
+                                      f"{why}", attr="file")]) from None
         included.bytes += len(text.encode("utf-8"))
         _count(c, rel, included, 0)  # it grew since
         sub = parse_xml(text, str(path), budget)
@@ -75,6 +89,10 @@ def _count(c: Element, rel: str, included: Included, more: int) -> None:
             "of included files is read for one model",
             "include each file once, or merge the model into fewer, smaller files",
             "file")])
+
+
+def _short(text: str) -> str:
+    return text if len(text) <= 200 else text[:100] + "..." + text[-40:]
 
 
 def _amount(n: int) -> str:
