@@ -360,9 +360,11 @@ def mutate_tree(rng: random.Random, root: ET.Element, kind: str, files: dict[str
     if op == 8 and parent is not None:
         target, _ = rng.choice(elements)
         if target is not e and e not in list(target.iter()):
-            (parent.remove(e) if rng.random() < 0.5 else None)
+            moved = rng.random() < 0.5  # moved, or copied
+            if moved:
+                parent.remove(e)
             target.append(copy.deepcopy(e))
-            return f"graft <{e.tag}> into <{target.tag}>"
+            return f"{'move' if moved else 'copy'} <{e.tag}> into <{target.tag}>"
     if op == 9:
         e.tag = _misspell(rng, e.tag)
         return f"tag -> <{e.tag}>"
@@ -372,7 +374,7 @@ def mutate_tree(rng: random.Random, root: ET.Element, kind: str, files: dict[str
 
 
 def _bodies(root: ET.Element) -> list[ET.Element]:
-    return [b for b in root.iter("body")]
+    return list(root.iter("body"))
 
 
 def _mutate_mjcf(rng: random.Random, root: ET.Element, op: int, files: dict[str, str]
@@ -486,7 +488,8 @@ def _mutate_urdf(rng: random.Random, root: ET.Element, op: int) -> str:
         if i is None:
             i = ET.SubElement(ln, "inertial")
         m = i.find("mass")
-        (i.remove(m) if m is not None and rng.random() < 0.3 else None)
+        if m is not None and rng.random() < 0.3:
+            i.remove(m)  # (else a second <mass>)
         ET.SubElement(i, "mass", {"value": rng.choice(["1", "0", "-1", "1e-20", awkward(rng)])})
         return f"urdf mass of {ln.get('name')}"
     if op == 14 and joints:
