@@ -631,3 +631,204 @@ def test_format_flag_reads_any_extension(tmp_path, capsys):
     copy.write_text((ROBOTS / "two_link_arm.urdf").read_text())
     assert main(["check", str(copy), "--format", "urdf"]) == 0
     capsys.readouterr()
+
+
+# ---- every number and keyword read, checked (exit 2, never 70) -------------------------
+
+BODY = ('<mujoco>{top}<worldbody><body {body}><joint {joint}/><geom size="0.1" {geom}/>'
+        "</body></worldbody>{end}</mujoco>")
+
+
+def _mjcf(top="", body="", joint="", geom="", end="") -> str:
+    return BODY.format(top=top, body=body, joint=joint, geom=geom, end=end)
+
+
+BAD_MJCF = [
+    (_mjcf(top='<option density="0 0 0"/>'), "<option density>", "expected 1 number, got 3"),
+    (_mjcf(top='<option wind="a b c"/>'), "<option wind>", "'a' is not a number"),
+    (_mjcf(top='<option wind="1 2"/>'), "<option wind>", "expected 3 numbers, got 2"),
+    (_mjcf(top='<option viscosity="1e400"/>'), "<option viscosity>", "'1e400' is too large"),
+    (_mjcf(body='gravcomp="1 1"'), "<body gravcomp>", "expected 1 number, got 2"),
+    (_mjcf(geom='group="nan"'), "<geom group>", "'nan' is not a whole number"),
+    (_mjcf(geom='group="1e400"'), "<geom group>", "'1e400' is not a whole number"),
+    (_mjcf(geom='group="3000000000"'), "<geom group>", "outside the integers MuJoCo reads"),
+    (_mjcf(geom='contype="1.5"'), "<geom contype>", "'1.5' is not a whole number"),
+    (_mjcf(top='<compiler inertiagrouprange="0 1.5"/>'), "<compiler inertiagrouprange>",
+     "'1.5' is not a whole number"),
+    (_mjcf(joint='damping="1e"'), "<joint damping>", "'1e' is not a number"),
+    (_mjcf(joint='damping="1 2 3 4"'), "<joint damping>", "expected 1 to 3 numbers, got 4"),
+    (_mjcf(joint='range="1"'), "<joint range>", "expected 2 numbers, got 1"),
+    (_mjcf(geom='mass="1_000"'), "<geom mass>", "'1_000' is not a number"),
+    (_mjcf(body='pos="0,0,1"'), "<body pos>", "separate numbers with spaces"),
+    (_mjcf(end='<keyframe><key qvel="x"/></keyframe>'), "<key qvel>", "'x' is not a number"),
+    (_mjcf(body='mocap="yes"'), "<body mocap>", "'yes' is not a value of 'mocap'"),
+    (_mjcf(joint='limited="yes"'), "<joint limited>", "'yes' is not a value of 'limited'"),
+    (_mjcf(geom='shellinertia="True"'), "<geom shellinertia>", "did you mean 'true'"),
+    (_mjcf(top='<option><flag gravity="off"/></option>'), "<flag gravity>",
+     "expected disable or enable"),
+    (_mjcf(top='<compiler balanceinertia="1"/>'), "<compiler balanceinertia>",
+     "'1' is not a value of 'balanceinertia'"),
+]
+
+
+@pytest.mark.parametrize("xml, key, said", BAD_MJCF)
+def test_every_mjcf_number_and_keyword_is_checked(xml, key, said, tmp_path, capsys):
+    """Bare float() and int(float()) reads ended in exit 70 (`<option density="0 0 0">`,
+    `wind="a b c"`, `gravcomp="1 1"`, `group="nan"` or `"1e400"`): each is now one
+    located message, exit 2, where MuJoCo refuses the value too."""
+    path = tmp_path / "m.xml"
+    path.write_text(xml)
+    assert main(["check", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert re.search(rf"^mbody: error: {re.escape(str(path))}:1:\d+: {re.escape(key)}: ", err)
+    assert said in err and "Traceback" not in err and "internal error" not in err
+    mj = _mujoco()
+    with pytest.raises(ValueError):
+        mj.MjModel.from_xml_string(xml)
+
+
+@pytest.mark.parametrize("xml", [
+    _mjcf(top='<option density="1.2" viscosity="0.1" wind="0 1 0"/>'),
+    _mjcf(body='gravcomp="0.5"', joint='damping="1 0.5" stiffness="2 1 0.1"'),
+    _mjcf(geom='group="3" contype="0" conaffinity="-1"'),
+    _mjcf(body='pos="0x1p-1 0 +.5"', joint='axis=" 0\t1\n 0 "'),
+    _mjcf(joint='range=""', geom='pos=""'),
+])
+def test_values_mujoco_reads_are_read(xml):
+    """What MuJoCo 4 accepts loads: fluid options and gravity compensation (noted),
+    damping and stiffness as polynomials (up to three coefficients), C's hexadecimal
+    numbers, any blanks around numbers, an empty value (as if not given)."""
+    mj = _mujoco()
+    mj.MjModel.from_xml_string(xml)
+    model = Model.from_spec(validate(read_mjcf(xml)))
+    assert model.body_names == ("body1",)
+
+
+def test_a_class_value_is_reported_at_the_class(tmp_path):
+    (msg,) = _issues('<mujoco>\n<default>\n  <geom group="x"/>\n</default>\n<worldbody>\n'
+                     '<body><joint/><geom size="0.1"/></body>\n</worldbody>\n</mujoco>')
+    assert msg.startswith("bad.xml:3:9: <geom group>: 'x' is not a whole number")
+
+
+@pytest.mark.parametrize("joint, link, key, said", [
+    ('<dynamics damping="1e"/>', "", "<dynamics damping>", "'1e' is not a number"),
+    ('<dynamics friction="inf"/>', "", "<dynamics friction>", "'inf' is not a finite number"),
+    ('<origin xyz="1 2"/>', "", "<origin xyz>", "expected 3 numbers, got 2"),
+    ('<axis xyz="0 0 1e999"/>', "", "<axis xyz>", "too large for a number"),
+    ("", '<visual><geometry><sphere radius="x"/></geometry></visual>', "<sphere radius>",
+     "'x' is not a number"),
+    ("", '<visual><geometry><box size="1 1"/></geometry></visual>', "<box size>",
+     "expected 3 numbers, got 2"),
+])
+def test_every_urdf_number_is_checked(joint, link, key, said, tmp_path, capsys):
+    path = tmp_path / "r.urdf"
+    path.write_text(ARM.format(joint=joint, child="b", link=link))
+    assert main(["check", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert re.search(rf"^mbody: error: {re.escape(str(path))}:1:\d+: {re.escape(key)}: ", err)
+    assert said in err and "Traceback" not in err
+
+
+def test_an_mbody_entry_number_is_checked():
+    base = ('<mujoco><worldbody><body name="a"><joint/><geom size="0.1"/></body>'
+            '</worldbody><custom>{}</custom></mujoco>')
+    (msg,) = _issues(base.format('<numeric name="mbody:dimension" data="inf"/>'))
+    assert "'inf' is not a finite number" in msg
+    (msg,) = _issues(base.format('<numeric name="mbody:body:a" data="1"/>'))
+    assert "a <numeric> entry holds mbody:dimension or mbody:reaction" in msg
+
+
+# ---- reading: marks found in one pass; included files bounded together ----------------
+
+def test_attribute_marks_with_angle_brackets_and_wide_characters():
+    """Each attribute's line and column, found by reading each tag once (the search up
+    to the first '>' stopped inside a value, and took time with the square of it)."""
+    text = ("<root a='1>2' b=\"x\"\n"
+            '  c="é>é"\tdd="4"><kid e="5"/>é<kid f="6"/></root>')
+    root = parse_xml(text)
+    first, second = text.split("\n")
+
+    def at(line: str, what: str) -> int:  # 1-based column, in characters
+        return line.index(what) + 1
+
+    assert root.attr_marks == {"a": (1, at(first, "a=")), "b": (1, at(first, "b=")),
+                               "c": (2, at(second, "c=")), "dd": (2, at(second, "dd="))}
+    assert root.attr_marks["dd"] == (2, 11)
+    kids = root.findall("kid")
+    assert kids[0].attr_marks == {"e": (2, at(second, "e="))}
+    assert kids[1].attr_marks == {"f": (2, at(second, "f="))} == {"f": (2, 36)}
+    assert (kids[1].line, kids[1].column) == (2, at(second, "<kid f"))
+
+
+def test_included_files_are_bounded_together(tmp_path, capsys, monkeypatch):
+    """100 includes of one 30 MB file took 3.8 GB, then 'out of memory': the bytes read
+    over all included files are bounded (MAX_INCLUDED_BYTES, 64 MiB; lowered here), and
+    the include that passes the bound is named at its line."""
+    from mbody.io.interop import mjcf_source
+
+    part = tmp_path / "part.xml"
+    part.write_text("<mujoco><custom>" + '<text name="t" data="x"/>' * 160
+                    + "</custom></mujoco>")
+    monkeypatch.setattr(mjcf_source, "MAX_INCLUDED_BYTES", 3 * part.stat().st_size)
+    main_file = tmp_path / "main.xml"
+    main_file.write_text('<mujoco model="m">\n' + '  <include file="part.xml"/>\n' * 4
+                         + '  <worldbody><body><joint/><geom size="0.1"/></body></worldbody>'
+                         "\n</mujoco>\n")
+    assert main(["check", str(main_file)]) == 2
+    err = capsys.readouterr().err
+    assert re.search(rf"^mbody: error: {re.escape(str(main_file))}:5:12: <include file>: "
+                     r"including 'part.xml' brings the included files to 15\.\d KiB "
+                     r"together \(include number 4\); at most 11\.\d KiB of included "
+                     "files is read for one model", err), err
+    main_file.write_text(main_file.read_text().replace('  <include file="part.xml"/>\n',
+                                                       "", 1))
+    assert main(["check", str(main_file)]) == 0
+
+
+def test_a_value_with_line_breaks_stays_on_its_line(tmp_path, capsys):
+    """Found by tools/fuzz_xml.py: a joint type written with &#10; split the message into
+    lines that looked like problems without a place; the break is written as \\n."""
+    path = tmp_path / "m.xml"
+    path.write_text(_mjcf(joint='type="1&#9;2&#10;3"'))
+    assert main(["check", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "unknown joint type '1\t2\\n3'" in err
+
+
+@pytest.mark.parametrize("key", ["²", "9" * 5000])
+def test_a_keyframe_index_that_is_no_number_is_a_name(key, capsys):
+    """'²' is a digit to str.isdigit but not to int(); 5000 digits are past int()'s
+    limit: both were exit 70."""
+    assert main(["check", str(ROBOTS / "two_link_arm.xml"), "--keyframe", key]) == 2
+    err = capsys.readouterr().err
+    assert "no keyframe named" in err and "(the file has: swing)" in err and len(err) < 300
+
+
+def test_a_planar_model_out_of_its_plane_is_refused(tmp_path, capsys):
+    """Found by tools/fuzz_xml.py: an exported planar model (mbody:dimension 2) whose body
+    was moved to z = -1e9 loaded with the z dropped; now each body and joint out of the
+    x-y plane is named at its line."""
+    from mbody.io.interop.mjcf_write import to_mjcf
+
+    text = to_mjcf(mbody.load(ROBOTS.parent / "triple_pendulum.yaml"))
+    path = tmp_path / "m.xml"
+    path.write_text(text)
+    assert main(["check", str(path)]) == 0
+    capsys.readouterr()
+    lines = text.split("\n")
+    (k,) = [i for i, line in enumerate(lines) if '<body name="lower"' in line]
+    lines[k] = re.sub(r'pos="([^ ]+) ([^ ]+) ([^"]+)"', r'pos="\1 \2 -1e9"', lines[k])
+    path.write_text("\n".join(lines))
+    assert main(["check", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert f"{path}:{k + 1}:" in err and "says the model moves in the world x-y plane, " \
+        "but body 'lower' is at z = -1e+09" in err and "joint 'B' is at z" in err
+
+
+def test_an_include_whose_name_is_too_long_is_located(tmp_path, capsys):
+    path = tmp_path / "m.xml"
+    path.write_text('<mujoco>\n  <include file="' + "x" * 5000 + '"/>\n</mujoco>\n')
+    assert main(["check", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"mbody: error: {path}:2:12: <include file>: cannot read the "
+                          "included file 'xxx") and "File name too long" in err

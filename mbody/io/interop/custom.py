@@ -35,7 +35,10 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 from mbody.errors import Issue, ModelError, did_you_mean
-from mbody.io.interop.xmlsource import Element
+from mbody.io.interop.attrvalues import read_numbers
+from mbody.io.interop.tree import ImportedDocument
+from mbody.io.interop.xmlsource import Element, one_line
+from mbody.model.loader import dotted
 
 PREFIX = "mbody:"
 KINDS = ("dimension", "body", "joint", "load", "reaction")
@@ -46,6 +49,7 @@ class Custom:
     """The ``mbody:`` entries of an MJCF file, each with its element (for messages)."""
 
     dimension: int = 3
+    dimension_element: Element | None = None
     bodies: dict[str, tuple[dict[str, Any], Element]] = field(default_factory=dict)
     joints: dict[str, tuple[dict[str, Any], Element]] = field(default_factory=dict)
     loads: list[tuple[str, dict[str, Any], Element]] = field(default_factory=list)
@@ -119,22 +123,23 @@ def read_custom(root: Element) -> Custom | None:
                                       attr="name"))
                 continue
             if e.tag == "numeric":
-                try:
-                    values = [float(t) for t in data.split()]
-                except ValueError:
-                    values = []
-                if len(values) != 1 or kind not in ("dimension", "reaction"):
-                    issues.append(e.issue(f"'{name}': expected one number in a <numeric> "
-                                          "mbody:dimension or mbody:reaction entry",
-                                          attr="data"))
+                if kind not in ("dimension", "reaction"):
+                    issues.append(e.issue(f"'{name}': a <numeric> entry holds "
+                                          "mbody:dimension or mbody:reaction",
+                                          "other entries are <text>", attr="name"))
+                    continue
+                values = read_numbers(e, "data", data, issues, count=1, hexadecimal=True)
+                if values is None:
                     continue
                 if kind == "dimension":
                     if values[0] not in (2.0, 3.0):
                         issues.append(e.issue(f"mbody:dimension must be 2 or 3, got "
-                                              f"{data}", attr="data"))
+                                              f"{values[0]:g}", attr="data"))
+                        continue
                     out.dimension = int(values[0])
+                    out.dimension_element = e
                 else:
-                    out.reactions[key] = (values[0], e)
+                    out.reactions[key] = (float(values[0]), e)
                 continue
             if kind == "reaction":
                 out.reactions[key] = (data, e)
@@ -160,6 +165,68 @@ def read_custom(root: Element) -> Custom | None:
     if issues:
         raise ModelError(issues)
     return out if found else None
+
+
+PLANE_TOL = 1e-9
+"""How far out of the world x-y plane (relative to the model's size, speeds and gravity)
+a planar model may put a body, a joint or a velocity: rounding, no more."""
+
+
+def planar_issues(doc: ImportedDocument, custom: Custom) -> list[Issue]:
+    """Where the file puts the model out of the x-y plane that ``mbody:dimension`` 2
+    says it moves in (a body off z = 0 or tilted, a velocity or gravity out of the
+    plane, a hinge not about z, a slide not in the plane): read as planar, those would be
+    dropped without a word.
+
+    Returns
+    -------
+    list of Issue
+        At the body or joint, in its own file; empty for a spatial model.
+    """
+    if custom.dimension != 2:
+        return []
+    data = doc.data
+    out: list[Issue] = []
+    dim = custom.dimension_element
+
+    def say(path: tuple[Any, ...], what: str) -> None:
+        line, col = doc.marks.get(path, (0, 0))
+        out.append(doc.locate(Issue(doc.file, line, col, dotted(path), one_line(
+            f"mbody:dimension 2 (line {dim.line if dim else '?'}) says the model moves in "
+            f"the world x-y plane, but {what}"), "write it in the plane, or remove "
+            "mbody:dimension to read the model as spatial")))
+
+    positions = [np.asarray(b["position"], float) for b in data["bodies"]]
+    size = max([1.0] + [float(np.abs(x).max()) for x in positions])
+    g = np.asarray(data["gravity"], float)
+    if abs(g[2]) > PLANE_TOL * max(1.0, float(np.abs(g).max())):
+        say(("gravity",), f"gravity has a z component ({g[2]:.6g})")
+    for k, b in enumerate(data["bodies"]):
+        p: tuple[Any, ...] = ("bodies", k)
+        name = b["name"]
+        if abs(positions[k][2]) > PLANE_TOL * size:
+            say(p, f"body '{name}' is at z = {positions[k][2]:.6g}")
+        R = np.asarray(b.get("orientation", {"matrix": np.eye(3)})["matrix"], float)
+        if np.abs(R[:2, 2]).max() > PLANE_TOL or R[2, 2] < 0:
+            say(p, f"body '{name}' is turned out of the plane (its z axis is "
+                f"{', '.join(f'{x:.3g}' for x in R[:, 2])})")
+        v = np.asarray(b["velocity"], float)
+        w = R @ np.asarray(b.get("angular_velocity", [0.0, 0.0, 0.0]), float)
+        if abs(v[2]) > PLANE_TOL * max(1.0, float(np.abs(v).max())):
+            say(p, f"body '{name}' moves along z ({v[2]:.6g})")
+        if np.abs(w[:2]).max() > PLANE_TOL * max(1.0, float(np.abs(w).max())):
+            say(p, f"body '{name}' turns about an axis out of z")
+    for k, j in enumerate(data.get("joints", [])):
+        p = ("joints", k)
+        at = np.asarray(j["at"], float)
+        if abs(at[2]) > PLANE_TOL * size:
+            say(p, f"joint '{j['name']}' is at z = {at[2]:.6g}")
+        axis = np.asarray(j.get("axis", [0.0, 0.0, 1.0]), float)
+        if j["type"] == "revolute" and np.abs(axis[:2]).max() > PLANE_TOL:
+            say(p, f"the hinge '{j['name']}' turns about an axis out of z")
+        if j["type"] == "prismatic" and abs(axis[2]) > PLANE_TOL:
+            say(p, f"the slide '{j['name']}' leaves the plane")
+    return out
 
 
 def restore(data: dict[str, Any], marks: list[dict[Any, tuple[int, int]]],

@@ -25,10 +25,11 @@ from typing import Any
 import numpy as np
 
 from mbody.errors import Issue, ModelError, did_you_mean
-from mbody.io.interop.custom import Custom, read_custom, restore
+from mbody.io.interop.attrvalues import BOOLEAN
+from mbody.io.interop.custom import Custom, planar_issues, read_custom, restore
 from mbody.io.interop.mjcf_compiler import z_to_quat
 from mbody.io.interop.mjcf_geoms import GEOM_TYPES, MIN_MASS, Geoms, solid
-from mbody.io.interop.mjcf_source import MAX_INCLUDES, check_names, expand_includes
+from mbody.io.interop.mjcf_source import MAX_INCLUDES, Included, check_names, expand_includes
 from mbody.io.interop.mjcf_state import state
 from mbody.io.interop.tree import ImportedDocument, Loop, TreeBody, TreeJoint, build, unit
 from mbody.io.interop.xmlsource import MAX_ELEMENTS, Element, parse_xml, read_xml
@@ -79,7 +80,7 @@ def read_mjcf(source: str | Path, *, keyframe: str | None = None,
                 if root.tag == "robot" else "an MJCF model starts with <mujoco>")
         raise ModelError([root.issue(f"expected <mujoco> as the root element, got "
                                      f"<{root.tag}>", hint)])
-    expand_includes(root, base, budget, [0])
+    expand_includes(root, base, budget, Included())
     issues: list[Issue] = []
     check_names(root, "mujoco", issues)
     if issues:
@@ -96,6 +97,8 @@ class _Reader(Geoms):
         self.childclasses: dict[int, str | None] = {}
         self.world_geoms: list[Element] = []
         self.body_index: dict[str, int] = {}
+        self.moving: list[bool] = []
+        """Per body: it or a body it hangs from has a joint."""
 
     # -- the file --------------------------------------------------------------------
     def read(self, keyframe: str | None) -> ImportedDocument:
@@ -108,22 +111,27 @@ class _Reader(Geoms):
             if g is not None:
                 gravity = g
             for f in o.findall("flag"):
-                if f.get("gravity") == "disable":
+                flags = {k: self.keyword(f, f.attrib, k, ("disable", "enable"), "enable")
+                         for k in ("gravity", "contact", "constraint")}
+                if flags["gravity"] == "disable":
                     gravity = np.zeros(3)
-                if f.get("contact") == "disable" or f.get("constraint") == "disable":
+                if flags["contact"] == "disable" or flags["constraint"] == "disable":
                     self.contact_off = True
-            for k in ("density", "viscosity"):
-                if float(o.get(k, "0") or 0) != 0:
+            for k, n in (("density", 1), ("viscosity", 1), ("wind", 3)):
+                x = self.attr(o, o.attrib, k, n)
+                if x is not None and x.any():
                     self.note("fluid forces", f"option {k}")
-            if o.get("wind") and any(float(t) for t in (o.get("wind") or "").split()):
-                self.note("fluid forces", "option wind")
         for d in root.findall("default"):
             self.defaults.read(d, None, self.issues)
         if self.issues:
             raise ModelError(self.issues)
+        self.read_hfields(root)
         worlds = root.findall("worldbody")
         for w in worlds:
-            for g in w.findall("geom") if not self.contact_off else ():
+            for g in w.findall("geom"):
+                self.geom(g, self.values(g, None))  # checked as MuJoCo checks it
+                if self.contact_off:
+                    continue
                 self.world_geoms.append(g)
                 self.note("contacts", f"world geom '{g.get('name') or g.get('type', '?')}'")
             for c in w.children:
@@ -138,12 +146,17 @@ class _Reader(Geoms):
         self.bound_masses(self.bodies)
         loops = self.equality()
         self.others()
+        if self.issues:
+            raise ModelError(self.issues)
         qpos, qvel, q0 = state(self, root, self.bodies, keyframe)
         name = root.get("model") or Path(self.file).stem
         doc = build(name, f"imported from {Path(self.file).name} (MJCF)", self.file,
                     self.bodies, qpos, qvel, q0, gravity, loops, root, "mjcf",
                     self.free_motions())
         if self.custom is not None:
+            off_plane = planar_issues(doc, self.custom)
+            if off_plane:
+                raise ModelError(off_plane)
             restore(doc.data, [doc.marks, doc.key_marks], self.custom, self.springs())
         if self.notes:
             doc.warnings.append(Issue(self.file, 0, 0, "", _summary(self.notes)))
@@ -214,9 +227,16 @@ class _Reader(Geoms):
                         b = self.bodies[i]
                         bodies.append(b.name)
                         at.append([float(x) for x in (b.R_inertia.T @ (p - b.com))[:d]])
-                k = self.attr(t, t.attrib, "stiffness", 1, np.zeros(1))
-                damp = self.attr(t, t.attrib, "damping", 1, np.zeros(1))
+                # a polynomial in MuJoCo 4 (up to three coefficients); mbody's springs
+                # and dampers are linear
+                k = self.attr(t, t.attrib, "stiffness", 3, np.zeros(1), lo=1)
+                damp = self.attr(t, t.attrib, "damping", 3, np.zeros(1), lo=1)
                 rest = self.attr(t, t.attrib, "springlength", 2, np.zeros(1), lo=1)
+                for key, x in (("stiffness", k), ("damping", damp)):
+                    if x[1:].any():
+                        self.fail(t, f"the spring '{name}' has a {key} that is not linear "
+                                  "(more than one coefficient); mbody's springs are linear",
+                                  "give one number", key)
                 out[name] = {"type": "spring", "bodies": bodies, "at": at,
                              "stiffness": float(k[0]), "rest_length": float(rest[0]),
                              "damping": float(damp[0])}
@@ -252,13 +272,15 @@ class _Reader(Geoms):
             free = next(j for j in joints if j.type == "free")
             self.fail(free.element, f"a free joint on '{name}', a body inside another "
                       "body", "free joints belong to bodies directly in <worldbody>")
-        if e.get("mocap") == "true":
+        if self.keyword(e, e.attrib, "mocap", BOOLEAN, "false") == "true":
             self.note("mocap bodies (fixed where the file puts them)", name)
-        if e.get("gravcomp") and float(e.get("gravcomp") or 0) != 0:
+        if self.attr(e, e.attrib, "gravcomp", 1, np.zeros(1)).any():
             self.note("gravity compensation", name)
         b = TreeBody(name, parent, pos, quat, joints, e)
-        self.mass(b, e, childclass)
+        moving = bool(joints) or (parent >= 0 and self.moving[parent])
+        self.mass(b, e, childclass, moving)
         index = len(self.bodies)
+        self.moving.append(moving)
         self.childclasses[index] = childclass
         self.bodies.append(b)
         self.body_index[name] = index
@@ -287,14 +309,16 @@ class _Reader(Geoms):
         ref = float(self.attr(c, v, "ref", 1, np.zeros(1))[0])
         if typ == "hinge":
             ref *= self.angle_scale
-        limited = v.get("limited", "auto")
-        if "range" in v and limited != "false":
+        limited = self.keyword(c, v, "limited", ("false", "true", "auto"), "auto")
+        limits = self.attr(c, v, "range", 2)
+        if limits is not None and limited != "false":
             self.note("joint limits", name)
-        for key, what in (("damping", "joint damping"), ("stiffness", "joint springs"),
-                          ("armature", "armature (rotor inertia)"),
-                          ("frictionloss", "joint friction")):
-            x = self.attr(c, v, key, 1)
-            if x is not None and float(x[0]) != 0:
+        # damping and stiffness: a polynomial in MuJoCo 4 (up to three coefficients)
+        for key, n, what in (("damping", 3, "joint damping"), ("stiffness", 3, "joint springs"),
+                             ("armature", 1, "armature (rotor inertia)"),
+                             ("frictionloss", 1, "joint friction")):
+            x = self.attr(c, v, key, n, lo=1)
+            if x is not None and x.any():
                 self.note(what, name)
         return TreeJoint(name, typ, pos, unit(axis), c, ref)
 
@@ -303,7 +327,7 @@ class _Reader(Geoms):
         for eq in self.root.findall("equality"):
             for c in eq.children:
                 v = self.values(c, None)
-                if v.get("active", "true") == "false":
+                if self.keyword(c, v, "active", BOOLEAN, "true") == "false":
                     continue
                 if c.tag not in ("connect", "weld"):
                     self.note("equality constraints", f"{c.tag} '{c.get('name') or ''}'")
@@ -361,7 +385,8 @@ class _Reader(Geoms):
             for g in b.element.findall("geom")]
         for i, g, cls in owners:
             v = self.values(g, cls)
-            bits = [self.attr(g, v, k, 1, np.ones(1)) for k in ("contype", "conaffinity")]
+            bits = [self.attr(g, v, k, 1, np.ones(1), integer=True)
+                    for k in ("contype", "conaffinity")]
             geoms.append((g, i, int(bits[0][0]), int(bits[1][0])))
 
         kinds: dict[tuple[int, int], set[int]] = {}  # (type, affinity) -> their bodies

@@ -13,7 +13,8 @@ import numpy as np
 
 from mbody.equations.spatial import axis_angle_quat, matrix_to_quat, quat_mul
 from mbody.errors import Issue, did_you_mean
-from mbody.io.interop.mjcf_defaults import Defaults
+from mbody.io.interop.attrvalues import BOOLEAN, read_keyword, read_numbers, split
+from mbody.io.interop.mjcf_defaults import ORIENTATIONS, Defaults, Values
 from mbody.io.interop.tree import unit
 from mbody.io.interop.xmlsource import Element
 
@@ -43,30 +44,36 @@ class Compiler:
         self.issues.append(e.issue(message, hint, attr))
 
     def numbers(self, e: Element, attr: str, value: str | None, n: int | None = None,
-                lo: int = 0) -> np.ndarray | None:
-        if value is None:
+                lo: int = 0, integer: bool = False) -> np.ndarray | None:
+        """The numbers of `value` (attribute `attr` of `e`): `n` of them, or `lo` to `n`;
+        None when the value is absent or empty (as MuJoCo reads it) or wrong (reported)."""
+        if value is None or not split(value):
             return None
-        try:
-            x = np.array([float(t) for t in value.split()])
-        except ValueError:
-            bad = next(t for t in value.split() if not _is_float(t))
-            self.fail(e, f"'{bad}' is not a number", "values are decimal numbers separated "
-                      "by spaces, such as \"0 0 1\"", attr)
-            return None
-        if not np.all(np.isfinite(x)):
-            self.fail(e, "expected finite numbers", attr=attr)
-            return None
-        if n is not None and not (lo or n) <= len(x) <= n:
-            want = f"{n}" if not lo else f"{lo} to {n}"
-            self.fail(e, f"expected {want} number{'s' if n > 1 else ''}, got {len(x)}",
-                      attr=attr)
-            return None
-        return x
+        return read_numbers(e, attr, value, self.issues, count=n, least=lo or n,
+                            integer=integer, hexadecimal=True)
+
+    @staticmethod
+    def at(e: Element, values: dict[str, str], name: str) -> Element:
+        """The element where attribute `name` of `e` was written (`e`, or its class's)."""
+        where = values.origin(name) if isinstance(values, Values) else None
+        return where or e
 
     def attr(self, e: Element, values: dict[str, str], name: str, n: int | None = None,
-             default: Any = None, lo: int = 0) -> Any:
-        x = self.numbers(e, name, values.get(name), n, lo)
+             default: Any = None, lo: int = 0, integer: bool = False) -> Any:
+        """The numbers of attribute `name` in `values` (`e`'s, over its class's), read at
+        the element where the value was written; `default` when it is not given."""
+        x = self.numbers(self.at(e, values, name), name, values.get(name), n, lo, integer)
         return default if x is None else x
+
+    def keyword(self, e: Element, values: dict[str, str], name: str,
+                choices: tuple[str, ...], default: str) -> str:
+        """The keyword of attribute `name` (one of `choices`, exactly as MuJoCo wants
+        it), or `default` when it is not given or wrong (reported)."""
+        text = values.get(name)
+        if text is None:
+            return default
+        return read_keyword(self.at(e, values, name), name, text, choices,
+                            self.issues) or default
 
     def compiler(self, c: Element) -> None:
         angle = c.get("angle")
@@ -89,46 +96,46 @@ class Compiler:
                 self.fail(c, f"inertiafromgeom must be true, false or auto, got '{ifg}'",
                           attr="inertiafromgeom")
             self.inertiafromgeom = ifg
-        g = self.attr(c, c.attrib, "inertiagrouprange", 2)
+        g = self.attr(c, c.attrib, "inertiagrouprange", 2, integer=True)
         if g is not None:
             self.groups = (int(g[0]), int(g[1]))
         for k in ("boundmass", "boundinertia", "settotalmass"):
             v = self.attr(c, c.attrib, k, 1)
             if v is not None:
                 setattr(self, k, float(v[0]))
-        if c.get("coordinate", "local") != "local":
+        if self.keyword(c, c.attrib, "coordinate", ("local", "global"), "local") != "local":
             self.fail(c, "coordinate='global' is not read (MuJoCo itself dropped it)",
                       "write every frame relative to its parent", "coordinate")
-        if c.get("balanceinertia") == "true":
+        if self.keyword(c, c.attrib, "balanceinertia", BOOLEAN, "false") == "true":
             self.note("compiler options", "balanceinertia")
 
-    def values(self, e: Element, childclass: str | None) -> dict[str, str]:
+    def values(self, e: Element, childclass: str | None) -> Values:
         """The element's attributes over its default class's."""
         return self.defaults.values(e, childclass, self.issues)
 
     def orientation(self, e: Element, values: dict[str, str]) -> np.ndarray:
         """A frame's orientation from whichever of MJCF's five forms is given."""
-        forms = [k for k in ("quat", "axisangle", "euler", "xyaxes", "zaxis") if k in values]
+        forms = [k for k in ORIENTATIONS if k in values]  # all from one element
         if len(forms) > 1:
-            here = [k for k in forms if k in e.attrib] or forms
-            self.fail(e, f"the orientation is given twice ({', '.join(forms)})",
-                      "give one of quat, axisangle, euler, xyaxes, zaxis", here[-1])
+            self.fail(self.at(e, values, forms[-1]), f"the orientation is given twice "
+                      f"({', '.join(forms)})", "give one of quat, axisangle, euler, xyaxes, "
+                      "zaxis", forms[-1])
             return np.array([1.0, 0, 0, 0])
         if not forms:
             return np.array([1.0, 0, 0, 0])
         k = forms[0]
-        v = self.numbers(e, k, values[k], {"quat": 4, "axisangle": 4, "euler": 3,
-                                           "xyaxes": 6, "zaxis": 3}[k])
+        v = self.attr(e, values, k, {"quat": 4, "axisangle": 4, "euler": 3, "xyaxes": 6,
+                                     "zaxis": 3}[k])
         if v is None:
             return np.array([1.0, 0, 0, 0])
         if k == "quat":
             if np.linalg.norm(v) < 1e-12:
-                self.fail(e, "the quaternion is zero", attr=k)
+                self.fail(self.at(e, values, k), "the quaternion is zero", attr=k)
                 return np.array([1.0, 0, 0, 0])
             return unit(v)
         if k == "axisangle":
             if np.linalg.norm(v[:3]) < 1e-12:
-                self.fail(e, "the rotation axis is zero", attr=k)
+                self.fail(self.at(e, values, k), "the rotation axis is zero", attr=k)
                 return np.array([1.0, 0, 0, 0])
             return axis_angle_quat(unit(v[:3]), v[3] * self.angle_scale)
         if k == "euler":
@@ -141,7 +148,7 @@ class Compiler:
             x = unit(v[:3])
             y = v[3:] - (v[3:] @ x) * x
             if np.linalg.norm(x) < 1e-12 or np.linalg.norm(y) < 1e-12:
-                self.fail(e, "xyaxes: the axes are zero or parallel", attr=k)
+                self.fail(self.at(e, values, k), "xyaxes: the axes are zero or parallel", attr=k)
                 return np.array([1.0, 0, 0, 0])
             y = unit(y)
             return matrix_to_quat(np.column_stack((x, y, np.cross(x, y))))
@@ -160,10 +167,4 @@ def z_to_quat(v: np.ndarray) -> np.ndarray:
     return axis_angle_quat(axis, math.atan2(s, v[2]))
 
 
-def _is_float(t: str) -> bool:
-    try:
-        float(t)
-    except ValueError:
-        return False
-    return True
 

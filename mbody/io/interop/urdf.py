@@ -12,6 +12,7 @@ dynamics, mimic joints and transmissions are listed in one warning.
 from __future__ import annotations
 
 import difflib
+import functools
 import math
 from collections.abc import Mapping
 from pathlib import Path
@@ -21,6 +22,7 @@ import numpy as np
 
 from mbody.equations.spatial import quat_to_matrix
 from mbody.errors import Issue, ModelError, did_you_mean
+from mbody.io.interop.attrvalues import read_numbers
 from mbody.io.interop.tree import (
     NV,
     ImportedDocument,
@@ -133,35 +135,52 @@ def _one_edit(a: str, b: str) -> bool:
             or a[i:i + 2] == b[i:i + 2][::-1] and a[i + 2:] == b[i + 2:])
 
 
+@functools.lru_cache(maxsize=4096)
 def _misspelt(name: str, known: tuple[str, ...]) -> bool:
-    return any(difflib.SequenceMatcher(None, name, k).ratio() >= TYPO_CUTOFF
-               or _one_edit(name, k) for k in known)
+    return any(_one_edit(name, k) or _alike(name, k) for k in known)
+
+
+def _alike(a: str, b: str) -> bool:
+    """difflib's ratio of `a` and `b` is at least TYPO_CUTOFF (its cheap upper bounds
+    first, as get_close_matches does: most names are ruled out by their lengths)."""
+    m = difflib.SequenceMatcher(None, a, b)
+    return (m.real_quick_ratio() >= TYPO_CUTOFF and m.quick_ratio() >= TYPO_CUTOFF
+            and m.ratio() >= TYPO_CUTOFF)
 
 
 def _check_names(root: Element, issues: list[Issue], ignored: list[str]) -> None:
     """A name very close to one of URDF's is misspelt (an error with a did-you-mean);
     any other unknown name is a tool's extension (Gazebo's, a vendor's): noted, not read.
     """
+    noted = set(ignored)  # (the list keeps file order; the set answers 'seen?' at once)
+
+    def note(what: str) -> None:
+        if what not in noted:
+            noted.add(what)
+            ignored.append(what)
+
     stack = [root]
     while stack:
         e = stack.pop()
         if e.tag in _OPEN:
             continue
+        known = _ATTRS.get(e.tag, ())
         for a in e.attrib:
-            known = _ATTRS.get(e.tag, ())
             if a not in known and ":" not in a:
                 if _misspelt(a, known):
-                    issues.append(unknown_name(e, a, known, f"attribute of <{e.tag}>", a))
-                elif f"{e.tag} {a}" not in ignored:
-                    ignored.append(f"{e.tag} {a}")
+                    issues.append(unknown_name(e, a, known, f"attribute of <{e.tag}>", a,
+                                               len(issues) < ModelError.SHOWN))
+                else:
+                    note(f"{e.tag} {a}")
+        kids = _CHILDREN.get(e.tag, ())
         for c in e.children:
-            kids = _CHILDREN.get(e.tag, ())
             if c.tag in kids:
                 stack.append(c)
             elif _misspelt(c.tag, kids):
-                issues.append(unknown_name(c, c.tag, kids, f"element in <{e.tag}>"))
-            elif f"<{c.tag}> in <{e.tag}>" not in ignored:
-                ignored.append(f"<{c.tag}> in <{e.tag}>")
+                issues.append(unknown_name(c, c.tag, kids, f"element in <{e.tag}>",
+                                           hint=len(issues) < ModelError.SHOWN))
+            else:
+                note(f"<{c.tag}> in <{e.tag}>")
     issues.sort(key=lambda i: (i.line, i.column))
 
 
@@ -185,21 +204,12 @@ class _Reader:
 
     def numbers(self, e: Element | None, attr: str, n: int, default: np.ndarray
                 ) -> np.ndarray:
+        """The `n` numbers of attribute `attr` of `e`; `default` when it is not there, or
+        when they are wrong (reported)."""
         if e is None or e.get(attr) is None:
             return default
-        text = e.get(attr) or ""
-        try:
-            x = np.array([float(t) for t in text.split()])
-        except ValueError:
-            self.issues.append(e.issue(f"'{text}' is not {n} number{'s' if n > 1 else ''}",
-                                       "numbers separated by spaces, such as \"0 0 1\"",
-                                       attr))
-            return default
-        if len(x) != n or not np.all(np.isfinite(x)):
-            self.issues.append(e.issue(f"expected {n} finite number{'s' if n > 1 else ''}, "
-                                       f"got '{text}'", attr=attr))
-            return default
-        return x
+        x = read_numbers(e, attr, e.get(attr) or "", self.issues, count=n)
+        return default if x is None else x
 
     def origin(self, e: Element) -> tuple[np.ndarray, np.ndarray]:
         o = e.find("origin")
@@ -333,7 +343,7 @@ class _Reader:
         dyn = j.find("dynamics")
         if dyn is not None:
             for k, what in (("damping", "joint damping"), ("friction", "joint friction")):
-                if float(dyn.get(k, "0") or 0) != 0:
+                if self.numbers(dyn, k, 1, np.zeros(1)).any():
                     self.note(what, name)
         if j.find("mimic") is not None:
             self.note("mimic joints (they move freely here)", name)
@@ -368,24 +378,21 @@ class _Reader:
             g = v.find("geometry")
             for s in g.children if g is not None else []:
                 shape: dict[str, Any]
-                try:
-                    if s.tag == "box":
-                        size = [float(x) for x in (s.get("size") or "").split()]
-                        vol, shape = float(np.prod(size)), {"box": size}
-                    elif s.tag in ("cylinder", "capsule"):
-                        r, L = float(s.get("radius") or 0), float(s.get("length") or 0)
-                        L += 2 * r if s.tag == "capsule" else 0
-                        vol, shape = math.pi * r * r * L, {"cylinder": {"radius": r,
-                                                                        "length": L}}
-                    elif s.tag == "sphere":
-                        r = float(s.get("radius") or 0)
-                        vol, shape = r ** 3 * 4, {"sphere": {"radius": r}}
-                    else:
-                        continue
-                except ValueError:
+                if s.tag == "box":
+                    size = [float(x) for x in self.numbers(s, "size", 3, np.zeros(3))]
+                    vol, shape = float(np.prod(size)), {"box": size}
+                elif s.tag in ("cylinder", "capsule"):
+                    r, L = (float(self.numbers(s, k, 1, np.zeros(1))[0])
+                            for k in ("radius", "length"))
+                    L += 2 * r if s.tag == "capsule" else 0
+                    vol, shape = math.pi * r * r * L, {"cylinder": {"radius": r,
+                                                                    "length": L}}
+                elif s.tag == "sphere":
+                    r = float(self.numbers(s, "radius", 1, np.zeros(1))[0])
+                    vol, shape = 4 * r * r * r, {"sphere": {"radius": r}}
+                else:
                     continue
-                if len(shape.get("box", [1, 1, 1])) == 3 and vol > 0 and (
-                        best is None or vol > best[0]):
+                if vol > 0 and (best is None or vol > best[0]):
                     best = (vol, shape)
         return best[1] if best else None
 

@@ -68,7 +68,7 @@ class Element:
         """An `Issue` located at this element (or at its attribute `attr`)."""
         line, col = self.where(attr)
         key = f"<{self.tag}{' ' + attr if attr else ''}>"
-        return Issue(self.file, line, col, key, message, hint)
+        return Issue(self.file, line, col, key, one_line(message), one_line(hint))
 
     def iter(self, tag: str | None = None) -> Iterator[Element]:
         """This element and every descendant (depth first), or those named `tag`."""
@@ -88,7 +88,9 @@ class Element:
         return [c for c in self.children if c.tag == tag]
 
 
-_ATTR = re.compile(rb"([^\s=/>]+)\s*=\s*(\"[^\"]*\"|'[^']*')")
+_ATTR = re.compile(rb"\s*([^\s=/>]+)\s*=\s*(?:\"[^\"]*\"|'[^']*')")
+"""One attribute of a start tag, matched where the previous one ended: a name, '=', a
+quoted value (which may hold '>'). Anchored, each byte of a tag is read once."""
 
 
 class _Reader:
@@ -98,8 +100,9 @@ class _Reader:
         self.data, self.file, self.budget = data, file, budget
         self.root: Element | None = None
         self.stack: list[Element] = []
-        # byte offset of each line start: attribute columns from expat's byte index
-        self.starts = [0] + [m.end() for m in re.finditer(rb"\n", data)]
+        # where the last mark was: attributes are marked in file order, so each mark
+        # counts lines and characters only from the one before (linear in the file)
+        self._at, self._line, self._line_start, self._column = 0, 1, 0, 0
         # decoded text re-encoded: its declared encoding no longer applies
         p = expat.ParserCreate(encoding)
         # as defusedxml's DefusedExpatParser: no DTD, hence no entity of any kind
@@ -125,15 +128,18 @@ class _Reader:
         raise ExternalReferenceForbidden(context, base, sysid, pubid)
 
     def _mark(self, offset: int) -> tuple[int, int]:
-        lo, hi = 0, len(self.starts) - 1
-        while lo < hi:  # the last line start at or before offset
-            mid = (lo + hi + 1) // 2
-            if self.starts[mid] <= offset:
-                lo = mid
-            else:
-                hi = mid - 1
-        col = len(self.data[self.starts[lo]:offset].decode("utf-8", "replace")) + 1
-        return lo + 1, col
+        """1-based (line, column) of the byte at `offset` (a character's first byte)."""
+        data = self.data
+        if offset < self._at:  # out of file order (never, with expat): count afresh
+            self._at, self._line, self._line_start, self._column = 0, 1, 0, 0
+        lines = data.count(b"\n", self._at, offset)
+        if lines:
+            self._line += lines
+            self._line_start = data.rfind(b"\n", self._at, offset) + 1
+            self._at, self._column = self._line_start, 0
+        self._column += len(data[self._at:offset].decode("utf-8", "replace"))
+        self._at = offset
+        return self._line, self._column + 1
 
     def _start(self, tag: str, attrib: dict[str, str]) -> None:
         p = self.parser
@@ -145,12 +151,13 @@ class _Reader:
         start = p.CurrentByteIndex
         line, col = p.CurrentLineNumber, p.CurrentColumnNumber + 1
         e = Element(tag, dict(attrib), self.file, line, col)
-        if attrib:
-            end = self.data.find(b">", start)
-            for m in _ATTR.finditer(self.data, start + 1 + len(tag.encode()), end + 1):
+        if attrib:  # expat has read the whole tag: its attributes follow one another
+            at = start + 1 + len(tag.encode())
+            while (m := _ATTR.match(self.data, at)) is not None:
                 name = m.group(1).decode("utf-8", "replace")
                 if name in attrib and name not in e.attr_marks:
                     e.attr_marks[name] = self._mark(m.start(1))
+                at = m.end()
         if self.stack:
             self.stack[-1].children.append(e)
         else:
@@ -248,7 +255,7 @@ def read_xml(path: str | Path, file: str | None = None,
 
 
 def unknown_name(e: Element, name: str, known: Iterable[str], what: str,
-                 attr: str | None = None) -> Issue:
+                 attr: str | None = None, hint: bool = True) -> Issue:
     """An issue for a name not in `known`, with a did-you-mean when one is close.
 
     Parameters
@@ -263,11 +270,27 @@ def unknown_name(e: Element, name: str, known: Iterable[str], what: str,
         What kind of name, for the message (``"element"``, ``"attribute of <joint>"``).
     attr : str, optional
         The attribute whose name is wrong.
+    hint : bool, optional
+        Look for a did-you-mean (False past the issues a message shows: a file of 200 000
+        unknown names is refused without 200 000 searches).
     """
-    choices = sorted(set(known))
-    hint = did_you_mean(name, choices)
-    if not hint and len(choices) <= 12:
-        hint = f"expected one of: {', '.join(choices)}" if choices else f"no {what} here"
+    said = ""
+    if hint:
+        choices = sorted(set(known))
+        said = did_you_mean(name, choices)
+        if not said and len(choices) <= 12:
+            said = f"expected one of: {', '.join(choices)}" if choices else f"no {what} here"
     line, col = e.where(attr)
     key = f"<{e.tag}>" if attr is None else f"<{e.tag} {attr}>"
-    return Issue(e.file, line, col, key, f"unknown {what} '{name}'", hint)
+    return Issue(e.file, line, col, key, one_line(f"unknown {what} '{name}'"), one_line(said))
+
+
+_BREAKS = str.maketrans({"\n": "\\n", "\r": "\\r", "\x0b": "\\v", "\x0c": "\\f",
+                         "\x1c": "\\x1c", "\x1d": "\\x1d", "\x1e": "\\x1e",
+                         "\x85": "\\x85", "\u2028": "\\u2028", "\u2029": "\\u2029"})
+
+
+def one_line(text: str) -> str:
+    """`text` with its line breaks written as escapes: a value quoted in a message (a
+    name written with ``&#10;``) must not start a line that looks like another problem."""
+    return text.translate(_BREAKS)
