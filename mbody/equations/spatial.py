@@ -149,15 +149,22 @@ def rmatvec(A: np.ndarray, v: np.ndarray) -> np.ndarray:
     return np.einsum("...ji,...j->...i", A, v)
 
 
+FRAME_TIE = 1e-12
+"""Direction components this close count as equal in the joint frame's rule."""
+
+
 def joint_frame_spatial(axis: np.ndarray | None) -> np.ndarray:
     """Contract rule for a spatial joint frame; returns W_E, columns = joint x, y, z axes.
 
     z along `axis` (world z when None); x = the world axis least aligned with z (first on a
-    tie) with its z component removed, normalised; y = z × x.
+    tie) with its z component removed, normalised; y = z × x. Components within
+    `FRAME_TIE` of each other tie: an axis read back from another program, (1.2e-16, 1,
+    0) for (0, 1, 0), keeps the frame the exact axis has.
     """
     z = np.array([0.0, 0.0, 1.0]) if axis is None else np.asarray(axis, float)
     z = z / np.linalg.norm(z)
-    i = int(np.argmin(np.abs(z)))  # argmin returns the first index on a tie
+    a = np.abs(z)
+    i = int(np.flatnonzero(a <= a.min() + FRAME_TIE)[0])  # the first on a tie
     x = np.eye(3)[i] - z[i] * z
     x /= np.linalg.norm(x)
     y = np.cross(z, x)
