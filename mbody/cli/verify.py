@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import sys
 
@@ -45,13 +44,13 @@ def _tolerance(text: str) -> float:
 
 def verify(a: argparse.Namespace) -> int:
     from mbody.answers.verify import verify as _verify
+    from mbody.io import jsontext
 
     regular_file(a.answers, "a YAML answers file")
     model = load_model(a.model)
     result = _verify(model, a.answers, tol=a.tol)
     if a.json:
-        json.dump(result.to_dict(), sys.stdout, indent=2, ensure_ascii=False)
-        print()
+        jsontext.dump(result.to_dict(), sys.stdout)
     else:
         print(result.text())
     return EXIT_OK if result.ok else EXIT_UNMET
