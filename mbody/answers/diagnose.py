@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from mbody.answers.compare import CONST, Fit, Row, fit, matches, same
+from mbody.answers.compare import CONST, Fit, Row, fit, fit_on, matches, same
 from mbody.answers.rows import BodyRows, LoadShare, MomentPoint, TrueRow
 from mbody.answers.text import num as _num
 from mbody.answers.text import row_text
@@ -161,7 +161,7 @@ class _Diagnoser:
             return None
         c = self.s.get(CONST)
         says = ("0 = 0" if c == 0.0 else
-                f"a number equal to another (they differ by {_num(abs(c))})")
+                f"a number equal to another (they differ by {_num(abs(c), abs(c))})")
         return Diagnosis(NOT_AN_EQUATION, "", "",
                          f"Once the model's numbers are put in, this says {says}: it has no "
                          "acceleration and no unknown reaction in it. A Newton-Euler "
@@ -514,15 +514,18 @@ class _Diagnoser:
                              f"any of {self.br.body}'s Newton-Euler rows.", {})
         _, r, t, words, text, f, wrong = best
         parts = []
+        # numbers at the student's scale: noise only against the row's own magnitude
+        ref = min(1.0, max((abs(v) for v in self.s.coef.values()), default=1.0))
         for key in wrong[:3]:
-            have, want = self.s.get(key), f.k * t.get(key)
+            have, want = self.s.get(key), f.times(t.get(key))
             name = "the constant" if key == CONST else key
             if have == 0.0:
-                parts.append(f"{name} is missing (expected {_num(want)})")
+                parts.append(f"{name} is missing (expected {_num(want, ref)})")
             elif want == 0.0:
-                parts.append(f"{name} does not belong here (you have {_num(have)})")
+                parts.append(f"{name} does not belong here (you have {_num(have, ref)})")
             else:
-                parts.append(f"{name} has {_num(have)} where {_num(want)} is expected")
+                parts.append(f"{name} has {_num(have, ref)} where {_num(want, ref)} is "
+                             "expected")
         more = f", and {len(wrong) - 3} more" if len(wrong) > 3 else ""
         combo = self.combination()
         return Diagnosis(
@@ -530,7 +533,7 @@ class _Diagnoser:
             (combo + " " if combo else "")
             + f"Closest is {words}; with every term on the left side, at your "
             "equation's scale: " + "; ".join(parts) + more + ".",
-            {"differs": {k: {"have": self.s.get(k), "expected": f.k * t.get(k)}
+            {"differs": {k: {"have": self.s.get(k), "expected": f.times(t.get(k))}
                          for k in wrong}})
 
     def wrong_sign(self) -> Diagnosis | None:
@@ -564,14 +567,7 @@ class _Diagnoser:
         acceleration breaking ties), so that the minority of wrong terms stands out."""
         best: tuple | None = None
         for key in sorted(self.s.keys & t.keys):
-            k = self.s.get(key) / t.get(key)
-            errors = {}
-            for name in sorted(self.s.keys | t.keys):
-                ref = max(self.s.err(name), abs(k) * t.err(name))
-                diff = abs(self.s.get(name) - k * t.get(name))
-                errors[name] = 0.0 if diff <= 1e-15 * ref else (
-                    diff / ref if ref > 0 else np.inf)
-            fk = Fit(k, max(errors.values(), default=0.0), errors)
+            fk = fit_on(self.s, t, key)
             score = (len(fk.wrong(self.tol)), key != acc, fk.error)
             if best is None or score < best[0]:
                 best = (score, fk)

@@ -78,11 +78,14 @@ class ParsedEquation:
         The equation as written.
     lhs, rhs : tuple
         The trees of the two sides (see the module's grammar).
+    equals : int
+        The 0-based position of its '='.
     """
 
     text: str
     lhs: Node
     rhs: Node
+    equals: int = 0
 
 
 def parse_equation(text: str, labels: Iterable[str] = ()) -> ParsedEquation:
@@ -117,7 +120,7 @@ def parse_equation(text: str, labels: Iterable[str] = ()) -> ParsedEquation:
             raise EquationError(text, pos, "an equation needs '='",
                                 "write it as left side = right side")
         parser.unexpected()
-    parser.take()
+    equals = parser.take()[2]
     if parser.peek()[0] == "end":
         raise EquationError(text, parser.peek()[2], "nothing on the right of '='",
                             "write 0 if the right side is zero")
@@ -127,7 +130,7 @@ def parse_equation(text: str, labels: Iterable[str] = ()) -> ParsedEquation:
         raise EquationError(text, pos, "a second '='", "write one equation per entry")
     if kind != "end":
         parser.unexpected()
-    return ParsedEquation(text, lhs, rhs)
+    return ParsedEquation(text, lhs, rhs, equals)
 
 
 def _tokenise(text: str, labels: Iterable[str]) -> list[tuple[str, str, int]]:
