@@ -15,9 +15,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         description="Read ANSWERS, a YAML file of equations (equations: - {body: NAME, eq: "
         "\"2*a_y = O.Fy - 19.62\"}), and say for each whether it is one of the body's "
         "Newton-Euler rows (any scaling or rearrangement counts) or which mistake of the "
-        "course explains the difference: missing_gyroscopic_term, wrong_moment_point, "
-        "reaction_treated_as_known, missing_reaction, reaction_sign, "
-        "single_inertia_in_space, missing_applied_load, not_an_equation_of_this_body. "
+        "course explains the difference: missing_gyroscopic_term, gyroscopic_term_sign, "
+        "missing_products_of_inertia, single_inertia_in_space, wrong_moment_point, "
+        "missing_reaction, reaction_sign, missing_applied_load, reaction_treated_as_known, "
+        "not_an_equation_of_this_body. "
         "Then list the rows no correct equation gave. Exit code 0 when every equation is "
         "correct, 1 when some are not, 2 for a bad model or answers file.")
     s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
