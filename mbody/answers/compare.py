@@ -280,12 +280,22 @@ both lists divided by 2^e."""
 
 def _unit(row: Row, keys: list[str]) -> Unit:
     """The row's coefficients and error scales over `keys`, divided by the power of two
-    nearest above the largest of them: exact in floating point, and the squares `fit`
-    takes neither overflow (a row written at 1e200) nor vanish (at 1e-170)."""
-    big = max((max(abs(row.get(k)), row.err(k)) for k in keys), default=0.0)
+    nearest above the largest of them when that is beyond 2^±200: exact in floating
+    point, and the squares `fit` takes neither overflow (a row written at 1e200) nor
+    vanish (at 1e-170); a row within 2^±200 is taken as it is (e = 0)."""
+    coef, scale = row.coef, row.scale
+    c = [coef.get(k, 0.0) for k in keys]
+    err = [scale[k] if k in scale else abs(v) for k, v in zip(keys, c, strict=True)]
+    big = max(max(map(abs, c), default=0.0), max(err, default=0.0))
     e = math.frexp(big)[1] if 0.0 < big < math.inf else 0
-    return ([math.ldexp(row.get(k), -e) for k in keys],
-            [math.ldexp(row.err(k), -e) for k in keys], e)
+    if -_SAFE <= e <= _SAFE:
+        return c, err, 0
+    return [math.ldexp(v, -e) for v in c], [math.ldexp(v, -e) for v in err], e
+
+
+_SAFE = 200
+"""Rows whose magnitudes are within 2^±200 are compared as they are: their squares and
+the weights 1/w² (w down to `_FLOOR` times them) stay normal doubles."""
 
 
 def _errors(keys: list[str], s: Unit, t: Unit, k: float, noise: float) -> Fit:

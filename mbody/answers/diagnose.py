@@ -342,8 +342,10 @@ class _Diagnoser:
         for e in self.br.euler:
             k = e.axis
             i, j = (k + 1) % 3, (k + 2) % 3
-            if self.s.get(e.acc) == 0.0:
-                continue
+            if self.s.get(e.acc) == 0.0 or any(
+                    self.s.get(a) != 0.0 for a in ("alpha_1", "alpha_2", "alpha_3")
+                    if a != e.acc):
+                continue  # the principal form has this row's angular acceleration alone
             for words, inertia in choices:
                 gyro = (inertia[j] - inertia[i]) * w[i] * w[j]
                 coef = {key: v for key, v in e.row.coef.items() if not key.startswith("alpha")}
