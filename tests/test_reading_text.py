@@ -85,3 +85,25 @@ def test_too_many_equations_are_refused(capsys, tmp_path):
     assert code == 2
     assert (f"a.yaml:3:3: equations: {MAX_EQUATIONS + 1} equations; at most {MAX_EQUATIONS} "
             "are checked at once (split the answers into several files)") in err
+
+
+def test_labels_the_name_token_would_split_are_read_whole(tmp_path):
+    """A chain whose joints are named pin-0, pin-1 ...: its reaction labels (pin-3.Fx) are
+    looked up per position by length (was: every label at every character, a quarter of
+    a second an equation with 1000 labels); the longest one wins (pin-10.Fx, not
+    pin-1.Fx followed by '0')."""
+    import mbody
+
+    n = 60
+    bodies = "\n".join(f"  - {{name: b{k}, mass: 1, inertia: 0.1, position: [{k + 0.5}, 0]}}"
+                       for k in range(n))
+    joints = "\n".join(f"  - {{name: pin-{k}, type: revolute, parent: "
+                       f"{'ground' if k == 0 else f'b{k - 1}'}, child: b{k}, at: [{k}, 0]}}"
+                       for k in range(n))
+    model = mbody.loads(f"dimension: 2\ngravity: [0, -9.81]\nbodies:\n{bodies}\n"
+                        f"joints:\n{joints}\n")
+    v = mbody.verify(model, [("b10", "m*a_x = pin-10.Fx - pin-11.Fx"),
+                             ("b10", "m*a_x = pin-10.Fx + pin-11.Fx"),
+                             ("b1", "m*a_y = pin-1.Fy-pin-2.Fy - m*g")])
+    assert [c.diagnosis for c in v.checks] == ["correct", "reaction_sign", "correct"]
+    assert v.checks[1].details["reactions"] == ["pin-11.Fx"]

@@ -11,7 +11,10 @@ growing with the square of their size:
   (``mass: "1000…0}"``, the number hint's regular expression) or plain with an
   underscore (``mass: 1000…0_x``, YAML 1.1's underscored number check): 80 kB took
   158 s;
-- an answers file of many equations (16 000: 31 s; each entry split the whole text).
+- an answers file of many equations (16 000: 31 s; each entry split the whole text);
+- equations on a model of many reactions whose labels the name token does not read
+  whole (pin-3.Fx): each character of each equation tried every label (a quarter of a
+  second an equation with 1000 labels).
 
 For each case and size the table shows the best time of --repeat runs, the time per
 unit of size, and the growth: log(t2/t1) / log(n2/n1) between a size and the one before
@@ -53,15 +56,28 @@ def model_with(value: str, key: str = "mass: 2.0") -> str:
     return PENDULUM.replace(key, value)
 
 
+def chain(n: int) -> str:
+    """A planar chain of n bodies on revolute joints named pin-0 ... (labels such as
+    pin-3.Fx, which the name token does not read whole)."""
+    bodies = "\n".join(f"  - {{name: b{k}, mass: 1, inertia: 0.1, position: [{k + 0.5}, 0]}}"
+                       for k in range(n))
+    joints = "\n".join(f"  - {{name: pin-{k}, type: revolute, parent: "
+                       f"{'ground' if k == 0 else f'b{k - 1}'}, child: b{k}, at: [{k}, 0]}}"
+                       for k in range(n))
+    return f"dimension: 2\ngravity: [0, -9.81]\nbodies:\n{bodies}\njoints:\n{joints}\n"
+
+
 @dataclass(frozen=True)
 class Case:
-    """One input shape: `make(n)` gives the text for size n; `unit` names n."""
+    """One input shape: `make(n)` gives the text for size n; `unit` names n; `model`,
+    for an answers case, the model's text (default: models/pendulum.yaml)."""
 
     name: str
     kind: str  # "model" (read by mbody.loads) or "answers" (checked by mbody.verify)
     make: Callable[[int], str]
     unit: str = "kB"
     sizes: tuple[int, ...] = (10_000, 20_000, 40_000, 80_000)
+    model: str = ""
 
 
 CASES: list[Case] = [
@@ -85,6 +101,11 @@ CASES: list[Case] = [
     Case("equations with an unknown name", "answers", lambda n: "equations:\n" + "".join(
         f'  - {{body: rod, eq: "m*a_x = O.Fxx + {k}"}}\n' for k in range(n)),
         unit="1000 equations", sizes=(2000, 4000, 8000, 16000)),
+    # each equation looked for the model's 1000 reaction labels at every character
+    Case("equations, 1000 labels 'pin-k.Fx'", "answers", lambda n: "equations:\n" + "".join(
+        f'  - {{body: b{k % 500}, eq: "m*a_x = pin-{k % 500}.Fx - pin-{k % 500 + 1}.Fx"}}\n'
+        for k in range(n)), unit="1000 equations", sizes=(500, 1000, 2000, 4000),
+        model=chain(501)),
 ]
 """The inputs measured (a new hang found by a fuzzer becomes a case here)."""
 
@@ -96,7 +117,8 @@ def reader(case: Case, folder: Path) -> Callable[[str], None]:
             with contextlib.suppress(MbodyError):
                 mbody.loads(text)
         return read
-    model = mbody.load(ROOT / "models" / "pendulum.yaml")
+    model = mbody.loads(case.model) if case.model else mbody.load(
+        ROOT / "models" / "pendulum.yaml")
     path = folder / "answers.yaml"
 
     def check(text: str) -> None:
