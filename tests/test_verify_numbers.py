@@ -65,6 +65,10 @@ def nth(text: str, token: str, n: int) -> int:
      "the smallest double (nonzero numbers would become 0) (multiply both sides by a power "
      "of ten)"),
     ("1e-200*1e-200*a_x = 1", "*", 1, "this product is too small to compute"),
+    # one term lost is enough, whatever the others
+    ("(2*a_x + 1e-200)*1e-200 = 0", "*", 2, "this product is too small to compute"),
+    ("(0 + a_x*1e-200)/1e100/1e100 = 1", "/", 2, "this quotient is too small to compute"),
+    ("a_x = 0.5^2000", "^", 1, "this power is too small to compute"),
     ("a_x = 0^(-1)", "^", 1, "0^-1 cannot be computed (a negative number to a fractional "
      "power, or 0 to a negative one)"),
     ("a_x = (-8)^(1/3)", "^", 1, "(-8)^0.333333 cannot be computed"),

@@ -147,14 +147,21 @@ def _binary(kind: str, a: _Form, b: _Form, pos: int, text: str) -> _Form:
     below the smallest normal double."""
     out = _operate(kind, a, b, pos, text)
     _checked(out, kind, pos, text)
-    if kind in "*/^":
-        before = [v for f in (a, b) for v in f.value.values()]
-        if all(v != 0.0 for v in before) and any(
-                abs(v) < sys.float_info.min for v in out.value.values()):
-            raise EquationError(text, pos, f"{_WHAT[kind]} is too small to compute: "
-                                "below 2.2e-308, the smallest double (nonzero numbers "
-                                "would become 0)", "multiply both sides by a power of ten")
+    if kind in "*/^" and _lost(kind, a, b, out):
+        raise EquationError(text, pos, f"{_WHAT[kind]} is too small to compute: below "
+                            "2.2e-308, the smallest double (nonzero numbers would become "
+                            "0)", "multiply both sides by a power of ten")
     return out
+
+
+def _lost(kind: str, a: _Form, b: _Form, out: _Form) -> bool:
+    """Whether a product, quotient or power of nonzero numbers fell below the smallest
+    normal double (to 0, or to a subnormal that has lost its digits), in any term."""
+    if kind == "^":
+        return a.c != 0.0 and abs(out.c) < sys.float_info.min
+    form, factor = (b, a.c) if kind == "*" and a.constant else (a, b.c)
+    return factor != 0.0 and any(form.value.get(k, 0.0) != 0.0 and abs(v) < sys.float_info.min
+                                 for k, v in out.value.items())
 
 
 def _checked(form: _Form, kind: str, pos: int, text: str) -> _Form:
