@@ -232,9 +232,9 @@ def test_not_an_equation_of_this_body():
     assert c.diagnosis == "not_an_equation_of_this_body" and "product" in c.explanation
     # no unknown at all
     assert diagnosis("pendulum", "rod", "m*g = 19.62") == "not_an_equation_of_this_body"
-    # the gyroscopic term with the wrong sign
+    # the gyroscopic term with the wrong sign: a diagnosis of its own
     c = check("seed_example_2", "body", "I_1*alpha_1 = (I_3 - I_2)*w_2*w_3")
-    assert c.diagnosis == "not_an_equation_of_this_body" and c.row == "body.w1"
+    assert c.diagnosis == "gyroscopic_term_sign" and c.row == "body.w1"
     # a true equation mixing two rows is not one row
     c = check("seed_example_1", "plate", "10*a_x + 10*a_y = 50")
     assert c.diagnosis == "not_an_equation_of_this_body"
@@ -520,7 +520,10 @@ def test_a_moment_of_the_wrong_sign_on_the_child_is_not_blamed_on_the_third_law(
 ])
 def test_a_load_or_the_gyroscopic_term_of_the_wrong_sign_is_named(name, body, eq, what, row):
     c = check(name, body, eq)
-    assert c.diagnosis == "not_an_equation_of_this_body" and c.row == row
+    # a load of the wrong sign is named within not_an_equation_of_this_body; the
+    # gyroscopic term's sign is a diagnosis of its own
+    assert c.diagnosis == ("gyroscopic_term_sign" if what == "omega x (I omega)" else
+                           "not_an_equation_of_this_body") and c.row == row
     assert c.details["wrong_sign"] == what and "of the wrong sign" in c.explanation
 
 

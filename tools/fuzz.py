@@ -590,8 +590,12 @@ def _worker(seed, indices, heavy_every, hang, results, workdir):
 
 
 def run(n: int, seed: int = 0, jobs: int = 1, heavy_every: int = 5, hang: float = 60.0,
-        first: int = 0, log=print) -> dict:
-    """Run mutations first .. first + n - 1; return the counts and the failures."""
+        first: int = 0, log=print, worker=None) -> dict:
+    """Run mutations first .. first + n - 1; return the counts and the failures.
+
+    `worker` runs a list of mutation numbers in a child process (default `_worker`, this
+    fuzzer's); another fuzzer (tools/fuzz_answers.py) passes its own, with the same
+    arguments and messages, to be watched for hangs the same way."""
     workdir = tempfile.mkdtemp(prefix="mbody-fuzz.")
     todo = list(range(first, first + n))
     verdicts: Counter = Counter()
@@ -605,7 +609,7 @@ def run(n: int, seed: int = 0, jobs: int = 1, heavy_every: int = 5, hang: float 
     def start(indices):
         if not indices:
             return
-        proc = ctx.Process(target=_worker, args=(seed, indices, heavy_every, hang / 2,
+        proc = ctx.Process(target=worker or _worker, args=(seed, indices, heavy_every, hang / 2,
                                                  results, workdir), daemon=True)
         proc.start()
         workers[proc.pid] = (proc, list(indices), None, None)

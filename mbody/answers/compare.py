@@ -11,6 +11,10 @@ rows match when, for some factor k,
 An exact zero on one side must be an exact zero (or rounding noise of the terms that
 made it) on the other: a term that is left out is never within tolerance, however
 small it is.
+
+The comparison does not depend on the scale a row is written at: ``1e-170*a_x =
+5e-170`` is ``a_x = 5``. `fit` brings both rows to magnitudes about 1 by powers of two
+(exact in floating point) before it squares anything.
 """
 
 from __future__ import annotations
@@ -174,6 +178,18 @@ class Fit:
     k: float
     error: float
     errors: dict[str, float]
+    ratio: float = 0.0
+    """k as the ratio of the two rows brought to magnitude 1: k = ratio·2^(es − et)."""
+    exponents: tuple[int, int] = (0, 0)
+    """(es, et): the powers of two that brought the student's row and the true row there."""
+
+    def times(self, x: float) -> float:
+        """k·x for a coefficient x of the true row, without overflow where k alone would
+        (a row written at 1e300 against one at 1e-10): a number at the student's scale."""
+        if self.ratio == 0.0:
+            return self.k * x
+        es, et = self.exponents
+        return _ldexp(self.ratio * math.ldexp(x, -et), es)
 
     def ok(self, tol: float) -> bool:
         """Whether every key matches within `tol`."""
@@ -212,10 +228,8 @@ def fit(s: Row, t: Row, free: Iterable[str] = ()) -> Fit | None:
     Fit or None
         None when t has no term to compare on, or s has none in common with it.
     """
-    skip = set(free)
-    keys = sorted((s.keys | t.keys) - skip)
-    tk = [t.get(key) for key in keys]
-    sk = [s.get(key) for key in keys]
+    keys = sorted((s.keys | t.keys) - set(free))
+    (sk, se, es), (tk, te, et) = _unit(s, keys), _unit(t, keys)
     tt = sum(v * v for v in tk)
     if tt == 0.0:
         return None
@@ -224,20 +238,89 @@ def fit(s: Row, t: Row, free: Iterable[str] = ()) -> Fit | None:
         return None
     for _ in range(3):  # weighted least squares: each key counts by its own tolerance
         num = den = 0.0
-        for key, a, b in zip(keys, sk, tk, strict=True):
-            w = max(s.err(key), abs(k) * t.err(key))
+        for a, b, ea, eb in zip(sk, tk, se, te, strict=True):
+            w = max(ea, abs(k) * eb)
             if w > 0.0 and b != 0.0:
+                w = max(w, _FLOOR)  # a coefficient known to 1e-150 counts as exact
                 num += a * b / (w * w)
                 den += b * b / (w * w)
         if den == 0.0 or num == 0.0:
             break
         k = num / den
+    return _errors(keys, (sk, se, es), (tk, te, et), k, 0.0)
+
+
+def fit_on(s: Row, t: Row, key: str) -> Fit:
+    """The fit with the factor that makes the coefficients of `key` agree exactly
+    (k = s_key / t_key), every key compared; a difference below 1e-15 of its tolerance's
+    reference counts as none.
+
+    Parameters
+    ----------
+    s, t : Row
+        The student's row and a true row (or a variant), both with a nonzero `key`.
+    key : str
+        The key whose coefficients fix the factor.
+
+    Returns
+    -------
+    Fit
+    """
+    keys = sorted(s.keys | t.keys)
+    (sk, se, es), (tk, te, et) = _unit(s, keys), _unit(t, keys)
+    i = keys.index(key)
+    k = sk[i] / tk[i] if tk[i] != 0.0 else 0.0  # 0: t spans over 2000 binades
+    return _errors(keys, (sk, se, es), (tk, te, et), k, 1e-15)
+
+
+Unit = tuple[list[float], list[float], int]
+"""A row over some keys brought to magnitude about 1: (coefficients, error scales, e),
+both lists divided by 2^e."""
+
+
+def _unit(row: Row, keys: list[str]) -> Unit:
+    """The row's coefficients and error scales over `keys`, divided by the power of two
+    nearest above the largest of them when that is beyond 2^±200: exact in floating
+    point, and the squares `fit` takes neither overflow (a row written at 1e200) nor
+    vanish (at 1e-170); a row within 2^±200 is taken as it is (e = 0)."""
+    coef, scale = row.coef, row.scale
+    c = [coef.get(k, 0.0) for k in keys]
+    err = [scale[k] if k in scale else abs(v) for k, v in zip(keys, c, strict=True)]
+    big = max(max(map(abs, c), default=0.0), max(err, default=0.0))
+    e = math.frexp(big)[1] if 0.0 < big < math.inf else 0
+    if -_SAFE <= e <= _SAFE:
+        return c, err, 0
+    return [math.ldexp(v, -e) for v in c], [math.ldexp(v, -e) for v in err], e
+
+
+_SAFE = 200
+"""Rows whose magnitudes are within 2^±200 are compared as they are: their squares and
+the weights 1/w² (w down to `_FLOOR` times them) stay normal doubles."""
+
+
+def _errors(keys: list[str], s: Unit, t: Unit, k: float, noise: float) -> Fit:
+    """The `Fit` of factor k between two rows at unit scale: per key |s − k t| over
+    max(scale_s, |k| scale_t), 0 where that difference is within `noise` of it."""
+    (sk, se, es), (tk, te, et) = s, t
     errors = {}
-    for key, a, b in zip(keys, sk, tk, strict=True):
-        ref = max(s.err(key), abs(k) * t.err(key))
+    for key, a, b, ea, eb in zip(keys, sk, tk, se, te, strict=True):
+        ref = max(ea, abs(k) * eb)
         diff = abs(a - k * b)
-        errors[key] = 0.0 if diff == 0.0 else (diff / ref if ref > 0.0 else math.inf)
-    return Fit(k, max(errors.values(), default=0.0), errors)
+        errors[key] = 0.0 if diff <= noise * ref else (diff / ref if ref > 0.0 else math.inf)
+    return Fit(_ldexp(k, es - et), max(errors.values(), default=0.0), errors, k, (es, et))
+
+
+def _ldexp(x: float, e: int) -> float:
+    """x·2^e, ±inf where that overflows (math.ldexp raises)."""
+    try:
+        return math.ldexp(x, e)
+    except OverflowError:
+        return math.copysign(math.inf, x)
+
+
+_FLOOR = 1e-150
+"""Smallest weight scale in `fit`, relative to a row's largest magnitude (its square is
+still a normal double)."""
 
 
 def matches(s: Row, t: Row, tol: float, free: Iterable[str] = ()) -> Fit | None:

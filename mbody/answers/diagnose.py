@@ -12,25 +12,28 @@ and the terms that differ are reported.
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from mbody import joint_types
-from mbody.answers.compare import CONST, Fit, Row, fit, matches, same
-from mbody.answers.rows import BodyRows, LoadShare, MomentPoint, TrueRow
+from mbody.answers.compare import CONST, Fit, Row, fit, fit_on, matches, same
+from mbody.answers.rows import BodyRows, MomentPoint, TrueRow
 from mbody.answers.text import num as _num
 from mbody.answers.text import row_text
 from mbody.answers.text import terms as _terms
 
 CORRECT = "correct"
 MISSING_GYROSCOPIC_TERM = "missing_gyroscopic_term"
+GYROSCOPIC_TERM_SIGN = "gyroscopic_term_sign"
 WRONG_MOMENT_POINT = "wrong_moment_point"
 REACTION_TREATED_AS_KNOWN = "reaction_treated_as_known"
 MISSING_REACTION = "missing_reaction"
 REACTION_SIGN = "reaction_sign"
 SINGLE_INERTIA_IN_SPACE = "single_inertia_in_space"
+MISSING_PRODUCTS_OF_INERTIA = "missing_products_of_inertia"
 MISSING_APPLIED_LOAD = "missing_applied_load"
 NOT_AN_EQUATION = "not_an_equation_of_this_body"
 
@@ -38,14 +41,19 @@ DIAGNOSES = {
     CORRECT: "equal to one of the body's Newton or Euler rows (up to scale and "
              "rearrangement)",
     MISSING_GYROSCOPIC_TERM: "an Euler row without its ω × Iω part",
-    WRONG_MOMENT_POINT: "moments taken about another point (a joint, the origin) with I_G "
-                        "and without the transport term",
-    REACTION_TREATED_AS_KNOWN: "an unknown reaction replaced by a number",
-    MISSING_REACTION: "an unknown reaction left out",
-    REACTION_SIGN: "a reaction with the wrong sign (the third law: −R on the parent)",
+    GYROSCOPIC_TERM_SIGN: "an Euler row with ω × Iω of the wrong sign (mind the cyclic "
+                          "order 1 → 2 → 3)",
+    MISSING_PRODUCTS_OF_INERTIA: "Euler's principal-axes form (I_1 α_1 + (I_3 − I_2) ω_2 "
+                                 "ω_3 = M_1) in body axes that are not principal: the "
+                                 "tensor's products of inertia left out",
     SINGLE_INERTIA_IN_SPACE: "one scalar inertia where the tensor's principal moments "
                              "differ",
+    WRONG_MOMENT_POINT: "moments taken about another point (a joint, the origin) with I_G "
+                        "and without the transport term",
+    MISSING_REACTION: "an unknown reaction left out",
+    REACTION_SIGN: "a reaction with the wrong sign (the third law: −R on the parent)",
     MISSING_APPLIED_LOAD: "an applied force or moment (or gravity) left out",
+    REACTION_TREATED_AS_KNOWN: "an unknown reaction replaced by a number",
     NOT_AN_EQUATION: "none of the above explains it",
 }
 """The fixed vocabulary of diagnoses, in the order they are tried, with their meaning."""
@@ -137,8 +145,9 @@ class _Diagnoser:
 
     def run(self) -> Diagnosis:
         for step in (self.no_unknowns, self.foreign, self.correct, self.gyroscopic,
-                     self.single_inertia, self.moment_point, self.missing_reaction,
-                     self.reaction_sign, self.missing_load, self.treated_as_known):
+                     self.gyroscopic_sign, self.products_of_inertia, self.single_inertia,
+                     self.moment_point, self.missing_reaction, self.reaction_sign,
+                     self.missing_load, self.treated_as_known):
             found = step()
             if found is not None:
                 return found
@@ -162,7 +171,7 @@ class _Diagnoser:
             return None
         c = self.s.get(CONST)
         says = ("0 = 0" if c == 0.0 else
-                f"a number equal to another (they differ by {_num(abs(c))})")
+                f"a number equal to another (they differ by {_num(abs(c), abs(c))})")
         return Diagnosis(NOT_AN_EQUATION, "", "",
                          f"Once the model's numbers are put in, this says {says}: it has no "
                          "acceleration and no unknown reaction in it. A Newton-Euler "
@@ -246,6 +255,26 @@ class _Diagnoser:
                      "value": t.get(CONST) - full.get(CONST)})
         return None
 
+    def gyroscopic_sign(self) -> Diagnosis | None:
+        """An Euler row with ω × Iω of the wrong sign: the cyclic order 1 → 2 → 3 turned
+        (``(I_3 − I_2) w_2 w_3`` on the right side of axis 1 instead of ``(I_2 − I_3)``)."""
+        for e in self.br.euler:
+            if e.gyro == 0.0 or abs(e.gyro) <= 1e-12 * e.row.err(CONST):
+                continue
+            t = e.row.with_term(CONST, e.row.get(CONST) - 2.0 * e.gyro, e.row.err(CONST))
+            if self.match(t) is None:
+                continue
+            J = self.br.J
+            mind = ("mind the cyclic order 1 → 2 → 3" if np.count_nonzero(J - np.diag(np.diag(J)))
+                    == 0 else "mind the order of the cross product, ω × (Iω)")
+            return Diagnosis(
+                GYROSCOPIC_TERM_SIGN, e.text, e.label,
+                f"This is {self.words(e)} with its gyroscopic term of the wrong sign: "
+                f"{self.gyro_words(e)} (on the right side it is −(ω × Iω)); {mind}. The row "
+                f"reads: {e.text}.",
+                {"wrong_sign": "omega x (I omega)", "value": e.gyro})
+        return None
+
     def gyro_words(self, e: TrueRow) -> str:
         k = e.axis
         J, w = self.br.J, self.br.omega
@@ -295,6 +324,54 @@ class _Diagnoser:
                 f"{self.inertia_words(e)}"
                 + (f", and keep ω × Iω ({_num(e.gyro)} N m)." if e.gyro else "."),
                 {"inertia_used": used, "term": f"I alpha_{k}"})
+        return None
+
+    def products_of_inertia(self) -> Diagnosis | None:
+        """Euler's principal-axes form, I_k α_k + (I_j − I_i) ω_i ω_j = M_k, written for a
+        body whose tensor has products of inertia in its body axes, with its diagonal
+        entries or its principal moments (in any order) as I_1, I_2, I_3."""
+        J = self.br.J
+        products = {f"I_{a + 1}{b + 1}": float(J[a, b]) for a, b in ((0, 1), (0, 2), (1, 2))
+                    if abs(J[a, b]) > 1e-12 * np.abs(J).max()}
+        if self.planar or not products:
+            return None  # principal body axes: the form is right (or the row is planar)
+        w = self.br.omega
+        moments = np.linalg.eigvalsh(J)
+        choices = [("its diagonal entries I_11, I_22, I_33", tuple(np.diag(J).tolist()))]
+        choices += [("its principal moments", p)
+                    for p in dict.fromkeys(itertools.permutations(moments.tolist()))]
+        for e in self.br.euler:
+            k = e.axis
+            i, j = (k + 1) % 3, (k + 2) % 3
+            if self.s.get(e.acc) == 0.0 or any(
+                    self.s.get(a) != 0.0 for a in ("alpha_1", "alpha_2", "alpha_3")
+                    if a != e.acc):
+                continue  # the principal form has this row's angular acceleration alone
+            for words, inertia in choices:
+                gyro = (inertia[j] - inertia[i]) * w[i] * w[j]
+                coef = {key: v for key, v in e.row.coef.items() if not key.startswith("alpha")}
+                coef[e.acc] = inertia[k]
+                coef[CONST] = e.row.get(CONST) - e.gyro + gyro
+                scale = {key: e.row.err(key) for key in coef if key not in (e.acc, CONST)}
+                scale[CONST] = max(0.0, e.row.err(CONST) - abs(e.gyro)) + abs(gyro)
+                t = Row.of(coef, scale)
+                if same(t, e.row, self.tol) or self.match(t) is None:
+                    continue
+                n = k + 1
+                form = (f"I_{n} α_{n} + (I_{j + 1} − I_{i + 1}) ω_{i + 1} ω_{j + 1} = M_{n}")
+                used = ", ".join(_num(x) for x in inertia)
+                listed = ", ".join(f"{name} = {_num(v)}" for name, v in products.items())
+                return Diagnosis(
+                    MISSING_PRODUCTS_OF_INERTIA, e.text, e.label,
+                    f"This is {self.words(e)} in its principal-axes form, {form}, with "
+                    f"{words} ({used} kg m²) as I_1, I_2, I_3. That form holds only along "
+                    f"principal axes, and {self.br.body}'s body axes are not: its tensor has "
+                    f"products of inertia ({listed} kg m²). In body axes keep the full "
+                    f"tensor: {self.inertia_words(e)} on the left, and (ω × Iω)_{n} = "
+                    f"{_num(e.gyro)} N m with it; or write Euler's equations along the "
+                    "principal axes, with ω and α in those axes.",
+                    {"inertia_used": list(inertia), "products": products,
+                     "term": f"(I alpha)_{n} and (omega x I omega)_{n}"})
         return None
 
     def inertia_words(self, e: TrueRow) -> str:
@@ -515,15 +592,18 @@ class _Diagnoser:
                              f"any of {self.br.body}'s Newton-Euler rows.", {})
         _, r, t, words, text, f, wrong = best
         parts = []
+        # numbers at the student's scale: noise only against the row's own magnitude
+        ref = min(1.0, max((abs(v) for v in self.s.coef.values()), default=1.0))
         for key in wrong[:3]:
-            have, want = self.s.get(key), f.k * t.get(key)
+            have, want = self.s.get(key), f.times(t.get(key))
             name = "the constant" if key == CONST else key
             if have == 0.0:
-                parts.append(f"{name} is missing (expected {_num(want)})")
+                parts.append(f"{name} is missing (expected {_num(want, ref)})")
             elif want == 0.0:
-                parts.append(f"{name} does not belong here (you have {_num(have)})")
+                parts.append(f"{name} does not belong here (you have {_num(have, ref)})")
             else:
-                parts.append(f"{name} has {_num(have)} where {_num(want)} is expected")
+                parts.append(f"{name} has {_num(have, ref)} where {_num(want, ref)} is "
+                             "expected")
         more = f", and {len(wrong) - 3} more" if len(wrong) > 3 else ""
         combo = self.combination()
         return Diagnosis(
@@ -531,33 +611,23 @@ class _Diagnoser:
             (combo + " " if combo else "")
             + f"Closest is {words}; with every term on the left side, at your "
             "equation's scale: " + "; ".join(parts) + more + ".",
-            {"differs": {k: {"have": self.s.get(k), "expected": f.k * t.get(k)}
+            {"differs": {k: {"have": self.s.get(k), "expected": f.times(t.get(k))}
                          for k in wrong}})
 
     def wrong_sign(self) -> Diagnosis | None:
-        """A row with one applied load, gravity or the gyroscopic term of the wrong sign:
-        no mistake of the table, but the commonest slip, so it is named."""
+        """A row with one applied load or gravity of the wrong sign: no mistake of the
+        table, but a common slip, so it is named (the gyroscopic term's sign is a
+        diagnosis of its own: `gyroscopic_sign`)."""
         for r in self.br.rows:
-            flips: list[tuple[LoadShare | None, float]] = [
-                (x, -2.0 * x.value) for x in r.loads]  # Q's share: −value in lhs − rhs
-            if r.euler and r.gyro != 0.0:
-                flips.append((None, 2.0 * r.gyro))  # b is on the left: +gyro
-            for x, change in flips:
+            for x in r.loads:
+                change = -2.0 * x.value  # Q's share: −value in lhs − rhs
                 t = r.row.with_term(CONST, r.row.get(CONST) - change, r.row.err(CONST))
                 if self.match(t) is None:
                     continue
-                if x is None:
-                    what = (f"its gyroscopic term of the wrong sign: {self.gyro_words(r)} "
-                            "(on the right side it is −(ω × Iω)); mind the cyclic order "
-                            "1 → 2 → 3")
-                    name = "omega x (I omega)"
-                else:
-                    what = f"{_load_words(x, r.euler)} of the wrong sign"
-                    name = x.name
                 return Diagnosis(
                     NOT_AN_EQUATION, r.text, r.label,
-                    f"This is {self.words(r)} with {what}. The row reads: {r.text}.",
-                    {"wrong_sign": name})
+                    f"This is {self.words(r)} with {_load_words(x, r.euler)} of the wrong "
+                    f"sign. The row reads: {r.text}.", {"wrong_sign": x.name})
         return None
 
     def consensus(self, t: Row, acc: str) -> Fit | None:
@@ -565,14 +635,7 @@ class _Diagnoser:
         acceleration breaking ties), so that the minority of wrong terms stands out."""
         best: tuple | None = None
         for key in sorted(self.s.keys & t.keys):
-            k = self.s.get(key) / t.get(key)
-            errors = {}
-            for name in sorted(self.s.keys | t.keys):
-                ref = max(self.s.err(name), abs(k) * t.err(name))
-                diff = abs(self.s.get(name) - k * t.get(name))
-                errors[name] = 0.0 if diff <= 1e-15 * ref else (
-                    diff / ref if ref > 0 else np.inf)
-            fk = Fit(k, max(errors.values(), default=0.0), errors)
+            fk = fit_on(self.s, t, key)
             score = (len(fk.wrong(self.tol)), key != acc, fk.error)
             if best is None or score < best[0]:
                 best = (score, fk)

@@ -11,16 +11,29 @@ Each sub-expression evaluates to a linear form ``Σ c_k u_k + c_0`` over the unk
 
 A product of two forms that both hold unknowns, a division by one, or a function of one
 is not a Newton-Euler equation: `NotLinear` says where.
+
+Every number stays a finite double: an operation whose result (or the magnitudes that
+go with it) goes beyond ±1.8e308, or a product of nonzero numbers that falls below the
+smallest normal double (2.2e-308, where digits are lost and then everything is 0), is
+refused at its operator with an `EquationError`, never carried on as inf, nan or a term
+that silently vanished. A long sum is evaluated in a loop (`left_spine`).
 """
 
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass, field
 
 from mbody.answers.compare import CONST, Row
 from mbody.answers.parse import EquationError, Node, ParsedEquation
+from mbody.answers.text import num as _num
 from mbody.answers.vocabulary import Vocabulary
+from mbody.model.expressions import left_spine
+
+_WHAT = {"+": "this sum", "-": "this difference", "*": "this product", "/": "this quotient",
+         "^": "this power", "exp": "exp( )", "tan": "tan( )", "sqrt": "sqrt( )",
+         "sin": "sin( )", "cos": "cos( )", "=": "the two sides"}
 
 
 class NotLinear(Exception):
@@ -88,7 +101,8 @@ def linear_row(eq: ParsedEquation, vocab: Vocabulary) -> Row:
         The equation multiplies, divides or takes a function of an unknown.
     """
     text = eq.text
-    form = _eval(eq.lhs, vocab, text).add(_eval(eq.rhs, vocab, text), -1.0)
+    form = _checked(_eval(eq.lhs, vocab, text).add(_eval(eq.rhs, vocab, text), -1.0),
+                    "=", eq.equals, text)
     # the constant's key is kept only when a number was written (even one that cancels,
     # m*g - m*g): "no number at all" is not "a reaction replaced by a number"
     keys = [k for k in form.value if k != CONST or form.mag[k] > 0.0]
@@ -97,6 +111,14 @@ def linear_row(eq: ParsedEquation, vocab: Vocabulary) -> Row:
 
 
 def _eval(node: Node, vocab: Vocabulary, text: str) -> _Form:
+    node, spine = left_spine(node)
+    form = _leaf(node, vocab, text)
+    for op in reversed(spine):
+        form = _binary(op[0], form, _eval(op[2], vocab, text), op[3], text)
+    return form
+
+
+def _leaf(node: Node, vocab: Vocabulary, text: str) -> _Form:
     kind = node[0]
     if kind == "num":
         return _Form.number(float(node[1]), exact=False)
@@ -115,9 +137,44 @@ def _eval(node: Node, vocab: Vocabulary, text: str) -> _Form:
         arg = _eval(node[2], vocab, text)
         if not arg.constant:
             raise NotLinear(node[3], f"{node[1]}( ) of an unknown ({_names(arg)})")
-        return _call(node[1], arg, text, node[3])
-    a, b = _eval(node[1], vocab, text), _eval(node[2], vocab, text)
-    pos = node[3]
+        return _checked(_call(node[1], arg, text, node[3]), node[1], node[3], text)
+    return _binary(kind, _eval(node[1], vocab, text), _eval(node[2], vocab, text), node[3],
+                   text)
+
+
+def _binary(kind: str, a: _Form, b: _Form, pos: int, text: str) -> _Form:
+    """a (kind) b, checked: finite, and no product or quotient of nonzero numbers lost
+    below the smallest normal double."""
+    out = _operate(kind, a, b, pos, text)
+    _checked(out, kind, pos, text)
+    if kind in "*/^" and _lost(kind, a, b, out):
+        raise EquationError(text, pos, f"{_WHAT[kind]} is too small to compute: below "
+                            "2.2e-308, the smallest double (nonzero numbers would become "
+                            "0)", "multiply both sides by a power of ten")
+    return out
+
+
+def _lost(kind: str, a: _Form, b: _Form, out: _Form) -> bool:
+    """Whether a product, quotient or power of nonzero numbers fell below the smallest
+    normal double (to 0, or to a subnormal that has lost its digits), in any term."""
+    if kind == "^":
+        return a.c != 0.0 and abs(out.c) < sys.float_info.min
+    form, factor = (b, a.c) if kind == "*" and a.constant else (a, b.c)
+    return factor != 0.0 and any(form.value.get(k, 0.0) != 0.0 and abs(v) < sys.float_info.min
+                                 for k, v in out.value.items())
+
+
+def _checked(form: _Form, kind: str, pos: int, text: str) -> _Form:
+    for table in (form.value, form.err, form.mag):
+        for v in table.values():
+            if not math.isfinite(v):
+                raise EquationError(text, pos, f"the numbers in {_WHAT[kind]} go beyond "
+                                    "±1.8e308, the largest double",
+                                    "divide both sides by a power of ten")
+    return form
+
+
+def _operate(kind: str, a: _Form, b: _Form, pos: int, text: str) -> _Form:
     if kind == "+":
         return a.add(b, 1.0)
     if kind == "-":
@@ -150,14 +207,23 @@ def _eval(node: Node, vocab: Vocabulary, text: str) -> _Form:
             return _Form.number(1.0, exact=True)
         raise NotLinear(pos, f"a power of an unknown ({_names(a)})")
     x = a.c
+    shown = f"{_num(x) if x >= 0 else f'({_num(x)})'}^{_num(p)}"
     try:
         v = math.pow(x, p)
-    except (OverflowError, ValueError):
-        raise EquationError(text, pos, f"{x:g}^{p:g} cannot be computed") from None
+    except OverflowError:
+        raise EquationError(text, pos, f"{shown} is beyond ±1.8e308, the largest double",
+                            "divide both sides by a power of ten") from None
+    except ValueError:  # math.pow says "math domain error"
+        raise EquationError(text, pos, f"{shown} cannot be computed",
+                            "a negative number to a fractional power, or 0 to a negative "
+                            "one") from None
     err = abs(p * v / x) * a.err.get(CONST, 0.0) if x != 0.0 else 0.0
     if x > 0.0:
         err += abs(v * math.log(x)) * b.err.get(CONST, 0.0)
-    mag = math.pow(a.mag.get(CONST, 0.0), p) if a.mag.get(CONST, 0.0) > 0.0 else abs(v)
+    try:
+        mag = math.pow(a.mag.get(CONST, 0.0), p) if a.mag.get(CONST, 0.0) > 0.0 else abs(v)
+    except OverflowError:
+        mag = math.inf  # the terms it was made of are too large: `_checked` says so
     return _Form({CONST: v}, {CONST: err}, {CONST: max(abs(v), mag)})
 
 

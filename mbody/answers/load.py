@@ -25,6 +25,9 @@ from mbody.model.loader import Document, dotted, load_text, read_file
 
 TOP_KEYS = ("equations", "student")
 ENTRY_KEYS = ("body", "eq")
+MAX_EQUATIONS = 20_000
+"""Most equations in one answers file (a student's answers hold tens; each one costs about a
+millisecond or two to diagnose, so this bounds the work at about half a minute)."""
 
 
 class AnswersError(ModelError):
@@ -194,6 +197,7 @@ def _reword(issue: Issue) -> Issue:
 
 def _build(data: Any, file: str, doc: Document | None, text: str) -> Answers:
     issues: list[Issue] = []
+    lines = text.split("\n") if text else []  # once: split per entry was quadratic
 
     def where(path: tuple, key: bool = False) -> tuple[int, int]:
         return doc.where(path, key=key) if doc is not None else (0, 0)
@@ -225,6 +229,9 @@ def _build(data: Any, file: str, doc: Document | None, text: str) -> Answers:
         err(("equations",), f"expected a list of {{body, eq}} entries, got {_kind(entries)}")
     elif not entries:
         err(("equations",), "the list of equations is empty")
+    elif len(entries) > MAX_EQUATIONS:
+        err(("equations",), f"{len(entries)} equations; at most {MAX_EQUATIONS} are checked at "
+            "once", "split the answers into several files")
     else:
         for n, e in enumerate(entries):
             path: tuple = ("equations", n)
@@ -248,7 +255,7 @@ def _build(data: Any, file: str, doc: Document | None, text: str) -> Answers:
                     'quote it: eq: "2*a_y = O.Fy - 19.62"')
                 continue
             line, col = where((*path, "eq"))
-            col += _quote_offset(text, line, col, eq)
+            col += _quote_offset(lines, line, col, eq)
             out.append(Answer(n + 1, body, eq, line, col, dotted((*path, "eq")),
                               *where((*path, "body"))))
     if issues:
@@ -256,11 +263,10 @@ def _build(data: Any, file: str, doc: Document | None, text: str) -> Answers:
     return Answers(file, tuple(out), str(student))
 
 
-def _quote_offset(text: str, line: int, col: int, eq: str) -> int:
+def _quote_offset(lines: list[str], line: int, col: int, eq: str) -> int:
     """Characters between a value's mark and its first character: 1 for a quote."""
-    if not text or not line:
+    if not lines or not line:
         return 0
-    lines = text.split("\n")
     if line > len(lines):
         return 0
     row = lines[line - 1][col - 1:]

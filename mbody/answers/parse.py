@@ -24,10 +24,11 @@ import math
 import re
 from collections.abc import Iterable
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Any, NoReturn
 
 from mbody.errors import MbodyError
-from mbody.model.expressions import OperatorParser, tokenise
+from mbody.model.expressions import Labels, OperatorParser, tokenise
 
 FUNCTIONS = ("sin", "cos", "tan", "sqrt", "exp")
 """The functions an equation may call (one argument each; angles in radians)."""
@@ -78,11 +79,14 @@ class ParsedEquation:
         The equation as written.
     lhs, rhs : tuple
         The trees of the two sides (see the module's grammar).
+    equals : int
+        The 0-based position of its '='.
     """
 
     text: str
     lhs: Node
     rhs: Node
+    equals: int = 0
 
 
 def parse_equation(text: str, labels: Iterable[str] = ()) -> ParsedEquation:
@@ -117,7 +121,7 @@ def parse_equation(text: str, labels: Iterable[str] = ()) -> ParsedEquation:
             raise EquationError(text, pos, "an equation needs '='",
                                 "write it as left side = right side")
         parser.unexpected()
-    parser.take()
+    equals = parser.take()[2]
     if parser.peek()[0] == "end":
         raise EquationError(text, parser.peek()[2], "nothing on the right of '='",
                             "write 0 if the right side is zero")
@@ -127,14 +131,18 @@ def parse_equation(text: str, labels: Iterable[str] = ()) -> ParsedEquation:
         raise EquationError(text, pos, "a second '='", "write one equation per entry")
     if kind != "end":
         parser.unexpected()
-    return ParsedEquation(text, lhs, rhs)
+    return ParsedEquation(text, lhs, rhs, equals)
 
 
 def _tokenise(text: str, labels: Iterable[str]) -> list[tuple[str, str, int]]:
-    # longest first, so that A.Fx is never taken for a prefix of AB.Fx
-    known = sorted((lab for lab in labels if not _TOKEN.fullmatch(lab)), key=len,
-                   reverse=True)
-    return tokenise(text.translate(_PASTED), _TOKEN, tuple(known))
+    return tokenise(text.translate(_PASTED), _TOKEN, _label_index(tuple(labels)))
+
+
+@lru_cache(maxsize=8)
+def _label_index(labels: tuple[str, ...]) -> Labels:
+    """The labels the name token would not read whole (``pin-1.Fx``); the longest is
+    taken first (A.Fx is never a prefix of AB.Fx); made once per model."""
+    return Labels.of(lab for lab in labels if not _TOKEN.fullmatch(lab))
 
 
 _BAD_HINTS = {

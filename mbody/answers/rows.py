@@ -18,7 +18,7 @@ from mbody import conventions as cv
 from mbody import joint_types
 from mbody.answers.compare import CONST, Row
 from mbody.answers.text import equation_text
-from mbody.answers.vocabulary import PLANAR_ACCELERATIONS, SPATIAL_ACCELERATIONS
+from mbody.answers.vocabulary import PLANAR_ACCELERATIONS, SPATIAL_ACCELERATIONS, joints_of
 from mbody.equations.assemble import Assembly
 from mbody.equations.fbd import BodyEquations, Equation
 
@@ -308,9 +308,8 @@ def body_rows(asm: Assembly, body: str) -> BodyRows:
     known = model.known_reactions_at(asm.state.t)
     joints: dict[str, tuple[str, float, str]] = {}
     cols = asm.columns
-    for j, joint in enumerate(model.joints):
-        if body not in (joint.parent, joint.child):
-            continue
+    for j in joints_of(model, i).tolist():
+        joint = model.joints[j]
         for label in joint.labels:
             if label not in known:
                 other = joint.parent if joint.child == body else joint.child

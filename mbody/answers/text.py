@@ -14,20 +14,23 @@ from mbody.answers.compare import CONST, Row
 from mbody.equations.fbd import Equation
 
 
-def num(x: float) -> str:
-    """A number to six significant figures; rounding noise (below 1e-12) is 0.
+def num(x: float, ref: float = 1.0) -> str:
+    """A number to six significant figures; rounding noise (below 1e-12 ref) is 0.
 
     Parameters
     ----------
     x : float
         The number.
+    ref : float
+        The magnitude it is noise against (default 1; the magnitude of a student's row
+        written at a tiny scale, such as 1e-170 a_x = 5e-170, so that its numbers show).
 
     Returns
     -------
     str
     """
     x = float(x)
-    x = 0.0 if abs(x) < 1e-12 else x
+    x = 0.0 if abs(x) < 1e-12 * ref else x
     s = f"{x:.6g}"
     return "0" if s in ("-0", "0") else s
 

@@ -280,13 +280,16 @@ def verify(model: Model | str | os.PathLike[str], answers: Any, *, tol: float = 
         return solved[0]
 
     checks = []
+    seen: dict[tuple, Diagnosis] = {}  # the same row of the same body: the same verdict
     for a, student, problem in parsed:
         if a.body not in rows:
             rows[a.body] = body_rows(asm, a.body)
         if student is None:
             d = _not_linear(a, problem)
         else:
-            d = diagnose(student, rows[a.body], tol, reactions)
+            key = (a.body, tuple(student.coef.items()), tuple(student.scale.items()))
+            d = seen.get(key) or seen.setdefault(key, diagnose(student, rows[a.body], tol,
+                                                                 reactions))
         checks.append(Check(a.index, a.body, a.eq, a.line, d.diagnosis, d.expected, d.row,
                             d.explanation, d.details))
     covered = {c.row for c in checks if c.correct}

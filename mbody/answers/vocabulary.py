@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -196,9 +197,9 @@ class Vocabulary:
         name = self.aliases.get(name, name)
         return name in self.values or name in self._unknown_set
 
-    @property
+    @cached_property
     def _unknown_set(self) -> frozenset[str]:
-        return frozenset(self.unknowns)
+        return frozenset(self.unknowns)  # once: a model may have thousands of reactions
 
     def summary(self) -> str:
         """The canonical names in one line (for error messages).
@@ -213,6 +214,14 @@ class Vocabulary:
             shown.append(", ".join(own[:6]) + (" ..." if len(own) > 6 else ""))
         shown += [n for n in self.values if "." not in n and n != "pi"]
         return ", ".join(shown)
+
+
+def joints_of(model: Model, i: int) -> np.ndarray:
+    """Indices of the joints that have body `i` as parent or child, in model order (from
+    the joint table's arrays: a body's vocabulary and rows cost its own joints, not the
+    model's)."""
+    jt = model.joint_table
+    return np.flatnonzero((jt.parent == i) | (jt.child == i))
 
 
 def vocabulary(model: Model, state: State, body: str) -> Vocabulary:
@@ -288,8 +297,9 @@ def vocabulary(model: Model, state: State, body: str) -> Vocabulary:
                     f"the inertia tensor of {body} is not diagonal in its body axes, so it "
                     "has no principal moments along them: use its entries I_11, I_12 ... "
                     "I_33")
-    for joint in model.joints:
-        if body in (joint.parent, joint.child) and not particle:
+    own = [model.joints[j] for j in joints_of(model, i)]
+    for joint in own:
+        if not particle:
             # I_O for the inertia about a pin: the course writes it I_G + m d²
             absent.setdefault(f"I_{joint.name}", (
                 f"there is no name for the inertia about joint {joint.name}: write it "
@@ -297,9 +307,9 @@ def vocabulary(model: Model, state: State, body: str) -> Vocabulary:
                 if planar else
                 f"there is no name for the inertia about joint {joint.name}: write "
                 "moments about the mass centre, with I_1, I_2, I_3 or I_11 ... I_33"))
-    reactions = tuple(r for r in model.reactions if r not in known)
-    touching = {label for joint in model.joints if body in (joint.parent, joint.child)
-                for label in joint.labels}
+    reactions = tuple(r for r in model.reactions if r not in known) if known else \
+        tuple(model.reactions)
+    touching = {label for joint in own for label in joint.labels}
     acting = tuple(r for r in reactions if r in touching)
     for label, value in known.items():
         values[label] = float(value)

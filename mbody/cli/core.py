@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 
 from mbody.cli.common import EXIT_OK, MODEL_HELP, load_model, parse_known
@@ -113,6 +112,7 @@ def _symbolic(asm, a: argparse.Namespace) -> int:
 
 def solve(a: argparse.Namespace) -> int:
     from mbody.equations.assemble import assemble as _assemble
+    from mbody.io import jsontext
     from mbody.present.text import reaction_table_text, solution_text
 
     model = load_model(a.model)
@@ -122,13 +122,11 @@ def solve(a: argparse.Namespace) -> int:
         acc = sol.accelerations.tolist()
         by_body = {name: {model.coordinates[r]: acc[r] for r in model.body_rows(i)}
                    for i, name in enumerate(model.body_names)}
-        json.dump({"model": model.name, "coordinates": sol.coordinates,
-                   "accelerations": acc, "by_body": by_body, "reactions": dict(sol.reactions),
-                   "solved": list(sol.solved), "not_unique": list(sol.not_unique),
-                   "backward_error": sol.residual, "condition": sol.condition,
-                   "warnings": sol.warnings},
-                  sys.stdout, indent=2)
-        print()
+        jsontext.dump({"model": model.name, "coordinates": sol.coordinates,
+                       "accelerations": acc, "by_body": by_body,
+                       "reactions": dict(sol.reactions), "solved": list(sol.solved),
+                       "not_unique": list(sol.not_unique), "backward_error": sol.residual,
+                       "condition": sol.condition, "warnings": sol.warnings}, sys.stdout)
     else:
         print(solution_text(sol, model))
         if sol.reactions:

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 
 from mbody.cli.common import EXIT_OK, MODEL_HELP, load_model
@@ -29,6 +28,7 @@ def jacobian(a: argparse.Namespace) -> int:
     import numpy as np
 
     from mbody.equations.assemble import assemble
+    from mbody.io import jsontext
 
     model = load_model(a.model)
     J = assemble(model).jacobian()
@@ -42,9 +42,8 @@ def jacobian(a: argparse.Namespace) -> int:
                          "entries": {J.columns[c]: float(v)
                                      for c, v in zip(A.indices[lo:hi], A.data[lo:hi],
                                                      strict=True)}})
-        json.dump({"model": model.name, "shape": list(A.shape), "columns": J.columns,
-                   "rows": rows}, sys.stdout, indent=2)
-        print()
+        jsontext.dump({"model": model.name, "shape": list(A.shape), "columns": J.columns,
+                       "rows": rows}, sys.stdout)
         return EXIT_OK
     print(f"constraint Jacobian G^T of {model.name!r}: {A.shape[0]} constraints x "
           f"{A.shape[1]} coordinates (G^T v = relative velocity each joint forbids; "

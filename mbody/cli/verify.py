@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import sys
 
@@ -16,9 +15,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         description="Read ANSWERS, a YAML file of equations (equations: - {body: NAME, eq: "
         "\"2*a_y = O.Fy - 19.62\"}), and say for each whether it is one of the body's "
         "Newton-Euler rows (any scaling or rearrangement counts) or which mistake of the "
-        "course explains the difference: missing_gyroscopic_term, wrong_moment_point, "
-        "reaction_treated_as_known, missing_reaction, reaction_sign, "
-        "single_inertia_in_space, missing_applied_load, not_an_equation_of_this_body. "
+        "course explains the difference: missing_gyroscopic_term, gyroscopic_term_sign, "
+        "missing_products_of_inertia, single_inertia_in_space, wrong_moment_point, "
+        "missing_reaction, reaction_sign, missing_applied_load, reaction_treated_as_known, "
+        "not_an_equation_of_this_body. "
         "Then list the rows no correct equation gave. Exit code 0 when every equation is "
         "correct, 1 when some are not, 2 for a bad model or answers file.")
     s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
@@ -45,13 +45,13 @@ def _tolerance(text: str) -> float:
 
 def verify(a: argparse.Namespace) -> int:
     from mbody.answers.verify import verify as _verify
+    from mbody.io import jsontext
 
     regular_file(a.answers, "a YAML answers file")
     model = load_model(a.model)
     result = _verify(model, a.answers, tol=a.tol)
     if a.json:
-        json.dump(result.to_dict(), sys.stdout, indent=2, ensure_ascii=False)
-        print()
+        jsontext.dump(result.to_dict(), sys.stdout)
     else:
         print(result.text())
     return EXIT_OK if result.ok else EXIT_UNMET

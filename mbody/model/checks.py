@@ -324,7 +324,9 @@ def _kind(value: Any) -> str:
 
 
 _DECIMAL_COMMA = re.compile(r"\s*([-+]?\d+),(\d+)\s*")
-_WITH_UNIT = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*"
+# \d+(?:\.\d*)? rather than \d+\.?\d*, which splits a run of digits every way before
+# failing (a 20 000-digit mass ending in '}': half a minute)
+_WITH_UNIT = re.compile(r"\s*([-+]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][-+]?\d+)?)\s*"
                         r"([A-Za-zµ°][A-Za-z0-9µ°/^·²³ .-]*)")
 _ANGLE_WORDS = re.compile(r"\s*([-+]?[\d.eE+-]+)\s*(°|degrees?|degs|grad|radians?)(\s*/\s*s)?\s*",
                           re.IGNORECASE)

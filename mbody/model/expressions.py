@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Any, NamedTuple, NoReturn, overload
@@ -97,6 +97,7 @@ class Expression:
         numbers: list[float] = []
 
         def emit(node: Node) -> None:
+            node, spine = left_spine(node)
             kind = node[0]
             if kind == "call":
                 emit(node[2])
@@ -107,6 +108,10 @@ class Expression:
                         emit(a)
                 codes.append(PROGRAM_CODES[kind])
             numbers.append(float(node[1]) if kind == "num" else 0.0)
+            for op in reversed(spine):
+                emit(op[2])
+                codes.append(PROGRAM_CODES[op[0]])
+                numbers.append(0.0)
 
         emit(self.tree)
         return np.array(codes, dtype=np.int64), np.array(numbers, dtype=float)
@@ -157,21 +162,51 @@ def compile_expression(text: str) -> Expression:
     return Expression(text, tree)
 
 
+@dataclass(frozen=True)
+class Labels:
+    """Whole names a tokeniser takes before its pattern (a student's equation names
+    reactions such as ``pin-1.Fx``, which the name token would split): the names, and
+    their lengths longest first, so that a position costs one set lookup per distinct
+    length, not one comparison per name (1000 reactions made an equation take a quarter
+    of a second)."""
+
+    names: frozenset[str]
+    lengths: tuple[int, ...]
+
+    @classmethod
+    def of(cls, names: Iterable[str]) -> Labels:
+        """The labels `names` (empty names dropped)."""
+        kept = frozenset(n for n in names if n)
+        return cls(kept, tuple(sorted({len(n) for n in kept}, reverse=True)))
+
+    def __bool__(self) -> bool:
+        return bool(self.names)
+
+    def at(self, text: str, i: int) -> str | None:
+        """The longest label at position i of `text` that ends where a name may end."""
+        for n in self.lengths:
+            name = text[i:i + n]
+            if name in self.names and not text[i + n:i + n + 1].isalnum():
+                return name
+        return None
+
+
 def tokenise(text: str, pattern: re.Pattern[str] = _TOKEN,
-             labels: tuple[str, ...] = ()) -> list[tuple[str, str, int]]:
+             labels: Labels | None = None) -> list[tuple[str, str, int]]:
     """(kind, text, position) tokens of `text` by `pattern`'s named groups, ending with
     ``("end", "", len(text))``; whitespace is dropped, a character no group matches is a
     ``"bad"`` token (reported when a parser reaches it, so errors come in reading order).
 
-    `labels`, longest first, are whole names taken before `pattern` is tried (a student's
-    equation names reactions such as ``A.Fx``), where they stand alone.
+    `labels` are whole names taken before `pattern` is tried, where they stand alone
+    (`Labels`).
     """
     out = []
     i = 0
     while i < len(text):
-        label = next((lab for lab in labels if text.startswith(lab, i)
-                      and not text[i + len(lab):i + len(lab) + 1].isalnum()), None)
-        if label is not None and (i == 0 or not (text[i - 1].isalnum() or text[i - 1] == "_")):
+        label = None
+        if labels and (i == 0 or not (text[i - 1].isalnum() or text[i - 1] == "_")):
+            label = labels.at(text, i)
+        if label is not None:
             out.append(("name", label, i))
             i += len(label)
             continue
@@ -196,6 +231,12 @@ def _describe(kind: str, value: str, what: str = "expression") -> str:
 class OperatorParser:
     """Sums, products, signs and powers over `tokenise`'s tokens, by precedence
     (``-2^2 = -4``, ``2^-1 = 0.5``, as on paper), nesting bounded by `MAX_DEPTH`.
+
+    Nesting is what recurses: parentheses, function calls, signs and powers (``2^2^2``
+    nests to the right) each count a level. A sum or a product of any length is read in
+    a loop and becomes a chain that grows to the left (``((a + b) + c) + d``), which
+    every walker of a tree follows in a loop too (`left_spine`): a long flat sum costs no
+    stack however long it is.
 
     The grammar shared by load expressions and a student's equations; a subclass says
     what an atom is (`atom`), how a node is built (`node`) and which error is raised
@@ -274,6 +315,7 @@ class OperatorParser:
         kind, value, pos = self.peek()
         if kind == "op" and value in ("^", "**"):
             self.take()
+            self._deeper(depth + 1, pos)  # 2^2^...^2 nests to the right, one level a '^'
             return self.node("^", pos, base, self.unary(depth + 1))
         return base
 
@@ -352,26 +394,50 @@ def _fold(node: Node) -> Node:
     return node
 
 
+CHAINS = frozenset("+-*/")
+"""The left-associative operators: a run of them builds a chain down the left operands."""
+
+
+def left_spine(node: tuple) -> tuple[tuple, list[tuple]]:
+    """(first operand, chain) of a left-growing chain of `CHAINS` operators:
+    ``((a + b) * c) - d`` -> ``(a, [-, *, +])`` (outermost first; apply in reverse, each
+    to the value so far and its right operand). A node that is no chain -> (node, []).
+
+    A long sum (``1+1+...+1``) is a tree as deep as it has terms; walking its spine in a
+    loop, and recursing only into right operands (whose depth the parser bounds), keeps
+    every walker of a tree within a few frames per level of nesting."""
+    spine = []
+    while node[0] in CHAINS:
+        spine.append(node)
+        node = node[1]
+    return node, spine
+
+
 def _eval(node: Node, t: np.ndarray) -> Any:
+    node, spine = left_spine(node)
     kind = node[0]
     if kind == "num":
-        return node[1]
-    if kind == "t":
-        return t
-    if kind == "neg":
-        return -_eval(node[1], t)
-    if kind == "call":
-        return FUNCTIONS[node[1]](_eval(node[2], t))
-    a, b = _eval(node[1], t), _eval(node[2], t)
-    if kind == "+":
-        return a + b
-    if kind == "-":
-        return a - b
-    if kind == "*":
-        return a * b
-    if kind == "/":
-        return np.divide(a, b)
-    return np.power(a, b)
+        value = node[1]
+    elif kind == "t":
+        value = t
+    elif kind == "neg":
+        value = -_eval(node[1], t)
+    elif kind == "call":
+        value = FUNCTIONS[node[1]](_eval(node[2], t))
+    else:  # '^'
+        value = np.power(_eval(node[1], t), _eval(node[2], t))
+    for op in reversed(spine):
+        b = _eval(op[2], t)
+        kind = op[0]
+        if kind == "+":
+            value = value + b
+        elif kind == "-":
+            value = value - b
+        elif kind == "*":
+            value = value * b
+        else:
+            value = np.divide(value, b)
+    return value
 
 
 PROGRAM_CODES = {"num": 0, "t": 1, "neg": 2, "+": 3, "-": 4, "*": 5, "/": 6, "^": 7,
@@ -393,6 +459,18 @@ def _closure(node: Node) -> Callable[[float], float]:
     raises where numpy gives inf or nan (1/0, log(-1), (-8)^(1/3), overflow): the caller
     (`Expression.at`) then asks numpy."""
     kind = node[0]
+    if kind in CHAINS:
+        first, spine = left_spine(node)
+        if len(spine) > 1:  # a long sum or product: one loop, not a closure per operator
+            head = _closure(first)
+            rest = [(_OPS[n[0]], _closure(n[2])) for n in reversed(spine)]
+
+            def chain(t: float) -> float:
+                value = head(t)
+                for op, f in rest:
+                    value = op(value, f(t))
+                return value
+            return chain
     if kind == "num":
         value = float(node[1])
         return lambda t: value

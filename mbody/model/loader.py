@@ -121,7 +121,10 @@ _NAN = re.compile(r"\.(nan|NaN|NAN)")
 # reads differently: refused, with what each reading gives.
 _RADIX = re.compile(r"([-+]?)0([xX][0-9a-fA-F_]+|[oO][0-7_]+|[bB][01_]+)")
 _SEXAGESIMAL = re.compile(r"[-+]?[0-9][0-9_]*(:[0-5]?[0-9])+(\.[0-9_]*)?")
-_UNDERSCORED = re.compile(r"[-+]?[0-9_]*[0-9][0-9_]*(\.[0-9_]*)?([eE][-+]?[0-9]+)?")
+# a run of digits and underscores with a digit in it: "the first character that is not an
+# underscore is a digit" (a lookahead) keeps the match linear; [0-9_]*[0-9][0-9_]* tried
+# every split of a long run (80 kB of digits ending in '_x': minutes)
+_UNDERSCORED = re.compile(r"[-+]?(?=_*[0-9])[0-9_]+(\.[0-9_]*)?([eE][-+]?[0-9]+)?")
 _FIRST = frozenset("0123456789+-.~tTfFnN")
 _NON_PRINTABLE = re.compile("[^\x09\x0a\x0d\x20-\x7e\x85\xa0-\ud7ff\ue000-\ufffd"
                             "\U00010000-\U0010ffff]")

@@ -1,7 +1,8 @@
 """The JSON export: one document that validates against the schema shipped with the package
 (`schema()`, mbody/data/assembly.schema.json); sparse matrices as sorted 0-based
 ``row, col, value`` triplets, one object per reaction column and per body. Floats are
-written by `json` with the shortest repr that reads back exactly."""
+written by `json` with the shortest repr that reads back exactly; a number that is not
+finite is written as null (`mbody.io.jsontext`: strict JSON)."""
 
 from __future__ import annotations
 
@@ -16,6 +17,7 @@ import scipy.sparse as sp
 from mbody import conventions as cv
 from mbody import joint_types
 from mbody.errors import MbodyError
+from mbody.io import jsontext
 from mbody.io.export.assembly import (
     COLUMN_TEXT,
     FORMAT,
@@ -62,8 +64,7 @@ def write(exp: ExportedAssembly, path: Path) -> None:
         The file to write.
     """
     with open(path, "w", encoding="utf-8") as fh:
-        json.dump(to_json(exp), fh, indent=1, allow_nan=False, ensure_ascii=False)
-        fh.write("\n")
+        jsontext.dump(to_json(exp), fh, indent=1)
 
 
 def schema() -> dict[str, Any]:

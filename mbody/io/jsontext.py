@@ -1,0 +1,85 @@
+"""JSON text that every strict reader parses: what ``--json`` prints and the JSON export.
+
+Python's `json` writes ``Infinity`` and ``NaN`` for floats that are not finite; they are
+not JSON (JavaScript's ``JSON.parse``, and most other readers, refuse the whole
+document). Here such a number is written as ``null``, and the page that describes each
+output says what a ``null`` there means (for ``mbody solve --json``: a condition
+estimate that is not computed, or infinite because the system is singular). numpy
+scalars and arrays become JSON numbers and lists, tuples become lists.
+
+    dumps({"condition": float("inf")})     # '{\\n  "condition": null\\n}'
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Mapping
+from typing import IO, Any
+
+import numpy as np
+
+
+def plain(value: Any) -> Any:
+    """`value` as JSON types: a float that is not finite -> None, numpy scalars -> Python
+    numbers, numpy arrays and tuples -> lists, mapping keys -> str.
+
+    Parameters
+    ----------
+    value
+        Nested dicts, lists, tuples, numpy arrays and scalars, str, numbers, None.
+
+    Returns
+    -------
+    Any
+        The same structure, every float finite or None.
+    """
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, str | bool | int) or value is None:
+        return value
+    if isinstance(value, Mapping):
+        return {str(k): plain(v) for k, v in value.items()}
+    if isinstance(value, np.ndarray):
+        if value.dtype.kind == "f" and np.isfinite(value).all():
+            return value.tolist()  # the common case, without a Python walk per number
+        return plain(value.tolist())
+    if isinstance(value, list | tuple):
+        return [plain(v) for v in value]
+    if isinstance(value, np.generic):
+        return plain(value.item())
+    raise TypeError(f"{type(value).__name__} is not a JSON value")
+
+
+def dumps(value: Any, *, indent: int | None = 2) -> str:
+    """Strict JSON text of `value` (`plain`), UTF-8 characters kept as they are.
+
+    Parameters
+    ----------
+    value
+        What to write.
+    indent : int or None
+        Indentation (None: one line).
+
+    Returns
+    -------
+    str
+        JSON without ``NaN`` or ``Infinity`` (no trailing newline).
+    """
+    return json.dumps(plain(value), indent=indent, allow_nan=False, ensure_ascii=False)
+
+
+def dump(value: Any, fh: IO[str], *, indent: int | None = 2) -> None:
+    """Write `dumps(value)` and a newline to the text file `fh`.
+
+    Parameters
+    ----------
+    value
+        What to write.
+    fh
+        An open text file (or ``sys.stdout``).
+    indent : int or None
+        Indentation (None: one line).
+    """
+    fh.write(dumps(value, indent=indent))
+    fh.write("\n")
