@@ -9,6 +9,7 @@ model's masses and inertia tensors) and builds the sparse matrix only when asked
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable, Iterator, Mapping
 from functools import cached_property
 from typing import TYPE_CHECKING
@@ -29,6 +30,7 @@ from mbody.equations.solution import (
 )
 from mbody.equations.symbolic import SymbolicEquations, assembly_symbolic
 from mbody.equations.workspace import Unknowns, workspace
+from mbody.equations.world import world_reactions
 from mbody.errors import MbodyError, did_you_mean
 from mbody.kernel import _core
 from mbody.model.model import Model, State, count
@@ -245,7 +247,7 @@ class Assembly:
         return values
 
     def solve(self, known: Mapping[str, float] | None = None, *,
-              condition: bool = False) -> Solution:
+              condition: bool = False, axes: str = "joint") -> Solution:
         """Accelerations, and the reactions not given (from the file or `known`).
 
         With every reaction known (or none): v̇ = M⁻¹ (Q + G λ − b). Otherwise the
@@ -258,8 +260,12 @@ class Assembly:
         known : mapping of str to float, optional
             Reaction values (N; N m) by label, added to the file's; the rest are solved.
         condition : bool
-            Also estimate the 1-norm condition number of the Schur complement Gᵀ M⁻¹ G
-            (`Solution.condition`; takes the numpy path).
+            Also compute the 1-norm condition number of the Schur complement Gᵀ M⁻¹ G
+            (`Solution.condition`).
+        axes : {"joint", "world"}
+            The axes of the reactions returned: each joint's frame (components as labelled,
+            the default), or world axes (each joint's force and moment on its child,
+            ``A.Fx, A.Fy...`` along world x, y, z: `mbody.equations.world`).
 
         Returns
         -------
@@ -267,11 +273,17 @@ class Assembly:
             The accelerations in the order of `coordinates`, every reaction value, and
             what the solve found (redundant or broken constraints, backward error).
         """
+        if axes not in ("joint", "world"):
+            raise MbodyError(f"axes must be 'joint' or 'world', got {axes!r}")
         ws = workspace(self.model)
         unknowns = (ws.unknowns(self.reaction_values(known)) if known
                     else ws.unknowns_at(self.state.t))
-        return solve_state(self.model, self.state, unknowns, condition=condition,
-                           columns=lambda: self.columns)
+        sol = solve_state(self.model, self.state, unknowns, condition=condition,
+                          columns=lambda: self.columns)
+        if axes == "world":
+            sol = dataclasses.replace(sol, reactions=world_reactions(
+                self.model, self.columns, sol.reactions), axes="world")
+        return sol
 
     def _repr_html_(self) -> str:  # notebook display: each body's free body and pair
         from mbody.present.rich import assembly_html  # a display hook (tools/check_imports.py)

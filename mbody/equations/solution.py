@@ -74,6 +74,9 @@ class Solution:
         Enforced constraints that the state breaks (φ ≠ 0 or Gᵀ v ≠ 0), as text.
     redundant : int
         Number of redundant constraints (unknown components minus the rank of G_U).
+    axes : str
+        ``joint``: `reactions` are the joint-frame components; ``world``: each joint's
+        force and moment in world axes (`mbody.equations.world`).
     """
 
     coordinates: list[str]
@@ -86,6 +89,7 @@ class Solution:
     method: str = "block-diagonal M"
     broken_joints: tuple[str, ...] = ()
     redundant: int = 0
+    axes: str = "joint"
 
     @property
     def warnings(self) -> list[str]:
