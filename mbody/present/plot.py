@@ -4,11 +4,13 @@
     drift  |E(t) − E(0)| / max(|E(0)|, max T)  and  ‖H(t) − H(0)‖ / max ‖H‖
 
 One `matplotlib.figure.Figure` (Agg canvas, no pyplot: safe in scripts, servers and
-tests); `save_plot` writes it atomically, the format taken from the file's extension.
+tests); `save_plot` draws it in memory and writes it atomically, the format taken from
+the file's extension.
 """
 
 from __future__ import annotations
 
+import io
 import os
 from collections.abc import Callable
 from functools import partial
@@ -21,7 +23,7 @@ from matplotlib.figure import Figure
 
 from mbody import conventions as cv
 from mbody.errors import MbodyError
-from mbody.io.atomic import atomic_path
+from mbody.io.atomic import write_atomic
 from mbody.simulate.trajectory import Trajectory
 
 MAX_BODIES = 6
@@ -173,6 +175,8 @@ def save_plot(traj: Trajectory, path: str | os.PathLike[str], bodies: list[str] 
         raise MbodyError(f"cannot write {str(path)!r}: the plot format comes from the "
                          f"extension, one of {', '.join('.' + f for f in FORMATS)}")
     fig = plot_trajectory(traj, bodies)
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format=fmt, dpi=dpi)
-    return Path(path)
+    # drawn in memory first: a writer failing half-way (a full disk) must meet a complete
+    # picture, not matplotlib's pdf or png stream in the middle of its compression
+    buf = io.BytesIO()
+    fig.savefig(buf, format=fmt, dpi=dpi)
+    return write_atomic(path, buf.getvalue())
