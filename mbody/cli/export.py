@@ -4,11 +4,20 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import math
 import sys
 from collections.abc import Iterator
 from typing import TYPE_CHECKING
 
-from mbody.cli.common import EXIT_OK, MODEL_HELP, load_model, parse_known, regular_file
+from mbody.cli.common import (
+    EXIT_OK,
+    MODEL_HELP,
+    bounded,
+    load_model,
+    output_stream,
+    parse_known,
+    regular_file,
+)
 from mbody.errors import MbodyError, OutputError
 
 if TYPE_CHECKING:
@@ -31,7 +40,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--csv", metavar="DIR", help="write CSV tables into this folder")
     s.add_argument("--state", metavar="RUN", help="take the state from this trajectory file "
                    "(written by 'mbody simulate -o RUN.npz')")
-    s.add_argument("--time", metavar="T", type=float, help="with --state: use the stored "
+    s.add_argument("--time", metavar="T",
+                   type=bounded("a finite number of seconds", -math.inf, math.inf),
+                   help="with --state: use the stored "
                    "sample nearest to time T in seconds (default: the last sample); samples "
                    "are not interpolated")
     s.add_argument("--known", metavar="LABEL=VALUE", action="append", default=[],
@@ -57,15 +68,16 @@ def export(a: argparse.Namespace) -> int:
         asm, source = assemble(model), ""
     exp = exported(asm, parse_known(a.known), source)
     N, m = len(exp.coordinates), len(exp.reactions)
+    say = output_stream(*a.output)
     for out in a.output:
         with _writing(out):
-            print(f"wrote {write_export(exp, out)}")
+            print(f"wrote {write_export(exp, out)}", file=say)
     if a.csv:
         with _writing(a.csv):
             print(f"wrote {write_csv(exp, a.csv)}/ (M.csv, G.csv, vectors.csv, columns.csv, "
-                  "bodies.csv, info.csv)")
+                  "bodies.csv, info.csv)", file=say)
     print(f"M {N}x{N} ({exp.M.nnz} non-zeros), b {N}, Q {N}, G {N}x{m} "
-          f"({exp.G.nnz} non-zeros); state: {exp.state_source}")
+          f"({exp.G.nnz} non-zeros); state: {exp.state_source}", file=say)
     return EXIT_OK
 
 
@@ -84,7 +96,7 @@ def latex(asm: Assembly, target: str, body: str | None = None) -> int:
         sys.stdout.write(text)
     else:
         with _writing(target):
-            print(f"wrote {write_atomic(target, text)}")
+            print(f"wrote {write_atomic(target, text)}", file=output_stream(target))
     return EXIT_OK
 
 
