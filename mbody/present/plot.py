@@ -24,11 +24,18 @@ from matplotlib.figure import Figure
 from mbody import conventions as cv
 from mbody.errors import MbodyError
 from mbody.io.atomic import write_atomic
+from mbody.present.draw.fonts import drawable
 from mbody.simulate.trajectory import Trajectory
 
 MAX_BODIES = 6
 """Bodies drawn in the angular-velocity panel (the rest are summed in the others)."""
 FORMATS = ("png", "pdf", "svg")
+
+
+def _text(name: str) -> str:
+    """A name as the figure can draw it: characters DejaVu Sans lacks as <U+XXXX>, and a
+    '$' that would start mathtext escaped."""
+    return drawable(name).replace("$", r"\$")
 
 
 def _energy_momentum(traj: Trajectory) -> tuple[np.ndarray, np.ndarray, np.ndarray, str]:
@@ -78,7 +85,8 @@ def plot_trajectory(traj: Trajectory, bodies: list[str] | None = None) -> Figure
     fig = Figure(figsize=(11, 1.5 + 3 * rows), layout="constrained")
     FigureCanvasAgg(fig)
     grid = fig.add_gridspec(rows, 2)
-    title = f"{traj.model_name or 'trajectory'}: {traj.n} bod{'y' if traj.n == 1 else 'ies'}"
+    title = (f"{_text(traj.model_name or 'trajectory')}: {traj.n} "
+             f"bod{'y' if traj.n == 1 else 'ies'}")
     if traj.info:
         title += (f", {traj.info.get('integrator', '')} rtol {traj.info.get('rtol', 0):g}")
     fig.suptitle(title)
@@ -97,11 +105,12 @@ def plot_trajectory(traj: Trajectory, bodies: list[str] | None = None) -> Figure
 def _omega_panel(traj: Trajectory, a: Axes, idx: list[int], names: list[str]) -> None:
     t, w = traj.t, traj.angular_velocity
     for i, b in zip(idx, names, strict=True):
+        shown = _text(b)
         if traj.dimension == cv.PLANAR:
-            a.plot(t, w[:, i], label=f"{b} θ̇")
+            a.plot(t, w[:, i], label=f"{shown} θ̇")
         else:
             for c in range(3):
-                a.plot(t, w[:, i, c], label=f"{b} ω{c + 1}")
+                a.plot(t, w[:, i, c], label=f"{shown} ω{c + 1}")
     shown = "" if len(names) == traj.n else f" (first {len(names)} of {traj.n} bodies)"
     a.set_title("angular velocity, body axes" + shown)
     a.set_ylabel("rad/s")
@@ -161,7 +170,7 @@ def _reaction_panel(traj: Trajectory, a: Axes, *, moment: bool, sel: list[int]) 
     axis, acting +R on the child and −R on the parent."""
     labels = list(traj.reaction_labels)
     for k in sel[:MAX_REACTIONS]:
-        a.plot(traj.t, traj.reactions[:, k], label=labels[k])
+        a.plot(traj.t, traj.reactions[:, k], label=_text(labels[k]))
     more = f" (first {MAX_REACTIONS} of {len(sel)})" if len(sel) > MAX_REACTIONS else ""
     a.set_title(f"joint reaction {'moments' if moment else 'forces'}, joint axes{more}")
     a.set_ylabel("N m" if moment else "N")
