@@ -244,3 +244,19 @@ def test_no_option_takes_a_special_file_as_a_folder(tmp_path, capsys):
                            "per body)\n")
     code, _, err = run(capsys, "export", PENDULUM, "--csv", "/dev/null")
     assert (code, err) == (2, "mbody: error: /dev/null: exists and is not a folder\n")
+
+
+@pytest.mark.parametrize(("args", "what"), [
+    (["check", ""], "the model"),
+    (["simulate", "{m}", "-o", ""], "-o"),
+    (["animate", ""], "the input"),
+    (["verify", "{m}", ""], "the answers file"),
+    (["assemble", "{m}", "--latex", ""], "--latex"),
+    (["export", "{m}", "--csv", ""], "--csv"),
+])
+def test_an_empty_file_name_is_refused(capsys, args, what):
+    """'' was read as the current folder, or taken for 'no output' after simulating
+    ('simulate -o ""' printed "wrote " and wrote nothing; 'animate ""' was exit 70)."""
+    code, out, err = run(capsys, *(a.format(m=PENDULUM) for a in args))
+    assert (code, out, err) == (2, "", f"mbody: error: an empty name for {what}; give a file "
+                                "name\n")

@@ -88,7 +88,8 @@ def animate(a: argparse.Namespace) -> int:
                          f"({number(t_end)} s at {number(fps)} per second); a page holds at "
                          f"most {number(FRAMES_MAX)} (give a shorter time or fewer per "
                          "second)")
-    out = a.output or (None if a.live else Path(a.source).with_suffix(".html").name)
+    source = Path(a.source)
+    out = a.output or (None if a.live or not source.name else source.with_suffix(".html").name)
     if out:  # fail now, not after simulating
         from mbody.io.atomic import ensure_writable
 

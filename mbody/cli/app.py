@@ -77,9 +77,14 @@ def _paths(value: object) -> list[str]:
     return [v for v in values if isinstance(v, str) and v and v != "-"]
 
 
-def refuse_overwriting(args: argparse.Namespace) -> None:
-    """Refuse an output of the command that is one of its input files, unless --force
-    (`mbody.cli.common.refuse_overwriting_inputs`)."""
+def check_paths(args: argparse.Namespace) -> None:
+    """Refuse an empty file name (an output '' would be no output, or the current folder;
+    an input '' the current folder), then an output of the command that is one of its
+    input files, unless --force (`mbody.cli.common.refuse_overwriting_inputs`)."""
+    for dest, what in (*OUTPUTS.items(), *INPUTS.items()):
+        values = getattr(args, dest, None)
+        if "" in (values if isinstance(values, list) else [values]):
+            raise MbodyError(f"an empty name for {what}; give a file name")
     inputs = [(INPUTS[dest], p) for dest in INPUTS for p in _paths(getattr(args, dest, None))]
     outputs = [(flag, p) for dest, flag in OUTPUTS.items()
                for p in _paths(getattr(args, dest, None))]
@@ -125,7 +130,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     out = _Stdout(sys.stdout)
     sys.stdout = out
     try:
-        refuse_overwriting(args)
+        check_paths(args)
         with max_bytes_limit(getattr(args, "max_bytes", None)):
             code = args.run(args)
         out.flush()  # a full device is reported here, not at exit
