@@ -18,7 +18,7 @@ from mbody.cli.common import (
     refuse_overwriting_inputs,
     regular_file,
 )
-from mbody.cli.sim import T_END_MAX
+from mbody.cli.sim import T_END_MAX, T_END_MIN
 from mbody.errors import MbodyError
 
 T_END, FPS = 10.0, 60.0
@@ -55,7 +55,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "point; dark red: couple)")
     s.add_argument("--body", metavar="NAME", action="append",
                    help="draw only this body (repeatable)")
-    s.add_argument("--t-end", type=bounded("a number of seconds", 0, T_END_MAX, lo_open=True),
+    s.add_argument("--t-end", type=bounded("a number of seconds", T_END_MIN, T_END_MAX),
                    metavar="S", help=f"seconds to simulate when SOURCE is a model (default "
                    f"{T_END:g}; a run file plays its own length; t_end x fps at most "
                    f"{number(FRAMES_MAX)} frames)")

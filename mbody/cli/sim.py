@@ -18,9 +18,11 @@ from mbody.cli.common import (
 )
 from mbody.errors import MbodyError
 
-T_END_MAX, FPS_MAX, SAMPLES_MAX = 1e9, 1e6, 10_000_000
+T_END_MIN, T_END_MAX, FPS_MAX, SAMPLES_MAX = 1e-9, 1e9, 1e6, 10_000_000
 """Bounds of --t-end (s), --fps and of the samples t_end x fps gives (as
-`mbody.simulate` keeps them: a run's samples are held in memory)."""
+`mbody.simulate` keeps them: a run's samples are held in memory). A span below 1e-9 s
+means nothing physical, and one of a few denormal seconds overflows the simulator's
+step-rate estimate."""
 RTOL, ATOL = (1e-13, 0.5), (1e-300, 1e6)
 """Tolerances --rtol and --atol accept: a relative tolerance below 1e-13 asks for digits
 a double does not have (SciPy's integrators raise it, with a warning, to 2.2e-14)."""
@@ -43,9 +45,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                        "with the run. Prints the run summary with the drift of energy, "
                        "angular momentum and joints; saves the trajectory with -o.")
     s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
-    s.add_argument("--t-end", type=bounded("a number of seconds", 0, T_END_MAX, lo_open=True),
+    s.add_argument("--t-end", type=bounded("a number of seconds", T_END_MIN, T_END_MAX),
                    default=10.0, metavar="SECONDS",
-                   help=f"simulated time, s (default 10; at most {number(T_END_MAX)}, and "
+                   help=f"simulated time, s (default 10; from {number(T_END_MIN)} to "
+                   f"{number(T_END_MAX)}, and "
                    f"t_end x fps at most {number(SAMPLES_MAX)} samples)")
     s.add_argument("--fps", default=60.0, metavar="N",
                    type=bounded("a number of samples per second", 0, FPS_MAX, lo_open=True),
