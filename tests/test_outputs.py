@@ -372,3 +372,34 @@ def test_a_real_full_disk(small_disk, run_file, command, name):
                                    f"nothing was written (the temporary {temporary} is "
                                    f"removed, and {name!r} is as it was)\n")
     assert [f.name for f in small_disk.iterdir()] == ["filler"]
+
+
+def test_export_writes_every_output_or_none(tmp_path, capsys, monkeypatch):
+    """The .npz fails after the .json is complete: neither is put in place, and a .json
+    that was there is as it was."""
+    from mbody.io.export import npz
+
+    def full(exp, path):
+        Path(path).write_bytes(b"PK partial")
+        _no_space()
+
+    monkeypatch.setattr(npz, "write", full)
+    old = tmp_path / "a.json"
+    old.write_text("old")
+    code, out, err = run(capsys, "export", PENDULUM, "-o", old, "-o", tmp_path / "b.npz",
+                         "--csv", tmp_path / "tables")
+    assert (code, out) == (2, "")
+    assert err == (f"mbody: error: cannot write {str(tmp_path / 'b.npz')!r}: No space left on "
+                   "device; nothing was written (the temporary file is removed, and 'b.npz' "
+                   "is as it was)\n")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.json"]
+    assert old.read_text() == "old"
+    monkeypatch.undo()
+    code, out, err = run(capsys, "export", PENDULUM, "-o", old, "-o", tmp_path / "b.npz",
+                         "--csv", tmp_path / "tables")
+    assert code == 0, err
+    assert out.splitlines()[:3] == [f"wrote {old}", f"wrote {tmp_path / 'b.npz'}",
+                                    f"wrote {tmp_path / 'tables'}/ (M.csv, G.csv, vectors.csv, "
+                                    "columns.csv, bodies.csv, info.csv)"]
+    assert mbody.load_export(old).coordinates == mbody.load_export(tmp_path / "tables"
+                                                                   ).coordinates

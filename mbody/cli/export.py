@@ -7,6 +7,7 @@ import contextlib
 import math
 import sys
 from collections.abc import Iterator
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 from mbody.cli.common import (
@@ -53,7 +54,14 @@ def register(sub: argparse._SubParsersAction) -> None:
 def export(a: argparse.Namespace) -> int:
     """`mbody export MODEL -o FILE... [--csv DIR]`: write the exports, print their sizes."""
     from mbody.equations.assemble import assemble
-    from mbody.io.export import assembly_from_trajectory, exported, write_csv, write_export
+    from mbody.io.atomic import atomic_folder, atomic_path
+    from mbody.io.export import (
+        SUFFIXES,
+        assembly_from_trajectory,
+        exported,
+        write_csv,
+        write_export,
+    )
 
     if not a.output and not a.csv:
         raise MbodyError("nothing to write: give -o FILE (.npz, .mat or .json) and/or "
@@ -68,14 +76,24 @@ def export(a: argparse.Namespace) -> int:
         asm, source = assemble(model), ""
     exp = exported(asm, parse_known(a.known), source)
     N, m = len(exp.coordinates), len(exp.reactions)
+    for out in a.output:  # an unknown suffix is refused before anything is written
+        if Path(out).suffix.lower() not in SUFFIXES:
+            write_export(exp, out)
+    with contextlib.ExitStack() as staged:  # every output, or none: each is written to a
+        for out in a.output:  # temporary file, and all are put in place at the end
+            tmp = staged.enter_context(atomic_path(out))
+            with _writing(out):
+                write_export(exp, tmp)
+        if a.csv:
+            folder = staged.enter_context(atomic_folder(a.csv))
+            with _writing(a.csv, "folder"):
+                write_csv(exp, folder)
     say = output_stream(*a.output)
     for out in a.output:
-        with _writing(out):
-            print(f"wrote {write_export(exp, out)}", file=say)
+        print(f"wrote {out}", file=say)
     if a.csv:
-        with _writing(a.csv):
-            print(f"wrote {write_csv(exp, a.csv)}/ (M.csv, G.csv, vectors.csv, columns.csv, "
-                  "bodies.csv, info.csv)", file=say)
+        print(f"wrote {a.csv}/ (M.csv, G.csv, vectors.csv, columns.csv, bodies.csv, "
+              "info.csv)", file=say)
     print(f"M {N}x{N} ({exp.M.nnz} non-zeros), b {N}, Q {N}, G {N}x{m} "
           f"({exp.G.nnz} non-zeros); state: {exp.state_source}", file=say)
     return EXIT_OK
@@ -101,11 +119,14 @@ def latex(asm: Assembly, target: str, body: str | None = None) -> int:
 
 
 @contextlib.contextmanager
-def _writing(target: str) -> Iterator[None]:
-    """An operating-system error while writing `target` becomes one clear message."""
+def _writing(target: str, kind: str = "file") -> Iterator[None]:
+    """An operating-system error while writing `target` (or its temporary `kind`, file or
+    folder) becomes one clear message naming `target`."""
     try:
         yield
-    except OutputError:  # already one message naming the file
-        raise
     except OSError as exc:
-        raise MbodyError(f"cannot write {target}: {exc.strerror or exc}") from None
+        if isinstance(exc, OutputError) and exc.filename == target:
+            raise  # already one message naming the file
+        raise OutputError(f"cannot write {target!r}: {exc.strerror or exc}; nothing was "
+                          f"written (the temporary {kind} is removed, and "
+                          f"{Path(target).name!r} is as it was)", exc, target) from None
