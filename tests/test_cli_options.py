@@ -264,3 +264,17 @@ def test_an_empty_file_name_is_refused(capsys, args, what):
     code, out, err = run(capsys, *(a.format(m=PENDULUM) for a in args))
     assert (code, out, err) == (2, "", f"mbody: error: an empty name for {what}; give a file "
                                 "name\n")
+
+
+def test_animate_forces_need_the_runs_own_model(tmp_path, capsys):
+    """A pendulum's run drawn with the slider-crank's loads was an IndexError (exit 70)."""
+    import mbody
+
+    run_file = tmp_path / "run.npz"
+    mbody.simulate(mbody.load(PENDULUM), t_end=0.2, fps=20).save(run_file)
+    code, out, err = run(capsys, "animate", run_file, "--forces", "--model",
+                         MODELS / "slider_crank.yaml", "-o", tmp_path / "a.html")
+    assert (code, out, err) == (2, "", f"mbody: error: the model 'slider-crank' has bodies the "
+                                f"run {run_file} does not have (crank, piston): its forces and "
+                                "reactions cannot be drawn on that run; give the model the run "
+                                "was computed from\n")

@@ -403,3 +403,19 @@ def test_export_writes_every_output_or_none(tmp_path, capsys, monkeypatch):
                                     "columns.csv, bodies.csv, info.csv)"]
     assert mbody.load_export(old).coordinates == mbody.load_export(tmp_path / "tables"
                                                                    ).coordinates
+
+
+def test_a_long_file_name_the_file_system_takes_is_written(tmp_path, capsys):
+    """A target name of 250 bytes is legal; its temporary name must fit too (it was the
+    target's name twice over: 'File name too long')."""
+    name = "y" * 245 + ".html"
+    code, _, err = run(capsys, "report", PENDULUM, "-o", tmp_path / name)
+    assert code == 0, err
+    assert [p.name for p in tmp_path.iterdir()] == [name]
+
+
+def test_a_file_name_too_long_is_refused_before_the_work(tmp_path, capsys):
+    target = tmp_path / ("x" * 300 + ".npz")
+    code, out, err = run(capsys, "simulate", PENDULUM, "-o", target)
+    assert (code, out) == (2, "")
+    assert err == f"mbody: error: cannot write {str(target)!r}: File name too long\n"

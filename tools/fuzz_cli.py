@@ -98,7 +98,8 @@ ODD_PATHS = ["dir", "fifo", "dangling.yaml", "missing.yaml", "empty.yaml", "bin.
              "dir/", "x" * 300 + ".yaml", "ans.yaml", "run.npz", "m.yaml", "-"]
 OUTPUTS = ["out.npz", "out.json", "out.mat", "out.svg", "out.png", "out.pdf", "out.html",
            "out.tex", "out.xml", "out.yaml", "out.gif", "out", "new/deep/out.json",
-           "new/deep/out.svg", "pics", "名.svg", "x" * 300 + ".svg", "OUT.SVG", ".svg"]
+           "new/deep/out.svg", "pics", "名.svg", "x" * 300 + ".svg", "y" * 250 + ".json",
+           "OUT.SVG", ".svg"]
 NUMBERS = ["0", "-0", "1", "-1", "0.5", "2", "3", "5", "10", "60", "72", "150", "600",
            "601", "1e-300", "5e-324", "1e-13", "1e-14", "0.49", "0.5", "0.51", "1e6",
            "1e9", "1e15", "1e308", "1e309", "1e400", "-1e400", "inf", "-inf", "nan", "NaN",
@@ -118,8 +119,8 @@ EDGES = {"t_end": ["1e9", "1e-9", "9e-10", "1e-300", "5e-324"], "fps": ["1e-300"
 they are fuzzed with besides LIGHT (a valid but long run, say --t-end 600, would only
 spend the run's time)."""
 REFUSED = ["0", "-0", "-1", "1e308", "1e309", "1e400", "-1e400", "inf", "-inf", "nan", "NaN",
-           "Infinity", "123456789012345678901234567890", "0x10", "1_000", "1,5", "1e", "",
-           " ", "abc", "-5"]
+           "Infinity", "123456789012345678901234567890", "0x10", "1,5", "1e", "", " ",
+           "abc", "-5", "1_000_000_000_0"]
 LABELS = ["O.Fx", "O.Fy", "O.Mz", "A.Fx", "A.Fy", "B.Fx", "P.Fy", "P.Mz", "o.fx", "",
           "杆.Fx", "shoulder", "elbow", "joint1", "joint2", "x", " O.Fx", "O.Fx "]
 VALUES = ["0", "3", "-2.5", "1e308", "1e-308", "nan", "inf", "abc", "", "30deg", "-45deg",

@@ -99,6 +99,12 @@ def animate(a: argparse.Namespace) -> int:
     if not a.source.lower().endswith((".yaml", ".yml")):  # a model may come through a pipe
         regular_file(a.source, "a model (.yaml) or a run file (.npz)")
     traj, model = resolve(a.source, a.model, t_end=a.t_end, fps=a.fps)
+    extra = [b for b in model.body_names if b not in traj.body_names]
+    if extra and (a.forces or a.reactions):  # loads are evaluated at the run's states
+        raise MbodyError(f"the model {model.name!r} has bodies the run {a.source} does not "
+                         f"have ({', '.join(extra[:6])}{' ...' if len(extra) > 6 else ''}): "
+                         "its forces and reactions cannot be drawn on that run; give the "
+                         "model the run was computed from")
     scene = build_scene(traj, model, forces=a.forces, bodies=a.body, reactions=a.reactions)
     what = (f"{len(scene.paths)} bod{'y' if len(scene.paths) == 1 else 'ies'}, "
             f"{scene.frames} frames, {scene.duration:g} s")

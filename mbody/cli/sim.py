@@ -178,9 +178,11 @@ def _cached(dispatcher) -> bool:
 
 
 def plot(a: argparse.Namespace) -> int:
+    from mbody.io.atomic import ensure_writable
     from mbody.present.plot import save_plot
     from mbody.simulate.trajectory import Trajectory
 
+    ensure_writable(a.output)  # before the figure is drawn (a second or two)
     regular_file(a.trajectory, "a run file written by 'mbody simulate -o RUN.npz'")
     traj = Trajectory.load(a.trajectory)
     save_plot(traj, a.output, a.body)

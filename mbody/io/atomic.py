@@ -94,6 +94,24 @@ def _plan(target: Path) -> tuple[str, Path]:
                      "never writes onto; give a file name")
 
 
+def _prefix(target: Path) -> str:
+    """A temporary file's prefix: a hidden name after the target's, short enough that a
+    target name the file system takes (up to 255 bytes) still leaves room for it."""
+    return f".{target.stem.encode()[:60].decode(errors='ignore')}."
+
+
+def _name_fits(target: Path, folder: Path) -> None:
+    """Refuse a file name longer than the file system takes, before any work."""
+    try:
+        limit = os.pathconf(folder, "PC_NAME_MAX")
+    except (OSError, ValueError, AttributeError):
+        limit = 255
+    size = len(os.fsencode(target.name))
+    if size > limit:
+        raise MbodyError(f"cannot write {str(target)!r}: the file name is {size} bytes long; "
+                         f"this file system takes at most {limit}")
+
+
 def _missing_folders(folder: Path) -> list[Path]:
     """`folder` and those of its parents that do not exist yet, deepest first; refuses
     a parent that exists and is not a folder."""
@@ -128,6 +146,7 @@ def ensure_writable(target: str | os.PathLike[str]) -> Path:
     if not os.access(existing, os.W_OK):
         raise MbodyError(f"cannot write {str(target)!r}: the folder {str(existing)!r} is "
                          "not writable")
+    _name_fits(target, existing)
     return folder
 
 
@@ -174,7 +193,7 @@ def atomic_path(target: str | os.PathLike[str], suffix: str = "") -> Iterator[Pa
     else:  # written through: the whole output is made first, away from the device
         where = None
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=suffix or target.suffix,
+        fd, tmp = tempfile.mkstemp(prefix=_prefix(target), suffix=suffix or target.suffix[:20],
                                    dir=where)
     except OSError as exc:
         _remove_folders(made)
@@ -327,7 +346,7 @@ def atomic_folder(target: str | os.PathLike[str]) -> Iterator[Path]:
     parent = target.parent if str(target.parent) else Path(".")
     made = _make_folders(target, parent)
     try:
-        tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.", dir=parent))
+        tmp = Path(tempfile.mkdtemp(prefix=_prefix(target), dir=parent))
     except OSError as exc:
         _remove_folders(made)
         raise MbodyError(f"cannot write {str(target)!r}: {exc.strerror or exc}") from None
