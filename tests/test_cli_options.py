@@ -162,9 +162,11 @@ BOUNDS = [
      "samples (1e9 s at 1e6 per second); at most 10 000 000 (give a shorter time or fewer per "
      "second)"),
     (["simulate", "{m}", "--rtol", "1e-20"], "argument --rtol: expected a relative tolerance "
-     "from 1e-13 to 0.5, got '1e-20'"),
+     "from 1e-13 to 0.01, got '1e-20'"),
     (["simulate", "{m}", "--atol", "0"], "argument --atol: expected an absolute tolerance from "
-     "1e-300 to 1e6, got '0'"),
+     "1e-300 to 0.01, got '0'"),
+    (["simulate", "{m}", "--rtol", "0.5"], "argument --rtol: expected a relative tolerance "
+     "from 1e-13 to 0.01, got '0.5'"),
     (["simulate", "{m}", "--max-steps", "1.5"], "argument --max-steps: expected a whole number "
      "of steps from 1 to 1 000 000 000 (0: no limit), got '1.5'"),
     (["simulate", "{m}", "--max-steps", "99999999999999999999999"], "argument --max-steps: "
@@ -218,7 +220,7 @@ def test_a_tiny_span_and_the_bounds_in_help(capsys):
     code, out, _ = run(capsys, "simulate", "--help")
     text = " ".join(out.split())
     assert "(default 10; from 1e-9 to 1e9, and t_end x fps at most 10 000 000 samples)" in text
-    assert "(default 1e-10; 1e-13 to 0.5)" in text
+    assert "(default 1e-10; 1e-13 to 0.01)" in text
     code, out, _ = run(capsys, "fbd", "--help")
     assert "resolution of png pictures, 10 to 600 (default 150)" in " ".join(out.split())
 

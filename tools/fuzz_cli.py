@@ -107,14 +107,14 @@ NUMBERS = ["0", "-0", "1", "-1", "0.5", "2", "3", "5", "10", "60", "72", "150", 
            "", " ", "abc", "1.5", "1000000000", "1000000001", "2147483648", "-5"]
 LIGHT = {"t_end": ["0.05", "0.2", "0.5", "1"], "fps": ["5", "20", "60"],
          "dpi": ["10", "30", "72", "150"], "max_steps": ["0", "1", "10", "1000", "100000"],
-         "max_wall": ["1e-9", "0.5", "5"], "rtol": ["1e-13", "1e-6", "0.1", "0.5"],
-         "atol": ["1e-300", "1e-12", "1", "1e6"], "hold": ["0.1"]}
+         "max_wall": ["1e-9", "0.5", "5"], "rtol": ["1e-13", "1e-6", "1e-3", "0.01"],
+         "atol": ["1e-300", "1e-12", "1e-3", "0.01"], "hold": ["0.1"]}
 """Valid values of the options that set the work, small enough to finish quickly."""
 EDGES = {"t_end": ["1e9", "1e-9", "9e-10", "1e-300", "5e-324"], "fps": ["1e-300", "1000", "1001"],
          "dpi": ["9", "11", "600", "601", "100000", "150.0"],
          "max_steps": ["1000000000", "1000000001", "-1", "1e3"],
-         "max_wall": ["1e7", "1.1e7"], "rtol": ["1e-14", "0.51", "1", "2"],
-         "atol": ["1e-301", "1e7", "-1e-12"], "hold": ["1e7", "1.1e7"]}
+         "max_wall": ["1e7", "1.1e7"], "rtol": ["1e-14", "0.011", "0.5", "1", "2"],
+         "atol": ["1e-301", "0.011", "1e6", "-1e-12"], "hold": ["1e7", "1.1e7"]}
 """Values at and just past the bounds of those options; with the refused NUMBERS, what
 they are fuzzed with besides LIGHT (a valid but long run, say --t-end 600, would only
 spend the run's time)."""
