@@ -537,7 +537,8 @@ def test_cli_writes_a_page_from_a_run_and_from_a_model(spinner, tmp_path):
     (["run.npz", "--body", "brik"], "unknown body 'brik'"),
     (["run.npz", "--model", "other.yaml"], "unknown body 'rotor'"),
     (["run.npz", "--hold", "3"], "--hold only applies with --live"),
-    (["run.npz", "--fps", "0"], "--fps must be > 0"),
+    (["run.npz", "--fps", "0"], "argument --fps: expected a number of frames per second "
+     "above 0 up to 1000, got '0'"),
 ])
 def test_cli_bad_input_exits_2(spinner, tmp_path, args, message):
     model, traj = spinner
@@ -572,5 +573,5 @@ def test_help_states_the_simulation_defaults_and_gravity():
                        capture_output=True, text=True, timeout=60)
     text = " ".join(p.stdout.split())
     assert f"when SOURCE is a model (default {sig['t_end'].default:g};" in text
-    assert f"(default {sig['fps'].default:g})" in text
+    assert f"(default {sig['fps'].default:g};" in text
     assert "gravity (m g at each mass centre)" in text

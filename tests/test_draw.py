@@ -367,7 +367,7 @@ def test_fbd_command_writes_one_picture_per_body(tmp_path, capsys):
         "fbd_crank.svg", "fbd_piston.svg", "fbd_rod.svg"]
     assert (tmp_path / "fbd_rod.svg").read_text().lstrip().startswith("<?xml")
     assert main(["fbd", "models/heavy_top.yaml", "-o", str(tmp_path), "--body", "top",
-                 "--format", "png", "--view", "front"]) == 0
+                 "--image-format", "png", "--view", "front"]) == 0
     assert (tmp_path / "fbd_top.png").read_bytes()[:4] == b"\x89PNG"
     assert "fbd_top.png" in capsys.readouterr().out
 
@@ -383,7 +383,7 @@ def test_fbd_command_bad_body_and_view_exit_2(tmp_path, capsys):
     assert "unknown view 'sideways'" in capsys.readouterr().err
     assert list(tmp_path.iterdir()) == []
     with pytest.raises(SystemExit) as exc:
-        main(["fbd", "models/slider_crank.yaml", "--format", "gif"])
+        main(["fbd", "models/slider_crank.yaml", "--image-format", "gif"])
     assert exc.value.code == 2
 
 

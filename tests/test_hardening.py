@@ -277,23 +277,33 @@ def test_stdout_to_a_file_that_cannot_grow_leaves_the_file_as_it_was(tmp_path):
     assert out.read_text() == "kept\n"  # cut back to where mbody started writing
 
 
+@pytest.fixture(scope="module")
+def pendulum_run(tmp_path_factory) -> Path:
+    """A short run of the pendulum saved as a run file."""
+    path = tmp_path_factory.mktemp("run") / "pendulum.npz"
+    mbody.simulate(mbody.load(MODELS / "pendulum.yaml"), t_end=1.0).save(path)
+    return path
+
+
 @pytest.mark.skipif(sys.platform != "linux", reason="RLIMIT_FSIZE semantics")
 @pytest.mark.parametrize(("command", "name"), [
     (["simulate", MODELS / "triple_pendulum.yaml", "--t-end", "2", "-o"], "run.npz"),
     (["export", MODELS / "triple_pendulum.yaml", "-o"], "eqs.json"),
     (["report", MODELS / "triple_pendulum.yaml", "-o"], "page.html"),
-    (["fbd", MODELS / "seed_example_1.yaml", "--format", "svg", "-o"], "pictures"),
+    (["fbd", MODELS / "seed_example_1.yaml", "--image-format", "svg", "-o"], "pictures"),
+    (["plot", "{run}", "-o"], "p.pdf"),
 ])
-def test_a_file_that_cannot_be_written_leaves_nothing(tmp_path, command, name):
+def test_a_file_that_cannot_be_written_leaves_nothing(tmp_path, command, name, pendulum_run):
     target = tmp_path / name
+    command = [pendulum_run if c == "{run}" else c for c in command]
     p = cli(*command, target, cwd=tmp_path, preexec_fn=_limited(4096))
     assert p.returncode == 2, p.stderr
-    shown = str(target / "fbd_plate.svg") if name == "pictures" else str(target)
-    assert p.stderr == (f"mbody: error: cannot write {shown!r}: File too large; nothing was "
-                        f"written (the temporary file is removed, and "
-                        f"{Path(shown).name!r} is as it was)\n")
-    left = [f.name for f in tmp_path.rglob("*") if f.is_file()]
-    assert left == []
+    temporary = "folder" if name == "pictures" else "file"
+    assert p.stderr == (f"mbody: error: cannot write {str(target)!r}: File too large; nothing "
+                        f"was written (the temporary {temporary} is removed, and {name!r} is "
+                        "as it was)\n")
+    left = [f.name for f in tmp_path.rglob("*")]
+    assert left == []  # no file, and no folder made for the output either
 
 
 def test_write_errors_from_python_are_model_free_messages(tmp_path, monkeypatch):

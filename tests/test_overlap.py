@@ -17,6 +17,13 @@ placed. What counts as an overlap (each pair counted once):
   Shafts and curves count here, not arrowheads or leaders (a head's back edge and the
   dotted leader of an arrow drawn beside its point are short and crosswise).
 
+Two parallel strokes farther apart than NEAR still read as one (`side_by_side`): an arrow
+whose centre line runs within SIDE points of another arrow's, or of a body axis, parallel
+and across from it along RUN points (B.Fy drawn 6 points beside P.Fy on the slider-crank's
+piston, B.Fx 6 points above x_B, a couple's double arrow along z_B). And a title names
+the body's mass and, unless it is a particle, its inertia about G, planar or spatial, in
+a line (or two) that fits the picture (`title_problems`).
+
 Two more measures of what a reader needs (`far_labels`, `touching_tips`):
 
 - a label far from what it names: the gap between its box and its own arrow (shaft,
@@ -30,8 +37,8 @@ and how many labels a picture joins to their arrow by a leader (`leaders`): at m
 LEADERS per picture, LEADERS_TOTAL over all, none to a body axis seen end-on (drawn
 as a ring with a dot or a cross beside G).
 
-Run as a script to print the count per model and view (overlaps / far labels /
-touching tips / leaders).
+Run as a script to print the count per model and view (overlaps and strokes side by
+side / far labels / touching tips / leaders).
 """
 
 from __future__ import annotations
@@ -160,9 +167,9 @@ def _hits_box(s: Stroke, box: np.ndarray, margin: float) -> bool:
     return bool(np.any(np.all((s.pts > lo) & (s.pts < hi), axis=1)))
 
 
-def _coincide(a: Stroke, b: Stroke) -> bool:
-    """A stretch of RUN points of `a` within NEAR of `b`, parallel to it."""
-    dist, j = cKDTree(b.pts).query(a.pts, distance_upper_bound=NEAR)
+def _coincide(a: Stroke, b: Stroke, near: float = NEAR) -> bool:
+    """A stretch of RUN points of `a` within `near` of `b`, parallel to it."""
+    dist, j = cKDTree(b.pts).query(a.pts, distance_upper_bound=near)
     near = np.isfinite(dist)
     close = near & (np.abs(np.sum(a.tan * b.tan[np.minimum(j, len(b.pts) - 1)], axis=1))
                     > np.cos(np.radians(10)))
@@ -200,6 +207,63 @@ def overlaps(scene: Scene) -> list[str]:
                 continue
             if _coincide(a, b) or _coincide(b, a):
                 found.append(f"{a.kind} {a.name} / {b.kind} {b.name} coincide")
+    return found
+
+
+SIDE = 12.0
+"""Two parallel strokes whose centre lines run closer than this (points) along RUN points
+read as one thick or double line: an arrow beside another arrow, or along a body axis
+(a 2-point dashed arrow and its head, 9 points wide, leave a clear gap only beyond it)."""
+
+
+def side_by_side(scene: Scene) -> list[str]:
+    """Every arrow (shaft or curve, not a head or a leader) running within SIDE points of
+    another arrow or of a body axis, parallel to it (within 10°) along RUN points: B.Fy
+    drawn 6 points beside P.Fy, B.Fx along x_B, a couple's double arrow along z_B."""
+    panel = next(p for p in scene.panels if p.gid == "drawing")
+    merged: dict[tuple[str, str], list[Stroke]] = {}
+    for st in strokes(panel):
+        if st.kind in ("arrow", "axis") and st.disc is None and not st.head:
+            merged.setdefault((st.kind, st.name), []).append(st)
+    whole = [Stroke(n, k, np.vstack([x.pts for x in v]), np.vstack([x.tan for x in v]))
+             for (k, n), v in merged.items()]
+    found = []
+    for i, a in enumerate(whole):
+        for b in whole[i + 1:]:
+            if "arrow" not in (a.kind, b.kind) or a.name == b.name:
+                continue
+            if _beside(a, b) or _beside(b, a):
+                found.append(f"{a.kind} {a.name} / {b.kind} {b.name} side by side")
+    return found
+
+
+def _beside(a: Stroke, b: Stroke) -> bool:
+    """A stretch of RUN points of `a` within SIDE of `b`, parallel to it and across from it
+    (the gap between them mostly across the strokes: two strokes that only meet end to
+    end, as gravity pointing down from G and y_B pointing up, are not side by side)."""
+    dist, j = cKDTree(b.pts).query(a.pts, distance_upper_bound=SIDE)
+    ok = np.isfinite(dist)
+    j = np.minimum(j, len(b.pts) - 1)
+    tb = b.tan[j]
+    parallel = np.abs(np.sum(a.tan * tb, axis=1)) > np.cos(np.radians(10))
+    gap = a.pts - b.pts[j]
+    along = np.abs(np.sum(gap * tb, axis=1))
+    across = ok & parallel & (along <= np.maximum(STEP, 0.5 * np.linalg.norm(gap, axis=1)))
+    return bool(np.count_nonzero(across) * STEP >= RUN)
+
+
+def title_problems(scene: Scene, fbd: object) -> list[str]:
+    """The title names the body, its mass and (unless a particle) its inertia about G,
+    planar or spatial, and fits in the picture."""
+    title = next(it for it in scene.root.items if getattr(it, "gid", None) == "title")
+    found = []
+    if "m = " not in title.s:
+        found.append(f"title without the mass: {title.s!r}")
+    if np.any(fbd.inertia) and "I_G" not in title.s:
+        found.append(f"title without the inertia: {title.s!r}")
+    x0, _, w, _ = text_box(title, title.xy)
+    if x0 < 0 or x0 + w > scene.width:
+        found.append(f"title {w:.0f} pt wide in a picture {scene.width:.0f} pt wide")
     return found
 
 
@@ -345,10 +409,57 @@ def test_measure_sees_far_labels_and_touching_tips():
     assert far_labels(sc) == []
 
 
+def test_measure_sees_arrows_side_by_side_and_along_an_axis_and_a_bare_title():
+    sc = Scene(300, 300)
+    p = sc.panel("drawing", (0, 0, 300, 300), np.zeros(2), np.array([300.0, 300.0]))
+    p.add(Line(np.array([[100.0, 100], [100, 200]]), "red", gid="arrow:reaction:P.Fy"),
+          Line(np.array([[106.0, 100], [106, 200]]), "red", gid="arrow:reaction:B.Fy"),
+          Line(np.array([[100.0, 100], [200, 100]]), "grey", gid="body-axis:x"),
+          Line(np.array([[100.0, 106], [180, 106]]), "red", gid="arrow:reaction:B.Fx"),
+          Line(np.array([[100.0, 100], [100, 20]]), "green", gid="arrow:gravity:gravity"))
+    assert side_by_side(sc) == [
+        "arrow reaction:P.Fy / arrow reaction:B.Fy side by side",
+        "axis body-axis:x / arrow reaction:B.Fx side by side"]
+    # 6 points apart is not 2: the older measure saw nothing here
+    assert [o for o in overlaps(sc) if "coincide" in o] == []
+    # gravity down from G and the axes from G only meet there; 14 points apart is clear
+    p.items[1].xy = np.array([[114.0, 100], [114, 200]])
+    p.items[3].xy = np.array([[100.0, 114], [180, 114]])
+    assert side_by_side(sc) == []
+
+    class Body:
+        inertia = np.diag([1.0, 2.0, 3.0])
+
+    sc.root.add(Text("Free-body diagram of b   (m = 1 kg, iso)", np.array([150.0, 290]),
+                     11, ha="center", va="center", weight="bold", gid="title"))
+    assert title_problems(sc, Body()) == [
+        "title without the inertia: 'Free-body diagram of b   (m = 1 kg, iso)'"]
+    sc.root.items[-1].s = "Free-body diagram of b   (m = 1 kg, I_G = diag(1, 2, 3) kg m²)"
+    (problem,) = title_problems(sc, Body())
+    assert problem.startswith("title ") and problem.endswith(" pt wide in a picture 300 pt "
+                                                             "wide")
+
+
 # -- every shipped picture ------------------------------------------------------------------
 @pytest.mark.parametrize("stem", [p.stem for p in MODELS])
 def test_no_overlaps_on_shipped_models(stem):
     bad = [f"{name} ({view}): {o}" for name, view, sc in scenes(stem) for o in overlaps(sc)]
+    assert bad == []
+
+
+@pytest.mark.parametrize("stem", [p.stem for p in MODELS])
+def test_no_arrow_runs_beside_another_or_along_a_body_axis_on_shipped_models(stem):
+    bad = [f"{name} ({view}): {o}" for name, view, sc in scenes(stem)
+           for o in side_by_side(sc)]
+    assert bad == []
+
+
+@pytest.mark.parametrize("stem", [p.stem for p in MODELS])
+def test_titles_give_mass_and_inertia_and_fit_on_shipped_models(stem):
+    m = mbody.load(ROOT / "models" / f"{stem}.yaml")
+    asm = mbody.assemble(m)
+    bad = [f"{name} ({view}): {o}" for name, view, sc in scenes(stem)
+           for o in title_problems(sc, asm.bodies[name].fbd)]
     assert bad == []
 
 
@@ -488,7 +599,7 @@ def main() -> int:
             continue
         per = []
         for name, view, sc in scenes(path.stem):
-            found, fl, tt = overlaps(sc), far_labels(sc), touching_tips(sc)
+            found, fl, tt = overlaps(sc) + side_by_side(sc), far_labels(sc), touching_tips(sc)
             ld = leaders(sc)
             total, far, tips = total + len(found), far + len(fl), tips + len(tt)
             lead += len(ld)

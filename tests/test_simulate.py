@@ -276,9 +276,12 @@ def test_cli_simulate_and_plot(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "joints: reactions solved at every step (coordinate projection" in out
     assert "O.Fx" in mbody.Trajectory.load(tmp_path / "pendulum.npz").reaction_labels
-    assert main(["simulate", str(MODELS / "seed_example_2.yaml"), "--fps", "-3"]) == 2
+    with pytest.raises(SystemExit) as exc:  # refused by the parser, with the range
+        main(["simulate", str(MODELS / "seed_example_2.yaml"), "--fps", "-3"])
+    assert exc.value.code == 2
     err = capsys.readouterr().err
-    assert "fps" in err and "Traceback" not in err
+    assert "argument --fps: expected a number of samples per second above 0 up to 1e6, " \
+        "got '-3'" in err and "Traceback" not in err
 
 
 def _panel_titles(traj: mbody.Trajectory) -> list[str]:

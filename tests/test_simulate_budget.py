@@ -87,13 +87,18 @@ def test_bad_budgets(kwargs):
 def test_cli_budget_options(capsys):
     args = ["simulate", str(MODELS / "seed_example_2.yaml"), "--t-end", "0.5"]
     assert main(args + ["--max-steps", "0"]) == 0  # 0: no limit
-    assert main(args + ["--max-steps", "-1"]) == 2
-    assert "--max-steps must be a whole number" in capsys.readouterr().err
-    assert main(args + ["--max-wall", "0"]) == 2
-    assert "--max-wall must be a positive number of seconds" in capsys.readouterr().err
-    with pytest.raises(SystemExit) as exc:
-        main(args + ["--max-steps", "many"])
-    assert exc.value.code == 2
+    # refused by the parser (argparse exits 2), with the documented range
+    for value, message in (
+            (["--max-steps", "-1"], "argument --max-steps: expected a whole number of steps "
+             "from 1 to 1 000 000 000 (0: no limit), got '-1'"),
+            (["--max-wall", "0"], "argument --max-wall: expected a number of seconds above 0 "
+             "up to 1e7, got '0'"),
+            (["--max-steps", "many"], "argument --max-steps: expected a whole number of steps "
+             "from 1 to 1 000 000 000 (0: no limit), got 'many'")):
+        with pytest.raises(SystemExit) as exc:
+            main(args + value)
+        assert exc.value.code == 2
+        assert capsys.readouterr().err.endswith(f"mbody: error: {message}\n")
 
 
 # -- warnings --------------------------------------------------------------------------------

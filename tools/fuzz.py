@@ -545,7 +545,7 @@ def run_case(case: Case, workdir: Path, hang: float) -> list[Outcome]:
                                                                   "e.mat"]))],
                      ["jacobian", p]]
             if rng.random() < 0.5:
-                heavy.append(["fbd", p, "-o", str(folder / "fbd"), "--format", "svg"])
+                heavy.append(["fbd", p, "-o", str(folder / "fbd"), "--image-format", "svg"])
             for command in heavy:
                 code, out, err, esc = run_command(command, hang)
                 outcomes.append(classify(command[0], code, out, err, esc, p))

@@ -3,18 +3,31 @@
 from __future__ import annotations
 
 import argparse
+import math
 import signal
 import sys
 import time
 from pathlib import Path
 from types import FrameType
 
-from mbody.cli.common import EXIT_OK, regular_file
+from mbody.cli.common import (
+    EXIT_OK,
+    bounded,
+    number,
+    output_stream,
+    refuse_overwriting_inputs,
+    regular_file,
+)
+from mbody.cli.sim import T_END_MAX, T_END_MIN
 from mbody.errors import MbodyError
 
 T_END, FPS = 10.0, 60.0
 """`mbody.simulate`'s defaults, which a MODEL is simulated with (tests keep them equal;
 the simulator is not imported at start-up)."""
+FRAMES_MAX, FPS_MAX, HOLD_MAX = 100_000, 1000.0, 1e7
+"""Most frames a page holds when a model is simulated for it (28 minutes at 60 per
+second; each frame is every body's pose in the page), most frames per second, and the
+longest --hold (s)."""
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -42,15 +55,19 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "point; dark red: couple)")
     s.add_argument("--body", metavar="NAME", action="append",
                    help="draw only this body (repeatable)")
-    s.add_argument("--t-end", type=float, metavar="S",
-                   help=f"seconds to simulate when SOURCE is a model (default {T_END:g}; "
-                   "a run file plays its own length)")
-    s.add_argument("--fps", type=float, metavar="N",
-                   help=f"frames per second when SOURCE is a model (default {FPS:g})")
+    s.add_argument("--t-end", type=bounded("a number of seconds", T_END_MIN, T_END_MAX),
+                   metavar="S", help=f"seconds to simulate when SOURCE is a model (default "
+                   f"{T_END:g}; a run file plays its own length; t_end x fps at most "
+                   f"{number(FRAMES_MAX)} frames)")
+    s.add_argument("--fps", type=bounded("a number of frames per second", 0, FPS_MAX, lo_open=True),
+                   metavar="N", help=f"frames per second when SOURCE is a model (default "
+                   f"{FPS:g}; at most {number(FPS_MAX)})")
     s.add_argument("--live", action="store_true",
                    help="serve the live viewer on 127.0.0.1 and print its URL; Ctrl-C stops")
-    s.add_argument("--hold", type=float, metavar="S",
-                   help="with --live: stop after S seconds instead of waiting for Ctrl-C")
+    s.add_argument("--hold", type=bounded("a number of seconds", 0, HOLD_MAX, lo_open=True),
+                   metavar="S",
+                   help="with --live: stop after S seconds instead of waiting for Ctrl-C "
+                   f"(at most {number(HOLD_MAX)})")
     s.set_defaults(run=animate)
 
 
@@ -64,23 +81,38 @@ def animate(a: argparse.Namespace) -> int:
 
     if a.hold is not None and not a.live:
         raise MbodyError("--hold only applies with --live")
-    for flag, value in (("--t-end", a.t_end), ("--fps", a.fps), ("--hold", a.hold)):
-        if value is not None and not value > 0:
-            raise MbodyError(f"{flag} must be > 0, got {value:g}")
-    if a.output:  # fail now, not after simulating
+    t_end, fps = a.t_end or T_END, a.fps or FPS
+    frames = math.floor(t_end * fps + 1e-9) + 1
+    if frames > FRAMES_MAX:
+        raise MbodyError(f"--t-end x --fps asks for {number(frames)} frames "
+                         f"({number(t_end)} s at {number(fps)} per second); a page holds at "
+                         f"most {number(FRAMES_MAX)} (give a shorter time or fewer per "
+                         "second)")
+    source = Path(a.source)
+    out = a.output or (None if a.live or not source.name else source.with_suffix(".html").name)
+    if out:  # fail now, not after simulating
         from mbody.io.atomic import ensure_writable
 
-        ensure_writable(a.output)
+        refuse_overwriting_inputs([("-o", out)], [("the input", a.source)]
+                                  + ([("the model", a.model)] if a.model else []), a.force)
+        ensure_writable(out)
     if not a.source.lower().endswith((".yaml", ".yml")):  # a model may come through a pipe
         regular_file(a.source, "a model (.yaml) or a run file (.npz)")
     traj, model = resolve(a.source, a.model, t_end=a.t_end, fps=a.fps)
+    extra = [b for b in model.body_names if b not in traj.body_names]
+    if extra and (a.forces or a.reactions):  # loads are evaluated at the run's states
+        raise MbodyError(f"the model {model.name!r} has bodies the run {a.source} does not "
+                         f"have ({', '.join(extra[:6])}{' ...' if len(extra) > 6 else ''}): "
+                         "its forces and reactions cannot be drawn on that run; give the "
+                         "model the run was computed from")
     scene = build_scene(traj, model, forces=a.forces, bodies=a.body, reactions=a.reactions)
     what = (f"{len(scene.paths)} bod{'y' if len(scene.paths) == 1 else 'ies'}, "
             f"{scene.frames} frames, {scene.duration:g} s")
-    out = a.output or (None if a.live else Path(a.source).with_suffix(".html").name)
     if out:
-        path = write_atomic(out, page_html(scene))
-        print(f"wrote {path} ({path.stat().st_size / 1e6:.1f} MB: {what})")
+        html = page_html(scene)
+        path = write_atomic(out, html)
+        print(f"wrote {path} ({len(html.encode()) / 1e6:.1f} MB: {what})",
+              file=output_stream(out))
     if not a.live:
         return EXIT_OK
 

@@ -21,8 +21,10 @@ from mbody.cli.common import (
     EXIT_INTERNAL,
     EXIT_OK,
     EXIT_UNMET,
+    PICTURE_FORMATS,
     add_import_options,
     byte_size,
+    refuse_overwriting_inputs,
 )
 from mbody.errors import MbodyError, ModelError, UnknownReactionsError, did_you_mean
 from mbody.model.loader import MAX_BYTES, max_bytes_limit
@@ -48,7 +50,45 @@ def build_parser() -> argparse.ArgumentParser:
                 help=f"largest model file read, in bytes or with a unit (200M, 1G); "
                 f"default {MAX_BYTES // 2**20}M, a guard against reading a wrong file whole")
             add_import_options(command)  # --format, --keyframe, --q: MJCF and URDF input
+        writes = [o for dest in OUTPUTS for o in _options(command, dest)]
+        if writes and "--force" not in command._option_string_actions:
+            command.add_argument(
+                "--force", action="store_true",
+                help=f"write {' or '.join(writes)} even when it is one of this command's "
+                "input files (the same file, however named), replacing that input")
     return p
+
+
+INPUTS = {"model": "the model", "source": "the input", "trajectory": "the run file",
+          "answers": "the answers file", "state": "the run file"}
+"""Argument destinations that name a file a command reads, and how a message calls it."""
+OUTPUTS = {"output": "-o", "latex": "--latex", "csv": "--csv"}
+"""Argument destinations that name a file (or folder) a command writes, and its option."""
+
+
+def _options(command: argparse.ArgumentParser, dest: str) -> list[str]:
+    """The option strings (or metavar, for a positional) of `command`'s `dest`."""
+    return [a.option_strings[0] if a.option_strings else str(a.metavar)
+            for a in command._actions if a.dest == dest]
+
+
+def _paths(value: object) -> list[str]:
+    values = value if isinstance(value, list) else [value]
+    return [v for v in values if isinstance(v, str) and v and v != "-"]
+
+
+def check_paths(args: argparse.Namespace) -> None:
+    """Refuse an empty file name (an output '' would be no output, or the current folder;
+    an input '' the current folder), then an output of the command that is one of its
+    input files, unless --force (`mbody.cli.common.refuse_overwriting_inputs`)."""
+    for dest, what in (*OUTPUTS.items(), *INPUTS.items()):
+        values = getattr(args, dest, None)
+        if "" in (values if isinstance(values, list) else [values]):
+            raise MbodyError(f"an empty name for {what}; give a file name")
+    inputs = [(INPUTS[dest], p) for dest in INPUTS for p in _paths(getattr(args, dest, None))]
+    outputs = [(flag, p) for dest, flag in OUTPUTS.items()
+               for p in _paths(getattr(args, dest, None))]
+    refuse_overwriting_inputs(outputs, inputs, getattr(args, "force", False))
 
 
 class _Parser(argparse.ArgumentParser):
@@ -63,10 +103,25 @@ class _Parser(argparse.ArgumentParser):
         bad = re.search(r"invalid choice: '([^']*)' \(choose from (.*)\)", message)
         if bad:  # argparse of Python 3.11 offers no suggestion for a misspelt command
             hint = did_you_mean(bad.group(1), re.findall(r"'([^']*)'", bad.group(2)))
+            if message.startswith("argument --format") and not hint:
+                hint = self._picture_format_hint(bad.group(1))
             message += f"; {hint}" if hint else ""
         self.print_usage(sys.stderr)
         sys.stderr.write(f"mbody: error: {message}\n")
         raise SystemExit(EXIT_INPUT)
+
+    def _picture_format_hint(self, value: str) -> str:
+        """`--format png` meant a picture's format (fbd's --format before 0.3): say where
+        that goes now."""
+        fmt = value.strip().lower().lstrip(".")
+        if fmt not in PICTURE_FORMATS:
+            return ""
+        if "--image-format" in self._option_string_actions:
+            return f"--format is the model file's format: did you mean --image-format {fmt}?"
+        if "--output" in self._option_string_actions:
+            return ("--format is the model file's format; a picture's format follows the "
+                    f"output file's extension (-o NAME.{fmt})")
+        return "--format is the model file's format"
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -75,6 +130,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     out = _Stdout(sys.stdout)
     sys.stdout = out
     try:
+        check_paths(args)
         with max_bytes_limit(getattr(args, "max_bytes", None)):
             code = args.run(args)
         out.flush()  # a full device is reported here, not at exit

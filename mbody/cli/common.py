@@ -10,9 +10,9 @@ from __future__ import annotations
 import argparse
 import functools
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from contextvars import ContextVar
-from typing import Any
+from typing import Any, TextIO
 
 from mbody.errors import MbodyError
 
@@ -57,6 +57,92 @@ def byte_size(text: str) -> int:
     if size < 1:
         raise argparse.ArgumentTypeError(f"expected a size of at least 1 byte, got {text!r}")
     return size
+
+
+def number(x: float) -> str:
+    """`x` as %g writes it, with exponents as people write them (1e9, 2.5e-13); an int
+    below 10^12 in full, its thousands apart (10 000 000)."""
+    import re
+
+    if isinstance(x, int) and abs(x) < 10**12:
+        return f"{x:,}".replace(",", " ")
+    x = float(x)
+    return re.sub(r"e\+?(-?)0*(\d)", r"e\1\2", f"{x:g}")
+
+
+def bounded(what: str, lo: float, hi: float, *, integer: bool = False,
+            lo_open: bool = False, zero: str | None = None) -> Callable[[str], float]:
+    """An argparse type: `what` (``"a number of seconds"``), from `lo` to `hi` (`lo`
+    itself excluded when `lo_open`; both infinite: any finite number), a whole number
+    when `integer`; `zero` names what 0 means when 0 is also allowed outside the range
+    (``--max-steps 0``: no limit). Anything else (a word, nan, inf, a number out of
+    range) is refused with the range, exit 2."""
+    def fmt(x: float) -> str:
+        return number(int(x)) if integer else number(x)
+
+    shown = what
+    if not (math.isinf(lo) and math.isinf(hi)):
+        shown += (f" {'above' if lo_open else 'from'} {fmt(lo)} {'up ' if lo_open else ''}"
+                  f"to {fmt(hi)}" + (f" (0: {zero})" if zero else ""))
+
+    def parse(text: str) -> float:
+        try:
+            x: float = int(text.strip()) if integer else float(text)
+        except (ValueError, OverflowError):
+            raise argparse.ArgumentTypeError(f"expected {shown}, got {text!r}") from None
+        if zero and x == 0:
+            return x
+        if not (math.isfinite(x) and (lo < x if lo_open else lo <= x) and x <= hi):
+            raise argparse.ArgumentTypeError(f"expected {shown}, got {text!r}")
+        return x
+
+    parse.__name__ = what  # argparse names the type in some messages
+    return parse
+
+
+def output_stream(*targets: str | None) -> TextIO:
+    """Where a command prints what it did: standard output, or standard error when one
+    of `targets` (its output files) is standard output itself (``-o /dev/stdout``), so
+    that the data written there is not mixed with text."""
+    import sys
+
+    from mbody.io.atomic import is_standard_output
+
+    if any(t is not None and t != "-" and is_standard_output(t) for t in targets):
+        return sys.stderr
+    return sys.stdout
+
+
+def refuse_overwriting_inputs(outputs: Iterable[tuple[str, str]],
+                              inputs: Iterable[tuple[str, str]], force: bool) -> None:
+    """Refuse (unless `force`) an output that is one of the command's own inputs: the
+    same file, compared by identity (device and inode: a link or another spelling of
+    the path is the same file), not by name. `outputs` and `inputs` are (what, path)
+    pairs: ``("-o", "m.yaml")``, ``("the model", "m.yaml")``."""
+    import os
+    import stat
+
+    if force:
+        return
+    seen = []
+    for what, path in inputs:
+        try:
+            st = os.stat(path)
+        except (OSError, ValueError):
+            continue
+        if stat.S_ISREG(st.st_mode):
+            seen.append((what, path, st))
+    for flag, path in outputs:
+        try:
+            st = os.stat(path)
+        except (OSError, ValueError):
+            continue  # a new file: nothing to lose
+        for what, source, st_in in seen:
+            if os.path.samestat(st, st_in):
+                same = "" if source == path else ", the same file"
+                raise MbodyError(f"{flag} {path} is {what} itself ({source}{same}): writing "
+                                 "there would replace the input; give another output file, "
+                                 "or --force to replace it")
 
 
 def regular_file(path: str, what: str) -> None:
@@ -109,16 +195,15 @@ MODEL_HELP = "a model file: mbody YAML, MuJoCo's MJCF (.xml) or URDF (.urdf)"
 def add_import_options(command: argparse.ArgumentParser) -> None:
     """Give a command that reads a model the options of MJCF and URDF input, and make its
     handler pass them to `load_model`. A command that has a ``--keyframe`` of its own
-    (``convert``) reads its input itself and is left as it is; where ``--format`` names
-    the output's format (``fbd``, ``export``), the model's is ``--model-format``."""
+    (``convert``) reads its input itself and is left as it is. ``--format`` (or its
+    alias ``--model-format``) is the model file's format on every command; a picture's
+    format is ``fbd --image-format`` or the output's extension, a converted model's
+    ``convert --to``."""
     taken = command._option_string_actions
     if "--keyframe" in taken:
         return
     g = command.add_argument_group("MJCF and URDF input")
-    g.add_argument("--model-format" if "--format" in taken else "--format",
-                   dest="model_format", choices=("yaml", "mjcf", "urdf"),
-                   help="the model file's format, when its extension (.yaml, .xml, .urdf) "
-                   "does not say it")
+    add_format_option(g)
     g.add_argument("--keyframe", metavar="NAME", help="MJCF: the <key> whose qpos and qvel "
                    "give the state (default: the reference pose, at rest)")
     g.add_argument("--q", action="append", default=[], metavar="JOINT=VALUE",
@@ -131,6 +216,23 @@ def add_import_options(command: argparse.ArgumentParser) -> None:
     run = command.get_default("run")
     if run is not None:
         command.set_defaults(run=_with_import_options(run))
+
+
+PICTURE_FORMATS = ("svg", "png", "pdf")
+"""`mbody.present.draw.FORMATS`, without importing matplotlib at start-up (a test keeps
+them equal)."""
+MODEL_FORMATS = ("yaml", "mjcf", "urdf")
+"""What ``--format`` names on every command: the format of the model file read."""
+
+
+def add_format_option(group: Any, extra: Sequence[str] = (), what: str = "model file") -> None:
+    """``--format`` (alias ``--model-format``, and `extra` aliases): the input model's
+    format, the one meaning it has on every command."""
+    group.add_argument("--format", "--model-format", *extra, dest="model_format",
+                       choices=MODEL_FORMATS, metavar="{yaml,mjcf,urdf}",
+                       help=f"the {what}'s format, when its extension (.yaml, .xml, .urdf) "
+                       "does not say it (alias: " + ", ".join(("--model-format", *extra))
+                       + ")")
 
 
 def _with_import_options(run: Callable[[argparse.Namespace], int]

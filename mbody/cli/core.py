@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from mbody.cli.common import EXIT_OK, MODEL_HELP, load_model, parse_known
+from mbody.cli.common import EXIT_OK, MODEL_HELP, load_model, output_stream, parse_known
 from mbody.errors import MbodyError
 
 
@@ -104,7 +104,8 @@ def _symbolic(asm, a: argparse.Namespace) -> int:
         sys.stdout.write(sym.document())
     else:
         try:
-            print(f"wrote {write_atomic(a.latex, sym.document())}")
+            print(f"wrote {write_atomic(a.latex, sym.document())}",
+                  file=output_stream(a.latex))
         except OSError as exc:
             raise MbodyError(f"cannot write {a.latex}: {exc.strerror or exc}") from None
     return EXIT_OK

@@ -7,11 +7,25 @@ import argparse
 import re
 from pathlib import Path
 
-from mbody.cli.common import EXIT_OK, MODEL_HELP, load_model
+from mbody.cli.common import (
+    EXIT_OK,
+    MODEL_HELP,
+    PICTURE_FORMATS,
+    bounded,
+    load_model,
+    output_stream,
+    refuse_overwriting_inputs,
+    regular_file,
+)
 from mbody.errors import MbodyError, did_you_mean
 
 VIEW_HELP = ("spatial models: iso (default), front, top, side, or ELEV,AZIM in degrees "
              "(for example 30,-60)")
+
+
+DPI = (10, 600)
+"""The resolutions `fbd --dpi` accepts (dots per inch): below 10 FreeType cannot draw the
+text; above 600 a picture of 8 inches takes a gigabyte of memory to draw."""
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -19,24 +33,29 @@ def register(sub: argparse._SubParsersAction) -> None:
                        description="Write one picture per body (or only --body NAME): its "
                        "outline, mass centre and axes, applied forces, gravity, couples and "
                        "reaction components (dashed), with the body's Newton-Euler pair "
-                       "under the drawing. Files are named fbd_<body>.<format>.")
+                       "under the drawing. Files are named fbd_<body>.<format>; all of them "
+                       "are written, or none (a failure leaves the folder as it was).")
     s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
     s.add_argument("-o", "--output", metavar="DIR", default=".",
                    help="folder for the pictures (created if missing; default: .)")
     s.add_argument("--body", metavar="NAME", help="only this body")
-    s.add_argument("--format", choices=("svg", "png", "pdf"), default="svg",
+    s.add_argument("--image-format", choices=PICTURE_FORMATS, default="svg",
                    help="picture format (default: svg)")
     s.add_argument("--view", metavar="VIEW", default="iso", help=VIEW_HELP)
-    s.add_argument("--dpi", type=int, default=150, help="resolution of png pictures")
+    s.add_argument("--dpi", type=bounded("a whole number of dots per inch", *DPI, integer=True),
+                   default=150, metavar="N",
+                   help=f"resolution of png pictures, {DPI[0]} to {DPI[1]} (default 150)")
     s.set_defaults(run=fbd)
 
-    s = sub.add_parser("graph", help="draw the body/joint graph",
-                       description="Draw the bodies and ground as nodes and every joint as "
-                       "an edge labelled with its type and number of reaction components.")
+    s = sub.add_parser("graph", help="the body/joint graph: as text, or drawn with -o",
+                       description="The bodies and ground as nodes and every joint as an "
+                       "edge (parent -> child) with its type and number of reaction "
+                       "components, then the graph's loops, connected parts and mobility. "
+                       "Printed as text; with -o FILE, drawn as a picture instead.")
     s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
-    s.add_argument("-o", "--output", metavar="FILE", default="graph.svg",
-                   help="picture file; its extension (.svg, .png, .pdf) sets the format "
-                   "(default: graph.svg)")
+    s.add_argument("-o", "--output", metavar="FILE",
+                   help="draw the graph into this picture; its extension (.svg, .png, .pdf) "
+                   "sets the format")
     s.set_defaults(run=graph)
 
     s = sub.add_parser("report", help="write one self-contained HTML page for the model",
@@ -65,9 +84,13 @@ def _file_name(body: str, taken: set[str]) -> str:
 
 def fbd(a: argparse.Namespace) -> int:
     from mbody.equations.assemble import assemble
+    from mbody.io.atomic import atomic_folder
     from mbody.present.draw import fbd_scene, parse_view, save_figure
 
     parse_view(a.view)  # a bad view is reported before any work
+    out = Path(a.output)
+    if out.exists() and not out.is_dir():
+        raise MbodyError(f"-o {a.output}: not a folder (fbd writes one picture per body)")
     model = load_model(a.model)
     if a.body is not None and a.body not in model.index:
         hint = did_you_mean(a.body, model.body_names)
@@ -75,18 +98,18 @@ def fbd(a: argparse.Namespace) -> int:
                          + (f" ({hint})" if hint else "")
                          + "; its bodies: " + ", ".join(model.body_names[:20])
                          + (" ..." if model.n > 20 else ""))
-    if a.dpi <= 0:
-        raise MbodyError(f"--dpi must be a positive number of dots per inch, got {a.dpi}")
     asm = assemble(model)
     names = [a.body] if a.body is not None else list(model.body_names)
-    out, taken = Path(a.output), set[str]()
-    if out.exists() and not out.is_dir():
-        raise MbodyError(f"-o {a.output}: not a folder (fbd writes one picture per body)")
-    for name in names:
-        fig = fbd_scene(asm.bodies[name].fbd, view=a.view)
-        path = save_figure(fig, out / f"{_file_name(name, taken)}.{a.format}", a.format,
-                           dpi=a.dpi)
-        print(f"wrote {path}  (body {name})")
+    taken = set[str]()
+    files = [(name, f"{_file_name(name, taken)}.{a.image_format}") for name in names]
+    refuse_overwriting_inputs([("-o", str(out / f)) for _, f in files],
+                              [("the model", a.model)], a.force)
+    with atomic_folder(out) as tmp:  # every picture, or none
+        for name, file in files:
+            fig = fbd_scene(asm.bodies[name].fbd, view=a.view)
+            save_figure(fig, tmp / file, a.image_format, dpi=a.dpi)
+    for name, file in files:
+        print(f"wrote {out / file}  (body {name})")
     return EXIT_OK
 
 
@@ -95,16 +118,40 @@ def graph(a: argparse.Namespace) -> int:
     from mbody.model.graph import topology
     from mbody.present.draw import FORMATS, graph_scene, save_figure
 
-    fmt = Path(a.output).suffix.lstrip(".").lower()
-    if fmt not in FORMATS:
+    fmt = Path(a.output).suffix.lstrip(".").lower() if a.output else None
+    if a.output and fmt not in FORMATS:
         raise MbodyError(f"-o {a.output}: the file name must end in "
                          + ", ".join("." + f for f in FORMATS) + " (it sets the format)")
     model = load_model(a.model)
     topo = topology(model, assemble(model).G if model.reactions else None)
+    if not a.output:
+        print(graph_text(model, topo))
+        return EXIT_OK
     path = save_figure(graph_scene(model, topo), a.output, fmt)
     print(f"wrote {path}  ({model.n} bodies, {len(model.joints)} joints, "
-          f"mobility {topo.mobility})")
+          f"mobility {topo.mobility})", file=output_stream(a.output))
     return EXIT_OK
+
+
+def graph_text(model, topo) -> str:
+    """`mbody graph MODEL` without -o: every joint as an edge, then the graph summary."""
+    from mbody.model.model import count
+    from mbody.present.text import graph_summary
+
+    lines = [f"body/joint graph of {model.name!r}: {count(model.n, 'body', 'bodies')} + "
+             f"ground, {count(len(model.joints), 'joint')} (edges: joint, type, parent -> "
+             "child, reaction components)"]
+    shown = model.joints[:200]
+    width = max([len(j.name) for j in shown] + [1])
+    kinds = max([len(j.type) for j in shown] + [1])
+    for j in shown:
+        lines.append(f"  {j.name:<{width}}  {j.type:<{kinds}}  {j.parent} -> {j.child}  "
+                     f"({count(len(j.labels), 'reaction component')})")
+    if len(model.joints) > len(shown):
+        lines.append(f"  ... and {len(model.joints) - len(shown)} more")
+    lines.append(graph_summary(model, topo))
+    lines.append("(draw it with -o FILE.svg, .png or .pdf)")
+    return "\n".join(lines)
 
 
 def report(a: argparse.Namespace) -> int:
@@ -117,7 +164,9 @@ def report(a: argparse.Namespace) -> int:
     if a.answers is not None:
         from mbody.answers.verify import verify
 
+        regular_file(a.answers, "a YAML answers file")
         answers = verify(model, a.answers)
     path = write_report(model, a.output, view=a.view, answers=answers)
-    print(f"wrote {path}  ({model.n} bod{'y' if model.n == 1 else 'ies'})")
+    print(f"wrote {path}  ({model.n} bod{'y' if model.n == 1 else 'ies'})",
+          file=output_stream(a.output))
     return EXIT_OK

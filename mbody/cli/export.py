@@ -4,11 +4,21 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import math
 import sys
 from collections.abc import Iterator
+from pathlib import Path
 from typing import TYPE_CHECKING
 
-from mbody.cli.common import EXIT_OK, MODEL_HELP, load_model, parse_known, regular_file
+from mbody.cli.common import (
+    EXIT_OK,
+    MODEL_HELP,
+    bounded,
+    load_model,
+    output_stream,
+    parse_known,
+    regular_file,
+)
 from mbody.errors import MbodyError, OutputError
 
 if TYPE_CHECKING:
@@ -31,7 +41,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--csv", metavar="DIR", help="write CSV tables into this folder")
     s.add_argument("--state", metavar="RUN", help="take the state from this trajectory file "
                    "(written by 'mbody simulate -o RUN.npz')")
-    s.add_argument("--time", metavar="T", type=float, help="with --state: use the stored "
+    s.add_argument("--time", metavar="T",
+                   type=bounded("a finite number of seconds", -math.inf, math.inf),
+                   help="with --state: use the stored "
                    "sample nearest to time T in seconds (default: the last sample); samples "
                    "are not interpolated")
     s.add_argument("--known", metavar="LABEL=VALUE", action="append", default=[],
@@ -42,7 +54,14 @@ def register(sub: argparse._SubParsersAction) -> None:
 def export(a: argparse.Namespace) -> int:
     """`mbody export MODEL -o FILE... [--csv DIR]`: write the exports, print their sizes."""
     from mbody.equations.assemble import assemble
-    from mbody.io.export import assembly_from_trajectory, exported, write_csv, write_export
+    from mbody.io.atomic import atomic_folder, atomic_path
+    from mbody.io.export import (
+        SUFFIXES,
+        assembly_from_trajectory,
+        exported,
+        write_csv,
+        write_export,
+    )
 
     if not a.output and not a.csv:
         raise MbodyError("nothing to write: give -o FILE (.npz, .mat or .json) and/or "
@@ -57,15 +76,26 @@ def export(a: argparse.Namespace) -> int:
         asm, source = assemble(model), ""
     exp = exported(asm, parse_known(a.known), source)
     N, m = len(exp.coordinates), len(exp.reactions)
+    for out in a.output:  # an unknown suffix is refused before anything is written
+        if Path(out).suffix.lower() not in SUFFIXES:
+            write_export(exp, out)
+    with contextlib.ExitStack() as staged:  # every output, or none: each is written to a
+        for out in a.output:  # temporary file, and all are put in place at the end
+            tmp = staged.enter_context(atomic_path(out))
+            with _writing(out):
+                write_export(exp, tmp)
+        if a.csv:
+            folder = staged.enter_context(atomic_folder(a.csv))
+            with _writing(a.csv, "folder"):
+                write_csv(exp, folder)
+    say = output_stream(*a.output)
     for out in a.output:
-        with _writing(out):
-            print(f"wrote {write_export(exp, out)}")
+        print(f"wrote {out}", file=say)
     if a.csv:
-        with _writing(a.csv):
-            print(f"wrote {write_csv(exp, a.csv)}/ (M.csv, G.csv, vectors.csv, columns.csv, "
-                  "bodies.csv, info.csv)")
+        print(f"wrote {a.csv}/ (M.csv, G.csv, vectors.csv, columns.csv, bodies.csv, "
+              "info.csv)", file=say)
     print(f"M {N}x{N} ({exp.M.nnz} non-zeros), b {N}, Q {N}, G {N}x{m} "
-          f"({exp.G.nnz} non-zeros); state: {exp.state_source}")
+          f"({exp.G.nnz} non-zeros); state: {exp.state_source}", file=say)
     return EXIT_OK
 
 
@@ -84,16 +114,19 @@ def latex(asm: Assembly, target: str, body: str | None = None) -> int:
         sys.stdout.write(text)
     else:
         with _writing(target):
-            print(f"wrote {write_atomic(target, text)}")
+            print(f"wrote {write_atomic(target, text)}", file=output_stream(target))
     return EXIT_OK
 
 
 @contextlib.contextmanager
-def _writing(target: str) -> Iterator[None]:
-    """An operating-system error while writing `target` becomes one clear message."""
+def _writing(target: str, kind: str = "file") -> Iterator[None]:
+    """An operating-system error while writing `target` (or its temporary `kind`, file or
+    folder) becomes one clear message naming `target`."""
     try:
         yield
-    except OutputError:  # already one message naming the file
-        raise
     except OSError as exc:
-        raise MbodyError(f"cannot write {target}: {exc.strerror or exc}") from None
+        if isinstance(exc, OutputError) and exc.filename == target:
+            raise  # already one message naming the file
+        raise OutputError(f"cannot write {target!r}: {exc.strerror or exc}; nothing was "
+                          f"written (the temporary {kind} is removed, and "
+                          f"{Path(target).name!r} is as it was)", exc, target) from None

@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from mbody.cli.common import EXIT_OK, load_model, regular_file
+from mbody.cli.common import EXIT_OK, add_format_option, load_model, output_stream, regular_file
 from mbody.errors import MbodyError, ModelError, did_you_mean
 
 FORMATS = {".yaml": "yaml", ".yml": "yaml", ".xml": "mjcf", ".mjcf": "mjcf", ".urdf": "urdf"}
@@ -32,14 +32,14 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.add_argument("source", metavar="SOURCE", help="the model to read (.yaml, .xml, .urdf)")
     s.add_argument("-o", "--output", metavar="OUTPUT", required=True,
                    help="the file to write (.yaml or .xml)")
-    s.add_argument("--format", choices=WRITTEN, help="the output format, when OUTPUT's "
-                   "extension does not say it")
-    s.add_argument("--from", dest="source_format", choices=tuple(NAMES),
-                   help="the input format, when SOURCE's extension does not say it")
+    s.add_argument("--to", choices=WRITTEN, metavar="{yaml,mjcf}",
+                   help="the output's format, when OUTPUT's extension does not say it")
+    add_format_option(s, ("--from",), what="SOURCE")
     s.add_argument("--keyframe", metavar="NAME", help="MJCF input: the keyframe whose "
                    "qpos/qvel give the initial state (default: 'initial' when the file has "
                    "it, as mbody's export writes; else the reference pose at rest)")
-    s.add_argument("--force", action="store_true", help="replace OUTPUT if it exists")
+    s.add_argument("--force", action="store_true", help="replace OUTPUT if it exists (even "
+                   "SOURCE itself: a model rewritten in place)")
     s.set_defaults(run=convert)
 
 
@@ -47,21 +47,19 @@ def convert(a: argparse.Namespace) -> int:
     """`mbody convert SOURCE -o OUTPUT`: read, convert, write atomically, say what."""
     from mbody.io.atomic import ensure_writable
 
-    src_format = a.source_format or _format(a.source, "SOURCE", "--from",
-                                            (".yaml", ".xml", ".urdf"))
-    if not a.format and Path(a.output).suffix.lower() == ".urdf":
+    _old_format_meaning(a)
+    src_format = a.model_format or _format(a.source, "SOURCE", "--format",
+                                           (".yaml", ".xml", ".urdf"))
+    if not a.to and Path(a.output).suffix.lower() == ".urdf":
         raise MbodyError(f"{a.output}: mbody reads URDF but does not write it; write "
                          ".yaml (mbody) or .xml (MJCF)")
-    out_format = a.format or _format(a.output, "OUTPUT", "--format", (".yaml", ".xml"))
+    out_format = a.to or _format(a.output, "OUTPUT", "--to", (".yaml", ".xml"))
     if not os.path.exists(a.source):
         raise MbodyError(f"{a.source}: no such file")
     regular_file(a.source, f"a model file ({NAMES[src_format]})")
-    if os.path.exists(a.output):
-        if os.path.samefile(a.source, a.output):
-            raise MbodyError(f"{a.output}: is SOURCE itself; give another OUTPUT")
-        if not a.force:
-            raise MbodyError(f"{a.output}: exists; give --force to replace it, or another "
-                             "OUTPUT")
+    if os.path.exists(a.output) and not a.force:
+        raise MbodyError(f"{a.output}: exists; give --force to replace it, or another "
+                         "OUTPUT")
     ensure_writable(a.output)
     if src_format == "yaml":
         model = load_model(a.source)
@@ -90,11 +88,24 @@ def convert(a: argparse.Namespace) -> int:
 
             write_document(getattr(document, "data", document), a.output, source=a.source,
                            notes=notes)
+    say = output_stream(a.output)
     print(f"wrote {a.output} ({NAMES[out_format]} of {model.name!r} from "
-          f"{NAMES[src_format]}: {_summary(model)})")
+          f"{NAMES[src_format]}: {_summary(model)})", file=say)
     if out_format == "mjcf":
-        print("the header comment of the file lists what MJCF cannot hold")
+        print("the header comment of the file lists what MJCF cannot hold", file=say)
     return EXIT_OK
+
+
+def _old_format_meaning(a: argparse.Namespace) -> None:
+    """Before 0.3, `convert --format` named the output's format: `--format mjcf` with a
+    .yaml SOURCE most likely still means that. Say so rather than read the YAML file as
+    MJCF."""
+    given = a.model_format
+    ext = FORMATS.get(Path(a.source).suffix.lower())
+    if given and ext and given != ext and given in WRITTEN:
+        raise MbodyError(f"--format {given}: --format is SOURCE's format, and {a.source} is "
+                         f"{NAMES[ext]} by its extension; did you mean --to {given} (the "
+                         "output's format)?")
 
 
 def _format(path: str, what: str, option: str, choices: tuple[str, ...]) -> str:

@@ -6,8 +6,30 @@ import argparse
 import math
 import sys
 
-from mbody.cli.common import EXIT_OK, MODEL_HELP, load_model, parse_known, regular_file
+from mbody.cli.common import (
+    EXIT_OK,
+    MODEL_HELP,
+    bounded,
+    load_model,
+    number,
+    output_stream,
+    parse_known,
+    regular_file,
+)
 from mbody.errors import MbodyError
+
+T_END_MIN, T_END_MAX, FPS_MAX, SAMPLES_MAX = 1e-9, 1e9, 1e6, 10_000_000
+"""Bounds of --t-end (s), --fps and of the samples t_end x fps gives (as
+`mbody.simulate` keeps them: a run's samples are held in memory). A span below 1e-9 s
+means nothing physical, and one of a few denormal seconds overflows the simulator's
+step-rate estimate."""
+RTOL, ATOL = (1e-13, 0.01), (1e-300, 0.01)
+"""Tolerances --rtol and --atol accept: a relative tolerance below 1e-13 asks for digits
+a double does not have (SciPy's integrators raise it, with a warning, to 2.2e-14); above
+1 % (relative, or 0.01 absolute) a step controls nothing, and a mechanism's integration
+can run away (rtol 0.5 or atol 1 on the shipped slider-crank and four-bar)."""
+MAX_STEPS, MAX_WALL = 10**9, 1e7
+"""Largest --max-steps (0: no limit) and --max-wall (s, 115 days)."""
 
 COMPILE_NOTICE = ("mbody: compiling the fast path once (about a minute); later runs start at "
                   "once")
@@ -25,26 +47,35 @@ def register(sub: argparse._SubParsersAction) -> None:
                        "with the run. Prints the run summary with the drift of energy, "
                        "angular momentum and joints; saves the trajectory with -o.")
     s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
-    s.add_argument("--t-end", type=float, default=10.0, metavar="SECONDS",
-                   help="simulated time, s (default 10)")
-    s.add_argument("--fps", type=float, default=60.0,
-                   help="output samples per second (default 60)")
+    s.add_argument("--t-end", type=bounded("a number of seconds", T_END_MIN, T_END_MAX),
+                   default=10.0, metavar="SECONDS",
+                   help=f"simulated time, s (default 10; from {number(T_END_MIN)} to "
+                   f"{number(T_END_MAX)}, and "
+                   f"t_end x fps at most {number(SAMPLES_MAX)} samples)")
+    s.add_argument("--fps", default=60.0, metavar="N",
+                   type=bounded("a number of samples per second", 0, FPS_MAX, lo_open=True),
+                   help=f"output samples per second (default 60; at most {number(FPS_MAX)})")
     s.add_argument("-o", "--output", metavar="RUN.npz",
                    help="save the trajectory here (.npz; read with mbody.Trajectory.load)")
-    s.add_argument("--rtol", type=float, default=None,
-                   help="relative tolerance per step (default 1e-10)")
-    s.add_argument("--atol", type=float, default=None,
-                   help="absolute tolerance per step (default 1e-12)")
+    s.add_argument("--rtol", type=bounded("a relative tolerance", *RTOL), default=None,
+                   metavar="REL", help=f"relative tolerance per step (default 1e-10; "
+                   f"{number(RTOL[0])} to {number(RTOL[1])})")
+    s.add_argument("--atol", type=bounded("an absolute tolerance", *ATOL), default=None,
+                   metavar="ABS", help=f"absolute tolerance per step (default 1e-12; "
+                   f"{number(ATOL[0])} to {number(ATOL[1])})")
     s.add_argument("--method", default="DOP853",
                    help="integrator: DOP853 (default), RK45, RK23, Radau, BDF, LSODA")
     s.add_argument("--known", metavar="LABEL=VALUE", action="append", default=[],
                    help="a known reaction value, e.g. --known A.Fx=3 (repeatable)")
-    s.add_argument("--max-steps", type=int, default=None, metavar="N",
-                   help="stop with a message after N integrator steps (default 1000000; "
-                   "0: no limit)")
-    s.add_argument("--max-wall", type=float, default=None, metavar="SECONDS",
+    s.add_argument("--max-steps", default=None, metavar="N",
+                   type=bounded("a whole number of steps", 1, MAX_STEPS, integer=True,
+                                zero="no limit"),
+                   help=f"stop with a message after N integrator steps (default 1000000, "
+                   f"at most {number(MAX_STEPS)}; 0: no limit)")
+    s.add_argument("--max-wall", type=bounded("a number of seconds", 0, MAX_WALL, lo_open=True),
+                   default=None, metavar="SECONDS",
                    help="stop with a message after this much wall-clock time (default: no "
-                   "limit)")
+                   f"limit; at most {number(MAX_WALL)} s)")
     s.add_argument("--progress", action="store_true",
                    help="show the progress bar on stderr even when it is not a terminal")
     s.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
@@ -73,13 +104,8 @@ def simulate(a: argparse.Namespace) -> int:
     from mbody.simulate.simulation import DEFAULT_ATOL, DEFAULT_MAX_STEPS, DEFAULT_RTOL, summary
     from mbody.simulate.simulation import simulate as _simulate
 
-    max_steps = DEFAULT_MAX_STEPS if a.max_steps is None else a.max_steps
-    if max_steps < 0:
-        raise MbodyError(f"--max-steps must be a whole number of steps (0: no limit), got "
-                         f"{max_steps}")
-    if a.max_wall is not None and not (a.max_wall > 0 and math.isfinite(a.max_wall)):
-        raise MbodyError(f"--max-wall must be a positive number of seconds, got "
-                         f"{a.max_wall:g}")
+    max_steps = DEFAULT_MAX_STEPS if a.max_steps is None else int(a.max_steps)
+    check_samples(a.t_end, a.fps)
     model = load_model(a.model)
     if a.output:  # fail now, not after a long integration
         from mbody.io.atomic import ensure_writable
@@ -96,8 +122,17 @@ def simulate(a: argparse.Namespace) -> int:
                      max_steps=max_steps or None, max_wall=a.max_wall)
     if a.output:
         traj.save(a.output)
-    print(summary(traj, a.output))
+    print(summary(traj, a.output), file=output_stream(a.output))
     return EXIT_OK
+
+
+def check_samples(t_end: float, fps: float, flags: str = "--t-end x --fps") -> None:
+    """Refuse a run of more than SAMPLES_MAX samples before any work (exit 2)."""
+    samples = math.floor(t_end * fps + 1e-9) + 1
+    if samples > SAMPLES_MAX:
+        raise MbodyError(f"{flags} asks for {number(samples)} samples ({number(t_end)} s "
+                         f"at {number(fps)} per second); at most {number(SAMPLES_MAX)} (give "
+                         "a shorter time or fewer per second)")
 
 
 def compile_pending(model, known, method: str = "DOP853") -> bool:
@@ -145,11 +180,13 @@ def _cached(dispatcher) -> bool:
 
 
 def plot(a: argparse.Namespace) -> int:
+    from mbody.io.atomic import ensure_writable
     from mbody.present.plot import save_plot
     from mbody.simulate.trajectory import Trajectory
 
+    ensure_writable(a.output)  # before the figure is drawn (a second or two)
     regular_file(a.trajectory, "a run file written by 'mbody simulate -o RUN.npz'")
     traj = Trajectory.load(a.trajectory)
     save_plot(traj, a.output, a.body)
-    print(f"wrote {a.output}")
+    print(f"wrote {a.output}", file=output_stream(a.output))
     return EXIT_OK

@@ -1,14 +1,27 @@
-"""Writing outputs without ever leaving a partial file: write a temporary file in the
-target's folder, flush it to disk, then rename it into place (atomic on POSIX)."""
+"""Writing outputs without ever leaving a partial file, and without ever replacing what
+is not a file: every output of mbody goes through here.
+
+A regular file (or a new one) is written to a temporary file in its folder, flushed to
+disk, then renamed into place (atomic on POSIX); a symbolic link is followed, so the
+file it names is replaced and the link stays. A target that is not a regular file (after
+following links) is never replaced: a character device (``/dev/null``, a terminal) or a
+named pipe is written through (opened and written, from a complete temporary copy, so
+that a writer's failure sends nothing); the command's own standard output (``-o
+/dev/stdout``) is written through its descriptor; a block device, a socket or a folder
+is refused. Folders made for an output are removed again when the output fails.
+"""
 
 from __future__ import annotations
 
 import contextlib
+import errno
 import gc
 import os
 import shutil
+import stat
 import sys
 import tempfile
+import time
 import traceback
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -16,65 +29,254 @@ from typing import IO, Any
 
 from mbody.errors import MbodyError, OutputError
 
+PIPE_WAIT = 2.0
+"""Seconds a named pipe given as an output may take to get a reader before it is refused
+(opening it blocks until a program reads it; no reader would hang the command)."""
+CHUNK = 1 << 20
+"""Bytes copied at a time when writing through a device or a pipe."""
 
-def ensure_writable(target: str | os.PathLike[str]) -> Path:
-    """Check (before any long work) that `target` can be written: its folder exists or can
-    be made, is a folder, and is writable; `target` itself is not a folder. Missing
-    folders are created. Returns the folder; raises `MbodyError` with the reason."""
-    target = Path(target)
-    folder = target.parent if str(target.parent) else Path(".")
-    if target.is_dir():
+
+def _kind(mode: int) -> str:
+    return ("a folder" if stat.S_ISDIR(mode) else "a named pipe" if stat.S_ISFIFO(mode)
+            else "a character device" if stat.S_ISCHR(mode)
+            else "a block device (a disk)" if stat.S_ISBLK(mode)
+            else "a socket" if stat.S_ISSOCK(mode) else "not a regular file")
+
+
+def _stdout_fd() -> int | None:
+    """The descriptor of `sys.stdout`, or None (a test's capture, a closed stream)."""
+    try:
+        return sys.stdout.fileno()
+    except (AttributeError, OSError, ValueError):
+        return None
+
+
+def is_standard_output(target: str | os.PathLike[str]) -> bool:
+    """Whether `target` is the file, pipe or terminal this process's standard output goes
+    to (``/dev/stdout``, ``/proc/self/fd/1``, or the file stdout is redirected to): a
+    command writing its output there prints its messages to stderr instead."""
+    fd = _stdout_fd()
+    if fd is None:
+        return False
+    try:
+        return os.path.samestat(os.stat(target), os.fstat(fd))
+    except (OSError, ValueError):
+        return False
+
+
+def _plan(target: Path) -> tuple[str, Path]:
+    """How `target` is written: ("rename", the real path to replace or create),
+    ("stdout", target) or ("through", target); refuses what can never be written."""
+    try:
+        st = os.stat(target)
+    except FileNotFoundError:
+        return "rename", Path(os.path.realpath(target))
+    except OSError as exc:  # a loop of links, a name too long, no permission to look
+        raise MbodyError(f"cannot write {str(target)!r}: {exc.strerror or exc}") from None
+    fd = _stdout_fd()
+    if fd is not None:
+        with contextlib.suppress(OSError, ValueError):
+            if os.path.samestat(st, os.fstat(fd)):
+                return "stdout", target
+    if stat.S_ISREG(st.st_mode):
+        real = Path(os.path.realpath(target))
+        try:
+            if os.path.samestat(os.stat(real), st):
+                return "rename", real
+        except OSError:
+            pass
+        return "through", target  # a /proc/self/fd link to a file that has no name left
+    if stat.S_ISCHR(st.st_mode) or stat.S_ISFIFO(st.st_mode):
+        return "through", target
+    if stat.S_ISDIR(st.st_mode):
         raise MbodyError(f"cannot write {str(target)!r}: it is a folder; give a file name")
+    raise MbodyError(f"cannot write {str(target)!r}: it is {_kind(st.st_mode)}, which mbody "
+                     "never writes onto; give a file name")
+
+
+def _prefix(target: Path) -> str:
+    """A temporary file's prefix: a hidden name after the target's, short enough that a
+    target name the file system takes (up to 255 bytes) still leaves room for it."""
+    return f".{target.stem.encode()[:60].decode(errors='ignore')}."
+
+
+def _name_fits(target: Path, folder: Path) -> None:
+    """Refuse a file name longer than the file system takes, before any work."""
+    try:
+        limit = os.pathconf(folder, "PC_NAME_MAX")
+    except (OSError, ValueError, AttributeError):
+        limit = 255
+    size = len(os.fsencode(target.name))
+    if size > limit:
+        raise MbodyError(f"cannot write {str(target)!r}: the file name is {size} bytes long; "
+                         f"this file system takes at most {limit}")
+
+
+def _missing_folders(folder: Path) -> list[Path]:
+    """`folder` and those of its parents that do not exist yet, deepest first; refuses
+    a parent that exists and is not a folder."""
+    missing = []
     for p in (folder, *folder.parents):
         if p.exists():
             if not p.is_dir():
-                raise MbodyError(f"cannot write {str(target)!r}: {str(p)!r} is a file, "
-                                 "not a folder")
+                raise MbodyError(f"{str(p)!r} is a file, not a folder")
             break
+        missing.append(p)
+    return missing
+
+
+def ensure_writable(target: str | os.PathLike[str]) -> Path:
+    """Check (before any long work) that `target` can be written, and change nothing:
+    a device or a named pipe must be writable by this user; a file's folder must exist
+    and be writable, or be one that can be made in a writable folder; `target` is not a
+    folder, a block device or a socket. Returns the folder (which may not exist yet);
+    raises `MbodyError` with the reason."""
+    target = Path(target)
+    how, real = _plan(target)
+    if how != "rename":
+        if how == "through" and not os.access(target, os.W_OK):
+            raise MbodyError(f"cannot write {str(target)!r}: permission denied")
+        return target.parent
+    folder = real.parent
     try:
+        missing = _missing_folders(folder)
+    except MbodyError as exc:
+        raise MbodyError(f"cannot write {str(target)!r}: {exc}") from None
+    existing = missing[-1].parent if missing else folder
+    if not os.access(existing, os.W_OK):
+        raise MbodyError(f"cannot write {str(target)!r}: the folder {str(existing)!r} is "
+                         "not writable")
+    _name_fits(target, existing)
+    return folder
+
+
+def _make_folders(target: Path, folder: Path) -> list[Path]:
+    """Make `folder` with its missing parents; return those made (deepest first)."""
+    try:
+        missing = _missing_folders(folder)
         folder.mkdir(parents=True, exist_ok=True)
+    except MbodyError as exc:
+        raise MbodyError(f"cannot write {str(target)!r}: {exc}") from None
     except OSError as exc:
         raise MbodyError(f"cannot write {str(target)!r}: cannot make the folder "
                          f"{str(folder)!r} ({exc.strerror or exc})") from None
-    if not os.access(folder, os.W_OK):
-        raise MbodyError(f"cannot write {str(target)!r}: the folder {str(folder)!r} is "
-                         "not writable")
-    return folder
+    return missing
+
+
+def _remove_folders(made: list[Path]) -> None:
+    """Remove the folders an output made, deepest first, if they are still empty."""
+    for p in made:
+        try:
+            p.rmdir()
+        except OSError:
+            break
 
 
 @contextlib.contextmanager
 def atomic_path(target: str | os.PathLike[str], suffix: str = "") -> Iterator[Path]:
-    """Yield a temporary path next to `target`; on success rename it onto `target`.
+    """Yield a temporary path to write the whole output to; on success put it in place.
 
-    On any exception the temporary file is removed and `target` is left untouched; an
-    operating-system error (ENOSPC, EDQUOT, EFBIG, EIO...) becomes one `OutputError`
-    (an `MbodyError` and an `OSError`) naming `target`.
-    `suffix` keeps the extension for writers that look at it (numpy, scipy.io).
+    A regular or new file is replaced by a rename (atomic); a device, a named pipe or
+    standard output is written through from the complete temporary file (see the
+    module's text). On any exception the temporary file (and any folder made for it) is
+    removed and `target` is left untouched; an operating-system error (ENOSPC, EDQUOT,
+    EFBIG, EIO...) becomes one `OutputError` (an `MbodyError` and an `OSError`) naming
+    `target`. `suffix` keeps the extension for writers that look at it (numpy,
+    scipy.io).
     """
     target = Path(target)
-    folder = ensure_writable(target)
+    how, real = _plan(target)
+    made: list[Path] = []
+    if how == "rename":
+        made = _make_folders(target, real.parent)
+        where: str | None = str(real.parent)
+    else:  # written through: the whole output is made first, away from the device
+        where = None
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=suffix or target.suffix,
-                                   dir=folder)
+        fd, tmp = tempfile.mkstemp(prefix=_prefix(target), suffix=suffix or target.suffix[:20],
+                                   dir=where)
     except OSError as exc:
+        _remove_folders(made)
         raise MbodyError(f"cannot write {str(target)!r}: {exc.strerror or exc}") from None
     os.close(fd)
     tmp_path = Path(tmp)
     os.chmod(tmp_path, 0o666 & ~_umask())  # mkstemp makes 0600; give what open() would
+    sent = False
     try:
         yield tmp_path
-        with open(tmp_path, "rb+") as fh:
-            os.fsync(fh.fileno())
-        os.replace(tmp_path, target)
+        if how == "rename":
+            with open(tmp_path, "rb+") as fh:
+                os.fsync(fh.fileno())
+            os.replace(tmp_path, real)
+        else:
+            sent = True
+            _write_through(tmp_path, target, how == "stdout")
     except BaseException as exc:
         with contextlib.suppress(OSError):
             tmp_path.unlink(missing_ok=True)
-        if isinstance(exc, OSError):  # a full disk, a quota, a file-size limit, I/O
+        _remove_folders(made)
+        if isinstance(exc, OSError) and not isinstance(exc, OutputError):
             _release(exc)
-            raise OutputError(f"cannot write {str(target)!r}: {exc.strerror or exc}; "
-                              "nothing was written (the temporary file is removed, and "
-                              f"{target.name!r} is as it was)", exc, str(target)) from None
+            raise OutputError(_failed(target, exc, sent), exc, str(target)) from None
         raise
+    finally:
+        if how != "rename":
+            with contextlib.suppress(OSError):
+                tmp_path.unlink(missing_ok=True)
+
+
+def _failed(target: Path, exc: OSError, sent: bool) -> str:
+    """The message of an output that failed with `exc` (after writing through began
+    when `sent`)."""
+    reason = exc.strerror or str(exc)
+    if sent:
+        return (f"cannot write {str(target)!r}: {reason}; the output is incomplete (a "
+                "device or a pipe is written as it goes and cannot be taken back)")
+    return (f"cannot write {str(target)!r}: {reason}; nothing was written (the temporary "
+            f"file is removed, and {target.name!r} is as it was)")
+
+
+def _open_through(target: Path) -> int:
+    """A descriptor writing to the device or pipe `target`, opened without blocking (a
+    pipe without a reader is retried for PIPE_WAIT seconds, then refused)."""
+    flags = os.O_WRONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0)
+    deadline = time.monotonic() + PIPE_WAIT
+    while True:
+        try:
+            fd = os.open(target, flags)
+            break
+        except OSError as exc:
+            if exc.errno != errno.ENXIO:  # ENXIO: a named pipe that nobody reads yet
+                raise
+            if time.monotonic() >= deadline:
+                raise MbodyError(f"cannot write {str(target)!r}: no program reads this named "
+                                 f"pipe (waited {PIPE_WAIT:g} s); start the reader first, or "
+                                 "give a file name") from None
+            time.sleep(0.05)
+    with contextlib.suppress(OSError, ImportError):  # writes block again, as for any pipe
+        import fcntl
+
+        fcntl.fcntl(fd, fcntl.F_SETFL, fcntl.fcntl(fd, fcntl.F_GETFL) & ~os.O_NONBLOCK)
+    return fd
+
+
+def _write_through(tmp: Path, target: Path, to_stdout: bool) -> None:
+    """Copy the complete output `tmp` into `target` (a device, a pipe, standard output)."""
+    if to_stdout:
+        sys.stdout.flush()
+        fd = _stdout_fd()
+        assert fd is not None  # _plan saw it
+    else:
+        fd = _open_through(target)
+    try:
+        with open(tmp, "rb") as src:
+            while chunk := src.read(CHUNK):
+                view = memoryview(chunk)
+                while view:
+                    view = view[os.write(fd, view):]
+    finally:
+        if not to_stdout:
+            os.close(fd)
 
 
 def write_atomic(target: str | os.PathLike[str],
@@ -85,7 +287,7 @@ def write_atomic(target: str | os.PathLike[str],
     Parameters
     ----------
     target
-        The file to write.
+        The file to write (or a device, pipe or standard output, written through).
     write
         The content, or a callable that writes it to the open file it is given (text
         is encoded, and bytes decoded, as UTF-8 when the mode asks for the other).
@@ -121,12 +323,14 @@ def atomic_folder(target: str | os.PathLike[str]) -> Iterator[Path]:
 
     A new `target` is the temporary folder renamed (one atomic step). An existing one
     gets each file renamed in (each file atomic; files of `target` not written are kept),
-    only after every file is complete, so a failed writer changes nothing.
+    only after every file is complete, so a failed writer changes nothing; a file of
+    `target` that is a device or a named pipe is written through, as `atomic_path` does.
 
     Parameters
     ----------
     target
-        The folder to fill; created with its parents if needed.
+        The folder to fill; created with its parents if needed (and removed again, with
+        the parents made for it, when the writer fails).
 
     Raises
     ------
@@ -140,10 +344,11 @@ def atomic_folder(target: str | os.PathLike[str]) -> Iterator[Path]:
     if target.exists() and not target.is_dir():
         raise MbodyError(f"{target}: exists and is not a folder")
     parent = target.parent if str(target.parent) else Path(".")
+    made = _make_folders(target, parent)
     try:
-        parent.mkdir(parents=True, exist_ok=True)
-        tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.", dir=parent))
+        tmp = Path(tempfile.mkdtemp(prefix=_prefix(target), dir=parent))
     except OSError as exc:
+        _remove_folders(made)
         raise MbodyError(f"cannot write {str(target)!r}: {exc.strerror or exc}") from None
     os.chmod(tmp, 0o777 & ~_umask())  # mkdtemp makes 0700; give what mkdir() would
     try:
@@ -151,16 +356,22 @@ def atomic_folder(target: str | os.PathLike[str]) -> Iterator[Path]:
         if not target.exists():
             os.replace(tmp, target)
         else:
-            for f in sorted(tmp.iterdir()):
-                os.replace(f, target / f.name)
-            tmp.rmdir()
+            files = sorted(tmp.iterdir())
+            plans = [(f, *_plan(target / f.name)) for f in files]  # refuse before moving
+            for f, how, real in plans:
+                if how == "rename":
+                    os.replace(f, real)
+                else:
+                    _write_through(f, target / f.name, how == "stdout")
+            shutil.rmtree(tmp)
     except BaseException as exc:
         shutil.rmtree(tmp, ignore_errors=True)
-        if isinstance(exc, OSError) and not isinstance(exc, OutputError):
+        _remove_folders(made)
+        if isinstance(exc, OSError):  # one of its files' OutputError too: name the folder
             _release(exc)
-            raise OutputError(f"cannot write {str(target)!r}: {exc.strerror or exc}; the "
-                              "temporary folder is removed, and the target is as it was",
-                              exc, str(target)) from None
+            raise OutputError(f"cannot write {str(target)!r}: {exc.strerror or exc}; nothing "
+                              "was written (the temporary folder is removed, and "
+                              f"{target.name!r} is as it was)", exc, str(target)) from None
         raise
 
 

@@ -4,11 +4,13 @@
     drift  |E(t) − E(0)| / max(|E(0)|, max T)  and  ‖H(t) − H(0)‖ / max ‖H‖
 
 One `matplotlib.figure.Figure` (Agg canvas, no pyplot: safe in scripts, servers and
-tests); `save_plot` writes it atomically, the format taken from the file's extension.
+tests); `save_plot` draws it in memory and writes it atomically, the format taken from
+the file's extension.
 """
 
 from __future__ import annotations
 
+import io
 import os
 from collections.abc import Callable
 from functools import partial
@@ -22,12 +24,19 @@ from matplotlib.figure import Figure
 from mbody import conventions as cv
 from mbody import joint_types
 from mbody.errors import MbodyError
-from mbody.io.atomic import atomic_path
+from mbody.io.atomic import write_atomic
+from mbody.present.draw.fonts import drawable
 from mbody.simulate.trajectory import Trajectory
 
 MAX_BODIES = 6
 """Bodies drawn in the angular-velocity panel (the rest are summed in the others)."""
 FORMATS = ("png", "pdf", "svg")
+
+
+def _text(name: str) -> str:
+    """A name as the figure can draw it: characters DejaVu Sans lacks as <U+XXXX>, and a
+    '$' that would start mathtext escaped."""
+    return drawable(name).replace("$", r"\$")
 
 
 def _energy_momentum(traj: Trajectory) -> tuple[np.ndarray, np.ndarray, np.ndarray, str]:
@@ -77,7 +86,8 @@ def plot_trajectory(traj: Trajectory, bodies: list[str] | None = None) -> Figure
     fig = Figure(figsize=(11, 1.5 + 3 * rows), layout="constrained")
     FigureCanvasAgg(fig)
     grid = fig.add_gridspec(rows, 2)
-    title = f"{traj.model_name or 'trajectory'}: {traj.n} bod{'y' if traj.n == 1 else 'ies'}"
+    title = (f"{_text(traj.model_name or 'trajectory')}: {traj.n} "
+             f"bod{'y' if traj.n == 1 else 'ies'}")
     if traj.info:
         title += (f", {traj.info.get('integrator', '')} rtol {traj.info.get('rtol', 0):g}")
     fig.suptitle(title)
@@ -96,11 +106,12 @@ def plot_trajectory(traj: Trajectory, bodies: list[str] | None = None) -> Figure
 def _omega_panel(traj: Trajectory, a: Axes, idx: list[int], names: list[str]) -> None:
     t, w = traj.t, traj.angular_velocity
     for i, b in zip(idx, names, strict=True):
+        shown = _text(b)
         if traj.dimension == cv.PLANAR:
-            a.plot(t, w[:, i], label=f"{b} θ̇")
+            a.plot(t, w[:, i], label=f"{shown} θ̇")
         else:
             for c in range(3):
-                a.plot(t, w[:, i, c], label=f"{b} ω{c + 1}")
+                a.plot(t, w[:, i, c], label=f"{shown} ω{c + 1}")
     shown = "" if len(names) == traj.n else f" (first {len(names)} of {traj.n} bodies)"
     a.set_title("angular velocity, body axes" + shown)
     a.set_ylabel("rad/s")
@@ -160,7 +171,7 @@ def _reaction_panel(traj: Trajectory, a: Axes, *, moment: bool, sel: list[int]) 
     axis, acting +R on the child and −R on the parent."""
     labels = list(traj.reaction_labels)
     for k in sel[:MAX_REACTIONS]:
-        a.plot(traj.t, traj.reactions[:, k], label=labels[k])
+        a.plot(traj.t, traj.reactions[:, k], label=_text(labels[k]))
     more = f" (first {MAX_REACTIONS} of {len(sel)})" if len(sel) > MAX_REACTIONS else ""
     a.set_title(f"joint reaction {'moments' if moment else 'forces'}, joint axes{more}")
     a.set_ylabel("N m" if moment else "N")
@@ -174,6 +185,8 @@ def save_plot(traj: Trajectory, path: str | os.PathLike[str], bodies: list[str] 
         raise MbodyError(f"cannot write {str(path)!r}: the plot format comes from the "
                          f"extension, one of {', '.join('.' + f for f in FORMATS)}")
     fig = plot_trajectory(traj, bodies)
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format=fmt, dpi=dpi)
-    return Path(path)
+    # drawn in memory first: a writer failing half-way (a full disk) must meet a complete
+    # picture, not matplotlib's pdf or png stream in the middle of its compression
+    buf = io.BytesIO()
+    fig.savefig(buf, format=fmt, dpi=dpi)
+    return write_atomic(path, buf.getvalue())

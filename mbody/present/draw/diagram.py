@@ -89,13 +89,8 @@ def fbd_scene(fbd: FreeBodyDiagram, *, view: View = "iso", equations: bool = Tru
     def top(y0: float) -> float:  # inches from the top -> points from the bottom
         return (H - y0) * IN
 
-    name = fbd.body
-    props = (f"m = {fmt(fbd.mass)} kg, particle" if not np.any(fbd.inertia)
-             else f"m = {fmt(fbd.mass)} kg, I_G = {fmt(fbd.inertia[2, 2])} kg m²" if planar
-             else f"m = {fmt(fbd.mass)} kg, view {view_name(view)}")
-    sc.title = title or f"Free-body diagram of {name}   ({props})"
-    sc.root.add(Text(sc.title, np.array([W / 2, top(0.25)]), 12, ha="center", va="center",
-                     weight="bold", gid="title"))
+    sc.title = title or f"Free-body diagram of {fbd.body}   ({_properties(fbd, planar, view)})"
+    sc.root.add(_title(sc.title, np.array([W / 2, top(0.25)]), 0.96 * W, h_title * IN))
     ax = sc.panel("drawing", (0.03 * W, top(h_title + h_draw), 0.94 * W, h_draw * IN))
 
     # body outline, hidden edges dotted
@@ -117,7 +112,8 @@ def fbd_scene(fbd: FreeBodyDiagram, *, view: View = "iso", equations: bool = Tru
     rg = 0.045 * lmax
     _centre_mark(ax, G, rg, zorder=6, gid="mass-centre")
     obstacles.append((G + 1.3 * rg * circle(16), "mass-centre"))
-    fixed = [o[0] for o in obstacles]  # strokes an arrow must not lie on: outline, axes
+    fixed = [o[0] for o in obstacles]  # strokes an arrow must not lie on: outline...
+    lines: list[np.ndarray] = []  # ... and body axes, which it must keep farther from
     labels: list[Label] = []
     axes3 = [fbd.W_R_B[:, k] * 0.38 * shape.size for k in range(2 if planar else 3)]
     for k, nm in enumerate("xyz"[:len(axes3)]):
@@ -151,7 +147,7 @@ def fbd_scene(fbd: FreeBodyDiagram, *, view: View = "iso", equations: bool = Tru
             ax.add(Poly(arrowhead, AXIS_COLOR, zorder=3, gid=f"{tag}:head"))
             obstacles.append((arrowhead[[0, 1, 2, 0]], tag))
         obstacles.append((seg, tag))
-        fixed.append(seg)
+        lines.append(seg)
         labels.append(Label(Text(f"${nm}_B$", tip, 8, AXIS_COLOR, math=True, zorder=10,
                                  gid=f"label:{tag}"), tip, tip - G, tag,
                             float(np.linalg.norm(tip - G))))
@@ -180,8 +176,11 @@ def fbd_scene(fbd: FreeBodyDiagram, *, view: View = "iso", equations: bool = Tru
         drawn: list[Item] = []
         arrow_obstacles: list[tuple[np.ndarray, str]] = []
         arrow_labels = [_arrow(drawn, a, lmax, hd, arrow_obstacles)
-                        for a in separate(arrs, fixed, ax.scale, G, hd)]
-        every = labels + arrow_labels
+                        for a in separate(arrs, fixed, ax.scale, G, hd, lines)]
+        # arrows' labels before the axes' and G's (an axis label has room all around
+        # its tip), the longest arrows' first: over the shipped pictures this order needs
+        # the fewest leaders (tests/test_overlap.py counts them)
+        every = sorted(arrow_labels, key=lambda lb: -lb.shaft) + labels
         boxes = place(ax, every, obstacles + arrow_obstacles)
         if attempt == 4 or (np.all(boxes[:, 0] >= x0) and np.all(boxes[:, 2] <= x0 + w)
                             and np.all(boxes[:, 1] >= y0) and np.all(boxes[:, 3] <= y0 + h)):
@@ -215,6 +214,43 @@ def fbd_scene(fbd: FreeBodyDiagram, *, view: View = "iso", equations: bool = Tru
                          np.array([0.04 * W, top(h_title + h_draw + h_band) - 0.12 * IN]), 9,
                          va="top", family="mono", gid="equations", linespacing=1.45))
     return sc
+
+
+def _properties(fbd: FreeBodyDiagram, planar: bool, view: View) -> str:
+    """The title's mass and inertia about G: I_G planar; spatial, the tensor in body axes
+    as diag(...) when it is diagonal there, else its principal moments."""
+    m = f"m = {fmt(fbd.mass)} kg"
+    J = np.asarray(fbd.inertia, dtype=float)
+    if not np.any(J):
+        return f"{m}, particle"
+    if planar:
+        return f"{m}, I_G = {fmt(J[2, 2])} kg m²"
+    off = J - np.diag(np.diag(J))
+    if np.max(np.abs(off)) <= 1e-12 * np.max(np.abs(J)):
+        inertia = f"I_G = diag({', '.join(fmt(x) for x in np.diag(J))}) kg m²"
+    else:
+        principal = np.linalg.eigvalsh((J + J.T) / 2)
+        inertia = f"I_G principal {', '.join(fmt(x) for x in principal)} kg m²"
+    return f"{m}, {inertia}, view {view_name(view)}"
+
+
+TITLE_SIZES = (12.0, 5.0)
+"""The title's type size (points), and the smallest it is set in to fit the picture."""
+
+
+def _title(s: str, xy: np.ndarray, width: float, height: float) -> Text:
+    """The title centred at `xy` within `width` points: on one line at the full size if it
+    fits, else on two (the body, then its properties in parentheses), the type made
+    smaller until it fits in `width` and `height` (a long name: a smaller title)."""
+    big, small = TITLE_SIZES
+    spacing = 1.2
+    if layout(s, big, weight="bold").width > width and "   (" in s:
+        head, _, rest = s.partition("   (")
+        s, spacing = f"{head}\n({rest}", 1.05
+    lay = layout(s, big, weight="bold", linespacing=spacing)
+    size = max(small, min(big, big * width / lay.width, big * height / lay.height))
+    return Text(s, xy, size, ha="center", va="center", weight="bold", gid="title",
+                linespacing=spacing, align="center")
 
 
 def _arrow(ax: list[Item], a: Arrow, lmax: float, hd: float,

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 import re
+import unicodedata
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -55,6 +56,7 @@ class _Font:
         # (ascender + descender) of the font's OS/2 (else hhea) table, whatever the line
         # holds
         self.line = _font_height(self.ft)
+        self.codes = frozenset(self.ft.get_charmap())  # the characters it can draw
 
     def char(self, c: str) -> tuple[int, float, str, float, float]:
         got = self.chars.get(c)
@@ -108,6 +110,38 @@ def _line_box(ink_top: float, ink_bottom: float, line: float) -> tuple[float, fl
 @lru_cache(maxsize=8)
 def _font(family: str, weight: str) -> _Font:
     return _Font("DejaVu Sans Mono" if family == "mono" else "DejaVu Sans", weight)
+
+
+_UNSEEN = frozenset(("Cc", "Cf", "Cs", "Co", "Cn", "Zl", "Zp"))
+"""Unicode categories drawn as nothing, or not at all (controls, format characters such
+as U+200B, surrogates, private use, unassigned, line and paragraph separators)."""
+
+
+@lru_cache(maxsize=4096)
+def drawable(s: str, family: str = "sans", weight: str = "normal") -> str:
+    """`s` as a picture shows it: each character the font cannot draw (杆 in DejaVu Sans,
+    an emoji in DejaVu Sans Mono), or that would draw as nothing (a control or format
+    character such as U+200B), written as ``<U+XXXX>``; newlines stay.
+
+    DejaVu has no CJK glyphs, and a missing glyph is an error in FreeType, a box or a
+    warning in matplotlib: the code point keeps a name recognisable, and two names that
+    differ only there different, while text outputs keep every name exact.
+
+    Parameters
+    ----------
+    s : str
+    family, weight : str
+        The font: 'sans' or 'mono'; 'normal' or 'bold'.
+
+    Returns
+    -------
+    str
+    """
+    codes = _font(family, weight).codes
+    if s.isascii() and s.replace("\n", "").isprintable():  # the usual case: nothing to do
+        return s
+    return "".join(c if c == "\n" or (ord(c) in codes and unicodedata.category(c)
+                                      not in _UNSEEN) else f"<U+{ord(c):04X}>" for c in s)
 
 
 def path_data(verts: np.ndarray, codes: np.ndarray) -> str:
@@ -169,6 +203,7 @@ def _plain(s: str, family: str, weight: str, size: float, linespacing: float,
     each line a box linespacing × the font height high with its ink centred in it,
     the lines stacked; width from the advances and kerning."""
     f = _font(family, weight)
+    s = drawable(s, family, weight)
     k = size / UNIT
     box = linespacing * f.line
     rows: list[tuple[float, float, float, list[tuple[str, float]]]] = []

@@ -23,6 +23,7 @@ from matplotlib.transforms import Affine2D, Transform, offset_copy
 
 from mbody.errors import MbodyError
 from mbody.io.atomic import write_atomic
+from mbody.present.draw.fonts import drawable
 from mbody.present.draw.scene import IN, Disc, Item, Line, Poly, Scene, Wedge
 from mbody.present.draw.style import FORMATS
 from mbody.present.draw.svg import scene_svg
@@ -56,7 +57,8 @@ def _artist(it: Item, fig: Figure, trans: Transform) -> Artist:
     if t.box is not None:
         bbox = {"boxstyle": f"{'round' if t.box.round else 'square'},pad={t.box.pad}",
                 "fc": t.box.face, "ec": t.box.edge, "lw": t.box.lw}
-    return MplText(t.xy[0], t.xy[1], t.s if t.math else tex_safe(t.s), color=t.color,
+    shown = t.s if t.math else tex_safe(drawable(t.s, t.family, t.weight))
+    return MplText(t.xy[0], t.xy[1], shown, color=t.color,
                    fontsize=t.size, ha=t.ha, va=t.va, weight=t.weight,
                    family=_FAMILY[t.family], zorder=t.zorder, gid=t.gid, clip_on=False,
                    bbox=bbox, linespacing=t.linespacing, multialignment=t.align,

@@ -1,5 +1,7 @@
 """Arrows kept apart: an arrow lying on another arrow, on the body's outline or on a body
-axis moves sideways, parallel to itself, by the least number of steps that clears it.
+axis moves sideways, parallel to itself, by the least number of steps that clears it
+(CLEAR from an edge of the outline; CLEAR_LINE, about one label's height, from another
+arrow or a body axis, which it would otherwise seem to double).
 
 Two reactions at one pin along the same axis (the piston's B.Fy and P.Fy), a force along
 a rod's edge, gravity inside a thin vertical link, a force along x_B: each would hide the
@@ -26,8 +28,12 @@ from mbody.conventions import REACTION
 from mbody.present.draw.arrows import END_ON, Arrow, head
 
 CLEAR = 5.5
-"""An arrow keeps this far (points) from any parallel stroke it runs beside."""
-STEP = 6.0
+"""An arrow keeps this far (points) from a parallel edge of the body's outline."""
+CLEAR_LINE = 12.5
+"""... and this far from a parallel arrow or body axis: two arrows 6 points apart read as
+one double line (B.Fy beside P.Fy at the piston's pin), an arrow that close to x_B as
+drawn along the axis."""
+STEP = 6.5
 """Sideways step (points) tried in turn on both sides: ±1, ±2, ... steps."""
 PARALLEL = np.cos(np.radians(12.0))
 """Strokes within 12° of each other are parallel."""
@@ -68,9 +74,11 @@ def segments(polylines: list[np.ndarray]) -> np.ndarray:
     return s[np.linalg.norm(s[:, 1] - s[:, 0], axis=1) > 1e-12]
 
 
-def _lies_on(a: np.ndarray, b: np.ndarray, clear: float, run: float) -> bool:
+def _lies_on(a: np.ndarray, b: np.ndarray, clear: float, run: float,
+             grow: float | None = None) -> bool:
     """Whether segment a (2, 2) runs within `clear` of a parallel segment of b (k, 2, 2)
-    along at least `run` (all in the same units)."""
+    along at least `run`, a's ends grown by `grow` (default `clear`; all in the same
+    units)."""
     if not len(b):
         return False
     da = a[1] - a[0]
@@ -88,10 +96,11 @@ def _lies_on(a: np.ndarray, b: np.ndarray, clear: float, run: float) -> bool:
     rel = b - a[0]
     s = rel @ ua
     n = rel @ np.array([-ua[1], ua[0]])
-    # a's stretch grown by `clear` at both ends: a stroke that starts just past a's tip
-    # still runs on it
-    lo = np.maximum(np.minimum(s[:, 0], s[:, 1]), -clear)
-    hi = np.minimum(np.maximum(s[:, 0], s[:, 1]), la + clear)
+    # a's stretch grown at both ends: a stroke that starts just past a's tip still runs
+    # on it
+    grow = clear if grow is None else grow
+    lo = np.maximum(np.minimum(s[:, 0], s[:, 1]), -grow)
+    hi = np.minimum(np.maximum(s[:, 0], s[:, 1]), la + grow)
     # across-distance at the two ends of the shared stretch (b is straight: linear)
     ds = np.where(np.abs(s[:, 1] - s[:, 0]) > 1e-12, s[:, 1] - s[:, 0], 1.0)
     n_lo = n[:, 0] + (lo - s[:, 0]) / ds * (n[:, 1] - n[:, 0])
@@ -109,10 +118,11 @@ def _lies_on(a: np.ndarray, b: np.ndarray, clear: float, run: float) -> bool:
 
 
 def separate(arrs: list[Arrow], fixed: list[np.ndarray], scale: float, centre: np.ndarray,
-             hd: float = 0.0) -> list[Arrow]:
+             hd: float = 0.0, lines: list[np.ndarray] | None = None) -> list[Arrow]:
     """The arrows, each straight one moved sideways where it would lie on a stroke drawn
-    before it (`fixed` polylines: outline and axes; then the arrows before it), or where
-    its tip would touch one (an unknown reaction first drawn shorter or longer).
+    before it (`fixed` polylines: the outline, within CLEAR; `lines`, the body axes, and
+    the arrows before it, within CLEAR_LINE), or where its tip would touch one (an
+    unknown reaction first drawn shorter or longer).
 
     Parameters
     ----------
@@ -120,6 +130,9 @@ def separate(arrs: list[Arrow], fixed: list[np.ndarray], scale: float, centre: n
         In drawing order; the first keeps its place where it can.
     fixed : list of (k, 2) arrays
         Strokes that stay where they are (data coordinates).
+    lines : list of (k, 2) arrays, optional
+        Strokes that stay where they are and that an arrow keeps CLEAR_LINE from (the
+        body axes).
     scale : float
         Points per data unit of the panel.
     centre : (2,) array
@@ -133,8 +146,9 @@ def separate(arrs: list[Arrow], fixed: list[np.ndarray], scale: float, centre: n
         New arrows (the given ones are left as they are).
     """
     unit = 1.0 / scale  # one point in data units
-    placed = segments(fixed)
-    near = placed.copy()  # what a tip keeps clear of: strokes and arrowheads
+    outline = segments(fixed)
+    placed = segments(list(lines or []))  # body axes, then each arrow placed
+    near = np.vstack((outline, placed))  # what a tip keeps clear of: strokes and heads
     tips = np.zeros((0, 2))
     clear = TIP * unit if hd > 0 else -1.0
     order = sorted(range(len(arrs)), key=lambda i: arrs[i].kind == REACTION)
@@ -160,7 +174,8 @@ def separate(arrs: list[Arrow], fixed: list[np.ndarray], scale: float, centre: n
             ok = False
             for f in factors:
                 seg = np.array([t0, t0 + f * a.vec])
-                if _lies_on(seg, placed, CLEAR * unit, RUN * unit):
+                if _lies_on(seg, outline, CLEAR * unit, RUN * unit) or _lies_on(
+                        seg, placed, CLEAR_LINE * unit, RUN * unit, CLEAR * unit):
                     continue
                 if headed and clear > 0 and (
                         _distance(seg[1:], near)[0] < clear

@@ -9,6 +9,7 @@ one HTML page never clash.
 from __future__ import annotations
 
 import math
+import re
 from html import escape
 
 import numpy as np
@@ -42,8 +43,18 @@ def _points(xy: np.ndarray, H: float) -> str:
     return " ".join(f"{_n(x)},{_n(H - y)}" for x, y in xy)
 
 
+_NOT_XML = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ud800-\udfff\ufffe\uffff]")
+"""Characters XML 1.0 does not allow anywhere, not even escaped."""
+
+
+def _xml(s: str) -> str:
+    """`s` escaped for an attribute, a comment or a title: a character XML does not allow
+    (a control character in a body's name) as ``<U+XXXX>``."""
+    return escape(_NOT_XML.sub(lambda m: f"<U+{ord(m.group()):04X}>", s))
+
+
 def _gid(gid: str | None) -> str:
-    return f' id="{escape(gid)}"' if gid else ""
+    return f' id="{_xml(gid)}"' if gid else ""
 
 
 class _Writer:
@@ -100,7 +111,7 @@ class _Writer:
         o, H = self.out, self.H
         # the string beside its glyphs, as matplotlib writes it: searchable, diffable
         o.append(f"<g{_gid(t.gid)}>" + "".join(
-            f"<!-- {escape(line).replace('--', '- -')} -->" for line in t.s.split("\n")))
+            f"<!-- {_xml(line).replace('--', '- -')} -->" for line in t.s.split("\n")))
         if t.box is not None:
             pad = t.box.pad * t.size
             r = pad if t.box.round else 0.0
@@ -149,7 +160,7 @@ def scene_svg(scene: Scene, prefix: str = "", standalone: bool = False) -> str:
             'xmlns:xlink="http://www.w3.org/1999/xlink" '
             f'width="{_n(scene.width)}pt" height="{_n(scene.height)}pt" '
             f'viewBox="0 0 {_n(scene.width)} {_n(scene.height)}" version="1.1">')
-    title = f"<title>{escape(scene.title)}</title>" if scene.title else ""
+    title = f"<title>{_xml(scene.title)}</title>" if scene.title else ""
     doc = "\n".join([head + title, "<defs>", *defs, "</defs>", *body, "</svg>"])
     if standalone:
         doc = '<?xml version="1.0" encoding="utf-8" standalone="no"?>\n' + doc + "\n"
