@@ -1,0 +1,79 @@
+"""`mbody equilibrium` and `--axes world`, run as a user runs them (a subprocess), their
+numbers against closed forms and Newton's law."""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+G0 = 9.81
+
+
+def mbody(*args: str | Path) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "mbody", *map(str, args)], cwd=ROOT,
+                          capture_output=True, text=True, timeout=300)
+
+
+def test_equilibrium_of_the_shipped_spring_loaded_arm():
+    """tan θ = k a / m g; at rest the pin carries what the spring and gravity leave:
+    R = −k (P − x_G) − m g (world axes); ω² = (k a l sin θ + m g l cos θ) / I_O."""
+    m, k, a, l, I_G = 2.0, 30.0, 1.2, 0.5, 0.1
+    p = mbody("equilibrium", "models/spring_loaded_arm.yaml", "--axes", "world", "--json")
+    assert p.returncode == 0, p.stderr
+    out = json.loads(p.stdout)
+    theta = math.atan(k * a / (m * G0))
+    x_G = np.array(out["position"][0][:2])
+    assert np.allclose(x_G, [l * math.sin(theta), -l * math.cos(theta)], atol=1e-9)
+    assert out["found"] and out["stable"] is True
+    R = -k * (np.array([a, 0.0]) - x_G) - m * np.array([0.0, -G0])
+    assert np.allclose([out["reactions"]["O.Fx"], out["reactions"]["O.Fy"]], R,
+                       rtol=1e-8, atol=1e-8 * m * G0)
+    omega2 = (k * a * l * math.sin(theta) + m * G0 * l * math.cos(theta)) / (I_G + m * l**2)
+    # the stiffness comes from central differences of step 1e-6 of the size: O(h^2) error
+    assert out["stiffness"] == [pytest.approx(omega2, rel=1e-6)]
+    text = mbody("equilibrium", "models/spring_loaded_arm.yaml")
+    assert text.returncode == 0 and "stable" in text.stdout and "61.4" in text.stdout
+
+
+def test_no_equilibrium_is_exit_1_with_a_hint(tmp_path):
+    """A wheel on a pin with a constant torque never rests."""
+    f = tmp_path / "wheel.yaml"
+    f.write_text("model: wheel\ndimension: 2\nbodies:\n  - {name: w, mass: 1, inertia: 0.1}\n"
+                 "loads:\n  - {name: T, type: torque, body: w, torque: 1}\n"
+                 "joints:\n  - {name: O, type: revolute, parent: ground, child: w, "
+                 "at: [0, 0]}\n")
+    p = mbody("equilibrium", f)
+    assert p.returncode == 1, p.stdout + p.stderr
+    assert "no equilibrium" in p.stdout and "hint" in p.stderr
+    assert "Traceback" not in p.stderr
+
+
+def test_solve_in_world_axes_satisfies_each_bodys_newton_law():
+    """slider_crank.yaml at t = 0: with the joints' world forces, m a = m g + Σ F on each
+    body (+F where it is the child, −F where it is the parent) + the applied forces."""
+    p = mbody("solve", "models/slider_crank.yaml", "--axes", "world", "--json")
+    assert p.returncode == 0, p.stderr
+    out = json.loads(p.stdout)
+    assert out["reaction_axes"] == "world"
+    R = out["reactions"]
+    F = {j: np.array([R[f"{j}.Fx"], R[f"{j}.Fy"]]) for j in "OABP"}
+    gas = np.array([-4000.0, 0.0])
+    on = {"crank": F["O"] - F["A"], "rod": F["A"] - F["B"], "piston": F["B"] + F["P"] + gas}
+    mass = {"crank": 0.4, "rod": 0.6, "piston": 0.5}
+    for body, force in on.items():
+        acc = out["by_body"][body]
+        a = np.array([acc[f"{body}.x"], acc[f"{body}.y"]])
+        scale = 4000.0
+        assert np.allclose(mass[body] * a, mass[body] * np.array([0, -G0]) + force,
+                           atol=1e-10 * scale), body
+    joint_frame = json.loads(mbody("solve", "models/slider_crank.yaml", "--json").stdout)
+    assert joint_frame["reaction_axes"] == "joint"
+    text = mbody("solve", "models/slider_crank.yaml", "--axes", "world")
+    assert "in world axes" in text.stdout and "on piston" in text.stdout
