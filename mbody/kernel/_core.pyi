@@ -55,6 +55,11 @@ PR_VELOCITY: int
 PR_RATIO: int
 PR_SINGULAR: int
 PROJECT_INFO: int
+KR_STEP: int
+KR_NEWTON: int
+KR_WORST: int
+KR_SINGULAR: int
+KR_INFO: int
 
 def solve_layout(n: int, m: int, planar: bool) -> tuple[int, int, int]: ...
 
@@ -89,3 +94,5 @@ class Unknowns:
     def project(self, t: float, y: _F, iters: int, robust_below: float, homogeneous: Any,
                 info: _F) -> None: ...
     def schur(self, t: float, y: _F, S_out: _F) -> None: ...
+    def kinematic_run(self, t: _F, y: _F, lam: _F, max_newton: int, tol: float, Y: _F,
+                      OUT: _F, info: _F) -> int: ...

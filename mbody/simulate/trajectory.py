@@ -438,3 +438,13 @@ def _jsonable(x: Any) -> Any:
     if isinstance(x, np.generic):
         return x.item()
     return x
+
+
+def model_text(model) -> str:
+    """The model file's text, when the model came from a readable file ('' otherwise):
+    what a trajectory keeps so that it can be drawn and checked without the file."""
+    p = Path(model.file) if model.file and not model.file.startswith("<") else None
+    try:
+        return p.read_text(encoding="utf-8") if p is not None and p.is_file() else ""
+    except (OSError, UnicodeDecodeError):
+        return ""

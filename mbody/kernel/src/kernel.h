@@ -214,4 +214,21 @@ int mb_derivative(const mb_model *md, const mb_unknowns *u, mb_work *w, double t
 void mb_project(const mb_model *md, const mb_unknowns *u, mb_work *w, double t, double *y,
                 int iters, double robust_below, int homogeneous, double *info);
 
+/* Slots of mb_kinematic_run's info (MB_KR_INFO of them): the last sample's last Newton
+ * step, the Newton steps taken in all, the most at one sample, the singular code. */
+enum { MB_KR_STEP = 0, MB_KR_NEWTON = 1, MB_KR_WORST = 2, MB_KR_SINGULAR = 3,
+       MB_KR_INFO = 4 };
+
+/* A kinematic run: for each of the K times t (increasing), y (in: a state near the first
+ * sample's; out: the last sample's) is carried from the previous sample by a Taylor step,
+ * moved onto every enforced joint and driver by Newton steps (mb_project, at most
+ * max_newton, until the largest step is at most tol), stored in Y (K x state size) and
+ * solved (mb_solve, lam: the known values) into OUT (K x mb_solve's out length). Returns
+ * K, or the index of the sample where the loops did not close (a step above tol after
+ * max_newton steps, a value not a number, or a motion without mass: info[MB_KR_SINGULAR]);
+ * info (MB_KR_INFO) <- slots MB_KR_*. */
+int64_t mb_kinematic_run(const mb_model *md, const mb_unknowns *u, mb_work *w,
+                         const double *t, int64_t K, double *y, const double *lam,
+                         int max_newton, double tol, double *Y, double *OUT, double *info);
+
 #endif

@@ -552,6 +552,63 @@ static PyObject *Unknowns_project(UnknownsObject *self, PyObject *const *args,
     Py_RETURN_NONE;
 }
 
+PyDoc_STRVAR(kinematic_run_doc,
+"kinematic_run(t, y, lam, max_newton, tol, Y, OUT, info) -> int\n\nA kinematic run "
+"(kernel.h: mb_kinematic_run): at each time of t (K, increasing),\ny carried forward, moved "
+"onto every joint and driver by Newton steps (at most\nmax_newton, until a step is at most "
+"tol), stored in Y (K x state_size) and solved\ninto OUT (K x solve_layout's length). "
+"Returns K, or the index of the sample where\nthe loops did not close; info (KR_INFO) <- "
+"slots KR_*.");
+
+static PyObject *Unknowns_kinematic_run(UnknownsObject *self, PyObject *const *args,
+                                        Py_ssize_t nargs) {
+    Py_buffer t, y, lam, Y, OUT, info;
+    double tol;
+    if (unknowns_ready(self) < 0 || check_nargs(nargs, 8, "kinematic_run") < 0 ||
+        get_double(args[4], &tol, "tol") < 0)
+        return NULL;
+    long max_newton = PyLong_AsLong(args[3]);
+    if (max_newton == -1 && PyErr_Occurred()) return NULL;
+    if (max_newton < 1 || max_newton > 1000) {
+        PyErr_SetString(PyExc_ValueError, "max_newton: expected 1 to 1000");
+        return NULL;
+    }
+    const mb_model *md = &self->model->md;
+    Py_ssize_t S = MB_STATE_SIZE(md->n, md->planar);
+    Py_ssize_t L = (md->planar ? 3 : 6) * md->n + 3 * md->m + MB_INFO;
+    PyObject *result = NULL;
+    if (get_buffer(args[0], &t, 0, 1, -1, "t") < 0) return NULL;
+    Py_ssize_t K = t.len / 8;
+    if (get_state(md, args[1], &y, 1, 1) < 0) goto t_;
+    if (get_buffer(args[2], &lam, 0, 1, md->m, "lam") < 0) goto y_;
+    if (get_buffer(args[5], &Y, 1, 1, K * S, "Y") < 0) goto lam_;
+    if (get_buffer(args[6], &OUT, 1, 1, K * L, "OUT") < 0) goto Y_;
+    if (get_buffer(args[7], &info, 1, 1, MB_KR_INFO, "info") < 0) goto OUT_;
+    const double *tt = t.buf;
+    for (Py_ssize_t k = 1; k < K; k++)
+        if (!(tt[k] > tt[k - 1])) {
+            PyErr_SetString(PyExc_ValueError, "t: expected increasing times");
+            goto info_;
+        }
+    /* the GIL is kept: the work buffers are the object's own (as every method's) */
+    int64_t done = mb_kinematic_run(md, &self->u, self->w, tt, K, y.buf, lam.buf,
+                                    (int)max_newton, tol, Y.buf, OUT.buf, info.buf);
+    result = PyLong_FromLongLong((long long)done);
+info_:
+    PyBuffer_Release(&info);
+OUT_:
+    PyBuffer_Release(&OUT);
+Y_:
+    PyBuffer_Release(&Y);
+lam_:
+    PyBuffer_Release(&lam);
+y_:
+    PyBuffer_Release(&y);
+t_:
+    PyBuffer_Release(&t);
+    return result;
+}
+
 PyDoc_STRVAR(schur_doc,
 "schur(t, y, S_out)\n\nS_out (mu x mu) <- S = G_U^T M^-1 G_U at (t, y), dense, in the "
 "unknowns' order (for a\ncondition estimate).");
@@ -603,6 +660,8 @@ static PyMethodDef Unknowns_methods[] = {
      solve_given_doc},
     {"derivative", (PyCFunction)(void (*)(void))Unknowns_derivative, METH_FASTCALL, derivative_doc},
     {"project", (PyCFunction)(void (*)(void))Unknowns_project, METH_FASTCALL, project_doc},
+    {"kinematic_run", (PyCFunction)(void (*)(void))Unknowns_kinematic_run, METH_FASTCALL,
+     kinematic_run_doc},
     {"schur", (PyCFunction)(void (*)(void))Unknowns_schur, METH_FASTCALL, schur_doc},
     {NULL, NULL, 0, NULL},
 };
@@ -674,6 +733,8 @@ PyMODINIT_FUNC PyInit__core(void) {
         {"ST_MU", MB_ST_MU}, {"ST_PATH", MB_ST_PATH}, {"ST_SINGULAR", MB_ST_SINGULAR},
         {"INFO", MB_INFO}, {"PR_STEP", MB_PR_STEP}, {"PR_VELOCITY", MB_PR_VELOCITY},
         {"PR_RATIO", MB_PR_RATIO}, {"PR_SINGULAR", MB_PR_SINGULAR},
+        {"KR_STEP", MB_KR_STEP}, {"KR_NEWTON", MB_KR_NEWTON}, {"KR_WORST", MB_KR_WORST},
+        {"KR_SINGULAR", MB_KR_SINGULAR}, {"KR_INFO", MB_KR_INFO},
         {"PROJECT_INFO", MB_PROJECT_INFO},
     };
     for (size_t i = 0; i < sizeof(constants) / sizeof(constants[0]); i++)

@@ -1,5 +1,5 @@
-"""`mbody equilibrium` and `--axes world`, run as a user runs them (a subprocess), their
-numbers against closed forms and Newton's law."""
+"""`mbody kinematics`, `mbody equilibrium` and `--axes world`, run as a user runs them (a
+subprocess), their numbers against closed forms and Newton's law."""
 
 from __future__ import annotations
 
@@ -77,3 +77,36 @@ def test_solve_in_world_axes_satisfies_each_bodys_newton_law():
     assert joint_frame["reaction_axes"] == "joint"
     text = mbody("solve", "models/slider_crank.yaml", "--axes", "world")
     assert "in world axes" in text.stdout and "on piston" in text.stdout
+
+
+def test_kinematics_of_the_shipped_driven_slider_crank(tmp_path):
+    """One revolution by default (one sample a degree); the saved run reads back with the
+    motor's torque among its reactions, the torque's peak matches the run's series, a
+    followed point is where its body carries it, and the energy balances."""
+    from mbody.simulate.trajectory import Trajectory
+
+    out = tmp_path / "run.npz"
+    p = mbody("kinematics", "models/slider_crank_driven.yaml", "-o", out,
+              "--point", "pin=rod:0.08,0")
+    assert p.returncode == 0, p.stderr
+    assert "peaks over the run" in p.stdout and "motor.M" in p.stdout
+    traj = Trajectory.load(out)
+    assert len(traj) == 361 and traj.t[-1] == pytest.approx(0.1, rel=1e-12)
+    M = traj.reactions[:, traj.reaction_labels.index("motor.M")]
+    assert f"{M[np.argmax(np.abs(M))]:.6g} N m" in p.stdout
+    # the rod's end (B on the rod) rides on the cylinder's axis y = 0 through the run
+    assert np.abs(traj.series["point:pin"][:, 1]).max() < 1e-12
+    j = json.loads(mbody("kinematics", "models/slider_crank_driven.yaml", "--json",
+                         "--axes", "world").stdout)
+    assert j["samples"] == 361 and j["power_balance_residual"] < 1e-12
+    assert {p["label"] for p in j["peaks"]} >= {"O.Fx", "O.Fy", "P.Fx", "motor.M"}
+
+
+def test_kinematics_refuses_bad_points_and_a_partly_driven_model(tmp_path):
+    p = mbody("kinematics", "models/slider_crank_driven.yaml", "--point", "pin=rod")
+    assert p.returncode == 2 and "NAME=BODY:X,Y" in p.stderr
+    p = mbody("kinematics", "models/slider_crank_driven.yaml", "--point", "pin=rodd:0,0")
+    assert p.returncode == 2 and "did you mean 'rod'" in p.stderr
+    p = mbody("kinematics", "models/flyball_governor.yaml")
+    assert p.returncode == 2 and "mbody simulate" in p.stderr
+    assert "Traceback" not in p.stderr
