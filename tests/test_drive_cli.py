@@ -110,3 +110,21 @@ def test_kinematics_refuses_bad_points_and_a_partly_driven_model(tmp_path):
     p = mbody("kinematics", "models/flyball_governor.yaml")
     assert p.returncode == 2 and "mbody simulate" in p.stderr
     assert "Traceback" not in p.stderr
+
+
+def test_plot_of_a_driven_run_against_the_crank_angle_and_time(tmp_path):
+    """The drivers' figure by default (against the driver's angle), against time on
+    request, the motion's figure with --motion; a misspelt driver gets a hint."""
+    from PIL import Image
+
+    run = tmp_path / "run.npz"
+    assert mbody("kinematics", "models/slider_crank_driven.yaml", "-o", run).returncode == 0
+    for extra, name in (((), "a.png"), (("--against", "time"), "b.png"),
+                        (("--motion",), "c.png")):
+        p = mbody("plot", run, "-o", tmp_path / name, *extra)
+        assert p.returncode == 0, p.stderr
+        with Image.open(tmp_path / name) as im:
+            assert im.size[0] > 600 and im.size[1] > 400
+    p = mbody("plot", run, "-o", tmp_path / "d.png", "--against", "motr")
+    assert p.returncode == 2 and "did you mean 'motor'" in p.stderr
+    assert not (tmp_path / "d.png").exists()

@@ -97,6 +97,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--body", action="append", default=None, metavar="NAME",
                    help="bodies for the angular-velocity panel (repeatable; default the "
                    "first 6)")
+    s.add_argument("--against", metavar="DRIVER|time", default=None,
+                   help="a run with drivers: plot the efforts and bearing loads against this "
+                   "driver's coordinate (default: the first driver; degrees for an angle) or "
+                   "against time")
+    s.add_argument("--motion", action="store_true",
+                   help="a run with drivers: plot the bodies' motion, energy and momentum "
+                   "instead of the drivers' figure")
     s.set_defaults(run=plot)
 
 
@@ -187,6 +194,6 @@ def plot(a: argparse.Namespace) -> int:
     ensure_writable(a.output)  # before the figure is drawn (a second or two)
     regular_file(a.trajectory, "a run file written by 'mbody simulate -o RUN.npz'")
     traj = Trajectory.load(a.trajectory)
-    save_plot(traj, a.output, a.body)
+    save_plot(traj, a.output, a.body, against=a.against, motion=a.motion)
     print(f"wrote {a.output}", file=output_stream(a.output))
     return EXIT_OK

@@ -182,6 +182,8 @@ def _trajectory(model: Model, t: np.ndarray, Y: np.ndarray, OUT: np.ndarray, pla
         colors=tuple(model.bodies[b].color for b in model.body_names),
         gravity=np.array(model.gravity), model_yaml=model_text(model))
     traj.series.update(_body_points(model, x, q, points))
+    traj.series.update(driver_series(model, t))
+    run_info["drivers"] = driver_facts(model)
     acc6 = np.zeros((K, n, 6))
     acc = OUT[:, :plan.N].reshape(K, n, -1)
     acc6[..., [0, 1, 5] if planar else slice(None)] = acc
@@ -191,6 +193,28 @@ def _trajectory(model: Model, t: np.ndarray, Y: np.ndarray, OUT: np.ndarray, pla
     run_info["peaks"] = peaks(model, traj)
     run_info["warnings"] = []
     return traj
+
+
+def driver_series(model: Model, t: np.ndarray) -> dict[str, np.ndarray]:
+    """'driver:<name>' -> (K,) each driver's coordinate at the times t (its law: rad for
+    an angle, m for a displacement)."""
+    d = model.drivers
+    if d is None:
+        return {}
+    return {f"driver:{name}": np.asarray(law[0](t), dtype=float)
+            for name, law in zip(d.names, d.laws, strict=True)}
+
+
+def driver_facts(model: Model) -> list[dict]:
+    """What a saved run says of each driver: name, joint, 'angle' or 'displacement', the
+    label of its effort."""
+    d = model.drivers
+    if d is None:
+        return []
+    joints = model.joints
+    return [{"name": name, "joint": joints[int(j)].name,
+             "kind": "angle" if c == "M" else "displacement", "effort": f"{name}.{c}"}
+            for name, j, c in zip(d.names, d.joint.tolist(), d.component, strict=True)]
 
 
 def _directions(model: Model, t: np.ndarray, Y: np.ndarray) -> np.ndarray:
