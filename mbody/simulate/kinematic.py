@@ -410,18 +410,28 @@ def summary(traj: Trajectory, path: str | None = None) -> str:
                 "joint-frame components")
         lines.append(f"peaks over the run (largest magnitude; {axes}"
                      + (f"; {drv}'s coordinate at that time" if drv else "") + "):")
-        rows = [[p["label"], f"{p['value']:.6g} {p['unit']}", f"t = {p['t']:.6g} s"]
+        big = max(abs(p["value"]) for p in peaks)
+        rows = [[p["label"], f"{_shown(p['value'], big)} {p['unit']}", f"t = {p['t']:.6g} s"]
                 + ([f"{drv} = {p['driver_value']:.6g} {p['driver_unit']}"] if drv else [])
                 for p in peaks]
         widths = [max(len(r[c]) for r in rows) for c in range(len(rows[0]))]
         lines += ["  " + "  ".join(c.ljust(w) for c, w in zip(r, widths, strict=True)).rstrip()
                   for r in rows]
+    work = max(abs(i["driver_work"]), abs(i["load_work"]), abs(i["energy_change"]))
     lines.append(f"energy check: the drivers' power plus the applied loads' equals "
                  f"d(T + V)/dt at every sample to {i['power_balance_residual']:.1e} of the "
-                 f"largest power; over the run the drivers' work {i['driver_work']:.6g} J + "
-                 f"the loads' {i['load_work']:.6g} J = the change of T + V "
-                 f"{i['energy_change']:.6g} J to {i['energy_balance_residual']:.1e} "
+                 f"largest power; over the run the drivers' work "
+                 f"{_shown(i['driver_work'], work)} J + "
+                 f"the loads' {_shown(i['load_work'], work)} J = the change of T + V "
+                 f"{_shown(i['energy_change'], work)} J to "
+                 f"{i['energy_balance_residual']:.1e} "
                  "(Simpson's rule over the samples)")
     if path:
         lines.append(f"saved {path}")
     return "\n".join(lines)
+
+
+def _shown(x: float, scale: float) -> str:
+    """x to 6 significant digits, 0 when it is rounding beside `scale` (below 1e-12 of
+    it): the figure then reads the same on every machine."""
+    return "0" if abs(x) <= 1e-12 * scale else f"{x:.6g}"
