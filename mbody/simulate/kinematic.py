@@ -118,13 +118,15 @@ def kinematic_run(model: Model, t_end: float, fps: float, *, t_start: float = 0.
     L = plan.o_info + _core.INFO
     Y = np.empty((K, S))
     OUT = np.empty((K, L))
+    energy = np.empty((K, 3))
     info = np.empty(_core.KR_INFO)
     y = ws.state_vector(model.initial.replace(t=float(t[0])))
     tol = CLOSE_RTOL * _size(model)
-    done = plan.solver.kinematic_run(t, y, unknowns.lam, MAX_NEWTON, tol, Y, OUT, info)
+    done = plan.solver.kinematic_run(t, y, unknowns.lam, MAX_NEWTON, tol, Y, OUT, energy,
+                                     info)
     if done < K:
         _failed(model, float(t[done]), y, info)
-    return _trajectory(model, t, Y, OUT, plan, info, points, axes)
+    return _trajectory(model, t, Y, OUT, energy, plan, info, points, axes)
 
 
 def _failed(model: Model, t: float, y: np.ndarray, info: np.ndarray) -> None:
@@ -146,8 +148,9 @@ def _failed(model: Model, t: float, y: np.ndarray, info: np.ndarray) -> None:
     raise KinematicsError(_cannot_close(model, t, cols.phi, bad, float(info[_core.KR_STEP])))
 
 
-def _trajectory(model: Model, t: np.ndarray, Y: np.ndarray, OUT: np.ndarray, plan,
-                info: np.ndarray, points: BodyPoints | None, axes: str) -> Trajectory:
+def _trajectory(model: Model, t: np.ndarray, Y: np.ndarray, OUT: np.ndarray,
+                energy: np.ndarray, plan, info: np.ndarray, points: BodyPoints | None,
+                axes: str) -> Trajectory:
     K, n = len(t), model.n
     planar = model.dimension == cv.PLANAR
     x = Y[:, :3 * n].reshape(K, n, 3)
@@ -187,7 +190,7 @@ def _trajectory(model: Model, t: np.ndarray, Y: np.ndarray, OUT: np.ndarray, pla
     acc6 = np.zeros((K, n, 6))
     acc = OUT[:, :plan.N].reshape(K, n, -1)
     acc6[..., [0, 1, 5] if planar else slice(None)] = acc
-    series, balance = energy_balance(model, traj, Y, acc6, lam)
+    series, balance = energy_balance(model, traj, Y, acc6, lam, energy)
     traj.series.update(series)
     run_info.update(balance)
     run_info["peaks"] = peaks(model, traj)
@@ -256,7 +259,7 @@ def _body_points(model: Model, x: np.ndarray, q: np.ndarray, points: BodyPoints 
 
 
 def energy_balance(model: Model, traj: Trajectory, Y: np.ndarray, acc6: np.ndarray,
-                   lam: np.ndarray) -> tuple[dict[str, np.ndarray], dict]:
+                   lam: np.ndarray, energy: np.ndarray) -> tuple[dict[str, np.ndarray], dict]:
     """The drivers' work against the energy (module doc): series 'kinetic_energy',
     'potential_energy', 'energy', 'driver_power', 'load_power', 'driver_work',
     'load_work' (K,); the run's totals; and the power balance at every sample,
@@ -264,48 +267,28 @@ def energy_balance(model: Model, traj: Trajectory, Y: np.ndarray, acc6: np.ndarr
     dV/dt = −Σ m g·v + Σ k (L − L0) L′ from the solved accelerations (`acc6`, (K, n, 6):
     a_G world, ω̇ body axes): its largest relative residual.
 
-    The applied loads' power is Q's (every load on the bodies, at their mass centres)
-    less gravity's, Σ m g · v, and the springs' elastic part, −Σ k (L − L0) L′: what
-    is not in V (forces, couples, dampers)."""
-    ws = workspace(model)
+    `energy` (K, 3) is the core's per sample: Q · v (every load on the bodies at their mass
+    centres, gravity and springs included), the springs' elastic energy and its rate. The
+    applied loads' power is Q · v less gravity's, Σ m g · v, and the springs' elastic
+    part: what is not in V (forces, couples, dampers)."""
     t = traj.t
     K, n = len(t), model.n
     T = traj.kinetic_energy()
     mass = np.asarray(model.mass, dtype=float)
     g = np.asarray(model.gravity, dtype=float)
+    J = np.asarray(model.J, dtype=float)
     d = model.drivers
     k = len(d.names) if d is not None else 0
     rates = (np.stack([law[1](t) for law in d.laws], axis=1)  # f′(t), (K, k)
              if k and d is not None else np.zeros((K, 0)))
     P_drive = (lam[:, lam.shape[1] - k:] * rates).sum(axis=1) if k else np.zeros(K)
-    sp = model.springs
-    s = len(sp.names)
-    stiff = np.asarray(sp.stiffness, dtype=float)
-    rest = np.asarray(sp.rest_length, dtype=float)
-    Q = np.empty((n, 6))
-    b = np.empty((n, 6))
-    springs = np.empty((s, 6))
-    P_loads = np.empty(K)
-    V = np.empty(K)
-    dV = np.empty(K)
-    J = np.asarray(model.J, dtype=float)
-    for i in range(K):  # Q · v less what V accounts for (doc)
-        y = Y[i]
-        ws.core.wrench_parts(float(t[i]), y, Q, b)
-        v, w = y[7 * n:10 * n].reshape(n, 3), y[10 * n:13 * n].reshape(n, 3)
-        x = y[:3 * n].reshape(n, 3)
-        P = float((Q[:, :3] * v).sum() + (Q[:, 3:] * w).sum()) - float(mass @ (v @ g))
-        V[i] = -float(mass @ (x @ g))
-        dV[i] = -float(mass @ (v @ g))
-        if s:
-            ws.core.springs(float(t[i]), y, springs)
-            stretch = springs[:, 0] - rest
-            P += float(stiff @ (stretch * springs[:, 1]))
-            V[i] += 0.5 * float(stiff @ stretch**2)
-            dV[i] += float(stiff @ (stretch * springs[:, 1]))
-        P_loads[i] = P
+    x = Y[:, :3 * n].reshape(K, n, 3)
     v = Y[:, 7 * n:10 * n].reshape(K, n, 3)
     w = Y[:, 10 * n:13 * n].reshape(K, n, 3)
+    gravity_power = (v @ g) @ mass  # (K,) Σ m g · v
+    V = -(x @ g) @ mass + energy[:, 1]
+    dV = -gravity_power + energy[:, 2]
+    P_loads = energy[:, 0] - gravity_power + energy[:, 2]
     Jw_dot = (J[None] @ acc6[..., 3:, None])[..., 0]
     dT = (mass * (v * acc6[..., :3]).sum(axis=2)).sum(axis=1) + (w * Jw_dot).sum(axis=(1, 2))
     dE = dT + dV

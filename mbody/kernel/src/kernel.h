@@ -223,12 +223,16 @@ enum { MB_KR_STEP = 0, MB_KR_NEWTON = 1, MB_KR_WORST = 2, MB_KR_SINGULAR = 3,
  * sample's; out: the last sample's) is carried from the previous sample by a Taylor step,
  * moved onto every enforced joint and driver by Newton steps (mb_project, at most
  * max_newton, until the largest step is at most tol), stored in Y (K x state size) and
- * solved (mb_solve, lam: the known values) into OUT (K x mb_solve's out length). Returns
+ * solved (mb_solve, lam: the known values) into OUT (K x mb_solve's out length), with
+ * (when ENERGY is not NULL) K x 3 energy terms: the applied loads' power Q . v (gravity
+ * and springs included), the springs' elastic energy and its rate. Returns
  * K, or the index of the sample where the loops did not close (a step above tol after
- * max_newton steps, a value not a number, or a motion without mass: info[MB_KR_SINGULAR]);
+ * max_newton steps, a value not a number, or a motion without mass: info[MB_KR_SINGULAR];
+ * -1 there: no memory for the scratch);
  * info (MB_KR_INFO) <- slots MB_KR_*. */
 int64_t mb_kinematic_run(const mb_model *md, const mb_unknowns *u, mb_work *w,
                          const double *t, int64_t K, double *y, const double *lam,
-                         int max_newton, double tol, double *Y, double *OUT, double *info);
+                         int max_newton, double tol, double *Y, double *OUT, double *ENERGY,
+                         double *info);
 
 #endif

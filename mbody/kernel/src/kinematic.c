@@ -3,6 +3,7 @@
  * with the reactions and drivers' efforts that take them (kinetostatics), without
  * integrating anything. A fully driven mechanism's motion is this; the same run follows
  * any mechanism's drivers while it holds the rest of its coordinates where they are. */
+#include <stdlib.h>
 #include <string.h>
 
 #include "internal.h"
@@ -47,14 +48,49 @@ static void predict(const mb_model *md, double *y, const double *acc, double dt)
     }
 }
 
+/* ENERGY's three values at y (after the solve): the applied loads' power Q . v (gravity
+ * and springs included; Q at the mass centres, moments in body axes with w), the springs'
+ * elastic energy sum k (L - L0)^2 / 2 and its rate sum k (L - L0) L'. */
+static void energy_terms(const mb_model *md, mb_work *w, double t, const double *y,
+                         double *Q, double *b, double *sp, double *e) {
+    int64_t n = md->n, s = md->s;
+    const double *v = y + 7 * n, *om = y + 10 * n;
+    mb_wrench_parts(md, w, t, y, Q, b);
+    double power = 0.0;
+    for (int64_t i = 0; i < n; i++)
+        for (int a = 0; a < 3; a++)
+            power += Q[6 * i + a] * v[3 * i + a] + Q[6 * i + 3 + a] * om[3 * i + a];
+    double V = 0.0, dV = 0.0;
+    if (s > 0) {
+        mb_springs(md, w, t, y, sp);
+        for (int64_t j = 0; j < s; j++) {
+            const double *row = md->springs + MB_SPRING_W * j;
+            double stretch = sp[6 * j] - row[S_REST];
+            V += 0.5 * row[S_STIFF] * stretch * stretch;
+            dV += row[S_STIFF] * stretch * sp[6 * j + 1];
+        }
+    }
+    e[0] = power, e[1] = V, e[2] = dV;
+}
+
 int64_t mb_kinematic_run(const mb_model *md, const mb_unknowns *u, mb_work *w,
                          const double *t, int64_t K, double *y, const double *lam,
-                         int max_newton, double tol, double *Y, double *OUT, double *info) {
+                         int max_newton, double tol, double *Y, double *OUT, double *ENERGY,
+                         double *info) {
     int64_t S = MB_STATE_SIZE(md->n, md->planar);
     int64_t L = (md->planar ? 3 : 6) * md->n + 3 * md->m + MB_INFO;
     double pr[MB_PROJECT_INFO];
     info[MB_KR_STEP] = 0.0, info[MB_KR_NEWTON] = 0.0, info[MB_KR_SINGULAR] = 0.0;
     info[MB_KR_WORST] = 0.0;
+    double *scratch = NULL;
+    if (ENERGY != NULL) {
+        scratch = malloc(sizeof(double) * (size_t)(12 * md->n + 6 * md->s + 1));
+        if (scratch == NULL) {
+            info[MB_KR_SINGULAR] = -1.0;
+            return 0;
+        }
+    }
+    int64_t done = K;
     for (int64_t k = 0; k < K; k++) {
         if (k > 0) predict(md, y, OUT + (k - 1) * L, t[k] - t[k - 1]);
         int it = 0;
@@ -63,19 +99,28 @@ int64_t mb_kinematic_run(const mb_model *md, const mb_unknowns *u, mb_work *w,
             mb_project(md, u, w, t[k], y, 1, 1e-2, 0, pr);
             if (pr[MB_PR_SINGULAR] != 0.0) {
                 info[MB_KR_SINGULAR] = pr[MB_PR_SINGULAR];
-                return k;
+                done = k;
+                break;
             }
             step = pr[MB_PR_STEP];
             if (!(step > tol)) break; /* also a step that is not a number: checked below */
         }
+        if (done < K) break;
         info[MB_KR_NEWTON] += (double)(it + 1);
         info[MB_KR_WORST] = fmax(info[MB_KR_WORST], (double)(it + 1));
         info[MB_KR_STEP] = step;
         int finite = 1;
         for (int64_t i = 0; i < S; i++) finite &= isfinite(y[i]);
-        if (it == max_newton || !finite) return k;
+        if (it == max_newton || !finite) {
+            done = k;
+            break;
+        }
         memcpy(Y + k * S, y, sizeof(double) * S);
         mb_solve(md, u, w, t[k], y, lam, OUT + k * L);
+        if (ENERGY != NULL)
+            energy_terms(md, w, t[k], y, scratch, scratch + 6 * md->n, scratch + 12 * md->n,
+                         ENERGY + 3 * k);
     }
-    return K;
+    free(scratch);
+    return done;
 }

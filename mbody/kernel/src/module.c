@@ -553,18 +553,19 @@ static PyObject *Unknowns_project(UnknownsObject *self, PyObject *const *args,
 }
 
 PyDoc_STRVAR(kinematic_run_doc,
-"kinematic_run(t, y, lam, max_newton, tol, Y, OUT, info) -> int\n\nA kinematic run "
-"(kernel.h: mb_kinematic_run): at each time of t (K, increasing),\ny carried forward, moved "
-"onto every joint and driver by Newton steps (at most\nmax_newton, until a step is at most "
-"tol), stored in Y (K x state_size) and solved\ninto OUT (K x solve_layout's length). "
-"Returns K, or the index of the sample where\nthe loops did not close; info (KR_INFO) <- "
+"kinematic_run(t, y, lam, max_newton, tol, Y, OUT, ENERGY, info) -> int\n\nA kinematic "
+"run (kernel.h: mb_kinematic_run): at each time of t (K, increasing),\ny carried forward, "
+"moved onto every joint and driver by Newton steps (at most\nmax_newton, until a step is at "
+"most tol), stored in Y (K x state_size), solved\ninto OUT (K x solve_layout's length) and "
+"its energy terms into ENERGY (K x 3:\nQ . v, the springs' elastic energy, its rate). "
+"Returns K, or the index of the\nsample where the loops did not close; info (KR_INFO) <- "
 "slots KR_*.");
 
 static PyObject *Unknowns_kinematic_run(UnknownsObject *self, PyObject *const *args,
                                         Py_ssize_t nargs) {
-    Py_buffer t, y, lam, Y, OUT, info;
+    Py_buffer t, y, lam, Y, OUT, E, info;
     double tol;
-    if (unknowns_ready(self) < 0 || check_nargs(nargs, 8, "kinematic_run") < 0 ||
+    if (unknowns_ready(self) < 0 || check_nargs(nargs, 9, "kinematic_run") < 0 ||
         get_double(args[4], &tol, "tol") < 0)
         return NULL;
     long max_newton = PyLong_AsLong(args[3]);
@@ -583,7 +584,8 @@ static PyObject *Unknowns_kinematic_run(UnknownsObject *self, PyObject *const *a
     if (get_buffer(args[2], &lam, 0, 1, md->m, "lam") < 0) goto y_;
     if (get_buffer(args[5], &Y, 1, 1, K * S, "Y") < 0) goto lam_;
     if (get_buffer(args[6], &OUT, 1, 1, K * L, "OUT") < 0) goto Y_;
-    if (get_buffer(args[7], &info, 1, 1, MB_KR_INFO, "info") < 0) goto OUT_;
+    if (get_buffer(args[7], &E, 1, 1, K * 3, "ENERGY") < 0) goto OUT_;
+    if (get_buffer(args[8], &info, 1, 1, MB_KR_INFO, "info") < 0) goto E_;
     const double *tt = t.buf;
     for (Py_ssize_t k = 1; k < K; k++)
         if (!(tt[k] > tt[k - 1])) {
@@ -592,10 +594,15 @@ static PyObject *Unknowns_kinematic_run(UnknownsObject *self, PyObject *const *a
         }
     /* the GIL is kept: the work buffers are the object's own (as every method's) */
     int64_t done = mb_kinematic_run(md, &self->u, self->w, tt, K, y.buf, lam.buf,
-                                    (int)max_newton, tol, Y.buf, OUT.buf, info.buf);
-    result = PyLong_FromLongLong((long long)done);
+                                    (int)max_newton, tol, Y.buf, OUT.buf, E.buf, info.buf);
+    if (((double *)info.buf)[MB_KR_SINGULAR] < 0.0)
+        PyErr_NoMemory();
+    else
+        result = PyLong_FromLongLong((long long)done);
 info_:
     PyBuffer_Release(&info);
+E_:
+    PyBuffer_Release(&E);
 OUT_:
     PyBuffer_Release(&OUT);
 Y_:
