@@ -20,6 +20,7 @@ work per body or per component.
 from __future__ import annotations
 
 from collections.abc import Mapping
+from typing import NamedTuple
 
 import numpy as np
 
@@ -60,38 +61,53 @@ def constrained_dynamics(model: Model, known: Mapping[str, float] | None = None,
     return ConstrainedDynamics(known, rate)
 
 
+class SampleFigures(NamedTuple):
+    """A run's figures at its K output samples (`sample_figures`)."""
+
+    reactions: np.ndarray | None
+    """(K, m) every reaction value (N; N m), or None when not asked for."""
+    lengths: np.ndarray | None
+    """(K, s) each spring's length (m), or None when not asked for."""
+    position_drift: float
+    """Largest |φ| (m for forces, rad for moments; a driven component: φ − f)."""
+    velocity_drift: float
+    """Largest |Gᵀ v| (a driven component: Gᵀ v − f′)."""
+
+
+def sample_figures(model: Model, unknowns: Unknowns, t: np.ndarray, Y: np.ndarray, *,
+                   reactions: bool = True, lengths: bool = False) -> SampleFigures:
+    """The figures of the sampled states Y (K, state size: the core's layout) at the times
+    t (K,), in one call of the compiled core: every reaction value (the components of
+    `unknowns` solved with the exact γ, the others at their given values, those varying
+    in t at t), the springs' lengths, and the joints' largest drift over every reaction
+    component."""
+    ws = workspace(model)
+    core = ws.core
+    K = len(t)
+    Y = np.ascontiguousarray(Y, dtype=float)
+    lam_out = np.empty((K, int(core.m))) if reactions else None
+    len_out = np.empty((K, int(core.s))) if lengths else None
+    drift = np.zeros(2)
+    _core.samples(ws.solver(unknowns), np.ascontiguousarray(unknowns.lam, dtype=float),
+                  np.ascontiguousarray(t, dtype=float), Y, lam_out, len_out, drift)
+    return SampleFigures(lam_out, len_out, float(drift[0]), float(drift[1]))
+
+
 def reactions_at(model: Model, unknowns: Unknowns, t: np.ndarray, Y: np.ndarray
                  ) -> np.ndarray:
-    """(K, m) every reaction value at the sampled states: Y (K, state size) in the core's
-    layout at the times t (K,); the components of `unknowns` solved with the exact γ, the
-    others at their given values (those varying in t at t)."""
-    solver = workspace(model).solver(unknowns)
-    n, m = model.n, len(unknowns.mask)
-    N, at, _ = _core.solve_layout(n, m, model.dimension == 2)
-    out = np.empty(N + 3 * m + _core.INFO)
-    lam = np.ascontiguousarray(unknowns.lam, dtype=float)
-    result = np.empty((len(t), m))
-    for k in range(len(t)):  # one call of the core per sample
-        solver.solve(float(t[k]), Y[k], lam, out)
-        result[k] = out[at:at + m]
-    return result
+    """(K, m) every reaction value at the sampled states (`sample_figures`)."""
+    out = sample_figures(model, unknowns, t, Y).reactions
+    assert out is not None
+    return out
 
 
 def drift_at(model: Model, t: np.ndarray, Y: np.ndarray) -> dict[str, float]:
     """Largest joint position error |φ| (m for forces, rad for moments) and velocity error
     |Gᵀ v| (a driven component: φ − f and Gᵀ v − f′) over the sampled states Y (K, state
     size) at the times t, every reaction component counted."""
-    core = workspace(model).core
-    m = int(core.m)
-    if not m:
-        return {"joint_position_drift": 0.0, "joint_velocity_drift": 0.0}
-    six, three = np.empty((2, m, 6)), np.empty((2, m, 3))
-    gamma, phi, gtv = np.empty(m), np.empty((len(t), m)), np.empty((len(t), m))
-    for k in range(len(t)):  # one call of the core per sample
-        core.columns(float(t[k]), Y[k], six[0], six[1], three[0], three[1], gamma, phi[k],
-                     gtv[k])
-    return {"joint_position_drift": float(np.max(np.abs(phi))),
-            "joint_velocity_drift": float(np.max(np.abs(gtv)))}
+    f = sample_figures(model, workspace(model).file_unknowns, t, Y, reactions=False)
+    return {"joint_position_drift": f.position_drift,
+            "joint_velocity_drift": f.velocity_drift}
 
 
 def pack_states(model: Model, states: list[State]) -> tuple[np.ndarray, np.ndarray]:

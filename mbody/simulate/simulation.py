@@ -40,7 +40,7 @@ from mbody.equations.workspace import workspace
 from mbody.errors import MbodyError, UnknownReactionsError, did_you_mean
 from mbody.model.expressions import Expression, check_times, compile_expression, first_nonfinite
 from mbody.model.model import Model, State
-from mbody.simulate.mechanism import BAUMGARTE_RATE, drift_at, reactions_at
+from mbody.simulate.mechanism import BAUMGARTE_RATE, sample_figures
 from mbody.simulate.projection import STAGE_PIVOT_RTOL, JointProjection
 from mbody.simulate.stepping import CORE, IMPLICIT, start
 from mbody.simulate.trajectory import Trajectory
@@ -250,7 +250,7 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
                 limit = min(limit, max(1, max_steps - steps))
             k, msg = run.advance(min(rate.next, t_end), limit, t_eval, k, Y)
             steps = run.steps
-            if run.status == "failed" or not np.all(np.isfinite(run.y)):
+            if run.status == "failed" or not math.isfinite(float(run.y.sum())):
                 culprit = _blame_expression(varying, run.t, run.t, run.step_size)
                 raise MbodyError(
                     f"the integration stopped at t = {run.t:.6g} s: "
@@ -297,13 +297,18 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
 
     labels = tuple(model.reactions)
     joint_info: dict = {}
+    lengths = None
     if mechanism:
         assert rhs.unknowns is not None
-        lam = reactions_at(run_model, rhs.unknowns, t_eval, Y)
+        figures = sample_figures(run_model, rhs.unknowns, t_eval, Y,
+                                 lengths=bool(len(model.springs.names)))
+        lam, lengths = figures.reactions, figures.lengths
         held = (PROJECTION_TEXT if projecting else
                 f"Baumgarte, alpha = beta = {BAUMGARTE_RATE:g} 1/s (scipy's integrators "
                 "keep their own history of the state, which a projection would break)")
-        joint_info = {"joint_stabilisation": held, **drift_at(run_model, t_eval, Y),
+        joint_info = {"joint_stabilisation": held,
+                      "joint_position_drift": figures.position_drift,
+                      "joint_velocity_drift": figures.velocity_drift,
                       "initial_joint_errors": joint_errors(model, s0),
                       "projection_evaluations": run.refreshed}
     elif dynamics is None and labels:
@@ -330,7 +335,7 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
         colors=tuple(model.bodies[b].color for b in model.body_names),
         gravity=np.array(model.gravity), model_yaml=_model_text(model))
     series, drift = _drift(run_model, traj, dynamics is None, ideal_joints=mechanism,
-                           samples=(t_eval, Y))
+                           lengths=lengths)
     traj.series.update(series)
     info.update(drift)
     info["warnings"] = [w for w in (rate.warning(), _spin_warning(traj)) if w]
@@ -617,36 +622,31 @@ def with_known(model: Model, known: Mapping[str, float | str] | None) -> Model:
 
 def _model_text(model: Model) -> str:
     """The model file's text, when the model came from a readable file."""
-    p = Path(model.file) if model.file and not model.file.startswith("<") else None
-    try:
-        return p.read_text(encoding="utf-8") if p is not None and p.is_file() else ""
+    if not model.file or model.file.startswith("<"):
+        return ""
+    try:  # a folder or a vanished file: OSError; a pipe is never a model's file
+        return Path(model.file).read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError):
         return ""
 
 
-def potential_energy(model: Model, traj: Trajectory,
-                     samples: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
+def potential_energy(model: Model, traj: Trajectory, lengths: np.ndarray | None = None
+                     ) -> np.ndarray:
     """V = −Σ m g·x + Σ ½ k (L − L0)²: (K,) gravity and spring potential, J; the springs'
-    lengths L from the compiled core (`samples`: the run's (t, Y) in the core's layout,
-    else packed from `traj`)."""
+    lengths L (K, s) as given, else from the compiled core at the trajectory's samples."""
     x, q, _, _ = traj.spatial()
-    V = -np.einsum("kni,i,n->k", x, model.gravity, model.mass)
+    V = -((x @ model.gravity) @ model.mass)
     sp = model.springs
     if len(sp.names):
-        core = workspace(model).core
-        if samples is None:
+        if lengths is None:
+            ws = workspace(model)
             K, n = len(traj.t), model.n
-            Y = np.zeros((K, int(core.state_size)))
+            Y = np.zeros((K, ws.state_size))
             Y[:, :3 * n] = x.reshape(K, -1)
             Y[:, 3 * n:7 * n] = q.reshape(K, -1)
-            samples = (traj.t, Y)
-        t, Y = samples
-        out = np.empty((len(sp.names), 6))
-        L = np.empty((len(t), len(sp.names)))
-        for k in range(len(t)):  # one call of the core per sample
-            core.springs(float(t[k]), Y[k], out)
-            L[k] = out[:, 0]
-        V = V + 0.5 * np.sum(sp.stiffness * (L - sp.rest_length) ** 2, axis=1)
+            lengths = sample_figures(model, ws.file_unknowns, traj.t, Y, reactions=False,
+                                     lengths=True).lengths
+        V = V + 0.5 * np.sum(sp.stiffness * (lengths - sp.rest_length) ** 2, axis=1)
     return V
 
 
@@ -656,8 +656,7 @@ def _has_unknown_reactions(model: Model, known: Mapping[str, float | str] | None
 
 
 def _drift(model: Model, traj: Trajectory, default_dynamics: bool, *,
-           ideal_joints: bool = False,
-           samples: tuple[np.ndarray, np.ndarray] | None = None
+           ideal_joints: bool = False, lengths: np.ndarray | None = None
            ) -> tuple[dict[str, np.ndarray], dict]:
     """Energy and angular-momentum series and their largest relative change.
 
@@ -667,7 +666,7 @@ def _drift(model: Model, traj: Trajectory, default_dynamics: bool, *,
     Σ W_R_B J ω (gravity has no moment about a mass centre); else it is not conserved.
     """
     T = traj.kinetic_energy()
-    V = potential_energy(model, traj, samples)
+    V = potential_energy(model, traj, lengths)
     E = T + V
     scale = max(abs(E[0]), float(np.max(np.abs(T))) if len(T) else 0.0)
     e_change = float(np.max(np.abs(E - E[0])) / scale) if scale > 0 else 0.0

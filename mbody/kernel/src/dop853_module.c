@@ -444,6 +444,53 @@ static PyObject *py_sampled(PyObject *self, PyObject *args) {
     return out;
 }
 
+static PyObject *py_samples(PyObject *self, PyObject *args) {
+    PyObject *unknowns, *lam, *times, *states, *reactions, *lengths, *drift;
+    if (!PyArg_ParseTuple(args, "OOOOOOO", &unknowns, &lam, &times, &states, &reactions,
+                          &lengths, &drift))
+        return NULL;
+    const mb_model *md;
+    const mb_unknowns *u;
+    mb_work *w;
+    if (!mb_unknowns_object(unknowns, &md, &u, &w)) {
+        PyErr_SetString(PyExc_TypeError, "unknowns: an initialised _core.Unknowns is needed");
+        return NULL;
+    }
+    Py_buffer bl, bt, by, br, bs, bd;
+    int have_r = 0, have_s = 0, ok = 0;
+    if (get_doubles(lam, &bl, 0, md->m, "lam") < 0) return NULL;
+    if (get_doubles(times, &bt, 0, -1, "t") < 0) goto lam_;
+    const int64_t K = (int64_t)(bt.len / 8), size = MB_STATE_SIZE(md->n, md->planar);
+    if (get_doubles(states, &by, 0, K * size, "Y") < 0) goto t_;
+    if (reactions != Py_None) {
+        if (get_doubles(reactions, &br, 1, K * md->m, "reactions") < 0) goto y_;
+        have_r = 1;
+    }
+    if (lengths != Py_None) {
+        if (get_doubles(lengths, &bs, 1, K * md->s, "lengths") < 0) goto r_;
+        have_s = 1;
+    }
+    if (get_doubles(drift, &bd, 1, 2, "drift") < 0) goto s_;
+    if (mb_samples(md, u, w, bl.buf, K, bt.buf, by.buf, size, have_r ? br.buf : NULL,
+                   have_s ? bs.buf : NULL, bd.buf) < 0)
+        PyErr_NoMemory();
+    else
+        ok = 1;
+    PyBuffer_Release(&bd);
+s_:
+    if (have_s) PyBuffer_Release(&bs);
+r_:
+    if (have_r) PyBuffer_Release(&br);
+y_:
+    PyBuffer_Release(&by);
+t_:
+    PyBuffer_Release(&bt);
+lam_:
+    PyBuffer_Release(&bl);
+    if (!ok) return NULL;
+    Py_RETURN_NONE;
+}
+
 static PyObject *py_system(PyObject *self, PyObject *args) {
     int s;
     double t;
@@ -516,6 +563,11 @@ static PyMethodDef dop853_methods[] = {
      "work) -> (status, k): steps as dop853_run, and after each step out's rows k, k + 1, "
      "... (len(t_eval) x n) <- the dense output at the sample times the step reached, each "
      "moved by project when project_samples; k: the first row not yet written."},
+    {"samples", py_samples, METH_VARARGS,
+     "samples(unknowns, lam, t, Y, reactions, lengths, drift): a run's figures at its K "
+     "output samples (Y: K rows of the packed state at the times t): reactions (K x m, or "
+     "None) <- every reaction value, the unknowns' solved; lengths (K x s, or None) <- the "
+     "springs' lengths; drift (2) <- the largest |phi| and |G^T v - f'|."},
     {"dop853_system", py_system, METH_VARARGS,
      "dop853_system(number, params, t, y, ydot): a built-in test system's y'."},
     {"dop853_tableau", py_tableau, METH_NOARGS,

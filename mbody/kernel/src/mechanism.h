@@ -54,4 +54,14 @@ int mb_mechanism_stage(void *ctx, double t, double *y);
  * rounding noise amplified by the small singular values. */
 int mb_mechanism_tangent(void *ctx, double t, const double *y, double *e);
 
+/* A run's figures at its K output samples, in one pass: the states are the rows of Y
+ * (`stride` doubles apart, MB_STATE_SIZE or 13 n used) at the times t. With reactions
+ * (K x m) not NULL: every reaction value (mb_solve: the unknown components solved with
+ * the exact gamma, the others at lam, those varying in t at t); with lengths (K x s) not
+ * NULL: each spring's length; drift[2] <- the largest |phi| and |G^T v - f'| over every
+ * component and sample. Returns 0, or -1 out of memory. */
+int mb_samples(const mb_model *md, const mb_unknowns *u, mb_work *w, const double *lam,
+               int64_t K, const double *t, const double *Y, int64_t stride,
+               double *reactions, double *lengths, double *drift);
+
 #endif
