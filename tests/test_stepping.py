@@ -208,3 +208,57 @@ loads:
             core.loads_at(t, out)
             np.testing.assert_allclose(out, model.forces.vector_at(t), rtol=1e-15, atol=0,
                                        equal_nan=True)
+
+
+PIN = {
+    "model": "pin", "dimension": 3, "gravity": [0, -9.81, 0],
+    "bodies": [{"name": "rod", "mass": 1.2, "inertia": [0.01, 0.1, 0.1],
+                "position": [0.5, 0, 0]}],
+    "joints": [{"name": "O", "type": "revolute", "parent": "ground", "child": "rod",
+                "at": [0, 0, 0], "axis": [0, 0, 1]}],
+}
+
+
+def test_a_driven_joint_is_followed_by_the_run():
+    """A time-dependent constraint (a law f(t) on the pin's turn, as drivers will add):
+    the run in C with its projection follows it with nothing else added. The rod,
+    released at rest while the law asks for f'(0) = 1 rad/s, is projected onto the law
+    at t = 0 (Gᵀ v = f'), then turns as f(t) = 0.5 sin 2t: its angle, rate and mass
+    centre are the closed form's at every sample, φ − f and Gᵀ v − f' at rounding."""
+    from mbody.equations.pack import Component, pack_model, pack_unknowns
+    from mbody.kernel import _core
+    from mbody.model.expressions import compile_expression
+    from mbody.simulate.projection import ITERATIONS, STAGE_ITERATIONS
+    from mbody.simulate.stepping import REFRESH_ATOL
+
+    model = mbody.load(PIN)
+    law = tuple(compile_expression(e) for e in ("0.5*sin(2*t)", "cos(2*t)", "-2*sin(2*t)"))
+    extra = (Component(0, _core.KIND_TURN, 2, law=law),)
+    core = _core.Model(*pack_model(model, extra), False)
+    m = core.m
+    U = np.arange(m)  # the pin's five components and the driven turn
+    solver = _core.Unknowns(core, pack_unknowns(model, U, extra))
+    y0 = initial_state(model)
+    info = np.empty(_core.PROJECT_INFO)
+    solver.project(0.0, y0, ITERATIONS, STAGE_PIVOT_RTOL, False, info)
+    assert y0[12] == pytest.approx(1.0, abs=1e-12)  # ω_z = f'(0)
+    params = np.zeros(_core.MECH_PARAMS + m)
+    params[_core.MECH_ROBUST] = STAGE_PIVOT_RTOL
+    params[_core.MECH_ITERS], params[_core.MECH_STAGE_ITERS] = ITERATIONS, STAGE_ITERATIONS
+    run = DOP853(solver, 0.0, y0, 3.0, rtol=1e-10, atol=1e-12, params=params, project=True,
+                 stage=True, tangent=True, refresh=REFRESH_ATOL)
+    t = np.arange(61) / 20.0
+    Y = np.empty((len(t), len(y0)))
+    Y[0], k = y0, 1
+    while run.status == "running":
+        k = run.sampled(3.0, 200, t, k, Y, project_samples=True)
+    assert run.status == "finished" and k == len(t)
+    f = 0.5 * np.sin(2 * t)
+    angle = 2 * np.arctan2(Y[:, 6], Y[:, 3])  # about z: q = [cos f/2, 0, 0, sin f/2]
+    np.testing.assert_allclose(angle, f, atol=1e-9)
+    np.testing.assert_allclose(Y[:, 12], np.cos(2 * t), atol=1e-9)
+    np.testing.assert_allclose(Y[:, :2], 0.5 * np.stack((np.cos(f), np.sin(f)), axis=1),
+                               atol=1e-9)
+    drift = np.zeros(2)
+    _core.samples(solver, np.zeros(m), t, Y, None, None, drift)
+    assert drift[0] <= 1e-13 and drift[1] <= 1e-12
