@@ -20,7 +20,6 @@ from randmodels import planar_model, spatial_model
 
 import mbody
 from mbody.equations import plan as planmod
-from mbody.simulate import state_derivative
 
 pytest.importorskip("numba")
 MODELS = sorted((Path(__file__).resolve().parent.parent / "models").glob("*.yaml"))
@@ -176,43 +175,6 @@ def packed(model: mbody.Model, state: mbody.State) -> np.ndarray:
                            state.velocity.ravel(), state.omega.ravel(), theta))
 
 
-@pytest.mark.parametrize("seed", range(8))
-@pytest.mark.parametrize("kind", ["planar", "spatial"])
-@pytest.mark.parametrize("known", ["none", "some", "all"])
-def test_state_derivative_equal(jit, seed, kind, known):
-    """The simulation right-hand side, Baumgarte terms (φ, Gᵀ v) included."""
-    model = random_model(kind, seed, known)
-    state = random_state(model, seed)
-    y = packed(model, state)
-    y[len(y) // 3] *= 1.01  # a quaternion off unit norm: both paths normalise it
-    jit("off")
-    f = state_derivative(model)
-    assert not f.compiled
-    a = f(0.3, y)
-    jit("on")
-    g = state_derivative(model)
-    assert g.compiled
-    b = g(0.3, y)
-    jit("off")
-    sol = mbody.assemble(model, state).solve()
-    object.__setattr__(sol, "condition", condition(model, state) if sol.solved else 1.0)
-    assert rel(a, b) <= tolerance(sol)
-
-
-def test_closed_loops_simulate_alike(jit):
-    """A planar four-bar over 0.5 s: the two paths' trajectories agree to the
-    integrator's tolerance (the same equations, rounded differently)."""
-    model = mbody.load(MODELS[0].parent / "fourbar_planar.yaml")
-    jit("off")
-    a = mbody.simulate(model, t_end=0.5, fps=20)
-    jit("on")
-    b = mbody.simulate(model, t_end=0.5, fps=20)
-    assert a.info["evaluation_path"] == "numpy" and b.info["evaluation_path"] == "compiled"
-    np.testing.assert_allclose(a.position, b.position, atol=1e-8)
-    np.testing.assert_allclose(a.reactions, b.reactions, rtol=1e-6,
-                               atol=1e-6 * np.abs(a.reactions).max())
-
-
 def test_auto_mode_compiles_only_repeated_work(jit):
     """In automatic mode a one-off solve takes the numpy path (no numba import for the
     command line), repeated ones the compiled path."""
@@ -223,7 +185,6 @@ def test_auto_mode_compiles_only_repeated_work(jit):
     for _ in range(planmod.JIT_AFTER):
         last = mbody.assemble(model).solve()
     assert last.method.endswith("(compiled)")
-    assert state_derivative(mbody.load(MODELS[0].parent / "pendulum.yaml")).compiled
 
 
 def test_without_numba_the_numpy_path_serves(jit, monkeypatch):
@@ -232,4 +193,3 @@ def test_without_numba_the_numpy_path_serves(jit, monkeypatch):
     model = mbody.load(MODELS[0].parent / "pendulum.yaml")
     sol = mbody.assemble(model).solve()
     assert "compiled" not in sol.method
-    assert not state_derivative(model).compiled
