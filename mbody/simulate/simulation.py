@@ -301,6 +301,7 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
         assert rhs.unknowns is not None
         figures = sample_figures(run_model, rhs.unknowns, t_eval, Y,
                                  lengths=bool(len(model.springs.names)))
+        assert figures.reactions is not None
         lam, lengths = figures.reactions, figures.lengths
         held = (PROJECTION_TEXT if projecting else
                 f"Baumgarte, alpha = beta = {BAUMGARTE_RATE:g} 1/s (scipy's integrators "
