@@ -269,19 +269,21 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
                     raise MbodyError(_budget_message(
                         f"the step budget: {steps} steps (--max-steps {max_steps})",
                         run.t, t_end, steps, rate, f"at that rate the whole run needs "
-                        f"about {steps * t_end / run.t:.2g} steps", "raise --max-steps"))
+                        f"about {steps * t_end / run.t:.2g} steps" if run.t > 0 else
+                        "the steps do not advance the time", "raise --max-steps"))
                 if max_wall is not None:
                     now = time.perf_counter()
                     if first is None:  # the pace is timed from here: no start-up costs
                         first = (run.t, now)
                     if now - wall > max_wall:
                         pace = ((now - first[1]) / (run.t - first[0]) if run.t > first[0]
-                                else (now - wall) / run.t)
+                                else (now - wall) / run.t if run.t > 0 else math.inf)
                         raise MbodyError(_budget_message(
                             f"the wall-time budget: {now - wall:.3g} s (--max-wall "
                             f"{max_wall:g})", run.t, t_end, steps, rate,
                             f"at that pace the rest of the run takes about "
-                            f"{pace * (t_end - run.t):.2g} s more", "raise --max-wall"))
+                            f"{pace * (t_end - run.t):.2g} s more" if math.isfinite(pace)
+                            else "no simulated time has passed yet", "raise --max-wall"))
     finally:
         bar.close()
     wall = time.perf_counter() - wall
@@ -527,6 +529,8 @@ class _StepRate:
 
     def so_far(self, t: float, steps: int) -> str:
         """'N steps per simulated second so far (M over the first T s)'."""
+        if t <= 0:
+            return f"{steps} steps without simulated time passing"
         text = f"{steps / t:.4g} steps per simulated second so far"
         if self.start is not None:
             text += f" ({self.start[1]:.4g} over the first {self.start[0]:.3g} s"
