@@ -148,7 +148,7 @@ class DOP853:
         return self._row(_core.DOP_W_F)
 
     @property
-    def y_old(self) -> np.ndarray:
+    def y_start(self) -> np.ndarray:
         """y at the start of the last step."""
         return self._row(_core.DOP_W_Y_OLD)
 
@@ -157,12 +157,12 @@ class DOP853:
         return float(self.state[_core.DOP_T])
 
     @property
-    def t_old(self) -> float:
+    def step_start(self) -> float:
         """Start of the last accepted step."""
         return float(self.state[_core.DOP_T_OLD])
 
     @property
-    def h_abs(self) -> float:
+    def next_step(self) -> float:
         """The next step's size, as proposed."""
         return float(self.state[_core.DOP_H])
 
