@@ -691,6 +691,19 @@ static PyTypeObject UnknownsType = {
     .tp_new = PyType_GenericNew,
 };
 
+/* For the integrator's module (dop853_module.c): the model, unknowns and scratch of an
+ * initialised Unknowns object (1), or 0 when obj is not one. */
+int mb_unknowns_object(PyObject *obj, const mb_model **md, const mb_unknowns **u,
+                       mb_work **w) {
+    if (!PyObject_TypeCheck(obj, &UnknownsType)) return 0;
+    UnknownsObject *self = (UnknownsObject *)obj;
+    if (self->w == NULL) return 0;
+    *md = &self->model->md;
+    *u = &self->u;
+    *w = self->w;
+    return 1;
+}
+
 /* -- module -------------------------------------------------------------------------- */
 
 PyDoc_STRVAR(solve_layout_doc,
