@@ -128,3 +128,20 @@ def test_plot_of_a_driven_run_against_the_crank_angle_and_time(tmp_path):
     p = mbody("plot", run, "-o", tmp_path / "d.png", "--against", "motr")
     assert p.returncode == 2 and "did you mean 'motor'" in p.stderr
     assert not (tmp_path / "d.png").exists()
+
+
+def test_simulate_on_driven_models(tmp_path):
+    """Fully driven: simulate is the kinematic run (no integrator); partly driven: the
+    integrated run's summary has the drivers' peaks and energy check, and its plot is
+    the drivers' figure."""
+    p = mbody("simulate", "models/slider_crank_driven.yaml", "--t-end", "0.1")
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.startswith("kinematic run of 'slider-crank-driven'")
+    run = tmp_path / "fly.npz"
+    p = mbody("simulate", "models/flyball_governor.yaml", "--t-end", "1", "-o", run)
+    assert p.returncode == 0, p.stderr
+    assert "integrator DOP853" in p.stdout and "motor.M" in p.stdout
+    assert "energy T + V: not conserved here (drivers do work: motor)" in p.stdout
+    assert "energy check: the drivers' power" in p.stdout
+    p = mbody("plot", run, "-o", tmp_path / "fly.png")
+    assert p.returncode == 0 and (tmp_path / "fly.png").stat().st_size > 10_000

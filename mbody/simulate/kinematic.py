@@ -66,6 +66,12 @@ def freedom(model: Model) -> int:
     return len(model.coordinates) - int(solver.generic_rank)
 
 
+def fully_driven(model: Model) -> bool:
+    """The model has drivers and they leave it no freedom (`freedom` is 0)."""
+    d = model.drivers
+    return d is not None and len(d.names) > 0 and freedom(model) == 0
+
+
 def kinematic_run(model: Model, t_end: float, fps: float, *, t_start: float = 0.0,
                   points: BodyPoints | None = None, axes: str = "joint") -> Trajectory:
     """The motion the drivers impose over [t_start, t_end], sampled at `fps`, with the
@@ -196,6 +202,31 @@ def _trajectory(model: Model, t: np.ndarray, Y: np.ndarray, OUT: np.ndarray,
     run_info["peaks"] = peaks(model, traj)
     run_info["warnings"] = []
     return traj
+
+
+def driven_figures(model: Model, traj: Trajectory, Y: np.ndarray, lam: np.ndarray,
+                   unknowns) -> None:
+    """What a run of a model with drivers adds to `traj` (integrated by `mbody.simulate`:
+    a partly driven mechanism): each driver's coordinate, its facts, the energy check
+    (`energy_balance`, the accelerations and energy terms at the samples from one call of
+    the core) and the peaks. `Y` (K, state size) the samples, `lam` (K, m) the reactions."""
+    ws = workspace(model)
+    t = traj.t
+    K, n = len(t), model.n
+    plan = ws.solve_plan(unknowns)
+    acc = np.empty((K, plan.N))
+    energy = np.empty((K, 3))
+    plan.solver.energy_samples(t, np.ascontiguousarray(Y), unknowns.lam, acc, energy)
+    acc6 = np.zeros((K, n, 6))
+    acc6[..., [0, 1, 5] if model.dimension == cv.PLANAR else slice(None)] = \
+        acc.reshape(K, n, -1)
+    traj.series.update(driver_series(model, t))
+    traj.info["drivers"] = driver_facts(model)
+    series, balance = energy_balance(model, traj, Y, acc6, lam, energy)
+    for key in ("driver_power", "driver_work", "load_power", "load_work"):
+        traj.series[key] = series[key]
+    traj.info.update({k: v for k, v in balance.items() if k != "energy_initial"})
+    traj.info["peaks"] = peaks(model, traj)
 
 
 def driver_series(model: Model, t: np.ndarray) -> dict[str, np.ndarray]:
@@ -386,6 +417,16 @@ def summary(traj: Trajectory, path: str | None = None) -> str:
     if i.get("redundant"):
         lines.append(f"warning: {i['redundant']} redundant constraint(s): the reactions they "
                      "share are the minimum-norm ones")
+    lines += driven_lines(traj)
+    if path:
+        lines.append(f"saved {path}")
+    return "\n".join(lines)
+
+
+def driven_lines(traj: Trajectory) -> list[str]:
+    """The peaks table and the energy check of a run with drivers (none without)."""
+    i = traj.info
+    lines: list[str] = []
     peaks = i.get("peaks") or []
     if peaks:
         drv = peaks[0].get("driver")
@@ -400,6 +441,8 @@ def summary(traj: Trajectory, path: str | None = None) -> str:
         widths = [max(len(r[c]) for r in rows) for c in range(len(rows[0]))]
         lines += ["  " + "  ".join(c.ljust(w) for c, w in zip(r, widths, strict=True)).rstrip()
                   for r in rows]
+    if "driver_work" not in i:
+        return lines
     work = max(abs(i["driver_work"]), abs(i["load_work"]), abs(i["energy_change"]))
     lines.append(f"energy check: the drivers' power plus the applied loads' equals "
                  f"d(T + V)/dt at every sample to {i['power_balance_residual']:.1e} of the "
@@ -409,9 +452,7 @@ def summary(traj: Trajectory, path: str | None = None) -> str:
                  f"{_shown(i['energy_change'], work)} J to "
                  f"{i['energy_balance_residual']:.1e} "
                  "(Simpson's rule over the samples)")
-    if path:
-        lines.append(f"saved {path}")
-    return "\n".join(lines)
+    return lines
 
 
 def _shown(x: float, scale: float) -> str:

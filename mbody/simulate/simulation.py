@@ -39,6 +39,8 @@ from mbody.equations.workspace import workspace
 from mbody.errors import MbodyError, UnknownReactionsError, did_you_mean
 from mbody.model.expressions import Expression, check_times, compile_expression, first_nonfinite
 from mbody.model.model import Model, State
+from mbody.simulate.kinematic import driven_figures, driven_lines, fully_driven, kinematic_run
+from mbody.simulate.kinematic import summary as kinematic_summary
 from mbody.simulate.mechanism import BAUMGARTE_RATE, sample_figures
 from mbody.simulate.projection import STAGE_PIVOT_RTOL, JointProjection
 from mbody.simulate.stepping import CORE, IMPLICIT, start
@@ -209,6 +211,10 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
         raise MbodyError(f"{K} output samples requested (t_end * fps); at most 10 million")
     varying = _varying_expressions(model, known)
     _check_span(varying, t_end)
+    if dynamics is None and initial is None and fully_driven(model):
+        # the drivers fix the motion: each sample's kinematics then its reactions, no
+        # integration (mbody.simulate.kinematic)
+        return kinematic_run(with_known(model, known), t_end, fps)
     rhs = state_derivative(model, known, dynamics)
     run_model = rhs.model  # the model with `known`'s values in its known reactions
     mechanism = dynamics is None and _has_unknown_reactions(run_model, None)
@@ -339,6 +345,9 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
                            lengths=lengths)  # run_model: `known` is among its reactions
     traj.series.update(series)
     info.update(drift)
+    if mechanism and run_model.drivers is not None and len(run_model.drivers.names):
+        assert rhs.unknowns is not None
+        driven_figures(run_model, traj, Y, lam, rhs.unknowns)
     info["warnings"] = [w for w in (rate.warning(), _spin_warning(traj)) if w]
     return traj
 
@@ -808,8 +817,12 @@ def conserved_lines(info: Mapping) -> list[tuple[str, str]]:
 
 
 def summary(traj: Trajectory, path: str | os.PathLike[str] | None = None) -> str:
-    """The run in a few lines: integrator, cost, and drift of the conserved quantities."""
+    """The run in a few lines: integrator, cost, and drift of the conserved quantities;
+    a run with drivers adds their peaks and energy check; a kinematic run (a fully driven
+    mechanism) has its own (`mbody.simulate.kinematic.summary`)."""
     i = traj.info
+    if i.get("kinematic"):
+        return kinematic_summary(traj, None if path is None else str(path))
     lines = [
         f"simulated {traj.model_name!r}: {traj.n} bod{'y' if traj.n == 1 else 'ies'}, "
         f"t = 0 .. {i['t_end']:g} s, {i['samples']} samples at {i['fps']:g} fps",
@@ -842,6 +855,7 @@ def summary(traj: Trajectory, path: str | os.PathLike[str] | None = None) -> str
     if traj.dimension == cv.SPATIAL:
         lines.append(f"quaternion norm error before renormalising: "
                      f"{i['quaternion_norm_error']:.1e}")
+    lines.extend(driven_lines(traj))
     lines.extend(f"warning: {w}" for w in i.get("warnings", ()))
     if path is not None:
         lines.append(f"wrote {path}")

@@ -235,4 +235,13 @@ int64_t mb_kinematic_run(const mb_model *md, const mb_unknowns *u, mb_work *w,
                          int max_newton, double tol, double *Y, double *OUT, double *ENERGY,
                          double *info);
 
+/* The accelerations (ACC, K x mb_solve's N: the model's coordinates) and the energy terms
+ * (ENERGY, K x 3, as mb_kinematic_run's) of K sampled states, the rows of Y (stride
+ * apart), with the unknown reactions solved (lam: the known values): the drivers' energy
+ * check of an integrated run. Returns 0, the first singular-mass status met, or -1 (no
+ * memory for the scratch). */
+int mb_energy_samples(const mb_model *md, const mb_unknowns *u, mb_work *w,
+                      const double *lam, int64_t K, const double *t, const double *Y,
+                      int64_t stride, double *ACC, double *ENERGY);
+
 #endif

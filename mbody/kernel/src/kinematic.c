@@ -124,3 +124,25 @@ int64_t mb_kinematic_run(const mb_model *md, const mb_unknowns *u, mb_work *w,
     free(scratch);
     return done;
 }
+
+int mb_energy_samples(const mb_model *md, const mb_unknowns *u, mb_work *w,
+                      const double *lam, int64_t K, const double *t, const double *Y,
+                      int64_t stride, double *ACC, double *ENERGY) {
+    int64_t n = md->n, N = (md->planar ? 3 : 6) * n;
+    int64_t L = N + 3 * md->m + MB_INFO;
+    double *buf = malloc(sizeof(double) * (size_t)(L + 12 * n + 6 * md->s + 1));
+    if (buf == NULL) return -1;
+    double *out = buf, *scratch = buf + L;
+    int status = 0;
+    for (int64_t k = 0; k < K; k++) {
+        const double *y = Y + k * stride;
+        mb_solve(md, u, w, t[k], y, lam, out);
+        if (out[N + 3 * md->m + MB_ST_SINGULAR] != 0.0 && status == 0)
+            status = (int)out[N + 3 * md->m + MB_ST_SINGULAR];
+        memcpy(ACC + k * N, out, sizeof(double) * N);
+        energy_terms(md, w, t[k], y, scratch, scratch + 6 * n, scratch + 12 * n,
+                     ENERGY + 3 * k);
+    }
+    free(buf);
+    return status;
+}

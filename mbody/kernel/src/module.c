@@ -616,6 +616,44 @@ t_:
     return result;
 }
 
+PyDoc_STRVAR(energy_samples_doc,
+"energy_samples(t, Y, lam, ACC, ENERGY) -> int\n\nAt each of the K sampled states (the "
+"rows of Y, K x state_size) at the times t:\nthe accelerations with the unknown reactions "
+"solved into ACC (K x N, the model's\ncoordinates) and ENERGY (K x 3): Q . v, the springs' "
+"elastic energy, its rate\n(kernel.h: mb_energy_samples). Returns 0 or the first "
+"singular-mass status.");
+
+static PyObject *Unknowns_energy_samples(UnknownsObject *self, PyObject *const *args,
+                                         Py_ssize_t nargs) {
+    Py_buffer t, Y, lam, A, E;
+    if (unknowns_ready(self) < 0 || check_nargs(nargs, 5, "energy_samples") < 0) return NULL;
+    const mb_model *md = &self->model->md;
+    Py_ssize_t S = MB_STATE_SIZE(md->n, md->planar), N = (md->planar ? 3 : 6) * md->n;
+    PyObject *result = NULL;
+    if (get_buffer(args[0], &t, 0, 1, -1, "t") < 0) return NULL;
+    Py_ssize_t K = t.len / 8;
+    if (get_buffer(args[1], &Y, 0, 1, K * S, "Y") < 0) goto t_;
+    if (get_buffer(args[2], &lam, 0, 1, md->m, "lam") < 0) goto Y_;
+    if (get_buffer(args[3], &A, 1, 1, K * N, "ACC") < 0) goto lam_;
+    if (get_buffer(args[4], &E, 1, 1, K * 3, "ENERGY") < 0) goto A_;
+    int status = mb_energy_samples(md, &self->u, self->w, lam.buf, K, t.buf, Y.buf, S,
+                                   A.buf, E.buf);
+    if (status < 0)
+        PyErr_NoMemory();
+    else
+        result = PyLong_FromLong(status);
+    PyBuffer_Release(&E);
+A_:
+    PyBuffer_Release(&A);
+lam_:
+    PyBuffer_Release(&lam);
+Y_:
+    PyBuffer_Release(&Y);
+t_:
+    PyBuffer_Release(&t);
+    return result;
+}
+
 PyDoc_STRVAR(schur_doc,
 "schur(t, y, S_out)\n\nS_out (mu x mu) <- S = G_U^T M^-1 G_U at (t, y), dense, in the "
 "unknowns' order (for a\ncondition estimate).");
@@ -669,6 +707,8 @@ static PyMethodDef Unknowns_methods[] = {
     {"project", (PyCFunction)(void (*)(void))Unknowns_project, METH_FASTCALL, project_doc},
     {"kinematic_run", (PyCFunction)(void (*)(void))Unknowns_kinematic_run, METH_FASTCALL,
      kinematic_run_doc},
+    {"energy_samples", (PyCFunction)(void (*)(void))Unknowns_energy_samples, METH_FASTCALL,
+     energy_samples_doc},
     {"schur", (PyCFunction)(void (*)(void))Unknowns_schur, METH_FASTCALL, schur_doc},
     {NULL, NULL, 0, NULL},
 };
