@@ -435,7 +435,9 @@ def driven_lines(traj: Trajectory) -> list[str]:
         lines.append(f"peaks over the run (largest magnitude; {axes}"
                      + (f"; {drv}'s coordinate at that time" if drv else "") + "):")
         big = max(abs(p["value"]) for p in peaks)
-        rows = [[p["label"], f"{_shown(p['value'], big)} {p['unit']}", f"t = {p['t']:.6g} s"]
+        rows = [[p["label"], f"0 {p['unit']}", "throughout"] + ([""] if drv else [])
+                if _shown(p["value"], big) == "0" else
+                [p["label"], f"{p['value']:.6g} {p['unit']}", f"t = {p['t']:.6g} s"]
                 + ([f"{drv} = {p['driver_value']:.6g} {p['driver_unit']}"] if drv else [])
                 for p in peaks]
         widths = [max(len(r[c]) for r in rows) for c in range(len(rows[0]))]
