@@ -355,7 +355,7 @@ def test_a_kinematic_run_of_the_driven_slider_crank_equals_the_hand_solution():
     assert np.abs(traj.series["load_power"]).max() < 1e-13 * power
     # τ ω = d(T + V)/dt at every sample, from the solved accelerations: to rounding
     assert info["power_balance_residual"] < 1e-12
-    # the work over the run by Simpson's rule: one sample a degree leaves an error of
+    # the work over the run by cubic quadrature (error O(h^4)): one sample a degree leaves
     # about (4 ω h)^4 / 180 = 1.3e-7 of it (the torque's fourth harmonic, h = 1 deg)
     fine = kinematic_run(model, period * 359 / 360, 360 / period)
     assert fine.info["energy_balance_residual"] < 1e-6
