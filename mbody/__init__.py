@@ -25,7 +25,7 @@ __version__ = "0.2.0"
 """The one version string (pyproject.toml reads it from here)."""
 
 _LAZY = {
-    "animate": "present.animate",
+    "animate": "present.animate", "draw_fbd": "drawing",
     "Assembly": "equations.assemble", "Solution": "equations.assemble",
     "assemble": "equations.assemble",
     "ExportedAssembly": "io.export", "load_export": "io.export",
@@ -46,7 +46,7 @@ __all__ = [
     "FreeBodyDiagram", "load_export",
     "Issue", "Joint", "Load", "MbodyError", "Model", "ModelError", "Solution", "State",
     "Trajectory", "simulate",
-    "UnknownReactionsError", "animate", "assemble", "equilibrium", "kinematic_run",
+    "UnknownReactionsError", "animate", "assemble", "draw_fbd", "equilibrium", "kinematic_run",
     "kinematics", "load",
     "loads", "verify",
 ]

@@ -17,19 +17,22 @@ from types import ModuleType
 MOVED = {
     "loader": "model.loader", "validate": "model.validate", "expr": "model.expressions",
     "graph": "model.graph",
-    "spatial": "equations.spatial", "loads": "equations.loads", "joints": "equations.joints",
+    "spatial": "util.spatial", "equations.spatial": "util.spatial",
+    "loads": "equations.loads", "joints": "equations.joints",
     "constraints": "equations.constraints", "fbd": "equations.fbd",
     "assemble": "equations.assemble", "dynamics": "solve.dynamics",
     "mechanism": "simulate.mechanism", "projection": "simulate.projection",
     "stepping": "simulate.stepping", "trajectory": "simulate.trajectory",
     "text": "present.text", "latex": "present.latex", "draw": "present.draw",
     "report": "present.report", "plot": "present.plot", "animate": "present.animate",
-    "export": "io.export", "atomic": "io.atomic",
+    "export": "io.export", "atomic": "util.atomic", "io.atomic": "util.atomic",
+    "io.jsontext": "util.jsontext",
     "commands": "cli.common", "commands.animate": "cli.animate", "commands.core": "cli.core",
     "commands.draw": "cli.draw", "commands.export": "cli.export",
     "commands.mechanism": "cli.mechanism", "commands.sim": "cli.sim",
 }
-"""Old path under mbody -> new path under mbody (release 0.2; the aliases go in 0.3).
+"""Old path under mbody -> new path under mbody (release 0.2, and the shared utilities'
+move to `mbody.util` in 0.3; the aliases go in 0.4).
 ``mbody.model`` and ``mbody.simulate`` are packages now that export the old modules'
 public names; ``mbody.cli.main`` is still the command's entry point. The numeric modules
 that the compiled core replaced (``kernels``, ``plan``, ``blockplan``, ``kkt``,

@@ -1,5 +1,6 @@
-"""`mbody.load` and `mbody.loads`: a model file read and validated (`mbody.model`), then,
-when the file asks for it, its bodies moved onto their joints and drivers at t = 0
+"""`mbody.load` and `mbody.loads`: a model file read and validated (`mbody.model` for
+mbody YAML, `mbody.io.interop` for MJCF and URDF), then, when the file asks for it, its
+bodies moved onto their joints and drivers at t = 0
 (`mbody.solve.kinematics.assembled`): joint points given on each body, or drivers. The
 file's own state is kept as ``model.file_state``; `mbody check` says how far each body
 moved."""
@@ -19,18 +20,43 @@ def load(source: str | os.PathLike[str] | dict, *, max_bytes: int | None = None,
          format: str | None = None, **options: Any) -> Model:
     """Read, validate and build a model, at its assembled pose.
 
-    Parameters, errors: those of `mbody.model.model.load` (a file path or a dict;
-    ``max_bytes``, ``format`` and the state options of MJCF and URDF imports), and
-    `mbody.solve.kinematics.KinematicsError` when the joints and drivers cannot all close
-    at t = 0.
+    Parameters
+    ----------
+    source : str, os.PathLike or dict
+        A path to a model file: mbody YAML, MJCF (``.xml``) or URDF (``.urdf``); or a
+        dict with a YAML file's content (for scripts).
+    max_bytes : int, optional
+        The largest file read (default `mbody.model.loader.MAX_BYTES`, 32 MiB, or the
+        command line's ``--max-bytes``); a larger file is refused before it is read.
+    format : {"yaml", "mjcf", "urdf"}, optional
+        The file's format, when its extension does not say it.
+    **options
+        The state of an imported model: ``keyframe="name"`` (MJCF; default its
+        reference pose at rest), ``joint_positions={...}``, ``joint_velocities={...}``
+        and ``floating_base=True`` (URDF; default every joint at 0, the root fixed).
+        See `mbody.io.interop.read_document`.
 
     Returns
     -------
     Model
         Its `initial` state is the file's, or, for a file with joint points per body or
         drivers, the nearest state where every joint and driver holds.
+
+    Raises
+    ------
+    mbody.ModelError
+        Listing every problem, each with its file, line and column.
+    mbody.solve.kinematics.KinematicsError
+        The joints and drivers cannot all close at t = 0.
     """
-    return assembled(read_model(source, max_bytes=max_bytes, format=format, **options))
+    if not isinstance(source, dict) and (
+            format or options or str(source).lower().endswith((".xml", ".mjcf", ".urdf"))):
+        from mbody.io.interop import import_spec  # MJCF, URDF: defusedxml, only for them
+
+        spec = import_spec(source, format, max_bytes=max_bytes, **options)
+        if spec is not None:  # None: the format is mbody YAML after all
+            return assembled(Model.from_spec(spec))
+    return assembled(read_model(source, max_bytes=max_bytes))
 
 
 def loads(text: str, file: str = "<string>") -> Model:

@@ -35,7 +35,7 @@ from bricard_run import MODEL, energy, joint_errors, p3, rotation, run
 from scipy.spatial.transform import Rotation
 
 import mbody
-from mbody.model.graph import topology
+from mbody.equations.topology import topology
 
 FPS = 60.0
 T_END = 10.0

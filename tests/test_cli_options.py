@@ -18,7 +18,6 @@ import pytest
 
 from mbody.cli import build_parser, main
 from mbody.cli.common import MODEL_FORMATS, PICTURE_FORMATS
-from mbody.cli.sim import COMPILE_NOTICE
 
 ROOT = Path(__file__).resolve().parent.parent
 MODELS = ROOT / "models"
@@ -32,7 +31,7 @@ def run(capsys, *args) -> tuple[int, str, str]:
         code = exc.code
     out, err = capsys.readouterr()
     assert "Traceback" not in err
-    return code, out, err.replace(COMPILE_NOTICE + "\n", "")
+    return code, out, err
 
 
 def last_line(err: str) -> str:

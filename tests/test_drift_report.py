@@ -17,8 +17,8 @@ import pytest
 
 import mbody
 from mbody.cli import main
-from mbody.equations.spatial import quat_to_matrix
 from mbody.simulate.simulation import conservation, summary
+from mbody.util.spatial import quat_to_matrix
 
 MODELS = Path(__file__).resolve().parent.parent / "models"
 QUANTITIES = ("energy", "momentum", "angular_momentum")

@@ -306,7 +306,7 @@ def test_a_file_that_cannot_be_written_leaves_nothing(tmp_path, command, name, p
 def test_write_errors_from_python_are_model_free_messages(tmp_path, monkeypatch):
     import errno
 
-    from mbody.io.atomic import write_atomic
+    from mbody.util.atomic import write_atomic
 
     target = tmp_path / "x.txt"
     target.write_text("old")

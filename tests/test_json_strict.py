@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 from mbody.cli.app import main
-from mbody.io import jsontext
+from mbody.util import jsontext
 
 ROOT = Path(__file__).resolve().parent.parent
 MODELS = ROOT / "models"

@@ -15,7 +15,7 @@ import pytest
 import mbody
 from mbody import conventions as cv
 from mbody.cli import main as cli_main
-from mbody.model.graph import topology
+from mbody.equations.topology import topology
 
 MODELS = Path(__file__).resolve().parent.parent / "models"
 ALL = sorted(MODELS.glob("*.yaml"))

@@ -12,7 +12,7 @@ import pytest
 import yaml
 
 import mbody
-from mbody.equations.spatial import quat_to_matrix
+from mbody.util.spatial import quat_to_matrix
 
 G0 = 9.81
 

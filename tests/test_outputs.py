@@ -31,8 +31,7 @@ import pytest
 
 import mbody
 from mbody.cli import main
-from mbody.cli.sim import COMPILE_NOTICE
-from mbody.io import atomic
+from mbody.util import atomic
 
 ROOT = Path(__file__).resolve().parent.parent
 MODELS = ROOT / "models"
@@ -44,7 +43,7 @@ def run(capsys, *args) -> tuple[int, str, str]:
     code = main([str(a) for a in args])
     out, err = capsys.readouterr()
     assert "Traceback" not in err
-    return code, out, err.replace(COMPILE_NOTICE + "\n", "")
+    return code, out, err
 
 
 def cli(*args, **kw) -> subprocess.CompletedProcess:
@@ -285,7 +284,7 @@ def test_every_command_that_writes_has_force():
     writing = {name for name, p in sub.choices.items()
                if any(a.dest in ("output", "latex", "csv") for a in p._actions)}
     assert writing == {"simulate", "plot", "fbd", "graph", "report", "animate", "export",
-                       "assemble", "convert"}
+                       "assemble", "convert", "kinematics"}
     for name in writing:
         assert "--force" in sub.choices[name]._option_string_actions, name
 
@@ -365,7 +364,7 @@ def test_a_real_full_disk(small_disk, run_file, command, name):
     filler.write_bytes(b"x" * 40_000)  # leaves about 24 kB
     argv = [run_file if c == "{run}" else c for c in command] + [small_disk / name]
     p = cli(*argv)
-    err = p.stderr.decode().replace(COMPILE_NOTICE + "\n", "")
+    err = p.stderr.decode()
     temporary = "folder" if name == "pictures" else "file"
     assert (p.returncode, err) == (2, f"mbody: error: cannot write "
                                    f"{str(small_disk / name)!r}: No space left on device; "

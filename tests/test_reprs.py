@@ -8,8 +8,8 @@ from pathlib import Path
 import pytest
 
 import mbody
+from mbody.equations.topology import topology
 from mbody.io.export import exported
-from mbody.model.graph import topology
 
 MODELS = sorted((Path(__file__).resolve().parents[1] / "models").glob("*.yaml"))
 
@@ -36,7 +36,7 @@ def test_trajectory_repr_is_short():
 
 NEXT = {  # what each repr suggests calling next
     "Solution": "sol[label]", "State": ".replace(", "Body": ".inertia",
-    "Joint": "reactions ", "BodyEquations": "print() it", "FreeBodyDiagram": ".draw()",
+    "Joint": "reactions ", "BodyEquations": "print() it", "FreeBodyDiagram": "draw_fbd(it)",
     "ForceOnBody": ".W_vector", "ConstraintJacobian": ".row(label)",
     "ReactionTable": ".labels", "JointTable": ".first", "ForceTable": ".vector_at(t)",
     "SpringTable": ".stiffness", "ReactionColumns": ".W_e", "AppliedLoads": ".W_F",

@@ -10,7 +10,7 @@ from scipy.special import ellipj, ellipkinc
 
 import mbody
 from mbody.cli import main
-from mbody.equations.spatial import quat_to_matrix
+from mbody.util.spatial import quat_to_matrix
 
 MODELS = Path(__file__).resolve().parent.parent / "models"
 

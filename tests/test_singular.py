@@ -164,7 +164,7 @@ def _ideal_steps(model, rtol: float, atol: float) -> int:
     own state layout and tolerances: what a solver that the crossings cost nothing takes."""
     import scipy.integrate
 
-    from mbody.equations.spatial import quaternion_rate
+    from mbody.util.spatial import quaternion_rate
 
     n = model.n
 

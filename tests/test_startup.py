@@ -114,7 +114,7 @@ with warnings.catch_warnings():  # the old flat paths, kept as aliases for one r
 assert mbody.cli.main(["check", MODEL]) == 0
 for n in ("animate", "assemble", "simulate", "loads"):
     assert callable(getattr(mbody, n)) and getattr(mbody, n) is names[n], n
-assert mbody.loads is mbody.model.loads
+assert mbody.loads is mbody.loading.loads  # the file read, then its pose assembled
 assert mbody.solve.dynamics.__name__ == "mbody.solve.dynamics"  # submodules on demand
 """.replace("MODEL", repr(str(PENDULUM)))
     assert loaded(code, NEVER_AT_IMPORT) == []
@@ -129,7 +129,7 @@ SEQUENCES = [a + b + c for a in "xyz" for b in "xyz" for c in "xyz" if a != b !=
 def test_euler_to_quat_is_scipys_to_the_bit(sequence: str):
     from scipy.spatial.transform import Rotation
 
-    from mbody.equations.spatial import euler_to_quat
+    from mbody.util.spatial import euler_to_quat
 
     rng = np.random.default_rng(sum(map(ord, sequence)))
     angles = np.vstack((rng.uniform(-7, 7, (200, 3)),
@@ -143,7 +143,7 @@ def test_euler_to_quat_is_scipys_to_the_bit(sequence: str):
 def test_matrix_to_quat_is_scipys_to_the_bit():
     from scipy.spatial.transform import Rotation
 
-    from mbody.equations.spatial import matrix_to_quat
+    from mbody.util.spatial import matrix_to_quat
 
     R = Rotation.random(3000, random_state=1).as_matrix()
     R[::7] = np.round(R[::7], 7)  # typed into a file: off orthogonal, so projected first
@@ -188,7 +188,7 @@ def test_pivoted_qr_is_scipys_without_ties():
     column norms tie (random matrices); the columns it keeps span A."""
     import scipy.linalg
 
-    from mbody.model.graph import pivoted_qr
+    from mbody.equations.topology import pivoted_qr
 
     rng = np.random.default_rng(3)
     for trial in range(400):
@@ -209,7 +209,7 @@ def test_pivoted_qr_is_scipys_without_ties():
 def test_pivoted_qr_breaks_ties_by_column_order():
     """Equal columns: the first is kept, the later ones are redundant, whatever rounding
     says (the spatial four-bar's closing pin carries its redundancy)."""
-    from mbody.model.graph import pivoted_qr, topology
+    from mbody.equations.topology import pivoted_qr, topology
 
     A = np.array([[1.0, 0.0, 1.0, 0.0], [0.0, 1.0, 0.0, 1.0], [0.0, 0.0, 0.0, 0.0]])
     d, piv = pivoted_qr(A)

@@ -65,7 +65,7 @@ def test_kinetic_energy_and_momentum_by_hand(run):
     v, w = traj.velocity[k, 0], traj.angular_velocity[k, 0]
     assert traj.kinetic_energy()[k] == pytest.approx(0.5 * m * v @ v + 0.5 * w @ J @ w,
                                                      rel=1e-14)
-    from mbody.equations.spatial import quat_to_matrix
+    from mbody.util.spatial import quat_to_matrix
 
     R = quat_to_matrix(traj.orientation[k, 0])
     H = np.cross(traj.position[k, 0], m * v) + R @ J @ w

@@ -70,7 +70,7 @@ def _unit_quats(rng: np.random.Generator, n: int) -> np.ndarray:
 
 
 def _quat_matrix(q: np.ndarray) -> np.ndarray:
-    from mbody.equations.spatial import quat_to_matrix
+    from mbody.util.spatial import quat_to_matrix
 
     return quat_to_matrix(q)
 
@@ -169,7 +169,7 @@ def mujoco_setup(model: Model, state: State):
     """
     import mujoco
 
-    from mbody.equations.spatial import quat_to_matrix
+    from mbody.util.spatial import quat_to_matrix
 
     g = " ".join(repr(float(x)) for x in model.gravity)
     # No geoms and contacts off: nothing but the free bodies' dynamics is computed.

@@ -16,11 +16,17 @@ function hides a dependency for nothing: it is listed, and the exit code is 1.
 ``--verbose`` lists every import made inside a function, with its reason.
 
 One upward import is allowed by design, a display hook: a notebook display method of an
-object (``_repr_html_``, ``_repr_latex_``, ``_repr_svg_``, ``__str__``) may import the
+object (``_repr_html_``, ``_repr_latex_``, ``_repr_svg_``, ``_repr_png_``) may import the
 presentation layer (`mbody.present`) that draws it. Such an edge is listed, and left out
 of the cycle search: the presentation layer imports the object's module, and the method
 runs only when the object is shown. Importing an mbody module by a string
 (``import_module("mbody...")``) hides the edge from this check, and is refused.
+
+The same holds between folders (`mbody.model`, `mbody.equations`...: the package's steps,
+docs/codebase.md): counting every import but the display hooks', the folders must form
+no cycle, so that they can be read and changed in one order. Modules directly in `mbody/`
+(the public entry points and `errors`, `conventions`) sit outside that order. The folders'
+order is printed with ``--verbose``.
 """
 
 from __future__ import annotations
@@ -42,7 +48,7 @@ SLOW = ("scipy", "matplotlib", "networkx", "meshcat", "numba", "tqdm", "sympy", 
 """Libraries that take tens to hundreds of milliseconds to import."""
 
 
-DISPLAY_HOOKS = ("_repr_html_", "_repr_latex_", "_repr_svg_", "_repr_png_", "__str__")
+DISPLAY_HOOKS = ("_repr_html_", "_repr_latex_", "_repr_svg_", "_repr_png_")
 """Methods that may import `mbody.present` (see the module's docstring)."""
 
 
@@ -193,10 +199,38 @@ def main(argv: list[str] | None = None) -> int:
         if a.verbose or why == "NEEDLESS":
             print(f"{modules[imp.source].relative_to(ROOT)}:{imp.line}: {imp.source} imports "
                   f"{imp.target} in a function: {why}")
+    folders = nx.DiGraph()
+    for imp in found:
+        src, dst = folder_of(imp.source, modules), folder_of(imp.target, modules)
+        if imp.display_hook or src is None or dst is None or src == dst:
+            continue
+        folders.add_edge(src, dst)
+        folders.edges[src, dst].setdefault("at", []).append(imp)
+    knots = [sorted(k) for k in nx.strongly_connected_components(folders) if len(k) > 1]
+    for knot in knots:
+        print("folder cycle: " + ", ".join(knot))
+        for src, dst in folders.subgraph(knot).edges:
+            imp = folders.edges[src, dst]["at"][0]
+            print(f"  {src} -> {dst}: {len(folders.edges[src, dst]['at'])} import(s), e.g. "
+                  f"{modules[imp.source].relative_to(ROOT)}:{imp.line} -> {imp.target}")
+    if a.verbose and not knots:  # importers after what they import
+        order = list(reversed(list(nx.topological_sort(folders))))
+        print("folders, each importing only from those before it: " + " -> ".join(order))
     print(f"{len(modules)} modules, {len(found)} imports between them "
           f"({len(late)} inside functions, {len(needless)} needless, {len(hidden)} by a "
-          f"string), {len(cycles)} cycle(s)")
-    return 1 if cycles or needless or hidden else 0
+          f"string), {len(cycles)} cycle(s); {folders.number_of_nodes()} folders, "
+          f"{len(knots)} folder cycle(s)")
+    return 1 if cycles or needless or hidden or knots else 0
+
+
+def folder_of(module: str, modules: dict[str, Path]) -> str | None:
+    """The folder (sub-package of mbody) a module lives in; None for a module directly in
+    mbody/ (outside the folders' order)."""
+    parts = module.split(".")
+    if len(parts) < 2:
+        return None
+    top = f"mbody.{parts[1]}"
+    return parts[1] if modules.get(top, Path()).name == "__init__.py" else None
 
 
 if __name__ == "__main__":

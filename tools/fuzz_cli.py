@@ -344,8 +344,8 @@ def warm_up(set_attr=setattr) -> dict[str, bytes]:
     import functools
 
     from mbody.cli import app
-    from mbody.io import atomic
     from mbody.model import loader
+    from mbody.util import atomic
 
     fuzz.warm_up()
     set_attr(atomic, "PIPE_WAIT", 0.05)

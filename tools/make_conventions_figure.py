@@ -22,7 +22,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.patches import FancyArrowPatch, Polygon  # noqa: E402
 
-from mbody.io.atomic import atomic_path  # noqa: E402
+from mbody.util.atomic import atomic_path  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 WORLD, BODY, JOINT, REACT, GRAV = "#555555", "#1f77b4", "#2ca02c", "#d62728", "#7f7f7f"

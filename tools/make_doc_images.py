@@ -15,7 +15,7 @@ import argparse
 from pathlib import Path
 
 import mbody
-from mbody.model.graph import topology
+from mbody.equations.topology import topology
 from mbody.present.draw import draw_graph, save_figure
 from mbody.present.plot import save_plot
 
@@ -36,7 +36,7 @@ def main(argv: list[str] | None = None) -> int:
     out = Path(a.output)
     for file, body, view, name in PICTURES:
         model = mbody.load(ROOT / "models" / file)
-        fig = mbody.assemble(model).bodies[body].fbd.draw(view=view)
+        fig = mbody.draw_fbd(mbody.assemble(model).bodies[body].fbd, view=view)
         print("wrote", save_figure(fig, out / name, dpi=a.dpi))
     run = mbody.kinematic_run(mbody.load(ROOT / "models" / "slider_crank_driven.yaml"),
                               0.1, 3600, axes="world")

@@ -24,7 +24,8 @@ from mbody.answers.rows import BodyRows, body_rows
 from mbody.answers.vocabulary import Vocabulary, vocabulary
 from mbody.equations.assemble import Assembly, assemble
 from mbody.errors import Issue, MbodyError, did_you_mean
-from mbody.model.model import Model, State, load
+from mbody.loading import load
+from mbody.model.model import Model, State
 
 TOLERANCE = 1e-3
 """Default relative tolerance on each coefficient: numbers written to about four

@@ -1,7 +1,8 @@
 """The `mbody` command: `app` parses the arguments and reports errors; one module per
 group of sub-commands (`core`: check, assemble, solve; `export`; `sim`: simulate, plot;
-`draw`: fbd, graph, report; `animate`; `mechanism`: jacobian), each with
-``register(subparsers)``; `common` holds what they share."""
+`drive`: kinematics; `statics`: equilibrium; `draw`: fbd, graph, report; `animate`;
+`mechanism`: jacobian; `verify`; `interop`: convert), each with ``register(subparsers)``;
+`common` holds what they share."""
 
 from mbody.cli.app import build_parser, main
 

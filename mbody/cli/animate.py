@@ -76,8 +76,8 @@ def _stop(signum: int, frame: FrameType | None) -> None:  # SIGTERM ends --live 
 
 
 def animate(a: argparse.Namespace) -> int:
-    from mbody.io.atomic import write_atomic
     from mbody.present.animate import LiveViewer, build_scene, page_html, resolve
+    from mbody.util.atomic import write_atomic
 
     if a.hold is not None and not a.live:
         raise MbodyError("--hold only applies with --live")
@@ -91,7 +91,7 @@ def animate(a: argparse.Namespace) -> int:
     source = Path(a.source)
     out = a.output or (None if a.live or not source.name else source.with_suffix(".html").name)
     if out:  # fail now, not after simulating
-        from mbody.io.atomic import ensure_writable
+        from mbody.util.atomic import ensure_writable
 
         refuse_overwriting_inputs([("-o", out)], [("the input", a.source)]
                                   + ([("the model", a.model)] if a.model else []), a.force)

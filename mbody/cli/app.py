@@ -7,7 +7,6 @@ Exit codes: 0 success; 1 the request cannot be met (e.g. reactions still unknown
 from __future__ import annotations
 
 import argparse
-import importlib
 import os
 import re
 import stat
@@ -16,6 +15,18 @@ import traceback
 from collections.abc import Sequence
 
 from mbody import __version__
+from mbody.cli import (
+    animate,
+    core,
+    draw,
+    drive,
+    export,
+    interop,
+    mechanism,
+    sim,
+    statics,
+    verify,
+)
 from mbody.cli.common import (
     EXIT_INPUT,
     EXIT_INTERNAL,
@@ -29,10 +40,11 @@ from mbody.cli.common import (
 from mbody.errors import MbodyError, ModelError, UnknownReactionsError, did_you_mean
 from mbody.model.loader import MAX_BYTES, max_bytes_limit
 
-COMMAND_MODULES = (
-    "core", "export", "sim", "drive", "draw", "animate", "mechanism", "statics", "verify",
-    "interop")
-"""Modules of `mbody.cli`; each has `register(subparsers)` adding its commands."""
+COMMAND_MODULES = (core, export, sim, drive, draw, animate, mechanism, statics, verify,
+                   interop)
+"""Modules of `mbody.cli`, in help order; each has `register(subparsers)` adding its
+commands (importing one loads only argparse: each command imports what it runs when it
+runs)."""
 
 def build_parser() -> argparse.ArgumentParser:
     p = _Parser(prog="mbody", description="Per-body Newton-Euler equations for multibody "
@@ -42,8 +54,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--version", action="version", version=f"mbody {__version__}")
     sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
-    for name in COMMAND_MODULES:
-        importlib.import_module(f"mbody.cli.{name}").register(sub)
+    for module in COMMAND_MODULES:
+        module.register(sub)
     for command in sub.choices.values():  # every command that reads a model file
         if any(a.dest in ("model", "source") for a in command._get_positional_actions()):
             command.add_argument(

@@ -106,7 +106,7 @@ def output_stream(*targets: str | None) -> TextIO:
     that the data written there is not mixed with text."""
     import sys
 
-    from mbody.io.atomic import is_standard_output
+    from mbody.util.atomic import is_standard_output
 
     if any(t is not None and t != "-" and is_standard_output(t) for t in targets):
         return sys.stderr

@@ -55,7 +55,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 def check(a: argparse.Namespace) -> int:
     from mbody.equations.assemble import assemble as _assemble
     from mbody.equations.constraints import joint_errors
-    from mbody.model.graph import topology
+    from mbody.equations.topology import topology
     from mbody.present.text import model_summary
 
     model = load_model(a.model, warn=False)  # the summary lists the warnings itself
@@ -97,7 +97,7 @@ def _symbolic(asm, a: argparse.Namespace) -> int:
     """`mbody assemble MODEL --symbolic [--body NAME] [--latex [FILE]]`."""
     from importlib.util import find_spec
 
-    from mbody.io.atomic import write_atomic
+    from mbody.util.atomic import write_atomic
 
     if find_spec("sympy") is None:
         raise MbodyError("--symbolic needs sympy; install it with: pip install "
@@ -121,8 +121,8 @@ def _symbolic(asm, a: argparse.Namespace) -> int:
 
 def solve(a: argparse.Namespace) -> int:
     from mbody.equations.assemble import assemble as _assemble
-    from mbody.io import jsontext
     from mbody.present.text import reaction_table_text, solution_text, world_reaction_text
+    from mbody.util import jsontext
 
     model = load_model(a.model)
     asm = _assemble(model)

@@ -84,8 +84,8 @@ def _file_name(body: str, taken: set[str]) -> str:
 
 def fbd(a: argparse.Namespace) -> int:
     from mbody.equations.assemble import assemble
-    from mbody.io.atomic import atomic_folder
     from mbody.present.draw import fbd_scene, parse_view, save_figure
+    from mbody.util.atomic import atomic_folder
 
     parse_view(a.view)  # a bad view is reported before any work
     out = Path(a.output)
@@ -115,7 +115,7 @@ def fbd(a: argparse.Namespace) -> int:
 
 def graph(a: argparse.Namespace) -> int:
     from mbody.equations.assemble import assemble
-    from mbody.model.graph import topology
+    from mbody.equations.topology import topology
     from mbody.present.draw import FORMATS, graph_scene, save_figure
 
     fmt = Path(a.output).suffix.lstrip(".").lower() if a.output else None

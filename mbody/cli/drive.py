@@ -77,8 +77,8 @@ def kinematics(a: argparse.Namespace) -> int:
     import sys
 
     from mbody.cli.sim import check_samples
-    from mbody.io import jsontext
     from mbody.simulate.kinematic import kinematic_run, revolution, summary
+    from mbody.util import jsontext
 
     points = parse_points(a.point)
     model = load_model(a.model)
@@ -89,7 +89,7 @@ def kinematics(a: argparse.Namespace) -> int:
         raise MbodyError(f"--t-end {t_end:g} is not after --t-start {a.t_start:g}")
     check_samples(t_end - a.t_start, fps)
     if a.output:  # fail now, not after the run
-        from mbody.io.atomic import ensure_writable
+        from mbody.util.atomic import ensure_writable
 
         ensure_writable(a.output)
     traj = kinematic_run(model, t_end, fps, t_start=a.t_start, points=points, axes=a.axes)

@@ -54,7 +54,6 @@ def register(sub: argparse._SubParsersAction) -> None:
 def export(a: argparse.Namespace) -> int:
     """`mbody export MODEL -o FILE... [--csv DIR]`: write the exports, print their sizes."""
     from mbody.equations.assemble import assemble
-    from mbody.io.atomic import atomic_folder, atomic_path
     from mbody.io.export import (
         SUFFIXES,
         assembly_from_trajectory,
@@ -62,6 +61,7 @@ def export(a: argparse.Namespace) -> int:
         write_csv,
         write_export,
     )
+    from mbody.util.atomic import atomic_folder, atomic_path
 
     if not a.output and not a.csv:
         raise MbodyError("nothing to write: give -o FILE (.npz, .mat or .json) and/or "
@@ -101,8 +101,8 @@ def export(a: argparse.Namespace) -> int:
 
 def latex(asm: Assembly, target: str, body: str | None = None) -> int:
     """`mbody assemble MODEL --latex [FILE]`: the LaTeX document to FILE (or stdout for -)."""
-    from mbody.io.atomic import write_atomic
     from mbody.present.latex import document
+    from mbody.util.atomic import write_atomic
 
     if body is not None and body not in asm.model.index:
         try:

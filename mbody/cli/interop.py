@@ -45,7 +45,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def convert(a: argparse.Namespace) -> int:
     """`mbody convert SOURCE -o OUTPUT`: read, convert, write atomically, say what."""
-    from mbody.io.atomic import ensure_writable
+    from mbody.util.atomic import ensure_writable
 
     _old_format_meaning(a)
     src_format = a.model_format or _format(a.source, "SOURCE", "--format",

@@ -28,7 +28,7 @@ def jacobian(a: argparse.Namespace) -> int:
     import numpy as np
 
     from mbody.equations.assemble import assemble
-    from mbody.io import jsontext
+    from mbody.util import jsontext
 
     model = load_model(a.model)
     J = assemble(model).jacobian()

@@ -111,7 +111,7 @@ def simulate(a: argparse.Namespace) -> int:
     check_samples(a.t_end, a.fps)
     model = load_model(a.model)
     if a.output:  # fail now, not after a long integration
-        from mbody.io.atomic import ensure_writable
+        from mbody.util.atomic import ensure_writable
 
         ensure_writable(a.output)
     known = parse_known(a.known)
@@ -137,9 +137,9 @@ def check_samples(t_end: float, fps: float, flags: str = "--t-end x --fps") -> N
 
 
 def plot(a: argparse.Namespace) -> int:
-    from mbody.io.atomic import ensure_writable
     from mbody.present.plot import save_plot
     from mbody.simulate.trajectory import Trajectory
+    from mbody.util.atomic import ensure_writable
 
     ensure_writable(a.output)  # before the figure is drawn (a second or two)
     regular_file(a.trajectory, "a run file written by 'mbody simulate -o RUN.npz'")

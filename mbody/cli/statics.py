@@ -28,9 +28,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 def equilibrium(a: argparse.Namespace) -> int:
 
     from mbody.equations.assemble import assemble
-    from mbody.io import jsontext
     from mbody.present.text import pose_text, reaction_table_text, world_reaction_text
     from mbody.solve.equilibrium import find_equilibrium
+    from mbody.util import jsontext
 
     model = load_model(a.model)
     found = find_equilibrium(model, t=a.t)

@@ -45,7 +45,7 @@ def _tolerance(text: str) -> float:
 
 def verify(a: argparse.Namespace) -> int:
     from mbody.answers.verify import verify as _verify
-    from mbody.io import jsontext
+    from mbody.util import jsontext
 
     regular_file(a.answers, "a YAML answers file")
     model = load_model(a.model)

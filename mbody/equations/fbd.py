@@ -16,6 +16,7 @@ import numpy as np
 
 from mbody import conventions as cv
 from mbody.conventions import APPLIED, GRAVITY, REACTION
+from mbody.equations.fbd_text import body_text
 from mbody.equations.joints import g_block
 from mbody.equations.symbolic import body_symbolic
 
@@ -138,33 +139,15 @@ class FreeBodyDiagram:
         """The reaction components of the body's joints, known or not."""
         return [f for f in self.forces if f.kind == REACTION]
 
-    def draw(self, **kwargs):
-        """A matplotlib figure of this diagram (see `mbody.present.draw.draw_fbd`).
-
-        Parameters
-        ----------
-        **kwargs
-            Passed to `mbody.present.draw.draw_fbd`: ``view``, ``equations``, ``width``,
-            ``title``.
-
-        Returns
-        -------
-        matplotlib.figure.Figure
-            The drawing (Agg canvas).
-        """
-        from mbody.present.draw import draw_fbd
-
-        return draw_fbd(self, **kwargs)
-
     def _repr_svg_(self) -> str:  # Jupyter shows a diagram as a picture
-        from mbody.present.draw import figure_svg
+        from mbody.present.draw import draw_fbd, figure_svg  # a display hook
 
-        return figure_svg(self.draw())
+        return figure_svg(draw_fbd(self))
 
     def __repr__(self) -> str:  # the dataclass's would print every force's arrays
         unknown = sum(f.unknown for f in self.forces)
         return (f"<FreeBodyDiagram of {self.body!r}: {len(self.applied)} applied, "
-                f"{len(self.reactions)} reaction ({unknown} unknown); .forces, .draw()>")
+                f"{len(self.reactions)} reaction ({unknown} unknown); .forces, mbody.draw_fbd(it)>")
 
 
 @dataclass(frozen=True)
@@ -272,9 +255,7 @@ class BodyEquations:
                 f"unknown{'' if unknown == 1 else 's'}; print() it, .fbd, .equations>")
 
     def __str__(self) -> str:  # the block `mbody assemble` prints
-        from mbody.present.rich import body_str  # a display hook (tools/check_imports.py)
-
-        return body_str(self)
+        return body_text(self, self.fbd.dimension)
 
     def _repr_html_(self) -> str:  # notebook display: diagram, forces table, the pair
         from mbody.present.rich import body_html  # a display hook (tools/check_imports.py)

@@ -24,8 +24,8 @@ import numpy as np
 
 from mbody import conventions as cv
 from mbody.equations.pack import pack_model, pack_unknowns
-from mbody.equations.spatial import quaternion_rate
 from mbody.kernel import _core
+from mbody.util.spatial import quaternion_rate
 
 if TYPE_CHECKING:
     from mbody.model.model import Model, State

@@ -14,13 +14,13 @@ import numpy as np
 
 from mbody import conventions as cv
 from mbody import joint_types
-from mbody.equations.spatial import joint_frame_planar, joint_frame_spatial, quat_to_matrix
 from mbody.joint_types.base import TILT, Component
 from mbody.model.drivers import DriverTable
 from mbody.model.expressions import ExpressionTable
 from mbody.model.records import Joint, Load, Records, field_names, record
 from mbody.model.tables import ForceTable, JointTable, ReactionTable, readonly
 from mbody.model.validate import JointSpecTable, LoadSpec, LoadTable
+from mbody.util.spatial import joint_frame_planar, joint_frame_spatial, quat_to_matrix
 
 if TYPE_CHECKING:
     from mbody.model.model import State

@@ -21,7 +21,6 @@ from typing import Any
 import numpy as np
 
 from mbody import conventions as cv
-from mbody.equations.spatial import quat_to_matrix
 from mbody.errors import Issue
 from mbody.model.build import joint_tables, located_loads, point_loads
 from mbody.model.drivers import DriverTable, driver_table
@@ -33,6 +32,7 @@ from mbody.model.records import Body, BodyRecords, Joint, Load, Records
 from mbody.model.reprs import count, name_list
 from mbody.model.tables import ForceTable, JointTable, ReactionTable, SpringTable, readonly
 from mbody.model.validate import JointSpecTable, Spec, validate
+from mbody.util.spatial import quat_to_matrix
 
 __all__ = ["Body", "BodyRecords", "ForceTable", "Joint", "JointTable", "Load", "Model",
            "ReactionTable", "Records", "SpringTable", "State", "count", "load", "loads"]
@@ -160,6 +160,9 @@ class Model:
         Known reaction values that vary in time (label -> expression of t).
     drivers : DriverTable, optional
         Joint coordinates prescribed as functions of time, whose efforts are unknowns.
+    file_state : State, optional
+        The state the file wrote, when `initial` is the assembled one (joint points per
+        body, or drivers); None when `initial` is the file's.
     """
 
     name: str
@@ -342,26 +345,20 @@ class Model:
         return model_html(self)
 
 
-def load(source: str | os.PathLike[str] | dict, *, max_bytes: int | None = None,
-         format: str | None = None, **options: Any) -> Model:
-    """Read, validate and build a model.
+def load(source: str | os.PathLike[str] | dict, *, max_bytes: int | None = None) -> Model:
+    """Read, validate and build a model from a YAML file or a dict, at the file's state
+    (`mbody.load` reads MJCF and URDF too, and moves a model whose file asks for it onto
+    its joints and drivers).
 
     Parameters
     ----------
     source : str, os.PathLike or dict
-        A path to a model file: YAML, MJCF (``.xml``) or URDF (``.urdf``); or a dict
-        with a YAML file's content (for scripts).
+        A path to an mbody YAML model file; or a dict with a YAML file's content (for
+        scripts).
     max_bytes : int, optional
         The largest file read (default `mbody.model.loader.MAX_BYTES`, 32 MiB, or the
         command line's ``--max-bytes``); a larger file is refused before it is read.
         Raise it for very large models (a 100 000-body file is about 80 MB).
-    format : {"yaml", "mjcf", "urdf"}, optional
-        The file's format, when its extension does not say it.
-    **options
-        The state of an imported model: ``keyframe="name"`` (MJCF; default its
-        reference pose at rest), ``joint_positions={...}``, ``joint_velocities={...}``
-        and ``floating_base=True`` (URDF; default every joint at 0, the root fixed).
-        See `mbody.io.interop.read_document`.
 
     Returns
     -------
@@ -374,12 +371,6 @@ def load(source: str | os.PathLike[str] | dict, *, max_bytes: int | None = None,
     """
     if isinstance(source, dict):
         return Model.from_spec(validate(Document(source, "<dict>")))
-    if format or options or str(source).lower().endswith((".xml", ".mjcf", ".urdf")):
-        from mbody.io.interop import import_spec  # MJCF, URDF: defusedxml, only for them
-
-        spec = import_spec(source, format, max_bytes=max_bytes, **options)
-        if spec is not None:
-            return Model.from_spec(spec)
     text = read_file(source, max_bytes)
     spec = fast_spec(text, str(source)) or validate(load_text(text, str(source)))
     del text  # before the arrays are built: the text is the largest thing held

@@ -21,7 +21,6 @@ import numpy as np
 
 from mbody import conventions as cv
 from mbody import joint_types
-from mbody.equations.spatial import euler_to_quat, matrix_to_quat, quat_to_matrix, shape_inertia
 from mbody.errors import Issue, ModelError, did_you_mean
 from mbody.model.checks import (
     _TOL,
@@ -48,6 +47,7 @@ from mbody.model.expressions import (
     first_nonfinite,
 )
 from mbody.model.loader import Document, Path_, Unrepresentable
+from mbody.util.spatial import euler_to_quat, matrix_to_quat, quat_to_matrix, shape_inertia
 
 TOP_KEYS = ("model", "dimension", "gravity", "bodies", "loads", "joints", "reactions",
             "drivers", "description")

@@ -24,9 +24,9 @@ from matplotlib.figure import Figure
 from mbody import conventions as cv
 from mbody import joint_types
 from mbody.errors import MbodyError
-from mbody.io.atomic import write_atomic
 from mbody.present.draw.fonts import drawable
 from mbody.simulate.trajectory import Trajectory
+from mbody.util.atomic import write_atomic
 
 MAX_BODIES = 6
 """Bodies drawn in the angular-velocity panel (the rest are summed in the others)."""

@@ -18,13 +18,13 @@ import numpy as np
 from mbody import __version__
 from mbody import conventions as cv
 from mbody.equations.assemble import Assembly, assemble
+from mbody.equations.topology import topology
 from mbody.errors import MbodyError
-from mbody.io.atomic import write_atomic
-from mbody.model.graph import topology
 from mbody.model.model import Model
 from mbody.present.answers import answers_section
 from mbody.present.draw import fbd_scene, figure_svg, graph_scene
 from mbody.present.text import body_text, model_summary
+from mbody.util.atomic import write_atomic
 
 if TYPE_CHECKING:
     from mbody.answers.verify import Verification

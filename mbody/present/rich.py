@@ -29,7 +29,7 @@ from mbody import conventions as cv
 from mbody import joint_types
 from mbody.conventions import REACTION
 from mbody.equations.assemble import assemble
-from mbody.model.graph import topology
+from mbody.equations.topology import topology
 from mbody.model.model import count
 from mbody.present import latex, text
 from mbody.present.animate import build_scene, page_html
@@ -176,20 +176,6 @@ def _load_row(ld: Any, dim: int) -> list[str]:
 
 
 # -- equations ---------------------------------------------------------------------------
-def body_str(eq: BodyEquations) -> str:
-    """The block ``mbody assemble`` prints for one body (`mbody.present.text.body_text`).
-
-    Parameters
-    ----------
-    eq : BodyEquations
-
-    Returns
-    -------
-    str
-    """
-    return text.body_text(eq, eq.fbd.dimension)
-
-
 def _body_parts(eq: BodyEquations, view: str = "iso") -> list[object]:
     from mbody.present.draw import fbd_scene  # matplotlib's fonts lay the labels out
 
@@ -237,7 +223,7 @@ def body_html(eq: BodyEquations, view: str = "iso") -> str:
         One ``div`` (well-formed XHTML).
     """
     return block(f"Body {eq.body!r}", *_body_parts(eq, view),
-                 note="print(it) for the text block; .fbd.draw() for a figure; "
+                 note="print(it) for the text block; mbody.draw_fbd(it.fbd) for a figure; "
                       ".equations for the rows")
 
 

@@ -6,34 +6,16 @@ import numpy as np
 
 from mbody import conventions as cv
 from mbody.equations.assemble import Assembly, Solution
-from mbody.equations.fbd import REACTION, BodyEquations, ForceOnBody
-from mbody.model.graph import Topology
+from mbody.equations.fbd_text import body_text, force_cells
+from mbody.equations.topology import Topology
 from mbody.model.model import Model, State
+from mbody.util.formatting import clean as _clean
+from mbody.util.formatting import num as _n
+from mbody.util.formatting import table as _table
+from mbody.util.formatting import vec as _v
 
-
-def _v(x: np.ndarray, dim: int) -> str:
-    x = np.asarray(x)[:2] if dim == cv.PLANAR else np.asarray(x)
-    return "(" + ", ".join(_n(v) for v in x) + ")"
-
-
-def _n(x: float) -> str:
-    x = 0.0 if abs(x) < 1e-12 else x  # rounding noise from rotations, e.g. -2.4e-17
-    s = f"{x:.6g}"
-    return "0" if s in ("-0", "0") else s
-
-
-def _table(header: list[str], rows: list[list[str]], indent: str = "  ") -> list[str]:
-    """Left-aligned columns, each as wide as its longest cell plus two spaces."""
-    widths = [max(len(r[c]) for r in [header, *rows]) for c in range(len(header))]
-    fmt = indent + "  ".join(f"{{:<{w}}}" for w in widths)
-    return [fmt.format(*r).rstrip() for r in [header, *rows]]
-
-
-def _clean(x: np.ndarray, rel: float = 1e-10) -> np.ndarray:
-    """Values below `rel` times the largest one printed as 0: rounding noise, not data."""
-    x = np.asarray(x, dtype=float)
-    top = float(np.max(np.abs(x), initial=0.0))
-    return np.where(np.abs(x) <= rel * top, 0.0, x)
+__all__ = ["assembly_text", "body_text", "force_cells", "graph_summary", "model_summary",
+           "pose_text", "reaction_table_text", "solution_text", "world_reaction_text"]
 
 
 def _plural(k: int, word: str) -> str:
@@ -199,71 +181,6 @@ def redundancy_warning(count: int, groups: list[tuple[str, ...]]) -> str:
     listed = "; ".join("{" + ", ".join(g) + "}" for g in groups)
     return (head + f"{len(groups)} indeterminacies (self-stresses, which load no body), "
             f"each shared by the reactions in braces: {listed}; their values are not unique")
-
-
-def force_cells(fo: ForceOnBody, dimension: int, minus: str = "-") -> list[str]:
-    """One free-body row as the picture draws it: name, point, components with unit,
-    moment about G.
-
-    A reaction on the joint's parent (-R) is named ``-A.Fx`` (with `minus`) and listed
-    with the unit vector and moment its arrow carries, along the +axis: the name times
-    the row is what the body's equations hold (``- A.Fx`` in Newton's rows). A known
-    reaction shows the value of what acts on this body (``-A.Fx = -98.1``) and the
-    actual force. A planar couple is a scalar about z.
-
-    Parameters
-    ----------
-    fo : ForceOnBody
-    dimension : int
-        2 (planar) or 3 (spatial).
-    minus : str
-        The minus of a parent-side name: ``-`` in text, ``−`` (U+2212) in HTML, as drawn.
-
-    Returns
-    -------
-    list of str
-        ``[name, point (body axes), components and unit (world axes), moment about G]``.
-    """
-    unit = "N m" if fo.couple else "N"
-    vec, mom = np.asarray(fo.W_vector, dtype=float), np.asarray(fo.B_moment, dtype=float)
-    name = fo.name
-    if fo.kind == REACTION:
-        name = fo.label if fo.side > 0 else minus + fo.label
-        if fo.value is None:  # per unit of what the name says: the arrow's +axis
-            vec, mom = fo.side * vec, fo.side * mom
-        else:
-            name += f" = {_n(fo.side * fo.value)}"
-    comp = _n(vec[2]) if fo.couple and dimension == cv.PLANAR else _v(vec, dimension)
-    if fo.unknown:
-        comp = "unit " + comp
-    point = "-" if fo.couple else _v(fo.B_r, dimension)
-    moment = _n(mom[2]) if dimension == cv.PLANAR else _v(mom, 3)
-    return [name, point, f"{comp} {unit}", moment]
-
-
-def body_text(eq: BodyEquations, dimension: int) -> str:
-    f = eq.fbd
-    out = [f"== {eq.body} ==  m {_n(f.mass)} kg, mass centre at {_v(f.W_position, dimension)} m"]
-    out.append("free body:")
-    rows = []
-    for fo in f.forces:
-        name, point, comp, mom = force_cells(fo, dimension)
-        label = "reaction" if fo.kind == REACTION else "couple" if fo.couple else fo.kind
-        rows.append([name, label, point, comp, mom])
-    if f.forces:
-        out += _table(["force", "kind", "point (body axes, m)", "components (world axes)",
-                       "moment about G" + (" (N m)" if dimension == cv.PLANAR
-                                           else " (body axes, N m)")], rows)
-    if not f.forces:
-        out.append("  (no forces)")
-    out.append("Newton (world axes):")
-    out += [f"  {e}" for e in eq.newton]
-    if not eq.euler:  # a particle: translation only
-        out.append("Euler: none (a particle has no rotation)")
-        return "\n".join(out)
-    out.append("Euler (about the mass centre, " + ("z):" if dimension == 2 else "body axes):"))
-    out += [f"  {e}" for e in eq.euler]
-    return "\n".join(out)
 
 
 def assembly_text(asm: Assembly, max_bodies: int = 200) -> str:

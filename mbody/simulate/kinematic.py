@@ -27,13 +27,15 @@ import numpy as np
 
 from mbody import conventions as cv
 from mbody.equations.assemble import singular_mass_error
+from mbody.equations.joints import reaction_columns
 from mbody.equations.workspace import workspace
 from mbody.equations.world import world_reaction_series
-from mbody.errors import MbodyError
+from mbody.errors import MbodyError, did_you_mean
 from mbody.kernel import _core
 from mbody.model.model import Model
 from mbody.simulate.trajectory import Trajectory, model_text
-from mbody.solve.kinematics import CLOSE_RTOL, KinematicsError, _cannot_close, _size
+from mbody.solve.kinematics import CLOSE_RTOL, KinematicsError, _cannot_close, _size, _state
+from mbody.util.spatial import quat_to_matrix
 
 MAX_NEWTON = 60
 """Newton steps at most at one sample (one or two from the previous sample's Taylor
@@ -139,9 +141,6 @@ def _failed(model: Model, t: float, y: np.ndarray, info: np.ndarray) -> None:
     if info[_core.KR_SINGULAR]:
         code = int(info[_core.KR_SINGULAR]) - 1
         raise singular_mass_error(model, code // 6, code % 6)
-    from mbody.equations.joints import reaction_columns
-    from mbody.solve.kinematics import _state
-
     if not np.isfinite(y).all():
         raise KinematicsError(f"the position analysis at t = {t:g} s diverged (a value is "
                               "not a number): a driver may be past a dead centre")
@@ -267,14 +266,10 @@ def _directions(model: Model, t: np.ndarray, Y: np.ndarray) -> np.ndarray:
 def _body_points(model: Model, x: np.ndarray, q: np.ndarray, points: BodyPoints | None
                  ) -> dict[str, np.ndarray]:
     """'point:<name>' -> (K, d) world positions of the named body points."""
-    from mbody.equations.spatial import quat_to_matrix
-
     out: dict[str, np.ndarray] = {}
     d = model.dimension
     for name, (body, p) in (points or {}).items():
         if body not in model.bodies:
-            from mbody.errors import did_you_mean
-
             hint = did_you_mean(body, list(model.body_names))
             raise MbodyError(f"point {name!r}: no body {body!r} in this model"
                              + (f"; {hint}" if hint else ""))

@@ -32,10 +32,10 @@ from typing import Any
 import numpy as np
 
 from mbody import conventions as cv
-from mbody.equations.spatial import planar_quat
 from mbody.errors import TrajectoryFileError
-from mbody.io.atomic import atomic_path
 from mbody.model.model import State, count, loads
+from mbody.util.atomic import atomic_path
+from mbody.util.spatial import planar_quat
 
 FORMAT = "mbody-trajectory"
 FORMAT_VERSION = 1

@@ -23,11 +23,11 @@ from collections.abc import Callable
 import numpy as np
 
 from mbody.equations.solution import singular_mass_error
-from mbody.equations.spatial import quaternion_rate
 from mbody.equations.workspace import Unknowns, Workspace, workspace
 from mbody.errors import MbodyError
 from mbody.kernel import _core
 from mbody.model.model import Model, State
+from mbody.util.spatial import quaternion_rate
 
 
 def status_error(model: Model, code: int) -> MbodyError:

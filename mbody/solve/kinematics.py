@@ -23,6 +23,7 @@ import dataclasses
 
 import numpy as np
 
+from mbody.equations.assemble import assemble
 from mbody.equations.joints import reaction_columns
 from mbody.equations.workspace import workspace
 from mbody.errors import Issue, MbodyError, ModelError
@@ -162,8 +163,6 @@ def check_drivers(model: Model) -> None:
 
 def mbody_assembly_G(model: Model) -> np.ndarray:
     """G at the file's pose, dense (rows: the model's coordinates)."""
-    from mbody.equations.assemble import assemble
-
     return assemble(model, model.initial).G.toarray()
 
 

@@ -25,7 +25,6 @@ from types import ModuleType
 
 from mbody.equations.assemble import Assembly
 from mbody.errors import MbodyError
-from mbody.io.atomic import atomic_path
 from mbody.io.export import csvfolder, jsonfile, mat, npz
 from mbody.io.export.assembly import (
     COLUMN_TEXT,
@@ -39,6 +38,7 @@ from mbody.io.export.assembly import (
 from mbody.io.export.csvfolder import CSV_DENSE_LIMIT, write_csv
 from mbody.io.export.jsonfile import from_json, schema, to_json
 from mbody.io.export.sample import assembly_from_trajectory, state_at
+from mbody.util.atomic import atomic_path
 
 __all__ = [
     "COLUMN_TEXT", "CSV_DENSE_LIMIT", "FORMAT", "SUFFIXES", "VERSION", "Columns",

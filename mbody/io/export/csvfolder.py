@@ -30,7 +30,6 @@ import scipy.sparse as sp
 
 from mbody.equations.assemble import Assembly
 from mbody.errors import MbodyError
-from mbody.io.atomic import atomic_folder
 from mbody.io.export.assembly import (
     FORMAT,
     VERSION,
@@ -39,6 +38,7 @@ from mbody.io.export.assembly import (
     build,
     check_format,
 )
+from mbody.util.atomic import atomic_folder
 
 CSV_DENSE_LIMIT = 1_000_000
 """M.csv and G.csv are labelled dense tables up to this many cells, else triplets."""
@@ -86,7 +86,7 @@ def write_csv(asm: Assembly | ExportedAssembly, folder: str | os.PathLike[str],
     Notes
     -----
     All six files are written to a temporary folder and moved in only when every one is
-    complete (`mbody.io.atomic.atomic_folder`).
+    complete (`mbody.util.atomic.atomic_folder`).
     """
     exp = as_export(asm, known)
     with atomic_folder(folder) as tmp:

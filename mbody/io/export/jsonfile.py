@@ -2,7 +2,7 @@
 (`schema()`, mbody/data/assembly.schema.json); sparse matrices as sorted 0-based
 ``row, col, value`` triplets, one object per reaction column and per body. Floats are
 written by `json` with the shortest repr that reads back exactly; a number that is not
-finite is written as null (`mbody.io.jsontext`: strict JSON)."""
+finite is written as null (`mbody.util.jsontext`: strict JSON)."""
 
 from __future__ import annotations
 
@@ -17,7 +17,6 @@ import scipy.sparse as sp
 from mbody import conventions as cv
 from mbody import joint_types
 from mbody.errors import MbodyError
-from mbody.io import jsontext
 from mbody.io.export.assembly import (
     COLUMN_TEXT,
     FORMAT,
@@ -26,6 +25,7 @@ from mbody.io.export.assembly import (
     build,
     check_format,
 )
+from mbody.util import jsontext
 
 
 def _triplets(A: sp.csc_matrix) -> dict[str, Any]:

@@ -11,12 +11,12 @@ from typing import Any
 
 import numpy as np
 
-from mbody.equations.spatial import axis_angle_quat, matrix_to_quat, quat_mul
 from mbody.errors import Issue, did_you_mean
 from mbody.io.interop.attrvalues import BOOLEAN, read_keyword, read_numbers, split
 from mbody.io.interop.mjcf_defaults import ORIENTATIONS, Defaults, Values
 from mbody.io.interop.tree import unit
 from mbody.io.interop.xmlsource import Element
+from mbody.util.spatial import axis_angle_quat, matrix_to_quat, quat_mul
 
 
 class Compiler:

@@ -20,13 +20,13 @@ from typing import Any
 
 import numpy as np
 
-from mbody.equations.spatial import quat_to_matrix
 from mbody.errors import did_you_mean
 from mbody.io.interop.attrvalues import BOOLEAN, split
 from mbody.io.interop.mjcf_compiler import Compiler, z_to_quat
 from mbody.io.interop.mjcf_defaults import Values
 from mbody.io.interop.tree import TreeBody
 from mbody.io.interop.xmlsource import Element
+from mbody.util.spatial import quat_to_matrix
 
 MIN_MASS = 1e-15
 """A body with less mass than this has none (MuJoCo's mjMINVAL is 1e-15)."""

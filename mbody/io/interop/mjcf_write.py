@@ -30,17 +30,17 @@ import numpy as np
 
 from mbody import __version__, joint_types
 from mbody import conventions as cv
-from mbody.equations.spatial import (
+from mbody.io.interop.custom import numeric, text
+from mbody.joint_types.base import SCREW
+from mbody.model.model import Joint, Model, count
+from mbody.util.atomic import write_atomic
+from mbody.util.spatial import (
     box_equivalent,
     matrix_to_quat,
     quat_conj,
     quat_mul,
     quat_to_matrix,
 )
-from mbody.io.atomic import write_atomic
-from mbody.io.interop.custom import numeric, text
-from mbody.joint_types.base import SCREW
-from mbody.model.model import Joint, Model, count
 
 PARTICLE_INERTIA = 1e-12
 """A particle's principal moments in MuJoCo, as a fraction of m ℓ² (ℓ the model's length

@@ -17,11 +17,11 @@ from typing import Any
 
 import numpy as np
 
-from mbody.equations.spatial import axis_angle_quat, quat_mul, quat_to_matrix
 from mbody.errors import Issue, ModelError
 from mbody.io.interop.xmlsource import Element
 from mbody.model.loader import Document, Path_, dotted
 from mbody.model.validate import Spec, validate
+from mbody.util.spatial import axis_angle_quat, quat_mul, quat_to_matrix
 
 GROUND = "ground"
 PARALLEL_TOL = 1e-9

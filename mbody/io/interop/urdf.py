@@ -20,7 +20,6 @@ from typing import Any
 
 import numpy as np
 
-from mbody.equations.spatial import quat_to_matrix
 from mbody.errors import Issue, ModelError, did_you_mean
 from mbody.io.interop.attrvalues import read_numbers
 from mbody.io.interop.tree import (
@@ -34,6 +33,7 @@ from mbody.io.interop.tree import (
     unit,
 )
 from mbody.io.interop.xmlsource import MAX_ELEMENTS, Element, parse_xml, read_xml, unknown_name
+from mbody.util.spatial import quat_to_matrix
 
 _ATTRS: dict[str, tuple[str, ...]] = {
     "robot": ("name", "version", "xmlns:xacro"), "link": ("name", "type"),

@@ -19,8 +19,8 @@ from pathlib import Path
 from typing import Any
 
 from mbody import __version__
-from mbody.io.atomic import write_atomic
 from mbody.model.loader import resolve_plain
+from mbody.util.atomic import write_atomic
 
 TOP_ORDER = ("model", "description", "dimension", "gravity", "bodies", "loads", "joints",
              "reactions")

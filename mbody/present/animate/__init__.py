@@ -20,7 +20,6 @@ from collections.abc import Iterable
 from pathlib import Path
 
 from mbody.errors import MbodyError
-from mbody.io.atomic import write_atomic
 from mbody.model.model import Model
 from mbody.present.animate.live import HOST, LiveViewer
 from mbody.present.animate.page import page_html, write_page
@@ -41,6 +40,7 @@ from mbody.present.animate.scene import (
 )
 from mbody.present.animate.source import Source, resolve
 from mbody.present.animate.wire import pack, unpack
+from mbody.util.atomic import write_atomic
 
 __all__ = [
     "CAMERA", "FILL", "COUPLE_COLOR", "FORCE_COLOR", "HOST", "PALETTE", "REACTION_COLOR",

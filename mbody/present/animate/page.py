@@ -14,11 +14,11 @@ from collections.abc import Iterable
 from pathlib import Path
 
 from mbody.errors import MbodyError
-from mbody.io.atomic import write_atomic
 from mbody.model.model import Model
 from mbody.present.animate.scene import Scene, build_scene
 from mbody.present.animate.wire import load_meshcat, pack
 from mbody.simulate.trajectory import Trajectory
+from mbody.util.atomic import write_atomic
 
 _PAGE = """<!DOCTYPE html>
 <html><head><meta charset="utf-8"><title>{title}</title>

@@ -30,11 +30,11 @@ import numpy as np
 from mbody import conventions as cv
 from mbody.equations.joints import reaction_columns
 from mbody.equations.loads import applied_loads
-from mbody.equations.spatial import box_equivalent, matvec, planar_quat, quat_to_matrix
 from mbody.errors import MbodyError, did_you_mean
 from mbody.model.model import Body, Model
 from mbody.present.animate.wire import load_meshcat
 from mbody.simulate.trajectory import Trajectory
+from mbody.util.spatial import box_equivalent, matvec, planar_quat, quat_to_matrix
 
 ROOT = "/meshcat/mbody"
 """Scene path of the model's frame; bodies are at ROOT/bodies/<name>."""

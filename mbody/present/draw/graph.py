@@ -53,7 +53,7 @@ def graph_scene(model: Model, topo: Any = None) -> Scene:
     ----------
     model : Model
     topo : Topology, optional
-        `mbody.model.graph.topology(model, ...)`: adds tree/loops and mobility to the title.
+        `mbody.equations.topology.topology(model, ...)`: adds tree/loops and mobility to the title.
 
     Returns
     -------

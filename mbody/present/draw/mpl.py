@@ -22,11 +22,11 @@ from matplotlib.text import Text as MplText
 from matplotlib.transforms import Affine2D, Transform, offset_copy
 
 from mbody.errors import MbodyError
-from mbody.io.atomic import write_atomic
 from mbody.present.draw.fonts import drawable
 from mbody.present.draw.scene import IN, Disc, Item, Line, Poly, Scene, Wedge
 from mbody.present.draw.style import FORMATS
 from mbody.present.draw.svg import scene_svg
+from mbody.util.atomic import write_atomic
 
 _FAMILY = {"sans": "DejaVu Sans", "mono": "DejaVu Sans Mono"}
 

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from mbody import conventions as cv
-from mbody.equations.spatial import box_equivalent
+from mbody.util.spatial import box_equivalent
 
 if TYPE_CHECKING:
     from mbody.equations.fbd import FreeBodyDiagram

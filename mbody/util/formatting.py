@@ -1,0 +1,33 @@
+"""Numbers, vectors and tables as the text outputs print them: 6 significant digits,
+rounding noise as 0."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def num(x: float) -> str:
+    """6 significant digits; |x| below 1e-12 (rounding from rotations, -2.4e-17) as 0."""
+    x = 0.0 if abs(x) < 1e-12 else x
+    s = f"{x:.6g}"
+    return "0" if s in ("-0", "0") else s
+
+
+def vec(x: np.ndarray, dim: int) -> str:
+    """``(x, y)`` of a planar model's vector (its first two components), ``(x, y, z)``."""
+    x = np.asarray(x)[:2] if dim == 2 else np.asarray(x)  # a planar model's
+    return "(" + ", ".join(num(v) for v in x) + ")"
+
+
+def table(header: list[str], rows: list[list[str]], indent: str = "  ") -> list[str]:
+    """Left-aligned columns, each as wide as its longest cell plus two spaces."""
+    widths = [max(len(r[c]) for r in [header, *rows]) for c in range(len(header))]
+    fmt = indent + "  ".join(f"{{:<{w}}}" for w in widths)
+    return [fmt.format(*r).rstrip() for r in [header, *rows]]
+
+
+def clean(x: np.ndarray, rel: float = 1e-10) -> np.ndarray:
+    """Values below `rel` times the largest one as 0: rounding noise, not data."""
+    x = np.asarray(x, dtype=float)
+    top = float(np.max(np.abs(x), initial=0.0))
+    return np.where(np.abs(x) <= rel * top, 0.0, x)
