@@ -8,16 +8,16 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-    from mbody.equations.fbd import BodyEquations, FreeBodyDiagram
+    from mbody.equations.fbd import FreeBodyDiagram
 
 
-def draw_fbd(fbd: FreeBodyDiagram | BodyEquations, **kwargs: Any) -> Figure:
+def draw_fbd(fbd: FreeBodyDiagram, **kwargs: Any) -> Figure:
     """The free-body diagram of one body as a matplotlib `Figure` (Agg canvas, no pyplot).
 
     Parameters
     ----------
-    fbd : FreeBodyDiagram or BodyEquations
-        ``asm.bodies[name].fbd`` (or ``asm.bodies[name]``).
+    fbd : FreeBodyDiagram
+        A body's free body, ``asm.bodies[name].fbd``.
     **kwargs
         ``view`` (spatial bodies: "iso", "front", "top"... or (azimuth, elevation)),
         ``equations`` (write the body's Newton-Euler pair under the drawing, default
