@@ -55,6 +55,14 @@ PR_VELOCITY: int
 PR_RATIO: int
 PR_SINGULAR: int
 PROJECT_INFO: int
+GQ_TURN: int
+GQ_CHILD_TURN: int
+GQ_SLIDE: int
+GQ_BODY: int
+GQ_W: int
+GI_RANK: int
+GI_RESIDUAL: int
+GENERALIZED_INFO: int
 
 def solve_layout(n: int, m: int, planar: bool) -> tuple[int, int, int]: ...
 
@@ -75,6 +83,8 @@ class Model:
     def columns(self, t: float, y: _F, child6: _F, parent6: _F, W_e: _F, W_P: _F,
                 gamma: _F, phi: _F, gtv: _F) -> None: ...
     def expression(self, e: int, t: float) -> float: ...
+    def coordinate_rows(self, t: float, y: _F, Iq: _I, cols: _I, rows: _F,
+                        values: _F) -> None: ...
 
 class Unknowns:
     mu: int
@@ -89,3 +99,7 @@ class Unknowns:
     def project(self, t: float, y: _F, iters: int, robust_below: float, homogeneous: Any,
                 info: _F) -> None: ...
     def schur(self, t: float, y: _F, S_out: _F) -> None: ...
+    def generalized(self, t: float, y: _F, lam: _F, Iq: _I, cols: _I, qdot: _F | None,
+                    out: _F) -> None: ...
+    def generalized_perturbed(self, t: float, y: _F, lam: _F, Iq: _I, cols: _I, qdot: _F,
+                              P: _F, out: _F) -> None: ...

@@ -214,4 +214,53 @@ int mb_derivative(const mb_model *md, const mb_unknowns *u, mb_work *w, double t
 void mb_project(const mb_model *md, const mb_unknowns *u, mb_work *w, double t, double *y,
                 int iters, double robust_below, int homogeneous, double *info);
 
+/* ---------------------------------------------------------------------------------------
+ * Generalized coordinates (generalized.c). A coordinate is a rate row a_k^T v, Iq
+ * (nq x MB_GQ_W) [kind, index, axis, rule]:
+ *   MB_GQ_TURN        joint `index`'s turn about its joint-frame axis `axis` (fixed in the
+ *                     parent): the rate MB_KIND_TURN measures; value atan2 as TURN's theta
+ *                     (rule 0), or a universal joint's first angle (rule 1)
+ *   MB_GQ_CHILD_TURN  a turn about an axis fixed in the child: axis 0-2 its body axes (a
+ *                     ball's quasi-velocities: no value), 3 the joint's axis2 (a universal
+ *                     joint's second angle, rule 2)
+ *   MB_GQ_SLIDE       the slide along the joint-frame axis `axis` (MB_KIND_FORCE's rate);
+ *                     value e . (P - P_p)
+ *   MB_GQ_BODY        body `index`'s own velocity component `axis` (0-2 world v, 3-5 body
+ *                     w); value its position (planar: its angle about z for axis 5)
+ * cols (nc): the velocity columns (indices into 6 n) the system lives on (planar: x, y,
+ * w3 per body; a particle's rotations left out), increasing. The held components are the
+ * unknowns' U; known components' values (lam) act as loads.
+ * mb_generalized's out: [T (N x nq) | v_e (N) | a0 (N) | M_q (nq x nq) | f_q (nq) |
+ * q (nq) | q' (nq) | info (MB_GENERALIZED_INFO)] with N = nc, so that v = T q' + v_e and
+ * v' = T q'' + a0 keep every held component (drivers' laws included) and
+ * M_q q'' = f_q = T^T (Q - b + G_K lam_K - M a0). q' is the given one, or (qdot NULL)
+ * A^T v of y's velocities; y's own velocities are otherwise not used.
+ * info: [smallest |R_kk| / largest of the scaled QR of C = [G_U^T; A^T] (0: the
+ * coordinates do not determine the motion), the least-squares residual of C T = [0; I]
+ * (0 on the configuration manifold)].
+ * ------------------------------------------------------------------------------------- */
+enum { MB_GQ_TURN = 0, MB_GQ_CHILD_TURN = 1, MB_GQ_SLIDE = 2, MB_GQ_BODY = 3,
+       MB_GQ_KINDS = 4, MB_GQ_W = 4 };
+enum { MB_GI_RANK = 0, MB_GI_RESIDUAL = 1, MB_GENERALIZED_INFO = 2 };
+
+/* 0 when Iq and cols describe coordinates of this model, else -1. */
+int mb_coordinates_check(const mb_model *md, int64_t nq, const int64_t *Iq, int64_t nc,
+                         const int64_t *cols);
+/* The coordinates' rate rows at y, rows (nq x nc) over the columns `cols`, and their values
+ * (nq); returns 0, or -1 when memory ran out. */
+int mb_coordinate_rows(const mb_model *md, mb_work *w, double t, const double *y, int64_t nq,
+                       const int64_t *Iq, int64_t nc, const int64_t *cols, double *rows,
+                       double *values);
+/* See above; returns 0, or -1 when memory ran out. */
+int mb_generalized(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
+                   const double *y, const double *lam, int64_t nq, const int64_t *Iq,
+                   int64_t nc, const int64_t *cols, const double *qdot, double *out);
+/* f_q at np perturbed states, P (np x 2 nq) rows [dq | du]: the positions of y0 moved along
+ * v = T(y0) dq for a unit time (x + v, q (x) exp(w / 2)), the rates q0' + du: fout (np x
+ * nq). For the linearisation's differences (its curves have the tangents T e_k). */
+int mb_generalized_perturbed(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
+                             const double *y0, const double *lam, int64_t nq,
+                             const int64_t *Iq, int64_t nc, const int64_t *cols,
+                             const double *qdot0, int64_t np, const double *P, double *fout);
+
 #endif
