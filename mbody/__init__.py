@@ -34,6 +34,8 @@ _LAZY = {
     "Body": "model.model", "Joint": "model.model", "Load": "model.model",
     "Model": "model.model", "State": "model.model", "load": "loading",
     "loads": "loading", "kinematics": "solve.kinematics",
+    "linearize": "solve.linearize", "Linearization": "solve.linearize",
+    "Generalized": "equations.generalized",
     "simulate": "simulate.simulation",
     "Trajectory": "simulate.trajectory",
     "verify": "answers.verify",
@@ -42,7 +44,7 @@ _LAZY = {
 
 __all__ = [
     "Assembly", "Body", "BodyEquations", "Equation", "ExportedAssembly", "ForceOnBody",
-    "FreeBodyDiagram", "load_export",
+    "FreeBodyDiagram", "Generalized", "Linearization", "linearize", "load_export",
     "Issue", "Joint", "Load", "MbodyError", "Model", "ModelError", "Solution", "State",
     "Trajectory", "simulate",
     "UnknownReactionsError", "animate", "assemble", "kinematics", "load", "loads", "verify",

@@ -110,6 +110,10 @@ class CoordinateSet:
         A chosen driver's effort label and the index of its coordinate.
     dof : int
         Degrees of freedom at the state they were chosen at.
+    cols : (N,) int array
+        The model's velocity columns (`columns`).
+    length : float
+        The model's length scale (m, `size`).
     tree : tuple of str
         The joints of the spanning tree (default choice), or ().
     """
@@ -118,6 +122,8 @@ class CoordinateSet:
     held: Unknowns
     efforts: tuple[tuple[str, int], ...]
     dof: int
+    cols: np.ndarray
+    length: float
     tree: tuple[str, ...] = ()
 
     @property
@@ -137,15 +143,27 @@ class CoordinateSet:
         return np.array([c.offset for c in self.items], dtype=float)
 
     @cached_property
+    def scales(self) -> np.ndarray:
+        """(k,) each coordinate's scale: 1 rad, or the model's length (m)."""
+        return np.where(self.angles, 1.0, self.length)
+
+    @cached_property
+    def angles(self) -> np.ndarray:
+        """(k,) True for a coordinate in rad (its value wraps)."""
+        return np.array([c.unit == "rad" for c in self.items], dtype=bool)
+
+    @cached_property
     def quasi(self) -> np.ndarray:
         return np.array([c.quasi for c in self.items], dtype=bool)
+
+    @cached_property
+    def quasi_int(self) -> np.ndarray:
+        return self.quasi.astype(np.int64)
 
     def values(self, raw: np.ndarray) -> np.ndarray:
         """The coordinates' values from the core's (offsets added, angles in (−π, π])."""
         q = raw + self.offsets
-        angle = np.array([c.unit == "rad" for c in self.items], dtype=bool)
-        q[angle] = q[angle] - WRAP * np.ceil((q[angle] - np.pi) / WRAP)
-        return q
+        return np.where(self.angles, q - WRAP * np.ceil((q - np.pi) / WRAP), q)
 
     def __repr__(self) -> str:
         return f"<CoordinateSet: {', '.join(self.labels)} ({self.dof} dof)>"
@@ -228,10 +246,26 @@ def _planar_angles(state: State) -> np.ndarray:
 
 
 def size(model: Model) -> float:
-    """The model's length scale (m): the spread of its mass centres, its joints' arms."""
-    pts = model.initial.position
-    spread = float(np.ptp(pts, axis=0).max()) if model.n > 1 else 0.0
-    arms = float(np.abs(model.joint_table.B_r_child).max()) if len(model.joints) else 0.0
+    """The model's length scale (m): the spread of its mass centres, joint points and
+    springs' ends at the initial state, or its joints' arms if larger (at least 1 mm)."""
+    st = model.initial
+    R = st.W_R_B
+    jt, sp = model.joint_table, model.springs
+    pts = [st.position]
+    if len(jt.child):
+        pts.append(st.position[jt.child] + np.einsum("jab,jb->ja", R[jt.child], jt.B_r_child))
+        p = np.asarray(jt.parent)
+        pts.append(np.where((p < 0)[:, None], jt.B_r_parent, st.position[p]
+                            + np.einsum("jab,jb->ja", R[p], jt.B_r_parent)))
+    for end, r in ((sp.a, sp.r_a), (sp.b, sp.r_b)):
+        if len(end):
+            body = np.asarray(end)
+            world = np.where((body < 0)[:, None], r, st.position[body]
+                             + np.einsum("jab,jb->ja", R[body], r))
+            pts.append(world)
+    allp = np.concatenate(pts)
+    spread = float(np.ptp(allp, axis=0).max()) if len(allp) > 1 else 0.0
+    arms = float(np.abs(jt.B_r_child).max()) if len(jt.child) else 0.0
     return max(spread, arms, 1e-3)
 
 
@@ -412,7 +446,7 @@ def choose(model: Model, state: State | None = None, labels: Sequence[str] | Non
         items = tuple(cands[k] for k in chosen_idx)
         efforts = tuple((model.reactions[first_driver + d],
                          labels.index(driver_labels[d])) for d in free)
-        return CoordinateSet(items, held, efforts, dof)
+        return CoordinateSet(items, held, efforts, dof, columns(model), size(model))
     # the default: drivers' coordinates, the tree's motions, the floating parts' roots
     tree, roots = spanning_tree(model)
     held = _held(model, known, range(n_drivers))
@@ -438,7 +472,8 @@ def choose(model: Model, state: State | None = None, labels: Sequence[str] | Non
     items = tuple(cands[k] for k in taken)
     efforts = tuple((model.reactions[first_driver + d], taken.index(by_label[lab]))
                     for d, lab in enumerate(driver_labels))
-    return CoordinateSet(items, held, efforts, dof, tuple(model.joints[j].name for j in tree))
+    return CoordinateSet(items, held, efforts, dof, columns(model), size(model),
+                         tuple(model.joints[j].name for j in tree))
 
 
 _CACHE: weakref.WeakKeyDictionary[Model, dict[tuple, CoordinateSet]] = \

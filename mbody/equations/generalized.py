@@ -72,6 +72,11 @@ class Generalized:
         The drivers' part of the velocity (0 without held drivers).
     a0 : (N,) array
         The bodies' accelerations at q'' = 0 (velocity terms, drivers' laws).
+    f_scale : (k,) array
+        The magnitude of the terms each generalized force is made of: what "f = 0" is
+        measured against, and its rounding (a pendulum hanging straight down has f = 0
+        from terms of size m g L). Per group of body rows (translations, rotations): the
+        largest entry of T's column times the sum of |Q|, |b|, |G_K λ_K| and |M a0|.
     rank : float
         Smallest over largest pivot of the projection's QR (1 well determined, 0 singular).
     residual : float
@@ -89,6 +94,7 @@ class Generalized:
     T: np.ndarray
     v_e: np.ndarray
     a0: np.ndarray
+    f_scale: np.ndarray
     rank: float
     residual: float
     warnings: tuple[str, ...] = field(default_factory=tuple)
@@ -227,13 +233,15 @@ def state_with_velocities(model: Model, state: State, v: np.ndarray) -> State:
 
 
 def layout(N: int, k: int) -> tuple[int, ...]:
-    """Offsets of T, v_e, a0, M, f, q, q', info and the end in the core's output."""
+    """Offsets of T, v_e, a0, M, f, q, q', f_scale, info and the end in the core's
+    output."""
     o = [0, N * k]
     o.append(o[-1] + N)      # a0
     o.append(o[-1] + N)      # M
     o.append(o[-1] + k * k)  # f
     o.append(o[-1] + k)      # q
     o.append(o[-1] + k)      # q'
+    o.append(o[-1] + k)      # f_scale
     o.append(o[-1] + k)      # info
     o.append(o[-1] + _core.GENERALIZED_INFO)
     return tuple(o)
@@ -285,15 +293,19 @@ def evaluate(model: Model, state: State, cs: CoordinateSet,
     """`Generalized` at `state` for the coordinate set `cs` (rates `qdot`, default the
     state's)."""
     ws = workspace(model)
-    solver = ws.solver(cs.held)
-    cols = columns(model)
-    N, k = len(cols), len(cs)
+    out = np.empty(layout(len(cs.cols), len(cs))[-1])
+    ws.solver(cs.held).generalized(
+        float(state.t), ws.pack_state(state), cs.held.lam, cs.Iq, cs.cols,
+        None if qdot is None else np.ascontiguousarray(qdot, dtype=float), out)
+    return from_output(model, state, cs, out)
+
+
+def from_output(model: Model, state: State, cs: CoordinateSet, out: np.ndarray
+                ) -> Generalized:
+    """`Generalized` from the core's output (`layout`)."""
+    N, k = len(cs.cols), len(cs)
     o = layout(N, k)
-    out = np.empty(o[-1])
-    y = ws.pack_state(state)
-    solver.generalized(float(state.t), y, cs.held.lam, cs.Iq, cols,
-                       None if qdot is None else np.ascontiguousarray(qdot, dtype=float), out)
-    info = out[o[7]:o[8]]
+    info = out[o[8]:o[9]]
     rank = float(info[_core.GI_RANK])
     if not rank > SINGULAR_RTOL:
         raise CoordinatesSingularError(
@@ -305,10 +317,7 @@ def evaluate(model: Model, state: State, cs: CoordinateSet,
     if residual > 1e-6:
         warnings = (f"the state is off its joints (least-squares residual {residual:.2g} of "
                     "the projection): the equations are those of the nearest motion",)
-    T = out[:o[1]].reshape(N, k)
-    return Generalized(model, state, cs, cs.values(out[o[5]:o[6]]), out[o[6]:o[7]].copy(),
-                       out[o[3]:o[4]].reshape(k, k), out[o[4]:o[5]].copy(), T,
-                       out[o[1]:o[2]].copy(), out[o[2]:o[3]].copy(), rank, residual,
-                       warnings)
-
-
+    return Generalized(model, state, cs, cs.values(out[o[5]:o[6]]), out[o[6]:o[7]],
+                       out[o[3]:o[4]].reshape(k, k), out[o[4]:o[5]],
+                       out[:o[1]].reshape(N, k), out[o[1]:o[2]], out[o[2]:o[3]],
+                       out[o[7]:o[8]], rank, residual, warnings)

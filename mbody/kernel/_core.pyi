@@ -63,6 +63,17 @@ GQ_W: int
 GI_RANK: int
 GI_RESIDUAL: int
 GENERALIZED_INFO: int
+LP_STEP: int
+LP_ROUNDING: int
+LP_STEADY: int
+LP_MOVING: int
+LINEARIZE_PARAMS: int
+LI_STEADY: int
+LI_UNSTEADY: int
+LI_TOL: int
+LI_KEPT: int
+LI_SINGULAR: int
+LINEARIZE_INFO: int
 
 def solve_layout(n: int, m: int, planar: bool) -> tuple[int, int, int]: ...
 
@@ -103,3 +114,7 @@ class Unknowns:
                     out: _F) -> None: ...
     def generalized_perturbed(self, t: float, y: _F, lam: _F, Iq: _I, cols: _I, qdot: _F,
                               P: _F, out: _F) -> None: ...
+    def linearize(self, t: float, y: _F, lam: _F, Iq: _I, cols: _I, scales: _F, quasi: _I,
+                  skip: _I, params: _F, out: _F) -> None: ...
+    def differences(self, t: float, y: _F, lam: _F, Iq: _I, cols: _I, qdot: _F, h: _F,
+                    hu: _F, fscale: _F, rounding: float, skip: _I, out: _F) -> None: ...

@@ -54,13 +54,13 @@ int mb_coordinates_check(const mb_model *md, int64_t nq, const int64_t *Iq, int6
 
 /* The scratch of one evaluation (allocated per call: a few small arrays). */
 typedef struct {
-    int64_t n, N, nq, mu, r, nrhs;
-    double *C, *B, *scale, *beta, *rdiag, *y, *arow, *agam, *r6, *Ma, *lam;
+    int64_t n, N, nq, mu, r;
+    double *C, *B, *fp, *scale, *beta, *rdiag, *y, *arow, *agam, *r6, *Ma, *lam;
     int64_t *col_of; /* 6 n: active column index, or -1 */
 } gen_scratch;
 
 static void scratch_free(gen_scratch *s) {
-    free(s->C), free(s->B), free(s->scale), free(s->beta), free(s->rdiag), free(s->y), free(s->arow);
+    free(s->C), free(s->B), free(s->fp), free(s->scale), free(s->beta), free(s->rdiag), free(s->y), free(s->arow);
     free(s->agam), free(s->r6), free(s->Ma), free(s->lam), free(s->col_of);
 }
 
@@ -68,10 +68,10 @@ static int scratch_new(gen_scratch *s, const mb_model *md, const mb_unknowns *u,
                        int64_t nc, const int64_t *cols) {
     memset(s, 0, sizeof(*s));
     s->n = md->n, s->N = nc, s->nq = nq, s->mu = u->mu, s->r = u->mu + nq;
-    s->nrhs = nq + 2; /* T's columns, v_e, a0 */
     int64_t r = s->r > 0 ? s->r : 1, N = nc > 0 ? nc : 1, n = md->n > 0 ? md->n : 1;
     s->C = calloc((size_t)(r * N), sizeof(double));
-    s->B = calloc((size_t)(r * s->nrhs), sizeof(double));
+    s->B = calloc((size_t)(3 * r + N), sizeof(double));
+    s->fp = calloc((size_t)r, sizeof(double));
     s->scale = calloc((size_t)N, sizeof(double));
     s->beta = calloc((size_t)N, sizeof(double));
     s->rdiag = calloc((size_t)N, sizeof(double));
@@ -82,7 +82,7 @@ static int scratch_new(gen_scratch *s, const mb_model *md, const mb_unknowns *u,
     s->Ma = calloc((size_t)(6 * n), sizeof(double));
     s->lam = calloc((size_t)(md->m > 0 ? md->m : 1), sizeof(double));
     s->col_of = calloc((size_t)(6 * n), sizeof(int64_t));
-    if (!s->C || !s->B || !s->scale || !s->beta || !s->rdiag || !s->y || !s->arow || !s->agam || !s->r6 ||
+    if (!s->C || !s->B || !s->fp || !s->scale || !s->beta || !s->rdiag || !s->y || !s->arow || !s->agam || !s->r6 ||
         !s->Ma || !s->lam || !s->col_of) {
         scratch_free(s);
         return -1;
@@ -248,6 +248,27 @@ static double qr_solve(const double *C, int64_t r, int64_t N, const double *scal
     return sqrt(resid);
 }
 
+/* x (N) <- the last `nq` entries of Q1 R^-T D x (r entries before selection; work: r
+ * doubles): (C^+)^T D x restricted to the coordinates' rows, i.e. T^T x when T is
+ * C^+ [0; I] (the transposed solve: one vector instead of nq columns of T). */
+static void qr_transposed(const double *C, int64_t r, int64_t N, const double *scale,
+                          const double *beta, const double *rdiag, const double *x,
+                          int64_t first, int64_t nq, double *out, double *work) {
+    for (int64_t k = 0; k < N; k++) { /* R^T z = D x, forward */
+        double s = scale[k] * x[k];
+        for (int64_t j = 0; j < k; j++) s -= C[j * N + k] * work[j];
+        work[k] = rdiag[k] != 0.0 ? s / rdiag[k] : 0.0;
+    }
+    for (int64_t i = N; i < r; i++) work[i] = 0.0;
+    for (int64_t k = N - 1; k >= 0; k--) { /* Q [z; 0] = H_0 ... H_{N-1} [z; 0] */
+        double s = 0.0;
+        for (int64_t i = k; i < r; i++) s += C[i * N + k] * work[i];
+        s *= beta[k];
+        for (int64_t i = k; i < r; i++) work[i] -= s * C[i * N + k];
+    }
+    for (int64_t k = 0; k < nq; k++) out[k] = work[first + k];
+}
+
 /* Adds row (child side [0..5] on body c, parent side [6..11] on body p) into C's row i. */
 static void put_row(const gen_scratch *s, double *Crow, const double *row, int64_t c,
                     int64_t p) {
@@ -288,62 +309,60 @@ static void rows_at(const mb_model *md, mb_work *w, gen_scratch *s, int64_t nq,
                        s->agam + k, values ? values + k : &(double){0.0});
 }
 
-/* One evaluation at positions s->y (its velocities replaced): see kernel.h. T (N x nq),
- * ve, a0 (N), Mq (nq x nq, may be NULL), fq (nq); qval, qd_out, info may be NULL. */
-static void evaluate(const mb_model *md, const mb_unknowns *u, mb_work *w, gen_scratch *s,
-                     int64_t nq, const int64_t *Iq, const double *qdot_in, const double *lam,
-                     double *T, double *ve, double *a0, double *Mq, double *fq, double *qval,
-                     double *qd_out, double *info) {
-    int64_t n = md->n, N = s->N, mu = s->mu, r = s->r, nr = nq + 1;
-    int64_t nq1 = nq > 0 ? nq : 1;
-    int64_t cc[nq1], cp[nq1];
-    double qd[nq1], *rdiag = s->rdiag;
+/* Stage 1 at positions s->y: rotations, the rows and C's QR (kept in s), the coordinates'
+ * rows and bodies (cc, cp) and values; the drivers' rates f' of the held components into
+ * s->fp. Returns the pivot ratio. */
+static double factor(const mb_model *md, const mb_unknowns *u, mb_work *w, gen_scratch *s,
+                     int64_t nq, const int64_t *Iq, int64_t *cc, int64_t *cp, double *qval) {
+    int64_t n = md->n, N = s->N, mu = s->mu, r = s->r;
     mb_rotations(n, s->y + 3 * n, w->R);
     rows_at(md, w, s, nq, Iq, cc, cp, qval);
-    for (int64_t k = 0; k < nq; k++)
-        qd[k] = qdot_in ? qdot_in[k] : row_dot_v(s->arow + 12 * k, cc[k], cp[k], s->y, n, s->col_of);
-    /* C = [G_U^T; A^T] and the right-hand sides [0 f'; I 0] */
     memset(s->C, 0, sizeof(double) * r * N);
-    memset(s->B, 0, sizeof(double) * r * nr);
     for (int64_t k = 0; k < mu; k++) {
         int64_t i = u->U[k], j = md->comps_i[4 * i];
         double row[12];
         memcpy(row, w->child6 + 6 * i, 6 * sizeof(double));
         memcpy(row + 6, w->parent6 + 6 * i, 6 * sizeof(double));
         put_row(s, s->C + k * N, row, md->joints_i[3 * j + 1], md->joints_i[3 * j]);
+        s->fp[k] = 0.0;
         if (md->comps_i[4 * i + 3] >= 0) {
             double f[3];
             mb_law(md, w, i, f);
-            s->B[k * nr + nq] = f[1];
+            s->fp[k] = f[1];
         }
     }
-    for (int64_t k = 0; k < nq; k++) {
-        put_row(s, s->C + (mu + k) * N, s->arow + 12 * k, cc[k], cp[k]);
-        s->B[(mu + k) * nr + k] = 1.0;
-    }
-    double ratio = qr_factor(s->C, r, N, s->scale, s->beta, rdiag);
-    double resid = qr_solve(s->C, r, N, s->scale, s->beta, rdiag, s->B, nr);
-    for (int64_t i = 0; i < N; i++) {
-        for (int64_t k = 0; k < nq; k++) T[i * nq + k] = s->B[i * nr + k];
-        ve[i] = s->B[i * nr + nq];
-    }
-    /* v = T q' + v_e into the state; then gamma at that velocity */
+    for (int64_t k = 0; k < nq; k++) put_row(s, s->C + (mu + k) * N, s->arow + 12 * k, cc[k], cp[k]);
+    return qr_factor(s->C, r, N, s->scale, s->beta, s->rdiag);
+}
+
+/* Stage 2 with C factored at s->y's positions: v = T q' + v_e into s->y, a0, and
+ * f_q = T^T (Q - b + G_K lam_K - M a0) (by the transposed solve); ve, a0 (N) written. */
+static void forces(const mb_model *md, const mb_unknowns *u, mb_work *w, gen_scratch *s,
+                   int64_t nq, const int64_t *Iq, const double *qd, const double *lam,
+                   double *ve, double *a0, double *fq) {
+    int64_t n = md->n, N = s->N, mu = s->mu, r = s->r;
+    int64_t nq1 = nq > 0 ? nq : 1, cc[nq1], cp[nq1];
+    double *g = s->B, *x = s->B + r, *work = s->B + 2 * r;
+    /* v_e: C v_e = [f'; 0]; v = C^+ [f'; q'] = v_e + T q' */
+    for (int64_t k = 0; k < mu; k++) g[k] = s->fp[k];
+    for (int64_t k = 0; k < nq; k++) g[mu + k] = 0.0;
+    qr_solve(s->C, r, N, s->scale, s->beta, s->rdiag, g, 1);
+    for (int64_t i = 0; i < N; i++) ve[i] = g[i];
+    for (int64_t k = 0; k < mu; k++) g[k] = s->fp[k];
+    for (int64_t k = 0; k < nq; k++) g[mu + k] = qd[k];
+    qr_solve(s->C, r, N, s->scale, s->beta, s->rdiag, g, 1);
     double *v = s->y + 7 * n, *om = s->y + 10 * n;
     memset(v, 0, sizeof(double) * 6 * n);
     for (int64_t i = 0; i < 6 * n; i++) {
         int64_t j = s->col_of[i];
         if (j < 0) continue;
-        double x = ve[j];
-        for (int64_t k = 0; k < nq; k++) x += T[j * nq + k] * qd[k];
-        if (i % 6 < 3) v[3 * (i / 6) + i % 6] = x;
-        else om[3 * (i / 6) + i % 6 - 3] = x;
+        if (i % 6 < 3) v[3 * (i / 6) + i % 6] = g[j];
+        else om[3 * (i / 6) + i % 6 - 3] = g[j];
     }
-    rows_at(md, w, s, nq, Iq, cc, cp, NULL);
-    /* a0: C a0 = [gamma_U; gamma_A] (the drivers' f'' is in gamma_U) */
-    double *g = s->B;
+    rows_at(md, w, s, nq, Iq, cc, cp, NULL); /* gamma at the velocities */
     for (int64_t k = 0; k < mu; k++) g[k] = w->gamma[u->U[k]];
     for (int64_t k = 0; k < nq; k++) g[mu + k] = s->agam[k];
-    qr_solve(s->C, r, N, s->scale, s->beta, rdiag, g, 1);
+    qr_solve(s->C, r, N, s->scale, s->beta, s->rdiag, g, 1);
     for (int64_t i = 0; i < N; i++) a0[i] = g[i];
     /* Q - b + G_K lam_K at the state */
     mb_loads_at(md, w);
@@ -360,34 +379,59 @@ static void evaluate(const mb_model *md, const mb_unknowns *u, mb_work *w, gen_s
                 for (int a = 0; a < 6; a++) s->r6[6 * p + a] += w->parent6[6 * i + a] * li;
         }
     }
-    /* M_q = T^T M T, f_q = T^T (r6 - M a0), body by body */
-    if (Mq != NULL) memset(Mq, 0, sizeof(double) * nq * nq);
-    for (int64_t k = 0; k < nq; k++) fq[k] = 0.0;
-    double MT[6 * nq1];
+    /* x = r6 - M a0 on the model's columns, then f = T^T x */
     for (int64_t b = 0; b < n; b++) {
         const double *body = md->bodies + MB_BODY_W * b, *J = body + B_J;
-        double mass = body[B_MASS];
-        int64_t jc[6];
-        double acc[6], rest[6], Macc[6];
+        double acc[6];
         for (int a = 0; a < 6; a++) {
-            jc[a] = s->col_of[6 * b + a];
-            acc[a] = jc[a] >= 0 ? a0[jc[a]] : 0.0;
+            int64_t j = s->col_of[6 * b + a];
+            acc[a] = j >= 0 ? a0[j] : 0.0;
         }
-        for (int a = 0; a < 3; a++) {
-            Macc[a] = mass * acc[a];
-            Macc[3 + a] = J[3 * a] * acc[3] + J[3 * a + 1] * acc[4] + J[3 * a + 2] * acc[5];
+        for (int a = 0; a < 6; a++) {
+            int64_t j = s->col_of[6 * b + a];
+            if (j < 0) continue;
+            double Ma = a < 3 ? body[B_MASS] * acc[a]
+                              : J[3 * (a - 3)] * acc[3] + J[3 * (a - 3) + 1] * acc[4] +
+                                    J[3 * (a - 3) + 2] * acc[5];
+            x[j] = s->r6[6 * b + a] - Ma;
         }
-        for (int a = 0; a < 6; a++) rest[a] = jc[a] >= 0 ? s->r6[6 * b + a] - Macc[a] : 0.0;
+    }
+    qr_transposed(s->C, r, N, s->scale, s->beta, s->rdiag, x, mu, nq, fq, work);
+}
+
+/* T (N x nq) from the factors: C T = [0; I]; returns the residual's norm (0 on the
+ * configuration manifold). */
+static double transformation(gen_scratch *s, int64_t nq, double *T) {
+    int64_t N = s->N, mu = s->mu, r = s->r;
+    double *g = s->B, resid = 0.0;
+    for (int64_t k = 0; k < nq; k++) {
+        memset(g, 0, sizeof(double) * r);
+        g[mu + k] = 1.0;
+        double e = qr_solve(s->C, r, N, s->scale, s->beta, s->rdiag, g, 1);
+        resid += e * e;
+        for (int64_t i = 0; i < N; i++) T[i * nq + k] = g[i];
+    }
+    return sqrt(resid);
+}
+
+/* M_q = T^T M T, body by body. */
+static void mass(const mb_model *md, const gen_scratch *s, int64_t nq, const double *T,
+                 double *Mq) {
+    int64_t nq1 = nq > 0 ? nq : 1;
+    double MT[6 * nq1];
+    memset(Mq, 0, sizeof(double) * nq * nq);
+    for (int64_t b = 0; b < md->n; b++) {
+        const double *body = md->bodies + MB_BODY_W * b, *J = body + B_J;
+        int64_t jc[6];
+        for (int a = 0; a < 6; a++) jc[a] = s->col_of[6 * b + a];
         for (int64_t k = 0; k < nq; k++) {
             double tc[6];
             for (int a = 0; a < 6; a++) tc[a] = jc[a] >= 0 ? T[jc[a] * nq + k] : 0.0;
             for (int a = 0; a < 3; a++) {
-                MT[a * nq + k] = mass * tc[a];
+                MT[a * nq + k] = body[B_MASS] * tc[a];
                 MT[(3 + a) * nq + k] = J[3 * a] * tc[3] + J[3 * a + 1] * tc[4] + J[3 * a + 2] * tc[5];
             }
-            for (int a = 0; a < 6; a++) fq[k] += tc[a] * rest[a];
         }
-        if (Mq == NULL) continue;
         for (int a = 0; a < 6; a++) {
             if (jc[a] < 0) continue;
             const double *Ta = T + jc[a] * nq;
@@ -397,17 +441,11 @@ static void evaluate(const mb_model *md, const mb_unknowns *u, mb_work *w, gen_s
             }
         }
     }
-    if (Mq != NULL) /* symmetric in exact arithmetic: made so to the last bit */
-        for (int64_t k = 0; k < nq; k++)
-            for (int64_t l = k + 1; l < nq; l++) {
-                double m = 0.5 * (Mq[k * nq + l] + Mq[l * nq + k]);
-                Mq[k * nq + l] = Mq[l * nq + k] = m;
-            }
-    if (qd_out != NULL) memcpy(qd_out, qd, sizeof(double) * nq);
-    if (info != NULL) {
-        info[MB_GI_RANK] = ratio;
-        info[MB_GI_RESIDUAL] = resid;
-    }
+    for (int64_t k = 0; k < nq; k++) /* symmetric in exact arithmetic: made so */
+        for (int64_t l = k + 1; l < nq; l++) {
+            double m = 0.5 * (Mq[k * nq + l] + Mq[l * nq + k]);
+            Mq[k * nq + l] = Mq[l * nq + k] = m;
+        }
 }
 
 int mb_generalized(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
@@ -415,12 +453,62 @@ int mb_generalized(const mb_model *md, const mb_unknowns *u, mb_work *w, double 
                    int64_t nc, const int64_t *cols, const double *qdot, double *out) {
     gen_scratch s;
     if (scratch_new(&s, md, u, nq, nc, cols) < 0) return -1;
-    int64_t N = nc;
-    memcpy(s.y, y, sizeof(double) * 13 * md->n);
+    int64_t N = nc, n = md->n, nq1 = nq > 0 ? nq : 1, cc[nq1], cp[nq1];
+    memcpy(s.y, y, sizeof(double) * 13 * n);
     mb_eval_all(md, w, t);
     double *T = out, *ve = T + N * nq, *a0 = ve + N, *Mq = a0 + N, *fq = Mq + nq * nq;
-    double *qv = fq + nq, *qd = qv + nq, *info = qd + nq;
-    evaluate(md, u, w, &s, nq, Iq, qdot, lam, T, ve, a0, Mq, fq, qv, qd, info);
+    double *qv = fq + nq, *qd = qv + nq, *scale = qd + nq, *info = scale + nq;
+    double ratio = factor(md, u, w, &s, nq, Iq, cc, cp, qv);
+    for (int64_t k = 0; k < nq; k++)
+        qd[k] = qdot ? qdot[k] : row_dot_v(s.arow + 12 * k, cc[k], cp[k], y, n, s.col_of);
+    double resid = transformation(&s, nq, T);
+    forces(md, u, w, &s, nq, Iq, qd, lam, ve, a0, fq);
+    mass(md, &s, nq, T, Mq);
+    info[MB_GI_RANK] = ratio;
+    info[MB_GI_RESIDUAL] = resid;
+    /* the magnitude of the terms that make each f_q (what its rounding is relative to):
+     * per group of rows (translations, rotations) the largest entry of T's column times
+     * the sum over the group's rows of |m g|, each load's and spring end's |share|, |b|,
+     * |G_K lam_K| and |M a0| */
+    int64_t nl = md->k + 2 * md->s;
+    double *Q = malloc(sizeof(double) * (size_t)(12 * (n > 0 ? n : 1) + 7 * (nl > 0 ? nl : 1)));
+    if (Q == NULL) {
+        scratch_free(&s);
+        return -1;
+    }
+    double *b = Q + 6 * n, *shares = b + 6 * n, sum[2] = {0.0, 0.0};
+    mb_wrench_parts(md, w, t, s.y, Q, b);
+    mb_load_wrenches_at(md, w, s.y, shares);
+    for (int64_t l = 0; l < nl; l++) {
+        int64_t body = (int64_t)shares[7 * l];
+        if (body < 0) continue;
+        for (int a = 0; a < 6; a++)
+            if (s.col_of[6 * body + a] >= 0) sum[a >= 3] += fabs(shares[7 * l + 1 + a]);
+    }
+    for (int64_t c = 0; c < 6 * n; c++) {
+        int64_t j = s.col_of[c];
+        if (j < 0) continue;
+        int64_t body = c / 6, a = c % 6;
+        const double *bd = md->bodies + MB_BODY_W * body;
+        double Ma = a < 3 ? bd[B_MASS] * fabs(a0[j]) : 0.0;
+        if (a >= 3)
+            for (int e = 0; e < 3; e++) {
+                int64_t je = s.col_of[6 * body + 3 + e];
+                if (je >= 0) Ma += fabs(bd[B_J + 3 * (a - 3) + e] * a0[je]);
+            }
+        double gravity = a < 3 ? bd[B_MASS] * fabs(md->gravity[a]) : 0.0;
+        double known = fabs(s.r6[c] - (Q[c] - b[c]));
+        sum[a >= 3] += gravity + fabs(b[c]) + known + Ma;
+    }
+    for (int64_t k = 0; k < nq; k++) {
+        double tau[2] = {0.0, 0.0};
+        for (int64_t c = 0; c < 6 * n; c++) {
+            int64_t j = s.col_of[c];
+            if (j >= 0) tau[c % 6 >= 3] = fmax(tau[c % 6 >= 3], fabs(T[j * nq + k]));
+        }
+        scale[k] = fmax(tau[0] * sum[0] + tau[1] * sum[1], fabs(fq[k]));
+    }
+    free(Q);
     scratch_free(&s);
     return 0;
 }
@@ -457,40 +545,38 @@ int mb_generalized_perturbed(const mb_model *md, const mb_unknowns *u, mb_work *
                              const double *qdot0, int64_t np, const double *P, double *fout) {
     gen_scratch s;
     if (scratch_new(&s, md, u, nq, nc, cols) < 0) return -1;
-    int64_t N = nc, n = md->n;
-    size_t big = (size_t)(N * (nq > 0 ? nq : 1) + 3 * (N > 0 ? N : 1) + nq * nq + 4 * nq + 16);
-    double *buf = malloc(big * sizeof(double));
-    double *ystart = malloc(sizeof(double) * 13 * (n > 0 ? n : 1));
-    if (buf == NULL || ystart == NULL) {
-        free(buf), free(ystart);
+    int64_t N = nc, n = md->n, nq1 = nq > 0 ? nq : 1, cc[nq1], cp[nq1];
+    double *buf = malloc(sizeof(double) * (size_t)(N * nq1 + 3 * (N > 0 ? N : 1) + 13 * (n > 0 ? n : 1)));
+    if (buf == NULL) {
         scratch_free(&s);
         return -1;
     }
-    double *T0 = buf, *ve = T0 + N * nq, *a0 = ve + N, *d = a0 + N, *fq = d + N;
+    double *T0 = buf, *ve = T0 + N * nq, *a0 = ve + N, *d = a0 + N, *ystart = d + N;
+    double qd[nq1];
     mb_eval_all(md, w, t);
     memcpy(s.y, y0, sizeof(double) * 13 * n);
     memcpy(ystart, y0, sizeof(double) * 13 * n);
-    evaluate(md, u, w, &s, nq, Iq, qdot0, lam, T0, ve, a0, NULL, fq, NULL, NULL, NULL);
-    double *T = malloc(sizeof(double) * (size_t)(N * (nq > 0 ? nq : 1)));
-    double qd[nq > 0 ? nq : 1];
-    if (T == NULL) {
-        free(buf), free(ystart);
-        scratch_free(&s);
-        return -1;
-    }
+    factor(md, u, w, &s, nq, Iq, cc, cp, NULL);
+    transformation(&s, nq, T0);
+    int factored = 1; /* C's factors are those of y0's positions */
     for (int64_t p = 0; p < np; p++) {
         const double *dq = P + 2 * nq * p, *du = dq + nq;
-        for (int64_t i = 0; i < N; i++) {
-            double x = 0.0;
-            for (int64_t k = 0; k < nq; k++) x += T0[i * nq + k] * dq[k];
-            d[i] = x;
+        int moved = 0;
+        for (int64_t k = 0; k < nq; k++) moved |= dq[k] != 0.0;
+        if (moved || !factored) {
+            for (int64_t i = 0; i < N; i++) {
+                double x = 0.0;
+                for (int64_t k = 0; k < nq; k++) x += T0[i * nq + k] * dq[k];
+                d[i] = x;
+            }
+            move(md, &s, ystart, d, s.y);
+            factor(md, u, w, &s, nq, Iq, cc, cp, NULL);
+            factored = !moved;
         }
-        move(md, &s, ystart, d, s.y);
         for (int64_t k = 0; k < nq; k++) qd[k] = qdot0[k] + du[k];
-        evaluate(md, u, w, &s, nq, Iq, qd, lam, T, ve, a0, NULL, fout + nq * p, NULL, NULL,
-                 NULL);
+        forces(md, u, w, &s, nq, Iq, qd, lam, ve, a0, fout + nq * p);
     }
-    free(T), free(buf), free(ystart);
+    free(buf);
     scratch_free(&s);
     return 0;
 }
@@ -517,4 +603,54 @@ int mb_coordinate_rows(const mb_model *md, mb_work *w, double t, const double *y
     }
     free(col_of);
     return 0;
+}
+
+int mb_differences(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
+                   const double *y0, const double *lam, int64_t nq, const int64_t *Iq,
+                   int64_t nc, const int64_t *cols, const double *qdot0, const double *h,
+                   const double *hu, const double *fscale, double rounding,
+                   const int64_t *skip, double *out) {
+    static const double step[6] = {1.0, -1.0, 0.5, -0.5, 0.25, -0.25};
+    int64_t moved = 0;
+    for (int64_t j = 0; j < nq; j++) moved += skip[j] ? 0 : 1;
+    int64_t np_ = 6 * moved + 2 * nq; /* velocity rows last: they reuse one factorisation */
+    double *P = calloc((size_t)(np_ * 2 * nq + np_ * nq + 1), sizeof(double));
+    if (P == NULL) return -1;
+    double *f = P + np_ * 2 * nq;
+    int64_t row = 0;
+    for (int64_t j = 0; j < nq; j++) {
+        if (skip[j]) continue;
+        for (int s = 0; s < 6; s++) P[(row + s) * 2 * nq + j] = step[s] * h[j];
+        row += 6;
+    }
+    for (int64_t j = 0; j < nq; j++) {
+        P[(row + 2 * j) * 2 * nq + nq + j] = hu[j];
+        P[(row + 2 * j + 1) * 2 * nq + nq + j] = -hu[j];
+    }
+    int status = mb_generalized_perturbed(md, u, w, t, y0, lam, nq, Iq, nc, cols, qdot0, np_,
+                                          P, f);
+    double *K = out, *Kerr = K + nq * nq, *D = Kerr + nq * nq, *Derr = D + nq * nq;
+    row = 0;
+    for (int64_t j = 0; j < nq && status == 0; j++) {
+        const double *fj = f + row * nq, *fu = f + (6 * moved + 2 * j) * nq;
+        for (int64_t i = 0; i < nq; i++) {
+            if (skip[j]) {
+                K[i * nq + j] = Kerr[i * nq + j] = 0.0;
+            } else {
+                double d0 = (fj[0 * nq + i] - fj[1 * nq + i]) / (2.0 * h[j]);
+                double d1 = (fj[2 * nq + i] - fj[3 * nq + i]) / (1.0 * h[j]);
+                double d2 = (fj[4 * nq + i] - fj[5 * nq + i]) / (0.5 * h[j]);
+                double r1 = (4.0 * d1 - d0) / 3.0, r2 = (4.0 * d2 - d1) / 3.0;
+                K[i * nq + j] = -(16.0 * r2 - r1) / 15.0;
+                Kerr[i * nq + j] =
+                    fabs(r1 - r2) / 15.0 + 4.0 * rounding * fscale[i] / (0.25 * h[j]);
+            }
+            D[i * nq + j] = -(fu[i] - fu[nq + i]) / (2.0 * hu[j]);
+            double big = fmax(fscale[i], fmax(fabs(fu[i]), fabs(fu[nq + i])));
+            Derr[i * nq + j] = 4.0 * rounding * big / hu[j];
+        }
+        if (!skip[j]) row += 6;
+    }
+    free(P);
+    return status;
 }

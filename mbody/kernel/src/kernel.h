@@ -231,10 +231,13 @@ void mb_project(const mb_model *md, const mb_unknowns *u, mb_work *w, double t, 
  * w3 per body; a particle's rotations left out), increasing. The held components are the
  * unknowns' U; known components' values (lam) act as loads.
  * mb_generalized's out: [T (N x nq) | v_e (N) | a0 (N) | M_q (nq x nq) | f_q (nq) |
- * q (nq) | q' (nq) | info (MB_GENERALIZED_INFO)] with N = nc, so that v = T q' + v_e and
+ * q (nq) | q' (nq) | f_scale (nq) | info (MB_GENERALIZED_INFO)] with N = nc, so that v = T q' + v_e and
  * v' = T q'' + a0 keep every held component (drivers' laws included) and
  * M_q q'' = f_q = T^T (Q - b + G_K lam_K - M a0). q' is the given one, or (qdot NULL)
  * A^T v of y's velocities; y's own velocities are otherwise not used.
+ * f_scale: the magnitude of the terms each f_q is made of (per group of rows,
+ * translations and rotations, the largest entry of T's column times the sum over the
+ * group of |Q| + |b| + |G_K lam_K| + |M a0|), what its rounding error is relative to.
  * info: [smallest |R_kk| / largest of the scaled QR of C = [G_U^T; A^T] (0: the
  * coordinates do not determine the motion), the least-squares residual of C T = [0; I]
  * (0 on the configuration manifold)].
@@ -262,5 +265,36 @@ int mb_generalized_perturbed(const mb_model *md, const mb_unknowns *u, mb_work *
                              const double *y0, const double *lam, int64_t nq,
                              const int64_t *Iq, int64_t nc, const int64_t *cols,
                              const double *qdot0, int64_t np, const double *P, double *fout);
+/* The linearisation's differences at y0 (rates q0'): K = -df_q/dq by central differences at
+ * steps h, h/2, h/4 per coordinate (h: nq) extrapolated twice (Richardson, O(h^6)), with the
+ * error bound |R1 - R2| / 15 + 4 rounding fscale_i / (h_j / 4); D = -df_q/dq' by one central
+ * difference at steps hu (exact for f quadratic in q'), error 4 rounding max|f| / hu.
+ * A coordinate with skip[j] != 0 is known not to enter f (a free body's position without
+ * springs...): its K column is 0 without evaluations.
+ * out: [K | K_err | D | D_err], each nq x nq (row i: the equation, column j: the
+ * coordinate). Returns 0, or -1 when memory ran out. */
+int mb_differences(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
+                   const double *y0, const double *lam, int64_t nq, const int64_t *Iq,
+                   int64_t nc, const int64_t *cols, const double *qdot0, const double *h,
+                   const double *hu, const double *fscale, double rounding,
+                   const int64_t *skip, double *out);
+/* The linearisation about (t, y) (linearize.c): mb_generalized there, mb_differences with
+ * steps params[MB_LP_STEP] x scales (positions) and the rates' scale (rates), the residual
+ * q'' = M^-1 f, steadiness (every |f_i| <= params[MB_LP_STEADY] f_scale_i, and no moving
+ * coordinate whose K column exceeds 10 x its error), the coordinates left out (cyclic and
+ * moving, or a quasi-velocity's angle: their K columns zeroed), the first-order matrix
+ * A = [[0, E], [-M^-1 K_kept, -M^-1 D]] and the tolerance sqrt(|M^-1| (|dK| + |dD|) |A|)
+ * (infinity norms; at least 1e3 eps |A|) on its eigenvalues. out: [mb_generalized's out |
+ * K | K_err | D | D_err (nq x nq each) | q'' (nq) | left out (nq, 0/1) | A (nz x nz in a
+ * slot of (2 nq)^2) | info (MB_LINEARIZE_INFO)], nz = kept + nq. Returns 0, or -1 when
+ * memory ran out. */
+enum { MB_LP_STEP = 0, MB_LP_ROUNDING = 1, MB_LP_STEADY = 2, MB_LP_MOVING = 3,
+       MB_LINEARIZE_PARAMS = 4 };
+enum { MB_LI_STEADY = 0, MB_LI_UNSTEADY = 1, MB_LI_TOL = 2, MB_LI_KEPT = 3,
+       MB_LI_SINGULAR = 4, MB_LINEARIZE_INFO = 5 };
+int mb_linearize(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
+                 const double *y, const double *lam, int64_t nq, const int64_t *Iq,
+                 int64_t nc, const int64_t *cols, const double *scales, const int64_t *quasi,
+                 const int64_t *skip, const double *params, double *out);
 
 #endif
