@@ -37,7 +37,8 @@ TARGET = 50.0
 
 
 def models(quick: bool) -> list[Path]:
-    out = sorted((ROOT / "models").glob("*.yaml")) + sorted((ROOT / "models" / "robots").glob("*.xml"))
+    out = sorted((ROOT / "models").glob("*.yaml"))
+    out += sorted((ROOT / "models" / "robots").glob("*.xml"))
     return out[:6] if quick else out
 
 
