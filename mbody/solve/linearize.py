@@ -20,8 +20,8 @@ linear ones), so a central difference in q' is exact up to rounding. In q, centr
 differences at steps h, h/2 and h/4 (h = 0.01 rad, or 0.01 of the model's size) are
 combined by Richardson's extrapolation twice (error O(h⁶)); the error is bounded by the
 estimated error of the second-to-last extrapolation (|R₁ − R₂|/15), plus the rounding of f
-(1e2 ε of the magnitude of the terms that make it, `Generalized.f_scale`, over the
-smallest step). Each perturbed state moves the bodies along T e_k by their exponential
+(10 ε of the magnitude of the terms that make it, `Generalized.f_scale`, times the
+projection's condition, over the smallest step). Each perturbed state moves the bodies along T e_k by their exponential
 maps: a curve through the state whose tangent is the coordinate's direction, which is
 all a derivative at the state needs (the compiled core evaluates f at all of them in one
 call, kernel.h: ``mb_generalized_perturbed``).
@@ -46,8 +46,11 @@ from mbody.solve.configure import move
 
 STEP = 1e-2
 """The largest of the three position steps (rad; times the model's size for lengths)."""
-ROUNDING = 1e2 * np.finfo(float).eps
-"""Relative rounding error of one evaluation of f, against its largest part."""
+ROUNDING = 10 * np.finfo(float).eps
+"""Relative rounding error of one evaluation of f against the terms it is made of
+(`Generalized.f_scale`), per unit of the projection's condition (the core divides it by
+the pivot ratio of [Gᵀ; Aᵀ]'s QR): a few sums of products and one backward-stable solve
+of a system of the model's size."""
 STEADY_RTOL = 1e-8
 """A state is steady when every generalized force is below this fraction of the terms
 that make it (`Generalized.f_scale`)."""

@@ -468,8 +468,8 @@ int mb_generalized(const mb_model *md, const mb_unknowns *u, mb_work *w, double 
     info[MB_GI_RESIDUAL] = resid;
     /* the magnitude of the terms that make each f_q (what its rounding is relative to):
      * per group of rows (translations, rotations) the largest entry of T's column times
-     * the sum over the group's rows of |m g|, each load's and spring end's |share|, |b|,
-     * |G_K lam_K| and |M a0| */
+     * the sum over the group's rows of |m g|, each load's and spring end's |share|,
+     * |w| |J w|, |G_K lam_K| and |M a0| */
     int64_t nl = md->k + 2 * md->s;
     double *Q = malloc(sizeof(double) * (size_t)(12 * (n > 0 ? n : 1) + 7 * (nl > 0 ? nl : 1)));
     if (Q == NULL) {
@@ -498,7 +498,17 @@ int mb_generalized(const mb_model *md, const mb_unknowns *u, mb_work *w, double 
             }
         double gravity = a < 3 ? bd[B_MASS] * fabs(md->gravity[a]) : 0.0;
         double known = fabs(s.r6[c] - (Q[c] - b[c]));
-        sum[a >= 3] += gravity + fabs(b[c]) + known + Ma;
+        /* the gyroscopic term's own size |w| |J w| (w x J w cancels about a principal axis) */
+        double gyro = 0.0;
+        if (a >= 3) {
+            const double *om = s.y + 10 * n + 3 * body, *J = bd + B_J;
+            double h0 = J[0] * om[0] + J[1] * om[1] + J[2] * om[2];
+            double h1 = J[3] * om[0] + J[4] * om[1] + J[5] * om[2];
+            double h2 = J[6] * om[0] + J[7] * om[1] + J[8] * om[2];
+            gyro = sqrt(om[0] * om[0] + om[1] * om[1] + om[2] * om[2]) *
+                   sqrt(h0 * h0 + h1 * h1 + h2 * h2);
+        }
+        sum[a >= 3] += gravity + fmax(fabs(b[c]), gyro) + known + Ma;
     }
     for (int64_t k = 0; k < nq; k++) {
         double tau[2] = {0.0, 0.0};

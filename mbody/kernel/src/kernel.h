@@ -237,7 +237,8 @@ void mb_project(const mb_model *md, const mb_unknowns *u, mb_work *w, double t, 
  * A^T v of y's velocities; y's own velocities are otherwise not used.
  * f_scale: the magnitude of the terms each f_q is made of (per group of rows,
  * translations and rotations, the largest entry of T's column times the sum over the
- * group of |Q| + |b| + |G_K lam_K| + |M a0|), what its rounding error is relative to.
+ * group of |m g|, each load's |share|, |w| |J w|, |G_K lam_K| and |M a0|), what its
+ * rounding error is relative to.
  * info: [smallest |R_kk| / largest of the scaled QR of C = [G_U^T; A^T] (0: the
  * coordinates do not determine the motion), the least-squares residual of C T = [0; I]
  * (0 on the configuration manifold)].
@@ -283,7 +284,9 @@ int mb_differences(const mb_model *md, const mb_unknowns *u, mb_work *w, double 
  * q'' = M^-1 f, steadiness (every |f_i| <= params[MB_LP_STEADY] f_scale_i, and no moving
  * coordinate whose K column exceeds 10 x its error), the coordinates left out (cyclic and
  * moving, or a quasi-velocity's angle: their K columns zeroed), the first-order matrix
- * A = [[0, E], [-M^-1 K_kept, -M^-1 D]] and the tolerance sqrt(|M^-1| (|dK| + |dD|) |A|)
+ * A = [[0, E], [-M^-1 K_kept, -M^-1 D]] (params[MB_LP_ROUNDING], the rounding of one
+ * evaluation of f relative to f_scale, is divided by the projection's pivot ratio) and
+ * the tolerance sqrt(|M^-1| (|dK| + |dD|) |A|)
  * (infinity norms; at least 1e3 eps |A|) on its eigenvalues. out: [mb_generalized's out |
  * K | K_err | D | D_err (nq x nq each) | q'' (nq) | left out (nq, 0/1) | A (nz x nz in a
  * slot of (2 nq)^2) | info (MB_LINEARIZE_INFO)], nz = kept + nq. Returns 0, or -1 when

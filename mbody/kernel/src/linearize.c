@@ -62,6 +62,10 @@ int mb_linearize(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
     rate = fmax(rate, sqrt(Fmax / fmax(Mmax, 1e-300)));
     for (int64_t i = 0; i < k; i++) rate = fmax(rate, fabs(qd[i]) / scales[i]);
     for (int64_t i = 0; i < k; i++) h[i] = step * scales[i], hu[i] = rate * scales[i];
+    /* one evaluation of f errs by about rounding x f_scale x cond(C) (the projection's
+     * QR: its pivot ratio bounds the condition from below; the factor is what its
+     * backward stability allows) */
+    rounding /= fmax(ginfo[MB_GI_RANK], 1e-8);
     if (mb_differences(md, u, w, t, y, lam, nq, Iq, nc, cols, qd, h, hu, F, rounding, skip,
                        K) < 0) {
         free(buf);
