@@ -308,3 +308,73 @@ def test_unknown_coordinate_has_a_did_you_mean():
         mbody.assemble(model).generalized(["O.angle", "A.angle", "upper.x"])
     with pytest.raises(MbodyError, match="does not add a motion"):
         mbody.assemble(model).generalized(["O.angle", "upper.theta"])
+
+
+# -- symbolic -----------------------------------------------------------------------------
+
+
+def test_double_pendulum_symbolic_equals_sympy_lagrangesmethod():
+    """M(q) and f(q, q') in symbols equal SymPy's LagrangesMethod on the same pendulum,
+    symbolically (the difference expands to 0), with the masses, inertias, g, the spring's
+    k and L0 and the couple as symbols and the lengths the file's numbers, exactly."""
+    sm = pytest.importorskip("sympy")
+    me = pytest.importorskip("sympy.physics.mechanics")
+    p = DP
+    model = mbody.loads(dp_yaml())
+    sym = mbody.assemble(model).generalized().symbolic()
+    R = sm.Rational
+    m1, m2, I1, I2, g, k, L0, tau = sm.symbols("m_upper m_lower I_upper I_lower g k_k L0_k "
+                                               "M_tau")
+    q1, q2 = me.dynamicsymbols("q1 q2")
+    u1, u2 = me.dynamicsymbols("q1 q2", 1)
+    N = me.ReferenceFrame("N")
+    B1 = N.orientnew("B1", "Axis", [q1, N.z])
+    B2 = N.orientnew("B2", "Axis", [q1 + q2, N.z])
+    O = me.Point("O")
+    O.set_vel(N, 0)
+    G1 = O.locatenew("G1", -R(p["a1"]) * B1.y)  # the upper rod's joint point O at (0, a1)
+    J = G1.locatenew("J", R(p["a1"] - p["L1"]) * B1.y)  # A at (0, a1 - L1) on it
+    G2 = J.locatenew("G2", -R(p["a2"]) * B2.y)
+    for pt, base, fr in ((G1, O, B1), (J, O, B1), (G2, J, B2)):
+        pt.v2pt_theory(base, N, fr)
+    bodies = (me.RigidBody("b1", G1, B1, m1, (me.inertia(B1, 0, 0, I1), G1)),
+              me.RigidBody("b2", G2, B2, m2, (me.inertia(B2, 0, 0, I2), G2)))
+    S = O.locatenew("S", R(p["sx"]) * N.x + R(p["sy"]) * N.y)
+    r = G2.pos_from(S)
+    length = sm.sqrt(r.dot(r))
+    forces = [(G1, -m1 * g * N.y), (G2, -m2 * g * N.y - k * (length - L0) * r / length),
+              (B2, tau * N.z)]
+    lm = me.LagrangesMethod(me.Lagrangian(N, *bodies), [q1, q2], forcelist=forces, frame=N)
+    lm.form_lagranges_equations()
+    subs = {u1: sym.qdot[0], u2: sym.qdot[1], q1: sym.q[0], q2: sym.q[1]}
+
+    def canonical(e):  # polynomial in cos and sin of each coordinate, sin² = 1 − cos²
+        e = sm.expand(sm.expand_trig(e))
+        return sm.expand(e.subs({sm.sin(x) ** 2: 1 - sm.cos(x) ** 2 for x in sym.q}))
+
+    for mine, theirs in ((sym.M, lm.mass_matrix), (sym.f, lm.forcing)):
+        theirs = me.msubs(theirs, subs)
+        for a, b in zip(mine, theirs, strict=True):
+            assert canonical(a - b) == 0
+    # compact: each mass-matrix entry is a sum of terms with at most one cos or sin
+    for entry in sym.M:
+        for term in sm.Add.make_args(entry):
+            assert len([f for f in sm.Mul.make_args(term) if isinstance(f, (sm.sin, sm.cos))]) <= 1
+    assert sym.M[0, 1].has(sm.cos(sym.q[1]))  # cos(A.angle): the relative angle, compact
+    # and they evaluate to the numeric equations at random states
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        q, qd = rng.uniform(-3, 3, 2), rng.normal(size=2)
+        g_ = mbody.assemble(model, dp_state(q, qd)).generalized()
+        M, f = sym.evaluate(q, qd)
+        assert np.abs(M - g_.M).max() <= 1e-12 * np.abs(M).max()
+        assert np.abs(f - g_.f).max() <= 1e-12 * max(np.abs(f).max(), 1.0)
+
+
+def test_symbolic_refuses_a_closed_loop():
+    pytest.importorskip("sympy")
+    from mbody.equations.symbolic.lagrange import NotSymbolicError
+
+    model = mbody.load(MODELS[0].parent / "fourbar_planar.yaml")
+    with pytest.raises(NotSymbolicError, match="close a loop"):
+        mbody.assemble(model).generalized().symbolic()
