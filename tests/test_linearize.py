@@ -184,7 +184,7 @@ def fb_angles(q: float):
 
 def fb_hand(q: float):
     """V'(q), V''(q) and I_eq(q) of the four-bar by hand."""
-    a, b, c, d = FB["a"], FB["b"], FB["c"], FB["d"]
+    a, b, c = FB["a"], FB["b"], FB["c"]
     m1, m2, m3 = FB["m"]
     g = FB["g"]
     (t3, t4), (w3, w4), (al3, al4) = fb_angles(q)
@@ -196,12 +196,10 @@ def fb_hand(q: float):
         return np.array([-np.sin(t), np.cos(t)])
 
     # mass centres and their first and second derivatives by q
-    G1, G1p, G1pp = a / 2 * e(q), a / 2 * ep(q), -a / 2 * e(q)
+    G1p, G1pp = a / 2 * ep(q), -a / 2 * e(q)
     A, Ap, App = a * e(q), a * ep(q), -a * e(q)
-    G2 = A + b / 2 * e(t3)
     G2p = Ap + b / 2 * ep(t3) * w3
     G2pp = App + b / 2 * (ep(t3) * al3 - e(t3) * w3**2)
-    G3 = np.array([d, 0.0]) + c / 2 * e(t4)
     G3p = c / 2 * ep(t4) * w4
     G3pp = c / 2 * (ep(t4) * al4 - e(t4) * w4**2)
     Vp = g * (m1 * G1p[1] + m2 * G2p[1] + m3 * G3p[1])
@@ -244,7 +242,8 @@ gravity: [0, {-FB['g']!r}]
 bodies:
 {chr(10).join(bodies)}
 loads:
-  - {{name: k, type: spring, bodies: [ground, coupler], at: [{v(FB['S'])}, [{FB['u'] - b / 2!r}, 0]],
+  - {{name: k, type: spring, bodies: [ground, coupler],
+      at: [{v(FB['S'])}, [{FB['u'] - b / 2!r}, 0]],
       stiffness: {FB['k']!r}, rest_length: {FB['L0']!r}}}
 joints:
   - {{name: O2, type: revolute, parent: ground, child: crank, at: [0, 0]}}

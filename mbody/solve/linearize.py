@@ -21,10 +21,10 @@ differences at steps h, h/2 and h/4 (h = 0.01 rad, or 0.01 of the model's size) 
 combined by Richardson's extrapolation twice (error O(h⁶)); the error is bounded by the
 estimated error of the second-to-last extrapolation (|R₁ − R₂|/15), plus the rounding of f
 (10 ε of the magnitude of the terms that make it, `Generalized.f_scale`, times the
-projection's condition, over the smallest step). Each perturbed state moves the bodies along T e_k by their exponential
-maps: a curve through the state whose tangent is the coordinate's direction, which is
-all a derivative at the state needs (the compiled core evaluates f at all of them in one
-call, kernel.h: ``mb_generalized_perturbed``).
+projection's condition, over the smallest step). Each perturbed state moves the bodies
+along T e_k by their exponential maps: a curve through the state whose tangent is the
+coordinate's direction, which is all a derivative at the state needs (the compiled core
+evaluates f at all of them in one call, kernel.h: ``mb_linearize``).
 """
 
 from __future__ import annotations

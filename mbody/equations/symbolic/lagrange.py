@@ -1,7 +1,7 @@
 """Lagrange's equations of a planar tree in symbols: ``M(q) q'' = f(q, q')``.
 
     sym = mbody.assemble(model).generalized().symbolic()
-    print(sym.text())       # one equation per coordinate
+    print(sym)              # one equation per coordinate
     sym.M[0, 1]             # m_lower*L*a*cos(A.angle) + ...: a sympy expression
 
 Built the way a student derives them, from the kinematics of the tree: each body's angle
@@ -19,8 +19,9 @@ with gravity, every applied force and couple (by the symbols `mbody assemble --s
 uses: ``F_push_x``, ``M_motor``), every spring (``k_<spring>``, ``L0_<spring>``,
 ``c_<spring>``: its law written out) and a chosen driver's effort (``motor.M``) on its
 coordinate. The bodies' masses and inertias are symbols (``m_<body>``, ``I_<body>``),
-gravity is ``g``; lengths stay numbers, held exactly (as rationals) so that the forms are
-exact and print in six digits.
+gravity is ``g``; lengths stay numbers, held exactly (as the simplest rationals within
+1e-12 of the model's size: the file's 0.25 is 1/4, its rounding noise is 0) so that the
+forms are exact and print in six digits.
 
 Only planar mechanisms whose joints form a tree (closed loops have no closed-form
 dependent coordinates), in the default coordinates (`mbody.equations.coordinates`).
@@ -55,9 +56,20 @@ Term = tuple[sp.Expr, sp.Expr, tuple[sp.Expr, sp.Expr]]
 """``(s, α, u)``: the vector s R(α) u (R: rotation by α about z)."""
 
 
-def _exact(x: float) -> sp.Expr:
-    """A model's float, exactly (its binary value as a rational)."""
-    return sp.Rational(float(x)) if x != 0 else sp.Integer(0)
+CLEAN_RTOL = 1e-12
+"""A length within this fraction of the model's size of a simpler rational is that
+rational (0.24999999999999997 is 1/4; a component of 1e-17 is 0): the rounding of the
+model's own arithmetic (joint points from world coordinates, frames), not geometry."""
+
+
+def _exact(x: float, scale: float = 1.0) -> sp.Expr:
+    """A model's number as an exact rational: the simplest within `CLEAN_RTOL` of
+    `scale` (so that the forms are exact, and free of rounding noise)."""
+    x = float(x)
+    tol = CLEAN_RTOL * max(scale, abs(x))
+    if abs(x) <= tol:
+        return sp.Integer(0)
+    return sp.nsimplify(x, tolerance=tol, rational=True)
 
 
 def _perp(u: tuple[sp.Expr, sp.Expr]) -> tuple[sp.Expr, sp.Expr]:
@@ -146,17 +158,15 @@ class SymbolicLagrange:
                if not r.is_Integer and r.q > 1000}
         return expr.xreplace(big)
 
-    def text(self) -> str:
-        """The equations as text, one per coordinate, with what each symbol stands for."""
-        from mbody.present.lagrange import symbolic_text
+    def __str__(self) -> str:  # the equations as text, one per coordinate, with the values
+        from mbody.present.lagrange import symbolic_text  # a display hook
 
         return symbolic_text(self)
 
-    def latex(self) -> str:
-        """The equations as LaTeX (an ``align*`` environment's body)."""
-        from mbody.present.lagrange import symbolic_latex
+    def _repr_latex_(self) -> str:  # a notebook shows the equations as display math
+        from mbody.present.lagrange import symbolic_latex  # a display hook
 
-        return symbolic_latex(self)
+        return "$$\\begin{aligned}" + symbolic_latex(self) + "\\end{aligned}$$"
 
 
 def symbolic_lagrange(model: Model, cs: CoordinateSet) -> SymbolicLagrange:
@@ -186,13 +196,14 @@ def symbolic_lagrange(model: Model, cs: CoordinateSet) -> SymbolicLagrange:
             "closed form, so the Lagrange equations are numeric only (mbody lagrange MODEL)")
     qs = {c.label: sp.Symbol(c.label) for c in cs.items}
     by_source: dict[tuple[str, str], str] = {}
-    for c in cs.items:
-        if c.kind == _core.GQ_BODY:
-            by_source[(c.source, ("x", "y", "", "", "", "theta")[c.axis])] = c.label
+    for coord in cs.items:
+        if coord.kind == _core.GQ_BODY:
+            by_source[(coord.source, ("x", "y", "", "", "", "theta")[coord.axis])] = coord.label
         else:
-            by_source[(c.source, "angle" if c.kind == _core.GQ_TURN else "displacement")] = \
-                c.label
+            kind = "angle" if coord.kind == _core.GQ_TURN else "displacement"
+            by_source[(coord.source, kind)] = coord.label
     n = model.n
+    L = cs.length
     theta: list[sp.Expr | None] = [None] * n
     pos: list[list[Term] | None] = [None] * n
     ref = model.file_state if model.file_state is not None else model.initial
@@ -218,9 +229,9 @@ def symbolic_lagrange(model: Model, cs: CoordinateSet) -> SymbolicLagrange:
                 theta[c] = tp + qs[angle_label]
             else:
                 off = file_angle[c] - (file_angle[p] if p >= 0 else 0.0)
-                theta[c] = tp + _exact(off)
-            Brp = tuple(_exact(x) for x in jt.B_r_parent[j][:2])
-            Brc = tuple(_exact(-x) for x in jt.B_r_child[j][:2])
+                theta[c] = tp + _exact(off, 1.0)
+            Brp = tuple(_exact(x, L) for x in jt.B_r_parent[j][:2])
+            Brc = tuple(_exact(-x, L) for x in jt.B_r_child[j][:2])
             base: list[Term] = [(sp.Integer(1), tp, Brp)] if p >= 0 else \
                 [(sp.Integer(1), sp.Integer(0), Brp)]
             parent_pos = pos[p] if p >= 0 else []
@@ -228,7 +239,7 @@ def symbolic_lagrange(model: Model, cs: CoordinateSet) -> SymbolicLagrange:
             terms = [*parent_pos, *base]
             slide = by_source.get((joint.name, "displacement"))
             if slide is not None:
-                e = tuple(_exact(x) for x in jt.P_E3[j][:2, 0])
+                e = tuple(_exact(x, 1.0) for x in jt.P_E3[j][:2, 0])
                 terms.append((qs[slide], tp, e))
             terms.append((sp.Integer(1), theta[c], Brc))
             pos[c] = terms
@@ -264,13 +275,13 @@ def symbolic_lagrange(model: Model, cs: CoordinateSet) -> SymbolicLagrange:
     dM = [M.diff(qm) for qm in q]
     f = [sp.Integer(0)] * k
     for a in range(k):
-        s = []
+        terms = []
         for b in range(k):
-            for c in range(k):
-                gam = (dM[c][a, b] + dM[b][a, c] - dM[a][b, c]) / 2
+            for m_ in range(k):
+                gam = (dM[m_][a, b] + dM[b][a, m_] - dM[a][b, m_]) / 2
                 if gam != 0:
-                    s.append(gam * qd[b] * qd[c])
-        f[a] = -sp.expand(sp.Add(*s))
+                    terms.append(gam * qd[b] * qd[m_])
+        f[a] = -sp.expand(sp.Add(*terms))
     # gravity
     gnorm = float(np.linalg.norm(model.gravity))
     if gnorm > 0:
@@ -280,7 +291,7 @@ def symbolic_lagrange(model: Model, cs: CoordinateSet) -> SymbolicLagrange:
         down: list[Term] = [(sp.Integer(1), sp.Integer(0), ghat)]
         for a in range(k):
             f[a] += sp.expand(g * sp.Add(*(mass[i] * _dot(down, dpos[i][a]) for i in range(n))))
-    _loads(model, f, q, qd, thetas, positions, values)
+    _loads(model, f, q, qd, thetas, positions, values, L)
     efforts = {label: r for label, r in cs.efforts}
     return SymbolicLagrange(model.name, tuple(cs.labels), tuple(q), tuple(qd), tuple(qdd), M,
                             sp.Matrix(f), efforts, values)
@@ -288,7 +299,7 @@ def symbolic_lagrange(model: Model, cs: CoordinateSet) -> SymbolicLagrange:
 
 def _loads(model: Model, f: list[sp.Expr], q: list[sp.Symbol], qd: list[sp.Symbol],
            thetas: list[sp.Expr], positions: list[list[Term]],
-           values: dict[sp.Symbol, float]) -> None:
+           values: dict[sp.Symbol, float], L: float) -> None:
     """The applied forces, couples and springs' generalized forces, added to f."""
     ft, spg = model.forces, model.springs
     loads = {ld.name: ld for ld in model.loads}
@@ -316,14 +327,14 @@ def _loads(model: Model, f: list[sp.Expr], q: list[sp.Symbol], qd: list[sp.Symbo
         force: list[Term] = [(sp.Integer(1), thetas[b] if ft.in_body[j] else sp.Integer(0),
                               (comps[0], comps[1]))]
         point = [*positions[b], (sp.Integer(1), thetas[b],
-                                 (_exact(ft.B_r[j][0]), _exact(ft.B_r[j][1])))]
+                                 (_exact(ft.B_r[j][0], L), _exact(ft.B_r[j][1], L)))]
         for a in range(k):
             f[a] += _dot(force, _diff(point, q[a]))
     for s in range(len(spg.names)):
         name = spg.names[s]
         ends = []
         for body, r in ((int(spg.a[s]), spg.r_a[s]), (int(spg.b[s]), spg.r_b[s])):
-            r2 = (_exact(r[0]), _exact(r[1]))
+            r2 = (_exact(r[0], L), _exact(r[1], L))
             ends.append([*positions[body], (sp.Integer(1), thetas[body], r2)] if body >= 0
                         else [(sp.Integer(1), sp.Integer(0), r2)])
         d = ends[1] + [(-t[0], t[1], t[2]) for t in ends[0]]  # P_b − P_a
