@@ -7,7 +7,7 @@ columns of M, the rows of f), ``units``, ``quasi`` (1 for a quasi-velocity), ``q
 ``qdot``, ``M``, ``f``, ``body_coordinates`` (the rows of T, v_e and a0: the stacked
 equations' coordinates), ``T``, ``v_e``, ``a0`` (v = T q' + v_e, v' = T q'' + a0),
 ``efforts`` and ``effort_rows`` (a chosen driver's effort and the coordinate it acts on),
-``held`` (the reaction components held as constraints), ``model``, ``file``, ``t``,
+``held`` (the reaction components held as constraints), ``model``, ``model_file``, ``t``,
 ``equation`` ("M q'' = f (+ efforts on their rows)"). Written atomically.
 """
 
@@ -38,7 +38,7 @@ def generalized_data(g: Generalized) -> dict[str, Any]:
     rows = [cs.labels.index(c) for c in g.efforts.values()]
     held = [r for r, h in zip(g.model.reactions, cs.held.mask, strict=True) if h]
     return {
-        "model": g.model.name, "file": g.model.file or "", "t": float(g.state.t),
+        "model": g.model.name, "model_file": g.model.file or "", "t": float(g.state.t),
         "equation": EQUATION,
         "coordinates": list(g.coordinates), "units": list(g.units),
         "quasi": [int(x) for x in cs.quasi],
@@ -107,7 +107,7 @@ def read_generalized(path: str | os.PathLike[str]) -> dict[str, Any]:
             out: dict[str, Any] = {k: z[k] for k in z.files}
         for k in _TEXT:
             out[k] = [str(x) for x in out[k]]
-        for k in ("model", "file", "equation"):
+        for k in ("model", "model_file", "equation"):
             out[k] = str(out[k])
         out["t"] = float(out["t"])
         return out
