@@ -73,6 +73,8 @@ LI_UNSTEADY: int
 LI_TOL: int
 LI_KEPT: int
 LI_SINGULAR: int
+LI_DA: int
+LI_NORM: int
 LINEARIZE_INFO: int
 
 def solve_layout(n: int, m: int, planar: bool) -> tuple[int, int, int]: ...

@@ -33,9 +33,9 @@ def verdict(lin: Linearization) -> str:
     extra = (f"; {neutral} neutral mode{'s' if neutral != 1 else ''} (λ = 0: a free or "
              "cyclic motion)") if neutral else ""
     if lin.stable:
-        return (f"stable: no eigenvalue has a positive real part (beyond "
-                f"{lin.tolerance:.2g} 1/s){extra}")
-    grows = [(k + 1, m) for k, m in enumerate(lin.modes) if m.eigenvalue.real > lin.tolerance]
+        return (f"stable: no eigenvalue has a positive real part (beyond its error, at most "
+                f"{lin.eigenvalue_errors.max():.2g} 1/s){extra}")
+    grows = [(k + 1, m) for k, m in enumerate(lin.modes) if m.eigenvalue.real > 0]
     k, m = grows[-1]
     return (f"unstable: mode {k} grows (λ = {_eigenvalue(m)} 1/s: e-folding in "
             f"{num(1.0 / m.eigenvalue.real, 4)} s){extra}")

@@ -129,9 +129,12 @@ class Linearization:
         The first-order system ``z' = A z``, z = (δq of the kept coordinates, δq'):
         ``[[0, E], [−M⁻¹ K, −M⁻¹ D]]``.
     tolerance : float
-        How far from 0 a real part must be to count (1/s): √(‖δA‖ ‖A‖), ‖δA‖ from the
-        derivatives' error bounds (‖M⁻¹‖ (‖δK‖ + ‖δD‖), infinity norms: a double
-        eigenvalue moves by that much), and at least 1e3 ε ‖A‖.
+        The most any eigenvalue may be off (1/s): √(‖δA‖ ‖A‖), ‖δA‖ = ‖M⁻¹‖ (‖δK‖ + ‖δD‖)
+        from the derivatives' error bounds (infinity norms; a double eigenvalue, a Jordan
+        block, moves by that much), and at least 1e3 ε ‖A‖. Each eigenvalue has its own,
+        smaller bound where it is simple (`eigenvalue_errors`).
+    dA : float
+        ‖δA‖, the bound on A's error (in A's units).
     warnings : tuple of str
         Why the state is not steady, and anything else worth saying.
     """
@@ -150,6 +153,7 @@ class Linearization:
     kept: np.ndarray
     A: np.ndarray
     tolerance: float
+    dA: float = 0.0
     warnings: tuple[str, ...] = field(default_factory=tuple)
 
     @property
@@ -158,31 +162,43 @@ class Linearization:
         return self.generalized.coordinates
 
     @cached_property
+    def _spectrum(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(eigenvalues, eigenvectors, error bounds), by real part then imaginary part."""
+        if not self.A.size:
+            return np.zeros(0, complex), np.zeros((0, 0), complex), np.zeros(0)
+        w, V = np.linalg.eig(self.A)
+        order = np.lexsort((w.imag, w.real))
+        w, V = w[order], V[:, order]
+        with np.errstate(over="ignore", invalid="ignore"):
+            try:  # the rows of V⁻¹ are the left eigenvectors, y_iᴴ x_i = 1, |x_i| = 1
+                cond = np.linalg.norm(np.linalg.inv(V), axis=1)
+            except np.linalg.LinAlgError:  # defective: the double eigenvalue's bound
+                cond = np.full(len(w), np.inf)
+            first = cond * self.dA
+        err = np.where(np.isfinite(first), np.minimum(first, self.tolerance), self.tolerance)
+        floor = 1e3 * np.finfo(float).eps * np.abs(self.A).sum(axis=1).max()
+        return w, V, np.maximum(err, floor)
+
+    @property
     def eigenvalues(self) -> np.ndarray:
         """The first-order system's eigenvalues (complex, 1/s: rad/s for the imaginary
         parts), by real part then imaginary part."""
-        if not self.A.size:
-            return np.zeros(0, complex)
-        w = np.linalg.eigvals(self.A)
-        return w[np.lexsort((w.imag, w.real))]
+        return self._spectrum[0]
 
-    @cached_property
-    def _eig(self) -> tuple[np.ndarray, np.ndarray]:
-        """Eigenvalues and eigenvectors (for the mode shapes), in `eigenvalues`' order."""
-        if not self.A.size:
-            return np.zeros(0, complex), np.zeros((0, 0), complex)
-        w, V = np.linalg.eig(self.A)
-        order = np.lexsort((w.imag, w.real))
-        return w[order], V[:, order]
+    @property
+    def eigenvalue_errors(self) -> np.ndarray:
+        """A bound on each eigenvalue's error (1/s), in `eigenvalues`' order: κ_i ‖δA‖ for
+        a simple one (κ_i its condition ‖x_i‖ ‖y_i‖ / |y_iᴴ x_i|), at most `tolerance`
+        (the bound of a double one); at least 1e3 ε ‖A‖."""
+        return self._spectrum[2]
 
     @cached_property
     def modes(self) -> list[Mode]:
         """The modes: oscillations (one per complex pair), growths, decays and neutral
         ones (λ = 0: a free or cyclic motion), neutral first, then by |λ|."""
-        w, V = self._eig
+        w, V, tol = self._spectrum
         if not len(w):
             return []
-        tol = self.tolerance
         k, kept = len(self.coordinates), self.kept
         nk = len(kept)
         mag = np.abs(w)
@@ -218,16 +234,18 @@ class Linearization:
         return [m for m in self.modes if m.kind == "oscillation"]
 
     @cached_property
-    def _oscillating(self) -> np.ndarray:
-        """The eigenvalues of the oscillations (Im λ > 0), by |λ|."""
-        w, tol = self.eigenvalues, self.tolerance
-        w = w[(w.imag > tol) & (np.abs(w) > tol)]
-        return w[np.argsort(np.abs(w))]
+    def _oscillating(self) -> tuple[np.ndarray, np.ndarray]:
+        """The eigenvalues of the oscillations (Im λ > 0) and their error bounds, by |λ|."""
+        w, _, tol = self._spectrum
+        keep = (w.imag > tol) & (np.abs(w) > tol)
+        w, tol = w[keep], tol[keep]
+        order = np.argsort(np.abs(w))
+        return w[order], tol[order]
 
     @property
     def frequencies(self) -> np.ndarray:
         """The natural frequencies |λ| of the oscillations (rad/s), ascending."""
-        return np.abs(self._oscillating)
+        return np.abs(self._oscillating[0])
 
     @property
     def frequencies_hz(self) -> np.ndarray:
@@ -237,17 +255,18 @@ class Linearization:
     @property
     def damping_ratios(self) -> np.ndarray:
         """ζ of each oscillation, in the order of `frequencies`."""
-        w = self._oscillating
-        return -np.where(np.abs(w.real) > self.tolerance, w.real, 0.0) / np.abs(w) + 0.0
+        w, tol = self._oscillating
+        return -np.where(np.abs(w.real) > tol, w.real, 0.0) / np.abs(w) + 0.0
 
     @property
     def stable(self) -> bool | None:
-        """False when an eigenvalue has a positive real part (beyond `tolerance`): a small
-        motion grows; True otherwise (neutral modes — a free motion, a cyclic coordinate —
-        do not count); None when the state is not steady."""
+        """False when an eigenvalue has a positive real part (beyond its error bound,
+        `eigenvalue_errors`): a small motion grows; True otherwise (neutral modes — a free
+        motion, a cyclic coordinate — do not count); None when the state is not steady."""
         if not self.steady:
             return None
-        return bool((self.eigenvalues.real <= self.tolerance).all())
+        w, _, err = self._spectrum
+        return bool((w.real <= err).all())
 
     @cached_property
     def K_geometric(self) -> np.ndarray:
@@ -371,7 +390,8 @@ def linearize(model: Model, state: State | None = None, *,
     return Linearization(model, state, g, g.M, D, K, K_err, D_err, residual,
                          bool(info[_core.LI_STEADY]),
                          tuple(labels[i] for i in np.flatnonzero(left)),
-                         np.flatnonzero(~left), A, float(info[_core.LI_TOL]), tuple(warnings))
+                         np.flatnonzero(~left), A, float(info[_core.LI_TOL]),
+                         float(info[_core.LI_DA]), tuple(warnings))
 
 
 def loads_stiffness(lin: Linearization) -> np.ndarray:

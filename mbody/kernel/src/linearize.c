@@ -139,6 +139,8 @@ int mb_linearize(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
     info[MB_LI_UNSTEADY] = (double)unsteady;
     info[MB_LI_TOL] = fmax(tol, 1e-300);
     info[MB_LI_KEPT] = (double)nk;
+    info[MB_LI_DA] = minv * (errK + errD);
+    info[MB_LI_NORM] = nA;
     free(buf);
     return 0;
 }

@@ -955,7 +955,8 @@ PyMODINIT_FUNC PyInit__core(void) {
         {"LP_STEP", MB_LP_STEP}, {"LP_ROUNDING", MB_LP_ROUNDING}, {"LP_STEADY", MB_LP_STEADY},
         {"LP_MOVING", MB_LP_MOVING}, {"LINEARIZE_PARAMS", MB_LINEARIZE_PARAMS},
         {"LI_STEADY", MB_LI_STEADY}, {"LI_UNSTEADY", MB_LI_UNSTEADY}, {"LI_TOL", MB_LI_TOL},
-        {"LI_KEPT", MB_LI_KEPT}, {"LI_SINGULAR", MB_LI_SINGULAR},
+        {"LI_KEPT", MB_LI_KEPT}, {"LI_SINGULAR", MB_LI_SINGULAR}, {"LI_DA", MB_LI_DA},
+        {"LI_NORM", MB_LI_NORM},
         {"LINEARIZE_INFO", MB_LINEARIZE_INFO},
     };
     for (size_t i = 0; i < sizeof(constants) / sizeof(constants[0]); i++)
