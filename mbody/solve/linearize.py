@@ -204,29 +204,33 @@ class Linearization:
         mag = np.abs(w)
         neutral = mag <= tol
         osc = ~neutral & (np.abs(w.imag) > tol)
-        take = ~(osc & (w.imag < 0))
-        shapes = np.zeros((k, len(w)), complex)
-        live = ~neutral
-        shapes[:, live] = V[nk:, live] / w[live]
-        pos = np.zeros((k, len(w)), complex)
-        pos[kept] = V[:nk]
-        has_pos = np.abs(pos).max(axis=0) > 1e-12 * np.abs(V).max(axis=0)
-        shapes[:, neutral] = np.where(has_pos[neutral], pos[:, neutral], V[nk:, neutral])
-        j = np.argmax(np.abs(shapes), axis=0)
-        shapes = shapes / shapes[j, np.arange(len(w))]
+        idx = np.flatnonzero(~(osc & (w.imag < 0)))  # one of each conjugate pair
+        w, V, tol, mag, neutral, osc = w[idx], V[:, idx], tol[idx], mag[idx], neutral[idx], \
+            osc[idx]
+        shapes = V[nk:] / np.where(neutral, 1.0, w)  # δq = δq' / λ
+        if neutral.any():  # a neutral mode: its δq if it has one, else its rate
+            pos = np.zeros((k, len(w)), complex)
+            pos[kept] = V[:nk]
+            has = neutral & (np.abs(pos).max(axis=0) > 1e-12 * np.abs(V).max(axis=0))
+            shapes[:, has] = pos[:, has]
+        cols = np.arange(len(w))
+        shapes = shapes / shapes[np.abs(shapes).argmax(axis=0), cols]
         shapes[np.abs(shapes) < 1e-14] = 0.0
-        real = np.abs(shapes.imag).max(axis=0) <= 1e-12  # undamped modes: in phase
-        shapes[:, real] = shapes[:, real].real
-        lam = np.where(np.abs(w.real) > tol, w.real, 0.0) + 1j * np.where(
-            np.abs(w.imag) > tol, w.imag, 0.0)
-        kind = np.where(neutral, "neutral", np.where(osc, "oscillation", np.where(
-            w.real > 0, "growth", "decay")))
-        with np.errstate(invalid="ignore", divide="ignore"):
-            zeta = np.where(neutral, np.nan, -lam.real / mag + 0.0)
-        freq = np.where(osc, mag, np.nan)
-        order = np.lexsort((mag, ~neutral))
-        return [Mode(complex(lam[i]), str(kind[i]), float(freq[i]), float(zeta[i]),
-                     shapes[:, i]) for i in order if take[i]]
+        in_phase = np.abs(shapes.imag).max(axis=0) <= 1e-12  # undamped modes
+        out = []
+        for c in np.argsort(mag + np.where(neutral, -np.inf, 0.0), kind="stable").tolist():
+            lam = w[c]
+            re = lam.real if abs(lam.real) > tol[c] else 0.0
+            im = lam.imag if abs(lam.imag) > tol[c] else 0.0
+            shape = shapes[:, c].real.astype(complex) if in_phase[c] else shapes[:, c]
+            if neutral[c]:
+                out.append(Mode(complex(re, im), "neutral", float("nan"), float("nan"), shape))
+            else:
+                kind = "oscillation" if osc[c] else ("growth" if lam.real > 0 else "decay")
+                out.append(Mode(complex(re, im), kind,
+                                float(mag[c]) if osc[c] else float("nan"),
+                                -re / float(mag[c]) + 0.0, shape))
+        return out
 
     @property
     def oscillations(self) -> list[Mode]:
