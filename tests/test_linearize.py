@@ -410,3 +410,22 @@ def test_an_inverted_pendulum_is_unstable():
     assert lin.steady and lin.stable is False
     assert [m.kind for m in lin.modes] == ["decay", "growth"] or \
         sorted(m.kind for m in lin.modes) == ["decay", "growth"]
+
+
+def test_a_mode_played_follows_its_shape():
+    """`animate --mode`'s motion: the coordinates of every frame are q0 + a Re(φ e^{λt})
+    (to the 1e-12 of the Newton steps onto them), the rates their derivative."""
+    from mbody.simulate.modes import mode_trajectory
+
+    model = mbody.load("models/double_pendulum.yaml")
+    lin = linearize(model, static_equilibrium(model))
+    traj = mode_trajectory(lin, 2, periods=1, fps=30)
+    mode, a = lin.modes[1], traj.info["amplitude"]
+    q0 = lin.generalized.q
+    for i in range(0, len(traj.t), 4):
+        g = mbody.assemble(model, traj.state(i)).generalized()
+        z = a * mode.shape * np.exp(mode.eigenvalue * traj.t[i])
+        np.testing.assert_allclose(g.q, q0 + z.real, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(g.qdot, (mode.eigenvalue * z).real, rtol=0, atol=1e-12)
+    assert traj.info["kind"] == "oscillation"
+    assert abs(traj.t[-1] - mode.period) <= 1 / 30  # one period, at 30 frames a second

@@ -4,8 +4,9 @@ mode, for pictures and animations.
 A configuration at coordinates δq from the reference is reached by moving the bodies
 along v = T(x) δq in small steps (the midpoint rule, each step back onto the joints by the
 core's projection): along the way every true coordinate changes at its rate, since the
-coordinates' rows satisfy Aᵀ T = I, so the coordinates land on q0 + δq (a ball joint's or
-a free body's quasi-velocities turn the body about its axes instead). The reference
+coordinates' rows satisfy Aᵀ T = I, and a few Newton steps at the end put the coordinates
+on q0 + δq exactly (a ball joint's or a free body's quasi-velocities, which have no
+values, turn the body about its axes instead). The reference
 motion's own motion — a steady spin, a precession — is not shown: the modes are drawn
 about the reference configuration.
 """
@@ -23,6 +24,9 @@ from mbody.solve.linearize import Linearization, Mode
 
 STEPS_PER_RAD = 20
 """Midpoint steps per radian (or per model size) of the path to a configuration."""
+CORRECTIONS = 4
+"""Newton steps at most onto the true coordinates' values at the path's end (the midpoint
+rule leaves them off by its O(h²))."""
 AMPLITUDE = 0.15
 """Default amplitude: the largest mass-centre displacement (or a body's turn times the
 model's size) this fraction of the model's size."""
@@ -61,11 +65,19 @@ def displaced(lin: Linearization, start: State, dq: np.ndarray) -> State:
     h = np.asarray(dq, dtype=float) / steps
     zero = np.zeros(len(cs))
     state = start
+    g = evaluate(model, state, cs, zero)
+    target = g.q + np.asarray(dq, dtype=float)
     for _ in range(steps):
-        T0 = evaluate(model, state, cs, zero).T
-        mid = move(model, state, 0.5 * (T0 @ h))
+        mid = move(model, state, 0.5 * (g.T @ h))
         T1 = evaluate(model, mid, cs, zero).T
         state = project(model, cs, move(model, state, T1 @ h))
+        g = evaluate(model, state, cs, zero)
+    for _ in range(CORRECTIONS):  # Newton onto the true coordinates' values
+        miss = np.where(cs.quasi, 0.0, target - g.q)
+        if not np.any(np.abs(miss) > 1e-13 * cs.scales):
+            break
+        state = project(model, cs, move(model, state, g.T @ miss))
+        g = evaluate(model, state, cs, zero)
     return state
 
 
