@@ -82,6 +82,8 @@ class Generalized:
     residual : float
         How far the state is off its joints, as the least-squares residual of the
         projection (0 on them).
+    warnings : tuple of str
+        What looked wrong (a state off its joints).
     """
 
     model: Model
@@ -142,7 +144,17 @@ class Generalized:
         return np.linalg.solve(self.M, rhs)
 
     def effort_vector(self, efforts: Mapping[str, float] | None = None) -> np.ndarray:
-        """The generalized forces of the drivers' efforts (each on its coordinate)."""
+        """The generalized forces of the drivers' efforts (each on its coordinate).
+
+        Parameters
+        ----------
+        efforts : mapping of str to float, optional
+            A chosen driver's effort (N m or N) by label.
+
+        Returns
+        -------
+        (k,) array
+        """
         out = np.zeros(len(self.f))
         index = dict(self.coordinate_set.efforts)
         for label, v in (efforts or {}).items():
@@ -153,11 +165,31 @@ class Generalized:
         return out
 
     def body_accelerations(self, qddot: np.ndarray) -> np.ndarray:
-        """v' = T q'' + a0: the bodies' accelerations (rows as `body_coordinates`)."""
+        """v' = T q'' + a0: the bodies' accelerations (rows as `body_coordinates`).
+
+        Parameters
+        ----------
+        qddot : (k,) array
+            The coordinates' accelerations.
+
+        Returns
+        -------
+        (N,) array
+        """
         return self.T @ np.asarray(qddot, dtype=float) + self.a0
 
     def velocities(self, qdot: np.ndarray | None = None) -> np.ndarray:
-        """v = T q' + v_e (rows as `body_coordinates`), for `qdot` or the state's rates."""
+        """v = T q' + v_e (rows as `body_coordinates`).
+
+        Parameters
+        ----------
+        qdot : (k,) array, optional
+            The coordinates' rates (default: the state's).
+
+        Returns
+        -------
+        (N,) array
+        """
         return self.T @ (self.qdot if qdot is None else np.asarray(qdot, float)) + self.v_e
 
     @cached_property
@@ -201,7 +233,13 @@ class Generalized:
 
     def symbolic(self) -> SymbolicLagrange:
         """M(q) and f(q, q') in symbols, for a planar tree (needs sympy): see
-        `mbody.equations.symbolic.lagrange`."""
+        `mbody.equations.symbolic.lagrange`.
+
+        Returns
+        -------
+        SymbolicLagrange
+            ``M``, ``f`` (sympy matrices), ``evaluate(q, qdot)``; printed, the equations.
+        """
         from mbody.equations.symbolic.lagrange import symbolic_lagrange  # sympy: slow
 
         return symbolic_lagrange(self.model, self.coordinate_set)
