@@ -37,18 +37,39 @@ def acceleration_name(label: str, quasi: bool) -> str:
     return f"{label}'" if quasi else f"{label}''"
 
 
+NOISE = 1e-12
+"""A printed number below this fraction of the terms that make it is rounding: shown 0."""
+
+
+def cleaned(g: Generalized) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(q, M, f, q'') with rounding noise set to 0, for printing: an off-diagonal M_kl
+    below `NOISE` √(M_kk M_ll) (M is positive definite), f below `NOISE` of its terms
+    (`Generalized.f_scale`), q'' below `NOISE` of |M⁻¹| f_scale, q below `NOISE` rad (or
+    of the model's size)."""
+    d = np.sqrt(np.abs(np.diag(g.M)))
+    M = np.where(np.abs(g.M) <= NOISE * np.outer(d, d), 0.0, g.M)
+    f = np.where(np.abs(g.f) <= NOISE * g.f_scale, 0.0, g.f)
+    cs = g.coordinate_set
+    q = np.where(np.abs(g.q) <= NOISE * cs.scales, 0.0, g.q)
+    qdd = g.accelerations() if not g.efforts else np.full(len(f), np.nan)
+    scale = np.abs(np.linalg.inv(g.M)) @ g.f_scale if len(f) else qdd
+    qdd = np.where(np.abs(qdd) <= NOISE * scale, 0.0, qdd)
+    return q, M, f, qdd
+
+
 def generalized_text(g: Generalized) -> str:
     """The equations ``M q'' = f`` at the state, with the coordinates, their values and
     rates, what each is, the accelerations they give and f split by source."""
     model = g.model
     cs = g.coordinate_set
+    q_shown, M_shown, f_shown, qdd_shown = cleaned(g)
     k = len(g.f)
     how = f"a spanning tree: {', '.join(cs.tree)}" if cs.tree else "as chosen"
     out = [f"model '{model.name}' at t = {g.state.t:g} s: {k} generalized coordinate"
            f"{'s' if k != 1 else ''} ({how})"]
     width = max([len(c) for c in g.coordinates] + [len("coordinate")])
     out.append(f"  {'coordinate':{width}s}  {'value':>14s}  {'rate':>16s}  meaning")
-    for c, q, qd in zip(cs.items, g.q, g.qdot, strict=True):
+    for c, q, qd in zip(cs.items, q_shown, g.qdot, strict=True):
         value = "(quasi)" if c.quasi else f"{num(q, DIGITS)} {c.unit}"
         out.append(f"  {c.label:{width}s}  {value:>14s}  {num(qd, DIGITS) + ' ' + c.rate_unit:>16s}"
                    f"  {c.meaning}")
@@ -63,15 +84,14 @@ def generalized_text(g: Generalized) -> str:
     names = [acceleration_name(c.label, c.quasi) for c in cs.items]
     effort_rows = {r: e for e, r in g.coordinate_set.efforts}
     for i in range(k):
-        row = _row(g.M[i], names, float(g.f[i]))
+        row = _row(M_shown[i], names, float(f_shown[i]))
         if i in effort_rows:
             row += f" + {effort_rows[i]}"
         out.append(f"  {row}")
     if not g.efforts:
-        qdd = g.accelerations()
         out.append("")
         out.append("so: " + ", ".join(f"{n} = {num(a, DIGITS)}" for n, a in
-                                      zip(names, qdd, strict=True)))
+                                      zip(names, qdd_shown, strict=True)))
     out.append("")
     out.append("f by source (in the coordinates' order):")
     noise = 1e-12 * g.f_scale  # rounding of the terms that make f
@@ -108,17 +128,18 @@ def generalized_latex(g: Generalized) -> str:
     cs = g.coordinate_set
     names = [coordinate_latex(c.label, 2, c.quasi) for c in cs.items]
     effort_rows = {r: e for e, r in cs.efforts}
+    _, M_shown, f_shown, _ = cleaned(g)
     rows = []
     for i in range(len(g.f)):
         lhs = ""
-        for c, name in zip(g.M[i], names, strict=True):
+        for c, name in zip(M_shown[i], names, strict=True):
             if c == 0.0:
                 continue
             mag = num(abs(c), DIGITS)
             body = name if mag == "1" else f"{mag}\\,{name}"
             lhs += (f"-{body}" if c < 0 else body) if not lhs else \
                 f" {'-' if c < 0 else '+'} {body}"
-        rhs = num(float(g.f[i]), DIGITS)
+        rhs = num(float(f_shown[i]), DIGITS)
         if i in effort_rows:
             rhs += f" + {latex_symbol(effort_rows[i])}"
         rows.append(f"{lhs or '0'} &= {rhs}")
