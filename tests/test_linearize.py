@@ -133,6 +133,8 @@ def test_steady_spin_about_a_principal_axis(axis, frame):
                                rtol=0, atol=1e-10 * abs(expected))
     assert abs(big[0] ** 2 - lam2) <= 1e-10 * abs(lam2)
     assert lin.stable is (axis != 1)
+    kinds = sorted(m.kind for m in lin.modes if m.kind != "neutral")
+    assert kinds == (["decay", "growth"] if axis == 1 else ["oscillation"])
     # the rest are the free motion's and the spin's zeros
     assert np.abs(w[np.abs(w) <= 1e-6]).max() <= lin.tolerance
 

@@ -207,7 +207,7 @@ class Linearization:
         idx = np.flatnonzero(~(osc & (w.imag < 0)))  # one of each conjugate pair
         w, V, tol, mag, neutral, osc = w[idx], V[:, idx], tol[idx], mag[idx], neutral[idx], \
             osc[idx]
-        shapes = V[nk:] / np.where(neutral, 1.0, w)  # δq = δq' / λ
+        shapes = (V[nk:] / np.where(neutral, 1.0, w)).astype(complex)  # δq = δq' / λ
         if neutral.any():  # a neutral mode: its δq if it has one, else its rate
             pos = np.zeros((k, len(w)), complex)
             pos[kept] = V[:nk]
