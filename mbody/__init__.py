@@ -35,6 +35,8 @@ _LAZY = {
     "Model": "model.model", "State": "model.model", "load": "loading",
     "loads": "loading", "kinematics": "solve.kinematics",
     "equilibrium": "solve.equilibrium", "kinematic_run": "simulate.kinematic",
+    "linearize": "solve.linearize", "Linearization": "solve.linearize",
+    "Generalized": "equations.generalized",
     "simulate": "simulate.simulation",
     "Trajectory": "simulate.trajectory",
     "verify": "answers.verify",
@@ -43,11 +45,11 @@ _LAZY = {
 
 __all__ = [
     "Assembly", "Body", "BodyEquations", "Equation", "ExportedAssembly", "ForceOnBody",
-    "FreeBodyDiagram", "load_export",
+    "FreeBodyDiagram", "Generalized", "Linearization", "linearize", "load_export",
     "Issue", "Joint", "Load", "MbodyError", "Model", "ModelError", "Solution", "State",
     "Trajectory", "simulate",
-    "UnknownReactionsError", "animate", "assemble", "draw_fbd", "equilibrium", "kinematic_run",
-    "kinematics", "load",
+    "UnknownReactionsError", "animate", "assemble", "draw_fbd", "equilibrium",
+    "kinematic_run", "kinematics", "load",
     "loads", "verify",
 ]
 

@@ -16,7 +16,8 @@ function hides a dependency for nothing: it is listed, and the exit code is 1.
 ``--verbose`` lists every import made inside a function, with its reason.
 
 One upward import is allowed by design, a display hook: a notebook display method of an
-object (``_repr_html_``, ``_repr_latex_``, ``_repr_svg_``, ``_repr_png_``) may import the
+object (``_repr_html_``, ``_repr_latex_``, ``_repr_svg_``, ``_repr_png_``,
+``_repr_pretty_``) may import the
 presentation layer (`mbody.present`) that draws it. Such an edge is listed, and left out
 of the cycle search: the presentation layer imports the object's module, and the method
 runs only when the object is shown. Importing an mbody module by a string
@@ -48,7 +49,7 @@ SLOW = ("scipy", "matplotlib", "networkx", "meshcat", "numba", "tqdm", "sympy", 
 """Libraries that take tens to hundreds of milliseconds to import."""
 
 
-DISPLAY_HOOKS = ("_repr_html_", "_repr_latex_", "_repr_svg_", "_repr_png_")
+DISPLAY_HOOKS = ("_repr_html_", "_repr_latex_", "_repr_svg_", "_repr_png_", "_repr_pretty_")
 """Methods that may import `mbody.present` (see the module's docstring)."""
 
 

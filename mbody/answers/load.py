@@ -8,6 +8,11 @@ equations:
     eq: I_G*alpha = -0.433013*O.Fx - 0.25*O.Fy
 ```
 
+An entry without a body is an equation in generalized coordinates (Lagrange's), written
+with the model's coordinate labels (``O.angle_ddot``) or with the answers' own names
+(``coordinates: {theta1: O.angle}``, then ``theta1_ddot``); ``coordinate: theta1`` may
+say which coordinate's equation it is (`mbody.answers.lagrange`).
+
 The file is read by mbody's own safe YAML loader (`mbody.model.loader`), so every value
 keeps its line and column: a problem with an entry is reported at the entry, and a
 problem inside an equation at its character.
@@ -23,8 +28,8 @@ from typing import Any
 from mbody.errors import Issue, ModelError, did_you_mean
 from mbody.model.loader import Document, dotted, load_text, read_file
 
-TOP_KEYS = ("equations", "student")
-ENTRY_KEYS = ("body", "eq")
+TOP_KEYS = ("equations", "student", "coordinates")
+ENTRY_KEYS = ("body", "eq", "coordinate")
 MAX_EQUATIONS = 20_000
 """Most equations in one answers file (a student's answers hold tens; each one costs about a
 millisecond or two to diagnose, so this bounds the work at about half a minute)."""
@@ -66,6 +71,9 @@ class Answer:
         Its place in the file: ``equations[2].eq``.
     body_line, body_column : int
         1-based position of its body's name (0 when not from a file).
+    coordinate : str
+        A Lagrange equation (no body): the coordinate it is the equation of, as the
+        answers name it ('' when not said).
     """
 
     index: int
@@ -76,6 +84,12 @@ class Answer:
     key: str = ""
     body_line: int = 0
     body_column: int = 0
+    coordinate: str = ""
+
+    @property
+    def lagrange(self) -> bool:
+        """An equation in generalized coordinates (an entry without a body)."""
+        return not self.body
 
 
 @dataclass(frozen=True)
@@ -95,6 +109,9 @@ class Answers:
     file: str
     equations: tuple[Answer, ...]
     student: str = ""
+    coordinates: tuple[tuple[str, str], ...] = ()
+    """The answers' own names of the generalized coordinates and the model's coordinate
+    each stands for (``coordinates: {theta1: O.angle}``), in the file's order."""
 
     def issue(self, a: Answer, message: str, *, position: int | None = None,
               body: bool = False, hint: str = "") -> Issue:
@@ -220,6 +237,23 @@ def _build(data: Any, file: str, doc: Document | None, text: str) -> Answers:
         student = ""
     if not isinstance(student, str | int | float):
         err(("student",), f"expected free text, got {_kind(student)}")
+    coords: list[tuple[str, str]] = []
+    given = data.get("coordinates")
+    if given is not None:
+        if not isinstance(given, Mapping) or not given:
+            err(("coordinates",), f"expected a mapping of your names to the model's "
+                f"coordinates, got {_kind(given)}", "coordinates: {theta1: O.angle, "
+                "theta2: A.angle}")
+        else:
+            for name, label in given.items():
+                if not isinstance(name, str) or not name.isidentifier():
+                    err(("coordinates", name), f"expected a name such as theta1, got "
+                        f"{_kind(name)}", key=True)
+                elif not isinstance(label, str):
+                    err(("coordinates", name), f"expected a coordinate label such as "
+                        f"O.angle, got {_kind(label)}")
+                else:
+                    coords.append((name, label))
     entries = data.get("equations")
     out: list[Answer] = []
     if entries is None:
@@ -243,6 +277,18 @@ def _build(data: Any, file: str, doc: Document | None, text: str) -> Answers:
                 err((*path, k), f"unknown key {k!r}; an entry has body and eq",
                     did_you_mean(str(k), ENTRY_KEYS), key=True)
             body, eq = e.get("body"), e.get("eq")
+            coordinate = e.get("coordinate")
+            if body is None and eq is not None:  # an equation in generalized coordinates
+                if coordinate is not None and not isinstance(coordinate, str):
+                    err((*path, "coordinate"), f"expected a coordinate's name, got "
+                        f"{_kind(coordinate)}")
+                    continue
+                body = ""
+            elif coordinate is not None:
+                err((*path, "coordinate"), "an entry with a body is a Newton-Euler equation: "
+                    "it has no coordinate", "leave out body: for an equation in generalized "
+                    "coordinates", key=True)
+                continue
             if body is None or eq is None:
                 missing = " and ".join(k for k, v in (("body", body), ("eq", eq)) if v is None)
                 err(path, f"missing {missing}", "each entry is {body: NAME, eq: \"...\"}")
@@ -257,10 +303,10 @@ def _build(data: Any, file: str, doc: Document | None, text: str) -> Answers:
             line, col = where((*path, "eq"))
             col += _quote_offset(lines, line, col, eq)
             out.append(Answer(n + 1, body, eq, line, col, dotted((*path, "eq")),
-                              *where((*path, "body"))))
+                              *where((*path, "body")), coordinate=str(coordinate or "")))
     if issues:
         raise AnswersError(issues)
-    return Answers(file, tuple(out), str(student))
+    return Answers(file, tuple(out), str(student), tuple(coords))
 
 
 def _quote_offset(lines: list[str], line: int, col: int, eq: str) -> int:

@@ -17,6 +17,7 @@ from typing import Any
 
 from mbody.answers.compare import Row
 from mbody.answers.diagnose import CORRECT, DIAGNOSES, NOT_AN_EQUATION, Diagnosis, diagnose
+from mbody.answers.lagrange import LAGRANGE_DIAGNOSES, check_lagrange
 from mbody.answers.linear import NotLinear, linear_row
 from mbody.answers.load import Answer, Answers, AnswersError, answers_from_data, read_answers
 from mbody.answers.parse import EquationError, parse_equation
@@ -188,8 +189,8 @@ class Verification:
         for c in self.checks:
             at = f"  (line {c.line})" if c.line else ""
             out.append(f"[{c.index}] {c.body}: {c.eq}{at}")
-            out.append(f"    {c.diagnosis}" + ("" if c.correct else
-                                               f": {DIAGNOSES[c.diagnosis]}"))
+            meaning = {**DIAGNOSES, **LAGRANGE_DIAGNOSES}[c.diagnosis]
+            out.append(f"    {c.diagnosis}" + ("" if c.correct else f": {meaning}"))
             if not c.correct and c.expected:
                 out.append(f"    expected ({c.row}): {c.expected}")
             out.extend(wrap.wrap(c.explanation))
@@ -249,7 +250,10 @@ def verify(model: Model | str | os.PathLike[str], answers: Any, *, tol: float = 
     rows: dict[str, BodyRows] = {}
     issues: list[Issue] = []
     parsed: list[tuple[Answer, Row | None, NotLinear | None]] = []
+    lagrange = [a for a in sheet.equations if a.lagrange]
     for a in sheet.equations:
+        if a.lagrange:  # an equation in generalized coordinates: checked below
+            continue
         if a.body not in model.index:
             hint = did_you_mean(a.body, model.body_names)
             shown = ", ".join(model.body_names[:10]) + (" ..." if model.n > 10 else "")
@@ -294,10 +298,18 @@ def verify(model: Model | str | os.PathLike[str], answers: Any, *, tol: float = 
         checks.append(Check(a.index, a.body, a.eq, a.line, d.diagnosis, d.expected, d.row,
                             d.explanation, d.details))
     covered = {c.row for c in checks if c.correct}
-    uncovered = tuple(Uncovered(b, r.label, r.text) for b, br in rows.items()
-                      for r in br.rows if r.label not in covered)
+    uncovered = [Uncovered(b, r.label, r.text) for b, br in rows.items()
+                 for r in br.rows if r.label not in covered]
+    n_rows = sum(len(br.rows) for br in rows.values())
+    if lagrange:
+        verdicts, missing, n = check_lagrange(model, state, sheet, lagrange, tol)
+        checks += [Check(a.index, name, a.eq, a.line, d.diagnosis, d.expected, d.row,
+                         d.explanation, d.details) for a, d, name in verdicts]
+        checks.sort(key=lambda c: c.index)
+        uncovered += [Uncovered(name, name, text) for name, text in missing]
+        n_rows += n
     return Verification(model.name, model.file or "", sheet.file, sheet.student, tol,
-                        tuple(checks), uncovered, sum(len(br.rows) for br in rows.values()))
+                        tuple(checks), tuple(uncovered), n_rows)
 
 
 def _answers(answers: Any) -> Answers:

@@ -68,7 +68,36 @@ def register(sub: argparse._SubParsersAction) -> None:
                    metavar="S",
                    help="with --live: stop after S seconds instead of waiting for Ctrl-C "
                    f"(at most {number(HOLD_MAX)})")
+    s.add_argument("--mode", type=int, metavar="K",
+                   help="play mode K of the linearisation (numbered as mbody modes lists "
+                   "them) instead of a simulation: three periods of its shape about the "
+                   "model's initial state")
+    s.add_argument("--equilibrium", action="store_true",
+                   help="with --mode: about the static equilibrium nearest the initial pose")
     s.set_defaults(run=animate)
+
+
+def _mode(a: argparse.Namespace):
+    """(trajectory, model) of `mbody animate MODEL --mode K`."""
+    from mbody.cli.common import load_model
+    from mbody.simulate.modes import mode_trajectory
+    from mbody.solve.linearize import linearize
+
+    if a.source.lower().endswith(".npz"):
+        raise MbodyError("--mode needs a model, not a run file")
+    if a.t_end is not None:
+        raise MbodyError("--t-end does not apply with --mode (three periods are played)")
+    model = load_model(a.source)
+    state = None
+    if a.equilibrium:
+        from mbody.solve.equilibrium import equilibrium
+
+        state = equilibrium(model)
+    lin = linearize(model, state)
+    traj = mode_trajectory(lin, a.mode, fps=a.fps or FPS)
+    for w in traj.info.get("warnings", []):
+        print(f"mbody: warning: {w}", file=sys.stderr)
+    return traj, model
 
 
 def _stop(signum: int, frame: FrameType | None) -> None:  # SIGTERM ends --live like Ctrl-C
@@ -98,7 +127,12 @@ def animate(a: argparse.Namespace) -> int:
         ensure_writable(out)
     if not a.source.lower().endswith((".yaml", ".yml")):  # a model may come through a pipe
         regular_file(a.source, "a model (.yaml) or a run file (.npz)")
-    traj, model = resolve(a.source, a.model, t_end=a.t_end, fps=a.fps)
+    if a.equilibrium and a.mode is None:
+        raise MbodyError("--equilibrium only applies with --mode")
+    if a.mode is not None:
+        traj, model = _mode(a)
+    else:
+        traj, model = resolve(a.source, a.model, t_end=a.t_end, fps=a.fps)
     extra = [b for b in model.body_names if b not in traj.body_names]
     if extra and (a.forces or a.reactions):  # loads are evaluated at the run's states
         raise MbodyError(f"the model {model.name!r} has bodies the run {a.source} does not "

@@ -22,6 +22,7 @@ from mbody.cli import (
     drive,
     export,
     interop,
+    lagrange,
     mechanism,
     sim,
     statics,
@@ -41,7 +42,7 @@ from mbody.errors import MbodyError, ModelError, UnknownReactionsError, did_you_
 from mbody.model.loader import MAX_BYTES, max_bytes_limit
 
 COMMAND_MODULES = (core, export, sim, drive, draw, animate, mechanism, statics, verify,
-                   interop)
+                   interop, lagrange)
 """Modules of `mbody.cli`, in help order; each has `register(subparsers)` adding its
 commands (importing one loads only argparse: each command imports what it runs when it
 runs)."""

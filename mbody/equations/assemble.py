@@ -10,7 +10,7 @@ model's masses and inertia tensors) and builds the sparse matrix only when asked
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from functools import cached_property
 from typing import TYPE_CHECKING
 
@@ -19,6 +19,7 @@ import numpy as np
 from mbody import conventions as cv
 from mbody.equations.constraints import ConstraintJacobian, joint_errors
 from mbody.equations.fbd import body_equations
+from mbody.equations.generalized import Generalized, generalized
 from mbody.equations.joints import ReactionColumns, g_matrix, reaction_columns
 from mbody.equations.loads import AppliedLoads, wrench_parts
 from mbody.equations.solution import (
@@ -216,6 +217,28 @@ class Assembly:
             its rows of M, b, Q and G (see `mbody.equations.symbolic`).
         """
         return assembly_symbolic(self, bodies)
+
+    def generalized(self, coordinates: Sequence[str] | None = None,
+                    known: Mapping[str, float] | None = None) -> Generalized:
+        """The equations in generalized coordinates, ``M_q q'' = f_q``: these equations
+        multiplied by Tᵀ, where v = T q' + v_e, which removes the reactions
+        (`mbody.equations.generalized`).
+
+        Parameters
+        ----------
+        coordinates : sequence of str, optional
+            One coordinate per degree of freedom by label (``O.angle``, ``P.displacement``,
+            a body's ``rod.theta``...); default: each driver's coordinate, a spanning
+            tree's joint coordinates, then a free body's own.
+        known : mapping of str to float, optional
+            Reaction values applied as loads (their joints not held), added to the file's.
+
+        Returns
+        -------
+        Generalized
+            ``M``, ``f``, ``T``, ``q``, ``qdot``, ``accelerations()``, ``symbolic()``.
+        """
+        return generalized(self.model, self.state, coordinates, known)
 
     # -- solving -----------------------------------------------------------------------
     def reaction_values(self, known: Mapping[str, float] | None = None) -> dict[str, float]:

@@ -124,6 +124,27 @@ def samples(unknowns: Unknowns, lam: _F, t: _F, Y: _F, reactions: _F | None,
 def dop853_system(number: int, params: _F, t: float, y: _F, ydot: _F) -> None: ...
 def dop853_tableau() -> dict[str, list[float]]: ...
 def dop853_work_size(n: int) -> int: ...
+GQ_TURN: int
+GQ_CHILD_TURN: int
+GQ_SLIDE: int
+GQ_BODY: int
+GQ_W: int
+GI_RANK: int
+GI_RESIDUAL: int
+GENERALIZED_INFO: int
+LP_STEP: int
+LP_ROUNDING: int
+LP_STEADY: int
+LP_MOVING: int
+LINEARIZE_PARAMS: int
+LI_STEADY: int
+LI_UNSTEADY: int
+LI_TOL: int
+LI_KEPT: int
+LI_SINGULAR: int
+LI_DA: int
+LI_NORM: int
+LINEARIZE_INFO: int
 
 def solve_layout(n: int, m: int, planar: bool) -> tuple[int, int, int]: ...
 
@@ -144,6 +165,8 @@ class Model:
     def columns(self, t: float, y: _F, child6: _F, parent6: _F, W_e: _F, W_P: _F,
                 gamma: _F, phi: _F, gtv: _F) -> None: ...
     def expression(self, e: int, t: float) -> float: ...
+    def coordinate_rows(self, t: float, y: _F, Iq: _I, cols: _I, rows: _F,
+                        values: _F) -> None: ...
 
 class Unknowns:
     mu: int
@@ -161,3 +184,11 @@ class Unknowns:
     def kinematic_run(self, t: _F, y: _F, lam: _F, max_newton: int, tol: float, Y: _F,
                       OUT: _F, ENERGY: _F, info: _F) -> int: ...
     def energy_samples(self, t: _F, Y: _F, lam: _F, ACC: _F, ENERGY: _F) -> int: ...
+    def generalized(self, t: float, y: _F, lam: _F, Iq: _I, cols: _I, qdot: _F | None,
+                    out: _F) -> None: ...
+    def generalized_perturbed(self, t: float, y: _F, lam: _F, Iq: _I, cols: _I, qdot: _F,
+                              P: _F, out: _F) -> None: ...
+    def linearize(self, t: float, y: _F, lam: _F, Iq: _I, cols: _I, scales: _F, quasi: _I,
+                  skip: _I, params: _F, out: _F) -> None: ...
+    def differences(self, t: float, y: _F, lam: _F, Iq: _I, cols: _I, qdot: _F, h: _F,
+                    hu: _F, fscale: _F, rounding: float, skip: _I, out: _F) -> None: ...

@@ -1,15 +1,19 @@
 """Static equilibrium: a configuration at rest where every acceleration vanishes.
 
-With the bodies at rest (v = 0, so no gyroscopic terms) and the drivers held where
-their laws put them at the time asked for, a state is an equilibrium when the solve
-gives v̇ = 0: the applied loads and gravity are carried by the joints alone. mbody
-finds one by Newton's method in the motions the joints allow (a basis of the null space
-of Gᵀ, orthonormal in the kinetic metric): from the file's pose, the residual is the
-accelerations at rest, a(q); a step δ solves J δ = −a with J = ∂a/∂δ by central
-differences along the basis; after each step the positions are moved back onto the
-joints (the compiled core's projection). At the equilibrium, J is −M⁻¹K in that basis:
-its eigenvalues say whether the configuration is stable (all negative: K positive
-definite), unstable (one positive) or neutral (one zero, to the differences' accuracy).
+With the bodies at rest (no gyroscopic terms) and the drivers held where their laws put
+them at the time asked for, a state is an equilibrium when every generalized force
+vanishes, f(q, 0) = 0 (`mbody.equations.generalized`: the free coordinates, less the
+drivers'). It is found by Newton's method from the file's pose: the stiffness
+K = −∂f/∂q comes from the linearisation (`mbody.solve.linearize`, differences of f with
+Richardson extrapolation), each step δq = K⁻¹ f moves the bodies along v = T δq, at most
+half a radian (or half the model's size) at a time, and back onto their joints
+(`mbody.solve.configure`). Newton's method finds the equilibrium nearest the start,
+stable or not; the linearisation there says which: the eigenvalues of M⁻¹K are the
+squared frequencies of small oscillations (all positive: stable; one negative: it falls
+away along that direction).
+
+    state = mbody.equilibrium(model)            # a State, or an error
+    found = find_equilibrium(model)             # found, moved, stiffness, stable
 """
 
 from __future__ import annotations
@@ -19,32 +23,37 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mbody.equations.assemble import assemble
-from mbody.equations.workspace import workspace
+from mbody.equations.coordinates import CoordinateSet
+from mbody.equations.generalized import evaluate, state_with_velocities
 from mbody.errors import MbodyError
-from mbody.kernel import _core
 from mbody.model.calculus import derivative
 from mbody.model.drivers import DriverTable
 from mbody.model.expressions import compile_expression
 from mbody.model.model import Model, State
+from mbody.solve.configure import move, project
 from mbody.solve.kinematics import kinematics
+from mbody.solve.linearize import STEADY_RTOL, Linearization, free_coordinates, linearize
 
 NEWTON_STEPS = 50
-ACCEL_RTOL = 1e-10
-"""Equilibrium when every acceleration is below this times g (or 1 m/s²) per length."""
-STEP_RTOL = 1e-6
-"""Central differences step: this fraction of the model's length (and radians)."""
+"""Newton steps at most (a few from a nearby start)."""
+
+
+class NoEquilibriumError(MbodyError):
+    """Newton's method did not find a static equilibrium from the start."""
 
 
 @dataclass(frozen=True)
 class Equilibrium:
     """What `find_equilibrium` found.
 
-    state: the configuration at rest; found: whether the accelerations vanished (to
-    ACCEL_RTOL); moved: the largest distance a mass centre moved from the start (m) and
-    the largest angle a body turned (rad); stiffness: the eigenvalues of K = −M J in the
-    allowed motions (1/s² per unit mass: positive is stiff), sorted; stable: every one
-    positive (None: not decided, one within the differences' error of 0); iterations.
+    state: the configuration at rest (the last Newton iterate when none was found);
+    found: whether every generalized force vanished (below `STEADY_RTOL` of the terms it
+    is made of); moved: the largest distance a mass centre moved from the start (m) and
+    the largest angle a body turned (rad); stiffness: the eigenvalues of M⁻¹K, the
+    squared frequencies of small oscillations (1/s², ascending; negative: unstable);
+    stable: the linearisation's verdict (None: not decided, a zero stiffness within its
+    error bound, or no equilibrium); iterations: Newton steps taken; residual: the
+    largest generalized force relative to its terms at the end.
     """
 
     state: State
@@ -53,11 +62,12 @@ class Equilibrium:
     stiffness: np.ndarray
     stable: bool | None
     iterations: int
+    residual: float
 
     def __str__(self) -> str:
         if not self.found:
             return (f"no equilibrium found in {self.iterations} Newton steps (the "
-                    "accelerations did not vanish)")
+                    f"generalized forces fell to {self.residual:.2g} of their terms at best)")
         verdict = {True: "stable (the stiffness is positive definite)",
                    False: "unstable (the stiffness has a negative direction)",
                    None: "neutral to the accuracy of the differences (a zero stiffness)"}
@@ -67,7 +77,8 @@ class Equilibrium:
 
 
 def held(model: Model, t: float) -> Model:
-    """The model with each driver held at its law's value at t (a constant law)."""
+    """The model with each driver held at its law's value at t (a constant law: its rate
+    and acceleration 0)."""
     d = model.drivers
     if d is None or not len(d):
         return model
@@ -83,51 +94,43 @@ def held(model: Model, t: float) -> Model:
 
 def find_equilibrium(model: Model, *, start: State | None = None, t: float = 0.0
                      ) -> Equilibrium:
-    """An equilibrium near `start` (default: the file's pose), the drivers held at t."""
+    """An equilibrium near `start` (default: the file's pose), the drivers held at time t
+    (module doc); `Equilibrium.found` says whether Newton's method converged."""
     m = held(model, t)
-    begin = (start if start is not None else model.initial).replace(t=t)
-    zero = np.zeros_like(begin.velocity)
-    state = kinematics(m, t, start=begin.replace(velocity=zero, omega=zero))
-    state = state.replace(velocity=zero, omega=zero.copy())
-    n = m.n
-    size = max(float(np.ptp(m.initial.position, axis=0).max()) if n > 1 else 0.0,
-               float(np.abs(m.joint_table.B_r_child).max()) if len(m.joints) else 0.0, 1e-3)
-    g = max(float(np.linalg.norm(m.gravity)), 1.0)
-    tol = ACCEL_RTOL * g
-    J = np.zeros((0, 0))
-    it = 0
-    found = False
-    while it < NEWTON_STEPS:
-        it += 1
-        acc = _accel(m, state)
-        if np.abs(acc).max(initial=0.0) <= tol:
+    begin = (start if start is not None else model.initial).replace(t=float(t))
+    cs = free_coordinates(m)
+    zero = np.zeros(len(cs))
+    state = _at_rest(m, cs, kinematics(m, float(t), start=begin))
+    best, found, steps = np.inf, False, 0
+    for steps in range(NEWTON_STEPS + 1):
+        g = evaluate(m, state, cs, zero)
+        ratio = float(np.max(np.abs(g.f) / np.maximum(g.f_scale, 1e-300), initial=0.0))
+        best = min(best, ratio)
+        if np.all(np.abs(g.f) <= STEADY_RTOL * g.f_scale):
             found = True
             break
-        basis, to_s = _allowed(m, state)
-        a = to_s @ acc  # s̈: the accelerations in the allowed coordinates
-        J = _jacobian(m, state, basis, to_s, STEP_RTOL * size, t)
+        if steps == NEWTON_STEPS:
+            break
+        lin = linearize(m, state, coordinates=cs.labels)
         try:
-            step = np.linalg.solve(J, -a)
+            dq = np.linalg.lstsq(lin.K, g.f, rcond=1e-12)[0]
         except np.linalg.LinAlgError:
-            step = np.linalg.lstsq(J, -a, rcond=None)[0]
-        limit = 0.2 * size  # a trust region: no jump across the configuration space
-        norm = float(np.linalg.norm(step))
-        if norm > limit:
-            step *= limit / norm
-        state = _moved(m, state, basis @ step, t)
-    basis, to_s = _allowed(m, state)
+            break
+        size = float(np.max(np.abs(dq) / cs.scales)) if len(dq) else 0.0
+        if size > 0.5:  # at most half a radian (or half the model's size) a step
+            dq *= 0.5 / size
+        state = project(m, cs, move(m, state, g.T @ dq))
+    state = _at_rest(m, cs, state)
     stiffness = np.zeros(0)
     stable: bool | None = None
-    if basis.shape[1]:
-        J = _jacobian(m, state, basis, to_s, STEP_RTOL * size, t)
-        stiffness = np.sort(np.linalg.eigvals(-J).real)
-        err = 1e-6 * max(1.0, float(np.abs(stiffness).max()))
-        stable = (True if stiffness[0] > err else False if stiffness[0] < -err else None)
-    moved = (float(np.linalg.norm(state.position - begin.position, axis=1).max()),
-             float((2 * np.arccos(np.abs(np.einsum("ij,ij->i", state.quaternion,
-                                                    begin.quaternion)).clip(0, 1))).max()))
-    out = state.replace(t=t)
-    return Equilibrium(out, found, moved, stiffness, stable, it)
+    if found and len(cs):
+        lin = linearize(m, state, coordinates=cs.labels)
+        stiffness = _squared_frequencies(lin)
+        stable = lin.stable
+    moved = (float(np.linalg.norm(state.position - begin.position, axis=1).max(initial=0.0)),
+             float((2 * np.arccos(np.abs((state.quaternion * begin.quaternion).sum(axis=1))
+                                  .clip(0, 1))).max(initial=0.0)))
+    return Equilibrium(state, found, moved, stiffness, stable, steps, best)
 
 
 def equilibrium(model: Model, *, start: State | None = None, t: float = 0.0) -> State:
@@ -135,76 +138,41 @@ def equilibrium(model: Model, *, start: State | None = None, t: float = 0.0) -> 
     pose by default), the drivers held at time t (`find_equilibrium` says more: how far
     it moved, whether it is stable).
 
+    Parameters
+    ----------
+    model : Model
+        The model.
+    start : State, optional
+        Where Newton's method starts (its velocities are dropped).
+    t : float
+        Time (s) at which the drivers are held and the loads taken.
+
+    Returns
+    -------
+    State
+        At rest, every generalized force below `STEADY_RTOL` of the terms it is made of.
+
     Raises
     ------
-    MbodyError
-        When Newton's method does not find one.
+    NoEquilibriumError
+        Newton's method did not converge from the start (no equilibrium near it, or
+        loads that never balance: a constant torque on a free wheel).
     """
     found = find_equilibrium(model, start=start, t=t)
     if not found.found:
-        raise MbodyError(str(found))
+        raise NoEquilibriumError(f"{model.name!r}: {found}; the loads may never balance (a "
+                                 "constant torque on a free wheel), or start nearer one")
     return found.state
 
 
-def _accel(model: Model, state: State) -> np.ndarray:
-    """The accelerations at rest (N,): v̇ in the model's coordinates."""
-    return assemble(model, state).solve().accelerations
+def _at_rest(model: Model, cs: CoordinateSet, state: State) -> State:
+    """`state` with the velocities of q' = 0 (a held driver's rate is 0 too)."""
+    g = evaluate(model, state, cs, np.zeros(len(cs)))
+    return state_with_velocities(model, state, g.v_e)
 
 
-def _jacobian(model: Model, state: State, basis: np.ndarray, to_s: np.ndarray, h: float,
-              t: float) -> np.ndarray:
-    """J = ∂s̈/∂s at rest by central differences along each allowed coordinate."""
-    J = np.empty((basis.shape[1], basis.shape[1]))
-    for k in range(basis.shape[1]):
-        ap = to_s @ _accel(model, _moved(model, state, basis[:, k] * h, t))
-        am = to_s @ _accel(model, _moved(model, state, -basis[:, k] * h, t))
-        J[:, k] = (ap - am) / (2 * h)
-    return J
-
-
-def _allowed(model: Model, state: State) -> tuple[np.ndarray, np.ndarray]:
-    """(B (N, k), Bᵀ M): a basis of the velocities the joints allow at `state` (the model's
-    coordinates), orthonormal in the kinetic metric (Bᵀ M B = I), and the map from
-    accelerations to the basis's coordinates (s̈ = Bᵀ M v̇)."""
-    asm = assemble(model, state)
-    G = asm.G.toarray()
-    M = asm.M.toarray()
-    N = len(model.coordinates)
-    if G.shape[1] == 0:
-        B = np.eye(N)
-    else:
-        u, s, vt = np.linalg.svd(G.T)
-        rank = int(np.sum(s > 1e-10 * (s[0] if len(s) else 1.0)))
-        B = vt[rank:].T
-    if B.shape[1] == 0:
-        return B, B.T
-    L = np.linalg.cholesky(B.T @ M @ B)
-    B = B @ np.linalg.inv(L).T  # Bᵀ M B = I: unit kinetic energy per coordinate
-    return B, B.T @ M
-
-
-def _moved(model: Model, state: State, dv: np.ndarray, t: float) -> State:
-    """`state` moved by the small motion `dv` (the model's coordinates: displacements and
-    rotations about body axes), then projected back onto the joints, at rest."""
-    n = model.n
-    rpb = model.rows_per_body
-    full = np.zeros(n * rpb)
-    full[model.rows if model.has_particles else slice(None)] = dv
-    d6 = np.zeros((n, 6))
-    d6[:, [0, 1, 5] if model.dimension == 2 else slice(None)] = full.reshape(n, rpb)
-    x = state.position + d6[:, :3]
-    q = state.quaternion.copy()
-    half = 0.5 * d6[:, 3:]
-    w, u = q[:, :1], q[:, 1:]
-    q = q + np.concatenate((-np.einsum("ij,ij->i", u, half)[:, None],
-                            w * half + np.cross(u, half)), axis=1)
-    q /= np.linalg.norm(q, axis=1, keepdims=True)
-    moved = state.replace(position=x, quaternion=q)
-    ws = workspace(model)
-    y = ws.state_vector(moved)
-    info = np.empty(_core.PROJECT_INFO)
-    ws.solver(ws.unknowns({})).project(t, y, 10, 1e-2, 1, info)
-    zero = np.zeros((n, 3))
-    return State(y[:3 * n].reshape(n, 3), y[3 * n:7 * n].reshape(n, 4) /
-                 np.linalg.norm(y[3 * n:7 * n].reshape(n, 4), axis=1)[:, None], zero,
-                 zero.copy(), t)
+def _squared_frequencies(lin: Linearization) -> np.ndarray:
+    """The eigenvalues of M⁻¹K (1/s²), ascending: real for the symmetric K of a static
+    equilibrium (M symmetric positive definite)."""
+    w = np.linalg.eigvals(np.linalg.solve(lin.M, lin.K))
+    return np.sort(w.real)

@@ -244,4 +244,91 @@ int mb_energy_samples(const mb_model *md, const mb_unknowns *u, mb_work *w,
                       const double *lam, int64_t K, const double *t, const double *Y,
                       int64_t stride, double *ACC, double *ENERGY);
 
+/* ---------------------------------------------------------------------------------------
+ * Generalized coordinates (generalized.c). A coordinate is a rate row a_k^T v, Iq
+ * (nq x MB_GQ_W) [kind, index, axis, rule]:
+ *   MB_GQ_TURN        joint `index`'s turn about its joint-frame axis `axis` (fixed in the
+ *                     parent): the rate MB_KIND_TURN measures; value atan2 as TURN's theta
+ *                     (rule 0), or a universal joint's first angle (rule 1)
+ *   MB_GQ_CHILD_TURN  a turn about an axis fixed in the child: axis 0-2 its body axes (a
+ *                     ball's quasi-velocities: no value), 3 the joint's axis2 (a universal
+ *                     joint's second angle, rule 2)
+ *   MB_GQ_SLIDE       the slide along the joint-frame axis `axis` (MB_KIND_FORCE's rate);
+ *                     value e . (P - P_p)
+ *   MB_GQ_BODY        body `index`'s own velocity component `axis` (0-2 world v, 3-5 body
+ *                     w); value its position (planar: its angle about z for axis 5)
+ * cols (nc): the velocity columns (indices into 6 n) the system lives on (planar: x, y,
+ * w3 per body; a particle's rotations left out), increasing. The held components are the
+ * unknowns' U; known components' values (lam) act as loads.
+ * mb_generalized's out: [T (N x nq) | v_e (N) | a0 (N) | M_q (nq x nq) | f_q (nq) |
+ * q (nq) | q' (nq) | f_scale (nq) | info (MB_GENERALIZED_INFO)] with N = nc, so that v = T q' + v_e and
+ * v' = T q'' + a0 keep every held component (drivers' laws included) and
+ * M_q q'' = f_q = T^T (Q - b + G_K lam_K - M a0). q' is the given one, or (qdot NULL)
+ * A^T v of y's velocities; y's own velocities are otherwise not used.
+ * f_scale: the magnitude of the terms each f_q is made of (per group of rows,
+ * translations and rotations, the largest entry of T's column times the sum over the
+ * group of |m g|, each load's |share|, |w| |J w|, |G_K lam_K| and |M a0|), what its
+ * rounding error is relative to.
+ * info: [smallest |R_kk| / largest of the scaled QR of C = [G_U^T; A^T] (0: the
+ * coordinates do not determine the motion), the least-squares residual of C T = [0; I]
+ * (0 on the configuration manifold)].
+ * ------------------------------------------------------------------------------------- */
+enum { MB_GQ_TURN = 0, MB_GQ_CHILD_TURN = 1, MB_GQ_SLIDE = 2, MB_GQ_BODY = 3,
+       MB_GQ_KINDS = 4, MB_GQ_W = 4 };
+enum { MB_GI_RANK = 0, MB_GI_RESIDUAL = 1, MB_GENERALIZED_INFO = 2 };
+
+/* 0 when Iq and cols describe coordinates of this model, else -1. */
+int mb_coordinates_check(const mb_model *md, int64_t nq, const int64_t *Iq, int64_t nc,
+                         const int64_t *cols);
+/* The coordinates' rate rows at y, rows (nq x nc) over the columns `cols`, and their values
+ * (nq); returns 0, or -1 when memory ran out. */
+int mb_coordinate_rows(const mb_model *md, mb_work *w, double t, const double *y, int64_t nq,
+                       const int64_t *Iq, int64_t nc, const int64_t *cols, double *rows,
+                       double *values);
+/* See above; returns 0, or -1 when memory ran out. */
+int mb_generalized(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
+                   const double *y, const double *lam, int64_t nq, const int64_t *Iq,
+                   int64_t nc, const int64_t *cols, const double *qdot, double *out);
+/* f_q at np perturbed states, P (np x 2 nq) rows [dq | du]: the positions of y0 moved along
+ * v = T(y0) dq for a unit time (x + v, q (x) exp(w / 2)), the rates q0' + du: fout (np x
+ * nq). For the linearisation's differences (its curves have the tangents T e_k). */
+int mb_generalized_perturbed(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
+                             const double *y0, const double *lam, int64_t nq,
+                             const int64_t *Iq, int64_t nc, const int64_t *cols,
+                             const double *qdot0, int64_t np, const double *P, double *fout);
+/* The linearisation's differences at y0 (rates q0'): K = -df_q/dq by central differences at
+ * steps h, h/2, h/4 per coordinate (h: nq) extrapolated twice (Richardson, O(h^6)), with the
+ * error bound |R1 - R2| / 15 + 4 rounding fscale_i / (h_j / 4); D = -df_q/dq' by one central
+ * difference at steps hu (exact for f quadratic in q'), error 4 rounding max|f| / hu.
+ * A coordinate with skip[j] != 0 is known not to enter f (a free body's position without
+ * springs...): its K column is 0 without evaluations.
+ * out: [K | K_err | D | D_err], each nq x nq (row i: the equation, column j: the
+ * coordinate). Returns 0, or -1 when memory ran out. */
+int mb_differences(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
+                   const double *y0, const double *lam, int64_t nq, const int64_t *Iq,
+                   int64_t nc, const int64_t *cols, const double *qdot0, const double *h,
+                   const double *hu, const double *fscale, double rounding,
+                   const int64_t *skip, double *out);
+/* The linearisation about (t, y) (linearize.c): mb_generalized there, mb_differences with
+ * steps params[MB_LP_STEP] x scales (positions) and the rates' scale (rates), the residual
+ * q'' = M^-1 f, steadiness (every |f_i| <= params[MB_LP_STEADY] f_scale_i, and no moving
+ * coordinate whose K column exceeds 10 x its error), the coordinates left out (cyclic and
+ * moving, or a quasi-velocity's angle: their K columns zeroed), the first-order matrix
+ * A = [[0, E], [-M^-1 K_kept, -M^-1 D]] (params[MB_LP_ROUNDING], the rounding of one
+ * evaluation of f relative to f_scale, is divided by the projection's pivot ratio) and
+ * the tolerance sqrt(|M^-1| (|dK| + |dD|) |A|)
+ * (infinity norms; at least 1e3 eps |A|) on its eigenvalues, with |dA| = |M^-1| (|dK| +
+ * |dD|) and |A| themselves (info's DA and NORM). out: [mb_generalized's out |
+ * K | K_err | D | D_err (nq x nq each) | q'' (nq) | left out (nq, 0/1) | A (nz x nz in a
+ * slot of (2 nq)^2) | info (MB_LINEARIZE_INFO)], nz = kept + nq. Returns 0, or -1 when
+ * memory ran out. */
+enum { MB_LP_STEP = 0, MB_LP_ROUNDING = 1, MB_LP_STEADY = 2, MB_LP_MOVING = 3,
+       MB_LINEARIZE_PARAMS = 4 };
+enum { MB_LI_STEADY = 0, MB_LI_UNSTEADY = 1, MB_LI_TOL = 2, MB_LI_KEPT = 3,
+       MB_LI_SINGULAR = 4, MB_LI_DA = 5, MB_LI_NORM = 6, MB_LINEARIZE_INFO = 7 };
+int mb_linearize(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
+                 const double *y, const double *lam, int64_t nq, const int64_t *Iq,
+                 int64_t nc, const int64_t *cols, const double *scales, const int64_t *quasi,
+                 const int64_t *skip, const double *params, double *out);
+
 #endif

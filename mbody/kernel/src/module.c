@@ -289,6 +289,66 @@ static PyObject *Model_expression(ModelObject *self, PyObject *const *args, Py_s
     return PyFloat_FromDouble(mb_expression(&self->md, e, t));
 }
 
+/* Iq and cols of a generalized call: views checked against the model (mb_coordinates_check). */
+static int get_coordinates(const mb_model *md, PyObject *Iq_obj, PyObject *cols_obj,
+                           Py_buffer *Iq, Py_buffer *cols) {
+    if (get_buffer(Iq_obj, Iq, 0, 0, -1, "Iq") < 0) return -1;
+    if (get_buffer(cols_obj, cols, 0, 0, -1, "cols") < 0) {
+        PyBuffer_Release(Iq);
+        return -1;
+    }
+    Py_ssize_t nI = Iq->len / 8;
+    if (nI % MB_GQ_W != 0 ||
+        mb_coordinates_check(md, nI / MB_GQ_W, Iq->buf, cols->len / 8, cols->buf) < 0) {
+        PyErr_SetString(PyExc_ValueError,
+                        "Iq and cols do not describe generalized coordinates of this model "
+                        "(kernel.h: kinds, joint or body indices, axes, increasing columns)");
+        PyBuffer_Release(Iq);
+        PyBuffer_Release(cols);
+        return -1;
+    }
+    return 0;
+}
+
+PyDoc_STRVAR(coordinate_rows_doc,
+"coordinate_rows(t, y, Iq, cols, rows, values)\n\nThe generalized coordinates' rate rows "
+"at (t, y) over the columns cols: rows\n(nq x len(cols)), and their values (nq; NaN for a "
+"quasi-velocity). kernel.h: MB_GQ_*.");
+
+static PyObject *Model_coordinate_rows(ModelObject *self, PyObject *const *args,
+                                       Py_ssize_t nargs) {
+    Py_buffer y, Iq, cols, rows, values;
+    double t;
+    if (model_ready(self) < 0 || check_nargs(nargs, 6, "coordinate_rows") < 0 ||
+        get_double(args[0], &t, "t") < 0)
+        return NULL;
+    const mb_model *md = &self->md;
+    if (get_state(md, args[1], &y, 0, 0) < 0) return NULL;
+    if (get_coordinates(md, args[2], args[3], &Iq, &cols) < 0) {
+        PyBuffer_Release(&y);
+        return NULL;
+    }
+    Py_ssize_t nq = Iq.len / 8 / MB_GQ_W, N = cols.len / 8;
+    int ok = get_buffer(args[4], &rows, 1, 1, nq * N, "rows") == 0;
+    if (ok && get_buffer(args[5], &values, 1, 1, nq, "values") < 0) {
+        PyBuffer_Release(&rows);
+        ok = 0;
+    }
+    int status = 0;
+    if (ok) {
+        status = mb_coordinate_rows(md, self->w, t, y.buf, nq, Iq.buf, N, cols.buf, rows.buf,
+                                    values.buf);
+        PyBuffer_Release(&rows);
+        PyBuffer_Release(&values);
+    }
+    PyBuffer_Release(&cols);
+    PyBuffer_Release(&Iq);
+    PyBuffer_Release(&y);
+    if (!ok) return NULL;
+    if (status < 0) return PyErr_NoMemory();
+    Py_RETURN_NONE;
+}
+
 static PyObject *Model_get_int(ModelObject *self, void *which) {
     const mb_model *md = &self->md;
     switch ((int)(intptr_t)which) {
@@ -322,6 +382,8 @@ static PyMethodDef Model_methods[] = {
     {"loads_at", (PyCFunction)(void (*)(void))Model_loads_at, METH_FASTCALL, loads_at_doc},
     {"columns", (PyCFunction)(void (*)(void))Model_columns, METH_FASTCALL, columns_doc},
     {"expression", (PyCFunction)(void (*)(void))Model_expression, METH_FASTCALL, expression_doc},
+    {"coordinate_rows", (PyCFunction)(void (*)(void))Model_coordinate_rows, METH_FASTCALL,
+     coordinate_rows_doc},
     {NULL, NULL, 0, NULL},
 };
 
@@ -681,6 +743,209 @@ static PyObject *Unknowns_schur(UnknownsObject *self, PyObject *const *args, Py_
     Py_RETURN_NONE;
 }
 
+PyDoc_STRVAR(generalized_doc,
+"generalized(t, y, lam, Iq, cols, qdot, out)\n\nThe velocity transformation and the "
+"generalized mass and forces at (t, y) with the\nunknowns' components held (kernel.h, "
+"mb_generalized): out [T (N x nq) | v_e (N) |\na0 (N) | M_q (nq x nq) | f_q (nq) | q (nq) "
+"| q' (nq) | f_scale (nq) | info (GENERALIZED_INFO)],\nN = len(cols), nq = len(Iq) / GQ_W. qdot: the "
+"rates (nq), or None for those of y's\nvelocities. lam (m): the known components' values "
+"(0 on held ones).");
+
+static PyObject *Unknowns_generalized(UnknownsObject *self, PyObject *const *args,
+                                      Py_ssize_t nargs) {
+    Py_buffer y, lam, Iq, cols, qdot, out;
+    double t;
+    int have_qdot = 0;
+    if (unknowns_ready(self) < 0 || check_nargs(nargs, 7, "generalized") < 0 ||
+        get_double(args[0], &t, "t") < 0)
+        return NULL;
+    const mb_model *md = &self->model->md;
+    if (get_state(md, args[1], &y, 0, 0) < 0) return NULL;
+    if (get_buffer(args[2], &lam, 0, 1, md->m, "lam") < 0) goto y_;
+    if (get_coordinates(md, args[3], args[4], &Iq, &cols) < 0) goto lam_;
+    Py_ssize_t nq = Iq.len / 8 / MB_GQ_W, N = cols.len / 8;
+    if (args[5] != Py_None) {
+        if (get_buffer(args[5], &qdot, 0, 1, nq, "qdot") < 0) goto Iq_;
+        have_qdot = 1;
+    }
+    if (get_buffer(args[6], &out, 1, 1, N * nq + 2 * N + nq * nq + 4 * nq + MB_GENERALIZED_INFO,
+                   "out") < 0)
+        goto qdot_;
+    int status = mb_generalized(md, &self->u, self->w, t, y.buf, lam.buf, nq, Iq.buf, N,
+                                cols.buf, have_qdot ? qdot.buf : NULL, out.buf);
+    PyBuffer_Release(&out);
+    if (have_qdot) PyBuffer_Release(&qdot);
+    PyBuffer_Release(&cols);
+    PyBuffer_Release(&Iq);
+    PyBuffer_Release(&lam);
+    PyBuffer_Release(&y);
+    if (status < 0) return PyErr_NoMemory();
+    Py_RETURN_NONE;
+qdot_:
+    if (have_qdot) PyBuffer_Release(&qdot);
+Iq_:
+    PyBuffer_Release(&cols);
+    PyBuffer_Release(&Iq);
+lam_:
+    PyBuffer_Release(&lam);
+y_:
+    PyBuffer_Release(&y);
+    return NULL;
+}
+
+PyDoc_STRVAR(generalized_perturbed_doc,
+"generalized_perturbed(t, y, lam, Iq, cols, qdot, P, out)\n\nf_q at perturbed states "
+"(kernel.h, mb_generalized_perturbed): P (np x 2 nq) rows\n[dq | du]: y's positions moved "
+"along T(y) dq, the rates qdot + du; out (np x nq).");
+
+static PyObject *Unknowns_generalized_perturbed(UnknownsObject *self, PyObject *const *args,
+                                                Py_ssize_t nargs) {
+    Py_buffer y, lam, Iq, cols, qdot, P, out;
+    double t;
+    if (unknowns_ready(self) < 0 || check_nargs(nargs, 8, "generalized_perturbed") < 0 ||
+        get_double(args[0], &t, "t") < 0)
+        return NULL;
+    const mb_model *md = &self->model->md;
+    if (get_state(md, args[1], &y, 0, 0) < 0) return NULL;
+    if (get_buffer(args[2], &lam, 0, 1, md->m, "lam") < 0) goto y_;
+    if (get_coordinates(md, args[3], args[4], &Iq, &cols) < 0) goto lam_;
+    Py_ssize_t nq = Iq.len / 8 / MB_GQ_W, N = cols.len / 8;
+    if (get_buffer(args[5], &qdot, 0, 1, nq, "qdot") < 0) goto Iq_;
+    if (get_buffer(args[6], &P, 0, 1, -1, "P") < 0) goto qdot_;
+    Py_ssize_t np_ = nq > 0 ? P.len / 8 / (2 * nq) : 0;
+    if (nq > 0 && P.len / 8 != np_ * 2 * nq) {
+        PyErr_SetString(PyExc_ValueError, "P: expected rows of 2 nq values");
+        goto P_;
+    }
+    if (get_buffer(args[7], &out, 1, 1, np_ * nq, "out") < 0) goto P_;
+    int status = mb_generalized_perturbed(md, &self->u, self->w, t, y.buf, lam.buf, nq,
+                                          Iq.buf, N, cols.buf, qdot.buf, np_, P.buf, out.buf);
+    PyBuffer_Release(&out);
+    PyBuffer_Release(&P);
+    PyBuffer_Release(&qdot);
+    PyBuffer_Release(&cols);
+    PyBuffer_Release(&Iq);
+    PyBuffer_Release(&lam);
+    PyBuffer_Release(&y);
+    if (status < 0) return PyErr_NoMemory();
+    Py_RETURN_NONE;
+P_:
+    PyBuffer_Release(&P);
+qdot_:
+    PyBuffer_Release(&qdot);
+Iq_:
+    PyBuffer_Release(&cols);
+    PyBuffer_Release(&Iq);
+lam_:
+    PyBuffer_Release(&lam);
+y_:
+    PyBuffer_Release(&y);
+    return NULL;
+}
+
+PyDoc_STRVAR(differences_doc,
+"differences(t, y, lam, Iq, cols, qdot, h, hu, fscale, rounding, skip, out)\n\nThe "
+"linearisation's differences (kernel.h, mb_differences): out [K | K_err | D | D_err],\n"
+"each nq x nq; h, hu, fscale (nq): position and rate steps, f's magnitudes; skip (nq,\n"
+"int64): coordinates known not to enter f.");
+
+static PyObject *Unknowns_differences(UnknownsObject *self, PyObject *const *args,
+                                      Py_ssize_t nargs) {
+    Py_buffer y, lam, Iq, cols, v[4], skip, out;
+    static const char *names[4] = {"qdot", "h", "hu", "fscale"};
+    double t, rounding;
+    if (unknowns_ready(self) < 0 || check_nargs(nargs, 12, "differences") < 0 ||
+        get_double(args[0], &t, "t") < 0 || get_double(args[9], &rounding, "rounding") < 0)
+        return NULL;
+    const mb_model *md = &self->model->md;
+    if (get_state(md, args[1], &y, 0, 0) < 0) return NULL;
+    if (get_buffer(args[2], &lam, 0, 1, md->m, "lam") < 0) {
+        PyBuffer_Release(&y);
+        return NULL;
+    }
+    if (get_coordinates(md, args[3], args[4], &Iq, &cols) < 0) {
+        PyBuffer_Release(&lam);
+        PyBuffer_Release(&y);
+        return NULL;
+    }
+    Py_ssize_t nq = Iq.len / 8 / MB_GQ_W, N = cols.len / 8;
+    int got = 0, ok = 1;
+    for (; got < 4; got++)
+        if (get_buffer(args[5 + got], &v[got], 0, 1, nq, names[got]) < 0) break;
+    int have_skip = 0;
+    if (got < 4 || get_buffer(args[10], &skip, 0, 0, nq, "skip") < 0) ok = 0;
+    else have_skip = 1;
+    if (ok && get_buffer(args[11], &out, 1, 1, 4 * nq * nq, "out") < 0) ok = 0;
+    int status = 0;
+    if (ok) {
+        status = mb_differences(md, &self->u, self->w, t, y.buf, lam.buf, nq, Iq.buf, N,
+                                cols.buf, v[0].buf, v[1].buf, v[2].buf, v[3].buf, rounding,
+                                skip.buf, out.buf);
+        PyBuffer_Release(&out);
+    }
+    if (have_skip) PyBuffer_Release(&skip);
+    for (int i = 0; i < got; i++) PyBuffer_Release(&v[i]);
+    PyBuffer_Release(&cols);
+    PyBuffer_Release(&Iq);
+    PyBuffer_Release(&lam);
+    PyBuffer_Release(&y);
+    if (!ok) return NULL;
+    if (status < 0) return PyErr_NoMemory();
+    Py_RETURN_NONE;
+}
+
+PyDoc_STRVAR(linearize_doc,
+"linearize(t, y, lam, Iq, cols, scales, quasi, skip, params, out)\n\nThe linearisation "
+"about (t, y) (kernel.h, mb_linearize): out [generalized's out | K | K_err\n| D | D_err | "
+"q'' | left out | A ((2 nq)^2 slot) | info (LINEARIZE_INFO)]; scales (nq):\n1 or the model's "
+"length; quasi, skip (nq, int64); params (LINEARIZE_PARAMS).");
+
+static PyObject *Unknowns_linearize(UnknownsObject *self, PyObject *const *args,
+                                    Py_ssize_t nargs) {
+    Py_buffer y, lam, Iq, cols, scales, quasi, skip, params, out;
+    double t;
+    if (unknowns_ready(self) < 0 || check_nargs(nargs, 10, "linearize") < 0 ||
+        get_double(args[0], &t, "t") < 0)
+        return NULL;
+    const mb_model *md = &self->model->md;
+    if (get_state(md, args[1], &y, 0, 0) < 0) return NULL;
+    if (get_buffer(args[2], &lam, 0, 1, md->m, "lam") < 0) {
+        PyBuffer_Release(&y);
+        return NULL;
+    }
+    if (get_coordinates(md, args[3], args[4], &Iq, &cols) < 0) {
+        PyBuffer_Release(&lam);
+        PyBuffer_Release(&y);
+        return NULL;
+    }
+    Py_ssize_t nq = Iq.len / 8 / MB_GQ_W, N = cols.len / 8;
+    int stage = 0, status = 0;
+    if (get_buffer(args[5], &scales, 0, 1, nq, "scales") == 0) stage = 1;
+    if (stage == 1 && get_buffer(args[6], &quasi, 0, 0, nq, "quasi") == 0) stage = 2;
+    if (stage == 2 && get_buffer(args[7], &skip, 0, 0, nq, "skip") == 0) stage = 3;
+    if (stage == 3 && get_buffer(args[8], &params, 0, 1, MB_LINEARIZE_PARAMS, "params") == 0)
+        stage = 4;
+    Py_ssize_t size = N * nq + 2 * N + nq * nq + 4 * nq + MB_GENERALIZED_INFO + 4 * nq * nq +
+                      2 * nq + 4 * nq * nq + MB_LINEARIZE_INFO;
+    if (stage == 4 && get_buffer(args[9], &out, 1, 1, size, "out") == 0) stage = 5;
+    if (stage == 5) {
+        status = mb_linearize(md, &self->u, self->w, t, y.buf, lam.buf, nq, Iq.buf, N, cols.buf,
+                              scales.buf, quasi.buf, skip.buf, params.buf, out.buf);
+        PyBuffer_Release(&out);
+    }
+    if (stage >= 4) PyBuffer_Release(&params);
+    if (stage >= 3) PyBuffer_Release(&skip);
+    if (stage >= 2) PyBuffer_Release(&quasi);
+    if (stage >= 1) PyBuffer_Release(&scales);
+    PyBuffer_Release(&cols);
+    PyBuffer_Release(&Iq);
+    PyBuffer_Release(&lam);
+    PyBuffer_Release(&y);
+    if (stage < 5) return NULL;
+    if (status < 0) return PyErr_NoMemory();
+    Py_RETURN_NONE;
+}
+
 static PyObject *Unknowns_get(UnknownsObject *self, void *which) {
     switch ((int)(intptr_t)which) {
     case 0: return PyLong_FromLongLong(self->u.mu);
@@ -710,6 +975,14 @@ static PyMethodDef Unknowns_methods[] = {
     {"energy_samples", (PyCFunction)(void (*)(void))Unknowns_energy_samples, METH_FASTCALL,
      energy_samples_doc},
     {"schur", (PyCFunction)(void (*)(void))Unknowns_schur, METH_FASTCALL, schur_doc},
+    {"generalized", (PyCFunction)(void (*)(void))Unknowns_generalized, METH_FASTCALL,
+     generalized_doc},
+    {"generalized_perturbed", (PyCFunction)(void (*)(void))Unknowns_generalized_perturbed,
+     METH_FASTCALL, generalized_perturbed_doc},
+    {"differences", (PyCFunction)(void (*)(void))Unknowns_differences, METH_FASTCALL,
+     differences_doc},
+    {"linearize", (PyCFunction)(void (*)(void))Unknowns_linearize, METH_FASTCALL,
+     linearize_doc},
     {NULL, NULL, 0, NULL},
 };
 
@@ -796,6 +1069,16 @@ PyMODINIT_FUNC PyInit__core(void) {
         {"KR_STEP", MB_KR_STEP}, {"KR_NEWTON", MB_KR_NEWTON}, {"KR_WORST", MB_KR_WORST},
         {"KR_SINGULAR", MB_KR_SINGULAR}, {"KR_INFO", MB_KR_INFO},
         {"PROJECT_INFO", MB_PROJECT_INFO},
+        {"GQ_TURN", MB_GQ_TURN}, {"GQ_CHILD_TURN", MB_GQ_CHILD_TURN},
+        {"GQ_SLIDE", MB_GQ_SLIDE}, {"GQ_BODY", MB_GQ_BODY}, {"GQ_W", MB_GQ_W},
+        {"GI_RANK", MB_GI_RANK}, {"GI_RESIDUAL", MB_GI_RESIDUAL},
+        {"GENERALIZED_INFO", MB_GENERALIZED_INFO},
+        {"LP_STEP", MB_LP_STEP}, {"LP_ROUNDING", MB_LP_ROUNDING}, {"LP_STEADY", MB_LP_STEADY},
+        {"LP_MOVING", MB_LP_MOVING}, {"LINEARIZE_PARAMS", MB_LINEARIZE_PARAMS},
+        {"LI_STEADY", MB_LI_STEADY}, {"LI_UNSTEADY", MB_LI_UNSTEADY}, {"LI_TOL", MB_LI_TOL},
+        {"LI_KEPT", MB_LI_KEPT}, {"LI_SINGULAR", MB_LI_SINGULAR}, {"LI_DA", MB_LI_DA},
+        {"LI_NORM", MB_LI_NORM},
+        {"LINEARIZE_INFO", MB_LINEARIZE_INFO},
     };
     for (size_t i = 0; i < sizeof(constants) / sizeof(constants[0]); i++)
         if (PyModule_AddIntConstant(m, constants[i].name, constants[i].value) < 0) goto fail;

@@ -1,0 +1,666 @@
+/* Generalized coordinates: the velocity transformation v = T q' + v_e, the generalized
+ * mass M_q = T^T M T and forces f_q = T^T (Q - b + G_K lam_K - M a0) (kernel.h).
+ *
+ * Each coordinate is a rate row a_k^T v (MB_GQ_*): a turn about a joint-frame axis
+ * (a revolute's angle, the rate MB_KIND_TURN measures), a turn about an axis fixed in the
+ * child (a ball's quasi-velocities about the child's body axes, a universal joint's
+ * second angle), a slide along a joint-frame axis (MB_KIND_FORCE's rate), or one of a
+ * body's own velocity components. With C = [G_U^T; A^T] (the held components, then the
+ * coordinates; r x N over the model's velocity columns):
+ *
+ *     C T = [0; I],    C v_e = [f'; 0],    C a0 = [gamma_U; gamma_A]
+ *
+ * (f' the drivers' rates; gamma the acceleration terms at v' = 0, so that
+ * v' = T q'' + a0). C has full column rank when the coordinates determine the motion;
+ * redundant joints make it taller than wide, and the system stays consistent on the
+ * configuration manifold (the least-squares solution is then the exact one). One
+ * Householder QR of C (columns scaled to unit length) serves every right-hand side. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal.h"
+
+#define TWO_PI 6.283185307179586
+#define PI 3.141592653589793
+
+static double wrap_angle(double a) { return a - TWO_PI * ceil((a - PI) / TWO_PI); }
+
+int mb_coordinates_check(const mb_model *md, int64_t nq, const int64_t *Iq, int64_t nc,
+                         const int64_t *cols) {
+    if (nq < 0 || nc < 0 || nc > 6 * md->n) return -1;
+    for (int64_t k = 0; k < nq; k++) {
+        const int64_t *c = Iq + MB_GQ_W * k;
+        int64_t kind = c[0], index = c[1], axis = c[2], rule = c[3];
+        if (rule < 0 || rule > 2) return -1;
+        switch (kind) {
+        case MB_GQ_TURN:
+        case MB_GQ_SLIDE:
+            if (index < 0 || index >= md->nj || axis < 0 || axis > 2) return -1;
+            break;
+        case MB_GQ_CHILD_TURN:
+            if (index < 0 || index >= md->nj || axis < 0 || axis > 3) return -1;
+            break;
+        case MB_GQ_BODY:
+            if (index < 0 || index >= md->n || axis < 0 || axis > 5) return -1;
+            break;
+        default: return -1;
+        }
+    }
+    for (int64_t j = 0; j < nc; j++)
+        if (cols[j] < 0 || cols[j] >= 6 * md->n || (j > 0 && cols[j] <= cols[j - 1]))
+            return -1;
+    return 0;
+}
+
+/* The scratch of one evaluation (allocated per call: a few small arrays). */
+typedef struct {
+    int64_t n, N, nq, mu, r;
+    double *C, *B, *fp, *scale, *beta, *rdiag, *y, *arow, *agam, *r6, *Ma, *lam;
+    int64_t *col_of; /* 6 n: active column index, or -1 */
+} gen_scratch;
+
+static void scratch_free(gen_scratch *s) {
+    free(s->C), free(s->B), free(s->fp), free(s->scale), free(s->beta), free(s->rdiag), free(s->y), free(s->arow);
+    free(s->agam), free(s->r6), free(s->Ma), free(s->lam), free(s->col_of);
+}
+
+static int scratch_new(gen_scratch *s, const mb_model *md, const mb_unknowns *u, int64_t nq,
+                       int64_t nc, const int64_t *cols) {
+    memset(s, 0, sizeof(*s));
+    s->n = md->n, s->N = nc, s->nq = nq, s->mu = u->mu, s->r = u->mu + nq;
+    int64_t r = s->r > 0 ? s->r : 1, N = nc > 0 ? nc : 1, n = md->n > 0 ? md->n : 1;
+    s->C = calloc((size_t)(r * N), sizeof(double));
+    s->B = calloc((size_t)(3 * r + N), sizeof(double));
+    s->fp = calloc((size_t)r, sizeof(double));
+    s->scale = calloc((size_t)N, sizeof(double));
+    s->beta = calloc((size_t)N, sizeof(double));
+    s->rdiag = calloc((size_t)N, sizeof(double));
+    s->y = calloc((size_t)(13 * n), sizeof(double));
+    s->arow = calloc((size_t)(12 * (nq > 0 ? nq : 1)), sizeof(double));
+    s->agam = calloc((size_t)(nq > 0 ? nq : 1), sizeof(double));
+    s->r6 = calloc((size_t)(6 * n), sizeof(double));
+    s->Ma = calloc((size_t)(6 * n), sizeof(double));
+    s->lam = calloc((size_t)(md->m > 0 ? md->m : 1), sizeof(double));
+    s->col_of = calloc((size_t)(6 * n), sizeof(int64_t));
+    if (!s->C || !s->B || !s->fp || !s->scale || !s->beta || !s->rdiag || !s->y || !s->arow || !s->agam || !s->r6 ||
+        !s->Ma || !s->lam || !s->col_of) {
+        scratch_free(s);
+        return -1;
+    }
+    for (int64_t i = 0; i < 6 * md->n; i++) s->col_of[i] = -1;
+    for (int64_t j = 0; j < nc; j++) s->col_of[cols[j]] = j;
+    return 0;
+}
+
+/* R^T e */
+static void to_body(const double *R, const double *e, double *B) {
+    for (int a = 0; a < 3; a++) B[a] = R[a] * e[0] + R[3 + a] * e[1] + R[6 + a] * e[2];
+}
+
+/* Coordinate k's rate row (child side row[0..5], parent side row[6..11]; its bodies in
+ * *c, *p), its acceleration term gamma (at the velocities w's joint data were made with)
+ * and its value (rad, m; NaN for a quasi-velocity). Needs w->R and the joint data of
+ * mb_columns_at at the same y. */
+static void coordinate_row(const mb_model *md, const mb_work *w, const double *y,
+                           const int64_t *c, double *row, int64_t *child, int64_t *parent,
+                           double *gamma, double *value) {
+    int64_t kind = c[0], index = c[1], axis = c[2], rule = c[3];
+    memset(row, 0, 12 * sizeof(double));
+    *gamma = 0.0;
+    *value = NAN;
+    if (kind == MB_GQ_BODY) {
+        int64_t n = md->n;
+        *child = index, *parent = -1;
+        row[axis] = 1.0;
+        if (axis < 3) *value = y[3 * index + axis];
+        else if (md->planar && axis == 5) {
+            const double *q = y + 3 * n + 4 * index;
+            *value = wrap_angle(2.0 * atan2(q[3], q[0]));
+        }
+        return;
+    }
+    int64_t j = index;
+    const double *jrow = md->joints + MB_JOINT_W * j;
+    int64_t p = md->joints_i[3 * j], ch = md->joints_i[3 * j + 1];
+    int particle_parent = (md->joints_i[3 * j + 2] & MB_J_PARTICLE_PARENT) != 0;
+    *child = ch, *parent = p;
+    const double *Rc = w->R + 9 * ch, *WE = w->jWE + 9 * j, *A = w->jRrel + 9 * j;
+    const double *wc = w->jwc + 3 * j, *wp = w->jwp + 3 * j;
+    double Rp[9] = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
+    if (p >= 0)
+        for (int a = 0; a < 9; a++) Rp[a] = w->R[9 * p + a];
+    double e[3], Bc[3], Bp[3], k[3];
+    mb_cross(wc, wp, k);
+    if (kind == MB_GQ_CHILD_TURN) {
+        double bB[3] = {0.0, 0.0, 0.0};
+        if (axis < 3) bB[axis] = 1.0;
+        else for (int a = 0; a < 3; a++) bB[a] = jrow[J_CAX2 + a];
+        for (int a = 0; a < 3; a++) e[a] = Rc[3 * a] * bB[0] + Rc[3 * a + 1] * bB[1] + Rc[3 * a + 2] * bB[2];
+        to_body(Rp, e, Bp);
+        for (int a = 0; a < 3; a++) row[3 + a] = bB[a], row[9 + a] = -Bp[a];
+        *gamma = -(e[0] * k[0] + e[1] * k[1] + e[2] * k[2]);
+    } else {
+        for (int a = 0; a < 3; a++) e[a] = WE[3 * a + axis], Bp[a] = jrow[J_PE3 + 3 * a + axis];
+        to_body(Rc, e, Bc);
+        if (kind == MB_GQ_TURN) {
+            for (int a = 0; a < 3; a++) row[3 + a] = Bc[a], row[9 + a] = -Bp[a];
+            *gamma = -(e[0] * k[0] + e[1] * k[1] + e[2] * k[2]);
+        } else { /* MB_GQ_SLIDE: the FORCE primitive's row */
+            double mc[3], mp[3];
+            const double *T = w->jT + 3 * j, *d = w->jd + 3 * j;
+            mb_cross(jrow + J_BRC, Bc, mc);
+            mb_cross(w->jBrp + 3 * j, Bp, mp);
+            for (int a = 0; a < 3; a++) {
+                row[a] = e[a], row[3 + a] = mc[a];
+                row[6 + a] = -e[a], row[9 + a] = particle_parent ? 0.0 : -mp[a];
+            }
+            *gamma = -(e[0] * T[0] + e[1] * T[1] + e[2] * T[2]);
+            *value = e[0] * d[0] + e[1] * d[1] + e[2] * d[2];
+        }
+    }
+    if (particle_parent)
+        for (int a = 9; a < 12; a++) row[a] = 0.0;
+    if (kind == MB_GQ_SLIDE) return;
+    /* values: rule 0 the turn about the frame's axis; 1, 2 a universal joint's first and
+     * second angle (R_rel = Rz(q1) R_b0(q2), b0 = axis2 in the joint frame at the file's
+     * pose); a child-fixed body axis has none (a quasi-velocity) */
+    if (rule == 0 && kind == MB_GQ_TURN) {
+        int i1 = (int)((axis + 1) % 3), i2 = (int)((axis + 2) % 3);
+        *value = atan2(A[3 * i2 + i1], A[3 * i1 + i1]);
+    } else if (rule == 1 || rule == 2) {
+        const double *CE = jrow + J_CE3, *ax2 = jrow + J_CAX2;
+        double b0[3], b[3];
+        for (int a = 0; a < 3; a++) /* C_E3^T axis2: axis2 in the child's joint frame */
+            b0[a] = CE[a] * ax2[0] + CE[3 + a] * ax2[1] + CE[6 + a] * ax2[2];
+        for (int a = 0; a < 3; a++) b[a] = A[3 * a] * b0[0] + A[3 * a + 1] * b0[1] + A[3 * a + 2] * b0[2];
+        double q1 = wrap_angle(atan2(b[1], b[0]) - atan2(b0[1], b0[0]));
+        if (rule == 1) {
+            *value = q1;
+        } else {
+            double c1 = cos(q1), s1 = sin(q1);
+            double z0 = A[2], z1 = A[5], z2 = A[8]; /* A z */
+            double r0 = c1 * z0 + s1 * z1, r1 = -s1 * z0 + c1 * z1; /* Rz(-q1) A z */
+            *value = atan2(b0[1] * r0 - b0[0] * r1, z2);
+        }
+    }
+}
+
+/* Householder QR of C (r x N, row-major, in place) with its columns scaled to unit
+ * length first (scale: the factors): the reflectors' vectors stay in C on and below the
+ * diagonal (beta their factors), R's strict upper triangle above it, R's diagonal in
+ * rdiag. Returns the smallest |R_kk| over the largest (0 when r < N). */
+static double qr_factor(double *C, int64_t r, int64_t N, double *scale, double *beta,
+                        double *rdiag) {
+    for (int64_t j = 0; j < N; j++) rdiag[j] = 0.0;
+    for (int64_t j = 0; j < N; j++) {
+        double s = 0.0;
+        for (int64_t i = 0; i < r; i++) s += C[i * N + j] * C[i * N + j];
+        s = s > 0.0 ? 1.0 / sqrt(s) : 1.0;
+        scale[j] = s;
+        for (int64_t i = 0; i < r; i++) C[i * N + j] *= s;
+    }
+    if (r < N) return 0.0; /* fewer rows than columns: the motion is not determined */
+    double big = 0.0, small = INFINITY;
+    for (int64_t k = 0; k < N; k++) {
+        double norm = 0.0;
+        for (int64_t i = k; i < r; i++) norm += C[i * N + k] * C[i * N + k];
+        norm = sqrt(norm);
+        double x0 = C[k * N + k];
+        double alpha = x0 >= 0.0 ? -norm : norm;
+        C[k * N + k] = x0 - alpha;
+        double vv = 0.0;
+        for (int64_t i = k; i < r; i++) vv += C[i * N + k] * C[i * N + k];
+        beta[k] = vv > 0.0 ? 2.0 / vv : 0.0;
+        for (int64_t c = k + 1; c < N; c++) {
+            double s = 0.0;
+            for (int64_t i = k; i < r; i++) s += C[i * N + k] * C[i * N + c];
+            s *= beta[k];
+            for (int64_t i = k; i < r; i++) C[i * N + c] -= s * C[i * N + k];
+        }
+        rdiag[k] = alpha;
+        big = fmax(big, fabs(alpha));
+        small = fmin(small, fabs(alpha));
+    }
+    return big > 0.0 ? small / big : 0.0;
+}
+
+/* B (r x nrhs, row-major) <- the least-squares solutions X (N x nrhs) of C X = B in its
+ * first N rows, with the factors of qr_factor. Returns the residual's norm (the part of
+ * B outside C's range: 0 for a consistent system). */
+static double qr_solve(const double *C, int64_t r, int64_t N, const double *scale,
+                       const double *beta, const double *rdiag, double *B, int64_t nrhs) {
+    double resid = 0.0;
+    for (int64_t c = 0; c < nrhs; c++) {
+        for (int64_t k = 0; k < N; k++) {
+            double s = 0.0;
+            for (int64_t i = k; i < r; i++) s += C[i * N + k] * B[i * nrhs + c];
+            s *= beta[k];
+            for (int64_t i = k; i < r; i++) B[i * nrhs + c] -= s * C[i * N + k];
+        }
+        for (int64_t i = N; i < r; i++) resid += B[i * nrhs + c] * B[i * nrhs + c];
+        for (int64_t k = N - 1; k >= 0; k--) {
+            double s = B[k * nrhs + c];
+            for (int64_t j = k + 1; j < N; j++) s -= C[k * N + j] * B[j * nrhs + c];
+            B[k * nrhs + c] = rdiag[k] != 0.0 ? s / rdiag[k] : 0.0;
+        }
+        for (int64_t k = 0; k < N; k++) B[k * nrhs + c] *= scale[k];
+    }
+    return sqrt(resid);
+}
+
+/* x (N) <- the last `nq` entries of Q1 R^-T D x (r entries before selection; work: r
+ * doubles): (C^+)^T D x restricted to the coordinates' rows, i.e. T^T x when T is
+ * C^+ [0; I] (the transposed solve: one vector instead of nq columns of T). */
+static void qr_transposed(const double *C, int64_t r, int64_t N, const double *scale,
+                          const double *beta, const double *rdiag, const double *x,
+                          int64_t first, int64_t nq, double *out, double *work) {
+    for (int64_t k = 0; k < N; k++) { /* R^T z = D x, forward */
+        double s = scale[k] * x[k];
+        for (int64_t j = 0; j < k; j++) s -= C[j * N + k] * work[j];
+        work[k] = rdiag[k] != 0.0 ? s / rdiag[k] : 0.0;
+    }
+    for (int64_t i = N; i < r; i++) work[i] = 0.0;
+    for (int64_t k = N - 1; k >= 0; k--) { /* Q [z; 0] = H_0 ... H_{N-1} [z; 0] */
+        double s = 0.0;
+        for (int64_t i = k; i < r; i++) s += C[i * N + k] * work[i];
+        s *= beta[k];
+        for (int64_t i = k; i < r; i++) work[i] -= s * C[i * N + k];
+    }
+    for (int64_t k = 0; k < nq; k++) out[k] = work[first + k];
+}
+
+/* Adds row (child side [0..5] on body c, parent side [6..11] on body p) into C's row i. */
+static void put_row(const gen_scratch *s, double *Crow, const double *row, int64_t c,
+                    int64_t p) {
+    for (int a = 0; a < 6; a++) {
+        int64_t j = s->col_of[6 * c + a];
+        if (j >= 0) Crow[j] += row[a];
+        if (p >= 0) {
+            j = s->col_of[6 * p + a];
+            if (j >= 0) Crow[j] += row[6 + a];
+        }
+    }
+}
+
+/* row . v for a coordinate's row and the state's velocities (world v, body w). */
+static double row_dot_v(const double *row, int64_t c, int64_t p, const double *y, int64_t n,
+                        const int64_t *col_of) {
+    const double *v = y + 7 * n, *om = y + 10 * n;
+    double s = 0.0;
+    for (int a = 0; a < 3; a++) {
+        if (col_of[6 * c + a] >= 0) s += row[a] * v[3 * c + a];
+        if (col_of[6 * c + 3 + a] >= 0) s += row[3 + a] * om[3 * c + a];
+        if (p >= 0) {
+            if (col_of[6 * p + a] >= 0) s += row[6 + a] * v[3 * p + a];
+            if (col_of[6 * p + 3 + a] >= 0) s += row[9 + a] * om[3 * p + a];
+        }
+    }
+    return s;
+}
+
+/* The columns of the held components and the coordinates' rows at s->y (positions; the
+ * velocities only enter gamma): into w's columns, s->arow, s->agam, values. */
+static void rows_at(const mb_model *md, mb_work *w, gen_scratch *s, int64_t nq,
+                    const int64_t *Iq, int64_t *cc, int64_t *cp, double *values) {
+    mb_columns_at(md, w, s->y, 1, w->child6, w->parent6, NULL, NULL, w->gamma, w->phi,
+                  w->gtv);
+    for (int64_t k = 0; k < nq; k++)
+        coordinate_row(md, w, s->y, Iq + MB_GQ_W * k, s->arow + 12 * k, cc + k, cp + k,
+                       s->agam + k, values ? values + k : &(double){0.0});
+}
+
+/* Stage 1 at positions s->y: rotations, the rows and C's QR (kept in s), the coordinates'
+ * rows and bodies (cc, cp) and values; the drivers' rates f' of the held components into
+ * s->fp. Returns the pivot ratio. */
+static double factor(const mb_model *md, const mb_unknowns *u, mb_work *w, gen_scratch *s,
+                     int64_t nq, const int64_t *Iq, int64_t *cc, int64_t *cp, double *qval) {
+    int64_t n = md->n, N = s->N, mu = s->mu, r = s->r;
+    mb_rotations(n, s->y + 3 * n, w->R);
+    rows_at(md, w, s, nq, Iq, cc, cp, qval);
+    memset(s->C, 0, sizeof(double) * r * N);
+    for (int64_t k = 0; k < mu; k++) {
+        int64_t i = u->U[k], j = md->comps_i[4 * i];
+        double row[12];
+        memcpy(row, w->child6 + 6 * i, 6 * sizeof(double));
+        memcpy(row + 6, w->parent6 + 6 * i, 6 * sizeof(double));
+        put_row(s, s->C + k * N, row, md->joints_i[3 * j + 1], md->joints_i[3 * j]);
+        s->fp[k] = 0.0;
+        if (md->comps_i[4 * i + 3] >= 0) {
+            double f[3];
+            mb_law(md, w, i, f);
+            s->fp[k] = f[1];
+        }
+    }
+    for (int64_t k = 0; k < nq; k++) put_row(s, s->C + (mu + k) * N, s->arow + 12 * k, cc[k], cp[k]);
+    return qr_factor(s->C, r, N, s->scale, s->beta, s->rdiag);
+}
+
+/* Stage 2 with C factored at s->y's positions: v = T q' + v_e into s->y, a0, and
+ * f_q = T^T (Q - b + G_K lam_K - M a0) (by the transposed solve); ve, a0 (N) written. */
+static void forces(const mb_model *md, const mb_unknowns *u, mb_work *w, gen_scratch *s,
+                   int64_t nq, const int64_t *Iq, const double *qd, const double *lam,
+                   double *ve, double *a0, double *fq) {
+    int64_t n = md->n, N = s->N, mu = s->mu, r = s->r;
+    int64_t nq1 = nq > 0 ? nq : 1, cc[nq1], cp[nq1];
+    double *g = s->B, *x = s->B + r, *work = s->B + 2 * r;
+    /* v_e: C v_e = [f'; 0]; v = C^+ [f'; q'] = v_e + T q' */
+    for (int64_t k = 0; k < mu; k++) g[k] = s->fp[k];
+    for (int64_t k = 0; k < nq; k++) g[mu + k] = 0.0;
+    qr_solve(s->C, r, N, s->scale, s->beta, s->rdiag, g, 1);
+    for (int64_t i = 0; i < N; i++) ve[i] = g[i];
+    for (int64_t k = 0; k < mu; k++) g[k] = s->fp[k];
+    for (int64_t k = 0; k < nq; k++) g[mu + k] = qd[k];
+    qr_solve(s->C, r, N, s->scale, s->beta, s->rdiag, g, 1);
+    double *v = s->y + 7 * n, *om = s->y + 10 * n;
+    memset(v, 0, sizeof(double) * 6 * n);
+    for (int64_t i = 0; i < 6 * n; i++) {
+        int64_t j = s->col_of[i];
+        if (j < 0) continue;
+        if (i % 6 < 3) v[3 * (i / 6) + i % 6] = g[j];
+        else om[3 * (i / 6) + i % 6 - 3] = g[j];
+    }
+    rows_at(md, w, s, nq, Iq, cc, cp, NULL); /* gamma at the velocities */
+    for (int64_t k = 0; k < mu; k++) g[k] = w->gamma[u->U[k]];
+    for (int64_t k = 0; k < nq; k++) g[mu + k] = s->agam[k];
+    qr_solve(s->C, r, N, s->scale, s->beta, s->rdiag, g, 1);
+    for (int64_t i = 0; i < N; i++) a0[i] = g[i];
+    /* Q - b + G_K lam_K at the state */
+    mb_loads_at(md, w);
+    mb_net_wrench_at(md, w, s->y, s->r6);
+    if (lam != NULL) {
+        mb_known_at(md, w, lam, s->lam);
+        for (int64_t i = 0; i < md->m; i++) {
+            double li = s->lam[i];
+            if (li == 0.0) continue;
+            int64_t j = md->comps_i[4 * i];
+            int64_t p = md->joints_i[3 * j], c = md->joints_i[3 * j + 1];
+            for (int a = 0; a < 6; a++) s->r6[6 * c + a] += w->child6[6 * i + a] * li;
+            if (p >= 0)
+                for (int a = 0; a < 6; a++) s->r6[6 * p + a] += w->parent6[6 * i + a] * li;
+        }
+    }
+    /* x = r6 - M a0 on the model's columns, then f = T^T x */
+    for (int64_t b = 0; b < n; b++) {
+        const double *body = md->bodies + MB_BODY_W * b, *J = body + B_J;
+        double acc[6];
+        for (int a = 0; a < 6; a++) {
+            int64_t j = s->col_of[6 * b + a];
+            acc[a] = j >= 0 ? a0[j] : 0.0;
+        }
+        for (int a = 0; a < 6; a++) {
+            int64_t j = s->col_of[6 * b + a];
+            if (j < 0) continue;
+            double Ma = a < 3 ? body[B_MASS] * acc[a]
+                              : J[3 * (a - 3)] * acc[3] + J[3 * (a - 3) + 1] * acc[4] +
+                                    J[3 * (a - 3) + 2] * acc[5];
+            x[j] = s->r6[6 * b + a] - Ma;
+        }
+    }
+    qr_transposed(s->C, r, N, s->scale, s->beta, s->rdiag, x, mu, nq, fq, work);
+}
+
+/* T (N x nq) from the factors: C T = [0; I]; returns the residual's norm (0 on the
+ * configuration manifold). */
+static double transformation(gen_scratch *s, int64_t nq, double *T) {
+    int64_t N = s->N, mu = s->mu, r = s->r;
+    double *g = s->B, resid = 0.0;
+    for (int64_t k = 0; k < nq; k++) {
+        memset(g, 0, sizeof(double) * r);
+        g[mu + k] = 1.0;
+        double e = qr_solve(s->C, r, N, s->scale, s->beta, s->rdiag, g, 1);
+        resid += e * e;
+        for (int64_t i = 0; i < N; i++) T[i * nq + k] = g[i];
+    }
+    return sqrt(resid);
+}
+
+/* M_q = T^T M T, body by body. */
+static void mass(const mb_model *md, const gen_scratch *s, int64_t nq, const double *T,
+                 double *Mq) {
+    int64_t nq1 = nq > 0 ? nq : 1;
+    double MT[6 * nq1];
+    memset(Mq, 0, sizeof(double) * nq * nq);
+    for (int64_t b = 0; b < md->n; b++) {
+        const double *body = md->bodies + MB_BODY_W * b, *J = body + B_J;
+        int64_t jc[6];
+        for (int a = 0; a < 6; a++) jc[a] = s->col_of[6 * b + a];
+        for (int64_t k = 0; k < nq; k++) {
+            double tc[6];
+            for (int a = 0; a < 6; a++) tc[a] = jc[a] >= 0 ? T[jc[a] * nq + k] : 0.0;
+            for (int a = 0; a < 3; a++) {
+                MT[a * nq + k] = body[B_MASS] * tc[a];
+                MT[(3 + a) * nq + k] = J[3 * a] * tc[3] + J[3 * a + 1] * tc[4] + J[3 * a + 2] * tc[5];
+            }
+        }
+        for (int a = 0; a < 6; a++) {
+            if (jc[a] < 0) continue;
+            const double *Ta = T + jc[a] * nq;
+            for (int64_t k = 0; k < nq; k++) {
+                if (Ta[k] == 0.0) continue;
+                for (int64_t l = 0; l < nq; l++) Mq[k * nq + l] += Ta[k] * MT[a * nq + l];
+            }
+        }
+    }
+    for (int64_t k = 0; k < nq; k++) /* symmetric in exact arithmetic: made so */
+        for (int64_t l = k + 1; l < nq; l++) {
+            double m = 0.5 * (Mq[k * nq + l] + Mq[l * nq + k]);
+            Mq[k * nq + l] = Mq[l * nq + k] = m;
+        }
+}
+
+int mb_generalized(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
+                   const double *y, const double *lam, int64_t nq, const int64_t *Iq,
+                   int64_t nc, const int64_t *cols, const double *qdot, double *out) {
+    gen_scratch s;
+    if (scratch_new(&s, md, u, nq, nc, cols) < 0) return -1;
+    int64_t N = nc, n = md->n, nq1 = nq > 0 ? nq : 1, cc[nq1], cp[nq1];
+    memcpy(s.y, y, sizeof(double) * 13 * n);
+    mb_eval_all(md, w, t);
+    double *T = out, *ve = T + N * nq, *a0 = ve + N, *Mq = a0 + N, *fq = Mq + nq * nq;
+    double *qv = fq + nq, *qd = qv + nq, *scale = qd + nq, *info = scale + nq;
+    double ratio = factor(md, u, w, &s, nq, Iq, cc, cp, qv);
+    for (int64_t k = 0; k < nq; k++)
+        qd[k] = qdot ? qdot[k] : row_dot_v(s.arow + 12 * k, cc[k], cp[k], y, n, s.col_of);
+    double resid = transformation(&s, nq, T);
+    forces(md, u, w, &s, nq, Iq, qd, lam, ve, a0, fq);
+    mass(md, &s, nq, T, Mq);
+    info[MB_GI_RANK] = ratio;
+    info[MB_GI_RESIDUAL] = resid;
+    /* the magnitude of the terms that make each f_q (what its rounding is relative to):
+     * per group of rows (translations, rotations) the largest entry of T's column times
+     * the sum over the group's rows of |m g|, each load's and spring end's |share|,
+     * |w| |J w|, |G_K lam_K| and |M a0| */
+    int64_t nl = md->k + 2 * md->s;
+    double *Q = malloc(sizeof(double) * (size_t)(12 * (n > 0 ? n : 1) + 7 * (nl > 0 ? nl : 1)));
+    if (Q == NULL) {
+        scratch_free(&s);
+        return -1;
+    }
+    double *b = Q + 6 * n, *shares = b + 6 * n, sum[2] = {0.0, 0.0};
+    mb_wrench_parts(md, w, t, s.y, Q, b);
+    mb_load_wrenches_at(md, w, s.y, shares);
+    for (int64_t l = 0; l < nl; l++) {
+        int64_t body = (int64_t)shares[7 * l];
+        if (body < 0) continue;
+        for (int a = 0; a < 6; a++)
+            if (s.col_of[6 * body + a] >= 0) sum[a >= 3] += fabs(shares[7 * l + 1 + a]);
+    }
+    for (int64_t c = 0; c < 6 * n; c++) {
+        int64_t j = s.col_of[c];
+        if (j < 0) continue;
+        int64_t body = c / 6, a = c % 6;
+        const double *bd = md->bodies + MB_BODY_W * body;
+        double Ma = a < 3 ? bd[B_MASS] * fabs(a0[j]) : 0.0;
+        if (a >= 3)
+            for (int e = 0; e < 3; e++) {
+                int64_t je = s.col_of[6 * body + 3 + e];
+                if (je >= 0) Ma += fabs(bd[B_J + 3 * (a - 3) + e] * a0[je]);
+            }
+        double gravity = a < 3 ? bd[B_MASS] * fabs(md->gravity[a]) : 0.0;
+        double known = fabs(s.r6[c] - (Q[c] - b[c]));
+        /* the gyroscopic term's own size |w| |J w| (w x J w cancels about a principal axis) */
+        double gyro = 0.0;
+        if (a >= 3) {
+            const double *om = s.y + 10 * n + 3 * body, *J = bd + B_J;
+            double h0 = J[0] * om[0] + J[1] * om[1] + J[2] * om[2];
+            double h1 = J[3] * om[0] + J[4] * om[1] + J[5] * om[2];
+            double h2 = J[6] * om[0] + J[7] * om[1] + J[8] * om[2];
+            gyro = sqrt(om[0] * om[0] + om[1] * om[1] + om[2] * om[2]) *
+                   sqrt(h0 * h0 + h1 * h1 + h2 * h2);
+        }
+        sum[a >= 3] += gravity + fmax(fabs(b[c]), gyro) + known + Ma;
+    }
+    for (int64_t k = 0; k < nq; k++) {
+        double tau[2] = {0.0, 0.0};
+        for (int64_t c = 0; c < 6 * n; c++) {
+            int64_t j = s.col_of[c];
+            if (j >= 0) tau[c % 6 >= 3] = fmax(tau[c % 6 >= 3], fabs(T[j * nq + k]));
+        }
+        scale[k] = fmax(tau[0] * sum[0] + tau[1] * sum[1], fabs(fq[k]));
+    }
+    free(Q);
+    scratch_free(&s);
+    return 0;
+}
+
+/* y <- the state y0 moved by the velocity d (N, the model's columns) for a unit time:
+ * positions x + d_v, orientations q (x) exp(d_w / 2) (body axes), exactly. */
+static void move(const mb_model *md, const gen_scratch *s, const double *y0, const double *d,
+                 double *y) {
+    int64_t n = md->n;
+    memcpy(y, y0, sizeof(double) * 13 * n);
+    for (int64_t b = 0; b < n; b++) {
+        double dv[6];
+        for (int a = 0; a < 6; a++) {
+            int64_t j = s->col_of[6 * b + a];
+            dv[a] = j >= 0 ? d[j] : 0.0;
+        }
+        for (int a = 0; a < 3; a++) y[3 * b + a] += dv[a];
+        double th = sqrt(dv[3] * dv[3] + dv[4] * dv[4] + dv[5] * dv[5]);
+        if (th == 0.0) continue;
+        double c = cos(0.5 * th), sn = sin(0.5 * th) / th;
+        double p0 = sn * dv[3], p1 = sn * dv[4], p2 = sn * dv[5];
+        double *q = y + 3 * n + 4 * b;
+        double qw = q[0], qx = q[1], qy = q[2], qz = q[3];
+        q[0] = qw * c - qx * p0 - qy * p1 - qz * p2;
+        q[1] = qx * c + qw * p0 + qy * p2 - qz * p1;
+        q[2] = qy * c + qw * p1 + qz * p0 - qx * p2;
+        q[3] = qz * c + qw * p2 + qx * p1 - qy * p0;
+    }
+}
+
+int mb_generalized_perturbed(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
+                             const double *y0, const double *lam, int64_t nq,
+                             const int64_t *Iq, int64_t nc, const int64_t *cols,
+                             const double *qdot0, int64_t np, const double *P, double *fout) {
+    gen_scratch s;
+    if (scratch_new(&s, md, u, nq, nc, cols) < 0) return -1;
+    int64_t N = nc, n = md->n, nq1 = nq > 0 ? nq : 1, cc[nq1], cp[nq1];
+    double *buf = malloc(sizeof(double) * (size_t)(N * nq1 + 3 * (N > 0 ? N : 1) + 13 * (n > 0 ? n : 1)));
+    if (buf == NULL) {
+        scratch_free(&s);
+        return -1;
+    }
+    double *T0 = buf, *ve = T0 + N * nq, *a0 = ve + N, *d = a0 + N, *ystart = d + N;
+    double qd[nq1];
+    mb_eval_all(md, w, t);
+    memcpy(s.y, y0, sizeof(double) * 13 * n);
+    memcpy(ystart, y0, sizeof(double) * 13 * n);
+    factor(md, u, w, &s, nq, Iq, cc, cp, NULL);
+    transformation(&s, nq, T0);
+    int factored = 1; /* C's factors are those of y0's positions */
+    for (int64_t p = 0; p < np; p++) {
+        const double *dq = P + 2 * nq * p, *du = dq + nq;
+        int moved = 0;
+        for (int64_t k = 0; k < nq; k++) moved |= dq[k] != 0.0;
+        if (moved || !factored) {
+            for (int64_t i = 0; i < N; i++) {
+                double x = 0.0;
+                for (int64_t k = 0; k < nq; k++) x += T0[i * nq + k] * dq[k];
+                d[i] = x;
+            }
+            move(md, &s, ystart, d, s.y);
+            factor(md, u, w, &s, nq, Iq, cc, cp, NULL);
+            factored = !moved;
+        }
+        for (int64_t k = 0; k < nq; k++) qd[k] = qdot0[k] + du[k];
+        forces(md, u, w, &s, nq, Iq, qd, lam, ve, a0, fout + nq * p);
+    }
+    free(buf);
+    scratch_free(&s);
+    return 0;
+}
+
+int mb_coordinate_rows(const mb_model *md, mb_work *w, double t, const double *y, int64_t nq,
+                       const int64_t *Iq, int64_t nc, const int64_t *cols, double *rows,
+                       double *values) {
+    int64_t n = md->n, *col_of = malloc(sizeof(int64_t) * (size_t)(6 * (n > 0 ? n : 1)));
+    if (col_of == NULL) return -1;
+    for (int64_t i = 0; i < 6 * n; i++) col_of[i] = -1;
+    for (int64_t j = 0; j < nc; j++) col_of[cols[j]] = j;
+    gen_scratch s;
+    memset(&s, 0, sizeof(s));
+    s.col_of = col_of;
+    mb_rotations(n, y + 3 * n, w->R);
+    mb_eval_all(md, w, t);
+    mb_columns_at(md, w, y, 1, w->child6, w->parent6, NULL, NULL, w->gamma, w->phi, w->gtv);
+    memset(rows, 0, sizeof(double) * nq * nc);
+    for (int64_t k = 0; k < nq; k++) {
+        double row[12], gamma;
+        int64_t c, p;
+        coordinate_row(md, w, y, Iq + MB_GQ_W * k, row, &c, &p, &gamma, values + k);
+        put_row(&s, rows + k * nc, row, c, p);
+    }
+    free(col_of);
+    return 0;
+}
+
+int mb_differences(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
+                   const double *y0, const double *lam, int64_t nq, const int64_t *Iq,
+                   int64_t nc, const int64_t *cols, const double *qdot0, const double *h,
+                   const double *hu, const double *fscale, double rounding,
+                   const int64_t *skip, double *out) {
+    static const double step[6] = {1.0, -1.0, 0.5, -0.5, 0.25, -0.25};
+    int64_t moved = 0;
+    for (int64_t j = 0; j < nq; j++) moved += skip[j] ? 0 : 1;
+    int64_t np_ = 6 * moved + 2 * nq; /* velocity rows last: they reuse one factorisation */
+    double *P = calloc((size_t)(np_ * 2 * nq + np_ * nq + 1), sizeof(double));
+    if (P == NULL) return -1;
+    double *f = P + np_ * 2 * nq;
+    int64_t row = 0;
+    for (int64_t j = 0; j < nq; j++) {
+        if (skip[j]) continue;
+        for (int s = 0; s < 6; s++) P[(row + s) * 2 * nq + j] = step[s] * h[j];
+        row += 6;
+    }
+    for (int64_t j = 0; j < nq; j++) {
+        P[(row + 2 * j) * 2 * nq + nq + j] = hu[j];
+        P[(row + 2 * j + 1) * 2 * nq + nq + j] = -hu[j];
+    }
+    int status = mb_generalized_perturbed(md, u, w, t, y0, lam, nq, Iq, nc, cols, qdot0, np_,
+                                          P, f);
+    double *K = out, *Kerr = K + nq * nq, *D = Kerr + nq * nq, *Derr = D + nq * nq;
+    row = 0;
+    for (int64_t j = 0; j < nq && status == 0; j++) {
+        const double *fj = f + row * nq, *fu = f + (6 * moved + 2 * j) * nq;
+        for (int64_t i = 0; i < nq; i++) {
+            if (skip[j]) {
+                K[i * nq + j] = Kerr[i * nq + j] = 0.0;
+            } else {
+                double d0 = (fj[0 * nq + i] - fj[1 * nq + i]) / (2.0 * h[j]);
+                double d1 = (fj[2 * nq + i] - fj[3 * nq + i]) / (1.0 * h[j]);
+                double d2 = (fj[4 * nq + i] - fj[5 * nq + i]) / (0.5 * h[j]);
+                double r1 = (4.0 * d1 - d0) / 3.0, r2 = (4.0 * d2 - d1) / 3.0;
+                K[i * nq + j] = -(16.0 * r2 - r1) / 15.0;
+                Kerr[i * nq + j] =
+                    fabs(r1 - r2) / 15.0 + 4.0 * rounding * fscale[i] / (0.25 * h[j]);
+            }
+            D[i * nq + j] = -(fu[i] - fu[nq + i]) / (2.0 * hu[j]);
+            double big = fmax(fscale[i], fmax(fabs(fu[i]), fabs(fu[nq + i])));
+            Derr[i * nq + j] = 4.0 * rounding * big / hu[j];
+        }
+        if (!skip[j]) row += 6;
+    }
+    free(P);
+    return status;
+}

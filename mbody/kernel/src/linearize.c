@@ -1,0 +1,146 @@
+/* The linearisation about a state in generalized coordinates (mbody/solve/linearize.py):
+ * the equations there (mb_generalized), the differences K = -df/dq, D = -df/dq' with
+ * their error bounds (mb_differences), whether the state is steady and which coordinates
+ * are cyclic symmetries to leave out, and the first-order matrix A with the tolerance on
+ * its eigenvalues' real parts. One call: the linearisation of a small model costs a few
+ * dozen evaluations of f, and a Python loop around them would cost more than they do. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal.h"
+
+/* L (k x k, lower, row-major) <- the Cholesky factor of the symmetric A; 0, or -1 when A
+ * is not positive definite. */
+static int cholesky(const double *A, int64_t k, double *L) {
+    for (int64_t i = 0; i < k; i++)
+        for (int64_t j = 0; j <= i; j++) {
+            double s = A[i * k + j];
+            for (int64_t p = 0; p < j; p++) s -= L[i * k + p] * L[j * k + p];
+            if (i == j) {
+                if (!(s > 0.0)) return -1;
+                L[i * k + i] = sqrt(s);
+            } else {
+                L[i * k + j] = s / L[j * k + j];
+            }
+        }
+    return 0;
+}
+
+int mb_linearize(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
+                 const double *y, const double *lam, int64_t nq, const int64_t *Iq,
+                 int64_t nc, const int64_t *cols, const double *scales, const int64_t *quasi,
+                 const int64_t *skip, const double *params, double *out) {
+    int64_t k = nq, N = nc, kk = k * k;
+    double step = params[MB_LP_STEP], rounding = params[MB_LP_ROUNDING];
+    double steady_rtol = params[MB_LP_STEADY], moving_rtol = params[MB_LP_MOVING];
+    double *gen = out;
+    int64_t ngen = N * k + 2 * N + kk + 4 * k + MB_GENERALIZED_INFO;
+    double *K = gen + ngen, *Kerr = K + kk, *D = Kerr + kk, *Derr = D + kk;
+    double *resid = Derr + kk, *left = resid + k, *A = left + k, *info = A + 4 * kk;
+    memset(info, 0, sizeof(double) * MB_LINEARIZE_INFO);
+    if (mb_generalized(md, u, w, t, y, lam, nq, Iq, nc, cols, NULL, gen) < 0) return -1;
+    const double *M = gen + N * k + 2 * N, *f = M + kk, *qd = f + 2 * k, *F = qd + k;
+    const double *ginfo = F + k;
+    if (!(ginfo[MB_GI_RANK] > 0.0) || k == 0) {
+        memset(K, 0, sizeof(double) * (4 * kk + 2 * k + 4 * kk));
+        info[MB_LI_STEADY] = k == 0;
+        return 0;
+    }
+    double *buf = malloc(sizeof(double) * (size_t)(2 * kk + 4 * k));
+    if (buf == NULL) return -1;
+    double *L = buf, *Minv = L + kk, *h = Minv + kk, *hu = h + k, *x = hu + k;
+    if (cholesky(M, k, L) < 0) {
+        info[MB_LI_SINGULAR] = 1.0;
+        free(buf);
+        return 0;
+    }
+    /* steps: positions STEP x scale; rates (exact for a quadratic) of the rates' scale,
+     * the larger of the state's and sqrt(f's terms / M) */
+    double Fmax = 0.0, Mmax = 0.0, rate = 1e-3;
+    for (int64_t i = 0; i < k; i++) Fmax = fmax(Fmax, F[i]);
+    for (int64_t i = 0; i < kk; i++) Mmax = fmax(Mmax, fabs(M[i]));
+    rate = fmax(rate, sqrt(Fmax / fmax(Mmax, 1e-300)));
+    for (int64_t i = 0; i < k; i++) rate = fmax(rate, fabs(qd[i]) / scales[i]);
+    for (int64_t i = 0; i < k; i++) h[i] = step * scales[i], hu[i] = rate * scales[i];
+    /* one evaluation of f errs by about rounding x f_scale x cond(C) (the projection's
+     * QR: its pivot ratio bounds the condition from below; the factor is what its
+     * backward stability allows) */
+    rounding /= fmax(ginfo[MB_GI_RANK], 1e-8);
+    if (mb_differences(md, u, w, t, y, lam, nq, Iq, nc, cols, qd, h, hu, F, rounding, skip,
+                       K) < 0) {
+        free(buf);
+        return -1;
+    }
+    /* q'' = M^-1 f; steady when every f_i is below steady_rtol of its terms */
+    int steady = 1;
+    for (int64_t i = 0; i < k; i++) {
+        resid[i] = f[i];
+        if (!(fabs(f[i]) <= steady_rtol * F[i])) steady = 0;
+    }
+    mb_cho_solve_dense(L, k, k, resid);
+    /* moving coordinates; cyclic ones (K's column within its error) moving, or a
+     * quasi-velocity's angle, are symmetries: left out */
+    double rmax = 0.0;
+    for (int64_t j = 0; j < k; j++) rmax = fmax(rmax, fabs(qd[j]) / scales[j]);
+    int64_t unsteady = 0, nk = 0;
+    for (int64_t j = 0; j < k; j++) {
+        int moving = fabs(qd[j]) / scales[j] > moving_rtol * rmax;
+        int cyclic = 1;
+        for (int64_t i = 0; i < k; i++)
+            if (!(fabs(K[i * k + j]) <= 10.0 * Kerr[i * k + j])) cyclic = 0;
+        left[j] = cyclic && (moving || quasi[j]);
+        if (left[j])
+            for (int64_t i = 0; i < k; i++) K[i * k + j] = 0.0;
+        else
+            nk++;
+        if (moving && !cyclic && unsteady == 0) unsteady = j + 1;
+    }
+    if (unsteady) steady = 0;
+    /* A = [[0, E], [-M^-1 K_kept, -M^-1 D]] (nz = nk + k); tolerance sqrt(dA |A|) */
+    int64_t nz = nk + k;
+    memset(A, 0, sizeof(double) * nz * nz);
+    for (int64_t j = 0; j < k; j++) { /* M^-1 column by column */
+        for (int64_t i = 0; i < k; i++) x[i] = i == j;
+        mb_cho_solve_dense(L, k, k, x);
+        for (int64_t i = 0; i < k; i++) Minv[i * k + j] = x[i];
+    }
+    int64_t r = 0;
+    for (int64_t j = 0; j < k; j++)
+        if (!left[j]) A[r * nz + nk + j] = 1.0, r++;
+    double minv = 0.0, errK = 0.0, errD = 0.0;
+    for (int64_t i = 0; i < k; i++) {
+        double a = 0.0, b = 0.0, c = 0.0;
+        for (int64_t j = 0; j < k; j++) {
+            a += fabs(Minv[i * k + j]);
+            b += fabs(Kerr[i * k + j]);
+            c += fabs(Derr[i * k + j]);
+        }
+        minv = fmax(minv, a), errK = fmax(errK, b), errD = fmax(errD, c);
+        double *row = A + (nk + i) * nz;
+        int64_t col = 0;
+        for (int64_t j = 0; j < k; j++) {
+            double sk = 0.0, sd = 0.0;
+            for (int64_t p = 0; p < k; p++) {
+                sk += Minv[i * k + p] * K[p * k + j];
+                sd += Minv[i * k + p] * D[p * k + j];
+            }
+            if (!left[j]) row[col++] = -sk;
+            row[nk + j] = -sd;
+        }
+    }
+    double nA = 0.0;
+    for (int64_t i = 0; i < nz; i++) {
+        double s = 0.0;
+        for (int64_t j = 0; j < nz; j++) s += fabs(A[i * nz + j]);
+        nA = fmax(nA, s);
+    }
+    double tol = fmax(sqrt(minv * (errK + errD) * nA), 1e3 * 2.220446049250313e-16 * nA);
+    info[MB_LI_STEADY] = steady;
+    info[MB_LI_UNSTEADY] = (double)unsteady;
+    info[MB_LI_TOL] = fmax(tol, 1e-300);
+    info[MB_LI_KEPT] = (double)nk;
+    info[MB_LI_DA] = minv * (errK + errD);
+    info[MB_LI_NORM] = nA;
+    free(buf);
+    return 0;
+}

@@ -1,0 +1,425 @@
+"""Linearisation about an equilibrium or a steady motion: small oscillations, natural
+frequencies, damping ratios, mode shapes and stability.
+
+In generalized coordinates the equations of motion are ``M(q) q'' = f(q, q')``
+(`mbody.equations.generalized`). About a state where q'' = 0 — an equilibrium, or a steady
+motion whose moving coordinates the equations do not depend on (a spin about a principal
+axis: the orientation is then a symmetry and is left out; a gyroscope's precession and
+spin angles) — a small motion δq obeys
+
+    M δq'' + D δq' + K δq = 0,      K = −∂f/∂q,  D = −∂f/∂q'
+
+K holds the stiffness of the loads (springs, a load that turns with a body) and the
+geometric stiffness of the constraint forces: T changes with q, so Tᵀ Q does even when Q
+does not (gravity). A linearisation in the bodies' own coordinates that forgets the
+second part (``λ ∂Gᵀ/∂q``) finds no stiffness at all in a pendulum under gravity.
+`Linearization.K_geometric` is that part on its own.
+
+Derivatives: f is quadratic in q' (the velocity terms, the gyroscopic terms and dampers'
+linear ones), so a central difference in q' is exact up to rounding. In q, central
+differences at steps h, h/2 and h/4 (h = 0.01 rad, or 0.01 of the model's size) are
+combined by Richardson's extrapolation twice (error O(h⁶)); the error is bounded by the
+estimated error of the second-to-last extrapolation (|R₁ − R₂|/15), plus the rounding of f
+(10 ε of the magnitude of the terms that make it, `Generalized.f_scale`, times the
+projection's condition, over the smallest step). Each perturbed state moves the bodies
+along T e_k by their exponential maps: a curve through the state whose tangent is the
+coordinate's direction, which is all a derivative at the state needs (the compiled core
+evaluates f at all of them in one call, kernel.h: ``mb_linearize``).
+"""
+
+from __future__ import annotations
+
+import weakref
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+
+from mbody.equations.coordinates import CoordinateSet, columns, coordinate_set
+from mbody.equations.generalized import Generalized, from_output, layout
+from mbody.equations.workspace import workspace
+from mbody.errors import MbodyError
+from mbody.kernel import _core
+from mbody.model.model import Model, State
+from mbody.solve.configure import move
+
+STEP = 1e-2
+"""The largest of the three position steps (rad; times the model's size for lengths)."""
+ROUNDING = 10 * np.finfo(float).eps
+"""Relative rounding error of one evaluation of f against the terms it is made of
+(`Generalized.f_scale`), per unit of the projection's condition (the core divides it by
+the pivot ratio of [Gᵀ; Aᵀ]'s QR): a few sums of products and one backward-stable solve
+of a system of the model's size."""
+STEADY_RTOL = 1e-8
+"""A state is steady when every generalized force is below this fraction of the terms
+that make it (`Generalized.f_scale`)."""
+MOVING_RTOL = 1e-12
+"""A coordinate moves when its rate exceeds this fraction of the rates' scale."""
+
+_PARAMS = np.zeros(_core.LINEARIZE_PARAMS)
+_PARAMS[[_core.LP_STEP, _core.LP_ROUNDING, _core.LP_STEADY, _core.LP_MOVING]] = (
+    STEP, ROUNDING, STEADY_RTOL, MOVING_RTOL)
+
+
+@dataclass(frozen=True)
+class Mode:
+    """One mode of the linearised motion.
+
+    Parameters
+    ----------
+    eigenvalue : complex
+        λ (1/s); an oscillation's has Im λ > 0 (its conjugate is the same mode).
+    kind : str
+        ``oscillation`` (a complex pair), ``growth`` (a real λ > 0), ``decay`` (a real
+        λ < 0) or ``neutral`` (λ = 0: a free or cyclic motion).
+    frequency : float
+        Natural frequency |λ| (rad/s) of an oscillation; NaN otherwise.
+    damping_ratio : float
+        ζ = −Re λ / |λ| (NaN for a neutral mode).
+    shape : (k,) complex array
+        The coordinates' amplitudes, the largest 1 (real and positive).
+    """
+
+    eigenvalue: complex
+    kind: str
+    frequency: float
+    damping_ratio: float
+    shape: np.ndarray
+
+    @property
+    def frequency_hz(self) -> float:
+        """The natural frequency in Hz."""
+        return self.frequency / (2.0 * np.pi)
+
+    @property
+    def period(self) -> float:
+        """2π/|Im λ| (s) of an oscillation; inf otherwise."""
+        w = abs(self.eigenvalue.imag)
+        return 2.0 * np.pi / w if w > 0 else float("inf")
+
+
+@dataclass(frozen=True, eq=False)
+class Linearization:
+    """``M δq'' + D δq' + K δq = 0`` about a state (module doc).
+
+    Parameters
+    ----------
+    model, state : Model, State
+        The model and the state linearised about.
+    generalized : Generalized
+        The equations in generalized coordinates there (the driven coordinates held).
+    M, D, K : (k, k) arrays
+        Generalized mass, damping (with the gyroscopic terms) and stiffness.
+    K_error, D_error : (k, k) arrays
+        Bounds on the differences' errors, entry by entry.
+    residual : (k,) array
+        q'' at the state (0 at an equilibrium or a steady motion).
+    steady : bool
+        Whether the state is an equilibrium or a steady motion (q'' = 0, and every moving
+        coordinate cyclic); otherwise the eigenvalues are those of the tangent system at
+        this instant, and `stable` is None.
+    left_out : tuple of str
+        The symmetries left out of the first-order system: the cyclic coordinates that
+        move (the spin of a steady spin, a gyroscope's precession), and the angles of
+        quasi-velocities the forces do not depend on (a free body's orientation).
+    kept : (k',) int array
+        The coordinates whose δq are in the first-order system (the others left out).
+    A : (k' + k, k' + k) array
+        The first-order system ``z' = A z``, z = (δq of the kept coordinates, δq'):
+        ``[[0, E], [−M⁻¹ K, −M⁻¹ D]]``.
+    tolerance : float
+        The most any eigenvalue may be off (1/s): √(‖δA‖ ‖A‖), ‖δA‖ = ‖M⁻¹‖ (‖δK‖ + ‖δD‖)
+        from the derivatives' error bounds (infinity norms; a double eigenvalue, a Jordan
+        block, moves by that much), and at least 1e3 ε ‖A‖. Each eigenvalue has its own,
+        smaller bound where it is simple (`eigenvalue_errors`).
+    dA : float
+        ‖δA‖, the bound on A's error (in A's units).
+    warnings : tuple of str
+        Why the state is not steady, and anything else worth saying.
+    """
+
+    model: Model
+    state: State
+    generalized: Generalized
+    M: np.ndarray
+    D: np.ndarray
+    K: np.ndarray
+    K_error: np.ndarray
+    D_error: np.ndarray
+    residual: np.ndarray
+    steady: bool
+    left_out: tuple[str, ...]
+    kept: np.ndarray
+    A: np.ndarray
+    tolerance: float
+    dA: float = 0.0
+    warnings: tuple[str, ...] = field(default_factory=tuple)
+
+    @property
+    def coordinates(self) -> list[str]:
+        """The coordinates (the driven ones held)."""
+        return self.generalized.coordinates
+
+    @cached_property
+    def _spectrum(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(eigenvalues, eigenvectors, error bounds), by real part then imaginary part."""
+        if not self.A.size:
+            return np.zeros(0, complex), np.zeros((0, 0), complex), np.zeros(0)
+        w, V = np.linalg.eig(self.A)
+        order = np.lexsort((w.imag, w.real))
+        w, V = w[order], V[:, order]
+        with np.errstate(over="ignore", invalid="ignore"):
+            try:  # the rows of V⁻¹ are the left eigenvectors, y_iᴴ x_i = 1, |x_i| = 1
+                cond = np.linalg.norm(np.linalg.inv(V), axis=1)
+            except np.linalg.LinAlgError:  # defective: the double eigenvalue's bound
+                cond = np.full(len(w), np.inf)
+            first = cond * self.dA
+        err = np.where(np.isfinite(first), np.minimum(first, self.tolerance), self.tolerance)
+        floor = 1e3 * np.finfo(float).eps * np.abs(self.A).sum(axis=1).max()
+        return w, V, np.maximum(err, floor)
+
+    @property
+    def eigenvalues(self) -> np.ndarray:
+        """The first-order system's eigenvalues (complex, 1/s: rad/s for the imaginary
+        parts), by real part then imaginary part."""
+        return self._spectrum[0]
+
+    @property
+    def eigenvalue_errors(self) -> np.ndarray:
+        """A bound on each eigenvalue's error (1/s), in `eigenvalues`' order: κ_i ‖δA‖ for
+        a simple one (κ_i its condition ‖x_i‖ ‖y_i‖ / |y_iᴴ x_i|), at most `tolerance`
+        (the bound of a double one); at least 1e3 ε ‖A‖."""
+        return self._spectrum[2]
+
+    @cached_property
+    def modes(self) -> list[Mode]:
+        """The modes: oscillations (one per complex pair), growths, decays and neutral
+        ones (λ = 0: a free or cyclic motion), neutral first, then by |λ|."""
+        w, V, tol = self._spectrum
+        if not len(w):
+            return []
+        k, kept = len(self.coordinates), self.kept
+        nk = len(kept)
+        mag = np.abs(w)
+        neutral = mag <= tol
+        osc = ~neutral & (np.abs(w.imag) > tol)
+        idx = np.flatnonzero(~(osc & (w.imag < 0)))  # one of each conjugate pair
+        w, V, tol, mag, neutral, osc = w[idx], V[:, idx], tol[idx], mag[idx], neutral[idx], \
+            osc[idx]
+        shapes = (V[nk:] / np.where(neutral, 1.0, w)).astype(complex)  # δq = δq' / λ
+        if neutral.any():  # a neutral mode: its δq if it has one, else its rate
+            pos = np.zeros((k, len(w)), complex)
+            pos[kept] = V[:nk]
+            has = neutral & (np.abs(pos).max(axis=0) > 1e-12 * np.abs(V).max(axis=0))
+            shapes[:, has] = pos[:, has]
+        cols = np.arange(len(w))
+        shapes = shapes / shapes[np.abs(shapes).argmax(axis=0), cols]
+        shapes[np.abs(shapes) < 1e-14] = 0.0
+        in_phase = np.abs(shapes.imag).max(axis=0) <= 1e-12  # undamped modes
+        out = []
+        for c in np.argsort(mag + np.where(neutral, -np.inf, 0.0), kind="stable").tolist():
+            lam = w[c]
+            re = lam.real if abs(lam.real) > tol[c] else 0.0
+            im = lam.imag if abs(lam.imag) > tol[c] else 0.0
+            shape = shapes[:, c].real.astype(complex) if in_phase[c] else shapes[:, c]
+            if neutral[c]:
+                out.append(Mode(complex(re, im), "neutral", float("nan"), float("nan"), shape))
+            else:
+                kind = "oscillation" if osc[c] else ("growth" if lam.real > 0 else "decay")
+                out.append(Mode(complex(re, im), kind,
+                                float(mag[c]) if osc[c] else float("nan"),
+                                -re / float(mag[c]) + 0.0, shape))
+        return out
+
+    @property
+    def oscillations(self) -> list[Mode]:
+        """The oscillatory modes, by natural frequency."""
+        return [m for m in self.modes if m.kind == "oscillation"]
+
+    @cached_property
+    def _oscillating(self) -> tuple[np.ndarray, np.ndarray]:
+        """The eigenvalues of the oscillations (Im λ > 0) and their error bounds, by |λ|."""
+        w, _, tol = self._spectrum
+        keep = (w.imag > tol) & (np.abs(w) > tol)
+        w, tol = w[keep], tol[keep]
+        order = np.argsort(np.abs(w))
+        return w[order], tol[order]
+
+    @property
+    def frequencies(self) -> np.ndarray:
+        """The natural frequencies |λ| of the oscillations (rad/s), ascending."""
+        return np.abs(self._oscillating[0])
+
+    @property
+    def frequencies_hz(self) -> np.ndarray:
+        """The natural frequencies in Hz."""
+        return self.frequencies / (2.0 * np.pi)
+
+    @property
+    def damping_ratios(self) -> np.ndarray:
+        """ζ of each oscillation, in the order of `frequencies`."""
+        w, tol = self._oscillating
+        return -np.where(np.abs(w.real) > tol, w.real, 0.0) / np.abs(w) + 0.0
+
+    @property
+    def stable(self) -> bool | None:
+        """False when an eigenvalue has a positive real part (beyond its error bound,
+        `eigenvalue_errors`): a small motion grows; True otherwise (neutral modes — a free
+        motion, a cyclic coordinate — do not count); None when the state is not steady."""
+        if not self.steady:
+            return None
+        w, _, err = self._spectrum
+        return bool((w.real <= err).all())
+
+    @cached_property
+    def K_geometric(self) -> np.ndarray:
+        """The constraint forces' geometric stiffness: K less the loads' own stiffness
+        −Tᵀ (∂(Q − b)/∂x) T (the bodies' velocities held), the part a linearisation in the
+        bodies' coordinates leaves out when it forgets λ ∂Gᵀ/∂q."""
+        return self.K - loads_stiffness(self)
+
+    def __repr__(self) -> str:
+        verdict = {True: "stable", False: "unstable", None: "not steady"}[self.stable]
+        f = ", ".join(f"{x:.4g}" for x in self.frequencies[:4])
+        return (f"<Linearization of {self.model.name!r}: {len(self.coordinates)} coordinates, "
+                f"{len(self.frequencies)} oscillation(s)" + (f" ({f} rad/s)" if f else "")
+                + f", {verdict}; .M, .D, .K, .eigenvalues, .modes>")
+
+    def _repr_pretty_(self, p, cycle: bool) -> None:  # IPython shows the text table
+        from mbody.present.modes import modes_text  # a display hook
+
+        p.text(modes_text(self))
+
+
+def free_coordinates(model: Model, coordinates: Sequence[str] | None = None) -> CoordinateSet:
+    """The coordinate set with the drivers held: the default set without the drivers'
+    coordinates, or `coordinates` (which must not name a driven one)."""
+    if coordinates is None:
+        base = coordinate_set(model)
+        driven = {k for _, k in base.efforts}
+        if not driven:
+            return base
+        coordinates = [c for k, c in enumerate(base.labels) if k not in driven]
+    return coordinate_set(model, list(coordinates))
+
+
+_SKIP: weakref.WeakKeyDictionary[CoordinateSet, np.ndarray] = weakref.WeakKeyDictionary()
+
+
+def _skip(model: Model, cs: CoordinateSet) -> np.ndarray:
+    """(k,) int64: 1 for a coordinate the generalized forces cannot depend on, so that its
+    column of K is 0 without evaluations: a body's own position coordinate when the body
+    has no joint and no spring (uniform gravity and loads fixed in world or body axes do
+    not depend on where it is); its rotation too when every load on it is a world force
+    at its mass centre or a couple in body axes."""
+    out = _SKIP.get(cs)
+    if out is not None:
+        return out
+    jt, sp, ft = model.joint_table, model.springs, model.forces
+    jointed = set(jt.parent.tolist()) | set(jt.child.tolist())
+    sprung = set(sp.a.tolist()) | set(sp.b.tolist())
+    turning = set()
+    for i, body in enumerate(ft.body.tolist()):
+        at_centre_world = not ft.in_body[i] and not ft.couple[i] and not np.any(ft.B_r[i])
+        body_couple = bool(ft.in_body[i]) and bool(ft.couple[i])
+        if not (at_centre_world or body_couple):
+            turning.add(body)
+    out = np.zeros(len(cs), dtype=np.int64)
+    for k, c in enumerate(cs.items):
+        if c.kind != _core.GQ_BODY or c.index in jointed or c.index in sprung:
+            continue
+        out[k] = 1 if c.axis < 3 or c.index not in turning else 0
+    _SKIP[cs] = out
+    return out
+
+
+def linearize(model: Model, state: State | None = None, *,
+              coordinates: Sequence[str] | None = None) -> Linearization:
+    """Linearise `model` about `state` (default: its initial state), an equilibrium or a
+    steady motion (module doc).
+
+    Parameters
+    ----------
+    model : Model
+        The model (its drivers are held: their coordinates are not free).
+    state : State, optional
+        An equilibrium (from `mbody.equilibrium`, or the file's) or a
+        steady motion.
+    coordinates : sequence of str, optional
+        The free coordinates (default: `Assembly.generalized`'s, less the drivers').
+
+    Returns
+    -------
+    Linearization
+        M, D, K, the eigenvalues, natural frequencies, damping ratios, modes, `stable`.
+
+    Raises
+    ------
+    MbodyError
+        Unknown or dependent coordinates, or coordinates singular at the state.
+    """
+    state = model.initial if state is None else state
+    cs = free_coordinates(model, coordinates)
+    k, N = len(cs), len(cs.cols)
+    ngen = layout(N, k)[-1]
+    kk = k * k
+    out = np.empty(ngen + 8 * kk + 2 * k + _core.LINEARIZE_INFO)
+    ws = workspace(model)
+    ws.solver(cs.held).linearize(float(state.t), ws.pack_state(state), cs.held.lam, cs.Iq,
+                                 cs.cols, cs.scales, cs.quasi_int, _skip(model, cs),
+                                 _PARAMS, out)
+    g = from_output(model, state, cs, out[:ngen])
+    K, K_err, D, D_err = out[ngen:ngen + 4 * kk].reshape(4, k, k)
+    o = ngen + 4 * kk
+    residual, left = out[o:o + k], out[o + k:o + 2 * k] > 0
+    info = out[o + 2 * k + 4 * kk:]
+    if info[_core.LI_SINGULAR]:
+        raise MbodyError(f"the generalized mass of '{model.name}' is not positive definite "
+                         "at this state: a motion of the coordinates carries no mass")
+    nz = int(info[_core.LI_KEPT]) + k
+    A = out[o + 2 * k:o + 2 * k + nz * nz].reshape(nz, nz)
+    warnings = list(g.warnings)
+    if not bool((np.abs(g.f) <= STEADY_RTOL * g.f_scale).all()):
+        worst = int(np.argmax(np.abs(residual)))
+        warnings.append(f"not an equilibrium or a steady motion: the generalized "
+                        f"accelerations here are not 0 ({cs.labels[worst]}'' = "
+                        f"{residual[worst]:.4g} {cs.items[worst].unit}/s^2); the eigenvalues "
+                        "are those of the tangent system at this instant")
+    j = int(info[_core.LI_UNSTEADY]) - 1
+    if j >= 0:
+        warnings.append(f"not a steady motion: {cs.labels[j]} moves ({g.qdot[j]:.4g} "
+                        f"{cs.items[j].rate_unit}) and the forces depend on it")
+    labels = cs.labels
+    return Linearization(model, state, g, g.M, D, K, K_err, D_err, residual,
+                         bool(info[_core.LI_STEADY]),
+                         tuple(labels[i] for i in np.flatnonzero(left)),
+                         np.flatnonzero(~left), A, float(info[_core.LI_TOL]),
+                         float(info[_core.LI_DA]), tuple(warnings))
+
+
+def loads_stiffness(lin: Linearization) -> np.ndarray:
+    """−Tᵀ ∂(Q − b)/∂x T: the loads' own stiffness, the bodies' velocities held (central
+    differences with Richardson's extrapolation, steps as `linearize`'s)."""
+    model, g = lin.model, lin.generalized
+    state = g.consistent_state
+    ws = workspace(model)
+    cols = columns(model)
+    k = len(g.f)
+    h = STEP * g.coordinate_set.scales
+    out = np.zeros((k, k))
+    wrench = np.empty((model.n, 6))
+
+    def Qb(s: State) -> np.ndarray:
+        ws.core.net_wrench(float(s.t), ws.pack_state(s), wrench)
+        return wrench.reshape(-1)[cols].copy()
+
+    for j in range(k):
+        d = []
+        for s in (1.0, 0.5, 0.25):
+            step = g.T[:, j] * s * h[j]
+            d.append((Qb(move(model, state, step)) - Qb(move(model, state, -step)))
+                     / (2 * s * h[j]))
+        r2 = (4 * d[2] - d[1]) / 3
+        out[:, j] = -g.T.T @ r2
+    return out

@@ -1,0 +1,164 @@
+"""`verify` for equations in generalized coordinates (`mbody.answers.lagrange`).
+
+A double pendulum (mass centres off the rods' middles) at moving states: a student's
+Lagrange equations written by hand in absolute angles (φ1, φ2: the rods' angles from
+hanging) and in relative ones (θ1 = φ1, θ2 = φ2 − φ1), with the model's symbols for the
+masses, inertias and g. The correct ones are diagnosed correct at every state; each of
+the course's mistakes (a velocity-squared term left out, the potential's gradient with the
+wrong sign, an inertial coupling left out, a mass matrix that is not symmetric, absolute
+and relative angles mixed) is named, and only on its own equation.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from test_generalized import dp_state
+
+import mbody
+from mbody.answers import AnswersError
+from mbody.answers.lagrange import (
+    ANGLES_MIXED,
+    MASS_MATRIX_NOT_SYMMETRIC,
+    MISSING_COUPLING_TERM,
+    MISSING_VELOCITY_TERM,
+    POTENTIAL_GRADIENT_SIGN,
+)
+
+P = dict(L1=0.62, a1=0.27, a2=0.33)
+MODEL = f"""
+model: dp
+dimension: 2
+gravity: [0, -9.81]
+bodies:
+  - {{name: upper, mass: 1.3, inertia: 0.031, position: [0, {-P['a1']!r}]}}
+  - {{name: lower, mass: 0.8, inertia: 0.017, position: [0, {-P['L1'] - P['a2']!r}]}}
+joints:
+  - {{name: O, type: revolute, parent: ground, child: upper, at: [[0, 0], [0, {P['a1']!r}]]}}
+  - {{name: A, type: revolute, parent: upper, child: lower,
+      at: [[0, {P['a1'] - P['L1']!r}], [0, {P['a2']!r}]]}}
+"""
+DP = dict(P, m1=1.3, m2=0.8, I1=0.031, I2=0.017, g=9.81, k=0.0, L0=0.4, tau=0.0, sx=0, sy=0)
+
+# absolute angles phi1, phi2 (upper.theta, lower.theta)
+M11 = "(I_upper + m_upper*0.27^2 + m_lower*0.62^2)"
+M12 = "m_lower*0.62*0.33*cos(phi1 - phi2)"
+M22 = "(I_lower + m_lower*0.33^2)"
+ABS1 = (f"{M11}*phi1_ddot + {M12}*phi2_ddot + m_lower*0.62*0.33*sin(phi1 - phi2)*phi2_dot^2"
+        " + (m_upper*0.27 + m_lower*0.62)*g*sin(phi1) = 0")
+ABS2 = (f"{M12}*phi1_ddot + {M22}*phi2_ddot - m_lower*0.62*0.33*sin(phi1 - phi2)*phi1_dot^2"
+        " + m_lower*0.33*g*sin(phi2) = 0")
+# relative angles theta1 = phi1, theta2 = phi2 - phi1 (O.angle, A.angle)
+R11 = ("(I_upper + I_lower + m_upper*0.27^2 + m_lower*(0.62^2 + 0.33^2 "
+       "+ 2*0.62*0.33*cos(theta2)))")
+R12 = "(I_lower + m_lower*(0.33^2 + 0.62*0.33*cos(theta2)))"
+REL1 = (f"{R11}*theta1_ddot + {R12}*theta2_ddot - m_lower*0.62*0.33*sin(theta2)*"
+        "(2*theta1_dot*theta2_dot + theta2_dot^2) + (m_upper*0.27 + m_lower*0.62)*g*sin(theta1)"
+        " + m_lower*0.33*g*sin(theta1 + theta2) = 0")
+REL2 = (f"{R12}*theta1_ddot + (I_lower + m_lower*0.33^2)*theta2_ddot + m_lower*0.62*0.33*"
+        "sin(theta2)*theta1_dot^2 + m_lower*0.33*g*sin(theta1 + theta2) = 0")
+
+ABSOLUTE = {"phi1": "upper.theta", "phi2": "lower.theta"}
+RELATIVE = {"theta1": "O.angle", "theta2": "A.angle"}
+
+STATES = [([0.4, -0.9], [1.3, -2.1]), ([2.2, 0.7], [-0.6, 1.7]), ([-1.1, 2.9], [2.4, 0.8])]
+
+
+def check(coordinates, equations, state):
+    model = mbody.loads(MODEL)
+    answers = {"coordinates": coordinates, "equations": [{"eq": e} for e in equations]}
+    return mbody.verify(model, answers, state=state)
+
+
+@pytest.mark.parametrize("q, qd", STATES)
+def test_correct_equations_are_correct_in_both_coordinates(q, qd):
+    state = dp_state(q, qd, DP)
+    v = check(ABSOLUTE, [ABS1, ABS2], state)
+    assert [c.diagnosis for c in v.checks] == ["correct", "correct"], v.text()
+    assert not v.uncovered
+    v = check(RELATIVE, [REL1, REL2], state)
+    assert [c.diagnosis for c in v.checks] == ["correct", "correct"], v.text()
+
+
+def test_the_models_own_labels_need_no_mapping():
+    state = dp_state([0.4, -0.9], [1.3, -2.1], DP)
+    eq = REL2.replace("theta1", "O.angle").replace("theta2", "A.angle")
+    model = mbody.loads(MODEL)
+    v = mbody.verify(model, {"equations": [{"eq": eq, "coordinate": "A.angle"}]}, state=state)
+    assert v.checks[0].correct, v.text()
+
+
+MISTAKES = [
+    # (name, coordinates, the wrong equation, the diagnosis)
+    ("velocity term left out", ABSOLUTE,
+     ABS1.replace(" + m_lower*0.62*0.33*sin(phi1 - phi2)*phi2_dot^2", ""),
+     MISSING_VELOCITY_TERM),
+    ("one of two velocity monomials left out", RELATIVE,
+     REL1.replace("(2*theta1_dot*theta2_dot + theta2_dot^2)", "theta2_dot^2"),
+     MISSING_VELOCITY_TERM),
+    ("gravity's sign", ABSOLUTE,
+     ABS2.replace("+ m_lower*0.33*g*sin(phi2)", "- m_lower*0.33*g*sin(phi2)"),
+     POTENTIAL_GRADIENT_SIGN),
+    ("coupling left out", ABSOLUTE, ABS1.replace(f" + {M12}*phi2_ddot", ""),
+     MISSING_COUPLING_TERM),
+    ("absolute formulas, relative values", RELATIVE,
+     ABS1.replace("phi1", "theta1").replace("phi2", "theta2"), ANGLES_MIXED),
+    ("relative formulas, absolute values", ABSOLUTE,
+     REL2.replace("theta1", "phi1").replace("theta2", "phi2"), ANGLES_MIXED),
+]
+
+
+@pytest.mark.parametrize("q, qd", STATES[:2])
+@pytest.mark.parametrize("name, coordinates, wrong, diagnosis", MISTAKES,
+                         ids=[m[0] for m in MISTAKES])
+def test_each_mistake_is_named(name, coordinates, wrong, diagnosis, q, qd):
+    state = dp_state(q, qd, DP)
+    right = [ABS1, ABS2] if coordinates is ABSOLUTE else [REL1, REL2]
+    v = check(coordinates, [*right, wrong], state)
+    assert [c.diagnosis for c in v.checks] == ["correct", "correct", diagnosis], v.text()
+    assert v.checks[2].expected  # the row it should have been
+
+
+def test_a_mass_matrix_that_is_not_symmetric():
+    """The φ1 equation's coupling coefficient differs from the φ2 equation's: named on the
+    equation whose coefficient is off (the other is the true one), and only there."""
+    state = dp_state([0.4, -0.9], [1.3, -2.1], DP)
+    wrong = ABS1.replace(M12, "m_lower*0.62*0.33*1.5*cos(phi1 - phi2)")
+    v = check(ABSOLUTE, [wrong, ABS2], state)
+    assert [c.diagnosis for c in v.checks] == [MASS_MATRIX_NOT_SYMMETRIC, "correct"], v.text()
+    d = v.checks[0].details
+    assert d["here"] == pytest.approx(1.5 * d["there"], rel=1e-9)
+
+
+def test_velocity_terms_at_rest_cannot_be_told_apart():
+    """At rest the velocity terms are 0: an equation without them is then the model's."""
+    state = dp_state([0.4, -0.9], [0.0, 0.0], DP)
+    v = check(ABSOLUTE, [ABS1.replace(" + m_lower*0.62*0.33*sin(phi1 - phi2)*phi2_dot^2", "")],
+              state)
+    assert v.checks[0].correct
+
+
+def test_bad_names_are_located_with_a_did_you_mean():
+    model = mbody.loads(MODEL)
+    with pytest.raises(AnswersError, match="did you mean 'theta1_ddot'|theta1_ddot"):
+        mbody.verify(model, {"coordinates": RELATIVE,
+                             "equations": [{"eq": "theta1_dddot = 0"}]})
+    with pytest.raises(AnswersError, match="coordinates"):
+        mbody.verify(model, {"coordinates": {"x": "O.angel", "y": "A.angle"},
+                             "equations": [{"eq": "x_ddot = 0"}]})
+    with pytest.raises(AnswersError, match="no coordinate 'theta3'"):
+        mbody.verify(model, {"coordinates": RELATIVE,
+                             "equations": [{"eq": REL1, "coordinate": "theta3"}]})
+
+
+def test_answers_file_reads_coordinates(tmp_path):
+    path = tmp_path / "answers.yaml"
+    path.write_text("student: A. Student\ncoordinates: {theta1: O.angle, theta2: A.angle}\n"
+                    "equations:\n"
+                    f"  - {{coordinate: theta2, eq: \"{REL2}\"}}\n")
+    model = mbody.loads(MODEL)
+    state = dp_state([0.4, -0.9], [1.3, -2.1], DP)
+    v = mbody.verify(model, path, state=state)
+    assert v.checks[0].correct and v.checks[0].line == 4
+    assert [u.row for u in v.uncovered] == ["theta1"]
+    assert np.isclose(v.rows, 2)
