@@ -199,6 +199,7 @@ class DriverTable:
     offset: np.ndarray
     laws: tuple[tuple[Expression, Expression, Expression], ...]
     where: tuple[tuple[int, int], ...]
+    speed: tuple[float | None, ...] = ()
 
     def __len__(self) -> int:
         return len(self.names)
@@ -221,6 +222,7 @@ def driver_table(specs: list[DriverSpec], joint_index: dict[str, int], dimension
         return None
     parent, child = joint_parent_child
     names, joint, kind, axis, comp, offset, laws, where = [], [], [], [], [], [], [], []
+    speed: list[float | None] = []
     for s in specs:
         j = joint_index[s.joint]
         rotation = s.motion.what == joint_types.ROTATION
@@ -239,6 +241,8 @@ def driver_table(specs: list[DriverSpec], joint_index: dict[str, int], dimension
         offset.append(off)
         laws.append((law, f1, derivative(f1)))
         where.append(s.where)
+        speed.append(s.speed if s.law is None else None)
     return DriverTable(tuple(names), np.array(joint, dtype=np.intp),
                        np.array(kind, dtype=np.intp), np.array(axis, dtype=np.intp),
-                       tuple(comp), np.array(offset), tuple(laws), tuple(where))
+                       tuple(comp), np.array(offset), tuple(laws), tuple(where),
+                       tuple(speed))
