@@ -298,8 +298,10 @@ def vocabulary(model: Model, state: State, body: str) -> Vocabulary:
                 f"there is no name for the inertia about joint {joint.name}: write "
                 "moments about the mass centre, with I_1, I_2, I_3 or I_11 ... I_33"))
     reactions = tuple(r for r in model.reactions if r not in known)
-    touching = {label for joint in model.joints if body in (joint.parent, joint.child)
-                for label in joint.labels}
+    touching = {label for j, joint in enumerate(model.joints)
+                if body in (joint.parent, joint.child)
+                for label in (*joint.labels, *(model.drivers.labels_of(j)
+                                               if model.drivers is not None else ()))}
     acting = tuple(r for r in reactions if r in touching)
     for label, value in known.items():
         values[label] = float(value)

@@ -209,6 +209,12 @@ class DriverTable:
         """``<driver>.M`` or ``<driver>.F``: the efforts' labels."""
         return tuple(f"{n}.{c}" for n, c in zip(self.names, self.component, strict=True))
 
+    def labels_of(self, joint: int) -> tuple[str, ...]:
+        """The efforts' labels of the drivers of joint `joint` (its index): they act on
+        that joint's two bodies, as its reactions do."""
+        return tuple(lab for lab, j in zip(self.labels, self.joint, strict=True)
+                     if int(j) == joint)
+
     def __repr__(self) -> str:
         return f"<DriverTable: {len(self)} driver(s) ({', '.join(self.labels[:4])})>"
 
