@@ -14,7 +14,10 @@ loads): they are put into ``xfrc_applied`` here, as the file's header says. Spri
 spatial tendons of the file itself.
 
 Tolerance: |mbody − MuJoCo| ≤ 1e-9 · max(1, |a|) for tree-structured models; closed
-loops are soft in MuJoCo (see `test_closed_loops_load_and_nearly_agree`).
+loops are soft in MuJoCo (see `test_closed_loops_load_and_nearly_agree`), and so are the
+couplings of helical joints, whose softness MuJoCo's own data give exactly (see
+`test_screws_agree_with_mujoco_to_the_softness_of_their_coupling`). MuJoCo has no
+drivers: a driven model is compared with the same model without its drivers.
 """
 
 from __future__ import annotations
@@ -41,16 +44,22 @@ MODELS = Path(__file__).resolve().parent.parent / "models"
 RTOL = 1e-9
 ALL = sorted(p.name for p in MODELS.glob("*.yaml"))
 LOOPS = {"fourbar_planar.yaml", "fourbar_spatial.yaml", "slider_crank.yaml",
-         "spinning_disc_bearings.yaml", "bricard.yaml"}
-TREES = [n for n in ALL if n not in LOOPS]
+         "spinning_disc_bearings.yaml", "bricard.yaml", "scotch_yoke.yaml"}
+SCREWS = {"screw_jack.yaml", "helical_chain.yaml"}
+"""Trees with a helical joint: its slide and hinge are coupled by a (soft) equality."""
+TREES = [n for n in ALL if n not in LOOPS | SCREWS]
 
 
-def _load(name: str, *, known: bool = True) -> mbody.Model:
-    """A shipped model; without its known reaction values when `known` is False."""
-    if known:
+def _load(name: str, *, known: bool = True, driven: bool = True) -> mbody.Model:
+    """A shipped model; without its known reaction values when `known` is False, without
+    its drivers when `driven` is False (MuJoCo's model: it has none)."""
+    if known and driven:
         return mbody.load(MODELS / name)
     data = load_text((MODELS / name).read_text(), name).data
-    data.pop("reactions", None)
+    if not known:
+        data.pop("reactions", None)
+    if not driven:
+        data.pop("drivers", None)
     return mbody.load(data)
 
 
@@ -228,7 +237,8 @@ def test_closed_loops_load_and_nearly_agree(name):
     m, d = _mujoco(model)
     assert m.neq >= 1 and len(spanning_tree(model).loops) == 1
     _forward(model, m, d)
-    ours = mbody.assemble(model, _state(model, m, d)).solve().accelerations
+    free = _load(name, driven=False)  # a driven model (scotch_yoke): MuJoCo has no drivers
+    ours = mbody.assemble(free, _state(model, m, d)).solve().accelerations
     _compare(ours, _accelerations(model, m, d), rtol=1e-3)
     m.eq_active0[:] = 0
     d = mujoco.MjData(m)
@@ -236,6 +246,102 @@ def test_closed_loops_load_and_nearly_agree(name):
     _forward(model, m, d)
     with pytest.raises(AssertionError, match="max relative difference"):
         _compare(ours, _accelerations(model, m, d), rtol=1e-2)
+
+
+def _softness(m, d) -> float:
+    """ρ = R/(A + R) of the one equality row MuJoCo holds at `d`: A = J M⁻¹ Jᵀ, the row's
+    inverse inertia, and R its regularisation (from solimp). MuJoCo's force is A/(A + R)
+    of the rigid one, so with a zero reference acceleration (the state on the constraint,
+    moving along it) its accelerations are a_rigid + ρ (a_free − a_rigid), a_free those
+    without the constraint: the softness, exactly."""
+    assert d.nefc == 1
+    J = d.efc_J.reshape(1, m.nv).copy()
+    X = np.zeros_like(J)
+    mujoco.mj_solveM(m, d, X, J)
+    return float(d.efc_R[0] / (J[0] @ X[0] + d.efc_R[0]))
+
+
+def _uncoupled(model: mbody.Model, m, d):
+    """MuJoCo at the state of `d` with every equality switched off."""
+    free = mujoco.MjData(m)
+    free.qpos[:], free.qvel[:] = d.qpos, d.qvel
+    free.eq_active[:] = 0
+    _forward(model, m, free)
+    return free
+
+
+def _on_the_screws(m, d, rng: np.random.Generator) -> None:
+    """A random state (MuJoCo's coordinates) that keeps every joint equality: joint1 −
+    ref = polycoef[1] (joint2 − ref), and so for the rates."""
+    _random_state(m, d, rng)
+    for k in range(m.neq):
+        assert m.eq_type[k] == mujoco.mjtEq.mjEQ_JOINT and not m.eq_data[k, [0, 2, 3, 4]].any()
+        j1, j2 = m.eq_obj1id[k], m.eq_obj2id[k]
+        q1, q2 = m.jnt_qposadr[j1], m.jnt_qposadr[j2]
+        a = m.eq_data[k, 1]
+        d.qpos[q1] = m.qpos0[q1] + a * (d.qpos[q2] - m.qpos0[q2])
+        d.qvel[m.jnt_dofadr[j1]] = a * d.qvel[m.jnt_dofadr[j2]]
+
+
+@pytest.mark.parametrize("name", sorted(SCREWS))
+def test_screws_agree_with_mujoco_to_the_softness_of_their_coupling(name):
+    """A helical joint is a slide and a hinge on its axis coupled by a joint equality,
+    soft in MuJoCo. At the keyframe and at random states on the screw, MuJoCo's
+    accelerations are mbody's plus ρ (a_free − mbody's), ρ its softness from its own
+    data (`_softness`; 3.6e-5 for the jack, 5.7e-7 for the chain), to 1e-9 of their size;
+    and so are the joints' reactions (``cfrc_int``): the screw's axial wrench included.
+    Without the coupling they do not agree at all."""
+    model = _load(name)
+    m, d = _mujoco(model)
+    assert m.neq == 1 and m.eq_type[0] == mujoco.mjtEq.mjEQ_JOINT
+    rng = np.random.default_rng(sum(map(ord, name)))
+    for k in range(3):
+        if k:
+            _on_the_screws(m, d, rng)
+        _forward(model, m, d)
+        state = _state(model, m, d)
+        asm = mbody.assemble(model, state)
+        sol = asm.solve()
+        assert sol.residual < 1e-12  # the state keeps the screw
+        rho = _softness(m, d)
+        assert 0 < rho < 1e-4
+        free = _uncoupled(model, m, d)
+        ours, theirs = sol.accelerations, _accelerations(model, m, d)
+        loose = _accelerations(model, m, free)
+        scale = max(1.0, float(np.abs(theirs).max()))
+        np.testing.assert_allclose(theirs - ours, rho * (loose - ours), rtol=0,
+                                   atol=RTOL * scale)
+        assert np.abs(loose - ours).max() > 1e-3 * scale  # the coupling matters
+        for body, w in _reaction_wrenches(model, asm, sol, state).items():
+            b = m.body(body).id
+            c = d.subtree_com[m.body_rootid[b]]
+            i = model.index[body]
+            mine = np.concatenate((w[:3] + np.cross(state.position[i] - c, w[3:]), w[3:]))
+            size = max(1.0, float(np.abs(d.cfrc_int[b]).max()))
+            np.testing.assert_allclose(d.cfrc_int[b] - mine,
+                                       rho * (free.cfrc_int[b] - mine), rtol=0,
+                                       atol=RTOL * size)
+
+
+def test_a_screw_is_written_so_that_mujoco_holds_it_stiffly():
+    """The coupling is written as θ = s/h (joint1 the hinge) when |h| < 1: MuJoCo's
+    estimate of the row's inverse inertia (the joints' own weights, added) then holds
+    the true one's larger term in full. Written s = h θ, the jack's screw gives way by a
+    quarter."""
+    model = _load("screw_jack.yaml")
+    xml = to_mjcf(model)
+    h = 0.005 / (2 * np.pi)
+    assert f'joint1="N:turn" joint2="N:slide" polycoef="0 {1 / h!r} 0 0 0"' in xml
+    m, d = _mujoco(model)
+    _forward(model, m, d)
+    assert _softness(m, d) < 1e-4
+    other = xml.replace(f'joint1="N:turn" joint2="N:slide" polycoef="0 {1 / h!r} 0 0 0"',
+                        f'joint1="N:slide" joint2="N:turn" polycoef="0 {h!r} 0 0 0"')
+    m2 = mujoco.MjModel.from_xml_string(other)
+    d2 = mujoco.MjData(m2)
+    mujoco.mj_resetDataKeyframe(m2, d2, 0)
+    _forward(model, m2, d2)
+    assert _softness(m2, d2) > 0.1
 
 
 def test_a_wrong_export_is_caught():
@@ -379,6 +485,22 @@ def _same_model(a: mbody.Model, b: mbody.Model) -> None:
     for t in (0.0, 0.013):  # loads and known values that vary in time vary alike
         np.testing.assert_array_equal(b.forces.vector_at(t), a.forces.vector_at(t))
         assert b.known_reactions_at(t) == a.known_reactions_at(t)
+    assert _drivers(b) == _drivers(a)
+    if a.drivers is not None:  # the same laws (a speed's offset: the file's angles)
+        assert b.drivers is not None
+        for t in (0.0, 0.013):
+            np.testing.assert_allclose([law[0](t) for law in b.drivers.laws],
+                                       [law[0](t) for law in a.drivers.laws], rtol=1e-12)
+    assert (b.file_state is None) == (a.file_state is None)  # assembled at load alike
+
+
+def _drivers(model: mbody.Model) -> list[tuple]:
+    d = model.drivers
+    if d is None:
+        return []
+    return [(n, model.joints[int(j)].name, c, s if s is not None else str(law[0]))
+            for n, j, c, s, law in zip(d.names, d.joint, d.component, d.speed, d.laws,
+                                       strict=True)]
 
 
 @pytest.mark.parametrize("name", ALL)
