@@ -22,6 +22,7 @@ drivers: a driven model is compared with the same model without its drivers.
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -545,6 +546,169 @@ def test_a_round_trip_that_loses_something_is_caught():
     back = mbody.loads(dump_document(document.data, source="exported.xml"))
     with pytest.raises(AssertionError):
         _same_model(model, back)
+
+
+def test_the_file_pose_entries_are_what_keeps_an_assembled_model():
+    """A model assembled at load is written at its assembled pose; its joint frames were
+    fixed to the parents at the file's pose. Read back without the file's pose (the
+    mbody:body entries removed), the helical chain's pin frame is the one the joint frame
+    rule gives at the assembled pose, turned about the axis from the file's: G differs."""
+    model = _load("helical_chain.yaml")
+    xml = to_mjcf(model)
+    assert "Assembled pose:" in xml and xml.count('name="mbody:body:') == 2
+    cut = "\n".join(ln for ln in xml.splitlines() if "mbody:body:" not in ln)
+    back = mbody.loads(dump_document(read_mjcf(cut, keyframe="initial").data, source="x"))
+    with pytest.raises(AssertionError, match="G"):
+        _same_equations(model, back, rtol=1e-6)
+
+
+def _pinned_slot() -> dict:
+    """A crank pinned to ground and a slotted link hanging on the crank's pin (a slot
+    whose parent is the link: in MuJoCo's tree, from the crank, the joint runs against
+    the tree); gravity −y."""
+    c, s = np.cos(0.5), np.sin(0.5)
+    return {"model": "pinned-slot", "dimension": 2, "gravity": [0, -9.81],
+            "bodies": [{"name": "crank", "mass": 1.0, "inertia": 0.01,
+                        "position": [0.05 * c, 0.05 * s], "angle": 0.5},
+                       {"name": "link", "mass": 0.7, "inertia": 0.02,
+                        "position": [0.1 * c, 0.1 * s - 0.2], "angle": 0.3}],
+            "joints": [{"name": "O", "type": "revolute", "parent": "ground", "child": "crank",
+                        "at": [0, 0]},
+                       {"name": "S", "type": "slot", "parent": "link", "child": "crank",
+                        "at": [0.1 * c, 0.1 * s], "axis": [0.2, 1.0]}]}
+
+
+def test_a_slot_written_against_the_tree_turns_before_it_slides():
+    """A pin in a slot seen from the pin's body: the link turns about the pin, then
+    slides along its own slot (MuJoCo: S:turn, then S:slide, in the link). Exact in
+    MuJoCo (a tree): the accelerations and the pin's force agree at random states, and
+    the model comes back with the slot's parent and child."""
+    model = mbody.load(_moving(_pinned_slot()))  # with rates that keep the joints
+    tree = spanning_tree(model)
+    assert tree.joint["link"].name == "S" and tree.parent["link"] == "crank"
+    xml = to_mjcf(model)
+    assert xml.index('name="S:turn"') < xml.index('name="S:slide"')
+    m, d = _mujoco(model)
+    assert m.neq == 0
+    rng = np.random.default_rng(3)
+    for k in range(3):
+        if k:
+            _random_state(m, d, rng)
+        _forward(model, m, d)
+        state = _state(model, m, d)
+        asm = mbody.assemble(model, state)
+        sol = asm.solve()
+        assert sol.residual < 1e-12
+        _compare(sol.accelerations, _accelerations(model, m, d))
+        _check_reactions(model, m, d, asm, sol, state)
+    back, _ = _through_mjcf(model)
+    _same_model(model, back)
+    assert [(j.name, j.parent, j.child) for j in back.joints if j.type == "slot"] == [
+        ("S", "link", "crank")]
+
+
+def _plain_screw(coupling: str, slide_axis: str = "0 0 1", key: str = "") -> str:
+    """A MuJoCo file of its own (no mbody entries): a nut on a screw tilted about y (a
+    slide and a hinge on one axis, coupled by `coupling`, a joint equality at MuJoCo's
+    default softness) carrying a swinging arm."""
+    h = 0.012
+    key = key or f'qpos="{0.7 * h!r} 0.7 0.3" qvel="{2 * h!r} 2 -1"'
+    if slide_axis.startswith("0 0 -"):
+        key = key.replace(f'"{0.7 * h!r} ', f'"{-0.7 * h!r} ').replace(f'"{2 * h!r} ',
+                                                                       f'"{-2 * h!r} ')
+    return f"""<mujoco model="screw">
+  <option gravity="0 0 -9.81"/>
+  <worldbody>
+    <body name="nut" pos="0.1 0 0.3" euler="0 20 0">
+      <joint name="lift" type="slide" axis="{slide_axis}"/>
+      <joint name="spin" type="hinge" axis="0 0 1"/>
+      <inertial pos="0 0 0" mass="3" diaginertia="0.02 0.02 0.01"/>
+      <body name="arm" pos="0.2 0 0">
+        <joint name="swing" type="hinge" pos="-0.1 0 0" axis="0 1 0"/>
+        <inertial pos="0 0 0" mass="0.5" diaginertia="0.001 0.004 0.004"/>
+      </body>
+    </body>
+  </worldbody>
+  <equality>{coupling}</equality>
+  <keyframe><key name="k" {key}/></keyframe>
+</mujoco>
+"""
+
+
+@pytest.mark.parametrize("coupling, slide_axis", [
+    ('<joint joint1="lift" joint2="spin" polycoef="0 0.012 0 0 0"/>', "0 0 1"),
+    (f'<joint joint1="spin" joint2="lift" polycoef="0 {1 / 0.012!r} 0 0 0"/>', "0 0 1"),
+    ('<joint joint1="lift" joint2="spin" polycoef="0 -0.012 0 0 0"/>', "0 0 -1"),
+])
+def test_a_mujoco_screw_is_read_as_a_helical_joint(tmp_path, coupling, slide_axis):
+    """A slide and a hinge on one axis tied by a joint equality with polycoef "0 a 0 0 0"
+    (either way round, the slide along or against the hinge's axis) is mbody's helical
+    joint of pitch 2π h (h: the advance along the hinge's axis per radian), exact in
+    mbody. MuJoCo keeps the equality softly, at its default impedance here: its
+    accelerations are mbody's plus ρ (a_free − mbody's), ρ from its own data."""
+    path = tmp_path / "screw.xml"
+    path.write_text(_plain_screw(coupling, slide_axis))
+    doc = read_mjcf(path, keyframe="k")
+    assert not doc.warnings  # the equality is the screw itself
+    [screw] = [j for j in doc.data["joints"] if j["name"] == "lift+spin"]
+    assert screw["type"] == "helical"
+    assert screw["pitch"] == pytest.approx(2 * np.pi * 0.012, rel=1e-15)
+    model = mbody.load(path, keyframe="k")
+    m = mujoco.MjModel.from_xml_path(str(path))
+    d = mujoco.MjData(m)
+    mujoco.mj_resetDataKeyframe(m, d, 0)
+    _forward(model, m, d)
+    state = _state(model, m, d)
+    np.testing.assert_allclose(state.position, model.initial.position, atol=1e-12)
+    sol = mbody.assemble(model, state).solve()
+    assert sol.residual < 1e-12
+    rho = _softness(m, d)
+    free = _uncoupled(model, m, d)
+    ours, theirs = sol.accelerations, _accelerations(model, m, d)
+    np.testing.assert_allclose(theirs - ours, rho * (_accelerations(model, m, free) - ours),
+                               rtol=0, atol=RTOL * max(1.0, float(np.abs(theirs).max())))
+
+
+@pytest.mark.parametrize("coupling, why", [
+    ('<joint joint1="lift" joint2="spin" polycoef="0 0.012 0.5 0 0"/>', "not linear"),
+    ('<joint joint1="lift" joint2="spin" polycoef="0.001 0.012 0 0 0"/>', "an offset"),
+    ('<joint joint1="spin" joint2="lift" polycoef="0 0 0 0 0"/>', "the hinge locked"),
+    ('<joint joint1="lift" joint2="swing" polycoef="0 0.012 0 0 0"/>', "another body"),
+])
+def test_a_joint_equality_that_is_not_a_screw_is_listed(coupling, why):
+    """Anything but an exactly linear tie of the body's own slide and hinge on one axis
+    stays what it was: a cylindrical joint, the equality listed as not imported."""
+    doc = read_mjcf(_plain_screw(coupling), keyframe="k")
+    assert [j["type"] for j in doc.data["joints"] if j["name"] == "lift+spin"] == [
+        "cylindrical"], why
+    assert "equality constraints (joint" in doc.warnings[0].message
+
+
+def test_a_state_off_the_screw_is_said():
+    """A keyframe that breaks the coupling: mbody's screw starts from the state as given
+    (MuJoCo would pull it back), and the warning says by how much."""
+    doc = read_mjcf(_plain_screw('<joint joint1="lift" joint2="spin" polycoef="0 0.012"/>',
+                                 key='qpos="0.02 0.7 0.3" qvel="0 2 -1"'), keyframe="k")
+    assert "screw couplings broken by the state" in doc.warnings[0].message
+    assert "by 0.0116 m, 0.024 m/s" in doc.warnings[0].message
+
+
+def test_a_hinge_then_a_slide_on_the_world_is_refused():
+    """In a planar export, a slide in the plane then a hinge about z is a pin in a slot;
+    a hinge then a slide puts the slot in the body and the pin on its parent, which
+    cannot be the world (a joint's child is never ground)."""
+    xml = to_mjcf(_load("scotch_yoke.yaml"))
+    assert '<joint name="S:slide"' in xml and '<joint name="S:turn"' in xml
+    body = re.search(r'<body name="yoke".*?</body>', xml, re.S)
+    assert body is not None
+    turned = body.group(0).replace('<joint name="P" type="slide" pos="0 0 0" axis="1 0 0"/>',
+                                   '<joint name="P:turn" type="hinge" axis="0 0 1"/>\n'
+                                   '      <joint name="P:slide" type="slide" axis="1 0 0"/>', 1)
+    assert turned != body.group(0)
+    xml = re.sub(r"  <keyframe>.*</keyframe>\n", "", xml.replace(body.group(0), turned),
+                 flags=re.S)
+    with pytest.raises(ModelError, match="a pin in a slot whose pin is the world's"):
+        read_mjcf(xml)
 
 
 def test_one_letter_joints_and_free_particles_round_trip():
