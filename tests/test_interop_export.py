@@ -289,7 +289,7 @@ def test_screws_agree_with_mujoco_to_the_softness_of_their_coupling(name):
     """A helical joint is a slide and a hinge on its axis coupled by a joint equality,
     soft in MuJoCo. At the keyframe and at random states on the screw, MuJoCo's
     accelerations are mbody's plus ρ (a_free − mbody's), ρ its softness from its own
-    data (`_softness`; 3.6e-5 for the jack, 5.7e-7 for the chain), to 1e-9 of their size;
+    data (`_softness`; 1.4e-5 for the jack, 5.7e-7 for the chain), to 1e-9 of their size;
     and so are the joints' reactions (``cfrc_int``): the screw's axial wrench included.
     Without the coupling they do not agree at all."""
     model = _load(name)
@@ -327,8 +327,8 @@ def test_screws_agree_with_mujoco_to_the_softness_of_their_coupling(name):
 def test_a_screw_is_written_so_that_mujoco_holds_it_stiffly():
     """The coupling is written as θ = s/h (joint1 the hinge) when |h| < 1: MuJoCo's
     estimate of the row's inverse inertia (the joints' own weights, added) then holds
-    the true one's larger term in full. Written s = h θ, the jack's screw gives way by a
-    quarter."""
+    the true one's larger term in full (softness 1.4e-5). Written s = h θ, MuJoCo's
+    force on the jack's screw is 4 % of the rigid one (0.96)."""
     model = _load("screw_jack.yaml")
     xml = to_mjcf(model)
     h = 0.005 / (2 * np.pi)
@@ -342,7 +342,7 @@ def test_a_screw_is_written_so_that_mujoco_holds_it_stiffly():
     d2 = mujoco.MjData(m2)
     mujoco.mj_resetDataKeyframe(m2, d2, 0)
     _forward(model, m2, d2)
-    assert _softness(m2, d2) > 0.1
+    assert _softness(m2, d2) > 0.9
 
 
 def test_a_wrong_export_is_caught():
