@@ -562,6 +562,26 @@ def test_the_file_pose_entries_are_what_keeps_an_assembled_model():
         _same_equations(model, back, rtol=1e-6)
 
 
+@pytest.mark.parametrize("old, new, message", [
+    ('"joint": "O", "speed"', '"joint": "Q", "speed"', "drivers[0].joint: no joint named 'Q'"),
+    ('"speed": 62.83185307179586', '"speed": "fast"', "drivers[0].speed: expected a rate"),
+    ("mbody:driver:", "mbody:drivr:", "did you mean 'driver'?"),
+    ('"position": [0.043, 0.0]', '"position": [0.043]', "position: expected 2 components"),
+    ('"at": [[0.0, 0.0], [0.05, 0.0]]', '"at": [[0.0, 0.0], [0.05]]', "at[1]: expected 2"),
+])
+def test_a_wrong_entry_is_an_error_at_its_line(tmp_path, old, new, message):
+    """The entries of a driver, a file's pose and a joint's per-body points are checked
+    as the model file is, each problem reported at the entry's line (exit 2)."""
+    xml = to_mjcf(_load("scotch_yoke.yaml"))
+    assert old in xml
+    path = tmp_path / "yoke.xml"
+    path.write_text(xml.replace(old, new, 1))
+    line = next(k for k, ln in enumerate(path.read_text().splitlines(), 1) if new in ln)
+    with pytest.raises(ModelError) as info:
+        mbody.load(path)
+    assert message in str(info.value) and f"yoke.xml:{line}:" in str(info.value)
+
+
 def _pinned_slot() -> dict:
     """A crank pinned to ground and a slotted link hanging on the crank's pin (a slot
     whose parent is the link: in MuJoCo's tree, from the crank, the joint runs against

@@ -259,6 +259,9 @@ def restore(data: dict[str, Any], marks: list[dict[Any, tuple[int, int]]],
             continue
         body = data["bodies"][index[name]]
         body.update(entry)
+        for table in marks:  # a key the entry gives is reported at the entry
+            for key in entry:
+                table[("bodies", index[name], key)] = e.where("data")
         if entry.get("inertia") == 0:  # a particle has no orientation and no spin
             for key in ("orientation", "angle", "angular_velocity"):
                 body.pop(key, None)
@@ -273,13 +276,16 @@ def restore(data: dict[str, Any], marks: list[dict[Any, tuple[int, int]]],
                  {j["parent"], j["child"]} == ends))]
             joints.append(({"name": name, **entry}, _element_marks(e)))
             continue
-        match = [j for j, _ in joints if j["name"] == name]
+        match = [(j, m) for j, m in joints if j["name"] == name]
         if not match:
             issues.append(e.issue(f"mbody:joint:{name}: no joint '{name}' in the file",
                                   did_you_mean(name, [j["name"] for j, _ in joints]),
                                   "name"))
             continue
-        j = match[0]
+        j, where = match[0]
+        for table in where:  # a key the entry gives is reported at the entry
+            for key in entry:
+                table[(key,)] = e.where("data")
         if entry.get("parent") == j["child"] and entry.get("child") == j["parent"] and \
                 "axis2" in j:  # the tree ran child -> parent: the axes swap back too
             j["axis"], j["axis2"] = j["axis2"], j["axis"]
