@@ -774,6 +774,63 @@ def test_round_trip_through_mjcf_gives_the_same_equations():
     assert reversed_joints > 0 and fixed > 0
 
 
+def _per_body(spec: dict, seed: int) -> dict:
+    """`spec` with every joint point given on each body (``at: [[parent], [child]]``,
+    from the joint table: where the file's world point is on each body) and every body
+    moved off its joints by about a millimetre and a degree: `mbody.load` assembles it
+    (Newton from the file's pose, which turns the parents and so the joint frames)."""
+    model = mbody.load(spec)
+    rng = np.random.default_rng(seed)
+    jt = model.joint_table
+    joints = [{**j, "at": [_floats(jt.B_r_parent[k]), _floats(jt.B_r_child[k])]}
+              for k, j in enumerate(spec["joints"])]
+    bodies = []
+    for i, b in enumerate(spec["bodies"]):
+        turn = 0.02 * rng.normal(size=3)
+        q = model.initial.quaternion[i]
+        dq = np.concatenate(([1.0], turn / 2))
+        w1, v1 = q[0], q[1:]
+        w2, v2 = dq[0], dq[1:]
+        moved = np.concatenate(([w1 * w2 - v1 @ v2], w1 * v2 + w2 * v1 + np.cross(v1, v2)))
+        bodies.append({**b, "position": _floats(np.asarray(b["position"])
+                                                + 1e-3 * rng.normal(size=3)),
+                       "orientation": {"quaternion": _floats(moved / np.linalg.norm(moved))}})
+    return {**spec, "bodies": bodies, "joints": joints}
+
+
+def _floats(v) -> list[float]:
+    return [float(x) for x in np.ravel(v)]
+
+
+def test_joint_points_per_body_round_trip_and_agree_with_mujoco():
+    """Random spatial trees of every joint type, rewritten with their joint points on
+    each body and moved off their joints: the export writes the assembled pose (MuJoCo's
+    accelerations and reactions agree with mbody's there, to 1e-9), and the model read
+    back (the file's pose, points and axes from the entries) assembles to the same
+    equations."""
+    mixes = [None, ("spherical", "fixed", "universal", "revolute"),
+             ("cylindrical", "spherical", "prismatic", "fixed")]
+    turned = 0.0
+    for k, spec in enumerate(s for t in mixes for s in _random_trees("spatial", t, 0,
+                                                                     count=2)):
+        model = mbody.load(_per_body(spec, k))
+        assert model.file_state is not None
+        turned = max(turned, float(np.abs(model.initial.quaternion
+                                          - model.file_state.quaternion).max()))
+        m, d = _mujoco(model)
+        _forward(model, m, d)
+        state = _state(model, m, d)
+        np.testing.assert_allclose(state.position, model.initial.position, atol=1e-12)
+        asm = mbody.assemble(model, state)
+        sol = asm.solve()
+        assert sol.residual < 1e-12  # MuJoCo's keyframe keeps every joint
+        _compare(sol.accelerations, _accelerations(model, m, d))
+        _check_reactions(model, m, d, asm, sol, state)
+        back, _ = _through_mjcf(model)
+        _same_model(model, back)
+    assert turned > 1e-3  # the assembly turned bodies, and so joint frames
+
+
 def _moving(spec: dict) -> dict:
     """`spec` at its pose with random velocities that respect its joints (MuJoCo's joint
     rates), so that the keyframe holds them exactly."""
