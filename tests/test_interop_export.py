@@ -713,6 +713,18 @@ def test_a_state_off_the_screw_is_said():
     assert "by 0.0116 m, 0.024 m/s" in doc.warnings[0].message
 
 
+def test_a_slot_needs_a_hinge_about_z():
+    """A slide in the plane and a hinge across it, about world x, are no pin in a slot
+    (the hinge would turn the body out of the plane): refused, naming the joints."""
+    xml = to_mjcf(_load("scotch_yoke.yaml"))
+    hinge = '<joint name="S:turn" type="hinge" pos="0.05 0 0" axis="0 0 1"/>'
+    assert hinge in xml  # in the crank's axes, turned 30 deg: world x is (cos, -sin, 0)
+    tilted = xml.replace(hinge, hinge.replace('axis="0 0 1"',
+                                              f'axis="{float(np.cos(np.pi / 6))!r} -0.5 0"'))
+    with pytest.raises(ModelError, match=r"slide 'S:slide', hinge 'S:turn'\) that no single"):
+        read_mjcf(tilted, keyframe="initial")
+
+
 def test_a_hinge_then_a_slide_on_the_world_is_refused():
     """In a planar export, a slide in the plane then a hinge about z is a pin in a slot;
     a hinge then a slide puts the slot in the body and the pin on its parent, which

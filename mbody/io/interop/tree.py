@@ -339,7 +339,8 @@ def map_joints(b: TreeBody, kin: Kinematics, i: int, scale: float, *, planar: bo
             sign = 1.0 if float(axes[sl] @ axes[h]) > 0 else -1.0
             return Mapped("helical", name, anchors[h], axes[h], None, first,
                           pitch=2.0 * np.pi * lead * sign)
-        if planar and abs(float(axes[0] @ axes[1])) <= 1e-9:
+        if planar and abs(abs(float(axes[h][2])) - 1.0) <= 1e-9 and abs(
+                float(axes[sl][2])) <= 1e-9:  # a hinge about z, a slide in the plane
             # the pin (the hinge's anchor) slides along a line fixed in the frame the
             # slide moves in: the parent's when the slide comes first; else the hinge
             # turns the line with the body, whose own line holds its parent's pin
