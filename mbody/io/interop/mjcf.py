@@ -180,6 +180,8 @@ class _Reader(Geoms):
     custom: Custom | None = None
     screws: dict[Screw, tuple[float, Element]]
     """(slide, hinge) -> (h, the equality): joint equalities that make a screw."""
+    joint_index: dict[str, tuple[int, TreeJoint]] | None = None
+    """Every joint by name: (its body's index, the joint)."""
 
     def free_motions(self) -> frozenset[int]:
         """Bodies in the world whose joints are exactly a free motion, as the mbody
@@ -374,7 +376,10 @@ class _Reader(Geoms):
         a 0 0 0": joint1 − its ref = a (joint2 − its ref)). It is then the screw itself,
         exact in mbody, not a soft constraint; its solref and solimp are not read."""
         names = (v.get("joint1"), v.get("joint2"))
-        found = {j.name: (i, j) for i, b in enumerate(self.bodies) for j in b.joints}
+        if self.joint_index is None:  # once: a file may have many joint equalities
+            self.joint_index = {j.name: (i, j) for i, b in enumerate(self.bodies)
+                                for j in b.joints}
+        found = self.joint_index
         ends = [found.get(_name(n)) if n else None for n in names]
         if ends[0] is None or ends[1] is None:
             return False
