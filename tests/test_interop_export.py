@@ -324,6 +324,39 @@ def test_screws_agree_with_mujoco_to_the_softness_of_their_coupling(name):
                                        atol=RTOL * size)
 
 
+def test_a_screw_written_against_the_tree():
+    """A nut (b) on a screw whose screw body (a) hangs from ground: from the tree, the
+    helical joint runs from its child to its parent; the inverse of a screw motion is a
+    screw of the same pitch about the same line, so the same slide, hinge and coupling
+    hold it. It agrees with MuJoCo to the softness and comes back the same."""
+    spec = {"model": "against", "dimension": 3, "gravity": [0, 0, -9.81],
+            "bodies": [{"name": "a", "mass": 2, "inertia": [0.1, 0.2, 0.25],
+                        "position": [0.3, 0, 0]},
+                       {"name": "b", "mass": 1, "inertia": [0.05, 0.05, 0.02],
+                        "position": [0.6, 0.1, -0.2],
+                        "orientation": {"euler": [10, 20, 30], "sequence": "ZYX"}}],
+            "joints": [{"name": "O", "type": "revolute", "parent": "ground", "child": "a",
+                        "at": [0, 0, 0], "axis": [0, 1, 0]},
+                       {"name": "H", "type": "helical", "parent": "b", "child": "a",
+                        "at": [0.6, 0, 0], "axis": [0.3, 0.2, 1], "pitch": 0.05}]}
+    model = mbody.load(spec)
+    assert spanning_tree(model).parent["b"] == "a"
+    back, _ = _through_mjcf(model)
+    _same_model(model, back)
+    m, d = _mujoco(model)
+    rng = np.random.default_rng(1)
+    for _ in range(3):
+        _on_the_screws(m, d, rng)
+        _forward(model, m, d)
+        sol = mbody.assemble(model, _state(model, m, d)).solve()
+        assert sol.residual < 1e-12
+        rho = _softness(m, d)
+        ours, theirs = sol.accelerations, _accelerations(model, m, d)
+        loose = _accelerations(model, m, _uncoupled(model, m, d))
+        np.testing.assert_allclose(theirs - ours, rho * (loose - ours), rtol=0,
+                                   atol=RTOL * max(1.0, float(np.abs(theirs).max())))
+
+
 def test_a_screw_is_written_so_that_mujoco_holds_it_stiffly():
     """The coupling is written as θ = s/h (joint1 the hinge) when |h| < 1: MuJoCo's
     estimate of the row's inverse inertia (the joints' own weights, added) then holds
