@@ -494,6 +494,41 @@ def test_yaml_numbers_and_text_read_back_as_written():
     assert yaml.safe_load(text) == document
 
 
+def test_yaml_keeps_drivers_pitches_and_points_per_body_as_written():
+    """Every driver law (an angle in degrees, a displacement, a speed with its unit), a
+    pitch and joint points per body come back from YAML as the file writes them: the
+    same document, the same model (through MJCF too, where the laws are kept as text and
+    a speed in rad/s)."""
+    document = {
+        "model": "laws", "dimension": 3, "gravity": [0, 0, -9.81],
+        "bodies": [{"name": "nut", "mass": 2.0, "inertia": [0.01, 0.01, 0.004],
+                    "position": [0, 0, 0.101]},
+                   {"name": "arm", "mass": 0.5, "inertia": [0.001, 0.02, 0.02],
+                    "position": [0.2, 0, 0.1]},
+                   {"name": "slider", "mass": 0.3, "inertia": [0.001, 0.001, 0.001],
+                    "position": [0.4, 0, 0.1]}],
+        "joints": [{"name": "H", "type": "helical", "parent": "ground", "child": "nut",
+                    "at": [[0, 0, 0.1], [0, 0, 0]], "axis": [0, 0, 1], "pitch": 0.004},
+                   {"name": "A", "type": "revolute", "parent": "nut", "child": "arm",
+                    "at": [[0.1, 0, 0], [-0.1, 0, 0]], "axis": [0, 0, 1]},
+                   {"name": "P", "type": "prismatic", "parent": "arm", "child": "slider",
+                    "at": [[0.1, 0, 0], [-0.1, 0, 0]], "axis": [1, 0, 0]}],
+        "drivers": [{"name": "spin", "joint": "H", "speed": "120 rpm"},
+                    {"name": "swing", "joint": "A", "angle": "10 deg*sin(3*t)"},
+                    {"name": "push", "joint": "P", "displacement": "0.02*t*t"}]}
+    text = dump_document(document, source=None)
+    assert "  - {name: swing, joint: A, angle: \"10 deg*sin(3*t)\"}" in text
+    assert "pitch: 0.004}" in text and "at: [[0, 0, 0.1], [0, 0, 0]]" in text
+    assert load_text(text, "t").data == document
+    model = mbody.loads(text)
+    assert model.file_state is not None and len(model.drivers) == 3
+    _same_equations(mbody.load(document), model)
+    back, xml = _through_mjcf(model)
+    assert 'name="mbody:driver:swing" data=\'{"joint": "A", "angle": "10 deg*sin(3*t)"}\'' \
+        in xml
+    _same_model(model, back)
+
+
 def _through_mjcf(model: mbody.Model) -> tuple[mbody.Model, str]:
     """YAML → MJCF (loaded by MuJoCo as written) → the MJCF reader → YAML → model."""
     xml = to_mjcf(model)
