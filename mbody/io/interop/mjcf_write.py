@@ -164,6 +164,7 @@ class _Geometry:
 
 
 def _geometry(m: Model) -> _Geometry:
+    """Where the export writes each joint of `m` (`_Geometry`)."""
     index = {j.name: k for k, j in enumerate(m.joints)}
     k = len(m.joints)
     if not _file_form(m):
@@ -205,6 +206,7 @@ class _Writer:
 
     model: Model
     scale: float
+    geo: _Geometry
     lines: list[str] = field(default_factory=list)
     qpos: list[float] = field(default_factory=list)
     qvel: list[float] = field(default_factory=list)
@@ -213,14 +215,8 @@ class _Writer:
     sites: dict[str, list[str]] = field(default_factory=dict)  # body -> its site lines
     worst_velocity: float = 0.0
     native: dict[str, str] = field(default_factory=dict)  # joint -> the body holding it
-    geometry: _Geometry | None = None
     screws: list[tuple[Joint, str, str]] = field(default_factory=list)
     """Helical joints of the tree: (joint, its MuJoCo slide, its MuJoCo hinge)."""
-
-    @property
-    def geo(self) -> _Geometry:
-        assert self.geometry is not None
-        return self.geometry
 
     def name(self, wanted: str) -> str:
         """A joint name not used yet (MuJoCo wants them unique)."""
@@ -254,7 +250,7 @@ def to_mjcf(model: Model, *, source: str | None = None) -> str:
     """
     geometry = _geometry(model)
     scale = _length_scale(model, geometry)
-    w = _Writer(model, scale, geometry=geometry)
+    w = _Writer(model, scale, geometry)
     tree = spanning_tree(model)
     for spring in range(len(model.springs.names)):
         _spring_sites(w, spring)
