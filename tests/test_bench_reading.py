@@ -27,7 +27,7 @@ def bench():
     return module
 
 
-@pytest.mark.parametrize("index", range(6))
+@pytest.mark.parametrize("index", range(7))
 def test_each_case_makes_what_it_says(bench, index, tmp_path):
     name, make = bench.CASES[index]
     item = make(20_000)
@@ -42,11 +42,14 @@ def test_each_case_makes_what_it_says(bench, index, tmp_path):
         with pytest.raises(ModelError, match="unknown attribute of <mujoco> 'a0'"):
             mbody.load(path)
     else:
-        assert mbody.load(path).body_names
+        model = mbody.load(path)
+        assert model.body_names
+        if "screws" in name:  # each body's slide and hinge, tied: a helical joint
+            assert {j.type for j in model.joints} == {"helical"}
 
 
 def test_the_table(bench, capsys):
-    assert len(bench.CASES) == 6
+    assert len(bench.CASES) == 7
     assert bench.main(["--sizes", "0.005,0.01", "--repeat", "1", "--only", "URDF"]) == 0
     out = capsys.readouterr().out
     # per case: its name, the header, a row per size; then the note on growth

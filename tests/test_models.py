@@ -89,8 +89,7 @@ def test_model_loads_checks_and_assembles(path: Path, capsys):
     rpb = 3 if model.dimension == cv.PLANAR else 6
     # a particle (inertia: 0) has translation rows only
     N = sum(model.dimension if b.particle else rpb for b in model.bodies.values())
-    m = (sum(len(j.components) for j in model.joints)  # then one effort per driver
-         + (len(model.drivers.names) if model.drivers is not None else 0))
+    m = sum(len(j.components) for j in model.joints) + len(model.drivers or ())  # efforts
     assert asm.M.shape == (N, N) and asm.b.shape == (N,) and asm.Q.shape == (N,)
     assert asm.G.shape == (N, m) and len(asm.reactions) == m
     assert len(asm.coordinates) == N
@@ -120,12 +119,10 @@ def test_joints_match_the_poses_and_velocities(path: Path):
     asm = mbody.assemble(model)
     v = velocity_vector(model)
     scale = max(1.0, float(np.abs(v).max()))
-    rate = np.zeros(len(model.reactions))
-    d = model.drivers
-    k = len(d.names) if d is not None else 0
-    if k:  # the drivers' efforts are the last components, their laws' rates f'(t)
-        rate[-k:] = [law[1](model.initial.t) for law in d.laws]
-    assert np.abs(asm.G.T @ v - rate).max() < 1e-12 * scale
+    rates = np.zeros(len(asm.reactions))
+    if model.drivers is not None:
+        rates[len(rates) - len(model.drivers):] = [law[1](0.0) for law in model.drivers.laws]
+    assert np.abs(asm.G.T @ v - rates).max() < 1e-12 * scale
 
     jt = model.joint_table
     for k, j in enumerate(model.joints):
@@ -368,3 +365,84 @@ def test_slider_crank_loop_closes():
     # The rod's angular velocity from the loop: r w cos th = l wrod cos phi (phi < 0).
     phi = np.arcsin(-r * np.sin(th) / l)
     assert wrod == pytest.approx(-r * w * np.cos(th) / (l * np.cos(phi)), rel=1e-12)
+
+
+def test_screw_jack_lifts_by_the_work_balance():
+    """τ θ̇ = d/dt(½ m (h θ̇)² + ½ J θ̇²) + m g h θ̇ with m the screw and the load, J the
+    screw's axial inertia (the platform turns freely on its bearing and keeps ω = 0)."""
+    model = load("screw_jack.yaml")
+    ms, mp, r, tau = 4.0, 200.0, 0.02, 2.0
+    h = 0.005 / (2 * np.pi)
+    m, J = ms + mp, ms * r * r / 2
+    thdd = (tau - m * G0 * h) / (m * h * h + J)
+    sol = mbody.assemble(model).solve()
+    acc = dict(zip(sol.coordinates, sol.accelerations, strict=True))
+    assert acc["screw.w3"] == pytest.approx(thdd, rel=1e-12)  # 438.518 rad/s^2
+    assert acc["screw.z"] == pytest.approx(h * thdd, rel=1e-12)
+    assert acc["platform.z"] == pytest.approx(h * thdd, rel=1e-12)
+    assert abs(acc["platform.w3"]) <= 1e-12 * thdd
+    assert sol.reactions["N.Wz"] == pytest.approx(m * (h * thdd + G0), rel=1e-12)
+    assert sol.reactions["T.Fz"] == pytest.approx(mp * (h * thdd + G0), rel=1e-12)
+
+
+def test_scotch_yoke_moves_harmonically_and_its_motor_supplies_the_power():
+    """The driver holds the crank at 30 deg and 600 rpm; the joints, given on each body,
+    put the yoke at x = r cos θ (the file says 0.043 m). x'' = −r ω² cos θ, and the
+    motor's torque is the yoke's power over ω: m_y r² ω² sin θ cos θ."""
+    model = load("scotch_yoke.yaml")
+    r, my, mc = 0.05, 0.8, 1.2
+    th, w = np.radians(30), 600 * 2 * np.pi / 60
+    assert model.file_state is not None and model.file_state.position[1, 0] == 0.043
+    s = model.initial
+    np.testing.assert_allclose(s.position[1, :2], [r * np.cos(th), 0], rtol=0, atol=1e-13)
+    assert s.velocity[1, 0] == pytest.approx(-r * w * np.sin(th), rel=1e-12)
+    assert s.omega[0, 2] == pytest.approx(w, rel=1e-12)
+    assert 2 * np.arctan2(s.quaternion[0, 3], s.quaternion[0, 0]) == pytest.approx(th, 1e-13)
+    sol = mbody.assemble(model).solve()
+    acc = dict(zip(sol.coordinates, sol.accelerations, strict=True))
+    xdd = -r * w * w * np.cos(th)
+    assert acc["yoke.x"] == pytest.approx(xdd, rel=1e-12)
+    assert abs(acc["crank.theta"]) <= 1e-12 * w * w
+    lam = sol.reactions
+    assert lam["motor.M"] == pytest.approx(my * r * r * w * w * np.sin(th) * np.cos(th),
+                                           rel=1e-12)
+    assert lam["S.Fy"] == pytest.approx(my * xdd, rel=1e-12)  # joint y: world -x
+    assert lam["P.Fy"] == pytest.approx(my * G0, rel=1e-12)
+    assert lam["P.Mz"] == pytest.approx(r * np.sin(th) * my * xdd, rel=1e-12)
+    assert (lam["O.Fx"], lam["O.Fy"]) == (pytest.approx(my * xdd, rel=1e-12),
+                                          pytest.approx(mc * G0, rel=1e-12))
+
+
+def test_helical_chain_equals_its_lagrange_equations():
+    """At the assembled pose, at rest: q = (θ₁ the turn on the screw, θ₂ the rod's about
+    the pin); each body's Jacobian written out (the carriage advances h θ̇₁ along the
+    screw's axis a and turns about it; the rod turns about a and the pin's axis a₂, fixed
+    in the carriage), M = Σ m Jᵥᵀ Jᵥ + J_ωᵀ I J_ω and Q = Σ Jᵥᵀ m g, q̈ = M⁻¹ Q; then
+    a_G = Jᵥ q̈ and ω̇ = J_ω q̈ (at rest there are no velocity terms)."""
+    model = load("helical_chain.yaml")
+    h = 0.1 / (2 * np.pi)
+    a = np.array([0.5, 0.5, np.sqrt(0.5)])
+    P1 = np.array([0.0, 0.0, 0.5])
+    s, f = model.initial, model.file_state
+    assert f is not None  # assembled: the file's pose is a few mm off
+    assert 1e-4 < np.abs(s.position - f.position).max() < 5e-3
+    R = s.W_R_B
+    x1, x2 = s.position
+    P2 = x1 + R[0] @ [0.15, 0.0, 0.0]
+    a2 = np.array([0.5, 0.5, -0.7071])
+    a2 = R[0] @ f.W_R_B[0].T @ (a2 / np.linalg.norm(a2))  # fixed in the carriage
+    Jv = [np.column_stack((h * a + np.cross(a, x1 - P1), np.zeros(3))),
+          np.column_stack((h * a + np.cross(a, x2 - P1), np.cross(a2, x2 - P2)))]
+    Jw = [np.column_stack((a, np.zeros(3))), np.column_stack((a, a2))]
+    g = np.array([0.0, 0.0, -G0])
+    M, Q = np.zeros((2, 2)), np.zeros(2)
+    for i in range(2):
+        I_world = R[i] @ model.J[i] @ R[i].T
+        M += model.mass[i] * Jv[i].T @ Jv[i] + Jw[i].T @ I_world @ Jw[i]
+        Q += model.mass[i] * Jv[i].T @ g
+    qdd = np.linalg.solve(M, Q)
+    want = np.concatenate([np.concatenate((Jv[i] @ qdd, R[i].T @ Jw[i] @ qdd))
+                           for i in range(2)])
+    sol = mbody.assemble(model).solve()
+    np.testing.assert_allclose(sol.accelerations, want, rtol=0,
+                               atol=1e-11 * np.abs(want).max())

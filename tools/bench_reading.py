@@ -19,6 +19,9 @@ The cases (issue 22):
   tried every start in it);
 - MJCF, many bodies: free bodies, one a line (what a large scene is), read whole
   into a model (the import's own work: forward kinematics, masses, the document);
+- MJCF, many screws: bodies each on a slide and a hinge tied by a joint equality, read
+  as helical joints (each equality's joints are found by name: once per file, not once
+  per equality, which would be quadratic);
 - URDF, one long line: the same for a robot file (materials after a small arm);
 - URDF, one element with many attributes: a URDF reader notes names outside the
   specification (tools' extensions) and reads on.
@@ -112,6 +115,17 @@ def mjcf_many_bodies(size: int) -> Input:
     return Input(f'<mujoco model="many"><worldbody>\n{bodies}</worldbody></mujoco>', ".xml")
 
 
+def mjcf_many_screws(size: int) -> Input:
+    body = ('<body name="n{k}" pos="{k} 0 1"><joint name="s{k}" type="slide"/>'
+            '<joint name="t{k}" type="hinge"/><geom type="cylinder" size="0.1 0.05"/></body>\n')
+    tie = '<joint joint1="t{k}" joint2="s{k}" polycoef="0 1000 0 0 0"/>\n'
+    n = max(1, size // len(body.format(k=1000) + tie.format(k=1000)))
+    bodies = "".join(body.format(k=k) for k in range(n))
+    ties = "".join(tie.format(k=k) for k in range(n))
+    return Input(f'<mujoco model="screws"><worldbody>\n{bodies}</worldbody>'
+                 f"<equality>\n{ties}</equality></mujoco>", ".xml")
+
+
 def urdf_many_attributes(size: int) -> Input:
     n = max(1, size // len(' a100000="1"'))
     attrs = "".join(f' a{k}="1"' for k in range(n))
@@ -129,6 +143,7 @@ CASES: list[tuple[str, Callable[[int], Input]]] = [
     ("MJCF, one element with many attributes", mjcf_many_attributes),
     ("MJCF, '>' inside an attribute value", mjcf_angle_brackets),
     ("MJCF, many bodies", mjcf_many_bodies),
+    ("MJCF, many screws", mjcf_many_screws),
     ("URDF, one long line", urdf_one_line),
     ("URDF, one element with many attributes", urdf_many_attributes),
 ]

@@ -310,7 +310,8 @@ def body_rows(asm: Assembly, body: str) -> BodyRows:
     cols = asm.columns
     for j in joints_of(model, i).tolist():
         joint = model.joints[j]
-        for label in joint.labels:
+        efforts = model.drivers.labels_of(j) if model.drivers is not None else ()
+        for label in (*joint.labels, *efforts):  # a driver's effort acts as a reaction
             if label not in known:
                 other = joint.parent if joint.child == body else joint.child
                 joints[label] = (joint.name, 1.0 if joint.child == body else -1.0, other)

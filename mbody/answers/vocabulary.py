@@ -309,7 +309,10 @@ def vocabulary(model: Model, state: State, body: str) -> Vocabulary:
                 "moments about the mass centre, with I_1, I_2, I_3 or I_11 ... I_33"))
     reactions = tuple(r for r in model.reactions if r not in known) if known else \
         tuple(model.reactions)
-    touching = {label for joint in own for label in joint.labels}
+    drivers = model.drivers
+    touching = {label for j in joints_of(model, i).tolist()  # a driver's effort: a reaction
+                for label in (*model.joints[j].labels,
+                              *(drivers.labels_of(j) if drivers is not None else ()))}
     acting = tuple(r for r in reactions if r in touching)
     for label, value in known.items():
         values[label] = float(value)

@@ -139,14 +139,16 @@ def _read(path: str, fmt: str, keyframe: str | None) -> Any:
 
 
 def _model(document: Any, source: str):
-    """The validated model of a document read from `source` (its issues name it)."""
+    """The validated model of a document read from `source` (its issues name it), at
+    its assembled pose when it gives joint points per body or drivers (`mbody.load`)."""
     from mbody.io.interop.tree import validate_imported
+    from mbody.loading import assembled
     from mbody.model.loader import Document
     from mbody.model.model import Model
 
     if not isinstance(document, Document):  # plain data: no lines to point at
         document = Document(document, source)
-    return Model.from_spec(validate_imported(document))
+    return assembled(Model.from_spec(validate_imported(document)))
 
 
 def _summary(model) -> str:

@@ -199,6 +199,7 @@ class DriverTable:
     offset: np.ndarray
     laws: tuple[tuple[Expression, Expression, Expression], ...]
     where: tuple[tuple[int, int], ...]
+    speed: tuple[float | None, ...] = ()
 
     def __len__(self) -> int:
         return len(self.names)
@@ -207,6 +208,12 @@ class DriverTable:
     def labels(self) -> tuple[str, ...]:
         """``<driver>.M`` or ``<driver>.F``: the efforts' labels."""
         return tuple(f"{n}.{c}" for n, c in zip(self.names, self.component, strict=True))
+
+    def labels_of(self, joint: int) -> tuple[str, ...]:
+        """The efforts' labels of the drivers of joint `joint` (its index): they act on
+        that joint's two bodies, as its reactions do."""
+        return tuple(lab for lab, j in zip(self.labels, self.joint, strict=True)
+                     if int(j) == joint)
 
     def __repr__(self) -> str:
         return f"<DriverTable: {len(self)} driver(s) ({', '.join(self.labels[:4])})>"
@@ -221,6 +228,7 @@ def driver_table(specs: list[DriverSpec], joint_index: dict[str, int], dimension
         return None
     parent, child = joint_parent_child
     names, joint, kind, axis, comp, offset, laws, where = [], [], [], [], [], [], [], []
+    speed: list[float | None] = []
     for s in specs:
         j = joint_index[s.joint]
         rotation = s.motion.what == joint_types.ROTATION
@@ -239,6 +247,8 @@ def driver_table(specs: list[DriverSpec], joint_index: dict[str, int], dimension
         offset.append(off)
         laws.append((law, f1, derivative(f1)))
         where.append(s.where)
+        speed.append(s.speed if s.law is None else None)
     return DriverTable(tuple(names), np.array(joint, dtype=np.intp),
                        np.array(kind, dtype=np.intp), np.array(axis, dtype=np.intp),
-                       tuple(comp), np.array(offset), tuple(laws), tuple(where))
+                       tuple(comp), np.array(offset), tuple(laws), tuple(where),
+                       tuple(speed))

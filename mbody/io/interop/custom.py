@@ -12,17 +12,25 @@ name                      element   data
 ========================  ========  ===================================================
 ``mbody:dimension``       numeric   2 (planar) or 3 (spatial)
 ``mbody:body:B``          text      JSON object of body B's keys MJCF cannot hold:
-                                    ``{"inertia": 0}`` for a particle
+                                    ``{"inertia": 0}`` for a particle; the file's pose
+                                    and velocities of a model assembled at load
 ``mbody:joint:J``         text      JSON object. With ``type``: the whole joint J (MJCF
                                     has no element that is exactly it: fixed joints, a
                                     particle's pin, joints that close loops). Without:
                                     the keys that differ from what MJCF says (``parent``
-                                    and ``child`` when the joint runs against the tree)
+                                    and ``child`` when the joint runs against the tree,
+                                    a screw's ``pitch``, the file's ``at`` and axes)
 ``mbody:load:L``          text      JSON object of load L as the model file writes it;
                                     ``{"type": "spring"}``: the spatial tendon L
 ``mbody:reaction:R``      numeric   the known value of reaction component R
 ``mbody:reaction:R``      text      the same, an expression of t
+``mbody:driver:D``        text      JSON object of driver D as the model file writes
+                                    it, but its name (``{"joint": "O", "speed": 10}``)
 ========================  ========  ===================================================
+
+A model that `mbody.load` assembles (joint points per body, drivers) is exported at its
+assembled pose; its body and joint entries hold the file's pose, points and axes, so
+that the document read back is the file that was written, and assembles the same way.
 """
 
 from __future__ import annotations
@@ -34,6 +42,7 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
+from mbody import joint_types
 from mbody.errors import Issue, ModelError, did_you_mean
 from mbody.io.interop.attrvalues import read_numbers
 from mbody.io.interop.tree import ImportedDocument
@@ -41,7 +50,7 @@ from mbody.io.interop.xmlsource import Element, one_line
 from mbody.model.loader import dotted
 
 PREFIX = "mbody:"
-KINDS = ("dimension", "body", "joint", "load", "reaction")
+KINDS = ("dimension", "body", "joint", "load", "reaction", "driver")
 
 
 @dataclass
@@ -54,6 +63,7 @@ class Custom:
     joints: dict[str, tuple[dict[str, Any], Element]] = field(default_factory=dict)
     loads: list[tuple[str, dict[str, Any], Element]] = field(default_factory=list)
     reactions: dict[str, tuple[float | str, Element]] = field(default_factory=dict)
+    drivers: list[tuple[str, dict[str, Any], Element]] = field(default_factory=list)
 
     def particle(self, body: str) -> bool:
         """Whether the entries make `body` a particle (``inertia: 0``)."""
@@ -160,6 +170,8 @@ def read_custom(root: Element) -> Custom | None:
                 out.bodies[key] = (value, e)
             elif kind == "joint":
                 out.joints[key] = (value, e)
+            elif kind == "driver":
+                out.drivers.append((key, value, e))
             else:
                 out.loads.append((key, value, e))
     if issues:
@@ -224,7 +236,7 @@ def planar_issues(doc: ImportedDocument, custom: Custom) -> list[Issue]:
         axis = np.asarray(j.get("axis", [0.0, 0.0, 1.0]), float)
         if j["type"] == "revolute" and np.abs(axis[:2]).max() > PLANE_TOL:
             say(p, f"the hinge '{j['name']}' turns about an axis out of z")
-        if j["type"] == "prismatic" and abs(axis[2]) > PLANE_TOL:
+        if _slides(j["type"]) and abs(axis[2]) > PLANE_TOL:
             say(p, f"the slide '{j['name']}' leaves the plane")
     return out
 
@@ -247,6 +259,9 @@ def restore(data: dict[str, Any], marks: list[dict[Any, tuple[int, int]]],
             continue
         body = data["bodies"][index[name]]
         body.update(entry)
+        for table in marks:  # a key the entry gives is reported at the entry
+            for key in entry:
+                table[("bodies", index[name], key)] = e.where("data")
         if entry.get("inertia") == 0:  # a particle has no orientation and no spin
             for key in ("orientation", "angle", "angular_velocity"):
                 body.pop(key, None)
@@ -261,13 +276,16 @@ def restore(data: dict[str, Any], marks: list[dict[Any, tuple[int, int]]],
                  {j["parent"], j["child"]} == ends))]
             joints.append(({"name": name, **entry}, _element_marks(e)))
             continue
-        match = [j for j, _ in joints if j["name"] == name]
+        match = [(j, m) for j, m in joints if j["name"] == name]
         if not match:
             issues.append(e.issue(f"mbody:joint:{name}: no joint '{name}' in the file",
                                   did_you_mean(name, [j["name"] for j, _ in joints]),
                                   "name"))
             continue
-        j = match[0]
+        j, where = match[0]
+        for table in where:  # a key the entry gives is reported at the entry
+            for key in entry:
+                table[(key,)] = e.where("data")
         if entry.get("parent") == j["child"] and entry.get("child") == j["parent"] and \
                 "axis2" in j:  # the tree ran child -> parent: the axes swap back too
             j["axis"], j["axis2"] = j["axis2"], j["axis"]
@@ -296,6 +314,17 @@ def restore(data: dict[str, Any], marks: list[dict[Any, tuple[int, int]]],
         for label, (_, e) in custom.reactions.items():
             for table in marks:
                 table[("reactions", label)] = e.where("data")
+    if custom.drivers:
+        data["drivers"] = [{"name": name, **entry} for name, entry, _ in custom.drivers]
+        for k, (_, _, e) in enumerate(custom.drivers):
+            for table in marks:
+                table[("drivers", k)] = e.where("data")
+
+
+def _slides(typ: str) -> bool:
+    """Whether a planar joint type slides (its `axis` is a direction in the plane)."""
+    jt = joint_types.TYPES[joint_types.PLANAR].get(typ)
+    return jt is not None and any(m.what == joint_types.TRANSLATION for m in jt.motions)
 
 
 def _marks_of(marks: list[dict[Any, tuple[int, int]]], path: tuple[Any, ...]
@@ -332,7 +361,7 @@ def _planar(data: dict[str, Any], custom: Custom,
                 table[("bodies", k, "angle")] = table[("bodies", k, "orientation")]
     for j in data.get("joints", []):
         j["at"] = j["at"][:2]
-        if j["type"] == "prismatic":
+        if _slides(j["type"]):  # the slide's direction in the plane (prismatic, slot)
             j["axis"] = j["axis"][:2]
         else:
             j.pop("axis", None)

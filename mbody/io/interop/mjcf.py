@@ -31,7 +31,18 @@ from mbody.io.interop.mjcf_compiler import z_to_quat
 from mbody.io.interop.mjcf_geoms import GEOM_TYPES, MIN_MASS, Geoms, solid
 from mbody.io.interop.mjcf_source import MAX_INCLUDES, Included, check_names, expand_includes
 from mbody.io.interop.mjcf_state import state
-from mbody.io.interop.tree import ImportedDocument, Loop, TreeBody, TreeJoint, build, unit
+from mbody.io.interop.tree import (
+    NQ,
+    NV,
+    ImportedDocument,
+    Loop,
+    Screw,
+    TreeBody,
+    TreeJoint,
+    build,
+    joint_order,
+    unit,
+)
 from mbody.io.interop.xmlsource import MAX_ELEMENTS, Element, parse_xml, read_xml
 
 __all__ = ["GEOM_TYPES", "MAX_INCLUDES", "MIN_MASS", "read_mjcf", "solid", "z_to_quat"]
@@ -99,6 +110,7 @@ class _Reader(Geoms):
         self.body_index: dict[str, int] = {}
         self.moving: list[bool] = []
         """Per body: it or a body it hangs from has a joint."""
+        self.screws = {}
 
     # -- the file --------------------------------------------------------------------
     def read(self, keyframe: str | None) -> ImportedDocument:
@@ -149,10 +161,12 @@ class _Reader(Geoms):
         if self.issues:
             raise ModelError(self.issues)
         qpos, qvel, q0 = state(self, root, self.bodies, keyframe)
+        self.screw_state(qpos, qvel, q0)
         name = root.get("model") or Path(self.file).stem
         doc = build(name, f"imported from {Path(self.file).name} (MJCF)", self.file,
                     self.bodies, qpos, qvel, q0, gravity, loops, root, "mjcf",
-                    self.free_motions())
+                    self.free_motions(), screws={k: h for k, (h, _) in self.screws.items()},
+                    planar=self.custom is not None and self.custom.dimension == 2)
         if self.custom is not None:
             off_plane = planar_issues(doc, self.custom)
             if off_plane:
@@ -164,6 +178,10 @@ class _Reader(Geoms):
 
     contact_off = False
     custom: Custom | None = None
+    screws: dict[Screw, tuple[float, Element]]
+    """(slide, hinge) -> (h, the equality): joint equalities that make a screw."""
+    joint_index: dict[str, tuple[int, TreeJoint]] | None = None
+    """Every joint by name: (its body's index, the joint)."""
 
     def free_motions(self) -> frozenset[int]:
         """Bodies in the world whose joints are exactly a free motion, as the mbody
@@ -329,6 +347,8 @@ class _Reader(Geoms):
                 v = self.values(c, None)
                 if self.keyword(c, v, "active", BOOLEAN, "true") == "false":
                     continue
+                if c.tag == "joint" and self.screw(c, v):
+                    continue
                 if c.tag not in ("connect", "weld"):
                     self.note("equality constraints", f"{c.tag} '{c.get('name') or ''}'")
                     continue
@@ -349,6 +369,59 @@ class _Reader(Geoms):
         if self.issues:
             raise ModelError(self.issues)
         return loops
+
+    def screw(self, c: Element, v: dict[str, str]) -> bool:
+        """Whether the joint equality `c` makes a helical joint: it ties a slide and a hinge
+        that are the only joints of one body, on one axis, exactly linearly (polycoef "0
+        a 0 0 0": joint1 − its ref = a (joint2 − its ref)). It is then the screw itself,
+        exact in mbody, not a soft constraint; its solref and solimp are not read."""
+        names = (v.get("joint1"), v.get("joint2"))
+        if self.joint_index is None:  # once: a file may have many joint equalities
+            self.joint_index = {j.name: (i, j) for i, b in enumerate(self.bodies)
+                                for j in b.joints}
+        found = self.joint_index
+        ends = [found.get(_name(n)) if n else None for n in names]
+        if ends[0] is None or ends[1] is None:
+            return False
+        (i1, j1), (i2, j2) = ends[0], ends[1]
+        coef = np.array([0.0, 1.0, 0.0, 0.0, 0.0])  # MuJoCo's default
+        given = self.attr(c, v, "polycoef", 5, None, lo=1)
+        if given is not None:
+            coef[:len(given)] = given
+        b = self.bodies[i1]
+        if (i1 != i2 or coef[0] != 0.0 or coef[2:].any() or len(b.joints) != 2
+                or {j1.type, j2.type} != {"slide", "hinge"}
+                or float(np.linalg.norm(np.cross(j1.axis, j2.axis))) > 1e-9):
+            return False
+        a = float(coef[1])
+        if j1.type == "slide":  # s = a θ
+            self.screws[(j1.name, j2.name)] = (a, c)
+        elif a != 0.0:  # θ = a s
+            self.screws[(j2.name, j1.name)] = (1.0 / a, c)
+        else:  # the hinge locked: no screw
+            return False
+        return True
+
+    def screw_state(self, qpos: np.ndarray, qvel: np.ndarray, q0: np.ndarray) -> None:
+        """Note a screw whose state breaks its coupling: mbody's helical joint starts from
+        the pose and rates as given, where MuJoCo pulls them back to the equality."""
+        if not self.screws:
+            return
+        at, rate = {}, {}
+        qa = va = 0
+        for _, j in joint_order(self.bodies):
+            at[j.name], rate[j.name] = qa, va
+            qa += NQ[j.type]
+            va += NV[j.type]
+        scale = max(1.0, float(np.abs(qpos).max(initial=0.0)))
+        for (slide, hinge), (h, c) in self.screws.items():
+            s, t = at[slide], at[hinge]
+            miss = abs((qpos[s] - q0[s]) - h * (qpos[t] - q0[t]))
+            speed = abs(qvel[rate[slide]] - h * qvel[rate[hinge]])
+            if miss > 1e-9 * scale or speed > 1e-9 * max(1.0, float(np.abs(qvel).max())):
+                self.note("screw couplings broken by the state (mbody's screw starts from "
+                          "the state as given)", f"{c.get('name') or slide} by {miss:.3g} m, "
+                          f"{speed:.3g} m/s")
 
     def body_ref(self, c: Element, name: str | None, attr: str) -> int | None:
         if name == "world":

@@ -7,14 +7,22 @@ tree sits in its child body (``pos`` = the joint point in the child's axes); a j
 that closes a loop becomes an equality constraint, which MuJoCo enforces softly.
 
 Joint types: revolute → hinge, prismatic → slide, cylindrical → slide + hinge on one
-axis, spherical → ball, universal → two hinges in the child body (MuJoCo composes a
-body's joints in order: the first axis stays fixed in the parent, the second turns with
-the first and is fixed in the child, which is the universal joint exactly; no massless
-intermediate body is needed, so the equations keep their bodies), fixed → no joint (the
-child is welded by nesting). A body with no joint to the tree's root gets a free joint
-(spatial), or slides along world x, y and a hinge about z (planar; slides only for a
-particle). Planar models are written in 3-D: every planar joint turns about world z or
-slides in the plane, so the motion stays planar.
+axis, helical → slide + hinge on one axis coupled by a joint equality (soft in MuJoCo),
+slot (planar) → slide along the slot, then a hinge at the pin, spherical → ball,
+universal → two hinges in the child body (MuJoCo composes a body's joints in order: the
+first axis stays fixed in the parent, the second turns with the first and is fixed in
+the child, which is the universal joint exactly; no massless intermediate body is
+needed, so the equations keep their bodies), fixed → no joint (the child is welded by
+nesting). A body with no joint to the tree's root gets a free joint (spatial), or slides
+along world x, y and a hinge about z (planar; slides only for a particle). Planar models
+are written in 3-D: every planar joint turns about world z or slides in the plane, so
+the motion stays planar.
+
+A model that `mbody.load` assembles (joint points given per body, drivers) is written
+at its assembled pose, where every joint closes: the state MuJoCo starts from is the one
+mbody starts from. The file's own form (its pose, its joint points and axes, the
+drivers) goes into ``mbody:`` entries, so that reading the file back gives the model
+file that was written, which assembles the same way.
 """
 
 from __future__ import annotations
@@ -48,8 +56,9 @@ scale): MuJoCo refuses a moving body without rotational inertia. The relative ch
 the accelerations is of this order."""
 
 LOOP_SOLIMP = "0.9999 0.9999 0.001 0.5 2"
-"""Impedance of the loop-closing equality constraints: MuJoCo's stiffest (its default,
-0.9, lets a loop give by about 10 % of the force that holds it together)."""
+"""Impedance of the loop-closing equality constraints and the screws' couplings: MuJoCo's
+stiffest (its default, 0.9, lets a loop give by about 10 % of the force that holds it
+together)."""
 
 _TREE_FIRST = {None: 0, "weld": 1, "connect": 2}
 """Which joints go into the tree first, by the MuJoCo equality that would close a loop
@@ -137,12 +146,67 @@ def spanning_tree(model: Model) -> _Tree:
     return tree
 
 
+@dataclass(frozen=True)
+class _Geometry:
+    """Every joint where the export writes it: at the initial state, world axes.
+
+    point: (k, 3) the joint point on the child (a slot's pin; the parent's point for a
+    particle child); frame: (k, 3, 3) the joint frame fixed in the parent, axes as
+    columns; axis2: (k, 3) a universal joint's child axis. A model whose initial state is
+    the file's pose gives them as its joints' records do (the file's numbers); an
+    assembled one from its joint table, carried to the assembled pose.
+    """
+
+    point: np.ndarray
+    frame: np.ndarray
+    axis2: np.ndarray
+    index: dict[str, int]
+
+
+def _geometry(m: Model) -> _Geometry:
+    """Where the export writes each joint of `m` (`_Geometry`)."""
+    index = {j.name: k for k, j in enumerate(m.joints)}
+    k = len(m.joints)
+    if not _file_form(m):
+        point = np.array([np.asarray(j.at, dtype=float) for j in m.joints]).reshape(k, 3)
+        frame = np.array([np.asarray(j.W_E0, dtype=float) for j in m.joints]).reshape(k, 3, 3)
+        axis2 = np.array([np.zeros(3) if j.axis2 is None else np.asarray(j.axis2, dtype=float)
+                          for j in m.joints]).reshape(k, 3)
+        return _Geometry(point, frame, axis2, index)
+    jt = m.joint_table
+    st = m.initial
+    R = quat_to_matrix(st.quaternion).reshape(-1, 3, 3)
+    p, c = jt.parent, jt.child
+    ground = p < 0
+    R_p = np.where(ground[:, None, None], np.eye(3), R[p])
+    x_p = np.where(ground[:, None], 0.0, st.position[p])
+    on_child = st.position[c] + (R[c] @ jt.B_r_child[:, :, None])[:, :, 0]
+    on_parent = x_p + (R_p @ jt.B_r_parent[:, :, None])[:, :, 0]
+    child_particle = m.particle[c]
+    point = np.where(child_particle[:, None], on_parent, on_child)
+    both = child_particle & jt.particle_parent  # two particles: the file's point
+    if both.any():
+        point[both] = [np.asarray(m.joints[int(q)].at, dtype=float)
+                       for q in np.flatnonzero(both)]
+    frame = R_p @ jt.P_E3
+    axis2 = (R[c] @ jt.C_axis2[:, :, None])[:, :, 0]
+    return _Geometry(point, frame, axis2, index)
+
+
+def _file_form(m: Model) -> bool:
+    """Whether the model's initial state is not the file's pose (`mbody.load` assembled
+    it: joint points per body, drivers), so that its joints' records, made at the file's
+    pose, are not where the export writes them."""
+    return m.file_state is not None or bool(m.joint_table.body_points.any())
+
+
 @dataclass
 class _Writer:
     """What `to_mjcf` accumulates: lines of the body tree, the keyframe, the notes."""
 
     model: Model
     scale: float
+    geo: _Geometry
     lines: list[str] = field(default_factory=list)
     qpos: list[float] = field(default_factory=list)
     qvel: list[float] = field(default_factory=list)
@@ -151,6 +215,8 @@ class _Writer:
     sites: dict[str, list[str]] = field(default_factory=dict)  # body -> its site lines
     worst_velocity: float = 0.0
     native: dict[str, str] = field(default_factory=dict)  # joint -> the body holding it
+    screws: list[tuple[Joint, str, str]] = field(default_factory=list)
+    """Helical joints of the tree: (joint, its MuJoCo slide, its MuJoCo hinge)."""
 
     def name(self, wanted: str) -> str:
         """A joint name not used yet (MuJoCo wants them unique)."""
@@ -182,8 +248,9 @@ def to_mjcf(model: Model, *, source: str | None = None) -> str:
     str
         The MJCF text.
     """
-    scale = _length_scale(model)
-    w = _Writer(model, scale)
+    geometry = _geometry(model)
+    scale = _length_scale(model, geometry)
+    w = _Writer(model, scale, geometry)
     tree = spanning_tree(model)
     for spring in range(len(model.springs.names)):
         _spring_sites(w, spring)
@@ -295,7 +362,8 @@ def _tree_joint(w: _Writer, j: Joint, parent: str, child: str, pad: str) -> None
     c = m.index[child]
     R_c = quat_to_matrix(m.initial.quaternion[c])
     x_c = m.initial.position[c]
-    P = np.asarray(j.at, dtype=float)
+    k = w.geo.index[j.name]
+    P = w.geo.point[k]
     B_P = _snap(R_c.T @ (P - x_c), w.scale)
     particle = bool(m.particle[c])
     if m.particle[c] and j.particle_joint == "pin":
@@ -305,13 +373,15 @@ def _tree_joint(w: _Writer, j: Joint, parent: str, child: str, pad: str) -> None
         return
     planar = m.dimension == cv.PLANAR
     jtype = joint_types.joint_type(m.dimension, j.type)
-    parts = _parts(j, jtype, planar, child)
+    parts = _parts(j, jtype, planar, child, w.geo.frame[k], w.geo.axis2[k])
     if not parts:  # fixed: welded by nesting
         return
     w.native[j.name] = child
     columns = []
+    written = []
     for nm, kind, a in parts:
         jn = w.name(nm)
+        written.append(jn)
         if kind == "ball":
             w.lines.append(f'{pad}<joint name={quoteattr(jn)} type="ball" pos="{_vec(B_P)}"/>')
             w.qpos += [1.0, 0.0, 0.0, 0.0]
@@ -321,6 +391,8 @@ def _tree_joint(w: _Writer, j: Joint, parent: str, child: str, pad: str) -> None
                            f'pos="{_vec(B_P)}" axis="{_vec(_snap(R_c.T @ a, 1.0))}"/>')
             w.qpos.append(0.0)
             columns.append(_column(kind, a, P, x_c))
+    if any(comp.kind == SCREW for comp in jtype.components):  # coupled in <equality>
+        w.screws.append((j, written[0], written[1]))
     w.qvel += _rates(w, j, parent, c, np.array(columns).T, particle)
 
 
@@ -328,13 +400,18 @@ _MJCF_KIND = {joint_types.ROTATION: "hinge", joint_types.TRANSLATION: "slide",
               joint_types.BALL: "ball"}
 
 
-def _parts(j: Joint, jtype: joint_types.JointType, planar: bool, child: str
-           ) -> list[tuple[str, str, np.ndarray]]:
-    """(name, MJCF joint type, world axis) of each MuJoCo joint that makes up `j`: one per
-    motion its type allows (mbody.joint_types), named ``<joint>:<part>`` when there are
-    several; a screw's rotation is written as a hinge and a slide along one axis (their
-    coupling is an equality, `_screws`)."""
-    E = np.asarray(j.W_E0, dtype=float)
+def _parts(j: Joint, jtype: joint_types.JointType, planar: bool, child: str,
+           E: np.ndarray, axis2: np.ndarray) -> list[tuple[str, str, np.ndarray]]:
+    """(name, MJCF joint type, world axis) of each MuJoCo joint that makes up `j`, in the
+    order MuJoCo composes them: one per motion its type allows (mbody.joint_types), named
+    ``<joint>:<part>`` when there are several; a screw's rotation is written as a slide
+    and a hinge along one axis (their coupling is an equality, `_screw_equalities`).
+
+    `E` is the joint frame (world, at the initial state) and `axis2` a universal joint's
+    child axis. Written against the tree (`child` is `j`'s parent), the parts come in the
+    reverse order, which is the inverse motion: a pin in a slot, a slide then a turn about
+    the pin, is seen from the pin's body as a turn about the pin, then a slide along the
+    slot (which turned with it)."""
     motions = list(jtype.motions)
     screw = any(c.kind == SCREW for c in jtype.components)
     if screw:  # the rotation and the advance it drags along
@@ -346,7 +423,7 @@ def _parts(j: Joint, jtype: joint_types.JointType, planar: bool, child: str
         if mo.what == joint_types.BALL:
             a = np.zeros(3)
         elif mo.on == "child":
-            a = np.asarray(j.axis2, dtype=float)
+            a = np.asarray(axis2, dtype=float)
         elif planar and mo.what == joint_types.ROTATION:
             a = np.array([0.0, 0.0, 1.0])  # a planar joint turns about world z
         else:
@@ -357,6 +434,9 @@ def _parts(j: Joint, jtype: joint_types.JointType, planar: bool, child: str
     if j.child != child and any(mo.on == "child" for mo in motions):
         # a universal joint written against the tree (child -> parent): the axes swap roles
         out = [(out[0][0], "hinge", out[1][2]), (out[1][0], "hinge", out[0][2])]
+    elif j.child != child and len(out) == 2 and float(np.linalg.norm(
+            np.cross(out[0][2], out[1][2]))) > 1e-9:
+        out.reverse()  # two motions that do not commute (a slot): the inverse order
     return out
 
 
@@ -454,6 +534,7 @@ def _equalities(w: _Writer, loops: list[Joint]) -> list[str]:
         c = m.index[j.child]
         R_c = quat_to_matrix(m.initial.quaternion[c])
         x_c = m.initial.position[c]
+        k = w.geo.index[j.name]
         other = "" if j.parent == cv.GROUND else f" body2={quoteattr(j.parent)}"
         if j.particle_joint == "link":
             w.notes.append(f"joint {j.name!r} (a particle's link) closes a loop: MuJoCo has "
@@ -461,9 +542,9 @@ def _equalities(w: _Writer, loops: list[Joint]) -> list[str]:
             continue
         loop = joint_types.joint_type(m.dimension, j.type).mjcf_loop
         if loop == "connect":
-            points = [np.asarray(j.at, dtype=float)]
+            points = [w.geo.point[k]]
             if j.type == "revolute" and m.dimension == cv.SPATIAL:  # its axis: a 2nd point
-                points.append(points[0] + w.scale * np.asarray(j.W_E0)[:, 2])
+                points.append(points[0] + w.scale * w.geo.frame[k][:, 2])
             for k, P in enumerate(points):
                 nm = j.name if k == 0 else f"{j.name}:axis"
                 lines.append(f"    <connect name={quoteattr(nm)} body1={quoteattr(j.child)}"
@@ -474,12 +555,39 @@ def _equalities(w: _Writer, loops: list[Joint]) -> list[str]:
         else:
             w.notes.append(f"joint {j.name!r} ({j.type}) closes a loop: MuJoCo has no "
                            "equality constraint of that kind, so it is left out")
-    if not lines:
+    screws = _screw_equalities(w)
+    if not lines and not screws:
         return []
-    return ["  <!-- Joints that close loops. MuJoCo enforces equality constraints softly",
+    what = " and ".join(x for x, there in (("Joints that close loops", lines),
+                                           ("the couplings of screws", screws)) if there)
+    return [f"  <!-- {what[0].upper()}{what[1:]}. MuJoCo enforces equality constraints softly",
             "       (a stiff spring-damper, solref/solimp), not exactly as mbody does:",
             "       accelerations agree only up to that softness. -->",
-            "  <equality>", *lines, "  </equality>"]
+            "  <equality>", *lines, *screws, "  </equality>"]
+
+
+def _screw_equalities(w: _Writer) -> list[str]:
+    """Each helical joint's slide and hinge coupled by a joint equality, s = h θ with h =
+    pitch/2π (MuJoCo: joint1 − its ref = Σ polycoef[k] (joint2 − its ref)^k).
+
+    MuJoCo's softness is R/(A + R) of the constraint's acceleration, where A is the
+    coupling's true inverse inertia and R = (1 − d)/d times MuJoCo's estimate of it, the
+    sum of the two joints' own inverse weights, which leaves out the factor h on one of
+    them. Written as the hinge following the slide (θ = s/h) when |h| < 1, A holds that
+    estimate's larger term in full: the screw jack (models/screw_jack.yaml, 5 mm per turn)
+    gives 1.4e-5, where s = h θ would give 0.96."""
+    lines = []
+    for j, slide, turn in w.screws:
+        pitch = float(w.model.joint_table.pitch[w.geo.index[j.name]])
+        h = pitch / (2.0 * math.pi)
+        if 0.0 < abs(h) < 1.0:
+            pair, coef = (turn, slide), 1.0 / h
+        else:
+            pair, coef = (slide, turn), h
+        lines.append(f"    <joint name={quoteattr(j.name)} joint1={quoteattr(pair[0])} "
+                     f'joint2={quoteattr(pair[1])} polycoef="0 {_num(coef)} 0 0 0" '
+                     f'solimp="{LOOP_SOLIMP}"/>')
+    return lines
 
 
 def _custom(w: _Writer, tree: _Tree) -> list[str]:
@@ -487,28 +595,42 @@ def _custom(w: _Writer, tree: _Tree) -> list[str]:
     elements lose, one small entry each, so that the MJCF reader restores the model."""
     m = w.model
     d = 2 if m.dimension == cv.PLANAR else 3
+    form = _file_form(m)
     out = [numeric("dimension", [d])]
-    out += [text(f"body:{name}", {"inertia": 0})
-            for i, name in enumerate(m.body_names) if m.particle[i]]
-    for j in m.joints:
+    for i, name in enumerate(m.body_names):
+        body: dict = {"inertia": 0} if m.particle[i] else {}
+        if form:
+            body.update(_file_pose(m, i, d))
+        if body:
+            out.append(text(f"body:{name}", body))
+    for k, j in enumerate(m.joints):
         holder = w.native.get(j.name)
+        pitch = float(m.joint_table.pitch[k])
         if holder is None:  # no MJCF element is exactly this joint: the whole joint
             entry: dict = {"type": j.type, "parent": j.parent, "child": j.child,
-                           "at": _floats(j.at[:d])}
+                           "at": _file_at(m, k, d)}
             if j.axis is not None:  # it sets the joint frame, so the reactions' axes
                 entry["axis"] = _floats(np.asarray(j.axis)[:d])
             if j.axis2 is not None:
                 entry["axis2"] = _floats(j.axis2)
+            if j.type == "helical":
+                entry["pitch"] = pitch
             out.append(text(f"joint:{j.name}", entry))
         else:
             lost: dict = {}
             if holder != j.child:  # written against the tree: its direction
                 lost = {"parent": j.parent, "child": j.child}
-            if j.axis is not None and j.type in ("spherical", "revolute") and (
-                    j.type == "spherical" or d == 2):
+            if form:  # the file's point and axes, at the file's pose
+                lost["at"] = _file_at(m, k, d)
+            if j.axis is not None and (form or j.type == "spherical" or (
+                    j.type == "revolute" and d == 2)):
                 # the axis sets the joint frame, hence the reaction components: a ball
                 # has no axis, and a planar hinge turns about z whatever the file's axis
                 lost["axis"] = _floats(np.asarray(j.axis)[:d])
+            if form and j.axis2 is not None:
+                lost["axis2"] = _floats(j.axis2)
+            if j.type == "helical":  # 2π h would round it
+                lost["pitch"] = pitch
             if lost:
                 out.append(text(f"joint:{j.name}", lost))
     for ld in m.loads:
@@ -517,9 +639,58 @@ def _custom(w: _Writer, tree: _Tree) -> list[str]:
         if label not in m.known_expressions:
             out.append(numeric(f"reaction:{label}", [value]))
     out += [text(f"reaction:{label}", str(e)) for label, e in m.known_expressions.items()]
+    drivers = m.drivers
+    if drivers is not None:
+        out += [text(f"driver:{name}", _driver_entry(m, k)) for k, name in
+                enumerate(drivers.names)]
     return ["  <!-- What MJCF cannot say, for mbody's reader (MuJoCo ignores it): see",
             "       the mbody documentation, interop, 'The mbody entries'. -->",
             "  <custom>", *("    " + s for s in out), "  </custom>"]
+
+
+def _file_pose(m: Model, i: int, d: int) -> dict:
+    """Body `i`'s state as the file writes it (the pose `mbody.load` assembled from):
+    position, orientation (planar: angle), velocity, angular velocity (body axes)."""
+    st = m.file_state if m.file_state is not None else m.initial
+    q = st.quaternion[i]
+    out: dict = {"position": _floats(st.position[i, :d])}
+    if not m.particle[i]:
+        if d == 2:
+            out["angle"] = float(2.0 * math.atan2(q[3], q[0]))
+        else:
+            out["orientation"] = {"quaternion": _floats(q)}
+    out["velocity"] = _floats(st.velocity[i, :d])
+    if not m.particle[i]:
+        out["angular_velocity"] = float(st.omega[i, 2]) if d == 2 else _floats(st.omega[i])
+    return out
+
+
+def _file_at(m: Model, k: int, d: int) -> list:
+    """Joint `k`'s ``at`` as the file gives it: one world point at the file's pose, or
+    ``[[parent point], [child point]]`` in each body's axes (world for ground)."""
+    jt = m.joint_table
+    if not jt.body_points[k]:
+        return _floats(np.asarray(m.joints[k].at)[:d])
+    child = jt.B_r_child[k]
+    c = int(jt.child[k])
+    if m.particle[c]:  # attached at the particle itself; the file's point says pin or link
+        st = m.file_state if m.file_state is not None else m.initial
+        child = np.asarray(m.joints[k].at, dtype=float) - st.position[c]
+    return [_floats(jt.B_r_parent[k][:d]), _floats(child[:d])]
+
+
+def _driver_entry(m: Model, k: int) -> dict:
+    """Driver `k` as the file writes it, but its name: its joint and its law (or rate)."""
+    drivers = m.drivers
+    assert drivers is not None
+    entry: dict = {"joint": m.joints[int(drivers.joint[k])].name}
+    speed = drivers.speed[k] if drivers.speed else None
+    if speed is not None:
+        entry["speed"] = float(speed)
+    else:
+        key = "angle" if drivers.component[k] == "M" else "displacement"
+        entry[key] = drivers.laws[k][0].text
+    return entry
 
 
 def _load_entry(ld, d: int) -> dict:
@@ -570,15 +741,39 @@ def _header(w: _Writer, tree: _Tree, source: str | None) -> str:
     """The comment at the top: where the file came from and what it leaves out."""
     m = w.model
     src = source if source is not None else m.file
+    form = _file_form(m)
+    drivers = m.drivers if m.drivers is not None and len(m.drivers) else None
+    lost = ["the dimension", "loads", "known reactions", "fixed joints", "particles",
+            "joint directions"]
+    lost += ["screw pitches"] * bool(w.screws) + ["drivers"] * (drivers is not None)
+    lost += ["the file's pose and joint points"] * form
     out = [f"Written by mbody {__version__} (mbody convert) from {src}.",
            f"Model {m.name!r}: {'planar' if m.dimension == cv.PLANAR else 'spatial'}, "
            f"{count(m.n, 'body', 'bodies')}, {count(len(m.joints), 'joint')}. Each MuJoCo "
            "body frame is the mbody body frame (mass centre, body axes) at the initial "
-           "pose; the keyframe 'initial' is the file's state.",
-           "What MJCF cannot say (the dimension, loads, known reactions, fixed joints, "
-           "particles, joint directions) is in <custom> as mbody: entries, which MuJoCo "
-           "ignores and mbody's reader restores.",
+           "pose; the keyframe 'initial' is the "
+           + ("assembled state." if form else "file's state."),
+           f"What MJCF cannot say ({', '.join(lost)}) is in <custom> as mbody: entries, "
+           "which MuJoCo ignores and mbody's reader restores.",
            ]
+    if form:
+        out.append("Assembled pose: the file gives joint points per body or drivers, so "
+                   "mbody moves its bodies onto every joint and driver before it starts; "
+                   "the bodies and joints are written there, and the file's own pose, "
+                   "points and axes are in <custom> (mbody:body, mbody:joint), which mbody "
+                   "reads back to assemble the same way.")
+    if drivers is not None:
+        out.append("Drivers (" + ", ".join(
+            f"{n!r} on joint {m.joints[int(k)].name!r}" for n, k in zip(
+                drivers.names, drivers.joint, strict=True))
+            + "): MJCF has no motion prescribed in time, so MuJoCo moves the mechanism "
+            "freely from the keyframe (its accelerations are those without the drivers); "
+            "they are in <custom> for mbody (mbody:driver).")
+    if w.screws:
+        out.append("Helical joints (" + ", ".join(repr(j.name) for j, _, _ in w.screws)
+                   + "): a slide and a hinge on the screw's axis, coupled by a joint "
+                   "equality (advance = pitch/2pi x turn), which MuJoCo keeps softly (see "
+                   "<equality>).")
     if m.dimension == cv.PLANAR:
         out.append("Planar model written in 3-D: bodies in the world x-y plane, joints "
                    "turning about world z or sliding in the plane.")
@@ -637,12 +832,12 @@ def _wrap(line: str, width: int = 88) -> str:
 # -- numbers ----------------------------------------------------------------------------
 
 
-def _length_scale(model: Model) -> float:
+def _length_scale(model: Model, geometry: _Geometry) -> float:
     """A typical length of the model (m): the largest distance from a mass centre to a
     joint point, else 1."""
     x = model.initial.position
-    d = [float(np.linalg.norm(np.asarray(j.at) - x[model.index[b]]))
-         for j in model.joints for b in (j.parent, j.child) if b != cv.GROUND]
+    d = [float(np.linalg.norm(geometry.point[k] - x[model.index[b]]))
+         for k, j in enumerate(model.joints) for b in (j.parent, j.child) if b != cv.GROUND]
     big = max(d, default=0.0)
     return big if big > 0 else 1.0
 

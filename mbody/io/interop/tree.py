@@ -252,12 +252,17 @@ def forward(bodies: list[TreeBody], qpos: np.ndarray, qvel: np.ndarray,
 class Mapped:
     """What a body's joints become: an mbody joint type with its data, or a problem."""
 
-    type: str | None  # revolute, prismatic, universal, spherical, cylindrical, fixed; None: free
+    type: str | None  # revolute, prismatic, universal, spherical, cylindrical, helical,
+    # slot, fixed; None: free
     name: str
     at: np.ndarray | None = None
     axis: np.ndarray | None = None
     axis2: np.ndarray | None = None
     element: Element | None = None
+    pitch: float | None = None
+    reverse: bool = False
+    """The joint's parent is the body and its child the body's tree parent (a pin in a
+    slot whose slot turns with the body: a hinge, then a slide)."""
 
 
 EXPORT_SUFFIXES = ({"1", "2"}, {"slide", "turn"})
@@ -286,8 +291,18 @@ def joint_name(names: list[str]) -> str:
     return stem if len(stem) >= 2 else "+".join(names)
 
 
-def map_joints(b: TreeBody, kin: Kinematics, i: int, scale: float) -> Mapped:
-    """The one mbody joint that is exactly a body's MJCF joints, or a `ModelError`."""
+Screw = tuple[str, str]
+"""A slide and a hinge by name (MJCF joints) that a joint equality couples linearly."""
+
+
+def map_joints(b: TreeBody, kin: Kinematics, i: int, scale: float, *, planar: bool = False,
+               screws: dict[Screw, float] | None = None) -> Mapped:
+    """The one mbody joint that is exactly a body's MJCF joints, or a `ModelError`.
+
+    `planar`: the file is an mbody planar export (``mbody:dimension`` 2), where a slide
+    in the plane and a hinge about z are a pin in a slot. `screws`: (slide, hinge) ->
+    the advance h (m/rad) an exactly linear joint equality ties them by, s − s_ref =
+    h (θ − θ_ref): with the two on one axis, a helical joint of pitch 2π h."""
     js = b.joints
     anchors, axes = kin.anchor[i], kin.axis[i]
     if not js:
@@ -314,15 +329,29 @@ def map_joints(b: TreeBody, kin: Kinematics, i: int, scale: float) -> Mapped:
         return Mapped("universal", name, anchors[0], axes[0], axes[1], first)
     if kinds == ["hinge"] * 3 and same_point and abs(float(np.linalg.det(np.array(axes)))) > 1e-6:
         return Mapped("spherical", name, anchors[0], None, None, first)
-    if sorted(kinds) == ["hinge", "slide"] and float(np.linalg.norm(
-            np.cross(axes[0], axes[1]))) <= 1e-9:
-        h = kinds.index("hinge")
-        return Mapped("cylindrical", name, anchors[h], axes[h], None, first)
+    if sorted(kinds) == ["hinge", "slide"]:
+        h, sl = kinds.index("hinge"), kinds.index("slide")
+        if float(np.linalg.norm(np.cross(axes[0], axes[1]))) <= 1e-9:
+            lead = (screws or {}).get((names[sl], names[h]))
+            if lead is None:
+                return Mapped("cylindrical", name, anchors[h], axes[h], None, first)
+            # s along the slide's axis; the screw advances along the hinge's
+            sign = 1.0 if float(axes[sl] @ axes[h]) > 0 else -1.0
+            return Mapped("helical", name, anchors[h], axes[h], None, first,
+                          pitch=2.0 * np.pi * lead * sign)
+        if planar and abs(abs(float(axes[h][2])) - 1.0) <= 1e-9 and abs(
+                float(axes[sl][2])) <= 1e-9:  # a hinge about z, a slide in the plane
+            # the pin (the hinge's anchor) slides along a line fixed in the frame the
+            # slide moves in: the parent's when the slide comes first; else the hinge
+            # turns the line with the body, whose own line holds its parent's pin
+            return Mapped("slot", name, anchors[h], axes[sl], None, first, reverse=h < sl)
     why = _why_not(kinds, same_point, axes)
     hint = ("mbody has no massless intermediate frames; what composes exactly: two hinges "
             "through one point with perpendicular axes (universal), three hinges through "
-            "one point (spherical), a hinge and a slide along one axis (cylindrical). Give "
-            "the intermediate frame a body with a mass, or change the joints")
+            "one point (spherical), a hinge and a slide along one axis (cylindrical; "
+            "helical when a joint equality ties them linearly), a slide in the plane and a "
+            "hinge about z in a planar model (slot). Give the intermediate frame a body "
+            "with a mass, or change the joints")
     if kinds.count("slide") == 2 and kinds.count("hinge") <= 1:
         # dm_control's planar walkers and objects: a mass would change their motion
         hint = ("two slides (and a hinge) make the body move in a plane; a spatial mbody "
@@ -374,11 +403,13 @@ def _floats(v: np.ndarray) -> list[float]:
 def build(name: str, description: str, file: str, bodies: list[TreeBody],
           qpos: np.ndarray, qvel: np.ndarray, q0: np.ndarray, gravity: np.ndarray,
           loops: list[Loop], root: Element, fmt: str,
-          free_bodies: frozenset[int] = frozenset()) -> ImportedDocument:
+          free_bodies: frozenset[int] = frozenset(), *, planar: bool = False,
+          screws: dict[Screw, float] | None = None) -> ImportedDocument:
     """The model-file values of the tree at joint state (qpos, qvel).
 
     `free_bodies` (tree indices) move freely: their joints are known to be exactly a free
     motion (the slides and hinge the MJCF export writes for a free planar body or particle).
+    `planar` and `screws`: as `map_joints` composes a body's joints.
 
     Bodies without mass that sit welded to their parent (frames: URDF's ``tool0``, a
     bare MJCF body) are left out, their children joined to the nearest body kept; a body
@@ -467,20 +498,32 @@ def build(name: str, description: str, file: str, bodies: list[TreeBody],
         doc.mark((*p, "name"), b.element, "name")
         for key in ("mass", "inertia"):
             doc.mark((*p, key), b.mass_element or b.element, key if key == "mass" else None)
-        m = (map_joints(b, kin, i, scale) if i not in free and i not in free_bodies
-             else Mapped(None, ""))
+        m = (map_joints(b, kin, i, scale, planar=planar, screws=screws)
+             if i not in free and i not in free_bodies else Mapped(None, ""))
         if i in points:
             m = Mapped("spherical", m.name, c, None, None, m.element)
         if m.type is None:
             continue
         parent = _parent_name(bodies, b.parent, owner, kept)
-        jd: dict[str, Any] = {"name": m.name, "type": m.type, "parent": parent,
-                              "child": b.name, "at": _floats(m.at if m.at is not None
-                                                             else kin.pos[i])}
+        ends = (parent, b.name)
+        if m.reverse:
+            if parent == GROUND:
+                raise ModelError([(m.element or b.element).issue(
+                    f"body '{b.name}' turns about a point fixed in the world and slides "
+                    f"along its own axis ({m.name}): a pin in a slot whose pin is the "
+                    "world's", "mbody's slot joint has the slot in its parent and the pin "
+                    "on its child, which cannot be ground: give the pin a body of its own, "
+                    "fixed to the world, or slide first, then turn (the slot in the world)")])
+            ends = (b.name, parent)
+        jd: dict[str, Any] = {"name": m.name, "type": m.type, "parent": ends[0],
+                              "child": ends[1], "at": _floats(m.at if m.at is not None
+                                                              else kin.pos[i])}
         if m.axis is not None:
             jd["axis"] = _floats(m.axis)
         if m.axis2 is not None:
             jd["axis2"] = _floats(m.axis2)
+        if m.pitch is not None:
+            jd["pitch"] = float(m.pitch)
         jp: Path_ = ("joints", len(out_joints))
         out_joints.append(jd)
         doc.mark(jp, m.element)

@@ -1,10 +1,10 @@
 """A model document (the plain data a model file parses to) written as mbody YAML.
 
 The layout is that of the shipped models: top-level keys in the contract's order, each
-body a block mapping whose values are one-line flow collections, each load and joint one
-flow mapping per line when it fits, known reactions one per line. Numbers are written
-so that they read back as the same double (``repr``, with a decimal point before an
-exponent so that YAML 1.1 readers such as PyYAML see a number too); text is quoted
+body a block mapping whose values are one-line flow collections, each load, joint and
+driver one flow mapping per line when it fits, known reactions one per line. Numbers are
+written so that they read back as the same double (``repr``, with a decimal point before
+an exponent so that YAML 1.1 readers such as PyYAML see a number too); text is quoted
 whenever a plain scalar could read as something else.
 """
 
@@ -23,12 +23,15 @@ from mbody.model.loader import resolve_plain
 from mbody.util.atomic import write_atomic
 
 TOP_ORDER = ("model", "description", "dimension", "gravity", "bodies", "loads", "joints",
-             "reactions")
+             "drivers", "reactions")
 BODY_ORDER = ("name", "mass", "inertia", "shape", "position", "angle", "orientation",
               "velocity", "angular_velocity", "color")
 LOAD_ORDER = ("name", "type", "body", "bodies", "force", "torque", "at", "frame",
               "stiffness", "rest_length", "damping")
-JOINT_ORDER = ("name", "type", "parent", "child", "at", "axis", "axis2")
+JOINT_ORDER = ("name", "type", "parent", "child", "at", "axis", "axis2", "pitch")
+DRIVER_ORDER = ("name", "joint", "angle", "displacement", "speed")
+FLOW_ORDER = {"loads": LOAD_ORDER, "joints": JOINT_ORDER, "drivers": DRIVER_ORDER}
+"""The sections written one flow mapping per item, and the order of their keys."""
 
 WIDTH = 92
 """Longest line of a load or joint, which continues on the next line beyond it."""
@@ -68,11 +71,10 @@ def dump_document(document: Mapping[str, Any], *, source: str | None,
             lines.append("bodies:")
             for body in value:
                 lines += _block_item(body, BODY_ORDER)
-        elif key in ("loads", "joints") and value and _is_list_of_maps(value):
+        elif key in FLOW_ORDER and value and _is_list_of_maps(value):
             lines.append(f"{key}:")
-            order = LOAD_ORDER if key == "loads" else JOINT_ORDER
             for item in value:
-                lines += _wrapped_flow(item, order)
+                lines += _wrapped_flow(item, FLOW_ORDER[key])
         elif key == "reactions" and isinstance(value, Mapping) and value:
             lines.append("reactions:")
             lines += [f"  {_scalar(k)}: {_flow(v)}" for k, v in value.items()]
