@@ -8,13 +8,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from mbody.equations.spatial import quaternion_rate
 from mbody.equations.workspace import Unknowns, workspace
 from mbody.kernel import _core
 from mbody.kernel.dop853 import DOP853
 from mbody.model.model import Model
 from mbody.simulate.projection import ITERATIONS, STAGE_ITERATIONS, STAGE_PIVOT_RTOL
 from mbody.simulate.stepping import REFRESH_ATOL
-from mbody.equations.spatial import quaternion_rate
 
 
 class Callbacks:
