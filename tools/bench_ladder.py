@@ -1,12 +1,12 @@
-"""Benchmark: ladders of closed loops at 50 to 500 unknowns, per evaluation, both paths.
+"""Benchmark: ladders of closed loops at 50 to 500 unknowns, per evaluation, on the core.
 
     python tools/bench_ladder.py [--quick] [--repeat R] [--sizes 50,100,250,500]
 
 A ladder of N parallelogram loops: N + 1 rungs (length L) hang from ground pins at
 x = 0, d, 2d, ..., and N couplers (length d) join the tips of neighbouring rungs. Each
 loop shares a rung with the next; with the bodies listed rung, coupler, rung, ... the
-Schur complement S = G_Uᵀ M⁻¹ G_U stays banded (half bandwidth 5 planar, 10 spatial).
-Three kinds, every reaction component unknown:
+Schur complement S = G_Uᵀ M⁻¹ G_U stays banded (its half bandwidth in the core's order is
+printed). Three kinds, every reaction component unknown:
 
 - planar: revolute pins everywhere; 2N + 1 bodies, 3N + 1 pins, 6N + 2 unknowns, 1 DOF;
 - spatial: the same ladder in space, rungs on revolutes about z, couplers on spherical
@@ -15,37 +15,39 @@ Three kinds, every reaction component unknown:
 - spatial-redundant: every joint a revolute about z, as a user would first write it:
   15N + 5 unknowns, 3 of them redundant per loop (S is singular; minimum-norm reactions).
 
+There is one numeric path: every evaluation goes through the compiled core
+(`mbody.kernel`, contract in `mbody/kernel/src/kernel.h`); the numba and numpy paths this
+benchmark once compared are gone, and with them the comparison.
+
 Per kind and size (microseconds per call, best of --repeat, `tools/timing.py`):
-``mbody.assemble(model, state).solve()`` and one call of ``mbody.simulate``'s right-hand
-side (``mbody.simulate.state_derivative``), on the compiled path (``set_jit('on')``) and
-on the numpy path (``set_jit('off')``), with the solver path each took (the solution's
-``method``; for the right-hand side, the numpy path's factorisation or the compiled
-call) and S's half bandwidth. The state: every rung at 30° from the vertical turning at
-1 rad/s (the couplers translate), so the velocity-product terms γ are not zero.
+``mbody.assemble(model, state).solve()`` (the public call), the core's solve alone
+(`Unknowns.solve` of the model's workspace, `mbody.equations.workspace`, on the packed
+state) and one call of ``mbody.simulate``'s right-hand side
+(``mbody.simulate.state_derivative``), with the route the core took (the solution's
+``method``) and S's half bandwidth. The state: every rung at 30° from the vertical
+turning at 1 rad/s (the couplers translate), so the velocity-product terms γ are not zero.
 
 Checked before anything is timed:
-- the two paths agree (accelerations and reactions, 1e-10 relative; on the redundant
-  kind to 10 cond(S) ε, what rounding leaves of a pseudo-inverse) and Gᵀ v̇ = γ (1e-9
-  relative to max(|γ|, ‖Gᵀ‖ |v̇|), infinity norms);
+- Gᵀ v̇ = γ (1e-9 relative to max(|γ|, ‖Gᵀ‖ |v̇|), infinity norms) and the Newton-Euler
+  equations M v̇ + b = Q + G λ with the reactions returned (the same, relative to the
+  largest of |Q − b|, ‖G‖ |λ|, ‖M‖ |v̇|);
 - the accelerations equal the closed form: a parallelogram ladder moves like one
   compound pendulum, every rung at the same angle θ with
-  θ̈ = −(g Σ(m_r L/2 + m_c L) / Σ(I_r,pivot + m_c L²)) sin θ, and the couplers translate;
+  θ̈ = −(g Σ(m_r L/2 + m_c L) / Σ(I_r,pivot + m_c L²)) sin θ, and the couplers translate
+  (1e-10 relative; on the redundant kind 10 cond(S) ε when larger, what rounding leaves
+  of a pseudo-inverse, cond(S) of S's nonzero part from the core's dense S);
+- simulate's right-hand side gives the solve's accelerations (to the same tolerance);
+- the core's route: the banded Cholesky of S where the joints are independent, and on
+  the redundant kind exactly 3 redundant components per loop;
 - released from rest, a simulated ladder (the smallest size) follows that pendulum's
   exact motion (θ(t) = 2 asin(k cd(ω t | k²)), k = sin(θ₀/2)) over 2 s, to 1e-7 rad;
-- no dense factorisation on the numpy path: numpy's and scipy's dense LAPACK entry
-  points are counted during one solve and one right-hand side (the compiled path's is
-  named by its `method`);
-- BLAS threads: what threadpoolctl sees, the CPU time the process's other threads (BLAS
-  workers) used while timing (from /proc; 0 when none ran), and each time again under
-  ``threadpool_limits(1)``.
+- other threads: the CPU time the process's other threads (BLAS workers) used while
+  timing (from /proc; 0 when none ran): the core calls no BLAS.
 """
 
 from __future__ import annotations
 
 import argparse
-import contextlib
-import importlib
-import importlib.util
 import math
 import sys
 import time
@@ -63,7 +65,9 @@ if str(ROOT / "tools") not in sys.path:  # tools/timing.py, also when loaded by 
 from timing import best  # noqa: E402
 
 import mbody  # noqa: E402
-from mbody.equations import plan as mplan  # noqa: E402
+from mbody.equations.workspace import workspace  # noqa: E402
+from mbody.kernel import _core  # noqa: E402
+from mbody.simulate import state_derivative  # noqa: E402
 
 L, D, W, G0 = 0.5, 0.3, 0.02, 9.81
 """Rung length, coupler length (pin spacing), bar thickness (m), gravity (m/s²)."""
@@ -207,82 +211,100 @@ def rel(a, b) -> float:
     return float(np.max(np.abs(a - b)) / max(float(np.max(np.abs(b))), 1e-300))
 
 
-def reactions(sol, model) -> np.ndarray:
-    arr = getattr(sol.reactions, "array", None)
-    return np.asarray(arr if arr is not None else [sol.reactions[r] for r in model.reactions])
+def inf_norm(A) -> float:
+    """‖A‖∞ of a sparse matrix: its largest absolute row sum."""
+    return float(np.max(np.asarray(abs(A).sum(axis=1)))) if A.shape[0] else 0.0
 
 
-def solve_with(model, state, mode: str):
-    previous = mplan.set_jit(mode)
-    try:
-        return mbody.assemble(model, state).solve()
-    finally:
-        mplan.set_jit(previous)
+def redundant_expected(kind: str, n_loops: int) -> int:
+    """Redundant reaction components of a ladder: 3 per loop when every joint is a
+    revolute about z (a planar loop in space: 6 equations, 3 of them repeated), else 0."""
+    return 3 * n_loops if kind == "spatial-redundant" else 0
 
 
-def condition(model, state) -> float:
-    """cond(S) (for a singular S, that of its nonzero part)."""
-    from mbody.solve.kkt import RANK_RTOL, ConstrainedSystem
-
-    previous = mplan.set_jit("off")
-    try:
-        asm = mbody.assemble(model, state)
-        sol = asm.solve(condition=True)
-        if not sol.redundant:
-            return float(sol.condition)
-        S = ConstrainedSystem(model, asm.columns, model.plan.file_unknowns).fact._S
-        S = S.toarray() if hasattr(S, "toarray") else np.asarray(S)
-        w = np.linalg.eigvalsh(0.5 * (S + S.T))
-        kept = w[w > RANK_RTOL * w[-1]]
-        return float(kept[-1] / kept[0])
-    finally:
-        mplan.set_jit(previous)
+def condition(model, state, sol) -> float:
+    """cond(S) of the unknowns' Schur complement S = G_Uᵀ M⁻¹ G_U; for a singular S (the
+    core found rank r < mu) that of its nonzero part, the r largest eigenvalues of the S
+    the core forms (`Unknowns.schur`)."""
+    if not sol.redundant:
+        return float(mbody.assemble(model, state).solve(condition=True).condition)
+    ws = workspace(model)
+    unknowns = ws.unknowns_at(state.t)
+    mu = len(unknowns.U)
+    S = np.empty((mu, mu))
+    ws.solver(unknowns).schur(float(state.t), ws.pack_state(state), S)
+    w = np.linalg.eigvalsh(0.5 * (S + S.T))
+    kept = w[len(w) - (mu - sol.redundant):]
+    return float(kept[-1] / kept[0])
 
 
-def constraint_residual(model, state, acc: np.ndarray) -> float:
+def constraint_residual(asm, acc: np.ndarray) -> float:
     """|Gᵀ v̇ − γ|∞ / max(|γ|∞, ‖Gᵀ‖∞ |v̇|∞): how far accelerations `acc` (in the
     solution's coordinates) are from holding the joints at acceleration level."""
-    asm = mbody.assemble(model, state)
     GT, gamma = asm.G.T.tocsr(), asm.jacobian().gamma
-    norm_GT = float(np.max(np.asarray(abs(GT).sum(axis=1))))
-    scale = max(float(np.max(np.abs(gamma))), norm_GT * float(np.max(np.abs(acc))), 1e-300)
+    scale = max(float(np.max(np.abs(gamma))), inf_norm(GT) * float(np.max(np.abs(acc))),
+                1e-300)
     return float(np.max(np.abs(GT @ acc - gamma))) / scale
+
+
+def dynamics_residual(asm, acc: np.ndarray, lam: np.ndarray) -> float:
+    """|M v̇ + b − Q − G λ|∞ relative to the largest of |Q − b|∞, ‖G‖∞ |λ|∞, ‖M‖∞ |v̇|∞:
+    how far the accelerations and the reactions `lam` (every component, in the columns'
+    order) are from the Newton-Euler equations."""
+    G = asm.G.tocsr()
+    r = asm.Q - asm.b
+    scale = max(float(np.max(np.abs(r))), inf_norm(G) * float(np.max(np.abs(lam))),
+                inf_norm(asm.M.tocsr()) * float(np.max(np.abs(acc))), 1e-300)
+    return float(np.max(np.abs(asm.M @ acc - r - G @ lam))) / scale
+
+
+def rhs_accelerations(model, f, y: np.ndarray) -> np.ndarray:
+    """The accelerations in one right-hand side f(0, y), in the solution's coordinates
+    (planar per body [a_x, a_y, α]; spatial [a_G (world), ω̇ (body axes)])."""
+    n = model.n
+    d = f(0.0, y)[7 * n:13 * n].reshape(2, n, 3)  # v̇ (world), ω̇ (body axes) per body
+    return (np.stack((d[0, :, 0], d[0, :, 1], d[1, :, 2]), axis=1) if model.dimension == 2
+            else np.concatenate((d[0], d[1]), axis=1)).ravel()
 
 
 @dataclass
 class Check:
-    acc: float  # compiled vs numpy, accelerations
-    lam: float  # compiled vs numpy, reactions
-    constraint: float  # `constraint_residual`, worse path
-    closed: float  # accelerations vs the closed form, worse path
-    rhs: float  # simulate's right-hand side (the core) vs the numpy solve's accelerations
+    constraint: float  # `constraint_residual`
+    dynamics: float  # `dynamics_residual`
+    closed: float  # accelerations vs the closed form
+    rhs: float  # simulate's right-hand side vs the solve's accelerations
     tol: float  # 1e-10; with redundant constraints 10 cond(S) ε when larger
+    method: str  # the core's route
+    redundant: int  # redundant components the core found
+    expected: int  # `redundant_expected`
+
+    @property
+    def route_ok(self) -> bool:
+        """Independent joints: the banded Cholesky; the redundant count as expected."""
+        banded = self.method.startswith("banded Cholesky")
+        return self.redundant == self.expected and (banded or self.expected > 0)
 
     @property
     def ok(self) -> bool:
-        return (max(self.acc, self.lam, self.closed, self.rhs) <= self.tol
-                and self.constraint <= max(1e-9, self.tol))
+        return (max(self.closed, self.rhs) <= self.tol and self.route_ok
+                and max(self.constraint, self.dynamics) <= max(1e-9, self.tol))
 
 
 def check(model, n_loops: int, kind: str) -> Check:
     state = model.initial
-    a, b = solve_with(model, state, "off"), solve_with(model, state, "on")
-    gta = max(constraint_residual(model, state, s.accelerations) for s in (a, b))
-    exact = closed_form_accelerations(n_loops, kind)
+    asm = mbody.assemble(model, state)
+    sol = asm.solve()
+    acc, lam = sol.accelerations, sol.reactions.array
     # Redundant constraints: the pseudo-inverse of S leaves rounding of cond(S) ε.
-    tol = 1e-10 if not a.redundant else max(1e-10, 10 * condition(model, state) * 2.2e-16)
-    y = initial_y(model)
-    f = rhs(model, "on")  # simulate's right-hand side: the compiled core, whatever the mode
+    tol = (1e-10 if not sol.redundant
+           else max(1e-10, 10 * condition(model, state, sol) * np.finfo(float).eps))
+    f = state_derivative(model)  # simulate's right-hand side
     assert f.compiled
-    n = model.n
-    d = f(0.0, y)[7 * n:13 * n].reshape(2, n, 3)  # v̇ (world), ω̇ (body axes) per body
-    acc = (np.stack((d[0, :, 0], d[0, :, 1], d[1, :, 2]), axis=1) if model.dimension == 2
-           else np.concatenate((d[0], d[1]), axis=1)).ravel()
     # the state keeps its joints: Baumgarte's terms vanish, the accelerations are the solve's
-    return Check(rel(b.accelerations, a.accelerations),
-                 rel(reactions(b, model), reactions(a, model)), gta,
-                 max(rel(s.accelerations, exact) for s in (a, b)),
-                 rel(acc, a.accelerations), tol)
+    return Check(constraint_residual(asm, acc), dynamics_residual(asm, acc, lam),
+                 rel(acc, closed_form_accelerations(n_loops, kind)),
+                 rel(rhs_accelerations(model, f, initial_y(model)), acc), tol, sol.method,
+                 sol.redundant, redundant_expected(kind, n_loops))
 
 
 def motion_error(kind: str, n_loops: int, t_end: float = 2.0) -> tuple[float, str]:
@@ -298,65 +320,15 @@ def motion_error(kind: str, n_loops: int, t_end: float = 2.0) -> tuple[float, st
     return float(np.max(np.abs(theta - exact))), traj.info["evaluation_path"]
 
 
-DENSE = {
-    "numpy.linalg": ("cholesky", "eigh", "eigvalsh", "eig", "svd", "inv", "solve", "lstsq",
-                     "pinv", "qr"),
-    "scipy.linalg": ("cholesky", "cho_factor", "lu_factor", "lu", "solve", "eigh",
-                     "eigvalsh", "svd", "inv", "lstsq", "pinvh", "qr", "ldl"),
-}
-
-
-@contextlib.contextmanager
-def dense_spy(min_size: int = 7):
-    """Count calls of numpy's and scipy's dense LAPACK entry points on matrices of at
-    least `min_size` rows (the per-body 3 x 3 and 6 x 6 products are not factorisations
-    of S). Yields the list of (function, shape) calls."""
-    calls: list[tuple[str, tuple[int, ...]]] = []
-    saved = []
-    for modname, names in DENSE.items():
-        mod = importlib.import_module(modname)
-        for name in names:
-            fn = getattr(mod, name, None)
-            if fn is None:
-                continue
-
-            def spy(*args, _fn=fn, _name=f"{modname}.{name}", **kw):
-                a = np.asarray(args[0]) if args else None
-                if a is not None and a.ndim == 2 and min(a.shape) >= min_size:
-                    calls.append((_name, a.shape))
-                return _fn(*args, **kw)
-
-            saved.append((mod, name, fn))
-            setattr(mod, name, spy)
-    try:
-        yield calls
-    finally:
-        for mod, name, fn in saved:
-            setattr(mod, name, fn)
-
-
 # -- timing ------------------------------------------------------------------------------------
 def initial_y(model) -> np.ndarray:
     """The state vector exactly as `simulate` builds it ([x | q | v | ω | θ (planar)])."""
-    s0 = model.initial
-    theta0 = (2.0 * np.arctan2(s0.quaternion[:, 3], s0.quaternion[:, 0])
-              if model.dimension == 2 else ())
-    return np.concatenate((s0.position.ravel(), s0.quaternion.ravel(), s0.velocity.ravel(),
-                           s0.omega.ravel(), theta0))
-
-
-def rhs(model, mode: str):
-    """simulate's right-hand side, on the path `mode` selects ('on' or 'off')."""
-    previous = mplan.set_jit(mode)
-    try:
-        return importlib.import_module("mbody.simulate").state_derivative(model)
-    finally:
-        mplan.set_jit(previous)
+    return workspace(model).state_vector(model.initial)
 
 
 def worker_cpu() -> float:
-    """CPU seconds used so far by the process's threads other than this one (BLAS and
-    numba workers), from /proc (Linux; nan elsewhere). Clock ticks: 10 ms resolution."""
+    """CPU seconds used so far by the process's threads other than this one (BLAS
+    workers), from /proc (Linux; nan elsewhere). Clock ticks: 10 ms resolution."""
     import os
     import threading
 
@@ -400,84 +372,51 @@ def timed(funcs: dict, repeat: int) -> tuple[dict[str, float], dict[str, float]]
     return out, {key: cpu[key] / wall[key] for key in funcs}
 
 
+COLUMNS = ("solve", "core", "rhs")
+"""assemble(model, state).solve(); the core's Unknowns.solve alone; simulate's f(t, y)."""
+
+
 @dataclass
 class Row:
     kind: str
     loops: int
     bodies: int
     mu: int
-    times: dict[str, float]  # solve-jit, solve-np, rhs-jit, rhs-np: s per call
+    times: dict[str, float]  # `COLUMNS`: s per call
     workers: dict[str, float]  # the same: other threads' CPU time / wall time
-    one_thread: dict[str, float]  # the times again under threadpool_limits(1)
-    method_jit: str
-    method_np: str
-    rhs_np: str
-    bw_jit: int
-    bw_np: int | None
-    dense: list
-    full_jit: str = ""  # the methods in full
-    full_np: str = ""
-    full_rhs: str = ""
-
-
-COLUMNS = ("solve-jit", "solve-np", "rhs-jit", "rhs-np")
+    method: str  # the core's route, in full
+    bw: int  # S's half bandwidth in the core's order
 
 
 def short(method: str) -> str:
     """The solution's `method`, shortened for the table; dense ones in capitals."""
     m = method.lower()
     if "banded" in m:
-        return ("banded Cholesky" + (", blocks" if "blocks" in m else "")
-                + (", sparse" if m == "banded cholesky of the schur complement" else ""))
-    for key, text in (("svd", "DENSE SVD"), ("eigen", "DENSE eigh"),
-                      ("pseudo-inverse", "DENSE eigh"), ("dense", "DENSE Cholesky")):
+        return "banded Cholesky"
+    for key, text in (("pivoted", "DENSE pivoted Cholesky"), ("svd", "DENSE SVD")):
         if key in m:
             return text
     return method
 
 
-def measure(kind: str, target: int, repeat: int, threads: bool) -> Row:
-    """Time one ladder (the kind's size nearest `target` unknowns) on both paths."""
+def measure(kind: str, target: int, repeat: int) -> Row:
+    """Time one ladder (the kind's size nearest `target` unknowns)."""
     n_loops = loops_for(kind, target)
     model = mbody.load(ladder_spec(n_loops, kind))
     state = model.initial
-    unknowns = model.plan.file_unknowns
-    y = initial_y(model)
-    funcs = {}
-    for mode, tag in (("on", "jit"), ("off", "np")):
-        def solve(mode=mode):
-            # the path is chosen per call from mbody.equations.plan.JIT (set_jit's global), set
-            # here directly: set_jit's parsing would be timed too
-            mplan.JIT = mode
-            return mbody.assemble(model, state).solve()
-
-        f = rhs(model, mode)  # the path is fixed when the right-hand side is made
-        funcs[f"solve-{tag}"] = solve
-        funcs[f"rhs-{tag}"] = lambda f=f: f(0.0, y)
-    previous = mplan.JIT
-    one: dict[str, float] = {}
-    try:
-        times, workers = timed(funcs, repeat)
-        if threads:
-            from threadpoolctl import threadpool_limits
-
-            with threadpool_limits(1):
-                one = timed(funcs, repeat)[0]
-        method_jit = funcs["solve-jit"]().method
-        with dense_spy() as calls:
-            method_np = funcs["solve-np"]().method
-            funcs["rhs-np"]()
-        mplan.JIT = "off"  # the numpy right-hand side's factorisation, as it makes it
-        system = mbody.assemble(model, state).constrained(unknowns, rate=20.0,
-                                                          refine=False)[2]
-    finally:
-        mplan.JIT = previous
-    bp = model.plan.block_plan(unknowns)
-    bw_jit = int(model.plan.packed_unknowns(unknowns)[1])
-    return Row(kind, n_loops, model.n, len(unknowns.U), times, workers, one, short(method_jit),
-               short(method_np), short(system.fact.method), bw_jit,
-               bp.bw if bp is not None else None, calls, method_jit, method_np,
-               system.fact.method)
+    ws = workspace(model)
+    unknowns = ws.file_unknowns
+    plan = ws.solve_plan(unknowns)
+    y, y13 = initial_y(model), ws.pack_state(state)
+    out = np.empty(plan.o_info + _core.INFO)
+    f = state_derivative(model)
+    funcs = {"solve": lambda: mbody.assemble(model, state).solve(),
+             "core": lambda: plan.solver.solve(0.0, y13, unknowns.lam, out),
+             "rhs": lambda: f(0.0, y)}
+    times, workers = timed(funcs, repeat)
+    method = mbody.assemble(model, state).solve().method
+    return Row(kind, n_loops, model.n, len(unknowns.U), times, workers, method,
+               int(plan.solver.bw))
 
 
 def blas_summary() -> str:
@@ -490,48 +429,23 @@ def blas_summary() -> str:
     return "BLAS: " + "; ".join(libs) if libs else "BLAS: none loaded"
 
 
-def print_rows(rows: list[Row], repeat: int, threads: bool) -> None:
+def print_rows(rows: list[Row], repeat: int) -> None:
     print(f"\nµs per call, best of {repeat}; solve = assemble(model, state).solve(); "
-          "RHS = simulate's f(t, y)")
-    head = (f"{'kind':<17} {'N':>3} {'n':>4} {'mu':>4} | {'solve':>8} {'numpy':>8} | "
-            f"{'RHS':>8} {'numpy':>8} | {'bw':>3} {'np':>3} | threads | "
-            "path: compiled / numpy solve / numpy RHS")
+          "core = the core's Unknowns.solve alone; RHS = simulate's f(t, y)")
+    head = (f"{'kind':<17} {'N':>3} {'n':>4} {'mu':>4} | {'solve':>8} {'core':>8} "
+            f"{'RHS':>8} | {'bw':>3} | threads | route")
     print(head)
     print("-" * len(head))
     for r in rows:
         t = r.times
         print(f"{r.kind:<17} {r.loops:>3} {r.bodies:>4} {r.mu:>4} | "
-              + " | ".join(f"{t[a] * 1e6:8.1f} {t[b] * 1e6:8.1f}"
-                           for a, b in (COLUMNS[:2], COLUMNS[2:]))
-              + f" | {r.bw_jit:>3} {r.bw_np if r.bw_np is not None else '-':>3} | "
-              f"{max(r.workers.values()):7.2f} | {r.method_jit} / {r.method_np} / {r.rhs_np}")
-    print("N loops, n bodies, mu unknown reaction components; bw, np: S's half bandwidth "
-          "(compiled order; numpy per-body blocks' order)")
-    print("threads: the largest over the four columns of the CPU time of threads other "
-          "than the caller's (BLAS workers) / wall time while timing; 0.00: none ran")
-    if threads and rows and rows[0].one_thread:
-        print("\nthe same under threadpool_limits(1), µs per call (× = default threads / "
-              "one thread)")
-        head = (f"{'kind':<17} {'mu':>4} | " + " | ".join(
-            f"{c:>9} {'×':>5}" for c in ("solve", "numpy", "RHS", "numpy")))
-        print(head)
-        print("-" * len(head))
-        for r in rows:
-            print(f"{r.kind:<17} {r.mu:>4} | " + " | ".join(
-                f"{r.one_thread[c] * 1e6:9.1f} {r.times[c] / r.one_thread[c]:5.2f}"
-                for c in COLUMNS))
-    for side, methods in (("compiled", {r.full_jit for r in rows}),
-                          ("numpy", {m for r in rows for m in (r.full_np, r.full_rhs)})):
-        print(f"{side} paths: " + "; ".join(f"{short(m)} = {m}" for m in sorted(methods)))
-    dense = [r for r in rows if r.dense]
-    print("\ndense factorisations on the numpy path (calls in one solve + one RHS): "
-          + ("" if dense else "none"))
-    for r in dense:
-        counts: dict[str, int] = {}
-        for name, shape in r.dense:
-            key = f"{name} {shape[0]}x{shape[1]}"
-            counts[key] = counts.get(key, 0) + 1
-        print(f"  {r.kind} mu={r.mu}: " + ", ".join(f"{k} ×{c}" for k, c in counts.items()))
+              + " ".join(f"{t[c] * 1e6:8.1f}" for c in COLUMNS)
+              + f" | {r.bw:>3} | {max(r.workers.values()):7.2f} | {short(r.method)}")
+    print("N loops, n bodies, mu unknown reaction components; bw: S's half bandwidth in "
+          "the core's order")
+    print("threads: the largest over the columns of the CPU time of threads other than "
+          "the caller's (BLAS workers) / wall time while timing; 0.00: none ran")
+    print("routes: " + "; ".join(f"{short(m)} = {m}" for m in sorted({r.method for r in rows})))
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -540,8 +454,6 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--repeat", type=int, help="timed runs per entry, best kept (default 9)")
     p.add_argument("--sizes", help="unknown counts, comma-separated (default 50,100,250,500)")
     p.add_argument("--kinds", default=",".join(KINDS), help=f"of {', '.join(KINDS)}")
-    p.add_argument("--no-threads", action="store_true",
-                   help="skip the second timing under threadpool_limits(1)")
     a = p.parse_args(argv)
     repeat = max(1, a.repeat or (3 if a.quick else 9))
     sizes = ([int(s) for s in a.sizes.split(",")] if a.sizes
@@ -550,32 +462,28 @@ def main(argv: list[str] | None = None) -> int:
     bad = [k for k in kinds if k not in KINDS]
     if bad:
         p.error(f"unknown kind(s) {', '.join(bad)}; of {', '.join(KINDS)}")
-    threads = not a.no_threads
-    if threads and importlib.util.find_spec("threadpoolctl") is None:
-        print("threadpoolctl not installed: no timing under threadpool_limits(1)")
-        threads = False
-    import numba
     import scipy
     import scipy.linalg  # noqa: F401 (its BLAS, for the summary; mbody loads it too)
 
-    print(f"mbody {mbody.__version__}, numpy {np.__version__}, scipy {scipy.__version__}, "
-          f"numba {numba.__version__}, Python {sys.version.split()[0]}")
-    mbody.assemble(mbody.load(ladder_spec(1, "planar"))).solve()  # imports, first compile
+    print(f"mbody {mbody.__version__} (one path: the compiled core, mbody.kernel._core), "
+          f"numpy {np.__version__}, scipy {scipy.__version__}, Python {sys.version.split()[0]}")
+    mbody.assemble(mbody.load(ladder_spec(1, "planar"))).solve()  # imports
     print(blas_summary())
     fails = 0
 
-    print("\nchecks: compiled vs numpy (accelerations, λ), Gᵀ v̇ = γ (`constraint_residual`), "
-          "accelerations vs the closed form, right-hand sides compiled vs numpy")
+    print("\nchecks: Gᵀ v̇ = γ, M v̇ + b = Q + G λ, accelerations vs the closed form, "
+          "simulate's right-hand side vs the solve, the core's route and redundant count")
     for kind in kinds:
         for target in sizes:
             n_loops = loops_for(kind, target)
             model = mbody.load(ladder_spec(n_loops, kind))
             c = check(model, n_loops, kind)
             fails += not c.ok
-            print(f"  {kind:<17} N={n_loops:<3} acc {c.acc:7.1e}  λ {c.lam:7.1e}  "
-                  f"Gᵀv̇−γ {c.constraint:7.1e}  closed form {c.closed:7.1e}  "
-                  f"RHS {c.rhs:7.1e}  (≤ {c.tol:.0e})  {'PASS' if c.ok else 'FAIL'}",
-                  flush=True)
+            print(f"  {kind:<17} N={n_loops:<3} Gᵀv̇−γ {c.constraint:7.1e}  "
+                  f"Mv̇+b−Q−Gλ {c.dynamics:7.1e}  closed form {c.closed:7.1e}  "
+                  f"RHS {c.rhs:7.1e}  (≤ {c.tol:.0e})  {short(c.method)}, "
+                  f"{c.redundant} redundant (expected {c.expected})  "
+                  f"{'PASS' if c.ok else 'FAIL'}", flush=True)
     for kind in kinds:
         if kind == "spatial-redundant":
             continue
@@ -587,8 +495,8 @@ def main(argv: list[str] | None = None) -> int:
               f"rung angles vs the exact pendulum {err:.1e} rad  {'PASS' if ok else 'FAIL'}",
               flush=True)
 
-    rows = [measure(kind, target, repeat, threads) for kind in kinds for target in sizes]
-    print_rows(rows, repeat, threads)
+    rows = [measure(kind, target, repeat) for kind in kinds for target in sizes]
+    print_rows(rows, repeat)
     return 1 if fails else 0
 
 

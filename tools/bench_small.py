@@ -7,8 +7,11 @@ gyroscope in gimbals, and the spatial four-bar (redundant constraints) as an ext
 each read from models/. Measured per system (microseconds per call, best of --repeat):
 
 - solve: ``mbody.assemble(model, model.initial).solve()`` (accelerations and every
-  unknown reaction), on the compiled path (after warm-up: the plan switches after
-  `mbody.equations.plan.JIT_AFTER` evaluations) and on the numpy path (``set_jit("off")``);
+  unknown reaction, as a user calls it), and beside it the compiled core's solve alone
+  (`Unknowns.solve` of the model's workspace, `mbody.equations.workspace`, on the packed
+  state: what the public call costs beyond the core is the difference). There is one
+  numeric path, the core (`mbody.kernel`); the numba and numpy paths this table once
+  compared are gone;
 - MuJoCo: ``mj_forward`` on an equivalent model built here from the mbody model's numbers
   (masses, inertias, poses, joint points and axes, loads, gravity, initial velocities):
   a tree of hinge, slide and ball joints, one MuJoCo body frame per mbody body at its mass
@@ -56,7 +59,8 @@ if str(ROOT / "tools") not in sys.path:  # tools/timing.py, also when loaded by 
 from timing import best  # noqa: E402
 
 import mbody  # noqa: E402
-from mbody.equations import plan as mplan  # noqa: E402
+from mbody.equations.workspace import workspace  # noqa: E402
+from mbody.kernel import _core  # noqa: E402
 
 MODELS = ROOT / "models"
 SYSTEMS = (
@@ -426,8 +430,8 @@ class Row:
     label: str
     n: int
     m: int
-    solve_jit: float
-    solve_np: float
+    solve: float         # assemble(model, state).solve(), s per call
+    core: float          # the core's Unknowns.solve alone, s per call
     mj: float
     rhs: float
     rhs_compiled: bool
@@ -441,22 +445,25 @@ class Row:
 
 
 def time_solve(model: mbody.Model, repeat: int) -> tuple[float, float]:
-    """(compiled, numpy) seconds per ``assemble(model, state).solve()``."""
+    """Seconds per call of ``assemble(model, state).solve()`` and of the core's solve
+    alone (`Unknowns.solve` with the file's unknowns on the packed state), at the
+    initial state."""
     state = model.initial
+    ws = workspace(model)
+    unknowns = ws.file_unknowns
+    plan = ws.solve_plan(unknowns)
+    y = ws.pack_state(state)
+    out = np.empty(plan.o_info + _core.INFO)
 
     def solve():
         return mbody.assemble(model, state).solve()
 
-    for _ in range(mplan.JIT_AFTER + 4):  # switch to the compiled path, compile, warm
-        solve()
-    t_jit = best(solve, repeat, 0.02)
-    previous = mplan.set_jit("off")
-    try:
-        solve()
-        t_np = best(solve, repeat, 0.02)
-    finally:
-        mplan.set_jit(previous)
-    return t_jit, t_np
+    def core():
+        plan.solver.solve(state.t, y, unknowns.lam, out)
+
+    for _ in range(3):  # warm: the workspace is made on the first call
+        solve(), core()
+    return best(solve, repeat, 0.02), best(core, repeat, 0.02)
 
 
 def time_rhs(model: mbody.Model, repeat: int) -> tuple[float, bool]:
@@ -491,7 +498,7 @@ def time_simulation(model: mbody.Model, file: str, sim_limit: float):
 
 def measure(label: str, file: str, repeat: int, sim_limit: float, have_mj: bool) -> Row:
     model = load(file)
-    t_jit, t_np = time_solve(model, repeat)
+    t_solve, t_core = time_solve(model, repeat)
     rhs, compiled = time_rhs(model, repeat)
     mj, check, vary = math.nan, None, False
     if have_mj:
@@ -503,7 +510,7 @@ def measure(label: str, file: str, repeat: int, sim_limit: float, have_mj: bool)
         mj = best(lambda: mujoco.mj_forward(m, d), repeat, 0.02)
         vary = eq.loads_vary
     wall, steps, evals, t_done, note = time_simulation(model, file, sim_limit)
-    return Row(label, model.n, unknown_count(model), t_jit, t_np, mj, rhs, compiled, wall,
+    return Row(label, model.n, unknown_count(model), t_solve, t_core, mj, rhs, compiled, wall,
                steps, evals, t_done, note, check, vary)
 
 
@@ -514,13 +521,13 @@ def mark(ok: bool) -> str:
 def print_table(rows: list[Row], repeat: int) -> None:
     print(f"per call: µs, best of {repeat}; ratio = mbody / MuJoCo mj_forward "
           "(lower: mbody faster)")
-    head = (f"{'system':<17}{'n':>2}{'m':>4} |{'solve':>7}{'numpy':>8}{'MuJoCo':>8}"
-            f"{'×':>6}{'np ×':>6}  ≤10× |{'RHS':>6} jit ≤15µs |{'10 s':>7}{'steps':>7}"
+    head = (f"{'system':<17}{'n':>2}{'m':>4} |{'solve':>7}{'core':>8}{'MuJoCo':>8}"
+            f"{'×':>6}{'core×':>6}  ≤10× |{'RHS':>6}   C ≤15µs |{'10 s':>7}{'steps':>7}"
             f"{'evals':>8}{'f %':>5}  ≤1 s")
     print(head)
     print("-" * len(head))
     for r in rows:
-        ratio, ratio_np = r.solve_jit / r.mj, r.solve_np / r.mj
+        ratio, ratio_core = r.solve / r.mj, r.core / r.mj
         soft = "‡" if r.check is not None and not r.check.exact else " "
         solve_mark = ("  -  " if math.isnan(ratio) else
                       mark(ratio <= SOLVE_TARGET) + ("*" if ratio <= SOLVE_STRETCH else " "))
@@ -531,13 +538,14 @@ def print_table(rows: list[Row], repeat: int) -> None:
             sim_mark = "MISS" if r.sim_wall > SIM_TARGET_S and r.sim_t == 0 else " n/a"
         dagger = "†" if r.sim_note else " "
         share = r.sim_evals * r.rhs / r.sim_wall if r.sim_wall > 0 else math.nan
-        print(f"{r.label:<17}{r.n:>2}{r.m:>4} |{r.solve_jit * 1e6:7.1f}"
-              f"{r.solve_np * 1e6:8.1f}{r.mj * 1e6:7.2f}{soft}{ratio:6.1f}{ratio_np:6.1f} "
+        print(f"{r.label:<17}{r.n:>2}{r.m:>4} |{r.solve * 1e6:7.1f}"
+              f"{r.core * 1e6:8.1f}{r.mj * 1e6:7.2f}{soft}{ratio:6.1f}{ratio_core:6.1f} "
               f"{solve_mark}|{r.rhs * 1e6:6.1f} {'yes' if r.rhs_compiled else ' no'} "
               f"{rhs_mark}  |{r.sim_wall:6.2f}{dagger}{r.sim_steps:7d}{r.sim_evals:8d}"
               f"{100 * share:5.0f}  {sim_mark}", flush=True)
-    print("n bodies, m unknown reaction components; solve = assemble(model, state).solve() "
-          "on the compiled path, numpy = the same with set_jit('off');")
+    print("n bodies, m unknown reaction components; solve = assemble(model, state).solve(), "
+          "core = the compiled core's Unknowns.solve alone (one path: the core); "
+          "RHS C: evaluated in the core (yes) or in Python;")
     print(f"targets: solve ≤ {SOLVE_TARGET:g}× mj_forward (* also the stretch "
           f"≤ {SOLVE_STRETCH:g}×); RHS ≤ {RHS_TARGET_US:g} µs a call (simulate's f(t, y)); "
           f"{T_SIM:g} s of simulate() at its defaults ≤ {SIM_TARGET_S:g} s wall")

@@ -565,8 +565,8 @@ def verdict(outcomes: list[Outcome]) -> str:
 # -- the run: worker processes watched for hangs ---------------------------------------------
 
 def warm_up() -> None:
-    """Compile (or load from numba's cache) the kernels once, before anything is timed: the
-    first simulation of a process may take tens of seconds, which is no hang."""
+    """Solve and simulate a few models once, before anything is timed: the first of a
+    process imports what they need (scipy, the core's workspace), which is no hang."""
     import mbody
 
     with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):

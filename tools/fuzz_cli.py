@@ -336,10 +336,11 @@ def run_case(case: Case, folder: Folder, hang: float) -> Outcome:
 
 
 def warm_up(set_attr=setattr) -> dict[str, bytes]:
-    """Compile (or load) numba's kernels; make named pipes refused after a short wait
-    (no writer on an input, no reader on an output) rather than the interactive one;
-    build the parser once per process, not once per case (12 ms, a third of a clean
-    error's time: argparse keeps no state between parses). Returns the run files' bytes.
+    """Run `fuzz.warm_up` (the first solve and simulation of a process); make named pipes
+    refused after a short wait (no writer on an input, no reader on an output) rather
+    than the interactive one; build the parser once per process, not once per case
+    (12 ms, a third of a clean error's time: argparse keeps no state between parses).
+    Returns the run files' bytes.
     `set_attr` sets those module attributes (pytest's monkeypatch.setattr undoes them)."""
     import functools
 

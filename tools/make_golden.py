@@ -1,7 +1,25 @@
 """Record what the physics gave before the compiled core replaced the numba and numpy
 paths: tests/data/golden.npz, which tests/test_golden.py holds the core to.
 
-    python tools/make_golden.py          # needs the old paths (mbody 0.2's numba module)
+This is the record of how those data were made, not a tool to run on today's tree: it
+calls the old numba path (`mbody.solve.compiled`), which commit a33363f removed. On a
+checkout without it the script says so and exits with status 2; importing it works
+anywhere (its models come from tests/golden_models.py, which does not need the old path).
+
+It must run at commit 95ff550, the one the file records (its `__commit__` entry), the
+last with the old paths: its mbody/ and models/ are what the data describe (models
+shipped since are not in them). This script and tests/golden_models.py, its list of
+models and states, came after it: copy both in.
+
+    git worktree add /tmp/golden 95ff550 && cd /tmp/golden
+    python3 -m venv .venv && .venv/bin/pip install -e .   # numba is a dependency there
+    cp <this checkout>/tools/make_golden.py tools/
+    cp <this checkout>/tests/golden_models.py tests/
+    .venv/bin/python tools/make_golden.py                  # -> tests/data/golden.npz
+
+Run so (on a copy of 2d4a3e0, whose mbody/ and models/ are 95ff550's), it gave every
+entry of today's golden.npz bit for bit but one: chain16/moved/cond, 0.8 % apart, an
+estimate made with random start vectors (scipy's onenormest on the sparse S).
 
 For every shipped model and seeded random mechanisms of every joint type (planar and
 spatial, trees and loops, some with known reactions), at the file's state and at a
@@ -9,7 +27,6 @@ moved state (joints broken: the formulas must agree off the manifold too), with 
 numba path: the accelerations, every reaction value, the not-unique flags, the rank,
 Q - b per body, the columns of G, γ, φ, Gᵀ v, ẏ at Baumgarte rate 0 and 7, and the
 state after a projection; and cond(S), from which the test derives its tolerance.
-Run once, on the last commit that had the old paths (recorded in the file).
 """
 
 from __future__ import annotations
@@ -17,6 +34,7 @@ from __future__ import annotations
 import subprocess
 import sys
 from pathlib import Path
+from types import ModuleType
 
 import numpy as np
 
@@ -26,10 +44,20 @@ sys.path.insert(0, str(ROOT / "tests"))
 from golden_models import all_models, moved_state, state_vector  # noqa: E402
 
 import mbody  # noqa: E402
-from mbody.solve import compiled as C  # noqa: E402
+
+RECORDED_AT = "95ff550d61d79bf232ab9fd2e34484b28d9bad2d"
+"""The commit tests/data/golden.npz was made at (its `__commit__`)."""
 
 
-def record(model: mbody.Model, state: mbody.State) -> dict[str, np.ndarray]:
+def old_path() -> ModuleType:
+    """The old numba path, `mbody.solve.compiled` (only on a checkout that has it)."""
+    from mbody.solve import compiled  # type: ignore[attr-defined]  # gone since a33363f
+
+    return compiled
+
+
+def record(C: ModuleType, model: mbody.Model, state: mbody.State) -> dict[str, np.ndarray]:
+    """The old path's results for `model` at `state` (`C`: `old_path()`)."""
     planar = model.dimension == 2
     y = state_vector(model, state)
     t = state.t
@@ -70,13 +98,20 @@ def record(model: mbody.Model, state: mbody.State) -> dict[str, np.ndarray]:
             "project_info": info, "cond": np.array(cond), "mask": mask}
 
 
-def main() -> None:
+def main() -> int:
+    try:
+        C = old_path()
+    except ImportError:
+        print(f"make_golden.py needs the old numba path (mbody.solve.compiled), removed in "
+              f"a33363f: run it on a checkout of {RECORDED_AT[:7]}, as its docstring says",
+              file=sys.stderr)
+        return 2
     data: dict[str, np.ndarray] = {}
     models = all_models()
     for name, model in models:
         for tag, state in (("file", model.initial), ("moved", moved_state(model, 1))):
             try:
-                rec = record(model, state)
+                rec = record(C, model, state)
             except mbody.MbodyError as exc:  # e.g. a singular mass at the moved state
                 print(f"{name}/{tag}: skipped ({exc})")
                 continue
@@ -89,7 +124,8 @@ def main() -> None:
     out.parent.mkdir(exist_ok=True)
     np.savez_compressed(out, **data)
     print(f"{out}: {len(models)} models, {out.stat().st_size / 1024:.0f} KB, from {commit[:10]}")
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main())

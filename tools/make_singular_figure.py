@@ -1,18 +1,20 @@
 """docs/images/fourbar_chain_crossing.png: the four-bar chain's accelerations through
 its flat position, solved by mbody and compared with the exact parallel motion.
 
-    python tools/make_singular_figure.py
+    python tools/make_singular_figure.py [--out PATH]
 
 For crank angles θ from 1e-13 to 1e-1 rad on either side of flat (θ = 0), at 2 rad/s,
-the relative error of `mbody.assemble(model).solve()` (every body's accelerations)
-against the one-angle ODE of the parallel motion (tests/fourbar_chain.py), and the same
-error for the plain Schur-complement solve that mbody used before (eigen-decomposition
-of S with a relative tolerance of 1e-10 on its eigenvalues), computed here from the same
-G, M and γ.
+the relative error of `mbody.assemble(model).solve()` (every body's accelerations, the
+compiled core's solve) against the one-angle ODE of the parallel motion
+(tests/fourbar_chain.py), and the same error for the plain Schur-complement solve that
+mbody used before (eigen-decomposition of S with a relative tolerance of 1e-10 on its
+eigenvalues), computed here in numpy from the same M, G, Q − b and γ as the assembly
+gives them.
 """
 
 from __future__ import annotations
 
+import argparse
 import sys
 from pathlib import Path
 
@@ -27,34 +29,41 @@ import matplotlib  # noqa: E402
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from fourbar_chain import FourbarChain  # noqa: E402
-from mbody.solve.kkt import ConstrainedSystem, block_solve  # noqa: E402
 
 import mbody  # noqa: E402
-from mbody.equations.constraints import gamma  # noqa: E402
+from mbody.equations.workspace import workspace  # noqa: E402
+from mbody.util.atomic import atomic_path  # noqa: E402
 
 CHAIN = FourbarChain(crank=0.25, spacing=0.5, width=0.03125)
 
 
 def schur_eigen(model) -> np.ndarray:
-    """The former solve: λ = S⁺ (γ − Gᵀ M⁻¹ r) with S's eigenvalues cut at 1e-10."""
+    """The former solve: λ_U = S⁺ (γ_U − G_Uᵀ M⁻¹ r), S = G_Uᵀ M⁻¹ G_U with its
+    eigenvalues cut at 1e-10 of the largest, r = Q − b + G_K λ_K; v̇ = M⁻¹ (r + G_U λ_U)
+    (the model's coordinates, as `Solution.accelerations`)."""
     asm = mbody.assemble(model)
-    unknowns = model.plan.file_unknowns
-    system = ConstrainedSystem(model, asm.columns, unknowns)
-    G = system.G.toarray() if hasattr(system.G, "toarray") else np.asarray(system.G)
-    r6 = asm._Q6 - asm._b6
-    a0 = block_solve(model, np.arange(model.n), r6).ravel()
-    H = np.stack([block_solve(model, np.arange(model.n), G[:, k].reshape(-1, 6)).ravel()
-                  for k in range(G.shape[1])], axis=1)
-    S = G.T @ H
+    unknowns = workspace(model).file_unknowns
+    G = asm.G.toarray()
+    GU, GK = G[:, unknowns.U], G[:, ~unknowns.mask]
+    M = asm.M.toarray()
+    r = asm.Q - asm.b + GK @ unknowns.lam[~unknowns.mask]
+    a0 = np.linalg.solve(M, r)
+    H = np.linalg.solve(M, GU)
+    S = GU.T @ H
     w, V = np.linalg.eigh(0.5 * (S + S.T))
     keep = w > 1e-10 * w[-1]
-    rhs = gamma(model, asm.state, asm.columns) - G.T @ a0
+    rhs = asm.jacobian().gamma[unknowns.U] - GU.T @ a0
     lam = V[:, keep] @ ((V[:, keep].T @ rhs) / w[keep])
-    acc = (a0 + H @ lam).reshape(-1, 6)
-    return acc[:, [0, 1, 5]].ravel()
+    return a0 + H @ lam
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--out", type=Path,
+                    default=ROOT / "docs" / "images" / "fourbar_chain_crossing.png",
+                    help="the picture (default: the docs' docs/images/"
+                    "fourbar_chain_crossing.png)")
+    args = ap.parse_args(argv)
     mags = np.logspace(-13, -1, 49)
     thetas = np.concatenate((-mags[::-1], mags))
     new, old = [], []
@@ -82,8 +91,9 @@ def main() -> None:
     ax.set_title("Four-bar chain (3 loops) through its flat position, 2 rad/s")
     ax.legend(fontsize=8, loc="upper right")
     fig.tight_layout()
-    out = ROOT / "docs" / "images" / "fourbar_chain_crossing.png"
-    fig.savefig(out)
+    out = args.out
+    with atomic_path(out, suffix=".png") as tmp:  # never a half-written picture
+        fig.savefig(tmp)
     print(f"wrote {out}")
 
 
