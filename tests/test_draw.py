@@ -503,3 +503,87 @@ def test_legend_symbols_are_drawn_as_in_the_picture(model_file, name):
     parent = any(t.s.startswith("−") for t in drawing_items
                  if isinstance(t, Text) and (t.gid or "").startswith("label:reaction:"))
     assert any(getattr(it, "gid", None) == "legend-handle:parent" for it in root) == parent
+
+
+# -- drivers' efforts -------------------------------------------------------------------------
+def _driven_arm():
+    """An arm on a pin with a hand driven about the elbow E (its effort on the hand, and
+    as −elbow.M on the arm, E's parent), and a block pressed along a slide S (a force)."""
+    return mbody.load({
+        "model": "t", "dimension": 2, "gravity": [0, -9.81],
+        "bodies": [{"name": "arm", "mass": 1.0, "inertia": 0.02, "position": [0.25, 0],
+                    "shape": {"box": [0.5, 0.05]}},
+                   {"name": "hand", "mass": 0.5, "inertia": 0.01, "position": [0.65, 0],
+                    "shape": {"box": [0.3, 0.05]}},
+                   {"name": "slide", "mass": 0.5, "inertia": 0.01, "position": [0, -0.5],
+                    "shape": {"box": [0.1, 0.1]}}],
+        "joints": [{"name": "O", "type": "revolute", "parent": "ground", "child": "arm",
+                    "at": [0, 0]},
+                   {"name": "E", "type": "revolute", "parent": "arm", "child": "hand",
+                    "at": [0.5, 0]},
+                   {"name": "S", "type": "prismatic", "parent": "ground", "child": "slide",
+                    "at": [0, -0.5], "axis": [1, 0]}],
+        "drivers": [{"name": "elbow", "joint": "E", "angle": "0.3*t"},
+                    {"name": "press", "joint": "S", "displacement": "0.1*t"}]})
+
+
+def _items(sc, gid):
+    return [it for p in (sc.root, *sc.panels) for it in p.items
+            if getattr(it, "gid", None) == gid]
+
+
+@pytest.mark.parametrize(("model", "name", "gid", "text"), [
+    ("slider_crank_driven.yaml", "crank", "couple:effort:motor.M", "motor.M"),
+    ("arm", "hand", "couple:effort:elbow.M", "elbow.M"),
+    ("arm", "arm", "couple:effort:elbow.M", "−elbow.M"),
+    ("arm", "slide", "arrow:effort:press.F", "press.F")])
+def test_driver_effort_is_drawn_as_an_actuators_effort_apart_from_reactions(
+        model, name, gid, text):
+    from mbody.present.draw.scene import Poly
+    from mbody.present.draw.style import DASHES
+
+    m = _driven_arm() if model == "arm" else mbody.load(ROOT / "models" / model)
+    fbd = mbody.assemble(m).bodies[name].fbd
+    sc = fbd_scene(fbd)
+    # its own colour and dash: neither a reaction's nor a solid applied load's
+    (shaft,) = _items(sc, gid)
+    assert shaft.color == COLORS["effort"] and shaft.dash == DASHES["effort"]
+    assert len({COLORS[k] for k in ("applied", "gravity", "reaction", "effort")}) == 4
+    assert DASHES["effort"] != DASHES["reaction"] and shaft.dash is not None
+    assert _items(sc, gid.replace("effort", "reaction")) == []
+    (label,) = _items(sc, "label:" + gid.split(":", 1)[1])
+    assert label.s == text and label.color == COLORS["effort"]
+    # the joints' reactions keep theirs
+    reactions = [it for it in next(p for p in sc.panels if p.gid == "drawing").items
+                 if isinstance(it, Line) and (it.gid or "").startswith("arrow:reaction:")]
+    assert reactions and all(r.color == COLORS["reaction"] and r.dash == DASHES["reaction"]
+                             for r in reactions)
+    # a legend entry for it, its handle drawn as the arrow is
+    (handle,) = _items(sc, "legend-handle:effort")
+    assert (handle.color, handle.lw, handle.dash) == (shaft.color, shaft.lw, shaft.dash)
+    assert any(isinstance(it, Poly) and it.face == shaft.color
+               for it in _items(sc, "legend-handle:effort:head"))
+    entries = [t.s for t in _items(sc, "legend-entry")]
+    assert any(s.startswith("driver effort") for s in entries)
+    # −elbow.M acts on the joint's parent: the legend says what the minus means, for an
+    # effort as for a reaction
+    minus = [t.s for t in next(p for p in sc.panels if p.gid == "drawing").items
+             if isinstance(t, Text) and t.s.startswith("−")]
+    assert (text in minus) == text.startswith("−")
+    assert any("on the joint's parent" in s for s in entries) == bool(minus)
+
+
+def test_no_effort_in_the_legend_without_a_driver_and_a_spatial_effort_is_a_moment():
+    sc = fbd_scene(body("slider_crank.yaml", "crank").fbd)
+    assert _items(sc, "legend-handle:effort") == []
+    assert not any(t.s.startswith("driver effort") for t in _items(sc, "legend-entry"))
+    spindle = body("flyball_governor.yaml", "spindle").fbd
+    # seen from the front the motor's torque about the vertical spindle is a double-headed
+    # arrow up the page; from the top it points at the eye: two rings
+    front = fbd_scene(spindle, view="front")
+    (shaft,) = _items(front, "couple:effort:motor.M")
+    d = shaft.xy[-1] - shaft.xy[0]
+    np.testing.assert_allclose(d / np.linalg.norm(d), [0, 1], atol=1e-9)
+    assert len(_items(front, "couple:effort:motor.M:head2")) == 1
+    top = fbd_scene(spindle, view="top")
+    assert len(_items(top, "couple:effort:motor.M:ring2")) == 1

@@ -6,7 +6,8 @@ Spatial bodies are drawn in an orthographic projection: a world vector W_v appea
 the page is exactly its projected vector. Planar bodies use the top view (world x
 right, y up). Every element carries a gid (``arrow:<kind>:<name>``,
 ``couple:<kind>:<name>``, ``label:<kind>:<name>``, ``body-outline``, ``mass-centre``,
-``equations``...) so that tests and tools can find it.
+``equations``...; kind applied, gravity, reaction or effort, a driver's) so that tests
+and tools can find it.
 """
 
 from __future__ import annotations
@@ -31,8 +32,9 @@ from mbody.present.draw.style import (
     BODY_EDGE,
     BODY_FACE,
     COLORS,
-    DASHED,
+    DASHES,
     DOTTED,
+    EFFORT,
     SCALE_NOTE,
 )
 from mbody.present.draw.views import View, eye, projection, view_name
@@ -257,7 +259,7 @@ def _arrow(ax: list[Item], a: Arrow, lmax: float, hd: float,
            obstacles: list[tuple[np.ndarray, str]]) -> Label:
     """Draw arrow `a` into `ax`: a shaft (gid = the arrow's) and a filled head (gid +
     ':head'); its strokes go to `obstacles`; returns its label."""
-    dash = DASHED if a.dashed else None
+    dash = a.dash
     shaft = 0.0  # curved and end-on arrows: no spots half-way along
     pts = a.arc if a.arc is not None else np.array([a.tail, a.tail + a.vec])
     ax.append(Line(pts, a.color, 2.0, dash, zorder=8, gid=a.gid))
@@ -368,7 +370,9 @@ def _legend(root: Panel, rect: tuple[float, float, float, float], arrs: list[Arr
     entries: list[tuple[str, str]] = [
         ("applied", "applied force (name, |F|)"), ("gravity", "gravity m g at G"),
         ("reaction", "reaction (unknown name, or known value)")]
-    if any(a.kind == REACTION and a.label.startswith("−") for a in arrs):
+    if any(a.kind == EFFORT for a in arrs):
+        entries.append((EFFORT, "driver effort: the actuator's torque or force"))
+    if any(a.kind in (REACTION, EFFORT) and a.label.startswith("−") for a in arrs):
         entries.append(("parent", "−A.Fx: on the joint's parent (−R)"))
     if any(a.couple for a in arrs):
         entries.append(("couple", "couple: curved arrow" if planar
@@ -409,12 +413,12 @@ def _legend(root: Panel, rect: tuple[float, float, float, float], arrs: list[Arr
             gid = f"legend-handle:{key}"
             if key in COLORS or key == "parent":
                 color = COLORS[REACTION if key == "parent" else key]
-                dash = DASHED if key in (REACTION, "parent") else None
+                dash = DASHES.get(REACTION if key == "parent" else key)
                 root.add(Line(np.array([h0, h1]), color, 2.0, dash, zorder=5, gid=gid),
                          Poly(head(h1, right, hd), color, zorder=5, gid=gid + ":head"))
             elif key == "couple":  # as the picture's first couple: its colour and dash
                 first = next(a for a in arrs if a.couple)
-                color, dash = first.color, DASHED if first.dashed else None
+                color, dash = first.color, first.dash
                 if planar:  # a curved arrow, as drawn about a point
                     mid = (h0 + h1) / 2
                     t = np.linspace(math.radians(-60), math.radians(210), 20)

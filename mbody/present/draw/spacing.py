@@ -15,7 +15,8 @@ gravity line): its point keeps TIP points from every stroke placed before it, an
 placed before it lies that near its shaft or head. An unknown reaction, whose length
 says nothing, is first drawn a little shorter (or longer) to clear; any arrow is then
 moved sideways as above. Known forces (applied, gravity) and couples are placed first,
-so that a reaction gives way to them: their lengths and points carry their values.
+so that a reaction (or a driver's effort) gives way to them: their lengths and points
+carry their values.
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ import numpy as np
 
 from mbody.conventions import REACTION
 from mbody.present.draw.arrows import END_ON, Arrow, head
+from mbody.present.draw.style import EFFORT
 
 CLEAR = 5.5
 """An arrow keeps this far (points) from a parallel edge of the body's outline."""
@@ -43,6 +45,8 @@ TIP = 5.0
 """An arrow's tip keeps this far (points) from the centre line of every other stroke."""
 LENGTHS = (1.0, 0.86, 0.72, 1.14)
 """Lengths (of its own) tried in turn for an unknown reaction at each sideways place."""
+GIVES_WAY = (REACTION, EFFORT)
+"""The kinds of arrow placed last, whose length may change: reactions, drivers' efforts."""
 
 
 def _distance(p: np.ndarray, segs: np.ndarray) -> np.ndarray:
@@ -151,7 +155,7 @@ def separate(arrs: list[Arrow], fixed: list[np.ndarray], scale: float, centre: n
     near = np.vstack((outline, placed))  # what a tip keeps clear of: strokes and heads
     tips = np.zeros((0, 2))
     clear = TIP * unit if hd > 0 else -1.0
-    order = sorted(range(len(arrs)), key=lambda i: arrs[i].kind == REACTION)
+    order = sorted(range(len(arrs)), key=lambda i: arrs[i].kind in GIVES_WAY)
     out: dict[int, Arrow] = {}
     for i in order:
         a = arrs[i]
@@ -165,7 +169,7 @@ def separate(arrs: list[Arrow], fixed: list[np.ndarray], scale: float, centre: n
         d = a.vec / n
         side = np.array([-d[1], d[0]])
         headed = n >= END_ON * a.length3  # drawn with a head (not end-on)
-        factors = LENGTHS if a.kind == REACTION and headed and hd > 0 else (1.0,)
+        factors = LENGTHS if a.kind in GIVES_WAY and headed and hd > 0 else (1.0,)
         away = 1.0 if float((a.tail + 0.5 * a.vec - centre) @ side) >= 0 else -1.0
         shift, f = 0.0, 1.0
         for k in range(13):  # 0, then ±1, ±2, ... steps, away from G first
