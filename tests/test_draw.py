@@ -571,6 +571,9 @@ def test_driver_effort_is_drawn_as_an_actuators_effort_apart_from_reactions(
              if isinstance(t, Text) and t.s.startswith("−")]
     assert (text in minus) == text.startswith("−")
     assert any("on the joint's parent" in s for s in entries) == bool(minus)
+    # the matplotlib figure draws it so too
+    line = arrows(fbd.draw(), gid)[gid]
+    assert to_hex(line.get_color()) == COLORS["effort"] and line.get_linestyle() != "-"
 
 
 def test_no_effort_in_the_legend_without_a_driver_and_a_spatial_effort_is_a_moment():
@@ -587,3 +590,44 @@ def test_no_effort_in_the_legend_without_a_driver_and_a_spatial_effort_is_a_mome
     assert len(_items(front, "couple:effort:motor.M:head2")) == 1
     top = fbd_scene(spindle, view="top")
     assert len(_items(top, "couple:effort:motor.M:ring2")) == 1
+
+
+# -- layout rules in general terms -------------------------------------------------------------
+def test_symbols_stay_small_when_a_long_thin_body_is_seen_end_on():
+    """Bricard's rod2 (1 m long, 0.1 m across) seen along its length from the front: its
+    arrows are sized by its length, the body is a 0.1 m square on the page; arrowheads
+    and G's marker are capped in points, not grown with the arrows."""
+    from mbody.present.draw.arrows import HEAD
+    from mbody.present.draw.diagram import SYMBOLS
+    from mbody.present.draw.scene import Disc, Poly
+
+    sc = fbd_scene(body("bricard.yaml", "rod2").fbd, view="front")
+    panel = next(p for p in sc.panels if p.gid == "drawing")
+    heads = [it for it in panel.items if isinstance(it, Poly)
+             and (it.gid or "").endswith(":head") and it.gid.startswith(("arrow:", "couple:"))]
+    assert len(heads) >= 4
+    lengths = [np.linalg.norm(h.xy[0] - (h.xy[1] + h.xy[2]) / 2) * panel.scale for h in heads]
+    assert max(lengths) <= HEAD * SYMBOLS * (1 + 1e-9)
+    shafts = [np.linalg.norm(np.diff(it.xy, axis=0)) * panel.scale for it in panel.items
+              if isinstance(it, Line) and (it.gid or "").startswith(("arrow:", "couple:"))]
+    assert max(shafts) > 10 * max(lengths)  # where a head a fixed share of the arrow is big
+    (marker,) = [it for it in panel.items if isinstance(it, Disc) and it.gid == "mass-centre"]
+    assert marker.r * panel.scale <= 0.045 * SYMBOLS * (1 + 1e-9)
+
+
+def test_an_arrow_along_an_outline_seen_almost_edge_on_is_moved_off_it():
+    """A curved outline is many short segments: together they count as an edge (a
+    cylinder's end seen almost edge-on, a thin ellipse, with a reaction along it)."""
+    from mbody.present.draw.arrows import Arrow
+    from mbody.present.draw.spacing import CLEAR, separate
+
+    t = np.linspace(0, 2 * np.pi, 73)
+    rim = np.column_stack((20 * np.cos(t), 0.6 * np.sin(t)))  # in points: scale 1
+    a = Arrow("arrow:reaction:A.Fz", "reaction", "A.Fz", COLORS["reaction"], (4.0, 2.5),
+              False, np.zeros(2), np.array([60.0, 0.0]), length3=60.0)
+    (b,) = separate([a], [rim], 1.0, np.array([0.0, 40.0]))
+    assert b.moved_from is not None and abs(b.tail[1]) >= CLEAR + 0.6
+    np.testing.assert_allclose(b.vec, a.vec)  # moved parallel to itself, full length
+    # a rim across the arrow is no edge along it
+    (c,) = separate([a], [rim[:, ::-1]], 1.0, np.array([0.0, 40.0]))
+    assert c.moved_from is None
