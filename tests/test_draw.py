@@ -504,3 +504,131 @@ def test_legend_symbols_are_drawn_as_in_the_picture(model_file, name):
     parent = any(t.s.startswith("−") for t in drawing_items
                  if isinstance(t, Text) and (t.gid or "").startswith("label:reaction:"))
     assert any(getattr(it, "gid", None) == "legend-handle:parent" for it in root) == parent
+
+
+# -- drivers' efforts -------------------------------------------------------------------------
+def _driven_arm():
+    """An arm on a pin with a hand driven about the elbow E (its effort on the hand, and
+    as −elbow.M on the arm, E's parent), and a block pressed along a slide S (a force)."""
+    return mbody.load({
+        "model": "t", "dimension": 2, "gravity": [0, -9.81],
+        "bodies": [{"name": "arm", "mass": 1.0, "inertia": 0.02, "position": [0.25, 0],
+                    "shape": {"box": [0.5, 0.05]}},
+                   {"name": "hand", "mass": 0.5, "inertia": 0.01, "position": [0.65, 0],
+                    "shape": {"box": [0.3, 0.05]}},
+                   {"name": "slide", "mass": 0.5, "inertia": 0.01, "position": [0, -0.5],
+                    "shape": {"box": [0.1, 0.1]}}],
+        "joints": [{"name": "O", "type": "revolute", "parent": "ground", "child": "arm",
+                    "at": [0, 0]},
+                   {"name": "E", "type": "revolute", "parent": "arm", "child": "hand",
+                    "at": [0.5, 0]},
+                   {"name": "S", "type": "prismatic", "parent": "ground", "child": "slide",
+                    "at": [0, -0.5], "axis": [1, 0]}],
+        "drivers": [{"name": "elbow", "joint": "E", "angle": "0.3*t"},
+                    {"name": "press", "joint": "S", "displacement": "0.1*t"}]})
+
+
+def _items(sc, gid):
+    return [it for p in (sc.root, *sc.panels) for it in p.items
+            if getattr(it, "gid", None) == gid]
+
+
+@pytest.mark.parametrize(("model", "name", "gid", "text"), [
+    ("slider_crank_driven.yaml", "crank", "couple:effort:motor.M", "motor.M"),
+    ("arm", "hand", "couple:effort:elbow.M", "elbow.M"),
+    ("arm", "arm", "couple:effort:elbow.M", "−elbow.M"),
+    ("arm", "slide", "arrow:effort:press.F", "press.F")])
+def test_driver_effort_is_drawn_as_an_actuators_effort_apart_from_reactions(
+        model, name, gid, text):
+    from mbody.present.draw.scene import Poly
+    from mbody.present.draw.style import DASHES
+
+    m = _driven_arm() if model == "arm" else mbody.load(ROOT / "models" / model)
+    fbd = mbody.assemble(m).bodies[name].fbd
+    sc = fbd_scene(fbd)
+    # its own colour and dash: neither a reaction's nor a solid applied load's
+    (shaft,) = _items(sc, gid)
+    assert shaft.color == COLORS["effort"] and shaft.dash == DASHES["effort"]
+    assert len({COLORS[k] for k in ("applied", "gravity", "reaction", "effort")}) == 4
+    assert DASHES["effort"] != DASHES["reaction"] and shaft.dash is not None
+    assert _items(sc, gid.replace("effort", "reaction")) == []
+    (label,) = _items(sc, "label:" + gid.split(":", 1)[1])
+    assert label.s == text and label.color == COLORS["effort"]
+    # the joints' reactions keep theirs
+    reactions = [it for it in next(p for p in sc.panels if p.gid == "drawing").items
+                 if isinstance(it, Line) and (it.gid or "").startswith("arrow:reaction:")]
+    assert reactions and all(r.color == COLORS["reaction"] and r.dash == DASHES["reaction"]
+                             for r in reactions)
+    # a legend entry for it, its handle drawn as the arrow is
+    (handle,) = _items(sc, "legend-handle:effort")
+    assert (handle.color, handle.lw, handle.dash) == (shaft.color, shaft.lw, shaft.dash)
+    assert any(isinstance(it, Poly) and it.face == shaft.color
+               for it in _items(sc, "legend-handle:effort:head"))
+    entries = [t.s for t in _items(sc, "legend-entry")]
+    assert any(s.startswith("driver effort") for s in entries)
+    # −elbow.M acts on the joint's parent: the legend says what the minus means, for an
+    # effort as for a reaction
+    minus = [t.s for t in next(p for p in sc.panels if p.gid == "drawing").items
+             if isinstance(t, Text) and t.s.startswith("−")]
+    assert (text in minus) == text.startswith("−")
+    assert any("on the joint's parent" in s for s in entries) == bool(minus)
+    # the matplotlib figure draws it so too
+    line = arrows(fbd.draw(), gid)[gid]
+    assert to_hex(line.get_color()) == COLORS["effort"] and line.get_linestyle() != "-"
+
+
+def test_no_effort_in_the_legend_without_a_driver_and_a_spatial_effort_is_a_moment():
+    sc = fbd_scene(body("slider_crank.yaml", "crank").fbd)
+    assert _items(sc, "legend-handle:effort") == []
+    assert not any(t.s.startswith("driver effort") for t in _items(sc, "legend-entry"))
+    spindle = body("flyball_governor.yaml", "spindle").fbd
+    # seen from the front the motor's torque about the vertical spindle is a double-headed
+    # arrow up the page; from the top it points at the eye: two rings
+    front = fbd_scene(spindle, view="front")
+    (shaft,) = _items(front, "couple:effort:motor.M")
+    d = shaft.xy[-1] - shaft.xy[0]
+    np.testing.assert_allclose(d / np.linalg.norm(d), [0, 1], atol=1e-9)
+    assert len(_items(front, "couple:effort:motor.M:head2")) == 1
+    top = fbd_scene(spindle, view="top")
+    assert len(_items(top, "couple:effort:motor.M:ring2")) == 1
+
+
+# -- layout rules in general terms -------------------------------------------------------------
+def test_symbols_stay_small_when_a_long_thin_body_is_seen_end_on():
+    """Bricard's rod2 (1 m long, 0.1 m across) seen along its length from the front: its
+    arrows are sized by its length, the body is a 0.1 m square on the page; arrowheads
+    and G's marker are capped in points, not grown with the arrows."""
+    from mbody.present.draw.arrows import HEAD
+    from mbody.present.draw.diagram import SYMBOLS
+    from mbody.present.draw.scene import Disc, Poly
+
+    sc = fbd_scene(body("bricard.yaml", "rod2").fbd, view="front")
+    panel = next(p for p in sc.panels if p.gid == "drawing")
+    heads = [it for it in panel.items if isinstance(it, Poly)
+             and (it.gid or "").endswith(":head") and it.gid.startswith(("arrow:", "couple:"))]
+    assert len(heads) >= 4
+    lengths = [np.linalg.norm(h.xy[0] - (h.xy[1] + h.xy[2]) / 2) * panel.scale for h in heads]
+    assert max(lengths) <= HEAD * SYMBOLS * (1 + 1e-9)
+    shafts = [np.linalg.norm(np.diff(it.xy, axis=0)) * panel.scale for it in panel.items
+              if isinstance(it, Line) and (it.gid or "").startswith(("arrow:", "couple:"))]
+    assert max(shafts) > 10 * max(lengths)  # where a head a fixed share of the arrow is big
+    (marker,) = [it for it in panel.items if isinstance(it, Disc) and it.gid == "mass-centre"]
+    assert marker.r * panel.scale <= 0.045 * SYMBOLS * (1 + 1e-9)
+
+
+def test_an_arrow_along_an_outline_seen_almost_edge_on_is_moved_off_it():
+    """A curved outline is many short segments: together they count as an edge (a
+    cylinder's end seen almost edge-on, a thin ellipse, with a reaction along it)."""
+    from mbody.present.draw.arrows import Arrow
+    from mbody.present.draw.spacing import CLEAR, separate
+
+    t = np.linspace(0, 2 * np.pi, 73)
+    rim = np.column_stack((20 * np.cos(t), 0.6 * np.sin(t)))  # in points: scale 1
+    a = Arrow("arrow:reaction:A.Fz", "reaction", "A.Fz", COLORS["reaction"], (4.0, 2.5),
+              False, np.zeros(2), np.array([60.0, 0.0]), length3=60.0)
+    (b,) = separate([a], [rim], 1.0, np.array([0.0, 40.0]))
+    assert b.moved_from is not None and abs(b.tail[1]) >= CLEAR + 0.6
+    np.testing.assert_allclose(b.vec, a.vec)  # moved parallel to itself, full length
+    # a rim across the arrow is no edge along it
+    (c,) = separate([a], [rim[:, ::-1]], 1.0, np.array([0.0, 40.0]))
+    assert c.moved_from is None

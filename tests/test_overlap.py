@@ -35,7 +35,10 @@ Two more measures of what a reader needs (`far_labels`, `touching_tips`):
 
 and how many labels a picture joins to their arrow by a leader (`leaders`): at most
 LEADERS per picture, LEADERS_TOTAL over all, none to a body axis seen end-on (drawn
-as a ring with a dot or a cross beside G).
+as a ring with a dot or a cross beside G). And no two rings overlap (`ring_overlaps`):
+arrows seen end-on and body axes seen end-on, whether at one point (several joints
+there, a force and a moment about one axis) or not: two rings drawn on one another read
+as one.
 
 Run as a script to print the count per model and view (overlaps and strokes side by
 side / far labels / touching tips / leaders).
@@ -588,6 +591,48 @@ def test_legend_fits_in_the_picture(stem):
     frame, beside the world-axes triad."""
     bad = [f"{name} ({view}): {o}" for name, view, sc in scenes(stem)
            for o in legend_problems(sc)]
+    assert bad == []
+
+
+def ring_overlaps(scene: Scene) -> list[str]:
+    """Every pair of rings in the drawing panel (arrows seen end-on, an outer ring for a
+    moment; body axes seen end-on) closer than MARGIN, one line each."""
+    panel = next(p for p in scene.panels if p.gid == "drawing")
+    rings: dict[str, tuple[np.ndarray, float]] = {}
+    for it in panel.items:
+        gid = getattr(it, "gid", None) or ""
+        if isinstance(it, Disc) and gid.endswith((":end-on", ":ring2", ":ring")):
+            owner = gid.rsplit(":", 1)[0]
+            c, r = panel.to_pt(it.center), it.r * panel.scale
+            if owner not in rings or r > rings[owner][1]:
+                rings[owner] = (c, r)
+    names = sorted(rings)
+    return [f"ring {a} / ring {b} overlap" for i, a in enumerate(names) for b in names[i + 1:]
+            if np.linalg.norm(rings[a][0] - rings[b][0]) < rings[a][1] + rings[b][1] + MARGIN]
+
+
+def test_measure_sees_rings_on_rings():
+    sc = Scene(200, 200)
+    p = sc.panel("drawing", (0, 0, 200, 200), np.zeros(2), np.array([200.0, 200.0]))
+    p.add(Disc(np.array([100.0, 100]), 8, None, "red", gid="arrow:reaction:B.Fz:end-on"),
+          Disc(np.array([100.0, 100]), 8, None, "red", gid="couple:reaction:B.Mz:end-on"),
+          Disc(np.array([100.0, 100]), 11.6, None, "red", gid="couple:reaction:B.Mz:ring2"),
+          Disc(np.array([114.0, 100]), 6, "white", "grey", gid="body-axis:z:ring"))
+    assert ring_overlaps(sc) == [
+        "ring arrow:reaction:B.Fz / ring body-axis:z overlap",
+        "ring arrow:reaction:B.Fz / ring couple:reaction:B.Mz overlap",
+        "ring body-axis:z / ring couple:reaction:B.Mz overlap"]
+    p.items[1].center = p.items[2].center = np.array([100.0, 70])  # 30 apart, 19.6 wide
+    p.items[3].center = np.array([115.0, 100])  # 15 from B.Fz: 1 point clear
+    assert ring_overlaps(sc) == []
+
+
+@pytest.mark.parametrize("stem", [p.stem for p in MODELS])
+def test_no_ring_on_another_on_shipped_models(stem):
+    """Arrows seen end-on at one point (the flyball governor's spindle from the top, a
+    Bricard rod seen along its length) are drawn beside each other, never one on
+    another."""
+    bad = [f"{name} ({view}): {o}" for name, view, sc in scenes(stem) for o in ring_overlaps(sc)]
     assert bad == []
 
 

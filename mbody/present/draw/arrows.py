@@ -8,7 +8,9 @@ so the smallest known force is one step long and every factor of 10 adds a step:
 1000 times another is drawn 4 times as long, and both stay readable. Couples use the same
 rule on their own scale (N m); unknown reactions have no magnitude and are drawn at a
 fixed length, dashed, in the reaction colour, along their joint axis: labelled A.Fx on
-the joint's child, −A.Fx on its parent (where the reaction acts as −R).
+the joint's child, −A.Fx on its parent (where the reaction acts as −R). A driver's effort
+(motor.M) is such an unknown too, drawn the same way but as an actuator's effort: in
+its own colour and dash (`style.EFFORT`).
 """
 
 from __future__ import annotations
@@ -22,7 +24,8 @@ import numpy as np
 
 from mbody import conventions as cv
 from mbody.conventions import GRAVITY, REACTION
-from mbody.present.draw.style import COLORS
+from mbody.model.drivers import EFFORT as DRIVER_EFFORT
+from mbody.present.draw.style import COLORS, DASHES, EFFORT
 from mbody.present.draw.views import eye
 
 if TYPE_CHECKING:
@@ -60,7 +63,7 @@ class Arrow:
     kind: str
     label: str
     color: str
-    dashed: bool
+    dash: tuple[float, ...] | None  # its dash pattern (line widths); None: solid
     couple: bool
     tail: np.ndarray  # (2,) page
     vec: np.ndarray  # (2,) page (projected drawn vector); planar couple: (sign, radius)
@@ -85,6 +88,14 @@ def _label(fo: ForceOnBody) -> str:
     if fo.kind == GRAVITY:
         return f"m g = {fmt(fo.magnitude)} N"
     return f"{fo.name} {fmt(fo.magnitude)} {unit}"
+
+
+def drawn_kind(fo: ForceOnBody) -> str:
+    """The kind an arrow is drawn as: the force's kind, or `EFFORT` for a driver's effort
+    (a reaction whose component, ``M`` or ``F``, only drivers have: `mbody.model.drivers`)."""
+    if fo.kind == REACTION and fo.label.rpartition(".")[2] in DRIVER_EFFORT.values():
+        return EFFORT
+    return fo.kind
 
 
 def _direction(fo: ForceOnBody) -> np.ndarray:
@@ -113,15 +124,15 @@ def arrows(fbd: FreeBodyDiagram, P: np.ndarray, lmax: float) -> list[Arrow]:
     out: list[Arrow] = []
     ring_count: dict[tuple[float, ...], int] = {}
     for fo in forces:
-        kind = fo.kind
-        if not fo.unknown and (fo.value == 0 if kind == REACTION else fo.magnitude == 0):
+        if not fo.unknown and (fo.value == 0 if fo.kind == REACTION else fo.magnitude == 0):
             continue  # nothing to draw; listed under the drawing instead
         ell = lengths.get(id(fo), lmax * (UNKNOWN_MOMENT if fo.couple else UNKNOWN_FORCE))
         d = _direction(fo)
         tail3 = np.asarray(fo.W_point, dtype=float)
         tail = P @ tail3
+        kind = drawn_kind(fo)
         gid = f"{'couple' if fo.couple else 'arrow'}:{kind}:{fo.label or fo.name}"
-        a = Arrow(gid, kind, _label(fo), COLORS[kind], kind == REACTION, fo.couple,
+        a = Arrow(gid, kind, _label(fo), COLORS[kind], DASHES.get(kind), fo.couple,
                    tail, P @ (ell * d), length3=ell, toward=float(ell * d @ eye(P)))
         if fo.couple and planar:
             sign = 1.0 if d[2] >= 0 else -1.0

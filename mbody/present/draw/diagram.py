@@ -6,7 +6,8 @@ Spatial bodies are drawn in an orthographic projection: a world vector W_v appea
 the page is exactly its projected vector. Planar bodies use the top view (world x
 right, y up). Every element carries a gid (``arrow:<kind>:<name>``,
 ``couple:<kind>:<name>``, ``label:<kind>:<name>``, ``body-outline``, ``mass-centre``,
-``equations``...) so that tests and tools can find it.
+``equations``...; kind applied, gravity, reaction or effort, a driver's) so that tests
+and tools can find it.
 """
 
 from __future__ import annotations
@@ -31,8 +32,9 @@ from mbody.present.draw.style import (
     BODY_EDGE,
     BODY_FACE,
     COLORS,
-    DASHED,
+    DASHES,
     DOTTED,
+    EFFORT,
     SCALE_NOTE,
 )
 from mbody.present.draw.views import View, eye, projection, view_name
@@ -73,7 +75,6 @@ def fbd_scene(fbd: FreeBodyDiagram, *, view: View = "iso", equations: bool = Tru
     reach = max([shape.size] + [2 * float(np.linalg.norm(f.B_r)) for f in fbd.forces])
     lmax = 0.55 * reach
     arrs = arrows(fbd, P, lmax)
-    hd = HEAD * lmax
 
     eq_lines = _equation_lines(fbd, planar) if equations else []
     zeros = [fo.signed_label for fo in fbd.forces if not fo.unknown and (
@@ -107,21 +108,31 @@ def fbd_scene(fbd: FreeBodyDiagram, *, view: View = "iso", equations: bool = Tru
                     zorder=2, gid="body-edge"))
         obstacles.append((pp, "outline"))
 
-    # mass centre G and body axes
+    # the symbols' size (heads, rings, markers) follows the arrows' up to SYMBOLS points:
+    # a long thin body seen end-on, small on the page beside its arrows, keeps them small
     G = P @ fbd.W_position
-    rg = 0.045 * lmax
-    _centre_mark(ax, G, rg, zorder=6, gid="mass-centre")
-    obstacles.append((G + 1.3 * rg * circle(16), "mass-centre"))
-    fixed = [o[0] for o in obstacles]  # strokes an arrow must not lie on: outline...
-    lines: list[np.ndarray] = []  # ... and body axes, which it must keep farther from
-    labels: list[Label] = []
     axes3 = [fbd.W_R_B[:, k] * 0.38 * shape.size for k in range(2 if planar else 3)]
+    ax.set_limits(*_padded(np.vstack([hull_pts, G + np.array([P @ v for v in axes3])]
+                                     + [(P @ fo.W_point)[None] for fo in fbd.forces]
+                                     + _arrow_extents(arrs))))
+    sym = min(lmax, SYMBOLS / ax.scale)
+    hd = HEAD * sym
+
+    # mass centre G and body axes
+    rg = 0.045 * sym
+    _centre_mark(ax, G, rg, zorder=6, gid="mass-centre")
+    fixed = [o[0] for o in obstacles]  # strokes an arrow must not lie on: outline...
+    obstacles.append((G + rg * circle(24), "mass-centre"))
+    lines: list[np.ndarray] = []  # ... and body axes, which it must keep farther from
+    marks: list[tuple[np.ndarray, float]] = []  # the rings of body axes seen end-on
+    labels: list[Label] = []
+    end_on_labels: list[Label] = []  # theirs
     for k, nm in enumerate("xyz"[:len(axes3)]):
         tag = f"body-axis:{nm}"
         tip = G + P @ axes3[k]
         if not planar and np.linalg.norm(tip - G) < END_ON * np.linalg.norm(axes3[k]):
             # seen end-on: a small ring beside G, a dot toward the eye, a cross away
-            c, r, u = _end_on_axis(G, rg, lmax, [P @ v for v in axes3]
+            c, r, u = _end_on_axis(G, rg, sym, [P @ v for v in axes3]
                                    + [a.vec for a in arrs if a.arc is None
                                       and np.linalg.norm(a.tail - G) < 2 * rg])
             # its short shaft stays under G's marker, for tools (as an end-on arrow's)
@@ -136,9 +147,10 @@ def fbd_scene(fbd: FreeBodyDiagram, *, view: View = "iso", equations: bool = Tru
             ring = c + r * circle(16)
             obstacles.append((ring, tag))
             fixed.append(ring)
-            anchor = c + r * u
-            labels.append(Label(Text(f"${nm}_B$", anchor, 8, AXIS_COLOR, math=True,
-                                     zorder=10, gid=f"label:{tag}"), anchor, u, tag))
+            marks.append((c, r))
+            end_on_labels.append(Label(Text(f"${nm}_B$", c, 8, AXIS_COLOR, math=True,
+                                            zorder=10, gid=f"label:{tag}"), c, u, tag,
+                                       radius=r))
             continue
         seg = np.array([G, tip])
         ax.add(Line(seg, AXIS_COLOR, 1.0, zorder=3, gid=tag))
@@ -152,35 +164,33 @@ def fbd_scene(fbd: FreeBodyDiagram, *, view: View = "iso", equations: bool = Tru
                                  gid=f"label:{tag}"), tip, tip - G, tag,
                             float(np.linalg.norm(tip - G))))
     labels.append(Label(Text("G", G, 9, zorder=10, gid="label:mass-centre"), G,
-                        np.array([-1.0, 1.0]), "mass-centre"))
+                        np.array([-1.0, 1.0]), "mass-centre", radius=rg))
 
     # joint points and points of application
     for fo in fbd.forces:
         if not fo.couple and np.linalg.norm(fo.B_r) > 0:
-            c, r = P @ fo.W_point, 0.022 * lmax
+            c, r = P @ fo.W_point, 0.022 * sym
             ax.add(Disc(c, r, "white", COLORS[fo.kind], 1.2, zorder=7,
                         gid="joint-point" if fo.kind == REACTION else "load-point"))
             obstacles.append((np.vstack((c + r * circle(12), c)), "point"))
 
     # limits: geometry first, then grown until every label fits; arrows are kept apart
     # and labels placed again at each scale, both measured in points
-    geo = np.vstack([o[0] for o in obstacles] + [np.array([a.tail, a.tail + a.vec])
-                                                  for a in arrs if a.arc is None]
-                    + [a.arc for a in arrs if a.arc is not None])
-    lo, hi = geo.min(axis=0), geo.max(axis=0)
-    span = max(float((hi - lo).max()), 1e-6)
-    ax.set_limits(lo - 0.18 * span, hi + 0.18 * span)
+    ax.set_limits(*_padded(np.vstack([o[0] for o in obstacles] + _arrow_extents(arrs))))
     lo, hi = ax.lo.copy(), ax.hi.copy()
     x0, y0, w, h = ax.rect
     for attempt in range(5):
         drawn: list[Item] = []
         arrow_obstacles: list[tuple[np.ndarray, str]] = []
-        arrow_labels = [_arrow(drawn, a, lmax, hd, arrow_obstacles)
-                        for a in separate(arrs, fixed, ax.scale, G, hd, lines)]
+        arrow_labels = [_arrow(drawn, a, sym, hd, arrow_obstacles)
+                        for a in separate(arrs, fixed, ax.scale, G, hd, lines, 0.05 * sym,
+                                             marks, rg)]
         # arrows' labels before the axes' and G's (an axis label has room all around
         # its tip), the longest arrows' first: over the shipped pictures this order needs
-        # the fewest leaders (tests/test_overlap.py counts them)
-        every = sorted(arrow_labels, key=lambda lb: -lb.shaft) + labels
+        # the fewest leaders (tests/test_overlap.py counts them); but the label of an
+        # axis seen end-on first of all: its ring beside G is where the crowd is, and it
+        # must be labelled right beside it
+        every = end_on_labels + sorted(arrow_labels, key=lambda lb: -lb.shaft) + labels
         boxes = place(ax, every, obstacles + arrow_obstacles)
         if attempt == 4 or (np.all(boxes[:, 0] >= x0) and np.all(boxes[:, 2] <= x0 + w)
                             and np.all(boxes[:, 1] >= y0) and np.all(boxes[:, 3] <= y0 + h)):
@@ -253,17 +263,46 @@ def _title(s: str, xy: np.ndarray, width: float, height: float) -> Text:
                 linespacing=spacing, align="center")
 
 
-def _arrow(ax: list[Item], a: Arrow, lmax: float, hd: float,
+SYMBOLS = 170.0
+"""Heads, rings and markers are sized as fractions of the longest arrow's length, but of
+no more than this many points (`HEAD` of it is an arrowhead's length)."""
+
+
+def _arrow_extents(arrs: list[Arrow]) -> list[np.ndarray]:
+    """The points each arrow reaches on the page: a straight one's tail and tip, a
+    curved one's arc."""
+    return [a.arc if a.arc is not None else np.array([a.tail, a.tail + a.vec]) for a in arrs]
+
+
+def _padded(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Limits around `pts` (k, 2), 18 % of their span to spare on every side."""
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    span = max(float((hi - lo).max()), 1e-6)
+    return lo - 0.18 * span, hi + 0.18 * span
+
+
+def _arrow(ax: list[Item], a: Arrow, sym: float, hd: float,
            obstacles: list[tuple[np.ndarray, str]]) -> Label:
     """Draw arrow `a` into `ax`: a shaft (gid = the arrow's) and a filled head (gid +
-    ':head'); its strokes go to `obstacles`; returns its label."""
-    dash = DASHED if a.dashed else None
+    ':head') of length `hd`, or an end-on ring of radius 0.05 `sym`; its strokes go to
+    `obstacles`; returns its label."""
+    dash = a.dash
     shaft = 0.0  # curved and end-on arrows: no spots half-way along
+    end_on = a.arc is None and np.linalg.norm(a.vec) < END_ON * a.length3
+    radius = 0.0  # what its label keeps beyond its anchor: an end-on arrow's ring
+    r = 0.05 * sym  # an end-on arrow's ring; a moment's outer ring is 1.45 times that
+    outer = r * (1.45 if a.couple else 1.0)
     pts = a.arc if a.arc is not None else np.array([a.tail, a.tail + a.vec])
+    if end_on:  # its short shaft, kept for tools, within its ring
+        pts = np.array([a.tail, a.tail + a.vec * min(1.0, 0.8 * r / max(
+            float(np.linalg.norm(a.vec)), 1e-300))])
     ax.append(Line(pts, a.color, 2.0, dash, zorder=8, gid=a.gid))
     obstacles.append((pts, a.gid))
     if a.moved_from is not None:  # drawn beside its point: a leader back to it
         lead = np.array([a.moved_from, a.tail])
+        if end_on:  # to the ring's rim
+            d_lead = lead[1] - lead[0]
+            lead[1] -= outer * d_lead / max(float(np.linalg.norm(d_lead)), 1e-300)
         ax.append(Line(lead, a.color, 0.9, DOTTED, zorder=8,
                        gid="leader:" + a.gid.split(":", 1)[1]))
         obstacles.append((lead, "leader:" + a.gid))
@@ -274,9 +313,8 @@ def _arrow(ax: list[Item], a: Arrow, lmax: float, hd: float,
             ax.append(Poly(tri, a.color, zorder=9, gid=a.gid + ":head"))
             obstacles.append((tri[[0, 1, 2, 0]], a.gid))
         anchor, direction = a.arc[-1], a.arc[-1] - a.tail
-    elif np.linalg.norm(a.vec) < END_ON * a.length3:
+    elif end_on:
         # seen end-on: a dot toward the eye, a cross away from it (two rings: a moment)
-        r = 0.05 * lmax
         for k in range(2 if a.couple else 1):
             ax.append(Disc(a.tail, r * (1 + 0.45 * k), None, a.color, 1.6, zorder=9,
                         gid=a.gid + (":end-on" if k == 0 else ":ring2")))
@@ -286,8 +324,11 @@ def _arrow(ax: list[Item], a: Arrow, lmax: float, hd: float,
             for s_ in (1, -1):
                 xx = a.tail + 0.7 * r * np.array([[-1, -s_], [1, s_]]) / math.sqrt(2)
                 ax.append(Line(xx, a.color, 1.4, zorder=9))
-        obstacles.append((a.tail + r * (1.5 if a.couple else 1.0) * circle(24), a.gid))
-        anchor, direction = a.tail + r * np.array([0.7, 0.7]), np.array([1.0, 0.7])
+        obstacles.append((a.tail + outer * circle(24), a.gid))
+        # its label beside the ring, first on the side away from the point it acts at
+        anchor, direction, radius = a.tail, np.array([1.0, 0.7]), outer
+        if a.moved_from is not None and np.linalg.norm(a.tail - a.moved_from) > 0:
+            direction = a.tail - a.moved_from
     else:
         n = np.linalg.norm(a.vec)
         tip = a.tail + a.vec
@@ -302,20 +343,21 @@ def _arrow(ax: list[Item], a: Arrow, lmax: float, hd: float,
         anchor, direction = tip, (a.vec if n > 1e-9 else np.array([1.0, 0.3]))
         shaft = float(n)
     text = Text(a.label, anchor, 9, a.color, zorder=10, gid="label:" + a.gid.split(":", 1)[1])
-    return Label(text, anchor, direction, a.gid, shaft)
+    return Label(text, anchor, direction, a.gid, shaft, radius)
 
 
-def _end_on_axis(G: np.ndarray, rg: float, lmax: float, away: list[np.ndarray]
+def _end_on_axis(G: np.ndarray, rg: float, sym: float, away: list[np.ndarray]
                  ) -> tuple[np.ndarray, float, np.ndarray]:
-    """Where a body axis seen end-on is drawn: a ring of radius r centred at c beside G's
-    marker (radius rg), in the direction u farthest from the strokes leaving G (`away`:
-    page vectors of the other axes and of the arrows at G); the label goes on along u."""
-    dirs = [v / np.linalg.norm(v) for v in away if np.linalg.norm(v) > 1e-9 * lmax]
+    """Where a body axis seen end-on is drawn: a ring of radius r (0.04 `sym`) centred at
+    c beside G's marker (radius rg), in the direction u farthest from the strokes leaving
+    G (`away`: page vectors of the other axes and of the arrows at G); the label goes on
+    along u."""
+    dirs = [v / np.linalg.norm(v) for v in away if np.linalg.norm(v) > 1e-9 * sym]
     ang = np.radians(np.arange(0, 360, 15) - 45.0)  # lower right first, on ties
     cand = np.column_stack((np.cos(ang), np.sin(ang)))
     worst = np.max(cand @ np.array(dirs).T, axis=1) if dirs else np.zeros(len(cand))
     u = cand[int(np.argmin(np.round(worst, 6)))]
-    r = 0.04 * lmax
+    r = 0.04 * sym
     return G + (rg + 1.8 * r) * u, r, u
 
 
@@ -368,7 +410,9 @@ def _legend(root: Panel, rect: tuple[float, float, float, float], arrs: list[Arr
     entries: list[tuple[str, str]] = [
         ("applied", "applied force (name, |F|)"), ("gravity", "gravity m g at G"),
         ("reaction", "reaction (unknown name, or known value)")]
-    if any(a.kind == REACTION and a.label.startswith("−") for a in arrs):
+    if any(a.kind == EFFORT for a in arrs):
+        entries.append((EFFORT, "driver effort: the actuator's torque or force"))
+    if any(a.kind in (REACTION, EFFORT) and a.label.startswith("−") for a in arrs):
         entries.append(("parent", "−A.Fx: on the joint's parent (−R)"))
     if any(a.couple for a in arrs):
         entries.append(("couple", "couple: curved arrow" if planar
@@ -409,12 +453,12 @@ def _legend(root: Panel, rect: tuple[float, float, float, float], arrs: list[Arr
             gid = f"legend-handle:{key}"
             if key in COLORS or key == "parent":
                 color = COLORS[REACTION if key == "parent" else key]
-                dash = DASHED if key in (REACTION, "parent") else None
+                dash = DASHES.get(REACTION if key == "parent" else key)
                 root.add(Line(np.array([h0, h1]), color, 2.0, dash, zorder=5, gid=gid),
                          Poly(head(h1, right, hd), color, zorder=5, gid=gid + ":head"))
             elif key == "couple":  # as the picture's first couple: its colour and dash
                 first = next(a for a in arrs if a.couple)
-                color, dash = first.color, DASHED if first.dashed else None
+                color, dash = first.color, first.dash
                 if planar:  # a curved arrow, as drawn about a point
                     mid = (h0 + h1) / 2
                     t = np.linspace(math.radians(-60), math.radians(210), 20)

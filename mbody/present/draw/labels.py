@@ -1,22 +1,27 @@
-"""Label placement: each label at the nearest spot around its anchor (an arrow's tip)
-where its box touches no stroke and no label placed before it.
+"""Label placement: each label at the nearest spot beside what it names (an arrow's tip
+or shaft, an axis, a marker) where its box touches no stroke and no other label.
 
-Greedy: labels in order, each tried at spots on rings around its anchor, nearest first;
-a spot's box (the text's box from `fonts`, grown by PAD) is scored by the strokes
-sampled inside it (every drawn line, arrowhead, outline, axis and marker, its own arrow
-included) and the labels it meets. The first ring with a free spot wins; only if none
-is free anywhere does the least crowded spot win. Works in points, without rendering,
-all spots of one ring of one label at once.
+A label's candidate spots are boxes touching its anchor (an arrow's tip; or the ring or
+marker it names, from outside) from every direction, a few gaps out, boxes sliding all
+along one side or the other of a straight shaft, and boxes around its tail; then boxes
+on rings farther out. A box (the text's box from `fonts`, grown by PAD) is scored by the
+strokes sampled inside it (every drawn line, arrowhead, outline, axis and marker, its
+own arrow included: counted in O(1) a box from a summed table of the samples on a
+1-point grid), by the labels it meets, and by how far it is from the tip. Works in
+points, without rendering.
 
 A label names its arrow only if it is near it: a free spot whose box is within NEAR
 label heights of the label's own strokes (its arrow's shaft and heads, its axis, its
-marker) beats any free spot farther out; the first spots tried lie beside the tip and
-all along a straight shaft. A label that finds no free spot near enough gets a leader
+marker) beats any free spot farther out. Labels are placed in turn, each at its best
+spot; then each label left without a free near spot tries again, moving the one or two
+labels in its way to free near spots of theirs (so that the order they were placed in
+matters less). A label that still finds no free spot near enough gets a leader
 (`Label.leader`, drawn by the diagram): a thin line from its box to its arrow.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,8 +34,19 @@ PAD = 2.5
 STEP = 1.0
 """Strokes are sampled every STEP points (below PAD: a stroke near a box has a sample
 inside its padded box)."""
-NEAR = 1.3
-"""A label's box within NEAR times its height of its own strokes is near them."""
+NEAR = 1.45
+"""A label's box within NEAR times its height of its own strokes is near them (measured
+to the strokes' samples, every STEP along them: never nearer than the strokes are)."""
+GAPS = (0.5, 3.0, 6.0, 9.0, 12.0)
+"""Gaps (points) between a candidate's padded box and its anchor or shaft."""
+ALONG = 4.0
+"""Candidate boxes beside a shaft are this far apart (points) along it."""
+RINGS = (12.0, 20.0, 30.0, 42.0, 58.0, 78.0, 100.0)
+"""Farther rings of candidates (points from the anchor), for a label with no near spot."""
+
+FREE, FAR, OUTSIDE = 2.5, 2.5, 2.0
+"""Score below FREE: a free near spot. FAR is added for a box farther than NEAR from its
+own strokes, OUTSIDE for one outside the panel (allowed: the limits grow later)."""
 
 
 @dataclass(slots=True)
@@ -43,6 +59,7 @@ class Label:
     direction: np.ndarray
     own: str
     shaft: float = 0.0  # a straight arrow's length (data): spots beside it, along it
+    radius: float = 0.0  # the anchor's ring or marker (data): spots start beyond it
     leader: np.ndarray | None = None  # (2, 2) data: box to its arrow, when placed far
 
 
@@ -56,25 +73,87 @@ def sample(points: np.ndarray, step: float) -> np.ndarray:
     return np.vstack((points[:1], inner))
 
 
-def _rings(length: float | None) -> list[np.ndarray]:
-    """Candidate spots (points), (c, 4) each: offset along and across the label's
-    direction, and the side the box lies on from that point (along, across), in groups
-    tried in turn: beyond the tip, beside it and beside a straight shaft (`length`
-    points) all along it, then rings farther and farther out."""
-    first: list[tuple[float, float, float, float]] = [
-        (5, 0, 1, 0), (5, 9, 1, 1), (5, -9, 1, -1), (0, 10, 0, 1), (0, -10, 0, -1),
-        (-5, 6, -1, 1), (-5, -6, -1, -1)]
-    if length is not None:  # beside the shaft, half-way first, then all along it: the
-        # box lies to the side (not centred on the shaft)
-        for f in (0.5, 0.3, 0.7, 0.15, 0.85, 0.05, 0.95):
-            first += [(-f * length, 6, 0, 1), (-f * length, -6, 0, -1)]
-    groups = [np.array(first, dtype=float)]
-    for r, n in ((12.0, 16), (20.0, 24), (30.0, 24), (42.0, 32), (58.0, 32), (78.0, 40),
-                 (100.0, 40)):
-        ang = np.linspace(0, 2 * np.pi, n, endpoint=False)
-        ring = np.column_stack((r * np.cos(ang), r * np.sin(ang)))
-        groups.append(np.hstack((ring, ring)))
-    return groups
+class _Counts:
+    """How many stroke samples lie in a box: a summed table of the samples on a 1-point
+    grid over the samples' extent (a box counts every cell it touches: at most a point
+    more than the box; a box's part outside the grid holds no sample)."""
+
+    def __init__(self, pts: np.ndarray) -> None:
+        lo = pts.min(axis=0) if len(pts) else np.zeros(2)
+        hi = pts.max(axis=0) if len(pts) else np.zeros(2)
+        self.lo = np.floor(lo) - 1.0
+        nx, ny = (np.ceil(hi - self.lo) + 2).astype(int)
+        self.n = np.array([nx, ny])
+        ix = np.floor(pts - self.lo).astype(int) + 1
+        grid = np.bincount(ix[:, 1] * (nx + 1) + ix[:, 0], minlength=(ny + 1) * (nx + 1)
+                           ).reshape(ny + 1, nx + 1)
+        self.table = grid.cumsum(axis=0).cumsum(axis=1)
+
+    def __call__(self, boxes: np.ndarray) -> np.ndarray:
+        """(c,) samples inside each box (c, 4): x0, y0, x1, y1 in points."""
+        a = np.clip(np.floor(boxes[:, :2] - self.lo).astype(int), 0, self.n - 1)
+        b = np.clip(np.floor(boxes[:, 2:] - self.lo).astype(int) + 1, 0, self.n)
+        t = self.table
+        return t[b[:, 1], b[:, 0]] - t[a[:, 1], b[:, 0]] - t[b[:, 1], a[:, 0]] + t[a[:, 1], a[:, 0]]
+
+
+def _touching(a: np.ndarray, u: np.ndarray, gap: np.ndarray, hw: float, hh: float
+              ) -> np.ndarray:
+    """Centres of boxes (half sizes hw, hh) lying `gap` beyond points `a` along unit
+    directions u (all broadcast to (..., 2) and (...)): each box in the half plane
+    (x − a)·u ≥ gap, touching its edge."""
+    reach = hw * np.abs(u[..., 0]) + hh * np.abs(u[..., 1])
+    return a + (gap + reach)[..., None] * u
+
+
+def _candidates(a: np.ndarray, d: np.ndarray, length: float, radius: float, hw: float,
+                hh: float) -> tuple[np.ndarray, np.ndarray]:
+    """Candidate box centres (c, 2) for a label anchored at `a` (its arrow's tip, or the
+    centre of a ring or marker of `radius`) along unit `d`, beside a straight shaft of
+    `length` behind the tip (0: none), boxes of half sizes hw, hh (all in points); and the
+    preference of each (small: nearer the tip, beyond it first, then beside the shaft,
+    then around its tail)."""
+    base = math.atan2(d[1], d[0])
+    ang = base + np.radians(np.arange(0, 360, 5))
+    u = np.column_stack((np.cos(ang), np.sin(ang)))  # (n, 2)
+    gaps = np.array(GAPS)[:, None]  # (g, 1)
+    behind = 1.0 - u @ d  # 0 beyond the tip, 2 behind it
+    centres = [_touching(a, u, radius + gaps, hw, hh).reshape(-1, 2)]
+    prefs = [(0.004 * gaps + 0.01 * behind).ravel()]
+    if length > 0:
+        nrm = np.array([-d[1], d[0]])
+        t = np.arange(0.5 * ALONG, length, ALONG)[:, None, None]  # (t, 1, 1)
+        sides = np.array([nrm, -nrm])[None, :, None, :]  # (1, 2, 1, 2)
+        p = a - t[..., None] * d  # (t, 1, 1, 2)
+        g3 = np.array(GAPS)[None, None, :]  # (1, 1, g)
+        centres.append(_touching(p, sides, g3, hw, hh).reshape(-1, 2))  # (t, 2, g, 2)
+        prefs.append(np.broadcast_to(0.004 * g3 + 0.02 + 0.0015 * t,
+                                     (len(t), 2, len(GAPS))).ravel())
+        # around the tail, last: where several arrows may start
+        centres.append(_touching(a - length * d, u, gaps, hw, hh).reshape(-1, 2))
+        prefs.append((0.004 * gaps + 0.03 + 0.0015 * length + 0.01 * (2.0 - behind)).ravel())
+    for r in RINGS:
+        n = 16 if r < 20 else 24 if r < 40 else 32 if r < 70 else 40
+        ang = base + np.linspace(0, 2 * np.pi, n, endpoint=False)
+        u = np.column_stack((np.cos(ang), np.sin(ang)))
+        centres.append(_touching(a, u, np.full(n, radius + r), hw, hh))
+        prefs.append(0.004 * r + 0.01 * (1.0 - u @ d))
+    return np.vstack(centres), np.concatenate(prefs)
+
+
+def _near(mine: np.ndarray, boxes: np.ndarray, gap: float) -> np.ndarray:
+    """(c,) whether each box (c, 4) lies within `gap` of one of the points `mine` (k, 2):
+    counted in the box grown by `gap` across and along (sure), then, for a point only in
+    the grown box's corners, measured."""
+    own = _Counts(mine)
+    sure = gap - 1.0  # a count takes in every cell a box touches: up to a point more
+    g = np.array([sure, 0.0, -sure, 0.0])  # grown left and right; then up and down
+    near = (own(boxes - g) + own(boxes - g[[1, 0, 3, 2]])) > 0
+    maybe = ~near & (own(boxes - gap * np.array([1.0, 1.0, -1.0, -1.0])) > 0)
+    if np.any(maybe):
+        b = boxes[maybe]
+        near[maybe] = _gap(mine, b[:, 0], b[:, 1], b[:, 2], b[:, 3]) <= gap
+    return near
 
 
 def place(panel: Panel, labels: list[Label], obstacles: list[tuple[np.ndarray, str]]
@@ -97,71 +176,93 @@ def place(panel: Panel, labels: list[Label], obstacles: list[tuple[np.ndarray, s
     tags = np.repeat(np.array([names[tag] for _, tag in obstacles] or [-1]),
                      [len(p) for p in pts] or [0])
     x0b, y0b, wb, hb = panel.rect
-    placed = np.zeros((0, 4))
-    for lab in labels:
+    anchors = np.array([panel.to_pt(lab.anchor) for lab in labels]).reshape(-1, 2)
+    counts = _Counts(P)
+
+    # every label's candidates, scored against the strokes once
+    cands: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+    sizes = []
+    for lab, a_pt in zip(labels, anchors, strict=True):
         t = lab.text
-        t.offset, t.ha, t.va = (0.0, 0.0), "left", "bottom"
-        lab.leader = None
+        t.offset, t.ha, t.va, lab.leader = (0.0, 0.0), "center", "center", None
         _, _, w, h = text_box(t, np.zeros(2))
-        a_pt = panel.to_pt(lab.anchor)
+        sizes.append((w, h))
         d = np.asarray(lab.direction, dtype=float)
         n = np.linalg.norm(d)
         d = d / n if n > 1e-12 else np.array([1.0, 0.0])
-        nrm = np.array([-d[1], d[0]])
-        length = lab.shaft * panel.scale if lab.shaft > 0 else None
+        hw, hh = w / 2 + PAD, h / 2 + PAD
+        c, pref = _candidates(a_pt, d, lab.shaft * panel.scale, lab.radius * panel.scale,
+                              hw, hh)
+        boxes = np.column_stack((c[:, 0] - hw, c[:, 1] - hh, c[:, 0] + hw, c[:, 1] + hh))
+        hits = counts(boxes)
+        score = pref + 10.0 * hits
+        outside = ((boxes[:, 0] < x0b) | (boxes[:, 2] > x0b + wb) | (boxes[:, 1] < y0b)
+                   | (boxes[:, 3] > y0b + hb))
+        score += OUTSIDE * outside
         mine = P[tags == names.get(lab.own, -2)] if len(P) else P
-        near_gap = NEAR * h
-        # strokes near enough to matter for this label
-        reach = 100.0 + w + h + 2 * PAD + (length or 0.0)  # spots along the shaft too
-        near = np.all(np.abs(P - a_pt) < reach, axis=1) if len(P) else np.zeros(0, bool)
-        Q = P[near]
-        best: tuple[float, float, float, float, float, float, float] | None = None
-        for g, sp in enumerate(_rings(length)):
-            off = sp[:, :1] * d + sp[:, 1:2] * nrm  # (c, 2) points
-            side = sp[:, 2:3] * d + sp[:, 3:4] * nrm
-            o = side / np.maximum(np.linalg.norm(side, axis=1, keepdims=True), 1e-12)
-            fx = np.where(o[:, 0] > 0.3, 0.0, np.where(o[:, 0] < -0.3, 1.0, 0.5))
-            fy = np.where(o[:, 1] > 0.3, 0.0, np.where(o[:, 1] < -0.3, 1.0, 0.5))
-            x0 = a_pt[0] + off[:, 0] - fx * w - PAD
-            y0 = a_pt[1] + off[:, 1] - fy * h - PAD
-            x1, y1 = x0 + w + 2 * PAD, y0 + h + 2 * PAD
-            score = 0.004 * np.linalg.norm(off, axis=1)  # nearer is better, all else equal
-            if len(Q):
-                inside = ((Q[None, :, 0] > x0[:, None]) & (Q[None, :, 0] < x1[:, None])
-                          & (Q[None, :, 1] > y0[:, None]) & (Q[None, :, 1] < y1[:, None]))
-                score += 10.0 * np.count_nonzero(inside, axis=1)
-            if len(placed):
-                ow = np.minimum(x1[:, None], placed[:, 2]) - np.maximum(x0[:, None],
-                                                                        placed[:, 0])
-                oh = np.minimum(y1[:, None], placed[:, 3]) - np.maximum(y0[:, None],
-                                                                        placed[:, 1])
-                hit = (ow > 0) & (oh > 0)
-                score += np.sum(np.where(hit, 200 + 5 * ow * oh, 0.0), axis=1)
-            outside = (x0 < x0b) | (x1 > x0b + wb) | (y0 < y0b) | (y1 > y0b + hb)
-            score += 2.0 * outside  # allowed (limits grow later) but not preferred
-            if len(mine):  # far from its own strokes: worse than any free spot near them
-                score += 2.5 * (_gap(mine, x0 + PAD, y0 + PAD, x1 - PAD, y1 - PAD)
-                                > near_gap)
-            k = int(np.argmin(score))  # the first of equal scores, as the spots are ordered
-            if best is None or score[k] < best[0]:
-                best = (float(score[k]), float(off[k, 0]), float(off[k, 1]), float(fx[k]),
-                        float(fy[k]), float(x0[k]), float(y0[k]))
-            # free and near (at most outside the panel for now): take it; once the near
-            # rings are tried, any free spot
-            if best[0] < 2.5 or (best[0] < 5.0 and g >= 2):
+        free = hits == 0
+        if len(mine) and np.any(free):  # a free spot far from its own strokes: worse than
+            # any free spot near them (a spot on a stroke is worse than both)
+            score[free] += FAR * ~_near(mine, boxes[free] + [PAD, PAD, -PAD, -PAD],
+                                        NEAR * h)
+        cands.append((boxes, score, mine))
+
+    placed = np.full((len(labels), 4), np.nan)
+
+    def best(i: int, others: np.ndarray) -> tuple[int, float]:
+        """Label i's best candidate beside the boxes `others` (m, 4); its score."""
+        boxes, score = cands[i][0], cands[i][1]
+        if len(others):
+            ow = (np.minimum(boxes[:, None, 2], others[:, 2])
+                  - np.maximum(boxes[:, None, 0], others[:, 0]))
+            oh = (np.minimum(boxes[:, None, 3], others[:, 3])
+                  - np.maximum(boxes[:, None, 1], others[:, 1]))
+            hit = (ow > 0) & (oh > 0)
+            score = score + np.sum(np.where(hit, 200 + 5 * ow * oh, 0.0), axis=1)
+        k = int(np.argmin(score))  # the first of equal scores: candidates are ordered
+        return k, float(score[k])
+
+    scores = np.zeros(len(labels))
+    for i in range(len(labels)):
+        k, s = best(i, placed[:i])
+        placed[i], scores[i] = cands[i][0][k], s
+
+    # a label without a free near spot: move the labels in its way, if they have others
+    for i in map(int, np.flatnonzero(scores >= FREE)):
+        boxes, score = cands[i][0], cands[i][1]
+        for spot in np.argsort(score, kind="stable")[:60]:
+            if score[spot] >= FREE:
                 break
-        assert best is not None
-        _, ox, oy, bx, by, bx0, by0 = best
-        t.offset = (ox, oy)
-        t.ha = "left" if bx == 0 else "right" if bx == 1 else "center"
-        t.va = "bottom" if by == 0 else "top" if by == 1 else "center"
-        box = np.array([bx0, by0, bx0 + w + 2 * PAD, by0 + h + 2 * PAD])
-        placed = np.vstack((placed, box))
+            box = boxes[spot]
+            rest = np.delete(np.arange(len(labels)), i)
+            ow = np.minimum(box[2], placed[rest, 2]) - np.maximum(box[0], placed[rest, 0])
+            oh = np.minimum(box[3], placed[rest, 3]) - np.maximum(box[1], placed[rest, 1])
+            blockers = rest[(ow > 0) & (oh > 0)]
+            if not 1 <= len(blockers) <= 2:
+                continue
+            trial, moved = placed.copy(), scores.copy()
+            trial[i], moved[i] = box, score[spot]
+            for j in blockers:
+                kj, moved[j] = best(int(j), np.delete(trial, j, axis=0))
+                if moved[j] >= FREE:
+                    break
+                trial[j] = cands[j][0][kj]
+            else:
+                placed, scores = trial, moved
+                break
+
+    for i, lab in enumerate(labels):
+        t = lab.text
+        box = placed[i]
+        a_pt = anchors[i]
+        c = (box[:2] + box[2:]) / 2
+        t.offset = (float(c[0] - a_pt[0]), float(c[1] - a_pt[1]))
+        mine = cands[i][2]
         if len(mine):
             lo, hi = box[:2] + PAD, box[2:] - PAD
             gaps = np.linalg.norm(mine - np.clip(mine, lo, hi), axis=1)
             j = int(np.argmin(gaps))
-            if gaps[j] > near_gap:  # a thin line from the box to its arrow
+            if gaps[j] > NEAR * sizes[i][1]:  # a thin line from the box to its arrow
                 ends = np.array([np.clip(mine[j], lo, hi), mine[j]])
                 lab.leader = (ends - panel.rect[:2]) / panel.scale + panel.lo
     return placed
@@ -175,4 +276,3 @@ def _gap(pts: np.ndarray, x0: np.ndarray, y0: np.ndarray, x1: np.ndarray, y1: np
     dy = np.maximum(np.maximum(y0[:, None] - pts[None, :, 1], pts[None, :, 1] - y1[:, None]),
                     0)
     return np.min(np.hypot(dx, dy), axis=1)
-
