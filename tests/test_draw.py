@@ -573,7 +573,7 @@ def test_driver_effort_is_drawn_as_an_actuators_effort_apart_from_reactions(
     assert (text in minus) == text.startswith("−")
     assert any("on the joint's parent" in s for s in entries) == bool(minus)
     # the matplotlib figure draws it so too
-    line = arrows(fbd.draw(), gid)[gid]
+    line = arrows(mbody.draw_fbd(fbd), gid)[gid]
     assert to_hex(line.get_color()) == COLORS["effort"] and line.get_linestyle() != "-"
 
 
