@@ -27,13 +27,22 @@ import numpy as np
 
 from mbody import conventions as cv
 from mbody.equations.assemble import singular_mass_error
+from mbody.equations.joints import reaction_columns
+from mbody.equations.spatial import quat_to_matrix
 from mbody.equations.workspace import workspace
-from mbody.equations.world import world_reaction_series
-from mbody.errors import MbodyError
+from mbody.errors import MbodyError, did_you_mean
 from mbody.kernel import _core
 from mbody.model.model import Model
-from mbody.simulate.trajectory import Trajectory, model_text
-from mbody.solve.kinematics import CLOSE_RTOL, KinematicsError, _cannot_close, _size
+from mbody.simulate.axes import check_axes, world_series
+from mbody.simulate.peaks import peaks
+from mbody.simulate.trajectory import Trajectory, keep_planar_angles, model_text
+from mbody.solve.kinematics import (
+    CLOSE_RTOL,
+    KinematicsError,
+    _cannot_close,
+    _size,
+    _state,
+)
 
 MAX_NEWTON = 60
 """Newton steps at most at one sample (one or two from the previous sample's Taylor
@@ -106,8 +115,7 @@ def kinematic_run(model: Model, t_end: float, fps: float, *, t_start: float = 0.
         At a sample where the loops cannot close (a dead centre, links that cannot
         reach): its time, the drivers' values and the distance left.
     """
-    if axes not in ("joint", "world"):
-        raise MbodyError(f"axes must be 'joint' or 'world', got {axes!r}")
+    check_axes(axes)
     t = sample_times(t_end, fps, t_start)
     free = freedom(model)
     if free:
@@ -139,9 +147,6 @@ def _failed(model: Model, t: float, y: np.ndarray, info: np.ndarray) -> None:
     if info[_core.KR_SINGULAR]:
         code = int(info[_core.KR_SINGULAR]) - 1
         raise singular_mass_error(model, code // 6, code % 6)
-    from mbody.equations.joints import reaction_columns
-    from mbody.solve.kinematics import _state
-
     if not np.isfinite(y).all():
         raise KinematicsError(f"the position analysis at t = {t:g} s diverged (a value is "
                               "not a number): a driver may be past a dead centre")
@@ -163,14 +168,15 @@ def _trajectory(model: Model, t: np.ndarray, Y: np.ndarray, OUT: np.ndarray,
     q = Y[:, 3 * n:7 * n].reshape(K, n, 4)
     v = Y[:, 7 * n:10 * n].reshape(K, n, 3)
     w = Y[:, 10 * n:13 * n].reshape(K, n, 3)
+    if planar:  # the Newton steps turn q, not the angle carried beside it
+        keep_planar_angles(Y, n)
     m = len(model.reactions)
     lam = OUT[:, plan.o_lam:plan.o_lam + m]
     stats = OUT[:, plan.o_info:]
     labels: tuple[str, ...] = tuple(model.reactions)
     values = lam
     if axes == "world":
-        W_e = _directions(model, t, Y)
-        labels, values = world_reaction_series(model, W_e, lam)
+        labels, values = world_series(model, t, Y, lam)
     pose = ((x[..., :2], v[..., :2], Y[:, 13 * n:], w[..., 2]) if planar else (x, v, q, w))
     run_info = {
         "integrator": "none (kinematic run: every sample's positions by Newton's method)",
@@ -251,30 +257,13 @@ def driver_facts(model: Model) -> list[dict]:
             for name, j, c in zip(d.names, d.joint.tolist(), d.component, strict=True)]
 
 
-def _directions(model: Model, t: np.ndarray, Y: np.ndarray) -> np.ndarray:
-    """(K, m, 3) each reaction component's direction (world) at each sample."""
-    ws = workspace(model)
-    m = len(model.reactions)
-    K = len(t)
-    W_e = np.empty((K, m, 3))
-    c6, p6, W_P = np.empty((m, 6)), np.empty((m, 6)), np.empty((m, 3))
-    gamma, phi, gtv = np.empty(m), np.empty(m), np.empty(m)
-    for k in range(K):
-        ws.core.columns(float(t[k]), Y[k], c6, p6, W_e[k], W_P, gamma, phi, gtv)
-    return W_e
-
-
 def _body_points(model: Model, x: np.ndarray, q: np.ndarray, points: BodyPoints | None
                  ) -> dict[str, np.ndarray]:
     """'point:<name>' -> (K, d) world positions of the named body points."""
-    from mbody.equations.spatial import quat_to_matrix
-
     out: dict[str, np.ndarray] = {}
     d = model.dimension
     for name, (body, p) in (points or {}).items():
         if body not in model.bodies:
-            from mbody.errors import did_you_mean
-
             hint = did_you_mean(body, list(model.body_names))
             raise MbodyError(f"point {name!r}: no body {body!r} in this model"
                              + (f"; {hint}" if hint else ""))
@@ -364,32 +353,6 @@ def _cumulative(f: np.ndarray, t: np.ndarray) -> np.ndarray:
 def _rate(f: np.ndarray, t: np.ndarray) -> np.ndarray:
     """df/dt at the samples (second-order differences; 0 for a single sample)."""
     return np.gradient(f, t, edge_order=2) if len(t) > 2 else np.zeros(len(t))
-
-
-def peaks(model: Model, traj: Trajectory) -> list[dict]:
-    """Each reaction's and effort's largest magnitude over the run: label, value (signed),
-    unit, time, and the first driver's coordinate then (its law at that time: degrees
-    for an angle, m for a displacement)."""
-    d = model.drivers
-    out: list[dict] = []
-    if not len(traj.reaction_labels) or not len(traj.t):
-        return out
-    R = np.asarray(traj.reactions)
-    at = np.argmax(np.abs(R), axis=0)
-    for c, label in enumerate(traj.reaction_labels):
-        k = int(at[c])
-        tk = float(traj.t[k])
-        entry = {"label": label, "value": float(R[k, c]),
-                 "unit": "N m" if label.rsplit(".", 1)[-1].startswith("M") else "N",
-                 "t": tk}
-        if d is not None and len(d.names):
-            value = float(d.laws[0][0](tk))
-            angle = d.component[0] == "M"
-            entry["driver"] = d.names[0]
-            entry["driver_value"] = math.degrees(value) if angle else value
-            entry["driver_unit"] = "deg" if angle else "m"
-        out.append(entry)
-    return out
 
 
 def revolution(model: Model) -> float | None:

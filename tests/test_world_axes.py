@@ -1,0 +1,273 @@
+"""Reactions in world axes (`--axes world`, ``axes="world"``) on runs, plots, the report
+and exports: the values against each body's Newton-Euler equations written out here,
+against `Assembly.solve(axes="world")` at a sample's state, and a run made in joint axes
+turned into world axes afterwards against one made in world axes."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+import mbody
+from mbody.equations.spatial import quat_to_matrix
+from mbody.simulate.axes import in_world_axes
+
+ROOT = Path(__file__).resolve().parents[1]
+MODELS = ROOT / "models"
+EPS = np.finfo(float).eps
+
+
+def _model(name: str) -> mbody.Model:
+    return mbody.load(MODELS / f"{name}.yaml")
+
+
+def _mbody(*args: str | Path) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "mbody", *map(str, args)], cwd=ROOT,
+                          capture_output=True, text=True, timeout=300)
+
+
+def newton_euler_residuals(model: mbody.Model, state: mbody.State,
+                           world: dict[str, float], couples: dict[str, list[float]]
+                           ) -> tuple[float, float]:
+    """Each body's Newton and Euler equations in world axes with the joints' world forces F
+    and moments M (on the child at the joint point; −F, −M on the parent) and the drivers'
+    efforts along their axes, the accelerations solved at `state`:
+
+        m a = m g + Σ ±F,    R (J ω̇ + ω × J ω) = Σ ±((P − x_G) × F + M) + couples.
+
+    Returns the largest residual of each kind relative to its largest term."""
+    asm = mbody.assemble(model, state)
+    sol = asm.solve()
+    cols = asm.columns
+    rt = model.reaction_table
+    n = model.n
+    planar = model.dimension == 2
+    acc = np.asarray(sol.accelerations).reshape(n, -1)
+    a = np.zeros((n, 3))
+    wdot = np.zeros((n, 3))
+    if planar:
+        a[:, :2], wdot[:, 2] = acc[:, :2], acc[:, 2]
+    else:
+        a, wdot = acc[:, :3], acc[:, 3:]
+    x = np.asarray(state.position)
+    R = quat_to_matrix(np.asarray(state.quaternion))
+    w = np.asarray(state.omega)
+    J = np.asarray(model.J)
+    mass = np.asarray(model.mass)
+    g = np.asarray(model.gravity)
+    force = mass[:, None] * g
+    moment = np.zeros((n, 3))
+    force_terms = [np.abs(mass[:, None] * a).max(), np.abs(force).max()]
+    moment_terms = []
+    index = {b: i for i, b in enumerate(model.body_names)}
+    for body, c in couples.items():
+        moment[index[body]] += c
+    labels = list(model.reactions)
+
+    def act(child: str, parent: str, P: np.ndarray, F: np.ndarray, M: np.ndarray) -> None:
+        for body, sign in ((child, 1.0), (parent, -1.0)):
+            if body in index:
+                i = index[body]
+                force[i] += sign * F
+                moment[i] += sign * (np.cross(P - x[i], F) + M)
+        force_terms.append(float(np.abs(F).max()))
+        moment_terms.append(float(np.abs(np.cross(P - x[index[child]], F) + M).max()))
+
+    for j, joint in enumerate(model.joints):
+        c = int(np.flatnonzero(rt.joint[:len(labels) - len(rt.driver_names)] == j)[0])
+        F = np.array([world.get(f"{joint.name}.F{ax}", 0.0) for ax in "xyz"])
+        M = np.array([world.get(f"{joint.name}.M{ax}", 0.0) for ax in "xyz"])
+        act(joint.child, joint.parent, cols.W_P[c], F, M)
+    for name in rt.driver_names:
+        label = next(lab for lab in labels if lab.split(".")[0] == name)
+        c = labels.index(label)
+        joint = model.joints[int(rt.joint[c])]
+        effort = world[label] * cols.W_e[c]
+        moving = label.endswith(".M")
+        act(joint.child, joint.parent, cols.W_P[c], 0 * effort if moving else effort,
+            effort if moving else 0 * effort)
+    newton = mass[:, None] * a - force
+    Jw = np.einsum("nij,nj->ni", J, w)
+    euler_body = np.einsum("nij,nj->ni", J, wdot) + np.cross(w, Jw)
+    euler = np.einsum("nij,nj->ni", R, euler_body) - moment
+    moment_terms.append(float(np.abs(euler_body).max()))
+    return (float(np.abs(newton).max() / max(force_terms)),
+            float(np.abs(euler).max() / max(max(moment_terms), 1e-300)))
+
+
+# -- simulate ------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("name, couples", [
+    ("double_pendulum", {}),                          # planar, integrated
+    ("fourbar_spatial", {}),                          # spatial, redundant joints
+    ("gyroscope_gimbals", {"inner": [0.05, 0, 0]}),   # a 200 rad/s rotor, a world couple
+    ("flyball_governor", {}),                         # partly driven: integrated
+    ("slider_crank_driven", {}),                      # fully driven: the kinematic run
+])
+def test_a_world_axes_run_keeps_each_bodys_newton_euler_equations(name, couples):
+    """At every tenth sample the stored world forces and moments balance each body's
+    m a and R (J ω̇ + ω × J ω), and equal `Assembly.solve(axes="world")` at the sample's
+    state. The solve's backward error is below 1e-14 on these models, so both hold to far
+    better than 1e-10 of their largest term."""
+    model = _model(name)
+    if name == "slider_crank_driven":  # without its gas force: gravity alone is applied
+        doc = yaml.safe_load((MODELS / f"{name}.yaml").read_text())
+        del doc["loads"]
+        model = mbody.loads(yaml.safe_dump(doc))
+    traj = mbody.simulate(model, 0.5, 40, axes="world")
+    assert traj.info["reaction_axes"] == "world"
+    labels = traj.reaction_labels
+    assert all(lab.rsplit(".", 1)[1] in ("Fx", "Fy", "Fz", "Mx", "My", "Mz", "M", "F")
+               for lab in labels)
+    scale = float(np.abs(traj.reactions).max())
+    for k in range(0, len(traj), 10):
+        state = traj.state(k)
+        values = dict(zip(labels, traj.reactions[k].tolist(), strict=True))
+        newton, euler = newton_euler_residuals(model, state, values, couples)
+        assert newton < 1e-10 and euler < 1e-10, (k, newton, euler)
+        solved = mbody.assemble(model, state).solve(axes="world")
+        assert list(solved.reactions) == list(labels)
+        # the same state up to the planar angle's rounding (its quaternion from θ/2)
+        tol = 16 * EPS * max(1.0, float(np.abs(traj.orientation).max())) * scale
+        assert np.abs(np.array(list(solved.reactions.values())) - traj.reactions[k]).max() \
+            <= tol, k
+
+
+@pytest.mark.parametrize("name, t_end, fps", [
+    ("double_pendulum", 10.0, 30),
+    ("slider_crank", 2.0, 30),            # planar, a wheel that turns many times
+    ("fourbar_spatial", 1.0, 30),
+    ("flyball_governor", 1.0, 30),
+    ("slider_crank_driven", 0.5, 40),     # samples 0.6 revolution apart
+])
+def test_a_joint_axes_run_turned_into_world_axes_equals_a_world_axes_run(
+        tmp_path, name, t_end, fps):
+    """Saved in joint axes, read back and turned into world axes with the model it
+    carries, a run equals the same run made in world axes: labels, values (to the
+    rounding of a planar angle's quaternion, θ/2 of a large θ), peaks and energy check."""
+    model = _model(name)
+    joint = mbody.simulate(model, t_end, fps)
+    assert joint.info["reaction_axes"] == "joint"
+    joint.save(tmp_path / "run.npz")
+    turned = in_world_axes(mbody.Trajectory.load(tmp_path / "run.npz"))
+    world = mbody.simulate(model, t_end, fps, axes="world")
+    assert turned.info["reaction_axes"] == "world"
+    assert turned.reaction_labels == world.reaction_labels
+    scale = float(np.abs(world.reactions).max())
+    # not the joint-frame values: some joint frame turns with its parent
+    assert turned.reaction_labels != joint.reaction_labels or \
+        np.abs(turned.reactions - joint.reactions).max() > 1e-3 * scale
+    angle = float(np.abs(world.orientation).max()) if model.dimension == 2 else 1.0
+    np.testing.assert_allclose(turned.reactions, world.reactions, rtol=0,
+                               atol=16 * EPS * max(1.0, angle) * scale)
+    if "peaks" in world.info:
+        assert [p["label"] for p in turned.info["peaks"]] == \
+            [p["label"] for p in world.info["peaks"]]
+        for key in ("energy_balance_residual", "power_balance_residual", "driver_work"):
+            assert turned.info[key] == world.info[key] == joint.info[key], key
+    # drivers' efforts are kept as they are
+    for lab in joint.reaction_labels:
+        if lab.split(".")[0] in (model.drivers.names if model.drivers else ()):
+            np.testing.assert_array_equal(
+                world.reactions[:, world.reaction_labels.index(lab)],
+                joint.reactions[:, joint.reaction_labels.index(lab)])
+    assert in_world_axes(world) is world  # already in world axes: as it is
+
+
+def test_a_pin_in_world_axes_is_the_same_force_whatever_the_parent_turns():
+    """The double pendulum's pin A is along its parent's (the upper rod's) frame in
+    joint axes, so its components turn with that rod, yet |F| is the same in both axes
+    and the world components are the joint ones turned by the rod's angle."""
+    model = _model("double_pendulum")
+    joint = mbody.simulate(model, 2.0, 20)
+    world = in_world_axes(joint)
+    jl, wl = joint.reaction_labels, world.reaction_labels
+    Fj = joint.reactions[:, [jl.index("A.Fx"), jl.index("A.Fy")]]
+    Fw = world.reactions[:, [wl.index("A.Fx"), wl.index("A.Fy")]]
+    turn = joint.orientation[:, 0] - joint.orientation[0, 0]  # upper's, from the file's
+    c, s = np.cos(turn), np.sin(turn)
+    # the joint frame is world-aligned at the file's pose, then turns with the parent
+    rotated = np.stack((c * Fj[:, 0] - s * Fj[:, 1], s * Fj[:, 0] + c * Fj[:, 1]), axis=1)
+    scale = float(np.abs(Fw).max())
+    assert np.abs(rotated - Fw).max() < 1e-13 * scale
+    assert np.abs(np.linalg.norm(Fj, axis=1) - np.linalg.norm(Fw, axis=1)).max() \
+        < 1e-13 * scale
+
+
+def test_turning_a_run_into_world_axes_needs_its_model():
+    model = _model("double_pendulum")
+    traj = mbody.simulate(model, 0.2, 20)
+    bare = mbody.Trajectory(traj.t, traj.position, traj.velocity, traj.orientation,
+                            traj.angular_velocity, traj.body_names, traj.dimension,
+                            reaction_labels=traj.reaction_labels, reactions=traj.reactions)
+    with pytest.raises(mbody.MbodyError, match="does not carry its model"):
+        in_world_axes(bare)
+    assert np.array_equal(in_world_axes(bare, model).reactions, in_world_axes(traj).reactions)
+    with pytest.raises(mbody.MbodyError, match="not those of the model"):
+        in_world_axes(traj, _model("triple_pendulum"))
+    with pytest.raises(mbody.MbodyError, match="axes must be 'joint' or 'world'"):
+        mbody.simulate(model, 0.2, 20, axes="body")
+
+
+def test_simulate_and_plot_from_the_command_line_in_world_axes(tmp_path):
+    """`simulate --axes world` saves world-axes reactions (the summary says so); `plot
+    --axes world` of a joint-axes run draws the converted run; `plot --axes joint` of a
+    world-axes run is refused with the way out; the figures' titles say the axes."""
+    from mbody.present.plot import plot_trajectory
+
+    run_w, run_j = tmp_path / "w.npz", tmp_path / "j.npz"
+    p = _mbody("simulate", "models/double_pendulum.yaml", "--t-end", "1", "--axes",
+               "world", "-o", run_w)
+    assert p.returncode == 0, p.stderr
+    assert "reactions stored in world axes" in p.stdout
+    w = mbody.Trajectory.load(run_w)
+    assert w.info["reaction_axes"] == "world" and w.reaction_labels[:2] == ("O.Fx", "O.Fy")
+    assert _mbody("simulate", "models/double_pendulum.yaml", "--t-end", "1", "-o",
+                  run_j).returncode == 0
+    j = mbody.Trajectory.load(run_j)
+    np.testing.assert_allclose(in_world_axes(j).reactions, w.reactions, rtol=0,
+                               atol=1e-13 * np.abs(w.reactions).max())
+    for run, extra in ((run_j, ("--axes", "world")), (run_w, ()), (run_j, ())):
+        out = tmp_path / f"{run.stem}{len(extra)}.png"
+        p = _mbody("plot", run, "-o", out, *extra)
+        assert p.returncode == 0, p.stderr
+        assert out.stat().st_size > 10_000
+    p = _mbody("plot", run_w, "-o", tmp_path / "x.png", "--axes", "joint")
+    assert p.returncode == 2 and "world axes" in p.stderr and "Traceback" not in p.stderr
+    assert not (tmp_path / "x.png").exists()
+    for traj, words in ((in_world_axes(j), "world axes"), (j, "joint axes")):
+        fig = plot_trajectory(traj)
+        titles = [a.get_title() for a in fig.axes]
+        assert any(t.startswith("joint reaction forces, " + words)
+                   for t in titles), titles
+        assert fig.get_suptitle().endswith("reactions in " + words)
+
+
+def test_plot_of_a_driven_run_in_world_axes(tmp_path):
+    """A kinematic run saved in joint axes, plotted with --axes world: the drivers'
+    figure says world axes; the bearing loads |F| are the same in both."""
+    from mbody.present.drive_plot import plot_driven
+
+    run = tmp_path / "run.npz"
+    assert _mbody("kinematics", "models/slider_crank_driven.yaml", "-o", run).returncode == 0
+    p = _mbody("plot", run, "-o", tmp_path / "a.png", "--axes", "world")
+    assert p.returncode == 0, p.stderr
+    joint = mbody.Trajectory.load(run)
+    world = in_world_axes(joint)
+    fig = plot_driven(world)
+    assert "reactions in world axes" in fig.get_suptitle()
+    assert any("world axes" in a.get_title() for a in fig.axes)
+    bearing_j = next(a for a in plot_driven(joint).axes if a.get_title().startswith("bearing"))
+    bearing_w = next(a for a in fig.axes if a.get_title().startswith("bearing"))
+    for lj, lw in zip(bearing_j.lines, bearing_w.lines, strict=True):
+        assert lj.get_label() == lw.get_label()
+        y = np.asarray(lj.get_ydata())
+        assert np.abs(y - np.asarray(lw.get_ydata())).max() < 1e-12 * y.max()
+    j = json.loads(_mbody("kinematics", "models/slider_crank_driven.yaml", "--json").stdout)
+    assert j["reaction_axes"] == "joint"
