@@ -23,10 +23,11 @@ from matplotlib.figure import Figure
 
 from mbody import conventions as cv
 from mbody import joint_types
+from mbody.equations.world import check_axes
 from mbody.errors import MbodyError
 from mbody.io.atomic import write_atomic
 from mbody.present.draw.fonts import drawable
-from mbody.simulate.axes import check_axes, in_world_axes
+from mbody.simulate.axes import in_world_axes
 from mbody.simulate.trajectory import Trajectory
 
 MAX_BODIES = 6

@@ -26,16 +26,6 @@ from mbody.model.model import Model
 from mbody.simulate.peaks import peaks
 from mbody.simulate.trajectory import Trajectory
 
-AXES = ("joint", "world")
-"""The axes a run's reactions can be stored in: each component along its joint frame (the
-default), or each joint's force and moment on its child in world axes."""
-
-
-def check_axes(axes: str) -> None:
-    """Refuse anything but one of `AXES`."""
-    if axes not in AXES:
-        raise MbodyError(f"axes must be 'joint' or 'world', got {axes!r}")
-
 
 def reaction_directions(model: Model, t: np.ndarray, Y: np.ndarray) -> np.ndarray:
     """(K, m) x 3: each reaction component's unit direction (world axes) at each sampled

@@ -30,10 +30,11 @@ from mbody.equations.assemble import singular_mass_error
 from mbody.equations.joints import reaction_columns
 from mbody.equations.spatial import quat_to_matrix
 from mbody.equations.workspace import workspace
+from mbody.equations.world import check_axes
 from mbody.errors import MbodyError, did_you_mean
 from mbody.kernel import _core
 from mbody.model.model import Model
-from mbody.simulate.axes import check_axes, world_series
+from mbody.simulate.axes import world_series
 from mbody.simulate.peaks import peaks
 from mbody.simulate.trajectory import Trajectory, keep_planar_angles, model_text
 from mbody.solve.kinematics import (

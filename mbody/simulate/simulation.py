@@ -36,10 +36,11 @@ import numpy as np
 from mbody import conventions as cv
 from mbody.equations.constraints import joint_errors
 from mbody.equations.workspace import workspace
+from mbody.equations.world import check_axes
 from mbody.errors import MbodyError, UnknownReactionsError, did_you_mean
 from mbody.model.expressions import Expression, check_times, compile_expression, first_nonfinite
 from mbody.model.model import Model, State
-from mbody.simulate.axes import check_axes, world_series
+from mbody.simulate.axes import world_series
 from mbody.simulate.kinematic import driven_figures, driven_lines, fully_driven, kinematic_run
 from mbody.simulate.kinematic import summary as kinematic_summary
 from mbody.simulate.mechanism import BAUMGARTE_RATE, sample_figures
