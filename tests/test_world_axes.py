@@ -33,13 +33,16 @@ def _mbody(*args: str | Path) -> subprocess.CompletedProcess:
 
 
 def newton_euler_residuals(model: mbody.Model, state: mbody.State,
-                           world: dict[str, float], couples: dict[str, list[float]]
+                           world: dict[str, float], couples: dict[str, list[float]],
+                           forces: dict[str, list[float]] | None = None
                            ) -> tuple[float, float]:
     """Each body's Newton and Euler equations in world axes with the joints' world forces F
     and moments M (on the child at the joint point; −F, −M on the parent) and the drivers'
     efforts along their axes, the accelerations solved at `state`:
 
-        m a = m g + Σ ±F,    R (J ω̇ + ω × J ω) = Σ ±((P − x_G) × F + M) + couples.
+        m a = m g + Σ ±F + forces,    R (J ω̇ + ω × J ω) = Σ ±((P − x_G) × F + M) + couples
+
+    (`couples` and `forces`, at the mass centres: the applied loads, world axes).
 
     Returns the largest residual of each kind relative to its largest term."""
     asm = mbody.assemble(model, state)
@@ -68,6 +71,8 @@ def newton_euler_residuals(model: mbody.Model, state: mbody.State,
     index = {b: i for i, b in enumerate(model.body_names)}
     for body, c in couples.items():
         moment[index[body]] += c
+    for body, f in (forces or {}).items():
+        force[index[body]] += f
     labels = list(model.reactions)
 
     def act(child: str, parent: str, P: np.ndarray, F: np.ndarray, M: np.ndarray) -> None:
@@ -350,3 +355,194 @@ def test_the_report_in_world_axes(tmp_path, name, couples):
     p = _mbody("report", MODELS / f"{name}.yaml", "--axes", "world", "-o", out)
     assert p.returncode == 0, p.stderr
     assert "Joint reactions in world axes" in out.read_text()
+
+
+# -- exports ---------------------------------------------------------------------------------
+
+JACK = {"model": "jack", "dimension": 3, "gravity": [0, 0, -9.81],
+        "bodies": [{"name": "nut", "mass": 50.0, "inertia": [0.03, 0.03, 0.02],
+                    "position": [0, 0, 0.2], "angular_velocity": [0, 0, 4.0],
+                    "velocity": [0, 0, 4.0 * 0.005 / (2 * np.pi)]}],
+        "loads": [{"name": "turn", "type": "torque", "body": "nut", "torque": [0, 0, 3.0]}],
+        "joints": [{"name": "H", "type": "helical", "parent": "ground", "child": "nut",
+                    "at": [0, 0, 0.2], "axis": [0, 0, 1], "pitch": 0.005}]}
+"""A nut on a vertical screw (tests/test_new_joint_types.py's screw jack): one helical
+joint, whose axial wrench Wz is a force along the screw and −(pitch/2π) Wz about it."""
+
+
+def _export_models() -> list[tuple[str, mbody.Model]]:
+    out = [(name, _model(name)) for name in ("slider_crank_driven", "fourbar_spatial",
+                                              "point_pendulum", "practice_1_translation")]
+    return out + [("jack", mbody.loads(yaml.safe_dump(JACK)))]
+
+
+def _write(exp, tmp_path: Path, fmt: str) -> Path:
+    from mbody.io import export as ex
+
+    if fmt == "csv":
+        return ex.write_csv(exp, tmp_path / "csv")
+    return ex.write_export(exp, tmp_path / f"eqs.{fmt}")
+
+
+@pytest.mark.parametrize("fmt", ["npz", "mat", "json", "csv"])
+def test_an_export_in_world_axes_round_trips_and_solves_like_the_assembly(tmp_path, fmt):
+    """Every format writes the map T and its labels and reads them back bit for bit; the
+    reloaded export's solve in world axes is `Assembly.solve(axes="world")` (the same
+    components summed, in another order: to rounding); T λ equals the world series
+    of `mbody.equations.world` for any λ (it is that sum's matrix)."""
+    from mbody.equations.world import world_reaction_series
+    from mbody.io import export as ex
+
+    rng = np.random.default_rng(25)
+    for name, model in _export_models():
+        asm = mbody.assemble(model)
+        exp = ex.exported(asm, axes="world")
+        back = ex.load_export(_write(exp, tmp_path / name, fmt))
+        assert back.differences(exp) == [], name
+        assert back.T is not None and back.world_reactions == exp.world_reactions
+        assert back.shape["T"] == (len(exp.world_reactions), len(model.reactions))
+        m = len(model.reactions)
+        lam = rng.standard_normal((3, m))
+        labels, series = world_reaction_series(model, np.repeat(asm.columns.W_e[None], 3, 0),
+                                               lam)
+        assert list(labels) == back.world_reactions
+        np.testing.assert_allclose((back.T @ lam.T).T, series, rtol=0,
+                                   atol=1e-14 * max(1.0, np.abs(series).max(initial=0)))
+        if not m:
+            assert back.T.shape == (0, 0)
+            continue
+        want = asm.solve(axes="world")
+        got = back.solve(axes="world")
+        assert got.axes == "world" and list(got.reactions) == list(want.reactions)
+        a, b = np.array(list(want.reactions.values())), np.array(list(got.reactions.values()))
+        np.testing.assert_allclose(b, a, rtol=0, atol=1e-13 * np.abs(a).max())
+        assert back.solve().reactions == asm.solve().reactions  # joint axes as before
+
+
+def test_a_screw_jacks_world_axes_from_its_export():
+    """The helical joint's axial wrench Wz: world H.Fz = Wz (the screw pushes the nut up)
+    and H.Mz = −(pitch/2π) Wz, with Wz = m (z̈ + g) (tests/test_new_joint_types.py)."""
+    from mbody.io import export as ex
+
+    model = mbody.loads(yaml.safe_dump(JACK))
+    exp = ex.exported(mbody.assemble(model), axes="world")
+    assert exp.world_reactions == ["H.Fx", "H.Fy", "H.Fz", "H.Mx", "H.My", "H.Mz"]
+    h = 0.005 / (2 * np.pi)
+    wz = exp.T.toarray()[:, exp.reactions.index("H.Wz")]
+    assert wz == pytest.approx([0, 0, 1, 0, 0, -h], abs=1e-15)
+    sol = exp.solve(axes="world")
+    m, J, tau = 50.0, 0.02, 3.0
+    Wz = m * (h * (tau - m * 9.81 * h) / (m * h * h + J) + 9.81)
+    assert sol.reactions["H.Fz"] == pytest.approx(Wz, rel=1e-12)
+    assert sol.reactions["H.Mz"] == pytest.approx(-h * Wz, rel=1e-12)
+
+
+def test_the_map_with_scipy_alone_gives_forces_that_balance_each_body(tmp_path):
+    """What coursework does with the npz file and no mbody: solve the joint-frame system
+    by hand, then world = T λ: those forces satisfy each body's Newton-Euler equations."""
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spla
+
+    from mbody.io import export as ex
+
+    model = _model("slider_crank")
+    path = ex.write_export(mbody.assemble(model), tmp_path / "eqs.npz", axes="world")
+    z = np.load(path, allow_pickle=False)
+
+    def mat(name: str) -> sp.csc_matrix:
+        return sp.csc_matrix((z[f"{name}_data"], z[f"{name}_indices"], z[f"{name}_indptr"]),
+                             shape=tuple(z[f"{name}_shape"]))
+
+    M, G, T = mat("M"), mat("G"), mat("T")
+    n, m = M.shape[0], G.shape[1]
+    K = sp.bmat([[M, -G], [G.T, None]]).tocsc()
+    x = spla.spsolve(K, np.concatenate((z["Q"] - z["b"], z["column_gamma"])))
+    world = dict(zip(map(str, z["world_reactions"]), (T @ x[n:]).tolist(), strict=True))
+    assert list(world) == list(mbody.assemble(model).solve(axes="world").reactions)
+    newton, euler = newton_euler_residuals(model, model.initial, world, {"crank": [0, 0, -60]},
+                                           forces={"piston": [-4000, 0, 0]})
+    assert newton < 1e-10 and euler < 1e-10
+    assert m == len(model.reactions)
+
+
+def test_exports_without_the_map_and_version_1_files_still_read(tmp_path):
+    """An export not asked for world axes holds no map (and says how to get one); a file
+    written by the version 1 layout reads as before."""
+    from mbody.io import export as ex
+
+    asm = mbody.assemble(_model("double_pendulum"))
+    exp = ex.exported(asm)
+    assert exp.T is None and exp.world_reactions == [] and "T" not in exp.shape
+    with pytest.raises(mbody.MbodyError, match="--axes world"):
+        exp.solve(axes="world")
+    with pytest.raises(mbody.MbodyError, match="axes must be"):
+        ex.exported(asm, axes="body")
+    # version 1 files, as the previous layout wrote them (the same fields, version 1)
+    npz = ex.write_export(exp, tmp_path / "old.npz")
+    arrays = dict(np.load(npz, allow_pickle=False))
+    assert int(arrays["version"]) == ex.VERSION == 2 and "T_data" not in arrays
+    arrays["version"] = np.array(1)
+    np.savez(tmp_path / "v1.npz", **arrays)
+    doc = json.loads(ex.write_export(exp, tmp_path / "old.json").read_text())
+    assert "world" not in doc
+    doc["version"] = 1
+    (tmp_path / "v1.json").write_text(json.dumps(doc))
+    folder = ex.write_csv(exp, tmp_path / "v1csv")
+    assert not (folder / "T.csv").exists()
+    info = (folder / "info.csv").read_text().replace("version,2", "version,1")
+    (folder / "info.csv").write_text(info)
+    for path in (tmp_path / "v1.npz", tmp_path / "v1.json", folder):
+        old = ex.load_export(path)
+        assert old.differences(exp) == [] and old.T is None, path
+        np.testing.assert_array_equal(old.solve().accelerations, asm.solve().accelerations)
+    # a version 1 file cannot hold a map: one that does was edited
+    doc["world"] = ex.to_json(ex.exported(asm, axes="world"))["world"]
+    (tmp_path / "bad.json").write_text(json.dumps(doc))
+    with pytest.raises(mbody.MbodyError, match="version 1 export holds no world-axes map"):
+        ex.load_export(tmp_path / "bad.json")
+
+
+def test_the_json_export_with_its_map_validates_against_the_schema(tmp_path):
+    jsonschema = pytest.importorskip("jsonschema")
+    from mbody.io import export as ex
+
+    schema = ex.schema()
+    doc = ex.to_json(ex.exported(mbody.assemble(_model("slider_crank_driven")), axes="world"))
+    jsonschema.validate(doc, schema)
+    assert doc["world"]["reactions"][-1] == "motor.M"
+    bad = json.loads(json.dumps(doc))
+    bad["world"]["T"]["shape"] = [3]
+    with pytest.raises(jsonschema.ValidationError):
+        jsonschema.validate(bad, schema)
+    bad = json.loads(json.dumps(doc))
+    bad["world"]["T"]["shape"] = [len(doc["world"]["reactions"]) + 1, len(doc["reactions"])]
+    (tmp_path / "bad.json").write_text(json.dumps(bad))
+    with pytest.raises(mbody.MbodyError, match="world-axes map T is 11x9; expected 10x9"):
+        ex.load_export(tmp_path / "bad.json")
+
+
+def test_export_world_axes_from_the_command_line_at_a_runs_sample(tmp_path):
+    """`mbody export MODEL --state RUN --time T --axes world`: T at the sample's state
+    turns the export's own joint-frame solve into the world-axes run's values there."""
+    from mbody.io import export as ex
+
+    run = tmp_path / "run.npz"
+    assert _mbody("simulate", "models/fourbar_planar.yaml", "--t-end", "0.5", "-o",
+                  run).returncode == 0
+    p = _mbody("export", "models/fourbar_planar.yaml", "--state", run, "--time", "0.3",
+               "--axes", "world", "-o", tmp_path / "e.json", "-o", tmp_path / "e.mat",
+               "--csv", tmp_path / "csv")
+    assert p.returncode == 0, p.stderr
+    assert "T.csv" in p.stdout and ", T 8x8 (" in p.stdout and "world axes = T lambda" in p.stdout
+    world = in_world_axes(mbody.Trajectory.load(run))
+    k = int(np.argmin(np.abs(world.t - 0.3)))
+    for path in (tmp_path / "e.json", tmp_path / "e.mat", tmp_path / "csv"):
+        got = ex.load_export(path).solve(axes="world")
+        assert list(got.reactions) == list(world.reaction_labels)
+        # the run's own solve at the same state (its quaternions from the stored angles,
+        # a few radians: rounding)
+        np.testing.assert_allclose(list(got.reactions.values()), world.reactions[k],
+                                   rtol=0, atol=1e-13 * np.abs(world.reactions).max())
+    p = _mbody("export", "models/fourbar_planar.yaml", "--axes", "sideways", "-o",
+               tmp_path / "x.npz")
+    assert p.returncode == 2 and "Traceback" not in p.stderr
