@@ -218,6 +218,14 @@ def test_turning_a_run_into_world_axes_needs_its_model():
         in_world_axes(traj, _model("triple_pendulum"))
     with pytest.raises(mbody.MbodyError, match="axes must be 'joint' or 'world'"):
         mbody.simulate(model, 0.2, 20, axes="body")
+    # an imported model's run keeps no YAML to rebuild it from: given, it converts
+    arm = mbody.load(MODELS / "robots" / "two_link_arm.xml")
+    run = mbody.simulate(arm, 0.2, 20)
+    with pytest.raises(mbody.MbodyError, match="imported model.*pass the model"):
+        in_world_axes(run)
+    world = mbody.simulate(arm, 0.2, 20, axes="world")
+    np.testing.assert_allclose(in_world_axes(run, arm).reactions, world.reactions, rtol=0,
+                               atol=1e-13 * np.abs(world.reactions).max())
 
 
 def test_simulate_and_plot_from_the_command_line_in_world_axes(tmp_path):

@@ -15,6 +15,7 @@ axes is converted afterwards with the model it carries (`in_world_axes`).
 from __future__ import annotations
 
 import dataclasses
+from pathlib import Path
 
 import numpy as np
 
@@ -81,6 +82,12 @@ def in_world_axes(traj: Trajectory, model: Model | None = None) -> Trajectory:
     model : Model, optional
         The run's model (default: the one it carries, `Trajectory.model`).
 
+    Returns
+    -------
+    Trajectory
+        The same run (its arrays shared, not copied) with `reactions` and
+        `reaction_labels` in world axes, ``info["reaction_axes"]`` "world".
+
     Raises
     ------
     MbodyError
@@ -91,13 +98,20 @@ def in_world_axes(traj: Trajectory, model: Model | None = None) -> Trajectory:
             or np.asarray(traj.reactions).shape[1:] != (len(traj.reaction_labels),):
         return traj
     if model is None:
+        again = "run it again with --axes world (axes='world')"
+        if Path(traj.model_file).suffix.lower() in (".xml", ".urdf", ".mjcf"):
+            raise MbodyError(
+                f"the run of {traj.model_name!r} was made from {traj.model_file}, an "
+                "imported model: turning its reactions into world axes needs the model "
+                "(the joints' directions at each sample), which a run carries for mbody "
+                f"YAML files only; {again}, or pass the model (in_world_axes(traj, model))")
         try:
             model = traj.model()
         except TrajectoryFileError:
             raise MbodyError(
                 f"the run of {traj.model_name!r} does not carry its model's text, which "
                 "turning its reactions into world axes needs (the joints' directions at "
-                "each sample); run it again with --axes world (axes='world')") from None
+                f"each sample); {again}") from None
     if tuple(model.reactions) != tuple(traj.reaction_labels) or \
             tuple(model.body_names) != tuple(traj.body_names):
         raise MbodyError(f"the run's reactions ({', '.join(traj.reaction_labels[:4])}...) are "
