@@ -554,3 +554,27 @@ def test_export_world_axes_from_the_command_line_at_a_runs_sample(tmp_path):
     p = _mbody("export", "models/fourbar_planar.yaml", "--axes", "sideways", "-o",
                tmp_path / "x.npz")
     assert p.returncode == 2 and "Traceback" not in p.stderr
+
+
+def test_the_notebook_shows_a_world_axes_solution_and_run_as_such():
+    """A world-axes `Solution` in a notebook says world axes and gives each joint the
+    status of its components (a redundant four-bar: solved and not-unique ones mixed)."""
+    import html
+    import re
+
+    from mbody.present.rich import solution_html, trajectory_html
+
+    model = _model("fourbar_spatial")
+    sol = mbody.assemble(model).solve(axes="world")
+    page = html.unescape(solution_html(sol))
+    assert "each joint's force and moment on its child, world axes" in page
+    rows = re.findall(r"<tr><td>([^<]+)</td><td[^>]*>[^<]+</td><td>([^<]+)</td></tr>", page)
+    assert [r[0] for r in rows] == list(sol.reactions)
+    joint = mbody.assemble(model).solve()
+    for label, status in rows:
+        mine = {lab for lab in joint.solved if lab.split(".")[0] == label.split(".")[0]}
+        free = mine & set(joint.not_unique)
+        assert status == ("not unique" if free == mine else "partly solved" if free
+                          else "solved"), label
+    run = mbody.simulate(_model("double_pendulum"), 0.1, 20, axes="world")
+    assert "O.Fx, O.Fy, A.Fx, A.Fy (world axes)" in trajectory_html(run)
