@@ -361,6 +361,19 @@ def test_a_kinematic_run_of_the_driven_slider_crank_equals_the_hand_solution():
     assert fine.info["energy_balance_residual"] < 1e-6
 
 
+def test_a_kinematic_run_with_samples_far_apart_stores_each_angle_at_its_pose():
+    """A quarter of a revolution between samples: the rod's stored angle is the closed
+    form's at each sample (the Newton steps that close the loop turn the rod; its stored
+    angle must follow them, not stay where the Taylor step left it)."""
+    from mbody.simulate.kinematic import kinematic_run
+
+    period = 2 * math.pi / OMEGA
+    traj = kinematic_run(driven_slider_crank(), 2 * period, 4 / period)
+    for k in range(len(traj)):
+        phi = slider_crank_kinematics(float(traj.orientation[k, 0]))["phi"]
+        assert traj.orientation[k, 1] == pytest.approx(phi, abs=1e-12), k
+
+
 def test_a_kinematic_runs_coupler_curve_equals_freudenstein():
     """A named coupler point followed over half a revolution from a pose 3 degrees off
     (joint points per body): its world path equals the closed form to 1e-10 m."""

@@ -188,13 +188,18 @@ def assignments(pairs: Sequence[str], flag: str, form: str,
     return out
 
 
-def add_axes_option(command: argparse.ArgumentParser) -> None:
-    """--axes {joint,world}: the axes reactions are given in (docs/reactions.md)."""
+def add_axes_option(command: argparse.ArgumentParser, saved: bool = False) -> None:
+    """--axes {joint,world}: the axes reactions are given in (docs/reactions.md); `saved`:
+    a command that reads a saved run, whose reactions stay as saved by default."""
+    words = ("each component along its joint frame, fixed to the parent; 'world' each "
+             "joint's force and moment on its child along world x, y, z (as a hand solution "
+             "in world axes writes them)")
     command.add_argument(
-        "--axes", choices=("joint", "world"), default="joint",
-        help="axes of the joint reactions: 'joint' (default) each component along its joint "
-        "frame, fixed to the parent; 'world' each joint's force and moment on its child "
-        "along world x, y, z (as a hand solution in world axes writes them)")
+        "--axes", choices=("joint", "world"), default=None if saved else "joint",
+        help=(f"axes of the joint reactions shown: 'joint' {words}; default: as the run "
+              "was saved (a run saved in joint axes is turned into world axes with the "
+              "model it carries)") if saved else
+        f"axes of the joint reactions: 'joint' (default) {words}")
 
 
 MODEL_HELP = "a model file: mbody YAML, MuJoCo's MJCF (.xml) or URDF (.urdf)"

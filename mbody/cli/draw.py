@@ -11,6 +11,7 @@ from mbody.cli.common import (
     EXIT_OK,
     MODEL_HELP,
     PICTURE_FORMATS,
+    add_axes_option,
     bounded,
     load_model,
     output_stream,
@@ -61,14 +62,16 @@ def register(sub: argparse._SubParsersAction) -> None:
     s = sub.add_parser("report", help="write one self-contained HTML page for the model",
                        description="One offline HTML page: the model summary, the topology "
                        "picture, the sizes of the stacked M, b, Q, G, the accelerations "
-                       "and joint reactions solved at the initial state (with units), and "
-                       "every body's free-body diagram and equations.")
+                       "and joint reactions solved at the initial state (with units; in "
+                       "world axes with --axes world), and every body's free-body diagram "
+                       "and equations.")
     s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
     s.add_argument("-o", "--output", metavar="FILE", default="report.html",
                    help="the page to write (default: report.html)")
     s.add_argument("--view", metavar="VIEW", default="iso", help=VIEW_HELP)
     s.add_argument("--answers", metavar="FILE", help="a student's equations (a YAML answers "
                    "file, see mbody verify): shown beside the expected rows")
+    add_axes_option(s)
     s.set_defaults(run=report)
 
 
@@ -166,7 +169,7 @@ def report(a: argparse.Namespace) -> int:
 
         regular_file(a.answers, "a YAML answers file")
         answers = verify(model, a.answers)
-    path = write_report(model, a.output, view=a.view, answers=answers)
+    path = write_report(model, a.output, view=a.view, answers=answers, axes=a.axes)
     print(f"wrote {path}  ({model.n} bod{'y' if model.n == 1 else 'ies'})",
           file=output_stream(a.output))
     return EXIT_OK

@@ -48,6 +48,11 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "are not interpolated")
     s.add_argument("--known", metavar="LABEL=VALUE", action="append", default=[],
                    help="a known reaction value recorded in the export, e.g. --known A.Fx=3")
+    s.add_argument("--axes", choices=("joint", "world"), default="joint",
+                   help="'world': add the map T (world = T lambda) from the joint-frame "
+                   "reaction values, the columns of G, to each joint's force and moment on "
+                   "its child along world x, y, z at the state, with their labels (T.csv "
+                   "in a CSV folder); 'joint' (default): M, b, Q, G alone")
     s.set_defaults(run=export)
 
 
@@ -74,7 +79,7 @@ def export(a: argparse.Namespace) -> int:
         asm, source = assembly_from_trajectory(model, a.state, a.time)
     else:
         asm, source = assemble(model), ""
-    exp = exported(asm, parse_known(a.known), source)
+    exp = exported(asm, parse_known(a.known), source, axes=a.axes)
     N, m = len(exp.coordinates), len(exp.reactions)
     for out in a.output:  # an unknown suffix is refused before anything is written
         if Path(out).suffix.lower() not in SUFFIXES:
@@ -93,9 +98,11 @@ def export(a: argparse.Namespace) -> int:
         print(f"wrote {out}", file=say)
     if a.csv:
         print(f"wrote {a.csv}/ (M.csv, G.csv, vectors.csv, columns.csv, bodies.csv, "
-              "info.csv)", file=say)
+              f"info.csv{', T.csv' if exp.T is not None else ''})", file=say)
+    world = (f", T {len(exp.world_reactions)}x{m} ({exp.T.nnz} non-zeros; world axes = "
+             "T lambda)" if exp.T is not None else "")
     print(f"M {N}x{N} ({exp.M.nnz} non-zeros), b {N}, Q {N}, G {N}x{m} "
-          f"({exp.G.nnz} non-zeros); state: {exp.state_source}", file=say)
+          f"({exp.G.nnz} non-zeros){world}; state: {exp.state_source}", file=say)
     return EXIT_OK
 
 

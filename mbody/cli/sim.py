@@ -9,6 +9,7 @@ import sys
 from mbody.cli.common import (
     EXIT_OK,
     MODEL_HELP,
+    add_axes_option,
     bounded,
     load_model,
     number,
@@ -75,6 +76,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--progress", action="store_true",
                    help="show the progress bar on stderr even when it is not a terminal")
     s.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    add_axes_option(s)
     s.set_defaults(run=simulate)
 
     s = sub.add_parser("plot", help="plot a saved run: angular velocity, energy, momentum, "
@@ -83,9 +85,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                        "time, and their relative drift, in one multi-panel figure. A run "
                        "that stores joint reactions (every run of a model with joints) gets "
                        "a third row: the reaction force components (N) and moment "
-                       "components (N m) over time, each along its joint-frame axis, +R on "
-                       "the child (the first 12 of each kind; a kind the joints do not have, "
-                       "such as the moments of a planar revolute joint, gets no panel).")
+                       "components (N m) over time, +R on the child, each along its "
+                       "joint-frame axis (or with --axes world each joint's force and moment "
+                       "in world axes) (the first 12 of each kind; a kind the joints do not "
+                       "have, such as the moments of a planar revolute joint, gets no panel).")
     s.add_argument("trajectory", metavar="RUN.npz",
                    help="a trajectory saved by 'mbody simulate -o'")
     s.add_argument("-o", "--output", required=True, metavar="FILE",
@@ -100,6 +103,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--motion", action="store_true",
                    help="a run with drivers: plot the bodies' motion, energy and momentum "
                    "instead of the drivers' figure")
+    add_axes_option(s, saved=True)
     s.set_defaults(run=plot)
 
 
@@ -120,7 +124,7 @@ def simulate(a: argparse.Namespace) -> int:
                      atol=DEFAULT_ATOL if a.atol is None else a.atol, method=a.method,
                      known=known,
                      progress=(a.progress or sys.stderr.isatty()) and not a.no_progress,
-                     max_steps=max_steps or None, max_wall=a.max_wall)
+                     max_steps=max_steps or None, max_wall=a.max_wall, axes=a.axes)
     if a.output:
         traj.save(a.output)
     print(summary(traj, a.output), file=output_stream(a.output))
@@ -144,6 +148,6 @@ def plot(a: argparse.Namespace) -> int:
     ensure_writable(a.output)  # before the figure is drawn (a second or two)
     regular_file(a.trajectory, "a run file written by 'mbody simulate -o RUN.npz'")
     traj = Trajectory.load(a.trajectory)
-    save_plot(traj, a.output, a.body, against=a.against, motion=a.motion)
+    save_plot(traj, a.output, a.body, against=a.against, motion=a.motion, axes=a.axes)
     print(f"wrote {a.output}", file=output_stream(a.output))
     return EXIT_OK

@@ -23,8 +23,10 @@ from matplotlib.figure import Figure
 
 from mbody import conventions as cv
 from mbody import joint_types
+from mbody.equations.world import check_axes
 from mbody.errors import MbodyError
 from mbody.present.draw.fonts import drawable
+from mbody.simulate.axes import in_world_axes
 from mbody.simulate.trajectory import Trajectory
 from mbody.util.atomic import write_atomic
 
@@ -90,6 +92,8 @@ def plot_trajectory(traj: Trajectory, bodies: list[str] | None = None) -> Figure
              f"bod{'y' if traj.n == 1 else 'ies'}")
     if traj.info:
         title += (f", {traj.info.get('integrator', '')} rtol {traj.info.get('rtol', 0):g}")
+    if len(panels) > 4:  # reactions shown: say in which axes
+        title += f"; reactions in {_axes_words(traj)}"
     fig.suptitle(title)
     for k, draw in enumerate(panels):
         r, c = divmod(k, 2)
@@ -166,28 +170,49 @@ def _reaction_columns(traj: Trajectory, moment: bool) -> list[int]:
             if joint_types.is_moment(lab) == moment]
 
 
+def _axes_words(traj: Trajectory) -> str:
+    """The axes a run's reactions are in, in words (``info["reaction_axes"]``; a run saved
+    before world axes existed is in joint axes)."""
+    return "world axes" if traj.info.get("reaction_axes") == "world" else "joint axes"
+
+
 def _reaction_panel(traj: Trajectory, a: Axes, *, moment: bool, sel: list[int]) -> None:
-    """Reaction components over time, forces (N) or moments (N m), each on its joint frame
-    axis, acting +R on the child and −R on the parent."""
+    """Reaction components over time, forces (N) or moments (N m), acting +R on the
+    child and −R on the parent: each along its joint-frame axis, or in world axes each
+    joint's force and moment on its child (``info["reaction_axes"]``)."""
     labels = list(traj.reaction_labels)
     for k in sel[:MAX_REACTIONS]:
         a.plot(traj.t, traj.reactions[:, k], label=_text(labels[k]))
     more = f" (first {MAX_REACTIONS} of {len(sel)})" if len(sel) > MAX_REACTIONS else ""
-    a.set_title(f"joint reaction {'moments' if moment else 'forces'}, joint axes{more}")
+    a.set_title(f"joint reaction {'moments' if moment else 'forces'}, {_axes_words(traj)}"
+                f"{more}")
     a.set_ylabel("N m" if moment else "N")
 
 
 def save_plot(traj: Trajectory, path: str | os.PathLike[str], bodies: list[str] | None = None,
-              dpi: int = 120, against: str | None = None, motion: bool = False) -> Path:
+              dpi: int = 120, against: str | None = None, motion: bool = False,
+              axes: str | None = None) -> Path:
     """Plot `traj` and write the figure atomically; format from the extension. A run with
     drivers gets their figure (`mbody.present.drive_plot`, against `against`: 'time' or a
-    driver) unless `motion` asks for the bodies' motion."""
+    driver) unless `motion` asks for the bodies' motion. `axes`: the reactions' axes,
+    'world' (a run saved in joint axes is turned into world axes with the model it
+    carries, `mbody.simulate.axes.in_world_axes`) or 'joint'; None: as saved."""
     from mbody.present.drive_plot import drivers_of, plot_driven
 
     fmt = Path(path).suffix.lower().lstrip(".")
     if fmt not in FORMATS:
         raise MbodyError(f"cannot write {str(path)!r}: the plot format comes from the "
                          f"extension, one of {', '.join('.' + f for f in FORMATS)}")
+    if axes is not None:
+        check_axes(axes)
+        saved = traj.info.get("reaction_axes", "joint")
+        if axes == "world":
+            traj = in_world_axes(traj)
+        elif saved == "world" and len(traj.reaction_labels):
+            raise MbodyError("this run stores its reactions in world axes (it was made with "
+                             "--axes world), which do not give back the joint-frame "
+                             "components; plot it without --axes joint, or run it again "
+                             "without --axes world")
     if against is not None and (motion or not drivers_of(traj)):
         raise MbodyError("--against applies to a run with drivers (their figure), not to "
                          "the motion's")

@@ -15,15 +15,16 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from mbody import __version__
+from mbody import __version__, joint_types
 from mbody import conventions as cv
-from mbody.equations.assemble import Assembly, assemble
+from mbody.equations.assemble import Assembly, Solution, assemble
 from mbody.equations.topology import topology
+from mbody.equations.world import check_axes
 from mbody.errors import MbodyError
 from mbody.model.model import Model
 from mbody.present.answers import answers_section
 from mbody.present.draw import fbd_scene, figure_svg, graph_scene
-from mbody.present.text import body_text, model_summary
+from mbody.present.text import body_text, joint_status, model_summary
 from mbody.util.atomic import write_atomic
 
 if TYPE_CHECKING:
@@ -58,9 +59,13 @@ def _e(s: object) -> str:
 
 def report_html(model: Model, *, asm: Assembly | None = None,
                 view: str | Sequence[float] | None = "iso",
-                max_bodies: int = MAX_BODIES, answers: Verification | None = None) -> str:
+                max_bodies: int = MAX_BODIES, answers: Verification | None = None,
+                axes: str = "joint") -> str:
     """The report page as one HTML string (UTF-8, no external resources); with `answers`
-    (what `mbody.verify` found), a student's equations beside the expected rows."""
+    (what `mbody.verify` found), a student's equations beside the expected rows; `axes`:
+    the solution's reactions along their joint frames ("joint") or, each joint's force
+    and moment on its child, in world axes ("world")."""
+    check_axes(axes)
     asm = assemble(model) if asm is None else asm
     topo = topology(model, asm.G if model.reactions else None)
     planar = model.dimension == cv.PLANAR
@@ -114,7 +119,7 @@ def report_html(model: Model, *, asm: Assembly | None = None,
                "</table>"
                f"<p class=\"muted\">Sign rule: {_e(cv.SIGN_RULE)}.</p></section>")
 
-    out.append(_solution_section(asm))
+    out.append(_solution_section(asm, axes))
     if answers is not None:
         out.append(answers_section(answers))
 
@@ -152,14 +157,15 @@ def _quiet(x: np.ndarray, rel: float = 1e-10) -> np.ndarray:
     return np.where(np.abs(x) <= rel * top, 0.0, x)
 
 
-def _solution_section(asm: Assembly) -> str:
+def _solution_section(asm: Assembly, axes: str = "joint") -> str:
     """The solved accelerations by body and every reaction's value, at the file's state
-    (what `mbody solve` prints), or why the model cannot be solved there."""
+    (what `mbody solve` prints, with ``--axes world`` when `axes` is "world"), or why the
+    model cannot be solved there."""
     model = asm.model
     head = ('<section id="solution"><h2>Solution at the initial state</h2>'
             f"<p>At t = {_num(asm.state.t)} s, the state written in the file. ")
     try:
-        sol = asm.solve()
+        sol = asm.solve(axes=axes)
     except MbodyError as e:
         return head + f"The equations cannot be solved there: {_e(e)}</p></section>"
     rows = cv.PLANAR_ROWS if model.dimension == cv.PLANAR else cv.SPATIAL_ROWS
@@ -178,7 +184,9 @@ def _solution_section(asm: Assembly) -> str:
         for i, name in enumerate(model.body_names))
     out.append(f'<h3>Accelerations</h3><table class="solution" id="accelerations">'
                f"<tr><th>body</th>{header}</tr>{body_rows}</table>")
-    if sol.reactions:
+    if sol.reactions and axes == "world":
+        out.append(_world_reactions(model, sol))
+    elif sol.reactions:
         is_moment = asm.columns.is_moment
         lam = _quiet(np.array([sol.reactions[r] for r in model.reactions], dtype=np.float64))
         solved, not_unique = set(sol.solved), set(sol.not_unique)
@@ -198,6 +206,30 @@ def _solution_section(asm: Assembly) -> str:
     out += [f"<p><strong>Warning:</strong> {_e(w)}</p>" for w in sol.warnings]
     out.append("</section>")
     return "".join(out)
+
+
+def _world_reactions(model: Model, sol: Solution) -> str:
+    """The reactions table in world axes: each joint's force and moment on its child
+    (`mbody.equations.world`), the drivers' efforts as they are; a joint's status is its
+    components' (`joint_status`)."""
+    labels = list(sol.reactions)
+    values = _quiet(np.array([sol.reactions[r] for r in labels], dtype=np.float64))
+    status = joint_status(model, sol)
+    drivers = set(model.reaction_table.driver_names)
+    child = {j.name: j.child for j in model.joints}
+    lines = "".join(
+        f"<tr><td>{_e(label)}</td><td>{_num(v)}</td>"
+        f"<td>{'N·m' if joint_types.is_moment(label) else 'N'}</td>"
+        f"<td>{_e('driver effort' if name in drivers else 'on ' + child[name])}</td>"
+        f"<td>{_e(status.get(name, 'given'))}</td></tr>"
+        for label, v, name in zip(labels, values, (lab.split('.', 1)[0] for lab in labels),
+                                  strict=True))
+    return ("<h3>Joint reactions in world axes</h3><p>Each joint's force F and moment M on "
+            "its child at the joint point, along world x, y, z (−F, −M on the parent); a "
+            "driver's effort about, or along, its joint's axis. The free-body diagrams below "
+            "draw each component along its joint frame.</p>"
+            '<table class="solution" id="reactions"><tr><th>reaction</th><th>value</th>'
+            f"<th>unit</th><th>acts</th><th>status</th></tr>{lines}</table>")
 
 
 def write_report(model: Model, path: str | Path, **kwargs: Any) -> Path:

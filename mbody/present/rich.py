@@ -303,10 +303,20 @@ def solution_html(sol: Solution) -> str:
     if labels:
         lam = _clean(np.array([sol.reactions[r] for r in labels]))
         solved, free = set(sol.solved), set(sol.not_unique)
+        status = {lab: "not unique" if lab in free else "solved" for lab in solved}
+        world = sol.axes == "world"
+        if world:  # a joint's world force and moment mix its components: theirs decide
+            by_joint: dict[str, set[str]] = {}
+            for lab, st in status.items():
+                by_joint.setdefault(lab.split(".", 1)[0], set()).add(st)
+            status = {j: st.pop() if len(st) == 1 else "partly solved"
+                      for j, st in by_joint.items()}
         rows = [[lab, f"{_n(v)} {_unit(lab)}",
-                 "not unique" if lab in free else "solved" if lab in solved else "given"]
+                 status.get(lab.split(".", 1)[0] if world else lab, "given")]
                 for lab, v in zip(labels[:MAX_ROWS], lam, strict=False)]
-        parts += [tag("p", tag("b", "Reactions"), " (on the child, along the joint axes)"),
+        where = ("each joint's force and moment on its child, world axes" if world else
+                 "on the child, along the joint axes")
+        parts += [tag("p", tag("b", "Reactions"), f" ({where})"),
                   table(["component", "value", "status"], rows, numeric=[1]),
                   *_more(len(labels) - MAX_ROWS, "components: sol.reactions")]
     if sol.residual is not None:
@@ -398,7 +408,8 @@ def trajectory_html(traj: Trajectory) -> str:
         facts.append(["joint position drift (m)", f"{info['joint_position_drift']:.2e}"])
     if traj.reaction_labels:
         facts.append(["reaction series", ", ".join(traj.reaction_labels[:20])
-                      + (" ..." if len(traj.reaction_labels) > 20 else "")])
+                      + (" ..." if len(traj.reaction_labels) > 20 else "")
+                      + (" (world axes)" if info.get("reaction_axes") == "world" else "")])
     parts: list[object] = [table(["", ""], facts)]
     if len(t) > 1 and traj.mass is not None:
         parts.append(_plot_png(traj))

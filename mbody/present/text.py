@@ -215,14 +215,11 @@ def solution_text(sol: Solution, model: Model) -> str:
     return "\n".join(lines)
 
 
-def world_reaction_text(model: Model, sol: Solution) -> str:
-    """A solution's reactions in world axes (``Assembly.solve(axes="world")``): each joint's
-    force and moment on its child at its joint point along world x, y, z, then the drivers'
-    efforts; a joint's status is that of its joint-frame components."""
-    if not sol.reactions:
-        return ""
+def joint_status(model: Model, sol: Solution) -> dict[str, str]:
+    """joint or driver name -> what the solve did with its joint-frame components: "solved",
+    "given", "not unique" (redundant constraints), or "partly solved" when they differ:
+    the status of a joint's world-axes force and moment, which mix its components."""
     solved, not_unique = set(sol.solved), set(sol.not_unique)
-    drivers = set(model.reaction_table.driver_names)
     status: dict[str, str] = {}
     for label in model.reactions:
         name = label.split(".", 1)[0]
@@ -231,6 +228,17 @@ def world_reaction_text(model: Model, sol: Solution) -> str:
         if status.get(name, s) != s:
             s = "partly solved"
         status[name] = s
+    return status
+
+
+def world_reaction_text(model: Model, sol: Solution) -> str:
+    """A solution's reactions in world axes (``Assembly.solve(axes="world")``): each joint's
+    force and moment on its child at its joint point along world x, y, z, then the drivers'
+    efforts; a joint's status is that of its joint-frame components."""
+    if not sol.reactions:
+        return ""
+    drivers = set(model.reaction_table.driver_names)
+    status = joint_status(model, sol)
     child = {j.name: j.child for j in model.joints}
     lam = _clean(np.array(list(sol.reactions.values()), dtype=float))
     rows = []

@@ -29,12 +29,20 @@ from mbody import conventions as cv
 from mbody.equations.assemble import singular_mass_error
 from mbody.equations.joints import reaction_columns
 from mbody.equations.workspace import workspace
-from mbody.equations.world import world_reaction_series
+from mbody.equations.world import check_axes
 from mbody.errors import MbodyError, did_you_mean
 from mbody.kernel import _core
 from mbody.model.model import Model
-from mbody.simulate.trajectory import Trajectory, model_text
-from mbody.solve.kinematics import CLOSE_RTOL, KinematicsError, _cannot_close, _size, _state
+from mbody.simulate.axes import world_series
+from mbody.simulate.peaks import peaks
+from mbody.simulate.trajectory import Trajectory, keep_planar_angles, model_text
+from mbody.solve.kinematics import (
+    CLOSE_RTOL,
+    KinematicsError,
+    _cannot_close,
+    _size,
+    _state,
+)
 from mbody.util.spatial import quat_to_matrix
 
 MAX_NEWTON = 60
@@ -108,8 +116,7 @@ def kinematic_run(model: Model, t_end: float, fps: float, *, t_start: float = 0.
         At a sample where the loops cannot close (a dead centre, links that cannot
         reach): its time, the drivers' values and the distance left.
     """
-    if axes not in ("joint", "world"):
-        raise MbodyError(f"axes must be 'joint' or 'world', got {axes!r}")
+    check_axes(axes)
     t = sample_times(t_end, fps, t_start)
     free = freedom(model)
     if free:
@@ -162,14 +169,15 @@ def _trajectory(model: Model, t: np.ndarray, Y: np.ndarray, OUT: np.ndarray,
     q = Y[:, 3 * n:7 * n].reshape(K, n, 4)
     v = Y[:, 7 * n:10 * n].reshape(K, n, 3)
     w = Y[:, 10 * n:13 * n].reshape(K, n, 3)
+    if planar:  # the Newton steps turn q, not the angle carried beside it
+        keep_planar_angles(Y, n)
     m = len(model.reactions)
     lam = OUT[:, plan.o_lam:plan.o_lam + m]
     stats = OUT[:, plan.o_info:]
     labels: tuple[str, ...] = tuple(model.reactions)
     values = lam
     if axes == "world":
-        W_e = _directions(model, t, Y)
-        labels, values = world_reaction_series(model, W_e, lam)
+        labels, values = world_series(model, t, Y, lam)
     pose = ((x[..., :2], v[..., :2], Y[:, 13 * n:], w[..., 2]) if planar else (x, v, q, w))
     run_info = {
         "integrator": "none (kinematic run: every sample's positions by Newton's method)",
@@ -248,19 +256,6 @@ def driver_facts(model: Model) -> list[dict]:
     return [{"name": name, "joint": joints[int(j)].name,
              "kind": "angle" if c == "M" else "displacement", "effort": f"{name}.{c}"}
             for name, j, c in zip(d.names, d.joint.tolist(), d.component, strict=True)]
-
-
-def _directions(model: Model, t: np.ndarray, Y: np.ndarray) -> np.ndarray:
-    """(K, m, 3) each reaction component's direction (world) at each sample."""
-    ws = workspace(model)
-    m = len(model.reactions)
-    K = len(t)
-    W_e = np.empty((K, m, 3))
-    c6, p6, W_P = np.empty((m, 6)), np.empty((m, 6)), np.empty((m, 3))
-    gamma, phi, gtv = np.empty(m), np.empty(m), np.empty(m)
-    for k in range(K):
-        ws.core.columns(float(t[k]), Y[k], c6, p6, W_e[k], W_P, gamma, phi, gtv)
-    return W_e
 
 
 def _body_points(model: Model, x: np.ndarray, q: np.ndarray, points: BodyPoints | None
@@ -361,32 +356,6 @@ def _cumulative(f: np.ndarray, t: np.ndarray) -> np.ndarray:
     part[0] = (5.0 * f[0] + 8.0 * f[1] - f[2]) * (step / 12.0)
     part[-1] = (5.0 * f[-1] + 8.0 * f[-2] - f[-3]) * (step / 12.0)
     out[1:] = np.cumsum(part)
-    return out
-
-
-def peaks(model: Model, traj: Trajectory) -> list[dict]:
-    """Each reaction's and effort's largest magnitude over the run: label, value (signed),
-    unit, time, and the first driver's coordinate then (its law at that time: degrees
-    for an angle, m for a displacement)."""
-    d = model.drivers
-    out: list[dict] = []
-    if not len(traj.reaction_labels) or not len(traj.t):
-        return out
-    R = np.asarray(traj.reactions)
-    at = np.argmax(np.abs(R), axis=0)
-    for c, label in enumerate(traj.reaction_labels):
-        k = int(at[c])
-        tk = float(traj.t[k])
-        entry = {"label": label, "value": float(R[k, c]),
-                 "unit": "N m" if label.rsplit(".", 1)[-1].startswith("M") else "N",
-                 "t": tk}
-        if d is not None and len(d.names):
-            value = float(d.laws[0][0](tk))
-            angle = d.component[0] == "M"
-            entry["driver"] = d.names[0]
-            entry["driver_value"] = math.degrees(value) if angle else value
-            entry["driver_unit"] = "deg" if angle else "m"
-        out.append(entry)
     return out
 
 

@@ -36,15 +36,24 @@ import numpy as np
 from mbody import conventions as cv
 from mbody.equations.constraints import joint_errors
 from mbody.equations.workspace import workspace
+from mbody.equations.world import check_axes
 from mbody.errors import MbodyError, UnknownReactionsError, did_you_mean
 from mbody.model.expressions import Expression, check_times, compile_expression, first_nonfinite
 from mbody.model.model import Model, State
+from mbody.simulate.axes import world_series
 from mbody.simulate.kinematic import driven_figures, driven_lines, fully_driven, kinematic_run
 from mbody.simulate.kinematic import summary as kinematic_summary
 from mbody.simulate.mechanism import BAUMGARTE_RATE, sample_figures
 from mbody.simulate.projection import STAGE_PIVOT_RTOL, JointProjection
 from mbody.simulate.stepping import CORE, IMPLICIT, start
-from mbody.simulate.trajectory import Trajectory, body_matvec, cross, model_text, rotate
+from mbody.simulate.trajectory import (
+    Trajectory,
+    body_matvec,
+    cross,
+    keep_planar_angles,
+    model_text,
+    rotate,
+)
 from mbody.solve.dynamics import Dynamics, StateDerivative, accelerations
 
 METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
@@ -135,7 +144,7 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
              known: Mapping[str, float | str] | None = None, progress: bool = False,
              dynamics: Dynamics | None = None, max_step: float = math.inf,
              initial: State | None = None, max_steps: int | None = DEFAULT_MAX_STEPS,
-             max_wall: float | None = None) -> Trajectory:
+             max_wall: float | None = None, axes: str = "joint") -> Trajectory:
     """Integrate the motion from `initial` (default the model's state) to `t_end` seconds.
 
     Samples at t = k / fps for k = 0 .. ⌊t_end · fps⌋. Reactions not given in the file
@@ -174,6 +183,11 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     max_wall : float or None
         Budget of wall-clock seconds (None: no limit). A run that hits either budget
         stops with an `MbodyError` saying where and why.
+    axes : {"joint", "world"}
+        The axes of the stored reactions (`Trajectory.reactions`, ``reaction_labels``):
+        each component along its joint frame (the default), or each joint's force and
+        moment on its child along world x, y, z (``A.Fx, A.Fy...``, the drivers' efforts
+        kept; `mbody.simulate.axes`). ``info["reaction_axes"]`` says which.
 
     Returns
     -------
@@ -195,6 +209,7 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     if not (0 < rtol < 1) or not (atol > 0):
         raise MbodyError(f"tolerances must satisfy 0 < rtol < 1 and atol > 0 "
                          f"(got rtol={rtol:g}, atol={atol:g})")
+    check_axes(axes)
     if method not in METHODS:
         raise MbodyError(f"unknown integrator {method!r}; "
                          + (did_you_mean(method, METHODS) or f"one of {', '.join(METHODS)}"))
@@ -214,7 +229,7 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     if dynamics is None and initial is None and fully_driven(model):
         # the drivers fix the motion: each sample's kinematics then its reactions, no
         # integration (mbody.simulate.kinematic)
-        return kinematic_run(with_known(model, known), t_end, fps)
+        return kinematic_run(with_known(model, known), t_end, fps, axes=axes)
     rhs = state_derivative(model, known, dynamics)
     run_model = rhs.model  # the model with `known`'s values in its known reactions
     mechanism = dynamics is None and _has_unknown_reactions(run_model, None)
@@ -297,6 +312,8 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     norm = np.linalg.norm(q, axis=2)
     q_err = float(np.max(np.abs(norm - 1.0))) if n else 0.0
     q /= norm[..., None]  # Y holds the stored samples from here
+    if planar:  # the projections turn q, not the angle carried beside it
+        keep_planar_angles(Y, n)
     x = Y[:, :3 * n].reshape(K, n, 3)
     v = Y[:, 7 * n:10 * n].reshape(K, n, 3)
     w = Y[:, 10 * n:13 * n].reshape(K, n, 3)
@@ -322,6 +339,9 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
         lam = known_reaction_dynamics(model, known).reactions_at(t_eval)
     else:
         lam = np.zeros((K, 0))
+    stored, values = labels, lam
+    if axes == "world" and labels and lam.shape[1] == len(labels):
+        stored, values = world_series(run_model, t_eval, Y, lam)
     info = {
         "integrator": method, "rtol": rtol, "atol": atol, "t_end": t_end, "fps": fps,
         "samples": K, "steps": steps, "evaluations": run.nfev,
@@ -330,14 +350,14 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
         "wall_time_s": wall, "quaternion_norm_error": q_err,
         "quaternion_handling": "integrated as is; rotation built from q/|q|; output "
                                "samples divided by |q|",
-        **joint_info,
+        **joint_info, "reaction_axes": axes,
     }
     pose: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] = (
         (x[..., :2], v[..., :2], Y[:, 13 * n:], w[..., 2]) if planar else (x, v, q, w))
     traj = Trajectory(
         t_eval, *pose, body_names=model.body_names, dimension=model.dimension,
-        model_name=model.name, model_file=model.file, reaction_labels=labels,
-        reactions=lam, info=info, mass=np.array(model.mass), inertia=np.array(model.J),
+        model_name=model.name, model_file=model.file, reaction_labels=stored,
+        reactions=values, info=info, mass=np.array(model.mass), inertia=np.array(model.J),
         shapes=tuple(model.bodies[b].shape for b in model.body_names),
         colors=tuple(model.bodies[b].color for b in model.body_names),
         gravity=np.array(model.gravity), model_yaml=model_text(model))
@@ -855,6 +875,10 @@ def summary(traj: Trajectory, path: str | os.PathLike[str] | None = None) -> str
     if traj.dimension == cv.SPATIAL:
         lines.append(f"quaternion norm error before renormalising: "
                      f"{i['quaternion_norm_error']:.1e}")
+    if i.get("reaction_axes") == "world" and np.asarray(traj.reactions).size and \
+            not i.get("peaks"):
+        lines.append("reactions stored in world axes: each joint's force and moment on its "
+                     "child along world x, y, z")
     lines.extend(driven_lines(traj))
     lines.extend(f"warning: {w}" for w in i.get("warnings", ()))
     if path is not None:

@@ -77,7 +77,10 @@ class Trajectory:
     reaction_labels : tuple of str
         Labels of the reaction series in `reactions`.
     reactions : (K, m) array
-        Reaction values by `reaction_labels` (N; N m); empty when none are tracked.
+        Reaction values by `reaction_labels` (N; N m); empty when none are tracked. Each
+        component along its joint frame, or, when ``info["reaction_axes"]`` is
+        ``"world"``, each joint's force and moment on its child in world axes
+        (`mbody.simulate.axes`).
     info : dict
         Run facts: integrator, tolerances, energy/momentum/constraint drift, and under
         ``"warnings"`` what looked wrong.
@@ -468,3 +471,16 @@ def rotate(q: np.ndarray, u: np.ndarray) -> np.ndarray:
     v = q[..., 1:]
     c = cross(v, u)
     return u + 2.0 * (q[..., :1] * c + cross(v, c))
+
+
+def keep_planar_angles(Y: np.ndarray, n: int) -> None:
+    """Set the planar angles carried in the packed samples `Y` (K, 14 n: the core's layout,
+    θ after [x | q | v | ω]) to their quaternions' own angles, each on the branch of the
+    carried angle (which counts the turns a quaternion cannot). The core's projections
+    and Newton steps turn q and leave θ where the step put it: the stored angle would
+    then break the joints the stored q keeps (by 1e-10 rad over a long run, by most of a
+    step when a kinematic run's samples are far apart)."""
+    q = Y[:, 3 * n:7 * n].reshape(len(Y), n, 4)
+    theta = Y[:, 13 * n:]
+    theta += np.remainder(2.0 * np.arctan2(q[..., 3], q[..., 0]) - theta + np.pi,
+                          2.0 * np.pi) - np.pi

@@ -5,6 +5,9 @@ read them without mbody: the coordinate label of every row, the reaction label o
 column of G and, per column, its joint, joint type, parent, child, component, direction
 (the joint-frame axis in world axes at that state), joint point and sign rule; the body
 masses, inertia tensors and state; and the conventions (`mbody.conventions.conventions`).
+Asked for world axes (``exported(asm, axes="world")``), an export also holds the map T
+from the joint-frame reaction values λ to the world-axes ones, world = T λ, with their
+labels (``O.Fx``...: each joint's force and moment on its child along world x, y, z).
 
     exp = exported(asm)                 # an `ExportedAssembly` (in memory)
     write_export(asm, "eqs.npz")        # or .mat / .json; write_csv(asm, "eqs_csv/")
@@ -57,7 +60,7 @@ def _module(fmt: str) -> ModuleType:
 
 
 def write_export(asm: Assembly | ExportedAssembly, path: str | os.PathLike[str],
-                 known: Mapping[str, float] | None = None) -> Path:
+                 known: Mapping[str, float] | None = None, axes: str = "joint") -> Path:
     """Write an export whose format follows the suffix of `path`, atomically.
 
     Parameters
@@ -68,6 +71,9 @@ def write_export(asm: Assembly | ExportedAssembly, path: str | os.PathLike[str],
         A file name ending in .npz, .mat or .json.
     known
         Reaction values to record as known, with an `Assembly`.
+    axes
+        "world": add the map T from the joint-frame reaction values to the world-axes
+        ones (`ExportedAssembly.T`), with an `Assembly` (an export has its own).
 
     Returns
     -------
@@ -85,7 +91,7 @@ def write_export(asm: Assembly | ExportedAssembly, path: str | os.PathLike[str],
     if fmt is None:
         raise MbodyError(f"{path}: unknown export format {path.suffix or '(no suffix)'!r}; "
                          "use a name ending in .npz, .mat or .json, or --csv DIR")
-    exp = as_export(asm, known)
+    exp = as_export(asm, known, axes)
     with atomic_path(path) as tmp:
         _module(fmt).write(exp, tmp)
     return path

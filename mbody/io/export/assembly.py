@@ -9,9 +9,10 @@ reader and maps the file to and from these names; nothing here knows a file form
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from types import SimpleNamespace
 from typing import Any
@@ -24,14 +25,16 @@ from mbody import joint_types
 from mbody.equations.assemble import Assembly, Solution
 from mbody.equations.pack import pack_columns_model, pack_unknowns_of
 from mbody.equations.solution import METHODS, singular_mass_error
+from mbody.equations.world import check_axes, world_map
 from mbody.errors import MbodyError
 from mbody.kernel import _core
 from mbody.model.model import Model, State
 
 FORMAT = "mbody-export"
 """The format tag every export carries; a reader refuses any other."""
-VERSION = 1
-"""The newest export layout this mbody writes and reads."""
+VERSION = 2
+"""The newest export layout this mbody writes and reads. Version 2 added the world-axes
+map (`ExportedAssembly.T`, written when asked for); version 1 files read as before."""
 
 COLUMN_TEXT = ("labels", "joint", "type", "parent", "child", "component", "kind", "sign")
 """Text fields of `Columns`, one entry per reaction column (in this order in files)."""
@@ -124,6 +127,15 @@ class ExportedAssembly:
         (N,) gyroscopic and applied-force vectors.
     G
         (N, m) scipy CSC reaction coupling.
+    world_reactions
+        (p,) labels of the reactions in world axes (``O.Fx``...: each joint's force and
+        moment on its child along world x, y, z, then the drivers' efforts;
+        `mbody.equations.world`), when the export holds the map `T`; else empty.
+    T
+        (p, m) scipy CSC map from the joint-frame values λ (the columns of G, in the order
+        of `reactions`) to the world-axes ones at this state, world = T λ; None when the
+        export was not asked for world axes (``exported(asm, axes="world")``, ``mbody
+        export --axes world``).
     """
 
     model: str
@@ -142,6 +154,8 @@ class ExportedAssembly:
     b: np.ndarray
     Q: np.ndarray
     G: sp.csc_matrix
+    world_reactions: list[str] = field(default_factory=list)
+    T: sp.csc_matrix | None = None
 
     @property
     def t(self) -> float:
@@ -156,22 +170,30 @@ class ExportedAssembly:
 
     @property
     def shape(self) -> dict[str, tuple[int, ...]]:
-        """The shape of M, b, Q and G."""
+        """The shape of M, b, Q, G (and T when the export holds it)."""
         N, m = len(self.coordinates), len(self.reactions)
-        return {"M": (N, N), "b": (N,), "Q": (N,), "G": (N, m)}
+        out: dict[str, tuple[int, ...]] = {"M": (N, N), "b": (N,), "Q": (N,), "G": (N, m)}
+        if self.T is not None:
+            out["T"] = (len(self.world_reactions), m)
+        return out
 
     def __repr__(self) -> str:  # the dataclass's would print every matrix
         N, m = len(self.coordinates), len(self.reactions)
-        return (f"<ExportedAssembly of {self.model!r}: M {N}x{N}, G {N}x{m}; state: "
+        world = "" if self.T is None else f", T {len(self.world_reactions)}x{m}"
+        return (f"<ExportedAssembly of {self.model!r}: M {N}x{N}, G {N}x{m}{world}; state: "
                 f"{self.state_source}; .solve(), .records()>")
 
-    def solve(self, known: Mapping[str, float] | None = None) -> Solution:
+    def solve(self, known: Mapping[str, float] | None = None, *,
+              axes: str = "joint") -> Solution:
         """Accelerations, and the reaction components not given (stored values or `known`).
 
         Parameters
         ----------
         known
             Reaction values by label, added to (or replacing) the stored known values.
+        axes
+            The axes of the reactions returned: "joint" (the columns of G) or "world"
+            (``T λ``, labelled by `world_reactions`: needs an export holding `T`).
 
         Returns
         -------
@@ -181,7 +203,8 @@ class ExportedAssembly:
         Raises
         ------
         MbodyError
-            For a label of `known` that is no reaction of this export.
+            For a label of `known` that is no reaction of this export, or world axes asked
+            of an export without `T`.
 
         Notes
         -----
@@ -192,7 +215,21 @@ class ExportedAssembly:
         to it), from the stored matrices alone: redundant constraints give the
         minimum-norm reactions, named.
         """
+        check_axes(axes)
+        if axes == "world" and self.T is None:
+            raise MbodyError("this export holds no world-axes map (T): export the model "
+                             "again with --axes world (exported(asm, axes='world'))")
+        sol = self._solve(known)
+        if axes == "world":
+            assert self.T is not None
+            lam = np.array([sol.reactions[r] for r in self.reactions], dtype=float)
+            world = self.T @ lam
+            sol = dataclasses.replace(sol, reactions=dict(zip(
+                self.world_reactions, world.tolist(), strict=True)), axes="world")
+        return sol
 
+    def _solve(self, known: Mapping[str, float] | None) -> Solution:
+        """The joint-frame solve (`solve`'s notes)."""
         values = self.known
         for label, v in (known or {}).items():
             if label not in self.reactions:
@@ -266,13 +303,16 @@ class ExportedAssembly:
         if self.t != other.t:
             out.append("t")
         for k in ("M", "G"):
-            a, b = getattr(self, k), getattr(other, k)
-            if a.shape != b.shape or not (_same(a.data, b.data) and _same(a.indices, b.indices)
-                                          and _same(a.indptr, b.indptr)):
+            if not _same_sparse(getattr(self, k), getattr(other, k)):
                 out.append(k)
         for k in (*COLUMN_TEXT, "W_e", "W_P", "known", "gamma", "phi"):
             if not _same(getattr(self.columns, k), getattr(other.columns, k)):
                 out.append(f"columns.{k}")
+        if self.world_reactions != other.world_reactions:
+            out.append("world_reactions")
+        if (self.T is None) != (other.T is None) or (
+                self.T is not None and other.T is not None and not _same_sparse(self.T, other.T)):
+            out.append("T")
         return out
 
 
@@ -365,6 +405,11 @@ def _same(a: Any, b: Any) -> bool:
     return bool(np.array_equal(a.astype(str), b.astype(str)))
 
 
+def _same_sparse(a: sp.csc_matrix, b: sp.csc_matrix) -> bool:
+    return a.shape == b.shape and _same(a.data, b.data) and _same(a.indices, b.indices) \
+        and _same(a.indptr, b.indptr)
+
+
 def _canonical(A: sp.spmatrix) -> sp.csc_matrix:
     """CSC with sorted indices and no stored zeros: one representation per matrix."""
     C = sp.csc_matrix(A, dtype=float, copy=True)
@@ -382,7 +427,7 @@ def text_array(values: Sequence[str]) -> np.ndarray:
 
 
 def exported(asm: Assembly, known: Mapping[str, float] | None = None,
-             state_source: str = "") -> ExportedAssembly:
+             state_source: str = "", axes: str = "joint") -> ExportedAssembly:
     """Collect the matrices, labels and per-column joint data of `asm` for export.
 
     Per column c with joint j: W_e[c] is the component's axis in world axes at
@@ -397,6 +442,10 @@ def exported(asm: Assembly, known: Mapping[str, float] | None = None,
         Reaction values added to the model file's (labels are checked).
     state_source
         Where the state came from; by default the model's initial state.
+    axes
+        "world" adds the map T from the joint-frame values to the world-axes ones at the
+        state (`ExportedAssembly.T`, `mbody.equations.world.world_map`); "joint" (the
+        default) leaves it out.
 
     Returns
     -------
@@ -424,6 +473,12 @@ def exported(asm: Assembly, known: Mapping[str, float] | None = None,
         np.array(cols.gamma, dtype=float).reshape(-1),
         np.array(cols.phi, dtype=float).reshape(-1),
     )
+    check_axes(axes)
+    world: tuple[str, ...] = ()
+    T = None
+    if axes == "world":
+        world, T = world_map(model, np.asarray(cols.W_e, dtype=float).reshape(-1, 3))
+        T = _canonical(T)
     st = asm.state
     state = State(np.array(st.position, dtype=float), np.array(st.quaternion, dtype=float),
                   np.array(st.velocity, dtype=float), np.array(st.omega, dtype=float),
@@ -436,14 +491,14 @@ def exported(asm: Assembly, known: Mapping[str, float] | None = None,
         body_names=list(model.body_names), masses=np.array(model.mass, dtype=float),
         inertias=np.array(model.J, dtype=float), state=state,
         M=_canonical(asm.M), b=np.array(asm.b, dtype=float), Q=np.array(asm.Q, dtype=float),
-        G=_canonical(asm.G),
+        G=_canonical(asm.G), world_reactions=list(world), T=T,
     )
 
 
-def as_export(obj: Assembly | ExportedAssembly,
-              known: Mapping[str, float] | None = None) -> ExportedAssembly:
-    """`obj` itself when already exported, else ``exported(obj, known)``."""
-    return obj if isinstance(obj, ExportedAssembly) else exported(obj, known)
+def as_export(obj: Assembly | ExportedAssembly, known: Mapping[str, float] | None = None,
+              axes: str = "joint") -> ExportedAssembly:
+    """`obj` itself when already exported, else ``exported(obj, known, axes=axes)``."""
+    return obj if isinstance(obj, ExportedAssembly) else exported(obj, known, axes=axes)
 
 
 def flat_arrays(exp: ExportedAssembly) -> dict[str, Any]:
@@ -463,6 +518,8 @@ def flat_arrays(exp: ExportedAssembly) -> dict[str, Any]:
     }
     for k in COLUMN_TEXT[1:]:
         out[f"column_{k}"] = getattr(c, k)
+    if exp.T is not None:  # the map itself is each format's to write, as M and G are
+        out["world_reactions"] = exp.world_reactions
     return out
 
 
@@ -476,7 +533,8 @@ def check_format(path: Path, fmt: str, version: int) -> None:
 
 
 def build(path: Path, get: Callable[[str], Any], M: sp.spmatrix | np.ndarray,
-          G: sp.spmatrix | np.ndarray) -> ExportedAssembly:
+          G: sp.spmatrix | np.ndarray, T: sp.spmatrix | np.ndarray | None = None
+          ) -> ExportedAssembly:
     """An `ExportedAssembly` from a reader's view of a file.
 
     Parameters
@@ -488,15 +546,29 @@ def build(path: Path, get: Callable[[str], Any], M: sp.spmatrix | np.ndarray,
         scalars, label lists as sequences of strings, numbers as array-likes).
     M, G
         The two matrices, in any sparse or dense form (stored canonically as CSC).
+    T
+        The world-axes map when the file holds one (version 2 on; its labels under
+        ``world_reactions``), else None (every version 1 file).
 
     Raises
     ------
     MbodyError
-        When the format tag is not `FORMAT` or the version is newer than `VERSION`.
+        When the format tag is not `FORMAT` or the version is newer than `VERSION`, or
+        the map's shape does not fit its labels and the reactions.
     """
-    check_format(path, str(get("format")), int(get("version")))
+    version = int(get("version"))
+    check_format(path, str(get("format")), version)
     n = len(get("body_names"))
     m = len(get("reactions"))
+    world: list[str] = []
+    if T is not None:
+        if version < 2:
+            raise MbodyError(f"{path}: a version {version} export holds no world-axes map, "
+                             "yet this one has one (an edited file?)")
+        world = [str(s) for s in get("world_reactions")]
+        if tuple(T.shape) != (len(world), m):
+            raise MbodyError(f"{path}: the world-axes map T is {T.shape[0]}x{T.shape[1]}; "
+                             f"expected {len(world)}x{m} (its labels by the reactions)")
 
     def vec(name: str, *shape: int) -> np.ndarray:
         return np.asarray(get(name), dtype=float).reshape(shape)
@@ -520,6 +592,7 @@ def build(path: Path, get: Callable[[str], Any], M: sp.spmatrix | np.ndarray,
         reactions=[str(s) for s in get("reactions")], columns=columns,
         body_names=[str(s) for s in get("body_names")], masses=vec("masses", n),
         inertias=vec("inertias", n, 3, 3), state=state,
-        M=_canonical(M), b=vec("b", N), Q=vec("Q", N), G=_canonical(G))
+        M=_canonical(M), b=vec("b", N), Q=vec("Q", N), G=_canonical(G),
+        world_reactions=world, T=None if T is None else _canonical(T))
 
 

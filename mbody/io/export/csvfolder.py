@@ -1,9 +1,10 @@
-"""The CSV export: a folder of six labelled tables, for spreadsheets and anything else that
-reads CSV.
+"""The CSV export: a folder of six labelled tables (seven with the world-axes map), for
+spreadsheets and anything else that reads CSV.
 
 | file | header |
 | --- | --- |
 | M.csv, G.csv | ``coordinate`` then the column labels (dense), or ``row, column, value`` |
+| T.csv | ``world`` then the reaction labels (dense), or triplets; only with the map |
 | vectors.csv | `VECTORS` |
 | columns.csv | `COLUMNS` (one line per reaction column) |
 | bodies.csv | `BODIES` (one line per body) |
@@ -12,7 +13,8 @@ reads CSV.
 The reader finds every column by its header name, never by its position: a table whose
 columns were reordered, or that gained columns (a spreadsheet's notes), reads the same. A
 missing column is an `MbodyError` naming the file and the column. The rows and columns of
-M.csv and G.csv are matched to vectors.csv and columns.csv by their labels too.
+M.csv and G.csv are matched to vectors.csv and columns.csv by their labels too; the rows
+of T.csv to the labels info.csv lists under ``world_reactions``.
 """
 
 from __future__ import annotations
@@ -55,6 +57,8 @@ BODIES = ("name", "mass", *(f"J{i}{j}" for i in (1, 2, 3) for j in (1, 2, 3)),
 TRIPLETS = ("row", "column", "value")
 """Header of M.csv and G.csv beyond `CSV_DENSE_LIMIT` cells."""
 FILES = ("info.csv", "vectors.csv", "columns.csv", "bodies.csv", "M.csv", "G.csv")
+MAP_FILE = "T.csv"
+"""The world-axes map's table, written with the six when the export holds it."""
 
 # columns.csv text fields -> the `flat_arrays` names `build` reads
 _COLUMN_TEXT = {"joint": "column_joint", "type": "column_type", "parent": "column_parent",
@@ -65,7 +69,7 @@ _INFO_KEYS = ("format", "version", "model", "model_file", "dimension", "t", "sta
 
 # -- writing --------------------------------------------------------------------------------
 def write_csv(asm: Assembly | ExportedAssembly, folder: str | os.PathLike[str],
-              known: Mapping[str, float] | None = None) -> Path:
+              known: Mapping[str, float] | None = None, axes: str = "joint") -> Path:
     """Write the export as CSV tables in `folder` (created if needed), atomically.
 
     Parameters
@@ -74,9 +78,12 @@ def write_csv(asm: Assembly | ExportedAssembly, folder: str | os.PathLike[str],
         An assembly (exported here) or an export.
     folder
         The folder to write M.csv, G.csv, vectors.csv, columns.csv, bodies.csv and
-        info.csv into; other files in it are left alone.
+        info.csv into (and T.csv when the export holds the world-axes map); other files
+        in it are left alone.
     known
         Reaction values to record as known, with an `Assembly`.
+    axes
+        "world": add the world-axes map T (with an `Assembly`; an export has its own).
 
     Returns
     -------
@@ -88,7 +95,7 @@ def write_csv(asm: Assembly | ExportedAssembly, folder: str | os.PathLike[str],
     All six files are written to a temporary folder and moved in only when every one is
     complete (`mbody.util.atomic.atomic_folder`).
     """
-    exp = as_export(asm, known)
+    exp = as_export(asm, known, axes)
     with atomic_folder(folder) as tmp:
         for name, rows in _tables(exp).items():
             with open(tmp / name, "w", newline="", encoding="utf-8") as fh:
@@ -96,11 +103,12 @@ def write_csv(asm: Assembly | ExportedAssembly, folder: str | os.PathLike[str],
     return Path(folder)
 
 
-def _matrix_rows(A: sp.csc_matrix, rows: Sequence[str],
-                 cols: Sequence[str]) -> Iterator[list[Any]]:
-    """M.csv or G.csv line by line (a generator: a large matrix is never all text)."""
+def _matrix_rows(A: sp.csc_matrix, rows: Sequence[str], cols: Sequence[str],
+                 corner: str = "coordinate") -> Iterator[list[Any]]:
+    """M.csv, G.csv or T.csv line by line (a generator: a large matrix is never all text);
+    `corner` heads the column of row labels in a dense table."""
     if A.shape[0] * A.shape[1] <= CSV_DENSE_LIMIT:
-        yield ["coordinate", *cols]
+        yield [corner, *cols]
         for label, r in zip(rows, A.toarray().tolist(), strict=True):
             yield [label, *r]
     else:
@@ -119,6 +127,8 @@ def _tables(exp: ExportedAssembly) -> dict[str, Any]:
         ["dimension", json.dumps(exp.dimension)], ["t", json.dumps(exp.t)],
         ["state_source", json.dumps(exp.state_source)]]
     info += [[f"conventions.{k}", json.dumps(v)] for k, v in exp.conventions.items()]
+    if exp.T is not None:
+        info.append(["world_reactions", json.dumps(exp.world_reactions)])
     vectors: list[list[Any]] = [list(VECTORS)] + [
         [lab, b, q] for lab, b, q in zip(exp.coordinates, exp.b.tolist(), exp.Q.tolist(),
                                          strict=True)]
@@ -132,10 +142,13 @@ def _tables(exp: ExportedAssembly) -> dict[str, Any]:
         [n, float(exp.masses[i]), *exp.inertias[i].ravel().tolist(),
          *st.position[i].tolist(), *st.quaternion[i].tolist(), *st.velocity[i].tolist(),
          *st.omega[i].tolist()] for i, n in enumerate(exp.body_names)]
-    return {"info.csv": info, "vectors.csv": vectors, "columns.csv": columns,
-            "bodies.csv": bodies,
-            "M.csv": _matrix_rows(exp.M, exp.coordinates, exp.coordinates),
-            "G.csv": _matrix_rows(exp.G, exp.coordinates, exp.reactions)}
+    tables: dict[str, Any] = {
+        "info.csv": info, "vectors.csv": vectors, "columns.csv": columns, "bodies.csv": bodies,
+        "M.csv": _matrix_rows(exp.M, exp.coordinates, exp.coordinates),
+        "G.csv": _matrix_rows(exp.G, exp.coordinates, exp.reactions)}
+    if exp.T is not None:
+        tables[MAP_FILE] = _matrix_rows(exp.T, exp.world_reactions, exp.reactions, "world")
+    return tables
 
 
 # -- reading --------------------------------------------------------------------------------
@@ -200,27 +213,29 @@ def _table(path: Path) -> _Table:
     return _Table(path, header, [r for _, r in numbered[1:]], [k for k, _ in numbered[1:]])
 
 
-def _matrix(t: _Table, rows: list[str], cols: list[str], what: str) -> sp.csc_matrix:
-    """M or G from its table, rows and columns placed by their labels (`rows` from
-    vectors.csv, `cols` from vectors.csv or columns.csv, as `what` says)."""
+def _matrix(t: _Table, rows: list[str], cols: list[str], what: str,
+            corner: str = "coordinate", rows_from: str = "vectors.csv") -> sp.csc_matrix:
+    """M, G or T from its table, rows and columns placed by their labels (`rows` from
+    `rows_from`, `cols` from vectors.csv or columns.csv, as `what` says; `corner` heads
+    the row labels of a dense table)."""
     ri = {s: i for i, s in enumerate(rows)}
     ci = {s: j for j, s in enumerate(cols)}
     shape = (len(rows), len(cols))
-    if "coordinate" not in t.header and set(TRIPLETS) <= set(t.header):
+    if corner not in t.header and set(TRIPLETS) <= set(t.header):
         r, c = [], []
         for lab_r, lab_c, k in zip(t.text("row"), t.text("column"), t.lines, strict=True):
             if lab_r not in ri or lab_c not in ci:
                 raise MbodyError(f"{t.path}, line {k}: ({lab_r!r}, {lab_c!r}) is not a row "
-                                 f"of vectors.csv and a column of {what}")
+                                 f"of {rows_from} and a column of {what}")
             r.append(ri[lab_r])
             c.append(ci[lab_c])
         return sp.csc_matrix((t.floats("value")[:, 0], (r, c)), shape=shape)
-    labels = t.text("coordinate")
+    labels = t.text(corner)
     # every other header is a column label: an unknown one means the tables disagree
-    extra = [h for h in t.header if h != "coordinate" and h not in ci]
+    extra = [h for h in t.header if h != corner and h not in ci]
     missing = [c for c in cols if c not in t.header]
     if extra or missing or sorted(labels) != sorted(rows) or len(set(labels)) != len(labels):
-        raise MbodyError(f"{t.path}: its labels do not match vectors.csv and {what}"
+        raise MbodyError(f"{t.path}: its labels do not match {rows_from} and {what}"
                          + (f" (columns not there: {', '.join(map(repr, extra))})"
                             if extra else "")
                          + (f" (no column {', '.join(map(repr, missing))})"
@@ -273,4 +288,10 @@ def read(folder: Path) -> ExportedAssembly:
         flat[name] = cols.text(head)
     M = _matrix(_table(folder / "M.csv"), coordinates, coordinates, "vectors.csv")
     G = _matrix(_table(folder / "G.csv"), coordinates, reactions, "columns.csv")
-    return build(folder, flat.__getitem__, M, G)
+    T = None
+    if "world_reactions" in info:  # the world-axes map, written when asked for
+        world = [str(s) for s in info["world_reactions"]]
+        flat["world_reactions"] = world
+        T = _matrix(_table(folder / MAP_FILE), world, reactions, "columns.csv", "world",
+                    "info.csv's world_reactions")
+    return build(folder, flat.__getitem__, M, G, T)

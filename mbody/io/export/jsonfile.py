@@ -1,6 +1,7 @@
 """The JSON export: one document that validates against the schema shipped with the package
 (`schema()`, mbody/data/assembly.schema.json); sparse matrices as sorted 0-based
-``row, col, value`` triplets, one object per reaction column and per body. Floats are
+``row, col, value`` triplets, one object per reaction column and per body; the world-axes
+map, when asked for, under ``world`` (its labels and T as triplets). Floats are
 written by `json` with the shortest repr that reads back exactly; a number that is not
 finite is written as null (`mbody.util.jsontext`: strict JSON)."""
 
@@ -42,7 +43,7 @@ def to_json(exp: ExportedAssembly) -> dict[str, Any]:
                "position": st.position[i].tolist(), "quaternion": st.quaternion[i].tolist(),
                "velocity": st.velocity[i].tolist(), "omega": st.omega[i].tolist()}
               for i, n in enumerate(exp.body_names)]
-    return {
+    doc: dict[str, Any] = {
         "format": FORMAT, "version": VERSION,
         "model": {"name": exp.model, "file": exp.file, "dimension": exp.dimension},
         "state": {"t": exp.t, "source": exp.state_source},
@@ -51,6 +52,9 @@ def to_json(exp: ExportedAssembly) -> dict[str, Any]:
         "bodies": bodies, "columns": exp.columns.records(),
         "M": _triplets(exp.M), "b": exp.b.tolist(), "Q": exp.Q.tolist(), "G": _triplets(exp.G),
     }
+    if exp.T is not None:
+        doc["world"] = {"reactions": exp.world_reactions, "T": _triplets(exp.T)}
+    return doc
 
 
 def write(exp: ExportedAssembly, path: Path) -> None:
@@ -124,5 +128,9 @@ def from_json(d: dict[str, Any], path: Path | str = "<json>") -> ExportedAssembl
     def mat(t: dict[str, Any]) -> sp.csc_matrix:
         return sp.csc_matrix((t["value"], (t["row"], t["col"])), shape=tuple(t["shape"]))
 
-    return build(Path(path), flat.__getitem__, mat(d["M"]), mat(d["G"]))
+    world = d.get("world")
+    if world is not None:
+        flat["world_reactions"] = world["reactions"]
+    return build(Path(path), flat.__getitem__, mat(d["M"]), mat(d["G"]),
+                 None if world is None else mat(world["T"]))
 

@@ -1,7 +1,8 @@
-"""The MATLAB .mat export: the `flat_arrays` names, M and G as MATLAB sparse matrices,
-vectors as columns (``M*vdot + b``), label lists as cell columns and the conventions also
-as a struct. scipy.io is imported when a .mat file is written or read, not before: it is
-slow to import and most runs never touch MATLAB files."""
+"""The MATLAB .mat export: the `flat_arrays` names, M and G (and the world-axes map T when
+asked for) as MATLAB sparse matrices, vectors as columns (``M*vdot + b``), label lists as
+cell columns and the conventions also as a struct. scipy.io is imported when a .mat file
+is written or read, not before: it is slow to import and most runs never touch MATLAB
+files."""
 
 from __future__ import annotations
 
@@ -42,10 +43,13 @@ def write(exp: ExportedAssembly, path: Path) -> None:
     import scipy.io
 
     arrs = flat_arrays(exp)
-    for k in ("coordinates", "reactions", "body_names", *(f"column_{k}" for k in
-                                                          COLUMN_TEXT[1:])):
-        arrs[k] = _cell(arrs[k])
+    for k in ("coordinates", "reactions", "body_names", "world_reactions",
+              *(f"column_{k}" for k in COLUMN_TEXT[1:])):
+        if k in arrs:
+            arrs[k] = _cell(arrs[k])
     arrs["M"], arrs["G"] = exp.M, exp.G
+    if exp.T is not None:  # world = T * lambda
+        arrs["T"] = exp.T
     # The conventions also as a MATLAB struct (lists as cells) for people reading it there.
     arrs["conventions"] = {k: (_cell(v) if isinstance(v, list) else v)
                            for k, v in exp.conventions.items()}
@@ -72,4 +76,4 @@ def read(path: Path) -> ExportedAssembly:
         # MATLAB has no scalars: these three come back as 1x1 matrices
         return v.ravel()[0] if v.size == 1 and k in ("version", "dimension", "t") else v
 
-    return build(path, get, data["M"], data["G"])
+    return build(path, get, data["M"], data["G"], data.get("T"))

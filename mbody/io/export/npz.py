@@ -1,6 +1,7 @@
-"""The npz export: numpy arrays under the `flat_arrays` names, each sparse matrix as its
-CSC arrays (``M_data, M_indices, M_indptr, M_shape``) so that one scipy call rebuilds it
-without mbody, and labels as plain string arrays (no pickling)."""
+"""The npz export: numpy arrays under the `flat_arrays` names, each sparse matrix (M, G, and
+the world-axes map T when asked for) as its CSC arrays (``M_data, M_indices, M_indptr,
+M_shape``) so that one scipy call rebuilds it without mbody, and labels as plain string
+arrays (no pickling)."""
 
 from __future__ import annotations
 
@@ -24,10 +25,13 @@ def write(exp: ExportedAssembly, path: Path) -> None:
         The file to write (numpy adds no suffix: the file handle is given).
     """
     arrs = flat_arrays(exp)
-    for k in ("coordinates", "reactions", "body_names"):
-        arrs[k] = text_array(arrs[k])
-    for name in ("M", "G"):
+    for k in ("coordinates", "reactions", "body_names", "world_reactions"):
+        if k in arrs:
+            arrs[k] = text_array(arrs[k])
+    for name in ("M", "G", "T"):
         A = getattr(exp, name)
+        if A is None:  # no world-axes map asked for
+            continue
         arrs.update({f"{name}_data": A.data, f"{name}_indices": A.indices,
                      f"{name}_indptr": A.indptr, f"{name}_shape": np.array(A.shape)})
     arrays: dict[str, Any] = {k: np.asarray(v) for k, v in arrs.items()}
@@ -48,4 +52,4 @@ def read(path: Path) -> ExportedAssembly:
         return sp.csc_matrix((data[f"{name}_data"], data[f"{name}_indices"],
                               data[f"{name}_indptr"]), shape=tuple(data[f"{name}_shape"]))
 
-    return build(path, get, mat("M"), mat("G"))
+    return build(path, get, mat("M"), mat("G"), mat("T") if "T_data" in data else None)
