@@ -12,6 +12,7 @@ from typing import Any
 from mbody.model.model import Model
 from mbody.model.model import load as read_model
 from mbody.model.model import loads as read_model_text
+from mbody.model.source import with_finish
 from mbody.solve.kinematics import assembled
 
 
@@ -30,9 +31,10 @@ def load(source: str | os.PathLike[str] | dict, *, max_bytes: int | None = None,
         Its `initial` state is the file's, or, for a file with joint points per body or
         drivers, the nearest state where every joint and driver holds.
     """
-    return assembled(read_model(source, max_bytes=max_bytes, format=format, **options))
+    return assembled(with_finish(read_model(source, max_bytes=max_bytes, format=format,
+                                            **options), assembled))
 
 
 def loads(text: str, file: str = "<string>") -> Model:
     """Like `load`, from YAML text (`file`: the name used in error messages)."""
-    return assembled(read_model_text(text, file))
+    return assembled(with_finish(read_model_text(text, file), assembled))
