@@ -38,6 +38,7 @@ _LAZY = {
     "simulate": "simulate.simulation",
     "Trajectory": "simulate.trajectory",
     "verify": "answers.verify",
+    "solve_many": "solve.batch", "Solutions": "solve.batch",
 }
 """Public name -> the submodule defining it."""
 
@@ -46,8 +47,8 @@ __all__ = [
     "FreeBodyDiagram", "load_export",
     "Issue", "Joint", "Load", "MbodyError", "Model", "ModelError", "Solution", "State",
     "Trajectory", "simulate",
-    "UnknownReactionsError", "animate", "assemble", "equilibrium", "kinematics", "load",
-    "loads", "verify",
+    "Solutions", "UnknownReactionsError", "animate", "assemble", "equilibrium", "kinematics",
+    "load", "loads", "solve_many", "verify",
 ]
 
 

@@ -55,6 +55,11 @@ PR_VELOCITY: int
 PR_RATIO: int
 PR_SINGULAR: int
 PROJECT_INFO: int
+KN_ITERS: int
+KN_ERROR: int
+KN_SINGULAR: int
+KN_STEP: int
+KN_INFO: int
 
 def solve_layout(n: int, m: int, planar: bool) -> tuple[int, int, int]: ...
 
@@ -89,3 +94,7 @@ class Unknowns:
     def project(self, t: float, y: _F, iters: int, robust_below: float, homogeneous: Any,
                 info: _F) -> None: ...
     def schur(self, t: float, y: _F, S_out: _F) -> None: ...
+    def solve_many(self, t: _F, Y: _F, lam: _F, out: _F, F: _F | None,
+                   rows: _I | None) -> None: ...
+    def kinematics_many(self, t: _F, Y: _F, F: _F | None, rows: _I | None,
+                        chain: _I | None, phi_scale: _F, settings: _F, info: _F) -> None: ...

@@ -154,8 +154,8 @@ def _keys(section: str, entry: Any) -> tuple[str, ...]:
         return JOINT_KEYS
     if section == "drivers":
         return DRIVER_KEYS
-    return LOAD_KEYS.get(entry.get("type"), _ALL_LOAD_KEYS) if isinstance(entry, dict) \
-        else _ALL_LOAD_KEYS
+    typ = entry.get("type") if isinstance(entry, dict) else None
+    return LOAD_KEYS.get(typ, _ALL_LOAD_KEYS) if isinstance(typ, str) else _ALL_LOAD_KEYS
 
 
 def _inside(doc: Document, at: Path_, rest: list[str], given: str, fail) -> Path_:
