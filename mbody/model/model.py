@@ -438,6 +438,27 @@ def load(source: str | os.PathLike[str] | dict, *, max_bytes: int | None = None,
     return _build(spec, kept)
 
 
+def from_source(source: Source) -> Model:
+    """The model a `Source` describes: its document read again, with its values set and
+    its finishing step taken (what a sweep's worker builds from what the command read).
+
+    Parameters
+    ----------
+    source : Source
+        `Model.source` of a model.
+
+    Returns
+    -------
+    Model
+        Equal to the model the source came from.
+    """
+    doc = source.read()
+    bare = _build(validate_edited(doc, []), dataclasses.replace(source, values=()))
+    if source.values:
+        return bare.with_values(dict(source.values))
+    return source.finish(bare) if source.finish is not None else bare
+
+
 def loads(text: str, file: str = "<string>") -> Model:
     """Like `load`, from YAML text.
 

@@ -71,13 +71,15 @@ class Evaluator:
         """`mbody.load` moves the bodies onto their joints at t = 0 (`assembled`)."""
 
     def solve(self, t: np.ndarray, Y: np.ndarray, F: np.ndarray | None = None,
-              rows: np.ndarray | None = None) -> np.ndarray:
+              rows: np.ndarray | None = None, states: np.ndarray | None = None
+              ) -> np.ndarray:
         """(K, width) the core's solve output at each state (t (K,), Y (K, 13 n or the
-        full state size))."""
+        full state size); with `states` (K,), state k is Y[states[k]])."""
         t = np.ascontiguousarray(t, dtype=float)
         out = np.empty((len(t), self.width))
         self.plan.solver.solve_many(t, np.ascontiguousarray(Y, dtype=float),
-                                    self.unknowns.lam, out, _f(F), _rows(rows))
+                                    self.unknowns.lam, out, _f(F), _rows(rows),
+                                    _rows(states))
         return out
 
     def kinematics(self, t: np.ndarray, Y: np.ndarray, F: np.ndarray | None = None,

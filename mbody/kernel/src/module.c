@@ -629,18 +629,19 @@ static const mb_model *model_of(const ModelObject *model, mb_model *scratch, int
 }
 
 PyDoc_STRVAR(solve_many_doc,
-"solve_many(t, Y, lam, out, F, rows)\n\nsolve() at K states in one call: t (K), Y (K x "
-"ys: each state packed, ys = 13 n or\nstate_size), lam (m: the known values of every "
+"solve_many(t, Y, lam, out, F, rows, states)\n\nsolve() at K states in one call: t (K), "
+"Y (S x ys: states packed, ys = 13 n\nor state_size), lam (m: the known values of every "
 "state, or K x m: each its own),\nout (K x L: each state's solve() output, L = "
-"solve_layout's info offset + INFO).\nF (C x nF) and rows (K): state k evaluated with the "
-"model of the same structure\nwhose packed F is F[rows[k]] (pack_model of a model whose I "
-"equals this one's);\nor None and None: this model.");
+"solve_layout's info offset + INFO).\nstates (K int64): state k is Y[states[k]]; or None: "
+"Y[k] (then S = K). F (C x nF)\nand rows (K): state k evaluated with the model of the same "
+"structure whose packed\nF is F[rows[k]] (pack_model of a model whose I equals this "
+"one's); or None and None:\nthis model.");
 
 static PyObject *Unknowns_solve_many(UnknownsObject *self, PyObject *const *args,
                                      Py_ssize_t nargs) {
-    Py_buffer t, Y, lam, out, Fv, rv;
-    int have = 0;
-    if (unknowns_ready(self) < 0 || check_nargs(nargs, 6, "solve_many") < 0) return NULL;
+    Py_buffer t, Y, lam, out, Fv, rv, sv;
+    int have = 0, have_states = 0;
+    if (unknowns_ready(self) < 0 || check_nargs(nargs, 7, "solve_many") < 0) return NULL;
     const mb_model *md = &self->model->md;
     if (get_buffer(args[0], &t, 0, 1, -1, "t") < 0) return NULL;
     Py_ssize_t K = t.len / 8;
@@ -648,15 +649,35 @@ static PyObject *Unknowns_solve_many(UnknownsObject *self, PyObject *const *args
     Py_ssize_t N = (md->planar ? 3 : 6) * md->n, L = N + 3 * md->m + MB_INFO;
     PyObject *result = NULL;
     if (get_buffer(args[1], &Y, 0, 1, -1, "Y") < 0) goto t_;
-    if (K > 0 && Y.len / 8 != K * full) {
-        ys = 13 * md->n;
-        if (Y.len / 8 != K * ys) {
+    if (args[6] != Py_None) {
+        if (get_buffer(args[6], &sv, 0, 0, K, "states") < 0) goto states_;
+        have_states = 1;
+    }
+    Py_ssize_t S = have_states ? -1 : K; /* states packed in Y */
+    {
+        Py_ssize_t nY = Y.len / 8;
+        if (S < 0) { /* a 2-D Y: its rows are the states, of full or 13 n values */
+            Py_ssize_t width = Y.ndim == 2 ? Y.shape[1] : -1;
+            if (width == full || width == 13 * md->n) ys = width, S = Y.shape[0];
+        } else if (nY != S * full) {
+            ys = 13 * md->n;
+        }
+        if (S < 0 || (S > 0 && nY != S * ys) || (S == 0 && nY != 0)) {
             PyErr_Format(PyExc_ValueError, "Y: expected %zd states of %zd (or %zd) values, "
-                         "got %zd values", K, full, ys, Y.len / 8);
-            goto Y_;
+                         "got %zd values", S < 0 ? K : S, full, (Py_ssize_t)(13 * md->n), nY);
+            goto states_;
+        }
+        if (have_states) {
+            const int64_t *st = sv.buf;
+            for (Py_ssize_t k = 0; k < K; k++)
+                if (st[k] < 0 || st[k] >= S) {
+                    PyErr_Format(PyExc_ValueError, "states[%zd] = %lld: Y holds %zd states",
+                                 k, (long long)st[k], S);
+                    goto states_;
+                }
         }
     }
-    if (get_buffer(args[2], &lam, 0, 1, -1, "lam") < 0) goto Y_;
+    if (get_buffer(args[2], &lam, 0, 1, -1, "lam") < 0) goto states_;
     Py_ssize_t nl = lam.len / 8;
     if (nl != md->m && nl != K * md->m) {
         PyErr_Format(PyExc_ValueError, "lam: expected %lld or %zd values, got %zd",
@@ -670,9 +691,10 @@ static PyObject *Unknowns_solve_many(UnknownsObject *self, PyObject *const *args
         const double *tv = t.buf, *yv = Y.buf, *lv = lam.buf;
         double *ov = out.buf;
         int per_state = nl != md->m; /* K x m (with K = 1 either reads the same) */
+        const int64_t *st = have_states ? sv.buf : NULL;
         for (Py_ssize_t k = 0; k < K; k++) {
             const mb_model *mk = model_of(self->model, &scratch, have, &Fv, &rv, k);
-            mb_solve(mk, &self->u, self->w, tv[k], yv + k * ys,
+            mb_solve(mk, &self->u, self->w, tv[k], yv + (st ? st[k] : k) * ys,
                      lv + (per_state ? k * md->m : 0), ov + k * L);
         }
     }
@@ -686,7 +708,8 @@ out_:
     PyBuffer_Release(&out);
 lam_:
     PyBuffer_Release(&lam);
-Y_:
+states_:
+    if (have_states) PyBuffer_Release(&sv);
     PyBuffer_Release(&Y);
 t_:
     PyBuffer_Release(&t);
