@@ -182,17 +182,16 @@ def test_overlapping_paths_are_built_in_full():
         assert np.array_equal(c.F, pack_model(model.with_values(v))[0])
 
 
-def test_a_composition_that_differs_from_a_full_build_falls_back(monkeypatch):
+def test_a_composition_that_differs_from_a_full_build_falls_back():
     """The safety net: if the probes' entries were incomplete (paths that do not act
-    apart in a way the probes cannot see), the case built in full disagrees, and every
+    apart in a way the probes cannot see), the case read in full disagrees, and every
     case is then built in full."""
     model = driven()
     values = values_grid()
     family = Family(model, ["bodies.rod.mass", "drivers.motor.speed"])
-    family.probe("bodies.rod.mass", 0.3)
+    family.cases(values)  # every value probed
+    assert family.separable
     family._touched["bodies.rod.mass"][0][:] = False  # pretend the mass touches nothing
-    family.probe = lambda path, value: Family.probe(family, path, value)  # type: ignore
-    monkeypatch.setattr(family, "_overlap", lambda paths: False)
     cases = family.cases(values)
     assert not family.separable
     for v, c in zip(values, cases, strict=True):
@@ -236,3 +235,24 @@ def test_a_heavier_rod_needs_a_larger_torque_in_proportion():
     state = mbody.kinematics(model, 0.013)
     sols = mbody.solve_many(model, state, values=values)
     assert np.allclose(sols.values[1], 2.0 * sols.values[0], rtol=1e-12, atol=1e-9)
+
+
+def test_peaks_many_folds_the_same_solves():
+    """The core's per-segment peaks are the largest |value| of solve_many's outputs over
+    each segment, bit for bit (three cases of a mass each, 40 instants)."""
+    model = driven()
+    ev = Evaluator(model)
+    family = Family(model, ["bodies.rod.mass"])
+    F = np.stack([c.F for c in family.cases([{"bodies.rod.mass": m} for m in (0.3, 0.7, 1.9)])])
+    t = np.linspace(0.0, 0.05, 40)
+    Y = np.ascontiguousarray(np.tile(ev.ws.state_vector(model.initial), (40, 1)))
+    chain = np.ones(40, np.int64)
+    chain[0] = 0
+    assert closed(ev.kinematics(t, Y, chain=chain, fast=True, predict=True)).all()
+    T, S, R = np.tile(t, 3), np.tile(np.arange(40), 3), np.repeat(np.arange(3), 40)
+    full = ev.solve(T, Y, F, R, S).reshape(3, 40, -1)[:, :, ev.o_lam:ev.o_lam + ev.m]
+    peaks = ev.peaks(T, Y, S, 40, F, R)
+    assert np.array_equal(peaks[:, :ev.m], np.abs(full).max(axis=1))
+    assert not peaks[:, ev.m].any()
+    with pytest.raises(ValueError, match="segment: expected a divisor"):
+        ev.peaks(T, Y, S, 7, F, R)

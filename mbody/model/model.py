@@ -355,6 +355,25 @@ class Model:
             A path that names nothing in the file (with a did-you-mean), or a value the
             file could not hold, at the line of its entry and naming its path.
         """
+        model = self.edited(values)
+        finish = model.source.finish if model.source is not None else None
+        return finish(model) if finish is not None else model
+
+    def edited(self, values: Mapping[str, Any]) -> Model:
+        """`with_values` before its last step: the file read again with the values set and
+        checked, the model built, but the bodies not yet moved onto their joints and
+        drivers (``model.source.finish``, which `mbody.load` takes). For a caller that
+        does that step itself (`mbody.solve.family`, in the compiled core).
+
+        Parameters
+        ----------
+        values : mapping of str to value
+            As `with_values`.
+
+        Returns
+        -------
+        Model
+        """
         src = self.source
         if src is None:
             raise MbodyError(f"model {self.name!r} was built from a Spec, not read from a file "
@@ -366,8 +385,7 @@ class Model:
         apply_values(doc, edits(doc, src.values, names))
         changes = edits(doc, given, names)
         apply_values(doc, changes)
-        model = _build(validate_edited(doc, changes), src.with_values(given))
-        return src.finish(model) if src.finish is not None else model
+        return _build(validate_edited(doc, changes), src.with_values(given))
 
     @classmethod
     def from_spec(cls, spec: Spec) -> Model:

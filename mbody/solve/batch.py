@@ -71,15 +71,31 @@ class Evaluator:
         """`mbody.load` moves the bodies onto their joints at t = 0 (`assembled`)."""
 
     def solve(self, t: np.ndarray, Y: np.ndarray, F: np.ndarray | None = None,
-              rows: np.ndarray | None = None, states: np.ndarray | None = None
-              ) -> np.ndarray:
+              rows: np.ndarray | None = None, states: np.ndarray | None = None,
+              out: np.ndarray | None = None) -> np.ndarray:
         """(K, width) the core's solve output at each state (t (K,), Y (K, 13 n or the
-        full state size); with `states` (K,), state k is Y[states[k]])."""
+        full state size); with `states` (K,), state k is Y[states[k]]); into `out`'s
+        first K rows when given (a buffer kept between calls)."""
         t = np.ascontiguousarray(t, dtype=float)
-        out = np.empty((len(t), self.width))
+        if out is None or len(out) < len(t):
+            out = np.empty((len(t), self.width))
+        out = out[:len(t)]
         self.plan.solver.solve_many(t, np.ascontiguousarray(Y, dtype=float),
                                     self.unknowns.lam, out, _f(F), _rows(rows),
                                     _rows(states))
+        return out
+
+    def peaks(self, t: np.ndarray, Y: np.ndarray, states: np.ndarray, segment: int,
+              F: np.ndarray | None = None, rows: np.ndarray | None = None) -> np.ndarray:
+        """The solves of `solve` folded per segment of `segment` consecutive states:
+        (K / segment, m + 1) the largest |value| of each reaction component over the
+        segment, then the first singular code of its states (0: none). States as `solve`
+        with `states` (Y[states[k]])."""
+        out = np.empty((len(t) // segment, self.m + 1))
+        self.plan.solver.peaks_many(np.ascontiguousarray(t, dtype=float),
+                                    np.ascontiguousarray(Y, dtype=float),
+                                    self.unknowns.lam, out, _f(F), _rows(rows),
+                                    np.ascontiguousarray(states, dtype=np.int64), segment)
         return out
 
     def kinematics(self, t: np.ndarray, Y: np.ndarray, F: np.ndarray | None = None,

@@ -27,10 +27,12 @@ from typing import Any
 
 import numpy as np
 
+from mbody import conventions as cv
 from mbody.equations.pack import pack_model
 from mbody.equations.workspace import workspace
 from mbody.errors import MbodyError
-from mbody.model.model import Model
+from mbody.kernel import _core
+from mbody.model.model import Model, State
 from mbody.model.values import plain
 
 
@@ -80,15 +82,46 @@ def extras_of(model: Model) -> np.ndarray:
     return np.array([float(law[1](0.0)) for law in drivers.laws])
 
 
-def pack(model: Model) -> Packed:
-    """`model` packed (`Packed`)."""
+def state_vector(model: Model, state: State) -> np.ndarray:
+    """The full packed state (`Workspace.state_vector`), without making a workspace."""
+    parts = [state.position.ravel(), state.quaternion.ravel(), state.velocity.ravel(),
+             state.omega.ravel()]
+    if model.dimension == cv.PLANAR:
+        q = state.quaternion
+        parts.append(2.0 * np.arctan2(q[:, 3], q[:, 0]))
+    return np.concatenate(parts)
+
+
+def pack(model: Model, like: Packed | None = None) -> Packed:
+    """`model` packed (`Packed`). With `like` (a model of the same structure whose joints
+    and pose are the same: only masses, loads or laws differ) its generic ranks are
+    `like`'s: they depend on the joints' geometry alone, and finding them takes a few
+    kinematic steps."""
     F, I = pack_model(model)
-    ws = workspace(model)
-    start = ws.state_vector(model.file_state if model.file_state is not None
-                            else model.initial)
-    ranks = (int(ws.solver(ws.file_unknowns).generic_rank),
-             int(ws.solver(ws.unknowns({})).generic_rank))
+    start = state_vector(model, model.file_state if model.file_state is not None
+                         else model.initial)
+    if like is not None and _same_geometry(model, F, I, start, like):
+        ranks = like.ranks
+    else:
+        ws = workspace(model)
+        ranks = (int(ws.solver(ws.file_unknowns).generic_rank),
+                 int(ws.solver(ws.unknowns({})).generic_rank))
     return Packed(F, I, start, extras_of(model), ranks)
+
+
+def _same_geometry(model: Model, F: np.ndarray, I: np.ndarray, start: np.ndarray,
+                   like: Packed) -> bool:
+    """The same structure, joints (F's joints block) and pose (the file's positions and
+    attitudes) as `like`: everything the joints' generic rank, and whether the drivers
+    are independent of the joints, depend on."""
+    if len(F) != len(like.F) or not np.array_equal(I, like.I):
+        return False
+    n, nj = model.n, len(model.joint_table.names)
+    k, s = len(model.forces.names), len(model.springs.names)
+    lo = 3 + _core.BODY_W * n + _core.LOAD_W * k + _core.SPRING_W * s
+    hi = lo + _core.JOINT_W * nj
+    return (np.array_equal(F[lo:hi], like.F[lo:hi])
+            and np.array_equal(start[:7 * n], like.start[:7 * n]))
 
 
 def _key(value: Any) -> str:
@@ -112,9 +145,11 @@ class Family:
         self.paths = tuple(paths)
         self.base = pack(model)
         self._probes: dict[tuple[str, str], Packed | str] = {}
+        self._shared: dict[tuple[str, str], bool] = {}  # probe of the base's structure
         self._touched = {p: (np.zeros(len(self.base.F), bool),
                              np.zeros(len(self.base.start), bool),
                              np.zeros(len(self.base.extras), bool)) for p in self.paths}
+        self._overlaps: dict[tuple[str, ...], bool] = {}  # cleared when a set grows
         self.separable = True
         """False once composing has been seen to differ from a full build (then every
         case is built in full)."""
@@ -125,19 +160,47 @@ class Family:
         got = self._probes.get(key)
         if got is None:
             try:
-                got = pack(self.model.with_values({path: value}))
+                got = self._probe_model({path: value})
             except MbodyError as exc:
                 got = str(exc)
-            if isinstance(got, Packed) and got.same_structure(self.base):
+            shared = isinstance(got, Packed) and got.same_structure(self.base)
+            if isinstance(got, Packed) and shared:
                 F, s, e = self._touched[path]
-                F |= got.F != self.base.F
-                s |= got.start != self.base.start
-                e |= got.extras != self.base.extras
+                grew = False
+                for mask, new in ((F, got.F != self.base.F),
+                                  (s, got.start != self.base.start),
+                                  (e, got.extras != self.base.extras)):
+                    if (new & ~mask).any():
+                        mask |= new
+                        grew = True
+                if grew:
+                    self._overlaps.clear()
             self._probes[key] = got
+            self._shared[key] = shared
         return got
+
+    def _probe_model(self, values: Mapping[str, Any]) -> Packed:
+        """The model with `values` set, read and checked in full, packed. Its last step
+        (`Model.with_values`' assembly at t = 0, which also checks that the drivers are
+        independent of the joints) is left to the core when the joints and the pose are
+        the base's (then it says nothing new, and its state is not what is packed: the
+        file's is); otherwise it is taken, and any problem it finds refuses the value."""
+        model = self.model.edited(values)
+        got = pack(model, self.base)
+        if got.ranks is self.base.ranks:  # the base's geometry: nothing new to check
+            return got
+        finish = model.source.finish if model.source is not None else None
+        return pack(finish(model), self.base) if finish is not None else got
 
     def _overlap(self, paths: Sequence[str]) -> bool:
         """Whether two of `paths` touch a common entry (then they may not act apart)."""
+        key = tuple(paths)
+        got = self._overlaps.get(key)
+        if got is None:
+            got = self._overlaps[key] = self._overlap_now(paths)
+        return got
+
+    def _overlap_now(self, paths: Sequence[str]) -> bool:
         for part in range(3):
             seen = np.zeros(len(self._touched[paths[0]][part]), dtype=np.int64)
             for p in paths:
@@ -149,25 +212,12 @@ class Family:
     def _full(self, values: Mapping[str, Any]) -> Case:
         try:
             model = self.model.with_values(values)
-            got = pack(model)
+            got = pack(model, self.base)
         except MbodyError as exc:
             return Case(error=str(exc))
         if got.same_structure(self.base):
             return Case(got.F, got.start, got.extras)
         return Case(got.F, got.start, got.extras, model=model)
-
-    def _composed(self, values: Mapping[str, Any]) -> Case | None:
-        """The case composed from its probes, or None when it must be built in full."""
-        F, start, extras = self.base.F.copy(), self.base.start.copy(), self.base.extras.copy()
-        for path, value in values.items():
-            got = self.probe(path, value)
-            if isinstance(got, str):
-                return Case(error=got)
-            if not got.same_structure(self.base):
-                return None
-            tF, ts, te = self._touched[path]
-            F[tF], start[ts], extras[te] = got.F[tF], got.start[ts], got.extras[te]
-        return Case(F, start, extras)
 
     def case(self, values: Mapping[str, Any]) -> Case:
         """One case: composed from its probes when its paths act apart, else built in full.
@@ -181,23 +231,13 @@ class Family:
         -------
         Case
         """
-        unknown = [p for p in values if p not in self._touched]
-        if unknown:
-            raise MbodyError(f"{unknown[0]!r} is not one of this family's paths "
-                             f"({', '.join(self.paths)})")
-        if not self.separable:
-            return self._full(values)
-        for path, value in values.items():
-            self.probe(path, value)
-        if len(values) > 1 and self._overlap(list(values)):
-            return self._full(values)
-        got = self._composed(values)
-        return self._full(values) if got is None else got
+        return self.cases([values])[0]
 
     def cases(self, values: Sequence[Mapping[str, Any]]) -> list[Case]:
-        """Every case of `values`; one case composed of several probes is also built in
-        full and compared bit for bit (F, the file's state, extras), and if it differs
-        every case is built in full from then on.
+        """Every case of `values` (as `case`, the composing done for all of them at
+        once); one case composed of several probes is also read in full and compared bit
+        for bit (F, the file's state, extras), and if it differs every case is built in
+        full from then on.
 
         Parameters
         ----------
@@ -208,11 +248,47 @@ class Family:
         -------
         list of Case
         """
-        out = [self.case(v) for v in values]
+        out: list[Case | None] = [None] * len(values)
+        groups: dict[tuple[str, ...], list[int]] = {}
+        for k, v in enumerate(values):
+            unknown = [p for p in v if p not in self._touched]
+            if unknown:
+                raise MbodyError(f"{unknown[0]!r} is not one of this family's paths "
+                                 f"({', '.join(self.paths)})")
+            if not self.separable:
+                out[k] = self._full(v)
+                continue
+            keys = [(p, _key(x)) for p, x in v.items()]
+            for pk, x in zip(keys, v.values(), strict=True):
+                if pk not in self._probes:
+                    self.probe(pk[0], x)
+            refused = next((self._probes[pk] for pk in keys
+                            if isinstance(self._probes[pk], str)), None)
+            if refused is not None:
+                out[k] = Case(error=refused)  # type: ignore[arg-type]
+            elif not all(self._shared[pk] for pk in keys) or (
+                    len(v) > 1 and self._overlap(list(v))):
+                out[k] = self._full(v)
+            else:
+                groups.setdefault(tuple(v), []).append(k)
+        for paths, ks in groups.items():
+            F = np.repeat(self.base.F[None], len(ks), axis=0)
+            start = np.repeat(self.base.start[None], len(ks), axis=0)
+            extras = np.repeat(self.base.extras[None], len(ks), axis=0)
+            for p in paths:
+                probes = [self._probes[(p, _key(values[k][p]))] for k in ks]
+                tF, ts, te = self._touched[p]
+                for whole, mask, part in ((F, tF, "F"), (start, ts, "start"),
+                                          (extras, te, "extras")):
+                    if mask.any():
+                        whole[:, mask] = np.stack([getattr(q, part)[mask] for q in probes])
+            for i, k in enumerate(ks):
+                out[k] = Case(F[i], start[i], extras[i])
+        cases: list[Case] = out  # type: ignore[assignment]
         if self.separable:
-            for v, c in zip(values, out, strict=True):
+            for v, c in zip(values, cases, strict=True):
                 if c.shared and len(v) > 1:
-                    full = self._full(v)
+                    full = self._checked(v)
                     same = (full.shared and full.F is not None and full.start is not None
                             and full.extras is not None and c.F is not None
                             and c.start is not None and c.extras is not None
@@ -223,4 +299,17 @@ class Family:
                         self.separable = False
                         return [self._full(v) for v in values]
                     break
-        return out
+        return cases
+
+    def _checked(self, values: Mapping[str, Any]) -> Case:
+        """A case read afresh to check a composed one: `Model.edited` and packed (its
+        F, file state and extras are those of `Model.with_values`, whose last step moves
+        the bodies and packs nothing new; taken too when the joints or pose differ from
+        the base's, to check the drivers)."""
+        try:
+            got = self._probe_model(values)
+        except MbodyError as exc:
+            return Case(error=str(exc))
+        return Case(got.F, got.start, got.extras) if got.same_structure(self.base) \
+            else Case(got.F, got.start, got.extras, model=self.model.with_values(values))
+

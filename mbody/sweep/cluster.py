@@ -56,6 +56,7 @@ class Report:
     workers: int = 0
     where: str = "this process"
     work: float = 0.0
+    cpu: float = 0.0
     wall: float = 0.0
     start: float = 0.0
     lost: int = 0
@@ -70,7 +71,8 @@ class Report:
     def text(self) -> str:
         return (f"{self.cases} cases in {self.wall:.1f} s on {self.where} "
                 f"({self.chunks} chunk(s) of up to {self.chunk} cases; the workers spent "
-                f"{100 * min(self.busy, 1.0):.0f}% of their time on cases"
+                f"{100 * min(self.busy, 1.0):.0f}% of their time on cases, "
+                f"{self.cpu:.1f} s of processor time"
                 + (f", {self.start:.1f} s starting the cluster" if self.start else "")
                 + (f"; {self.lost} chunk(s) lost with their workers, written as failed"
                    if self.lost else "") + ")")
@@ -116,6 +118,7 @@ def run(job: Job, todo: Sequence[int], results: Results, *, scheduler: str | Non
     def take(rows: Rows) -> None:
         results.add(rows)
         report.cases += len(rows.indices)
+        report.cpu += rows.cpu
         bar.update(len(rows.indices))
         if on_chunk is not None:
             on_chunk(rows)
@@ -178,10 +181,13 @@ def _on_dask(job: Job, todo: list[int], per_case: float, chunk: int | None,
     try:
         if scheduler is None:
             n = workers or os.cpu_count() or 1
+            # every server on the loopback: the scheduler's HTTP routes (no dashboard) at a
+            # free port, the workers and their nannies; their shutdown chatter silenced
             cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                   host="127.0.0.1", dashboard_address=None,
+                                   host="127.0.0.1", dashboard_address="127.0.0.1:0",
                                    worker_dashboard_address=None,
-                                   silence_logs=logging.ERROR)
+                                   scheduler_kwargs={"dashboard": False},
+                                   silence_logs=logging.CRITICAL)
             client = Client(cluster, set_as_default=False)
             report.where = f"a local cluster of {n} worker processes"
         else:

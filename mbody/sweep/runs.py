@@ -35,6 +35,7 @@ from typing import Any
 import numpy as np
 
 from mbody import conventions as cv
+from mbody.equations.solution import singular_mass_error
 from mbody.errors import MbodyError
 from mbody.kernel import _core
 from mbody.model.model import Model, from_source
@@ -99,6 +100,9 @@ class Rows:
     errors: list[str | None]
     seconds: float = 0.0
     worker: str = ""
+    cpu: float = 0.0
+    """The processor seconds the evaluation took (`seconds` is wall-clock: on a shared
+    machine, also other programs' time)."""
 
 
 def final_labels(model: Model) -> list[str]:
@@ -202,7 +206,7 @@ def run_chunk(job: Job, indices: Sequence[int]) -> Rows:
     import os
     import socket
 
-    begin = time.perf_counter()
+    begin, cpu = time.perf_counter(), time.process_time()
     ctx = context(job)
     indices = [int(i) for i in indices]
     values = [job.grid.values(i) for i in indices]
@@ -223,7 +227,7 @@ def run_chunk(job: Job, indices: Sequence[int]) -> Rows:
         if e is not None:
             outputs[k] = np.nan
     return Rows(indices, outputs, errors, time.perf_counter() - begin,
-                f"{socket.gethostname()}:{os.getpid()}")
+                f"{socket.gethostname()}:{os.getpid()}", time.process_time() - cpu)
 
 
 def _evaluate(ctx: Context, values: list[dict[str, Any]]) -> tuple[np.ndarray, list]:
@@ -274,8 +278,6 @@ def _groups(ctx: Context, cases: list[Case]
 
 
 def _singular(ev: Evaluator, out: np.ndarray) -> str | None:
-    from mbody.equations.solution import singular_mass_error
-
     code = int(out[ev.o_info + _core.ST_SINGULAR])
     if code:
         return str(singular_mass_error(ev.model, (code - 1) // 6, (code - 1) % 6))
@@ -359,16 +361,14 @@ def _kinetostatics(ctx: Context, ev: Evaluator, ks: list[int], F: np.ndarray | N
         final = final_values(ev.model, Y[-1:])[0]
         for b in range(0, len(js), per_call):
             part = js[b:b + per_call]
-            res = ev.solve(np.tile(t, len(part)), Y,
-                           F, None if F is None else np.repeat(part, steps),
-                           np.tile(np.arange(steps), len(part))).reshape(len(part), steps, -1)
-            peaks = np.abs(res[:, :, ev.o_lam:ev.o_lam + ev.m]).max(axis=1)
-            singular = res[:, :, ev.o_info + _core.ST_SINGULAR] != 0
+            res = ev.peaks(np.tile(t, len(part)), Y, np.tile(np.arange(steps), len(part)),
+                           steps, F, None if F is None else np.repeat(part, steps))
             rows = np.array([ks[j] for j in part])
             out[rows] = np.concatenate((np.broadcast_to(final, (len(part), len(final))),
-                                        peaks), axis=1)
-            for i in np.flatnonzero(singular.any(axis=1)):
-                errors[rows[i]] = _singular(ev, res[i, int(np.argmax(singular[i]))])
+                                        res[:, :ev.m]), axis=1)
+            for i in np.flatnonzero(res[:, ev.m]):
+                code = int(res[i, ev.m]) - 1
+                errors[rows[i]] = str(singular_mass_error(ev.model, code // 6, code % 6))
 
 
 def _motion_key(ctx: Context, ev: Evaluator, F: np.ndarray | None, start: np.ndarray,

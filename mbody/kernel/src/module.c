@@ -5,6 +5,7 @@
  * while it runs. */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "internal.h"
@@ -716,6 +717,103 @@ t_:
     return result;
 }
 
+PyDoc_STRVAR(peaks_many_doc,
+"peaks_many(t, Y, lam, peaks, F, rows, states, segment)\n\nsolve_many's solves, each "
+"state's output folded into its segment's row of peaks\ninstead of written out: state k "
+"is in segment k // segment; peaks (K / segment x\n(m + 1)) <- per segment the largest "
+"|lambda_i| of each reaction component (known\nvalues included), then the first nonzero "
+"singular code of its states (0: none). t,\nY, lam, F, rows, states: as solve_many's (K "
+"a multiple of segment).");
+
+static PyObject *Unknowns_peaks_many(UnknownsObject *self, PyObject *const *args,
+                                     Py_ssize_t nargs) {
+    Py_buffer t, Y, lam, pk, Fv, rv, sv;
+    int have = 0, have_states = 0;
+    if (unknowns_ready(self) < 0 || check_nargs(nargs, 8, "peaks_many") < 0) return NULL;
+    const mb_model *md = &self->model->md;
+    long segment = PyLong_AsLong(args[7]);
+    if (segment == -1 && PyErr_Occurred()) return NULL;
+    if (get_buffer(args[0], &t, 0, 1, -1, "t") < 0) return NULL;
+    Py_ssize_t K = t.len / 8, S = 0, ys = MB_STATE_SIZE(md->n, md->planar);
+    Py_ssize_t N = (md->planar ? 3 : 6) * md->n, L = N + 3 * md->m + MB_INFO;
+    PyObject *result = NULL;
+    if (segment < 1 || K % segment != 0) {
+        PyErr_Format(PyExc_ValueError, "segment: expected a divisor of the %zd states, got %ld",
+                     K, segment);
+        goto t_;
+    }
+    if (get_buffer(args[1], &Y, 0, 1, -1, "Y") < 0) goto t_;
+    if (args[6] == Py_None) {
+        PyErr_SetString(PyExc_ValueError, "states: expected K int64 indices into Y");
+        goto Y_;
+    }
+    if (get_buffer(args[6], &sv, 0, 0, K, "states") < 0) goto Y_;
+    have_states = 1;
+    {
+        Py_ssize_t width = Y.ndim == 2 ? Y.shape[1] : -1;
+        if (width != ys && width != 13 * md->n) {
+            PyErr_Format(PyExc_ValueError, "Y: expected rows of %zd (or %zd) values", ys,
+                         (Py_ssize_t)(13 * md->n));
+            goto states_;
+        }
+        ys = width, S = Y.shape[0];
+        const int64_t *st = sv.buf;
+        for (Py_ssize_t k = 0; k < K; k++)
+            if (st[k] < 0 || st[k] >= S) {
+                PyErr_Format(PyExc_ValueError, "states[%zd] = %lld: Y holds %zd states", k,
+                             (long long)st[k], S);
+                goto states_;
+            }
+    }
+    if (get_buffer(args[2], &lam, 0, 1, md->m, "lam") < 0) goto states_;
+    if (get_buffer(args[3], &pk, 1, 1, (K / segment) * (md->m + 1), "peaks") < 0) goto lam_;
+    if (get_values(self->model, args[4], args[5], K, &Fv, &rv, &have) < 0) goto pk_;
+    {
+        double *out = malloc(sizeof(double) * (size_t)L);
+        if (out == NULL) {
+            PyErr_NoMemory();
+            goto values_;
+        }
+        mb_model scratch;
+        const double *tv = t.buf, *yv = Y.buf;
+        const int64_t *st = sv.buf;
+        double *pv = pk.buf;
+        int64_t m = md->m;
+        for (Py_ssize_t k = 0; k < K; k++) {
+            double *row = pv + (k / segment) * (m + 1);
+            if (k % segment == 0)
+                for (int64_t i = 0; i <= m; i++) row[i] = 0.0;
+            const mb_model *mk = model_of(self->model, &scratch, have, &Fv, &rv, k);
+            mb_solve(mk, &self->u, self->w, tv[k], yv + st[k] * ys, lam.buf, out);
+            for (int64_t i = 0; i < m; i++) {
+                double a = fabs(out[N + i]);
+                if (!(a <= row[i])) row[i] = a; /* a NaN stays */
+            }
+            double code = out[N + 3 * m + MB_ST_SINGULAR];
+            if (row[m] == 0.0 && code != 0.0) row[m] = code;
+        }
+        free(out);
+    }
+    Py_INCREF(Py_None);
+    result = Py_None;
+values_:
+    if (have) {
+        PyBuffer_Release(&Fv);
+        PyBuffer_Release(&rv);
+    }
+pk_:
+    PyBuffer_Release(&pk);
+lam_:
+    PyBuffer_Release(&lam);
+states_:
+    if (have_states) PyBuffer_Release(&sv);
+Y_:
+    PyBuffer_Release(&Y);
+t_:
+    PyBuffer_Release(&t);
+    return result;
+}
+
 PyDoc_STRVAR(kinematics_many_doc,
 "kinematics_many(t, Y, F, rows, chain, phi_scale, settings, info)\n\nThe kinematic "
 "analysis (kernel.h: mb_kinematics) at K times, in place: Y (K x\nstate_size, each row "
@@ -817,6 +915,8 @@ static PyMethodDef Unknowns_methods[] = {
      solve_many_doc},
     {"kinematics_many", (PyCFunction)(void (*)(void))Unknowns_kinematics_many, METH_FASTCALL,
      kinematics_many_doc},
+    {"peaks_many", (PyCFunction)(void (*)(void))Unknowns_peaks_many, METH_FASTCALL,
+     peaks_many_doc},
     {NULL, NULL, 0, NULL},
 };
 
