@@ -34,7 +34,7 @@ _LAZY = {
     "Body": "model.model", "Joint": "model.model", "Load": "model.model",
     "Model": "model.model", "State": "model.model", "load": "loading",
     "loads": "loading", "kinematics": "solve.kinematics",
-    "equilibrium": "solve.equilibrium",
+    "equilibrium": "solve.equilibrium", "kinematic_run": "simulate.kinematic",
     "simulate": "simulate.simulation",
     "Trajectory": "simulate.trajectory",
     "verify": "answers.verify",
@@ -47,8 +47,8 @@ __all__ = [
     "FreeBodyDiagram", "load_export",
     "Issue", "Joint", "Load", "MbodyError", "Model", "ModelError", "Solution", "State",
     "Trajectory", "simulate",
-    "Solutions", "UnknownReactionsError", "animate", "assemble", "equilibrium", "kinematics",
-    "load", "loads", "solve_many", "verify",
+    "Solutions", "UnknownReactionsError", "animate", "assemble", "equilibrium",
+    "kinematic_run", "kinematics", "load", "loads", "solve_many", "verify",
 ]
 
 

@@ -114,11 +114,11 @@ def proposal_sensitivity(solver: DOP853, fun, rtol: float, atol) -> float:
     by 1/8 of that."""
     n, t = solver.n, tableau()
     K = solver.work[_core.DOP_W_K * n:(_core.DOP_W_K + 13) * n].reshape(13, n)
-    y, h = solver.y_old, solver.step_size
+    y, h = solver.y_start, solver.step_size
     u = 16 * EPS
     weights = np.vstack((t["a"][:12, :13], np.append(t["b"], 0.0)))  # stages 0..12
     dz = u * (np.abs(y) + abs(h) * (np.abs(weights) @ np.abs(K)))
-    dK = u * np.abs(K) + dz @ jacobian_size(fun, solver.t_old, y).T
+    dK = u * np.abs(K) + dz @ jacobian_size(fun, solver.step_start, y).T
     dK[0] = 0.0  # f(t, y): the same evaluation in both
     sc = atol + np.maximum(np.abs(y), np.abs(solver.y)) * rtol
     rel = []
@@ -130,11 +130,11 @@ def proposal_sensitivity(solver: DOP853, fun, rtol: float, atol) -> float:
 
 
 def rounding_scale(solver: DOP853, rows: int, weights: np.ndarray) -> np.ndarray:
-    """|y_old| + |y| + |h| sum_j w_j |K_j|: the size of the terms a state or dense output
+    """|y_start| + |y| + |h| sum_j w_j |K_j|: the size of the terms a state or dense output
     of the last step sums (the bound on its rounding, divided by eps)."""
     n = solver.n
     K = solver.work[_core.DOP_W_K * n:(_core.DOP_W_K + rows) * n].reshape(rows, n)
-    return (np.abs(solver.y_old) + np.abs(solver.y)
+    return (np.abs(solver.y_start) + np.abs(solver.y)
             + abs(solver.step_size) * (weights[:rows] @ np.abs(K)))
 
 
@@ -156,7 +156,7 @@ def synced_steps(fun, y0, t0, t_bound, *, rtol, atol, max_step=math.inf):
     assert mine.nfev == ref0.nfev == 2
     steps = rejected_steps = compared = 0
     while mine.status == "running":
-        t_start, y_start, h_start = mine.t, mine.y.copy(), mine.h_abs
+        t_start, y_start, h_start = mine.t, mine.y.copy(), mine.next_step
         rejected, nfev = mine.rejected, mine.nfev
         mine.step()
         steps += 1
@@ -177,7 +177,7 @@ def synced_steps(fun, y0, t0, t_bound, *, rtol, atol, max_step=math.inf):
         assert ref.t == pytest.approx(mine.t, rel=1e-14, abs=1e-300)
         scale = rounding_scale(mine, 12, b_weights)
         assert_within(ref.y - mine.y, 256 * EPS * scale)
-        inside = mine.t_old + mine.step_size * np.array([0.0, 0.13, 0.5, 0.87, 1.0])
+        inside = mine.step_start + mine.step_size * np.array([0.0, 0.13, 0.5, 0.87, 1.0])
         dense = mine.dense(inside)  # (samples, n)
         scale = rounding_scale(mine, 16, d_weights)
         assert_within(ref.dense_output()(inside).T - dense, 256 * EPS * scale)
@@ -188,7 +188,7 @@ def synced_steps(fun, y0, t0, t_bound, *, rtol, atol, max_step=math.inf):
                 h_ref = abs(ref.t - ref.t_old)
                 if attempts > 1:  # no growth right after a rejection (scipy's had none)
                     h_ref = min(h_ref, abs(mine.step_size))
-                h_mine = min(mine.h_abs, max_step)
+                h_mine = min(mine.next_step, max_step)
                 tol = proposal_sensitivity(mine, fun, rtol, atol)
                 assert abs(h_ref - h_mine) <= tol * h_mine, (steps, h_ref, h_mine, tol)
                 compared += 1
@@ -237,17 +237,17 @@ def test_initial_step_is_scipys(name, rtol):
                       atol=rtol * 1e-3)
     ref.step()
     assert ref.nfev == 2 + STAGE_EVALS  # accepted at once: its size is the initial step
-    assert ref.t - t0 == pytest.approx(mine.h_abs, rel=1e-14)
+    assert ref.t - t0 == pytest.approx(mine.next_step, rel=1e-14)
 
 
 def test_initial_step_limits():
     """HNW's fall-backs and the bounds: a state and slope of zero take 1e-6 (h0 = 1e-6,
     h1 = max(1e-6, 1e-3 h0)); the step never exceeds max_step nor the interval."""
-    assert DOP853(oscillator, 0.0, [0.0, 0.0], 10.0).h_abs == 1e-6
-    free = DOP853(oscillator, 0.0, [1.0, 0.0], 10.0).h_abs
-    assert DOP853(oscillator, 0.0, [1.0, 0.0], 10.0, max_step=free / 3).h_abs == free / 3
-    assert DOP853(oscillator, 0.0, [1.0, 0.0], free / 5).h_abs == free / 5
-    assert DOP853(oscillator, 0.0, [1.0, 0.0], 10.0, first_step=0.25).h_abs == 0.25
+    assert DOP853(oscillator, 0.0, [0.0, 0.0], 10.0).next_step == 1e-6
+    free = DOP853(oscillator, 0.0, [1.0, 0.0], 10.0).next_step
+    assert DOP853(oscillator, 0.0, [1.0, 0.0], 10.0, max_step=free / 3).next_step == free / 3
+    assert DOP853(oscillator, 0.0, [1.0, 0.0], free / 5).next_step == free / 5
+    assert DOP853(oscillator, 0.0, [1.0, 0.0], 10.0, first_step=0.25).next_step == 0.25
     # y' = -1e-7 y: |y'| / sc = 1e-4 suggests h0 = 0.01 |y| / |y'| = 100, yet on [0, 1]
     # the Euler probe stays inside the interval, and the step is the interval
     times = []
@@ -256,7 +256,7 @@ def test_initial_step_limits():
         times.append(t)
         return -1e-7 * y
 
-    assert DOP853(slow, 0.0, [1.0], 1.0).h_abs == 1.0
+    assert DOP853(slow, 0.0, [1.0], 1.0).next_step == 1.0
     assert len(times) == 2 and max(times) <= 1.0
 
 
@@ -277,7 +277,7 @@ def test_minimal_step_failure():
         assert message == ref_message
         assert mine.nfev == ref.nfev
         assert abs(mine.t - 1.0) < 1e-5 and mine.t == pytest.approx(ref.t, rel=1e-12)
-        assert mine.h_abs < 10 * 2 * EPS * abs(mine.t)
+        assert mine.next_step < 10 * 2 * EPS * abs(mine.t)
 
 
 # -- accuracy against closed forms ---------------------------------------------------------
@@ -294,7 +294,7 @@ def test_order_eight_with_fixed_steps():
         worst = 0.0
         while s.status == "running":
             s.step()
-            mid = s.t_old + 0.5 * s.step_size
+            mid = s.step_start + 0.5 * s.step_size
             worst = max(worst, float(np.max(np.abs(s.dense(mid)
                                                    - [math.cos(mid), -math.sin(mid)]))))
         assert s.rejected == 0 and s.steps in (m, m + 1)
@@ -347,7 +347,7 @@ def test_runs_in_chunks_equal_one_run():
         parts.run(t_stop, max_steps=7)
         assert parts.steps - steps <= 7
         assert parts.t >= t_stop or parts.steps - steps == 7
-        assert parts.t_old < t_stop or parts.steps - steps == 0
+        assert parts.step_start < t_stop or parts.steps - steps == 0
         reached.append(parts.t)
         while parts.t < t_stop:
             parts.run(t_stop, max_steps=7)
@@ -363,12 +363,12 @@ def test_dense_output_ends_on_the_step():
         s.dense(0.0)
     s.run(2.0)
     nfev = s.nfev
-    ends = s.dense([s.t_old, s.t])
+    ends = s.dense([s.step_start, s.t])
     assert s.nfev == nfev + 3  # the three extra stages, once per step
-    s.dense(0.5 * (s.t_old + s.t))
+    s.dense(0.5 * (s.step_start + s.t))
     assert s.nfev == nfev + 3
-    assert_within(ends[0] - s.y_old, 4 * EPS * np.abs(s.y_old))
-    assert_within(ends[1] - s.y, 64 * EPS * (np.abs(s.y) + np.abs(s.y_old)))
+    assert_within(ends[0] - s.y_start, 4 * EPS * np.abs(s.y_start))
+    assert_within(ends[1] - s.y, 64 * EPS * (np.abs(s.y) + np.abs(s.y_start)))
 
 
 def test_python_exception_stops_the_run():
@@ -440,7 +440,7 @@ def test_projection_after_each_step():
 
 
 def test_dense_output_after_a_projection():
-    """The dense output of a step whose end was projected runs from y_old to the
+    """The dense output of a step whose end was projected runs from y_start to the
     projected y, with the slopes the steps start from: k_1 at the start, and at the end
     the fresh derivative at the projected state (an artificial move of 1 % of the
     velocity, far above refresh), not k_13 at the unprojected end."""
@@ -458,7 +458,7 @@ def test_dense_output_after_a_projection():
         h = s.step_size
         k1 = s.work[_core.DOP_W_K * n:(_core.DOP_W_K + 1) * n].copy()
         k13 = s.work[(_core.DOP_W_K + 12) * n:(_core.DOP_W_K + 13) * n].copy()
-        p = s.dense(s.t_old + h * np.array([0.0, d, 2 * d, 1 - 2 * d, 1 - d, 1.0]))
+        p = s.dense(s.step_start + h * np.array([0.0, d, 2 * d, 1 - 2 * d, 1 - d, 1.0]))
         start = (-3 * p[0] + 4 * p[1] - p[2]) / (2 * d * h)  # second-order differences
         end = (3 * p[5] - 4 * p[4] + p[3]) / (2 * d * h)
         # their error: d^2 / 3 max|p'''| / h, p of degree 7 in s whose coefficients are

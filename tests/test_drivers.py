@@ -324,3 +324,168 @@ def test_driver_errors_are_located():
             mbody.loads(base + "drivers:\n" + drivers + "\n", "sc.yaml")
         assert expected in str(exc.value)
         assert all(i.line > 0 for i in exc.value.issues)
+
+
+# -- a whole run (mbody.simulate.kinematic: one call of the compiled core) -----------------
+
+def test_a_kinematic_run_of_the_driven_slider_crank_equals_the_hand_solution():
+    """A revolution at 36 samples: every pin load and the motor torque (world axes)
+    against the hand-written Newton-Euler rows, 1e-9 relative; the drivers' work equals
+    the change of T + V (no other load); the motor torque equals the energy method's
+    τ ω = dT/dt + dV/dt at each sample."""
+    from mbody.simulate.kinematic import kinematic_run
+
+    model = driven_slider_crank()
+    period = 2 * math.pi / OMEGA
+    traj = kinematic_run(model, period * 35 / 36, 36 / period, axes="world")
+    assert len(traj) == 36
+    labels = traj.reaction_labels
+    for k in range(36):
+        theta = float(traj.orientation[k, 0])
+        hand = hand_newton_euler(theta)
+        scale = max(abs(v) for v in hand.values())
+        for label, value in hand.items():
+            got = traj.reactions[k, labels.index(label)]
+            assert got == pytest.approx(value, abs=1e-9 * scale), (k, label)
+        kin = slider_crank_kinematics(theta)
+        assert traj.position[k, 2, 0] == pytest.approx(kin["xb"], abs=1e-12)
+    info = traj.info
+    # no applied load: Q is gravity alone, and Q·v − m g·v is rounding
+    power = float(np.abs(traj.series["driver_power"]).max())
+    assert np.abs(traj.series["load_power"]).max() < 1e-13 * power
+    # τ ω = d(T + V)/dt at every sample, from the solved accelerations: to rounding
+    assert info["power_balance_residual"] < 1e-12
+    # the work over the run by cubic quadrature (error O(h^4)): one sample a degree leaves
+    # about (4 ω h)^4 / 180 = 1.3e-7 of it (the torque's fourth harmonic, h = 1 deg)
+    fine = kinematic_run(model, period * 359 / 360, 360 / period)
+    assert fine.info["energy_balance_residual"] < 1e-6
+
+
+def test_a_kinematic_runs_coupler_curve_equals_freudenstein():
+    """A named coupler point followed over half a revolution from a pose 3 degrees off
+    (joint points per body): its world path equals the closed form to 1e-10 m."""
+    from mbody.simulate.kinematic import kinematic_run
+
+    model = mbody.loads(fourbar(0.3, math.radians(3), True))
+    traj = kinematic_run(model, math.pi / 2, 120 / math.pi,
+                         points={"P": ("coupler", [0.0, 0.05])})
+    a, c, d = 0.1, 0.25, 0.3
+    path = traj.series["point:P"]
+    assert path.shape == (len(traj), 2)
+    for k, t in enumerate(traj.t.tolist()):
+        theta = 0.3 + 2 * t
+        Ax, Ay = a * math.cos(theta), a * math.sin(theta)
+        psi = freudenstein(theta)
+        Bx, By = d + c * math.cos(psi), c * math.sin(psi)
+        ang = math.atan2(By - Ay, Bx - Ax)
+        want = np.array([(Ax + Bx) / 2, (Ay + By) / 2]) + \
+            0.05 * np.array([-math.sin(ang), math.cos(ang)])
+        assert np.abs(path[k] - want).max() <= 1e-10, k
+
+
+def test_a_kinematic_run_stops_at_a_dead_centre_with_the_distance_left():
+    """The four-bar's rocker driven instead of its crank, at a constant rate: a rocker
+    swings between two limits (where crank and coupler line up), so the run stops at
+    the first sample past the upper one, naming the time and the driver's value."""
+    from mbody.simulate.kinematic import kinematic_run
+    from mbody.solve.kinematics import KinematicsError
+
+    doc = yaml.safe_load(fourbar(0.3))
+    psi0 = doc["bodies"][2]["angle"]
+    # the rocker's angle over a crank revolution, from its value at the start (-1.546 rad)
+    swing = max(freudenstein(th) for th in np.linspace(0, 2 * math.pi, 20001)) - \
+        freudenstein(0.3)
+    doc["drivers"] = [{"name": "rock", "joint": "D", "angle": f"{psi0!r} + t"}]
+    model = mbody.loads(yaml.safe_dump(doc))
+    with pytest.raises(KinematicsError, match=r"cannot all close at t = ([0-9.]+) s with "
+                       r"rock = ") as err:
+        kinematic_run(model, 2 * math.pi, 100)
+    t_stop = float(err.value.args[0].split("t = ")[1].split(" s")[0])
+    # the first sample past the limit: within one sample (0.01 s) of it
+    assert 0.0 < t_stop - swing <= 0.01 + 1e-9
+
+
+def test_a_kinematic_runs_energy_check_counts_springs_and_dampers():
+    """The arm on its pin driven to 0.5 sin 3t against a damped spring: the springs'
+    elastic energy is in V and the damper's dissipation in the loads' work, so the
+    drivers' power plus the loads' is d(T + V)/dt to rounding, and the damper's work over
+    the run is −∫ c L′² dt (computed here from the run's own spring lengths)."""
+    from mbody.simulate.kinematic import _cumulative, kinematic_run
+
+    text = (ROOT / "models" / "spring_loaded_arm.yaml").read_text()
+    text = text.replace("rest_length: 0}", "rest_length: 0.3, damping: 2}")
+    text += 'drivers:\n  - {name: m, joint: O, angle: "0.5*sin(3*t)"}\n'
+    model = mbody.loads(text)
+    run = kinematic_run(model, 2.0, 500)
+    assert run.info["power_balance_residual"] < 1e-12
+    # the spring runs from the wall point (1.2, 0) to the rod's mass centre
+    x = run.position[:, 0]
+    L = np.linalg.norm(x - np.array([1.2, 0.0]), axis=1)
+    Ld = np.gradient(L, run.t, edge_order=2)
+    damper = float(_cumulative(-2.0 * Ld**2, run.t)[-1])
+    # np.gradient's second-order differences at 500 per second: about 1e-5 relative
+    assert run.info["load_work"] == pytest.approx(damper, rel=1e-4)
+    assert run.info["driver_work"] + run.info["load_work"] == pytest.approx(
+        run.info["energy_change"], rel=1e-9)
+
+
+# -- mbody.simulate on driven models ------------------------------------------------------
+
+def test_simulate_of_a_fully_driven_mechanism_is_its_kinematic_run():
+    """No integration: the drivers fix the motion, so simulate returns the kinematic run
+    (its samples, reactions and energy check), the same numbers as kinematic_run."""
+    from mbody.simulate.kinematic import kinematic_run
+
+    model = mbody.load(ROOT / "models" / "slider_crank_driven.yaml")
+    run = mbody.simulate(model, 0.05, 1200)
+    ref = kinematic_run(model, 0.05, 1200)
+    assert run.info["kinematic"] and run.info["steps"] == 0
+    np.testing.assert_array_equal(run.reactions, ref.reactions)
+    assert run.info["power_balance_residual"] < 1e-12
+
+
+def arm_angle(traj, body: int) -> tuple[np.ndarray, np.ndarray]:
+    """An arm's angle θ from hanging (its mass centre seen from the hinge at (0, 0, 0.6))
+    and its rate θ̇, from the run's positions and velocities."""
+    r = traj.position[:, body] - np.array([0.0, 0.0, 0.6])
+    v = traj.velocity[:, body]
+    rho = np.hypot(r[:, 0], r[:, 1])
+    rho_dot = (r[:, 0] * v[:, 0] + r[:, 1] * v[:, 1]) / rho
+    theta = np.arctan2(rho, -r[:, 2])
+    theta_dot = (rho_dot * -r[:, 2] - rho * -v[:, 2]) / (rho**2 + r[:, 2] ** 2)
+    return theta, theta_dot
+
+
+def test_a_partly_driven_flyball_governor_follows_its_closed_form():
+    """The spindle driven at Ω = 2π rad/s, the arms free: each arm's angle obeys
+    (I_t + m l²) θ̈ = Ω² sin θ cos θ (I_t + m l² − I_a) − m g l sin θ (integrated here
+    by scipy at rtol 1e-12), and the motor's torque is the rate of the arms' angular
+    momentum about the spindle, 2 × 2 Ω (I_t + m l² − I_a) sin θ cos θ θ̇."""
+    from scipy.integrate import solve_ivp
+
+    model = mbody.load(ROOT / "models" / "flyball_governor.yaml")
+    run = mbody.simulate(model, 3.0, 100)
+    assert not run.info.get("kinematic") and run.info["steps"] > 0
+    m, l, W = 1.0, 0.25, 2 * math.pi
+    I_t, I_a = float(model.J[1, 0, 0]), float(model.J[1, 2, 2])
+    I_O = I_t + m * l * l
+
+    def f(t, y):
+        th, om = y
+        return [om, (W**2 * math.sin(th) * math.cos(th) * (I_O - I_a)
+                     - m * G0 * l * math.sin(th)) / I_O]
+
+    ref = solve_ivp(f, (0.0, 3.0), [math.radians(30), 0.0], method="DOP853", rtol=1e-12,
+                    atol=1e-14, t_eval=run.t)
+    for body in (1, 2):
+        theta, theta_dot = arm_angle(run, body)
+        # DOP853 at rtol 1e-10 over 3 s (about 3 swings): the angle to 1e-7 rad
+        assert np.abs(theta - ref.y[0]).max() < 1e-7
+    theta, theta_dot = arm_angle(run, 1)
+    torque = run.reactions[:, run.reaction_labels.index("motor.M")]
+    expected = 4 * W * (I_O - I_a) * np.sin(theta) * np.cos(theta) * theta_dot
+    assert np.abs(torque - expected).max() < 1e-9 * np.abs(expected).max()
+    # the energy check: the motor's work is the change of T + V (no other load)
+    assert run.info["power_balance_residual"] < 1e-12
+    assert run.info["driver_work"] == pytest.approx(run.info["energy_change"], rel=1e-5)
+    assert {"driver:motor", "driver_work"} <= set(run.series)

@@ -89,7 +89,8 @@ def test_model_loads_checks_and_assembles(path: Path, capsys):
     rpb = 3 if model.dimension == cv.PLANAR else 6
     # a particle (inertia: 0) has translation rows only
     N = sum(model.dimension if b.particle else rpb for b in model.bodies.values())
-    m = sum(len(j.components) for j in model.joints)
+    m = (sum(len(j.components) for j in model.joints)  # then one effort per driver
+         + (len(model.drivers.names) if model.drivers is not None else 0))
     assert asm.M.shape == (N, N) and asm.b.shape == (N,) and asm.Q.shape == (N,)
     assert asm.G.shape == (N, m) and len(asm.reactions) == m
     assert len(asm.coordinates) == N
@@ -112,24 +113,29 @@ _INCONSISTENT: set[str] = set()  # rotor_gyroscopic_bearings: now a universal jo
     if p.stem in _INCONSISTENT else p
     for p in ALL if "joints:" in p.read_text()], ids=lambda p: p.stem)
 def test_joints_match_the_poses_and_velocities(path: Path):
-    """Gᵀ v = 0: the initial velocities respect every joint; and every joint point lies
-    on each box-shaped body it connects (a pin at the end of a link, not beside it)."""
+    """Gᵀ v = f′(t): the initial velocities respect every joint (0) and driver (its
+    law's rate); and every joint point lies on each box-shaped body it connects (a pin
+    at the end of a link, not beside it)."""
     model = mbody.load(path)
     asm = mbody.assemble(model)
     v = velocity_vector(model)
     scale = max(1.0, float(np.abs(v).max()))
-    assert np.abs(asm.G.T @ v).max() < 1e-12 * scale
+    rate = np.zeros(len(model.reactions))
+    d = model.drivers
+    k = len(d.names) if d is not None else 0
+    if k:  # the drivers' efforts are the last components, their laws' rates f'(t)
+        rate[-k:] = [law[1](model.initial.t) for law in d.laws]
+    assert np.abs(asm.G.T @ v - rate).max() < 1e-12 * scale
 
-    s = model.initial
-    for j in model.joints:
-        for name in (j.parent, j.child):
+    jt = model.joint_table
+    for k, j in enumerate(model.joints):
+        for name, on_body in ((j.parent, jt.B_r_parent[k]), (j.child, jt.B_r_child[k])):
             if name == cv.GROUND:
                 continue
             body = model.bodies[name]
             if not body.shape or "box" not in body.shape:
                 continue
-            i = body.index
-            B_r = s.W_R_B[i].T @ (j.at - s.position[i])
+            B_r = on_body  # the joint point in the body's axes, from its mass centre
             half = np.array(body.shape["box"]) / 2
             d = len(half)
             assert np.all(np.abs(B_r[:d]) <= half + 1e-9), (j.name, name, B_r, half)

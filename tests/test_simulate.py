@@ -314,53 +314,22 @@ def test_plot_leaves_out_panels_with_nothing_to_show(tmp_path, capsys):
     assert len(_panel_titles(free)) == 4
 
 
-SLOW_COMPILE = 2.0
-"""Seconds a patched numba compile takes in the tests below (a real first one: a minute)."""
+def test_a_known_reaction_of_t_on_a_mechanism_is_the_cores():
+    """`known` values that vary in time join the model's known reactions, which the core
+    evaluates at every stage (once refused for mechanisms): the same run as the value
+    written in the file's `reactions:`, the stored series the expression itself, and the
+    other components solved."""
+    import yaml
 
-
-def _first_evaluation_compiles(monkeypatch) -> None:
-    """Make the run's first evaluation compile a numba function slowly, as the first run
-    on a machine compiles `mbody.solve.compiled`'s kernels at their first call (the right-
-    hand side's first evaluation, scipy's at t = 0, and the first compiled steps): numba's
-    own compile, made SLOW_COMPILE seconds longer."""
-    import time
-
-    numba = pytest.importorskip("numba")
-    from mbody.solve.dynamics import StateDerivative
-
-    @numba.njit  # not cached: compiled at its first call, in the run
-    def first(t):
-        return t + 1.0
-
-    compile_ = first._compiler.compile
-
-    def slow_compile(*args, **kwargs):
-        time.sleep(SLOW_COMPILE)
-        return compile_(*args, **kwargs)
-
-    monkeypatch.setattr(first._compiler, "compile", slow_compile)
-    call = StateDerivative.__call__
-
-    def evaluate(self, t, y):
-        first(t)
-        return call(self, t, y)
-
-    monkeypatch.setattr(StateDerivative, "__call__", evaluate)
-
-
-def test_wall_time_leaves_out_the_one_off_compile(monkeypatch):
-    """The summary's time is the integration's; a compile on the way (the first run on a
-    machine) is said apart, not added to it; the next run compiles nothing."""
-    from mbody.simulate.simulation import summary
-
-    _first_evaluation_compiles(monkeypatch)
-    traj = mbody.simulate(_model("torque_free_asymmetric"), t_end=0.5, fps=30)
-    i = traj.info
-    assert i["wall_time_s"] < SLOW_COMPILE  # was 2.5 s: the compile counted as integrating
-    assert SLOW_COMPILE <= i["compile_time_s"] < SLOW_COMPILE + 30
-    assert (f"evaluations ({i['sampling_evaluations']} of them for the samples), "
-            f"{i['wall_time_s']:.3g} s (plus {i['compile_time_s']:.3g} s to compile the fast "
-            "path once)\n") in summary(traj)
-    again = mbody.simulate(_model("torque_free_asymmetric"), t_end=0.5, fps=30)
-    assert again.info["compile_time_s"] == 0 and again.info["wall_time_s"] < SLOW_COMPILE
-    assert "compile" not in summary(again)
+    path = Path(__file__).resolve().parents[1] / "models" / "double_pendulum.yaml"
+    given = mbody.simulate(mbody.load(path), 1.0, 30, known={"A.Fx": "0.5*sin(3*t)"})
+    spec = yaml.safe_load(path.read_text())
+    spec["reactions"] = {"A.Fx": "0.5*sin(3*t)"}
+    written = mbody.simulate(mbody.load(spec), 1.0, 30)
+    np.testing.assert_array_equal(given.position, written.position)
+    np.testing.assert_array_equal(given.reactions, written.reactions)
+    i = given.reaction_labels.index("A.Fx")
+    np.testing.assert_allclose(given.reactions[:, i], 0.5 * np.sin(3 * given.t), rtol=0,
+                               atol=1e-15)
+    free = mbody.simulate(mbody.load(path), 1.0, 30)  # A.Fx solved: another motion
+    assert np.max(np.abs(free.position - given.position)) > 1e-3

@@ -164,7 +164,7 @@ def _ideal_steps(model, rtol: float, atol: float) -> int:
     own state layout and tolerances: what a solver that the crossings cost nothing takes."""
     import scipy.integrate
 
-    from mbody.solve.dynamics import quaternion_rate
+    from mbody.equations.spatial import quaternion_rate
 
     n = model.n
 
@@ -227,3 +227,34 @@ def test_fourbar_chain_simulated_through_its_flat_positions(rtol, atol):
         assert traj.info["energy_drift"] <= 1e-8
     assert traj.info["joint_position_drift"] <= 1e-12
     assert traj.info["warnings"] == []
+
+
+def test_fourbar_chain_crossing_in_c_equals_the_python_callbacks():
+    """The run with its projection, stage projection and error along the joints bound in
+    C (mbody/kernel/src/mechanism.c) takes the chain through its first two crossings as
+    the same DOP853 calling them written in Python (tests/mechanism_reference.py) does."""
+    from mechanism_reference import Callbacks
+
+    from mbody.simulate import state_derivative
+    from mbody.simulate.projection import STAGE_PIVOT_RTOL, JointProjection
+
+    model = mbody.loads(CHAIN.yaml(0.3, 0.0))
+    fast = mbody.simulate(model, 0.6, 60, rtol=1e-10, atol=1e-12)
+    rhs = state_derivative(model)
+    y0 = _state_vector(model)
+    _, _, ratio = JointProjection(model, rhs.unknowns)(y0, 0.0)
+    slow = Callbacks(model, rhs.unknowns).dop853(y0, 0.6, 1e-10, 1e-12,
+                                                 filter_first=ratio < STAGE_PIVOT_RTOL)
+    t = fast.t
+    Y = np.empty((len(t), len(y0)))
+    Y[0], k = y0, 1
+    while slow.status == "running":
+        k = slow.sampled(0.6, 100, t, k, Y, project_samples=True)
+    n = model.n
+    position = Y[:, :3 * n].reshape(len(t), n, 3)[..., :2]
+    exact = _exact_positions(t, 0.3)
+    for run in (fast.position, position):
+        assert float(np.max(np.abs(run - exact))) <= 1e-8
+    assert fast.info["evaluation_path"] == "compiled"
+    assert (fast.info["steps"], fast.info["evaluations"]) == (slow.steps, slow.nfev)
+    np.testing.assert_allclose(fast.position, position, atol=1e-9)

@@ -1,9 +1,11 @@
 """Benchmark: simulate N free, torque-free rigid bodies for T seconds (default 1000, 10 s).
 
 Reports the integrator's steps and derivative evaluations, the cost per body-step, and
-how much of the cost is fixed Python overhead: the cost of one evaluation is modelled as
-c(n) = a + b n, with a (overhead, independent of n) measured on 1 body and b (the
-vectorised numpy work per body) from the difference with N bodies.
+how much of the cost is fixed Python overhead when the accelerations are given as a
+Python `dynamics` (called from the core's DOP853 at every evaluation): the cost of one
+evaluation is modelled as c(n) = a + b n, with a (overhead, independent of n) measured on
+1 body and b (the work per body) from the difference with N bodies. The same runs on the
+compiled core alone (the default, no `dynamics`) are timed beside.
 
     python tools/bench_simulate.py [--bodies 1000] [--t-end 10] [--fps 60]
 """
@@ -49,10 +51,12 @@ def run(model: mbody.Model, t_end: float, fps: float) -> dict:
     traj = mbody.simulate(model, t_end, fps, dynamics=timed)
     wall = time.perf_counter() - t0
     i = traj.info
+    core = mbody.simulate(model, t_end, fps).info  # the default: the compiled core alone
     # "wall": the integration loop only; "post": drift figures and Trajectory, once per run.
     return {"n": model.n, "wall": i["wall_time_s"], "post": wall - i["wall_time_s"],
             "steps": i["steps"], "evals": i["evaluations"],
-            "accel": spent[0], "samples": i["samples"],
+            "accel": spent[0], "samples": i["samples"], "core": core["wall_time_s"],
+            "core_evals": core["evaluations"],
             "drift": (max(np.abs(traj.kinetic_energy() / traj.kinetic_energy()[0] - 1)))}
 
 
@@ -74,6 +78,10 @@ def main() -> None:
         print(f"{r['n']:>7} {r['wall']:>8.3f} {r['steps']:>6} {r['evals']:>6} "
               f"{1e6 * r['wall'] / r['evals']:>8.1f} {1e6 * r['accel'] / r['evals']:>13.1f} "
               f"{1e6 * r['wall'] / (r['steps'] * r['n']):>12.3f} {r['drift']:>10.1e}")
+    for r in (one, big):
+        print(f"{r['n']:>7} bodies on the compiled core (no dynamics given: no Python per "
+              f"evaluation): {r['core']:.3f} s, {r['core_evals']} evaluations, "
+              f"{1e6 * r['core'] / r['core_evals']:.2f} us/eval")
     print(f"after the loop, drift figures and the Trajectory took {big['post']:.3f} s "
           f"({big['samples']} samples x {big['n']} bodies)")
     a_ = one["wall"] / one["evals"]  # per evaluation, almost all fixed overhead

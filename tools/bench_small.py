@@ -20,11 +20,15 @@ each read from models/. Measured per system (microseconds per call, best of --re
 - 10 s of ``mbody.simulate(model, t_end=10)`` at its defaults (DOP853, rtol 1e-10,
   atol 1e-12): wall time of the whole call, steps and right-hand-side evaluations.
 
-Then time to accuracy on the two tree models whose MuJoCo equivalents are exact (double
-pendulum, heavy top): the mass-centre position error at t = 10 s against a tight
-reference, and the wall time each engine needs for a given error (mbody's DOP853 over a
-range of tolerances; MuJoCo's RK4 over a range of fixed steps, stepped in C by
-``mujoco.rollout``). Before timing anything, each MuJoCo equivalent is checked against
+Then time to accuracy on the double pendulum and the heavy top (trees: their MuJoCo
+equivalents are exact) and the slider-crank (a closed loop, coasting without its loads):
+the mass-centre position error at t = 10 s against a tight reference, and the wall time
+each engine needs for a given error (the whole ``mbody.simulate`` call over a range of
+tolerances, later calls in this process and the first call in a fresh process apart;
+MuJoCo's RK4 over a range of fixed steps, stepped in C by ``mujoco.rollout``); and the
+open double pendulum against Exudyn's minimal-coordinate kinematic tree with its DOPRI5
+(``pip install -e ".[bench]"``; skipped when Exudyn is not installed).
+Before timing anything, each MuJoCo equivalent is checked against
 mbody at the initial state (positions, velocities and accelerations of every mass
 centre and body rotation) and the result printed. Targets (from the issue) are printed
 beside the numbers with PASS/MISS.
@@ -35,6 +39,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import math
+import os
 import sys
 import time
 from dataclasses import dataclass
@@ -65,14 +70,20 @@ SYSTEMS = (
     ("four-bar spatial", "fourbar_spatial.yaml"),  # extra: 3 redundant constraints
 )
 """(label, file in models/) of every system in the first table."""
-ACCURACY = ("double pendulum", "heavy top")
-"""Tree models used for time to accuracy (their MuJoCo equivalents are exact)."""
+ACCURACY = ("double pendulum", "heavy top", "slider-crank")
+"""Models of the time-to-accuracy part: two trees (their MuJoCo equivalents are exact) and
+the slider-crank, a closed loop (MuJoCo closes it with a soft equality constraint), which
+coasts here from its initial state without its loads (MuJoCo's `xfrc_applied` cannot vary
+in time inside a rollout)."""
+WITHOUT_LOADS = ("slider-crank",)
+"""Accuracy models run without their (time-varying) loads."""
 
 T_SIM = 10.0
 SOLVE_TARGET, SOLVE_STRETCH = 10.0, 3.0   # solve time / mj_forward time
 RHS_TARGET_US = 15.0                      # one right-hand-side call, µs
 SIM_TARGET_S = 1.0                        # 10 s of simulation, wall s
-ACCURACY_TARGET = 10.0                    # mbody time / MuJoCo time for the same error
+ACCURACY_TARGET = 1.0                     # whole simulate() / MuJoCo RK4, same error
+EXUDYN_TARGET = 2.0                       # whole simulate() / Exudyn's tree (DOPRI5)
 CHECK_RTOL = 1e-8                         # MuJoCo equivalents agree with mbody to this
 SOLIMP = "0.9999 0.9999 0.001"
 """Impedance of the loop-closing `connect` constraints: the stiffest MuJoCo allows (its
@@ -82,6 +93,15 @@ this leaves 1e-4). It does not change mj_forward's time."""
 
 def load(file: str) -> mbody.Model:
     return mbody.load(MODELS / file)
+
+
+def load_without_loads(file: str) -> mbody.Model:
+    """The shipped model with its `loads:` left out (the same bodies, joints, state)."""
+    import yaml
+
+    spec = yaml.safe_load((MODELS / file).read_text(encoding="utf-8"))
+    spec.pop("loads", None)
+    return mbody.load(spec)
 
 
 # -- timing --------------------------------------------------------------------------------
@@ -521,8 +541,9 @@ def print_table(rows: list[Row], repeat: int) -> None:
     print(f"targets: solve ≤ {SOLVE_TARGET:g}× mj_forward (* also the stretch "
           f"≤ {SOLVE_STRETCH:g}×); RHS ≤ {RHS_TARGET_US:g} µs a call (simulate's f(t, y)); "
           f"{T_SIM:g} s of simulate() at its defaults ≤ {SIM_TARGET_S:g} s wall")
-    print("f %: evaluations × RHS time as a share of the simulation's wall time (the rest "
-          "is the integrator's own Python per step, sampling and the run's summary)")
+    print("f %: evaluations × the RHS time measured from Python as a share of the 10 s "
+          "run's wall time; the run calls the same right-hand side from C, without "
+          "Python's call overhead, so this can exceed 100 %")
     if any(r.check is not None and not r.check.exact for r in rows):
         print("‡ closed loop: MuJoCo cuts it at one pin and closes it with an equality "
               f"constraint (connect, solimp {SOLIMP}: as stiff as MuJoCo allows); it is soft, "
@@ -621,30 +642,65 @@ def time_to_reach(points: list[tuple[float, float]], target: float) -> tuple[flo
     return math.nan, ""
 
 
-def ratio_verdict(tb: float, bb: str, tm: float, bm: str) -> tuple[str, str]:
-    """(ratio text, verdict) for mbody's and MuJoCo's times to an error, either of which
-    may be an upper bound ('≤'): '?' when the bound leaves the target undecided."""
-    if math.isnan(tb) or math.isnan(tm):
-        return "-", "-"
+def ratio_verdict(tb: float, bb: str, tm: float, bm: str,
+                  target: float = ACCURACY_TARGET) -> tuple[str, str]:
+    """(ratio text, verdict) for mbody's and the other engine's times to an error, either
+    of which may be an upper bound ('≤'): '?' when the bound leaves the target undecided;
+    the other engine never reaching the error while mbody does is a PASS."""
+    if math.isnan(tb):
+        return "-", "-" if math.isnan(tm) else "MISS"
+    if math.isnan(tm):
+        return "-", "PASS"
     r = tb / tm
     if bb and bm:
         return f"~{r:.2f}", "?"
     if bb:  # the true ratio is at most r
-        return f"≤{r:.2f}", "PASS" if r <= ACCURACY_TARGET else "?"
+        return f"≤{r:.2f}", "PASS" if r <= target else "?"
     if bm:  # the true ratio is at least r
-        return f"≥{r:.2f}", "MISS" if r > ACCURACY_TARGET else "?"
-    return f"{r:.2f}", mark(r <= ACCURACY_TARGET)
+        return f"≥{r:.2f}", "MISS" if r > target else "?"
+    return f"{r:.2f}", mark(r <= target)
+
+
+FIRST_CALL = """
+import sys, time
+t0 = time.perf_counter()
+import mbody
+{load}
+t1 = time.perf_counter()
+x = mbody.simulate(model, t_end={t_end!r}, fps={fps!r}, rtol={rtol!r}, atol={atol!r})
+t2 = time.perf_counter()
+mbody.simulate(model, t_end={t_end!r}, fps={fps!r}, rtol={rtol!r}, atol={atol!r})
+t3 = time.perf_counter()
+print(t2 - t1, t3 - t2)
+"""
+
+
+def first_call(file: str, without_loads: bool, t_end: float, rtol: float, atol: float
+               ) -> tuple[float, float]:
+    """(first, second) wall time of the whole `mbody.simulate` call in a fresh process
+    (the model loaded before either is timed; bytecode cached, as after an install)."""
+    import subprocess
+
+    how = ("import yaml\nspec = yaml.safe_load(open({f!r}).read())\nspec.pop('loads', None)"
+           "\nmodel = mbody.load(spec)" if without_loads else "model = mbody.load({f!r})")
+    code = FIRST_CALL.format(load=how.format(f=str(MODELS / file)), t_end=t_end,
+                             fps=1.0 / t_end, rtol=rtol, atol=atol)
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True, cwd=ROOT, env=env).stdout.split()
+    return float(out[0]), float(out[1])
 
 
 def accuracy(label: str, file: str, quick: bool, repeat: int) -> None:
     import mujoco
 
-    model = load(file)
+    without = label in WITHOUT_LOADS
+    model = load_without_loads(file) if without else load(file)
     t_end = T_SIM
     eq = mujoco_equivalent(model, integrator="RK4")
     check = check_equivalent(model, eq)
-    print(f"\ntime to accuracy: {label} ({file}), t = {t_end:g} s; error = max over bodies "
-          "of |x_G − x_G,ref| (m)")
+    print(f"\ntime to accuracy: {label} ({file}{', its loads left out' if without else ''}), "
+          f"t = {t_end:g} s; error = max over bodies of |x_G − x_G,ref| (m)")
     print(f"  MuJoCo equivalent at t = 0: accelerations agree to {check.acc:.1e} relative, "
           f"qacc conversion to {check.qacc:.1e}: {mark(check.acc <= CHECK_RTOL)} "
           f"(≤ {CHECK_RTOL:g})")
@@ -656,10 +712,11 @@ def accuracy(label: str, file: str, quick: bool, repeat: int) -> None:
     steps = [5e-2, 1e-2, 2e-3, 5e-4, 1e-4] if quick else \
         [5e-2, 2e-2, 1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4, 5e-5, 2e-5, 1e-5]
     mbody_run(model, 0.1, 1e-6, 1e-8)  # warm
-    mb = []
+    mb, first = [], []
     for rtol in rtols:
         wall, x = best_once(lambda r=rtol: mbody_run(model, t_end, r, r * 1e-2), repeat)
         mb.append((rtol, wall, float(np.abs(x - x_ref).max())))
+        first.append(first_call(file, without, t_end, rtol, rtol * 1e-2)[0])
     mj = []
     previous = mujoco.get_mju_user_warning()
     mujoco.set_mju_user_warning(lambda text: None)  # a diverged run is shown in the table
@@ -677,35 +734,123 @@ def accuracy(label: str, file: str, quick: bool, repeat: int) -> None:
     print(f"  reference: mbody DOP853 rtol {ref_tol[0]:g}, atol {ref_tol[1]:g}; the closest "
           f"MuJoCo RK4 run (h = {close[1]:g} s) ends {close[0]:.1e} m from it")
     gap = " " * 8
-    print(f"  {'mbody DOP853':<28}{gap}MuJoCo RK4")
-    print(f"  {'rtol':>7} {'wall s':>8} {'error m':>9}{gap}{'h s':>7} {'steps':>8} "
-          f"{'wall s':>8} {'error m':>9}")
+    print(f"  {'mbody DOP853':<37}{gap}MuJoCo RK4")
+    print(f"  {'rtol':>7} {'first s':>8} {'wall s':>8} {'error m':>9}{gap}{'h s':>7} "
+          f"{'steps':>8} {'wall s':>8} {'error m':>9}")
     for k in range(max(len(mb), len(mj))):
-        left = (f"  {mb[k][0]:7.0e} {mb[k][1]:8.4f} {mb[k][2]:9.1e}" if k < len(mb)
-                else " " * 28)
+        left = (f"  {mb[k][0]:7.0e} {first[k]:8.4f} {mb[k][1]:8.4f} {mb[k][2]:9.1e}"
+                if k < len(mb) else " " * 37)
         right = ""
         if k < len(mj):
             err = f"{mj[k][2]:9.1e}" if math.isfinite(mj[k][2]) else f"{'diverged':>9}"
             right = f"{mj[k][0]:7.0e} {mj[k][3]:8d} {mj[k][1]:8.4f} {err}"
         print(left + gap + right)
-    print(f"  wall s: best of {repeat}; mbody: one whole simulate() call (samples at 0 and "
-          f"{t_end:g} s only), atol = rtol / 100; MuJoCo: from mj_resetData, stepped in C by "
-          "mujoco.rollout")
-    print(f"  {'error ≤':>9} {'mbody s':>9} {'MuJoCo s':>9} {'ratio':>7}  "
-          f"≤{ACCURACY_TARGET:g}×")
+    print(f"  wall s: best of {repeat} later calls in this process; first s: the first call "
+          f"in a fresh process (mbody imported and the model loaded before it); mbody: one "
+          f"whole simulate() call (samples at 0 and {t_end:g} s only), atol = rtol / 100; "
+          "MuJoCo: from mj_resetData, stepped in C by mujoco.rollout")
+    print(f"  {'error ≤':>9} {'mbody s':>11} {'MuJoCo s':>9} {'ratio':>7}  "
+          f"≤{ACCURACY_TARGET:g}×   {'first s':>11} {'ratio':>7}  ≤{ACCURACY_TARGET:g}×")
     for target in (1e-4, 1e-6, 1e-8):
         tb, bb = time_to_reach([(w, e) for _, w, e in mb], target)
+        tf, bf = time_to_reach([(f, e) for f, (_, _, e) in zip(first, mb, strict=True)],
+                               target)
         tm, bm = time_to_reach([(w, e) for _, w, e, _ in mj], target)
         text, verdict = ratio_verdict(tb, bb, tm, bm)
-
-        def fmt(t: float, b: str) -> str:
-            return "not reached" if math.isnan(t) else f"{b}{t:.4f}"
-
-        print(f"  {target:9.0e} {fmt(tb, bb):>9} {fmt(tm, bm):>9} {text:>7}  {verdict}",
-              flush=True)
+        ftext, fverdict = ratio_verdict(tf, bf, tm, bm)
+        print(f"  {target:9.0e} {fmt(tb, bb):>11} {fmt(tm, bm):>9} {text:>7}  {verdict:<5}"
+              f"{fmt(tf, bf):>11} {ftext:>7}  {fverdict}", flush=True)
     print("  time to an error: log-log interpolation between the two runs around it "
           "(≤: an upper bound, the cheapest run or the one after a diverged run; "
           "ratio = mbody / MuJoCo; ?: the bound leaves the target undecided)")
+
+
+def fmt(t: float, b: str) -> str:
+    return "not reached" if math.isnan(t) else f"{b}{t:.4f}"
+
+
+# -- Exudyn: the open double pendulum as a minimal-coordinate tree --------------------------
+def exudyn_double_pendulum(rtol: float, atol: float, t_end: float):
+    """(wall s of SolveDynamic, mass-centre positions (2, 3) at t_end) of the shipped
+    double pendulum as Exudyn's kinematic tree (two revolute joints about z, joint
+    angles relative to the parent link) integrated by its DOPRI5 with automatic steps."""
+    import exudyn as exu
+    from exudyn.robotics import Robot, RobotBase, RobotLink, RobotTool
+
+    model = load("double_pendulum.yaml")
+    L = 0.5
+    m, Izz = float(model.mass[0]), float(model.J[0][2, 2])
+    inertia = np.diag([Izz, 1e-4, Izz])  # a rod along its link's y axis
+    robot = Robot(gravity=[0, -9.81, 0], base=RobotBase(), tool=RobotTool(),
+                  referenceConfiguration=[])
+    for i in range(2):
+        pre = np.eye(4)
+        if i:
+            pre[1, 3] = -L
+        robot.AddLink(RobotLink(m, [0, -L / 2, 0], inertia, jointType="Rz", preHT=pre))
+    angles = [math.radians(30.0), math.radians(15.0)]  # absolute 30 and 45 deg
+    robot.referenceConfiguration = angles
+    SC = exu.SystemContainer()
+    mbs = SC.AddSystem()
+    robot.CreateKinematicTree(mbs)
+    mbs.Assemble()
+    st = exu.SimulationSettings()
+    ti = st.timeIntegration
+    ti.endTime = t_end
+    ti.numberOfSteps = 10  # with automatic steps: the largest step is endTime / this
+    ti.automaticStepSize = True
+    ti.absoluteTolerance = atol
+    ti.relativeTolerance = rtol
+    ti.verboseMode = 0
+    st.solution.file.write = False
+    st.show.computationTime = False
+    st.show.statistics = False
+    t0 = time.perf_counter()
+    mbs.SolveDynamic(st, solverType=exu.DynamicSolverType.DOPRI5)
+    wall = time.perf_counter() - t0
+    q = np.array(mbs.systemData.GetODE2Coordinates()) + np.array(angles)
+    a1, a2 = q[0], q[0] + q[1]
+    G1 = L / 2 * np.array([math.sin(a1), -math.cos(a1), 0.0])
+    G2 = L * np.array([math.sin(a1), -math.cos(a1), 0.0]) \
+        + L / 2 * np.array([math.sin(a2), -math.cos(a2), 0.0])
+    return wall, np.stack((G1, G2))
+
+
+def exudyn_accuracy(quick: bool, repeat: int) -> None:
+    try:
+        import exudyn
+    except ImportError:
+        print("\nExudyn: not installed (pip install -e '.[bench]')")
+        return
+    t_end = T_SIM
+    model = load("double_pendulum.yaml")
+    x_ref = mbody_run(model, t_end, 1e-13, 1e-14)
+    print(f"\ntime to accuracy: the open double pendulum against Exudyn {exudyn.__version__}'s "
+          f"kinematic tree (minimal coordinates, DOPRI5), t = {t_end:g} s; reference: mbody "
+          "DOP853 rtol 1e-13")
+    rtols = [1e-4, 1e-6, 1e-8, 1e-10] if quick else \
+        [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11]
+    exudyn_double_pendulum(1e-6, 1e-8, 0.1)  # warm
+    mb, ex = [], []
+    for rtol in rtols:
+        wall, x = best_once(lambda r=rtol: mbody_run(model, t_end, r, r * 1e-2), repeat)
+        mb.append((rtol, wall, float(np.abs(x - x_ref).max())))
+        runs = [exudyn_double_pendulum(rtol, rtol * 1e-2, t_end) for _ in range(repeat)]
+        wall_x, x_x = min(runs, key=lambda r: r[0])
+        ex.append((rtol, wall_x, float(np.abs(x_x[:, :2] - x_ref[:, :2]).max())))
+    print(f"  {'rtol':>7} {'mbody s':>9} {'error m':>9}   {'Exudyn s':>9} {'error m':>9}")
+    for (r, wb, eb), (_, wx, ee) in zip(mb, ex, strict=True):
+        print(f"  {r:7.0e} {wb:9.4f} {eb:9.1e}   {wx:9.4f} {ee:9.1e}")
+    print(f"  wall s: best of {repeat}; mbody: one whole simulate() call; Exudyn: "
+          "SolveDynamic alone (the model built before), atol = rtol / 100 for both")
+    print(f"  {'error ≤':>9} {'mbody s':>11} {'Exudyn s':>11} {'ratio':>7}  "
+          f"≤{EXUDYN_TARGET:g}×")
+    for target in (1e-4, 1e-6, 1e-8):
+        tb, bb = time_to_reach([(w, e) for _, w, e in mb], target)
+        tx, bx = time_to_reach([(w, e) for _, w, e in ex], target)
+        text, verdict = ratio_verdict(tb, bb, tx, bx, EXUDYN_TARGET)
+        print(f"  {target:9.0e} {fmt(tb, bb):>11} {fmt(tx, bx):>11} {text:>7}  {verdict}",
+              flush=True)
 
 
 def run(quick: bool, repeat: int, sim_limit: float, accuracy_runs: bool) -> None:
@@ -718,14 +863,9 @@ def run(quick: bool, repeat: int, sim_limit: float, accuracy_runs: bool) -> None
         have_mj, version = False, "not importable"
     import scipy
 
-    try:
-        import numba
-
-        jit = numba.__version__
-    except ImportError:
-        jit = "not installed (no compiled path)"
-    print(f"mbody {mbody.__version__}, numpy {np.__version__}, scipy {scipy.__version__}, "
-          f"numba {jit}, MuJoCo {version}, Python {sys.version.split()[0]}")
+    print(f"mbody {mbody.__version__} (compiled core: mbody.kernel._core), numpy "
+          f"{np.__version__}, scipy {scipy.__version__}, MuJoCo {version}, Python "
+          f"{sys.version.split()[0]}")
     rows = [measure(label, file, repeat, sim_limit, have_mj) for label, file in SYSTEMS]
     print_table(rows, repeat)
     if have_mj:
@@ -734,6 +874,8 @@ def run(quick: bool, repeat: int, sim_limit: float, accuracy_runs: bool) -> None
         files = dict(SYSTEMS)
         for label in ACCURACY:
             accuracy(label, files[label], quick, 1 if quick else min(repeat, 3))
+    if accuracy_runs:
+        exudyn_accuracy(quick, 1 if quick else min(repeat, 3))
 
 
 def main(argv: list[str] | None = None) -> int:

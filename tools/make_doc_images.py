@@ -6,7 +6,7 @@ Planar: the slider-crank's piston (gas force 4000 N beside 4.9 N of weight: the 
 length scale at work; two reactions at one pin drawn side by side) and the upper link
 of the double pendulum (the parent of joint A: its reactions are labelled −A.Fx, −A.Fy).
 Spatial: the heavy top on its pivot, isometric view. And the slider-crank's body/joint
-graph.
+graph. The driven slider-crank's revolution (docs/driven.md).
 """
 
 from __future__ import annotations
@@ -17,6 +17,7 @@ from pathlib import Path
 import mbody
 from mbody.model.graph import topology
 from mbody.present.draw import draw_graph, save_figure
+from mbody.present.plot import save_plot
 
 ROOT = Path(__file__).resolve().parent.parent
 PICTURES = (  # (model file, body, view, output name)
@@ -37,6 +38,9 @@ def main(argv: list[str] | None = None) -> int:
         model = mbody.load(ROOT / "models" / file)
         fig = mbody.assemble(model).bodies[body].fbd.draw(view=view)
         print("wrote", save_figure(fig, out / name, dpi=a.dpi))
+    run = mbody.kinematic_run(mbody.load(ROOT / "models" / "slider_crank_driven.yaml"),
+                              0.1, 3600, axes="world")
+    print("wrote", save_plot(run, out / "driven_slider_crank.png", dpi=a.dpi))
     model = mbody.load(ROOT / "models" / "slider_crank.yaml")
     fig = draw_graph(model, topology(model, mbody.assemble(model).G))
     print("wrote", save_figure(fig, out / "graph_slider_crank.png", dpi=a.dpi))

@@ -156,9 +156,8 @@ double_asm"""),
 ## 7. Simulate
 
 `mbody.simulate(model, t_end, fps)` integrates the motion with the reactions solved at
-every step. (The first simulation after installing mbody compiles its solver with numba,
-about a minute once; later runs load the compiled code.) A run shows its facts, its plots
-and the motion in 3-D."""),
+every step, in mbody's compiled core (built when mbody was installed: nothing compiles
+when a run starts). A run shows its facts, its plots and the motion in 3-D."""),
     ("code", """\
 run = mbody.simulate(double, 1.0, 30)
 run"""),

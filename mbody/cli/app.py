@@ -30,7 +30,8 @@ from mbody.errors import MbodyError, ModelError, UnknownReactionsError, did_you_
 from mbody.model.loader import MAX_BYTES, max_bytes_limit
 
 COMMAND_MODULES = (
-    "core", "export", "sim", "draw", "animate", "mechanism", "verify", "interop", "sweep")
+    "core", "export", "sim", "drive", "draw", "animate", "mechanism", "statics", "verify",
+    "interop", "sweep")
 """Modules of `mbody.cli`; each has `register(subparsers)` adding its commands."""
 
 def build_parser() -> argparse.ArgumentParser:

@@ -194,6 +194,15 @@ def assignments(pairs: Sequence[str], flag: str, form: str,
     return out
 
 
+def add_axes_option(command: argparse.ArgumentParser) -> None:
+    """--axes {joint,world}: the axes reactions are given in (docs/reactions.md)."""
+    command.add_argument(
+        "--axes", choices=("joint", "world"), default="joint",
+        help="axes of the joint reactions: 'joint' (default) each component along its joint "
+        "frame, fixed to the parent; 'world' each joint's force and moment on its child "
+        "along world x, y, z (as a hand solution in world axes writes them)")
+
+
 MODEL_HELP = "a model file: mbody YAML, MuJoCo's MJCF (.xml) or URDF (.urdf)"
 """The MODEL argument's help on every command that reads one."""
 

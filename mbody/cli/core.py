@@ -5,7 +5,14 @@ from __future__ import annotations
 import argparse
 import sys
 
-from mbody.cli.common import EXIT_OK, MODEL_HELP, load_model, output_stream, parse_known
+from mbody.cli.common import (
+    EXIT_OK,
+    MODEL_HELP,
+    add_axes_option,
+    load_model,
+    output_stream,
+    parse_known,
+)
 from mbody.errors import MbodyError
 
 
@@ -41,6 +48,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--known", metavar="LABEL=VALUE", action="append", default=[],
                    help="a known reaction value, e.g. --known A.Fx=3 (repeatable)")
     s.add_argument("--json", action="store_true", help="machine-readable output")
+    add_axes_option(s)
     s.set_defaults(run=solve)
 
 
@@ -114,11 +122,11 @@ def _symbolic(asm, a: argparse.Namespace) -> int:
 def solve(a: argparse.Namespace) -> int:
     from mbody.equations.assemble import assemble as _assemble
     from mbody.io import jsontext
-    from mbody.present.text import reaction_table_text, solution_text
+    from mbody.present.text import reaction_table_text, solution_text, world_reaction_text
 
     model = load_model(a.model)
     asm = _assemble(model)
-    sol = asm.solve(known=parse_known(a.known), condition=True)
+    sol = asm.solve(known=parse_known(a.known), condition=True, axes=a.axes)
     if a.json:
         acc = sol.accelerations.tolist()
         by_body = {name: {model.coordinates[r]: acc[r] for r in model.body_rows(i)}
@@ -127,10 +135,12 @@ def solve(a: argparse.Namespace) -> int:
                        "accelerations": acc, "by_body": by_body,
                        "reactions": dict(sol.reactions), "solved": list(sol.solved),
                        "not_unique": list(sol.not_unique), "backward_error": sol.residual,
-                       "condition": sol.condition, "warnings": sol.warnings}, sys.stdout)
+                       "condition": sol.condition, "warnings": sol.warnings,
+                       "reaction_axes": sol.axes}, sys.stdout)
     else:
         print(solution_text(sol, model))
         if sol.reactions:
             print()
-            print(reaction_table_text(asm, sol))
+            print(world_reaction_text(model, sol) if sol.axes == "world"
+                  else reaction_table_text(asm, sol))
     return EXIT_OK

@@ -31,10 +31,6 @@ can run away (rtol 0.5 or atol 1 on the shipped slider-crank and four-bar)."""
 MAX_STEPS, MAX_WALL = 10**9, 1e7
 """Largest --max-steps (0: no limit) and --max-wall (s, 115 days)."""
 
-COMPILE_NOTICE = ("mbody: compiling the fast path once (about a minute); later runs start at "
-                  "once")
-"""What `mbody simulate` says on stderr before a run that compiles the numba kernels."""
-
 
 def register(sub: argparse._SubParsersAction) -> None:
     s = sub.add_parser("simulate", help="integrate the motion (unknown reactions solved "
@@ -97,6 +93,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--body", action="append", default=None, metavar="NAME",
                    help="bodies for the angular-velocity panel (repeatable; default the "
                    "first 6)")
+    s.add_argument("--against", metavar="DRIVER|time", default=None,
+                   help="a run with drivers: plot the efforts and bearing loads against this "
+                   "driver's coordinate (default: the first driver; degrees for an angle) or "
+                   "against time")
+    s.add_argument("--motion", action="store_true",
+                   help="a run with drivers: plot the bodies' motion, energy and momentum "
+                   "instead of the drivers' figure")
     s.set_defaults(run=plot)
 
 
@@ -112,8 +115,6 @@ def simulate(a: argparse.Namespace) -> int:
 
         ensure_writable(a.output)
     known = parse_known(a.known)
-    if compile_pending(model, known, a.method):  # else ~20 s of silence on the first run
-        print(COMPILE_NOTICE, file=sys.stderr, flush=True)
     traj = _simulate(model, a.t_end, a.fps,
                      rtol=DEFAULT_RTOL if a.rtol is None else a.rtol,
                      atol=DEFAULT_ATOL if a.atol is None else a.atol, method=a.method,
@@ -135,50 +136,6 @@ def check_samples(t_end: float, fps: float, flags: str = "--t-end x --fps") -> N
                          "a shorter time or fewer per second)")
 
 
-def compile_pending(model, known, method: str = "DOP853") -> bool:
-    """Whether simulating `model` will first compile `mbody.solve.compiled`'s kernels: the
-    compiled path serves it (numba importable, `MBODY_JIT` not off, a model it takes) and
-    numba's cache holds no machine code for this machine of a kernel the run calls
-    (`derivative`; `rk_run` for DOP853's compiled runs; `solve` and `project` too for
-    a mechanism's reactions and projection). The cache is empty after
-    an install, and stale after numba or mbody/solve/compiled.py changed (it is keyed by the
-    numba version and the source file's time stamp and size). Imports numba, as the run
-    itself would; never raises (numba's cache layout is not public: on any surprise the
-    answer is no, and the run is merely silent while it compiles)."""
-    from mbody.equations import plan
-    from mbody.simulate.simulation import _has_unknown_reactions
-
-    if plan.JIT == "off" or not 0 < model.n <= plan.COMPILED_MAX_BODIES:
-        return False
-    C = plan.compiled()
-    if C is None:
-        return False
-    kernels = [C.derivative]
-    if method == "DOP853":
-        kernels.append(C.rk_run)
-    if _has_unknown_reactions(model, known):
-        kernels += [C.solve, C.project]
-    try:
-        return not all(_cached(k) for k in kernels)
-    except Exception:  # noqa: BLE001 - a guess about numba's internals, never fatal
-        return False
-
-
-def _cached(dispatcher) -> bool:
-    """numba's on-disk cache has an entry of `dispatcher` (``njit(cache=True)``) for this
-    machine and this byte code, fresh for the source file (an index file
-    ``<function>-<line>.py<XY>.nbi`` beside the data, in mbody/__pycache__ or where
-    NUMBA_CACHE_DIR or numba's fallback puts it)."""
-    import hashlib
-
-    from numba.core.registry import cpu_target
-
-    index = dispatcher._cache._cache_file._load_index()  # {} when missing or stale
-    magic = cpu_target.target_context.codegen().magic_tuple()
-    code = hashlib.sha256(dispatcher.py_func.__code__.co_code).hexdigest()
-    return any(key[1] == magic and key[2][0] == code for key in index)
-
-
 def plot(a: argparse.Namespace) -> int:
     from mbody.io.atomic import ensure_writable
     from mbody.present.plot import save_plot
@@ -187,6 +144,6 @@ def plot(a: argparse.Namespace) -> int:
     ensure_writable(a.output)  # before the figure is drawn (a second or two)
     regular_file(a.trajectory, "a run file written by 'mbody simulate -o RUN.npz'")
     traj = Trajectory.load(a.trajectory)
-    save_plot(traj, a.output, a.body)
+    save_plot(traj, a.output, a.body, against=a.against, motion=a.motion)
     print(f"wrote {a.output}", file=output_stream(a.output))
     return EXIT_OK

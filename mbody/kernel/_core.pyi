@@ -60,6 +60,75 @@ KN_ERROR: int
 KN_SINGULAR: int
 KN_STEP: int
 KN_INFO: int
+KR_STEP: int
+KR_NEWTON: int
+KR_WORST: int
+KR_SINGULAR: int
+KR_INFO: int
+
+# DOP853 (src/dop853.h, dop853_module.c): state slots, statuses, work rows, test systems;
+# a mechanism's params (src/mechanism.h)
+DOP_STATE_SIZE: int
+DOP_PROJECT_INFO: int
+DOP_RTOL: int
+DOP_ATOL: int
+DOP_MAX_STEP: int
+DOP_T_BOUND: int
+DOP_SAFETY: int
+DOP_FAC_MIN: int
+DOP_FAC_MAX: int
+DOP_REFRESH: int
+DOP_T: int
+DOP_H: int
+DOP_DIRECTION: int
+DOP_T_OLD: int
+DOP_H_OLD: int
+DOP_STATUS: int
+DOP_CODE: int
+DOP_STEPS: int
+DOP_REJECTED: int
+DOP_NFEV: int
+DOP_REFRESHED: int
+DOP_FILTER: int
+DOP_FILTER_NEXT: int
+DOP_DENSE: int
+DOP_DENSE_NFEV: int
+DOP_INFO: int
+DOP_RUNNING: int
+DOP_FINISHED: int
+DOP_TOO_SMALL: int
+DOP_STOPPED: int
+DOP_W_Y: int
+DOP_W_F: int
+DOP_W_Y_OLD: int
+DOP_W_K: int
+DOP_W_DENSE: int
+DOP_W_ROWS: int
+DOP_PY_ERROR: int
+DOP_SYSTEM_OSCILLATOR: int
+DOP_SYSTEM_VAN_DER_POL: int
+DOP_SYSTEM_ARENSTORF: int
+DOP_SYSTEM_PENDULUM: int
+MECH_RATE: int
+MECH_ROBUST: int
+MECH_ITERS: int
+MECH_STAGE_ITERS: int
+MECH_PARAMS: int
+
+_Problem = tuple[Any, Any, Any, Any, Any, Any]
+
+def dop853_start(problem: _Problem, t0: float, y0: _F, first_step: float, state: _F,
+                 work: _F) -> int: ...
+def dop853_run(problem: _Problem, t_stop: float, max_steps: int, state: _F,
+               work: _F) -> int: ...
+def dop853_dense(problem: _Problem, t: _F, out: _F, state: _F, work: _F) -> int: ...
+def dop853_sampled(problem: _Problem, t_stop: float, max_steps: int, t_eval: _F, k: int,
+                   out: _F, project_samples: bool, state: _F, work: _F) -> tuple[int, int]: ...
+def samples(unknowns: Unknowns, lam: _F, t: _F, Y: _F, reactions: _F | None,
+            lengths: _F | None, drift: _F) -> None: ...
+def dop853_system(number: int, params: _F, t: float, y: _F, ydot: _F) -> None: ...
+def dop853_tableau() -> dict[str, list[float]]: ...
+def dop853_work_size(n: int) -> int: ...
 
 def solve_layout(n: int, m: int, planar: bool) -> tuple[int, int, int]: ...
 
@@ -100,3 +169,6 @@ class Unknowns:
                    states: _I, segment: int) -> None: ...
     def kinematics_many(self, t: _F, Y: _F, F: _F | None, rows: _I | None,
                         chain: _I | None, phi_scale: _F, settings: _F, info: _F) -> None: ...
+    def kinematic_run(self, t: _F, y: _F, lam: _F, max_newton: int, tol: float, Y: _F,
+                      OUT: _F, ENERGY: _F, info: _F) -> int: ...
+    def energy_samples(self, t: _F, Y: _F, lam: _F, ACC: _F, ENERGY: _F) -> int: ...

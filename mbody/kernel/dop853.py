@@ -3,8 +3,10 @@
 `DOP853` steps an ODE y' = f(t, y) with Dormand and Prince's 8(5,3) pair, Hairer, Nørsett
 and Wanner's step-size control and the 7th-order dense output: the same accepted steps
 as ``scipy.integrate.DOP853`` (tests/test_dop853.py). The right-hand side is one of the
-core's built-in test systems (`SYSTEMS`, evaluated in C) or a Python callable (a few
-microseconds an evaluation more). The run's whole state lives in two numpy arrays,
+core's built-in test systems (`SYSTEMS`, evaluated in C), a mechanism of the core (a
+``_core.Unknowns``: ``mb_derivative`` with its projection, src/mechanism.h; a whole
+simulation then steps without Python) or a Python callable (a few microseconds an
+evaluation more). The run's whole state lives in two numpy arrays,
 ``state`` (slots ``_core.DOP_*``) and ``work`` (rows of n: y, f, the last step's stages,
 its dense output), which the core reads and writes in place.
 """
@@ -42,8 +44,10 @@ class DOP853:
 
     Parameters
     ----------
-    rhs : str or callable
-        A name in `SYSTEMS` (with `params`), or f(t, y) -> y' (array of len(y0)).
+    rhs : str, callable or _core.Unknowns
+        A name in `SYSTEMS` (with `params`), f(t, y) -> y' (array of len(y0)), or the
+        core's solver of a mechanism, with `params` = [``_core.MECH_*`` settings, the
+        known reaction values (m)] (src/mechanism.h).
     t0, y0, t_bound : float, array, float
         Start and end of the run (t_bound < t0 integrates backwards).
     rtol, atol : float; float or array
@@ -53,21 +57,25 @@ class DOP853:
         Longest step.
     first_step : float, optional
         The first step's size; by default Hairer, Nørsett and Wanner's estimate.
-    project, stage, tangent : callable, optional
+    project, stage, tangent : callable or True, optional
         `project(t, y) -> info` moves y in place after each accepted step and returns
         up to four numbers: the size of the move (above `refresh` times atol, the next
         step starts from a fresh f(t, y)), whether the next step is filtered, and two of
         the caller's own (kept in `info`). In a filtered step each evaluation is made at
         `stage(t, y)`'s move of a copy of its state, and the error estimates pass through
-        `tangent(t, y, e)` (e mapped in place). See src/dop853.h.
+        `tangent(t, y, e)` (e mapped in place). See src/dop853.h. True, with a mechanism
+        as `rhs`: the core's own (src/mechanism.h), no Python called.
     """
 
-    def __init__(self, rhs: str | Rhs, t0: float, y0: Sequence[float] | np.ndarray,
-                 t_bound: float, *, rtol: float = 1e-3, atol: float | np.ndarray = 1e-6,
-                 max_step: float = math.inf, first_step: float | None = None,
-                 params: Sequence[float] = (), project: Callable | None = None,
-                 stage: Callable | None = None, tangent: Callable | None = None,
-                 refresh: float = 0.0, filter_first: bool = False):
+    def __init__(self, rhs: str | Rhs | _core.Unknowns, t0: float,
+                 y0: Sequence[float] | np.ndarray, t_bound: float, *, rtol: float = 1e-3,
+                 atol: float | np.ndarray = 1e-6, max_step: float = math.inf,
+                 first_step: float | None = None,
+                 params: Sequence[float] | np.ndarray = (),
+                 project: Callable | bool | None = None,
+                 stage: Callable | bool | None = None,
+                 tangent: Callable | bool | None = None, refresh: float = 0.0,
+                 filter_first: bool = False):
         y0 = np.array(y0, dtype=float).ravel()
         self.n = n = len(y0)
         atol_vector = np.ndim(atol) > 0
@@ -80,7 +88,9 @@ class DOP853:
         s[_core.DOP_REFRESH] = refresh
         s[_core.DOP_FILTER_NEXT] = float(filter_first)
         if isinstance(rhs, str):
-            core_rhs: int | Callable = SYSTEMS[rhs]
+            core_rhs: int | Callable | _core.Unknowns = SYSTEMS[rhs]
+        elif isinstance(rhs, _core.Unknowns):
+            core_rhs = rhs
         else:
             fun = rhs
 
@@ -99,6 +109,17 @@ class DOP853:
         t_stop = self.state[_core.DOP_T_BOUND] if t_stop is None else t_stop
         _core.dop853_run(self.problem, float(t_stop), int(max_steps), self.state, self.work)
         return self.status
+
+    def sampled(self, t_stop: float, max_steps: int, t_eval: np.ndarray, k: int,
+                out: np.ndarray, project_samples: bool = False) -> int:
+        """Steps as `run`, and after each step the dense output at the times t_eval[k],
+        t_eval[k + 1], ... the step reached, into out's rows k, k + 1, ... (out:
+        (len(t_eval), n), C-contiguous), each moved by the projection when
+        `project_samples`; returns the first row not yet written."""
+        _, k = _core.dop853_sampled(self.problem, float(t_stop), int(max_steps), t_eval,
+                                    int(k), out, bool(project_samples), self.state,
+                                    self.work)
+        return int(k)
 
     def step(self) -> str | None:
         """One step (scipy's `OdeSolver.step`): None, or why the run failed."""
@@ -127,7 +148,7 @@ class DOP853:
         return self._row(_core.DOP_W_F)
 
     @property
-    def y_old(self) -> np.ndarray:
+    def y_start(self) -> np.ndarray:
         """y at the start of the last step."""
         return self._row(_core.DOP_W_Y_OLD)
 
@@ -136,12 +157,12 @@ class DOP853:
         return float(self.state[_core.DOP_T])
 
     @property
-    def t_old(self) -> float:
+    def step_start(self) -> float:
         """Start of the last accepted step."""
         return float(self.state[_core.DOP_T_OLD])
 
     @property
-    def h_abs(self) -> float:
+    def next_step(self) -> float:
         """The next step's size, as proposed."""
         return float(self.state[_core.DOP_H])
 
@@ -164,6 +185,16 @@ class DOP853:
         return int(self.state[_core.DOP_REJECTED])
 
     @property
+    def dense_evaluations(self) -> int:
+        """Evaluations made for dense output (3 per step interpolated; part of nfev)."""
+        return int(self.state[_core.DOP_DENSE_NFEV])
+
+    @property
+    def code(self) -> int:
+        """The callback's code that stopped the run (status "stopped"), else 0."""
+        return int(self.state[_core.DOP_CODE])
+
+    @property
     def refreshed(self) -> int:
         """Fresh derivatives after a projection."""
         return int(self.state[_core.DOP_REFRESHED])
@@ -178,9 +209,10 @@ class DOP853:
         return self.state[_core.DOP_INFO:_core.DOP_INFO + _core.DOP_PROJECT_INFO].copy()
 
 
-def _project(fn: Callable | None) -> Callable | None:
-    if fn is None:
-        return None
+def _project(fn: Callable | bool | None) -> Callable | bool | None:
+    if fn is None or fn is True:
+        return fn
+    assert callable(fn)
 
     def project(t: float, y: memoryview, info: memoryview) -> None:
         values = np.atleast_1d(np.asarray(fn(t, np.frombuffer(y)), dtype=float))
@@ -190,18 +222,20 @@ def _project(fn: Callable | None) -> Callable | None:
     return project
 
 
-def _stage(fn: Callable | None) -> Callable | None:
-    if fn is None:
-        return None
+def _stage(fn: Callable | bool | None) -> Callable | bool | None:
+    if fn is None or fn is True:
+        return fn
+    assert callable(fn)
 
     def stage(t: float, y: memoryview) -> None:
         fn(t, np.frombuffer(y))
     return stage
 
 
-def _tangent(fn: Callable | None) -> Callable | None:
-    if fn is None:
-        return None
+def _tangent(fn: Callable | bool | None) -> Callable | bool | None:
+    if fn is None or fn is True:
+        return fn
+    assert callable(fn)
 
     def tangent(t: float, y: memoryview, e: memoryview) -> None:
         fn(t, np.frombuffer(y).copy(), np.frombuffer(e))

@@ -94,7 +94,8 @@ def joint_tables(dimension: int, js: JointSpecTable, names: tuple[str, ...],
     C_E = RcT @ W_E0
     B_r_child = (RcT @ (at - xc)[:, :, None])[:, :, 0]
     B_r_parent = np.where(ground[:, None], at, (RpT @ (at - xp)[:, :, None])[:, :, 0])
-    if js.body_points is not None and js.body_points.any():  # the file gives them
+    if (js.body_points is not None and js.body_points.any()  # the file gives them
+            and js.at_child is not None and js.at_parent is not None):
         on = js.body_points
         B_r_child[on] = js.at_child[on]
         B_r_parent[on] = js.at_parent[on]

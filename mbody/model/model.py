@@ -440,8 +440,7 @@ def load(source: str | os.PathLike[str] | dict, *, max_bytes: int | None = None,
     """
     if isinstance(source, dict):
         doc = Document(source, "<dict>")
-        spec = validate(doc)
-        return _build(spec, Source("<dict>", document=dataclasses.replace(
+        return _build(validate(doc), Source("<dict>", document=dataclasses.replace(
             doc, data=copy.deepcopy(source))))
     if format or options or str(source).lower().endswith((".xml", ".mjcf", ".urdf")):
         from mbody.io.interop import import_spec  # MJCF, URDF: defusedxml, only for them

@@ -178,13 +178,21 @@ def _reaction_panel(traj: Trajectory, a: Axes, *, moment: bool, sel: list[int]) 
 
 
 def save_plot(traj: Trajectory, path: str | os.PathLike[str], bodies: list[str] | None = None,
-              dpi: int = 120) -> Path:
-    """Plot `traj` and write the figure atomically; format from the extension."""
+              dpi: int = 120, against: str | None = None, motion: bool = False) -> Path:
+    """Plot `traj` and write the figure atomically; format from the extension. A run with
+    drivers gets their figure (`mbody.present.drive_plot`, against `against`: 'time' or a
+    driver) unless `motion` asks for the bodies' motion."""
+    from mbody.present.drive_plot import drivers_of, plot_driven
+
     fmt = Path(path).suffix.lower().lstrip(".")
     if fmt not in FORMATS:
         raise MbodyError(f"cannot write {str(path)!r}: the plot format comes from the "
                          f"extension, one of {', '.join('.' + f for f in FORMATS)}")
-    fig = plot_trajectory(traj, bodies)
+    if against is not None and (motion or not drivers_of(traj)):
+        raise MbodyError("--against applies to a run with drivers (their figure), not to "
+                         "the motion's")
+    fig = (plot_driven(traj, against) if drivers_of(traj) and not motion
+           else plot_trajectory(traj, bodies))
     # drawn in memory first: a writer failing half-way (a full disk) must meet a complete
     # picture, not matplotlib's pdf or png stream in the middle of its compression
     buf = io.BytesIO()

@@ -8,7 +8,7 @@ from mbody import conventions as cv
 from mbody.equations.assemble import Assembly, Solution
 from mbody.equations.fbd import REACTION, BodyEquations, ForceOnBody
 from mbody.model.graph import Topology
-from mbody.model.model import Model
+from mbody.model.model import Model, State
 
 
 def _v(x: np.ndarray, dim: int) -> str:
@@ -137,6 +137,23 @@ def assembly_moves(model: Model) -> list[str]:
     return [f"{name} moved {dk * 1e3:.3g} mm, turned {ak:.3g} deg"
             for name, dk, ak in zip(model.body_names, d.tolist(), turned.tolist(), strict=True)
             if dk > 1e-12 or ak > 1e-10]
+
+
+def pose_text(model: Model, state: State) -> str:
+    """Each body's mass centre (world, m) and orientation at `state`: the angle about z
+    (deg) in a planar model, the quaternion (w, x, y, z) in a spatial one."""
+    rows = []
+    planar = model.dimension == cv.PLANAR
+    for i, name in enumerate(model.body_names):
+        x = _clean(state.position[i])
+        q = state.quaternion[i]
+        turn = (f"{_n(np.degrees(2.0 * np.arctan2(q[3], q[0])))} deg" if planar
+                else "(" + ", ".join(_n(c) for c in _clean(q)) + ")")
+        rows.append([name, _v(x, model.dimension), turn])
+    lines = ["pose (mass centres in world axes, m):"]
+    lines += _table(["body", "position", "angle" if planar else "quaternion (w, x, y, z)"],
+                    rows)
+    return "\n".join(lines)
 
 
 def graph_summary(model: Model, topo: Topology) -> str:
@@ -278,6 +295,41 @@ def solution_text(sol: Solution, model: Model) -> str:
         lines.append(f"  {name:<{width}}" + "  ".join(
             f"{cv.ACCELERATION_NAMES[r]} = {_n(v)} {units.get(r, 'rad/s^2')}"
             for r, v in zip(rows[:len(idx)], acc[idx], strict=True)))
+    return "\n".join(lines)
+
+
+def world_reaction_text(model: Model, sol: Solution) -> str:
+    """A solution's reactions in world axes (``Assembly.solve(axes="world")``): each joint's
+    force and moment on its child at its joint point along world x, y, z, then the drivers'
+    efforts; a joint's status is that of its joint-frame components."""
+    if not sol.reactions:
+        return ""
+    solved, not_unique = set(sol.solved), set(sol.not_unique)
+    drivers = set(model.reaction_table.driver_names)
+    status: dict[str, str] = {}
+    for label in model.reactions:
+        name = label.split(".", 1)[0]
+        s = ("not unique" if label in not_unique else
+             "solved" if label in solved else "given")
+        if status.get(name, s) != s:
+            s = "partly solved"
+        status[name] = s
+    child = {j.name: j.child for j in model.joints}
+    lam = _clean(np.array(list(sol.reactions.values()), dtype=float))
+    rows = []
+    for label, v in zip(sol.reactions, lam, strict=True):
+        name, comp = label.split(".", 1)
+        unit = "N m" if comp.startswith("M") else "N"
+        what = "driver effort" if name in drivers else f"on {child[name]}"
+        rows.append([name, comp, what, f"{_n(v)} {unit}", status.get(name, "given")])
+    lines = ["joint reactions in world axes: each joint's force F and moment M on its child "
+             "at the joint point (-F, -M on the parent); drivers' efforts about or along "
+             "their joint's axis"]
+    lines += _table(["joint", "comp", "acts", "value", "status"], rows)
+    if sol.residual is not None:
+        lines.append(f"solve: {sol.method}; relative backward error {sol.residual:.1e}")
+    for w in sol.warnings:
+        lines.append(f"warning: {w}")
     return "\n".join(lines)
 
 

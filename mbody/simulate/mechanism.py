@@ -1,7 +1,7 @@
 """Jointed mechanisms in motion: accelerations with the unknown reactions solved at every
-step, joint drift held down by Baumgarte stabilisation (used by the implicit integrators;
-the explicit ones project the state instead, `mbody.simulate.projection`), reactions along a
-trajectory.
+step, joint drift held down by Baumgarte stabilisation (used by scipy's integrators; the
+core's DOP853 projects the state instead, `mbody.simulate.projection`), and what a run
+reports at its output samples: the reactions and the joints' drift.
 
 Integrating ``Gᵀ v̇ = γ`` alone lets the joints drift apart (rounding and truncation
 errors in φ and φ̇ = Gᵀ v are never corrected). Baumgarte's method replaces it by
@@ -12,18 +12,22 @@ so that the constraint error obeys φ̈ + 2 α φ̇ + β² φ = 0 and decays (cr
 for α = β) instead of growing. The reactions stored with a trajectory are solved at each
 output sample with the exact γ (no stabilisation terms), so they are the physical ones
 for the sampled state.
+
+Every figure here is one call of the compiled core per sample (`mbody.kernel`): no Python
+work per body or per component.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
+from typing import NamedTuple
 
 import numpy as np
 
-from mbody.equations.assemble import assemble
-from mbody.equations.constraints import phi
-from mbody.equations.joints import constraint_velocity, reaction_columns
+from mbody.equations.workspace import Unknowns, workspace
+from mbody.kernel import _core
 from mbody.model.model import Model, State
+from mbody.solve.dynamics import StateDerivative
 
 BAUMGARTE_RATE = 20.0
 """α = β in 1/s: joint errors decay with a time constant of 1/20 s."""
@@ -40,40 +44,94 @@ class ConstrainedDynamics:
         """How the joints are held, in words (for a trajectory's info)."""
 
     def __call__(self, model: Model, state: State) -> np.ndarray:
-        unknowns = model.plan.unknowns_at(state.t, self.known)
-        return assemble(model, state).constrained(unknowns, rate=self.rate, refine=False)[0]
+        ws = workspace(model)
+        f = StateDerivative(model, unknowns=ws.unknowns_at(state.t, self.known),
+                            rate=self.rate)
+        n = model.n
+        y = np.zeros(ws.state_size)
+        y[:13 * n] = ws.pack_state(state)
+        acc = f(state.t, y)[7 * n:13 * n].reshape(2, n, 3)
+        return np.concatenate((acc[0], acc[1]), axis=1)
 
 
 def constrained_dynamics(model: Model, known: Mapping[str, float] | None = None, *,
                          rate: float = BAUMGARTE_RATE) -> ConstrainedDynamics:
     """f(model, state) -> (n, 6) accelerations with the unknown reactions solved each call,
-    stabilised with α = β = `rate` (1/s; 0 turns stabilisation off). The numpy path;
-    `mbody.solve.dynamics.StateDerivative` takes the compiled one where it can."""
+    stabilised with α = β = `rate` (1/s; 0 turns stabilisation off)."""
     return ConstrainedDynamics(known, rate)
+
+
+class SampleFigures(NamedTuple):
+    """A run's figures at its K output samples (`sample_figures`)."""
+
+    reactions: np.ndarray | None
+    """(K, m) every reaction value (N; N m), or None when not asked for."""
+    lengths: np.ndarray | None
+    """(K, s) each spring's length (m), or None when not asked for."""
+    position_drift: float
+    """Largest |φ| (m for forces, rad for moments; a driven component: φ − f)."""
+    velocity_drift: float
+    """Largest |Gᵀ v| (a driven component: Gᵀ v − f′)."""
+
+
+def sample_figures(model: Model, unknowns: Unknowns, t: np.ndarray, Y: np.ndarray, *,
+                   reactions: bool = True, lengths: bool = False) -> SampleFigures:
+    """The figures of the sampled states Y (K, state size: the core's layout) at the times
+    t (K,), in one call of the compiled core: every reaction value (the components of
+    `unknowns` solved with the exact γ, the others at their given values, those varying
+    in t at t), the springs' lengths, and the joints' largest drift over every reaction
+    component."""
+    ws = workspace(model)
+    core = ws.core
+    K = len(t)
+    Y = np.ascontiguousarray(Y, dtype=float)
+    lam_out = np.empty((K, int(core.m))) if reactions else None
+    len_out = np.empty((K, int(core.s))) if lengths else None
+    drift = np.zeros(2)
+    _core.samples(ws.solver(unknowns), np.ascontiguousarray(unknowns.lam, dtype=float),
+                  np.ascontiguousarray(t, dtype=float), Y, lam_out, len_out, drift)
+    return SampleFigures(lam_out, len_out, float(drift[0]), float(drift[1]))
+
+
+def reactions_at(model: Model, unknowns: Unknowns, t: np.ndarray, Y: np.ndarray
+                 ) -> np.ndarray:
+    """(K, m) every reaction value at the sampled states (`sample_figures`)."""
+    out = sample_figures(model, unknowns, t, Y).reactions
+    assert out is not None
+    return out
+
+
+def drift_at(model: Model, t: np.ndarray, Y: np.ndarray) -> dict[str, float]:
+    """Largest joint position error |φ| (m for forces, rad for moments) and velocity error
+    |Gᵀ v| (a driven component: φ − f and Gᵀ v − f′) over the sampled states Y (K, state
+    size) at the times t, every reaction component counted."""
+    f = sample_figures(model, workspace(model).file_unknowns, t, Y, reactions=False)
+    return {"joint_position_drift": f.position_drift,
+            "joint_velocity_drift": f.velocity_drift}
+
+
+def pack_states(model: Model, states: list[State]) -> tuple[np.ndarray, np.ndarray]:
+    """(t (K,), Y (K, state size)): states in the core's layout (planar angles 0: the
+    evaluations do not read them)."""
+    ws = workspace(model)
+    Y = np.zeros((len(states), ws.state_size))
+    for k, s in enumerate(states):
+        Y[k, :13 * model.n] = ws.pack_state(s)
+    return np.array([s.t for s in states], dtype=float), Y
 
 
 def reactions_along(model: Model, states: list[State],
                     known: Mapping[str, float] | None = None) -> np.ndarray:
-    """(K, m) every reaction value at each sampled state (exact γ, no stabilisation).
-
-    One constrained solve per sample: a loop over time samples, each vectorised over bodies.
-    """
-    out = np.empty((len(states), len(model.reactions)))
-    for k, s in enumerate(states):
-        sol = assemble(model, s).solve(known=known)
-        arr = getattr(sol.reactions, "array", None)
-        out[k] = arr if arr is not None else [sol.reactions[r] for r in model.reactions]
-    return out
+    """(K, m) every reaction value at each sampled state (exact γ, no stabilisation); the
+    components not in the file's or `known`'s values solved."""
+    t, Y = pack_states(model, states)
+    if not len(states):
+        return np.zeros((0, len(model.reactions)))
+    return reactions_at(model, workspace(model).unknowns_at(float(t[0]), known), t, Y)
 
 
 def constraint_drift(model: Model, states: list[State]) -> dict[str, float]:
     """Largest joint position error |φ| (m for forces, rad for moments) and velocity error
     |Gᵀ v| over the samples."""
-    pos = vel = 0.0
-    if not len(model.reactions):
-        return {"joint_position_drift": 0.0, "joint_velocity_drift": 0.0}
-    for s in states:
-        cols = reaction_columns(model, s)
-        pos = max(pos, float(np.max(np.abs(phi(model, s, cols=cols)))))
-        vel = max(vel, float(np.max(np.abs(constraint_velocity(model, cols, s)))))
-    return {"joint_position_drift": pos, "joint_velocity_drift": vel}
+    t, Y = pack_states(model, states)
+    return drift_at(model, t, Y)

@@ -2,13 +2,13 @@
 
     ẋ = v,   q̇ = ½ q ⊗ (0, ω),   v̇ = a_G,   ω̇ = J⁻¹ (B_M − ω × J ω)     per body,
 
-where (a_G, ω̇) = M⁻¹ (Q + G λ − b) come from the same loads, gyroscopic terms and
-reaction columns as `assemble` (through `mbody.solve.dynamics.accelerations`), with every
-reaction value λ known (absent, given in the file, or passed as `known`).
+where (a_G, ω̇) = M⁻¹ (Q + G λ − b) come from the compiled core (`mbody.kernel`: the same
+loads, gyroscopic terms and reaction columns as `assemble`), with the reactions not given
+(in the file or as `known`) solved at every evaluation.
 
 State: x (n, 3) world, q (n, 4) W_R_B quaternions [w, x, y, z], v (n, 3) world, ω (n, 3)
-body axes, packed as blocks ``[x | q | v | ω]`` (13 n numbers) so that every block is a
-contiguous (n, k) view: the derivative is vectorised over bodies, with no per-body loop.
+body axes, packed as blocks ``[x | q | v | ω]`` (13 n numbers; planar models add θ (n))
+so that every block is a contiguous (n, k) view: the core's layout (kernel.h).
 
 Quaternions: the exact flow keeps ‖q‖ = 1 (q̇ · q = 0), so q is integrated as it is; the
 rotation used inside the derivative is built from q/‖q‖, and the quaternions stored at the
@@ -16,50 +16,46 @@ output samples are divided by their norms (the largest |‖q‖ − 1| before th
 as ``info['quaternion_norm_error']``). The integrator is never restarted, so the
 renormalisation changes nothing but the stored samples.
 
-Accelerations are pluggable: `dynamics(model, state) -> (n, 6)` rows [a_G world,
-ω̇ body axes]; the default is `known_reaction_dynamics(model, known)`.
+How the run steps is `mbody.simulate.stepping`'s: DOP853 (the default) entirely in the
+core, the other methods through scipy. Accelerations are pluggable: `dynamics(model,
+state) -> (n, 6)` rows [a_G world, ω̇ body axes] replaces the core's (called from Python
+at every evaluation).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import sys
 import time
-import warnings
-from collections.abc import Callable, Mapping
-from pathlib import Path
+from collections.abc import Mapping
 
 import numpy as np
 
 from mbody import conventions as cv
 from mbody.equations.constraints import joint_errors
-from mbody.equations.kernels import spring_ends
-from mbody.equations.spatial import matvec, quat_to_matrix
+from mbody.equations.workspace import workspace
 from mbody.errors import MbodyError, UnknownReactionsError, did_you_mean
 from mbody.model.expressions import Expression, check_times, compile_expression, first_nonfinite
 from mbody.model.model import Model, State
-from mbody.simulate.mechanism import (
-    ConstrainedDynamics,
-    constrained_dynamics,
-    constraint_drift,
-    reactions_along,
-)
+from mbody.simulate.kinematic import driven_figures, driven_lines, fully_driven, kinematic_run
+from mbody.simulate.kinematic import summary as kinematic_summary
+from mbody.simulate.mechanism import BAUMGARTE_RATE, sample_figures
 from mbody.simulate.projection import STAGE_PIVOT_RTOL, JointProjection
-from mbody.simulate.stepping import REFRESH_ATOL, CompileClock, integrator
-from mbody.simulate.trajectory import Trajectory
+from mbody.simulate.stepping import CORE, IMPLICIT, start
+from mbody.simulate.trajectory import Trajectory, body_matvec, cross, model_text, rotate
 from mbody.solve.dynamics import Dynamics, StateDerivative, accelerations
 
 METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
-"""scipy.integrate's step-by-step solvers (imported when a simulation starts)."""
-IMPLICIT = ("Radau", "BDF", "LSODA")
-"""The methods for stiff problems (LSODA switches to BDF when it finds stiffness)."""
+"""The integrators: DOP853 is the compiled core's, the others scipy.integrate's (imported
+when such a run starts)."""
 DEFAULT_RTOL = 1e-10
 DEFAULT_ATOL = 1e-12
 DEFAULT_MAX_STEPS = 1_000_000
 """Step budget of a run. The heaviest shipped model needs about 9 300 steps for 10 s (the
 slider-crank that ran away to 700 rad/s, 24 500): a hundred times that, yet a small
-mechanism (about 0.3 ms per step) reaches it in minutes rather than hours."""
+mechanism (a few microseconds per step) reaches it in seconds, a large one in minutes."""
 
 
 def known_reaction_dynamics(model: Model, known: Mapping[str, float | str] | None = None
@@ -69,26 +65,14 @@ def known_reaction_dynamics(model: Model, known: Mapping[str, float | str] | Non
     `known` values are numbers or expressions of t (text, see docs/expressions.md).
     Raises `UnknownReactionsError` when a reaction component has no value.
     """
+    given = with_known(model, known)
     labels = model.reactions
-    values: dict[str, float] = dict(model.known_reactions)
-    exprs: dict[str, Expression] = dict(model.known_expressions)
-    for label, v in (known or {}).items():
-        if label not in labels:
-            hint = did_you_mean(label, labels)
-            raise MbodyError(f"no reaction component {label!r} in this model"
-                             + (f"; {hint}" if hint else ""))
-        if isinstance(v, str):
-            e = compile_expression(v)
-            values[label] = e.value
-            exprs[label] = e
-        else:
-            values[label] = float(v)
-            exprs.pop(label, None)
-    missing = [r for r in labels if r not in values]
+    missing = [r for r in labels if r not in given.known_reactions]
     if missing:
         raise UnknownReactionsError(missing)
-    base = np.array([values[r] for r in labels], dtype=float)
-    varying = [(labels.index(r), e) for r, e in exprs.items() if not e.constant]
+    base = np.array([given.known_reactions[r] for r in labels], dtype=float)
+    varying = [(given.reaction_index[r], e) for r, e in given.known_expressions.items()
+               if not e.constant]
     return KnownReactionDynamics(base, varying)
 
 
@@ -155,8 +139,8 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     """Integrate the motion from `initial` (default the model's state) to `t_end` seconds.
 
     Samples at t = k / fps for k = 0 .. ⌊t_end · fps⌋. Reactions not given in the file
-    or in `known` are solved for at every step, the joints held by projection (explicit
-    methods) or Baumgarte's terms (implicit ones).
+    or in `known` are solved for at every step, the joints held by projection (DOP853)
+    or Baumgarte's terms (scipy's methods).
 
     Parameters
     ----------
@@ -171,10 +155,11 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
         component); 0 < rtol < 1, atol > 0.
     method : str
         One of `METHODS` (DOP853: explicit Runge-Kutta of order 8 with a 7th-order
-        interpolant; Radau, BDF and LSODA for stiff problems).
+        interpolant, the compiled core's; RK45 and RK23 scipy's explicit ones; Radau, BDF
+        and LSODA scipy's for stiff problems).
     known : mapping of str to float or str, optional
         Reaction values by label (N; N m), numbers or expressions of t (text, see
-        docs/expressions.md), added to the file's.
+        docs/expressions.md), added to the file's (replacing its value of that label).
     progress : bool
         Show a progress bar over simulated time on stderr (tqdm).
     dynamics : Dynamics, optional
@@ -202,17 +187,6 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     MbodyError
         An argument out of range, an unknown method or reaction label, or a budget hit.
     """
-    with CompileClock() as clock:
-        return _simulate(model, t_end, fps, rtol, atol, method, known, progress, dynamics,
-                         max_step, initial, max_steps, max_wall, clock)
-
-
-def _simulate(model: Model, t_end: float, fps: float, rtol: float, atol: float, method: str,
-              known: Mapping[str, float | str] | None, progress: bool,
-              dynamics: Dynamics | None, max_step: float, initial: State | None,
-              max_steps: int | None, max_wall: float | None,
-              clock: CompileClock) -> Trajectory:
-    """`simulate`, with `clock` timing numba's compiling (left out of the wall time)."""
     t_end, fps = float(t_end), float(fps)
     if not (math.isfinite(t_end) and t_end > 0):
         raise MbodyError(f"t_end must be a positive number of seconds, got {t_end:g}")
@@ -235,162 +209,124 @@ def _simulate(model: Model, t_end: float, fps: float, rtol: float, atol: float, 
     K = int(math.floor(t_end * fps + 1e-9)) + 1
     if K > 10_000_000:
         raise MbodyError(f"{K} output samples requested (t_end * fps); at most 10 million")
-    mechanism = dynamics is None and _has_unknown_reactions(model, known)
     varying = _varying_expressions(model, known)
     _check_span(varying, t_end)
+    if dynamics is None and initial is None and fully_driven(model):
+        # the drivers fix the motion: each sample's kinematics then its reactions, no
+        # integration (mbody.simulate.kinematic)
+        return kinematic_run(with_known(model, known), t_end, fps)
     rhs = state_derivative(model, known, dynamics)
-    clock.watch()  # numba is imported now if the compiled path serves
-    f = rhs.dynamics
+    run_model = rhs.model  # the model with `known`'s values in its known reactions
+    mechanism = dynamics is None and _has_unknown_reactions(run_model, None)
     n = model.n
     planar = model.dimension == cv.PLANAR
     s0 = model.initial if initial is None else initial
-    projection: JointProjection | None = None
-    if mechanism and method not in IMPLICIT and rhs.unknowns is not None:
-        # the joints held by projecting the state after every step (mbody.simulate.projection);
-        # the implicit methods keep their own history of y, so Baumgarte's terms hold them
-        projection = JointProjection(model, rhs.unknowns, compiled=rhs.compiled)
-        rhs.projection, rhs.rate = projection, 0.0
+    # the joints held by projecting the state after every step (mbody.simulate.projection);
+    # scipy's integrators keep their own history of y, so Baumgarte's terms hold them
+    projecting = mechanism and method in CORE
+    if projecting:
+        rhs.rate = 0.0
     # Planar models also integrate θ itself (θ̇ = ω_z): the angle read back from a
     # quaternion is only known modulo 2π, and a fast wheel turns more than π per frame.
     theta0 = 2.0 * np.arctan2(s0.quaternion[:, 3], s0.quaternion[:, 0]) if planar else ()
     y0 = np.concatenate((s0.position.ravel(), s0.quaternion.ravel(), s0.velocity.ravel(),
                          s0.omega.ravel(), theta0))
     size = len(y0)
-    if projection is not None:  # the run starts on the joints
-        _, _, ratio = projection(y0, s0.t)
-        rhs.project_stages = ratio < STAGE_PIVOT_RTOL
+    ratio = 1.0
+    if projecting:  # the run starts on the joints
+        assert rhs.unknowns is not None
+        _, _, ratio = JointProjection(run_model, rhs.unknowns)(y0, 0.0)
     bar = _Progress(progress, t_end, model.name or "simulate")
 
-    t_eval = np.arange(K) / fps
+    # k / fps, the last one at most t_end (K allows t_end * fps to fall 1e-9 short of k)
+    t_eval = np.minimum(np.arange(K) / fps, t_end)
     Y = np.empty((K, size))
     Y[0] = y0
-    k, steps, sampling, refreshed = 1, 0, 0, 0
+    k, steps = 1, 0
     rate = _StepRate(t_end)
-    wall, compiling = time.perf_counter(), clock.seconds
+    wall = time.perf_counter()
     try:
-        fun: Callable[[float, np.ndarray], np.ndarray] = rhs
-        if method in ("Radau", "BDF"):  # their Jacobian estimate passes strided columns of y
-            def contiguous(t: float, y: np.ndarray) -> np.ndarray:
-                return rhs(t, np.ascontiguousarray(y))
-
-            fun = contiguous
-        with np.errstate(all="ignore"):  # its first-step norm may overflow: handled below
-            solver = integrator(method, rhs)(fun, 0.0, y0, t_end, rtol=rtol, atol=atol,
-                                              max_step=max_step)
-        t_prev, check_at = 0.0, PREDICT_FROM
-        advance = getattr(solver, "advance", None)  # compiled DOP853 (mbody.simulate.stepping)
+        run = start(method, rhs, y0, t_end, rtol, atol, max_step, project=projecting,
+                    filter_first=ratio < STAGE_PIVOT_RTOL)
+        check_at = PREDICT_FROM
         first = None
-        while solver.status == "running":
-            ran = None
-            if advance is not None:  # steps up to the next sample in one compiled call
-                limit = min(CHUNK_STEPS, max(1, check_at - steps))
-                if max_steps is not None:
-                    limit = min(limit, max(1, max_steps - steps))
-                ran = advance(float(t_eval[k]) if k < K else t_end, limit)
-                msg = solver.TOO_SMALL_STEP if solver.status == "failed" else None
-            if ran is None:
-                try:  # overflow in an implicit method's Jacobian estimate is handled below
-                    with np.errstate(all="ignore"), warnings.catch_warnings():
-                        if method in IMPLICIT:  # LinAlgWarning on a singular iteration,
-                            warnings.simplefilter("ignore")  # LSODA's convergence failures
-                        msg = solver.step()
-                except (ValueError, np.linalg.LinAlgError) as exc:
-                    if method not in IMPLICIT:
-                        raise
-                    raise MbodyError(
-                        f"the integrator {method} failed at t = {solver.t:.6g} s: {exc} "
-                        "(its numerical Jacobian broke down, as it can where the state "
-                        "barely changes). Try another stiff integrator (--method "
-                        + " or ".join(m for m in ("LSODA", "BDF") if m != method)
-                        + ") or looser tolerances (e.g. --rtol 1e-6 --atol 1e-9)") from None
-            if solver.status == "failed" or not np.all(np.isfinite(solver.y)):
-                culprit = _blame_expression(varying, t_prev, solver.t, solver.step_size)
+        while run.status == "running":
+            limit = min(CHUNK_STEPS, max(1, check_at - steps))
+            if max_steps is not None:
+                limit = min(limit, max(1, max_steps - steps))
+            k, msg = run.advance(min(rate.next, t_end), limit, t_eval, k, Y)
+            steps = run.steps
+            if run.status == "failed" or not math.isfinite(float(run.y.sum())):
+                culprit = _blame_expression(varying, run.t, run.t, run.step_size)
                 raise MbodyError(
-                    f"the integration stopped at t = {solver.t:.6g} s: "
+                    f"the integration stopped at t = {run.t:.6g} s: "
                     + (culprit or (msg or "the state is no longer finite")
                        + " (a body escaping to infinity, or tolerances too tight for "
                        "double precision?)"))
-            t_prev = solver.t
-            if ran is not None:  # projected (and refreshed) in the compiled call
-                steps += ran.steps
-                refreshed += ran.refreshed
-                ratio = ran.ratio
-            else:
-                steps += 1
-            if projection is not None and ran is None:
-                moved, changed, ratio = projection(solver.y, solver.t)
-                if rhs.project_stages or max(moved, changed) > REFRESH_ATOL * atol:
-                    solver.f = solver.fun(solver.t, solver.y)  # the next step starts here
-                    refreshed += 1
-            j = int(np.searchsorted(t_eval, solver.t, side="right"))
-            if j > k:  # DOP853's interpolant costs 3 evaluations here (docs/simulation.md)
-                nfev = solver.nfev
-                Y[k:j] = solver.dense_output()(t_eval[k:j]).T
-                sampling += solver.nfev - nfev
-                if projection is not None:  # the samples on the joints too
-                    for i in range(k, j):
-                        projection(Y[i], float(t_eval[i]))
-                k = j
-            if projection is not None:  # for the next step's stages (after the sampling,
-                rhs.project_stages = ratio < STAGE_PIVOT_RTOL  # which used this step's)
-            rate.step(solver.t, steps)
-            bar.update(solver.t)
-            if solver.status == "running":
+            rate.step(run.t, steps)
+            bar.update(run.t)
+            if run.status == "running":
                 if steps >= check_at:  # the whole run's cost, predicted from its start
                     check_at = 2 * steps
-                    _predict(model, method, solver.t, t_end, steps, rate, max_steps,
+                    _predict(model, method, run.t, t_end, steps, rate, max_steps,
                              max_wall, time.perf_counter() - wall)
                 if max_steps is not None and steps >= max_steps:
                     raise MbodyError(_budget_message(
                         f"the step budget: {steps} steps (--max-steps {max_steps})",
-                        solver.t, t_end, steps, rate, f"at that rate the whole run needs "
-                        f"about {steps * t_end / solver.t:.2g} steps", "raise --max-steps"))
+                        run.t, t_end, steps, rate, f"at that rate the whole run needs "
+                        f"about {steps * t_end / run.t:.2g} steps" if run.t > 0 else
+                        "the steps do not advance the time", "raise --max-steps"))
                 if max_wall is not None:
                     now = time.perf_counter()
                     if first is None:  # the pace is timed from here: no start-up costs
-                        first = (solver.t, now)
+                        first = (run.t, now)
                     if now - wall > max_wall:
-                        pace = ((now - first[1]) / (solver.t - first[0]) if solver.t > first[0]
-                                else (now - wall) / solver.t)
+                        pace = ((now - first[1]) / (run.t - first[0]) if run.t > first[0]
+                                else (now - wall) / run.t if run.t > 0 else math.inf)
                         raise MbodyError(_budget_message(
                             f"the wall-time budget: {now - wall:.3g} s (--max-wall "
-                            f"{max_wall:g})", solver.t, t_end, steps, rate,
+                            f"{max_wall:g})", run.t, t_end, steps, rate,
                             f"at that pace the rest of the run takes about "
-                            f"{pace * (t_end - solver.t):.2g} s more", "raise --max-wall"))
+                            f"{pace * (t_end - run.t):.2g} s more" if math.isfinite(pace)
+                            else "no simulated time has passed yet", "raise --max-wall"))
     finally:
         bar.close()
-    # the integration's own time: a first run's one-off compile is reported apart
-    wall = time.perf_counter() - wall - (clock.seconds - compiling)
+    wall = time.perf_counter() - wall
 
-    x = Y[:, :3 * n].reshape(K, n, 3)
     q = Y[:, 3 * n:7 * n].reshape(K, n, 4)
-    v = Y[:, 7 * n:10 * n].reshape(K, n, 3)
-    w = Y[:, 10 * n:13 * n].reshape(K, n, 3)
     norm = np.linalg.norm(q, axis=2)
     q_err = float(np.max(np.abs(norm - 1.0))) if n else 0.0
-    q = q / norm[..., None]
+    q /= norm[..., None]  # Y holds the stored samples from here
+    x = Y[:, :3 * n].reshape(K, n, 3)
+    v = Y[:, 7 * n:10 * n].reshape(K, n, 3)
+    w = Y[:, 10 * n:13 * n].reshape(K, n, 3)
 
     labels = tuple(model.reactions)
-    reactions_at = getattr(f, "reactions_at", None)
-    lam = (reactions_at(t_eval) if reactions_at is not None and labels
-           else np.zeros((K, 0)))
     joint_info: dict = {}
+    lengths = None
     if mechanism:
-        states = [State(x[k], q[k], v[k], w[k], float(t_eval[k])) for k in range(K)]
-        lam = reactions_along(model, states, _numeric_known(model, known))
-
-        stabilisation = f.stabilisation if isinstance(f, ConstrainedDynamics) else "none"
-        held = (PROJECTION_TEXT if projection is not None else
-                f"{stabilisation} (the implicit methods keep their own history of the "
-                "state, which a projection would break)")
-        joint_info = {"joint_stabilisation": held, **constraint_drift(model, states),
+        assert rhs.unknowns is not None
+        figures = sample_figures(run_model, rhs.unknowns, t_eval, Y,
+                                 lengths=bool(len(model.springs.names)))
+        assert figures.reactions is not None
+        lam, lengths = figures.reactions, figures.lengths
+        held = (PROJECTION_TEXT if projecting else
+                f"Baumgarte, alpha = beta = {BAUMGARTE_RATE:g} 1/s (scipy's integrators "
+                "keep their own history of the state, which a projection would break)")
+        joint_info = {"joint_stabilisation": held,
+                      "joint_position_drift": figures.position_drift,
+                      "joint_velocity_drift": figures.velocity_drift,
                       "initial_joint_errors": joint_errors(model, s0),
-                      "projection_evaluations": refreshed}
+                      "projection_evaluations": run.refreshed}
+    elif dynamics is None and labels:
+        lam = known_reaction_dynamics(model, known).reactions_at(t_eval)
+    else:
+        lam = np.zeros((K, 0))
     info = {
         "integrator": method, "rtol": rtol, "atol": atol, "t_end": t_end, "fps": fps,
-        "samples": K, "steps": steps, "evaluations": solver.nfev,
-        "sampling_evaluations": sampling, "step_rate": rate.figures(steps),
-        "evaluation_path": "compiled" if rhs.compiled else "numpy",
+        "samples": K, "steps": steps, "evaluations": run.nfev,
+        "sampling_evaluations": run.sampling_evaluations, "step_rate": rate.figures(steps),
+        "evaluation_path": "compiled" if rhs.compiled else "python",
         "wall_time_s": wall, "quaternion_norm_error": q_err,
         "quaternion_handling": "integrated as is; rotation built from q/|q|; output "
                                "samples divided by |q|",
@@ -404,11 +340,14 @@ def _simulate(model: Model, t_end: float, fps: float, rtol: float, atol: float, 
         reactions=lam, info=info, mass=np.array(model.mass), inertia=np.array(model.J),
         shapes=tuple(model.bodies[b].shape for b in model.body_names),
         colors=tuple(model.bodies[b].color for b in model.body_names),
-        gravity=np.array(model.gravity), model_yaml=_model_text(model))
-    series, drift = _drift(model, traj, dynamics is None, ideal_joints=mechanism, known=known)
+        gravity=np.array(model.gravity), model_yaml=model_text(model))
+    series, drift = _drift(run_model, traj, dynamics is None, ideal_joints=mechanism,
+                           lengths=lengths)  # run_model: `known` is among its reactions
     traj.series.update(series)
     info.update(drift)
-    info["compile_time_s"] = clock.seconds  # the whole call's, reactions' kernels included
+    if mechanism and run_model.drivers is not None and len(run_model.drivers.names):
+        assert rhs.unknowns is not None
+        driven_figures(run_model, traj, Y, lam, rhs.unknowns)
     info["warnings"] = [w for w in (rate.warning(), _spin_warning(traj)) if w]
     return traj
 
@@ -598,6 +537,8 @@ class _StepRate:
 
     def so_far(self, t: float, steps: int) -> str:
         """'N steps per simulated second so far (M over the first T s)'."""
+        if t <= 0:
+            return f"{steps} steps without simulated time passing"
         text = f"{steps / t:.4g} steps per simulated second so far"
         if self.start is not None:
             text += f" ({self.start[1]:.4g} over the first {self.start[0]:.3g} s"
@@ -656,72 +597,64 @@ def _spin_warning(traj: Trajectory) -> str | None:
 def state_derivative(model: Model, known: Mapping[str, float | str] | None = None,
                      dynamics: Dynamics | None = None) -> StateDerivative:
     """ẏ = f(t, y), what `simulate` integrates (`mbody.solve.dynamics.StateDerivative`): the
-    unknown reactions solved at every call (Baumgarte-stabilised, `mbody.simulate.mechanism`) or
-    every reaction known (`known_reaction_dynamics`), or `dynamics` when given."""
-    plan = model.plan
+    compiled core's, with the reactions not given in the file or in `known` solved at every
+    call (Baumgarte-stabilised, α = β = `BAUMGARTE_RATE`; `simulate` turns that off where it
+    projects), or `dynamics` when given. Its `model` is `model` with `known`'s values
+    among its known reactions (numbers, or expressions of t that the core evaluates)."""
     if dynamics is not None:
         return StateDerivative(model, dynamics)
-    if _has_unknown_reactions(model, known):  # a mechanism: reactions solved every call
-        numeric = _numeric_known(model, known)
-        f = constrained_dynamics(model, numeric)
-
-        def known_values_at(t: float) -> np.ndarray:
-            return plan.unknowns_at(t, numeric).lam
-
-        return StateDerivative(model, f, unknowns=plan.unknowns_at(0.0, numeric),
-                               rate=f.rate, compiled=True,
-                               known_at=known_values_at if model.known_expressions else None)
-    given = known_reaction_dynamics(model, known)
-    labels = model.reactions
-    every = plan.unknowns(dict(zip(labels, given.values_at(0.0).tolist(), strict=True)))
-    return StateDerivative(model, given, unknowns=every,
-                           known_at=given.values_at if given.varying else None, compiled=True)
+    run_model = with_known(model, known)
+    rate = BAUMGARTE_RATE if _has_unknown_reactions(run_model, None) else 0.0
+    return StateDerivative(run_model, unknowns=workspace(run_model).file_unknowns, rate=rate)
 
 
-def _model_text(model: Model) -> str:
-    """The model file's text, when the model came from a readable file."""
-    p = Path(model.file) if model.file and not model.file.startswith("<") else None
-    try:
-        return p.read_text(encoding="utf-8") if p is not None and p.is_file() else ""
-    except (OSError, UnicodeDecodeError):
-        return ""
+def with_known(model: Model, known: Mapping[str, float | str] | None) -> Model:
+    """`model` with the reaction values `known` (label -> number, or expression of t as
+    text) among its known reactions, replacing the file's value of a label; the same model
+    when `known` is empty. Raises `MbodyError` for a label the model does not have."""
+    if not known:
+        return model
+    values: dict[str, float] = dict(model.known_reactions)
+    exprs: dict[str, Expression] = dict(model.known_expressions)
+    for label, v in known.items():
+        if label not in model.reaction_index:
+            hint = did_you_mean(label, model.reactions)
+            raise MbodyError(f"no reaction component {label!r} in this model"
+                             + (f"; {hint}" if hint else ""))
+        exprs.pop(label, None)
+        if isinstance(v, str):
+            e = compile_expression(v)
+            values[label] = e.value
+            if not e.constant:
+                exprs[label] = e
+        else:
+            values[label] = float(v)
+    return dataclasses.replace(model, known_reactions=values, known_expressions=exprs)
 
 
-def potential_energy(model: Model, traj: Trajectory) -> np.ndarray:
-    """V = −Σ m g·x + Σ ½ k (L − L0)²: (K,) gravity and spring potential, J."""
+def potential_energy(model: Model, traj: Trajectory, lengths: np.ndarray | None = None
+                     ) -> np.ndarray:
+    """V = −Σ m g·x + Σ ½ k (L − L0)²: (K,) gravity and spring potential, J; the springs'
+    lengths L (K, s) as given, else from the compiled core at the trajectory's samples."""
     x, q, _, _ = traj.spatial()
-    V = -np.einsum("kni,i,n->k", x, model.gravity, model.mass)
+    V = -((x @ model.gravity) @ model.mass)
     sp = model.springs
     if len(sp.names):
-
-        Pa, Pb, _, _ = spring_ends(model, x, q)
-        L = np.linalg.norm(Pb - Pa, axis=2)
-        V = V + 0.5 * np.sum(sp.stiffness * (L - sp.rest_length) ** 2, axis=1)
+        if lengths is None:
+            ws = workspace(model)
+            K, n = len(traj.t), model.n
+            Y = np.zeros((K, ws.state_size))
+            Y[:, :3 * n] = x.reshape(K, -1)
+            Y[:, 3 * n:7 * n] = q.reshape(K, -1)
+            lengths = sample_figures(model, ws.file_unknowns, traj.t, Y, reactions=False,
+                                     lengths=True).lengths
+        V = V + 0.5 * np.sum(sp.stiffness * (lengths - sp.rest_length) ** 2, axis=1)
     return V
 
 
 def _has_unknown_reactions(model: Model, known: Mapping[str, float | str] | None) -> bool:
     given = set(model.known_reactions) | set(getattr(model, "known_expressions", {}))
     return bool(set(model.reactions) - given - set(known or {}))
-
-
-def _numeric_known(model: Model, known: Mapping[str, float | str] | None
-                   ) -> dict[str, float] | None:
-    """`known` for the constrained path (numbers only; formulas of t go in the file)."""
-    if not known:
-        return None
-    out = {}
-    for label, v in known.items():
-        if label not in model.reaction_index:
-            hint = did_you_mean(label, model.reactions)
-            raise MbodyError(f"no reaction component {label!r} in this model"
-                             + (f"; {hint}" if hint else ""))
-        if isinstance(v, str):
-            raise MbodyError(f"{label}: a known value given as a formula of t is supported "
-                             "for models whose reactions are all known; write it in the "
-                             "model file's 'reactions:' instead")
-        out[label] = float(v)
-    return out
 
 
 def _named(names: list[str], most: int = 3) -> str:
@@ -763,6 +696,9 @@ def conservation(model: Model, default_dynamics: bool = True, ideal_joints: bool
         energy.append(f"applied loads do work: {_named(loads)}")
     if dampers:
         energy.append(f"dampers dissipate: {_named(dampers)}")
+    drivers = list(model.drivers.names) if model.drivers is not None else []
+    if drivers and ideal_joints:  # a driver's effort does work on its moving joint
+        energy.append(f"drivers do work: {_named(drivers)}")
     given = list(model.known_reactions) if ideal_joints else list(model.reactions)
     given += [k for k in known or {} if k not in given]
     if given:  # solved reactions of ideal joints do no work (Gᵀ v = 0); given ones may
@@ -808,18 +744,19 @@ def _change(series: np.ndarray, terms: np.ndarray) -> float:
 
 
 def _drift(model: Model, traj: Trajectory, default_dynamics: bool, *,
-           ideal_joints: bool = False, known: Mapping[str, float | str] | None = None
-           ) -> tuple[dict[str, np.ndarray], dict]:
+           ideal_joints: bool = False, known: Mapping[str, float | str] | None = None,
+           lengths: np.ndarray | None = None) -> tuple[dict[str, np.ndarray], dict]:
     """Energy, linear and angular momentum: their series, largest relative change, and
     whether the model conserves them (`conservation`, with its reasons when not).
 
     Energy E = T + V; its change is relative to max(|E(0)|, max T). Linear momentum
     p = Σ m v and angular momentum H = Σ (r × m v + W_R_B J ω) (r and v from the world
     origin, or from the system's mass centre; spin only: Σ W_R_B J ω): relative to the
-    largest sum of their terms' magnitudes (`_change`)."""
+    largest sum of their terms' magnitudes (`_change`). `lengths`: the springs' lengths at
+    the samples (K, s), when the run has them."""
     why = conservation(model, default_dynamics, ideal_joints, known)
     T = traj.kinetic_energy()
-    V = potential_energy(model, traj)
+    V = potential_energy(model, traj, lengths)
     E = T + V
     scale = max(abs(E[0]), float(np.max(np.abs(T))) if len(T) else 0.0)
     e_change = float(np.max(np.abs(E - E[0])) / scale) if scale > 0 else 0.0
@@ -828,7 +765,7 @@ def _drift(model: Model, traj: Trajectory, default_dynamics: bool, *,
     x, q, v, w = traj.spatial()
     mv = mass[:, None] * v  # (K, n, 3) each body's momentum
     p = mv.sum(axis=1)
-    spin = matvec(quat_to_matrix(q), matvec(np.asarray(model.J, dtype=float), w))
+    spin = rotate(q, body_matvec(np.asarray(model.J, dtype=float), w))
     kind = why["angular_momentum_kind"]
     if kind.startswith("spin"):
         terms = spin
@@ -836,9 +773,9 @@ def _drift(model: Model, traj: Trajectory, default_dynamics: bool, *,
         r, u = x, v
         if kind.endswith("system's mass centre"):
             M = float(mass.sum())
-            r = x - (np.einsum("n,kni->ki", mass, x) / M)[:, None]
+            r = x - ((mass @ x) / M)[:, None]
             u = v - (p / M)[:, None]
-        terms = np.concatenate((np.cross(r, mass[:, None] * u), spin), axis=1)
+        terms = np.concatenate((cross(r, mass[:, None] * u), spin), axis=1)
     H = terms.sum(axis=1)
     series = {"kinetic_energy": T, "potential_energy": V, "energy": E, "angular_momentum": H}
     return series, {
@@ -880,8 +817,12 @@ def conserved_lines(info: Mapping) -> list[tuple[str, str]]:
 
 
 def summary(traj: Trajectory, path: str | os.PathLike[str] | None = None) -> str:
-    """The run in a few lines: integrator, cost, and drift of the conserved quantities."""
+    """The run in a few lines: integrator, cost, and drift of the conserved quantities;
+    a run with drivers adds their peaks and energy check; a kinematic run (a fully driven
+    mechanism) has its own (`mbody.simulate.kinematic.summary`)."""
     i = traj.info
+    if i.get("kinematic"):
+        return kinematic_summary(traj, None if path is None else str(path))
     lines = [
         f"simulated {traj.model_name!r}: {traj.n} bod{'y' if traj.n == 1 else 'ies'}, "
         f"t = 0 .. {i['t_end']:g} s, {i['samples']} samples at {i['fps']:g} fps",
@@ -889,9 +830,7 @@ def summary(traj: Trajectory, path: str | os.PathLike[str] | None = None) -> str
         f"{i['steps']} steps, {i['evaluations']} evaluations"
         + (f" ({i['sampling_evaluations']} of them for the samples)"
            if i.get("sampling_evaluations") else "")
-        + f", {i['wall_time_s']:.3g} s"
-        + (f" (plus {i['compile_time_s']:.3g} s to compile the fast path once)"
-           if i.get("compile_time_s") else ""),
+        + f", {i['wall_time_s']:.3g} s",
     ]
     # a drift figure only for what the model conserves: the relative change of anything
     # else (a motor's work, gravity's moment) is physics, not an error
@@ -916,6 +855,7 @@ def summary(traj: Trajectory, path: str | os.PathLike[str] | None = None) -> str
     if traj.dimension == cv.SPATIAL:
         lines.append(f"quaternion norm error before renormalising: "
                      f"{i['quaternion_norm_error']:.1e}")
+    lines.extend(driven_lines(traj))
     lines.extend(f"warning: {w}" for w in i.get("warnings", ()))
     if path is not None:
         lines.append(f"wrote {path}")

@@ -1,163 +1,206 @@
-"""The integrator classes a simulation steps with: scipy's, refined for mechanisms.
+"""How a simulation steps: the compiled core's DOP853, or one of scipy's integrators.
 
-Two refinements, each a subclass of the scipy class the user chose:
-
-- **Compiled steps** (DOP853 on a compiled model): scipy's DOP853 calls the right-hand
-  side twelve times a step from Python and combines the stages with numpy, about 6 µs
-  an evaluation on top of the evaluation itself, and the simulation loop adds its own
-  Python per step; on a small mechanism that is several times the physics.
-  `Stepper.advance` takes the steps up to the next output sample in one call of
-  `mbody.solve.compiled.rk_run`: scipy's step-size control and DOP853's stages and error norm
-  (`rk_attempt`), the projection after each step and the loads' expressions of time, all
-  compiled. The solver's fields are left as scipy's own steps leave them, so its dense
-  output and `step()` go on from there, and the steps are scipy's to rounding
-  (`tests/test_stepping.py`).
-- **Error along the joints** (a mechanism held by projection, near a singular position,
-  ``rhs.project_stages``): the error estimate counts only the part along the joints
-  (`mbody.simulate.projection.tangent_error`); those steps take scipy's path.
+- **DOP853** (the default) is the core's (`mbody.kernel.dop853`, written from Hairer,
+  Nørsett and Wanner; its steps are scipy's DOP853's, tests/test_dop853.py). With the
+  core's right-hand side (`mbody.solve.dynamics.StateDerivative` on the compiled core)
+  the whole run is in C: the stages, the step-size control, the projection onto the
+  joints after each step (`mbody.simulate.projection`: the stage projection and the
+  error along the joints near singular positions too), the loads' and laws' expressions
+  of t, the dense output at the output samples and their projection. `CoreRun.advance`
+  returns to Python only every so many steps (progress, budgets). A `dynamics` given in
+  Python is called from the same C loop.
+- **RK45, RK23, Radau, BDF, LSODA** are scipy's, through its public `OdeSolver` API only
+  (the constructor, `step()`, `t`, `y`, `step_size`, `nfev`, `status`,
+  `dense_output()`); scipy is imported for them alone. Nothing is written into scipy's
+  objects, so mechanisms are held by Baumgarte's terms in the right-hand side
+  (`mbody.simulate.mechanism`), not by projection.
 """
 
 from __future__ import annotations
 
 import math
-import sys
-from typing import Any, NamedTuple
+import warnings
+from typing import Any
 
 import numpy as np
 
-from mbody.equations.plan import compiled as compiled_module
-from mbody.simulate.projection import STAGE_PIVOT_RTOL, tangent_error
-from mbody.solve.dynamics import StateDerivative
-from mbody.solve.kkt import singular_mass_error
+from mbody.errors import MbodyError
+from mbody.kernel import _core
+from mbody.kernel.dop853 import DOP853, TOO_SMALL_STEP
+from mbody.simulate.projection import ITERATIONS, STAGE_ITERATIONS, STAGE_PIVOT_RTOL
+from mbody.solve.dynamics import StateDerivative, status_error
 
 REFRESH_ATOL = 1e-2
 """A projection that moves the state by more than this fraction of atol restarts the
 next step from the derivative at the projected state (one evaluation); a smaller one is
 left to the next step's error control."""
 
-COMPILED_STEPS = True
-"""Whether DOP853 steps of compiled models go through `mbody.solve.compiled.rk_attempt` (the
-tests switch it off to compare with scipy's own steps)."""
+CORE = ("DOP853",)
+"""The methods the compiled core steps; the others are scipy's."""
+IMPLICIT = ("Radau", "BDF", "LSODA")
+"""The methods for stiff problems (LSODA switches to BDF when it finds stiffness)."""
 
 
-def integrator(method: str, rhs: StateDerivative) -> type[Any]:
-    """scipy's integrator class `method`, or a subclass refining it for `rhs` (module
-    docstring)."""
-    import scipy.integrate
+class CoreRun:
+    """DOP853 in the compiled core from (0, y0) to t_bound (tolerances, largest step), on
+    the right-hand side `rhs`; with `project`, the state is moved onto the joints of
+    ``rhs.unknowns`` after every step and at every output sample, and `filter_first`
+    says whether the first step starts near a singular position."""
 
-    base: type[Any] = getattr(scipy.integrate, method)  # an OdeSolver subclass
-    projection = rhs.projection
-    compiled = (COMPILED_STEPS and method == "DOP853" and rhs.compiled
-                and rhs.known_at is None)
-    if projection is None and not compiled:
-        return base
-    class Stepper(base):
-        def _estimate_error_norm(self, K, h, scale):
-            if projection is None or not rhs.project_stages:
-                return super()._estimate_error_norm(K, h, scale)
-            if hasattr(self, "E5"):  # DOP853's two embedded estimates (as scipy combines them)
-                e5 = tangent_error(projection, self.y, K.T @ self.E5) / scale
-                e3 = tangent_error(projection, self.y, K.T @ self.E3) / scale
-                n5, n3 = float(e5 @ e5), float(e3 @ e3)
-                if n5 == 0 and n3 == 0:
-                    return 0.0
-                return abs(h) * n5 / math.sqrt((n5 + 0.01 * n3) * len(scale))
-            e = tangent_error(projection, self.y, (K.T @ self.E) * h) / scale
-            return float(np.linalg.norm(e)) / math.sqrt(len(e))
+    method = "DOP853"
 
-        if compiled:
-            def advance(self, t_stop: float, max_steps: int) -> Advance | None:
-                """Steps (each followed by the projection, when the run has one) until
-                the first that reaches t_stop, at most max_steps of them, in one compiled
-                call; None when the next step needs the Python path (near a singular
-                position, or vector tolerances): take it with `step()`."""
-                if rhs.project_stages or np.ndim(self.atol) or np.ndim(self.rtol):
-                    return None
-                return _compiled_run(self, rhs, t_stop, max_steps)
-
-    Stepper.__name__ = base.__name__
-    return Stepper
-
-
-class Advance(NamedTuple):
-    """What one `advance` did: steps taken, fresh derivatives after a projection, and
-    `mbody.simulate.projection.geometric_ratio` before the last step's projection (1 without)."""
-
-    steps: int
-    refreshed: int
-    ratio: float
-
-
-def _compiled_run(solver, rhs: StateDerivative, t_stop: float, max_steps: int) -> Advance:
-    """Steps by `mbody.solve.compiled.rk_run`; the solver's fields left as scipy's own steps
-    leave them (so that its dense output and next `step()` go on from there)."""
-    c = compiled_module()
-    model = rhs.model
-    run = np.zeros(c.RUN_SIZE)
-    run[c.RUN_T], run[c.RUN_H] = solver.t, solver.h_abs
-    y, f = solver.y.copy(), solver.f.copy()
-    y_old = np.empty_like(y)
-    projection = rhs.projection
-    c.rk_run(rhs._F, rhs._I, rhs._Iu, *model.plan.load_program, rhs._lam, rhs.rate,
-             rhs.planar, solver.A, solver.B, solver.C, solver.E3, solver.E5, solver.rtol,
-             solver.atol, solver.max_step, solver.t_bound, t_stop, max_steps,
-             projection is not None, STAGE_PIVOT_RTOL, REFRESH_ATOL * solver.atol,
-             y, f, solver.K, y_old, run)
-    steps = int(run[c.RUN_STEPS])
-    solver.nfev += int(run[c.RUN_NFEV])
-    status = run[c.RUN_STATUS]
-    if status == 2.0:
-        code = int(run[c.RUN_RATIO])
-        raise singular_mass_error(model, (code - 1) // 6, (code - 1) % 6)
-    solver.h_abs = run[c.RUN_H]
-    if steps:
-        solver.t_old, solver.h_previous = run[c.RUN_T_OLD], run[c.RUN_H_OLD]
-        solver.t, solver.y, solver.y_old, solver.f = run[c.RUN_T], y, y_old, f
-    if status == 1.0:
-        solver.status = "failed"
-    elif solver.direction * (solver.t - solver.t_bound) >= 0:
-        solver.status = "finished"
-    return Advance(steps, int(run[c.RUN_REFRESHED]),
-                   float(run[c.RUN_RATIO]) if steps else 1.0)
-
-
-class CompileClock:
-    """The wall time numba spends compiling while this is entered: the time inside its
-    ``numba:compile`` events (numba's event API; a compile nested in another counted once).
-    Loading machine code from numba's cache raises no such event, so a run that loads the
-    cached fast path counts 0 here, and the first run after an install counts the one-off
-    compile of `mbody.solve.compiled`'s kernels (about a minute), which its timing leaves
-    out of the integration's. Numba is not imported here: `watch` starts listening once
-    it is (after `state_derivative` has picked the compiled path); without numba, 0."""
-
-    def __init__(self) -> None:
-        self._listener: Any = None
-
-    def __enter__(self) -> CompileClock:
-        self.watch()
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        if self._listener is not None:  # kept: `seconds` reads it after the run
-            from numba.core import event
-
-            event.unregister("numba:compile", self._listener)
-
-    def watch(self) -> None:
-        """Start listening, if numba is imported and this is not listening yet."""
-        if self._listener is not None or "numba" not in sys.modules:
-            return
-        try:
-            from numba.core import event
-
-            listener = event.TimingListener()
-            event.register("numba:compile", listener)
-        except Exception:  # noqa: BLE001 - numba's event API moved: time nothing, never fail
-            return
-        self._listener = listener
+    def __init__(self, rhs: StateDerivative, y0: np.ndarray, t_bound: float, rtol: float,
+                 atol: float, max_step: float, *, project: bool = False,
+                 filter_first: bool = False):
+        self.rhs, self.projecting = rhs, project
+        core = True if project else None
+        if rhs.solver is not None:
+            params = np.concatenate(([0.0] * _core.MECH_PARAMS, rhs.lam))
+            params[_core.MECH_RATE] = rhs.rate
+            params[_core.MECH_ROBUST] = STAGE_PIVOT_RTOL
+            params[_core.MECH_ITERS] = ITERATIONS
+            params[_core.MECH_STAGE_ITERS] = STAGE_ITERATIONS
+            self.solver = DOP853(rhs.solver, 0.0, y0, t_bound, rtol=rtol, atol=atol,
+                                 max_step=max_step, params=params, project=core,
+                                 stage=core, tangent=core, refresh=REFRESH_ATOL,
+                                 filter_first=filter_first)
+        else:  # a Python right-hand side (`dynamics`), called from the core's loop
+            self.solver = DOP853(rhs, 0.0, y0, t_bound, rtol=rtol, atol=atol,
+                                 max_step=max_step)
+        self._raise_stop()
 
     @property
-    def seconds(self) -> float:
-        """Compiling so far (s), compiles under way not counted."""
-        lis = self._listener
-        return float(lis.duration) if lis is not None and lis.done else 0.0
+    def status(self) -> str:
+        return self.solver.status
+
+    @property
+    def t(self) -> float:
+        return self.solver.t
+
+    @property
+    def y(self) -> np.ndarray:
+        return self.solver.y
+
+    @property
+    def step_size(self) -> float:
+        return abs(self.solver.step_size)
+
+    @property
+    def steps(self) -> int:
+        return self.solver.steps
+
+    @property
+    def nfev(self) -> int:
+        return self.solver.nfev
+
+    @property
+    def sampling_evaluations(self) -> int:
+        return self.solver.dense_evaluations
+
+    @property
+    def refreshed(self) -> int:
+        return self.solver.refreshed
+
+    def advance(self, t_stop: float, max_steps: int, t_eval: np.ndarray, k: int,
+                Y: np.ndarray) -> tuple[int, str | None]:
+        """Steps until the first that reaches t_stop, at most max_steps of them, with the
+        samples t_eval[k ..] they reach written into Y's rows (projected with the state);
+        returns (the first sample not yet written, why the run failed or None)."""
+        k = self.solver.sampled(t_stop, max_steps, t_eval, k, Y, self.projecting)
+        self._raise_stop()
+        return k, TOO_SMALL_STEP if self.status == "failed" else None
+
+    def _raise_stop(self) -> None:
+        """A callback that stopped the run: a motion without mass (the core's code)."""
+        if self.solver.status == "stopped":
+            raise status_error(self.rhs.model, self.solver.code)
+
+
+class ScipyRun:
+    """scipy.integrate's `method` (RK45, RK23, Radau, BDF, LSODA) from (0, y0) to t_bound
+    on `rhs`, one step per `advance`, through its public API only."""
+
+    def __init__(self, method: str, rhs: StateDerivative, y0: np.ndarray, t_bound: float,
+                 rtol: float, atol: float, max_step: float):
+        import scipy.integrate  # only for these methods: DOP853 runs never import it
+
+        self.method, self.rhs = method, rhs
+        self._steps, self._y_ok = 0, True
+
+        def fun(t: float, y: np.ndarray) -> np.ndarray:
+            # Radau's and BDF's Jacobian estimates pass strided columns of y
+            return rhs(t, np.ascontiguousarray(y))
+
+        with np.errstate(all="ignore"):  # its first-step norm may overflow: checked later
+            self.solver: Any = getattr(scipy.integrate, method)(
+                fun, 0.0, y0, t_bound, rtol=rtol, atol=atol, max_step=max_step)
+
+    @property
+    def status(self) -> str:
+        return str(self.solver.status)
+
+    @property
+    def t(self) -> float:
+        return float(self.solver.t)
+
+    @property
+    def y(self) -> np.ndarray:
+        return self.solver.y
+
+    @property
+    def step_size(self) -> float:
+        h = self.solver.step_size
+        return 0.0 if h is None else float(h)
+
+    @property
+    def steps(self) -> int:
+        return self._steps
+
+    @property
+    def nfev(self) -> int:
+        return int(self.solver.nfev)
+
+    sampling_evaluations = 0
+    """Their interpolants are free."""
+    refreshed = 0
+
+    def advance(self, t_stop: float, max_steps: int, t_eval: np.ndarray, k: int,
+                Y: np.ndarray) -> tuple[int, str | None]:
+        """One step, with the samples t_eval[k ..] it reached written into Y's rows (from
+        the step's interpolant); returns (the first sample not yet written, why the run
+        failed or None)."""
+        solver = self.solver
+        try:  # overflow in an implicit method's Jacobian estimate is handled below
+            with np.errstate(all="ignore"), warnings.catch_warnings():
+                if self.method in IMPLICIT:  # LinAlgWarning on a singular iteration,
+                    warnings.simplefilter("ignore")  # LSODA's convergence failures
+                msg = solver.step()
+        except (ValueError, np.linalg.LinAlgError) as exc:
+            if self.method not in IMPLICIT:
+                raise
+            others = " or ".join(m for m in ("LSODA", "BDF") if m != self.method)
+            raise MbodyError(
+                f"the integrator {self.method} failed at t = {solver.t:.6g} s: {exc} (its "
+                "numerical Jacobian broke down, as it can where the state barely changes). "
+                f"Try another stiff integrator (--method {others}) or looser tolerances "
+                "(e.g. --rtol 1e-6 --atol 1e-9)") from None
+        if solver.status == "failed":
+            return k, msg
+        self._steps += 1
+        j = int(np.searchsorted(t_eval, solver.t, side="right"))
+        if j > k:
+            Y[k:j] = solver.dense_output()(t_eval[k:j]).T
+        return j, None
+
+
+def start(method: str, rhs: StateDerivative, y0: np.ndarray, t_bound: float, rtol: float,
+          atol: float, max_step: float = math.inf, *, project: bool = False,
+          filter_first: bool = False) -> CoreRun | ScipyRun:
+    """The run of `method` from (0, y0): the core's (`CORE`) or scipy's."""
+    if method in CORE:
+        return CoreRun(rhs, y0, t_bound, rtol, atol, max_step, project=project,
+                       filter_first=filter_first)
+    if project:
+        raise ValueError(f"{method} is scipy's: it does not project (Baumgarte's terms hold "
+                         "the joints)")
+    return ScipyRun(method, rhs, y0, t_bound, rtol, atol, max_step)

@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 
 from mbody import conventions as cv
-from mbody.equations.spatial import matvec, planar_quat, quat_to_matrix
+from mbody.equations.spatial import planar_quat
 from mbody.errors import TrajectoryFileError
 from mbody.io.atomic import atomic_path
 from mbody.model.model import State, count, loads
@@ -240,8 +240,7 @@ class Trajectory:
         """
         m, J = self._need_inertia()
         _, _, v, w = self.spatial()
-        T = 0.5 * m * np.einsum("kni,kni->kn", v, v) \
-            + 0.5 * np.einsum("kni,kni->kn", w, matvec(J, w))
+        T = 0.5 * m * (v * v).sum(axis=2) + 0.5 * (w * body_matvec(J, w)).sum(axis=2)
         return T if per_body else T.sum(axis=1)
 
     def spin_angular_momentum(self) -> np.ndarray:
@@ -254,7 +253,7 @@ class Trajectory:
         """
         m, J = self._need_inertia()
         _, q, _, w = self.spatial()
-        return matvec(quat_to_matrix(q), matvec(J, w)).sum(axis=1)
+        return rotate(q, body_matvec(J, w)).sum(axis=1)
 
     def angular_momentum(self) -> np.ndarray:
         """H = Σ (x × m v + W_R_B J ω): angular momentum about the world origin.
@@ -266,7 +265,7 @@ class Trajectory:
         """
         m, _ = self._need_inertia()
         x, _, v, _ = self.spatial()
-        orbital = np.cross(x, m[:, None] * v).sum(axis=1)
+        orbital = cross(x, m[:, None] * v).sum(axis=1)
         return orbital + self.spin_angular_momentum()
 
     def model(self):
@@ -438,3 +437,34 @@ def _jsonable(x: Any) -> Any:
     if isinstance(x, np.generic):
         return x.item()
     return x
+
+
+def model_text(model) -> str:
+    """The model file's text, when the model came from a readable file ('' otherwise):
+    what a trajectory keeps so that it can be drawn and checked without the file."""
+    p = Path(model.file) if model.file and not model.file.startswith("<") else None
+    try:
+        return p.read_text(encoding="utf-8") if p is not None and p.is_file() else ""
+    except (OSError, UnicodeDecodeError):
+        return ""
+
+
+def body_matvec(J: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """(K, n, 3) J_i w_ki for each body's (n, 3, 3) tensor J_i (matmul broadcast over K)."""
+    return (J @ w[..., None])[..., 0]
+
+
+def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a × b over the last axis, as np.cross gives it, a few times faster on many short
+    arrays (np.cross moves axes and checks shapes on every call)."""
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    return np.stack((a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0), axis=-1)
+
+
+def rotate(q: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """W_R_B u for unit quaternions q (..., 4) [w, x, y, z]: u + 2 w (v × u) + 2 v × (v × u),
+    v the vector part (the rotation matrix never formed)."""
+    v = q[..., 1:]
+    c = cross(v, u)
+    return u + 2.0 * (q[..., :1] * c + cross(v, c))

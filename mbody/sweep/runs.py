@@ -38,8 +38,9 @@ from mbody import conventions as cv
 from mbody.equations.solution import singular_mass_error
 from mbody.errors import MbodyError
 from mbody.kernel import _core
-from mbody.model.model import Model, from_source
+from mbody.model.model import Model, State, from_source
 from mbody.model.source import Source
+from mbody.simulate.simulation import simulate
 from mbody.solve.batch import Evaluator, closed
 from mbody.solve.family import Case, Family
 from mbody.solve.kinematics import kinematics as kinematics_at
@@ -399,9 +400,7 @@ def _kinematics_error(ctx: Context, case: Case, values: dict[str, Any], t: np.nd
             "found no closure where the single one did: report it)")
 
 
-def _state(model: Model, y: np.ndarray):
-    from mbody.model.model import State
-
+def _state(model: Model, y: np.ndarray) -> State:
     n = model.n
     q = y[3 * n:7 * n].reshape(n, 4)
     return State(y[:3 * n].reshape(n, 3).copy(), q / np.linalg.norm(q, axis=1)[:, None],
@@ -432,8 +431,6 @@ def _per_model(ctx: Context, values: list[dict[str, Any]], one) -> tuple[np.ndar
 
 
 def _simulate(ctx: Context, model: Model, case: Case) -> np.ndarray:
-    from mbody.simulate.simulation import simulate
-
     traj = simulate(model, t_end=_end(ctx, case), fps=ctx.job.settings.fps)
     last = traj.state(len(traj.t) - 1)
     Y = np.concatenate((last.position.ravel(), last.quaternion.ravel()))[None]

@@ -267,6 +267,7 @@ int mb_dop853_start(const mb_ode *p, double t0, const double *y0, double first_s
     state[MB_DOP_REFRESHED] = 0.0;
     state[MB_DOP_FILTER] = state[MB_DOP_FILTER_NEXT];
     state[MB_DOP_DENSE] = 0.0;
+    state[MB_DOP_DENSE_NFEV] = 0.0;
     for (int i = 0; i < MB_DOP_PROJECT_INFO; i++) state[MB_DOP_INFO + i] = 0.0;
     memcpy(work + MB_DOP_W_Y * n, y0, (size_t)n * sizeof(double));
     int code = evaluate(p, state[MB_DOP_FILTER_NEXT] != 0.0, t0, work + MB_DOP_W_Y * n,
@@ -364,7 +365,7 @@ int mb_dop853_run(const mb_ode *p, double t_stop, int64_t max_steps, double *sta
         int rejected = 0;
         double h, t_new;
         for (;;) {
-            if (h_abs < min_step) {
+            if (!(h_abs >= min_step)) { /* NaN too: a state or f no longer finite */
                 state[MB_DOP_T] = t;
                 state[MB_DOP_H] = h_abs;
                 state[MB_DOP_STATUS] = MB_DOP_TOO_SMALL;
@@ -444,6 +445,7 @@ int mb_dop853_dense(const mb_ode *p, const double *t, int64_t m, double *out,
             combine(n, y_old, K, A[s], s, h, z);
             int code = evaluate(p, filtered, t_old + C[s] * h, z, K + s * n, work, state);
             if (code) return stopped(state, code);
+            state[MB_DOP_DENSE_NFEV] += 1.0;
         }
         /* HNW's continuous extension: rows 0 .. 2 from y_old, y and the slopes at both
          * ends (f: at the step's end, as the next step starts), rows 3 .. 6 h sum d k. */
@@ -478,4 +480,33 @@ int mb_dop853_dense(const mb_ode *p, const double *t, int64_t m, double *out,
         }
     }
     return 0;
+}
+
+int mb_dop853_sampled(const mb_ode *p, double t_stop, int64_t max_steps, const double *t_eval,
+                      int64_t m, int64_t *k, double *out, int project_samples, double *state,
+                      double *work) {
+    const int64_t n = p->n;
+    const double direction = state[MB_DOP_DIRECTION];
+    int status = (int)state[MB_DOP_STATUS];
+    for (int64_t taken = 0; taken < max_steps && status == MB_DOP_RUNNING; taken++) {
+        const double before = state[MB_DOP_STEPS];
+        status = mb_dop853_run(p, t_stop, 1, state, work);
+        if (state[MB_DOP_STEPS] == before && status != MB_DOP_FINISHED) break; /* failed */
+        const double t = state[MB_DOP_T];
+        int64_t j = *k;
+        while (j < m && direction * (t_eval[j] - t) <= 0.0) j++;
+        if (j > *k && n > 0) {
+            int code = mb_dop853_dense(p, t_eval + *k, j - *k, out + *k * n, state, work);
+            if (code) return code;
+            if (project_samples && p->project != NULL)
+                for (int64_t i = *k; i < j; i++) {
+                    double info[MB_DOP_PROJECT_INFO];
+                    code = p->project(p->ctx, t_eval[i], out + i * n, info);
+                    if (code) return stopped(state, code);
+                }
+        }
+        *k = j;
+        if (status == MB_DOP_RUNNING && direction * (t - t_stop) >= 0.0) break;
+    }
+    return status;
 }

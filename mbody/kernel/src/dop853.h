@@ -81,6 +81,7 @@ enum {
     MB_DOP_FILTER,      /* whether the last accepted step was filtered */
     MB_DOP_FILTER_NEXT, /* whether the next one is */
     MB_DOP_DENSE,       /* whether the last step's dense output is prepared */
+    MB_DOP_DENSE_NFEV,  /* evaluations of rhs made for dense output (part of NFEV) */
     MB_DOP_INFO,        /* the last projection's info (MB_DOP_PROJECT_INFO slots) */
     MB_DOP_STATE_SIZE = MB_DOP_INFO + 4
 };
@@ -117,6 +118,16 @@ int mb_dop853_run(const mb_ode *p, double t_stop, int64_t max_steps, double *sta
  * in state[MB_DOP_CODE]). */
 int mb_dop853_dense(const mb_ode *p, const double *t, int64_t m, double *out,
                     double *state, double *work);
+
+/* Steps as mb_dop853_run (until the first that reaches t_stop, max_steps of them, t_bound
+ * or a failure), and after each accepted step the dense output at the sample times
+ * t_eval[*k], t_eval[*k + 1], ... (of m, increasing in the run's direction) that the step
+ * reached, into the rows *k, *k + 1, ... of out (m rows of n); with project_samples each
+ * such row is then moved by the project callback at its time (its info discarded). *k
+ * advances past the rows written. Returns the status, as mb_dop853_run. */
+int mb_dop853_sampled(const mb_ode *p, double t_stop, int64_t max_steps, const double *t_eval,
+                      int64_t m, int64_t *k, double *out, int project_samples, double *state,
+                      double *work);
 
 /* The tableau as data (for tests): c (16), a (16 x 16, row s: stage s's weights), b (12),
  * e5, e3 (13), d (4 x 16). */

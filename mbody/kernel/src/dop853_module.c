@@ -4,14 +4,18 @@
  * A problem is the tuple (rhs, params, project, stage, tangent, atol):
  *   rhs      an int, one of the built-in test systems below (SYSTEM_*), with its
  *            parameters `params` (a float64 buffer), or a callable rhs(t, y, ydot)
- *            writing y'(t, y) into ydot (y, ydot: memoryviews of float64);
- *   project  None or project(t, y, info) (y, info writable; dop853.h's project);
- *   stage    None or stage(t, y) (y writable);
- *   tangent  None or tangent(t, y, e) (e writable);
+ *            writing y'(t, y) into ydot (y, ydot: memoryviews of float64), or a
+ *            _core.Unknowns: the core's mechanism (mechanism.h: mb_derivative), with
+ *            `params` = [MECH_PARAMS settings (MECH_*), lam (m)];
+ *   project  None or project(t, y, info) (y, info writable; dop853.h's project), or
+ *            True with a _core.Unknowns rhs: the core's projection (mechanism.h);
+ *   stage    None or stage(t, y) (y writable), or True (the core's);
+ *   tangent  None or tangent(t, y, e) (e writable), or True (the core's);
  *   atol     None or a float64 buffer of n absolute tolerances.
  * Python callables cost a few microseconds an evaluation: they are for tests and for
- * problems without a compiled right-hand side. state and work are float64 buffers of
- * STATE_SIZE and work_size(n) (caller-owned: numpy arrays).
+ * problems without a compiled right-hand side; a mechanism's run calls no Python at all.
+ * state and work are float64 buffers of STATE_SIZE and work_size(n) (caller-owned: numpy
+ * arrays).
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
@@ -19,6 +23,12 @@
 #include <math.h>
 
 #include "dop853.h"
+#include "mechanism.h"
+
+/* The model, unknowns and scratch of a _core.Unknowns object: 1, or 0 when obj is not an
+ * initialised one (module.c). */
+int mb_unknowns_object(PyObject *obj, const mb_model **md, const mb_unknowns **u,
+                       mb_work **w);
 
 /* ---------------------------------------------------------------------------------------
  * Built-in test systems (plain ODEs with known behaviour), written with the same
@@ -67,13 +77,16 @@ static const system_fn SYSTEM_FN[SYSTEMS] = {oscillator, van_der_pol, arenstorf,
 /* ---------------------------------------------------------------------------------------
  * A problem tuple held for one call.
  * ------------------------------------------------------------------------------------- */
+enum { SYSTEM_PYTHON = -1, SYSTEM_MECHANISM = -2 };
+
 typedef struct {
-    int system;        /* SYSTEM_*, or -1: a Python callable */
+    int system;        /* SYSTEM_*, SYSTEM_PYTHON or SYSTEM_MECHANISM */
     const double *params;
     PyObject *rhs, *project, *stage, *tangent; /* borrowed */
     Py_buffer params_view, atol_view;
     int has_params, has_atol;
     int64_t n;
+    mb_mechanism mech; /* SYSTEM_MECHANISM: the core's model, unknowns, scratch */
 } problem;
 
 enum { PY_ERROR = -1000 }; /* a callback's code: a Python exception is set */
@@ -82,6 +95,23 @@ static int system_rhs(void *ctx, double t, const double *y, double *ydot) {
     const problem *pr = ctx;
     SYSTEM_FN[pr->system](pr->params, y, ydot);
     return 0;
+}
+
+/* The core's mechanism (mechanism.h), its ctx inside the problem. */
+static int mech_rhs(void *ctx, double t, const double *y, double *ydot) {
+    return mb_mechanism_rhs(&((problem *)ctx)->mech, t, y, ydot);
+}
+
+static int mech_project(void *ctx, double t, double *y, double *info) {
+    return mb_mechanism_project(&((problem *)ctx)->mech, t, y, info);
+}
+
+static int mech_stage(void *ctx, double t, double *y) {
+    return mb_mechanism_stage(&((problem *)ctx)->mech, t, y);
+}
+
+static int mech_tangent(void *ctx, double t, const double *y, double *e) {
+    return mb_mechanism_tangent(&((problem *)ctx)->mech, t, y, e);
 }
 
 static PyObject *view(double *x, int64_t n, int writable) {
@@ -149,6 +179,65 @@ static void problem_release(problem *pr) {
     if (pr->has_params) PyBuffer_Release(&pr->params_view);
     if (pr->has_atol) PyBuffer_Release(&pr->atol_view);
     pr->has_params = pr->has_atol = 0;
+    PyMem_Free(pr->mech.scratch);
+    pr->mech.scratch = NULL;
+}
+
+static int is_unknowns(PyObject *obj) {
+    const mb_model *md;
+    const mb_unknowns *u;
+    mb_work *w;
+    return mb_unknowns_object(obj, &md, &u, &w);
+}
+
+/* A mechanism's rhs: the Unknowns object's model, its params and lam; n checked. */
+static int mechanism_read(PyObject *rhs, PyObject *params, int64_t n, problem *pr) {
+    const mb_model *md;
+    const mb_unknowns *u;
+    mb_work *w;
+    if (!mb_unknowns_object(rhs, &md, &u, &w)) {
+        PyErr_SetString(PyExc_TypeError, "rhs: an initialised _core.Unknowns is needed");
+        return -1;
+    }
+    if (MB_STATE_SIZE(md->n, md->planar) != n) {
+        PyErr_Format(PyExc_ValueError, "the mechanism's state has %lld values, not %lld",
+                     (long long)MB_STATE_SIZE(md->n, md->planar), (long long)n);
+        return -1;
+    }
+    if (get_doubles(params, &pr->params_view, 0, MB_MECH_PARAMS + md->m, "params") < 0)
+        return -1;
+    pr->has_params = 1;
+    pr->params = pr->params_view.buf;
+    pr->mech.md = md;
+    pr->mech.u = u;
+    pr->mech.w = w;
+    pr->mech.params = pr->params;
+    pr->mech.lam = pr->params + MB_MECH_PARAMS;
+    pr->mech.scratch = PyMem_Malloc((size_t)mb_mechanism_scratch(md) * sizeof(double) + 1);
+    if (pr->mech.scratch == NULL) {
+        PyErr_NoMemory();
+        return -1;
+    }
+    pr->system = SYSTEM_MECHANISM;
+    return 0;
+}
+
+/* A callback slot: None (none), True (the core's, for a mechanism) or a callable. */
+static int callback_kind(PyObject *obj, const problem *pr, const char *what) {
+    if (obj == Py_None) return 0;
+    if (obj == Py_True) {
+        if (pr->system != SYSTEM_MECHANISM) {
+            PyErr_Format(PyExc_TypeError, "%s: True (the core's) needs a _core.Unknowns rhs",
+                         what);
+            return -1;
+        }
+        return 1;
+    }
+    if (!PyCallable_Check(obj)) {
+        PyErr_Format(PyExc_TypeError, "%s: None, True or a callable", what);
+        return -1;
+    }
+    return 2;
 }
 
 /* Reads the problem tuple into pr and ode; n: the size of y. */
@@ -179,25 +268,30 @@ static int problem_read(PyObject *tuple, int64_t n, problem *pr, mb_ode *ode) {
         pr->params = pr->params_view.buf;
         ode->rhs = system_rhs;
     } else if (PyCallable_Check(rhs)) {
-        pr->system = -1;
+        pr->system = SYSTEM_PYTHON;
         pr->rhs = rhs;
         ode->rhs = python_rhs;
+    } else if (is_unknowns(rhs)) {
+        if (mechanism_read(rhs, params, n, pr) < 0) {
+            problem_release(pr);
+            return -1;
+        }
+        ode->rhs = mech_rhs;
     } else {
-        PyErr_SetString(PyExc_TypeError, "rhs: a built-in system number or a callable");
+        PyErr_SetString(PyExc_TypeError,
+                        "rhs: a built-in system number, a callable or a _core.Unknowns");
         return -1;
     }
-    if (project != Py_None) {
-        pr->project = project;
-        ode->project = python_project;
+    int kp = callback_kind(project, pr, "project"), ks = callback_kind(stage, pr, "stage");
+    int kt = callback_kind(tangent, pr, "tangent");
+    if (kp < 0 || ks < 0 || kt < 0) {
+        problem_release(pr);
+        return -1;
     }
-    if (stage != Py_None) {
-        pr->stage = stage;
-        ode->stage = python_stage;
-    }
-    if (tangent != Py_None) {
-        pr->tangent = tangent;
-        ode->tangent = python_tangent;
-    }
+    pr->project = project, pr->stage = stage, pr->tangent = tangent;
+    ode->project = kp == 1 ? mech_project : kp == 2 ? python_project : NULL;
+    ode->stage = ks == 1 ? mech_stage : ks == 2 ? python_stage : NULL;
+    ode->tangent = kt == 1 ? mech_tangent : kt == 2 ? python_tangent : NULL;
     if (atol != Py_None) {
         if (get_doubles(atol, &pr->atol_view, 0, n, "atol") < 0) {
             problem_release(pr);
@@ -314,6 +408,89 @@ static PyObject *py_dense(PyObject *self, PyObject *args) {
     return out;
 }
 
+static PyObject *py_sampled(PyObject *self, PyObject *args) {
+    PyObject *tuple, *times, *result, *state, *work;
+    double t_stop;
+    long long max_steps, k;
+    int project_samples;
+    if (!PyArg_ParseTuple(args, "O!dLOLOpOO", &PyTuple_Type, &tuple, &t_stop, &max_steps,
+                          &times, &k, &result, &project_samples, &state, &work))
+        return NULL;
+    Py_buffer bs, bw, bt, bo;
+    int64_t n;
+    if (buffers(state, work, &bs, &bw, &n) < 0) return NULL;
+    problem pr;
+    mb_ode ode;
+    PyObject *out = NULL;
+    if (get_doubles(times, &bt, 0, -1, "t_eval") == 0) {
+        const int64_t m = (int64_t)(bt.len / 8);
+        if (k < 0 || k > m) {
+            PyErr_Format(PyExc_ValueError, "k: expected 0 to %lld", (long long)m);
+        } else if (get_doubles(result, &bo, 1, (Py_ssize_t)(m * n), "out") == 0) {
+            if (problem_read(tuple, n, &pr, &ode) == 0) {
+                int64_t kk = (int64_t)k;
+                int status = mb_dop853_sampled(&ode, t_stop, (int64_t)max_steps, bt.buf, m,
+                                               &kk, bo.buf, project_samples, bs.buf, bw.buf);
+                PyObject *st = status_or_error(status, bs.buf);
+                if (st != NULL) out = Py_BuildValue("(NL)", st, (long long)kk);
+                problem_release(&pr);
+            }
+            PyBuffer_Release(&bo);
+        }
+        PyBuffer_Release(&bt);
+    }
+    PyBuffer_Release(&bs);
+    PyBuffer_Release(&bw);
+    return out;
+}
+
+static PyObject *py_samples(PyObject *self, PyObject *args) {
+    PyObject *unknowns, *lam, *times, *states, *reactions, *lengths, *drift;
+    if (!PyArg_ParseTuple(args, "OOOOOOO", &unknowns, &lam, &times, &states, &reactions,
+                          &lengths, &drift))
+        return NULL;
+    const mb_model *md;
+    const mb_unknowns *u;
+    mb_work *w;
+    if (!mb_unknowns_object(unknowns, &md, &u, &w)) {
+        PyErr_SetString(PyExc_TypeError, "unknowns: an initialised _core.Unknowns is needed");
+        return NULL;
+    }
+    Py_buffer bl, bt, by, br, bs, bd;
+    int have_r = 0, have_s = 0, ok = 0;
+    if (get_doubles(lam, &bl, 0, md->m, "lam") < 0) return NULL;
+    if (get_doubles(times, &bt, 0, -1, "t") < 0) goto lam_;
+    const int64_t K = (int64_t)(bt.len / 8), size = MB_STATE_SIZE(md->n, md->planar);
+    if (get_doubles(states, &by, 0, K * size, "Y") < 0) goto t_;
+    if (reactions != Py_None) {
+        if (get_doubles(reactions, &br, 1, K * md->m, "reactions") < 0) goto y_;
+        have_r = 1;
+    }
+    if (lengths != Py_None) {
+        if (get_doubles(lengths, &bs, 1, K * md->s, "lengths") < 0) goto r_;
+        have_s = 1;
+    }
+    if (get_doubles(drift, &bd, 1, 2, "drift") < 0) goto s_;
+    if (mb_samples(md, u, w, bl.buf, K, bt.buf, by.buf, size, have_r ? br.buf : NULL,
+                   have_s ? bs.buf : NULL, bd.buf) < 0)
+        PyErr_NoMemory();
+    else
+        ok = 1;
+    PyBuffer_Release(&bd);
+s_:
+    if (have_s) PyBuffer_Release(&bs);
+r_:
+    if (have_r) PyBuffer_Release(&br);
+y_:
+    PyBuffer_Release(&by);
+t_:
+    PyBuffer_Release(&bt);
+lam_:
+    PyBuffer_Release(&bl);
+    if (!ok) return NULL;
+    Py_RETURN_NONE;
+}
+
 static PyObject *py_system(PyObject *self, PyObject *args) {
     int s;
     double t;
@@ -381,6 +558,16 @@ static PyMethodDef dop853_methods[] = {
     {"dop853_dense", py_dense, METH_VARARGS,
      "dop853_dense(problem, t, out, state, work) -> status: out (len(t), n) <- the "
      "last step's dense output at the times t."},
+    {"dop853_sampled", py_sampled, METH_VARARGS,
+     "dop853_sampled(problem, t_stop, max_steps, t_eval, k, out, project_samples, state, "
+     "work) -> (status, k): steps as dop853_run, and after each step out's rows k, k + 1, "
+     "... (len(t_eval) x n) <- the dense output at the sample times the step reached, each "
+     "moved by project when project_samples; k: the first row not yet written."},
+    {"samples", py_samples, METH_VARARGS,
+     "samples(unknowns, lam, t, Y, reactions, lengths, drift): a run's figures at its K "
+     "output samples (Y: K rows of the packed state at the times t): reactions (K x m, or "
+     "None) <- every reaction value, the unknowns' solved; lengths (K x s, or None) <- the "
+     "springs' lengths; drift (2) <- the largest |phi| and |G^T v - f'|."},
     {"dop853_system", py_system, METH_VARARGS,
      "dop853_system(number, params, t, y, ydot): a built-in test system's y'."},
     {"dop853_tableau", py_tableau, METH_NOARGS,
@@ -405,7 +592,11 @@ int mb_dop853_register(PyObject *m) {
         {"DOP_STEPS", MB_DOP_STEPS}, {"DOP_REJECTED", MB_DOP_REJECTED},
         {"DOP_NFEV", MB_DOP_NFEV}, {"DOP_REFRESHED", MB_DOP_REFRESHED},
         {"DOP_FILTER", MB_DOP_FILTER}, {"DOP_FILTER_NEXT", MB_DOP_FILTER_NEXT},
-        {"DOP_DENSE", MB_DOP_DENSE}, {"DOP_INFO", MB_DOP_INFO},
+        {"DOP_DENSE", MB_DOP_DENSE}, {"DOP_DENSE_NFEV", MB_DOP_DENSE_NFEV},
+        {"DOP_INFO", MB_DOP_INFO},
+        {"MECH_RATE", MB_MECH_RATE}, {"MECH_ROBUST", MB_MECH_ROBUST},
+        {"MECH_ITERS", MB_MECH_ITERS}, {"MECH_STAGE_ITERS", MB_MECH_STAGE_ITERS},
+        {"MECH_PARAMS", MB_MECH_PARAMS},
         {"DOP_RUNNING", MB_DOP_RUNNING}, {"DOP_FINISHED", MB_DOP_FINISHED},
         {"DOP_TOO_SMALL", MB_DOP_TOO_SMALL}, {"DOP_STOPPED", MB_DOP_STOPPED},
         {"DOP_W_Y", MB_DOP_W_Y}, {"DOP_W_F", MB_DOP_W_F}, {"DOP_W_Y_OLD", MB_DOP_W_Y_OLD},

@@ -233,4 +233,34 @@ void mb_kinematics(const mb_model *md, const mb_unknowns *u, mb_work *w, double 
  * w dt in body axes, planar angles by w_z dt): a start for the Newton steps at t + dt. */
 void mb_predict(const mb_model *md, double *y, double dt);
 
+/* Slots of mb_kinematic_run's info (MB_KR_INFO of them): the last sample's last Newton
+ * step, the Newton steps taken in all, the most at one sample, the singular code. */
+enum { MB_KR_STEP = 0, MB_KR_NEWTON = 1, MB_KR_WORST = 2, MB_KR_SINGULAR = 3,
+       MB_KR_INFO = 4 };
+
+/* A kinematic run: for each of the K times t (increasing), y (in: a state near the first
+ * sample's; out: the last sample's) is carried from the previous sample by a Taylor step,
+ * moved onto every enforced joint and driver by Newton steps (mb_project, at most
+ * max_newton, until the largest step is at most tol), stored in Y (K x state size) and
+ * solved (mb_solve, lam: the known values) into OUT (K x mb_solve's out length), with
+ * (when ENERGY is not NULL) K x 3 energy terms: the applied loads' power Q . v (gravity
+ * and springs included), the springs' elastic energy and its rate. Returns
+ * K, or the index of the sample where the loops did not close (a step above tol after
+ * max_newton steps, a value not a number, or a motion without mass: info[MB_KR_SINGULAR];
+ * -1 there: no memory for the scratch);
+ * info (MB_KR_INFO) <- slots MB_KR_*. */
+int64_t mb_kinematic_run(const mb_model *md, const mb_unknowns *u, mb_work *w,
+                         const double *t, int64_t K, double *y, const double *lam,
+                         int max_newton, double tol, double *Y, double *OUT, double *ENERGY,
+                         double *info);
+
+/* The accelerations (ACC, K x mb_solve's N: the model's coordinates) and the energy terms
+ * (ENERGY, K x 3, as mb_kinematic_run's) of K sampled states, the rows of Y (stride
+ * apart), with the unknown reactions solved (lam: the known values): the drivers' energy
+ * check of an integrated run. Returns 0, the first singular-mass status met, or -1 (no
+ * memory for the scratch). */
+int mb_energy_samples(const mb_model *md, const mb_unknowns *u, mb_work *w,
+                      const double *lam, int64_t K, const double *t, const double *Y,
+                      int64_t stride, double *ACC, double *ENERGY);
+
 #endif

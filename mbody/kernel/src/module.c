@@ -553,6 +553,108 @@ static PyObject *Unknowns_project(UnknownsObject *self, PyObject *const *args,
     Py_RETURN_NONE;
 }
 
+PyDoc_STRVAR(kinematic_run_doc,
+"kinematic_run(t, y, lam, max_newton, tol, Y, OUT, ENERGY, info) -> int\n\nA kinematic "
+"run (kernel.h: mb_kinematic_run): at each time of t (K, increasing),\ny carried forward, "
+"moved onto every joint and driver by Newton steps (at most\nmax_newton, until a step is at "
+"most tol), stored in Y (K x state_size), solved\ninto OUT (K x solve_layout's length) and "
+"its energy terms into ENERGY (K x 3:\nQ . v, the springs' elastic energy, its rate). "
+"Returns K, or the index of the\nsample where the loops did not close; info (KR_INFO) <- "
+"slots KR_*.");
+
+static PyObject *Unknowns_kinematic_run(UnknownsObject *self, PyObject *const *args,
+                                        Py_ssize_t nargs) {
+    Py_buffer t, y, lam, Y, OUT, E, info;
+    double tol;
+    if (unknowns_ready(self) < 0 || check_nargs(nargs, 9, "kinematic_run") < 0 ||
+        get_double(args[4], &tol, "tol") < 0)
+        return NULL;
+    long max_newton = PyLong_AsLong(args[3]);
+    if (max_newton == -1 && PyErr_Occurred()) return NULL;
+    if (max_newton < 1 || max_newton > 1000) {
+        PyErr_SetString(PyExc_ValueError, "max_newton: expected 1 to 1000");
+        return NULL;
+    }
+    const mb_model *md = &self->model->md;
+    Py_ssize_t S = MB_STATE_SIZE(md->n, md->planar);
+    Py_ssize_t L = (md->planar ? 3 : 6) * md->n + 3 * md->m + MB_INFO;
+    PyObject *result = NULL;
+    if (get_buffer(args[0], &t, 0, 1, -1, "t") < 0) return NULL;
+    Py_ssize_t K = t.len / 8;
+    if (get_state(md, args[1], &y, 1, 1) < 0) goto t_;
+    if (get_buffer(args[2], &lam, 0, 1, md->m, "lam") < 0) goto y_;
+    if (get_buffer(args[5], &Y, 1, 1, K * S, "Y") < 0) goto lam_;
+    if (get_buffer(args[6], &OUT, 1, 1, K * L, "OUT") < 0) goto Y_;
+    if (get_buffer(args[7], &E, 1, 1, K * 3, "ENERGY") < 0) goto OUT_;
+    if (get_buffer(args[8], &info, 1, 1, MB_KR_INFO, "info") < 0) goto E_;
+    const double *tt = t.buf;
+    for (Py_ssize_t k = 1; k < K; k++)
+        if (!(tt[k] > tt[k - 1])) {
+            PyErr_SetString(PyExc_ValueError, "t: expected increasing times");
+            goto info_;
+        }
+    /* the GIL is kept: the work buffers are the object's own (as every method's) */
+    int64_t done = mb_kinematic_run(md, &self->u, self->w, tt, K, y.buf, lam.buf,
+                                    (int)max_newton, tol, Y.buf, OUT.buf, E.buf, info.buf);
+    if (((double *)info.buf)[MB_KR_SINGULAR] < 0.0)
+        PyErr_NoMemory();
+    else
+        result = PyLong_FromLongLong((long long)done);
+info_:
+    PyBuffer_Release(&info);
+E_:
+    PyBuffer_Release(&E);
+OUT_:
+    PyBuffer_Release(&OUT);
+Y_:
+    PyBuffer_Release(&Y);
+lam_:
+    PyBuffer_Release(&lam);
+y_:
+    PyBuffer_Release(&y);
+t_:
+    PyBuffer_Release(&t);
+    return result;
+}
+
+PyDoc_STRVAR(energy_samples_doc,
+"energy_samples(t, Y, lam, ACC, ENERGY) -> int\n\nAt each of the K sampled states (the "
+"rows of Y, K x state_size) at the times t:\nthe accelerations with the unknown reactions "
+"solved into ACC (K x N, the model's\ncoordinates) and ENERGY (K x 3): Q . v, the springs' "
+"elastic energy, its rate\n(kernel.h: mb_energy_samples). Returns 0 or the first "
+"singular-mass status.");
+
+static PyObject *Unknowns_energy_samples(UnknownsObject *self, PyObject *const *args,
+                                         Py_ssize_t nargs) {
+    Py_buffer t, Y, lam, A, E;
+    if (unknowns_ready(self) < 0 || check_nargs(nargs, 5, "energy_samples") < 0) return NULL;
+    const mb_model *md = &self->model->md;
+    Py_ssize_t S = MB_STATE_SIZE(md->n, md->planar), N = (md->planar ? 3 : 6) * md->n;
+    PyObject *result = NULL;
+    if (get_buffer(args[0], &t, 0, 1, -1, "t") < 0) return NULL;
+    Py_ssize_t K = t.len / 8;
+    if (get_buffer(args[1], &Y, 0, 1, K * S, "Y") < 0) goto t_;
+    if (get_buffer(args[2], &lam, 0, 1, md->m, "lam") < 0) goto Y_;
+    if (get_buffer(args[3], &A, 1, 1, K * N, "ACC") < 0) goto lam_;
+    if (get_buffer(args[4], &E, 1, 1, K * 3, "ENERGY") < 0) goto A_;
+    int status = mb_energy_samples(md, &self->u, self->w, lam.buf, K, t.buf, Y.buf, S,
+                                   A.buf, E.buf);
+    if (status < 0)
+        PyErr_NoMemory();
+    else
+        result = PyLong_FromLong(status);
+    PyBuffer_Release(&E);
+A_:
+    PyBuffer_Release(&A);
+lam_:
+    PyBuffer_Release(&lam);
+Y_:
+    PyBuffer_Release(&Y);
+t_:
+    PyBuffer_Release(&t);
+    return result;
+}
+
 PyDoc_STRVAR(schur_doc,
 "schur(t, y, S_out)\n\nS_out (mu x mu) <- S = G_U^T M^-1 G_U at (t, y), dense, in the "
 "unknowns' order (for a\ncondition estimate).");
@@ -910,6 +1012,10 @@ static PyMethodDef Unknowns_methods[] = {
      solve_given_doc},
     {"derivative", (PyCFunction)(void (*)(void))Unknowns_derivative, METH_FASTCALL, derivative_doc},
     {"project", (PyCFunction)(void (*)(void))Unknowns_project, METH_FASTCALL, project_doc},
+    {"kinematic_run", (PyCFunction)(void (*)(void))Unknowns_kinematic_run, METH_FASTCALL,
+     kinematic_run_doc},
+    {"energy_samples", (PyCFunction)(void (*)(void))Unknowns_energy_samples, METH_FASTCALL,
+     energy_samples_doc},
     {"schur", (PyCFunction)(void (*)(void))Unknowns_schur, METH_FASTCALL, schur_doc},
     {"solve_many", (PyCFunction)(void (*)(void))Unknowns_solve_many, METH_FASTCALL,
      solve_many_doc},
@@ -937,6 +1043,19 @@ static PyTypeObject UnknownsType = {
     .tp_init = (initproc)Unknowns_init,
     .tp_new = PyType_GenericNew,
 };
+
+/* For the integrator's module (dop853_module.c): the model, unknowns and scratch of an
+ * initialised Unknowns object (1), or 0 when obj is not one. */
+int mb_unknowns_object(PyObject *obj, const mb_model **md, const mb_unknowns **u,
+                       mb_work **w) {
+    if (!PyObject_TypeCheck(obj, &UnknownsType)) return 0;
+    UnknownsObject *self = (UnknownsObject *)obj;
+    if (self->w == NULL) return 0;
+    *md = &self->model->md;
+    *u = &self->u;
+    *w = self->w;
+    return 1;
+}
 
 /* -- module -------------------------------------------------------------------------- */
 
@@ -990,6 +1109,8 @@ PyMODINIT_FUNC PyInit__core(void) {
         {"PROJECT_INFO", MB_PROJECT_INFO}, {"KN_ITERS", MB_KN_ITERS},
         {"KN_ERROR", MB_KN_ERROR}, {"KN_SINGULAR", MB_KN_SINGULAR}, {"KN_STEP", MB_KN_STEP},
         {"KN_INFO", MB_KN_INFO},
+        {"KR_STEP", MB_KR_STEP}, {"KR_NEWTON", MB_KR_NEWTON}, {"KR_WORST", MB_KR_WORST},
+        {"KR_SINGULAR", MB_KR_SINGULAR}, {"KR_INFO", MB_KR_INFO},
     };
     for (size_t i = 0; i < sizeof(constants) / sizeof(constants[0]); i++)
         if (PyModule_AddIntConstant(m, constants[i].name, constants[i].value) < 0) goto fail;

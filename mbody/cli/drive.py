@@ -1,0 +1,110 @@
+"""kinematics: a driven mechanism's motion over time, and the reactions and drivers'
+efforts it takes."""
+
+from __future__ import annotations
+
+import argparse
+
+from mbody.cli.common import (
+    EXIT_OK,
+    MODEL_HELP,
+    add_axes_option,
+    bounded,
+    load_model,
+    output_stream,
+)
+from mbody.errors import MbodyError
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    from mbody.cli.sim import FPS_MAX, T_END_MAX
+
+    s = sub.add_parser(
+        "kinematics", help="a driven mechanism's motion, reactions and drivers' efforts "
+        "over time (no integration)",
+        description="Move MODEL by its drivers: at each sample time the positions that "
+        "close every joint and driver (Newton's method from the previous sample, on the "
+        "branch of the file's pose), the velocities and accelerations they impose, and the "
+        "reactions and drivers' efforts that take them (kinetostatics). Prints each "
+        "reaction's and effort's peak and an energy check; saves the run with -o in the "
+        "format plot, animate, export and report read. For a fully driven mechanism this "
+        "is its motion; a partly driven one needs 'mbody simulate'.")
+    s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
+    s.add_argument("--t-end", type=bounded("a number of seconds", -T_END_MAX, T_END_MAX),
+                   default=None, metavar="SECONDS",
+                   help="the last sample's time, s (default: one revolution of the first "
+                   "driver when it turns at a constant rate, else 1)")
+    s.add_argument("--t-start", type=bounded("a number of seconds", -T_END_MAX, T_END_MAX),
+                   default=0.0, metavar="SECONDS", help="the first sample's time, s "
+                   "(default 0)")
+    s.add_argument("--fps", type=bounded("a number of samples per second", 0, FPS_MAX,
+                                         lo_open=True),
+                   default=None, metavar="N", help="samples per second (default: 360 per "
+                   "revolution of a constant-rate driver, one a degree; else 100)")
+    s.add_argument("--point", action="append", default=[], metavar="NAME=BODY:X,Y[,Z]",
+                   help="a body point to follow (repeatable), in the body's axes from its "
+                   "mass centre, e.g. --point P=coupler:0.1,0.05; saved with the run "
+                   "(series 'point:NAME')")
+    s.add_argument("-o", "--output", metavar="RUN.npz",
+                   help="save the run here (.npz; read with mbody.Trajectory.load)")
+    s.add_argument("--json", action="store_true",
+                   help="the summary as JSON (samples, peaks, energy check)")
+    add_axes_option(s)
+    s.set_defaults(run=kinematics)
+
+
+def parse_points(pairs: list[str]) -> dict[str, tuple[str, list[float]]]:
+    """``["P=coupler:0.1,0.05"]`` -> ``{"P": ("coupler", [0.1, 0.05])}``."""
+    out: dict[str, tuple[str, list[float]]] = {}
+    for p in pairs:
+        name, sep, rest = p.partition("=")
+        body, sep2, coords = rest.partition(":")
+        if not (sep and sep2 and name.strip() and body.strip()):
+            raise MbodyError(f"--point expects NAME=BODY:X,Y[,Z] (for example "
+                             f"P=coupler:0.1,0.05), got {p!r}")
+        try:
+            xs = [float(c) for c in coords.split(",")]
+        except ValueError:
+            raise MbodyError(f"--point {name}: {coords!r} is not a list of numbers (X,Y or "
+                             "X,Y,Z)") from None
+        if name.strip() in out:
+            raise MbodyError(f"--point {name}: given twice")
+        out[name.strip()] = (body.strip(), xs)
+    return out
+
+
+def kinematics(a: argparse.Namespace) -> int:
+    import sys
+
+    from mbody.cli.sim import check_samples
+    from mbody.io import jsontext
+    from mbody.simulate.kinematic import kinematic_run, revolution, summary
+
+    points = parse_points(a.point)
+    model = load_model(a.model)
+    turn = revolution(model)
+    t_end = a.t_end if a.t_end is not None else a.t_start + (turn if turn else 1.0)
+    fps = a.fps if a.fps is not None else (360.0 / turn if turn else 100.0)
+    if t_end <= a.t_start:
+        raise MbodyError(f"--t-end {t_end:g} is not after --t-start {a.t_start:g}")
+    check_samples(t_end - a.t_start, fps)
+    if a.output:  # fail now, not after the run
+        from mbody.io.atomic import ensure_writable
+
+        ensure_writable(a.output)
+    traj = kinematic_run(model, t_end, fps, t_start=a.t_start, points=points, axes=a.axes)
+    if a.output:
+        traj.save(a.output)
+    if a.json:
+        i = traj.info
+        jsontext.dump({"model": model.name, "samples": i["samples"], "t_end": i["t_end"],
+                       "fps": i["fps"], "newton_steps": i["newton_steps"],
+                       "backward_error": i["backward_error"], "reaction_axes": a.axes,
+                       "peaks": i["peaks"], "driver_work": i["driver_work"],
+                       "load_work": i["load_work"], "energy_change": i["energy_change"],
+                       "energy_balance_residual": i["energy_balance_residual"],
+                       "power_balance_residual": i["power_balance_residual"],
+                       "output": a.output}, output_stream(a.output) if a.output else sys.stdout)
+        return EXIT_OK
+    print(summary(traj, a.output), file=output_stream(a.output))
+    return EXIT_OK

@@ -1,0 +1,466 @@
+"""A kinematic run: a driven mechanism's motion over time, and what it takes.
+
+A mechanism whose drivers leave it no freedom (as many independent drivers as degrees of
+freedom) is moved by its drivers alone: at each sample time the positions that close
+every joint and driver (Newton's method from the previous sample carried forward, so
+the run stays on the branch of the file's pose), the velocities and accelerations the
+constraints then impose, and the reactions and drivers' efforts that take them, from
+the Newton-Euler equations (kinetostatics, or inverse dynamics). Nothing is integrated.
+The whole run is one call of the compiled core (`mbody.kernel`: kinematic.c).
+
+The drivers' work is checked against the energy: with every joint ideal (its solved
+reactions do no work), dT/dt = Σ effort · f′ + Σ Q · v over the bodies (Q the applied
+loads, gravity and springs included), so T(t) − T(0) equals the work of the drivers
+and of Q; the run reports both sides and their difference (a cubic quadrature over the
+samples, `_cumulative`: its error is of order (ω Δt)⁴, ω the fastest rate).
+
+    traj = kinematic_run(model, t_end=0.1, fps=3600)      # a Trajectory
+    traj.reactions[:, traj.reaction_labels.index("motor.M")]
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+
+from mbody import conventions as cv
+from mbody.equations.assemble import singular_mass_error
+from mbody.equations.workspace import workspace
+from mbody.equations.world import world_reaction_series
+from mbody.errors import MbodyError
+from mbody.kernel import _core
+from mbody.model.model import Model
+from mbody.simulate.trajectory import Trajectory, model_text
+from mbody.solve.kinematics import CLOSE_RTOL, KinematicsError, _cannot_close, _size
+
+MAX_NEWTON = 60
+"""Newton steps at most at one sample (one or two from the previous sample's Taylor
+step; more only near a dead centre)."""
+MAX_SAMPLES = 10_000_000
+"""Samples at most in one run (memory: the states and solves of every sample are kept)."""
+
+BodyPoints = Mapping[str, tuple[str, Sequence[float]]]
+"""name -> (body, point in the body's axes from its mass centre, m): points to follow."""
+
+
+def sample_times(t_end: float, fps: float, t_start: float = 0.0) -> np.ndarray:
+    """The sample times t_start, t_start + 1/fps, ... up to t_end (a last sample 1e-9 of
+    a step short of t_end counts: t_end * fps need not be a whole number in floats)."""
+    if not (math.isfinite(t_end) and math.isfinite(fps) and fps > 0 and t_end > t_start):
+        raise MbodyError(f"a kinematic run needs t_end > {t_start:g} s and fps > 0, got "
+                         f"t_end {t_end!r}, fps {fps!r}")
+    count = int(math.floor((t_end - t_start) * fps + 1e-9)) + 1
+    if count > MAX_SAMPLES:
+        raise MbodyError(f"{count} samples ({t_end - t_start:g} s at {fps:g} fps) is more "
+                         f"than {MAX_SAMPLES}; lower --fps or --t-end")
+    return t_start + np.arange(count) / fps
+
+
+def freedom(model: Model) -> int:
+    """The degrees of freedom the joints and drivers leave (the model's coordinates less
+    the generic rank of the enforced constraints): 0 for a fully driven mechanism."""
+    ws = workspace(model)
+    solver = ws.solver(ws.file_unknowns)
+    return len(model.coordinates) - int(solver.generic_rank)
+
+
+def fully_driven(model: Model) -> bool:
+    """The model has drivers and they leave it no freedom (`freedom` is 0)."""
+    d = model.drivers
+    return d is not None and len(d.names) > 0 and freedom(model) == 0
+
+
+def kinematic_run(model: Model, t_end: float, fps: float, *, t_start: float = 0.0,
+                  points: BodyPoints | None = None, axes: str = "joint") -> Trajectory:
+    """The motion the drivers impose over [t_start, t_end], sampled at `fps`, with the
+    reactions and drivers' efforts at each sample (module doc).
+
+    Parameters
+    ----------
+    model : Model
+        A fully driven mechanism: its drivers leave it no freedom (`freedom` is 0).
+    t_end, fps : float
+        The last time (s) and the samples per second.
+    t_start : float
+        The first sample's time (s).
+    points : mapping, optional
+        Body points to follow, name -> (body, [x, y(, z)] in its axes from its mass
+        centre): their world positions go into ``series['point:<name>']`` (K, d).
+    axes : {"joint", "world"}
+        The reactions' axes (`mbody.equations.world`).
+
+    Returns
+    -------
+    Trajectory
+        Every body's motion; `reactions` by `reaction_labels` (the drivers' efforts
+        among them); ``info`` with the Newton steps, the energy check and the peaks.
+
+    Raises
+    ------
+    MbodyError
+        The mechanism is not fully driven (its free coordinates need integrating:
+        `mbody.simulate`).
+    KinematicsError
+        At a sample where the loops cannot close (a dead centre, links that cannot
+        reach): its time, the drivers' values and the distance left.
+    """
+    if axes not in ("joint", "world"):
+        raise MbodyError(f"axes must be 'joint' or 'world', got {axes!r}")
+    t = sample_times(t_end, fps, t_start)
+    free = freedom(model)
+    if free:
+        d = model.drivers
+        have = len(d.names) if d is not None else 0
+        raise MbodyError(f"{model.name!r} is not fully driven: its {have} driver(s) leave "
+                         f"{free} degree(s) of freedom, whose motion follows from the "
+                         "forces; integrate it with mbody simulate (mbody.simulate), which "
+                         "follows the drivers and integrates the rest")
+    ws = workspace(model)
+    unknowns = ws.file_unknowns
+    plan = ws.solve_plan(unknowns)
+    K, S = len(t), ws.state_size
+    L = plan.o_info + _core.INFO
+    Y = np.empty((K, S))
+    OUT = np.empty((K, L))
+    energy = np.empty((K, 3))
+    info = np.empty(_core.KR_INFO)
+    y = ws.state_vector(model.initial.replace(t=float(t[0])))
+    tol = CLOSE_RTOL * _size(model)
+    done = plan.solver.kinematic_run(t, y, unknowns.lam, MAX_NEWTON, tol, Y, OUT, energy,
+                                     info)
+    if done < K:
+        _failed(model, float(t[done]), y, info)
+    return _trajectory(model, t, Y, OUT, energy, plan, info, points, axes)
+
+
+def _failed(model: Model, t: float, y: np.ndarray, info: np.ndarray) -> None:
+    if info[_core.KR_SINGULAR]:
+        code = int(info[_core.KR_SINGULAR]) - 1
+        raise singular_mass_error(model, code // 6, code % 6)
+    from mbody.equations.joints import reaction_columns
+    from mbody.solve.kinematics import _state
+
+    if not np.isfinite(y).all():
+        raise KinematicsError(f"the position analysis at t = {t:g} s diverged (a value is "
+                              "not a number): a driver may be past a dead centre")
+    cols = reaction_columns(model, _state(model, y, t))
+    size = _size(model)
+    scale = np.where(model.reaction_table.is_moment, 1.0, size)
+    bad = np.flatnonzero(np.abs(cols.phi) > 1e3 * CLOSE_RTOL * scale)
+    if not len(bad):
+        bad = np.argsort(-np.abs(cols.phi / scale))[:1]
+    raise KinematicsError(_cannot_close(model, t, cols.phi, bad, float(info[_core.KR_STEP])))
+
+
+def _trajectory(model: Model, t: np.ndarray, Y: np.ndarray, OUT: np.ndarray,
+                energy: np.ndarray, plan, info: np.ndarray, points: BodyPoints | None,
+                axes: str) -> Trajectory:
+    K, n = len(t), model.n
+    planar = model.dimension == cv.PLANAR
+    x = Y[:, :3 * n].reshape(K, n, 3)
+    q = Y[:, 3 * n:7 * n].reshape(K, n, 4)
+    v = Y[:, 7 * n:10 * n].reshape(K, n, 3)
+    w = Y[:, 10 * n:13 * n].reshape(K, n, 3)
+    m = len(model.reactions)
+    lam = OUT[:, plan.o_lam:plan.o_lam + m]
+    stats = OUT[:, plan.o_info:]
+    labels: tuple[str, ...] = tuple(model.reactions)
+    values = lam
+    if axes == "world":
+        W_e = _directions(model, t, Y)
+        labels, values = world_reaction_series(model, W_e, lam)
+    pose = ((x[..., :2], v[..., :2], Y[:, 13 * n:], w[..., 2]) if planar else (x, v, q, w))
+    run_info = {
+        "integrator": "none (kinematic run: every sample's positions by Newton's method)",
+        "t_end": float(t[-1]), "fps": float(1.0 / (t[1] - t[0])) if K > 1 else 0.0,
+        "samples": K, "steps": 0, "evaluations": K,
+        "newton_steps": int(info[_core.KR_NEWTON]),
+        "newton_steps_most": int(info[_core.KR_WORST]),
+        "reaction_axes": axes, "kinematic": True,
+        "backward_error": float(stats[:, _core.ST_BERR].max(initial=0.0)),
+        "redundant": int((stats[:, _core.ST_MU] - stats[:, _core.ST_RANK]).max(initial=0)),
+    }
+    traj = Trajectory(
+        t, *pose, body_names=model.body_names, dimension=model.dimension,
+        model_name=model.name, model_file=model.file, reaction_labels=labels,
+        reactions=values, info=run_info, mass=np.array(model.mass),
+        inertia=np.array(model.J),
+        shapes=tuple(model.bodies[b].shape for b in model.body_names),
+        colors=tuple(model.bodies[b].color for b in model.body_names),
+        gravity=np.array(model.gravity), model_yaml=model_text(model))
+    traj.series.update(_body_points(model, x, q, points))
+    traj.series.update(driver_series(model, t))
+    run_info["drivers"] = driver_facts(model)
+    acc6 = np.zeros((K, n, 6))
+    acc = OUT[:, :plan.N].reshape(K, n, -1)
+    acc6[..., [0, 1, 5] if planar else slice(None)] = acc
+    series, balance = energy_balance(model, traj, Y, acc6, lam, energy)
+    traj.series.update(series)
+    run_info.update(balance)
+    run_info["peaks"] = peaks(model, traj)
+    run_info["warnings"] = []
+    return traj
+
+
+def driven_figures(model: Model, traj: Trajectory, Y: np.ndarray, lam: np.ndarray,
+                   unknowns) -> None:
+    """What a run of a model with drivers adds to `traj` (integrated by `mbody.simulate`:
+    a partly driven mechanism): each driver's coordinate, its facts, the energy check
+    (`energy_balance`, the accelerations and energy terms at the samples from one call of
+    the core) and the peaks. `Y` (K, state size) the samples, `lam` (K, m) the reactions."""
+    ws = workspace(model)
+    t = traj.t
+    K, n = len(t), model.n
+    plan = ws.solve_plan(unknowns)
+    acc = np.empty((K, plan.N))
+    energy = np.empty((K, 3))
+    plan.solver.energy_samples(t, np.ascontiguousarray(Y), unknowns.lam, acc, energy)
+    acc6 = np.zeros((K, n, 6))
+    acc6[..., [0, 1, 5] if model.dimension == cv.PLANAR else slice(None)] = \
+        acc.reshape(K, n, -1)
+    traj.series.update(driver_series(model, t))
+    traj.info["drivers"] = driver_facts(model)
+    series, balance = energy_balance(model, traj, Y, acc6, lam, energy)
+    for key in ("driver_power", "driver_work", "load_power", "load_work"):
+        traj.series[key] = series[key]
+    traj.info.update({k: v for k, v in balance.items() if k != "energy_initial"})
+    traj.info["peaks"] = peaks(model, traj)
+
+
+def driver_series(model: Model, t: np.ndarray) -> dict[str, np.ndarray]:
+    """'driver:<name>' -> (K,) each driver's coordinate at the times t (its law: rad for
+    an angle, m for a displacement)."""
+    d = model.drivers
+    if d is None:
+        return {}
+    return {f"driver:{name}": np.asarray(law[0](t), dtype=float)
+            for name, law in zip(d.names, d.laws, strict=True)}
+
+
+def driver_facts(model: Model) -> list[dict]:
+    """What a saved run says of each driver: name, joint, 'angle' or 'displacement', the
+    label of its effort."""
+    d = model.drivers
+    if d is None:
+        return []
+    joints = model.joints
+    return [{"name": name, "joint": joints[int(j)].name,
+             "kind": "angle" if c == "M" else "displacement", "effort": f"{name}.{c}"}
+            for name, j, c in zip(d.names, d.joint.tolist(), d.component, strict=True)]
+
+
+def _directions(model: Model, t: np.ndarray, Y: np.ndarray) -> np.ndarray:
+    """(K, m, 3) each reaction component's direction (world) at each sample."""
+    ws = workspace(model)
+    m = len(model.reactions)
+    K = len(t)
+    W_e = np.empty((K, m, 3))
+    c6, p6, W_P = np.empty((m, 6)), np.empty((m, 6)), np.empty((m, 3))
+    gamma, phi, gtv = np.empty(m), np.empty(m), np.empty(m)
+    for k in range(K):
+        ws.core.columns(float(t[k]), Y[k], c6, p6, W_e[k], W_P, gamma, phi, gtv)
+    return W_e
+
+
+def _body_points(model: Model, x: np.ndarray, q: np.ndarray, points: BodyPoints | None
+                 ) -> dict[str, np.ndarray]:
+    """'point:<name>' -> (K, d) world positions of the named body points."""
+    from mbody.equations.spatial import quat_to_matrix
+
+    out: dict[str, np.ndarray] = {}
+    d = model.dimension
+    for name, (body, p) in (points or {}).items():
+        if body not in model.bodies:
+            from mbody.errors import did_you_mean
+
+            hint = did_you_mean(body, list(model.body_names))
+            raise MbodyError(f"point {name!r}: no body {body!r} in this model"
+                             + (f"; {hint}" if hint else ""))
+        r = np.zeros(3)
+        r[:d] = np.asarray(p, dtype=float)[:d]
+        if len(p) != d or not np.isfinite(r).all():
+            raise MbodyError(f"point {name!r}: expected {d} finite coordinates in the body's "
+                             f"axes, got {list(p)!r}")
+        i = model.bodies[body].index
+        R = quat_to_matrix(q[:, i])  # (K, 3, 3)
+        out[f"point:{name}"] = (x[:, i] + R @ r)[:, :d]
+    return out
+
+
+def energy_balance(model: Model, traj: Trajectory, Y: np.ndarray, acc6: np.ndarray,
+                   lam: np.ndarray, energy: np.ndarray) -> tuple[dict[str, np.ndarray], dict]:
+    """The drivers' work against the energy (module doc): series 'kinetic_energy',
+    'potential_energy', 'energy', 'driver_power', 'load_power', 'driver_work',
+    'load_work' (K,); the run's totals; and the power balance at every sample,
+    P_drivers + P_loads = d(T + V)/dt with dT/dt = Σ m v·a + ωᵀ J ω̇ (body axes) and
+    dV/dt = −Σ m g·v + Σ k (L − L0) L′ from the solved accelerations (`acc6`, (K, n, 6):
+    a_G world, ω̇ body axes): its largest relative residual.
+
+    `energy` (K, 3) is the core's per sample: Q · v (every load on the bodies at their mass
+    centres, gravity and springs included), the springs' elastic energy and its rate. The
+    applied loads' power is Q · v less gravity's, Σ m g · v, and the springs' elastic
+    part: what is not in V (forces, couples, dampers)."""
+    t = traj.t
+    K, n = len(t), model.n
+    T = traj.kinetic_energy()
+    mass = np.asarray(model.mass, dtype=float)
+    g = np.asarray(model.gravity, dtype=float)
+    J = np.asarray(model.J, dtype=float)
+    d = model.drivers
+    k = len(d.names) if d is not None else 0
+    rates = (np.stack([law[1](t) for law in d.laws], axis=1)  # f′(t), (K, k)
+             if k and d is not None else np.zeros((K, 0)))
+    P_drive = (lam[:, lam.shape[1] - k:] * rates).sum(axis=1) if k else np.zeros(K)
+    x = Y[:, :3 * n].reshape(K, n, 3)
+    v = Y[:, 7 * n:10 * n].reshape(K, n, 3)
+    w = Y[:, 10 * n:13 * n].reshape(K, n, 3)
+    gravity_power = (v @ g) @ mass  # (K,) Σ m g · v
+    V = -(x @ g) @ mass + energy[:, 1]
+    dV = -gravity_power + energy[:, 2]
+    P_loads = energy[:, 0] - gravity_power + energy[:, 2]
+    Jw_dot = (J[None] @ acc6[..., 3:, None])[..., 0]
+    dT = (mass * (v * acc6[..., :3]).sum(axis=2)).sum(axis=1) + (w * Jw_dot).sum(axis=(1, 2))
+    dE = dT + dV
+    power = max(float(np.abs(P_drive).max(initial=0.0)),
+                float(np.abs(P_loads).max(initial=0.0)), float(np.abs(dE).max(initial=0.0)),
+                1e-300)
+    power_residual = float(np.abs(P_drive + P_loads - dE).max(initial=0.0)) / power
+    W_drive = _cumulative(P_drive, t)
+    W_loads = _cumulative(P_loads, t)
+    E = T + V
+    residual = W_drive[-1] + W_loads[-1] - (E[-1] - E[0])
+    scale = max(float(np.abs(W_drive).max(initial=0.0)),
+                float(np.abs(W_loads).max(initial=0.0)),
+                float(np.abs(E - E[0]).max(initial=0.0)), 1e-300)
+    series = {"kinetic_energy": T, "potential_energy": V, "energy": E,
+              "driver_power": P_drive, "driver_work": W_drive, "load_power": P_loads,
+              "load_work": W_loads}
+    return series, {
+        "driver_work": float(W_drive[-1]), "load_work": float(W_loads[-1]),
+        "energy_change": float(E[-1] - E[0]),
+        "energy_balance_residual": float(abs(residual) / scale),
+        "power_balance_residual": power_residual,
+        "energy_initial": float(E[0]),
+    }
+
+
+def _cumulative(f: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """∫ f dt from t[0] to each sample. On equal steps h each interval is the integral of
+    the cubic through its two samples and their outer neighbours,
+    h (−f₋₁ + 13 f₀ + 13 f₁ − f₂) / 24 (error O(h⁵) an interval), the first and last by
+    the quadratic through three samples, h (5 f₀ + 8 f₁ − f₂) / 12; unequal steps (a last
+    sample clamped to t_end) by trapezoids."""
+    K = len(t)
+    out = np.zeros(K)
+    if K < 2:
+        return out
+    h = np.diff(t)
+    if K < 4 or np.ptp(h) > 1e-9 * h[0]:
+        out[1:] = np.cumsum(0.5 * (f[1:] + f[:-1]) * h)
+        return out
+    step = float(h.mean())
+    part = np.empty(K - 1)
+    part[1:-1] = (-f[:-3] + 13.0 * f[1:-2] + 13.0 * f[2:-1] - f[3:]) * (step / 24.0)
+    part[0] = (5.0 * f[0] + 8.0 * f[1] - f[2]) * (step / 12.0)
+    part[-1] = (5.0 * f[-1] + 8.0 * f[-2] - f[-3]) * (step / 12.0)
+    out[1:] = np.cumsum(part)
+    return out
+
+
+def peaks(model: Model, traj: Trajectory) -> list[dict]:
+    """Each reaction's and effort's largest magnitude over the run: label, value (signed),
+    unit, time, and the first driver's coordinate then (its law at that time: degrees
+    for an angle, m for a displacement)."""
+    d = model.drivers
+    out: list[dict] = []
+    if not len(traj.reaction_labels) or not len(traj.t):
+        return out
+    R = np.asarray(traj.reactions)
+    at = np.argmax(np.abs(R), axis=0)
+    for c, label in enumerate(traj.reaction_labels):
+        k = int(at[c])
+        tk = float(traj.t[k])
+        entry = {"label": label, "value": float(R[k, c]),
+                 "unit": "N m" if label.rsplit(".", 1)[-1].startswith("M") else "N",
+                 "t": tk}
+        if d is not None and len(d.names):
+            value = float(d.laws[0][0](tk))
+            angle = d.component[0] == "M"
+            entry["driver"] = d.names[0]
+            entry["driver_value"] = math.degrees(value) if angle else value
+            entry["driver_unit"] = "deg" if angle else "m"
+        out.append(entry)
+    return out
+
+
+def revolution(model: Model) -> float | None:
+    """The time of one revolution (s) of the first driver when it turns at a constant rate
+    (a `speed` driver, or an angle law of constant slope), else None."""
+    d = model.drivers
+    if d is None or not len(d.names) or d.component[0] != "M":
+        return None
+    rate = d.laws[0][1]
+    w = float(rate(0.0))
+    if w == 0.0 or not all(float(rate(t)) == w for t in (0.37, 1.1, 7.3)):
+        return None
+    return 2.0 * math.pi / abs(w)
+
+
+def summary(traj: Trajectory, path: str | None = None) -> str:
+    """A kinematic run in a few lines: the samples, Newton's work, each reaction's and
+    effort's peak (with the first driver's coordinate then), and the energy check."""
+    i = traj.info
+    lines = [f"kinematic run of {traj.model_name!r}: {i['samples']} samples, t = "
+             f"{float(traj.t[0]):g} .. {i['t_end']:g} s"
+             + (f" at {i['fps']:g} per second" if i["fps"] else "")
+             + f"; {i['newton_steps']} Newton steps (at most {i['newton_steps_most']} at a "
+             f"sample); largest relative backward error {i['backward_error']:.1e}"]
+    if i.get("redundant"):
+        lines.append(f"warning: {i['redundant']} redundant constraint(s): the reactions they "
+                     "share are the minimum-norm ones")
+    lines += driven_lines(traj)
+    if path:
+        lines.append(f"saved {path}")
+    return "\n".join(lines)
+
+
+def driven_lines(traj: Trajectory) -> list[str]:
+    """The peaks table and the energy check of a run with drivers (none without)."""
+    i = traj.info
+    lines: list[str] = []
+    peaks = i.get("peaks") or []
+    if peaks:
+        drv = peaks[0].get("driver")
+        axes = ("world axes" if i.get("reaction_axes") == "world" else
+                "joint-frame components")
+        lines.append(f"peaks over the run (largest magnitude; {axes}"
+                     + (f"; {drv}'s coordinate at that time" if drv else "") + "):")
+        big = max(abs(p["value"]) for p in peaks)
+        rows = [[p["label"], f"0 {p['unit']}", "throughout"] + ([""] if drv else [])
+                if _shown(p["value"], big) == "0" else
+                [p["label"], f"{p['value']:.6g} {p['unit']}", f"t = {p['t']:.6g} s"]
+                + ([f"{drv} = {p['driver_value']:.6g} {p['driver_unit']}"] if drv else [])
+                for p in peaks]
+        widths = [max(len(r[c]) for r in rows) for c in range(len(rows[0]))]
+        lines += ["  " + "  ".join(c.ljust(w) for c, w in zip(r, widths, strict=True)).rstrip()
+                  for r in rows]
+    if "driver_work" not in i:
+        return lines
+    work = max(abs(i["driver_work"]), abs(i["load_work"]), abs(i["energy_change"]))
+    lines.append(f"energy check: the drivers' power plus the applied loads' equals "
+                 f"d(T + V)/dt at every sample to {i['power_balance_residual']:.1e} of the "
+                 f"largest power; over the run the drivers' work "
+                 f"{_shown(i['driver_work'], work)} J + "
+                 f"the loads' {_shown(i['load_work'], work)} J = the change of T + V "
+                 f"{_shown(i['energy_change'], work)} J to "
+                 f"{i['energy_balance_residual']:.1e} "
+                 "(cubic quadrature over the samples)")
+    return lines
+
+
+def _shown(x: float, scale: float) -> str:
+    """x to 6 significant digits, 0 when it is rounding beside `scale` (below 1e-12 of
+    it): the figure then reads the same on every machine."""
+    return "0" if abs(x) <= 1e-12 * scale else f"{x:.6g}"
