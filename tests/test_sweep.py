@@ -397,3 +397,29 @@ def test_the_local_cluster_gives_the_numbers_of_this_process(driven_file, tmp_pa
     for a, b in zip(read(out)[1], here, strict=True):
         x, y = floats(a[3:-1]), floats(b[3:-1])
         assert a[:3] == b[:3] and np.abs(x - y).max() <= 1e-12 * np.abs(y).max()
+
+
+def test_simulate_rows_are_the_cases_simulated_one_by_one(tmp_path):
+    """Each row: mbody.simulate of the case's model, its last sample's position
+    coordinates and the largest |value| of each reaction over the samples; a pendulum's
+    swing does not depend on its mass, its pin's load is proportional to it."""
+    base = mbody.load(ROOT / "models" / "pendulum.yaml")
+    job = Job(base.source, parse_grid(["bodies.rod.mass=1:3:3"]),
+              Settings("simulate", t_end=0.5, fps=40), uuid.uuid4().hex)
+    results = Results(tmp_path / "s.csv", columns(base, job.settings), job.grid)
+    cluster.run(job, range(3), results, workers=0, progress=False)
+    results.finish()
+    header, rows = read(tmp_path / "s.csv")
+    for row in rows:
+        model = base.with_values({"bodies.rod.mass": float(row[1])})
+        traj = mbody.simulate(model, t_end=0.5, fps=40)
+        last = traj.state(len(traj.t) - 1)
+        y = np.concatenate((last.position.ravel(), last.quaternion.ravel()))[None]
+        peaks = np.abs(traj.reactions).max(axis=0)
+        want = [*final_values(model, y)[0],
+                *(peaks[list(traj.reaction_labels).index(r)] for r in model.reactions)]
+        assert floats(row[2:-1]).tolist() == want
+    finals = np.array([floats(r[2:5]) for r in rows])
+    assert np.abs(finals - finals[0]).max() <= 1e-12
+    loads = np.array([floats(r[5:-1]) for r in rows])
+    assert np.allclose(loads / loads[0], np.array([[1.0], [2.0], [3.0]]), rtol=1e-9)

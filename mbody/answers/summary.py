@@ -119,10 +119,23 @@ class ClassSummary:
         return max((len(g.wrong) for g in self.graded), default=0)
 
     def header(self) -> list[str]:
+        """The files' table's columns.
+
+        Returns
+        -------
+        list of str
+            `HEADER`, ``mistake 1`` ... (`width` of them), ``error``.
+        """
         return [*HEADER, *(f"mistake {k + 1}" for k in range(self.width)), "error"]
 
     def rows(self) -> list[list[str | int]]:
-        """One row per file (`header`)."""
+        """The files' table.
+
+        Returns
+        -------
+        list of lists
+            One row per file, in the order given (columns: `header`).
+        """
         out: list[list[str | int]] = []
         for g in self.graded:
             cells = [mistake_text(c) for c in g.wrong]
@@ -131,8 +144,14 @@ class ClassSummary:
         return out
 
     def csv(self) -> str:
-        """The summary as CSV: the files' table; a blank line; the class's mistakes
-        (`MISTAKES_HEADER`), the most frequent first."""
+        """The summary as CSV.
+
+        Returns
+        -------
+        str
+            The files' table; a blank line; the class's mistakes (`MISTAKES_HEADER`), the
+            most frequent first.
+        """
         buf = io.StringIO()
         w = csv.writer(buf, lineterminator="\n")
         w.writerow(self.header())
@@ -144,7 +163,13 @@ class ClassSummary:
         return buf.getvalue()
 
     def text(self) -> str:
-        """A few lines for the terminal: the class's counts and its commonest mistakes."""
+        """What ``mbody verify --summary`` prints.
+
+        Returns
+        -------
+        str
+            The class's counts and its five most frequent mistakes.
+        """
         n = len(self.graded)
         ok = sum(1 for g in self.graded if g.verification and g.verification.ok)
         bad = sum(1 for g in self.graded if g.error)

@@ -165,6 +165,10 @@ class Model:
         Known reaction values that vary in time (label -> expression of t).
     drivers : DriverTable, optional
         Joint coordinates prescribed as functions of time, whose efforts are unknowns.
+    file_state : State, optional
+        The file's own state when `initial` is the assembled one (None otherwise).
+    source : Source, optional
+        What the model was read from and the values set since (`with_values`).
     """
 
     name: str

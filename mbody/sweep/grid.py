@@ -1,7 +1,9 @@
 """The cases of a sweep: each ``--set PATH=START:STOP:COUNT`` an axis, the Cartesian grid
 of the axes (the last one varying fastest), or N random samples (seeded).
 
-    bodies.rod.mass=0.3:1.2:10         10 values from 0.3 to 1.2, both included
+    bodies.rod.mass=0.3:1.2:10         10 values from 0.3 to 1.2, both included, evenly
+                                       spaced (to 15 significant digits: 0.4:0.8:3 is
+                                       0.4, 0.6, 0.8)
     drivers.motor.speed=100 rpm:3000 rpm:30     a unit, as the file reads it
     joints.P.axis.1=0,0.1,0.25         the values listed (commas, as Hydra's multirun)
     bodies.crank.mass=0.5              one value, the same in every case (not a column)
@@ -60,7 +62,11 @@ class Axis:
         if self.listed:
             return list(self.values)
         lo, hi = self.values
-        return np.linspace(lo, hi, self.count).tolist() if self.count > 1 else [lo]
+        if self.count == 1:
+            return [lo]
+        # to 15 significant digits, as written: 0.4:0.8:3 gives 0.6, not linspace's
+        # 0.6000000000000001 (a double holds 15 digits exactly)
+        return [float(f"{x:.15g}") for x in np.linspace(lo, hi, self.count).tolist()]
 
     def drawn(self, u: float) -> Any:
         """The value a uniform number u in [0, 1) draws (a random sample)."""
