@@ -308,28 +308,38 @@ def dask_cluster(tmp_path):
     env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "PYTHONPATH": str(ROOT)}
     logs = [open(tmp_path / f"{n}.log", "w") for n in ("scheduler", "w1", "w2")]  # noqa: SIM115
     procs = [subprocess.Popen([sys.executable, "-m", "dask", "scheduler", "--host",
-                               "127.0.0.1", "--port", str(port), "--no-dashboard"],
+                               "127.0.0.1", "--port", str(port), "--no-dashboard",
+                               "--dashboard-address", "127.0.0.1:0"],
                               stdout=logs[0], stderr=subprocess.STDOUT, env=env)]
     try:
+        wait_for(lambda: _listening(port), 120, "the scheduler")
         for i in (1, 2):
             procs.append(subprocess.Popen(
                 [sys.executable, "-m", "dask", "worker", address, "--no-nanny", "--nthreads",
-                 "1", "--host", "127.0.0.1", "--no-dashboard", "--name", f"w{i}"],
+                 "1", "--host", "127.0.0.1", "--no-dashboard", "--dashboard-address",
+                 "127.0.0.1:0", "--name", f"w{i}"],
                 stdout=logs[i], stderr=subprocess.STDOUT, env=env))
         with Client(address, timeout=60) as client:
             client.wait_for_workers(2, timeout=120)
         yield address, procs
     finally:
-        for p in procs:
+        for p in reversed(procs):  # the workers, then the scheduler
             if p.poll() is None:
                 p.terminate()
         for p in procs:
             try:
-                p.wait(timeout=20)
+                p.wait(timeout=30)
             except subprocess.TimeoutExpired:
                 p.kill()
+                p.wait()
         for f in logs:
             f.close()
+
+
+def _listening(port: int) -> bool:
+    with socket.socket() as s:
+        s.settimeout(1.0)
+        return s.connect_ex(("127.0.0.1", port)) == 0
 
 
 def test_a_worker_killed_mid_run_loses_and_repeats_nothing(dask_cluster, tmp_path):

@@ -217,3 +217,22 @@ def test_set_on_the_command_line():
     assert p.returncode == 2 and "PATH=VALUE" in p.stderr
     p = run("check", str(SLIDER), "--set", "bodies.rod.mass=1:20")
     assert p.returncode == 2 and "base-60" in p.stderr
+
+
+def test_convert_writes_the_model_with_the_values_set(tmp_path):
+    """convert --set: the YAML written is the document with the value in place (read
+    back, the same model as with_values gives); an MJCF import's YAML form too."""
+    out = tmp_path / "p.yaml"
+    p = run("convert", str(SLIDER), "-o", str(out), "--set", "bodies.rod.mass=2")
+    assert p.returncode == 0, p.stderr
+    same_model(mbody.load(out), mbody.load(SLIDER).with_values({"bodies.rod.mass": 2}))
+    arm = mbody.load(ARM)
+    name = arm.body_names[1]
+    out = tmp_path / "arm.yaml"
+    p = run("convert", str(ARM), "-o", str(out), "--set", f"bodies.{name}.mass=7")
+    assert p.returncode == 0, p.stderr
+    assert mbody.load(out).mass[1] == 7.0
+    p = run("convert", str(SLIDER), "-o", str(tmp_path / "q.yaml"), "--set",
+            "bodies.rod.mas=2")
+    assert p.returncode == 2 and "did you mean 'mass'" in p.stderr
+    assert not (tmp_path / "q.yaml").exists()
