@@ -40,6 +40,7 @@ _LAZY = {
     "simulate": "simulate.simulation",
     "Trajectory": "simulate.trajectory",
     "verify": "answers.verify",
+    "solve_many": "solve.batch", "Solutions": "solve.batch",
 }
 """Public name -> the submodule defining it."""
 
@@ -48,9 +49,8 @@ __all__ = [
     "FreeBodyDiagram", "Generalized", "Linearization", "linearize", "load_export",
     "Issue", "Joint", "Load", "MbodyError", "Model", "ModelError", "Solution", "State",
     "Trajectory", "simulate",
-    "UnknownReactionsError", "animate", "assemble", "draw_fbd", "equilibrium",
-    "kinematic_run", "kinematics", "load",
-    "loads", "verify",
+    "Solutions", "UnknownReactionsError", "animate", "assemble", "draw_fbd", "equilibrium",
+    "kinematic_run", "kinematics", "load", "loads", "solve_many", "verify",
 ]
 
 

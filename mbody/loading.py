@@ -13,6 +13,7 @@ from typing import Any
 from mbody.model.model import Model
 from mbody.model.model import load as read_model
 from mbody.model.model import loads as read_model_text
+from mbody.model.source import Source, with_finish
 from mbody.solve.kinematics import assembled
 
 
@@ -55,10 +56,11 @@ def load(source: str | os.PathLike[str] | dict, *, max_bytes: int | None = None,
 
         spec = import_spec(source, format, max_bytes=max_bytes, **options)
         if spec is not None:  # None: the format is mbody YAML after all
-            return assembled(Model.from_spec(spec))
-    return assembled(read_model(source, max_bytes=max_bytes))
+            model = Model.from_spec(spec, Source(str(source), document=spec.document))
+            return assembled(with_finish(model, assembled))
+    return assembled(with_finish(read_model(source, max_bytes=max_bytes), assembled))
 
 
 def loads(text: str, file: str = "<string>") -> Model:
     """Like `load`, from YAML text (`file`: the name used in error messages)."""
-    return assembled(read_model_text(text, file))
+    return assembled(with_finish(read_model_text(text, file), assembled))

@@ -26,12 +26,13 @@ PENDULUM = ROOT / "models" / "pendulum.yaml"
 SHIPPED = sorted((ROOT / "models").glob("*.yaml"))
 
 HEAVY = ("networkx", "matplotlib", "meshcat", "numba", "scipy.sparse", "scipy.spatial",
-         "scipy.linalg", "tqdm", "jsonschema", "scipy.integrate")
+         "scipy.linalg", "tqdm", "jsonschema", "scipy.integrate", "dask", "distributed",
+         "pyarrow")
 """Slow to import and not needed by check, assemble or solve of a shipped model (scipy.linalg
 alone costs 0.1-0.2 s, as much as the whole command)."""
 
 NEVER_AT_IMPORT = ("networkx", "matplotlib", "meshcat", "numba", "scipy.spatial", "tqdm",
-                   "jsonschema", "scipy.integrate")
+                   "jsonschema", "scipy.integrate", "dask", "distributed", "pyarrow")
 """Not loaded by resolving the public names either (`mbody.ExportedAssembly` is in
 `mbody.export`, which holds scipy.sparse matrices)."""
 
@@ -93,6 +94,30 @@ def test_shipped_model_commands_load_no_heavy_module(path: Path):
                        text=True, timeout=120)
     assert p.returncode == 0, p.stderr
     assert json.loads(p.stdout.splitlines()[-1]) == {"check": [], "assemble": [], "solve": []}
+
+
+DASK = ("dask", "distributed", "pyarrow")
+"""What only `mbody sweep` loads (its cluster, its Parquet output)."""
+
+
+def test_only_the_sweep_loads_dask():
+    """Every command's help, and verify, export and jacobian at work, in one process: no
+    dask, distributed or pyarrow (the sweep imports them when it runs a cluster)."""
+    answers = ROOT / "models" / "answers" / "pendulum.yaml"
+    code = (
+        "import contextlib, io, tempfile, os\nimport mbody.cli\n"
+        "from mbody.cli.app import build_parser\n"
+        "names = build_parser()._subparsers._group_actions[0].choices\n"
+        "for name in names:\n"
+        "    with contextlib.redirect_stdout(io.StringIO()), contextlib.suppress(SystemExit):\n"
+        "        mbody.cli.main([name, '--help'])\n"
+        "out = os.path.join(tempfile.mkdtemp(), 'e.json')\n"
+        f"for argv in (['verify', {str(PENDULUM)!r}, {str(answers)!r}],\n"
+        f"             ['export', {str(PENDULUM)!r}, '-o', out],\n"
+        f"             ['jacobian', {str(PENDULUM)!r}]):\n"
+        "    with contextlib.redirect_stdout(io.StringIO()):\n"
+        "        assert mbody.cli.main(argv) in (0, 1), argv\n")
+    assert loaded(code, DASK) == []
 
 
 def test_public_names_survive_lazy_loading():

@@ -9,6 +9,7 @@ import sys
 import time
 from pathlib import Path
 from types import FrameType
+from typing import Any
 
 from mbody.cli.common import (
     EXIT_OK,
@@ -100,6 +101,27 @@ def _mode(a: argparse.Namespace):
     return traj, model
 
 
+def _with_values(a: argparse.Namespace) -> tuple[Any, Any]:
+    """(source, model) for `resolve`: with ``--set``, the model files read with the
+    values set (`load_model`); a run file's motion is computed already."""
+    if not getattr(a, "set_values", None):
+        return a.source, a.model
+    from mbody.cli.common import load_model
+
+    model = load_model(a.model) if a.model else None
+    if a.source.lower().endswith((".yaml", ".yml", ".xml", ".urdf")):
+        return load_model(a.source), model
+    with open(a.source, "rb") as fh:
+        run = fh.read(4) == b"PK\x03\x04" or a.source.lower().endswith(".npz")
+    if not run:
+        return load_model(a.source), model
+    if model is None:
+        raise MbodyError(f"--set changes a model's values, and {a.source} is a run whose "
+                         "motion is computed already: give the model file to simulate it "
+                         "with them, or --model for the loads drawn on this run")
+    return a.source, model
+
+
 def _stop(signum: int, frame: FrameType | None) -> None:  # SIGTERM ends --live like Ctrl-C
     raise KeyboardInterrupt
 
@@ -132,7 +154,8 @@ def animate(a: argparse.Namespace) -> int:
     if a.mode is not None:
         traj, model = _mode(a)
     else:
-        traj, model = resolve(a.source, a.model, t_end=a.t_end, fps=a.fps)
+        source_arg, model_arg = _with_values(a)
+        traj, model = resolve(source_arg, model_arg, t_end=a.t_end, fps=a.fps)
     extra = [b for b in model.body_names if b not in traj.body_names]
     if extra and (a.forces or a.reactions):  # loads are evaluated at the run's states
         raise MbodyError(f"the model {model.name!r} has bodies the run {a.source} does not "

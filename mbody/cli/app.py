@@ -26,6 +26,7 @@ from mbody.cli import (
     mechanism,
     sim,
     statics,
+    sweep,
     verify,
 )
 from mbody.cli.common import (
@@ -42,7 +43,7 @@ from mbody.errors import MbodyError, ModelError, UnknownReactionsError, did_you_
 from mbody.model.loader import MAX_BYTES, max_bytes_limit
 
 COMMAND_MODULES = (core, export, sim, drive, draw, animate, mechanism, statics, verify,
-                   interop, lagrange)
+                   interop, lagrange, sweep)
 """Modules of `mbody.cli`, in help order; each has `register(subparsers)` adding its
 commands (importing one loads only argparse: each command imports what it runs when it
 runs)."""
@@ -76,7 +77,7 @@ def build_parser() -> argparse.ArgumentParser:
 INPUTS = {"model": "the model", "source": "the input", "trajectory": "the run file",
           "answers": "the answers file", "state": "the run file"}
 """Argument destinations that name a file a command reads, and how a message calls it."""
-OUTPUTS = {"output": "-o", "latex": "--latex", "csv": "--csv"}
+OUTPUTS = {"output": "-o", "latex": "--latex", "csv": "--csv", "summary": "--summary"}
 """Argument destinations that name a file (or folder) a command writes, and its option."""
 
 

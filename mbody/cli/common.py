@@ -22,6 +22,8 @@ EXIT_OK, EXIT_UNMET, EXIT_INPUT, EXIT_INTERNAL = 0, 1, 2, 70
 _IMPORT: ContextVar[dict[str, Any] | None] = ContextVar("mbody_import_options",
                                                      default=None)
 """The command's ``--format``, ``--keyframe``, ``--q``... as `mbody.load` options."""
+_VALUES: ContextVar[dict[str, Any] | None] = ContextVar("mbody_set_values", default=None)
+"""The command's ``--set PATH=VALUE`` values (`Model.with_values`)."""
 
 
 def load_model(path: str, *, warn: bool = True):
@@ -29,12 +31,16 @@ def load_model(path: str, *, warn: bool = True):
     go to stderr, so that a questionable input never passes unseen. The file size limit
     is the command's ``--max-bytes`` (set around the command by `mbody.cli.app.main`);
     the format and an imported model's state are its ``--format``, ``--keyframe``,
-    ``--q``, ``--qd`` and ``--floating-base`` (`add_import_options`)."""
+    ``--q``, ``--qd`` and ``--floating-base``, and its ``--set PATH=VALUE`` values are
+    set in it (`add_import_options`)."""
     import sys
 
     from mbody.loading import load
 
     model = load(path, **(_IMPORT.get() or {}))
+    values = _VALUES.get()
+    if values:
+        model = model.with_values(values)
     if warn:
         for w in model.warnings:
             sys.stderr.write(f"mbody: warning: {w}\n")
@@ -227,6 +233,14 @@ def add_import_options(command: argparse.ArgumentParser) -> None:
                    help="URDF: a joint's rate, rad/s or m/s; repeatable; others at rest")
     g.add_argument("--floating-base", action="store_true", help="URDF: the root link moves "
                    "freely (a legged robot) instead of being fixed to the world")
+    if "--set" not in taken:
+        command.add_argument(
+            "--set", action="append", default=[], metavar="PATH=VALUE", dest="set_values",
+            help="change a value of the model file before anything else: "
+            "bodies.<name>.<key>, loads.<name>.<key>, joints.<name>.<key>, "
+            "drivers.<name>.<key> or gravity, then a component's index "
+            "(bodies.rod.position.1=0.05); the value as the file would hold it "
+            "(2, '100 rpm', '[0, -9.81]'); repeatable; checked as the file is")
     run = command.get_default("run")
     if run is not None:
         command.set_defaults(run=_with_import_options(run))
@@ -254,11 +268,25 @@ def _with_import_options(run: Callable[[argparse.Namespace], int]
     @functools.wraps(run)
     def wrapped(a: argparse.Namespace) -> int:
         token = _IMPORT.set(import_options(a))
+        given = _VALUES.set(set_values(getattr(a, "set_values", None) or []))
         try:
             return run(a)
         finally:
             _IMPORT.reset(token)
+            _VALUES.reset(given)
     return wrapped
+
+
+def set_values(pairs: Sequence[str]) -> dict[str, Any]:
+    """``--set`` options -> ``{path: value}``, each value read as the model file would
+    read it (`mbody.model.values.parse_value`); a path given twice keeps the last."""
+    from mbody.model.values import parse_assignment, parse_value
+
+    out: dict[str, Any] = {}
+    for pair in pairs:
+        path, text = parse_assignment(pair)
+        out[path] = parse_value(text, path)
+    return out
 
 
 def import_options(a: argparse.Namespace) -> dict[str, Any]:

@@ -40,6 +40,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "it, as mbody's export writes; else the reference pose at rest)")
     s.add_argument("--force", action="store_true", help="replace OUTPUT if it exists (even "
                    "SOURCE itself: a model rewritten in place)")
+    s.add_argument("--set", action="append", default=[], metavar="PATH=VALUE",
+                   dest="set_values", help="change a value of SOURCE's model (paths of its "
+                   "YAML form, as for every command: bodies.<name>.<key>...) before it is "
+                   "written; repeatable")
     s.set_defaults(run=convert)
 
 
@@ -61,6 +65,8 @@ def convert(a: argparse.Namespace) -> int:
         raise MbodyError(f"{a.output}: exists; give --force to replace it, or another "
                          "OUTPUT")
     ensure_writable(a.output)
+    if a.set_values:
+        return _convert_with_values(a, src_format, out_format)
     if src_format == "yaml":
         model = load_model(a.source)
         if out_format == "mjcf":
@@ -93,6 +99,37 @@ def convert(a: argparse.Namespace) -> int:
           f"{NAMES[src_format]}: {_summary(model)})", file=say)
     if out_format == "mjcf":
         print("the header comment of the file lists what MJCF cannot hold", file=say)
+    return EXIT_OK
+
+
+def _convert_with_values(a: argparse.Namespace, src_format: str, out_format: str) -> int:
+    """convert with --set: the model read as every command reads it, the values set and
+    checked (`Model.with_values`), then its document (values in place) or its MJCF
+    written."""
+    from mbody.cli.common import set_values
+    from mbody.loading import load
+    from mbody.model.values import apply, edits, entry_names
+
+    values = set_values(a.set_values)
+    keyframe = a.keyframe if src_format == "mjcf" else None
+    base = load(a.source, format=src_format if src_format != "yaml" else None,
+                **({"keyframe": keyframe} if keyframe is not None else {}))
+    model = base.with_values(values)  # every rule of the file checked, located
+    if out_format == "mjcf":
+        from mbody.io.interop.mjcf_write import write_mjcf
+
+        write_mjcf(model, a.output, source=a.source)
+    else:
+        from mbody.io.interop.yaml_write import write_document
+
+        src = model.source
+        assert src is not None  # a model read from a file keeps its source
+        doc = src.read()
+        apply(doc, edits(doc, src.values, entry_names(base)))
+        write_document(doc.data, a.output, source=a.source)
+    print(f"wrote {a.output} ({NAMES[out_format]} of {model.name!r} from "
+          f"{NAMES[src_format]} with {len(values)} value(s) set: {_summary(model)})",
+          file=output_stream(a.output))
     return EXIT_OK
 
 

@@ -7,6 +7,7 @@ import math
 import sys
 
 from mbody.cli.common import EXIT_OK, EXIT_UNMET, MODEL_HELP, load_model, regular_file
+from mbody.errors import MbodyError
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -19,10 +20,17 @@ def register(sub: argparse._SubParsersAction) -> None:
         "missing_products_of_inertia, single_inertia_in_space, wrong_moment_point, "
         "missing_reaction, reaction_sign, missing_applied_load, reaction_treated_as_known, "
         "not_an_equation_of_this_body. "
-        "Then list the rows no correct equation gave. Exit code 0 when every equation is "
-        "correct, 1 when some are not, 2 for a bad model or answers file.")
+        "Then list the rows no correct equation gave. Several answers files (a class): "
+        "each checked in turn; --summary writes one row per file and the class's most "
+        "frequent mistakes. Exit code 0 when every equation is correct, 1 when some are "
+        "not (or a class's file cannot be read), 2 for a bad model or answers file.")
     s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
-    s.add_argument("answers", metavar="ANSWERS", help="a YAML answers file")
+    s.add_argument("answers", metavar="ANSWERS", nargs="+",
+                   help="a YAML answers file, or several (answers/*.yaml)")
+    s.add_argument("--summary", metavar="FILE",
+                   help="a class's summary: .csv (one row per answers file: file, student, "
+                   "equations, correct, each wrong equation's diagnosis; then the most "
+                   "frequent mistakes with counts) or .html (the same as a page)")
     s.add_argument("--json", action="store_true",
                    help="machine-readable output: one entry per equation, in file order")
     s.add_argument("--tol", type=_tolerance, default=1e-3, metavar="REL",
@@ -47,11 +55,56 @@ def verify(a: argparse.Namespace) -> int:
     from mbody.answers.verify import verify as _verify
     from mbody.util import jsontext
 
-    regular_file(a.answers, "a YAML answers file")
+    if a.summary is not None or len(a.answers) > 1:
+        return _class(a)
+    answers = a.answers[0]
+    regular_file(answers, "a YAML answers file")
     model = load_model(a.model)
-    result = _verify(model, a.answers, tol=a.tol)
+    result = _verify(model, answers, tol=a.tol)
     if a.json:
         jsontext.dump(result.to_dict(), sys.stdout)
     else:
         print(result.text())
     return EXIT_OK if result.ok else EXIT_UNMET
+
+
+def _class(a: argparse.Namespace) -> int:
+    """Several answers files: each in turn, and with --summary the class's table."""
+    from pathlib import Path
+
+    from mbody.answers.summary import grade
+    from mbody.io import jsontext
+    from mbody.util.atomic import ensure_writable, write_atomic
+
+    kind = None
+    if a.summary is not None:
+        kind = Path(a.summary).suffix.lower()
+        if kind not in (".csv", ".html", ".htm"):
+            raise MbodyError(f"--summary {a.summary}: the summary is written as .csv or "
+                             f".html; got {kind or 'no extension'}")
+        ensure_writable(a.summary)
+    for f in a.answers:
+        regular_file(f, "a YAML answers file")
+    model = load_model(a.model)
+    summary = grade(model, a.answers, tol=a.tol)
+    if a.json:
+        jsontext.dump([{"file": g.file, "student": g.student, "error": g.error,
+                        **(g.verification.to_dict() if g.verification else {})}
+                       for g in summary.graded], sys.stdout)
+    elif a.summary is None:
+        for g in summary.graded:
+            print(f"== {g.file} ==")
+            print(g.verification.text() if g.verification else f"not checked: {g.error}")
+            print()
+    if a.summary is not None:
+        if kind == ".csv":
+            write_atomic(a.summary, summary.csv())
+        else:
+            from mbody.present.summary import class_summary_html
+
+            write_atomic(a.summary, class_summary_html(summary))
+        say = sys.stderr if a.json else sys.stdout
+        print(summary.text(), file=say)
+        print(f"wrote {a.summary}", file=say)
+    every = all(g.verification is not None and g.verification.ok for g in summary.graded)
+    return EXIT_OK if every else EXIT_UNMET

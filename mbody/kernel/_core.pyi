@@ -55,6 +55,11 @@ PR_VELOCITY: int
 PR_RATIO: int
 PR_SINGULAR: int
 PROJECT_INFO: int
+KN_ITERS: int
+KN_ERROR: int
+KN_SINGULAR: int
+KN_STEP: int
+KN_INFO: int
 KR_STEP: int
 KR_NEWTON: int
 KR_WORST: int
@@ -181,6 +186,12 @@ class Unknowns:
     def project(self, t: float, y: _F, iters: int, robust_below: float, homogeneous: Any,
                 info: _F) -> None: ...
     def schur(self, t: float, y: _F, S_out: _F) -> None: ...
+    def solve_many(self, t: _F, Y: _F, lam: _F, out: _F, F: _F | None,
+                   rows: _I | None, states: _I | None) -> None: ...
+    def peaks_many(self, t: _F, Y: _F, lam: _F, peaks: _F, F: _F | None, rows: _I | None,
+                   states: _I, segment: int) -> None: ...
+    def kinematics_many(self, t: _F, Y: _F, F: _F | None, rows: _I | None,
+                        chain: _I | None, phi_scale: _F, settings: _F, info: _F) -> None: ...
     def kinematic_run(self, t: _F, y: _F, lam: _F, max_newton: int, tol: float, Y: _F,
                       OUT: _F, ENERGY: _F, info: _F) -> int: ...
     def energy_samples(self, t: _F, Y: _F, lam: _F, ACC: _F, ENERGY: _F) -> int: ...

@@ -12,6 +12,8 @@ validated specification in `mbody.model.build`; this module re-exports their pub
 
 from __future__ import annotations
 
+import copy
+import dataclasses
 import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
@@ -21,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from mbody import conventions as cv
-from mbody.errors import Issue
+from mbody.errors import Issue, MbodyError
 from mbody.model.build import joint_tables, located_loads, point_loads
 from mbody.model.drivers import DriverTable, driver_table
 from mbody.model.expressions import Expression
@@ -30,8 +32,11 @@ from mbody.model.graph import body_graph
 from mbody.model.loader import Document, load_text, read_file
 from mbody.model.records import Body, BodyRecords, Joint, Load, Records
 from mbody.model.reprs import count, name_list
+from mbody.model.source import Source
 from mbody.model.tables import ForceTable, JointTable, ReactionTable, SpringTable, readonly
 from mbody.model.validate import JointSpecTable, Spec, validate
+from mbody.model.values import apply as apply_values
+from mbody.model.values import edits, entry_names, validate_edited
 from mbody.util.spatial import quat_to_matrix
 
 __all__ = ["Body", "BodyRecords", "ForceTable", "Joint", "JointTable", "Load", "Model",
@@ -161,8 +166,9 @@ class Model:
     drivers : DriverTable, optional
         Joint coordinates prescribed as functions of time, whose efforts are unknowns.
     file_state : State, optional
-        The state the file wrote, when `initial` is the assembled one (joint points per
-        body, or drivers); None when `initial` is the file's.
+        The file's own state when `initial` is the assembled one (None otherwise).
+    source : Source, optional
+        What the model was read from and the values set since (`with_values`).
     """
 
     name: str
@@ -192,6 +198,9 @@ class Model:
     """The state the file wrote when `initial` is the assembled one (`mbody.load` moves the
     bodies onto their joints and drivers when the file gives joint points per body or
     drivers: `mbody.solve.kinematics.assembled`); None when `initial` is the file's."""
+    source: Source | None = None
+    """What the model was read from, and the values set since (`with_values`); None for a
+    model built from a `Spec` directly."""
 
     def __repr__(self) -> str:  # the dataclass's would print every array (2-9 KB)
         kind = "planar" if self.dimension == cv.PLANAR else "spatial"
@@ -324,20 +333,81 @@ class Model:
 
         return body_graph(self)
 
-    @classmethod
-    def from_spec(cls, spec: Spec) -> Model:
-        """Build the arrays from a validated specification (what `load` does last).
+    def with_values(self, values: Mapping[str, Any]) -> Model:
+        """The model with some of the file's values changed, read and checked again.
 
         Parameters
         ----------
-        spec : Spec
-            The output of `mbody.model.validate.validate`.
+        values : mapping of str to value
+            Path -> what the file would hold there: ``{"bodies.rod.mass": 2.0,
+            "drivers.motor.speed": "100 rpm", "bodies.rod.position.1": 0.05}``. A path is
+            ``bodies.<name>.<key>``, ``loads.<name>.<key>``, ``joints.<name>.<key>``,
+            ``drivers.<name>.<key>`` or ``gravity``, then an index or key inside a list
+            or mapping (`mbody.model.values`). An MJCF or URDF model's paths are those of
+            its YAML form (``mbody convert``).
+
+        Returns
+        -------
+        Model
+            A new model, as `mbody.load` would give for the file with those values: every
+            rule of the file checked, the bodies moved onto their joints and drivers when
+            the file asks for it. This model is unchanged.
+
+        Raises
+        ------
+        ModelError
+            A path that names nothing in the file (with a did-you-mean), or a value the
+            file could not hold, at the line of its entry and naming its path.
+        """
+        model = self.edited(values)
+        finish = model.source.finish if model.source is not None else None
+        return finish(model) if finish is not None else model
+
+    def edited(self, values: Mapping[str, Any]) -> Model:
+        """`with_values` before its last step: the file read again with the values set and
+        checked, the model built, but the bodies not yet moved onto their joints and
+        drivers (``model.source.finish``, which `mbody.load` takes). For a caller that
+        does that step itself (`mbody.solve.family`, in the compiled core).
+
+        Parameters
+        ----------
+        values : mapping of str to value
+            As `with_values`.
 
         Returns
         -------
         Model
         """
-        return _build(spec)
+        src = self.source
+        if src is None:
+            raise MbodyError(f"model {self.name!r} was built from a Spec, not read from a file "
+                             "or a dictionary: there is no document to set values in (use "
+                             "mbody.load)")
+        given = tuple((str(k), v) for k, v in values.items())
+        doc = src.read()
+        names = entry_names(self)
+        apply_values(doc, edits(doc, src.values, names))
+        changes = edits(doc, given, names)
+        apply_values(doc, changes)
+        return _build(validate_edited(doc, changes), src.with_values(given))
+
+    @classmethod
+    def from_spec(cls, spec: Spec, source: Source | None = None) -> Model:
+        """Build the arrays from a validated specification (what `load` does last).
+
+        Parameters
+        ----------
+        spec : Spec
+            The output of `mbody.model.validate.validate` (or of an MJCF or URDF import).
+        source : Source, optional
+            What the specification was read from (`Model.source`: what `with_values`
+            edits); None for a specification built in code.
+
+        Returns
+        -------
+        Model
+        """
+        return _build(spec, source)
 
     def _repr_html_(self) -> str:  # notebook display: summary tables and the graph
         from mbody.present.rich import model_html  # a display hook (tools/check_imports.py)
@@ -370,11 +440,35 @@ def load(source: str | os.PathLike[str] | dict, *, max_bytes: int | None = None)
         Listing every problem, each with its file, line and column.
     """
     if isinstance(source, dict):
-        return Model.from_spec(validate(Document(source, "<dict>")))
+        doc = Document(source, "<dict>")
+        return _build(validate(doc), Source("<dict>", document=dataclasses.replace(
+            doc, data=copy.deepcopy(source))))
     text = read_file(source, max_bytes)
     spec = fast_spec(text, str(source)) or validate(load_text(text, str(source)))
-    del text  # before the arrays are built: the text is the largest thing held
-    return Model.from_spec(spec)
+    kept = Source.of_text(text, str(source))
+    del text  # before the arrays are built: the text is the largest thing held (unless kept)
+    return _build(spec, kept)
+
+
+def from_source(source: Source) -> Model:
+    """The model a `Source` describes: its document read again, with its values set and
+    its finishing step taken (what a sweep's worker builds from what the command read).
+
+    Parameters
+    ----------
+    source : Source
+        `Model.source` of a model.
+
+    Returns
+    -------
+    Model
+        Equal to the model the source came from.
+    """
+    doc = source.read()
+    bare = _build(validate_edited(doc, []), dataclasses.replace(source, values=()))
+    if source.values:
+        return bare.with_values(dict(source.values))
+    return source.finish(bare) if source.finish is not None else bare
 
 
 def loads(text: str, file: str = "<string>") -> Model:
@@ -400,10 +494,10 @@ def loads(text: str, file: str = "<string>") -> Model:
     spec = fast_spec(text, file)
     if spec is None:
         spec = validate(load_text(text, file))
-    return Model.from_spec(spec)
+    return _build(spec, Source.of_text(text, file, from_file=False))
 
 
-def _build(spec: Spec) -> Model:
+def _build(spec: Spec, source: Source | None = None) -> Model:
     t = spec.table()
     n = len(t.names)
     names = t.names
@@ -444,4 +538,4 @@ def _build(spec: Spec) -> Model:
     return Model(spec.name, spec.file, spec.dimension, names, mass, J, readonly(J_inv),
                  readonly(spec.gravity), initial, bodies, loads, joints, forces, springs,
                  table, dict(spec.reactions), spec.description, tuple(spec.warnings),
-                 dict(spec.reaction_expressions), drivers)
+                 dict(spec.reaction_expressions), drivers, source=source)

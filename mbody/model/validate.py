@@ -260,6 +260,9 @@ class Spec:
     """The fast path's joints (then `joints` is empty)."""
     drivers: list[DriverSpec] = field(default_factory=list)
     """Joint coordinates prescribed in time (`mbody.model.drivers`)."""
+    document: Document | None = None
+    """The document an MJCF or URDF import validated (its YAML form), kept so that values
+    can be set in it (`Model.with_values`); None otherwise."""
 
     def table(self) -> BodyTable:
         """The bodies as arrays, from `body_table` or else from `bodies`."""

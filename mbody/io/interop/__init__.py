@@ -127,4 +127,5 @@ def import_spec(path: str | os.PathLike[str], format: str | None = None, *,
         doc = read_document(path, fmt, **options)
     spec = validate_imported(doc)
     spec.warnings[:0] = doc.warnings
+    spec.document = doc  # its YAML form, where Model.with_values sets values
     return spec

@@ -147,6 +147,10 @@ typedef struct {
 /* Views of F and I (no copy); returns 0, or -1 when the sizes do not add up. */
 int mb_model_view(mb_model *md, const double *F, int64_t nF, const int64_t *I, int64_t nI,
                   int planar);
+/* `out` = `md` with its float views moved from F0 (the array md views) onto F: the same
+ * model structure (I) with other values (masses, lengths, law constants...), as
+ * pack.py packs a model whose I equals md's. No copy, no check beyond md's own. */
+void mb_model_rebase(mb_model *out, const mb_model *md, const double *F0, const double *F);
 int mb_unknowns_view(mb_unknowns *u, const mb_model *md, const int64_t *Iu, int64_t nIu);
 
 /* Scratch memory for evaluations of one (model, unknowns): allocated once, reused. */
@@ -213,6 +217,21 @@ int mb_derivative(const mb_model *md, const mb_unknowns *u, mb_work *w, double t
  * start, status]. Null-space solves below a geometric ratio of robust_below. */
 void mb_project(const mb_model *md, const mb_unknowns *u, mb_work *w, double t, double *y,
                 int iters, double robust_below, int homogeneous, double *info);
+
+/* Kinematic analysis at t (mbody.solve.kinematics): y (the full state) moved, in place,
+ * onto every enforced joint and driver. fast == 0: as the Python loop does it, `max_iters`
+ * calls of mb_project(1 step) until a step is at most step_tol. fast == 1 (a fully driven
+ * mechanism, whose velocities the constraints fix): Newton steps until every
+ * |phi_i| / phi_scale[i] is at most phi_tol or a step is at most step_tol, then one
+ * velocity projection. info[MB_KN_INFO] <- [steps, max |phi_i| / phi_scale[i] at the
+ * end, singular code (0: none), the last step]. */
+enum { MB_KN_ITERS = 0, MB_KN_ERROR = 1, MB_KN_SINGULAR = 2, MB_KN_STEP = 3, MB_KN_INFO = 4 };
+void mb_kinematics(const mb_model *md, const mb_unknowns *u, mb_work *w, double t, double *y,
+                   const double *phi_scale, int max_iters, double step_tol, double phi_tol,
+                   double robust_below, int fast, double *info);
+/* y moved along its own velocities for dt (positions by v dt, attitudes by the rotation
+ * w dt in body axes, planar angles by w_z dt): a start for the Newton steps at t + dt. */
+void mb_predict(const mb_model *md, double *y, double dt);
 
 /* Slots of mb_kinematic_run's info (MB_KR_INFO of them): the last sample's last Newton
  * step, the Newton steps taken in all, the most at one sample, the singular code. */

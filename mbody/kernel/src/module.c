@@ -5,6 +5,7 @@
  * while it runs. */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "internal.h"
@@ -946,6 +947,312 @@ static PyObject *Unknowns_linearize(UnknownsObject *self, PyObject *const *args,
     Py_RETURN_NONE;
 }
 
+/* -- batches: one call, many states ------------------------------------------------ */
+
+/* The optional (F, rows) pair of a batch: F (C x nF float64: models of this structure
+ * with other values, pack.py's F of each) and rows (K int64: which F each state uses), or
+ * both None. Fills *nrows (0 without them). Returns 0, or -1 with an exception set. */
+static int get_values(const ModelObject *model, PyObject *F, PyObject *rows, Py_ssize_t K,
+                      Py_buffer *Fv, Py_buffer *rv, int *have) {
+    *have = 0;
+    if (F == Py_None && rows == Py_None) return 0;
+    if (F == Py_None || rows == Py_None) {
+        PyErr_SetString(PyExc_ValueError, "F and rows: give both, or neither");
+        return -1;
+    }
+    Py_ssize_t nF = model->F.len / 8;
+    if (get_buffer(F, Fv, 0, 1, -1, "F") < 0) return -1;
+    if (nF == 0 || Fv->len / 8 % nF != 0) {
+        PyErr_Format(PyExc_ValueError, "F: expected rows of %zd values (this model's F), got "
+                     "%zd values", nF, Fv->len / 8);
+        PyBuffer_Release(Fv);
+        return -1;
+    }
+    Py_ssize_t C = Fv->len / 8 / nF;
+    if (get_buffer(rows, rv, 0, 0, K, "rows") < 0) {
+        PyBuffer_Release(Fv);
+        return -1;
+    }
+    const int64_t *r = rv->buf;
+    for (Py_ssize_t k = 0; k < K; k++)
+        if (r[k] < 0 || r[k] >= C) {
+            PyErr_Format(PyExc_ValueError, "rows[%zd] = %lld: F has %zd rows", k,
+                         (long long)r[k], C);
+            PyBuffer_Release(Fv);
+            PyBuffer_Release(rv);
+            return -1;
+        }
+    *have = 1;
+    return 0;
+}
+
+/* The model state k is evaluated with: md itself, or md rebased onto F[rows[k]]. */
+static const mb_model *model_of(const ModelObject *model, mb_model *scratch, int have,
+                                const Py_buffer *Fv, const Py_buffer *rv, Py_ssize_t k) {
+    if (!have) return &model->md;
+    Py_ssize_t nF = model->F.len / 8;
+    const double *F = (const double *)Fv->buf + nF * ((const int64_t *)rv->buf)[k];
+    mb_model_rebase(scratch, &model->md, model->F.buf, F);
+    return scratch;
+}
+
+PyDoc_STRVAR(solve_many_doc,
+"solve_many(t, Y, lam, out, F, rows, states)\n\nsolve() at K states in one call: t (K), "
+"Y (S x ys: states packed, ys = 13 n\nor state_size), lam (m: the known values of every "
+"state, or K x m: each its own),\nout (K x L: each state's solve() output, L = "
+"solve_layout's info offset + INFO).\nstates (K int64): state k is Y[states[k]]; or None: "
+"Y[k] (then S = K). F (C x nF)\nand rows (K): state k evaluated with the model of the same "
+"structure whose packed\nF is F[rows[k]] (pack_model of a model whose I equals this "
+"one's); or None and None:\nthis model.");
+
+static PyObject *Unknowns_solve_many(UnknownsObject *self, PyObject *const *args,
+                                     Py_ssize_t nargs) {
+    Py_buffer t, Y, lam, out, Fv, rv, sv;
+    int have = 0, have_states = 0;
+    if (unknowns_ready(self) < 0 || check_nargs(nargs, 7, "solve_many") < 0) return NULL;
+    const mb_model *md = &self->model->md;
+    if (get_buffer(args[0], &t, 0, 1, -1, "t") < 0) return NULL;
+    Py_ssize_t K = t.len / 8;
+    Py_ssize_t full = MB_STATE_SIZE(md->n, md->planar), ys = full;
+    Py_ssize_t N = (md->planar ? 3 : 6) * md->n, L = N + 3 * md->m + MB_INFO;
+    PyObject *result = NULL;
+    if (get_buffer(args[1], &Y, 0, 1, -1, "Y") < 0) goto t_;
+    if (args[6] != Py_None) {
+        if (get_buffer(args[6], &sv, 0, 0, K, "states") < 0) goto states_;
+        have_states = 1;
+    }
+    Py_ssize_t S = have_states ? -1 : K; /* states packed in Y */
+    {
+        Py_ssize_t nY = Y.len / 8;
+        if (S < 0) { /* a 2-D Y: its rows are the states, of full or 13 n values */
+            Py_ssize_t width = Y.ndim == 2 ? Y.shape[1] : -1;
+            if (width == full || width == 13 * md->n) ys = width, S = Y.shape[0];
+        } else if (nY != S * full) {
+            ys = 13 * md->n;
+        }
+        if (S < 0 || (S > 0 && nY != S * ys) || (S == 0 && nY != 0)) {
+            PyErr_Format(PyExc_ValueError, "Y: expected %zd states of %zd (or %zd) values, "
+                         "got %zd values", S < 0 ? K : S, full, (Py_ssize_t)(13 * md->n), nY);
+            goto states_;
+        }
+        if (have_states) {
+            const int64_t *st = sv.buf;
+            for (Py_ssize_t k = 0; k < K; k++)
+                if (st[k] < 0 || st[k] >= S) {
+                    PyErr_Format(PyExc_ValueError, "states[%zd] = %lld: Y holds %zd states",
+                                 k, (long long)st[k], S);
+                    goto states_;
+                }
+        }
+    }
+    if (get_buffer(args[2], &lam, 0, 1, -1, "lam") < 0) goto states_;
+    Py_ssize_t nl = lam.len / 8;
+    if (nl != md->m && nl != K * md->m) {
+        PyErr_Format(PyExc_ValueError, "lam: expected %lld or %zd values, got %zd",
+                     (long long)md->m, K * md->m, nl);
+        goto lam_;
+    }
+    if (get_buffer(args[3], &out, 1, 1, K * L, "out") < 0) goto lam_;
+    if (get_values(self->model, args[4], args[5], K, &Fv, &rv, &have) < 0) goto out_;
+    {
+        mb_model scratch;
+        const double *tv = t.buf, *yv = Y.buf, *lv = lam.buf;
+        double *ov = out.buf;
+        int per_state = nl != md->m; /* K x m (with K = 1 either reads the same) */
+        const int64_t *st = have_states ? sv.buf : NULL;
+        for (Py_ssize_t k = 0; k < K; k++) {
+            const mb_model *mk = model_of(self->model, &scratch, have, &Fv, &rv, k);
+            mb_solve(mk, &self->u, self->w, tv[k], yv + (st ? st[k] : k) * ys,
+                     lv + (per_state ? k * md->m : 0), ov + k * L);
+        }
+    }
+    if (have) {
+        PyBuffer_Release(&Fv);
+        PyBuffer_Release(&rv);
+    }
+    Py_INCREF(Py_None);
+    result = Py_None;
+out_:
+    PyBuffer_Release(&out);
+lam_:
+    PyBuffer_Release(&lam);
+states_:
+    if (have_states) PyBuffer_Release(&sv);
+    PyBuffer_Release(&Y);
+t_:
+    PyBuffer_Release(&t);
+    return result;
+}
+
+PyDoc_STRVAR(peaks_many_doc,
+"peaks_many(t, Y, lam, peaks, F, rows, states, segment)\n\nsolve_many's solves, each "
+"state's output folded into its segment's row of peaks\ninstead of written out: state k "
+"is in segment k // segment; peaks (K / segment x\n(m + 1)) <- per segment the largest "
+"|lambda_i| of each reaction component (known\nvalues included), then the first nonzero "
+"singular code of its states (0: none). t,\nY, lam, F, rows, states: as solve_many's (K "
+"a multiple of segment).");
+
+static PyObject *Unknowns_peaks_many(UnknownsObject *self, PyObject *const *args,
+                                     Py_ssize_t nargs) {
+    Py_buffer t, Y, lam, pk, Fv, rv, sv;
+    int have = 0, have_states = 0;
+    if (unknowns_ready(self) < 0 || check_nargs(nargs, 8, "peaks_many") < 0) return NULL;
+    const mb_model *md = &self->model->md;
+    long segment = PyLong_AsLong(args[7]);
+    if (segment == -1 && PyErr_Occurred()) return NULL;
+    if (get_buffer(args[0], &t, 0, 1, -1, "t") < 0) return NULL;
+    Py_ssize_t K = t.len / 8, S = 0, ys = MB_STATE_SIZE(md->n, md->planar);
+    Py_ssize_t N = (md->planar ? 3 : 6) * md->n, L = N + 3 * md->m + MB_INFO;
+    PyObject *result = NULL;
+    if (segment < 1 || K % segment != 0) {
+        PyErr_Format(PyExc_ValueError, "segment: expected a divisor of the %zd states, got %ld",
+                     K, segment);
+        goto t_;
+    }
+    if (get_buffer(args[1], &Y, 0, 1, -1, "Y") < 0) goto t_;
+    if (args[6] == Py_None) {
+        PyErr_SetString(PyExc_ValueError, "states: expected K int64 indices into Y");
+        goto Y_;
+    }
+    if (get_buffer(args[6], &sv, 0, 0, K, "states") < 0) goto Y_;
+    have_states = 1;
+    {
+        Py_ssize_t width = Y.ndim == 2 ? Y.shape[1] : -1;
+        if (width != ys && width != 13 * md->n) {
+            PyErr_Format(PyExc_ValueError, "Y: expected rows of %zd (or %zd) values", ys,
+                         (Py_ssize_t)(13 * md->n));
+            goto states_;
+        }
+        ys = width, S = Y.shape[0];
+        const int64_t *st = sv.buf;
+        for (Py_ssize_t k = 0; k < K; k++)
+            if (st[k] < 0 || st[k] >= S) {
+                PyErr_Format(PyExc_ValueError, "states[%zd] = %lld: Y holds %zd states", k,
+                             (long long)st[k], S);
+                goto states_;
+            }
+    }
+    if (get_buffer(args[2], &lam, 0, 1, md->m, "lam") < 0) goto states_;
+    if (get_buffer(args[3], &pk, 1, 1, (K / segment) * (md->m + 1), "peaks") < 0) goto lam_;
+    if (get_values(self->model, args[4], args[5], K, &Fv, &rv, &have) < 0) goto pk_;
+    {
+        double *out = malloc(sizeof(double) * (size_t)L);
+        if (out == NULL) {
+            PyErr_NoMemory();
+            goto values_;
+        }
+        mb_model scratch;
+        const double *tv = t.buf, *yv = Y.buf;
+        const int64_t *st = sv.buf;
+        double *pv = pk.buf;
+        int64_t m = md->m;
+        for (Py_ssize_t k = 0; k < K; k++) {
+            double *row = pv + (k / segment) * (m + 1);
+            if (k % segment == 0)
+                for (int64_t i = 0; i <= m; i++) row[i] = 0.0;
+            const mb_model *mk = model_of(self->model, &scratch, have, &Fv, &rv, k);
+            mb_solve(mk, &self->u, self->w, tv[k], yv + st[k] * ys, lam.buf, out);
+            for (int64_t i = 0; i < m; i++) {
+                double a = fabs(out[N + i]);
+                if (!(a <= row[i])) row[i] = a; /* a NaN stays */
+            }
+            double code = out[N + 3 * m + MB_ST_SINGULAR];
+            if (row[m] == 0.0 && code != 0.0) row[m] = code;
+        }
+        free(out);
+    }
+    Py_INCREF(Py_None);
+    result = Py_None;
+values_:
+    if (have) {
+        PyBuffer_Release(&Fv);
+        PyBuffer_Release(&rv);
+    }
+pk_:
+    PyBuffer_Release(&pk);
+lam_:
+    PyBuffer_Release(&lam);
+states_:
+    if (have_states) PyBuffer_Release(&sv);
+Y_:
+    PyBuffer_Release(&Y);
+t_:
+    PyBuffer_Release(&t);
+    return result;
+}
+
+PyDoc_STRVAR(kinematics_many_doc,
+"kinematics_many(t, Y, F, rows, chain, phi_scale, settings, info)\n\nThe kinematic "
+"analysis (kernel.h: mb_kinematics) at K times, in place: Y (K x\nstate_size, each row "
+"its start; moved onto every enforced joint and driver at\nt[k]). chain (K int64): 1 where "
+"row k starts from row k - 1's result (copied\nthere), moved along its velocities for "
+"t[k] - t[k-1] when settings' predict is\nset; or None. F, rows: as solve_many's. "
+"phi_scale (m): each component's scale\n(lengths: the model's size; angles: 1). settings "
+"(6): [max_iters, step_tol,\nphi_tol, robust_below, fast, predict]. info (K x KN_INFO) <- "
+"each row's\n[steps, max |phi| / scale, singular code, last step].");
+
+static PyObject *Unknowns_kinematics_many(UnknownsObject *self, PyObject *const *args,
+                                          Py_ssize_t nargs) {
+    Py_buffer t, Y, Fv, rv, ch, sc, st, info;
+    int have = 0, have_chain = 0;
+    if (unknowns_ready(self) < 0 || check_nargs(nargs, 8, "kinematics_many") < 0) return NULL;
+    const mb_model *md = &self->model->md;
+    if (get_buffer(args[0], &t, 0, 1, -1, "t") < 0) return NULL;
+    Py_ssize_t K = t.len / 8, ys = MB_STATE_SIZE(md->n, md->planar);
+    PyObject *result = NULL;
+    if (get_buffer(args[1], &Y, 1, 1, K * ys, "Y") < 0) goto t_;
+    if (get_values(self->model, args[2], args[3], K, &Fv, &rv, &have) < 0) goto Y_;
+    if (args[4] != Py_None) {
+        if (get_buffer(args[4], &ch, 0, 0, K, "chain") < 0) goto values_;
+        have_chain = 1;
+    }
+    if (get_buffer(args[5], &sc, 0, 1, md->m, "phi_scale") < 0) goto chain_;
+    if (get_buffer(args[6], &st, 0, 1, 6, "settings") < 0) goto scale_;
+    if (get_buffer(args[7], &info, 1, 1, K * MB_KN_INFO, "info") < 0) goto settings_;
+    {
+        const double *s = st.buf;
+        if (!(s[0] >= 0 && s[0] <= 1000)) {
+            PyErr_SetString(PyExc_ValueError, "settings[0] (max_iters): expected 0 to 1000");
+            goto info_;
+        }
+        mb_model scratch;
+        const double *tv = t.buf;
+        const int64_t *cv = have_chain ? ch.buf : NULL;
+        double *yv = Y.buf, *iv = info.buf;
+        int fast = s[4] != 0.0, predict = s[5] != 0.0;
+        for (Py_ssize_t k = 0; k < K; k++) {
+            double *y = yv + k * ys;
+            if (cv != NULL && cv[k] && k > 0) {
+                memcpy(y, y - ys, sizeof(double) * ys);
+                if (predict) mb_predict(md, y, tv[k] - tv[k - 1]);
+            }
+            const mb_model *mk = model_of(self->model, &scratch, have, &Fv, &rv, k);
+            mb_kinematics(mk, &self->u, self->w, tv[k], y, sc.buf, (int)s[0], s[1], s[2],
+                          s[3], fast, iv + k * MB_KN_INFO);
+        }
+    }
+    Py_INCREF(Py_None);
+    result = Py_None;
+info_:
+    PyBuffer_Release(&info);
+settings_:
+    PyBuffer_Release(&st);
+scale_:
+    PyBuffer_Release(&sc);
+chain_:
+    if (have_chain) PyBuffer_Release(&ch);
+values_:
+    if (have) {
+        PyBuffer_Release(&Fv);
+        PyBuffer_Release(&rv);
+    }
+Y_:
+    PyBuffer_Release(&Y);
+t_:
+    PyBuffer_Release(&t);
+    return result;
+}
+
 static PyObject *Unknowns_get(UnknownsObject *self, void *which) {
     switch ((int)(intptr_t)which) {
     case 0: return PyLong_FromLongLong(self->u.mu);
@@ -983,6 +1290,12 @@ static PyMethodDef Unknowns_methods[] = {
      differences_doc},
     {"linearize", (PyCFunction)(void (*)(void))Unknowns_linearize, METH_FASTCALL,
      linearize_doc},
+    {"solve_many", (PyCFunction)(void (*)(void))Unknowns_solve_many, METH_FASTCALL,
+     solve_many_doc},
+    {"kinematics_many", (PyCFunction)(void (*)(void))Unknowns_kinematics_many, METH_FASTCALL,
+     kinematics_many_doc},
+    {"peaks_many", (PyCFunction)(void (*)(void))Unknowns_peaks_many, METH_FASTCALL,
+     peaks_many_doc},
     {NULL, NULL, 0, NULL},
 };
 
@@ -1066,9 +1379,11 @@ PyMODINIT_FUNC PyInit__core(void) {
         {"ST_MU", MB_ST_MU}, {"ST_PATH", MB_ST_PATH}, {"ST_SINGULAR", MB_ST_SINGULAR},
         {"INFO", MB_INFO}, {"PR_STEP", MB_PR_STEP}, {"PR_VELOCITY", MB_PR_VELOCITY},
         {"PR_RATIO", MB_PR_RATIO}, {"PR_SINGULAR", MB_PR_SINGULAR},
+        {"PROJECT_INFO", MB_PROJECT_INFO}, {"KN_ITERS", MB_KN_ITERS},
+        {"KN_ERROR", MB_KN_ERROR}, {"KN_SINGULAR", MB_KN_SINGULAR}, {"KN_STEP", MB_KN_STEP},
+        {"KN_INFO", MB_KN_INFO},
         {"KR_STEP", MB_KR_STEP}, {"KR_NEWTON", MB_KR_NEWTON}, {"KR_WORST", MB_KR_WORST},
         {"KR_SINGULAR", MB_KR_SINGULAR}, {"KR_INFO", MB_KR_INFO},
-        {"PROJECT_INFO", MB_PROJECT_INFO},
         {"GQ_TURN", MB_GQ_TURN}, {"GQ_CHILD_TURN", MB_GQ_CHILD_TURN},
         {"GQ_SLIDE", MB_GQ_SLIDE}, {"GQ_BODY", MB_GQ_BODY}, {"GQ_W", MB_GQ_W},
         {"GI_RANK", MB_GI_RANK}, {"GI_RESIDUAL", MB_GI_RESIDUAL},

@@ -95,6 +95,17 @@ int mb_model_view(mb_model *md, const double *F, int64_t nF, const int64_t *I, i
     return 0;
 }
 
+void mb_model_rebase(mb_model *out, const mb_model *md, const double *F0, const double *F) {
+    *out = *md;
+    out->gravity = F + (md->gravity - F0);
+    out->bodies = F + (md->bodies - F0);
+    out->loads = F + (md->loads - F0);
+    out->springs = F + (md->springs - F0);
+    out->joints = F + (md->joints - F0);
+    out->comps_f = F + (md->comps_f - F0);
+    out->numbers = F + (md->numbers - F0);
+}
+
 int mb_unknowns_view(mb_unknowns *u, const mb_model *md, const int64_t *Iu, int64_t nIu) {
     if (nIu < 3) return -1;
     u->mu = Iu[0], u->bw = Iu[1], u->nnz = Iu[2];

@@ -1,0 +1,226 @@
+"""Running a sweep's chunks: on Dask (``dask.distributed``), or in this process.
+
+By default the command starts a local cluster of worker processes (one thread each, one
+per core; every server bound to 127.0.0.1, no dashboard) and stops it at the end;
+``scheduler="tcp://HOST:PORT"`` sends the same chunks to an existing cluster, whose
+workers import the same mbody. ``workers=0`` runs them here, without Dask.
+
+Chunks are sized from a measurement: the first cases are run here first (their rows
+kept), and a chunk then holds about `CHUNK_SECONDS` of work, so that scheduling is a
+small share, and at most a `CHUNKS_PER_WORKER`-th of a worker's share of the cases, so
+that the workers stay busy to the end and a worker lost mid-run costs one chunk: Dask
+runs a lost worker's chunk again on another. Each chunk's rows are written once, by the
+case numbers they carry (`mbody.sweep.table.Results`), so every case is in the output
+exactly once; a chunk that cannot be run at all (its workers died repeatedly) is written
+as rows saying so.
+
+This module imports dask only when a cluster is used.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import os
+import sys
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from mbody.errors import MbodyError
+from mbody.sweep.runs import Job, Rows, run_chunk
+from mbody.sweep.table import Results
+
+CHUNK_SECONDS = 2.0
+"""Work in one chunk, in seconds of one worker (Dask's cost per task is a few
+milliseconds: under 1 %)."""
+CHUNKS_PER_WORKER = 4
+"""At least this many chunks per worker (the load stays balanced to the end)."""
+PILOT_SECONDS = 0.3
+"""Work measured here before the chunks are sized (its rows are kept)."""
+CONNECT_SECONDS = 30.0
+"""How long a scheduler and its first worker are waited for."""
+
+
+@dataclass
+class Report:
+    """How a sweep ran: cases run here and in chunks, the chunk size, the workers, the
+    seconds of work the chunks took and the wall-clock seconds (`start` of them starting
+    the cluster)."""
+
+    cases: int = 0
+    chunks: int = 0
+    chunk: int = 0
+    workers: int = 0
+    where: str = "this process"
+    work: float = 0.0
+    cpu: float = 0.0
+    wall: float = 0.0
+    start: float = 0.0
+    lost: int = 0
+
+    @property
+    def busy(self) -> float:
+        """The share of the workers' wall-clock time spent on cases (the rest: starting,
+        scheduling, moving data, waiting for the last chunks)."""
+        span = (self.wall - self.start) * max(self.workers, 1)
+        return self.work / span if span > 0 else 1.0
+
+    def text(self) -> str:
+        return (f"{self.cases} cases in {self.wall:.1f} s on {self.where} "
+                f"({self.chunks} chunk(s) of up to {self.chunk} cases; the workers spent "
+                f"{100 * min(self.busy, 1.0):.0f}% of their time on cases, "
+                f"{self.cpu:.1f} s of processor time"
+                + (f", {self.start:.1f} s starting the cluster" if self.start else "")
+                + (f"; {self.lost} chunk(s) lost with their workers, written as failed"
+                   if self.lost else "") + ")")
+
+
+def run(job: Job, todo: Sequence[int], results: Results, *, scheduler: str | None = None,
+        workers: int | None = None, chunk: int | None = None, progress: bool = True,
+        on_chunk: Callable[[Rows], None] | None = None) -> Report:
+    """Run cases `todo` of `job` (module doc), their rows into `results`.
+
+    Parameters
+    ----------
+    job : Job
+        The sweep.
+    todo : sequence of int
+        The cases to run (those not in the output yet).
+    results : Results
+        Where each chunk's rows go as it finishes.
+    scheduler : str, optional
+        An existing cluster's scheduler (``tcp://HOST:PORT``).
+    workers : int, optional
+        The local cluster's worker processes (default: one per core); 0: no cluster.
+    chunk : int, optional
+        Cases per chunk (default: measured).
+    progress : bool
+        A progress bar on standard error.
+    on_chunk : callable, optional
+        Called with each chunk's rows after they are written.
+
+    Returns
+    -------
+    Report
+    """
+    from tqdm import tqdm  # type: ignore[import-untyped]  # tqdm ships no types
+
+    begin = time.perf_counter()
+    report = Report()
+    todo = list(todo)
+    bar = tqdm(total=len(results.done) + len(todo), initial=len(results.done), unit="case",
+               disable=not progress, file=sys.stderr, mininterval=0.5, smoothing=0.1,
+               dynamic_ncols=True)
+
+    def take(rows: Rows) -> None:
+        results.add(rows)
+        report.cases += len(rows.indices)
+        report.cpu += rows.cpu
+        bar.update(len(rows.indices))
+        if on_chunk is not None:
+            on_chunk(rows)
+
+    try:
+        per_case, todo = _pilot(job, todo, take, chunk)
+        if workers == 0 and scheduler is None:
+            size = chunk or max(1, min(len(todo), round(CHUNK_SECONDS / per_case)))
+            report.chunk = size
+            for part in _chunks(todo, size):
+                rows = run_chunk(job, part)
+                report.work += rows.seconds
+                report.chunks += 1
+                take(rows)
+            report.workers = 1
+        elif todo:
+            _on_dask(job, todo, per_case, chunk, scheduler, workers, take, report, begin,
+                     len(results.outputs))
+    finally:
+        bar.close()
+        results.close()
+        report.wall = time.perf_counter() - begin
+    return report
+
+
+def _chunks(todo: Sequence[int], size: int) -> list[list[int]]:
+    return [list(todo[i:i + size]) for i in range(0, len(todo), size)]
+
+
+def _pilot(job: Job, todo: list[int], take: Callable[[Rows], None], chunk: int | None
+           ) -> tuple[float, list[int]]:
+    """Run the first cases here, doubling until `PILOT_SECONDS` of work (or a fiftieth of
+    the cases): the seconds one case takes, and the cases left."""
+    if chunk is not None or not todo:
+        return 1.0, todo
+    cap = max(1, len(todo) // 50)
+    n, done, per_case = 1, 0, 0.0
+    while done < len(todo):
+        part = todo[done:done + n]
+        rows = run_chunk(job, part)
+        take(rows)
+        done += len(part)
+        if done > 1:  # the first case also built the model: not counted
+            per_case = max(rows.seconds / len(part), 1e-6)
+        if rows.seconds >= PILOT_SECONDS or done >= cap:
+            break
+        n *= 2
+    return (per_case or 1e-3), todo[done:]
+
+
+def _on_dask(job: Job, todo: list[int], per_case: float, chunk: int | None,
+             scheduler: str | None, workers: int | None, take: Callable[[Rows], None],
+             report: Report, begin: float, width: int) -> None:
+    try:
+        from dask.distributed import Client, LocalCluster, as_completed
+    except ImportError:
+        raise MbodyError("sweeps run on Dask (dask.distributed): pip install 'mbody[sweep]' "
+                         "(or --workers 0 to run them in this process)") from None
+    cluster = None
+    try:
+        if scheduler is None:
+            n = workers or os.cpu_count() or 1
+            # every server on the loopback: the scheduler's HTTP routes (no dashboard) at a
+            # free port, the workers and their nannies; their shutdown chatter silenced
+            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                   host="127.0.0.1", dashboard_address="127.0.0.1:0",
+                                   worker_dashboard_address=None,
+                                   scheduler_kwargs={"dashboard": False},
+                                   silence_logs=logging.CRITICAL)
+            client = Client(cluster, set_as_default=False)
+            report.where = f"a local cluster of {n} worker processes"
+        else:
+            try:
+                client = Client(scheduler, timeout=CONNECT_SECONDS, set_as_default=False)
+                client.wait_for_workers(1, timeout=CONNECT_SECONDS)
+            except (OSError, TimeoutError) as exc:
+                raise MbodyError(f"--scheduler {scheduler}: no cluster answered ({exc})"
+                                 ) from None
+            n = len(client.scheduler_info()["workers"])
+            report.where = f"the cluster at {scheduler} ({n} workers)"
+        report.workers = n
+        report.start = time.perf_counter() - begin
+        size = chunk or max(1, min(round(CHUNK_SECONDS / per_case),
+                                   math.ceil(len(todo) / (CHUNKS_PER_WORKER * n))))
+        report.chunk = size
+        parts = _chunks(todo, size)
+        futures = {client.submit(run_chunk, job, part, pure=False,
+                                 key=f"mbody-sweep-{job.key[:12]}-{i}"): part
+                   for i, part in enumerate(parts)}
+        for fut in as_completed(futures, loop=client.loop):
+            part = futures[fut]
+            try:
+                rows = fut.result()
+            except Exception as exc:  # noqa: BLE001 - the chunk's cases say so, not lost
+                report.lost += 1
+                why = (f"not run: the chunk's workers were lost ({type(exc).__name__}: "
+                       f"{exc}); run the sweep again to run these cases")
+                rows = Rows(part, np.full((len(part), width), np.nan), [why] * len(part))
+            report.work += rows.seconds
+            report.chunks += 1
+            take(rows)
+        client.close()
+    finally:
+        if cluster is not None:
+            cluster.close()

@@ -1,0 +1,244 @@
+"""The cases of a sweep: each ``--set PATH=START:STOP:COUNT`` an axis, the Cartesian grid
+of the axes (the last one varying fastest), or N random samples (seeded).
+
+    bodies.rod.mass=0.3:1.2:10         10 values from 0.3 to 1.2, both included, evenly
+                                       spaced (to 15 significant digits: 0.4:0.8:3 is
+                                       0.4, 0.6, 0.8)
+    drivers.motor.speed=100 rpm:3000 rpm:30     a unit, as the file reads it
+    joints.P.axis.1=0,0.1,0.25         the values listed (commas, as Hydra's multirun)
+    bodies.crank.mass=0.5              one value, the same in every case (not a column)
+    gravity=[0, -1.62]                 one value too: a list is a vector
+
+With ``--samples N --seed S`` each axis is a range ``START:STOP`` drawn uniformly (or a
+list drawn from), N cases. A case is found from its index alone (`Grid.values`), so a
+process evaluating a chunk of cases needs only the indices.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import Any
+
+import numpy as np
+
+from mbody.errors import MbodyError
+from mbody.model.values import parse_assignment, parse_value
+
+MAX_CASES = 100_000_000
+"""Most cases one sweep holds (a grid's size is the product of its axes' counts)."""
+_NUMBER = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S.*?)?\s*")
+
+
+@dataclass(frozen=True)
+class Axis:
+    """One varied path.
+
+    Parameters
+    ----------
+    path : str
+        The path as given (the results' column name).
+    values : tuple
+        The values listed, or (start, stop) of a range.
+    count : int
+        A range's number of grid values (0: drawn at random, or a listed axis).
+    unit : str
+        A range's unit as written (``rpm``), '' for none.
+    listed : bool
+        The values are listed (``[a, b, c]``), not a range.
+    """
+
+    path: str
+    values: tuple[Any, ...]
+    count: int = 0
+    unit: str = ""
+    listed: bool = False
+
+    def grid_values(self) -> list[Any]:
+        """The axis's values in grid order (as the results' column shows them)."""
+        if self.listed:
+            return list(self.values)
+        lo, hi = self.values
+        if self.count == 1:
+            return [lo]
+        # to 15 significant digits, as written: 0.4:0.8:3 gives 0.6, not linspace's
+        # 0.6000000000000001 (a double holds 15 digits exactly)
+        return [float(f"{x:.15g}") for x in np.linspace(lo, hi, self.count).tolist()]
+
+    def drawn(self, u: float) -> Any:
+        """The value a uniform number u in [0, 1) draws (a random sample)."""
+        if self.listed:
+            return self.values[min(int(u * len(self.values)), len(self.values) - 1)]
+        lo, hi = self.values
+        return lo + (hi - lo) * u
+
+    def for_file(self, number: Any) -> Any:
+        """A column's value as the file would hold it (with the axis's unit)."""
+        if self.unit and isinstance(number, float | int):
+            return f"{number!r} {self.unit}"
+        return number
+
+
+@dataclass(frozen=True)
+class Grid:
+    """Every case of a sweep (module doc).
+
+    Parameters
+    ----------
+    axes : tuple of Axis
+        The varied paths, in the order given.
+    fixed : dict
+        Paths set to one value in every case (applied to the model, not columns).
+    samples : int or None
+        N random cases instead of the grid.
+    seed : int
+        The random samples' seed.
+    """
+
+    axes: tuple[Axis, ...]
+    fixed: dict[str, Any] = field(default_factory=dict)
+    samples: int | None = None
+    seed: int = 0
+
+    @property
+    def paths(self) -> tuple[str, ...]:
+        return tuple(a.path for a in self.axes)
+
+    @cached_property
+    def _columns(self) -> list[list[Any]]:
+        return [a.grid_values() for a in self.axes]
+
+    def __len__(self) -> int:
+        if self.samples is not None:
+            return self.samples
+        return math.prod(len(c) for c in self._columns)
+
+    @cached_property
+    def _draws(self) -> np.ndarray:
+        """(N, axes) uniform numbers in [0, 1), one column per axis (the same in every
+        process: numpy's PCG64 from the seed)."""
+        rng = np.random.default_rng(self.seed)
+        return rng.random((len(self), len(self.axes)))
+
+    def numbers(self, index: int) -> list[Any]:
+        """Case `index`'s value of each axis, as the results' columns show it."""
+        if self.samples is not None:
+            return [a.drawn(u) for a, u in zip(self.axes, self._draws[index].tolist(),
+                                               strict=True)]
+        out = []
+        for col in reversed(self._columns):
+            index, r = divmod(index, len(col))
+            out.append(col[r])
+        return out[::-1]
+
+    def values(self, index: int) -> dict[str, Any]:
+        """Case `index` as `Model.with_values` takes it (path -> value for the file)."""
+        return {a.path: a.for_file(x) for a, x in zip(self.axes, self.numbers(index),
+                                                         strict=True)}
+
+
+def parse_grid(specs: Sequence[str], samples: int | None = None, seed: int = 0) -> Grid:
+    """The `Grid` of ``--set`` options (module doc).
+
+    Parameters
+    ----------
+    specs : sequence of str
+        ``PATH=START:STOP:COUNT``, ``PATH=[a, b, ...]`` or ``PATH=VALUE`` each.
+    samples : int, optional
+        N random cases (then ranges are ``START:STOP``).
+    seed : int
+        Their seed.
+
+    Returns
+    -------
+    Grid
+
+    Raises
+    ------
+    MbodyError
+        A malformed range (with what was expected), a path given twice, no varied path,
+        or more than `MAX_CASES` cases.
+    """
+    axes: list[Axis] = []
+    fixed: dict[str, Any] = {}
+    seen: set[str] = set()
+    for spec in specs:
+        path, text = parse_assignment(spec)
+        if path in seen:
+            raise MbodyError(f"--set {path} is given twice")
+        seen.add(path)
+        parts = _top_level(text, ",")
+        if ":" in text and len(_top_level(text, ":")) > 1:
+            axes.append(_range(path, text, samples is not None))
+        elif len(parts) > 1:
+            if any(not p.strip() for p in parts):
+                raise MbodyError(f"--set {path}: an empty value in the list {text!r}")
+            axes.append(Axis(path, tuple(parse_value(p, path) for p in parts), listed=True))
+        else:
+            fixed[path] = parse_value(text, path)
+    if not axes:
+        raise MbodyError("a sweep varies at least one value: --set PATH=START:STOP:COUNT "
+                         "(for example bodies.rod.mass=0.3:1.2:10)")
+    if samples is not None and samples < 1:
+        raise MbodyError(f"--samples: expected at least 1 case, got {samples}")
+    grid = Grid(tuple(axes), fixed, samples, seed)
+    size = samples if samples is not None else math.prod(len(a.grid_values()) for a in axes)
+    if size > MAX_CASES:
+        raise MbodyError(f"the sweep has {size:,} cases; at most {MAX_CASES:,} are run "
+                         "(fewer values per axis, or --samples N)".replace(",", " "))
+    return grid
+
+
+def _top_level(text: str, sep: str) -> list[str]:
+    """`text` split at each `sep` outside brackets and quotes (``[0, 1]`` is one value)."""
+    parts, depth, quote, start = [], 0, "", 0
+    for i, ch in enumerate(text):
+        if quote:
+            quote = "" if ch == quote else quote
+        elif ch in "'\"":
+            quote = ch
+        elif ch in "[{":
+            depth += 1
+        elif ch in "]}":
+            depth -= 1
+        elif ch == sep and depth == 0:
+            parts.append(text[start:i])
+            start = i + 1
+    return [*parts, text[start:]]
+
+
+def _range(path: str, text: str, random: bool) -> Axis:
+    parts = text.split(":")
+    form = "START:STOP" if random else "START:STOP:COUNT"
+    example = f"{path}=0.3:1.2" if random else f"{path}=0.3:1.2:10"
+    if len(parts) != (2 if random else 3):
+        extra = " (with --samples, the count is the number of samples)" if random else ""
+        raise MbodyError(f"--set {path}: expected {form}, such as {example}; got {text!r}"
+                         + extra)
+    ends, units = [], []
+    for part in parts[:2]:
+        m = _NUMBER.fullmatch(part)
+        if not m:
+            raise MbodyError(f"--set {path}: {part.strip()!r} is not a number (a range is "
+                             f"{form}, such as {example})")
+        x = float(m.group(1))
+        if not math.isfinite(x):
+            raise MbodyError(f"--set {path}: expected a finite number, got {part.strip()!r}")
+        ends.append(x)
+        units.append(m.group(2) or "")
+    if units[0] != units[1]:
+        raise MbodyError(f"--set {path}: the range's ends have different units "
+                         f"({units[0] or 'none'} and {units[1] or 'none'})")
+    count = 0
+    if not random:
+        try:
+            count = int(parts[2].strip())
+        except ValueError:
+            raise MbodyError(f"--set {path}: the count {parts[2].strip()!r} is not a whole "
+                             f"number (a range is {form})") from None
+        if count < 1:
+            raise MbodyError(f"--set {path}: expected a count of at least 1, got {count}")
+    return Axis(path, (ends[0], ends[1]), count, units[0])

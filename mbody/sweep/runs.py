@@ -1,0 +1,450 @@
+"""What a sweep computes for each case, a chunk of cases at a time: the runs and their
+output columns.
+
+- ``solve``: one solve at each case's initial state; columns ``acceleration:<coordinate>``
+  and ``reaction:<label>``.
+- ``kinematics``: the kinematic analysis at `steps` instants from 0 to T, each from the
+  previous one, then a solve at each (a driven mechanism's kinetostatics); columns
+  ``final:<coordinate>`` and ``peak:<label>``.
+- ``simulate``: `mbody.simulate` to T; the same columns.
+- ``modes``: the natural frequencies about the initial state; ``frequency:<k>``.
+
+``final:`` is the last instant's position coordinate (planar ``x``, ``y`` in m and
+``theta`` in rad, in (−π, π]; spatial ``x``, ``y``, ``z`` and the attitude's quaternion
+``qw``, ``qx``, ``qy``, ``qz``); ``peak:`` the largest magnitude over the instants of a
+reaction component or a driver's effort (joint-frame components, N or N m).
+
+A chunk's cases are evaluated together: their values packed by one `Family` (each value
+read once), their solves and kinematic analyses in single calls of the compiled core
+(`mbody.solve.batch.Evaluator`). A fully driven mechanism's motion depends on its joints,
+drivers and start only (not on masses, loads or gravity): cases that differ only there
+share one kinematic analysis. A case that fails is a row with its message; an
+unexpected failure of a chunk is retried case by case, so that only the failing case
+says so.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from mbody import conventions as cv
+from mbody.equations.solution import singular_mass_error
+from mbody.errors import MbodyError
+from mbody.kernel import _core
+from mbody.model.model import Model, State, from_source
+from mbody.model.source import Source
+from mbody.simulate.simulation import simulate
+from mbody.solve.batch import Evaluator, closed
+from mbody.solve.family import Case, Family
+from mbody.solve.kinematics import kinematics as kinematics_at
+from mbody.sweep import modes
+from mbody.sweep.grid import Grid
+
+RUNS = ("solve", "kinematics", "simulate", "modes")
+"""What ``--run`` names."""
+SOLVE_BLOCK = 50_000
+"""Most states solved in one call of the core (a block's arrays stay a few tens of MB)."""
+
+
+@dataclass(frozen=True)
+class Settings:
+    """How each case is run.
+
+    Parameters
+    ----------
+    run : str
+        One of `RUNS`.
+    t_end : float or None
+        The run's end (s), for ``kinematics`` and ``simulate``.
+    revolutions : float or None
+        Or the end as turns of the first driver that turns (``--t-end "1 rev"``): the
+        time it takes at its rate at t = 0, in each case.
+    steps : int
+        The ``kinematics`` run's instants, from 0 to the end (both included).
+    fps : float
+        The ``simulate`` run's samples per second.
+    """
+
+    run: str = "solve"
+    t_end: float | None = None
+    revolutions: float | None = None
+    steps: int = 101
+    fps: float = 60.0
+
+
+@dataclass(frozen=True)
+class Job:
+    """Everything a process needs to evaluate cases of one sweep: the model's source
+    (with its fixed values), the grid and the settings; `key` names the sweep (a process
+    keeps what it built for it)."""
+
+    source: Source
+    grid: Grid
+    settings: Settings
+    key: str
+
+
+@dataclass
+class Rows:
+    """A chunk's results: case indices, the output columns (float, NaN where a case
+    failed), each case's error or None, and the seconds its evaluation took."""
+
+    indices: list[int]
+    outputs: np.ndarray
+    errors: list[str | None]
+    seconds: float = 0.0
+    worker: str = ""
+    cpu: float = 0.0
+    """The processor seconds the evaluation took (`seconds` is wall-clock: on a shared
+    machine, also other programs' time)."""
+
+
+def final_labels(model: Model) -> list[str]:
+    """The ``final:`` columns' coordinates (module doc)."""
+    if model.dimension == cv.PLANAR:
+        return cv.coordinate_labels(list(model.body_names), model.dimension)
+    return [f"{b}.{c}" for b in model.body_names
+            for c in ("x", "y", "z", "qw", "qx", "qy", "qz")]
+
+
+def final_values(model: Model, Y: np.ndarray) -> np.ndarray:
+    """(K, len(final_labels)) the position coordinates of packed states Y (K, >= 7 n)."""
+    n = model.n
+    x = Y[:, :3 * n].reshape(-1, n, 3)
+    q = Y[:, 3 * n:7 * n].reshape(-1, n, 4)
+    if model.dimension == cv.PLANAR:
+        theta = 2.0 * np.arctan2(q[..., 3], q[..., 0])
+        theta = np.where(theta > np.pi, theta - 2 * np.pi, theta)
+        theta = np.where(theta <= -np.pi, theta + 2 * np.pi, theta)
+        return np.concatenate((x[..., :2], theta[..., None]), axis=2).reshape(len(Y), -1)
+    return np.concatenate((x, q), axis=2).reshape(len(Y), -1)
+
+
+def columns(model: Model, settings: Settings) -> list[str]:
+    """The output columns of a run of `model` (module doc)."""
+    if settings.run == "solve":
+        return ([f"acceleration:{c}" for c in model.coordinates]
+                + [f"reaction:{r}" for r in model.reactions])
+    if settings.run == "modes":
+        return [f"frequency:{k + 1}" for k in range(modes.mode_count(model))]
+    return ([f"final:{c}" for c in final_labels(model)]
+            + [f"peak:{r}" for r in model.reactions])
+
+
+def turning_driver(model: Model) -> int:
+    """The index of the first driver that turns (its rate sets ``--t-end N rev``)."""
+    drivers = model.drivers
+    for i, comp in enumerate(drivers.component if drivers is not None else ()):
+        if comp == "M":
+            return i
+    raise MbodyError("--t-end in revolutions needs a driver that turns a joint (an angle "
+                     "or a speed about an axis); this model has none: give the time in "
+                     "seconds")
+
+
+def check_settings(model: Model, settings: Settings) -> None:
+    """Refuse settings the model cannot run, before any case is."""
+    if settings.run not in RUNS:
+        raise MbodyError(f"unknown run {settings.run!r}; expected one of {', '.join(RUNS)}")
+    if settings.run in ("kinematics", "simulate"):
+        if settings.t_end is None and settings.revolutions is None:
+            raise MbodyError(f"the {settings.run} run needs --t-end (seconds, or '1 rev')")
+        if settings.revolutions is not None:
+            turning_driver(model)
+    if settings.run == "kinematics" and settings.steps < 2:
+        raise MbodyError(f"--steps: expected at least 2 instants, got {settings.steps}")
+
+
+# -- a process's sweep: the model, its family, its evaluator, built once ---------------
+
+@dataclass
+class Context:
+    """What one process builds once per sweep (`context`)."""
+
+    job: Job
+    model: Model
+    family: Family
+    evaluator: Evaluator
+    width: int
+    driver: int = -1
+    kin_from: int = 0
+    """Where the entries of F that a fully driven motion depends on start (joints,
+    components, expression numbers: after gravity, bodies, loads and springs)."""
+    cache: dict[str, Any] = field(default_factory=dict)
+
+
+_CONTEXTS: dict[str, Context] = {}
+_KEEP = 2
+
+
+def context(job: Job) -> Context:
+    """This process's `Context` of `job`, built on first use."""
+    ctx = _CONTEXTS.get(job.key)
+    if ctx is None:
+        model = from_source(job.source)
+        cols = columns(model, job.settings)
+        n, k, s = model.n, len(model.forces.names), len(model.springs.names)
+        driver = turning_driver(model) if job.settings.revolutions is not None else -1
+        ctx = Context(job, model, Family(model, job.grid.paths), Evaluator(model), len(cols),
+                      driver, 3 + _core.BODY_W * n + _core.LOAD_W * k + _core.SPRING_W * s)
+        while len(_CONTEXTS) >= _KEEP:
+            _CONTEXTS.pop(next(iter(_CONTEXTS)))
+        _CONTEXTS[job.key] = ctx
+    return ctx
+
+
+def run_chunk(job: Job, indices: Sequence[int]) -> Rows:
+    """Evaluate cases `indices` of `job` (what a worker runs)."""
+    import os
+    import socket
+
+    begin, cpu = time.perf_counter(), time.process_time()
+    ctx = context(job)
+    indices = [int(i) for i in indices]
+    values = [job.grid.values(i) for i in indices]
+    try:
+        outputs, errors = _evaluate(ctx, values)
+    except Exception:  # a bug in one case must not lose the others: each on its own
+        outputs = np.full((len(values), ctx.width), np.nan)
+        errors = []
+        for k, v in enumerate(values):
+            try:
+                out, err = _evaluate(ctx, [v])
+                outputs[k], e = out[0], err[0]
+            except Exception as exc:  # noqa: BLE001 - reported in the case's row
+                e = f"internal error (a bug in mbody; please report it): " \
+                    f"{type(exc).__name__}: {exc}"
+            errors.append(e)
+    for k, e in enumerate(errors):
+        if e is not None:
+            outputs[k] = np.nan
+    return Rows(indices, outputs, errors, time.perf_counter() - begin,
+                f"{socket.gethostname()}:{os.getpid()}", time.process_time() - cpu)
+
+
+def _evaluate(ctx: Context, values: list[dict[str, Any]]) -> tuple[np.ndarray, list]:
+    run = ctx.job.settings.run
+    if run == "solve":
+        return _solve(ctx, values)
+    if run == "kinematics":
+        return _kinematics(ctx, values)
+    if run == "simulate":
+        return _per_model(ctx, values, _simulate)
+    return _per_model(ctx, values, _modes)
+
+
+# -- solve -------------------------------------------------------------------------------
+
+def _solve(ctx: Context, values: list[dict[str, Any]]) -> tuple[np.ndarray, list]:
+    cases = ctx.family.cases(values)
+    out = np.full((len(values), ctx.width), np.nan)
+    errors: list[str | None] = [c.error for c in cases]
+    for ev, ks, F in _groups(ctx, cases):
+        rows = None if F is None else np.arange(len(ks))
+        Y, ok = ev.assemble(np.stack([cases[k].start for k in ks]), F, rows)  # type: ignore
+        res = ev.solve(np.zeros(len(ks)), Y, F, rows)
+        for j, k in enumerate(ks):
+            if not ok[j]:
+                errors[k] = _load_error(ctx, values[k])
+                continue
+            errors[k] = _singular(ev, res[j]) or errors[k]
+            acc = res[j, :ev.N] if ev.plan.rows is None else res[j, :ev.N][ev.plan.rows]
+            out[k] = np.concatenate((acc, res[j, ev.o_lam:ev.o_lam + ev.m]))
+    return out, errors
+
+
+def _groups(ctx: Context, cases: list[Case]
+            ) -> list[tuple[Evaluator, list[int], np.ndarray | None]]:
+    """(evaluator, the cases it evaluates, their F rows or None): the family's structure
+    for the shared cases, and each case of a structure of its own by itself."""
+    out: list[tuple[Evaluator, list[int], np.ndarray | None]] = []
+    shared = [k for k, c in enumerate(cases) if c.shared]
+    if shared:
+        out.append((ctx.evaluator, shared, np.stack([cases[k].F for k in shared])))  # type: ignore
+    for k, c in enumerate(cases):
+        if c.model is not None:
+            ev = Evaluator(c.model)
+            if ev.width == ctx.evaluator.width:
+                out.append((ev, [k], None))
+    return out
+
+
+def _singular(ev: Evaluator, out: np.ndarray) -> str | None:
+    code = int(out[ev.o_info + _core.ST_SINGULAR])
+    if code:
+        return str(singular_mass_error(ev.model, (code - 1) // 6, (code - 1) % 6))
+    return None
+
+
+def _load_error(ctx: Context, values: Mapping[str, Any]) -> str:
+    """The message `mbody.load` gives a case whose joints do not close at t = 0."""
+    try:
+        ctx.model.with_values(values)
+    except MbodyError as exc:
+        return str(exc)
+    return "the joints and drivers do not close at t = 0 with these values"
+
+
+# -- kinematics: a driven mechanism's kinetostatics -------------------------------------
+
+def _end(ctx: Context, case: Case) -> float:
+    s = ctx.job.settings
+    if s.revolutions is None:
+        return float(s.t_end)  # type: ignore[arg-type]
+    rate = float(case.extras[ctx.driver])  # type: ignore[index]
+    if rate == 0.0 or not math.isfinite(rate):
+        raise MbodyError(f"--t-end {s.revolutions:g} rev: the driver does not turn at t = 0 "
+                         f"(its rate is {rate:g} rad/s) with these values")
+    return 2.0 * math.pi * s.revolutions / abs(rate)
+
+
+def _kinematics(ctx: Context, values: list[dict[str, Any]]) -> tuple[np.ndarray, list]:
+    cases = ctx.family.cases(values)
+    out = np.full((len(values), ctx.width), np.nan)
+    errors: list[str | None] = [c.error for c in cases]
+    for ev, ks, F in _groups(ctx, cases):
+        ends: dict[int, float] = {}
+        for k in ks:
+            try:
+                ends[k] = _end(ctx, cases[k])
+            except MbodyError as exc:
+                errors[k] = str(exc)
+        keep = [i for i, k in enumerate(ks) if k in ends]
+        ks = [ks[i] for i in keep]
+        Fk = None if F is None else F[keep]
+        if ks:
+            _kinetostatics(ctx, ev, ks, Fk, cases, values, ends, out, errors)
+    return out, errors
+
+
+def _kinetostatics(ctx: Context, ev: Evaluator, ks: list[int], F: np.ndarray | None,
+                   cases: list[Case], values: list[dict[str, Any]], ends: dict[int, float],
+                   out: np.ndarray, errors: list[str | None]) -> None:
+    """Cases `ks` (F: their rows, or None for a model of its own): each assembled at
+    t = 0, its instants' kinematic analysis (one per distinct motion), then every
+    instant's solve; their final positions and peaks into `out`."""
+    steps = ctx.job.settings.steps
+    Y0, ok = ev.assemble(np.stack([cases[k].start for k in ks]),  # type: ignore[misc]
+                         F, None if F is None else np.arange(len(ks)))
+    motions: dict[bytes, list[int]] = {}
+    for j, k in enumerate(ks):
+        if not ok[j]:
+            errors[k] = _load_error(ctx, values[k])
+            continue
+        key = _motion_key(ctx, ev, None if F is None else F[j], cases[k].start,  # type: ignore
+                          ends[k], j)
+        motions.setdefault(key, []).append(j)
+    per_call = max(1, SOLVE_BLOCK // steps)
+    for js in motions.values():
+        j0 = js[0]
+        t = np.linspace(0.0, ends[ks[j0]], steps)
+        Y = np.ascontiguousarray(np.tile(Y0[j0], (steps, 1)))
+        chain = np.ones(steps, dtype=np.int64)
+        chain[0] = 0
+        info = ev.kinematics(t, Y, None if F is None else F[j0:j0 + 1],
+                             None if F is None else np.zeros(steps, np.int64), chain,
+                             fast=ev.fully_driven, predict=ev.fully_driven)
+        bad = np.flatnonzero(~closed(info))
+        if len(bad):
+            msg = _kinematics_error(ctx, cases[ks[j0]], values[ks[j0]], t, Y, int(bad[0]))
+            for j in js:
+                errors[ks[j]] = msg
+            continue
+        final = final_values(ev.model, Y[-1:])[0]
+        for b in range(0, len(js), per_call):
+            part = js[b:b + per_call]
+            res = ev.peaks(np.tile(t, len(part)), Y, np.tile(np.arange(steps), len(part)),
+                           steps, F, None if F is None else np.repeat(part, steps))
+            rows = np.array([ks[j] for j in part])
+            out[rows] = np.concatenate((np.broadcast_to(final, (len(part), len(final))),
+                                        res[:, :ev.m]), axis=1)
+            for i in np.flatnonzero(res[:, ev.m]):
+                code = int(res[i, ev.m]) - 1
+                errors[rows[i]] = str(singular_mass_error(ev.model, code // 6, code % 6))
+
+
+def _motion_key(ctx: Context, ev: Evaluator, F: np.ndarray | None, start: np.ndarray,
+                end: float, j: int) -> bytes:
+    """What a case's motion depends on: for a fully driven mechanism its joints, drivers
+    and expressions (F from `kin_from` on), the file's pose (the branch it starts on) and
+    the instants; for any other, the case itself (masses and loads move it too)."""
+    if not ev.fully_driven:
+        return f"case {j}".encode()
+    h = hashlib.sha256()
+    if F is not None:
+        h.update(F[ctx.kin_from:].tobytes())
+    h.update(start[:7 * ev.model.n].tobytes())
+    h.update(np.float64(end).tobytes())
+    return h.digest()
+
+
+def _kinematics_error(ctx: Context, case: Case, values: dict[str, Any], t: np.ndarray,
+                      Y: np.ndarray, k: int) -> str:
+    """The message `mbody.kinematics` gives where the loops did not close (instant k)."""
+    try:
+        model = case.model if case.model is not None else ctx.model.with_values(values)
+        start = _state(model, Y[k - 1]) if k > 0 else model.initial
+        kinematics_at(model, float(t[k]), start=start)
+    except MbodyError as exc:
+        return str(exc)
+    return (f"the joints and drivers do not close at t = {t[k]:g} s (the batched analysis "
+            "found no closure where the single one did: report it)")
+
+
+def _state(model: Model, y: np.ndarray) -> State:
+    n = model.n
+    q = y[3 * n:7 * n].reshape(n, 4)
+    return State(y[:3 * n].reshape(n, 3).copy(), q / np.linalg.norm(q, axis=1)[:, None],
+                 y[7 * n:10 * n].reshape(n, 3).copy(), y[10 * n:13 * n].reshape(n, 3).copy())
+
+
+# -- simulate and modes: one model per case ----------------------------------------------
+
+def _per_model(ctx: Context, values: list[dict[str, Any]], one) -> tuple[np.ndarray, list]:
+    cases = ctx.family.cases(values)
+    out = np.full((len(values), ctx.width), np.nan)
+    errors: list[str | None] = [c.error for c in cases]
+    for k, (v, c) in enumerate(zip(values, cases, strict=True)):
+        if c.error is not None:
+            continue
+        try:
+            model = c.model if c.model is not None else ctx.model.with_values(v)
+            row = one(ctx, model, c)
+        except MbodyError as exc:
+            errors[k] = str(exc)
+            continue
+        if len(row) != ctx.width:
+            errors[k] = ("these values change the model's sizes (bodies, reaction "
+                         "components); sweep them apart")
+            continue
+        out[k] = row
+    return out, errors
+
+
+def _simulate(ctx: Context, model: Model, case: Case) -> np.ndarray:
+    traj = simulate(model, t_end=_end(ctx, case), fps=ctx.job.settings.fps)
+    last = traj.state(len(traj.t) - 1)
+    Y = np.concatenate((last.position.ravel(), last.quaternion.ravel()))[None]
+    peaks = np.full(len(model.reactions), np.nan)
+    labels = list(traj.reaction_labels)
+    if labels and traj.reactions.size:
+        where = {r: i for i, r in enumerate(labels)}
+        mags = np.abs(np.asarray(traj.reactions)).max(axis=0)
+        for i, r in enumerate(model.reactions):
+            if r in where:
+                peaks[i] = mags[where[r]]
+    return np.concatenate((final_values(model, Y)[0], peaks))
+
+
+def _modes(ctx: Context, model: Model, case: Case) -> np.ndarray:
+    f = modes.frequencies(model)
+    row = np.full(ctx.width, np.nan)
+    row[:min(len(f), ctx.width)] = f[:ctx.width]
+    return row

@@ -1,0 +1,123 @@
+"""A class graded at once (``mbody verify MODEL answers/*.yaml --summary class.csv``):
+each row is what `verify` says of that file alone; the class's mistakes are counted as
+the rows show them; a file that cannot be read is a row with its problem."""
+
+from __future__ import annotations
+
+import csv
+import io
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+from collections import Counter
+from pathlib import Path
+
+import pytest
+
+import mbody
+from mbody.answers.summary import grade
+from mbody.present.summary import class_summary_html
+
+ROOT = Path(__file__).resolve().parent.parent
+MODEL = ROOT / "models" / "double_pendulum.yaml"
+RIGHT = ["m*a_x = A.Fx", "m*a_y = A.Fy - m*g", "m*a_x = O.Fx - A.Fx",
+         "m*a_y = O.Fy - A.Fy - m*g"]
+BODIES = ["lower", "lower", "upper", "upper"]
+WRONG = {0: ("m*a_x = -A.Fx", "reaction_sign"), 1: ("m*a_y = A.Fy", "missing_applied_load"),
+         2: ("m*a_x = O.Fx + A.Fx", "reaction_sign"), 3: ("m*a_y = O.Fy - m*g",
+                                                         "missing_reaction")}
+CLASS = {  # student -> the equations they got wrong
+    "ana": [], "ben": [2], "chloe": [2, 3], "dev": [0, 1, 2, 3], "eli": [1], "fay": [2]}
+
+
+@pytest.fixture
+def answers(tmp_path) -> list[Path]:
+    files = []
+    for i, (name, wrong) in enumerate(CLASS.items()):
+        eqs = [WRONG[k][0] if k in wrong else RIGHT[k] for k in range(4)]
+        head = [f"student: {name.title()} Example"] if i % 2 == 0 else []
+        lines = head + ["equations:"] + [f'  - {{body: {b}, eq: "{e}"}}'
+                                         for b, e in zip(BODIES, eqs, strict=True)]
+        path = tmp_path / f"{name}.yaml"
+        path.write_text("\n".join(lines) + "\n")
+        files.append(path)
+    bad = tmp_path / "zed.yaml"
+    bad.write_text('equations:\n  - {body: lowr, eq: "m*a_x = A.Fx"}\n')
+    return [*files, bad]
+
+
+def tables(text: str) -> tuple[list[list[str]], list[list[str]]]:
+    rows = list(csv.reader(io.StringIO(text)))
+    blank = rows.index([])
+    return rows[:blank], rows[blank + 1:]
+
+
+def test_each_row_is_what_verify_says_of_that_file(answers):
+    model = mbody.load(MODEL)
+    summary = grade(model, answers)
+    files, mistakes = tables(summary.csv())
+    assert files[0][:4] == ["file", "student", "equations", "correct"]
+    assert files[0][-1] == "error" and files[0][4:-1] == [f"mistake {k}" for k in (1, 2, 3, 4)]
+    for row, path in zip(files[1:], answers, strict=True):
+        assert row[0] == str(path)
+        if path.stem == "zed":
+            assert row[1] == "zed" and row[2:4] == ["0", "0"]
+            assert "no body named 'lowr'" in row[-1] and "did you mean 'lower'" in row[-1]
+            continue
+        alone = mbody.verify(model, path)
+        wrong = CLASS[path.stem]
+        assert row[1] == (alone.student or path.stem)
+        assert row[2:4] == [str(len(alone.checks)), str(4 - len(wrong))]
+        cells = [c for c in row[4:-1] if c]
+        assert cells == [f"{c.diagnosis} (equation {c.index}, {c.row})"
+                         for c in alone.checks if not c.correct]
+        assert [c.split(" (")[0] for c in cells] == [WRONG[k][1] for k in wrong]
+    # the students named in their files keep their names; the others their file's stem
+    assert files[1][1] == "Ana Example" and files[2][1] == "ben"
+    # the class's mistakes: counted from the rows, the most frequent first
+    want = Counter()
+    for wrong in CLASS.values():
+        for k in wrong:
+            want[(WRONG[k][1], ["lower.x", "lower.y", "upper.x", "upper.y"][k])] += 1
+    assert mistakes[0] == ["mistake", "row", "equations", "students", "meaning"]
+    got = {(m[0], m[1]): int(m[2]) for m in mistakes[1:]}
+    assert got == dict(want)
+    counts = [int(m[2]) for m in mistakes[1:]]
+    assert counts == sorted(counts, reverse=True) and counts[0] == 4  # upper.x's sign
+
+
+def test_the_html_summary_is_one_escaped_page(answers):
+    summary = grade(mbody.load(MODEL), answers)
+    page = class_summary_html(summary)
+    assert page.startswith("<!DOCTYPE html>")
+    root = ET.fromstring(page.split("\n", 1)[1])  # well-formed: escaped everywhere
+    text = "".join(root.itertext())
+    assert "Ana Example" in text and "reaction_sign" in text and "lowr" in text
+    assert "The class's most frequent mistakes" in text
+
+
+def run(*argv: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "mbody", *argv], capture_output=True,
+                          text=True, cwd=ROOT, timeout=300)
+
+
+def test_the_command_line(answers, tmp_path):
+    out = tmp_path / "class.csv"
+    p = run("verify", str(MODEL), *map(str, answers), "--summary", str(out))
+    assert p.returncode == 1, p.stderr  # some equations are wrong
+    assert f"wrote {out}" in p.stdout and "7 answers file(s)" in p.stdout
+    assert out.read_text() == grade(mbody.load(MODEL), answers).csv()
+    p = run("verify", str(MODEL), str(answers[0]), "--summary", str(tmp_path / "x.txt"))
+    assert p.returncode == 2 and ".csv or .html" in p.stderr
+    # one file and no summary: the report as before, exit 0 when all is correct
+    p = run("verify", str(MODEL), str(answers[0]))
+    assert p.returncode == 0 and "4 of 4 equations correct" in p.stdout
+    # several files without a summary: each report in turn
+    p = run("verify", str(MODEL), str(answers[0]), str(answers[1]))
+    assert p.returncode == 1 and p.stdout.count("== ") == 2
+    # the output may not be an input (an answers file whose name ends in .csv)
+    odd = tmp_path / "odd.csv"
+    odd.write_text(answers[0].read_text())
+    p = run("verify", str(MODEL), str(odd), "--summary", str(odd))
+    assert p.returncode == 2 and "is the answers file itself" in p.stderr
+    assert odd.read_text() == answers[0].read_text()
