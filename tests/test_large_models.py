@@ -24,7 +24,7 @@ from mbody import joint_types
 from mbody.model import fast
 from mbody.model.loader import load_text
 from mbody.model.model import BodyRecords, Model, Records
-from mbody.model.validate import validate
+from mbody.model.validate import JointSpecTable, validate
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tools"))
@@ -72,10 +72,11 @@ def every_joint_type() -> str:
     return dump(spec)
 
 
-def eager_reaction_table(model: Model) -> dict[str, np.ndarray | tuple[str, ...]]:
+def eager_reaction_table(model: Model, spec=None) -> dict[str, np.ndarray | tuple[str, ...]]:
     """The reaction table's per-component fields as `Model.from_spec` built them before
-    issue 15: per joint, its frame and points at the initial pose (from its record), then
-    one row per component."""
+    issue 15: per joint, its frame and points at the initial pose (from its record; the
+    points the file gives on each body where `spec` has them), then one row per
+    component."""
     js = list(model.joints)
     nj = len(js)
     idx = model.index
@@ -96,6 +97,12 @@ def eager_reaction_table(model: Model) -> dict[str, np.ndarray | tuple[str, ...]
     B_r_parent = np.where(ground[:, None], at, (RpT @ (at - xp)[:, :, None])[:, :, 0])
     axis2 = np.array([j.axis2 if j.axis2 is not None else np.zeros(3) for j in js],
                      dtype=float).reshape(nj, 3)
+    js_spec = None if spec is None else (
+        spec.joint_table if spec.joint_table is not None
+        else JointSpecTable.from_specs(spec.joints, idx))
+    if js_spec is not None and js_spec.body_points is not None:
+        on = js_spec.body_points
+        B_r_child[on], B_r_parent[on] = js_spec.at_child[on], js_spec.at_parent[on]
     C_axis2 = (RcT @ axis2[:, :, None])[:, :, 0]
     p_particle = np.array([j.parent in particle for j in js], dtype=bool)
     c_particle = np.array([j.child in particle for j in js], dtype=bool)
@@ -107,7 +114,9 @@ def eager_reaction_table(model: Model) -> dict[str, np.ndarray | tuple[str, ...]
         P_c = xc + (Rc @ B_r_child[:, :, None])[:, :, 0]
         P_p = np.where(ground[:, None], B_r_parent, xp + (Rp @ B_r_parent[:, :, None])[:, :, 0])
         length[link] = np.linalg.norm((P_c - P_p)[link], axis=1)
-    comps = [j.components for j in js]
+    # the reference predates the helical joint (its coupled component Wz): such a joint's
+    # rows are left out here, and compared by tests/test_new_joint_types.py
+    comps = [j.components if known_joint(j) else () for j in js]
     row_joint = np.repeat(np.arange(nj, dtype=np.intp),
                           np.array([len(cs) for cs in comps], dtype=np.intp))
     axis = np.array([6 if comp == "Mt" else cv.LINK_AXIS if comp == cv.LINK
@@ -117,8 +126,8 @@ def eager_reaction_table(model: Model) -> dict[str, np.ndarray | tuple[str, ...]
                          dtype=bool)[row_joint]
     column = np.where(axis == 6, 2, axis % 3)
     registry = [joint_types.joint_type(model.dimension, j.type) for j in js]
-    parts = [t.particle[j.particle_joint] if j.particle_joint else t.components
-             for t, j in zip(registry, js, strict=True)]
+    parts = [(t.particle[j.particle_joint] if j.particle_joint else t.components)
+             if known_joint(j) else () for t, j in zip(registry, js, strict=True)]
     return {
         "component": np.array([joint_types.COMPONENT_CODE[c.name] for cs in parts
                                for c in cs], dtype=np.intp),
@@ -139,29 +148,45 @@ def eager_reaction_table(model: Model) -> dict[str, np.ndarray | tuple[str, ...]
     }
 
 
+def known_joint(j) -> bool:
+    """Whether the eager reference knows every component of joint record `j`."""
+    return all(c in cv.COMPONENTS or c in ("Mt", cv.LINK) for c in j.components)
+
+
 def same_bits(a, b) -> bool:
     a, b = np.asarray(a), np.asarray(b)
     return a.dtype == b.dtype and a.shape == b.shape and a.tobytes() == b.tobytes()
 
 
-def assert_derived_equal_eager(model: Model) -> None:
+def assert_derived_equal_eager(model: Model, spec=None) -> None:
     rt = model.reaction_table
     assert not set(rt.DERIVED) & set(vars(rt))  # nothing derived before it is asked for
-    old = eager_reaction_table(model)
+    old = eager_reaction_table(model, spec)
     assert set(old) == {"joint", "component", "kind", "frame_axis", *rt.DERIVED}
+    # the joints' rows the reference knows; the drivers' efforts come last, after them
+    known = np.array([known_joint(j) for j in model.joints], dtype=bool)
+    m, nd = len(rt.joint), len(rt.driver_names)
+    rows = np.flatnonzero(known[rt.joint] & (np.arange(m) < m - nd))
     for k, v in old.items():
         if k == "labels":
-            assert getattr(rt, k) == v
+            assert tuple(rt.labels[i] for i in rows) == v
         else:
-            assert same_bits(getattr(rt, k), v), k
+            assert same_bits(np.asarray(getattr(rt, k))[rows], v), k
+    # each driver's effort: on its joint, named <driver>.M or .F, a moment for an angle
+    d = model.drivers
+    for i, name in enumerate(rt.driver_names):
+        r = m - nd + i
+        assert name == d.names[i] and rt.joint[r] == d.joint[i]
+        assert rt.labels[r] == f"{name}.{d.component[i]}"
+        assert bool(rt.is_moment[r]) == (d.component[i] == "M")
     # the joint table as it was picked back out of the reaction table
     first = (np.unique(old["joint"], return_index=True)[1] if len(old["joint"])
              else np.zeros(0, int))
     jt = model.joint_table
     for k in ("parent", "child", "B_r_child", "B_r_parent", "P_E3", "C_E3", "C_axis2", "link",
               "particle_parent", "length"):
-        assert same_bits(getattr(jt, k), np.asarray(old[k])[first]), k
-    assert same_bits(jt.first, first)
+        assert same_bits(np.asarray(getattr(jt, k))[known], np.asarray(old[k])[first]), k
+    assert same_bits(np.asarray(jt.first)[known], rows[first])
     assert jt.names == tuple(j.name for j in model.joints)
 
 
@@ -175,11 +200,12 @@ def texts() -> list[tuple[str, str]]:
 @pytest.mark.parametrize("name, text", texts(), ids=lambda x: x if len(x) < 40 else "")
 def test_derived_reaction_table_equals_the_eager_one(name, text, monkeypatch):
     """Through the located path, and the fast path wherever it reads the file."""
-    assert_derived_equal_eager(Model.from_spec(validate(load_text(text, "m.yaml"))))
+    spec = validate(load_text(text, "m.yaml"))
+    assert_derived_equal_eager(Model.from_spec(spec), spec)
     monkeypatch.setattr(fast, "MIN_BYTES", 0)
     spec = fast.fast_spec(text, "m.yaml")
     if spec is not None:
-        assert_derived_equal_eager(Model.from_spec(spec))
+        assert_derived_equal_eager(Model.from_spec(spec), spec)
 
 
 def test_the_generated_files_take_the_fast_path_and_match_the_located_one(monkeypatch):
