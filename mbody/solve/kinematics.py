@@ -42,6 +42,12 @@ class KinematicsError(MbodyError):
     driver past a dead centre, links too short), named with its distance left."""
 
 
+class AssemblyError(ModelError, KinematicsError):
+    """A model file whose joints and drivers cannot all close at t = 0 (`mbody.load`): a
+    problem of the file (a `ModelError`, located at its first driver's entry when it has
+    drivers), and a `KinematicsError`."""
+
+
 def kinematics(model: Model, t: float = 0.0, *, start: State | None = None) -> State:
     """The positions and velocities that close every joint and driver at time `t`.
 
@@ -178,5 +184,16 @@ def assembled(model: Model) -> Model:
     if not needs or not len(model.reactions):
         return model
     check_drivers(model)
-    state = kinematics(model, 0.0)
+    try:
+        state = kinematics(model, 0.0)
+    except KinematicsError as exc:
+        drivers = model.drivers
+        if drivers is not None and len(drivers):
+            (line, col), key = drivers.where[0], "drivers[0]"
+        else:
+            (line, col), key = (0, 0), "joints"
+        raise AssemblyError([Issue(
+            model.file, line, col, key, str(exc),
+            "check the joints' points on each body and the drivers' values at t = 0")]
+        ) from None
     return dataclasses.replace(model, initial=state, file_state=model.initial)
