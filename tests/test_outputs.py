@@ -282,9 +282,11 @@ def test_every_command_that_writes_has_force():
 
     sub = next(a for a in build_parser()._actions if a.dest == "command")
     writing = {name for name, p in sub.choices.items()
-               if any(a.dest in ("output", "latex", "csv") for a in p._actions)}
+               if any(a.dest in ("output", "latex", "csv", "summary", "picture")
+                      for a in p._actions)}
     assert writing == {"simulate", "plot", "fbd", "graph", "report", "animate", "export",
-                       "assemble", "convert", "kinematics"}
+                       "assemble", "convert", "kinematics", "lagrange", "modes", "sweep",
+                       "verify"}
     for name in writing:
         assert "--force" in sub.choices[name]._option_string_actions, name
 

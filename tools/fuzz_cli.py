@@ -77,9 +77,10 @@ ACCEPTED, CLEAN, CRASH, HANG = fuzz.ACCEPTED, fuzz.CLEAN, fuzz.CRASH, fuzz.HANG
 Outcome = fuzz.Outcome
 
 COMMANDS = ("check", "assemble", "solve", "export", "simulate", "plot", "fbd", "graph",
-            "report", "animate", "jacobian", "verify", "convert")
+            "report", "animate", "jacobian", "verify", "convert", "kinematics",
+            "equilibrium", "lagrange", "modes", "sweep")
 """The commands (a test keeps this equal to the parser's), for the report's rows."""
-NOT_FUZZED = {"--live", "--progress", "--help", "-h"}
+NOT_FUZZED = {"--live", "--progress", "--help", "-h", "--scheduler"}
 """Options never chosen (see the module's text)."""
 
 # -- the fixtures of a case's folder ------------------------------------------------------------
@@ -87,11 +88,12 @@ NOT_FUZZED = {"--live", "--progress", "--help", "-h"}
 FIXTURES = {"m.yaml": "pendulum.yaml", "sc.yaml": "slider_crank.yaml",
             "top.yaml": "heavy_top.yaml", "seed.yaml": "seed_example_1.yaml",
             "arm.xml": "robots/two_link_arm.xml", "arm.urdf": "robots/two_link_arm.urdf",
-            "ans.yaml": "answers/pendulum.yaml", "名.yaml": "pendulum.yaml"}
+            "ans.yaml": "answers/pendulum.yaml", "名.yaml": "pendulum.yaml",
+            "d.yaml": "slider_crank_driven.yaml"}
 """Case-folder name -> shipped file copied there."""
 
 MODEL_PATHS = ["m.yaml", "m.yaml", "sc.yaml", "top.yaml", "seed.yaml", "arm.xml", "arm.urdf",
-               "名.yaml", "link.yaml"]
+               "名.yaml", "link.yaml", "d.yaml", "d.yaml"]
 RUN_PATHS = ["run.npz", "run.npz", "sc.npz"]
 ODD_PATHS = ["dir", "fifo", "dangling.yaml", "missing.yaml", "empty.yaml", "bin.yaml",
              "/dev/null", "/dev/zero", "/dev/full", "sub/../m.yaml", "", " ", "m.yaml/x",
@@ -99,7 +101,7 @@ ODD_PATHS = ["dir", "fifo", "dangling.yaml", "missing.yaml", "empty.yaml", "bin.
 OUTPUTS = ["out.npz", "out.json", "out.mat", "out.svg", "out.png", "out.pdf", "out.html",
            "out.tex", "out.xml", "out.yaml", "out.gif", "out", "new/deep/out.json",
            "new/deep/out.svg", "pics", "名.svg", "x" * 300 + ".svg", "y" * 250 + ".json",
-           "OUT.SVG", ".svg"]
+           "OUT.SVG", ".svg", "out.csv", "out.parquet"]
 NUMBERS = ["0", "-0", "1", "-1", "0.5", "2", "3", "5", "10", "60", "72", "150", "600",
            "601", "1e-300", "5e-324", "1e-13", "1e-14", "0.49", "0.5", "0.51", "1e6",
            "1e9", "1e15", "1e308", "1e309", "1e400", "-1e400", "inf", "-inf", "nan", "NaN",
@@ -132,9 +134,21 @@ TEXT = {"view": ["iso", "front", "top", "side", "30,-60", "90,0", "-90,180", "na
         "method": ["DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA", "rk45", "Euler", ""],
         "keyframe": ["initial", "home", "", "杆", "x" * 500],
         "max_bytes": ["1", "10", "100", "1k", "64k", "200M", "1G", "0", "-1", "1e3", "1.5G",
-                      "99999999999999999999G", "abc", "", "2 M", "5MiB"]}
+                      "99999999999999999999G", "abc", "", "2 M", "5MiB"],
+        "point": ["P=crank:0.05,0", "P=rod:0,0", "Q=piston:0,0", "P=rood:0,0", "P=crank:1",
+                  "=crank:0,0", "P=crank:nan,0", "P", "P=crank:1e400,0", "P=ground:0,0"],
+        "set_values": ["bodies.rod.mass=2", "bodies.rod.mas=2", "gravity.1=-1.6",
+                       "bodies.rod.mass=-1", "bodies.rod.mass=1:20", "x=1",
+                       "bodies.rod.mass", "drivers.motor.speed=100 rpm",
+                       "bodies.rod.position.5=1", "bodies.rod.mass=1e400"],
+        "grid": ["bodies.rod.mass=1:2:3", "bodies.rod.mass=1:2:0", "bodies.rod.mass=1,2",
+                 "bodies.rod.mas=1:2:2", "gravity.1=-9.81:-1.6:2", "bodies.rod.mass=1:2:1e9",
+                 "drivers.motor.speed=100:600:2", "bodies.crank.mass=0.2:0.6:2", "x"],
+        "coordinates": ["O", "O.turn", "rod.theta", "x", "", "O,O"],
+        "against": ["time", "motor", "O", "bogus", ""]}
 CHOICE_WRONG = ["png", "svg", "pdf", "gif", "yml", "xml", "YAML", "", "mjcf ", "json"]
-WEIGHTS = {"animate": 0.6, "plot": 0.5, "fbd": 0.8, "report": 0.8}
+WEIGHTS = {"animate": 0.6, "plot": 0.5, "fbd": 0.8, "report": 0.8, "sweep": 0.5,
+           "lagrange": 0.6}
 """How often a command is chosen (1 by default): those whose accepted runs take a tenth
 of a second or more, less often."""
 UNKNOWN = ["--bogus", "--forse", "-x", "--format=", "--t_end", "--", "-", "--json=1",
@@ -260,6 +274,8 @@ def make_case(seed: int, index: int, commands: dict[str, argparse.ArgumentParser
         argv += ["--t-end", rng.choice(LIGHT["t_end"])]
     if name == "simulate" and "max_wall" not in given:
         argv += ["--max-wall", "5"]
+    if name == "sweep" and "workers" not in given:
+        argv += ["--workers", "0"]  # in this process: a local cluster per case is slow
     if rng.random() < 0.04:
         argv.insert(rng.randrange(1, len(argv) + 1), rng.choice(UNKNOWN))
     if rng.random() < 0.03:

@@ -77,7 +77,8 @@ def build_parser() -> argparse.ArgumentParser:
 INPUTS = {"model": "the model", "source": "the input", "trajectory": "the run file",
           "answers": "the answers file", "state": "the run file"}
 """Argument destinations that name a file a command reads, and how a message calls it."""
-OUTPUTS = {"output": "-o", "latex": "--latex", "csv": "--csv", "summary": "--summary"}
+OUTPUTS = {"output": "-o", "latex": "--latex", "csv": "--csv", "summary": "--summary",
+           "picture": "--picture"}
 """Argument destinations that name a file (or folder) a command writes, and its option."""
 
 

@@ -49,9 +49,9 @@ def equilibrium(a: argparse.Namespace) -> int:
         return EXIT_OK if found.found else EXIT_UNMET
     print(f"{model.name!r}: {found}")
     if not found.found:
-        print("hint: start from a pose nearer the equilibrium (the file's positions), or "
-              "check that the loads can balance (a constant torque on a free wheel never "
-              "does)", file=sys.stderr)
+        print("mbody: cannot solve: no equilibrium from the file's pose; start from a pose "
+              "nearer one (the file's positions), or check that the loads can balance (a "
+              "constant torque on a free wheel never does)", file=sys.stderr)
         return EXIT_UNMET
     print(pose_text(model, state))
     if len(found.stiffness):

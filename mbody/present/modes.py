@@ -25,6 +25,9 @@ def _eigenvalue(m: Mode) -> str:
 
 def verdict(lin: Linearization) -> str:
     """One line: stable, unstable (which mode grows, its time constant) or no verdict."""
+    if not len(lin.coordinates):
+        return ("no free coordinate: the drivers prescribe every degree of freedom, so "
+                "nothing oscillates about this motion (mbody kinematics MODEL gives it)")
     if lin.stable is None:
         return ("no verdict: the state is not an equilibrium or a steady motion; the "
                 "eigenvalues are those of the tangent system at this instant (mbody modes "
