@@ -46,13 +46,15 @@ def equilibrium(a: argparse.Namespace) -> int:
             "bodies": list(model.body_names),
             "reactions": dict(sol.reactions) if sol else {},
             "reaction_axes": a.axes}, sys.stdout)
-        return EXIT_OK if found.found else EXIT_UNMET
-    print(f"{model.name!r}: {found}")
+    else:
+        print(f"{model.name!r}: {found}")
     if not found.found:
         print("mbody: cannot solve: no equilibrium from the file's pose; start from a pose "
               "nearer one (the file's positions), or check that the loads can balance (a "
               "constant torque on a free wheel never does)", file=sys.stderr)
         return EXIT_UNMET
+    if a.json:
+        return EXIT_OK
     print(pose_text(model, state))
     if len(found.stiffness):
         print("stiffness eigenvalues, M^-1 K: the squared frequencies of small oscillations "
