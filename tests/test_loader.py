@@ -512,3 +512,18 @@ def test_model_from_a_pipe(tmp_path):
         assert mbody.load(fifo).mass.tolist() == [10.0]
     finally:
         writer.join(timeout=5)
+
+
+def test_a_missing_file_names_the_nearest_one_beside_it(tmp_path):
+    """A misspelt model file: the file of the same suffix whose name is nearest, with its
+    folder (nothing when no name is near: '.yaml' alone does not make two names alike)."""
+    (tmp_path / "slider_crank_driven.yaml").write_text("x")
+    (tmp_path / "scotch_yoke.yaml").write_text("x")
+    with pytest.raises(ModelError) as err:
+        mbody.load(tmp_path / "slider_crank_drive.yaml")
+    (i,) = err.value.issues
+    assert i.message == "no such file"
+    assert i.hint == f"did you mean '{tmp_path / 'slider_crank_driven.yaml'}'?"
+    with pytest.raises(ModelError) as err:
+        mbody.load(tmp_path / "nothing_like_it.yaml")
+    assert err.value.issues[0].hint == ""

@@ -439,3 +439,25 @@ def test_simulate_rows_are_the_cases_simulated_one_by_one(tmp_path):
     assert np.abs(finals - finals[0]).max() <= 1e-12
     loads = np.array([floats(r[5:-1]) for r in rows])
     assert np.allclose(loads / loads[0], np.array([[1.0], [2.0], [3.0]]), rtol=1e-9)
+
+
+def test_what_a_newcomer_got_wrong_is_refused_or_said(tmp_path):
+    """A kinematics sweep of a model that is not fully driven is refused as `mbody
+    kinematics` refuses it (it had given rows of a pendulum that never moved); a range
+    of count 1 across two values is refused (it had run START alone); a sweep where every
+    case fails exits 1 with the first case's message."""
+    def sweep(*args):
+        return subprocess.run([sys.executable, "-m", "mbody", "sweep", *args, "--workers", "0",
+                               "--quiet"], capture_output=True, text=True, cwd=tmp_path)
+
+    p = sweep(str(ROOT / "models" / "double_pendulum.yaml"), "--set",
+              "bodies.upper.mass=1:2:2", "--run", "kinematics", "--t-end", "0.1", "--out",
+              "y.csv")
+    assert p.returncode == 2 and "is not fully driven" in p.stderr
+    assert not (tmp_path / "y.csv").exists()
+    p = sweep(str(SLIDER), "--set", "bodies.rod.mass=0.4:0.8:1", "--out", "z.csv")
+    assert p.returncode == 2 and "a count of 1 is one value" in p.stderr
+    p = sweep(str(SLIDER), "--set", "joints.P.axis=0:1:2", "--out", "f.csv")
+    assert p.returncode == 1 and "every case failed; case 0:" in p.stderr
+    header, rows = read(tmp_path / "f.csv")
+    assert len(rows) == 2 and all(r[header.index("error")] for r in rows)

@@ -7,7 +7,7 @@ import re
 import sys
 import uuid
 
-from mbody.cli.common import EXIT_OK, MODEL_HELP, bounded, load_model, output_stream
+from mbody.cli.common import EXIT_OK, EXIT_UNMET, MODEL_HELP, bounded, load_model, output_stream
 from mbody.errors import MbodyError
 
 RUN_NAMES = ("solve", "kinematics", "simulate", "modes")
@@ -116,4 +116,9 @@ def sweep(a: argparse.Namespace) -> int:
           + (f", {failed} failed (see their error column)" if failed else ""), file=say)
     if todo:
         print(report.text(), file=say)
+    if results.rows and failed == len(results.rows):  # nothing computed: say so, exit 1
+        first = results.rows[min(results.rows)][-1]
+        sys.stderr.write(f"mbody: cannot solve: every case failed; case {min(results.rows)}: "
+                         f"{first}\n")
+        return EXIT_UNMET
     return EXIT_OK

@@ -48,7 +48,7 @@ from yaml.events import (
     StreamEndEvent,
 )
 
-from mbody.errors import Issue, ModelError
+from mbody.errors import Issue, ModelError, did_you_mean
 
 # libyaml keeps line marks and is many times faster than the pure-Python parser
 _Loader: type[yaml.SafeLoader] | type[yaml.CSafeLoader] = getattr(
@@ -372,6 +372,23 @@ def _size(n: int) -> str:
     return mib if n >= 2**20 else f"{mib} ({n:,} bytes)"
 
 
+def _near_file(path: Path, most: int = 2000) -> str:
+    """A did-you-mean among the files beside a missing `path` (at most `most` entries of
+    its folder are looked at: a huge folder costs no more), or ''."""
+    try:
+        with os.scandir(path.parent) as entries:
+            names = [e.name for _, e in zip(range(most), entries, strict=False)]
+    except OSError:
+        return ""
+    # names compared without the suffix they share (".yaml" would make any two alike)
+    stems = {Path(n).stem: n for n in names if Path(n).suffix == path.suffix}
+    close = did_you_mean(path.stem, stems)
+    if not close:
+        return ""
+    found = path.parent / stems[close.split("'")[1]]
+    return f"did you mean '{found}'?"
+
+
 def read_file(path: str | os.PathLike[str], max_bytes: int | None = None) -> str:
     """The text of a model file, refusing files over `max_bytes` before reading them.
 
@@ -386,13 +403,13 @@ def read_file(path: str | os.PathLike[str], max_bytes: int | None = None) -> str
     p = Path(path)
     name = str(path)
 
-    def refuse(message: str) -> ModelError:
-        return ModelError([Issue(name, 0, 0, "", message)])
+    def refuse(message: str, hint: str = "") -> ModelError:
+        return ModelError([Issue(name, 0, 0, "", message, hint)])
 
     try:
         st = os.stat(p)
     except FileNotFoundError:
-        raise refuse("no such file") from None
+        raise refuse("no such file", _near_file(p)) from None
     except OSError as exc:
         raise refuse(f"cannot read the file: {exc.strerror}") from None
     kind = _file_kind(st.st_mode)

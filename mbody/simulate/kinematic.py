@@ -82,6 +82,19 @@ def fully_driven(model: Model) -> bool:
     return d is not None and len(d.names) > 0 and freedom(model) == 0
 
 
+def require_fully_driven(model: Model) -> None:
+    """Refuse (`MbodyError`) a mechanism whose drivers leave degrees of freedom: their
+    motion follows from the forces, and only an integration (`mbody.simulate`) finds it."""
+    free = freedom(model)
+    if free:
+        d = model.drivers
+        have = len(d.names) if d is not None else 0
+        raise MbodyError(f"{model.name!r} is not fully driven: its {have} driver(s) leave "
+                         f"{free} degree(s) of freedom, whose motion follows from the "
+                         "forces; integrate it with mbody simulate (mbody.simulate), which "
+                         "follows the drivers and integrates the rest")
+
+
 def kinematic_run(model: Model, t_end: float, fps: float, *, t_start: float = 0.0,
                   points: BodyPoints | None = None, axes: str = "joint") -> Trajectory:
     """The motion the drivers impose over [t_start, t_end], sampled at `fps`, with the
@@ -118,14 +131,7 @@ def kinematic_run(model: Model, t_end: float, fps: float, *, t_start: float = 0.
     """
     check_axes(axes)
     t = sample_times(t_end, fps, t_start)
-    free = freedom(model)
-    if free:
-        d = model.drivers
-        have = len(d.names) if d is not None else 0
-        raise MbodyError(f"{model.name!r} is not fully driven: its {have} driver(s) leave "
-                         f"{free} degree(s) of freedom, whose motion follows from the "
-                         "forces; integrate it with mbody simulate (mbody.simulate), which "
-                         "follows the drivers and integrates the rest")
+    require_fully_driven(model)
     ws = workspace(model)
     unknowns = ws.file_unknowns
     plan = ws.solve_plan(unknowns)

@@ -68,12 +68,23 @@ class Equilibrium:
         if not self.found:
             return (f"no equilibrium found in {self.iterations} Newton steps (the "
                     f"generalized forces fell to {self.residual:.2g} of their terms at best)")
-        verdict = {True: "stable (the stiffness is positive definite)",
-                   False: "unstable (the stiffness has a negative direction)",
-                   None: "neutral to the accuracy of the differences (a zero stiffness)"}
+        k = self.stiffness
+        if not len(k):
+            verdict = ("no free coordinate (the drivers prescribe every degree of freedom): "
+                       "nothing to be stable or unstable")
+        elif self.stable is False:
+            verdict = "unstable (the stiffness has a negative direction)"
+        elif self.stable is None:
+            verdict = "neutral to the accuracy of the differences (a zero stiffness)"
+        elif (k > 0).all():
+            verdict = "stable (the stiffness is positive definite)"
+        else:  # no growing mode, but directions of zero stiffness: free or cyclic motions
+            zero = int((k <= 0).sum())
+            verdict = (f"neutrally stable: no direction falls away, {zero} of the "
+                       f"{len(k)} have no stiffness (a free or cyclic motion)")
         return (f"equilibrium found in {self.iterations} Newton steps: bodies moved up to "
                 f"{self.moved[0]:.4g} m and turned up to {np.degrees(self.moved[1]):.4g} deg "
-                f"from the start; {verdict[self.stable]}")
+                f"from the start; {verdict}")
 
 
 def held(model: Model, t: float) -> Model:

@@ -241,4 +241,8 @@ def _range(path: str, text: str, random: bool) -> Axis:
                              f"number (a range is {form})") from None
         if count < 1:
             raise MbodyError(f"--set {path}: expected a count of at least 1, got {count}")
+        if count == 1 and ends[0] != ends[1]:  # one value cannot span both ends
+            raise MbodyError(f"--set {path}: a count of 1 is one value, and {parts[0].strip()}"
+                             f" and {parts[1].strip()} are two; give a count of 2 or more, or "
+                             f"the value alone (--set {path}={parts[0].strip()})")
     return Axis(path, (ends[0], ends[1]), count, units[0])

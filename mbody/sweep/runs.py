@@ -40,6 +40,7 @@ from mbody.errors import MbodyError
 from mbody.kernel import _core
 from mbody.model.model import Model, State, from_source
 from mbody.model.source import Source
+from mbody.simulate.kinematic import require_fully_driven
 from mbody.simulate.simulation import simulate
 from mbody.solve.batch import Evaluator, closed
 from mbody.solve.family import Case, Family
@@ -160,6 +161,8 @@ def check_settings(model: Model, settings: Settings) -> None:
             turning_driver(model)
     if settings.run == "kinematics" and settings.steps < 2:
         raise MbodyError(f"--steps: expected at least 2 instants, got {settings.steps}")
+    if settings.run == "kinematics":  # as `mbody kinematics` refuses it (--run simulate)
+        require_fully_driven(model)
 
 
 # -- a process's sweep: the model, its family, its evaluator, built once ---------------
