@@ -88,22 +88,35 @@ def _options(command: argparse.ArgumentParser, dest: str) -> list[str]:
             for a in command._actions if a.dest == dest]
 
 
+def _subcommand(parser: argparse.ArgumentParser,
+                args: argparse.Namespace) -> argparse.ArgumentParser | None:
+    """The parser of the command `args` were read by."""
+    sub = next((a for a in parser._actions if a.dest == "command"), None)
+    choices = getattr(sub, "choices", None) or {}
+    return choices.get(getattr(args, "command", None))
+
+
 def _paths(value: object) -> list[str]:
     values = value if isinstance(value, list) else [value]
     return [v for v in values if isinstance(v, str) and v and v != "-"]
 
 
-def check_paths(args: argparse.Namespace) -> None:
+def check_paths(args: argparse.Namespace,
+                command: argparse.ArgumentParser | None = None) -> None:
     """Refuse an empty file name (an output '' would be no output, or the current folder;
     an input '' the current folder), then an output of the command that is one of its
-    input files, unless --force (`mbody.cli.common.refuse_overwriting_inputs`)."""
+    input files, unless --force (`mbody.cli.common.refuse_overwriting_inputs`). An output
+    is named by `command`'s own first option for it (sweep's ``--out``), else OUTPUTS'."""
     for dest, what in (*OUTPUTS.items(), *INPUTS.items()):
         values = getattr(args, dest, None)
         if "" in (values if isinstance(values, list) else [values]):
             raise MbodyError(f"an empty name for {what}; give a file name")
     inputs = [(INPUTS[dest], p) for dest in INPUTS for p in _paths(getattr(args, dest, None))]
-    outputs = [(flag, p) for dest, flag in OUTPUTS.items()
-               for p in _paths(getattr(args, dest, None))]
+    def flag(dest: str) -> str:
+        own = _options(command, dest) if command is not None else []
+        return own[0] if own else OUTPUTS[dest]
+
+    outputs = [(flag(dest), p) for dest in OUTPUTS for p in _paths(getattr(args, dest, None))]
     refuse_overwriting_inputs(outputs, inputs, getattr(args, "force", False))
 
 
@@ -146,7 +159,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     out = _Stdout(sys.stdout)
     sys.stdout = out
     try:
-        check_paths(args)
+        check_paths(args, _subcommand(parser, args))
         with max_bytes_limit(getattr(args, "max_bytes", None)):
             code = args.run(args)
         out.flush()  # a full device is reported here, not at exit

@@ -63,6 +63,7 @@ void mb_rotations(int64_t n, const double *q, double *R);
 void mb_minv(const double *body, const double *g, double *out);
 void mb_body_point(int64_t body, const double *r, const double *x, const double *R,
                    const double *v, const double *w, double *P, double *V);
+void mb_turn_exact(double *q, const double *th);
 
 static inline void mb_cross(const double *a, const double *b, double *out) {
     double o0 = a[1] * b[2] - a[2] * b[1], o1 = a[2] * b[0] - a[0] * b[2],

@@ -33,17 +33,7 @@ static void predict(const mb_model *md, double *y, const double *acc, double dt)
         }
         /* q <- q (x) (cos |th|/2, sin |th|/2 th/|th|): the exact turn, so that a planar
          * body's angle (y[13 n + i], carried beside q) stays q's own angle */
-        double ang = sqrt(th[0] * th[0] + th[1] * th[1] + th[2] * th[2]);
-        double c = cos(0.5 * ang), f = ang > 0.0 ? sin(0.5 * ang) / ang : 0.5;
-        double p0 = f * th[0], p1 = f * th[1], p2 = f * th[2];
-        double *qi = q + 4 * i;
-        double qw = qi[0], qx = qi[1], qy = qi[2], qz = qi[3];
-        double nw = c * qw - qx * p0 - qy * p1 - qz * p2;
-        double nx = c * qx + qw * p0 + qy * p2 - qz * p1;
-        double ny = c * qy + qw * p1 + qz * p0 - qx * p2;
-        double nz = c * qz + qw * p2 + qx * p1 - qy * p0;
-        double s = 1.0 / sqrt(nw * nw + nx * nx + ny * ny + nz * nz);
-        qi[0] = nw * s, qi[1] = nx * s, qi[2] = ny * s, qi[3] = nz * s;
+        mb_turn_exact(q + 4 * i, th);
         if (md->planar) y[13 * n + i] += th[2];
     }
 }

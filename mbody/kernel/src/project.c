@@ -127,16 +127,7 @@ void mb_predict(const mb_model *md, double *y, double dt) {
         }
         for (int a = 0; a < 3; a++) x[a] += d[a];
         /* the exact rotation by w dt (body axes) rather than move()'s first-order one */
-        double th = sqrt(d[3] * d[3] + d[4] * d[4] + d[5] * d[5]);
-        double c = cos(0.5 * th), s = th > 0.0 ? sin(0.5 * th) / th : 0.5;
-        double p0 = s * d[3], p1 = s * d[4], p2 = s * d[5];
-        double qw = qi[0], qx = qi[1], qy = qi[2], qz = qi[3];
-        double nw = c * qw - qx * p0 - qy * p1 - qz * p2;
-        double nx = c * qx + qw * p0 + qy * p2 - qz * p1;
-        double ny = c * qy + qw * p1 + qz * p0 - qx * p2;
-        double nz = c * qz + qw * p2 + qx * p1 - qy * p0;
-        double r = 1.0 / sqrt(nw * nw + nx * nx + ny * ny + nz * nz);
-        qi[0] = nw * r, qi[1] = nx * r, qi[2] = ny * r, qi[3] = nz * r;
+        mb_turn_exact(qi, d + 3);
         if (md->planar) y[13 * n + i] += d[5];
     }
 }

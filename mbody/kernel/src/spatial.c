@@ -51,3 +51,18 @@ void mb_body_point(int64_t body, const double *r, const double *x, const double 
         V[a] = v[3 * body + a] + Rb[3 * a] * c[0] + Rb[3 * a + 1] * c[1] + Rb[3 * a + 2] * c[2];
     }
 }
+
+/* q <- q (x) (cos |th|/2, sin |th|/2 th/|th|), normalised: the body turned exactly by the
+ * rotation vector th (body axes), not to first order. */
+void mb_turn_exact(double *q, const double *th) {
+    double ang = sqrt(th[0] * th[0] + th[1] * th[1] + th[2] * th[2]);
+    double c = cos(0.5 * ang), f = ang > 0.0 ? sin(0.5 * ang) / ang : 0.5;
+    double p0 = f * th[0], p1 = f * th[1], p2 = f * th[2];
+    double qw = q[0], qx = q[1], qy = q[2], qz = q[3];
+    double nw = c * qw - qx * p0 - qy * p1 - qz * p2;
+    double nx = c * qx + qw * p0 + qy * p2 - qz * p1;
+    double ny = c * qy + qw * p1 + qz * p0 - qx * p2;
+    double nz = c * qz + qw * p2 + qx * p1 - qy * p0;
+    double s = 1.0 / sqrt(nw * nw + nx * nx + ny * ny + nz * nz);
+    q[0] = nw * s, q[1] = nx * s, q[2] = ny * s, q[3] = nz * s;
+}
