@@ -64,6 +64,19 @@ def test_a_display_hook_may_import_the_presentation_layer(tmp_path, monkeypatch,
     assert "imports mbody.present by a string" in capsys.readouterr().out
 
 
+def test_the_package_does_not_import_its_own_old_paths(tmp_path, monkeypatch, capsys):
+    """An alias kept for users' code warns on import: inside mbody it is refused (a
+    command importing mbody.io.jsontext had failed under warnings as errors)."""
+    files = {"_moved.py": 'MOVED = {"io.jsontext": "util.jsontext"}\n',
+             "util/__init__.py": "", "util/jsontext.py": "",
+             "cli.py": "def run():\n    from mbody.io import jsontext\n    return jsontext\n"}
+    assert _planted(tmp_path, monkeypatch, files) == 1
+    assert ("mbody/cli.py:2: mbody.cli imports mbody.io.jsontext, an old path: use "
+            "mbody.util.jsontext") in capsys.readouterr().out
+    files["cli.py"] = files["cli.py"].replace("mbody.io import", "mbody.util import")
+    assert _planted(tmp_path, monkeypatch, files) == 0
+
+
 @pytest.mark.parametrize("old, new", [("dynamics", "solve.dynamics"),
                                       ("validate", "model.validate"),
                                       ("commands.sim", "cli.sim"),

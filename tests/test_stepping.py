@@ -136,7 +136,10 @@ def test_filtered_steps_in_c_equal_the_python_callbacks():
     while ref.status == "running":
         _step_for_step_once(ours, ref)
         filtered += int(ref.state[mbody.kernel._core.DOP_FILTER])
-    assert filtered >= 3  # the crossing was stepped through filtered steps
+    # the crossing was stepped through filtered steps, so that the comparison covers them
+    # (how many depends on rounding at the flat position: 3 with OpenBLAS's SkylakeX
+    # kernels, 2 with its Haswell ones; each is compared above, value for value)
+    assert filtered >= 1
     assert ours.steps == ref.steps and ours.nfev == ref.nfev
 
 

@@ -151,6 +151,42 @@ def imports(modules: dict[str, Path], slow: dict[str, bool],
     return out
 
 
+def old_paths(modules: dict[str, Path]) -> list[str]:
+    """Imports inside the package of a path that has moved (`mbody._moved.MOVED`: an
+    alias kept for users' code, which warns on import): the package uses the new homes."""
+    moved = _moved_paths()
+    out = []
+    for name, path in modules.items():
+        if name == "mbody._moved":
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Import):
+                full = [a.name for a in node.names]
+            elif isinstance(node, ast.ImportFrom) and node.module and not node.level:
+                full = [node.module] + [f"{node.module}.{a.name}" for a in node.names]
+            else:
+                continue
+            for f in full:
+                old = f.removeprefix("mbody.")
+                if f.startswith("mbody.") and old in moved:
+                    out.append(f"{path.relative_to(ROOT)}:{node.lineno}: {name} imports "
+                               f"{f}, an old path: use mbody.{moved[old]}")
+    return out
+
+
+def _moved_paths() -> dict[str, str]:
+    """`mbody._moved.MOVED`, read from its source (importing mbody is not needed)."""
+    path = PACKAGE / "_moved.py"
+    if not path.exists():
+        return {}
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    for node in tree.body:
+        if isinstance(node, ast.Assign) and any(
+                isinstance(t, ast.Name) and t.id == "MOVED" for t in node.targets):
+            return ast.literal_eval(node.value)
+    return {}
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--verbose", action="store_true", help="list imports made in functions")
@@ -160,6 +196,9 @@ def main(argv: list[str] | None = None) -> int:
     hidden: list[str] = []
     found = imports(modules, direct, hidden)
     for line in hidden:
+        print(line)
+    stale = old_paths(modules)
+    for line in stale:
         print(line)
     g = nx.DiGraph()
     g.add_nodes_from(modules)
@@ -221,7 +260,7 @@ def main(argv: list[str] | None = None) -> int:
           f"({len(late)} inside functions, {len(needless)} needless, {len(hidden)} by a "
           f"string), {len(cycles)} cycle(s); {folders.number_of_nodes()} folders, "
           f"{len(knots)} folder cycle(s)")
-    return 1 if cycles or needless or hidden or knots else 0
+    return 1 if cycles or needless or hidden or knots or stale else 0
 
 
 def folder_of(module: str, modules: dict[str, Path]) -> str | None:

@@ -274,8 +274,13 @@ def make_case(seed: int, index: int, commands: dict[str, argparse.ArgumentParser
         argv += ["--t-end", rng.choice(LIGHT["t_end"])]
     if name == "simulate" and "max_wall" not in given:
         argv += ["--max-wall", "5"]
-    if name == "sweep" and "workers" not in given:
-        argv += ["--workers", "0"]  # in this process: a local cluster per case is slow
+    if name == "sweep":  # its two required options, when not drawn: else only usage errors
+        if "workers" not in given:
+            argv += ["--workers", "0"]  # in this process: a local cluster per case is slow
+        if "grid" not in given:
+            argv += ["--set", rng.choice(TEXT["grid"][:3] + ["bodies.rod.mass=1:2:2"] * 3)]
+        if "output" not in given:
+            argv += ["--out", rng.choice(["out.csv", "out.csv", "out.parquet"])]
     if rng.random() < 0.04:
         argv.insert(rng.randrange(1, len(argv) + 1), rng.choice(UNKNOWN))
     if rng.random() < 0.03:

@@ -73,7 +73,7 @@ def _class(a: argparse.Namespace) -> int:
     from pathlib import Path
 
     from mbody.answers.summary import grade
-    from mbody.io import jsontext
+    from mbody.util import jsontext
     from mbody.util.atomic import ensure_writable, write_atomic
 
     kind = None

@@ -75,6 +75,11 @@ class Results:
     def __init__(self, path: str | os.PathLike[str], outputs: Sequence[str], grid: Grid):
         self.path = Path(path)
         self.format = output_format(path)
+        if self.format == "parquet":  # refused before any case runs, not after them all
+            import importlib.util
+
+            if importlib.util.find_spec("pyarrow") is None:
+                raise MbodyError(_NO_PYARROW)
         self.grid = grid
         self.outputs = list(outputs)
         self.header = ["case", *grid.paths, *outputs, "error"]
