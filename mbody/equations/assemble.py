@@ -28,6 +28,7 @@ from mbody.equations.solution import (
     ReactionValues,
     Solution,
     singular_mass_error,
+    solution,
 )
 from mbody.equations.symbolic import SymbolicEquations, assembly_symbolic
 from mbody.equations.workspace import Unknowns, workspace
@@ -367,7 +368,7 @@ def solve_state(model: Model, state: State, unknowns: Unknowns, *, condition: bo
     reactions = ReactionValues(labels, model.reaction_index, lam)
     mu = len(unknowns.U)
     if not mu:
-        return Solution(model.coordinates, acc, reactions)
+        return solution(model.coordinates, acc, reactions)
     info = out[o_info:]
     if info[_core.ST_SINGULAR]:
         code = int(info[_core.ST_SINGULAR]) - 1
@@ -385,9 +386,10 @@ def solve_state(model: Model, state: State, unknowns: Unknowns, *, condition: bo
     cond = None
     if condition:
         cond = _condition(model, state, unknowns, plan.solver, y, rank, columns)
-    return Solution(model.coordinates, acc, reactions, plan.labels, not_unique,
-                    float(info[_core.ST_BERR]), cond, METHODS[int(info[_core.ST_PATH])],
-                    broken, mu - rank)
+    return solution(model.coordinates, acc, reactions, solved=plan.labels,
+                    not_unique=not_unique, residual=float(info[_core.ST_BERR]),
+                    condition=cond, method=METHODS[int(info[_core.ST_PATH])],
+                    broken_joints=broken, redundant=mu - rank)
 
 
 DENSE_CONDITION = 2000
