@@ -276,7 +276,7 @@ class Assembly:
 
         With every reaction known (or none): v̇ = M⁻¹ (Q + G λ − b). Otherwise the
         Newton-Euler pairs and the joint constraints are solved together,
-        ``M v̇ − G_U λ_U = Q − b + G_K λ_K``, ``G_Uᵀ v̇ = γ_U`` (see `mbody.solve.kkt`);
+        ``M v̇ − G_U λ_U = Q − b + G_K λ_K``, ``G_Uᵀ v̇ = γ_U`` (the compiled core: `solve_state`);
         the joints of known components are not enforced.
 
         Parameters

@@ -1,6 +1,6 @@
 /* The entry points that evaluate a mechanism at one state with its unknown reactions
  * solved: mb_solve (what Assembly.solve returns) and mb_derivative (the simulation's
- * right-hand side, Baumgarte-stabilised). As mbody.solve.compiled.solve / derivative. */
+ * right-hand side, Baumgarte-stabilised). */
 #include <string.h>
 
 #include "internal.h"

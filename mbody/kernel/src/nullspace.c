@@ -1,5 +1,5 @@
-/* The robust solve on G_U's geometry (mbody.solve.nullspace.NullSpaceSolve; the port
- * of mbody.solve.compiled._null_space): G^ = T G_U C^-1 (rows scaled to one length,
+/* The robust solve on G_U's geometry (what mbody.solve.nullspace did in numpy before
+ * 0.3): G^ = T G_U C^-1 (rows scaled to one length,
  * columns to unit norm), its SVD G^ = U1 s1 V1^T with the rank decided at G_RANK_RTOL,
  * the allowed motions U2 (the complement of U1), their reduced mass matrix
  * U2^T M^ U2 (a motion without mass: the singular code), REFINE_STEPS rounds of

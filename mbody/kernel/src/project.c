@@ -1,5 +1,5 @@
-/* The coordinate projection (mbody.simulate.projection; the port of
- * mbody.solve.compiled.project): positions moved onto the enforced joints by
+/* The coordinate projection (mbody.simulate.projection's JointProjection calls it):
+ * positions moved onto the enforced joints by
  * Gauss-Newton steps M D - G_U mu = 0, G_U^T D = -phi_U (the smallest move in the
  * kinetic metric), then velocities by the mass-orthogonal projection
  * M Dv - G_U mu = 0, G_U^T Dv = -(G^T v - f'). Near a singular position (geometric

@@ -2,7 +2,7 @@
  * complement S = G_U^T M^-1 G_U: banded Cholesky with one round of iterative refinement;
  * when S's pivots are not trusted, the pivoted route for exactly redundant joints, else
  * the null-space route (nullspace.c). The backward error is measured on residuals
- * r1 = r6 - (M a - G_U lam), r2 = gam - G_U^T a. As mbody.solve.compiled. */
+ * r1 = r6 - (M a - G_U lam), r2 = gam - G_U^T a. */
 #include <string.h>
 
 #include "internal.h"
