@@ -461,3 +461,21 @@ def test_what_a_newcomer_got_wrong_is_refused_or_said(tmp_path):
     assert p.returncode == 1 and "every case failed; case 0:" in p.stderr
     header, rows = read(tmp_path / "f.csv")
     assert len(rows) == 2 and all(r[header.index("error")] for r in rows)
+
+
+def test_a_local_cluster_that_cannot_start_is_a_clean_error(tmp_path, monkeypatch):
+    """'Nanny failed to start' on a busy machine (the CLI fuzzer met it) is an MbodyError
+    that says what to do, not an internal error; the rows already run are kept."""
+    distributed = pytest.importorskip("distributed")
+
+    def failing(*args, **kwargs):
+        raise RuntimeError("Nanny failed to start.")
+
+    monkeypatch.setattr(distributed, "LocalCluster", failing)
+    base = mbody.load(SLIDER)
+    job = Job(base.source, parse_grid(["bodies.rod.mass=1:2:3"]), Settings("solve"),
+              uuid.uuid4().hex)
+    results = Results(tmp_path / "c.csv", columns(base, job.settings), job.grid)
+    with pytest.raises(MbodyError, match=r"could not start a local Dask cluster of 2 .*"
+                                         r"--workers 0"):
+        cluster.run(job, [0, 1, 2], results, workers=2, progress=False)

@@ -183,12 +183,19 @@ def _on_dask(job: Job, todo: list[int], per_case: float, chunk: int | None,
             n = workers or os.cpu_count() or 1
             # every server on the loopback: the scheduler's HTTP routes (no dashboard) at a
             # free port, the workers and their nannies; their shutdown chatter silenced
-            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                   host="127.0.0.1", dashboard_address="127.0.0.1:0",
-                                   worker_dashboard_address=None,
-                                   scheduler_kwargs={"dashboard": False},
-                                   silence_logs=logging.CRITICAL)
-            client = Client(cluster, set_as_default=False)
+            try:
+                cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                       host="127.0.0.1", dashboard_address="127.0.0.1:0",
+                                       worker_dashboard_address=None,
+                                       scheduler_kwargs={"dashboard": False},
+                                       silence_logs=logging.CRITICAL)
+                client = Client(cluster, set_as_default=False)
+            except (RuntimeError, OSError, TimeoutError) as exc:  # a worker that never came up
+                raise MbodyError(
+                    f"could not start a local Dask cluster of {n} worker process(es) ({exc}); "
+                    "the machine may be short of memory or busy: give fewer --workers, or "
+                    "--workers 0 to run the cases in this process (the same command "
+                    "resumes)") from None
             report.where = f"a local cluster of {n} worker processes"
         else:
             try:
