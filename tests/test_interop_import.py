@@ -832,3 +832,23 @@ def test_an_include_whose_name_is_too_long_is_located(tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.startswith(f"mbody: error: {path}:2:12: <include file>: cannot read the "
                           "included file 'xxx") and "File name too long" in err
+
+
+def test_a_planar_mjcf_body_with_zero_inertia_reads_as_a_point_mass(tmp_path):
+    """mbody's planar export of a point pendulum with its <inertial> given diaginertia
+    0 0 0 (the XML fuzzer's case): read back as the particle it is (it raised a KeyError
+    on the orientation such a body does not have)."""
+    path = tmp_path / "pp.xml"
+    path.write_text(
+        '<mujoco model="point-pendulum"><option gravity="0 -9.81 0" /><worldbody>'
+        '<body name="bob" pos="0.5 -0.8660254037844386 0" quat="1 0 0 0">'
+        '<joint name="O" type="hinge" pos="-0.5 0.8660254037844386 0" axis="0 0 1" />'
+        '<inertial pos="0 0 0" mass="1" diaginertia="0 0 0" /></body></worldbody>'
+        '<custom><numeric name="mbody:dimension" data="2" />'
+        '<text name="mbody:body:bob" data="{&quot;inertia&quot;: 0}" /></custom></mujoco>')
+    model = mbody.load(path)
+    assert model.dimension == 2 and bool(model.particle[0])
+    np.testing.assert_allclose(model.initial.position[0, :2], [0.5, -0.8660254037844386])
+    # the point pendulum at 30 deg from the vertical: g sin(30 deg) / L along the path
+    a = mbody.assemble(model).solve().accelerations
+    np.testing.assert_allclose(np.hypot(a[0], a[1]), 9.81 * 0.5, rtol=1e-12)

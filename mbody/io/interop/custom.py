@@ -345,13 +345,19 @@ def _planar(data: dict[str, Any], custom: Custom,
     data["dimension"] = 2
     data["gravity"] = data["gravity"][:2]
     for k, b in enumerate(data["bodies"]):
-        R = np.array(b.pop("orientation")["matrix"], dtype=float)
-        J = b["inertia"]
-        b["inertia"] = float(J[2][2])
+        # a body read without inertia (a point mass: MJCF's diaginertia 0) has no
+        # orientation, and its inertia is the number 0
+        orientation = b.pop("orientation", None)
+        J = b.get("inertia")
+        if isinstance(J, list):
+            b["inertia"] = float(J[2][2])
         b["position"] = b["position"][:2]
-        b["angle"] = float(np.arctan2(R[1, 0], R[0, 0]))
+        if orientation is not None:
+            R = np.array(orientation["matrix"], dtype=float)
+            b["angle"] = float(np.arctan2(R[1, 0], R[0, 0]))
         b["velocity"] = b["velocity"][:2]
-        b["angular_velocity"] = float(b["angular_velocity"][2])
+        if isinstance(b.get("angular_velocity"), list):
+            b["angular_velocity"] = float(b["angular_velocity"][2])
         shape = b.get("shape")
         if shape and ("box" in shape or "ellipsoid" in shape):
             kind = next(iter(shape))
