@@ -59,7 +59,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--chunk", type=bounded("a number of cases", 1, 1e8, integer=True),
                    metavar="N", help="cases per chunk sent to a worker (default: measured, "
                    "about 2 s of work)")
-    s.add_argument("--quiet", action="store_true", help="no progress bar")
+    s.add_argument("--quiet", action="store_true", help="no progress bar (there is one only "
+                   "on a terminal)")
     s.set_defaults(run=sweep)
 
 
@@ -105,7 +106,8 @@ def sweep(a: argparse.Namespace) -> int:
     say = output_stream(a.output)
     try:
         report = cluster.run(job, todo, results, scheduler=a.scheduler, workers=a.workers,
-                             chunk=a.chunk, progress=not a.quiet)
+                             chunk=a.chunk,
+                             progress=sys.stderr.isatty() and not a.quiet)
     except KeyboardInterrupt:
         sys.stderr.write(f"mbody: interrupted: {len(results.rows)} of {len(grid)} cases kept "
                          f"in {results.journal}; the same command resumes\n")
