@@ -472,6 +472,9 @@ def test_a_local_cluster_that_cannot_start_is_a_clean_error(tmp_path, monkeypatc
         raise RuntimeError("Nanny failed to start.")
 
     monkeypatch.setattr(distributed, "LocalCluster", failing)
+    import dask.distributed  # re-exports the name: patched there too, where mbody reads it
+
+    monkeypatch.setattr(dask.distributed, "LocalCluster", failing)
     base = mbody.load(SLIDER)
     job = Job(base.source, parse_grid(["bodies.rod.mass=1:2:3"]), Settings("solve"),
               uuid.uuid4().hex)
