@@ -105,3 +105,23 @@ def test_a_drawing_scene_has_a_short_repr():
         assert text.startswith("<Scene ") and " panel" in text and "figure_svg" in text
         assert all(len(repr(p)) < 300 for p in (sc.root, *sc.panels))
     assert "Free-body diagram of upper" in repr(fbd_scene(asm.bodies["upper"].fbd))
+
+
+def test_the_fast_solution_is_a_solution_as_the_dataclass_makes_it():
+    """`solution()` (the solve's hot path) fills every field of `Solution`, no more, and
+    equals the dataclass's own construction; the result stays frozen."""
+    import dataclasses
+
+    import numpy as np
+
+    from mbody.equations.solution import Solution, solution
+
+    names = [f.name for f in dataclasses.fields(Solution)]
+    args = [["a"], np.zeros(1), {"A.Fx": 1.0}, ("A.Fx",), ("A.Fx",), 1e-16, 2.0, "m",
+            ("B",), 1, "world"]
+    fast = solution(*args)
+    assert list(vars(fast)) == names
+    assert fast == Solution(*args)
+    assert solution(*args[:3]) == Solution(*args[:3])
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        fast.redundant = 2  # type: ignore[misc]

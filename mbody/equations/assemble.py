@@ -369,7 +369,7 @@ def solve_state(model: Model, state: State, unknowns: Unknowns, *, condition: bo
     mu = len(unknowns.U)
     if not mu:
         return solution(model.coordinates, acc, reactions)
-    info = out[o_info:]
+    info = out[o_info:].tolist()  # Python floats: a numpy scalar read costs more, 6 times
     if info[_core.ST_SINGULAR]:
         code = int(info[_core.ST_SINGULAR]) - 1
         raise singular_mass_error(model, code // 6, code % 6)

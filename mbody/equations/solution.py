@@ -6,8 +6,7 @@ solve routes; the error for a motion that carries no mass.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import MISSING, dataclass, fields
-from typing import Any
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -159,17 +158,23 @@ def singular_mass_error(model, body: int, row: int) -> MbodyError:
                       "it mass or inertia there, or a joint that holds it")
 
 
-_DEFAULTS = {f.name: f.default for f in fields(Solution) if f.default is not MISSING}
+_NEW, _SET = object.__new__, object.__setattr__
 
 
 def solution(coordinates: list[str], accelerations: np.ndarray,
-             reactions: Mapping[str, float], **given: Any) -> Solution:
-    """`Solution(coordinates, accelerations, reactions, **given)`, made without the frozen
-    dataclass's __init__ (an object.__setattr__ per field: a microsecond of a few-microsecond
-    solve); still frozen, equal to one made the usual way."""
-    obj = object.__new__(Solution)
-    d = obj.__dict__
-    d.update(_DEFAULTS)
-    d["coordinates"], d["accelerations"], d["reactions"] = coordinates, accelerations, reactions
-    d.update(given)
+             reactions: Mapping[str, float], solved: tuple[str, ...] = (),
+             not_unique: tuple[str, ...] = (), residual: float | None = None,
+             condition: float | None = None, method: str = "block-diagonal M",
+             broken_joints: tuple[str, ...] = (), redundant: int = 0,
+             axes: str = "joint") -> Solution:
+    """`Solution(...)` with the same arguments, made without the frozen dataclass's
+    __init__ (an object.__setattr__ per field: a microsecond of a five-microsecond solve);
+    still frozen, equal to one made the usual way (tests/test_reprs.py holds the fields
+    the same)."""
+    obj = _NEW(Solution)
+    _SET(obj, "__dict__", {
+        "coordinates": coordinates, "accelerations": accelerations, "reactions": reactions,
+        "solved": solved, "not_unique": not_unique, "residual": residual,
+        "condition": condition, "method": method, "broken_joints": broken_joints,
+        "redundant": redundant, "axes": axes})
     return obj
