@@ -48,6 +48,7 @@ import time
 import traceback
 import warnings
 from collections import Counter
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -673,42 +674,77 @@ def run(n: int, seed: int = 0, jobs: int = 1, heavy_every: int = 5, hang: float 
             "seconds": time.perf_counter() - t0}
 
 
+def fuzz_arguments(doc: str, what: str, *, jobs: int | None = None,
+                   hang: float = 60.0) -> argparse.ArgumentParser:
+    """The options every fuzzer here takes: -n, --seed, --jobs, --hang, --only, --show
+    (`what`: a case's name in the help, "mutations", "cases"...)."""
+    ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
+    ap.add_argument("-n", type=int, default=10_000, help=f"{what} (default 10000)")
+    ap.add_argument("--seed", type=int, default=0)
+    cpus = os.cpu_count() or 1
+    ap.add_argument("--jobs", type=int, default=jobs if jobs is not None else cpus,
+                    help="worker processes (default: "
+                    + (f"{jobs})" if jobs is not None else "one per CPU)"))
+    ap.add_argument("--hang", type=float, default=hang, metavar="SECONDS",
+                    help=f"a case without an answer this long is a hang (default {hang:g})")
+    ap.add_argument("--only", type=int, metavar="I", help="run case I alone, and show it")
+    ap.add_argument("--show", type=int, default=5, help="failures shown in full")
+    return ap
+
+
+def count_lines(counts: Mapping[str, int], rows: Sequence[tuple[str, str, str]]) -> list[str]:
+    """The report's totals: one line per (label, kind, why)."""
+    return [f"  {label:<13}{counts[kind]:7d}" + (f"   ({why})" if why else "")
+            for label, kind, why in rows]
+
+
+def per_command_lines(per: Mapping[tuple[str, str], int], commands: Sequence[str],
+                      kinds: Sequence[str], head: str, width: int = 10) -> list[str]:
+    """The report's table of outcomes per command (a command with none left out)."""
+    lines = [f"  per command: {head}"]
+    for command in commands:
+        row = [per[(command, k)] for k in kinds]
+        if any(row):
+            lines.append(f"    {command:<{width}} {row[0]:9d} {row[1]:12d} {row[2]:6d} "
+                         f"{row[3]:5d}")
+    return lines
+
+
+def failure_lines(outcomes: Sequence[Outcome], shown: Mapping[str, object],
+                  kinds: Sequence[str] = (CRASH, HANG)) -> list[str]:
+    """A failed case in full: its outcomes of `kinds`, then each file (name -> content,
+    1500 characters at most, indented)."""
+    lines = [f"  {o.command}: {o.kind} (exit {o.code})\n{o.detail}"
+             for o in outcomes if o.kind in kinds]
+    for name, content in shown.items():
+        text = content if isinstance(content, str) else repr(content)
+        lines.append(f"  {name}:\n    " + text[:1500].replace("\n", "\n    "))
+    return lines
+
+
 def report(result: dict, show: int = 5) -> str:
     v, c = result["verdicts"], result["commands"]
     lines = [f"mbody fuzz: {result['n']} mutations of the shipped models (seed "
              f"{result['seed']}), {sum(c.values())} commands, {result['seconds']:.0f} s",
-             f"  clean errors  {v[CLEAN]:6d}   (check refused the file, naming what and where)",
-             f"  accepted      {v[ACCEPTED]:6d}   (check passed; the commands run on it below)",
-             f"  crashes       {v[CRASH]:6d}",
-             f"  hangs         {v[HANG]:6d}",
-             "  per command:   accepted  clean error  crash  hang"]
-    for command in ("check", "assemble", "solve", "simulate", "export", "jacobian", "fbd"):
-        row = [c[(command, k)] for k in (ACCEPTED, CLEAN, CRASH, HANG)]
-        if any(row):
-            lines.append(f"    {command:<10} {row[0]:9d} {row[1]:12d} {row[2]:6d} {row[3]:5d}")
+             *count_lines(v, [("clean errors", CLEAN, "check refused the file, naming what "
+                               "and where"),
+                              ("accepted", ACCEPTED, "check passed; the commands run on it "
+                               "below"),
+                              ("crashes", CRASH, ""), ("hangs", HANG, "")]),
+             *per_command_lines(c, ("check", "assemble", "solve", "simulate", "export",
+                                    "jacobian", "fbd"), (ACCEPTED, CLEAN, CRASH, HANG),
+                                "  accepted  clean error  crash  hang")]
     for i, base, did, content, outcomes in result["failures"][:show]:
         lines.append(f"\n#{i} {base}: {'; '.join(did)}")
-        for o in outcomes:
-            if o.kind in (CRASH, HANG):
-                lines.append(f"  {o.command}: {o.kind} (exit {o.code})\n{o.detail}")
-        shown = content if isinstance(content, str) else repr(content)
-        lines.append("  model:\n    " + shown[:1500].replace("\n", "\n    "))
+        lines += failure_lines(outcomes, {"model": content})
     return "\n".join(lines)
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("-n", type=int, default=10_000, help="mutations (default 10000)")
-    ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
-                    help="worker processes (default: one per CPU)")
+    ap = fuzz_arguments(__doc__, "mutations")
     ap.add_argument("--heavy-every", type=int, default=5, metavar="K",
                     help="simulate, export, jacobian (and sometimes fbd) every K-th mutation "
                     "that check accepts (default 5; 0: never)")
-    ap.add_argument("--hang", type=float, default=60.0, metavar="SECONDS",
-                    help="a mutation without an answer this long is a hang (default 60)")
-    ap.add_argument("--only", type=int, metavar="I", help="run mutation I alone, and show it")
-    ap.add_argument("--show", type=int, default=5, help="crashes and hangs shown in full")
     a = ap.parse_args(argv)
     if a.only is not None:
         case = make_case(a.seed, a.only, _bases(), a.heavy_every)

@@ -39,7 +39,6 @@ reruns one).
 
 from __future__ import annotations
 
-import argparse
 import copy
 import json
 import os
@@ -487,38 +486,25 @@ def report(result: dict, show: int = 5) -> str:
     v, c = result["verdicts"], result["commands"]
     lines = [f"mbody fuzz_answers: {result['n']} answers files (seed {result['seed']}), "
              f"{sum(c.values())} commands, {result['seconds']:.0f} s",
-             f"  judged        {v[JUDGED]:6d}   (every equation got a verdict: exit 0 or 1)",
-             f"  clean errors  {v[CLEAN]:6d}   (the answers refused, every problem located)",
-             f"  crashes       {v[CRASH]:6d}",
-             f"  hangs         {v[HANG]:6d}",
-             "  per command:      judged  clean error  crash  hang"]
-    for command in ("verify", "verify --json", "report", "?"):
-        row = [c[(command, k)] for k in (JUDGED, CLEAN, CRASH, HANG)]
-        if any(row):
-            lines.append(f"    {command:<14} {row[0]:7d} {row[1]:12d} {row[2]:6d} {row[3]:5d}")
+             *fuzz.count_lines(v, [("judged", JUDGED, "every equation got a verdict: exit 0 "
+                                    "or 1"),
+                                   ("clean errors", CLEAN, "the answers refused, every problem "
+                                    "located"),
+                                   ("crashes", CRASH, ""), ("hangs", HANG, "")]),
+             *fuzz.per_command_lines(c, ("verify", "verify --json", "report", "?"),
+                                     (JUDGED, CLEAN, CRASH, HANG),
+                                     "     judged  clean error  crash  hang", width=14)]
     for i, base, did, content, outcomes in result["failures"][:show]:
         lines.append(f"\n#{i} {base}: {'; '.join(did)}")
-        for o in outcomes:
-            if o.kind in (CRASH, HANG):
-                lines.append(f"  {o.command}: {o.kind} (exit {o.code})\n{o.detail}")
-        shown = content if isinstance(content, str) else repr(content)
-        lines.append("  answers:\n    " + shown[:1500].replace("\n", "\n    "))
+        lines += fuzz.failure_lines(outcomes, {"answers": content})
     return "\n".join(lines)
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("-n", type=int, default=10_000, help="cases (default 10000)")
-    ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
-                    help="worker processes (default: one per CPU)")
+    ap = fuzz.fuzz_arguments(__doc__, "cases")
     ap.add_argument("--heavy-every", type=int, default=100, metavar="K",
                     help="report --answers on every K-th case that verify judged "
                     "(default 100; 0: never)")
-    ap.add_argument("--hang", type=float, default=60.0, metavar="SECONDS",
-                    help="a case without an answer this long is a hang (default 60)")
-    ap.add_argument("--only", type=int, metavar="I", help="run case I alone, and show it")
-    ap.add_argument("--show", type=int, default=5, help="crashes and hangs shown in full")
     a = ap.parse_args(argv)
     if a.only is not None:
         case = make_case(a.seed, a.only, _bases(), a.heavy_every)

@@ -469,15 +469,12 @@ def report(result: dict, show: int = 5) -> str:
     k, per = result["kinds"], result["per"]
     lines = [f"mbody fuzz_cli: {result['n']} command lines (seed {result['seed']}), "
              f"{result['seconds']:.0f} s",
-             f"  clean errors  {k[CLEAN]:6d}   (exit 1 or 2, one message)",
-             f"  accepted      {k[ACCEPTED]:6d}   (exit 0; verify's 1: a wrong equation)",
-             f"  crashes       {k[CRASH]:6d}",
-             f"  hangs         {k[HANG]:6d}",
-             "  per command:   accepted  clean error  crash  hang"]
-    for command in [c for c in (*COMMANDS, "?") if any(per[(c, kind)] for kind in
-                                                       (ACCEPTED, CLEAN, CRASH, HANG))]:
-        row = [per[(command, kind)] for kind in (ACCEPTED, CLEAN, CRASH, HANG)]
-        lines.append(f"    {command:<10} {row[0]:9d} {row[1]:12d} {row[2]:6d} {row[3]:5d}")
+             *fuzz.count_lines(k, [("clean errors", CLEAN, "exit 1 or 2, one message"),
+                                   ("accepted", ACCEPTED, "exit 0; verify's 1: a wrong "
+                                    "equation"),
+                                   ("crashes", CRASH, ""), ("hangs", HANG, "")]),
+             *fuzz.per_command_lines(per, (*COMMANDS, "?"), (ACCEPTED, CLEAN, CRASH, HANG),
+                                     "  accepted  clean error  crash  hang")]
     for i, argv, o in result["failures"][:show]:
         lines.append(f"\n#{i}: mbody {' '.join(repr(a) if not a or ' ' in a else a for a in argv)}"
                      f"\n  {o.kind} (exit {o.code})\n{o.detail}")
@@ -485,16 +482,7 @@ def report(result: dict, show: int = 5) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("-n", type=int, default=10_000, help="command lines (default 10000)")
-    ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
-                    help="worker processes (default: one per CPU)")
-    ap.add_argument("--hang", type=float, default=60.0, metavar="SECONDS",
-                    help="a case without an answer this long is a hang (default 60)")
-    ap.add_argument("--only", type=int, metavar="I", help="run case I alone, and show it")
-    ap.add_argument("--show", type=int, default=5, help="crashes and hangs shown in full")
-    a = ap.parse_args(argv)
+    a = fuzz.fuzz_arguments(__doc__, "command lines").parse_args(argv)
     if a.only is not None:
         workdir = Path(tempfile.mkdtemp(prefix="mbody-fuzz-cli."))
         folder = Folder(workdir, warm_up())

@@ -41,7 +41,6 @@ reproduces one, printing its files).
 
 from __future__ import annotations
 
-import argparse
 import contextlib
 import copy
 import io
@@ -78,6 +77,9 @@ from fuzz import (  # noqa: E402  (the YAML fuzzer: its commands and their class
     _misspell,
     _unlocated_problems,
     classify,
+    count_lines,
+    failure_lines,
+    fuzz_arguments,
     run_command,
     verdict,
 )
@@ -902,36 +904,23 @@ def report(result: dict, show: int = 5) -> str:
     v, c = result["verdicts"], result["compared"]
     lines = [f"mbody fuzz_xml: {result['n']} mutated MJCF and URDF models (seed "
              f"{result['seed']}), {result['seconds']:.0f} s",
-             f"  clean errors  {v[CLEAN]:6d}   (check refused the file, naming what and where)",
-             f"  accepted      {v[ACCEPTED]:6d}   (check passed; solve ran on it)",
-             f"  crashes       {v[CRASH]:6d}",
-             f"  hangs         {v[HANG]:6d}",
-             f"  mismatches    {v[MISMATCH]:6d}   (with MuJoCo)",
+             *count_lines(v, [("clean errors", CLEAN, "check refused the file, naming "
+                                    "what and where"),
+                                   ("accepted", ACCEPTED, "check passed; solve ran on it"),
+                                   ("crashes", CRASH, ""), ("hangs", HANG, ""),
+                                   ("mismatches", MISMATCH, "with MuJoCo")]),
              f"  against MuJoCo: masses compared on {c['masses']} accepted MJCF files, "
              f"accelerations on {c['accelerations']}; {c['not compared']} not compared "
              "(MuJoCo refuses them, or no body to match)"]
     for i, case, outcomes in result["failures"][:show]:
         lines.append(f"\n#{i} {case.base}: {'; '.join(case.did)}")
-        for o in outcomes:
-            if o.kind in (CRASH, HANG, MISMATCH):
-                lines.append(f"  {o.command}: {o.kind} (exit {o.code})\n{o.detail}")
-        for rel, content in case.files.items():
-            shown = content if isinstance(content, str) else repr(content)
-            lines.append(f"  {rel}:\n    " + shown[:1500].replace("\n", "\n    "))
+        lines += failure_lines(outcomes, case.files, (CRASH, HANG, MISMATCH))
     return "\n".join(lines)
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("-n", type=int, default=10_000, help="cases (default 10000)")
-    ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--jobs", type=int, default=min(2, os.cpu_count() or 1),
-                    help="processes (default 2)")
-    ap.add_argument("--hang", type=float, default=30.0, metavar="SECONDS",
-                    help="a command without an answer this long is a hang (default 30)")
-    ap.add_argument("--only", type=int, metavar="I", help="run case I alone, and show it")
-    ap.add_argument("--show", type=int, default=5, help="failures shown in full")
-    a = ap.parse_args(argv)
+    a = fuzz_arguments(__doc__, "cases", jobs=min(2, os.cpu_count() or 1),
+                            hang=30.0).parse_args(argv)
     if a.only is not None:
         case = make_case(a.seed, a.only, bases())
         print(f"#{a.only} {case.base}: {'; '.join(case.did)}")

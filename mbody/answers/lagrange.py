@@ -38,7 +38,7 @@ from mbody.answers.linear import NotLinear, linear_row
 from mbody.answers.load import Answer, Answers, AnswersError
 from mbody.answers.parse import EquationError, parse_equation
 from mbody.answers.text import num
-from mbody.answers.vocabulary import Vocabulary
+from mbody.answers.vocabulary import Vocabulary, name_gravity
 from mbody.equations.coordinates import CoordinateSet, columns, coordinate_set
 from mbody.equations.generalized import Generalized, evaluate, generalized
 from mbody.equations.symbolic import load_symbols
@@ -225,11 +225,7 @@ def vocabulary(model: Model, state: State, truth: _Truth) -> Vocabulary:
     efforts = tuple(e for e, _ in g.coordinate_set.efforts)
     values: dict[str, float] = {"pi": float(np.pi), "t": float(state.t)}
     absent: dict[str, str] = {}
-    gravity = float(np.linalg.norm(model.gravity))
-    if gravity > 0:
-        values["g"] = gravity
-    else:
-        absent["g"] = "this model has no gravity, so 'g' stands for nothing here"
+    name_gravity(model, values, absent)
     aliases: dict[str, str] = {}
     for j, (name, label) in enumerate(zip(truth.names, truth.labels, strict=True)):
         if g.quasi[j]:

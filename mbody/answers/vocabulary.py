@@ -216,6 +216,16 @@ class Vocabulary:
         return ", ".join(shown)
 
 
+def name_gravity(model: Model, values: dict[str, float], absent: dict[str, str]) -> None:
+    """`g` in an equation: |gravity| (m/s^2) into `values`, or, for a model without
+    gravity, why the name means nothing here into `absent`."""
+    gravity = float(np.linalg.norm(model.gravity))
+    if gravity > 0:
+        values["g"] = gravity
+    else:
+        absent["g"] = "this model has no gravity, so 'g' stands for nothing here"
+
+
 def joints_of(model: Model, i: int) -> np.ndarray:
     """Indices of the joints that have body `i` as parent or child, in model order (from
     the joint table's arrays: a body's vocabulary and rows cost its own joints, not the
@@ -248,11 +258,7 @@ def vocabulary(model: Model, state: State, body: str) -> Vocabulary:
     known = model.known_reactions_at(state.t)
     values: dict[str, float] = {"m": float(model.mass[i]), "pi": float(np.pi)}
     absent: dict[str, str] = {}
-    gravity = float(np.linalg.norm(model.gravity))
-    if gravity > 0:
-        values["g"] = gravity
-    else:
-        absent["g"] = "this model has no gravity, so 'g' stands for nothing here"
+    name_gravity(model, values, absent)
     aliases = dict(_ALIASES_BOTH)
     aliases.update(_ALIASES_PLANAR if planar else _ALIASES_SPATIAL)
     accelerations: tuple[str, ...] = PLANAR_ACCELERATIONS if planar else SPATIAL_ACCELERATIONS

@@ -211,6 +211,10 @@ def add_axes_option(command: argparse.ArgumentParser, saved: bool = False) -> No
 MODEL_HELP = "a model file: mbody YAML, MuJoCo's MJCF (.xml) or URDF (.urdf)"
 """The MODEL argument's help on every command that reads one."""
 
+VIEW_HELP = ("spatial models: iso (default), front, top, side, or ELEV,AZIM in degrees "
+             "(for example 30,-60)")
+"""The --view option's help: how a spatial model's picture is seen (fbd, report, modes)."""
+
 
 def add_import_options(command: argparse.ArgumentParser) -> None:
     """Give a command that reads a model the options of MJCF and URDF input, and make its

@@ -11,6 +11,7 @@ from mbody.cli.common import (
     EXIT_OK,
     MODEL_HELP,
     PICTURE_FORMATS,
+    VIEW_HELP,
     add_axes_option,
     bounded,
     load_model,
@@ -19,10 +20,6 @@ from mbody.cli.common import (
     regular_file,
 )
 from mbody.errors import MbodyError, did_you_mean
-
-VIEW_HELP = ("spatial models: iso (default), front, top, side, or ELEV,AZIM in degrees "
-             "(for example 30,-60)")
-
 
 DPI = (10, 600)
 """The resolutions `fbd --dpi` accepts (dots per inch): below 10 FreeType cannot draw the

@@ -9,7 +9,7 @@ import json
 import sys
 from collections.abc import Iterator
 
-from mbody.cli.common import EXIT_OK, MODEL_HELP, load_model, parse_known
+from mbody.cli.common import EXIT_OK, MODEL_HELP, VIEW_HELP, load_model, parse_known
 from mbody.errors import MbodyError, OutputError
 
 
@@ -66,9 +66,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "mbody lagrange, less the drivers')")
     s.add_argument("--picture", metavar="FILE",
                    help="draw the mode shapes to FILE (.svg, .png or .pdf)")
-    s.add_argument("--view", metavar="VIEW",
-                   help="the picture's view of a spatial model: iso (default), front, top, "
-                   "side, or ELEV,AZIM in degrees")
+    s.add_argument("--view", metavar="VIEW", help="the --picture's view of " + VIEW_HELP)
     s.add_argument("--json", action="store_true", help="machine-readable output")
     s.set_defaults(run=modes)
 
