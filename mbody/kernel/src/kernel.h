@@ -350,4 +350,14 @@ int mb_linearize(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
                  int64_t nc, const int64_t *cols, const double *scales, const int64_t *quasi,
                  const int64_t *skip, const double *params, double *out);
 
+/* spectrum.c: the eigenvalues of the real n x n matrix A (row-major), by real part then
+ * imaginary part, with unit right eigenvectors (largest entry real and positive) and a
+ * bound on each eigenvalue's error: kappa dA for a simple one (kappa its condition
+ * number |x| |y| / |y^H x|, dA the bound on A's error), at most tol, at least
+ * 1e3 eps |A|_inf (tol where kappa dA is not finite: a Jordan block). out (float64,
+ * 2 n + 2 n^2 + n): [eigenvalues (n complex, interleaved re, im) | V (n x n complex,
+ * row-major, column k the k-th eigenvalue's vector) | bounds (n)]. Returns 0, 1 when the
+ * QR iteration did not converge, or -1 when memory ran out. */
+int mb_spectrum(const double *A, int64_t n, double dA, double tol, double *out);
+
 #endif

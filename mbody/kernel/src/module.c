@@ -1345,11 +1345,41 @@ static PyObject *solve_layout(PyObject *mod, PyObject *args) {
     return Py_BuildValue("(LLL)", N, N, N + 3 * m);
 }
 
+PyDoc_STRVAR(spectrum_doc,
+"spectrum(A, dA, tol, out) -> int\n\nThe eigenvalues, unit right eigenvectors and error "
+"bounds of the\nsquare float64 matrix A (kernel.h, mb_spectrum), into out (float64, "
+"2 n + 2 n^2 + n:\nview a complex array of n + n^2 + n entries as float64). Returns 0, "
+"or 1 when the\nQR iteration did not converge.");
+
+static PyObject *spectrum(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    Py_buffer A, out;
+    double dA, tol;
+    if (check_nargs(nargs, 4, "spectrum") < 0 || get_double(args[1], &dA, "dA") < 0 ||
+        get_double(args[2], &tol, "tol") < 0 || get_buffer(args[0], &A, 0, 1, -1, "A") < 0)
+        return NULL;
+    Py_ssize_t n = (Py_ssize_t)floor(sqrt((double)(A.len / 8)) + 0.5);
+    if (n * n != A.len / 8) {
+        PyBuffer_Release(&A);
+        return PyErr_Format(PyExc_ValueError, "A: expected a square matrix, got %zd values",
+                            A.len / 8);
+    }
+    if (get_buffer(args[3], &out, 1, 1, 2 * n + 2 * n * n + n, "out") < 0) {
+        PyBuffer_Release(&A);
+        return NULL;
+    }
+    int status = mb_spectrum(A.buf, n, dA, tol, out.buf);
+    PyBuffer_Release(&out);
+    PyBuffer_Release(&A);
+    if (status < 0) return PyErr_NoMemory();
+    return PyLong_FromLong(status);
+}
+
 /* The DOP853 integrator's entry points (dop853_module.c). */
 int mb_dop853_register(PyObject *m);
 
 static PyMethodDef methods[] = {
     {"solve_layout", solve_layout, METH_VARARGS, solve_layout_doc},
+    {"spectrum", (PyCFunction)(void (*)(void))spectrum, METH_FASTCALL, spectrum_doc},
     {NULL, NULL, 0, NULL},
 };
 
