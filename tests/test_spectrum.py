@@ -84,3 +84,27 @@ def test_empty_and_zero() -> None:
 def test_rejects_a_non_square_matrix() -> None:
     with pytest.raises(ValueError, match="square"):
         _core.spectrum(np.zeros(5), 0.0, 0.0, np.zeros(10))
+
+
+def test_modes_of_a_double_pendulum_are_its_two_oscillations() -> None:
+    """mb_modes on a spectrum with two undamped pairs: one mode per pair, by frequency,
+    real shapes with their largest entry 1 (the in-phase and the anti-phase swing)."""
+    M = np.array([[2.0, 0.5], [0.5, 1.0]])
+    K = np.array([[30.0, 0.0], [0.0, 10.0]])
+    A = np.block([[np.zeros((2, 2)), np.eye(2)], [-np.linalg.solve(M, K), np.zeros((2, 2))]])
+    n = len(A)
+    spec = np.empty(3 * n + 2 * n * n)
+    assert _core.spectrum(A, 1e-12, 1e-6, spec) == 0
+    out = np.empty(_core.MODE_W * n + 2 * n * 2)
+    m = _core.modes(spec, 2, np.arange(2, dtype=np.int64), out)
+    assert m == 2
+    rows = out[:_core.MODE_W * m].reshape(m, _core.MODE_W)
+    shapes = out[_core.MODE_W * n:_core.MODE_W * n + 2 * m * 2].view(complex).reshape(m, 2)
+    lam2, vecs = np.linalg.eig(np.linalg.solve(M, K))  # omega^2 and shapes, independently
+    order = np.argsort(lam2)
+    assert np.allclose(rows[:, _core.MODE_FREQUENCY], np.sqrt(lam2[order]), rtol=1e-12)
+    assert np.all(rows[:, _core.MODE_KIND] == _core.MODE_OSCILLATION)
+    assert np.all(shapes.imag == 0) and np.allclose(np.abs(shapes).max(axis=1), 1.0)
+    for c, j in enumerate(order):
+        ref = vecs[:, j] / vecs[np.argmax(np.abs(vecs[:, j])), j]
+        assert np.allclose(shapes[c].real, ref, atol=1e-12)

@@ -19,6 +19,7 @@ Everything is computed by the compiled core in one call (kernel.h, ``mb_generali
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -270,6 +271,7 @@ def state_with_velocities(model: Model, state: State, v: np.ndarray) -> State:
     return state.replace(velocity=six[:, :3].copy(), omega=six[:, 3:].copy())
 
 
+@functools.lru_cache(maxsize=256)
 def layout(N: int, k: int) -> tuple[int, ...]:
     """Offsets of T, v_e, a0, M, f, q, q', f_scale, info and the end in the core's
     output."""

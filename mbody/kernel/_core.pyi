@@ -127,6 +127,7 @@ def dop853_sampled(problem: _Problem, t_stop: float, max_steps: int, t_eval: _F,
 def samples(unknowns: Unknowns, lam: _F, t: _F, Y: _F, reactions: _F | None,
             lengths: _F | None, drift: _F) -> None: ...
 def spectrum(A: _F, dA: float, tol: float, out: _F) -> int: ...
+def modes(spectrum: _F, k: int, kept: _I, out: _F) -> int: ...
 def dop853_system(number: int, params: _F, t: float, y: _F, ydot: _F) -> None: ...
 def dop853_tableau() -> dict[str, list[float]]: ...
 def dop853_work_size(n: int) -> int: ...
@@ -149,6 +150,18 @@ LI_TOL: int
 LI_KEPT: int
 LI_SINGULAR: int
 LI_DA: int
+MODE_INDEX: int
+MODE_KIND: int
+MODE_RE: int
+MODE_IM: int
+MODE_FREQUENCY: int
+MODE_DAMPING: int
+MODE_W: int
+MODE_NEUTRAL: int
+MODE_OSCILLATION: int
+MODE_GROWTH: int
+MODE_DECAY: int
+LI_RESTING: int
 LI_NORM: int
 LINEARIZE_INFO: int
 

@@ -57,6 +57,9 @@ that make it (`Generalized.f_scale`)."""
 MOVING_RTOL = 1e-12
 """A coordinate moves when its rate exceeds this fraction of the rates' scale."""
 
+_KINDS = {_core.MODE_NEUTRAL: "neutral", _core.MODE_OSCILLATION: "oscillation",
+          _core.MODE_GROWTH: "growth", _core.MODE_DECAY: "decay"}
+
 _PARAMS = np.zeros(_core.LINEARIZE_PARAMS)
 _PARAMS[[_core.LP_STEP, _core.LP_ROUNDING, _core.LP_STEADY, _core.LP_MOVING]] = (
     STEP, ROUNDING, STEADY_RTOL, MOVING_RTOL)
@@ -162,15 +165,22 @@ class Linearization:
         return self.generalized.coordinates
 
     @cached_property
-    def _spectrum(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(eigenvalues, unit eigenvectors, error bounds), by real part then imaginary part
-        (the compiled core's QR iteration, kernel.h: ``mb_spectrum``; each bound from the
-        eigenvalue's own left and right vectors)."""
+    def _spectrum_out(self) -> np.ndarray:
+        """The compiled core's spectrum of A (kernel.h: ``mb_spectrum``): eigenvalues,
+        unit eigenvectors and error bounds (each from the eigenvalue's own left and right
+        vectors), by real part then imaginary part."""
         n = len(self.A)
         out = np.empty(3 * n + 2 * n * n)
         if _core.spectrum(self.A, self.dA, self.tolerance, out):
             raise MbodyError(f"the eigenvalues of '{self.model.name}'s linearisation did not "
                              "converge (the QR iteration's limit)")
+        return out
+
+    @cached_property
+    def _spectrum(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(eigenvalues, unit eigenvectors, error bounds), by real part then imaginary
+        part."""
+        n, out = len(self.A), self._spectrum_out
         return (out[:2 * n].view(complex), out[2 * n:2 * n + 2 * n * n].view(complex)
                 .reshape(n, n), out[2 * n + 2 * n * n:])
 
@@ -190,42 +200,19 @@ class Linearization:
     @cached_property
     def modes(self) -> list[Mode]:
         """The modes: oscillations (one per complex pair), growths, decays and neutral
-        ones (λ = 0: a free or cyclic motion), neutral first, then by |λ|."""
-        w, V, tol = self._spectrum
-        if not len(w):
+        ones (λ = 0: a free or cyclic motion), neutral first, then by |λ| (kernel.h:
+        ``mb_modes``)."""
+        n, k = len(self.A), len(self.coordinates)
+        if not n:
             return []
-        k, kept = len(self.coordinates), self.kept
-        nk = len(kept)
-        mag = np.abs(w)
-        neutral = mag <= tol
-        osc = ~neutral & (np.abs(w.imag) > tol)
-        idx = np.flatnonzero(~(osc & (w.imag < 0)))  # one of each conjugate pair
-        w, V, tol, mag, neutral, osc = w[idx], V[:, idx], tol[idx], mag[idx], neutral[idx], \
-            osc[idx]
-        shapes = (V[nk:] / np.where(neutral, 1.0, w)).astype(complex)  # δq = δq' / λ
-        if neutral.any():  # a neutral mode: its δq if it has one, else its rate
-            pos = np.zeros((k, len(w)), complex)
-            pos[kept] = V[:nk]
-            has = neutral & (np.abs(pos).max(axis=0) > 1e-12 * np.abs(V).max(axis=0))
-            shapes[:, has] = pos[:, has]
-        cols = np.arange(len(w))
-        shapes = shapes / shapes[np.abs(shapes).argmax(axis=0), cols]
-        shapes[np.abs(shapes) < 1e-14] = 0.0
-        in_phase = np.abs(shapes.imag).max(axis=0) <= 1e-12  # undamped modes
-        out = []
-        for c in np.argsort(mag + np.where(neutral, -np.inf, 0.0), kind="stable").tolist():
-            lam = w[c]
-            re = lam.real if abs(lam.real) > tol[c] else 0.0
-            im = lam.imag if abs(lam.imag) > tol[c] else 0.0
-            shape = shapes[:, c].real.astype(complex) if in_phase[c] else shapes[:, c]
-            if neutral[c]:
-                out.append(Mode(complex(re, im), "neutral", float("nan"), float("nan"), shape))
-            else:
-                kind = "oscillation" if osc[c] else ("growth" if lam.real > 0 else "decay")
-                out.append(Mode(complex(re, im), kind,
-                                float(mag[c]) if osc[c] else float("nan"),
-                                -re / float(mag[c]) + 0.0, shape))
-        return out
+        out = np.empty(_core.MODE_W * n + 2 * n * k)
+        m = _core.modes(self._spectrum_out, k, self.kept, out)
+        rows = out[:_core.MODE_W * m].reshape(m, _core.MODE_W).tolist()
+        start = _core.MODE_W * n
+        shapes = out[start:start + 2 * m * k].view(complex).reshape(m, k)
+        return [Mode(complex(r[_core.MODE_RE], r[_core.MODE_IM]), _KINDS[int(r[_core.MODE_KIND])],
+                     r[_core.MODE_FREQUENCY], r[_core.MODE_DAMPING], shapes[c])
+                for c, r in enumerate(rows)]
 
     @property
     def oscillations(self) -> list[Mode]:
@@ -365,32 +352,33 @@ def linearize(model: Model, state: State | None = None, *,
                                  cs.cols, cs.scales, cs.quasi_int, _skip(model, cs),
                                  _PARAMS, out)
     g = from_output(model, state, cs, out[:ngen])
-    K, K_err, D, D_err = out[ngen:ngen + 4 * kk].reshape(4, k, k)
     o = ngen + 4 * kk
-    residual, left = out[o:o + k], out[o + k:o + 2 * k] > 0
-    info = out[o + 2 * k + 4 * kk:]
+    K, K_err, D, D_err = out[ngen:o].reshape(4, k, k)
+    residual = out[o:o + k]
+    left = (out[o + k:o + 2 * k] > 0).tolist()
+    info = out[o + 2 * k + 4 * kk:].tolist()
     if info[_core.LI_SINGULAR]:
         raise MbodyError(f"the generalized mass of '{model.name}' is not positive definite "
                          "at this state: a motion of the coordinates carries no mass")
     nz = int(info[_core.LI_KEPT]) + k
     A = out[o + 2 * k:o + 2 * k + nz * nz].reshape(nz, nz)
     warnings = list(g.warnings)
-    if not bool((np.abs(g.f) <= STEADY_RTOL * g.f_scale).all()):
+    labels = cs.labels
+    if not info[_core.LI_RESTING]:
         worst = int(np.argmax(np.abs(residual)))
         warnings.append(f"not an equilibrium or a steady motion: the generalized "
-                        f"accelerations here are not 0 ({cs.labels[worst]}'' = "
+                        f"accelerations here are not 0 ({labels[worst]}'' = "
                         f"{residual[worst]:.4g} {cs.items[worst].unit}/s^2); the eigenvalues "
                         "are those of the tangent system at this instant")
     j = int(info[_core.LI_UNSTEADY]) - 1
     if j >= 0:
-        warnings.append(f"not a steady motion: {cs.labels[j]} moves ({g.qdot[j]:.4g} "
+        warnings.append(f"not a steady motion: {labels[j]} moves ({g.qdot[j]:.4g} "
                         f"{cs.items[j].rate_unit}) and the forces depend on it")
-    labels = cs.labels
     return Linearization(model, state, g, g.M, D, K, K_err, D_err, residual,
                          bool(info[_core.LI_STEADY]),
-                         tuple(labels[i] for i in np.flatnonzero(left)),
-                         np.flatnonzero(~left), A, float(info[_core.LI_TOL]),
-                         float(info[_core.LI_DA]), tuple(warnings))
+                         tuple(c for c, out_ in zip(labels, left, strict=True) if out_),
+                         np.array([i for i, out_ in enumerate(left) if not out_], np.int64),
+                         A, info[_core.LI_TOL], info[_core.LI_DA], tuple(warnings))
 
 
 def loads_stiffness(lin: Linearization) -> np.ndarray:

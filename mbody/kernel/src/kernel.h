@@ -337,14 +337,16 @@ int mb_differences(const mb_model *md, const mb_unknowns *u, mb_work *w, double 
  * evaluation of f relative to f_scale, is divided by the projection's pivot ratio) and
  * the tolerance sqrt(|M^-1| (|dK| + |dD|) |A|)
  * (infinity norms; at least 1e3 eps |A|) on its eigenvalues, with |dA| = |M^-1| (|dK| +
- * |dD|) and |A| themselves (info's DA and NORM). out: [mb_generalized's out |
+ * |dD|) and |A| themselves (info's DA and NORM), and RESTING: q'' = 0 within params[MB_LP_STEADY]
+ * of f's terms. out: [mb_generalized's out |
  * K | K_err | D | D_err (nq x nq each) | q'' (nq) | left out (nq, 0/1) | A (nz x nz in a
  * slot of (2 nq)^2) | info (MB_LINEARIZE_INFO)], nz = kept + nq. Returns 0, or -1 when
  * memory ran out. */
 enum { MB_LP_STEP = 0, MB_LP_ROUNDING = 1, MB_LP_STEADY = 2, MB_LP_MOVING = 3,
        MB_LINEARIZE_PARAMS = 4 };
 enum { MB_LI_STEADY = 0, MB_LI_UNSTEADY = 1, MB_LI_TOL = 2, MB_LI_KEPT = 3,
-       MB_LI_SINGULAR = 4, MB_LI_DA = 5, MB_LI_NORM = 6, MB_LINEARIZE_INFO = 7 };
+       MB_LI_SINGULAR = 4, MB_LI_DA = 5, MB_LI_NORM = 6, MB_LI_RESTING = 7,
+       MB_LINEARIZE_INFO = 8 };
 int mb_linearize(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
                  const double *y, const double *lam, int64_t nq, const int64_t *Iq,
                  int64_t nc, const int64_t *cols, const double *scales, const int64_t *quasi,
@@ -359,5 +361,19 @@ int mb_linearize(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
  * row-major, column k the k-th eigenvalue's vector) | bounds (n)]. Returns 0, 1 when the
  * QR iteration did not converge, or -1 when memory ran out. */
 int mb_spectrum(const double *A, int64_t n, double dA, double tol, double *out);
+/* The modes of a spectrum (mb_spectrum's out, n eigenvalues) of a linearisation with k
+ * coordinates, nk of them kept (their indices in kept; z = (their delta q, all delta q')):
+ * one of each conjugate pair, classified as neutral (|lambda| within its bound: a free or
+ * cyclic motion), oscillation, growth or decay, neutral first, then by |lambda|. out
+ * (MB_MODE_W n + 2 n k): [rows of MB_MODE_W | shapes (k complex each, interleaved)], the
+ * first m of each used: a shape is delta q'/lambda
+ * (a neutral mode's delta q if it has one, else its rate), its largest entry 1, entries
+ * below 1e-14 set to 0, real when its imaginary parts are all below 1e-12. Returns m, or
+ * -1 when memory ran out. */
+enum { MB_MODE_INDEX = 0, MB_MODE_KIND = 1, MB_MODE_RE = 2, MB_MODE_IM = 3,
+       MB_MODE_FREQUENCY = 4, MB_MODE_DAMPING = 5, MB_MODE_W = 6 };
+enum { MB_MODE_NEUTRAL = 0, MB_MODE_OSCILLATION = 1, MB_MODE_GROWTH = 2, MB_MODE_DECAY = 3 };
+int64_t mb_modes(int64_t n, const double *spectrum, int64_t k, int64_t nk,
+                 const int64_t *kept, double *out);
 
 #endif

@@ -43,7 +43,7 @@ int mb_linearize(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
     const double *ginfo = F + k;
     if (!(ginfo[MB_GI_RANK] > 0.0) || k == 0) {
         memset(K, 0, sizeof(double) * (4 * kk + 2 * k + 4 * kk));
-        info[MB_LI_STEADY] = k == 0;
+        info[MB_LI_STEADY] = info[MB_LI_RESTING] = k == 0;
         return 0;
     }
     double *buf = malloc(sizeof(double) * (size_t)(2 * kk + 4 * k));
@@ -77,6 +77,7 @@ int mb_linearize(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
         resid[i] = f[i];
         if (!(fabs(f[i]) <= steady_rtol * F[i])) steady = 0;
     }
+    info[MB_LI_RESTING] = steady; /* q'' = 0 (the moving coordinates not yet judged) */
     mb_cho_solve_dense(L, k, k, resid);
     /* moving coordinates; cyclic ones (K's column within its error) moving, or a
      * quasi-velocity's angle, are symmetries: left out */

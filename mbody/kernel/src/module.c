@@ -1374,12 +1374,60 @@ static PyObject *spectrum(PyObject *mod, PyObject *const *args, Py_ssize_t nargs
     return PyLong_FromLong(status);
 }
 
+PyDoc_STRVAR(modes_doc,
+"modes(spectrum, k, kept, out) -> int\n\nThe modes of spectrum()'s out for k coordinates, "
+"the kept ones' indices in\nkept (int64) (kernel.h, mb_modes), into out (float64, "
+"MODE_W n + 2 n k). Returns their\nnumber m.");
+
+static PyObject *modes(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    Py_buffer spec, kept, out;
+    long long k;
+    if (check_nargs(nargs, 4, "modes") < 0) return NULL;
+    k = PyLong_AsLongLong(args[1]);
+    if (k == -1 && PyErr_Occurred()) return NULL;
+    if (k < 0) return PyErr_Format(PyExc_ValueError, "k: expected k >= 0");
+    if (get_buffer(args[0], &spec, 0, 1, -1, "spectrum") < 0) return NULL;
+    Py_ssize_t len = spec.len / 8;
+    Py_ssize_t n = (Py_ssize_t)floor((sqrt(9.0 + 8.0 * (double)len) - 3.0) / 4.0 + 0.5);
+    if (3 * n + 2 * n * n != len) {
+        PyBuffer_Release(&spec);
+        return PyErr_Format(PyExc_ValueError, "spectrum: expected 3 n + 2 n^2 values, got %zd",
+                            len);
+    }
+    if (get_buffer(args[2], &kept, 0, 0, -1, "kept") < 0) {
+        PyBuffer_Release(&spec);
+        return NULL;
+    }
+    Py_ssize_t nk = kept.len / 8;
+    const int64_t *kp = kept.buf;
+    int bad = nk > n || nk > k;
+    for (Py_ssize_t j = 0; j < nk && !bad; j++) bad = kp[j] < 0 || kp[j] >= k;
+    if (bad || n - nk != k) {
+        PyBuffer_Release(&kept);
+        PyBuffer_Release(&spec);
+        return PyErr_Format(PyExc_ValueError,
+                            "kept: expected indices below k = %lld, and n = kept + k", k);
+    }
+    if (get_buffer(args[3], &out, 1, 1, MB_MODE_W * n + 2 * n * k, "out") < 0) {
+        PyBuffer_Release(&kept);
+        PyBuffer_Release(&spec);
+        return NULL;
+    }
+    int64_t m = mb_modes(n, spec.buf, k, nk, kp, out.buf);
+    PyBuffer_Release(&out);
+    PyBuffer_Release(&kept);
+    PyBuffer_Release(&spec);
+    if (m < 0) return PyErr_NoMemory();
+    return PyLong_FromLongLong(m);
+}
+
 /* The DOP853 integrator's entry points (dop853_module.c). */
 int mb_dop853_register(PyObject *m);
 
 static PyMethodDef methods[] = {
     {"solve_layout", solve_layout, METH_VARARGS, solve_layout_doc},
     {"spectrum", (PyCFunction)(void (*)(void))spectrum, METH_FASTCALL, spectrum_doc},
+    {"modes", (PyCFunction)(void (*)(void))modes, METH_FASTCALL, modes_doc},
     {NULL, NULL, 0, NULL},
 };
 
@@ -1422,7 +1470,12 @@ PyMODINIT_FUNC PyInit__core(void) {
         {"LP_MOVING", MB_LP_MOVING}, {"LINEARIZE_PARAMS", MB_LINEARIZE_PARAMS},
         {"LI_STEADY", MB_LI_STEADY}, {"LI_UNSTEADY", MB_LI_UNSTEADY}, {"LI_TOL", MB_LI_TOL},
         {"LI_KEPT", MB_LI_KEPT}, {"LI_SINGULAR", MB_LI_SINGULAR}, {"LI_DA", MB_LI_DA},
-        {"LI_NORM", MB_LI_NORM},
+        {"LI_NORM", MB_LI_NORM}, {"LI_RESTING", MB_LI_RESTING},
+        {"MODE_INDEX", MB_MODE_INDEX}, {"MODE_KIND", MB_MODE_KIND}, {"MODE_RE", MB_MODE_RE},
+        {"MODE_IM", MB_MODE_IM}, {"MODE_FREQUENCY", MB_MODE_FREQUENCY},
+        {"MODE_DAMPING", MB_MODE_DAMPING}, {"MODE_W", MB_MODE_W},
+        {"MODE_NEUTRAL", MB_MODE_NEUTRAL}, {"MODE_OSCILLATION", MB_MODE_OSCILLATION},
+        {"MODE_GROWTH", MB_MODE_GROWTH}, {"MODE_DECAY", MB_MODE_DECAY},
         {"LINEARIZE_INFO", MB_LINEARIZE_INFO},
     };
     for (size_t i = 0; i < sizeof(constants) / sizeof(constants[0]); i++)

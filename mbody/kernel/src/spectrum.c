@@ -361,3 +361,86 @@ int mb_spectrum(const double *A, int64_t n, double dA, double tol, double *out) 
     free(buf);
     return 0;
 }
+
+int64_t mb_modes(int64_t n, const double *spectrum, int64_t k, int64_t nk,
+                 const int64_t *kept, double *out) {
+    const double complex *w = (const double complex *)spectrum, *V = w + n;
+    const double *tol = spectrum + 2 * (n + n * n);
+    double complex *shapes = (double complex *)(out + MB_MODE_W * n);
+    double *key = malloc(sizeof(double) * (size_t)(n > 0 ? n : 1));
+    double complex *row = malloc(sizeof(double complex) * (size_t)(n * (k > 0 ? k : 1) + 1));
+    int64_t *order = malloc(sizeof(int64_t) * (size_t)(n > 0 ? n : 1));
+    if (key == NULL || row == NULL || order == NULL) {
+        free(key), free(row), free(order);
+        return -1;
+    }
+    int64_t m = 0;
+    for (int64_t i = 0; i < n; i++) {
+        double complex lam = w[i];
+        double t = tol[i], mag = cabs(lam);
+        int neutral = mag <= t, osc = !neutral && fabs(cimag(lam)) > t;
+        if (osc && cimag(lam) < 0.0) continue; /* one of each conjugate pair */
+        double *mode = out + MB_MODE_W * m;
+        double re = fabs(creal(lam)) > t ? creal(lam) : 0.0;
+        double im = fabs(cimag(lam)) > t ? cimag(lam) : 0.0;
+        mode[MB_MODE_INDEX] = (double)i;
+        mode[MB_MODE_KIND] = neutral ? MB_MODE_NEUTRAL
+                                     : osc ? MB_MODE_OSCILLATION
+                                           : creal(lam) > 0.0 ? MB_MODE_GROWTH : MB_MODE_DECAY;
+        mode[MB_MODE_RE] = re, mode[MB_MODE_IM] = im;
+        mode[MB_MODE_FREQUENCY] = osc ? mag : NAN;
+        double zeta = neutral ? NAN : -re / mag;
+        mode[MB_MODE_DAMPING] = zeta == 0.0 ? 0.0 : zeta; /* not -0 */
+        key[m] = neutral ? -INFINITY : mag;
+        /* the shape: delta q = delta q' / lambda; a neutral mode's delta q if it has one
+         * (kept coordinates), else its rate */
+        double complex *s = row + k * m;
+        int positions = 0;
+        if (neutral) {
+            double top = 0.0, big = 0.0;
+            for (int64_t r = 0; r < n; r++) big = fmax(big, cabs(V[r * n + i]));
+            for (int64_t r = 0; r < k; r++) s[r] = 0.0;
+            for (int64_t j = 0; j < nk; j++) {
+                s[kept[j]] = V[j * n + i];
+                top = fmax(top, cabs(V[j * n + i]));
+            }
+            positions = top > 1e-12 * big;
+        }
+        if (!positions)
+            for (int64_t r = 0; r < k; r++) s[r] = V[(nk + r) * n + i] / (neutral ? 1.0 : lam);
+        int64_t at = 0; /* the largest entry (the first of equals) becomes 1 */
+        for (int64_t r = 1; r < k; r++)
+            if (cabs(s[r]) > cabs(s[at])) at = r;
+        double complex pivot = k > 0 ? s[at] : 1.0;
+        double imag = 0.0;
+        for (int64_t r = 0; r < k; r++) {
+            s[r] /= pivot;
+            if (cabs(s[r]) < 1e-14) s[r] = 0.0;
+            imag = fmax(imag, fabs(cimag(s[r])));
+        }
+        if (imag <= 1e-12) /* undamped: the coordinates move in phase */
+            for (int64_t r = 0; r < k; r++) s[r] = creal(s[r]);
+        m++;
+    }
+    for (int64_t i = 0; i < m; i++) order[i] = i;
+    for (int64_t i = 1; i < m; i++) { /* neutral first, then by |lambda| (stable) */
+        int64_t o = order[i], j = i;
+        while (j > 0 && key[order[j - 1]] > key[o]) {
+            order[j] = order[j - 1];
+            j--;
+        }
+        order[j] = o;
+    }
+    double *sorted = malloc(sizeof(double) * (size_t)(MB_MODE_W * (m > 0 ? m : 1)));
+    if (sorted == NULL) {
+        free(key), free(row), free(order);
+        return -1;
+    }
+    for (int64_t c = 0; c < m; c++) {
+        memcpy(sorted + MB_MODE_W * c, out + MB_MODE_W * order[c], sizeof(double) * MB_MODE_W);
+        memcpy(shapes + k * c, row + k * order[c], sizeof(double complex) * (size_t)k);
+    }
+    memcpy(out, sorted, sizeof(double) * (size_t)(MB_MODE_W * m));
+    free(sorted), free(key), free(row), free(order);
+    return m;
+}
