@@ -620,47 +620,86 @@ int mb_differences(const mb_model *md, const mb_unknowns *u, mb_work *w, double 
                    int64_t nc, const int64_t *cols, const double *qdot0, const double *h,
                    const double *hu, const double *fscale, double rounding,
                    const int64_t *skip, double *out) {
-    static const double step[6] = {1.0, -1.0, 0.5, -0.5, 0.25, -0.25};
-    int64_t moved = 0;
+    int64_t moved = 0, n2 = 2 * nq;
     for (int64_t j = 0; j < nq; j++) moved += skip[j] ? 0 : 1;
-    int64_t np_ = 6 * moved + 2 * nq; /* velocity rows last: they reuse one factorisation */
-    double *P = calloc((size_t)(np_ * 2 * nq + np_ * nq + 1), sizeof(double));
-    if (P == NULL) return -1;
-    double *f = P + np_ * 2 * nq;
+    /* first pass: steps +-h, +-h/2 of every moved coordinate, then the rates' (they reuse
+     * one factorisation); second pass: +-h/4 of the coordinates that need it */
+    int64_t np1 = 4 * moved + 2 * nq, np2 = 2 * moved;
+    double *P = calloc((size_t)(np1 * n2 + np1 * nq + np2 * n2 + np2 * nq + 1), sizeof(double));
+    int64_t *third = malloc(sizeof(int64_t) * (size_t)(nq > 0 ? nq : 1));
+    if (P == NULL || third == NULL) {
+        free(P), free(third);
+        return -1;
+    }
+    double *f = P + np1 * n2, *P2 = f + np1 * nq, *f2 = P2 + np2 * n2;
+    static const double step[4] = {1.0, -1.0, 0.5, -0.5};
     int64_t row = 0;
     for (int64_t j = 0; j < nq; j++) {
         if (skip[j]) continue;
-        for (int s = 0; s < 6; s++) P[(row + s) * 2 * nq + j] = step[s] * h[j];
-        row += 6;
+        for (int s = 0; s < 4; s++) P[(row + s) * n2 + j] = step[s] * h[j];
+        row += 4;
     }
     for (int64_t j = 0; j < nq; j++) {
-        P[(row + 2 * j) * 2 * nq + nq + j] = hu[j];
-        P[(row + 2 * j + 1) * 2 * nq + nq + j] = -hu[j];
+        P[(row + 2 * j) * n2 + nq + j] = hu[j];
+        P[(row + 2 * j + 1) * n2 + nq + j] = -hu[j];
     }
-    int status = mb_generalized_perturbed(md, u, w, t, y0, lam, nq, Iq, nc, cols, qdot0, np_,
+    int status = mb_generalized_perturbed(md, u, w, t, y0, lam, nq, Iq, nc, cols, qdot0, np1,
                                           P, f);
     double *K = out, *Kerr = K + nq * nq, *D = Kerr + nq * nq, *Derr = D + nq * nq;
+    /* a column whose two differences agree within their rounding has nothing left for a
+     * third step to extrapolate away (a coordinate the forces do not depend on, or depend
+     * on linearly): it stops at one extrapolation */
+    int64_t n3 = 0;
     row = 0;
     for (int64_t j = 0; j < nq && status == 0; j++) {
-        const double *fj = f + row * nq, *fu = f + (6 * moved + 2 * j) * nq;
+        third[j] = -1;
+        if (skip[j]) continue;
+        const double *fj = f + row * nq;
+        int need = 0;
+        for (int64_t i = 0; i < nq && !need; i++) {
+            double d0 = (fj[i] - fj[nq + i]) / (2.0 * h[j]);
+            double d1 = (fj[2 * nq + i] - fj[3 * nq + i]) / (1.0 * h[j]);
+            need = !(fabs(d0 - d1) <= 4.0 * rounding * fscale[i] / (0.25 * h[j]));
+        }
+        if (need) {
+            third[j] = n3;
+            P2[(2 * n3) * n2 + j] = 0.25 * h[j];
+            P2[(2 * n3 + 1) * n2 + j] = -0.25 * h[j];
+            n3++;
+        }
+        row += 4;
+    }
+    if (status == 0 && n3 > 0)
+        status = mb_generalized_perturbed(md, u, w, t, y0, lam, nq, Iq, nc, cols, qdot0,
+                                          2 * n3, P2, f2);
+    row = 0;
+    for (int64_t j = 0; j < nq && status == 0; j++) {
+        const double *fj = f + row * nq, *fu = f + (4 * moved + 2 * j) * nq;
+        const double *f3 = third[j] >= 0 ? f2 + 2 * third[j] * nq : NULL;
         for (int64_t i = 0; i < nq; i++) {
+            double round_err = 4.0 * rounding * fscale[i] / (0.25 * h[j]);
             if (skip[j]) {
                 K[i * nq + j] = Kerr[i * nq + j] = 0.0;
             } else {
                 double d0 = (fj[0 * nq + i] - fj[1 * nq + i]) / (2.0 * h[j]);
                 double d1 = (fj[2 * nq + i] - fj[3 * nq + i]) / (1.0 * h[j]);
-                double d2 = (fj[4 * nq + i] - fj[5 * nq + i]) / (0.5 * h[j]);
-                double r1 = (4.0 * d1 - d0) / 3.0, r2 = (4.0 * d2 - d1) / 3.0;
-                K[i * nq + j] = -(16.0 * r2 - r1) / 15.0;
-                Kerr[i * nq + j] =
-                    fabs(r1 - r2) / 15.0 + 4.0 * rounding * fscale[i] / (0.25 * h[j]);
+                double r1 = (4.0 * d1 - d0) / 3.0;
+                if (f3 != NULL) {
+                    double d2 = (f3[i] - f3[nq + i]) / (0.5 * h[j]);
+                    double r2 = (4.0 * d2 - d1) / 3.0;
+                    K[i * nq + j] = -(16.0 * r2 - r1) / 15.0;
+                    Kerr[i * nq + j] = fabs(r1 - r2) / 15.0 + round_err;
+                } else { /* |d0 - d1| within rounding: d1's truncation is below it too */
+                    K[i * nq + j] = -r1;
+                    Kerr[i * nq + j] = fabs(d0 - d1) + round_err;
+                }
             }
             D[i * nq + j] = -(fu[i] - fu[nq + i]) / (2.0 * hu[j]);
             double big = fmax(fscale[i], fmax(fabs(fu[i]), fabs(fu[nq + i])));
             Derr[i * nq + j] = 4.0 * rounding * big / hu[j];
         }
-        if (!skip[j]) row += 6;
+        if (!skip[j]) row += 4;
     }
-    free(P);
+    free(P), free(third);
     return status;
 }

@@ -317,7 +317,9 @@ int mb_generalized_perturbed(const mb_model *md, const mb_unknowns *u, mb_work *
                              const double *qdot0, int64_t np, const double *P, double *fout);
 /* The linearisation's differences at y0 (rates q0'): K = -df_q/dq by central differences at
  * steps h, h/2, h/4 per coordinate (h: nq) extrapolated twice (Richardson, O(h^6)), with the
- * error bound |R1 - R2| / 15 + 4 rounding fscale_i / (h_j / 4); D = -df_q/dq' by one central
+ * error bound |R1 - R2| / 15 + 4 rounding fscale_i / (h_j / 4); a column whose differences
+ * at h and h/2 (d0, d1) agree within that rounding term in every row stops at R1, bound
+ * |d0 - d1| + the rounding term (no step h/4); D = -df_q/dq' by one central
  * difference at steps hu (exact for f quadratic in q'), error 4 rounding max|f| / hu.
  * A coordinate with skip[j] != 0 is known not to enter f (a free body's position without
  * springs...): its K column is 0 without evaluations.
