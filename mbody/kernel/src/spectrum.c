@@ -217,8 +217,8 @@ static void solve2(double complex a, double complex b, double complex c, double 
 
 /* Scales x (n) down when its entries grow past 1e150 (a chain of guarded pivots). */
 static void rescale(double complex *x, int64_t n) {
-    double big = 0.0;
-    for (int64_t i = 0; i < n; i++) big = fmax(big, cabs(x[i]));
+    double big = 0.0; /* |re| + |im|: within a factor sqrt(2) of |x|, without hypot */
+    for (int64_t i = 0; i < n; i++) big = fmax(big, fabs(creal(x[i])) + fabs(cimag(x[i])));
     if (big > 1e150)
         for (int64_t i = 0; i < n; i++) x[i] /= big;
 }
