@@ -340,23 +340,31 @@ def evaluate(model: Model, state: State, cs: CoordinateSet,
     return from_output(model, state, cs, out)
 
 
-def from_output(model: Model, state: State, cs: CoordinateSet, out: np.ndarray
-                ) -> Generalized:
-    """`Generalized` from the core's output (`layout`)."""
-    N, k = len(cs.cols), len(cs)
-    o = layout(N, k)
-    info = out[o[8]:o[9]]
-    rank = float(info[_core.GI_RANK])
+def checked(model: Model, state: State, cs: CoordinateSet, out: np.ndarray
+            ) -> tuple[float, float, tuple[str, ...]]:
+    """(pivot ratio, residual, warnings) of the core's output (`layout`); raises
+    `CoordinatesSingularError` when the coordinates do not determine the motion."""
+    o = layout(len(cs.cols), len(cs))
+    rank = float(out[o[8] + _core.GI_RANK])
     if not rank > SINGULAR_RTOL:
         raise CoordinatesSingularError(
             f"the coordinates {', '.join(cs.labels)} do not determine the motion of "
             f"'{model.name}' at t = {state.t:g} s (a singular position for them: pivot "
             f"ratio {rank:.1e}); choose others with coordinates= (--coordinates)")
-    residual = float(info[_core.GI_RESIDUAL])
+    residual = float(out[o[8] + _core.GI_RESIDUAL])
     warnings: tuple[str, ...] = ()
     if residual > 1e-6:
         warnings = (f"the state is off its joints (least-squares residual {residual:.2g} of "
                     "the projection): the equations are those of the nearest motion",)
+    return rank, residual, warnings
+
+
+def from_output(model: Model, state: State, cs: CoordinateSet, out: np.ndarray
+                ) -> Generalized:
+    """`Generalized` from the core's output (`layout`)."""
+    N, k = len(cs.cols), len(cs)
+    o = layout(N, k)
+    rank, residual, warnings = checked(model, state, cs, out)
     return Generalized(model, state, cs, cs.values(out[o[5]:o[6]]), out[o[6]:o[7]],
                        out[o[3]:o[4]].reshape(k, k), out[o[4]:o[5]],
                        out[:o[1]].reshape(N, k), out[o[1]:o[2]], out[o[2]:o[3]],

@@ -37,7 +37,7 @@ from functools import cached_property
 import numpy as np
 
 from mbody.equations.coordinates import CoordinateSet, columns, coordinate_set
-from mbody.equations.generalized import Generalized, from_output, layout
+from mbody.equations.generalized import Generalized, checked, from_output, layout
 from mbody.equations.workspace import workspace
 from mbody.errors import MbodyError
 from mbody.kernel import _core
@@ -110,8 +110,8 @@ class Linearization:
     ----------
     model, state : Model, State
         The model and the state linearised about.
-    generalized : Generalized
-        The equations in generalized coordinates there (the driven coordinates held).
+    coordinate_set : CoordinateSet
+        The coordinates (the driven ones held).
     M, D, K : (k, k) arrays
         Generalized mass, damping (with the gyroscopic terms) and stiffness.
     K_error, D_error : (k, k) arrays
@@ -140,11 +140,16 @@ class Linearization:
         ‖δA‖, the bound on A's error (in A's units).
     warnings : tuple of str
         Why the state is not steady, and anything else worth saying.
+
+    The compiled core computes it all in one call (kernel.h: ``mb_linearize``): the
+    equations there (`generalized`, made on first use), the differences, A, its spectrum
+    (``mb_spectrum``: each eigenvalue's bound from its own left and right vectors) and
+    its modes (``mb_modes``); the private fields are views of that output.
     """
 
     model: Model
     state: State
-    generalized: Generalized
+    coordinate_set: CoordinateSet
     M: np.ndarray
     D: np.ndarray
     K: np.ndarray
@@ -158,23 +163,21 @@ class Linearization:
     tolerance: float
     dA: float = 0.0
     warnings: tuple[str, ...] = field(default_factory=tuple)
+    _generalized_out: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    _spectrum_out: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    _modes_out: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    _mode_count: int = 0
+    _growing: int = 0
+
+    @cached_property
+    def generalized(self) -> Generalized:
+        """The equations in generalized coordinates there (the driven coordinates held)."""
+        return from_output(self.model, self.state, self.coordinate_set, self._generalized_out)
 
     @property
     def coordinates(self) -> list[str]:
         """The coordinates (the driven ones held)."""
-        return self.generalized.coordinates
-
-    @cached_property
-    def _spectrum_out(self) -> np.ndarray:
-        """The compiled core's spectrum of A (kernel.h: ``mb_spectrum``): eigenvalues,
-        unit eigenvectors and error bounds (each from the eigenvalue's own left and right
-        vectors), by real part then imaginary part."""
-        n = len(self.A)
-        out = np.empty(3 * n + 2 * n * n)
-        if _core.spectrum(self.A, self.dA, self.tolerance, out):
-            raise MbodyError(f"the eigenvalues of '{self.model.name}'s linearisation did not "
-                             "converge (the QR iteration's limit)")
-        return out
+        return self.coordinate_set.labels
 
     @cached_property
     def _spectrum(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -202,17 +205,18 @@ class Linearization:
         """The modes: oscillations (one per complex pair), growths, decays and neutral
         ones (λ = 0: a free or cyclic motion), neutral first, then by |λ| (kernel.h:
         ``mb_modes``)."""
-        n, k = len(self.A), len(self.coordinates)
-        if not n:
-            return []
-        out = np.empty(_core.MODE_W * n + 2 * n * k)
-        m = _core.modes(self._spectrum_out, k, self.kept, out)
-        rows = out[:_core.MODE_W * m].reshape(m, _core.MODE_W).tolist()
+        m, n, k = self._mode_count, len(self.A), len(self.coordinates)
+        rows = self._mode_rows.tolist()
         start = _core.MODE_W * n
-        shapes = out[start:start + 2 * m * k].view(complex).reshape(m, k)
+        shapes = self._modes_out[start:start + 2 * m * k].view(complex).reshape(m, k)
         return [Mode(complex(r[_core.MODE_RE], r[_core.MODE_IM]), _KINDS[int(r[_core.MODE_KIND])],
                      r[_core.MODE_FREQUENCY], r[_core.MODE_DAMPING], shapes[c])
                 for c, r in enumerate(rows)]
+
+    @property
+    def _mode_rows(self) -> np.ndarray:
+        """(modes, MODE_W): the modes' rows from the core, in `modes`' order."""
+        return self._modes_out[:_core.MODE_W * self._mode_count].reshape(-1, _core.MODE_W)
 
     @property
     def oscillations(self) -> list[Mode]:
@@ -220,18 +224,15 @@ class Linearization:
         return [m for m in self.modes if m.kind == "oscillation"]
 
     @cached_property
-    def _oscillating(self) -> tuple[np.ndarray, np.ndarray]:
-        """The eigenvalues of the oscillations (Im λ > 0) and their error bounds, by |λ|."""
-        w, _, tol = self._spectrum
-        keep = (w.imag > tol) & (np.abs(w) > tol)
-        w, tol = w[keep], tol[keep]
-        order = np.argsort(np.abs(w))
-        return w[order], tol[order]
+    def _oscillating(self) -> np.ndarray:
+        """The oscillations' rows of `_mode_rows` (by |λ|)."""
+        rows = self._mode_rows
+        return rows[rows[:, _core.MODE_KIND] == _core.MODE_OSCILLATION]
 
     @property
     def frequencies(self) -> np.ndarray:
         """The natural frequencies |λ| of the oscillations (rad/s), ascending."""
-        return np.abs(self._oscillating[0])
+        return self._oscillating[:, _core.MODE_FREQUENCY]
 
     @property
     def frequencies_hz(self) -> np.ndarray:
@@ -241,8 +242,7 @@ class Linearization:
     @property
     def damping_ratios(self) -> np.ndarray:
         """ζ of each oscillation, in the order of `frequencies`."""
-        w, tol = self._oscillating
-        return -np.where(np.abs(w.real) > tol, w.real, 0.0) / np.abs(w) + 0.0
+        return self._oscillating[:, _core.MODE_DAMPING]
 
     @property
     def stable(self) -> bool | None:
@@ -251,8 +251,7 @@ class Linearization:
         motion, a cyclic coordinate — do not count); None when the state is not steady."""
         if not self.steady:
             return None
-        w, _, err = self._spectrum
-        return bool((w.real <= err).all())
+        return self._growing == 0
 
     @cached_property
     def K_geometric(self) -> np.ndarray:
@@ -344,25 +343,32 @@ def linearize(model: Model, state: State | None = None, *,
     state = model.initial if state is None else state
     cs = free_coordinates(model, coordinates)
     k, N = len(cs), len(cs.cols)
-    ngen = layout(N, k)[-1]
-    kk = k * k
-    out = np.empty(ngen + 8 * kk + 2 * k + _core.LINEARIZE_INFO)
+    gl = layout(N, k)
+    ngen, kk = gl[-1], k * k
+    o = ngen + 4 * kk  # q'', then left out, A and info
+    o_info = o + 2 * k + 4 * kk
+    o_spec = o_info + _core.LINEARIZE_INFO
+    o_modes = o_spec + 6 * k + 8 * kk
+    out = np.empty(o_modes + 12 * k + 4 * kk)
     ws = workspace(model)
     ws.solver(cs.held).linearize(float(state.t), ws.pack_state(state), cs.held.lam, cs.Iq,
                                  cs.cols, cs.scales, cs.quasi_int, _skip(model, cs),
                                  _PARAMS, out)
-    g = from_output(model, state, cs, out[:ngen])
-    o = ngen + 4 * kk
-    K, K_err, D, D_err = out[ngen:o].reshape(4, k, k)
-    residual = out[o:o + k]
-    left = (out[o + k:o + 2 * k] > 0).tolist()
-    info = out[o + 2 * k + 4 * kk:].tolist()
+    gen = out[:ngen]
+    _, _, gen_warnings = checked(model, state, cs, gen)
+    info = out[o_info:o_spec].tolist()
     if info[_core.LI_SINGULAR]:
         raise MbodyError(f"the generalized mass of '{model.name}' is not positive definite "
                          "at this state: a motion of the coordinates carries no mass")
+    if info[_core.LI_UNCONVERGED]:
+        raise MbodyError(f"the eigenvalues of '{model.name}'s linearisation did not converge "
+                         "(the QR iteration's limit)")
+    K, K_err, D, D_err = out[ngen:o].reshape(4, k, k)
+    residual = out[o:o + k]
+    left = (out[o + k:o + 2 * k] > 0).tolist()
     nz = int(info[_core.LI_KEPT]) + k
     A = out[o + 2 * k:o + 2 * k + nz * nz].reshape(nz, nz)
-    warnings = list(g.warnings)
+    warnings = list(gen_warnings)
     labels = cs.labels
     if not info[_core.LI_RESTING]:
         worst = int(np.argmax(np.abs(residual)))
@@ -372,13 +378,16 @@ def linearize(model: Model, state: State | None = None, *,
                         "are those of the tangent system at this instant")
     j = int(info[_core.LI_UNSTEADY]) - 1
     if j >= 0:
-        warnings.append(f"not a steady motion: {labels[j]} moves ({g.qdot[j]:.4g} "
+        warnings.append(f"not a steady motion: {labels[j]} moves ({gen[gl[6] + j]:.4g} "
                         f"{cs.items[j].rate_unit}) and the forces depend on it")
-    return Linearization(model, state, g, g.M, D, K, K_err, D_err, residual,
-                         bool(info[_core.LI_STEADY]),
+    return Linearization(model, state, cs, gen[gl[3]:gl[4]].reshape(k, k), D, K, K_err, D_err,
+                         residual, bool(info[_core.LI_STEADY]),
                          tuple(c for c, out_ in zip(labels, left, strict=True) if out_),
                          np.array([i for i, out_ in enumerate(left) if not out_], np.int64),
-                         A, info[_core.LI_TOL], info[_core.LI_DA], tuple(warnings))
+                         A, info[_core.LI_TOL], info[_core.LI_DA], tuple(warnings), gen,
+                         out[o_spec:o_spec + 3 * nz + 2 * nz * nz],
+                         out[o_modes:o_modes + _core.MODE_W * nz + 2 * nz * k],
+                         int(info[_core.LI_MODES]), int(info[_core.LI_GROWING]))
 
 
 def loads_stiffness(lin: Linearization) -> np.ndarray:

@@ -340,15 +340,18 @@ int mb_differences(const mb_model *md, const mb_unknowns *u, mb_work *w, double 
  * the tolerance sqrt(|M^-1| (|dK| + |dD|) |A|)
  * (infinity norms; at least 1e3 eps |A|) on its eigenvalues, with |dA| = |M^-1| (|dK| +
  * |dD|) and |A| themselves (info's DA and NORM), and RESTING: q'' = 0 within params[MB_LP_STEADY]
- * of f's terms. out: [mb_generalized's out |
+ * of f's terms; then A's spectrum (mb_spectrum; UNCONVERGED when its QR iteration did
+ * not converge), the number of eigenvalues beyond their bounds on the growing side
+ * (GROWING) and the modes (mb_modes, MODES of them). out: [mb_generalized's out |
  * K | K_err | D | D_err (nq x nq each) | q'' (nq) | left out (nq, 0/1) | A (nz x nz in a
- * slot of (2 nq)^2) | info (MB_LINEARIZE_INFO)], nz = kept + nq. Returns 0, or -1 when
- * memory ran out. */
+ * slot of (2 nq)^2) | info (MB_LINEARIZE_INFO) | spectrum (of nz, in a slot of
+ * 6 nq + 8 nq^2) | modes (of nz, in a slot of 12 nq + 4 nq^2)], nz = kept + nq. Returns
+ * 0, or -1 when memory ran out. */
 enum { MB_LP_STEP = 0, MB_LP_ROUNDING = 1, MB_LP_STEADY = 2, MB_LP_MOVING = 3,
        MB_LINEARIZE_PARAMS = 4 };
 enum { MB_LI_STEADY = 0, MB_LI_UNSTEADY = 1, MB_LI_TOL = 2, MB_LI_KEPT = 3,
        MB_LI_SINGULAR = 4, MB_LI_DA = 5, MB_LI_NORM = 6, MB_LI_RESTING = 7,
-       MB_LINEARIZE_INFO = 8 };
+       MB_LI_GROWING = 8, MB_LI_MODES = 9, MB_LI_UNCONVERGED = 10, MB_LINEARIZE_INFO = 11 };
 int mb_linearize(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
                  const double *y, const double *lam, int64_t nq, const int64_t *Iq,
                  int64_t nc, const int64_t *cols, const double *scales, const int64_t *quasi,

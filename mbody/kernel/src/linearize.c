@@ -142,6 +142,25 @@ int mb_linearize(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
     info[MB_LI_KEPT] = (double)nk;
     info[MB_LI_DA] = minv * (errK + errD);
     info[MB_LI_NORM] = nA;
+    /* the spectrum of A and its modes, in the same call (the verdict needs them all) */
+    double *spec = info + MB_LINEARIZE_INFO, *modes = spec + 6 * k + 8 * kk;
+    int64_t *kept = (int64_t *)x; /* x's k doubles are free now */
+    for (int64_t j = 0, c = 0; j < k; j++)
+        if (!left[j]) kept[c++] = j;
+    int status = mb_spectrum(A, nz, info[MB_LI_DA], info[MB_LI_TOL], spec);
+    if (status != 0) {
+        free(buf);
+        if (status < 0) return -1;
+        info[MB_LI_UNCONVERGED] = 1.0;
+        return 0;
+    }
+    const double *re = spec, *err = spec + 2 * (nz + nz * nz);
+    int64_t growing = 0;
+    for (int64_t i = 0; i < nz; i++) growing += !(re[2 * i] <= err[i]);
+    info[MB_LI_GROWING] = (double)growing;
+    int64_t m = mb_modes(nz, spec, k, nk, kept, modes);
     free(buf);
+    if (m < 0) return -1;
+    info[MB_LI_MODES] = (double)m;
     return 0;
 }

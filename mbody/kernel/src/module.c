@@ -927,7 +927,7 @@ static PyObject *Unknowns_linearize(UnknownsObject *self, PyObject *const *args,
     if (stage == 3 && get_buffer(args[8], &params, 0, 1, MB_LINEARIZE_PARAMS, "params") == 0)
         stage = 4;
     Py_ssize_t size = N * nq + 2 * N + nq * nq + 4 * nq + MB_GENERALIZED_INFO + 4 * nq * nq +
-                      2 * nq + 4 * nq * nq + MB_LINEARIZE_INFO;
+                      2 * nq + 4 * nq * nq + MB_LINEARIZE_INFO + 18 * nq + 12 * nq * nq;
     if (stage == 4 && get_buffer(args[9], &out, 1, 1, size, "out") == 0) stage = 5;
     if (stage == 5) {
         status = mb_linearize(md, &self->u, self->w, t, y.buf, lam.buf, nq, Iq.buf, N, cols.buf,
@@ -1471,6 +1471,8 @@ PyMODINIT_FUNC PyInit__core(void) {
         {"LI_STEADY", MB_LI_STEADY}, {"LI_UNSTEADY", MB_LI_UNSTEADY}, {"LI_TOL", MB_LI_TOL},
         {"LI_KEPT", MB_LI_KEPT}, {"LI_SINGULAR", MB_LI_SINGULAR}, {"LI_DA", MB_LI_DA},
         {"LI_NORM", MB_LI_NORM}, {"LI_RESTING", MB_LI_RESTING},
+        {"LI_GROWING", MB_LI_GROWING}, {"LI_MODES", MB_LI_MODES},
+        {"LI_UNCONVERGED", MB_LI_UNCONVERGED},
         {"MODE_INDEX", MB_MODE_INDEX}, {"MODE_KIND", MB_MODE_KIND}, {"MODE_RE", MB_MODE_RE},
         {"MODE_IM", MB_MODE_IM}, {"MODE_FREQUENCY", MB_MODE_FREQUENCY},
         {"MODE_DAMPING", MB_MODE_DAMPING}, {"MODE_W", MB_MODE_W},
