@@ -185,37 +185,41 @@ static void coordinate_row(const mb_model *md, const mb_work *w, const double *y
     }
 }
 
-/* Householder QR of C (r x N, row-major, in place) with its columns scaled to unit
- * length first (scale: the factors): the reflectors' vectors stay in C on and below the
- * diagonal (beta their factors), R's strict upper triangle above it, R's diagonal in
- * rdiag. Returns the smallest |R_kk| over the largest (0 when r < N). */
+/* C (r x N) is kept by columns (column j at C + j r): each step of the QR below runs down
+ * columns, so that its loops read memory in order (the same sums in the same order as by
+ * rows, so the same numbers). */
+
+/* Householder QR of C (in place) with its columns scaled to unit length first (scale: the
+ * factors): the reflectors' vectors stay in C on and below the diagonal (beta their
+ * factors), R's strict upper triangle above it, R's diagonal in rdiag. Returns the
+ * smallest |R_kk| over the largest (0 when r < N). */
 static double qr_factor(double *C, int64_t r, int64_t N, double *scale, double *beta,
                         double *rdiag) {
     for (int64_t j = 0; j < N; j++) rdiag[j] = 0.0;
     for (int64_t j = 0; j < N; j++) {
-        double s = 0.0;
-        for (int64_t i = 0; i < r; i++) s += C[i * N + j] * C[i * N + j];
+        double s = 0.0, *col = C + j * r;
+        for (int64_t i = 0; i < r; i++) s += col[i] * col[i];
         s = s > 0.0 ? 1.0 / sqrt(s) : 1.0;
         scale[j] = s;
-        for (int64_t i = 0; i < r; i++) C[i * N + j] *= s;
+        for (int64_t i = 0; i < r; i++) col[i] *= s;
     }
     if (r < N) return 0.0; /* fewer rows than columns: the motion is not determined */
     double big = 0.0, small = INFINITY;
     for (int64_t k = 0; k < N; k++) {
-        double norm = 0.0;
-        for (int64_t i = k; i < r; i++) norm += C[i * N + k] * C[i * N + k];
+        double *v = C + k * r, norm = 0.0;
+        for (int64_t i = k; i < r; i++) norm += v[i] * v[i];
         norm = sqrt(norm);
-        double x0 = C[k * N + k];
+        double x0 = v[k];
         double alpha = x0 >= 0.0 ? -norm : norm;
-        C[k * N + k] = x0 - alpha;
+        v[k] = x0 - alpha;
         double vv = 0.0;
-        for (int64_t i = k; i < r; i++) vv += C[i * N + k] * C[i * N + k];
+        for (int64_t i = k; i < r; i++) vv += v[i] * v[i];
         beta[k] = vv > 0.0 ? 2.0 / vv : 0.0;
         for (int64_t c = k + 1; c < N; c++) {
-            double s = 0.0;
-            for (int64_t i = k; i < r; i++) s += C[i * N + k] * C[i * N + c];
+            double s = 0.0, *col = C + c * r;
+            for (int64_t i = k; i < r; i++) s += v[i] * col[i];
             s *= beta[k];
-            for (int64_t i = k; i < r; i++) C[i * N + c] -= s * C[i * N + k];
+            for (int64_t i = k; i < r; i++) col[i] -= s * v[i];
         }
         rdiag[k] = alpha;
         big = fmax(big, fabs(alpha));
@@ -224,27 +228,26 @@ static double qr_factor(double *C, int64_t r, int64_t N, double *scale, double *
     return big > 0.0 ? small / big : 0.0;
 }
 
-/* B (r x nrhs, row-major) <- the least-squares solutions X (N x nrhs) of C X = B in its
- * first N rows, with the factors of qr_factor. Returns the residual's norm (the part of
- * B outside C's range: 0 for a consistent system). */
+/* b (r) <- the least-squares solution x (N) of C x = b in its first N entries, with the
+ * factors of qr_factor. Returns the residual's norm (the part of b outside C's range: 0
+ * for a consistent system). */
 static double qr_solve(const double *C, int64_t r, int64_t N, const double *scale,
-                       const double *beta, const double *rdiag, double *B, int64_t nrhs) {
+                       const double *beta, const double *rdiag, double *b) {
     double resid = 0.0;
-    for (int64_t c = 0; c < nrhs; c++) {
-        for (int64_t k = 0; k < N; k++) {
-            double s = 0.0;
-            for (int64_t i = k; i < r; i++) s += C[i * N + k] * B[i * nrhs + c];
-            s *= beta[k];
-            for (int64_t i = k; i < r; i++) B[i * nrhs + c] -= s * C[i * N + k];
-        }
-        for (int64_t i = N; i < r; i++) resid += B[i * nrhs + c] * B[i * nrhs + c];
-        for (int64_t k = N - 1; k >= 0; k--) {
-            double s = B[k * nrhs + c];
-            for (int64_t j = k + 1; j < N; j++) s -= C[k * N + j] * B[j * nrhs + c];
-            B[k * nrhs + c] = rdiag[k] != 0.0 ? s / rdiag[k] : 0.0;
-        }
-        for (int64_t k = 0; k < N; k++) B[k * nrhs + c] *= scale[k];
+    for (int64_t k = 0; k < N; k++) {
+        const double *v = C + k * r;
+        double s = 0.0;
+        for (int64_t i = k; i < r; i++) s += v[i] * b[i];
+        s *= beta[k];
+        for (int64_t i = k; i < r; i++) b[i] -= s * v[i];
     }
+    for (int64_t i = N; i < r; i++) resid += b[i] * b[i];
+    for (int64_t k = N - 1; k >= 0; k--) {
+        double s = b[k];
+        for (int64_t j = k + 1; j < N; j++) s -= C[j * r + k] * b[j];
+        b[k] = rdiag[k] != 0.0 ? s / rdiag[k] : 0.0;
+    }
+    for (int64_t k = 0; k < N; k++) b[k] *= scale[k];
     return sqrt(resid);
 }
 
@@ -255,29 +258,32 @@ static void qr_transposed(const double *C, int64_t r, int64_t N, const double *s
                           const double *beta, const double *rdiag, const double *x,
                           int64_t first, int64_t nq, double *out, double *work) {
     for (int64_t k = 0; k < N; k++) { /* R^T z = D x, forward */
+        const double *col = C + k * r;
         double s = scale[k] * x[k];
-        for (int64_t j = 0; j < k; j++) s -= C[j * N + k] * work[j];
+        for (int64_t j = 0; j < k; j++) s -= col[j] * work[j];
         work[k] = rdiag[k] != 0.0 ? s / rdiag[k] : 0.0;
     }
     for (int64_t i = N; i < r; i++) work[i] = 0.0;
     for (int64_t k = N - 1; k >= 0; k--) { /* Q [z; 0] = H_0 ... H_{N-1} [z; 0] */
+        const double *v = C + k * r;
         double s = 0.0;
-        for (int64_t i = k; i < r; i++) s += C[i * N + k] * work[i];
+        for (int64_t i = k; i < r; i++) s += v[i] * work[i];
         s *= beta[k];
-        for (int64_t i = k; i < r; i++) work[i] -= s * C[i * N + k];
+        for (int64_t i = k; i < r; i++) work[i] -= s * v[i];
     }
     for (int64_t k = 0; k < nq; k++) out[k] = work[first + k];
 }
 
-/* Adds row (child side [0..5] on body c, parent side [6..11] on body p) into C's row i. */
-static void put_row(const gen_scratch *s, double *Crow, const double *row, int64_t c,
-                    int64_t p) {
+/* Adds row (child side [0..5] on body c, parent side [6..11] on body p) into a matrix row
+ * whose column j is at[j * stride] (C's row i: C + i, stride r). */
+static void put_row(const gen_scratch *s, double *at, int64_t stride, const double *row,
+                    int64_t c, int64_t p) {
     for (int a = 0; a < 6; a++) {
         int64_t j = s->col_of[6 * c + a];
-        if (j >= 0) Crow[j] += row[a];
+        if (j >= 0) at[j * stride] += row[a];
         if (p >= 0) {
             j = s->col_of[6 * p + a];
-            if (j >= 0) Crow[j] += row[6 + a];
+            if (j >= 0) at[j * stride] += row[6 + a];
         }
     }
 }
@@ -323,7 +329,7 @@ static double factor(const mb_model *md, const mb_unknowns *u, mb_work *w, gen_s
         double row[12];
         memcpy(row, w->child6 + 6 * i, 6 * sizeof(double));
         memcpy(row + 6, w->parent6 + 6 * i, 6 * sizeof(double));
-        put_row(s, s->C + k * N, row, md->joints_i[3 * j + 1], md->joints_i[3 * j]);
+        put_row(s, s->C + k, r, row, md->joints_i[3 * j + 1], md->joints_i[3 * j]);
         s->fp[k] = 0.0;
         if (md->comps_i[4 * i + 3] >= 0) {
             double f[3];
@@ -331,7 +337,7 @@ static double factor(const mb_model *md, const mb_unknowns *u, mb_work *w, gen_s
             s->fp[k] = f[1];
         }
     }
-    for (int64_t k = 0; k < nq; k++) put_row(s, s->C + (mu + k) * N, s->arow + 12 * k, cc[k], cp[k]);
+    for (int64_t k = 0; k < nq; k++) put_row(s, s->C + mu + k, r, s->arow + 12 * k, cc[k], cp[k]);
     return qr_factor(s->C, r, N, s->scale, s->beta, s->rdiag);
 }
 
@@ -346,11 +352,11 @@ static void forces(const mb_model *md, const mb_unknowns *u, mb_work *w, gen_scr
     /* v_e: C v_e = [f'; 0]; v = C^+ [f'; q'] = v_e + T q' */
     for (int64_t k = 0; k < mu; k++) g[k] = s->fp[k];
     for (int64_t k = 0; k < nq; k++) g[mu + k] = 0.0;
-    qr_solve(s->C, r, N, s->scale, s->beta, s->rdiag, g, 1);
+    qr_solve(s->C, r, N, s->scale, s->beta, s->rdiag, g);
     for (int64_t i = 0; i < N; i++) ve[i] = g[i];
     for (int64_t k = 0; k < mu; k++) g[k] = s->fp[k];
     for (int64_t k = 0; k < nq; k++) g[mu + k] = qd[k];
-    qr_solve(s->C, r, N, s->scale, s->beta, s->rdiag, g, 1);
+    qr_solve(s->C, r, N, s->scale, s->beta, s->rdiag, g);
     double *v = s->y + 7 * n, *om = s->y + 10 * n;
     memset(v, 0, sizeof(double) * 6 * n);
     for (int64_t i = 0; i < 6 * n; i++) {
@@ -362,7 +368,7 @@ static void forces(const mb_model *md, const mb_unknowns *u, mb_work *w, gen_scr
     rows_at(md, w, s, nq, Iq, cc, cp, NULL); /* gamma at the velocities */
     for (int64_t k = 0; k < mu; k++) g[k] = w->gamma[u->U[k]];
     for (int64_t k = 0; k < nq; k++) g[mu + k] = s->agam[k];
-    qr_solve(s->C, r, N, s->scale, s->beta, s->rdiag, g, 1);
+    qr_solve(s->C, r, N, s->scale, s->beta, s->rdiag, g);
     for (int64_t i = 0; i < N; i++) a0[i] = g[i];
     /* Q - b + G_K lam_K at the state */
     mb_loads_at(md, w);
@@ -407,7 +413,7 @@ static double transformation(gen_scratch *s, int64_t nq, double *T) {
     for (int64_t k = 0; k < nq; k++) {
         memset(g, 0, sizeof(double) * r);
         g[mu + k] = 1.0;
-        double e = qr_solve(s->C, r, N, s->scale, s->beta, s->rdiag, g, 1);
+        double e = qr_solve(s->C, r, N, s->scale, s->beta, s->rdiag, g);
         resid += e * e;
         for (int64_t i = 0; i < N; i++) T[i * nq + k] = g[i];
     }
@@ -609,7 +615,7 @@ int mb_coordinate_rows(const mb_model *md, mb_work *w, double t, const double *y
         double row[12], gamma;
         int64_t c, p;
         coordinate_row(md, w, y, Iq + MB_GQ_W * k, row, &c, &p, &gamma, values + k);
-        put_row(&s, rows + k * nc, row, c, p);
+        put_row(&s, rows + k * nc, 1, row, c, p);
     }
     free(col_of);
     return 0;
