@@ -349,11 +349,14 @@ static void forces(const mb_model *md, const mb_unknowns *u, mb_work *w, gen_scr
     int64_t n = md->n, N = s->N, mu = s->mu, r = s->r;
     int64_t nq1 = nq > 0 ? nq : 1, cc[nq1], cp[nq1];
     double *g = s->B, *x = s->B + r, *work = s->B + 2 * r;
-    /* v_e: C v_e = [f'; 0]; v = C^+ [f'; q'] = v_e + T q' */
-    for (int64_t k = 0; k < mu; k++) g[k] = s->fp[k];
-    for (int64_t k = 0; k < nq; k++) g[mu + k] = 0.0;
-    qr_solve(s->C, r, N, s->scale, s->beta, s->rdiag, g);
-    for (int64_t i = 0; i < N; i++) ve[i] = g[i];
+    /* v_e: C v_e = [f'; 0] (wanted by mb_generalized only: ve NULL skips it);
+     * v = C^+ [f'; q'] = v_e + T q' */
+    if (ve != NULL) {
+        for (int64_t k = 0; k < mu; k++) g[k] = s->fp[k];
+        for (int64_t k = 0; k < nq; k++) g[mu + k] = 0.0;
+        qr_solve(s->C, r, N, s->scale, s->beta, s->rdiag, g);
+        for (int64_t i = 0; i < N; i++) ve[i] = g[i];
+    }
     for (int64_t k = 0; k < mu; k++) g[k] = s->fp[k];
     for (int64_t k = 0; k < nq; k++) g[mu + k] = qd[k];
     qr_solve(s->C, r, N, s->scale, s->beta, s->rdiag, g);
@@ -567,7 +570,7 @@ int mb_generalized_perturbed(const mb_model *md, const mb_unknowns *u, mb_work *
         scratch_free(&s);
         return -1;
     }
-    double *T0 = buf, *ve = T0 + N * nq, *a0 = ve + N, *d = a0 + N, *ystart = d + N;
+    double *T0 = buf, *a0 = T0 + N * nq + N, *d = a0 + N, *ystart = d + N;
     double qd[nq1];
     mb_eval_all(md, w, t);
     memcpy(s.y, y0, sizeof(double) * 13 * n);
@@ -590,7 +593,7 @@ int mb_generalized_perturbed(const mb_model *md, const mb_unknowns *u, mb_work *
             factored = !moved;
         }
         for (int64_t k = 0; k < nq; k++) qd[k] = qdot0[k] + du[k];
-        forces(md, u, w, &s, nq, Iq, qd, lam, ve, a0, fout + nq * p);
+        forces(md, u, w, &s, nq, Iq, qd, lam, NULL, a0, fout + nq * p);
     }
     free(buf);
     scratch_free(&s);
