@@ -7,12 +7,14 @@
 #define TWO_PI 6.283185307179586
 #define PI 3.141592653589793
 
+static const double IDENTITY[9] = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
+
 /* What one joint's components share, at one state (world axes unless said). */
 typedef struct {
     const double *row;      /* the joint's packed row */
     int64_t p, c;           /* parent (-1 ground), child */
     const double *Rc;       /* the child's W_R_B */
-    double Rp[9];           /* the parent's (identity for ground) */
+    const double *Rp;       /* the parent's (identity for ground) */
     const double *WE;       /* (R_p P_E3), row-major: WE[3 a + b] */
     const double *Rrel;     /* A = (R_p P_E3)^T (R_c C_E3) */
     const double *P, *Brp, *d, *T, *wc, *wp;
@@ -81,7 +83,7 @@ static void load_joint(const mb_model *md, const mb_work *w, int64_t j, joint_st
     js->row = md->joints + MB_JOINT_W * j;
     js->p = md->joints_i[3 * j], js->c = md->joints_i[3 * j + 1];
     js->Rc = w->R + 9 * js->c;
-    for (int a = 0; a < 9; a++) js->Rp[a] = js->p >= 0 ? w->R[9 * js->p + a] : (a % 4 == 0);
+    js->Rp = js->p >= 0 ? w->R + 9 * js->p : IDENTITY;
     js->WE = w->jWE + 9 * j, js->Rrel = w->jRrel + 9 * j;
     js->P = w->jP + 3 * j, js->Brp = w->jBrp + 3 * j, js->d = w->jd + 3 * j;
     js->T = w->jT + 3 * j, js->wc = w->jwc + 3 * j, js->wp = w->jwp + 3 * j;
