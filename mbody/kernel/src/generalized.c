@@ -99,12 +99,15 @@ static void to_body(const double *R, const double *e, double *B) {
 
 /* Coordinate k's rate row (child side row[0..5], parent side row[6..11]; its bodies in
  * *c, *p), its acceleration term gamma (at the velocities w's joint data were made with)
- * and its value (rad, m; NaN for a quasi-velocity). Needs w->R and the joint data of
- * mb_columns_at at the same y. */
+ * and, unless value is NULL, its value (rad, m; NaN for a quasi-velocity). Needs w->R and
+ * the joint data of mb_columns_at at the same y. */
 static void coordinate_row(const mb_model *md, const mb_work *w, const double *y,
                            const int64_t *c, double *row, int64_t *child, int64_t *parent,
                            double *gamma, double *value) {
     int64_t kind = c[0], index = c[1], axis = c[2], rule = c[3];
+    double unused;
+    if (value == NULL) value = &unused;
+    int values = value != &unused;
     memset(row, 0, 12 * sizeof(double));
     *gamma = 0.0;
     *value = NAN;
@@ -126,9 +129,8 @@ static void coordinate_row(const mb_model *md, const mb_work *w, const double *y
     *child = ch, *parent = p;
     const double *Rc = w->R + 9 * ch, *WE = w->jWE + 9 * j, *A = w->jRrel + 9 * j;
     const double *wc = w->jwc + 3 * j, *wp = w->jwp + 3 * j;
-    double Rp[9] = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
-    if (p >= 0)
-        for (int a = 0; a < 9; a++) Rp[a] = w->R[9 * p + a];
+    static const double identity[9] = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
+    const double *Rp = p >= 0 ? w->R + 9 * p : identity;
     double e[3], Bc[3], Bp[3], k[3];
     mb_cross(wc, wp, k);
     if (kind == MB_GQ_CHILD_TURN) {
@@ -160,7 +162,7 @@ static void coordinate_row(const mb_model *md, const mb_work *w, const double *y
     }
     if (particle_parent)
         for (int a = 9; a < 12; a++) row[a] = 0.0;
-    if (kind == MB_GQ_SLIDE) return;
+    if (kind == MB_GQ_SLIDE || !values) return;
     /* values: rule 0 the turn about the frame's axis; 1, 2 a universal joint's first and
      * second angle (R_rel = Rz(q1) R_b0(q2), b0 = axis2 in the joint frame at the file's
      * pose); a child-fixed body axis has none (a quasi-velocity) */
@@ -312,7 +314,7 @@ static void rows_at(const mb_model *md, mb_work *w, gen_scratch *s, int64_t nq,
                   w->gtv);
     for (int64_t k = 0; k < nq; k++)
         coordinate_row(md, w, s->y, Iq + MB_GQ_W * k, s->arow + 12 * k, cc + k, cp + k,
-                       s->agam + k, values ? values + k : &(double){0.0});
+                       s->agam + k, values ? values + k : NULL);
 }
 
 /* Stage 1 at positions s->y: rotations, the rows and C's QR (kept in s), the coordinates'
