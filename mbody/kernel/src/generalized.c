@@ -343,7 +343,8 @@ static double factor(const mb_model *md, const mb_unknowns *u, mb_work *w, gen_s
     return qr_factor(s->C, r, N, s->scale, s->beta, s->rdiag);
 }
 
-/* Stage 2 with C factored at s->y's positions: v = T q' + v_e into s->y, a0, and
+/* Stage 2 with C factored at s->y's positions (the last mb_columns_at there): v = T q' +
+ * v_e into s->y, a0, and
  * f_q = T^T (Q - b + G_K lam_K - M a0) (by the transposed solve); ve, a0 (N) written. */
 static void forces(const mb_model *md, const mb_unknowns *u, mb_work *w, gen_scratch *s,
                    int64_t nq, const int64_t *Iq, const double *qd, const double *lam,
@@ -370,7 +371,11 @@ static void forces(const mb_model *md, const mb_unknowns *u, mb_work *w, gen_scr
         if (i % 6 < 3) v[3 * (i / 6) + i % 6] = g[j];
         else om[3 * (i / 6) + i % 6 - 3] = g[j];
     }
-    rows_at(md, w, s, nq, Iq, cc, cp, NULL); /* gamma at the velocities */
+    /* gamma at the velocities (the positions, so the columns, are factor's) */
+    mb_gammas_at(md, w, s->y, 1, w->child6, w->parent6, w->gamma, w->gtv);
+    for (int64_t k = 0; k < nq; k++)
+        coordinate_row(md, w, s->y, Iq + MB_GQ_W * k, s->arow + 12 * k, cc + k, cp + k,
+                       s->agam + k, NULL);
     for (int64_t k = 0; k < mu; k++) g[k] = w->gamma[u->U[k]];
     for (int64_t k = 0; k < nq; k++) g[mu + k] = s->agam[k];
     qr_solve(s->C, r, N, s->scale, s->beta, s->rdiag, g);

@@ -90,6 +90,11 @@ void mb_springs_at(const mb_model *md, mb_work *w, const double *y, double *out)
 void mb_columns_at(const mb_model *md, mb_work *w, const double *y, int laws,
                    double *child6, double *parent6, double *W_e, double *W_P,
                    double *gamma, double *phi, double *gtv);
+/* The velocity part of mb_columns_at at y, whose positions are those of the last
+ * mb_columns_at (its columns child6, parent6 and the joints' frames and points still in
+ * w): the joints' velocity data, gamma and G^T v, the same numbers as a whole call. */
+void mb_gammas_at(const mb_model *md, mb_work *w, const double *y, int laws,
+                  const double *child6, const double *parent6, double *gamma, double *gtv);
 
 /* solve.c */
 void mb_schur(const mb_model *md, const mb_unknowns *u, const double *bodies,

@@ -25,33 +25,20 @@ typedef struct {
     double *child6, *parent6, gamma, phi, e[3];
 } column;
 
-static void joint_geometry(const mb_model *md, mb_work *w, const double *y, int64_t j) {
+/* The joint's velocity data at y (w_c, w_p and T = the relative acceleration's velocity
+ * part), from its points (P, the parent's point of it) already in w. */
+static void joint_velocities(const mb_model *md, mb_work *w, const double *y, int64_t j) {
     int64_t n = md->n;
     const double *x = y, *v = y + 7 * n, *om = y + 10 * n;
-    const double *row = md->joints + MB_JOINT_W * j;
     int64_t p = md->joints_i[3 * j], c = md->joints_i[3 * j + 1];
-    double Rp[9] = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
-    if (p >= 0)
-        for (int a = 0; a < 9; a++) Rp[a] = w->R[9 * p + a];
-    const double *Rc = w->R + 9 * c;
-    const double *PE = row + J_PE3, *CE = row + J_CE3;
-    double *WE = w->jWE + 9 * j, *P = w->jP + 3 * j, *Brp = w->jBrp + 3 * j;
-    double *d = w->jd + 3 * j, *T = w->jT + 3 * j, *wc = w->jwc + 3 * j, *wp = w->jwp + 3 * j;
-    double *Rrel = w->jRrel + 9 * j;
-    for (int a = 0; a < 3; a++)
-        for (int b = 0; b < 3; b++)
-            WE[3 * a + b] = Rp[3 * a] * PE[b] + Rp[3 * a + 1] * PE[3 + b] + Rp[3 * a + 2] * PE[6 + b];
-    for (int a = 0; a < 3; a++)
-        P[a] = x[3 * c + a] + Rc[3 * a] * row[J_BRC] + Rc[3 * a + 1] * row[J_BRC + 1] +
-               Rc[3 * a + 2] * row[J_BRC + 2];
+    const double *Rp = p >= 0 ? w->R + 9 * p : IDENTITY, *Rc = w->R + 9 * c;
+    const double *P = w->jP + 3 * j;
+    double *T = w->jT + 3 * j, *wc = w->jwc + 3 * j, *wp = w->jwp + 3 * j;
     double xp[3] = {0.0, 0.0, 0.0}, vp[3] = {0.0, 0.0, 0.0};
     if (p >= 0)
         for (int a = 0; a < 3; a++) xp[a] = x[3 * p + a], vp[a] = v[3 * p + a];
     double s[3] = {P[0] - xp[0], P[1] - xp[1], P[2] - xp[2]};
     for (int a = 0; a < 3; a++) {
-        Brp[a] = Rp[a] * s[0] + Rp[3 + a] * s[1] + Rp[6 + a] * s[2];
-        d[a] = P[a] - (xp[a] + Rp[3 * a] * row[J_BRP] + Rp[3 * a + 1] * row[J_BRP + 1] +
-                       Rp[3 * a + 2] * row[J_BRP + 2]);
         wc[a] = Rc[3 * a] * om[3 * c] + Rc[3 * a + 1] * om[3 * c + 1] + Rc[3 * a + 2] * om[3 * c + 2];
         wp[a] = 0.0;
         if (p >= 0)
@@ -67,6 +54,32 @@ static void joint_geometry(const mb_model *md, mb_work *w, const double *y, int6
     mb_cross(wc, cr, aa);
     mb_cross(wp, Vr, bb);
     for (int a = 0; a < 3; a++) T[a] = t[a] + aa[a] - bb[a];
+}
+
+static void joint_geometry(const mb_model *md, mb_work *w, const double *y, int64_t j) {
+    const double *x = y;
+    const double *row = md->joints + MB_JOINT_W * j;
+    int64_t p = md->joints_i[3 * j], c = md->joints_i[3 * j + 1];
+    const double *Rp = p >= 0 ? w->R + 9 * p : IDENTITY, *Rc = w->R + 9 * c;
+    const double *PE = row + J_PE3, *CE = row + J_CE3;
+    double *WE = w->jWE + 9 * j, *P = w->jP + 3 * j, *Brp = w->jBrp + 3 * j;
+    double *d = w->jd + 3 * j, *Rrel = w->jRrel + 9 * j;
+    for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++)
+            WE[3 * a + b] = Rp[3 * a] * PE[b] + Rp[3 * a + 1] * PE[3 + b] + Rp[3 * a + 2] * PE[6 + b];
+    for (int a = 0; a < 3; a++)
+        P[a] = x[3 * c + a] + Rc[3 * a] * row[J_BRC] + Rc[3 * a + 1] * row[J_BRC + 1] +
+               Rc[3 * a + 2] * row[J_BRC + 2];
+    double xp[3] = {0.0, 0.0, 0.0};
+    if (p >= 0)
+        for (int a = 0; a < 3; a++) xp[a] = x[3 * p + a];
+    double s[3] = {P[0] - xp[0], P[1] - xp[1], P[2] - xp[2]};
+    for (int a = 0; a < 3; a++) {
+        Brp[a] = Rp[a] * s[0] + Rp[3 + a] * s[1] + Rp[6 + a] * s[2];
+        d[a] = P[a] - (xp[a] + Rp[3 * a] * row[J_BRP] + Rp[3 * a + 1] * row[J_BRP + 1] +
+                       Rp[3 * a + 2] * row[J_BRP + 2]);
+    }
+    joint_velocities(md, w, y, j);
     /* R_rel = (R_p P_E3)^T (R_c C_E3), for the moment components' phi */
     for (int a = 0; a < 3; a++)
         for (int b = 0; b < 3; b++) {
@@ -301,6 +314,60 @@ void mb_columns_at(const mb_model *md, mb_work *w, const double *y, int laws,
             for (int a = 0; a < 3; a++) W_e[3 * i + a] = col.e[a];
         if (W_P != NULL)
             for (int a = 0; a < 3; a++) W_P[3 * i + a] = js.P[a];
+    }
+}
+
+void mb_gammas_at(const mb_model *md, mb_work *w, const double *y, int laws,
+                  const double *child6, const double *parent6, double *gamma, double *gtv) {
+    int64_t n = md->n;
+    const double *v = y + 7 * n, *om = y + 10 * n;
+    for (int64_t j = 0; j < md->nj; j++) joint_velocities(md, w, y, j);
+    joint_state js;
+    for (int64_t i = 0; i < md->m; i++) {
+        const int64_t *ci = md->comps_i + 4 * i;
+        int64_t j = ci[0], kind = ci[1], axis = ci[2];
+        double off = md->comps_f[MB_COMP_W * i], h = md->comps_f[MB_COMP_W * i + 1];
+        double f[3] = {0.0, 0.0, 0.0};
+        int driven = laws && ci[3] >= 0;
+        if (driven) mb_law(md, w, i, f);
+        load_joint(md, w, j, &js);
+        double e[3], Bp[3], g;
+        switch (kind) { /* each kind's gamma as its column function writes it */
+        case MB_KIND_FORCE:
+            frame_axis(&js, axis, e, Bp);
+            g = -(e[0] * js.T[0] + e[1] * js.T[1] + e[2] * js.T[2]);
+            break;
+        case MB_KIND_TILT:
+        case MB_KIND_LOCK:
+        case MB_KIND_TURN:
+            frame_axis(&js, axis, e, Bp);
+            g = moment_gamma(&js, e);
+            break;
+        case MB_KIND_RIGHT_ANGLE:
+        case MB_KIND_LINK: { /* their gammas need the whole column's geometry */
+            double c6[6], p6[6];
+            column col = {c6, p6, 0.0, 0.0, {0.0, 0.0, 0.0}};
+            if (kind == MB_KIND_LINK) link(md, y, &js, &col);
+            else right_angle(&js, &col);
+            g = col.gamma;
+            break;
+        }
+        default: { /* SCREW: the FORCE gamma less h times the moment's */
+            frame_axis(&js, axis, e, Bp);
+            double gamma_force = -(e[0] * js.T[0] + e[1] * js.T[1] + e[2] * js.T[2]);
+            g = gamma_force - h * moment_gamma(&js, e);
+            break;
+        }
+        }
+        (void)off;
+        const double *c6 = child6 + 6 * i, *p6 = parent6 + 6 * i;
+        int64_t p = js.p, c = js.c;
+        double s = 0.0;
+        for (int a = 0; a < 3; a++) s += c6[a] * v[3 * c + a] + c6[3 + a] * om[3 * c + a];
+        if (p >= 0)
+            for (int a = 0; a < 3; a++) s += p6[a] * v[3 * p + a] + p6[3 + a] * om[3 * p + a];
+        gamma[i] = driven ? g + f[2] : g;
+        gtv[i] = driven ? s - f[1] : s;
     }
 }
 
