@@ -93,6 +93,52 @@ def sample_figures(model: Model, unknowns: Unknowns, t: np.ndarray, Y: np.ndarra
     return SampleFigures(lam_out, len_out, float(drift[0]), float(drift[1]))
 
 
+ANGULAR_MOMENTUM_ABOUT = {"world origin": 0, "spins": 1, "mass centre": 2}
+"""The core's codes of the point angular momentum is taken about (`conserved_figures`)."""
+
+
+class ConservedFigures(NamedTuple):
+    """What a run conserves, at its K samples (`conserved_figures`)."""
+
+    kinetic_energy: np.ndarray
+    """(K,) T = Σ ½ m vᵀv + ½ ωᵀ J ω (J)."""
+    potential_energy: np.ndarray
+    """(K,) V = −Σ m g·x + Σ ½ k (L − L0)² (J)."""
+    angular_momentum: np.ndarray
+    """(K, 3) H, world axes (kg m²/s), about the point asked for."""
+    energy_drift: float
+    """max |E − E(0)| / max(|E(0)|, max T), E = T + V (0 when that scale is 0)."""
+    momentum_drift: float
+    """max |p − p(0)| over the largest Σ |m v| (0 when that is)."""
+    angular_momentum_drift: float
+    """max |H − H(0)| over the largest sum of its terms' magnitudes (0 when that is)."""
+    momentum_initial: np.ndarray
+    """(3,) p = Σ m v at the first sample (kg m/s)."""
+
+
+def conserved_figures(model: Model, Y: np.ndarray, about: str,
+                      lengths: np.ndarray | None = None) -> ConservedFigures:
+    """Energy, linear and angular momentum at the sampled states Y (K, state size: the
+    core's layout, unit quaternions; a planar model's carried angles) in one call of the
+    compiled core (`_core.conservation`), with their largest relative changes. `about`:
+    a key of `ANGULAR_MOMENTUM_ABOUT` (the spins alone, or with the orbital terms about
+    the world origin or the system's mass centre); `lengths` (K, s): the springs' lengths
+    at the samples (needed when the model has springs)."""
+    K = len(Y)
+    sp = model.springs
+    T, V, H, figures = np.empty(K), np.empty(K), np.empty((K, 3)), np.empty(6)
+    _core.conservation(np.ascontiguousarray(model.mass, dtype=float),
+                       np.ascontiguousarray(model.J, dtype=float),
+                       np.ascontiguousarray(model.gravity, dtype=float),
+                       np.ascontiguousarray(sp.stiffness, dtype=float),
+                       np.ascontiguousarray(sp.rest_length, dtype=float),
+                       None if lengths is None else np.ascontiguousarray(lengths, dtype=float),
+                       np.ascontiguousarray(Y, dtype=float), model.dimension == 2,
+                       ANGULAR_MOMENTUM_ABOUT[about], T, V, H, figures)
+    return ConservedFigures(T, V, H, float(figures[0]), float(figures[1]),
+                            float(figures[2]), figures[3:6].copy())
+
+
 def reactions_at(model: Model, unknowns: Unknowns, t: np.ndarray, Y: np.ndarray
                  ) -> np.ndarray:
     """(K, m) every reaction value at the sampled states (`sample_figures`)."""
