@@ -141,8 +141,9 @@ class DOP853:
 
     @property
     def core_time(self) -> float:
-        """Seconds the core spent in `sampled` and `sampled_marks` calls (steps, dense
-        output, sample projections), by a monotonic clock."""
+        """Seconds the core spent starting the run (f(t0, y0), the first step's size)
+        and in `sampled` and `sampled_marks` calls (steps, dense output, sample
+        projections), by a monotonic clock."""
         return float(self.state[_core.DOP_WALL])
 
     def step(self) -> str | None:

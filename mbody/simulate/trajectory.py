@@ -444,10 +444,19 @@ def _jsonable(x: Any) -> Any:
 
 def model_text(model) -> str:
     """The model file's text, when the model came from a readable file ('' otherwise):
-    what a trajectory keeps so that it can be drawn and checked without the file."""
-    p = Path(model.file) if model.file and not model.file.startswith("<") else None
+    what a trajectory keeps so that it can be drawn and checked without the file. The
+    text the model was read from when it kept it (`Model.source`: every hand-written
+    file; its line ends read as a text file reads them), else the file as it is now."""
+    if not model.file or model.file.startswith("<"):
+        return ""
+    p = Path(model.file)
+    source = getattr(model, "source", None)
+    if source is not None and source.text is not None and source.file == model.file:
+        # not read again: a second read and decode cost as much as the rest of a short
+        # run's bookkeeping
+        return source.text.replace("\r\n", "\n").replace("\r", "\n") if p.is_file() else ""
     try:
-        return p.read_text(encoding="utf-8") if p is not None and p.is_file() else ""
+        return p.read_text(encoding="utf-8") if p.is_file() else ""
     except (OSError, UnicodeDecodeError):
         return ""
 

@@ -82,7 +82,7 @@ enum {
     MB_DOP_FILTER_NEXT, /* whether the next one is */
     MB_DOP_DENSE,       /* whether the last step's dense output is prepared */
     MB_DOP_DENSE_NFEV,  /* evaluations of rhs made for dense output (part of NFEV) */
-    MB_DOP_WALL,        /* seconds spent in the binding's calls of mb_dop853_sampled */
+    MB_DOP_WALL,        /* seconds spent in the binding's calls of _start and _sampled */
     MB_DOP_MARK_WIDTH,  /* the marks' window (mb_dop853_sampled; 0: no marks) */
     MB_DOP_MARK_NEXT,   /* the next mark's time (the caller sets the first) */
     MB_DOP_INFO,        /* the last projection's info (MB_DOP_PROJECT_INFO slots) */

@@ -362,7 +362,9 @@ static PyObject *py_start(PyObject *self, PyObject *args) {
     PyObject *out = NULL;
     if (get_doubles(y0, &by, 0, (Py_ssize_t)n, "y0") == 0) {
         if (problem_read(tuple, n, &pr, &ode) == 0) {
+            const double start = now_seconds();
             int status = mb_dop853_start(&ode, t0, by.buf, first_step, bs.buf, bw.buf);
+            ((double *)bs.buf)[MB_DOP_WALL] += now_seconds() - start;
             out = status_or_error(status, bs.buf);
             problem_release(&pr);
         }
@@ -652,7 +654,7 @@ static PyMethodDef dop853_methods[] = {
      "moved by project when project_samples; k: the first row not yet written. With "
      "marks (a float64 buffer of rows (t, steps)): -> (status, k, count), the first count "
      "rows written at each step reaching DOP_MARK_NEXT or t_bound (dop853.h); the seconds "
-     "spent are added to state[DOP_WALL]."},
+     "spent are added to state[DOP_WALL] (as dop853_start's)."},
     {"samples", py_samples, METH_VARARGS,
      "samples(unknowns, lam, t, Y, reactions, lengths, drift): a run's figures at its K "
      "output samples (Y: K rows of the packed state at the times t): reactions (K x m, or "

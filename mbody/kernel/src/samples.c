@@ -2,7 +2,9 @@
  * springs' lengths and the joints' drift, one pass over the samples in C. */
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
+#include "internal.h"
 #include "mechanism.h"
 
 int mb_samples(const mb_model *md, const mb_unknowns *u, mb_work *w, const double *lam,
@@ -23,9 +25,14 @@ int mb_samples(const mb_model *md, const mb_unknowns *u, mb_work *w, const doubl
         if (reactions != NULL) {
             mb_solve(md, u, w, t[k], y, lam, out);
             for (int64_t i = 0; i < m; i++) reactions[k * m + i] = out[N + i];
+            /* the solve evaluated every component's phi and G^T v - f' at this state
+             * (evaluate.c: mb_columns_at, as mb_columns does): taken from its work */
+            memcpy(phi, w->phi, (size_t)m * sizeof(double));
+            memcpy(gtv, w->gtv, (size_t)m * sizeof(double));
+        } else if (m > 0) {
+            mb_columns(md, w, t[k], y, c6, p6, We, WP, gamma, phi, gtv);
         }
         if (m > 0) {
-            mb_columns(md, w, t[k], y, c6, p6, We, WP, gamma, phi, gtv);
             for (int64_t i = 0; i < m; i++) {
                 if (fabs(phi[i]) > drift[0] || phi[i] != phi[i]) drift[0] = fabs(phi[i]);
                 if (fabs(gtv[i]) > drift[1] || gtv[i] != gtv[i]) drift[1] = fabs(gtv[i]);
