@@ -38,6 +38,7 @@ from mbody.equations.constraints import joint_errors
 from mbody.equations.workspace import workspace
 from mbody.equations.world import check_axes
 from mbody.errors import MbodyError, UnknownReactionsError, did_you_mean
+from mbody.kernel import _core
 from mbody.model.expressions import Expression, check_times, compile_expression, first_nonfinite
 from mbody.model.model import Model, State
 from mbody.simulate.axes import world_series
@@ -48,7 +49,6 @@ from mbody.simulate.projection import STAGE_PIVOT_RTOL, JointProjection
 from mbody.simulate.stepping import CORE, IMPLICIT, start
 from mbody.simulate.trajectory import (
     Trajectory,
-    keep_planar_angles,
     model_text,
 )
 from mbody.solve.dynamics import Dynamics, StateDerivative, accelerations
@@ -315,12 +315,10 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     wall = time.perf_counter() - wall
     stepping_time = wall if run.integration_time is None else run.integration_time
 
+    # Y holds the stored samples from here: unit quaternions, and the planar angles set
+    # to theirs (the projections turn q, not the angle carried beside it), in one pass
+    q_err = _core.unit_samples(Y, n, planar)
     q = Y[:, 3 * n:7 * n].reshape(K, n, 4)
-    norm = np.linalg.norm(q, axis=2)
-    q_err = float(np.max(np.abs(norm - 1.0))) if n else 0.0
-    q /= norm[..., None]  # Y holds the stored samples from here
-    if planar:  # the projections turn q, not the angle carried beside it
-        keep_planar_angles(Y, n)
     x = Y[:, :3 * n].reshape(K, n, 3)
     v = Y[:, 7 * n:10 * n].reshape(K, n, 3)
     w = Y[:, 10 * n:13 * n].reshape(K, n, 3)

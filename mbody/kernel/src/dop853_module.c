@@ -580,6 +580,29 @@ done:
     Py_RETURN_NONE;
 }
 
+static PyObject *py_unit_samples(PyObject *self, PyObject *args) {
+    PyObject *states;
+    long long n;
+    int planar;
+    if (!PyArg_ParseTuple(args, "OLp", &states, &n, &planar)) return NULL;
+    if (n < 0) {
+        PyErr_SetString(PyExc_ValueError, "n must be >= 0");
+        return NULL;
+    }
+    Py_buffer b;
+    if (get_doubles(states, &b, 1, -1, "Y") < 0) return NULL;
+    const int64_t size = MB_STATE_SIZE((int64_t)n, planar), count = (int64_t)(b.len / 8);
+    if (size == 0 ? count != 0 : count % size != 0) {
+        PyErr_Format(PyExc_ValueError, "Y: rows of %lld values expected", (long long)size);
+        PyBuffer_Release(&b);
+        return NULL;
+    }
+    const double worst = mb_unit_samples((int64_t)n, planar, size ? count / size : 0, b.buf,
+                                         size);
+    PyBuffer_Release(&b);
+    return PyFloat_FromDouble(worst);
+}
+
 static PyObject *py_system(PyObject *self, PyObject *args) {
     int s;
     double t;
@@ -668,6 +691,10 @@ static PyMethodDef dop853_methods[] = {
      "origin, 1: the spins alone, 2: about the system's mass centre), figures (6) <- the "
      "largest relative changes of E, p and H, then p at the first sample (6; mechanism.h: "
      "mb_conservation)."},
+    {"unit_samples", py_unit_samples, METH_VARARGS,
+     "unit_samples(Y, n, planar) -> the largest |norm - 1| of the quaternions: the samples "
+     "Y (K rows of the packed state) finished in place: unit quaternions, and a planar "
+     "model's carried angles set to theirs on their branch (mechanism.h)."},
     {"dop853_system", py_system, METH_VARARGS,
      "dop853_system(number, params, t, y, ydot): a built-in test system's y'."},
     {"dop853_tableau", py_tableau, METH_NOARGS,

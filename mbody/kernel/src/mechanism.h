@@ -64,6 +64,13 @@ int mb_samples(const mb_model *md, const mb_unknowns *u, mb_work *w, const doubl
                int64_t K, const double *t, const double *Y, int64_t stride,
                double *reactions, double *lengths, double *drift);
 
+/* A run's K stored samples (the rows of Y, `stride` doubles apart: the core's layout)
+ * finished in place: each quaternion divided by its norm, and with `planar` each carried
+ * angle theta set to its quaternion's own angle 2 atan2(q_z, q_w) on theta's branch (the
+ * turns a quaternion cannot count kept; mbody.simulate.trajectory.keep_planar_angles).
+ * Returns the largest |norm - 1| before (NaN if a norm is). */
+double mb_unit_samples(int64_t n, int planar, int64_t K, double *Y, int64_t stride);
+
 /* What a run conserves, at its K samples (the rows of Y, `stride` doubles apart: the core's
  * layout; a planar model's spatial form: x, v with z = 0, q from the carried angle, w
  * about z alone): T[k] = sum of 1/2 m v.v + 1/2 w.J w; V[k] = -sum m x.g + sum of

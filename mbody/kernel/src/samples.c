@@ -181,3 +181,30 @@ int mb_conservation(int64_t n, int planar, const double *mass, const double *J,
     for (int a = 0; a < 3; a++) figures[3 + a] = p0[a];
     return 0;
 }
+
+double mb_unit_samples(int64_t n, int planar, int64_t K, double *Y, int64_t stride) {
+    const double pi = 3.141592653589793, two_pi = 6.283185307179586; /* numpy's pi, 2 pi */
+    double worst = 0.0;
+    for (int64_t k = 0; k < K; k++) {
+        double *y = Y + k * stride;
+        for (int64_t i = 0; i < n; i++) {
+            double *q = y + 3 * n + 4 * i;
+            const double norm = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+            const double e = fabs(norm - 1.0);
+            if (e > worst || e != e) worst = e;
+            for (int a = 0; a < 4; a++) q[a] /= norm;
+            if (planar) { /* the carried angle moved onto q's own, on its branch */
+                double *theta = y + 13 * n + i;
+                const double a = 2.0 * atan2(q[3], q[0]) - *theta + pi;
+                double r = fmod(a, two_pi); /* numpy's remainder: the sign of the divisor */
+                if (r != 0.0) {
+                    if (r < 0.0) r += two_pi;
+                } else {
+                    r = 0.0;
+                }
+                *theta += r - pi;
+            }
+        }
+    }
+    return worst;
+}
