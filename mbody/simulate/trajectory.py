@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import json
 import os
-import zipfile
 import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -358,6 +357,10 @@ class Trajectory:
             kind = ("a YAML model file? run 'mbody simulate MODEL -o run.npz' first"
                     if p.suffix in (".yaml", ".yml") else "not a .npz archive")
             raise TrajectoryFileError(f"{name}: not an mbody trajectory file ({kind})")
+        # here, not at the top: a simulation makes a Trajectory without reading a file, and
+        # zipfile costs a millisecond of its first call in a process
+        import zipfile
+
         try:
             # Open the file here: np.load leaves its own handle open when the zip is bad.
             with open(p, "rb") as fh, np.load(fh, allow_pickle=False) as z:
