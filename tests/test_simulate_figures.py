@@ -86,7 +86,8 @@ def numpy_figures(model: mbody.Model, Y: np.ndarray, about: str, lengths: np.nda
         return 0.0 if scale <= 0 else np.max(np.linalg.norm(series - series[0], axis=1)) / scale
 
     e_scale = max(abs(E[0]), np.max(np.abs(T)))
-    return {"T": T, "V": V, "H": H, "p0": p[0],
+    spin_rate = np.abs(w[..., 2]) if model.dimension == 2 else np.linalg.norm(w, axis=2)
+    return {"T": T, "V": V, "H": H, "p0": p[0], "spin_peak": spin_rate.max(axis=0),
             "energy": np.max(np.abs(E - E[0])) / e_scale if e_scale > 0 else 0.0,
             "momentum": change(p, mv), "angular": change(H, terms),
             "T_scale": np.max(np.abs(T)) + np.max(np.abs(V)),
@@ -102,6 +103,7 @@ def assert_figures_equal(c, ref) -> None:
                                atol=RTOL * ref["H_scale"])
     np.testing.assert_allclose(c.momentum_initial, ref["p0"], rtol=0,
                                atol=RTOL * ref["p_scale"])
+    np.testing.assert_allclose(c.spin_peak, ref["spin_peak"], rtol=RTOL, atol=0)
     # each change is already relative to its scale
     assert abs(c.energy_drift - ref["energy"]) <= RTOL
     assert abs(c.momentum_drift - ref["momentum"]) <= RTOL
@@ -149,7 +151,7 @@ def test_conserved_figures_refuse_missing_lengths_and_bad_sizes():
     with pytest.raises(ValueError, match="kind"):
         _core.conservation(np.ones(1), np.eye(3).ravel(), np.zeros(3), np.zeros(0),
                            np.zeros(0), None, np.zeros(13), False, 3, np.zeros(1),
-                           np.zeros(1), np.zeros(3), np.zeros(6))
+                           np.zeros(1), np.zeros(3), np.zeros(6), np.zeros(1))
 
 
 @pytest.mark.parametrize("dimension", [2, 3])

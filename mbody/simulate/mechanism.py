@@ -102,15 +102,16 @@ class ConservedFigures:
     NamedTuple: it is made at every simulate's import, where a NamedTuple costs 0.1 ms."""
 
     __slots__ = ("kinetic_energy", "potential_energy", "angular_momentum", "energy_drift",
-                 "momentum_drift", "angular_momentum_drift", "momentum_initial")
+                 "momentum_drift", "angular_momentum_drift", "momentum_initial", "spin_peak")
 
     def __init__(self, kinetic_energy: np.ndarray, potential_energy: np.ndarray,
                  angular_momentum: np.ndarray, energy_drift: float, momentum_drift: float,
-                 angular_momentum_drift: float, momentum_initial: np.ndarray):
+                 angular_momentum_drift: float, momentum_initial: np.ndarray,
+                 spin_peak: np.ndarray):
         self.kinetic_energy, self.potential_energy = kinetic_energy, potential_energy
         self.angular_momentum, self.energy_drift = angular_momentum, energy_drift
         self.momentum_drift, self.angular_momentum_drift = momentum_drift, angular_momentum_drift
-        self.momentum_initial = momentum_initial
+        self.momentum_initial, self.spin_peak = momentum_initial, spin_peak
 
     kinetic_energy: np.ndarray
     """(K,) T = Σ ½ m vᵀv + ½ ωᵀ J ω (J)."""
@@ -126,6 +127,8 @@ class ConservedFigures:
     """max |H − H(0)| over the largest sum of its terms' magnitudes (0 when that is)."""
     momentum_initial: np.ndarray
     """(3,) p = Σ m v at the first sample (kg m/s)."""
+    spin_peak: np.ndarray
+    """(n,) each body's largest |ω| over the samples (rad/s; planar: |ω_z|)."""
 
 
 def conserved_figures(model: Model, Y: np.ndarray, about: str,
@@ -139,6 +142,7 @@ def conserved_figures(model: Model, Y: np.ndarray, about: str,
     K = len(Y)
     sp = model.springs
     T, V, H, figures = np.empty(K), np.empty(K), np.empty((K, 3)), np.empty(6)
+    spin = np.empty(model.n)
     _core.conservation(np.ascontiguousarray(model.mass, dtype=float),
                        np.ascontiguousarray(model.J, dtype=float),
                        np.ascontiguousarray(model.gravity, dtype=float),
@@ -146,9 +150,9 @@ def conserved_figures(model: Model, Y: np.ndarray, about: str,
                        np.ascontiguousarray(sp.rest_length, dtype=float),
                        None if lengths is None else np.ascontiguousarray(lengths, dtype=float),
                        np.ascontiguousarray(Y, dtype=float), model.dimension == 2,
-                       ANGULAR_MOMENTUM_ABOUT[about], T, V, H, figures)
+                       ANGULAR_MOMENTUM_ABOUT[about], T, V, H, figures, spin)
     return ConservedFigures(T, V, H, float(figures[0]), float(figures[1]),
-                            float(figures[2]), figures[3:6].copy())
+                            float(figures[2]), figures[3:6].copy(), spin)
 
 
 def reactions_at(model: Model, unknowns: Unknowns, t: np.ndarray, Y: np.ndarray

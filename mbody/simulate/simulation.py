@@ -367,14 +367,14 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
         shapes=tuple(model.bodies[b].shape for b in model.body_names),
         colors=tuple(model.bodies[b].color for b in model.body_names),
         gravity=np.array(model.gravity), model_yaml=model_text(model))
-    series, drift = _drift(run_model, t_eval, Y, dynamics is None, ideal_joints=mechanism,
-                           lengths=lengths)  # run_model: `known` is among its reactions
-    traj.series.update(series)
+    series, drift, spin_peak = _drift(run_model, t_eval, Y, dynamics is None,
+                                      ideal_joints=mechanism, lengths=lengths)
+    traj.series.update(series)  # run_model: `known` is among its reactions
     info.update(drift)
     if mechanism and run_model.drivers is not None and len(run_model.drivers.names):
         assert rhs.unknowns is not None
         driven_figures(run_model, traj, Y, lam, rhs.unknowns)
-    info["warnings"] = [w for w in (rate.warning(), _spin_warning(traj)) if w]
+    info["warnings"] = [w for w in (rate.warning(), _spin_warning(traj, spin_peak)) if w]
     return traj
 
 
@@ -598,10 +598,14 @@ def _budget_message(what: str, t: float, t_end: float, steps: int, rate: _StepRa
             f"model is stiff (very stiff springs), or {raise_it}.")
 
 
-def _spin_warning(traj: Trajectory) -> str | None:
-    """A body whose spin aliases the frame rate: |ω| / 2π > fps / 2 at a sample."""
+def _spin_warning(traj: Trajectory, peak: np.ndarray | None = None) -> str | None:
+    """A body whose spin aliases the frame rate: |ω| / 2π > fps / 2 at a sample. `peak`:
+    each body's largest |ω| (rad/s) when known (the core's, `conserved_figures`): the
+    samples are then looked at only when a body is that fast."""
     fps, w = traj.info["fps"], traj.angular_velocity
     if traj.n == 0 or not len(w):
+        return None
+    if peak is not None and not np.any(peak / (2 * np.pi) > fps / 2):
         return None
     rate = np.abs(w) if traj.dimension == cv.PLANAR else np.linalg.norm(w, axis=2)
     peak = rate.max(axis=0)  # (n,) rad/s
@@ -760,7 +764,8 @@ def conservation(model: Model, default_dynamics: bool = True, ideal_joints: bool
 
 def _drift(model: Model, t: np.ndarray, Y: np.ndarray, default_dynamics: bool, *,
            ideal_joints: bool = False, known: Mapping[str, float | str] | None = None,
-           lengths: np.ndarray | None = None) -> tuple[dict[str, np.ndarray], dict]:
+           lengths: np.ndarray | None = None
+           ) -> tuple[dict[str, np.ndarray], dict, np.ndarray]:
     """Energy, linear and angular momentum at the samples Y (K, state size: the core's
     layout, as stored) at the times t: their series, largest relative change, and whether
     the model conserves them (`conservation`, with its reasons when not).
@@ -770,7 +775,8 @@ def _drift(model: Model, t: np.ndarray, Y: np.ndarray, default_dynamics: bool, *
     origin, or from the system's mass centre; spin only: Σ W_R_B J ω): relative to the
     largest sum of their terms' magnitudes. All in one call of the compiled core
     (`mbody.simulate.mechanism.conserved_figures`). `lengths`: the springs' lengths at the
-    samples (K, s), when the run has them (else the core computes them)."""
+    samples (K, s), when the run has them (else the core computes them). Also returns
+    each body's largest |ω| over the samples (n,), from the same pass."""
     why = conservation(model, default_dynamics, ideal_joints, known)
     if len(model.springs.names) and lengths is None:
         lengths = sample_figures(model, workspace(model).file_unknowns, t, Y,
@@ -793,7 +799,7 @@ def _drift(model: Model, t: np.ndarray, Y: np.ndarray, default_dynamics: bool, *
         "angular_momentum_drift": c.angular_momentum_drift,
         "angular_momentum_initial": H[0].tolist(),
         "angular_momentum_not_conserved": why["angular_momentum"],
-    }
+    }, c.spin_peak
 
 
 def conserved_lines(info: Mapping) -> list[tuple[str, str]]:

@@ -528,20 +528,20 @@ lam_:
 }
 
 static PyObject *py_conservation(PyObject *self, PyObject *args) {
-    /* mass, J, gravity, stiffness, rest, lengths (or None), Y | T, V, H, figures */
-    PyObject *o[11];
+    /* mass, J, gravity, stiffness, rest, lengths (or None), Y | T, V, H, figures, spin */
+    PyObject *o[12];
     int planar, kind;
-    if (!PyArg_ParseTuple(args, "OOOOOOOpiOOOO", &o[0], &o[1], &o[2], &o[3], &o[4], &o[5],
-                          &o[6], &planar, &kind, &o[7], &o[8], &o[9], &o[10]))
+    if (!PyArg_ParseTuple(args, "OOOOOOOpiOOOOO", &o[0], &o[1], &o[2], &o[3], &o[4], &o[5],
+                          &o[6], &planar, &kind, &o[7], &o[8], &o[9], &o[10], &o[11]))
         return NULL;
     if (kind < 0 || kind > 2) {
         PyErr_SetString(PyExc_ValueError, "kind: 0 (world origin), 1 (spins), 2 (mass centre)");
         return NULL;
     }
-    static const char *names[11] = {"mass", "J", "gravity", "stiffness", "rest", "lengths",
-                                    "Y", "T", "V", "H", "figures"};
-    Py_buffer b[11];
-    int held[11] = {0};
+    static const char *names[12] = {"mass", "J", "gravity", "stiffness", "rest", "lengths",
+                                    "Y", "T", "V", "H", "figures", "spin"};
+    Py_buffer b[12];
+    int held[12] = {0};
     int ok = 0;
     /* the sizes follow from mass (n), stiffness (s) and T (K) */
     if (get_doubles(o[0], &b[0], 0, -1, names[0]) < 0) return NULL;
@@ -553,9 +553,9 @@ static PyObject *py_conservation(PyObject *self, PyObject *args) {
     if (get_doubles(o[7], &b[7], 1, -1, names[7]) < 0) goto done;
     held[7] = 1;
     const int64_t K = (int64_t)(b[7].len / 8);
-    const Py_ssize_t sizes[11] = {n, 9 * n, 3, s, s, K * s, K * MB_STATE_SIZE(n, planar), K,
-                                  K, 3 * K, 6};
-    for (int i = 1; i < 11; i++) {
+    const Py_ssize_t sizes[12] = {n, 9 * n, 3, s, s, K * s, K * MB_STATE_SIZE(n, planar), K,
+                                  K, 3 * K, 6, n};
+    for (int i = 1; i < 12; i++) {
         if (held[i]) continue;
         if (i == 5 && o[5] == Py_None) {
             if (s > 0) {
@@ -569,12 +569,12 @@ static PyObject *py_conservation(PyObject *self, PyObject *args) {
     }
     if (mb_conservation(n, planar, b[0].buf, b[1].buf, b[2].buf, s, b[3].buf, b[4].buf,
                         held[5] ? b[5].buf : NULL, K, b[6].buf, MB_STATE_SIZE(n, planar), kind,
-                        b[7].buf, b[8].buf, b[9].buf, b[10].buf) < 0)
+                        b[7].buf, b[8].buf, b[9].buf, b[10].buf, b[11].buf) < 0)
         PyErr_NoMemory();
     else
         ok = 1;
 done:
-    for (int i = 0; i < 11; i++)
+    for (int i = 0; i < 12; i++)
         if (held[i]) PyBuffer_Release(&b[i]);
     if (!ok) return NULL;
     Py_RETURN_NONE;
@@ -685,12 +685,12 @@ static PyMethodDef dop853_methods[] = {
      "springs' lengths; drift (2) <- the largest |phi| and |G^T v - f'|."},
     {"conservation", py_conservation, METH_VARARGS,
      "conservation(mass, J, gravity, stiffness, rest, lengths, Y, planar, kind, T, V, H, "
-     "figures): what a run conserves at its K samples (Y: K rows of the packed state): T "
+     "figures, spin): what a run conserves at its K samples (Y: K rows of the packed state): T "
      "(K) <- kinetic energy, V (K) <- gravity's and the springs' potential (lengths: K x s, "
      "None without springs), H (K x 3) <- angular momentum (kind 0: about the world "
      "origin, 1: the spins alone, 2: about the system's mass centre), figures (6) <- the "
-     "largest relative changes of E, p and H, then p at the first sample (6; mechanism.h: "
-     "mb_conservation)."},
+     "largest relative changes of E, p and H, then p at the first sample (6), spin (n) <- "
+     "each body's largest |w| (mechanism.h: mb_conservation)."},
     {"unit_samples", py_unit_samples, METH_VARARGS,
      "unit_samples(Y, n, planar) -> the largest |norm - 1| of the quaternions: the samples "
      "Y (K rows of the packed state) finished in place: unit quaternions, and a planar "

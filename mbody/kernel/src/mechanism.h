@@ -80,12 +80,13 @@ double mb_unit_samples(int64_t n, int planar, int64_t K, double *Y, int64_t stri
  * to its position and velocity). figures (6): the largest relative changes of E = T + V
  * (over max(|E(0)|, max T)), of p = sum m v and of H (each over the largest sum of its
  * terms' magnitudes), 0 where that scale is 0; figures[3 ..] (3) <- p at the first
- * sample. mass (n), J (n x 9, body axes), gravity (3), stiffness and rest (s). Returns 0,
- * or -1 out of memory. */
+ * sample; spin_peak (n) <- each body's largest |w| over the samples (planar: |w_z|). mass (n),
+ * J (n x 9, body axes), gravity (3), stiffness and rest (s). Returns 0, or -1 out of
+ * memory. */
 int mb_conservation(int64_t n, int planar, const double *mass, const double *J,
                     const double *gravity, int64_t s, const double *stiffness,
                     const double *rest, const double *lengths, int64_t K, const double *Y,
                     int64_t stride, int kind, double *T, double *V, double *H,
-                    double *figures);
+                    double *figures, double *spin_peak);
 
 #endif

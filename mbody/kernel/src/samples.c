@@ -65,7 +65,7 @@ int mb_conservation(int64_t n, int planar, const double *mass, const double *J,
                     const double *gravity, int64_t s, const double *stiffness,
                     const double *rest, const double *lengths, int64_t K, const double *Y,
                     int64_t stride, int kind, double *T, double *V, double *H,
-                    double *figures) {
+                    double *figures, double *spin_peak) {
     /* per body at one sample: x, v, w, q (spatial form), m u, the orbital term, spin */
     double *buf = malloc((size_t)(n > 0 ? n : 1) * 3 * 6 * sizeof(double));
     if (buf == NULL) return -1;
@@ -75,6 +75,7 @@ int mb_conservation(int64_t n, int planar, const double *mass, const double *J,
     for (int64_t i = 0; i < n; i++) M += mass[i];
     double p0[3] = {0.0, 0.0, 0.0}, H0[3] = {0.0, 0.0, 0.0}, E0 = 0.0;
     double t_max = 0.0, e_max = 0.0, p_scale = 0.0, p_max = 0.0, h_scale = 0.0, h_max = 0.0;
+    for (int64_t i = 0; i < n; i++) spin_peak[i] = 0.0;
     for (int64_t k = 0; k < K; k++) {
         const double *y = Y + k * stride;
         double Tk = 0.0, Vg = 0.0, p[3] = {0.0, 0.0, 0.0}, mv_sum = 0.0;
@@ -96,6 +97,8 @@ int mb_conservation(int64_t n, int planar, const double *mass, const double *J,
                 for (int a = 0; a < 4; a++) q[a] = y[3 * n + 4 * i + a];
             }
             const double *vi = v + 3 * i, *wi = w + 3 * i, *Ji = J + 9 * i;
+            const double rate = planar ? fabs(wi[2]) : norm3(wi);
+            if (rate > spin_peak[i] || rate != rate) spin_peak[i] = rate;
             double Jw[3];
             for (int r = 0; r < 3; r++)
                 Jw[r] = Ji[3 * r] * wi[0] + Ji[3 * r + 1] * wi[1] + Ji[3 * r + 2] * wi[2];
