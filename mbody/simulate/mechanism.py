@@ -1,7 +1,8 @@
 """Jointed mechanisms in motion: accelerations with the unknown reactions solved at every
 step, joint drift held down by Baumgarte stabilisation (used by scipy's integrators; the
 core's DOP853 projects the state instead, `mbody.simulate.projection`), and what a run
-reports at its output samples: the reactions and the joints' drift.
+reports at its output samples: the reactions and the joints' drift, the energy and the
+linear and angular momentum.
 
 Integrating ``Gᵀ v̇ = γ`` alone lets the joints drift apart (rounding and truncation
 errors in φ and φ̇ = Gᵀ v are never corrected). Baumgarte's method replaces it by
@@ -13,8 +14,8 @@ for α = β) instead of growing. The reactions stored with a trajectory are solv
 output sample with the exact γ (no stabilisation terms), so they are the physical ones
 for the sampled state.
 
-Every figure here is one call of the compiled core per sample (`mbody.kernel`): no Python
-work per body or per component.
+Every figure here comes from one call of the compiled core over all the samples
+(`mbody.kernel`): no Python work per sample, body or component.
 """
 
 from __future__ import annotations
