@@ -145,6 +145,24 @@ assert mbody.solve.dynamics.__name__ == "mbody.solve.dynamics"  # submodules on 
     assert loaded(code, NEVER_AT_IMPORT) == []
 
 
+PLAIN_SIMULATE = ("mbody.equations.symbolic", "mbody.equations.assemble", "mbody.equations.fbd",
+                  "mbody.equations.generalized", "mbody.equations.coordinates", "sympy",
+                  "scipy", "tqdm", "zipfile")
+"""What a DOP853 simulate of a model does not need: the symbolic layer and the assembly
+around it (the first call of a process imported them through one helper, 10 ms), scipy's
+integrators, a progress bar, the zip reader of saved runs."""
+
+
+@pytest.mark.parametrize("name", ["pendulum", "double_pendulum", "heavy_top",
+                                  "spring_mass_damper", "slider_crank_driven"])
+def test_a_plain_simulate_imports_only_what_it_needs(name: str):
+    """`mbody.simulate` after `mbody.load`, in a fresh process: a jointed mechanism, a
+    spinning top, free bodies with a spring, a fully driven mechanism (a kinematic run)."""
+    path = ROOT / "models" / f"{name}.yaml"
+    code = f"import mbody\nmbody.simulate(mbody.load({str(path)!r}), t_end=0.5)"
+    assert loaded(code, PLAIN_SIMULATE) == []
+
+
 # -- numpy in place of scipy on the start-up path: the same numbers ---------------------
 
 SEQUENCES = [a + b + c for a in "xyz" for b in "xyz" for c in "xyz" if a != b != c]

@@ -4,7 +4,7 @@ Every array argument is a C-contiguous float64 (int64 for F/I/Iu: I and Iu) buff
 exactly the size the model implies; a wrong one raises ValueError naming it.
 """
 
-from typing import Any
+from typing import Any, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -93,6 +93,9 @@ DOP_FILTER: int
 DOP_FILTER_NEXT: int
 DOP_DENSE: int
 DOP_DENSE_NFEV: int
+DOP_WALL: int
+DOP_MARK_WIDTH: int
+DOP_MARK_NEXT: int
 DOP_INFO: int
 DOP_RUNNING: int
 DOP_FINISHED: int
@@ -122,8 +125,17 @@ def dop853_start(problem: _Problem, t0: float, y0: _F, first_step: float, state:
 def dop853_run(problem: _Problem, t_stop: float, max_steps: int, state: _F,
                work: _F) -> int: ...
 def dop853_dense(problem: _Problem, t: _F, out: _F, state: _F, work: _F) -> int: ...
+@overload
 def dop853_sampled(problem: _Problem, t_stop: float, max_steps: int, t_eval: _F, k: int,
                    out: _F, project_samples: bool, state: _F, work: _F) -> tuple[int, int]: ...
+@overload
+def dop853_sampled(problem: _Problem, t_stop: float, max_steps: int, t_eval: _F, k: int,
+                   out: _F, project_samples: bool, state: _F, work: _F, marks: _F
+                   ) -> tuple[int, int, int]: ...
+def unit_samples(Y: _F, n: int, planar: bool) -> float: ...
+def conservation(mass: _F, J: _F, gravity: _F, stiffness: _F, rest: _F, lengths: _F | None,
+                 Y: _F, planar: bool, kind: int, T: _F, V: _F, H: _F, figures: _F,
+                 spin: _F) -> None: ...
 def samples(unknowns: Unknowns, lam: _F, t: _F, Y: _F, reactions: _F | None,
             lengths: _F | None, drift: _F) -> None: ...
 def spectrum(A: _F, dA: float, tol: float, out: _F) -> int: ...

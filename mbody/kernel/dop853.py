@@ -121,6 +121,31 @@ class DOP853:
                                     self.work)
         return int(k)
 
+    def sampled_marks(self, t_stop: float, max_steps: int, t_eval: np.ndarray, k: int,
+                      out: np.ndarray, project_samples: bool, marks: np.ndarray
+                      ) -> tuple[int, int]:
+        """`sampled`, and at each step that reaches the next mark (`mark_windows`) or
+        t_bound, the row (t, accepted steps) into `marks` (rows of 2, C-contiguous; the
+        run returns when they are full); returns (the first row of out not yet written,
+        the rows of marks written)."""
+        _, k, count = _core.dop853_sampled(self.problem, float(t_stop), int(max_steps),
+                                           t_eval, int(k), out, bool(project_samples),
+                                           self.state, self.work, marks)
+        return int(k), int(count)
+
+    def mark_windows(self, width: float) -> None:
+        """Marks (`sampled_marks`) at the first step reaching each multiple of `width`
+        after the current time, and at t_bound."""
+        self.state[_core.DOP_MARK_WIDTH] = width
+        self.state[_core.DOP_MARK_NEXT] = (math.floor(self.t / width) + 1) * width
+
+    @property
+    def core_time(self) -> float:
+        """Seconds the core spent starting the run (f(t0, y0), the first step's size)
+        and in `sampled` and `sampled_marks` calls (steps, dense output, sample
+        projections), by a monotonic clock."""
+        return float(self.state[_core.DOP_WALL])
+
     def step(self) -> str | None:
         """One step (scipy's `OdeSolver.step`): None, or why the run failed."""
         self.run(max_steps=1)

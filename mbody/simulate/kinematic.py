@@ -26,8 +26,8 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from mbody import conventions as cv
-from mbody.equations.assemble import singular_mass_error
 from mbody.equations.joints import reaction_columns
+from mbody.equations.solution import singular_mass_error
 from mbody.equations.workspace import workspace
 from mbody.equations.world import check_axes
 from mbody.errors import MbodyError, did_you_mean

@@ -38,21 +38,18 @@ from mbody.equations.constraints import joint_errors
 from mbody.equations.workspace import workspace
 from mbody.equations.world import check_axes
 from mbody.errors import MbodyError, UnknownReactionsError, did_you_mean
+from mbody.kernel import _core
 from mbody.model.expressions import Expression, check_times, compile_expression, first_nonfinite
 from mbody.model.model import Model, State
 from mbody.simulate.axes import world_series
 from mbody.simulate.kinematic import driven_figures, driven_lines, fully_driven, kinematic_run
 from mbody.simulate.kinematic import summary as kinematic_summary
-from mbody.simulate.mechanism import BAUMGARTE_RATE, sample_figures
+from mbody.simulate.mechanism import BAUMGARTE_RATE, conserved_figures, sample_figures
 from mbody.simulate.projection import STAGE_PIVOT_RTOL, JointProjection
 from mbody.simulate.stepping import CORE, IMPLICIT, start
 from mbody.simulate.trajectory import (
     Trajectory,
-    body_matvec,
-    cross,
-    keep_planar_angles,
     model_text,
-    rotate,
 )
 from mbody.solve.dynamics import Dynamics, StateDerivative, accelerations
 
@@ -265,11 +262,16 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
                     filter_first=ratio < STAGE_PIVOT_RTOL)
         check_at = PREDICT_FROM
         first = None
+        # the core notes where each step-rate window ends as it steps: no return to
+        # Python at each one (scipy's runs come back after every step anyway). A wall-time
+        # budget is checked in Python, so such a run still comes back at every window.
+        marking = max_wall is None and run.mark_windows(rate.width)
         while run.status == "running":
             limit = min(CHUNK_STEPS, max(1, check_at - steps))
             if max_steps is not None:
                 limit = min(limit, max(1, max_steps - steps))
-            k, msg = run.advance(min(rate.next, t_end), limit, t_eval, k, Y)
+            k, msg = run.advance(t_end if marking else min(rate.next, t_end), limit, t_eval,
+                                 k, Y)
             steps = run.steps
             if run.status == "failed" or not math.isfinite(float(run.y.sum())):
                 culprit = _blame_expression(varying, run.t, run.t, run.step_size)
@@ -278,7 +280,11 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
                     + (culprit or (msg or "the state is no longer finite")
                        + " (a body escaping to infinity, or tolerances too tight for "
                        "double precision?)"))
-            rate.step(run.t, steps)
+            if marking:
+                for t_mark, steps_mark in run.marks():
+                    rate.step(t_mark, steps_mark)
+            else:
+                rate.step(run.t, steps)
             bar.update(run.t)
             if run.status == "running":
                 if steps >= check_at:  # the whole run's cost, predicted from its start
@@ -307,13 +313,12 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     finally:
         bar.close()
     wall = time.perf_counter() - wall
+    stepping_time = wall if run.integration_time is None else run.integration_time
 
+    # Y holds the stored samples from here: unit quaternions, and the planar angles set
+    # to theirs (the projections turn q, not the angle carried beside it), in one pass
+    q_err = _core.unit_samples(Y, n, planar)
     q = Y[:, 3 * n:7 * n].reshape(K, n, 4)
-    norm = np.linalg.norm(q, axis=2)
-    q_err = float(np.max(np.abs(norm - 1.0))) if n else 0.0
-    q /= norm[..., None]  # Y holds the stored samples from here
-    if planar:  # the projections turn q, not the angle carried beside it
-        keep_planar_angles(Y, n)
     x = Y[:, :3 * n].reshape(K, n, 3)
     v = Y[:, 7 * n:10 * n].reshape(K, n, 3)
     w = Y[:, 10 * n:13 * n].reshape(K, n, 3)
@@ -347,7 +352,8 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
         "samples": K, "steps": steps, "evaluations": run.nfev,
         "sampling_evaluations": run.sampling_evaluations, "step_rate": rate.figures(steps),
         "evaluation_path": "compiled" if rhs.compiled else "python",
-        "wall_time_s": wall, "quaternion_norm_error": q_err,
+        "wall_time_s": wall, "integration_time_s": stepping_time,
+        "quaternion_norm_error": q_err,
         "quaternion_handling": "integrated as is; rotation built from q/|q|; output "
                                "samples divided by |q|",
         **joint_info, "reaction_axes": axes,
@@ -361,14 +367,14 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
         shapes=tuple(model.bodies[b].shape for b in model.body_names),
         colors=tuple(model.bodies[b].color for b in model.body_names),
         gravity=np.array(model.gravity), model_yaml=model_text(model))
-    series, drift = _drift(run_model, traj, dynamics is None, ideal_joints=mechanism,
-                           lengths=lengths)  # run_model: `known` is among its reactions
-    traj.series.update(series)
+    series, drift, spin_peak = _drift(run_model, t_eval, Y, dynamics is None,
+                                      ideal_joints=mechanism, lengths=lengths)
+    traj.series.update(series)  # run_model: `known` is among its reactions
     info.update(drift)
     if mechanism and run_model.drivers is not None and len(run_model.drivers.names):
         assert rhs.unknowns is not None
         driven_figures(run_model, traj, Y, lam, rhs.unknowns)
-    info["warnings"] = [w for w in (rate.warning(), _spin_warning(traj)) if w]
+    info["warnings"] = [w for w in (rate.warning(), _spin_warning(traj, spin_peak)) if w]
     return traj
 
 
@@ -592,10 +598,14 @@ def _budget_message(what: str, t: float, t_end: float, steps: int, rate: _StepRa
             f"model is stiff (very stiff springs), or {raise_it}.")
 
 
-def _spin_warning(traj: Trajectory) -> str | None:
-    """A body whose spin aliases the frame rate: |ω| / 2π > fps / 2 at a sample."""
+def _spin_warning(traj: Trajectory, peak: np.ndarray | None = None) -> str | None:
+    """A body whose spin aliases the frame rate: |ω| / 2π > fps / 2 at a sample. `peak`:
+    each body's largest |ω| (rad/s) when known (the core's, `conserved_figures`): the
+    samples are then looked at only when a body is that fast."""
     fps, w = traj.info["fps"], traj.angular_velocity
     if traj.n == 0 or not len(w):
+        return None
+    if peak is not None and not np.any(peak / (2 * np.pi) > fps / 2):
         return None
     rate = np.abs(w) if traj.dimension == cv.PLANAR else np.linalg.norm(w, axis=2)
     peak = rate.max(axis=0)  # (n,) rad/s
@@ -752,62 +762,44 @@ def conservation(model: Model, default_dynamics: bool = True, ideal_joints: bool
             "angular_momentum": "; ".join(turning), "angular_momentum_kind": kind}
 
 
-def _change(series: np.ndarray, terms: np.ndarray) -> float:
-    """max over the samples of |x(t) − x(0)|, relative to the largest sum of the
-    magnitudes of the terms x is the sum of (K, n, 3): what its rounding is relative to,
-    and not 0 when the sum is (two bodies spinning against each other: H = 0); 0 when
-    every term is."""
-    scale = float(np.max(np.linalg.norm(terms, axis=2).sum(axis=1))) if terms.size else 0.0
-    if scale <= 0:
-        return 0.0
-    return float(np.max(np.linalg.norm(series - series[0], axis=1)) / scale)
-
-
-def _drift(model: Model, traj: Trajectory, default_dynamics: bool, *,
+def _drift(model: Model, t: np.ndarray, Y: np.ndarray, default_dynamics: bool, *,
            ideal_joints: bool = False, known: Mapping[str, float | str] | None = None,
-           lengths: np.ndarray | None = None) -> tuple[dict[str, np.ndarray], dict]:
-    """Energy, linear and angular momentum: their series, largest relative change, and
-    whether the model conserves them (`conservation`, with its reasons when not).
+           lengths: np.ndarray | None = None
+           ) -> tuple[dict[str, np.ndarray], dict, np.ndarray]:
+    """Energy, linear and angular momentum at the samples Y (K, state size: the core's
+    layout, as stored) at the times t: their series, largest relative change, and whether
+    the model conserves them (`conservation`, with its reasons when not).
 
     Energy E = T + V; its change is relative to max(|E(0)|, max T). Linear momentum
     p = Σ m v and angular momentum H = Σ (r × m v + W_R_B J ω) (r and v from the world
     origin, or from the system's mass centre; spin only: Σ W_R_B J ω): relative to the
-    largest sum of their terms' magnitudes (`_change`). `lengths`: the springs' lengths at
-    the samples (K, s), when the run has them."""
+    largest sum of their terms' magnitudes. All in one call of the compiled core
+    (`mbody.simulate.mechanism.conserved_figures`). `lengths`: the springs' lengths at the
+    samples (K, s), when the run has them (else the core computes them). Also returns
+    each body's largest |ω| over the samples (n,), from the same pass."""
     why = conservation(model, default_dynamics, ideal_joints, known)
-    T = traj.kinetic_energy()
-    V = potential_energy(model, traj, lengths)
-    E = T + V
-    scale = max(abs(E[0]), float(np.max(np.abs(T))) if len(T) else 0.0)
-    e_change = float(np.max(np.abs(E - E[0])) / scale) if scale > 0 else 0.0
-
-    mass = np.asarray(model.mass, dtype=float)
-    x, q, v, w = traj.spatial()
-    mv = mass[:, None] * v  # (K, n, 3) each body's momentum
-    p = mv.sum(axis=1)
-    spin = rotate(q, body_matvec(np.asarray(model.J, dtype=float), w))
+    if len(model.springs.names) and lengths is None:
+        lengths = sample_figures(model, workspace(model).file_unknowns, t, Y,
+                                 reactions=False, lengths=True).lengths
     kind = why["angular_momentum_kind"]
-    if kind.startswith("spin"):
-        terms = spin
-    else:
-        r, u = x, v
-        if kind.endswith("system's mass centre"):
-            M = float(mass.sum())
-            r = x - ((mass @ x) / M)[:, None]
-            u = v - (p / M)[:, None]
-        terms = np.concatenate((cross(r, mass[:, None] * u), spin), axis=1)
-    H = terms.sum(axis=1)
+    about = ("spins" if kind.startswith("spin") else
+             "mass centre" if kind.endswith("system's mass centre") else "world origin")
+    c = conserved_figures(model, Y, about, lengths)
+    T, V, H = c.kinetic_energy, c.potential_energy, c.angular_momentum
+    E = T + V
     series = {"kinetic_energy": T, "potential_energy": V, "energy": E, "angular_momentum": H}
     return series, {
-        "energy_conserved": not why["energy"], "energy_drift": e_change,
+        "energy_conserved": not why["energy"], "energy_drift": c.energy_drift,
         "energy_initial": float(E[0]), "energy_not_conserved": why["energy"],
-        "momentum_conserved": not why["momentum"], "momentum_drift": _change(p, mv),
-        "momentum_initial": p[0].tolist(), "momentum_not_conserved": why["momentum"],
+        "momentum_conserved": not why["momentum"], "momentum_drift": c.momentum_drift,
+        "momentum_initial": c.momentum_initial.tolist(),
+        "momentum_not_conserved": why["momentum"],
         "angular_momentum_conserved": not why["angular_momentum"],
         "angular_momentum_kind": kind,
-        "angular_momentum_drift": _change(H, terms), "angular_momentum_initial": H[0].tolist(),
+        "angular_momentum_drift": c.angular_momentum_drift,
+        "angular_momentum_initial": H[0].tolist(),
         "angular_momentum_not_conserved": why["angular_momentum"],
-    }
+    }, c.spin_peak
 
 
 def conserved_lines(info: Mapping) -> list[tuple[str, str]]:

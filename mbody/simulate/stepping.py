@@ -35,6 +35,10 @@ REFRESH_ATOL = 1e-2
 next step from the derivative at the projected state (one evaluation); a smaller one is
 left to the next step's error control."""
 
+MARKS = 64
+"""Window marks one `CoreRun.advance` may note before it returns (a run's step-rate
+windows are 20, `mbody.simulate.simulation._StepRate`)."""
+
 CORE = ("DOP853",)
 """The methods the compiled core steps; the others are scipy's."""
 IMPLICIT = ("Radau", "BDF", "LSODA")
@@ -68,6 +72,28 @@ class CoreRun:
             self.solver = DOP853(rhs, 0.0, y0, t_bound, rtol=rtol, atol=atol,
                                  max_step=max_step)
         self._raise_stop()
+        self._marks = np.empty((MARKS, 2))
+        self._marked = 0
+        self._marking = False
+
+    def mark_windows(self, width: float) -> bool:
+        """Have the core note (t, steps) at the first step reaching each multiple of
+        `width`, and at t_bound, while it runs (`marks`): a caller that follows the run
+        window by window need not stop it at each window's end. True (scipy's runs
+        cannot)."""
+        self.solver.mark_windows(width)
+        self._marking = True
+        return True
+
+    def marks(self) -> list[tuple[float, int]]:
+        """The (t, steps) the last `advance` noted (`mark_windows`)."""
+        return [(float(t), int(s)) for t, s in self._marks[:self._marked].tolist()]
+
+    @property
+    def integration_time(self) -> float:
+        """Seconds the core spent stepping (its own clock: steps, dense output and the
+        samples' projections; no Python round trip counted)."""
+        return self.solver.core_time
 
     @property
     def status(self) -> str:
@@ -106,7 +132,11 @@ class CoreRun:
         """Steps until the first that reaches t_stop, at most max_steps of them, with the
         samples t_eval[k ..] they reach written into Y's rows (projected with the state);
         returns (the first sample not yet written, why the run failed or None)."""
-        k = self.solver.sampled(t_stop, max_steps, t_eval, k, Y, self.projecting)
+        if self._marking:
+            k, self._marked = self.solver.sampled_marks(t_stop, max_steps, t_eval, k, Y,
+                                                        self.projecting, self._marks)
+        else:
+            k = self.solver.sampled(t_stop, max_steps, t_eval, k, Y, self.projecting)
         self._raise_stop()
         return k, TOO_SMALL_STEP if self.status == "failed" else None
 
@@ -163,6 +193,15 @@ class ScipyRun:
     sampling_evaluations = 0
     """Their interpolants are free."""
     refreshed = 0
+    integration_time = None
+    """Not timed apart from the loop (the caller's wall time is all integration)."""
+
+    def mark_windows(self, width: float) -> bool:
+        """False: one step per `advance`, the caller follows the windows itself."""
+        return False
+
+    def marks(self) -> list[tuple[float, int]]:
+        return []
 
     def advance(self, t_stop: float, max_steps: int, t_eval: np.ndarray, k: int,
                 Y: np.ndarray) -> tuple[int, str | None]:

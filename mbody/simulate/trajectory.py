@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import json
 import os
-import zipfile
 import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -358,6 +357,10 @@ class Trajectory:
             kind = ("a YAML model file? run 'mbody simulate MODEL -o run.npz' first"
                     if p.suffix in (".yaml", ".yml") else "not a .npz archive")
             raise TrajectoryFileError(f"{name}: not an mbody trajectory file ({kind})")
+        # here, not at the top: a simulation makes a Trajectory without reading a file, and
+        # zipfile costs a millisecond of its first call in a process
+        import zipfile
+
         try:
             # Open the file here: np.load leaves its own handle open when the zip is bad.
             with open(p, "rb") as fh, np.load(fh, allow_pickle=False) as z:
@@ -444,10 +447,19 @@ def _jsonable(x: Any) -> Any:
 
 def model_text(model) -> str:
     """The model file's text, when the model came from a readable file ('' otherwise):
-    what a trajectory keeps so that it can be drawn and checked without the file."""
-    p = Path(model.file) if model.file and not model.file.startswith("<") else None
+    what a trajectory keeps so that it can be drawn and checked without the file. The
+    text the model was read from when it kept it (`Model.source`: every hand-written
+    file; its line ends read as a text file reads them), else the file as it is now."""
+    if not model.file or model.file.startswith("<"):
+        return ""
+    p = Path(model.file)
+    source = getattr(model, "source", None)
+    if source is not None and source.text is not None and source.file == model.file:
+        # not read again: a second read and decode cost as much as the rest of a short
+        # run's bookkeeping
+        return source.text.replace("\r\n", "\n").replace("\r", "\n") if p.is_file() else ""
     try:
-        return p.read_text(encoding="utf-8") if p is not None and p.is_file() else ""
+        return p.read_text(encoding="utf-8") if p.is_file() else ""
     except (OSError, UnicodeDecodeError):
         return ""
 

@@ -484,10 +484,12 @@ int mb_dop853_dense(const mb_ode *p, const double *t, int64_t m, double *out,
 
 int mb_dop853_sampled(const mb_ode *p, double t_stop, int64_t max_steps, const double *t_eval,
                       int64_t m, int64_t *k, double *out, int project_samples, double *state,
-                      double *work) {
+                      double *work, double *marks, int64_t marks_cap, int64_t *count) {
     const int64_t n = p->n;
-    const double direction = state[MB_DOP_DIRECTION];
+    const double direction = state[MB_DOP_DIRECTION], width = state[MB_DOP_MARK_WIDTH];
+    const int marking = marks != NULL && width > 0.0 && marks_cap > 0;
     int status = (int)state[MB_DOP_STATUS];
+    if (marking && *count >= marks_cap) return status;
     for (int64_t taken = 0; taken < max_steps && status == MB_DOP_RUNNING; taken++) {
         const double before = state[MB_DOP_STEPS];
         status = mb_dop853_run(p, t_stop, 1, state, work);
@@ -506,6 +508,13 @@ int mb_dop853_sampled(const mb_ode *p, double t_stop, int64_t max_steps, const d
                 }
         }
         *k = j;
+        if (marking && !(t < state[MB_DOP_MARK_NEXT] && t < state[MB_DOP_T_BOUND])) {
+            marks[2 * *count] = t;
+            marks[2 * *count + 1] = state[MB_DOP_STEPS];
+            ++*count;
+            state[MB_DOP_MARK_NEXT] = (floor(t / width) + 1.0) * width;
+            if (*count >= marks_cap) break;
+        }
         if (status == MB_DOP_RUNNING && direction * (t - t_stop) >= 0.0) break;
     }
     return status;

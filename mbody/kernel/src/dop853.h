@@ -82,6 +82,9 @@ enum {
     MB_DOP_FILTER_NEXT, /* whether the next one is */
     MB_DOP_DENSE,       /* whether the last step's dense output is prepared */
     MB_DOP_DENSE_NFEV,  /* evaluations of rhs made for dense output (part of NFEV) */
+    MB_DOP_WALL,        /* seconds spent in the binding's calls of _start and _sampled */
+    MB_DOP_MARK_WIDTH,  /* the marks' window (mb_dop853_sampled; 0: no marks) */
+    MB_DOP_MARK_NEXT,   /* the next mark's time (the caller sets the first) */
     MB_DOP_INFO,        /* the last projection's info (MB_DOP_PROJECT_INFO slots) */
     MB_DOP_STATE_SIZE = MB_DOP_INFO + 4
 };
@@ -124,10 +127,18 @@ int mb_dop853_dense(const mb_ode *p, const double *t, int64_t m, double *out,
  * t_eval[*k], t_eval[*k + 1], ... (of m, increasing in the run's direction) that the step
  * reached, into the rows *k, *k + 1, ... of out (m rows of n); with project_samples each
  * such row is then moved by the project callback at its time (its info discarded). *k
- * advances past the rows written. Returns the status, as mb_dop853_run. */
+ * advances past the rows written.
+ *
+ * Marks (marks not NULL, state[MB_DOP_MARK_WIDTH] = w > 0): after each accepted step
+ * that reaches state[MB_DOP_MARK_NEXT] or t_bound, the row (t, accepted steps) is written
+ * to marks[2 * *count ..] and *count advances; the next mark is then at
+ * (floor(t / w) + 1) w. The run returns when *count reaches marks_cap. These are the
+ * points at which a caller stepping window by window (t_stop at each window's end) would
+ * have been called back, without the round trips (mbody.simulate's step-rate windows).
+ * Returns the status, as mb_dop853_run. */
 int mb_dop853_sampled(const mb_ode *p, double t_stop, int64_t max_steps, const double *t_eval,
                       int64_t m, int64_t *k, double *out, int project_samples, double *state,
-                      double *work);
+                      double *work, double *marks, int64_t marks_cap, int64_t *count);
 
 /* The tableau as data (for tests): c (16), a (16 x 16, row s: stage s's weights), b (12),
  * e5, e3 (13), d (4 x 16). */

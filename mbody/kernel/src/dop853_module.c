@@ -21,9 +21,28 @@
 #include <Python.h>
 
 #include <math.h>
+#ifdef _WIN32
+#include <windows.h>
+#else
+#include <time.h>
+#endif
 
 #include "dop853.h"
 #include "mechanism.h"
+
+/* A monotonic clock in seconds: what a sampled run reports as its integration time. */
+static double now_seconds(void) {
+#ifdef _WIN32
+    LARGE_INTEGER count, frequency;
+    QueryPerformanceCounter(&count);
+    QueryPerformanceFrequency(&frequency);
+    return (double)count.QuadPart / (double)frequency.QuadPart;
+#else
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+#endif
+}
 
 /* The model, unknowns and scratch of a _core.Unknowns object: 1, or 0 when obj is not an
  * initialised one (module.c). */
@@ -343,7 +362,9 @@ static PyObject *py_start(PyObject *self, PyObject *args) {
     PyObject *out = NULL;
     if (get_doubles(y0, &by, 0, (Py_ssize_t)n, "y0") == 0) {
         if (problem_read(tuple, n, &pr, &ode) == 0) {
+            const double start = now_seconds();
             int status = mb_dop853_start(&ode, t0, by.buf, first_step, bs.buf, bw.buf);
+            ((double *)bs.buf)[MB_DOP_WALL] += now_seconds() - start;
             out = status_or_error(status, bs.buf);
             problem_release(&pr);
         }
@@ -409,16 +430,22 @@ static PyObject *py_dense(PyObject *self, PyObject *args) {
 }
 
 static PyObject *py_sampled(PyObject *self, PyObject *args) {
-    PyObject *tuple, *times, *result, *state, *work;
+    PyObject *tuple, *times, *result, *state, *work, *marks = Py_None;
     double t_stop;
     long long max_steps, k;
     int project_samples;
-    if (!PyArg_ParseTuple(args, "O!dLOLOpOO", &PyTuple_Type, &tuple, &t_stop, &max_steps,
-                          &times, &k, &result, &project_samples, &state, &work))
+    if (!PyArg_ParseTuple(args, "O!dLOLOpOO|O", &PyTuple_Type, &tuple, &t_stop, &max_steps,
+                          &times, &k, &result, &project_samples, &state, &work, &marks))
         return NULL;
-    Py_buffer bs, bw, bt, bo;
+    Py_buffer bs, bw, bt, bo, bm;
     int64_t n;
     if (buffers(state, work, &bs, &bw, &n) < 0) return NULL;
+    const int have_marks = marks != Py_None;
+    if (have_marks && get_doubles(marks, &bm, 1, -1, "marks") < 0) {
+        PyBuffer_Release(&bs);
+        PyBuffer_Release(&bw);
+        return NULL;
+    }
     problem pr;
     mb_ode ode;
     PyObject *out = NULL;
@@ -428,17 +455,26 @@ static PyObject *py_sampled(PyObject *self, PyObject *args) {
             PyErr_Format(PyExc_ValueError, "k: expected 0 to %lld", (long long)m);
         } else if (get_doubles(result, &bo, 1, (Py_ssize_t)(m * n), "out") == 0) {
             if (problem_read(tuple, n, &pr, &ode) == 0) {
-                int64_t kk = (int64_t)k;
-                int status = mb_dop853_sampled(&ode, t_stop, (int64_t)max_steps, bt.buf, m,
-                                               &kk, bo.buf, project_samples, bs.buf, bw.buf);
+                int64_t kk = (int64_t)k, count = 0;
+                double *st_buf = bs.buf;
+                const double start = now_seconds();
+                int status = mb_dop853_sampled(
+                    &ode, t_stop, (int64_t)max_steps, bt.buf, m, &kk, bo.buf,
+                    project_samples, st_buf, bw.buf, have_marks ? bm.buf : NULL,
+                    have_marks ? (int64_t)(bm.len / 16) : 0, &count);
+                st_buf[MB_DOP_WALL] += now_seconds() - start;
                 PyObject *st = status_or_error(status, bs.buf);
-                if (st != NULL) out = Py_BuildValue("(NL)", st, (long long)kk);
+                if (st != NULL)
+                    out = have_marks ? Py_BuildValue("(NLL)", st, (long long)kk,
+                                                     (long long)count)
+                                     : Py_BuildValue("(NL)", st, (long long)kk);
                 problem_release(&pr);
             }
             PyBuffer_Release(&bo);
         }
         PyBuffer_Release(&bt);
     }
+    if (have_marks) PyBuffer_Release(&bm);
     PyBuffer_Release(&bs);
     PyBuffer_Release(&bw);
     return out;
@@ -489,6 +525,82 @@ lam_:
     PyBuffer_Release(&bl);
     if (!ok) return NULL;
     Py_RETURN_NONE;
+}
+
+static PyObject *py_conservation(PyObject *self, PyObject *args) {
+    /* mass, J, gravity, stiffness, rest, lengths (or None), Y | T, V, H, figures, spin */
+    PyObject *o[12];
+    int planar, kind;
+    if (!PyArg_ParseTuple(args, "OOOOOOOpiOOOOO", &o[0], &o[1], &o[2], &o[3], &o[4], &o[5],
+                          &o[6], &planar, &kind, &o[7], &o[8], &o[9], &o[10], &o[11]))
+        return NULL;
+    if (kind < 0 || kind > 2) {
+        PyErr_SetString(PyExc_ValueError, "kind: 0 (world origin), 1 (spins), 2 (mass centre)");
+        return NULL;
+    }
+    static const char *names[12] = {"mass", "J", "gravity", "stiffness", "rest", "lengths",
+                                    "Y", "T", "V", "H", "figures", "spin"};
+    Py_buffer b[12];
+    int held[12] = {0};
+    int ok = 0;
+    /* the sizes follow from mass (n), stiffness (s) and T (K) */
+    if (get_doubles(o[0], &b[0], 0, -1, names[0]) < 0) return NULL;
+    held[0] = 1;
+    const int64_t n = (int64_t)(b[0].len / 8);
+    if (get_doubles(o[3], &b[3], 0, -1, names[3]) < 0) goto done;
+    held[3] = 1;
+    const int64_t s = (int64_t)(b[3].len / 8);
+    if (get_doubles(o[7], &b[7], 1, -1, names[7]) < 0) goto done;
+    held[7] = 1;
+    const int64_t K = (int64_t)(b[7].len / 8);
+    const Py_ssize_t sizes[12] = {n, 9 * n, 3, s, s, K * s, K * MB_STATE_SIZE(n, planar), K,
+                                  K, 3 * K, 6, n};
+    for (int i = 1; i < 12; i++) {
+        if (held[i]) continue;
+        if (i == 5 && o[5] == Py_None) {
+            if (s > 0) {
+                PyErr_SetString(PyExc_ValueError, "lengths: the springs' lengths are needed");
+                goto done;
+            }
+            continue;
+        }
+        if (get_doubles(o[i], &b[i], i >= 7, sizes[i], names[i]) < 0) goto done;
+        held[i] = 1;
+    }
+    if (mb_conservation(n, planar, b[0].buf, b[1].buf, b[2].buf, s, b[3].buf, b[4].buf,
+                        held[5] ? b[5].buf : NULL, K, b[6].buf, MB_STATE_SIZE(n, planar), kind,
+                        b[7].buf, b[8].buf, b[9].buf, b[10].buf, b[11].buf) < 0)
+        PyErr_NoMemory();
+    else
+        ok = 1;
+done:
+    for (int i = 0; i < 12; i++)
+        if (held[i]) PyBuffer_Release(&b[i]);
+    if (!ok) return NULL;
+    Py_RETURN_NONE;
+}
+
+static PyObject *py_unit_samples(PyObject *self, PyObject *args) {
+    PyObject *states;
+    long long n;
+    int planar;
+    if (!PyArg_ParseTuple(args, "OLp", &states, &n, &planar)) return NULL;
+    if (n < 0) {
+        PyErr_SetString(PyExc_ValueError, "n must be >= 0");
+        return NULL;
+    }
+    Py_buffer b;
+    if (get_doubles(states, &b, 1, -1, "Y") < 0) return NULL;
+    const int64_t size = MB_STATE_SIZE((int64_t)n, planar), count = (int64_t)(b.len / 8);
+    if (size == 0 ? count != 0 : count % size != 0) {
+        PyErr_Format(PyExc_ValueError, "Y: rows of %lld values expected", (long long)size);
+        PyBuffer_Release(&b);
+        return NULL;
+    }
+    const double worst = mb_unit_samples((int64_t)n, planar, size ? count / size : 0, b.buf,
+                                         size);
+    PyBuffer_Release(&b);
+    return PyFloat_FromDouble(worst);
 }
 
 static PyObject *py_system(PyObject *self, PyObject *args) {
@@ -562,12 +674,27 @@ static PyMethodDef dop853_methods[] = {
      "dop853_sampled(problem, t_stop, max_steps, t_eval, k, out, project_samples, state, "
      "work) -> (status, k): steps as dop853_run, and after each step out's rows k, k + 1, "
      "... (len(t_eval) x n) <- the dense output at the sample times the step reached, each "
-     "moved by project when project_samples; k: the first row not yet written."},
+     "moved by project when project_samples; k: the first row not yet written. With "
+     "marks (a float64 buffer of rows (t, steps)): -> (status, k, count), the first count "
+     "rows written at each step reaching DOP_MARK_NEXT or t_bound (dop853.h); the seconds "
+     "spent are added to state[DOP_WALL] (as dop853_start's)."},
     {"samples", py_samples, METH_VARARGS,
      "samples(unknowns, lam, t, Y, reactions, lengths, drift): a run's figures at its K "
      "output samples (Y: K rows of the packed state at the times t): reactions (K x m, or "
      "None) <- every reaction value, the unknowns' solved; lengths (K x s, or None) <- the "
      "springs' lengths; drift (2) <- the largest |phi| and |G^T v - f'|."},
+    {"conservation", py_conservation, METH_VARARGS,
+     "conservation(mass, J, gravity, stiffness, rest, lengths, Y, planar, kind, T, V, H, "
+     "figures, spin): what a run conserves at its K samples (Y: K rows of the packed state): T "
+     "(K) <- kinetic energy, V (K) <- gravity's and the springs' potential (lengths: K x s, "
+     "None without springs), H (K x 3) <- angular momentum (kind 0: about the world "
+     "origin, 1: the spins alone, 2: about the system's mass centre), figures (6) <- the "
+     "largest relative changes of E, p and H, then p at the first sample (6), spin (n) <- "
+     "each body's largest |w| (mechanism.h: mb_conservation)."},
+    {"unit_samples", py_unit_samples, METH_VARARGS,
+     "unit_samples(Y, n, planar) -> the largest |norm - 1| of the quaternions: the samples "
+     "Y (K rows of the packed state) finished in place: unit quaternions, and a planar "
+     "model's carried angles set to theirs on their branch (mechanism.h)."},
     {"dop853_system", py_system, METH_VARARGS,
      "dop853_system(number, params, t, y, ydot): a built-in test system's y'."},
     {"dop853_tableau", py_tableau, METH_NOARGS,
@@ -593,7 +720,8 @@ int mb_dop853_register(PyObject *m) {
         {"DOP_NFEV", MB_DOP_NFEV}, {"DOP_REFRESHED", MB_DOP_REFRESHED},
         {"DOP_FILTER", MB_DOP_FILTER}, {"DOP_FILTER_NEXT", MB_DOP_FILTER_NEXT},
         {"DOP_DENSE", MB_DOP_DENSE}, {"DOP_DENSE_NFEV", MB_DOP_DENSE_NFEV},
-        {"DOP_INFO", MB_DOP_INFO},
+        {"DOP_WALL", MB_DOP_WALL}, {"DOP_MARK_WIDTH", MB_DOP_MARK_WIDTH},
+        {"DOP_MARK_NEXT", MB_DOP_MARK_NEXT}, {"DOP_INFO", MB_DOP_INFO},
         {"MECH_RATE", MB_MECH_RATE}, {"MECH_ROBUST", MB_MECH_ROBUST},
         {"MECH_ITERS", MB_MECH_ITERS}, {"MECH_STAGE_ITERS", MB_MECH_STAGE_ITERS},
         {"MECH_PARAMS", MB_MECH_PARAMS},

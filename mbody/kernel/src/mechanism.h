@@ -64,4 +64,29 @@ int mb_samples(const mb_model *md, const mb_unknowns *u, mb_work *w, const doubl
                int64_t K, const double *t, const double *Y, int64_t stride,
                double *reactions, double *lengths, double *drift);
 
+/* A run's K stored samples (the rows of Y, `stride` doubles apart: the core's layout)
+ * finished in place: each quaternion divided by its norm, and with `planar` each carried
+ * angle theta set to its quaternion's own angle 2 atan2(q_z, q_w) on theta's branch (the
+ * turns a quaternion cannot count kept; mbody.simulate.trajectory.keep_planar_angles).
+ * Returns the largest |norm - 1| before (NaN if a norm is). */
+double mb_unit_samples(int64_t n, int planar, int64_t K, double *Y, int64_t stride);
+
+/* What a run conserves, at its K samples (the rows of Y, `stride` doubles apart: the core's
+ * layout; a planar model's spatial form: x, v with z = 0, q from the carried angle, w
+ * about z alone): T[k] = sum of 1/2 m v.v + 1/2 w.J w; V[k] = -sum m x.g + sum of
+ * 1/2 k (L - L0)^2 over the s springs (their lengths: lengths, K x s); H[k] (3) the
+ * angular momentum, kind 1: the spins sum W_R_B J w alone, kind 0: with the orbital terms
+ * x x m v about the world origin, kind 2: about the system's mass centre (x and v relative
+ * to its position and velocity). figures (6): the largest relative changes of E = T + V
+ * (over max(|E(0)|, max T)), of p = sum m v and of H (each over the largest sum of its
+ * terms' magnitudes), 0 where that scale is 0; figures[3 ..] (3) <- p at the first
+ * sample; spin_peak (n) <- each body's largest |w| over the samples (planar: |w_z|). mass (n),
+ * J (n x 9, body axes), gravity (3), stiffness and rest (s). Returns 0, or -1 out of
+ * memory. */
+int mb_conservation(int64_t n, int planar, const double *mass, const double *J,
+                    const double *gravity, int64_t s, const double *stiffness,
+                    const double *rest, const double *lengths, int64_t K, const double *Y,
+                    int64_t stride, int kind, double *T, double *V, double *H,
+                    double *figures, double *spin_peak);
+
 #endif
