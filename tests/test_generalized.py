@@ -385,3 +385,44 @@ def test_symbolic_refuses_a_closed_loop():
     model = mbody.load(MODELS[0].parent / "fourbar_planar.yaml")
     with pytest.raises(NotSymbolicError, match="close a loop"):
         mbody.assemble(model).generalized().symbolic()
+
+
+@pytest.mark.parametrize("name", ["double_pendulum", "heavy_top", "rotor_gyroscopic_bearings",
+                                  "spinning_disc_bearings", "gyroscope_gimbals",
+                                  "slider_crank", "fourbar_spatial", "flyball_governor",
+                                  "helical_chain", "spring_mass_damper"])
+def test_perturbed_evaluations_equal_whole_ones(name):
+    """The linearisation's evaluations (the core moves the positions along T dq and keeps
+    the joints' columns between a position's evaluations, recomputing only their velocity
+    terms at new rates) equal whole evaluations at the moved state: f to the rounding of
+    the terms it is made of."""
+    from mbody.equations.generalized import evaluate, layout, state_with_velocities
+    from mbody.equations.workspace import workspace
+    from mbody.solve.configure import move
+    from mbody.solve.linearize import free_coordinates
+
+    model = mbody.load(Path(__file__).resolve().parent.parent / "models" / f"{name}.yaml")
+    state = model.initial
+    cs = free_coordinates(model)
+    k = len(cs)
+    g0 = evaluate(model, state, cs)
+    rng = np.random.default_rng(len(name))
+    # rows: positions and rates together, rates alone twice (the columns are reused)
+    dq = 1e-2 * rng.normal(size=(4, k)) * cs.scales
+    du = rng.normal(size=(4, k)) * np.maximum(np.abs(g0.qdot), 1.0)
+    dq[2:] = 0.0
+    P = np.ascontiguousarray(np.hstack((dq, du)))
+    out = np.empty(4 * k)
+    ws = workspace(model)
+    ws.solver(cs.held).generalized_perturbed(float(state.t), ws.pack_state(state),
+                                             cs.held.lam, cs.Iq, cs.cols, g0.qdot, P, out)
+    f = out.reshape(4, k)
+    assert layout(len(cs.cols), k)[-1] > 0
+    for row in range(4):
+        moved = move(model, state, g0.T @ dq[row])
+        rates = g0.qdot + du[row]
+        at = evaluate(model, moved, cs, qdot=rates)  # T and v_e there: the velocities
+        moved = state_with_velocities(model, moved, at.T @ rates + at.v_e)
+        ref = evaluate(model, moved, cs)  # a whole evaluation at that state
+        scale = np.maximum(ref.f_scale, 1e-300)
+        assert np.all(np.abs(f[row] - ref.f) <= 1e-11 * scale), (row, f[row], ref.f)
