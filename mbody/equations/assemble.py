@@ -27,11 +27,12 @@ from mbody.equations.solution import (
     METHODS,
     ReactionValues,
     Solution,
+    plain_solution,
     singular_mass_error,
     solution,
 )
 from mbody.equations.symbolic import SymbolicEquations, assembly_symbolic
-from mbody.equations.workspace import Unknowns, workspace
+from mbody.equations.workspace import SolvePlan, Unknowns, Workspace, workspace
 from mbody.equations.world import world_reactions
 from mbody.errors import MbodyError, did_you_mean
 from mbody.kernel import _core
@@ -297,17 +298,23 @@ class Assembly:
             The accelerations in the order of `coordinates`, every reaction value, and
             what the solve found (redundant or broken constraints, backward error).
         """
+        ws = workspace(self.model)
+        if not known and axes == "joint":  # the usual call: the file's unknowns
+            return _solve(ws, ws.file_plan, self.model, self.state, ws.file_unknowns,
+                          condition, self._columns)
         if axes not in ("joint", "world"):
             raise MbodyError(f"axes must be 'joint' or 'world', got {axes!r}")
-        ws = workspace(self.model)
         unknowns = (ws.unknowns(self.reaction_values(known)) if known
                     else ws.unknowns_at(self.state.t))
-        sol = solve_state(self.model, self.state, unknowns, condition=condition,
-                          columns=lambda: self.columns)
+        sol = _solve(ws, ws.solve_plan(unknowns), self.model, self.state, unknowns,
+                     condition, self._columns)
         if axes == "world":
             sol = dataclasses.replace(sol, reactions=world_reactions(
                 self.model, self.columns, sol.reactions), axes="world")
         return sol
+
+    def _columns(self) -> ReactionColumns:  # what solve_state asks for when it needs them
+        return self.columns
 
     def _repr_html_(self) -> str:  # notebook display: each body's free body and pair
         from mbody.present.rich import assembly_html  # a display hook (tools/check_imports.py)
@@ -356,40 +363,44 @@ def solve_state(model: Model, state: State, unknowns: Unknowns, *, condition: bo
     the joints' geometry). `columns` gives the reaction columns at `state` when a broken
     joint must be described or a large S's condition estimated (made only then)."""
     ws = workspace(model)
-    plan = ws.solve_plan(unknowns)
-    out = np.empty(plan.o_info + _core.INFO)
-    y = ws.pack_state(state)
-    plan.solver.solve(state.t, y, unknowns.lam, out)
-    N, o_lam, o_info = plan.N, plan.o_lam, plan.o_info
-    m = (o_info - o_lam) // 3  # λ, Gᵀv and the not-unique flags, m each
-    labels = model.reactions
-    acc = out[:N] if plan.rows is None else out[:N][plan.rows]
-    lam = out[o_lam:o_lam + m]
-    reactions = ReactionValues(labels, model.reaction_index, lam)
-    mu = len(unknowns.U)
+    return _solve(ws, ws.solve_plan(unknowns), model, state, unknowns, condition, columns)
+
+
+def _solve(ws: Workspace, plan: SolvePlan, model: Model, state: State, unknowns: Unknowns,
+           condition: bool, columns: Callable[[], ReactionColumns] | None) -> Solution:
+    """`solve_state` with the workspace and the plan in hand. The hot path of every small
+    solve: each line costs a tenth of a microsecond or so, so the plain case (full rank,
+    nothing broken, no condition asked for) reads what it needs from the plan and builds
+    the `Solution` from the plan's constant fields."""
+    solver, N, o_lam, o_info, labels, rows, size, m, mu, reactions, index, fields = plan
+    out = np.empty(size)
+    info = solver.solve(state.t, ws.pack_state(state), unknowns.lam, out)
+    acc = out[:N] if rows is None else out[:N][rows]
+    values = ReactionValues(reactions, index, out[o_lam:o_lam + m])
     if not mu:
-        return solution(model.coordinates, acc, reactions)
-    info = out[o_info:].tolist()  # Python floats: a numpy scalar read costs more, 6 times
-    if info[_core.ST_SINGULAR]:
-        code = int(info[_core.ST_SINGULAR]) - 1
+        return solution(model.coordinates, acc, values)
+    rank, berr, n_broken, _, path, singular = info
+    if singular:
+        code = int(singular) - 1
         raise singular_mass_error(model, code // 6, code % 6)
+    if rank == mu and not n_broken and not condition:
+        return plain_solution(fields, acc, values, berr, METHODS[int(path)])
     broken: tuple[str, ...] = ()
-    if info[_core.ST_BROKEN] > 0:  # rare: describe the broken joints
+    if n_broken > 0:  # rare: describe the broken joints
         cols = columns() if columns is not None else reaction_columns(model, state)
         broken = tuple(joint_errors(model, state, cols, unknowns.mask,
                                     gtv=out[o_lam + m:o_lam + 2 * m]))
-    rank = int(info[_core.ST_RANK])
+    r = int(rank)
     not_unique: tuple[str, ...] = ()
-    if rank < mu:
+    if r < mu:
         flags = out[o_lam + 2 * m:o_info]
-        not_unique = tuple(labels[i] for i in np.flatnonzero(flags))
+        not_unique = tuple(reactions[i] for i in np.flatnonzero(flags))
     cond = None
     if condition:
-        cond = _condition(model, state, unknowns, plan.solver, y, rank, columns)
-    return solution(model.coordinates, acc, reactions, solved=plan.labels,
-                    not_unique=not_unique, residual=float(info[_core.ST_BERR]),
-                    condition=cond, method=METHODS[int(info[_core.ST_PATH])],
-                    broken_joints=broken, redundant=mu - rank)
+        cond = _condition(model, state, unknowns, solver, ws.pack_state(state), r, columns)
+    return solution(model.coordinates, acc, values, solved=labels, not_unique=not_unique,
+                    residual=berr, condition=cond, method=METHODS[int(path)],
+                    broken_joints=broken, redundant=mu - r)
 
 
 DENSE_CONDITION = 2000
