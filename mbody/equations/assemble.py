@@ -32,7 +32,13 @@ from mbody.equations.solution import (
     solution,
 )
 from mbody.equations.symbolic import SymbolicEquations, assembly_symbolic
-from mbody.equations.workspace import SolvePlan, Unknowns, Workspace, workspace
+from mbody.equations.workspace import (
+    NOT_UNIQUE_KEPT,
+    SolvePlan,
+    Unknowns,
+    Workspace,
+    workspace,
+)
 from mbody.equations.world import world_reactions
 from mbody.errors import MbodyError, did_you_mean
 from mbody.kernel import _core
@@ -372,7 +378,8 @@ def _solve(ws: Workspace, plan: SolvePlan, model: Model, state: State, unknowns:
     solve: each line costs a tenth of a microsecond or so, so the plain case (full rank,
     nothing broken, no condition asked for) reads what it needs from the plan and builds
     the `Solution` from the plan's constant fields."""
-    solver, N, o_lam, o_info, labels, rows, size, m, mu, reactions, index, fields = plan
+    (solver, N, o_lam, o_info, labels, rows, size, m, mu, reactions, index, fields,
+     patterns) = plan
     out = np.empty(size)
     info = solver.solve(state.t, ws.pack_state(state), unknowns.lam, out)
     acc = out[:N] if rows is None else out[:N][rows]
@@ -383,8 +390,17 @@ def _solve(ws: Workspace, plan: SolvePlan, model: Model, state: State, unknowns:
     if singular:
         code = int(singular) - 1
         raise singular_mass_error(model, code // 6, code % 6)
-    if rank == mu and not n_broken and not condition:
-        return plain_solution(fields, acc, values, berr, METHODS[int(path)])
+    if not n_broken and not condition:
+        if rank == mu:
+            return plain_solution(fields, acc, values, berr, METHODS[int(path)])
+        key = out[o_lam + 2 * m:o_info].tobytes()  # the not-unique flags
+        shared = patterns.get(key)
+        if shared is None:
+            shared = tuple(reactions[i] for i in np.flatnonzero(out[o_lam + 2 * m:o_info]))
+            if len(patterns) < NOT_UNIQUE_KEPT:
+                patterns[key] = shared
+        return plain_solution(fields, acc, values, berr, METHODS[int(path)], shared,
+                              mu - int(rank))
     broken: tuple[str, ...] = ()
     if n_broken > 0:  # rare: describe the broken joints
         cols = columns() if columns is not None else reaction_columns(model, state)

@@ -186,15 +186,19 @@ def solution_fields(coordinates: list[str], solved: tuple[str, ...]) -> dict[str
 
 
 def plain_solution(fields: dict[str, object], accelerations: np.ndarray,
-                   reactions: Mapping[str, float], residual: float, method: str) -> Solution:
-    """`Solution` of a plain solve from its constant `fields` (`solution_fields`): the
-    solve's hot path, a dictionary's copy and three entries (a fifth of a microsecond;
-    the keyword call of `solution` takes twice that). Equal to the dataclass's own."""
+                   reactions: Mapping[str, float], residual: float, method: str,
+                   not_unique: tuple[str, ...] = (), redundant: int = 0) -> Solution:
+    """`Solution` of a plain solve (nothing broken, no condition asked for) from its
+    constant `fields` (`solution_fields`): the solve's hot path, a dictionary's copy and
+    a few entries (a fifth of a microsecond; the keyword call of `solution` takes twice
+    that). Equal to the dataclass's own."""
     obj = _NEW(Solution)
     d = obj.__dict__
     d.update(fields)
     d["accelerations"], d["reactions"] = accelerations, reactions
     d["residual"], d["method"] = residual, method
+    if redundant:
+        d["not_unique"], d["redundant"] = not_unique, redundant
     return obj
 
 

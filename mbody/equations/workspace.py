@@ -63,8 +63,10 @@ class SolvePlan(NamedTuple):
     a model with particles keeps (None: all); and what every solve with them reads
     besides the state, looked up once: the length of the output (size), the number of
     reaction components (m) and of unknown ones (mu), the model's reaction labels and
-    their index, and the constant fields of a plain solve's `Solution` (`fields`:
-    `mbody.equations.solution.solution_fields`)."""
+    their index, the constant fields of a plain solve's `Solution` (`fields`:
+    `mbody.equations.solution.solution_fields`), and the labels of the components that
+    redundant constraints leave undetermined, by the core's flags (bytes; filled as met,
+    up to `NOT_UNIQUE_KEPT` patterns: a mechanism redundant by its structure has one)."""
 
     solver: _core.Unknowns
     N: int
@@ -78,6 +80,11 @@ class SolvePlan(NamedTuple):
     reactions: list[str]
     reaction_index: dict[str, int]
     fields: dict[str, object]
+    not_unique: dict[bytes, tuple[str, ...]]
+
+
+NOT_UNIQUE_KEPT = 64
+"""Patterns of not-unique reactions a plan keeps (`SolvePlan.not_unique`)."""
 
 
 class Workspace:
@@ -165,7 +172,8 @@ class Workspace:
             plan = SolvePlan(self.solver(unknowns), N, o_lam, o_info, labels,
                              model.rows if model.has_particles else None,
                              o_info + _core.INFO, m, len(unknowns.U), model.reactions,
-                             model.reaction_index, solution_fields(model.coordinates, labels))
+                             model.reaction_index, solution_fields(model.coordinates, labels),
+                             {})
             self._plans[unknowns.key] = plan
         return plan
 
