@@ -388,35 +388,35 @@ def _solve(ws: Workspace, plan: SolvePlan, model: Model, state: State, unknowns:
         return solution(model.coordinates, acc, values)
     rank, berr, n_broken, _, path, singular = info
     if singular:
-        code = int(singular) - 1
+        code = singular - 1
         raise singular_mass_error(model, code // 6, code % 6)
     if not n_broken and not condition:
         if rank == mu:
-            return plain_solution(fields, acc, values, berr, METHODS[int(path)])
+            return plain_solution(fields, acc, values, berr, METHODS[path])
         key = out[o_lam + 2 * m:o_info].tobytes()  # the not-unique flags
         shared = patterns.get(key)
         if shared is None:
             shared = tuple(reactions[i] for i in np.flatnonzero(out[o_lam + 2 * m:o_info]))
             if len(patterns) < NOT_UNIQUE_KEPT:
                 patterns[key] = shared
-        return plain_solution(fields, acc, values, berr, METHODS[int(path)], shared,
-                              mu - int(rank))
+        return plain_solution(fields, acc, values, berr, METHODS[path], shared,
+                              mu - rank)
     broken: tuple[str, ...] = ()
     if n_broken > 0:  # rare: describe the broken joints
         cols = columns() if columns is not None else reaction_columns(model, state)
         broken = tuple(joint_errors(model, state, cols, unknowns.mask,
                                     gtv=out[o_lam + m:o_lam + 2 * m]))
-    r = int(rank)
     not_unique: tuple[str, ...] = ()
-    if r < mu:
+    if rank < mu:
         flags = out[o_lam + 2 * m:o_info]
         not_unique = tuple(reactions[i] for i in np.flatnonzero(flags))
     cond = None
     if condition:
-        cond = _condition(model, state, unknowns, solver, ws.pack_state(state), r, columns)
+        cond = _condition(model, state, unknowns, solver, ws.pack_state(state), rank,
+                          columns)
     return solution(model.coordinates, acc, values, solved=labels, not_unique=not_unique,
-                    residual=berr, condition=cond, method=METHODS[int(path)],
-                    broken_joints=broken, redundant=mu - r)
+                    residual=berr, condition=cond, method=METHODS[path],
+                    broken_joints=broken, redundant=mu - rank)
 
 
 DENSE_CONDITION = 2000
