@@ -230,8 +230,8 @@ static void solve_again(const mb_model *md, const mb_unknowns *u, mb_work *w,
  * it, and the remaining diagonal entries (rem) are updated by its squares; only the
  * factor's rows move with a pivot. Every entry is the same sum, in the same order, as the
  * outer-product factor of the whole symmetric matrix (the route's first version), so the
- * numbers are those; at a fifth of its work (no trailing update of both triangles, no
- * swap of whole rows and columns). Returns the rank r. */
+ * numbers are those, for about half its instructions (no trailing update of both
+ * triangles, no swap of whole rows and columns). Returns the rank r. */
 static int64_t pivoted_cholesky(const mb_unknowns *u, const double *S0, double *S,
                                 const double *diag, double *rem, int64_t *perm) {
     int64_t mu = u->mu, bw = u->bw, W = bw + 1;
