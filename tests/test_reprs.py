@@ -125,3 +125,44 @@ def test_the_fast_solution_is_a_solution_as_the_dataclass_makes_it():
     assert solution(*args[:3]) == Solution(*args[:3])
     with pytest.raises(dataclasses.FrozenInstanceError):
         fast.redundant = 2  # type: ignore[misc]
+
+
+def test_the_plain_solution_is_a_solution_as_the_dataclass_makes_it():
+    """`plain_solution` (a full-rank solve's hot path: the plan's constant fields and the
+    four that change) equals the dataclass's construction, field for field and in order,
+    stays frozen, and leaves the plan's fields as they were."""
+    import dataclasses
+
+    import numpy as np
+
+    from mbody.equations.solution import METHODS, Solution, plain_solution, solution_fields
+
+    names = [f.name for f in dataclasses.fields(Solution)]
+    fields = solution_fields(["a"], ("A.Fx",))
+    before = dict(fields)
+    acc, lam = np.ones(1), {"A.Fx": 1.0}
+    fast = plain_solution(fields, acc, lam, 1e-16, METHODS[2])
+    assert list(vars(fast)) == names
+    assert fast == Solution(["a"], acc, lam, ("A.Fx",), residual=1e-16, method=METHODS[2])
+    assert fields == before
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        fast.residual = 0.0  # type: ignore[misc]
+
+
+def test_reaction_values_array_is_read_only_and_the_values():
+    """`ReactionValues.array` is the values given, as a read-only view (made on first
+    use), the same object on every read."""
+    import numpy as np
+
+    from mbody.equations.solution import ReactionValues
+
+    values = np.array([1.0, -2.0])
+    rv = ReactionValues(["A.Fx", "A.Fy"], {"A.Fx": 0, "A.Fy": 1}, values)
+    assert rv["A.Fy"] == -2.0 and dict(rv) == {"A.Fx": 1.0, "A.Fy": -2.0}
+    arr = rv.array
+    assert arr is rv.array and np.shares_memory(arr, values)
+    assert not arr.flags.writeable
+    with pytest.raises(ValueError):
+        arr[0] = 3.0
+    sol = mbody.assemble(mbody.load(MODELS[0].parent / "double_pendulum.yaml")).solve()
+    assert not sol.reactions.array.flags.writeable  # type: ignore[attr-defined]

@@ -27,11 +27,18 @@ from mbody.equations.solution import (
     METHODS,
     ReactionValues,
     Solution,
+    plain_solution,
     singular_mass_error,
     solution,
 )
 from mbody.equations.symbolic import SymbolicEquations, assembly_symbolic
-from mbody.equations.workspace import Unknowns, workspace
+from mbody.equations.workspace import (
+    NOT_UNIQUE_KEPT,
+    SolvePlan,
+    Unknowns,
+    Workspace,
+    workspace,
+)
 from mbody.equations.world import world_reactions
 from mbody.errors import MbodyError, did_you_mean
 from mbody.kernel import _core
@@ -297,17 +304,23 @@ class Assembly:
             The accelerations in the order of `coordinates`, every reaction value, and
             what the solve found (redundant or broken constraints, backward error).
         """
+        ws = workspace(self.model)
+        if not known and axes == "joint":  # the usual call: the file's unknowns
+            return _solve(ws, ws.file_plan, self.model, self.state, ws.file_unknowns,
+                          condition, self._columns)
         if axes not in ("joint", "world"):
             raise MbodyError(f"axes must be 'joint' or 'world', got {axes!r}")
-        ws = workspace(self.model)
         unknowns = (ws.unknowns(self.reaction_values(known)) if known
                     else ws.unknowns_at(self.state.t))
-        sol = solve_state(self.model, self.state, unknowns, condition=condition,
-                          columns=lambda: self.columns)
+        sol = _solve(ws, ws.solve_plan(unknowns), self.model, self.state, unknowns,
+                     condition, self._columns)
         if axes == "world":
             sol = dataclasses.replace(sol, reactions=world_reactions(
                 self.model, self.columns, sol.reactions), axes="world")
         return sol
+
+    def _columns(self) -> ReactionColumns:  # what solve_state asks for when it needs them
+        return self.columns
 
     def _repr_html_(self) -> str:  # notebook display: each body's free body and pair
         from mbody.present.rich import assembly_html  # a display hook (tools/check_imports.py)
@@ -356,39 +369,53 @@ def solve_state(model: Model, state: State, unknowns: Unknowns, *, condition: bo
     the joints' geometry). `columns` gives the reaction columns at `state` when a broken
     joint must be described or a large S's condition estimated (made only then)."""
     ws = workspace(model)
-    plan = ws.solve_plan(unknowns)
-    out = np.empty(plan.o_info + _core.INFO)
-    y = ws.pack_state(state)
-    plan.solver.solve(state.t, y, unknowns.lam, out)
-    N, o_lam, o_info = plan.N, plan.o_lam, plan.o_info
-    m = (o_info - o_lam) // 3  # λ, Gᵀv and the not-unique flags, m each
-    labels = model.reactions
-    acc = out[:N] if plan.rows is None else out[:N][plan.rows]
-    lam = out[o_lam:o_lam + m]
-    reactions = ReactionValues(labels, model.reaction_index, lam)
-    mu = len(unknowns.U)
+    return _solve(ws, ws.solve_plan(unknowns), model, state, unknowns, condition, columns)
+
+
+def _solve(ws: Workspace, plan: SolvePlan, model: Model, state: State, unknowns: Unknowns,
+           condition: bool, columns: Callable[[], ReactionColumns] | None) -> Solution:
+    """`solve_state` with the workspace and the plan in hand. The hot path of every small
+    solve: each line costs a tenth of a microsecond or so, so the plain case (full rank,
+    nothing broken, no condition asked for) reads what it needs from the plan and builds
+    the `Solution` from the plan's constant fields."""
+    (solver, N, o_lam, o_info, labels, rows, size, m, mu, reactions, index, fields,
+     patterns) = plan
+    out = np.empty(size)
+    info = solver.solve(state.t, ws.pack_state(state), unknowns.lam, out)
+    acc = out[:N] if rows is None else out[:N][rows]
+    values = ReactionValues(reactions, index, out[o_lam:o_lam + m])
     if not mu:
-        return solution(model.coordinates, acc, reactions)
-    info = out[o_info:].tolist()  # Python floats: a numpy scalar read costs more, 6 times
-    if info[_core.ST_SINGULAR]:
-        code = int(info[_core.ST_SINGULAR]) - 1
+        return solution(model.coordinates, acc, values)
+    rank, berr, n_broken, _, path, singular = info
+    if singular:
+        code = singular - 1
         raise singular_mass_error(model, code // 6, code % 6)
+    if not n_broken and not condition:
+        if rank == mu:
+            return plain_solution(fields, acc, values, berr, METHODS[path])
+        key = out[o_lam + 2 * m:o_info].tobytes()  # the not-unique flags
+        shared = patterns.get(key)
+        if shared is None:
+            shared = tuple(reactions[i] for i in np.flatnonzero(out[o_lam + 2 * m:o_info]))
+            if len(patterns) < NOT_UNIQUE_KEPT:
+                patterns[key] = shared
+        return plain_solution(fields, acc, values, berr, METHODS[path], shared,
+                              mu - rank)
     broken: tuple[str, ...] = ()
-    if info[_core.ST_BROKEN] > 0:  # rare: describe the broken joints
+    if n_broken > 0:  # rare: describe the broken joints
         cols = columns() if columns is not None else reaction_columns(model, state)
         broken = tuple(joint_errors(model, state, cols, unknowns.mask,
                                     gtv=out[o_lam + m:o_lam + 2 * m]))
-    rank = int(info[_core.ST_RANK])
     not_unique: tuple[str, ...] = ()
     if rank < mu:
         flags = out[o_lam + 2 * m:o_info]
-        not_unique = tuple(labels[i] for i in np.flatnonzero(flags))
+        not_unique = tuple(reactions[i] for i in np.flatnonzero(flags))
     cond = None
     if condition:
-        cond = _condition(model, state, unknowns, plan.solver, y, rank, columns)
-    return solution(model.coordinates, acc, reactions, solved=plan.labels,
-                    not_unique=not_unique, residual=float(info[_core.ST_BERR]),
-                    condition=cond, method=METHODS[int(info[_core.ST_PATH])],
+        cond = _condition(model, state, unknowns, solver, ws.pack_state(state), rank,
+                          columns)
+    return solution(model.coordinates, acc, values, solved=labels, not_unique=not_unique,
+                    residual=berr, condition=cond, method=METHODS[path],
                     broken_joints=broken, redundant=mu - rank)
 
 

@@ -24,6 +24,7 @@ import numpy as np
 
 from mbody import conventions as cv
 from mbody.equations.pack import pack_model, pack_unknowns
+from mbody.equations.solution import solution_fields
 from mbody.kernel import _core
 from mbody.util.spatial import quaternion_rate
 
@@ -59,7 +60,13 @@ class Unknowns:
 class SolvePlan(NamedTuple):
     """One set of unknowns' solve, laid out: the core's solver; where `Unknowns.solve`
     writes (N accelerations, λ at o_lam, info at o_info); the unknowns' labels; the rows
-    a model with particles keeps (None: all)."""
+    a model with particles keeps (None: all); and what every solve with them reads
+    besides the state, looked up once: the length of the output (size), the number of
+    reaction components (m) and of unknown ones (mu), the model's reaction labels and
+    their index, the constant fields of a plain solve's `Solution` (`fields`:
+    `mbody.equations.solution.solution_fields`), and the labels of the components that
+    redundant constraints leave undetermined, by the core's flags (bytes; filled as met,
+    up to `NOT_UNIQUE_KEPT` patterns: a mechanism redundant by its structure has one)."""
 
     solver: _core.Unknowns
     N: int
@@ -67,6 +74,17 @@ class SolvePlan(NamedTuple):
     o_info: int
     labels: tuple[str, ...]
     rows: np.ndarray | None
+    size: int
+    m: int
+    mu: int
+    reactions: list[str]
+    reaction_index: dict[str, int]
+    fields: dict[str, object]
+    not_unique: dict[bytes, tuple[str, ...]]
+
+
+NOT_UNIQUE_KEPT = 64
+"""Patterns of not-unique reactions a plan keeps (`SolvePlan.not_unique`)."""
 
 
 class Workspace:
@@ -150,11 +168,19 @@ class Workspace:
             model = self.model
             m = len(unknowns.mask)
             N, o_lam, o_info = _core.solve_layout(model.n, m, self.planar)
-            plan = SolvePlan(self.solver(unknowns), N, o_lam, o_info,
-                             unknowns.labels(model.reactions),
-                             model.rows if model.has_particles else None)
+            labels = unknowns.labels(model.reactions)
+            plan = SolvePlan(self.solver(unknowns), N, o_lam, o_info, labels,
+                             model.rows if model.has_particles else None,
+                             o_info + _core.INFO, m, len(unknowns.U), model.reactions,
+                             model.reaction_index, solution_fields(model.coordinates, labels),
+                             {})
             self._plans[unknowns.key] = plan
         return plan
+
+    @cached_property
+    def file_plan(self) -> SolvePlan:
+        """`solve_plan` of `file_unknowns` (a solve without extra known values)."""
+        return self.solve_plan(self.file_unknowns)
 
     def _generic_rank(self, unknowns: Unknowns, solver: _core.Unknowns) -> int:
         """The rank of G_U at the mechanism's generic configurations, decided on its

@@ -461,11 +461,12 @@ static int unknowns_ready(UnknownsObject *self) {
 }
 
 PyDoc_STRVAR(solve_doc,
-"solve(t, y, lam, out)\n\nAccelerations and reactions at (t, y) with the unknown "
+"solve(t, y, lam, out) -> info\n\nAccelerations and reactions at (t, y) with the unknown "
 "components solved; lam (m):\nthe known values (0 on unknown components). out: "
 "solve_layout(n, m, planar)'s\nlength: accelerations (planar [a_x, a_y, alpha], spatial "
 "[a_G world, w' body\naxes] per body), lambda (m, known values in place), G^T v (m), "
-"not-unique flags (m),\ninfo (INFO: slots ST_*).");
+"not-unique flags (m),\ninfo (INFO: slots ST_*). Returns info as a tuple (slots ST_*): the "
+"backward error a\nfloat, the rest ints.");
 
 static PyObject *Unknowns_solve(UnknownsObject *self, PyObject *const *args, Py_ssize_t nargs) {
     Py_buffer y, lam, out;
@@ -488,8 +489,19 @@ static PyObject *Unknowns_solve(UnknownsObject *self, PyObject *const *args, Py_
     mb_solve(md, &self->u, self->w, t, y.buf, lam.buf, out.buf);
     PyBuffer_Release(&y);
     PyBuffer_Release(&lam);
+    /* info again as Python numbers, what the caller reads first (cheaper than a slice's
+     * tolist): the backward error a float, the counts and codes ints (small ones are
+     * Python's shared objects, nothing to allocate) */
+    const double *info = (const double *)out.buf + N + 3 * md->m;
+    PyObject *res = PyTuple_New(MB_INFO);
+    for (int k = 0; res != NULL && k < MB_INFO; k++) {
+        PyObject *v = k == MB_ST_BERR ? PyFloat_FromDouble(info[k])
+                                      : PyLong_FromLongLong((long long)info[k]);
+        if (v == NULL) Py_CLEAR(res);
+        else PyTuple_SET_ITEM(res, k, v);
+    }
     PyBuffer_Release(&out);
-    Py_RETURN_NONE;
+    return res;
 }
 
 PyDoc_STRVAR(set_generic_rank_doc,

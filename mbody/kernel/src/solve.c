@@ -222,52 +222,70 @@ static void solve_again(const mb_model *md, const mb_unknowns *u, mb_work *w,
     minv_all(md, w->rhs, acc);
 }
 
-/* Exactly redundant joints, fast: S factorised with symmetric pivoting on each pivot's
- * share of its diagonal entry; the columns left with less than PIVOT_RTOL are redundant
+/* S's pivoted Cholesky factor, from its lower band S0 (mu x (bw + 1)): symmetric
+ * pivoting on each pivot's share of its diagonal entry (diag), columns whose share is
+ * PIVOT_RTOL or less left out; the factor's columns in pivot order (perm) in the lower
+ * triangle of S (mu x mu): L11 (r x r), then L21 in the rows of the columns left out.
+ * Left-looking: each step forms only the pivot's column, from S0 and the columns before
+ * it, and the remaining diagonal entries (rem) are updated by its squares; only the
+ * factor's rows move with a pivot. Every entry is the same sum, in the same order, as the
+ * outer-product factor of the whole symmetric matrix (the route's first version), so the
+ * numbers are those, for about half its instructions (no trailing update of both
+ * triangles, no swap of whole rows and columns). Returns the rank r. */
+static int64_t pivoted_cholesky(const mb_unknowns *u, const double *S0, double *S,
+                                const double *diag, double *rem, int64_t *perm) {
+    int64_t mu = u->mu, bw = u->bw, W = bw + 1;
+    for (int64_t k = 0; k < mu; k++) perm[k] = k, rem[k] = diag[k];
+    int64_t r = 0;
+    for (int64_t k = 0; k < mu; k++) {
+        int64_t jb = -1;
+        double best = PIVOT_RTOL;
+        for (int64_t j = k; j < mu; j++) {
+            double dj = diag[perm[j]];
+            if (dj > 0.0 && rem[j] > best * dj) jb = j, best = rem[j] / dj;
+        }
+        if (jb < 0) break;
+        if (jb != k) {
+            for (int64_t c = 0; c < k; c++) {
+                double t = S[k * mu + c];
+                S[k * mu + c] = S[jb * mu + c], S[jb * mu + c] = t;
+            }
+            int64_t t = perm[k];
+            perm[k] = perm[jb], perm[jb] = t;
+            double tr = rem[k];
+            rem[k] = rem[jb], rem[jb] = tr;
+        }
+        double d = sqrt(rem[k]);
+        S[k * mu + k] = d;
+        int64_t p = perm[k];
+        const double *Lk = S + k * mu;
+        for (int64_t i = k + 1; i < mu; i++) {
+            int64_t a = perm[i], hi = a > p ? a : p, lo = a > p ? p : a;
+            double s = hi - lo <= bw ? S0[hi * W + hi - lo] : 0.0;
+            double *Li = S + i * mu;
+            for (int64_t c = 0; c < k; c++) s -= Li[c] * Lk[c];
+            Li[k] = s / d;
+            rem[i] -= Li[k] * Li[k];
+        }
+        r++;
+    }
+    return r;
+}
+
+/* Exactly redundant joints, fast: S factorised with symmetric pivoting
+ * (pivoted_cholesky); the columns left with less than PIVOT_RTOL are redundant
  * if G_U's columns themselves are combinations x_j of the kept ones. Then lam on the
  * kept columns, the minimum-norm lam through the null space [-X; I], and the not-unique
  * flags. w->lamU holds gam - G_U^T M^-1 r on entry. Returns the rank, or -1 (the
  * null-space route takes over). S0: S's lower band before factorisation. */
 static int64_t redundant(const mb_model *md, const mb_unknowns *u, mb_work *w) {
-    int64_t n = md->n, mu = u->mu, bw = u->bw, W = bw + 1;
+    int64_t n = md->n, mu = u->mu, W = u->bw + 1;
     if (mb_ensure_dense(w)) return -1;
     mb_dense *dn = w->dense;
     double *S = dn->S, *diag = dn->diag, *X = dn->X;
     int64_t *perm = dn->perm;
-    memset(S, 0, sizeof(double) * mu * mu);
-    for (int64_t i = 0; i < mu; i++)
-        for (int64_t j = i - bw > 0 ? i - bw : 0; j <= i; j++)
-            S[i * mu + j] = S[j * mu + i] = w->S0[i * W + i - j];
-    for (int64_t k = 0; k < mu; k++) diag[k] = S[k * mu + k], perm[k] = k;
-    int64_t r = 0;
-    for (int64_t k = 0; k < mu; k++) { /* outer-product Cholesky, symmetric pivoting */
-        int64_t jb = -1;
-        double best = PIVOT_RTOL;
-        for (int64_t j = k; j < mu; j++) {
-            double dj = diag[perm[j]];
-            if (dj > 0.0 && S[j * mu + j] > best * dj) jb = j, best = S[j * mu + j] / dj;
-        }
-        if (jb < 0) break;
-        if (jb != k) {
-            for (int64_t c = 0; c < mu; c++) {
-                double t = S[k * mu + c];
-                S[k * mu + c] = S[jb * mu + c], S[jb * mu + c] = t;
-            }
-            for (int64_t c = 0; c < mu; c++) {
-                double t = S[c * mu + k];
-                S[c * mu + k] = S[c * mu + jb], S[c * mu + jb] = t;
-            }
-            int64_t t = perm[k];
-            perm[k] = perm[jb], perm[jb] = t;
-        }
-        double d = sqrt(S[k * mu + k]);
-        S[k * mu + k] = d;
-        for (int64_t i = k + 1; i < mu; i++) S[i * mu + k] /= d;
-        for (int64_t i = k + 1; i < mu; i++) S[k * mu + i] = S[i * mu + k];
-        for (int64_t j = k + 1; j < mu; j++)
-            for (int64_t i = k + 1; i < mu; i++) S[i * mu + j] -= S[i * mu + k] * S[j * mu + k];
-        r++;
-    }
+    for (int64_t k = 0; k < mu; k++) diag[k] = w->S0[k * W];
+    int64_t r = pivoted_cholesky(u, w->S0, S, diag, dn->rhs, perm); /* rhs: scratch here */
     if (r == mu || r == 0) return -1;
     int64_t nd = mu - r;
     /* X (r x nd): L11^T X = L21^T, the kept columns' combinations for the dropped ones */
