@@ -29,10 +29,12 @@ evaluates f at all of them in one call, kernel.h: ``mb_linearize``).
 
 from __future__ import annotations
 
+import functools
 import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import NamedTuple
 
 import numpy as np
 
@@ -56,6 +58,17 @@ STEADY_RTOL = 1e-8
 that make it (`Generalized.f_scale`)."""
 MOVING_RTOL = 1e-12
 """A coordinate moves when its rate exceeds this fraction of the rates' scale."""
+
+def _mode(eigenvalue: complex, kind: str, frequency: float, damping_ratio: float,
+          shape: np.ndarray) -> Mode:
+    """`Mode(...)`, made without the frozen dataclass's __init__ (an object.__setattr__ per
+    field); equal to one made the usual way."""
+    obj = object.__new__(Mode)
+    object.__setattr__(obj, "__dict__", {"eigenvalue": eigenvalue, "kind": kind,
+                                         "frequency": frequency, "damping_ratio": damping_ratio,
+                                         "shape": shape})
+    return obj
+
 
 _KINDS = {_core.MODE_NEUTRAL: "neutral", _core.MODE_OSCILLATION: "oscillation",
           _core.MODE_GROWTH: "growth", _core.MODE_DECAY: "decay"}
@@ -102,11 +115,44 @@ class Mode:
         return 2.0 * np.pi / w if w > 0 else float("inf")
 
 
+class _Offsets(NamedTuple):
+    """Where each part of `mb_linearize`'s output starts, for N columns and k
+    coordinates (kernel.h)."""
+
+    k: int
+    ngen: int      # the generalized equations' part ends
+    M: int         # M_q (k x k) in it
+    qdot: int      # q' (k) in it
+    diffs: int     # K, K_err, D, D_err (4 k^2)
+    resid: int     # q'' (k), then the left-out flags (k), then A's slot (4 k^2)
+    info: int
+    spectrum: int
+    modes: int
+    end: int
+
+
+@functools.lru_cache(maxsize=256)
+def _offsets(N: int, k: int) -> _Offsets:
+    gl = layout(N, k)
+    kk = k * k
+    resid = gl[-1] + 4 * kk
+    info = resid + 2 * k + 4 * kk
+    spectrum = info + _core.LINEARIZE_INFO
+    modes = spectrum + 6 * k + 8 * kk
+    return _Offsets(k, gl[-1], gl[3], gl[6], gl[-1], resid, info, spectrum, modes,
+                    modes + 12 * k + 4 * kk)
+
+
 @dataclass(frozen=True, eq=False)
 class Linearization:
     """``M δq'' + D δq' + K δq = 0`` about a state (module doc).
 
-    Parameters
+    The compiled core computes it all in one call (kernel.h: ``mb_linearize``): the
+    equations there (`generalized`), the differences, A, its spectrum (``mb_spectrum``:
+    each eigenvalue's bound from its own left and right vectors) and its modes
+    (``mb_modes``). The attributes are views of that output, made when first read.
+
+    Attributes
     ----------
     model, state : Model, State
         The model and the state linearised about.
@@ -140,39 +186,96 @@ class Linearization:
         ‖δA‖, the bound on A's error (in A's units).
     warnings : tuple of str
         Why the state is not steady, and anything else worth saying.
-
-    The compiled core computes it all in one call (kernel.h: ``mb_linearize``): the
-    equations there (`generalized`, made on first use), the differences, A, its spectrum
-    (``mb_spectrum``: each eigenvalue's bound from its own left and right vectors) and
-    its modes (``mb_modes``); the private fields are views of that output.
     """
 
     model: Model
     state: State
     coordinate_set: CoordinateSet
-    M: np.ndarray
-    D: np.ndarray
-    K: np.ndarray
-    K_error: np.ndarray
-    D_error: np.ndarray
-    residual: np.ndarray
-    steady: bool
-    left_out: tuple[str, ...]
-    kept: np.ndarray
-    A: np.ndarray
-    tolerance: float
-    dA: float = 0.0
-    warnings: tuple[str, ...] = field(default_factory=tuple)
-    _generalized_out: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
-    _spectrum_out: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
-    _modes_out: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
-    _mode_count: int = 0
-    _growing: int = 0
+    warnings: tuple[str, ...]
+    _out: np.ndarray = field(repr=False)
+    _at: _Offsets = field(repr=False)
+    _info: list[float] = field(repr=False)
+
+    @property
+    def steady(self) -> bool:
+        return bool(self._info[_core.LI_STEADY])
+
+    @property
+    def tolerance(self) -> float:
+        return self._info[_core.LI_TOL]
+
+    @property
+    def dA(self) -> float:
+        return self._info[_core.LI_DA]
+
+    @cached_property
+    def M(self) -> np.ndarray:
+        k = self._at.k
+        return self._out[self._at.M:self._at.M + k * k].reshape(k, k)
+
+    @cached_property
+    def _differences(self) -> np.ndarray:
+        k = self._at.k
+        return self._out[self._at.diffs:self._at.diffs + 4 * k * k].reshape(4, k, k)
+
+    @property
+    def K(self) -> np.ndarray:
+        return self._differences[0]
+
+    @property
+    def K_error(self) -> np.ndarray:
+        return self._differences[1]
+
+    @property
+    def D(self) -> np.ndarray:
+        return self._differences[2]
+
+    @property
+    def D_error(self) -> np.ndarray:
+        return self._differences[3]
+
+    @cached_property
+    def residual(self) -> np.ndarray:
+        return self._out[self._at.resid:self._at.resid + self._at.k]
+
+    @cached_property
+    def _left(self) -> np.ndarray:
+        k, at = self._at.k, self._at.resid + self._at.k
+        return self._out[at:at + k] > 0
+
+    @cached_property
+    def left_out(self) -> tuple[str, ...]:
+        labels = self.coordinate_set.labels
+        return tuple(labels[i] for i in np.flatnonzero(self._left))
+
+    @cached_property
+    def kept(self) -> np.ndarray:
+        return np.flatnonzero(~self._left)
+
+    @property
+    def _nz(self) -> int:
+        return int(self._info[_core.LI_KEPT]) + self._at.k
+
+    @cached_property
+    def A(self) -> np.ndarray:
+        nz, at = self._nz, self._at.resid + 2 * self._at.k
+        return self._out[at:at + nz * nz].reshape(nz, nz)
+
+    @cached_property
+    def _spectrum_out(self) -> np.ndarray:
+        nz = self._nz
+        return self._out[self._at.spectrum:self._at.spectrum + 3 * nz + 2 * nz * nz]
+
+    @cached_property
+    def _modes_out(self) -> np.ndarray:
+        nz = self._nz
+        return self._out[self._at.modes:self._at.modes + _core.MODE_W * nz + 2 * nz * self._at.k]
 
     @cached_property
     def generalized(self) -> Generalized:
         """The equations in generalized coordinates there (the driven coordinates held)."""
-        return from_output(self.model, self.state, self.coordinate_set, self._generalized_out)
+        return from_output(self.model, self.state, self.coordinate_set,
+                           self._out[:self._at.ngen])
 
     @property
     def coordinates(self) -> list[str]:
@@ -205,18 +308,20 @@ class Linearization:
         """The modes: oscillations (one per complex pair), growths, decays and neutral
         ones (λ = 0: a free or cyclic motion), neutral first, then by |λ| (kernel.h:
         ``mb_modes``)."""
-        m, n, k = self._mode_count, len(self.A), len(self.coordinates)
+        m, n, k = int(self._info[_core.LI_MODES]), self._nz, self._at.k
         rows = self._mode_rows.tolist()
         start = _core.MODE_W * n
         shapes = self._modes_out[start:start + 2 * m * k].view(complex).reshape(m, k)
-        return [Mode(complex(r[_core.MODE_RE], r[_core.MODE_IM]), _KINDS[int(r[_core.MODE_KIND])],
-                     r[_core.MODE_FREQUENCY], r[_core.MODE_DAMPING], shapes[c])
+        return [_mode(complex(r[_core.MODE_RE], r[_core.MODE_IM]),
+                      _KINDS[int(r[_core.MODE_KIND])], r[_core.MODE_FREQUENCY],
+                      r[_core.MODE_DAMPING], shapes[c])
                 for c, r in enumerate(rows)]
 
     @property
     def _mode_rows(self) -> np.ndarray:
         """(modes, MODE_W): the modes' rows from the core, in `modes`' order."""
-        return self._modes_out[:_core.MODE_W * self._mode_count].reshape(-1, _core.MODE_W)
+        m = int(self._info[_core.LI_MODES])
+        return self._modes_out[:_core.MODE_W * m].reshape(m, _core.MODE_W)
 
     @property
     def oscillations(self) -> list[Mode]:
@@ -251,7 +356,7 @@ class Linearization:
         motion, a cyclic coordinate — do not count); None when the state is not steady."""
         if not self.steady:
             return None
-        return self._growing == 0
+        return self._info[_core.LI_GROWING] == 0
 
     @cached_property
     def K_geometric(self) -> np.ndarray:
@@ -342,52 +447,32 @@ def linearize(model: Model, state: State | None = None, *,
     """
     state = model.initial if state is None else state
     cs = free_coordinates(model, coordinates)
-    k, N = len(cs), len(cs.cols)
-    gl = layout(N, k)
-    ngen, kk = gl[-1], k * k
-    o = ngen + 4 * kk  # q'', then left out, A and info
-    o_info = o + 2 * k + 4 * kk
-    o_spec = o_info + _core.LINEARIZE_INFO
-    o_modes = o_spec + 6 * k + 8 * kk
-    out = np.empty(o_modes + 12 * k + 4 * kk)
+    at = _offsets(len(cs.cols), len(cs))
+    out = np.empty(at.end)
     ws = workspace(model)
     ws.solver(cs.held).linearize(float(state.t), ws.pack_state(state), cs.held.lam, cs.Iq,
                                  cs.cols, cs.scales, cs.quasi_int, _skip(model, cs),
                                  _PARAMS, out)
-    gen = out[:ngen]
-    _, _, gen_warnings = checked(model, state, cs, gen)
-    info = out[o_info:o_spec].tolist()
+    _, _, warnings = checked(model, state, cs, out[:at.ngen])
+    info = out[at.info:at.spectrum].tolist()
     if info[_core.LI_SINGULAR]:
         raise MbodyError(f"the generalized mass of '{model.name}' is not positive definite "
                          "at this state: a motion of the coordinates carries no mass")
     if info[_core.LI_UNCONVERGED]:
         raise MbodyError(f"the eigenvalues of '{model.name}'s linearisation did not converge "
                          "(the QR iteration's limit)")
-    K, K_err, D, D_err = out[ngen:o].reshape(4, k, k)
-    residual = out[o:o + k]
-    left = (out[o + k:o + 2 * k] > 0).tolist()
-    nz = int(info[_core.LI_KEPT]) + k
-    A = out[o + 2 * k:o + 2 * k + nz * nz].reshape(nz, nz)
-    warnings = list(gen_warnings)
-    labels = cs.labels
     if not info[_core.LI_RESTING]:
+        residual = out[at.resid:at.resid + at.k]
         worst = int(np.argmax(np.abs(residual)))
-        warnings.append(f"not an equilibrium or a steady motion: the generalized "
-                        f"accelerations here are not 0 ({labels[worst]}'' = "
-                        f"{residual[worst]:.4g} {cs.items[worst].unit}/s^2); the eigenvalues "
-                        "are those of the tangent system at this instant")
+        warnings += (f"not an equilibrium or a steady motion: the generalized "
+                     f"accelerations here are not 0 ({cs.labels[worst]}'' = "
+                     f"{residual[worst]:.4g} {cs.items[worst].unit}/s^2); the eigenvalues "
+                     "are those of the tangent system at this instant",)
     j = int(info[_core.LI_UNSTEADY]) - 1
     if j >= 0:
-        warnings.append(f"not a steady motion: {labels[j]} moves ({gen[gl[6] + j]:.4g} "
-                        f"{cs.items[j].rate_unit}) and the forces depend on it")
-    return Linearization(model, state, cs, gen[gl[3]:gl[4]].reshape(k, k), D, K, K_err, D_err,
-                         residual, bool(info[_core.LI_STEADY]),
-                         tuple(c for c, out_ in zip(labels, left, strict=True) if out_),
-                         np.array([i for i, out_ in enumerate(left) if not out_], np.int64),
-                         A, info[_core.LI_TOL], info[_core.LI_DA], tuple(warnings), gen,
-                         out[o_spec:o_spec + 3 * nz + 2 * nz * nz],
-                         out[o_modes:o_modes + _core.MODE_W * nz + 2 * nz * k],
-                         int(info[_core.LI_MODES]), int(info[_core.LI_GROWING]))
+        warnings += (f"not a steady motion: {cs.labels[j]} moves ({out[at.qdot + j]:.4g} "
+                     f"{cs.items[j].rate_unit}) and the forces depend on it",)
+    return Linearization(model, state, cs, warnings, out, at, info)
 
 
 def loads_stiffness(lin: Linearization) -> np.ndarray:
