@@ -128,6 +128,7 @@ class _Offsets(NamedTuple):
     info: int
     spectrum: int
     modes: int
+    oscillations: int  # their frequencies, then their damping ratios
     end: int
 
 
@@ -139,8 +140,9 @@ def _offsets(N: int, k: int) -> _Offsets:
     info = resid + 2 * k + 4 * kk
     spectrum = info + _core.LINEARIZE_INFO
     modes = spectrum + 6 * k + 8 * kk
+    oscillations = modes + 12 * k + 4 * kk
     return _Offsets(k, gl[-1], gl[3], gl[6], gl[-1], resid, info, spectrum, modes,
-                    modes + 12 * k + 4 * kk)
+                    oscillations, oscillations + 4 * k)
 
 
 @dataclass(frozen=True, eq=False)
@@ -328,16 +330,11 @@ class Linearization:
         """The oscillatory modes, by natural frequency."""
         return [m for m in self.modes if m.kind == "oscillation"]
 
-    @cached_property
-    def _oscillating(self) -> np.ndarray:
-        """The oscillations' rows of `_mode_rows` (by |λ|)."""
-        rows = self._mode_rows
-        return rows[rows[:, _core.MODE_KIND] == _core.MODE_OSCILLATION]
-
     @property
     def frequencies(self) -> np.ndarray:
         """The natural frequencies |λ| of the oscillations (rad/s), ascending."""
-        return self._oscillating[:, _core.MODE_FREQUENCY]
+        count, at = int(self._info[_core.LI_OSCILLATIONS]), self._at.oscillations
+        return self._out[at:at + count]
 
     @property
     def frequencies_hz(self) -> np.ndarray:
@@ -347,7 +344,8 @@ class Linearization:
     @property
     def damping_ratios(self) -> np.ndarray:
         """ζ of each oscillation, in the order of `frequencies`."""
-        return self._oscillating[:, _core.MODE_DAMPING]
+        count, at = int(self._info[_core.LI_OSCILLATIONS]), self._at.oscillations
+        return self._out[at + count:at + 2 * count]
 
     @property
     def stable(self) -> bool | None:

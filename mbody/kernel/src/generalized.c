@@ -631,77 +631,110 @@ int mb_coordinate_rows(const mb_model *md, mb_work *w, double t, const double *y
     return 0;
 }
 
+/* f at y0's positions moved by +-scale h_j along coordinate j, for each j with want[j]:
+ * into fl + (3 j + level) 2 nq (the + step's f, then the - step's). */
+static int steps_at(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
+                    const double *y0, const double *lam, int64_t nq, const int64_t *Iq,
+                    int64_t nc, const int64_t *cols, const double *qdot0, const double *h,
+                    const int *want, int level, double scale, double *fl) {
+    int64_t count = 0, n2 = 2 * nq;
+    for (int64_t j = 0; j < nq; j++) count += want[j] ? 1 : 0;
+    if (count == 0) return 0;
+    double *P = calloc((size_t)(2 * count * n2 + 2 * count * nq), sizeof(double));
+    if (P == NULL) return -1;
+    double *f = P + 2 * count * n2;
+    int64_t row = 0;
+    for (int64_t j = 0; j < nq; j++) {
+        if (!want[j]) continue;
+        P[row * n2 + j] = scale * h[j];
+        P[(row + 1) * n2 + j] = -scale * h[j];
+        row += 2;
+    }
+    int status = mb_generalized_perturbed(md, u, w, t, y0, lam, nq, Iq, nc, cols, qdot0,
+                                          2 * count, P, f);
+    row = 0;
+    for (int64_t j = 0; j < nq && status == 0; j++) {
+        if (!want[j]) continue;
+        memcpy(fl + (3 * j + level) * n2, f + row * nq, sizeof(double) * (size_t)n2);
+        row += 2;
+    }
+    free(P);
+    return status;
+}
+
 int mb_differences(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
                    const double *y0, const double *lam, int64_t nq, const int64_t *Iq,
                    int64_t nc, const int64_t *cols, const double *qdot0, const double *h,
-                   const double *hu, const double *fscale, double rounding,
+                   const double *hu, const double *fscale, const double *f0, double rounding,
                    const int64_t *skip, double *out) {
-    int64_t moved = 0, n2 = 2 * nq;
-    for (int64_t j = 0; j < nq; j++) moved += skip[j] ? 0 : 1;
-    /* first pass: steps +-h, +-h/2 of every moved coordinate, then the rates' (they reuse
-     * one factorisation); second pass: +-h/4 of the coordinates that need it */
-    int64_t np1 = 4 * moved + 2 * nq, np2 = 2 * moved;
-    double *P = calloc((size_t)(np1 * n2 + np1 * nq + np2 * n2 + np2 * nq + 1), sizeof(double));
-    int64_t *third = malloc(sizeof(int64_t) * (size_t)(nq > 0 ? nq : 1));
-    if (P == NULL || third == NULL) {
-        free(P), free(third);
+    int64_t n2 = 2 * nq, nq1 = nq > 0 ? nq : 1;
+    /* f at +-h (the rates' rows too: they reuse one factorisation), then +-h/2 where the
+     * +-h ones are not flat, then +-h/4 where the differences at h and h/2 disagree */
+    double *fl = calloc((size_t)(3 * nq1 * n2 + n2 * nq1 + n2 * n2 + 1), sizeof(double));
+    int *want = calloc((size_t)(3 * nq1), sizeof(int));
+    if (fl == NULL || want == NULL) {
+        free(fl), free(want);
         return -1;
     }
-    double *f = P + np1 * n2, *P2 = f + np1 * nq, *f2 = P2 + np2 * n2;
-    static const double step[4] = {1.0, -1.0, 0.5, -0.5};
-    int64_t row = 0;
+    double *fu = fl + 3 * nq * n2, *P = fu + n2 * nq;
+    int *flat = want + nq1, *third = flat + nq1;
     for (int64_t j = 0; j < nq; j++) {
-        if (skip[j]) continue;
-        for (int s = 0; s < 4; s++) P[(row + s) * n2 + j] = step[s] * h[j];
-        row += 4;
+        P[(2 * j) * n2 + nq + j] = hu[j];
+        P[(2 * j + 1) * n2 + nq + j] = -hu[j];
+        want[j] = !skip[j];
     }
-    for (int64_t j = 0; j < nq; j++) {
-        P[(row + 2 * j) * n2 + nq + j] = hu[j];
-        P[(row + 2 * j + 1) * n2 + nq + j] = -hu[j];
-    }
-    int status = mb_generalized_perturbed(md, u, w, t, y0, lam, nq, Iq, nc, cols, qdot0, np1,
-                                          P, f);
-    double *K = out, *Kerr = K + nq * nq, *D = Kerr + nq * nq, *Derr = D + nq * nq;
-    /* a column whose two differences agree within their rounding has nothing left for a
-     * third step to extrapolate away (a coordinate the forces do not depend on, or depend
-     * on linearly): it stops at one extrapolation */
-    int64_t n3 = 0;
-    row = 0;
+    int status = nq > 0 ? mb_generalized_perturbed(md, u, w, t, y0, lam, nq, Iq, nc, cols,
+                                                   qdot0, 2 * nq, P, fu) : 0;
+    if (status == 0) status = steps_at(md, u, w, t, y0, lam, nq, Iq, nc, cols, qdot0, h, want,
+                                       0, 1.0, fl);
+    /* flat: f at +-h equals f at the state within one evaluation's rounding in every row
+     * (a coordinate the forces do not depend on: a body's position under uniform
+     * gravity, a cyclic spin); its column is its central difference */
     for (int64_t j = 0; j < nq && status == 0; j++) {
-        third[j] = -1;
-        if (skip[j]) continue;
-        const double *fj = f + row * nq;
-        int need = 0;
-        for (int64_t i = 0; i < nq && !need; i++) {
+        flat[j] = 0;
+        if (skip[j] || f0 == NULL) continue;
+        const double *fp = fl + 3 * j * n2, *fm = fp + nq;
+        int same = 1;
+        for (int64_t i = 0; i < nq && same; i++) {
+            double tol = 4.0 * rounding * fscale[i];
+            same = fabs(fp[i] - f0[i]) <= tol && fabs(fm[i] - f0[i]) <= tol;
+        }
+        flat[j] = same;
+        want[j] = !skip[j] && !same;
+    }
+    if (status == 0) status = steps_at(md, u, w, t, y0, lam, nq, Iq, nc, cols, qdot0, h, want,
+                                       1, 0.5, fl);
+    /* a column whose two differences agree within their rounding has nothing left for a
+     * third step to extrapolate away (a coordinate the forces depend on linearly): it
+     * stops at one extrapolation */
+    for (int64_t j = 0; j < nq && status == 0; j++) {
+        third[j] = 0;
+        if (!want[j]) continue;
+        const double *fj = fl + 3 * j * n2;
+        for (int64_t i = 0; i < nq && !third[j]; i++) {
             double d0 = (fj[i] - fj[nq + i]) / (2.0 * h[j]);
             double d1 = (fj[2 * nq + i] - fj[3 * nq + i]) / (1.0 * h[j]);
-            need = !(fabs(d0 - d1) <= 4.0 * rounding * fscale[i] / (0.25 * h[j]));
+            third[j] = !(fabs(d0 - d1) <= 4.0 * rounding * fscale[i] / (0.25 * h[j]));
         }
-        if (need) {
-            third[j] = n3;
-            P2[(2 * n3) * n2 + j] = 0.25 * h[j];
-            P2[(2 * n3 + 1) * n2 + j] = -0.25 * h[j];
-            n3++;
-        }
-        row += 4;
     }
-    if (status == 0 && n3 > 0)
-        status = mb_generalized_perturbed(md, u, w, t, y0, lam, nq, Iq, nc, cols, qdot0,
-                                          2 * n3, P2, f2);
-    row = 0;
+    if (status == 0) status = steps_at(md, u, w, t, y0, lam, nq, Iq, nc, cols, qdot0, h, third,
+                                       2, 0.25, fl);
+    double *K = out, *Kerr = K + nq * nq, *D = Kerr + nq * nq, *Derr = D + nq * nq;
     for (int64_t j = 0; j < nq && status == 0; j++) {
-        const double *fj = f + row * nq, *fu = f + (4 * moved + 2 * j) * nq;
-        const double *f3 = third[j] >= 0 ? f2 + 2 * third[j] * nq : NULL;
+        const double *fj = fl + 3 * j * n2, *fr = fu + 2 * j * nq;
         for (int64_t i = 0; i < nq; i++) {
             double round_err = 4.0 * rounding * fscale[i] / (0.25 * h[j]);
+            double d0 = (fj[0 * nq + i] - fj[1 * nq + i]) / (2.0 * h[j]);
             if (skip[j]) {
                 K[i * nq + j] = Kerr[i * nq + j] = 0.0;
+            } else if (flat[j]) {
+                K[i * nq + j] = -d0;
+                Kerr[i * nq + j] = fabs(d0) + round_err;
             } else {
-                double d0 = (fj[0 * nq + i] - fj[1 * nq + i]) / (2.0 * h[j]);
                 double d1 = (fj[2 * nq + i] - fj[3 * nq + i]) / (1.0 * h[j]);
                 double r1 = (4.0 * d1 - d0) / 3.0;
-                if (f3 != NULL) {
-                    double d2 = (f3[i] - f3[nq + i]) / (0.5 * h[j]);
+                if (third[j]) {
+                    double d2 = (fj[4 * nq + i] - fj[5 * nq + i]) / (0.5 * h[j]);
                     double r2 = (4.0 * d2 - d1) / 3.0;
                     K[i * nq + j] = -(16.0 * r2 - r1) / 15.0;
                     Kerr[i * nq + j] = fabs(r1 - r2) / 15.0 + round_err;
@@ -710,12 +743,11 @@ int mb_differences(const mb_model *md, const mb_unknowns *u, mb_work *w, double 
                     Kerr[i * nq + j] = fabs(d0 - d1) + round_err;
                 }
             }
-            D[i * nq + j] = -(fu[i] - fu[nq + i]) / (2.0 * hu[j]);
-            double big = fmax(fscale[i], fmax(fabs(fu[i]), fabs(fu[nq + i])));
+            D[i * nq + j] = -(fr[i] - fr[nq + i]) / (2.0 * hu[j]);
+            double big = fmax(fscale[i], fmax(fabs(fr[i]), fabs(fr[nq + i])));
             Derr[i * nq + j] = 4.0 * rounding * big / hu[j];
         }
-        if (!skip[j]) row += 4;
     }
-    free(P), free(third);
+    free(fl), free(want);
     return status;
 }

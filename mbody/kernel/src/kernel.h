@@ -319,7 +319,10 @@ int mb_generalized_perturbed(const mb_model *md, const mb_unknowns *u, mb_work *
  * steps h, h/2, h/4 per coordinate (h: nq) extrapolated twice (Richardson, O(h^6)), with the
  * error bound |R1 - R2| / 15 + 4 rounding fscale_i / (h_j / 4); a column whose differences
  * at h and h/2 (d0, d1) agree within that rounding term in every row stops at R1, bound
- * |d0 - d1| + the rounding term (no step h/4); D = -df_q/dq' by one central
+ * |d0 - d1| + the rounding term (no step h/4); with f0 (f at y0; NULL: no such test), a
+ * column whose f at +-h equals f0 within 4 rounding fscale_i in every row (flat: a
+ * coordinate the forces do not depend on) is its difference d0, bound |d0| + the
+ * rounding term (no step h/2 either); D = -df_q/dq' by one central
  * difference at steps hu (exact for f quadratic in q'), error 4 rounding max|f| / hu.
  * A coordinate with skip[j] != 0 is known not to enter f (a free body's position without
  * springs...): its K column is 0 without evaluations.
@@ -328,7 +331,7 @@ int mb_generalized_perturbed(const mb_model *md, const mb_unknowns *u, mb_work *
 int mb_differences(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
                    const double *y0, const double *lam, int64_t nq, const int64_t *Iq,
                    int64_t nc, const int64_t *cols, const double *qdot0, const double *h,
-                   const double *hu, const double *fscale, double rounding,
+                   const double *hu, const double *fscale, const double *f0, double rounding,
                    const int64_t *skip, double *out);
 /* The linearisation about (t, y) (linearize.c): mb_generalized there, mb_differences with
  * steps params[MB_LP_STEP] x scales (positions) and the rates' scale (rates), the residual
@@ -345,13 +348,15 @@ int mb_differences(const mb_model *md, const mb_unknowns *u, mb_work *w, double 
  * (GROWING) and the modes (mb_modes, MODES of them). out: [mb_generalized's out |
  * K | K_err | D | D_err (nq x nq each) | q'' (nq) | left out (nq, 0/1) | A (nz x nz in a
  * slot of (2 nq)^2) | info (MB_LINEARIZE_INFO) | spectrum (of nz, in a slot of
- * 6 nq + 8 nq^2) | modes (of nz, in a slot of 12 nq + 4 nq^2)], nz = kept + nq. Returns
+ * 6 nq + 8 nq^2) | modes (of nz, in a slot of 12 nq + 4 nq^2) | the OSCILLATIONS modes'
+ * frequencies, then their damping ratios (in a slot of 4 nq)], nz = kept + nq. Returns
  * 0, or -1 when memory ran out. */
 enum { MB_LP_STEP = 0, MB_LP_ROUNDING = 1, MB_LP_STEADY = 2, MB_LP_MOVING = 3,
        MB_LINEARIZE_PARAMS = 4 };
 enum { MB_LI_STEADY = 0, MB_LI_UNSTEADY = 1, MB_LI_TOL = 2, MB_LI_KEPT = 3,
        MB_LI_SINGULAR = 4, MB_LI_DA = 5, MB_LI_NORM = 6, MB_LI_RESTING = 7,
-       MB_LI_GROWING = 8, MB_LI_MODES = 9, MB_LI_UNCONVERGED = 10, MB_LINEARIZE_INFO = 11 };
+       MB_LI_GROWING = 8, MB_LI_MODES = 9, MB_LI_UNCONVERGED = 10, MB_LI_OSCILLATIONS = 11,
+       MB_LINEARIZE_INFO = 12 };
 int mb_linearize(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
                  const double *y, const double *lam, int64_t nq, const int64_t *Iq,
                  int64_t nc, const int64_t *cols, const double *scales, const int64_t *quasi,

@@ -66,8 +66,8 @@ int mb_linearize(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
      * QR: its pivot ratio bounds the condition from below; the factor is what its
      * backward stability allows) */
     rounding /= fmax(ginfo[MB_GI_RANK], 1e-8);
-    if (mb_differences(md, u, w, t, y, lam, nq, Iq, nc, cols, qd, h, hu, F, rounding, skip,
-                       K) < 0) {
+    if (mb_differences(md, u, w, t, y, lam, nq, Iq, nc, cols, qd, h, hu, F, f, rounding,
+                       skip, K) < 0) {
         free(buf);
         return -1;
     }
@@ -162,5 +162,16 @@ int mb_linearize(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
     free(buf);
     if (m < 0) return -1;
     info[MB_LI_MODES] = (double)m;
+    /* the oscillations' frequencies, then their damping ratios, in the modes' order */
+    double *osc = modes + 12 * k + 4 * kk;
+    int64_t count = 0;
+    for (int64_t c = 0; c < m; c++)
+        if (modes[MB_MODE_W * c + MB_MODE_KIND] == MB_MODE_OSCILLATION) count++;
+    for (int64_t c = 0, i = 0; c < m; c++) {
+        const double *row = modes + MB_MODE_W * c;
+        if (row[MB_MODE_KIND] != MB_MODE_OSCILLATION) continue;
+        osc[i] = row[MB_MODE_FREQUENCY], osc[count + i] = row[MB_MODE_DAMPING], i++;
+    }
+    info[MB_LI_OSCILLATIONS] = (double)count;
     return 0;
 }

@@ -892,8 +892,8 @@ static PyObject *Unknowns_differences(UnknownsObject *self, PyObject *const *arg
     int status = 0;
     if (ok) {
         status = mb_differences(md, &self->u, self->w, t, y.buf, lam.buf, nq, Iq.buf, N,
-                                cols.buf, v[0].buf, v[1].buf, v[2].buf, v[3].buf, rounding,
-                                skip.buf, out.buf);
+                                cols.buf, v[0].buf, v[1].buf, v[2].buf, v[3].buf, NULL,
+                                rounding, skip.buf, out.buf);
         PyBuffer_Release(&out);
     }
     if (have_skip) PyBuffer_Release(&skip);
@@ -939,7 +939,7 @@ static PyObject *Unknowns_linearize(UnknownsObject *self, PyObject *const *args,
     if (stage == 3 && get_buffer(args[8], &params, 0, 1, MB_LINEARIZE_PARAMS, "params") == 0)
         stage = 4;
     Py_ssize_t size = N * nq + 2 * N + nq * nq + 4 * nq + MB_GENERALIZED_INFO + 4 * nq * nq +
-                      2 * nq + 4 * nq * nq + MB_LINEARIZE_INFO + 18 * nq + 12 * nq * nq;
+                      2 * nq + 4 * nq * nq + MB_LINEARIZE_INFO + 22 * nq + 12 * nq * nq;
     if (stage == 4 && get_buffer(args[9], &out, 1, 1, size, "out") == 0) stage = 5;
     if (stage == 5) {
         status = mb_linearize(md, &self->u, self->w, t, y.buf, lam.buf, nq, Iq.buf, N, cols.buf,
@@ -1484,7 +1484,7 @@ PyMODINIT_FUNC PyInit__core(void) {
         {"LI_KEPT", MB_LI_KEPT}, {"LI_SINGULAR", MB_LI_SINGULAR}, {"LI_DA", MB_LI_DA},
         {"LI_NORM", MB_LI_NORM}, {"LI_RESTING", MB_LI_RESTING},
         {"LI_GROWING", MB_LI_GROWING}, {"LI_MODES", MB_LI_MODES},
-        {"LI_UNCONVERGED", MB_LI_UNCONVERGED},
+        {"LI_UNCONVERGED", MB_LI_UNCONVERGED}, {"LI_OSCILLATIONS", MB_LI_OSCILLATIONS},
         {"MODE_INDEX", MB_MODE_INDEX}, {"MODE_KIND", MB_MODE_KIND}, {"MODE_RE", MB_MODE_RE},
         {"MODE_IM", MB_MODE_IM}, {"MODE_FREQUENCY", MB_MODE_FREQUENCY},
         {"MODE_DAMPING", MB_MODE_DAMPING}, {"MODE_W", MB_MODE_W},
