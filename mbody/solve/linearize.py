@@ -70,6 +70,10 @@ def _mode(eigenvalue: complex, kind: str, frequency: float, damping_ratio: float
     return obj
 
 
+_ROW = (_core.MODE_RE, _core.MODE_IM, _core.MODE_KIND, _core.MODE_FREQUENCY,
+        _core.MODE_DAMPING)
+"""Where a mode's eigenvalue (re, im), kind, frequency and damping ratio are in its row."""
+
 _KINDS = {_core.MODE_NEUTRAL: "neutral", _core.MODE_OSCILLATION: "oscillation",
           _core.MODE_GROWTH: "growth", _core.MODE_DECAY: "decay"}
 
@@ -311,13 +315,11 @@ class Linearization:
         ones (λ = 0: a free or cyclic motion), neutral first, then by |λ| (kernel.h:
         ``mb_modes``)."""
         m, n, k = int(self._info[_core.LI_MODES]), self._nz, self._at.k
-        rows = self._mode_rows.tolist()
         start = _core.MODE_W * n
         shapes = self._modes_out[start:start + 2 * m * k].view(complex).reshape(m, k)
-        return [_mode(complex(r[_core.MODE_RE], r[_core.MODE_IM]),
-                      _KINDS[int(r[_core.MODE_KIND])], r[_core.MODE_FREQUENCY],
-                      r[_core.MODE_DAMPING], shapes[c])
-                for c, r in enumerate(rows)]
+        re, im, kind, freq, damp = _ROW
+        return [_mode(complex(r[re], r[im]), _KINDS[r[kind]], r[freq], r[damp], shape)
+                for r, shape in zip(self._mode_rows.tolist(), shapes, strict=True)]
 
     @property
     def _mode_rows(self) -> np.ndarray:
