@@ -49,7 +49,7 @@ def gamma(model: Model, state: State, cols: ReactionColumns,
     return cols.gamma
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # no generated ==: its fields are arrays
 class ConstraintJacobian:
     """The velocity-level constraint Jacobian of the joints, Φ_v = Gᵀ, with labels.
 
