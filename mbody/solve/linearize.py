@@ -156,42 +156,19 @@ class Linearization:
     The compiled core computes it all in one call (kernel.h: ``mb_linearize``): the
     equations there (`generalized`), the differences, A, its spectrum (``mb_spectrum``:
     each eigenvalue's bound from its own left and right vectors) and its modes
-    (``mb_modes``). The attributes are views of that output, made when first read.
+    (``mb_modes``). The attributes below are views of that output, made when first read;
+    `mbody.linearize` makes it.
 
-    Attributes
+    Parameters
     ----------
     model, state : Model, State
         The model and the state linearised about.
     coordinate_set : CoordinateSet
         The coordinates (the driven ones held).
-    M, D, K : (k, k) arrays
-        Generalized mass, damping (with the gyroscopic terms) and stiffness.
-    K_error, D_error : (k, k) arrays
-        Bounds on the differences' errors, entry by entry.
-    residual : (k,) array
-        q'' at the state (0 at an equilibrium or a steady motion).
-    steady : bool
-        Whether the state is an equilibrium or a steady motion (q'' = 0, and every moving
-        coordinate cyclic); otherwise the eigenvalues are those of the tangent system at
-        this instant, and `stable` is None.
-    left_out : tuple of str
-        The symmetries left out of the first-order system: the cyclic coordinates that
-        move (the spin of a steady spin, a gyroscope's precession), and the angles of
-        quasi-velocities the forces do not depend on (a free body's orientation).
-    kept : (k',) int array
-        The coordinates whose δq are in the first-order system (the others left out).
-    A : (k' + k, k' + k) array
-        The first-order system ``z' = A z``, z = (δq of the kept coordinates, δq'):
-        ``[[0, E], [−M⁻¹ K, −M⁻¹ D]]``.
-    tolerance : float
-        The most any eigenvalue may be off (1/s): √(‖δA‖ ‖A‖), ‖δA‖ = ‖M⁻¹‖ (‖δK‖ + ‖δD‖)
-        from the derivatives' error bounds (infinity norms; a double eigenvalue, a Jordan
-        block, moves by that much), and at least 1e3 ε ‖A‖. Each eigenvalue has its own,
-        smaller bound where it is simple (`eigenvalue_errors`).
-    dA : float
-        ‖δA‖, the bound on A's error (in A's units).
     warnings : tuple of str
         Why the state is not steady, and anything else worth saying.
+    _out, _at, _info : array, offsets, list
+        The core's output, where its parts start, and its info entries.
     """
 
     model: Model
@@ -204,18 +181,27 @@ class Linearization:
 
     @property
     def steady(self) -> bool:
+        """Whether the state is an equilibrium or a steady motion (q'' = 0, and every
+        moving coordinate cyclic); otherwise the eigenvalues are those of the tangent system
+        at this instant, and `stable` is None."""
         return bool(self._info[_core.LI_STEADY])
 
     @property
     def tolerance(self) -> float:
+        """The most any eigenvalue may be off (1/s): √(‖δA‖ ‖A‖), ‖δA‖ = ‖M⁻¹‖
+        (‖δK‖ + ‖δD‖) from the derivatives' error bounds (infinity norms; a double
+        eigenvalue, a Jordan block, moves by that much), and at least 1e3 ε ‖A‖. Each
+        eigenvalue has its own, smaller bound where it is simple (`eigenvalue_errors`)."""
         return self._info[_core.LI_TOL]
 
     @property
     def dA(self) -> float:
+        """‖δA‖, the bound on A's error (in A's units)."""
         return self._info[_core.LI_DA]
 
     @cached_property
     def M(self) -> np.ndarray:
+        """(k, k) generalized mass."""
         k = self._at.k
         return self._out[self._at.M:self._at.M + k * k].reshape(k, k)
 
@@ -226,22 +212,28 @@ class Linearization:
 
     @property
     def K(self) -> np.ndarray:
+        """(k, k) stiffness −∂f/∂q (the loads' and the constraint forces' geometric
+        stiffness)."""
         return self._differences[0]
 
     @property
     def K_error(self) -> np.ndarray:
+        """(k, k) bounds on K's errors, entry by entry."""
         return self._differences[1]
 
     @property
     def D(self) -> np.ndarray:
+        """(k, k) damping −∂f/∂q' (with the gyroscopic terms)."""
         return self._differences[2]
 
     @property
     def D_error(self) -> np.ndarray:
+        """(k, k) bounds on D's errors, entry by entry."""
         return self._differences[3]
 
     @cached_property
     def residual(self) -> np.ndarray:
+        """(k,) q'' at the state (0 at an equilibrium or a steady motion)."""
         return self._out[self._at.resid:self._at.resid + self._at.k]
 
     @cached_property
@@ -251,11 +243,16 @@ class Linearization:
 
     @cached_property
     def left_out(self) -> tuple[str, ...]:
+        """The symmetries left out of the first-order system: the cyclic coordinates
+        that move (the spin of a steady spin, a gyroscope's precession), and the angles of
+        quasi-velocities the forces do not depend on (a free body's orientation)."""
         labels = self.coordinate_set.labels
         return tuple(labels[i] for i in np.flatnonzero(self._left))
 
     @cached_property
     def kept(self) -> np.ndarray:
+        """(k',) int: the coordinates whose δq are in the first-order system (the
+        others left out)."""
         return np.flatnonzero(~self._left)
 
     @property
@@ -264,6 +261,8 @@ class Linearization:
 
     @cached_property
     def A(self) -> np.ndarray:
+        """(k' + k, k' + k) first-order system ``z' = A z``, z = (δq of the kept
+        coordinates, δq'): ``[[0, E], [−M⁻¹ K, −M⁻¹ D]]``."""
         nz, at = self._nz, self._at.resid + 2 * self._at.k
         return self._out[at:at + nz * nz].reshape(nz, nz)
 
