@@ -140,6 +140,35 @@ static double turn_angle(const joint_state *js, int64_t axis) {
 
 static double wrap(double a) { return a - TWO_PI * ceil((a - PI) / TWO_PI); }
 
+/* -e . T: gamma of a force along e (T: the joint's relative acceleration's velocity
+ * part). */
+static double force_gamma(const joint_state *js, const double *e) {
+    return -(e[0] * js->T[0] + e[1] * js->T[1] + e[2] * js->T[2]);
+}
+
+/* G_i^T v for a component's columns c6 (on body c) and p6 (on body p, -1: ground). */
+static double column_dot_v(const double *c6, const double *p6, int64_t c, int64_t p,
+                           const double *v, const double *om) {
+    double s = 0.0;
+    for (int a = 0; a < 3; a++) s += c6[a] * v[3 * c + a] + c6[3 + a] * om[3 * c + a];
+    if (p >= 0)
+        for (int a = 0; a < 3; a++) s += p6[a] * v[3 * p + a] + p6[3 + a] * om[3 * p + a];
+    return s;
+}
+
+/* Component i's joint, kind, axis, offset and lead (h); its law's f, f', f'' at w's time
+ * into f when `laws` and it has one (returns whether it does). */
+static int component(const mb_model *md, const mb_work *w, int64_t i, int laws, int64_t *j,
+                     int64_t *kind, int64_t *axis, double *off, double *h, double *f) {
+    const int64_t *ci = md->comps_i + 4 * i;
+    *j = ci[0], *kind = ci[1], *axis = ci[2];
+    *off = md->comps_f[MB_COMP_W * i], *h = md->comps_f[MB_COMP_W * i + 1];
+    f[0] = f[1] = f[2] = 0.0;
+    int driven = laws && ci[3] >= 0;
+    if (driven) mb_law(md, w, i, f);
+    return driven;
+}
+
 /* MB_KIND_FORCE: child6 = [e; B_r_c x R_c^T e], parent6 = [-e; -(B_r_p x Bp)],
  * phi = e . d, gamma = -e . T. */
 static void force(const joint_state *js, int64_t axis, column *col) {
@@ -154,7 +183,7 @@ static void force(const joint_state *js, int64_t axis, column *col) {
         col->child6[3 + a] = mc[a];
         col->parent6[3 + a] = -mp[a];
     }
-    col->gamma = -(e[0] * js->T[0] + e[1] * js->T[1] + e[2] * js->T[2]);
+    col->gamma = force_gamma(js, e);
     col->phi = e[0] * js->d[0] + e[1] * js->d[1] + e[2] * js->d[2];
 }
 
@@ -275,12 +304,9 @@ void mb_columns_at(const mb_model *md, mb_work *w, const double *y, int laws,
     for (int64_t j = 0; j < md->nj; j++) joint_geometry(md, w, y, j);
     joint_state js;
     for (int64_t i = 0; i < md->m; i++) {
-        const int64_t *ci = md->comps_i + 4 * i;
-        int64_t j = ci[0], kind = ci[1], axis = ci[2];
-        double off = md->comps_f[MB_COMP_W * i], h = md->comps_f[MB_COMP_W * i + 1];
-        double f[3] = {0.0, 0.0, 0.0};
-        int driven = laws && ci[3] >= 0;
-        if (driven) mb_law(md, w, i, f);
+        int64_t j, kind, axis;
+        double off, h, f[3];
+        int driven = component(md, w, i, laws, &j, &kind, &axis, &off, &h, f);
         load_joint(md, w, j, &js);
         column col = {child6 + 6 * i, parent6 + 6 * i, 0.0, 0.0, {0.0, 0.0, 0.0}};
         switch (kind) {
@@ -300,12 +326,8 @@ void mb_columns_at(const mb_model *md, mb_work *w, const double *y, int laws,
         p6[0] = -c6[0], p6[1] = -c6[1], p6[2] = -c6[2];
         if (md->joints_i[3 * j + 2] & MB_J_PARTICLE_PARENT) /* forces act at the particle */
             p6[3] = p6[4] = p6[5] = 0.0;
-        int64_t p = js.p, c = js.c;
-        double s = 0.0;
-        for (int a = 0; a < 3; a++) s += c6[a] * v[3 * c + a] + c6[3 + a] * om[3 * c + a];
-        if (p >= 0)
-            for (int a = 0; a < 3; a++) s += p6[a] * v[3 * p + a] + p6[3 + a] * om[3 * p + a];
-        else
+        double s = column_dot_v(c6, p6, js.c, js.p, v, om);
+        if (js.p < 0)
             for (int a = 0; a < 6; a++) p6[a] = 0.0;
         gamma[i] = driven ? col.gamma + f[2] : col.gamma;
         phi[i] = col.phi;
@@ -324,18 +346,15 @@ void mb_gammas_at(const mb_model *md, mb_work *w, const double *y, int laws,
     for (int64_t j = 0; j < md->nj; j++) joint_velocities(md, w, y, j);
     joint_state js;
     for (int64_t i = 0; i < md->m; i++) {
-        const int64_t *ci = md->comps_i + 4 * i;
-        int64_t j = ci[0], kind = ci[1], axis = ci[2];
-        double off = md->comps_f[MB_COMP_W * i], h = md->comps_f[MB_COMP_W * i + 1];
-        double f[3] = {0.0, 0.0, 0.0};
-        int driven = laws && ci[3] >= 0;
-        if (driven) mb_law(md, w, i, f);
+        int64_t j, kind, axis;
+        double off, h, f[3];
+        int driven = component(md, w, i, laws, &j, &kind, &axis, &off, &h, f);
         load_joint(md, w, j, &js);
         double e[3], Bp[3], g;
         switch (kind) { /* each kind's gamma as its column function writes it */
         case MB_KIND_FORCE:
             frame_axis(&js, axis, e, Bp);
-            g = -(e[0] * js.T[0] + e[1] * js.T[1] + e[2] * js.T[2]);
+            g = force_gamma(&js, e);
             break;
         case MB_KIND_TILT:
         case MB_KIND_LOCK:
@@ -352,20 +371,13 @@ void mb_gammas_at(const mb_model *md, mb_work *w, const double *y, int laws,
             g = col.gamma;
             break;
         }
-        default: { /* SCREW: the FORCE gamma less h times the moment's */
+        default: /* SCREW: the FORCE gamma less h times the moment's */
             frame_axis(&js, axis, e, Bp);
-            double gamma_force = -(e[0] * js.T[0] + e[1] * js.T[1] + e[2] * js.T[2]);
-            g = gamma_force - h * moment_gamma(&js, e);
+            g = force_gamma(&js, e) - h * moment_gamma(&js, e);
             break;
         }
-        }
         (void)off;
-        const double *c6 = child6 + 6 * i, *p6 = parent6 + 6 * i;
-        int64_t p = js.p, c = js.c;
-        double s = 0.0;
-        for (int a = 0; a < 3; a++) s += c6[a] * v[3 * c + a] + c6[3 + a] * om[3 * c + a];
-        if (p >= 0)
-            for (int a = 0; a < 3; a++) s += p6[a] * v[3 * p + a] + p6[3 + a] * om[3 * p + a];
+        double s = column_dot_v(child6 + 6 * i, parent6 + 6 * i, js.c, js.p, v, om);
         gamma[i] = driven ? g + f[2] : g;
         gtv[i] = driven ? s - f[1] : s;
     }
