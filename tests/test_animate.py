@@ -451,13 +451,14 @@ def _listening(pid):
 def test_live_cli_binds_loopback_and_stops_on_ctrl_c(spinner, tmp_path):
     model, traj = spinner
     run = traj.save(tmp_path / "run.npz")
-    proc = subprocess.Popen([sys.executable, "-m", "mbody.cli", "animate", str(run), "--live"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            cwd=tmp_path)
+    err = open(tmp_path / "stderr.txt", "w+")  # noqa: SIM115 - a file, not a pipe to fill up
+    proc = subprocess.Popen([sys.executable, "-X", "faulthandler", "-m", "mbody.cli", "animate",
+                             str(run), "--live"],
+                            stdout=subprocess.PIPE, stderr=err, text=True, cwd=tmp_path)
     server = None
     try:
         line = proc.stdout.readline()
-        assert "127.0.0.1 only" in line, line + proc.stderr.read()
+        assert "127.0.0.1 only" in line, line + (tmp_path / "stderr.txt").read_text()
         url = re.search(r"http://127\.0\.0\.1:(\d+)/static/", line)
         assert url, line
         (server,) = psutil.Process(proc.pid).children()
@@ -466,14 +467,21 @@ def test_live_cli_binds_loopback_and_stops_on_ctrl_c(spinner, tmp_path):
         assert {a.ip for a in addrs} == {"127.0.0.1"}
         assert int(url.group(1)) in {a.port for a in addrs}
         proc.send_signal(signal.SIGINT)
-        assert proc.wait(15) == 0
-        assert "viewer stopped" in proc.stderr.read()
+        try:
+            code = proc.wait(15)
+        except subprocess.TimeoutExpired:  # say where it hung: its stack, then its stderr
+            proc.send_signal(signal.SIGABRT)  # faulthandler (-X) prints the stacks
+            proc.wait(10)
+            raise AssertionError("the viewer did not stop within 15 s of Ctrl-C:\n"
+                                 + (tmp_path / "stderr.txt").read_text()[-4000:]) from None
+        assert code == 0
+        assert "viewer stopped" in (tmp_path / "stderr.txt").read_text()
     finally:
         if proc.poll() is None:
             proc.kill()
             proc.wait()
         proc.stdout.close()
-        proc.stderr.close()
+        err.close()
     assert server is not None and not server.is_running()
     assert not psutil.Process().children(recursive=True)
 

@@ -170,8 +170,8 @@ class LiveViewer:
         if self._sock is not None:
             self._sock.close(linger=0)
             self._sock = None
-        if self._ctx is not None:
-            self._ctx.term()
+        if self._ctx is not None:  # destroy: whatever socket is left closes unsent first
+            self._ctx.destroy(linger=0)
             self._ctx = None
         if self.proc is not None:
             proc, self.proc = self.proc, None
