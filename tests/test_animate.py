@@ -448,13 +448,22 @@ def _listening(pid):
             if c.status == psutil.CONN_LISTEN]
 
 
-def test_live_cli_binds_loopback_and_stops_on_ctrl_c(spinner, tmp_path):
+def _ignore_sigint() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+@pytest.mark.parametrize("started_ignoring", [False, True])
+def test_live_cli_binds_loopback_and_stops_on_ctrl_c(spinner, tmp_path, started_ignoring):
+    """The live viewer listens on 127.0.0.1 only and Ctrl-C stops it cleanly, also when the
+    command was started with SIGINT ignored (a shell's background job, nohup: Python then
+    keeps ignoring it unless the command asks for it)."""
     model, traj = spinner
     run = traj.save(tmp_path / "run.npz")
     err = open(tmp_path / "stderr.txt", "w+")  # noqa: SIM115 - a file, not a pipe to fill up
     proc = subprocess.Popen([sys.executable, "-X", "faulthandler", "-m", "mbody.cli", "animate",
                              str(run), "--live"],
-                            stdout=subprocess.PIPE, stderr=err, text=True, cwd=tmp_path)
+                            stdout=subprocess.PIPE, stderr=err, text=True, cwd=tmp_path,
+                            preexec_fn=_ignore_sigint if started_ignoring else None)
     server = None
     try:
         line = proc.stdout.readline()

@@ -174,6 +174,10 @@ def animate(a: argparse.Namespace) -> int:
         return EXIT_OK
 
     previous = signal.signal(signal.SIGTERM, _stop)
+    # Ctrl-C stops the viewer even when this process was started with SIGINT ignored (a
+    # shell's background job, nohup): Python then leaves it ignored instead of raising
+    # KeyboardInterrupt, and the viewer would only stop when killed
+    previous_int = signal.signal(signal.SIGINT, signal.default_int_handler)
     viewer = None
     try:
         viewer = LiveViewer()
@@ -189,5 +193,6 @@ def animate(a: argparse.Namespace) -> int:
         if viewer is not None:
             viewer.close()
         signal.signal(signal.SIGTERM, previous)
+        signal.signal(signal.SIGINT, previous_int)
     print("viewer stopped", file=sys.stderr)
     return EXIT_OK
