@@ -124,10 +124,9 @@ class _Offsets(NamedTuple):
     coordinates (kernel.h)."""
 
     k: int
-    ngen: int      # the generalized equations' part ends
+    ngen: int      # the generalized equations' part ends; K, K_err, D, D_err (4 k^2) follow
     M: int         # M_q (k x k) in it
     qdot: int      # q' (k) in it
-    diffs: int     # K, K_err, D, D_err (4 k^2)
     resid: int     # q'' (k), then the left-out flags (k), then A's slot (4 k^2)
     info: int
     spectrum: int
@@ -145,8 +144,8 @@ def _offsets(N: int, k: int) -> _Offsets:
     spectrum = info + _core.LINEARIZE_INFO
     modes = spectrum + 6 * k + 8 * kk
     oscillations = modes + 12 * k + 4 * kk
-    return _Offsets(k, gl[-1], gl[3], gl[6], gl[-1], resid, info, spectrum, modes,
-                    oscillations, oscillations + 4 * k)
+    return _Offsets(k, gl[-1], gl[3], gl[6], resid, info, spectrum, modes, oscillations,
+                    oscillations + 4 * k)
 
 
 @dataclass(frozen=True, eq=False)
@@ -208,7 +207,7 @@ class Linearization:
     @cached_property
     def _differences(self) -> np.ndarray:
         k = self._at.k
-        return self._out[self._at.diffs:self._at.diffs + 4 * k * k].reshape(4, k, k)
+        return self._out[self._at.ngen:self._at.ngen + 4 * k * k].reshape(4, k, k)
 
     @property
     def K(self) -> np.ndarray:

@@ -278,6 +278,25 @@ static void vectors(const double *T, int64_t n, const int64_t *start, int64_t k,
 #undef Tt
 }
 
+/* order (n) <- the indices sorted by first, then by second (NULL: none), equal keys kept
+ * in index order (insertion sort: n is a few dozen). */
+static void stable_order(int64_t n, const double *first, const double *second,
+                         int64_t *order) {
+    for (int64_t i = 0; i < n; i++) order[i] = i;
+    for (int64_t i = 1; i < n; i++) {
+        int64_t o = order[i], j = i;
+        while (j > 0) {
+            int64_t p = order[j - 1];
+            int after = first[p] > first[o] ||
+                        (second != NULL && first[p] == first[o] && second[p] > second[o]);
+            if (!after) break;
+            order[j] = p;
+            j--;
+        }
+        order[j] = o;
+    }
+}
+
 int mb_spectrum(const double *A, int64_t n, double dA, double tol, double *out) {
     double complex *w_out = (double complex *)out, *V_out = w_out + n;
     double *err_out = out + 2 * (n + n * n);
@@ -335,17 +354,7 @@ int mb_spectrum(const double *A, int64_t n, double dA, double tol, double *out) 
             for (int64_t i = 0; i < n; i++) V_out[i * n + k + 1] = conj(V_out[i * n + k]);
         }
     }
-    /* by real part, then imaginary part (stable) */
-    for (int64_t i = 0; i < n; i++) order[i] = i;
-    for (int64_t i = 1; i < n; i++) {
-        int64_t o = order[i], j = i;
-        while (j > 0 && (wr[order[j - 1]] > wr[o] ||
-                         (wr[order[j - 1]] == wr[o] && wi[order[j - 1]] > wi[o]))) {
-            order[j] = order[j - 1];
-            j--;
-        }
-        order[j] = o;
-    }
+    stable_order(n, wr, wi, order); /* by real part, then imaginary part */
     /* V's columns in that order, row by row through x */
     for (int64_t i = 0; i < n; i++) {
         for (int64_t c = 0; c < n; c++) x[c] = V_out[i * n + order[c]];
@@ -422,15 +431,7 @@ int64_t mb_modes(int64_t n, const double *spectrum, int64_t k, int64_t nk,
             for (int64_t r = 0; r < k; r++) s[r] = creal(s[r]);
         m++;
     }
-    for (int64_t i = 0; i < m; i++) order[i] = i;
-    for (int64_t i = 1; i < m; i++) { /* neutral first, then by |lambda| (stable) */
-        int64_t o = order[i], j = i;
-        while (j > 0 && key[order[j - 1]] > key[o]) {
-            order[j] = order[j - 1];
-            j--;
-        }
-        order[j] = o;
-    }
+    stable_order(m, key, NULL, order); /* neutral first, then by |lambda| */
     double *sorted = malloc(sizeof(double) * (size_t)(MB_MODE_W * (m > 0 ? m : 1)));
     if (sorted == NULL) {
         free(key), free(row), free(order);
