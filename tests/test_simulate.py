@@ -333,3 +333,33 @@ def test_a_known_reaction_of_t_on_a_mechanism_is_the_cores():
                                atol=1e-15)
     free = mbody.simulate(mbody.load(path), 1.0, 30)  # A.Fx solved: another motion
     assert np.max(np.abs(free.position - given.position)) > 1e-3
+
+
+def test_initial_joint_errors_are_the_runs_own_start_each_time():
+    """A model's own start is checked once and kept (`Workspace.memo`); a run from another
+    state reports that state's errors, and neither changes what the next run reports."""
+    model = mbody.load(MODELS / "pendulum.yaml")
+    s0 = model.initial
+    off = mbody.State(s0.position + [0.0, 0.1, 0.0], s0.quaternion.copy(),
+                      s0.velocity.copy(), s0.omega.copy(), 0.0)
+    first = mbody.simulate(model, 0.1, 10).info["initial_joint_errors"]
+    assert first == []
+    moved = mbody.simulate(model, 0.1, 10, initial=off).info["initial_joint_errors"]
+    assert moved and all("phi" in e for e in moved)
+    first.append("changed by the caller")
+    again = mbody.simulate(model, 0.1, 10).info["initial_joint_errors"]
+    assert again == []
+    assert mbody.simulate(model, 0.1, 10, initial=off).info["initial_joint_errors"] == moved
+
+
+def test_a_run_keeps_the_model_text_after_the_file_is_gone(tmp_path):
+    """The trajectory keeps the text the model was read from (line ends as a text file
+    reads them), with the file since removed: it can still be drawn and checked."""
+    text = (MODELS / "pendulum.yaml").read_text(encoding="utf-8")
+    path = tmp_path / "pendulum.yaml"
+    path.write_bytes(text.replace("\n", "\r\n").encode("utf-8"))
+    model = mbody.load(path)
+    path.unlink()
+    traj = mbody.simulate(model, 0.1, 10)
+    assert traj.model_yaml == text
+    assert mbody.simulate(model, 0.1, 10).model_yaml == text

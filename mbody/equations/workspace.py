@@ -92,7 +92,8 @@ class Workspace:
 
     core: the core's model (`mbody.kernel._core.Model`): loads, columns of G, φ, γ, Gᵀv.
     `solver(unknowns)` gives the core's `Unknowns` for one set of unknown components
-    (solve, derivative, projection), made once per set.
+    (solve, derivative, projection), made once per set; `memo` keeps what other layers
+    derive from the model once (the same life: a model is frozen).
     """
 
     def __init__(self, model: Model):
@@ -103,6 +104,10 @@ class Workspace:
         self._solvers: dict[bytes, _core.Unknowns] = {}
         self._plans: dict[bytes, SolvePlan] = {}
         self._lock = threading.Lock()
+        self.memo: dict[object, object] = {}
+        """Facts other layers derive from the model alone, kept while it lives (a
+        simulation's conservation reasons, its initial joint errors...): keys are the
+        deriving module's own tuples, values never handed out to be changed."""
 
     @property
     def model(self) -> Model:

@@ -29,7 +29,8 @@ import math
 import os
 import sys
 import time
-from collections.abc import Mapping
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from typing import TypeVar
 
 import numpy as np
 
@@ -52,6 +53,8 @@ from mbody.simulate.trajectory import (
     model_text,
 )
 from mbody.solve.dynamics import Dynamics, StateDerivative, accelerations
+
+_T = TypeVar("_T")
 
 METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
 """The integrators: DOP853 is the compiled core's, the others scipy.integrate's (imported
@@ -251,7 +254,9 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     bar = _Progress(progress, t_end, model.name or "simulate")
 
     # k / fps, the last one at most t_end (K allows t_end * fps to fall 1e-9 short of k)
-    t_eval = np.minimum(np.arange(K) / fps, t_end)
+    t_eval = np.arange(K, dtype=float)
+    t_eval /= fps
+    np.minimum(t_eval, t_end, out=t_eval)
     Y = np.empty((K, size))
     Y[0] = y0
     k, steps = 1, 0
@@ -281,8 +286,7 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
                        + " (a body escaping to infinity, or tolerances too tight for "
                        "double precision?)"))
             if marking:
-                for t_mark, steps_mark in run.marks():
-                    rate.step(t_mark, steps_mark)
+                rate.steps_at(run.marks())
             else:
                 rate.step(run.t, steps)
             bar.update(run.t)
@@ -338,7 +342,7 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
         joint_info = {"joint_stabilisation": held,
                       "joint_position_drift": figures.position_drift,
                       "joint_velocity_drift": figures.velocity_drift,
-                      "initial_joint_errors": joint_errors(model, s0),
+                      "initial_joint_errors": _initial_joint_errors(model, initial),
                       "projection_evaluations": run.refreshed}
     elif dynamics is None and labels:
         lam = known_reaction_dynamics(model, known).reactions_at(t_eval)
@@ -364,8 +368,10 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
         t_eval, *pose, body_names=model.body_names, dimension=model.dimension,
         model_name=model.name, model_file=model.file, reaction_labels=stored,
         reactions=values, info=info, mass=np.array(model.mass), inertia=np.array(model.J),
-        shapes=tuple(model.bodies[b].shape for b in model.body_names),
-        colors=tuple(model.bodies[b].color for b in model.body_names),
+        shapes=_memo(model, ("shapes",), lambda: tuple(
+            model.bodies[b].shape for b in model.body_names)),
+        colors=_memo(model, ("colors",), lambda: tuple(
+            model.bodies[b].color for b in model.body_names)),
         gravity=np.array(model.gravity), model_yaml=model_text(model))
     series, drift, spin_peak = _drift(run_model, t_eval, Y, dynamics is None,
                                       ideal_joints=mechanism, lengths=lengths)
@@ -538,23 +544,33 @@ class _StepRate:
     def __init__(self, t_end: float):
         self.t_end, self.width = t_end, t_end / self.WINDOWS
         self.start: tuple[float, float] | None = None  # (t, steps per second) until t
-        self.mark = (0.0, 0)  # (t, steps) where the current window began
+        self.mark: tuple[float, float] = (0.0, 0)  # (t, steps) where the window began
         self.next = self.width
         self.slow: list[tuple[float, float, float]] = []  # (t0, t1, rate) windows
         self.peak = 0.0
 
     def step(self, t: float, steps: int) -> None:
-        if t < self.next and t < self.t_end:
-            return
-        t0, n0 = self.mark
-        r = (steps - n0) / (t - t0)
-        if self.start is None:
-            self.start = (t, r)
-        elif r > self.FACTOR * self.start[1] and steps - n0 >= self.MIN_STEPS:
-            self.slow.append((t0, t, r))
-        self.peak = max(self.peak, r)
-        self.mark = (t, steps)
-        self.next = (math.floor(t / self.width) + 1) * self.width
+        """The run is at t after `steps` steps: a window that ends there is counted."""
+        self.steps_at(((t, steps),))
+
+    def steps_at(self, marks: Iterable[Sequence[float]]) -> None:
+        """The run passed each (t, steps) of `marks`, in time order (the core's notes
+        where a window ends, `CoreRun.marks`): the windows ending there are counted."""
+        start, mark, nxt, peak = self.start, self.mark, self.next, self.peak
+        for t, steps in marks:
+            if t < nxt and t < self.t_end:
+                continue
+            t0, n0 = mark
+            r = (steps - n0) / (t - t0)
+            if start is None:
+                start = (t, r)
+            elif r > self.FACTOR * start[1] and steps - n0 >= self.MIN_STEPS:
+                self.slow.append((t0, t, r))
+            if r > peak:
+                peak = r
+            mark = (t, steps)
+            nxt = (math.floor(t / self.width) + 1) * self.width
+        self.start, self.mark, self.next, self.peak = start, mark, nxt, peak
 
     def figures(self, steps: int) -> dict:
         """Steps per simulated second: over the first part, the busiest window, overall."""
@@ -602,10 +618,11 @@ def _spin_warning(traj: Trajectory, peak: np.ndarray | None = None) -> str | Non
     """A body whose spin aliases the frame rate: |ω| / 2π > fps / 2 at a sample. `peak`:
     each body's largest |ω| (rad/s) when known (the core's, `conserved_figures`): the
     samples are then looked at only when a body is that fast."""
-    fps, w = traj.info["fps"], traj.angular_velocity
-    if traj.n == 0 or not len(w):
+    fps = traj.info["fps"]
+    if peak is not None and not any(p / (2 * np.pi) > fps / 2 for p in peak.tolist()):
         return None
-    if peak is not None and not np.any(peak / (2 * np.pi) > fps / 2):
+    w = traj.angular_velocity
+    if traj.n == 0 or not len(w):
         return None
     rate = np.abs(w) if traj.dimension == cv.PLANAR else np.linalg.norm(w, axis=2)
     peak = rate.max(axis=0)  # (n,) rad/s
@@ -680,6 +697,26 @@ def potential_energy(model: Model, traj: Trajectory, lengths: np.ndarray | None 
                                      lengths=True).lengths
         V = V + 0.5 * np.sum(sp.stiffness * (lengths - sp.rest_length) ** 2, axis=1)
     return V
+
+
+def _memo(model: Model, key: tuple, make: Callable[[], _T]) -> _T:
+    """What `make()` derives from `model` alone, made on a model's first run and kept in
+    its workspace (`Workspace.memo`): a repeated run of one model (a tolerance study, a
+    benchmark) does not redo it. Values are never changed by their users."""
+    memo = workspace(model).memo
+    key = (__name__, *key)
+    if key not in memo:
+        memo[key] = make()
+    return memo[key]  # type: ignore[return-value]  # each key's maker fixes its type
+
+
+def _initial_joint_errors(model: Model, initial: State | None) -> list[str]:
+    """The joints the run's first state breaks, as text (`joint_errors`): `initial`'s, or
+    the model's own initial state's (worked out once per model)."""
+    if initial is not None:
+        return joint_errors(model, initial)
+    return list(_memo(model, ("initial_joint_errors",),
+                      lambda: tuple(joint_errors(model, model.initial))))
 
 
 def _has_unknown_reactions(model: Model, known: Mapping[str, float | str] | None) -> bool:
@@ -777,7 +814,9 @@ def _drift(model: Model, t: np.ndarray, Y: np.ndarray, default_dynamics: bool, *
     (`mbody.simulate.mechanism.conserved_figures`). `lengths`: the springs' lengths at the
     samples (K, s), when the run has them (else the core computes them). Also returns
     each body's largest |ω| over the samples (n,), from the same pass."""
-    why = conservation(model, default_dynamics, ideal_joints, known)
+    why = (_memo(model, ("conservation", default_dynamics, ideal_joints),
+                 lambda: conservation(model, default_dynamics, ideal_joints))
+           if not known else conservation(model, default_dynamics, ideal_joints, known))
     if len(model.springs.names) and lengths is None:
         lengths = sample_figures(model, workspace(model).file_unknowns, t, Y,
                                  reactions=False, lengths=True).lengths

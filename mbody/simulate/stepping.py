@@ -85,9 +85,9 @@ class CoreRun:
         self._marking = True
         return True
 
-    def marks(self) -> list[tuple[float, int]]:
-        """The (t, steps) the last `advance` noted (`mark_windows`)."""
-        return [(float(t), int(s)) for t, s in self._marks[:self._marked].tolist()]
+    def marks(self) -> list[list[float]]:
+        """The [t, steps] the last `advance` noted (`mark_windows`)."""
+        return self._marks[:self._marked].tolist()
 
     @property
     def integration_time(self) -> float:
@@ -200,7 +200,7 @@ class ScipyRun:
         """False: one step per `advance`, the caller follows the windows itself."""
         return False
 
-    def marks(self) -> list[tuple[float, int]]:
+    def marks(self) -> list[list[float]]:
         return []
 
     def advance(self, t_stop: float, max_steps: int, t_eval: np.ndarray, k: int,

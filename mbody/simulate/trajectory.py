@@ -21,6 +21,7 @@ reads it back and raises `TrajectoryFileError` for anything else.
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import zlib
@@ -449,19 +450,27 @@ def model_text(model) -> str:
     """The model file's text, when the model came from a readable file ('' otherwise):
     what a trajectory keeps so that it can be drawn and checked without the file. The
     text the model was read from when it kept it (`Model.source`: every hand-written
-    file; its line ends read as a text file reads them), else the file as it is now."""
+    file; its line ends read as a text file reads them; kept even if the file has gone
+    since), else the file as it is now."""
     if not model.file or model.file.startswith("<"):
         return ""
-    p = Path(model.file)
     source = getattr(model, "source", None)
     if source is not None and source.text is not None and source.file == model.file:
-        # not read again: a second read and decode cost as much as the rest of a short
-        # run's bookkeeping
-        return source.text.replace("\r\n", "\n").replace("\r", "\n") if p.is_file() else ""
+        # neither read nor looked up again: a read, or even a stat, costs as much as the
+        # rest of a short run's bookkeeping
+        return _text_lines(source.text)
+    p = Path(model.file)
     try:
         return p.read_text(encoding="utf-8") if p.is_file() else ""
     except (OSError, UnicodeDecodeError):
         return ""
+
+
+@functools.lru_cache(maxsize=16)
+def _text_lines(text: str) -> str:
+    """`text` with its line ends read as a text file reads them (\\r\\n and \\r as \\n),
+    worked out once per text: every run of a model keeps it."""
+    return text.replace("\r\n", "\n").replace("\r", "\n")
 
 
 def body_matvec(J: np.ndarray, w: np.ndarray) -> np.ndarray:

@@ -97,7 +97,10 @@ int mb_conservation(int64_t n, int planar, const double *mass, const double *J,
                 for (int a = 0; a < 4; a++) q[a] = y[3 * n + 4 * i + a];
             }
             const double *vi = v + 3 * i, *wi = w + 3 * i, *Ji = J + 9 * i;
-            const double rate = planar ? fabs(wi[2]) : norm3(wi);
+            /* spatial: the squared rate, its square root taken once, of the largest
+             * (sqrt is monotonic) */
+            const double rate = planar ? fabs(wi[2])
+                                       : wi[0] * wi[0] + wi[1] * wi[1] + wi[2] * wi[2];
             if (rate > spin_peak[i] || rate != rate) spin_peak[i] = rate;
             double Jw[3];
             for (int r = 0; r < 3; r++)
@@ -169,11 +172,18 @@ int mb_conservation(int64_t n, int planar, const double *mass, const double *J,
         t_max = k == 0 ? fabs(Tk) : max_nan(t_max, fabs(Tk));
         e_max = k == 0 ? fabs(Ek - E0) : max_nan(e_max, fabs(Ek - E0));
         p_scale = k == 0 ? mv_sum : max_nan(p_scale, mv_sum);
-        p_max = k == 0 ? norm3(dp) : max_nan(p_max, norm3(dp));
+        /* p_max and h_max squared until the end, as the rates (sqrt is monotonic) */
+        const double dp2 = dp[0] * dp[0] + dp[1] * dp[1] + dp[2] * dp[2];
+        const double dH2 = dH[0] * dH[0] + dH[1] * dH[1] + dH[2] * dH[2];
+        p_max = k == 0 ? dp2 : max_nan(p_max, dp2);
         h_scale = k == 0 ? terms : max_nan(h_scale, terms);
-        h_max = k == 0 ? norm3(dH) : max_nan(h_max, norm3(dH));
+        h_max = k == 0 ? dH2 : max_nan(h_max, dH2);
     }
     free(buf);
+    p_max = sqrt(p_max);
+    h_max = sqrt(h_max);
+    if (!planar)
+        for (int64_t i = 0; i < n; i++) spin_peak[i] = sqrt(spin_peak[i]);
     /* relative changes, as simulation.py's numpy did them: energy's relative to
      * max(|E(0)|, max T) (0 unless that is > 0), the momenta's to their largest sum of
      * the terms' magnitudes (0 where that is <= 0) */
