@@ -36,7 +36,7 @@ import numpy as np
 
 from mbody import conventions as cv
 from mbody.equations.constraints import joint_errors
-from mbody.equations.workspace import workspace
+from mbody.equations.workspace import Unknowns, workspace
 from mbody.equations.world import check_axes
 from mbody.errors import MbodyError, UnknownReactionsError, did_you_mean
 from mbody.kernel import _core
@@ -235,28 +235,15 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     mechanism = dynamics is None and _has_unknown_reactions(run_model, None)
     n = model.n
     planar = model.dimension == cv.PLANAR
-    s0 = model.initial if initial is None else initial
     # the joints held by projecting the state after every step (mbody.simulate.projection);
     # scipy's integrators keep their own history of y, so Baumgarte's terms hold them
     projecting = mechanism and method in CORE
     if projecting:
         rhs.rate = 0.0
-    # Planar models also integrate θ itself (θ̇ = ω_z): the angle read back from a
-    # quaternion is only known modulo 2π, and a fast wheel turns more than π per frame.
-    theta0 = 2.0 * np.arctan2(s0.quaternion[:, 3], s0.quaternion[:, 0]) if planar else ()
-    y0 = np.concatenate((s0.position.ravel(), s0.quaternion.ravel(), s0.velocity.ravel(),
-                         s0.omega.ravel(), theta0))
+    y0, ratio = _start(run_model, initial, rhs.unknowns if projecting else None)
     size = len(y0)
-    ratio = 1.0
-    if projecting:  # the run starts on the joints
-        assert rhs.unknowns is not None
-        _, _, ratio = JointProjection(run_model, rhs.unknowns)(y0, 0.0)
     bar = _Progress(progress, t_end, model.name or "simulate")
-
-    # k / fps, the last one at most t_end (K allows t_end * fps to fall 1e-9 short of k)
-    t_eval = np.arange(K, dtype=float)
-    t_eval /= fps
-    np.minimum(t_eval, t_end, out=t_eval)
+    t_eval = _sample_times(model, K, fps, t_end)
     Y = np.empty((K, size))
     Y[0] = y0
     k, steps = 1, 0
@@ -708,6 +695,47 @@ def _memo(model: Model, key: tuple, make: Callable[[], _T]) -> _T:
     if key not in memo:
         memo[key] = make()
     return memo[key]  # type: ignore[return-value]  # each key's maker fixes its type
+
+
+def _start(model: Model, initial: State | None, projected: Unknowns | None
+           ) -> tuple[np.ndarray, float]:
+    """(y0, geometric ratio): a run's first state packed in the core's layout, moved onto
+    the joints of the unknowns `projected` when given (their ratio there, else 1; see
+    `JointProjection`). Made once per model from its own initial state (`initial` None),
+    a fresh copy handed out."""
+    def make() -> tuple[np.ndarray, float]:
+        s0 = model.initial if initial is None else initial
+        # Planar models also integrate θ itself (θ̇ = ω_z): the angle read back from a
+        # quaternion is only known modulo 2π, and a fast wheel turns more than π per frame.
+        theta0 = (2.0 * np.arctan2(s0.quaternion[:, 3], s0.quaternion[:, 0])
+                  if model.dimension == cv.PLANAR else ())
+        y0 = np.concatenate((s0.position.ravel(), s0.quaternion.ravel(),
+                             s0.velocity.ravel(), s0.omega.ravel(), theta0))
+        ratio = 1.0
+        if projected is not None:  # the run starts on the joints
+            _, _, ratio = JointProjection(model, projected)(y0, 0.0)
+        return y0, ratio
+
+    if initial is not None:
+        return make()
+    y0, ratio = _memo(model, ("start", None if projected is None else projected.key), make)
+    return y0.copy(), ratio
+
+
+def _sample_times(model: Model, K: int, fps: float, t_end: float) -> np.ndarray:
+    """(K,) the output times k / fps, the last at most t_end (K allows t_end · fps to fall
+    1e-9 short of k): a fresh array, the model's last run's copied when it asked for the
+    same (the memo keeps one)."""
+    last: dict[tuple[int, float, float], np.ndarray] = _memo(
+        model, ("sample_times",), dict)
+    t = last.get((K, fps, t_end))
+    if t is None:
+        t = np.arange(K, dtype=float)
+        t /= fps
+        np.minimum(t, t_end, out=t)
+        last.clear()
+        last[K, fps, t_end] = t
+    return t.copy()
 
 
 def _initial_joint_errors(model: Model, initial: State | None) -> list[str]:
