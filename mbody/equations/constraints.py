@@ -49,7 +49,7 @@ def gamma(model: Model, state: State, cols: ReactionColumns,
     return cols.gamma
 
 
-@dataclass(frozen=True, eq=False)  # no generated ==: its fields are arrays
+@dataclass(frozen=True, eq=False, init=False, repr=False)  # no ==: its fields are arrays
 class ConstraintJacobian:
     """The velocity-level constraint Jacobian of the joints, Φ_v = Gᵀ, with labels.
 
@@ -65,6 +65,14 @@ class ConstraintJacobian:
     columns: list[str]
     gamma: np.ndarray
     phi: np.ndarray
+
+    def __init__(self, matrix: sp.csr_matrix, rows: list[str], columns: list[str],
+                 gamma: np.ndarray, phi: np.ndarray) -> None:
+        # the dataclass's own __init__, written out: the generated one is compiled from
+        # its source when the class is made, at every simulate's import (frozen: the
+        # fields go into __dict__ directly, as object.__setattr__ would put them)
+        self.__dict__.update({"matrix": matrix, "rows": rows, "columns": columns,
+                              "gamma": gamma, "phi": phi})
 
     @property
     def shape(self) -> tuple[int, int]:

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import threading
 import weakref
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from functools import cached_property
 from typing import TYPE_CHECKING, NamedTuple
@@ -96,8 +96,9 @@ class Workspace:
     derive from the model once (the same life: a model is frozen).
     """
 
-    def __init__(self, model: Model):
-        self._model = weakref.ref(model)  # the workspace goes with the model, not after
+    def __init__(self, model: Model, gone: Callable[[weakref.ref], object] | None = None):
+        # the workspace goes with the model, not after; `gone` is called when it does
+        self._model = weakref.ref(model, gone)
         self.planar = model.dimension == cv.PLANAR
         F, I = pack_model(model)
         self.core = _core.Model(F, I, self.planar)
@@ -265,8 +266,10 @@ class Workspace:
 
 
 _WORKSPACES: dict[int, Workspace] = {}
-"""id(model) -> its workspace; an entry goes with its model (weakref.finalize). A plain
-dict: a lookup per evaluation, where a WeakKeyDictionary's costs a microsecond."""
+"""id(model) -> its workspace; an entry goes with its model (the callback of the
+workspace's weak reference to it: a weakref.finalize would do the same, but its first use
+in a process imports atexit). A plain dict: a lookup per evaluation, where a
+WeakKeyDictionary's costs a microsecond."""
 _LOCK = threading.Lock()
 
 
@@ -277,7 +280,7 @@ def workspace(model: Model) -> Workspace:
         with _LOCK:
             ws = _WORKSPACES.get(id(model))
             if ws is None or ws._model() is not model:
-                ws = Workspace(model)
-                _WORKSPACES[id(model)] = ws
-                weakref.finalize(model, _WORKSPACES.pop, id(model), None)
+                key = id(model)
+                ws = Workspace(model, lambda _: _WORKSPACES.pop(key, None))
+                _WORKSPACES[key] = ws
     return ws

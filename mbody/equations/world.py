@@ -17,7 +17,7 @@ a weld both. Drivers' efforts stay as they are (a torque about the driven axis).
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import TYPE_CHECKING, NamedTuple
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -81,19 +81,20 @@ def world_map(model: Model, W_e: np.ndarray) -> tuple[tuple[str, ...], sp.csc_ma
     return lay.labels, T
 
 
-class _Layout(NamedTuple):  # a NamedTuple: made at every simulate's import, 0.1 ms
+class _Layout:
     """Where each joint-frame component goes in world axes: world value `row` gets `coef`
     times the component `col`'s value times its direction's `axis` entry (one entry per
     such part, in component order); a driver's effort `driver_cols` is copied to
-    `driver_rows`."""
+    `driver_rows`. A plain class, not a NamedTuple: it is made at every simulate's
+    import, where a NamedTuple costs 0.1 ms."""
 
-    labels: tuple[str, ...]
-    row: np.ndarray
-    col: np.ndarray
-    axis: np.ndarray
-    coef: np.ndarray
-    driver_rows: np.ndarray
-    driver_cols: np.ndarray
+    __slots__ = ("labels", "row", "col", "axis", "coef", "driver_rows", "driver_cols")
+
+    def __init__(self, labels: tuple[str, ...], row: np.ndarray, col: np.ndarray,
+                 axis: np.ndarray, coef: np.ndarray, driver_rows: np.ndarray,
+                 driver_cols: np.ndarray):
+        self.labels, self.row, self.col, self.axis = labels, row, col, axis
+        self.coef, self.driver_rows, self.driver_cols = coef, driver_rows, driver_cols
 
 
 def _layout(model: Model) -> _Layout:

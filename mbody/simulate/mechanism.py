@@ -21,7 +21,6 @@ Every figure here comes from one call of the compiled core over all the samples
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import NamedTuple
 
 import numpy as np
 
@@ -62,8 +61,16 @@ def constrained_dynamics(model: Model, known: Mapping[str, float] | None = None,
     return ConstrainedDynamics(known, rate)
 
 
-class SampleFigures(NamedTuple):
-    """A run's figures at its K output samples (`sample_figures`)."""
+class SampleFigures:
+    """A run's figures at its K output samples (`sample_figures`). A plain class, as
+    `ConservedFigures`."""
+
+    __slots__ = ("reactions", "lengths", "position_drift", "velocity_drift")
+
+    def __init__(self, reactions: np.ndarray | None, lengths: np.ndarray | None,
+                 position_drift: float, velocity_drift: float):
+        self.reactions, self.lengths = reactions, lengths
+        self.position_drift, self.velocity_drift = position_drift, velocity_drift
 
     reactions: np.ndarray | None
     """(K, m) every reaction value (N; N m), or None when not asked for."""
