@@ -258,14 +258,15 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
         # Python at each one (scipy's runs come back after every step anyway). A wall-time
         # budget is checked in Python, so such a run still comes back at every window.
         marking = max_wall is None and run.mark_windows(rate.width)
-        while run.status == "running":
+        status = run.status
+        while status == "running":
             limit = min(CHUNK_STEPS, max(1, check_at - steps))
             if max_steps is not None:
                 limit = min(limit, max(1, max_steps - steps))
             k, msg = run.advance(t_end if marking else min(rate.next, t_end), limit, t_eval,
                                  k, Y)
-            steps = run.steps
-            if run.status == "failed" or not math.isfinite(float(run.y.sum())):
+            steps, status = run.steps, run.status
+            if status == "failed" or not math.isfinite(float(run.y.sum())):
                 culprit = _blame_expression(varying, run.t, run.t, run.step_size)
                 raise MbodyError(
                     f"the integration stopped at t = {run.t:.6g} s: "
@@ -276,8 +277,9 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
                 rate.steps_at(run.marks())
             else:
                 rate.step(run.t, steps)
-            bar.update(run.t)
-            if run.status == "running":
+            if progress:
+                bar.update(run.t)
+            if status == "running":
                 if steps >= check_at:  # the whole run's cost, predicted from its start
                     check_at = 2 * steps
                     _predict(model, method, run.t, t_end, steps, rate, max_steps,
@@ -304,7 +306,9 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     finally:
         bar.close()
     wall = time.perf_counter() - wall
-    stepping_time = wall if run.integration_time is None else run.integration_time
+    stepping_time = run.integration_time
+    if stepping_time is None:  # scipy's: the loop's wall time
+        stepping_time = wall
 
     # Y holds the stored samples from here: unit quaternions, and the planar angles set
     # to theirs (the projections turn q, not the angle carried beside it), in one pass
@@ -351,15 +355,14 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     }
     pose: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] = (
         (x[..., :2], v[..., :2], Y[:, 13 * n:], w[..., 2]) if planar else (x, v, q, w))
+    shapes, colors = _memo(model, ("appearance",), lambda: (
+        tuple(model.bodies[b].shape for b in model.body_names),
+        tuple(model.bodies[b].color for b in model.body_names)))
     traj = Trajectory(
         t_eval, *pose, body_names=model.body_names, dimension=model.dimension,
         model_name=model.name, model_file=model.file, reaction_labels=stored,
         reactions=values, info=info, mass=np.array(model.mass), inertia=np.array(model.J),
-        shapes=_memo(model, ("shapes",), lambda: tuple(
-            model.bodies[b].shape for b in model.body_names)),
-        colors=_memo(model, ("colors",), lambda: tuple(
-            model.bodies[b].color for b in model.body_names)),
-        gravity=np.array(model.gravity), model_yaml=model_text(model))
+        shapes=shapes, colors=colors, gravity=np.array(model.gravity), model_yaml=model_text(model))
     series, drift, spin_peak = _drift(run_model, t_eval, Y, dynamics is None,
                                       ideal_joints=mechanism, lengths=lengths)
     traj.series.update(series)  # run_model: `known` is among its reactions
