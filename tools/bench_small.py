@@ -28,7 +28,8 @@ equivalents are exact) and the slider-crank (a closed loop, coasting without its
 the mass-centre position error at t = 10 s against a tight reference, and the wall time
 each engine needs for a given error (the whole ``mbody.simulate`` call over a range of
 tolerances, later calls in this process and the first call in a fresh process apart;
-MuJoCo's RK4 over a range of fixed steps, stepped in C by ``mujoco.rollout``); and the
+MuJoCo's RK4 over a range of fixed steps, stepped in C by ``mujoco.rollout``, its own
+first call in a fresh process shown beside for context); and the
 open double pendulum against Exudyn's minimal-coordinate kinematic tree with its DOPRI5
 (``pip install -e ".[bench]"``; skipped when Exudyn is not installed).
 Before timing anything, each MuJoCo equivalent is checked against
@@ -699,6 +700,37 @@ def first_call(file: str, without_loads: bool, t_end: float, rtol: float, atol: 
     return float(out[0]), float(out[1])
 
 
+MUJOCO_FIRST_CALL = """
+import sys, time
+sys.path.insert(0, {tools!r})
+import mujoco
+import bench_small as B
+model = B.load_without_loads({file!r}) if {without!r} else B.load({file!r})
+eq = B.mujoco_equivalent(model, timestep={h!r}, integrator="RK4")
+m = mujoco.MjModel.from_xml_string(eq.xml)
+d = mujoco.MjData(m)
+t1 = time.perf_counter()
+B.mujoco_run(m, d, eq, {t_end!r})
+t2 = time.perf_counter()
+print(t2 - t1)
+"""
+
+
+def mujoco_first_call(file: str, without_loads: bool, h: float, t_end: float) -> float:
+    """Wall time of MuJoCo's first `mujoco_run` in a fresh process (mujoco imported, the
+    model compiled and its MjData made before it, as mbody's first call has mbody
+    imported and the model loaded): its own start-up (the rollout module, first calls)
+    counted, as mbody's is."""
+    import subprocess
+
+    code = MUJOCO_FIRST_CALL.format(tools=str(Path(__file__).resolve().parent), file=file,
+                                    without=without_loads, h=h, t_end=t_end)
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True, cwd=ROOT, env=env).stdout.split()
+    return float(out[-1])
+
+
 def accuracy(label: str, file: str, quick: bool, repeat: int) -> None:
     import mujoco
 
@@ -725,7 +757,7 @@ def accuracy(label: str, file: str, quick: bool, repeat: int) -> None:
         wall, x = best_once(lambda r=rtol: mbody_run(model, t_end, r, r * 1e-2), repeat)
         mb.append((rtol, wall, float(np.abs(x - x_ref).max())))
         first.append(first_call(file, without, t_end, rtol, rtol * 1e-2)[0])
-    mj = []
+    mj, mj_first = [], []
     previous = mujoco.get_mju_user_warning()
     mujoco.set_mju_user_warning(lambda text: None)  # a diverged run is shown in the table
     try:
@@ -736,6 +768,7 @@ def accuracy(label: str, file: str, quick: bool, repeat: int) -> None:
             mujoco_run(m, d, eq, 10 * h)  # warm (the first rollout call sets itself up)
             wall, x = best_once(lambda m=m, d=d: mujoco_run(m, d, eq, t_end), repeat)
             mj.append((h, wall, float(np.abs(x - x_ref).max()), int(round(t_end / h))))
+            mj_first.append(mujoco_first_call(file, without, h, t_end))
     finally:
         mujoco.set_mju_user_warning(previous)
     close = min((e, h) for h, _, e, _ in mj)
@@ -744,21 +777,23 @@ def accuracy(label: str, file: str, quick: bool, repeat: int) -> None:
     gap = " " * 8
     print(f"  {'mbody DOP853':<37}{gap}MuJoCo RK4")
     print(f"  {'rtol':>7} {'first s':>8} {'wall s':>8} {'error m':>9}{gap}{'h s':>7} "
-          f"{'steps':>8} {'wall s':>8} {'error m':>9}")
+          f"{'steps':>8} {'first s':>8} {'wall s':>8} {'error m':>9}")
     for k in range(max(len(mb), len(mj))):
         left = (f"  {mb[k][0]:7.0e} {first[k]:8.4f} {mb[k][1]:8.4f} {mb[k][2]:9.1e}"
                 if k < len(mb) else " " * 37)
         right = ""
         if k < len(mj):
             err = f"{mj[k][2]:9.1e}" if math.isfinite(mj[k][2]) else f"{'diverged':>9}"
-            right = f"{mj[k][0]:7.0e} {mj[k][3]:8d} {mj[k][1]:8.4f} {err}"
+            right = f"{mj[k][0]:7.0e} {mj[k][3]:8d} {mj_first[k]:8.4f} {mj[k][1]:8.4f} {err}"
         print(left + gap + right)
     print(f"  wall s: best of {repeat} later calls in this process; first s: the first call "
           f"in a fresh process (mbody imported and the model loaded before it); mbody: one "
           f"whole simulate() call (samples at 0 and {t_end:g} s only), atol = rtol / 100; "
-          "MuJoCo: from mj_resetData, stepped in C by mujoco.rollout")
+          "MuJoCo: from mj_resetData, stepped in C by mujoco.rollout; its first s: the "
+          "first call in a fresh process (mujoco imported, the model compiled before it)")
     print(f"  {'error ≤':>9} {'mbody s':>11} {'MuJoCo s':>9} {'ratio':>7}  "
-          f"≤{ACCURACY_TARGET:g}×   {'first s':>11} {'ratio':>7}  ≤{ACCURACY_TARGET:g}×")
+          f"≤{ACCURACY_TARGET:g}×   {'first s':>11} {'ratio':>7}  ≤{ACCURACY_TARGET:g}×"
+          f"   {'MuJoCo first s':>14} {'first/first':>11}")
     for target in (1e-4, 1e-6, 1e-8):
         tb, bb = time_to_reach([(w, e) for _, w, e in mb], target)
         tf, bf = time_to_reach([(f, e) for f, (_, _, e) in zip(first, mb, strict=True)],
@@ -766,11 +801,17 @@ def accuracy(label: str, file: str, quick: bool, repeat: int) -> None:
         tm, bm = time_to_reach([(w, e) for _, w, e, _ in mj], target)
         text, verdict = ratio_verdict(tb, bb, tm, bm)
         ftext, fverdict = ratio_verdict(tf, bf, tm, bm)
+        tmf, bmf = time_to_reach([(f, e) for f, (_, _, e, _) in zip(mj_first, mj,
+                                                                   strict=True)], target)
+        fftext, _ = ratio_verdict(tf, bf, tmf, bmf)
         print(f"  {target:9.0e} {fmt(tb, bb):>11} {fmt(tm, bm):>9} {text:>7}  {verdict:<5}"
-              f"{fmt(tf, bf):>11} {ftext:>7}  {fverdict}", flush=True)
+              f"{fmt(tf, bf):>11} {ftext:>7}  {fverdict:<5}{fmt(tmf, bmf):>14} {fftext:>11}",
+              flush=True)
     print("  time to an error: log-log interpolation between the two runs around it "
           "(≤: an upper bound, the cheapest run or the one after a diverged run; "
-          "ratio = mbody / MuJoCo; ?: the bound leaves the target undecided)")
+          "ratio = mbody / MuJoCo; ?: the bound leaves the target undecided). The "
+          "verdicts compare both of mbody's calls with MuJoCo's later calls; first/first, "
+          "mbody's first call over MuJoCo's own, is for context")
 
 
 def fmt(t: float, b: str) -> str:
