@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+import inspect
 import json
 from pathlib import Path
 
@@ -10,6 +12,7 @@ import pytest
 
 import mbody
 from mbody.cli import main
+from mbody.equations.constraints import ConstraintJacobian
 from mbody.errors import TrajectoryFileError
 from mbody.simulate.trajectory import FORMAT, FORMAT_VERSION, Trajectory
 
@@ -143,3 +146,29 @@ def test_cli_bad_trajectory_exits_2_without_traceback(run, tmp_path, capsys):
         err = capsys.readouterr().err
         assert err.startswith("mbody: error: ") and str(f) in err and "Traceback" not in err
     assert not (tmp_path / "x.png").exists()
+
+
+@pytest.mark.parametrize("cls", [Trajectory, ConstraintJacobian])
+def test_the_written_out_init_takes_the_fields_in_order(cls):
+    """`Trajectory` and `ConstraintJacobian` write their dataclass __init__ out (the
+    generated one costs its compile at every import): it must take exactly the fields, in
+    their order, with the same defaults, so that a field added later cannot be missed."""
+    params = list(inspect.signature(cls.__init__).parameters.values())[1:]
+    fields = dataclasses.fields(cls)
+    assert [p.name for p in params] == [f.name for f in fields]
+    for p, f in zip(params, fields, strict=True):
+        if f.default is not dataclasses.MISSING:
+            assert p.default == f.default, f.name
+        elif f.default_factory is not dataclasses.MISSING:
+            assert p.default is None, f.name  # None: the field's default_factory
+        else:
+            assert p.default is inspect.Parameter.empty, f.name
+    made = cls(*[object() for f in fields if f.default is dataclasses.MISSING
+                 and f.default_factory is dataclasses.MISSING])
+    for f in fields:  # each default_factory field made, as the generated __init__ would
+        if f.default_factory is not dataclasses.MISSING:
+            want = f.default_factory()
+            assert type(getattr(made, f.name)) is type(want), f.name
+            assert np.shape(getattr(made, f.name)) == np.shape(want), f.name
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        setattr(made, fields[0].name, 0)
