@@ -26,7 +26,7 @@ MOVED = {
     "text": "present.text", "latex": "present.latex", "draw": "present.draw",
     "report": "present.report", "plot": "present.plot", "animate": "present.animate",
     "export": "io.export", "atomic": "util.atomic", "io.atomic": "util.atomic",
-    "io.jsontext": "util.jsontext",
+    "io.jsontext": "util.jsontext", "io.interop.yaml_write": "model.yaml_write",
     "commands": "cli.common", "commands.animate": "cli.animate", "commands.core": "cli.core",
     "commands.draw": "cli.draw", "commands.export": "cli.export",
     "commands.mechanism": "cli.mechanism", "commands.sim": "cli.sim",

@@ -434,6 +434,18 @@ def test_stiff_spring_is_stopped_early_and_a_stiff_integrator_finishes_it(tmp_pa
     assert traj.info["steps"] < 5000 and abs(traj.position[-1, 0, 0] - 1.0) < 1e-6
 
 
+def test_a_long_smooth_run_is_stopped_early_as_long_not_stiff(capsys):
+    """A pendulum at rest takes 16 steps a simulated second: a run of 1e5 s needs 1.6
+    million steps, over the budget, and the reason given is its length, not stiffness."""
+    code, out, err = run(capsys, "simulate", MODELS / "pendulum.yaml", "--t-end", "1e5",
+                         "--no-progress")
+    assert code == 2 and out == ""
+    assert "the run is long, and its cost grows with --t-end; a stiff integrator would " \
+        "not help. To go on: a shorter --t-end, a looser --rtol (e.g. 1e-6), or raise " \
+        "--max-steps." in err
+    assert "stiff (time scales" not in err
+
+
 def test_an_implicit_method_whose_jacobian_breaks_down_says_what_to_try(tmp_path, capsys):
     path = tmp_path / "spring.yaml"
     path.write_text(STIFF_SPRING)

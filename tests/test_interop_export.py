@@ -35,9 +35,9 @@ from mbody.cli.app import main
 from mbody.errors import ModelError
 from mbody.io.interop.mjcf import read_mjcf
 from mbody.io.interop.mjcf_write import spanning_tree, to_mjcf
-from mbody.io.interop.yaml_write import dump_document
 from mbody.model import State
 from mbody.model.loader import load_text
+from mbody.model.yaml_write import dump_document
 
 mujoco = pytest.importorskip("mujoco")
 

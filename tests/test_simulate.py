@@ -10,6 +10,7 @@ from scipy.special import ellipj, ellipkinc
 
 import mbody
 from mbody.cli import main
+from mbody.simulate import summary
 from mbody.util.spatial import quat_to_matrix
 
 MODELS = Path(__file__).resolve().parent.parent / "models"
@@ -344,8 +345,12 @@ def test_initial_joint_errors_are_the_runs_own_start_each_time():
                       s0.velocity.copy(), s0.omega.copy(), 0.0)
     first = mbody.simulate(model, 0.1, 10).info["initial_joint_errors"]
     assert first == []
-    moved = mbody.simulate(model, 0.1, 10, initial=off).info["initial_joint_errors"]
+    run = mbody.simulate(model, 0.1, 10, initial=off)
+    moved = run.info["initial_joint_errors"]
     assert moved and all("phi" in e for e in moved)
+    # said among the run's warnings too (Python users read those), once in the summary
+    assert run.info["warnings"][0].startswith("the initial state breaks joint constraints")
+    assert summary(run).count("the initial state breaks joint constraints") == 1
     first.append("changed by the caller")
     again = mbody.simulate(model, 0.1, 10).info["initial_joint_errors"]
     assert again == []
@@ -381,3 +386,12 @@ def test_a_repeated_run_is_the_first_one_again(name):
         np.testing.assert_array_equal(getattr(second, k), v)
     other = mbody.simulate(model, 0.25, 20)
     assert other.t[-1] == 0.25 and len(other.t) == 6
+
+
+def test_a_method_named_in_the_wrong_case_gets_its_name_suggested():
+    model = mbody.load(MODELS / "pendulum.yaml")
+    with pytest.raises(mbody.MbodyError, match=r"unknown integrator 'dop853'; did you mean "
+                                               r"'DOP853'\?"):
+        mbody.simulate(model, 1.0, method="dop853")
+    with pytest.raises(mbody.MbodyError, match=r"did you mean 'LSODA'\?"):
+        mbody.simulate(model, 1.0, method="lsoda")

@@ -172,3 +172,49 @@ def test_the_written_out_init_takes_the_fields_in_order(cls):
             assert np.shape(getattr(made, f.name)) == np.shape(want), f.name
     with pytest.raises(dataclasses.FrozenInstanceError):
         setattr(made, fields[0].name, 0)
+
+
+def test_a_run_with_values_set_rebuilds_the_model_it_ran(tmp_path, capsys):
+    """`--set` (Model.with_values) changes the model after its text was read: the saved
+    run lists the values (info["model_values"]) and `Trajectory.model` sets them again,
+    so the rebuilt model runs the same motion."""
+    path = tmp_path / "run.npz"
+    code = main(["simulate", str(MODELS / "pendulum.yaml"), "--t-end", "1", "--no-progress",
+                 "--set", "bodies.rod.mass=5", "--set", "bodies.rod.mass=4", "-o", str(path)])
+    capsys.readouterr()
+    assert code == 0
+    traj = Trajectory.load(path)
+    assert traj.info["model_values"] == [["bodies.rod.mass", 4]]  # the last --set wins
+    model = traj.model()
+    assert float(model.mass[0]) == 4.0 == float(traj.mass[0])
+    again = mbody.simulate(model, t_end=1)
+    np.testing.assert_array_equal(again.position, traj.position)
+    plain = mbody.load(MODELS / "pendulum.yaml")
+    assert "model_values" not in mbody.simulate(plain, t_end=1).info
+    twice = plain.with_values({"bodies.rod.mass": 5}).with_values({"bodies.rod.mass": 3})
+    run = mbody.simulate(twice, t_end=0.1)
+    assert len(run.info["model_values"]) == 2 and float(run.model().mass[0]) == 3.0
+
+
+@pytest.mark.parametrize("file", ["robots/two_link_arm.urdf", "robots/two_link_arm.xml"])
+def test_a_run_of_an_mjcf_or_urdf_model_carries_its_yaml_form(file):
+    """An MJCF or URDF model's run carries the model's YAML form (not the XML, which
+    `loads` cannot read): `Trajectory.model` rebuilds it and runs the same motion."""
+    model = mbody.load(MODELS / file)
+    traj = mbody.simulate(model, 0.5, 10)
+    assert traj.model_yaml.startswith("# Converted by mbody") and "<" not in traj.model_yaml
+    rebuilt = traj.model()
+    assert rebuilt.body_names == model.body_names
+    again = mbody.simulate(rebuilt, 0.5, 10)
+    # the YAML form writes every number so that it reads back as the same double
+    np.testing.assert_allclose(again.position, traj.position, rtol=0, atol=1e-12)
+
+
+def test_a_run_of_a_text_or_a_dictionary_carries_it():
+    """A model given as text (`loads`) or as a dictionary keeps it for its runs."""
+    text = (MODELS / "pendulum.yaml").read_text(encoding="utf-8")
+    for model in (mbody.loads(text), mbody.load(mbody.load(MODELS / "pendulum.yaml")
+                                                .source.read().data)):
+        traj = mbody.simulate(model, 0.5, 10)
+        again = mbody.simulate(traj.model(), 0.5, 10)
+        np.testing.assert_array_equal(again.position, traj.position)

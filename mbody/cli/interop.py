@@ -74,8 +74,8 @@ def convert(a: argparse.Namespace) -> int:
 
             write_mjcf(model, a.output, source=a.source)
         else:
-            from mbody.io.interop.yaml_write import write_document
             from mbody.model.loader import load_text, read_file
+            from mbody.model.yaml_write import write_document
 
             document = load_text(read_file(a.source), a.source).data
             write_document(document, a.output, source=a.source)
@@ -90,7 +90,7 @@ def convert(a: argparse.Namespace) -> int:
 
             write_mjcf(model, a.output, source=a.source)
         else:
-            from mbody.io.interop.yaml_write import write_document
+            from mbody.model.yaml_write import write_document
 
             write_document(getattr(document, "data", document), a.output, source=a.source,
                            notes=notes)
@@ -120,7 +120,7 @@ def _convert_with_values(a: argparse.Namespace, src_format: str, out_format: str
 
         write_mjcf(model, a.output, source=a.source)
     else:
-        from mbody.io.interop.yaml_write import write_document
+        from mbody.model.yaml_write import write_document
 
         src = model.source
         assert src is not None  # a model read from a file keeps its source

@@ -35,7 +35,7 @@ from mbody.kernel import _core
 from mbody.model.model import Model
 from mbody.simulate.axes import world_series
 from mbody.simulate.peaks import peaks
-from mbody.simulate.trajectory import Trajectory, keep_planar_angles, model_text
+from mbody.simulate.trajectory import Trajectory, keep_planar_angles, model_text, model_values
 from mbody.solve.kinematics import (
     CLOSE_RTOL,
     KinematicsError,
@@ -203,6 +203,9 @@ def _trajectory(model: Model, t: np.ndarray, Y: np.ndarray, OUT: np.ndarray,
         shapes=tuple(model.bodies[b].shape for b in model.body_names),
         colors=tuple(model.bodies[b].color for b in model.body_names),
         gravity=np.array(model.gravity), model_yaml=model_text(model))
+    values_set = model_values(model)
+    if values_set:  # what Trajectory.model sets again on the text it carries
+        run_info["model_values"] = values_set
     traj.series.update(_body_points(model, x, q, points))
     traj.series.update(driver_series(model, t))
     run_info["drivers"] = driver_facts(model)

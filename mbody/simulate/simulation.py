@@ -48,10 +48,7 @@ from mbody.simulate.kinematic import summary as kinematic_summary
 from mbody.simulate.mechanism import BAUMGARTE_RATE, conserved_figures, sample_figures
 from mbody.simulate.projection import STAGE_PIVOT_RTOL, JointProjection
 from mbody.simulate.stepping import CORE, IMPLICIT, start
-from mbody.simulate.trajectory import (
-    Trajectory,
-    model_text,
-)
+from mbody.simulate.trajectory import Trajectory, model_text, model_values
 from mbody.solve.dynamics import Dynamics, StateDerivative, accelerations
 
 _T = TypeVar("_T")
@@ -353,6 +350,9 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
                                "samples divided by |q|",
         **joint_info, "reaction_axes": axes,
     }
+    values_set = model_values(model)
+    if values_set:  # what Trajectory.model sets again on the text it carries
+        info["model_values"] = values_set
     pose: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] = (
         (x[..., :2], v[..., :2], Y[:, 13 * n:], w[..., 2]) if planar else (x, v, q, w))
     shapes, colors = _memo(model, ("appearance",), lambda: (
@@ -362,7 +362,8 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
         t_eval, *pose, body_names=model.body_names, dimension=model.dimension,
         model_name=model.name, model_file=model.file, reaction_labels=stored,
         reactions=values, info=info, mass=np.array(model.mass), inertia=np.array(model.J),
-        shapes=shapes, colors=colors, gravity=np.array(model.gravity), model_yaml=model_text(model))
+        shapes=shapes, colors=colors, gravity=np.array(model.gravity),
+        model_yaml=_memo(model, ("text",), lambda: model_text(model)))
     series, drift, spin_peak = _drift(run_model, t_eval, Y, dynamics is None,
                                       ideal_joints=mechanism, lengths=lengths)
     traj.series.update(series)  # run_model: `known` is among its reactions
@@ -370,8 +371,24 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     if mechanism and run_model.drivers is not None and len(run_model.drivers.names):
         assert rhs.unknowns is not None
         driven_figures(run_model, traj, Y, lam, rhs.unknowns)
-    info["warnings"] = [w for w in (rate.warning(), _spin_warning(traj, spin_peak)) if w]
+    broken = info.get("initial_joint_errors")
+    info["warnings"] = [w for w in (_broken_start(broken, projecting) if broken else None,
+                                    rate.warning(), _spin_warning(traj, spin_peak)) if w]
     return traj
+
+
+BROKEN_START = "the initial state breaks joint constraints: "
+"""How the warning of a start off its joints begins (`_broken_start`)."""
+
+
+def _broken_start(broken: list[str], projected: bool) -> str:
+    """The warning of a run whose start breaks the joints `broken` (their errors as text,
+    `joint_errors`), as its joints were held: by projection, or by Baumgarte's terms."""
+    return (BROKEN_START + ", ".join(broken)
+            + ("; the run starts from the nearest state that keeps them (projected), so "
+               "energy and the motion are not those of the state as written" if projected
+               else "; the stabilisation pulls the joints together, so energy and the "
+               "early motion are not those of the model as written"))
 
 
 PROJECTION_TEXT = ("coordinate projection after every step: positions by Gauss-Newton, "
@@ -417,9 +434,10 @@ def _predict(model: Model, method: str, t: float, t_end: float, steps: int, rate
 
 
 def _cost_cause(model: Model, steps_per_second: float, method: str) -> tuple[str, str]:
-    """Why the steps are short, and what helps: a fast spin (which every integrator must
+    """Why the run costs so much, and what helps: a fast spin (which every integrator must
     follow), inertias too far apart for double precision (rounding noise that no
-    integrator steps over), or stiffness (which an implicit integrator steps over)."""
+    integrator steps over), stiffness (which an implicit integrator steps over), or
+    nothing but its length (steps no shorter than smooth motion takes)."""
     w = np.linalg.norm(np.asarray(model.initial.omega), axis=1) if model.n else np.zeros(0)
     i = int(np.argmax(w)) if len(w) else 0
     spin = float(w[i]) if len(w) else 0.0
@@ -441,6 +459,11 @@ def _cost_cause(model: Model, steps_per_second: float, method: str) -> tuple[str
                 "no integrator steps over it.",
                 "a realistic smallest moment (a thin rod's m r^2 / 2 with its real radius), "
                 "a shorter --t-end")
+    if steps_per_second <= MODEST_STEP_RATE:
+        return (f"The steps are not short ({steps_per_second:.4g} per simulated second, as "
+                "smooth motion takes at these tolerances): the run is long, and its cost "
+                "grows with --t-end; a stiff integrator would not help.",
+                "a shorter --t-end, a looser --rtol (e.g. 1e-6)")
     fastest = f"{spin:.3g} rad/s" if spin > 0 else "none"
     cause = (f"That is far more steps than the motion explains (the fastest spin at the "
              f"start: {fastest}): the model is stiff (time scales far apart, such as a very "
@@ -451,6 +474,11 @@ def _cost_cause(model: Model, steps_per_second: float, method: str) -> tuple[str
     return (cause + ", and an explicit integrator must resolve the fastest of them.",
             "a stiff integrator (--method LSODA, BDF or Radau), a shorter --t-end")
 
+
+MODEST_STEP_RATE = 2000.0
+"""Steps per simulated second up to which a run's cost is put down to its length: the
+shipped models take 14 (a free body) to 920 (the slider-crank turning 16 times a second)
+at the default tolerances; a stiff model (a spring of 1e8 N/m on a gram) takes about 1e5."""
 
 INERTIA_SPREAD = 1e10
 """Ratio of a body's largest to smallest principal moment beyond which rounding noise
@@ -925,15 +953,10 @@ def summary(traj: Trajectory, path: str | os.PathLike[str] | None = None) -> str
                      f"largest joint error |phi| {i['joint_position_drift']:.1e}, "
                      f"|G^T v| {i['joint_velocity_drift']:.1e}")
         broken = i.get("initial_joint_errors") or []
-        if broken:
-            lines.append("warning: the initial state breaks joint constraints: "
-                         + ", ".join(broken)
-                         + ("; the run starts from the nearest state that keeps them "
-                            "(projected), so energy and the motion are not those of the "
-                            "state as written"
-                            if i["joint_stabilisation"] == PROJECTION_TEXT else
-                            "; the stabilisation pulls the joints together, so energy and "
-                            "the early motion are not those of the model as written"))
+        if broken and not any(w.startswith(BROKEN_START) for w in i.get("warnings", ())):
+            # a run saved before the warning was among info["warnings"]
+            lines.append("warning: " + _broken_start(
+                broken, i["joint_stabilisation"] == PROJECTION_TEXT))
     if traj.dimension == cv.SPATIAL:
         lines.append(f"quaternion norm error before renormalising: "
                      f"{i['quaternion_norm_error']:.1e}")

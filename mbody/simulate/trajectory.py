@@ -34,6 +34,7 @@ import numpy as np
 from mbody import conventions as cv
 from mbody.errors import TrajectoryFileError
 from mbody.model.model import State, count, loads
+from mbody.model.yaml_write import dump_document
 from mbody.util.atomic import atomic_path
 from mbody.util.spatial import planar_quat
 
@@ -297,7 +298,9 @@ class Trajectory:
         return orbital + self.spin_angular_momentum()
 
     def model(self):
-        """Rebuild the `Model` from the YAML text stored with the run.
+        """Rebuild the `Model` from the YAML text stored with the run, with the values
+        that were set on it (``info["model_values"]``: `Model.with_values`, ``--set``)
+        set again: the model the run integrated.
 
         Returns
         -------
@@ -306,12 +309,18 @@ class Trajectory:
         Raises
         ------
         TrajectoryFileError
-            The trajectory carries no YAML text (the model did not come from a file).
+            The trajectory carries no YAML text (its model was built in code).
         """
         if not self.model_yaml:
             raise TrajectoryFileError("this trajectory does not carry its model's YAML text "
-                                      "(the model did not come from a file)")
-        return loads(self.model_yaml, self.model_file or "<trajectory>")
+                                      "(the model was built in code, not read from a file, "
+                                      "a text or a dictionary)")
+        model = loads(self.model_yaml, self.model_file or "<trajectory>")
+        for path, value in self.info.get("model_values", ()):
+            # one at a time, as set: each setting reads the text again with every value
+            # before it, so a later value of a path wins as it did
+            model = model.with_values({path: value})
+        return model
 
     # -- files -------------------------------------------------------------------------
     def save(self, path: str | os.PathLike[str]) -> Path:
@@ -472,23 +481,35 @@ def _jsonable(x: Any) -> Any:
 
 
 def model_text(model) -> str:
-    """The model file's text, when the model came from a readable file ('' otherwise):
-    what a trajectory keeps so that it can be drawn and checked without the file. The
-    text the model was read from when it kept it (`Model.source`: every hand-written
-    file; its line ends read as a text file reads them; kept even if the file has gone
-    since), else the file as it is now."""
-    if not model.file or model.file.startswith("<"):
-        return ""
+    """The model as mbody YAML text, what a trajectory keeps so that it can be drawn,
+    checked and rebuilt (`Trajectory.model`) without the file: the text it was read from
+    (a YAML file, or a text given to `loads`; its line ends read as a text file reads them;
+    kept even if the file has gone since), the YAML form of its document (a dictionary, an
+    MJCF or URDF file: `mbody.model.yaml_write`), or a large file's text as it is now; ''
+    for a model built in code. The values set on the model since it was read are not in
+    it: `model_values` lists them."""
     source = getattr(model, "source", None)
-    if source is not None and source.text is not None and source.file == model.file:
+    if source is not None and source.text is not None:
         # neither read nor looked up again: a read, or even a stat, costs as much as the
         # rest of a short run's bookkeeping
         return _text_lines(source.text)
+    if source is not None and source.document is not None:
+        return dump_document(source.document.data, source=source.file)
+    if not model.file or model.file.startswith("<"):
+        return ""
     p = Path(model.file)
     try:
         return p.read_text(encoding="utf-8") if p.is_file() else ""
     except (OSError, UnicodeDecodeError):
         return ""
+
+
+def model_values(model) -> list[list[Any]]:
+    """The values set on the model since it was read (`Model.with_values`, ``--set``), in
+    order, as [path, value] pairs: what `Trajectory.model` sets again on the kept text
+    (``info["model_values"]``)."""
+    source = getattr(model, "source", None)
+    return [[path, value] for path, value in source.values] if source is not None else []
 
 
 @functools.lru_cache(maxsize=16)
