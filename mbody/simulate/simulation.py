@@ -478,7 +478,8 @@ def _cost_cause(model: Model, steps_per_second: float, method: str) -> tuple[str
 MODEST_STEP_RATE = 2000.0
 """Steps per simulated second up to which a run's cost is put down to its length: the
 shipped models take 14 (a free body) to 920 (the slider-crank turning 16 times a second)
-at the default tolerances; a stiff model (a spring of 1e8 N/m on a gram) takes about 1e5."""
+at the default tolerances; the stiff spring of tests/test_hardening.py (1e9 N/m on 1 kg)
+about 160 000."""
 
 INERTIA_SPREAD = 1e10
 """Ratio of a body's largest to smallest principal moment beyond which rounding noise
