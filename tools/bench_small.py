@@ -705,6 +705,7 @@ import sys, time
 sys.path.insert(0, {tools!r})
 import mujoco
 import bench_small as B
+mujoco.set_mju_user_warning(lambda text: None)  # a diverged run is shown in the table
 model = B.load_without_loads({file!r}) if {without!r} else B.load({file!r})
 eq = B.mujoco_equivalent(model, timestep={h!r}, integrator="RK4")
 m = mujoco.MjModel.from_xml_string(eq.xml)
