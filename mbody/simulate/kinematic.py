@@ -35,7 +35,13 @@ from mbody.kernel import _core
 from mbody.model.model import Model
 from mbody.simulate.axes import world_series
 from mbody.simulate.peaks import peaks
-from mbody.simulate.trajectory import Trajectory, keep_planar_angles, model_text, model_values
+from mbody.simulate.trajectory import (
+    Trajectory,
+    appearance,
+    keep_planar_angles,
+    model_text,
+    model_values,
+)
 from mbody.solve.kinematics import (
     CLOSE_RTOL,
     KinematicsError,
@@ -195,14 +201,13 @@ def _trajectory(model: Model, t: np.ndarray, Y: np.ndarray, OUT: np.ndarray,
         "backward_error": float(stats[:, _core.ST_BERR].max(initial=0.0)),
         "redundant": int((stats[:, _core.ST_MU] - stats[:, _core.ST_RANK]).max(initial=0)),
     }
+    shapes, colors = appearance(model)
     traj = Trajectory(
         t, *pose, body_names=model.body_names, dimension=model.dimension,
         model_name=model.name, model_file=model.file, reaction_labels=labels,
         reactions=values, info=run_info, mass=np.array(model.mass),
         inertia=np.array(model.J),
-        shapes=tuple(model.bodies[b].shape for b in model.body_names),
-        colors=tuple(model.bodies[b].color for b in model.body_names),
-        gravity=np.array(model.gravity), model_yaml=model_text(model))
+        shapes=shapes, colors=colors, gravity=np.array(model.gravity), model_yaml=model_text(model))
     values_set = model_values(model)
     if values_set:  # what Trajectory.model sets again on the text it carries
         run_info["model_values"] = values_set

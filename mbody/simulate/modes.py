@@ -18,7 +18,7 @@ import numpy as np
 from mbody.equations.generalized import evaluate, state_with_velocities
 from mbody.errors import MbodyError
 from mbody.model.model import State
-from mbody.simulate.trajectory import Trajectory
+from mbody.simulate.trajectory import Trajectory, appearance
 from mbody.solve.configure import move, project
 from mbody.solve.linearize import Linearization, Mode
 
@@ -127,11 +127,10 @@ def mode_trajectory(lin: Linearization, k: int, *, periods: float = 3.0, fps: fl
             "warnings": [] if mode.kind == "oscillation" else
             [f"mode {k} does not oscillate ({mode.kind}): its shape is played back and forth "
              "at 1 Hz"]}
+    shapes, colors = appearance(model)
     return Trajectory.from_states(
         t, np.array(pos), np.array(quat), np.array(vel), np.array(om),
         body_names=model.body_names, dimension=model.dimension, model_name=model.name,
         model_file=model.file, info=info, mass=np.array(model.mass),
-        inertia=np.array(model.J),
-        shapes=tuple(model.bodies[b].shape for b in model.body_names),
-        colors=tuple(model.bodies[b].color for b in model.body_names),
+        inertia=np.array(model.J), shapes=shapes, colors=colors,
         gravity=np.array(model.gravity))

@@ -48,7 +48,7 @@ from mbody.simulate.kinematic import summary as kinematic_summary
 from mbody.simulate.mechanism import BAUMGARTE_RATE, conserved_figures, sample_figures
 from mbody.simulate.projection import STAGE_PIVOT_RTOL, JointProjection
 from mbody.simulate.stepping import CORE, IMPLICIT, start
-from mbody.simulate.trajectory import Trajectory, model_text, model_values
+from mbody.simulate.trajectory import Trajectory, appearance, model_text, model_values
 from mbody.solve.dynamics import Dynamics, StateDerivative, accelerations
 
 _T = TypeVar("_T")
@@ -355,9 +355,7 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
         info["model_values"] = values_set
     pose: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] = (
         (x[..., :2], v[..., :2], Y[:, 13 * n:], w[..., 2]) if planar else (x, v, q, w))
-    shapes, colors = _memo(model, ("appearance",), lambda: (
-        tuple(model.bodies[b].shape for b in model.body_names),
-        tuple(model.bodies[b].color for b in model.body_names)))
+    shapes, colors = _memo(model, ("appearance",), lambda: appearance(model))
     traj = Trajectory(
         t_eval, *pose, body_names=model.body_names, dimension=model.dimension,
         model_name=model.name, model_file=model.file, reaction_labels=stored,

@@ -504,6 +504,13 @@ def model_text(model) -> str:
         return ""
 
 
+def appearance(model) -> tuple[tuple[dict | None, ...], tuple[str | None, ...]]:
+    """(shapes, colors): each body's drawing shape and colour as the file gives them (None:
+    the default), in body order, what a trajectory keeps to be drawn without the file."""
+    bodies = [model.bodies[b] for b in model.body_names]
+    return tuple(b.shape for b in bodies), tuple(b.color for b in bodies)
+
+
 def model_values(model) -> list[list[Any]]:
     """The values set on the model since it was read (`Model.with_values`, ``--set``), in
     order, as [path, value] pairs: what `Trajectory.model` sets again on the kept text
