@@ -31,6 +31,7 @@ import numpy as np
 
 from mbody.equations.joints import ReactionColumns, reaction_columns
 from mbody.model.model import Model, State
+from mbody.util.frozen import Frozen
 
 if TYPE_CHECKING:
     import scipy.sparse as sp
@@ -49,8 +50,8 @@ def gamma(model: Model, state: State, cols: ReactionColumns,
     return cols.gamma
 
 
-@dataclass(frozen=True, eq=False, init=False, repr=False)  # no ==: its fields are arrays
-class ConstraintJacobian:
+@dataclass(eq=False, init=False, repr=False)  # no ==: its fields are arrays; Frozen
+class ConstraintJacobian(Frozen):
     """The velocity-level constraint Jacobian of the joints, Φ_v = Gᵀ, with labels.
 
     matrix: (m, N) sparse; row k is the constraint that reaction component `rows[k]`

@@ -36,6 +36,7 @@ from mbody.errors import TrajectoryFileError
 from mbody.model.model import State, count, loads
 from mbody.model.yaml_write import dump_document
 from mbody.util.atomic import atomic_path
+from mbody.util.frozen import Frozen
 from mbody.util.spatial import planar_quat
 
 FORMAT = "mbody-trajectory"
@@ -48,8 +49,8 @@ _TEXTS = ("model_name", "model_file", "model_yaml")
 _SERIES = "series/"
 
 
-@dataclass(frozen=True, eq=False, init=False, repr=False)  # __init__ and __repr__ below
-class Trajectory:
+@dataclass(eq=False, init=False, repr=False)  # __init__ and __repr__ below; Frozen
+class Trajectory(Frozen):
     """The motion of every body over time, as `simulate` returns it.
 
     Arrays have a leading time axis of K samples and a body axis of n bodies (file order);
