@@ -144,6 +144,14 @@ def test_spin_about_a_non_principal_axis_is_not_steady():
     lin = mbody.linearize(model)
     assert not lin.steady and lin.stable is None
     assert "not an equilibrium or a steady motion" in lin.warnings[0]
+    # the spin's components are quasi-velocities: their rate is one prime, not two
+    assert "body.w" in lin.warnings[0] and "' = " in lin.warnings[0]
+    assert "'' = " not in lin.warnings[0]
+
+
+def test_a_moving_pendulum_names_its_angle_acceleration_with_two_primes():
+    lin = mbody.linearize(mbody.load("models/double_pendulum.yaml"))
+    assert any(".angle'' = " in w for w in lin.warnings)
 
 
 # -- a closed four-bar ------------------------------------------------------------------------

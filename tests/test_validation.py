@@ -288,7 +288,9 @@ def test_planar_inertia_is_a_scalar(model_file):
 def test_planar_inertia_must_be_positive(model_file):
     # (inertia: 0 is a particle, see tests/test_particles.py)
     text = PLANAR.replace("inertia: 0.5", "inertia: -0.5")
-    problem(model_file, text, "inertia: »-0.5", "bodies[0].inertia", "expected a number > 0")
+    i = problem(model_file, text, "inertia: »-0.5", "bodies[0].inertia",
+                "expected a number > 0")
+    assert "'inertia: 0' makes a particle" in i.hint  # 0 is allowed: the hint says so
 
 
 def test_spatial_inertia_is_not_a_scalar(model_file):
@@ -327,6 +329,7 @@ def test_inertia_tensor_must_be_positive_definite(model_file):
     i = problem(model_file, text, "[[2", "bodies[0].inertia", "not positive definite",
                 "principal moments (-1, 4, 5)")
     assert "every principal moment must be > 0" in i.hint
+    assert "'inertia: 0' makes a particle" in i.hint
 
 
 def test_zero_principal_moment_is_not_positive_definite(model_file):

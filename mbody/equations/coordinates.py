@@ -94,6 +94,12 @@ class Coordinate:
     def rate_unit(self) -> str:
         return f"{self.unit}/s"
 
+    @property
+    def acceleration_label(self) -> str:
+        """``O.angle''`` (a coordinate's second derivative), ``S.w1'`` (a quasi-velocity's
+        rate: it is itself a velocity)."""
+        return f"{self.label}'" if self.quasi else f"{self.label}''"
+
 
 @dataclass(frozen=True, eq=False)
 class CoordinateSet:

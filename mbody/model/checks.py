@@ -161,9 +161,10 @@ class Checker:
         return True
 
     def number(self, path: Path_, value: Any, *, positive: bool = False,
-               nonneg: bool = False, scale: bool = False) -> float | None:
+               nonneg: bool = False, scale: bool = False, sign_hint: str = "") -> float | None:
         """A finite number within ±`MAX_MAGNITUDE`; with `scale` (a mass or a size, which
-        is divided by) also 0 or at least `MIN_MAGNITUDE` in magnitude."""
+        is divided by) also 0 or at least `MIN_MAGNITUDE` in magnitude. `sign_hint`: what
+        to say when `positive` or `nonneg` refuses it."""
         if isinstance(value, Unrepresentable):  # 1e400, 1e-400, a 5 000-digit integer
             self._out_of_range(path, value.shown, value.large)  # never silently 0 or inf
             return None
@@ -185,10 +186,10 @@ class Checker:
             self._too_small(path, _show(value))
             return None
         if positive and x <= 0:
-            self.err(path, f"expected a number > 0, got {_show(value)}")
+            self.err(path, f"expected a number > 0, got {_show(value)}", sign_hint)
             return None
         if nonneg and x < 0:
-            self.err(path, f"expected a number >= 0, got {_show(value)}")
+            self.err(path, f"expected a number >= 0, got {_show(value)}", sign_hint)
             return None
         return x
 

@@ -469,9 +469,14 @@ def _zero_inertia(value: Any) -> bool:
     return False
 
 
+PARTICLE_HINT = "'inertia: 0' makes a particle: a point mass, which nothing turns"
+"""What an inertia refused for its sign also allows (docs/model-format: Particles)."""
+
+
 def _inertia(c: Checker, path: Path_, value: Any) -> np.ndarray | None:
     if c.dim == cv.PLANAR:
-        I = c.number(path, value, positive=True) if not isinstance(value, list) else None
+        I = c.number(path, value, positive=True, sign_hint=PARTICLE_HINT) \
+            if not isinstance(value, list) else None
         if isinstance(value, list):
             c.err(path, "a planar body's inertia is the scalar I_G about its mass centre "
                   f"(kg m^2), got {_kind(value)}")
@@ -498,7 +503,8 @@ def _inertia(c: Checker, path: Path_, value: Any) -> np.ndarray | None:
         J, principal = np.diag(v), v
     if np.any(principal <= 0):
         c.err(path, "the inertia tensor is not positive definite "
-              f"(principal moments {_fmt(principal)})", "every principal moment must be > 0")
+              f"(principal moments {_fmt(principal)})",
+              "every principal moment must be > 0; " + PARTICLE_HINT)
         return None
     a, b, d = np.sort(principal)
     if not realisable(principal):

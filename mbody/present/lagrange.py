@@ -31,12 +31,6 @@ def _row(coef: np.ndarray, names: list[str], rhs: float) -> str:
     return f"{terms or '0'} = {num(rhs, DIGITS)}"
 
 
-def acceleration_name(label: str, quasi: bool) -> str:
-    """``O.angle''`` (a coordinate's second derivative), ``S.w1'`` (a quasi-velocity's
-    rate)."""
-    return f"{label}'" if quasi else f"{label}''"
-
-
 NOISE = 1e-12
 """A printed number below this fraction of the terms that make it is rounding: shown 0."""
 
@@ -81,7 +75,7 @@ def generalized_text(g: Generalized) -> str:
     out.append("M q'' = f: the Newton-Euler rows multiplied by T^T, where v = T q' + v_e; the "
                f"reactions drop out (T^T G = 0 for {len(held)} held component"
                f"{'s' if len(held) != 1 else ''})")
-    names = [acceleration_name(c.label, c.quasi) for c in cs.items]
+    names = [c.acceleration_label for c in cs.items]
     effort_rows = {r: e for e, r in g.coordinate_set.efforts}
     for i in range(k):
         row = _row(M_shown[i], names, float(f_shown[i]))

@@ -463,7 +463,7 @@ def linearize(model: Model, state: State | None = None, *,
         residual = out[at.resid:at.resid + at.k]
         worst = int(np.argmax(np.abs(residual)))
         warnings += (f"not an equilibrium or a steady motion: the generalized "
-                     f"accelerations here are not 0 ({cs.labels[worst]}'' = "
+                     f"accelerations here are not 0 ({cs.items[worst].acceleration_label} = "
                      f"{residual[worst]:.4g} {cs.items[worst].unit}/s^2); the eigenvalues "
                      "are those of the tangent system at this instant",)
     j = int(info[_core.LI_UNSTEADY]) - 1
