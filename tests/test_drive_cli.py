@@ -55,6 +55,9 @@ def test_no_equilibrium_is_exit_1_with_a_hint(tmp_path):
     assert "no equilibrium" in p.stdout and p.stderr.startswith("mbody: cannot solve: ")
     assert "start from a pose nearer one" in p.stderr
     assert "Traceback" not in p.stderr
+    # the constant torque cancels nothing: the residual, relative to its terms, stays 1
+    assert "the loads never balanced" in p.stdout
+    assert "generalized force was 1 of the size of the terms it sums" in p.stdout
 
 
 def test_solve_in_world_axes_satisfies_each_bodys_newton_law():

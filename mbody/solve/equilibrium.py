@@ -66,8 +66,10 @@ class Equilibrium:
 
     def __str__(self) -> str:
         if not self.found:
-            return (f"no equilibrium found in {self.iterations} Newton steps (the "
-                    f"generalized forces fell to {self.residual:.2g} of their terms at best)")
+            return (f"no equilibrium found in {self.iterations} Newton steps: the loads "
+                    f"never balanced (at best the largest generalized force was "
+                    f"{self.residual:.2g} of the size of the terms it sums; 0 is balance, "
+                    "1 no cancelling at all)")
         k = self.stiffness
         if not len(k):
             verdict = ("no free coordinate (the drivers prescribe every degree of freedom): "
