@@ -150,3 +150,25 @@ def test_simulate_on_driven_models(tmp_path):
     assert "energy check: the drivers' power" in p.stdout
     p = mbody("plot", run, "-o", tmp_path / "fly.png")
     assert p.returncode == 0 and (tmp_path / "fly.png").stat().st_size > 10_000
+
+
+def test_check_says_which_velocities_the_drivers_rates_set(tmp_path):
+    """The double pendulum at rest in its file, its top pin driven by θ₁ = 30° + 0.5 sin 3t:
+    the assembly gives the upper rod θ₁' = 1.5 rad/s, and the lower rod the rate of least
+    kinetic energy, θ₂' = −M₁₂/M₂₂ θ₁' with M₁₂ = m L (L/2) cos(θ₁ − θ₂) and
+    M₂₂ = I_G + m (L/2)² = m L²/3 (uniform 1 kg, 0.5 m rods at 30° and 45°)."""
+    text = (ROOT / "models/double_pendulum.yaml").read_text()
+    f = tmp_path / "shaken.yaml"
+    f.write_text(text.rstrip() + "\ndrivers:\n  - {name: shake, joint: O, "
+                 "angle: \"30 deg + 0.5*sin(3*t)\"}\n")
+    p = mbody("check", f)
+    assert p.returncode == 0, p.stderr
+    line = next(x for x in p.stdout.splitlines() if x.startswith("assembled velocities"))
+    m, L, w1 = 1.0, 0.5, 1.5
+    w2 = -(m * L * L / 2 * math.cos(math.radians(30 - 45))) / (m * L * L / 3) * w1
+    assert f"upper {L / 2 * w1:g} m/s, {w1:g} rad/s (the file's 0 m/s, 0 rad/s)" in line
+    shown = float(line.split("lower ")[1].split(" rad/s")[0].split(", ")[1])
+    assert shown == pytest.approx(w2, rel=1e-5)  # printed to 6 digits
+    # without drivers nothing changes, and no such line is printed
+    plain = mbody("check", "models/double_pendulum.yaml")
+    assert "assembled velocities" not in plain.stdout

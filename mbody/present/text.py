@@ -101,6 +101,10 @@ def model_summary(model: Model, topo: Topology) -> str:
         moved = assembly_moves(model)
         out.append("assembled pose (every joint and driver holds at t = 0): "
                    + ("; ".join(moved) if moved else "the file's pose already did"))
+        changed = assembly_velocity_changes(model)
+        if changed:  # the drivers' rates, or velocities the joints did not allow
+            out.append("assembled velocities (every joint's and driver's rate holds at "
+                       "t = 0; the change of least kinetic energy): " + "; ".join(changed))
     out.append("")
     out.append(graph_summary(model, topo))
     for w in model.warnings:
@@ -119,6 +123,28 @@ def assembly_moves(model: Model) -> list[str]:
     return [f"{name} moved {dk * 1e3:.3g} mm, turned {ak:.3g} deg"
             for name, dk, ak in zip(model.body_names, d.tolist(), turned.tolist(), strict=True)
             if dk > 1e-12 or ak > 1e-10]
+
+
+def assembly_velocity_changes(model: Model) -> list[str]:
+    """Each body whose velocity or angular velocity the assembly changed, with the new and
+    the file's values, in words (planar: the spin about z, signed; spatial: magnitudes)."""
+    before = model.file_state
+    if before is None:
+        return []
+    now = model.initial
+    planar = model.dimension == cv.PLANAR
+
+    def speeds(s: State, i: int) -> str:
+        w = s.omega[i][2] if planar else np.linalg.norm(s.omega[i])
+        return f"{_n(float(np.linalg.norm(s.velocity[i])))} m/s, {_n(float(w))} rad/s"
+
+    out = []
+    for i, name in enumerate(model.body_names):
+        dv = float(np.linalg.norm(now.velocity[i] - before.velocity[i]))
+        dw = float(np.linalg.norm(now.omega[i] - before.omega[i]))
+        if dv > 1e-12 or dw > 1e-12:
+            out.append(f"{name} {speeds(now, i)} (the file's {speeds(before, i)})")
+    return out
 
 
 def pose_text(model: Model, state: State) -> str:
