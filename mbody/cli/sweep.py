@@ -20,10 +20,12 @@ def register(sub: argparse._SubParsersAction) -> None:
         "sweep", help="run a model over a grid of values (or random samples), on Dask",
         description="Vary values of the model file by path and run every case: a solve, "
         "the kinematic analysis with the reactions and driver efforts at each instant, a "
-        "simulation, or the natural frequencies. One row per case in --out: the varied "
-        "paths, then <quantity>:<label> columns (acceleration:, reaction:, final:, peak:, "
-        "frequency:) and error. Cases run on a local Dask cluster started for the command "
-        "(--workers), or on an existing one (--scheduler). An interrupted sweep resumes: "
+        "simulation, or the natural frequencies (with whether the state is an equilibrium "
+        "and stable, as mbody modes says). One row per case in --out: the varied paths, "
+        "then <quantity>:<label> columns (acceleration:, reaction:, final:, peak:, "
+        "frequency:; steady, stable) and error. Cases run on a local Dask cluster started "
+        "for the command (--workers), or on an existing one (--scheduler). An interrupted "
+        "sweep resumes: "
         "the same command runs only the cases not in --out yet.")
     s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
     s.add_argument("--set", dest="grid", action="append", default=[], required=True,
@@ -47,6 +49,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="kinematics: instants from 0 to the end, both included (default 101)")
     s.add_argument("--fps", type=bounded("samples per second", 0.0, 1e6, lo_open=True),
                    default=60.0, metavar="F", help="simulate: samples per second (default 60)")
+    s.add_argument("--equilibrium", action="store_true",
+                   help="modes: linearise each case about the static equilibrium nearest its "
+                   "initial pose, as mbody modes --equilibrium (Newton's method; stable or "
+                   "not); without it, about the initial state, which may not be one")
     s.add_argument("--out", "-o", dest="output", required=True, metavar="FILE",
                    help="the results: .csv or .parquet (an unfinished one resumes)")
     s.add_argument("--scheduler", metavar="ADDRESS",
@@ -79,6 +85,7 @@ def sweep(a: argparse.Namespace) -> int:
     from mbody.model.values import edits, entry_names
     from mbody.sweep import cluster
     from mbody.sweep.grid import parse_grid
+    from mbody.sweep.modes import not_steady_warning
     from mbody.sweep.runs import Job, Settings, check_settings, columns
     from mbody.sweep.table import Results, output_format
 
@@ -98,7 +105,7 @@ def sweep(a: argparse.Namespace) -> int:
     if a.t_end is not None:
         unit, x = a.t_end
         t_end, revs = (x, None) if unit == "s" else (None, x)
-    settings = Settings(kind, t_end, revs, a.steps, a.fps)
+    settings = Settings(kind, t_end, revs, a.steps, a.fps, a.equilibrium)
     check_settings(model, settings)
     results = Results(a.output, columns(model, settings), grid)
     todo = [k for k in range(len(grid)) if k not in results.rows]
@@ -118,6 +125,9 @@ def sweep(a: argparse.Namespace) -> int:
           + (f", {failed} failed (see their error column)" if failed else ""), file=say)
     if todo:
         print(report.text(), file=say)
+    warning = not_steady_warning(results.header, results.rows.values(), a.equilibrium)
+    if warning:
+        sys.stderr.write(f"mbody: warning: {warning}\n")
     if results.rows and failed == len(results.rows):  # nothing computed: say so, exit 1
         first = results.rows[min(results.rows)][-1]
         sys.stderr.write(f"mbody: cannot solve: every case failed; case {min(results.rows)}: "

@@ -7,7 +7,10 @@ output columns.
   previous one, then a solve at each (a driven mechanism's kinetostatics); columns
   ``final:<coordinate>`` and ``peak:<label>``.
 - ``simulate``: `mbody.simulate` to T; the same columns.
-- ``modes``: the natural frequencies about the initial state; ``frequency:<k>``.
+- ``modes``: the natural frequencies about the initial state (or, with `equilibrium`,
+  about the static equilibrium nearest it), and what ``mbody modes`` says with them;
+  columns ``frequency:<k>``, ``steady`` and ``stable`` (`mbody.sweep.modes`), and with
+  `equilibrium` the equilibrium's position coordinates ``equilibrium:<coordinate>``.
 
 ``final:`` is the last instant's position coordinate (planar ``x``, ``y`` in m and
 ``theta`` in rad, in (−π, π]; spatial ``x``, ``y``, ``z`` and the attitude's quaternion
@@ -71,6 +74,9 @@ class Settings:
         The ``kinematics`` run's instants, from 0 to the end (both included).
     fps : float
         The ``simulate`` run's samples per second.
+    equilibrium : bool
+        The ``modes`` run about the static equilibrium nearest each case's initial pose
+        (``mbody modes --equilibrium``), not about the initial state.
     """
 
     run: str = "solve"
@@ -78,6 +84,7 @@ class Settings:
     revolutions: float | None = None
     steps: int = 101
     fps: float = 60.0
+    equilibrium: bool = False
 
 
 @dataclass(frozen=True)
@@ -128,13 +135,22 @@ def final_values(model: Model, Y: np.ndarray) -> np.ndarray:
     return np.concatenate((x, q), axis=2).reshape(len(Y), -1)
 
 
+def pose_values(model: Model, state: State) -> np.ndarray:
+    """(len(final_labels),) the position coordinates of one state."""
+    Y = np.concatenate((state.position.ravel(), state.quaternion.ravel()))[None]
+    return final_values(model, Y)[0]
+
+
 def columns(model: Model, settings: Settings) -> list[str]:
     """The output columns of a run of `model` (module doc)."""
     if settings.run == "solve":
         return ([f"acceleration:{c}" for c in model.coordinates]
                 + [f"reaction:{r}" for r in model.reactions])
     if settings.run == "modes":
-        return [f"frequency:{k + 1}" for k in range(modes.mode_count(model))]
+        return ([f"frequency:{k + 1}" for k in range(modes.mode_count(model))]
+                + [modes.STEADY, modes.STABLE]
+                + ([f"{modes.POSE}{c}" for c in final_labels(model)]
+                   if settings.equilibrium else []))
     return ([f"final:{c}" for c in final_labels(model)]
             + [f"peak:{r}" for r in model.reactions])
 
@@ -154,6 +170,10 @@ def check_settings(model: Model, settings: Settings) -> None:
     """Refuse settings the model cannot run, before any case is."""
     if settings.run not in RUNS:
         raise MbodyError(f"unknown run {settings.run!r}; expected one of {', '.join(RUNS)}")
+    if settings.equilibrium and settings.run != "modes":
+        raise MbodyError(f"--equilibrium goes with --run modes (it linearises each case about "
+                         f"its static equilibrium); the {settings.run} run starts from each "
+                         "case's initial state")
     if settings.run in ("kinematics", "simulate"):
         if settings.t_end is None and settings.revolutions is None:
             raise MbodyError(f"the {settings.run} run needs --t-end (seconds, or '1 rev')")
@@ -434,7 +454,6 @@ def _per_model(ctx: Context, values: list[dict[str, Any]], one) -> tuple[np.ndar
 def _simulate(ctx: Context, model: Model, case: Case) -> np.ndarray:
     traj = simulate(model, t_end=_end(ctx, case), fps=ctx.job.settings.fps)
     last = traj.state(len(traj.t) - 1)
-    Y = np.concatenate((last.position.ravel(), last.quaternion.ravel()))[None]
     peaks = np.full(len(model.reactions), np.nan)
     labels = list(traj.reaction_labels)
     if labels and traj.reactions.size:
@@ -443,11 +462,18 @@ def _simulate(ctx: Context, model: Model, case: Case) -> np.ndarray:
         for i, r in enumerate(model.reactions):
             if r in where:
                 peaks[i] = mags[where[r]]
-    return np.concatenate((final_values(model, Y)[0], peaks))
+    return np.concatenate((pose_values(model, last), peaks))
 
 
 def _modes(ctx: Context, model: Model, case: Case) -> np.ndarray:
-    f = modes.frequencies(model)
-    row = np.full(ctx.width, np.nan)
-    row[:min(len(f), ctx.width)] = f[:ctx.width]
-    return row
+    """frequency:1 ... (NaN beyond the oscillations), steady, stable, then the
+    equilibrium's pose when the run is about it."""
+    lin = modes.linearization(model, ctx.job.settings.equilibrium)
+    k = len(lin.coordinates)
+    f = np.asarray(lin.frequencies, dtype=float)  # ascending, at most one a coordinate
+    row = np.full(k, np.nan)
+    row[:len(f)] = f
+    parts = [row, np.array(modes.verdict_values(lin))]
+    if ctx.job.settings.equilibrium:
+        parts.append(pose_values(model, lin.state))
+    return np.concatenate(parts)
