@@ -34,7 +34,7 @@ from mbody.errors import MbodyError, did_you_mean
 from mbody.kernel import _core
 from mbody.model.model import Model
 from mbody.simulate.axes import world_series
-from mbody.simulate.peaks import peaks
+from mbody.simulate.peaks import record_peaks, steady_rate
 from mbody.simulate.trajectory import (
     Trajectory,
     appearance,
@@ -239,8 +239,8 @@ def _trajectory(model: Model, t: np.ndarray, Y: np.ndarray, OUT: np.ndarray,
     series, balance = energy_balance(model, traj, Y, acc6, lam, energy)
     traj.series.update(series)
     run_info.update(balance)
-    run_info["peaks"] = peaks(model, traj)
     run_info["warnings"] = []
+    record_peaks(model, traj)
     return traj
 
 
@@ -249,7 +249,9 @@ def driven_figures(model: Model, traj: Trajectory, Y: np.ndarray, lam: np.ndarra
     """What a run of a model with drivers adds to `traj` (integrated by `mbody.simulate`:
     a partly driven mechanism): each driver's coordinate, its facts, the energy check
     (`energy_balance`, the accelerations and energy terms at the samples from one call of
-    the core) and the peaks. `Y` (K, state size) the samples, `lam` (K, m) the reactions."""
+    the core) and the peaks, with the warning of samples too sparse for them
+    (`record_peaks`: among ``info["warnings"]``). `Y` (K, state size) the samples, `lam`
+    (K, m) the reactions."""
     ws = workspace(model)
     t = traj.t
     K, n = len(t), model.n
@@ -266,7 +268,7 @@ def driven_figures(model: Model, traj: Trajectory, Y: np.ndarray, lam: np.ndarra
     for key in ("driver_power", "driver_work", "load_power", "load_work"):
         traj.series[key] = series[key]
     traj.info.update({k: v for k, v in balance.items() if k != "energy_initial"})
-    traj.info["peaks"] = peaks(model, traj)
+    record_peaks(model, traj)
 
 
 def driver_series(model: Model, t: np.ndarray) -> dict[str, np.ndarray]:
@@ -408,11 +410,8 @@ def revolution(model: Model) -> float | None:
     d = model.drivers
     if d is None or not len(d.names) or d.component[0] != "M":
         return None
-    rate = d.laws[0][1]
-    w = float(rate(0.0))
-    if w == 0.0 or not all(float(rate(t)) == w for t in (0.37, 1.1, 7.3)):
-        return None
-    return 2.0 * math.pi / abs(w)
+    w = steady_rate(d.laws[0][1], np.array([0.0, 0.37, 1.1, 7.3]))
+    return None if w is None else 2.0 * math.pi / abs(w)
 
 
 def summary(traj: Trajectory, path: str | None = None) -> str:
@@ -428,6 +427,7 @@ def summary(traj: Trajectory, path: str | None = None) -> str:
         lines.append(f"warning: {i['redundant']} redundant constraint(s): the reactions they "
                      "share are the minimum-norm ones")
     lines += driven_lines(traj)
+    lines.extend(f"warning: {w}" for w in i.get("warnings", ()))
     if path:
         lines.append(f"saved {path}")
     return "\n".join(lines)
