@@ -127,7 +127,9 @@ def kinematic_run(model: Model, t_end: float, fps: float, *, t_start: float = 0.
     -------
     Trajectory
         Every body's motion; `reactions` by `reaction_labels` (the drivers' efforts
-        among them); ``info`` with the Newton steps, the energy check and the peaks.
+        among them); ``info`` with the Newton steps, the energy check and the peaks,
+        and under ``info["warnings"]`` samples too sparse for those peaks
+        (`mbody.simulate.peaks.sampling_warning`).
 
     Raises
     ------
