@@ -191,7 +191,7 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     Trajectory
         The sampled motion, whose `info` holds the run facts and drift figures, and under
         ``info["warnings"]`` what looked wrong (a cost that exploded, a spin the frame
-        rate aliases).
+        rate aliases, samples too sparse for the drivers' motion to trust its peaks).
 
     Raises
     ------
@@ -370,8 +370,10 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
         assert rhs.unknowns is not None
         driven_figures(run_model, traj, Y, lam, rhs.unknowns)
     broken = info.get("initial_joint_errors")
+    # a run with drivers has its samples' warning already (driven_figures: record_peaks)
     info["warnings"] = [w for w in (_broken_start(broken, projecting) if broken else None,
-                                    rate.warning(), _spin_warning(traj, spin_peak)) if w]
+                                    rate.warning(), _spin_warning(traj, spin_peak)) if w
+                        ] + info.get("warnings", [])
     return traj
 
 

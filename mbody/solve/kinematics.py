@@ -20,6 +20,7 @@ efforts are what it takes (kinetostatics).
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 
@@ -68,10 +69,20 @@ def kinematics(model: Model, t: float = 0.0, *, start: State | None = None) -> S
 
     Raises
     ------
+    MbodyError
+        `t` is not a finite number.
     KinematicsError
         The loops cannot close at `t` (which joints, the drivers' values, the distance
         left).
     """
+    try:
+        t = float(t)
+    except (TypeError, ValueError):
+        raise MbodyError(f"t must be a finite number of seconds (the time the drivers' "
+                         f"laws are taken at), got {t!r}") from None
+    if not math.isfinite(t):
+        raise MbodyError(f"t must be a finite number of seconds (the time the drivers' "
+                         f"laws are taken at), got {t!r}")
     ws = workspace(model)
     state = model.initial if start is None else start
     unknowns = ws.unknowns({})  # every joint and driver holds
