@@ -1,0 +1,86 @@
+"""What a command line's leftover words were probably meant to be: a misspelt option
+(``--t_end`` for ``--t-end``, ``--know`` for ``--known``), an option of another command,
+or one positional argument too many. `mbody.cli.app` adds this to argparse's
+"unrecognized arguments" so that the message says what was expected, not only what was
+refused."""
+
+from __future__ import annotations
+
+import argparse
+import re
+from collections.abc import Mapping, Sequence
+
+from mbody.errors import closest
+
+_NUMBER = re.compile(r"-\.?\d")
+"""A leading minus before a digit is a negative number (a value), not an option."""
+
+
+def option_like(word: str) -> bool:
+    """Whether argparse would read `word` as an option string rather than a value."""
+    return (len(word) > 1 and word.startswith("-") and word != "--"
+            and not _NUMBER.match(word) and " " not in word)
+
+
+def unknown_options(command: argparse.ArgumentParser, words: Sequence[str]) -> list[str]:
+    """The words before ``--`` in `words` that look like options `command` does not have
+    (``--name=value`` and ``-ovalue`` are its own ``--name`` and ``-o``)."""
+    known = command._option_string_actions
+    out = []
+    for word in words:
+        if word == "--":
+            break
+        if option_like(word) and word.split("=", 1)[0] not in known and \
+                not (word[1] != "-" and word[:2] in known):
+            out.append(word)
+    return out
+
+
+def option_hint(command_name: str, command: argparse.ArgumentParser, word: str,
+                commands: Mapping[str, argparse.ArgumentParser]) -> str:
+    """For an unknown option string `word` of `command`: the closest of its own options
+    (`mbody.errors.closest`; an underscore is read as a hyphen), else the other commands
+    that have exactly that option, else ''."""
+    name = word.split("=", 1)[0]
+    spelt = name.replace("_", "-")
+    # compared without their dashes: every long option shares '--', which alone makes
+    # '--zqxw' "close" to '--q'; a long option is preferred to a short one of one letter
+    options = sorted(command._option_string_actions, key=lambda o: not o.startswith("--"))
+    bare: dict[str, str] = {}
+    for option in options:
+        bare.setdefault(option.lstrip("-"), option)
+    meant = closest(spelt.lstrip("-"), bare)
+    if meant is not None:
+        return f"did you mean '{bare[meant]}'?"
+    others = [c for c, p in commands.items()
+              if c != command_name and spelt in p._option_string_actions]
+    if others:
+        return f"{spelt} is an option of {', '.join(others)}, not of {command_name}"
+    return ""
+
+
+def unrecognized_message(command_name: str, command: argparse.ArgumentParser,
+                         extras: Sequence[str],
+                         commands: Mapping[str, argparse.ArgumentParser]) -> str:
+    """argparse's "unrecognized arguments: ..." with what each was probably meant to be:
+    a did-you-mean for a misspelt option, or, when every leftover is a positional word,
+    how many positional arguments the command takes."""
+    message = f"unrecognized arguments: {' '.join(extras)}"
+    options = unknown_options(command, extras)
+    if options:
+        hints = [(w, option_hint(command_name, command, w, commands)) for w in options]
+        found = [f"{w.split('=', 1)[0]}: {h}" if len(options) > 1 else h
+                 for w, h in hints if h]
+        if found:
+            return f"{message}; {'; '.join(found)}"
+        help_ = f"mbody {command_name} --help" if command_name else "mbody --help"
+        return f"{message}; {help_} lists the options"
+    takes = [str(a.metavar or a.dest) for a in command._get_positional_actions()
+             if a.nargs != argparse.PARSER]
+    extra = [w for w in extras if w != "--"]
+    if takes and extra:
+        n = len(extra)
+        many = "one argument" if n == 1 else f"{n} arguments"
+        return (f"{message}; {command_name or 'mbody'} takes {' '.join(takes)} "
+                f"(and options), so {many} too many")
+    return message
