@@ -10,6 +10,7 @@ probably meant, exit 2, never a traceback.
 
 from __future__ import annotations
 
+import math
 import os
 import subprocess
 import sys
@@ -139,4 +140,75 @@ def test_the_installed_command_end_to_end():
     assert p.stderr.startswith("usage: mbody simulate ")
     assert p.stderr.endswith("mbody: error: unrecognized arguments: --t_end 3; did you mean "
                              "'--t-end'?\n")
+
+
+# == units of a driver's speed (in the file, or set by --set) ======================
+
+@pytest.mark.parametrize(("typed", "meant"), [
+    ("600 RPM", "600 rpm"),     # the case only: the closest
+    ("10 HZ", "10 Hz"),
+    ("600 rps", "600 rev/s"),   # by spelling 'rpm', 60 times slower: an abbreviation
+    ("600 RPS", "600 rev/s"),
+    ("10 rad/sec", "10 rad/s"),
+])
+def test_a_misspelt_rate_unit_gets_a_did_you_mean(typed, meant):
+    import mbody
+
+    model = mbody.load(DRIVEN)
+    with pytest.raises(mbody.ModelError) as err:
+        model.with_values({"drivers.motor.speed": typed})
+    issue = err.value.issues[0]
+    assert issue.key == "drivers.motor.speed" and f"got '{typed}'" in issue.message
+    assert issue.hint.startswith(f"did you mean '{meant}'? units: rad/s, deg/s, rpm, "
+                                 "rev/min, rev/s, Hz; set by drivers.motor.speed=")
+    assert model.with_values({"drivers.motor.speed": meant}).drivers is not None
+
+
+def test_a_unit_with_nothing_close_lists_the_units_only():
+    import mbody
+
+    with pytest.raises(mbody.ModelError) as err:
+        mbody.load(DRIVEN).with_values({"drivers.motor.speed": "600 furlongs"})
+    assert err.value.issues[0].hint.startswith("units: rad/s, deg/s, rpm, rev/min, rev/s, "
+                                               "Hz; set by")
+
+
+def test_a_misspelt_rate_unit_on_the_command_line(capsys):
+    code, out, err = run(capsys, "kinematics", DRIVEN, "--set", "drivers.motor.speed=600 RPM")
+    assert (code, out) == (2, "")
+    assert err.startswith("mbody: error: ") and err.count("\n") == 1
+    assert "got '600 RPM' (did you mean '600 rpm'? units: " in err
+    assert "set by drivers.motor.speed=600 RPM;" in err
+
+
+def test_a_rate_out_of_range_names_the_value_as_typed_and_the_range(capsys):
+    """1e300 rpm is 1.05e299 rad/s: it was refused quoting the law mbody built from it
+    ('0.5235987755982988 + 1.0471975511965978e+299*t')."""
+    code, out, err = run(capsys, "kinematics", DRIVEN, "--set",
+                         "drivers.motor.speed=1e300 rpm")
+    assert (code, out) == (2, "")
+    rpm_max = 1e100 * 60 / (2 * math.pi)  # 9.55e100 rpm is 1e100 rad/s
+    assert err == ("mbody: error: models/slider_crank_driven.yaml:42:36: drivers.motor.speed:"
+                   " the rate '1e300 rpm' is out of range: expected a magnitude of at most "
+                   f"1e+100 rad/s ({rpm_max:.3g} rpm) (set by drivers.motor.speed=1e300 rpm; "
+                   "the file's own value is on line 42)\n").replace(
+                       "models/", f"{MODELS}/")
+
+
+@pytest.mark.parametrize(("typed", "ok"), [
+    ("9.5e100 rpm", True), ("9.6e100 rpm", False),  # the bound is on rad/s: 9.55e100 rpm
+    ("1e100 rad/s", True), ("-1.1e100 rad/s", False), ("1e400 rpm", False),
+    ("5.7e101 deg/s", True), ("5.8e101 deg/s", False),
+])
+def test_the_rate_bound_is_the_models_number_bound_in_rad_per_s(typed, ok):
+    import mbody
+
+    model = mbody.load(DRIVEN)
+    if ok:
+        rate = model.with_values({"drivers.motor.speed": typed}).drivers.speed[0]
+        assert 1e99 < abs(rate) <= 1e100
+    else:
+        with pytest.raises(mbody.ModelError, match="out of range: expected a magnitude of at "
+                           r"most 1e\+100 rad/s"):
+            model.with_values({"drivers.motor.speed": typed})
 
