@@ -10,6 +10,7 @@ probably meant, exit 2, never a traceback.
 
 from __future__ import annotations
 
+import json
 import math
 import os
 import subprocess
@@ -212,3 +213,74 @@ def test_the_rate_bound_is_the_models_number_bound_in_rad_per_s(typed, ok):
                            r"most 1e\+100 rad/s"):
             model.with_values({"drivers.motor.speed": typed})
 
+
+# == kinematics --t-end in turns, as sweep's ======================================
+
+def kinematic_json(capsys, *args) -> dict:
+    code, out, err = run(capsys, "kinematics", DRIVEN, "--json", *args)
+    assert code == 0, err
+    return json.loads(out)
+
+
+@pytest.mark.parametrize(("t_end", "t_start", "end", "samples"), [
+    ("1 rev", "0", 0.1, 361),          # 600 rpm: a turn is 60/600 = 0.1 s
+    ("2 revs", "0", 0.2, 721),
+    ("2.5 revolutions", "1", 1.25, 901),  # turns after --t-start
+    ("0.05", "0", 0.05, 181),          # seconds, as before
+])
+def test_kinematics_t_end_in_turns_of_the_driver(capsys, t_end, t_start, end, samples):
+    run_ = kinematic_json(capsys, "--t-end", t_end, "--t-start", t_start)
+    assert run_["t_end"] == pytest.approx(end, rel=1e-12)
+    assert run_["samples"] == samples  # 3600 per second: one a degree
+
+
+def test_one_turn_is_the_default_run(capsys):
+    assert kinematic_json(capsys, "--t-end", "1 rev") == kinematic_json(capsys)
+
+
+def test_turns_need_a_driver_at_a_constant_rate(capsys, tmp_path):
+    varying = tmp_path / "varying.yaml"
+    varying.write_text(DRIVEN.read_text().replace('speed: "600 rpm"',
+                                                  'angle: "30 deg + 60*t + sin(t)"'))
+    for model, extra in ((varying, []), (DRIVEN, ["--set", "drivers.motor.speed=0"])):
+        code, out, err = run(capsys, "kinematics", model, "--t-end", "1 rev", *extra)
+        assert (code, out) == (2, "")
+        assert err == ("mbody: error: --t-end 1 rev: this model's first driver does not "
+                       "turn at a constant rate, so a turn has no fixed time; give the end "
+                       "in seconds\n")
+
+
+@pytest.mark.parametrize(("typed", "expected"), [
+    ("1 turn", "expected a time in seconds from -1e9 to 1e9, or turns such as '1 rev', "
+               "got '1 turn'"),
+    ("0 rev", "expected a number of turns above 0 up to 1e6, got '0 rev'"),
+])
+def test_a_bad_end_time_says_which_forms_are_accepted(capsys, typed, expected):
+    code, _, err = run(capsys, "kinematics", DRIVEN, "--t-end", typed)
+    usage, message = usage_and_message(err)
+    assert code == 2 and usage.startswith("usage: mbody kinematics ")
+    assert message == f"argument --t-end: {expected}"
+
+
+def test_sweep_reads_its_end_time_with_the_same_parser():
+    from mbody.cli import build_parser
+
+    parse = build_parser().parse_args
+    base = ["sweep", str(DRIVEN), "--set", "bodies.rod.mass=1:2:2", "-o", "x.csv"]
+    assert parse([*base, "--t-end", "1 rev"]).t_end == ("rev", 1.0)
+    assert parse([*base, "--t-end", "0.5"]).t_end == ("s", 0.5)
+    assert parse(["kinematics", str(DRIVEN), "--t-end", "1 rev"]).t_end == ("rev", 1.0)
+
+
+@pytest.mark.parametrize(("args", "said", "t_end"), [
+    ([], "the default end (a turn)", 2 * math.pi / 1e-90),
+    (["--t-end", "2 rev"], "--t-end 2 rev", 2 * 2 * math.pi / 1e-90),
+])
+def test_an_end_in_turns_keeps_the_bound_of_seconds(capsys, args, said, t_end):
+    """A driver barely turning (1e-90 rad/s) turns once in 6.3e90 s; the run was started
+    and its position analysis diverged at t = 1.7e88 s."""
+    code, out, err = run(capsys, "kinematics", DRIVEN, "--set", "drivers.motor.speed=1e-90",
+                         *args)
+    assert (code, out) == (2, "")
+    assert err.startswith(f"mbody: error: {said} is t = {t_end:.3g} s (")
+    assert err.endswith("at most 1e+09 s: give --t-end in seconds\n")
