@@ -132,6 +132,27 @@ def test_an_extra_model_path_says_it_is_one_too_many(capsys):
                        "options), so one argument too many")
 
 
+@pytest.mark.parametrize(("args", "left", "quoted"), [
+    (("kinematics", DRIVEN, "--t-end", "1", "rev"), "rev", "--t-end '1 rev'"),
+    (("kinematics", DRIVEN, "--set", "drivers.motor.speed=600", "rpm"), "rpm",
+     "--set 'drivers.motor.speed=600 rpm'"),
+    (("sweep", DRIVEN, "--set", "drivers.motor.speed=300", "rpm:1200", "rpm:4", "-o", "x.csv"),
+     "rpm:1200 rpm:4", "--set 'drivers.motor.speed=300 rpm:1200 rpm:4'"),
+])
+def test_a_value_split_at_its_space_is_told_to_be_quoted(capsys, args, left, quoted):
+    code, _, err = run(capsys, *args)
+    assert code == 2
+    assert usage_and_message(err)[1] == (f"unrecognized arguments: {left}; a value with a "
+                                         f"space is one argument: quote it, {quoted}")
+
+
+def test_an_extra_model_after_an_options_value_is_not_taken_for_a_unit(capsys):
+    code, _, err = run(capsys, "check", PENDULUM, "--set", "bodies.rod.mass=2", PENDULUM)
+    assert code == 2
+    assert usage_and_message(err)[1].endswith("check takes MODEL (and options), so one "
+                                              "argument too many")
+
+
 def test_the_installed_command_end_to_end():
     """As a user runs it: a subprocess, exit 2, no traceback, the command's usage."""
     env = {k: v for k, v in os.environ.items() if k != "MBODY_DEBUG"}

@@ -144,7 +144,8 @@ class _Parser(argparse.ArgumentParser):
             commands = _commands(self)
             name = getattr(known, "command", None) or ""
             command = commands.get(name, self)
-            command.error(unrecognized_message(name, command, extras, commands))
+            command.error(unrecognized_message(name, command, extras, commands,
+                                               getattr(command, "_words", ())))
         return known
 
     def error(self, message: str):  # one paragraph, exit 2, as for any bad input

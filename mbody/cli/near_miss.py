@@ -59,12 +59,36 @@ def option_hint(command_name: str, command: argparse.ArgumentParser, word: str,
     return ""
 
 
+_UNIT = re.compile(r"[A-Za-z][A-Za-z/^²³]*(:.*)?")
+"""A unit after a number: 'rpm', 'rev', 'deg/s'; in a sweep's range, 'rpm:1200'."""
+
+
+def split_value(command: argparse.ArgumentParser, words: Sequence[str],
+                extras: Sequence[str]) -> str:
+    """A hint when leftovers are the rest of an option's value split by the shell at a
+    space before a unit (``--t-end 1 rev``, ``--set drivers.motor.speed=600 rpm``,
+    ``--set PATH=300 rpm:1200 rpm:4``), else ''."""
+    for i in range(2, len(words)):
+        action = command._option_string_actions.get(words[i - 2])
+        if (words[i] in extras and _UNIT.fullmatch(words[i]) and words[i - 1][-1:].isdigit()
+                and action is not None and action.nargs is None and action.option_strings):
+            j = i + 1
+            while (j < len(words) and ":" in words[j - 1] and words[j] in extras
+                   and not option_like(words[j])):  # a range goes on: 'rpm:1200 rpm:4'
+                j += 1
+            return (f"a value with a space is one argument: quote it, {words[i - 2]} "
+                    f"'{' '.join(words[i - 1:j])}'")
+    return ""
+
+
 def unrecognized_message(command_name: str, command: argparse.ArgumentParser,
                          extras: Sequence[str],
-                         commands: Mapping[str, argparse.ArgumentParser]) -> str:
+                         commands: Mapping[str, argparse.ArgumentParser],
+                         words: Sequence[str] = ()) -> str:
     """argparse's "unrecognized arguments: ..." with what each was probably meant to be:
     a did-you-mean for a misspelt option, or, when every leftover is a positional word,
-    how many positional arguments the command takes."""
+    the quotes a value with a space needs (`split_value`, from the command's `words`),
+    or how many positional arguments the command takes."""
     message = f"unrecognized arguments: {' '.join(extras)}"
     options = unknown_options(command, extras)
     if options:
@@ -78,6 +102,9 @@ def unrecognized_message(command_name: str, command: argparse.ArgumentParser,
     takes = [str(a.metavar or a.dest) for a in command._get_positional_actions()
              if a.nargs != argparse.PARSER]
     extra = [w for w in extras if w != "--"]
+    quote = split_value(command, words, extra)
+    if quote:
+        return f"{message}; {quote}"
     if takes and extra:
         n = len(extra)
         many = "one argument" if n == 1 else f"{n} arguments"
