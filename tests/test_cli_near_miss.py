@@ -115,6 +115,33 @@ def test_a_misspelt_top_level_option(capsys):
     assert message == "unrecognized arguments: --verison; did you mean '--version'?"
 
 
+CHOICES = ("(choose from 'check', 'assemble', 'solve', 'export', 'simulate', 'plot', "
+           "'kinematics', 'fbd', 'graph', 'report', 'animate', 'jacobian', 'equilibrium', "
+           "'verify', 'convert', 'lagrange', 'modes', 'sweep')")
+
+
+def test_an_option_before_the_command_is_told_to_go_after_it(capsys):
+    """`mbody --t-end 3 simulate M`: argparse takes '3' for the command."""
+    code, _, err = run(capsys, "--t-end", "3", "simulate", PENDULUM)
+    usage, message = usage_and_message(err)
+    assert code == 2 and usage.startswith("usage: mbody [-h]")
+    assert message == (f"argument COMMAND: invalid choice: '3' {CHOICES}; --t-end is an "
+                       "option of simulate, kinematics, animate, sweep; it goes after the "
+                       "command")
+    code, _, err = run(capsys, "--t-end=3", "simulate", PENDULUM)
+    usage, message = usage_and_message(err)
+    assert code == 2 and usage.startswith("usage: mbody simulate ")
+    assert message == ("unrecognized arguments: --t-end=3; --t-end goes after the command: "
+                       "mbody simulate ... --t-end=3")
+
+
+def test_a_misspelt_commands_own_options_are_not_called_misplaced(capsys):
+    code, _, err = run(capsys, "chek", "--set", "bodies.rod.mass=2", PENDULUM)
+    assert code == 2
+    assert usage_and_message(err)[1] == (f"argument COMMAND: invalid choice: 'chek' "
+                                         f"{CHOICES}; did you mean 'check'?")
+
+
 def test_negative_numbers_and_words_after_a_double_dash_are_not_options(capsys):
     code, _, err = run(capsys, "check", PENDULUM, "-3", "--", "-x")
     assert code == 2

@@ -39,7 +39,7 @@ from mbody.cli.common import (
     byte_size,
     refuse_overwriting_inputs,
 )
-from mbody.cli.near_miss import unknown_options, unrecognized_message
+from mbody.cli.near_miss import options_hint, unknown_options, unrecognized_message
 from mbody.errors import MbodyError, ModelError, UnknownReactionsError, did_you_mean
 from mbody.model.loader import MAX_BYTES, max_bytes_limit
 
@@ -165,6 +165,12 @@ class _Parser(argparse.ArgumentParser):
             hint = did_you_mean(bad.group(1), re.findall(r"'([^']*)'", bad.group(2)))
             if message.startswith("argument --format") and not hint:
                 hint = self._picture_format_hint(bad.group(1))
+            words = getattr(self, "_words", [])
+            before = words[:words.index(bad.group(1))] if bad.group(1) in words else []
+            misplaced = unknown_options(self, before)  # `mbody --t-end 3 simulate ...`
+            if message.startswith("argument COMMAND") and misplaced:
+                hint = "; ".join(filter(None, [hint, options_hint("", self, misplaced,
+                                                                  _commands(self))]))
             message += f"; {hint}" if hint else ""
         self.print_usage(sys.stderr)
         sys.stderr.write(f"mbody: error: {message}\n")

@@ -26,23 +26,43 @@ def unknown_options(command: argparse.ArgumentParser, words: Sequence[str]) -> l
     """The words before ``--`` in `words` that look like options `command` does not have
     (``--name=value`` and ``-ovalue`` are its own ``--name`` and ``-o``)."""
     known = command._option_string_actions
+    return [w for w in option_words(words) if w.split("=", 1)[0] not in known
+            and not (w[1] != "-" and w[:2] in known)]
+
+
+def option_words(words: Sequence[str]) -> list[str]:
+    """The words before ``--`` in `words` that argparse reads as option strings."""
     out = []
     for word in words:
         if word == "--":
             break
-        if option_like(word) and word.split("=", 1)[0] not in known and \
-                not (word[1] != "-" and word[:2] in known):
+        if option_like(word):
             out.append(word)
     return out
+
+
+def options_hint(command_name: str, command: argparse.ArgumentParser,
+                 options: Sequence[str], commands: Mapping[str, argparse.ArgumentParser]
+                 ) -> str:
+    """`option_hint` of each of `options` (named when there are several), or where the
+    options are listed when none has one."""
+    hints = [(w, option_hint(command_name, command, w, commands)) for w in options]
+    found = [f"{w.split('=', 1)[0]}: {h}" if len(options) > 1 else h for w, h in hints if h]
+    if found:
+        return "; ".join(found)
+    return f"mbody {command_name + ' ' if command_name else ''}--help lists the options"
 
 
 def option_hint(command_name: str, command: argparse.ArgumentParser, word: str,
                 commands: Mapping[str, argparse.ArgumentParser]) -> str:
     """For an unknown option string `word` of `command`: the closest of its own options
     (`mbody.errors.closest`; an underscore is read as a hyphen), else the other commands
-    that have exactly that option, else ''."""
+    that have exactly that option, else ''. `command_name` '' is `mbody` itself, before
+    any command, and one of `command`'s own options unrecognized was given there."""
     name = word.split("=", 1)[0]
     spelt = name.replace("_", "-")
+    if name in command._option_string_actions:  # `mbody --t-end=3 simulate MODEL`
+        return f"{name} goes after the command: mbody {command_name} ... {word}"
     # compared without their dashes: every long option shares '--', which alone makes
     # '--zqxw' "close" to '--q'; a long option is preferred to a short one of one letter
     options = sorted(command._option_string_actions, key=lambda o: not o.startswith("--"))
@@ -54,8 +74,12 @@ def option_hint(command_name: str, command: argparse.ArgumentParser, word: str,
         return f"did you mean '{bare[meant]}'?"
     others = [c for c, p in commands.items()
               if c != command_name and spelt in p._option_string_actions]
+    owners = ("every command" if len(others) > 1 and len(others) == len(commands)
+              else ", ".join(others))
+    if others and command_name:
+        return f"{spelt} is an option of {owners}, not of {command_name}"
     if others:
-        return f"{spelt} is an option of {', '.join(others)}, not of {command_name}"
+        return f"{spelt} is an option of {owners}; it goes after the command"
     return ""
 
 
@@ -90,15 +114,9 @@ def unrecognized_message(command_name: str, command: argparse.ArgumentParser,
     the quotes a value with a space needs (`split_value`, from the command's `words`),
     or how many positional arguments the command takes."""
     message = f"unrecognized arguments: {' '.join(extras)}"
-    options = unknown_options(command, extras)
+    options = option_words(extras)  # argparse left them: unknown, or before the command
     if options:
-        hints = [(w, option_hint(command_name, command, w, commands)) for w in options]
-        found = [f"{w.split('=', 1)[0]}: {h}" if len(options) > 1 else h
-                 for w, h in hints if h]
-        if found:
-            return f"{message}; {'; '.join(found)}"
-        help_ = f"mbody {command_name} --help" if command_name else "mbody --help"
-        return f"{message}; {help_} lists the options"
+        return f"{message}; {options_hint(command_name, command, options, commands)}"
     takes = [str(a.metavar or a.dest) for a in command._get_positional_actions()
              if a.nargs != argparse.PARSER]
     extra = [w for w in extras if w != "--"]
