@@ -135,6 +135,14 @@ def test_an_option_before_the_command_is_told_to_go_after_it(capsys):
                        "mbody simulate ... --t-end=3")
 
 
+def test_an_option_without_a_command(capsys):
+    code, _, err = run(capsys, "--t-end")
+    usage, message = usage_and_message(err)
+    assert code == 2 and usage.startswith("usage: mbody [-h]")
+    assert message == ("unrecognized arguments: --t-end; --t-end is an option of simulate, "
+                       "kinematics, animate, sweep; it goes after the command")
+
+
 def test_a_misspelt_commands_own_options_are_not_called_misplaced(capsys):
     code, _, err = run(capsys, "chek", "--set", "bodies.rod.mass=2", PENDULUM)
     assert code == 2

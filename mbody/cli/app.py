@@ -98,9 +98,7 @@ def _commands(parser: argparse.ArgumentParser) -> dict[str, argparse.ArgumentPar
 def _subcommand(parser: argparse.ArgumentParser,
                 args: argparse.Namespace) -> argparse.ArgumentParser | None:
     """The parser of the command `args` were read by."""
-    sub = next((a for a in parser._actions if a.dest == "command"), None)
-    choices = getattr(sub, "choices", None) or {}
-    return choices.get(getattr(args, "command", None))
+    return _commands(parser).get(getattr(args, "command", None) or "")
 
 
 def _paths(value: object) -> list[str]:
@@ -153,7 +151,7 @@ class _Parser(argparse.ArgumentParser):
         # (`convert M --ouput F`, `mbody --verison`): name that too, it is often the cause
         unknown = unknown_options(self, getattr(self, "_words", []))
         if "required: COMMAND" in message and unknown:
-            message = unrecognized_message("", self, unknown, {})
+            message = unrecognized_message("", self, unknown, _commands(self))
         elif "required: COMMAND" in message:  # bare `mbody`: show what there is to do
             self.print_help(sys.stderr)
             raise SystemExit(EXIT_INPUT)
