@@ -116,7 +116,13 @@ class TrajectoryFileError(MbodyError):
 def did_you_mean(word: str, choices: Iterable[str]) -> str:
     """A 'did you mean ...?' hint for a misspelt name, or '' when nothing is close (a
     name that differs only in case is the closest: 'dop853' for 'DOP853')."""
+    close = closest(word, choices)
+    return f"did you mean '{close}'?" if close is not None else ""
+
+
+def closest(word: str, choices: Iterable[str]) -> str | None:
+    """The choice `word` was probably meant to be (`did_you_mean`'s), or None."""
     names = [str(c) for c in choices]
     same = [c for c in names if c.casefold() == str(word).casefold()]
     close = same or difflib.get_close_matches(str(word), names, n=1, cutoff=0.6)
-    return f"did you mean '{close[0]}'?" if close else ""
+    return close[0] if close else None

@@ -39,6 +39,7 @@ from mbody.cli.common import (
     byte_size,
     refuse_overwriting_inputs,
 )
+from mbody.cli.near_miss import options_hint, unknown_options, unrecognized_message
 from mbody.errors import MbodyError, ModelError, UnknownReactionsError, did_you_mean
 from mbody.model.loader import MAX_BYTES, max_bytes_limit
 
@@ -88,12 +89,16 @@ def _options(command: argparse.ArgumentParser, dest: str) -> list[str]:
             for a in command._actions if a.dest == dest]
 
 
+def _commands(parser: argparse.ArgumentParser) -> dict[str, argparse.ArgumentParser]:
+    """The sub-commands' parsers of `parser`, by name ({} when it has none)."""
+    sub = next((a for a in parser._actions if a.dest == "command"), None)
+    return dict(getattr(sub, "choices", None) or {})
+
+
 def _subcommand(parser: argparse.ArgumentParser,
                 args: argparse.Namespace) -> argparse.ArgumentParser | None:
     """The parser of the command `args` were read by."""
-    sub = next((a for a in parser._actions if a.dest == "command"), None)
-    choices = getattr(sub, "choices", None) or {}
-    return choices.get(getattr(args, "command", None))
+    return _commands(parser).get(getattr(args, "command", None) or "")
 
 
 def _paths(value: object) -> list[str]:
@@ -125,15 +130,45 @@ class _Parser(argparse.ArgumentParser):
         kwargs.setdefault("allow_abbrev", False)  # --know must not silently mean --known
         super().__init__(*args, **kwargs)
 
+    def parse_known_args(self, args=None, namespace=None):
+        self._words = list(sys.argv[1:] if args is None else args)  # for `error`
+        return super().parse_known_args(args, namespace)
+
+    def parse_args(self, args=None, namespace=None):
+        """As argparse's, but words no command took are reported by that command's
+        parser (its usage line) with what they were probably meant to be."""
+        known, extras = self.parse_known_args(args, namespace)
+        if extras:
+            commands = _commands(self)
+            name = getattr(known, "command", None) or ""
+            command = commands.get(name, self)
+            command.error(unrecognized_message(name, command, extras, commands,
+                                               getattr(command, "_words", ())))
+        return known
+
     def error(self, message: str):  # one paragraph, exit 2, as for any bad input
-        if "required: COMMAND" in message:  # bare `mbody`: show what there is to do
+        # argparse stops at a missing argument before it reports a misspelt option
+        # (`convert M --ouput F`, `mbody --verison`): name that too, it is often the cause
+        unknown = unknown_options(self, getattr(self, "_words", []))
+        if "required: COMMAND" in message and unknown:
+            message = unrecognized_message("", self, unknown, _commands(self))
+        elif "required: COMMAND" in message:  # bare `mbody`: show what there is to do
             self.print_help(sys.stderr)
             raise SystemExit(EXIT_INPUT)
+        elif message.startswith("the following arguments are required") and unknown:
+            name = self.prog.split()[-1]
+            message += "; also " + unrecognized_message(name, self, unknown, {})
         bad = re.search(r"invalid choice: '([^']*)' \(choose from (.*)\)", message)
         if bad:  # argparse of Python 3.11 offers no suggestion for a misspelt command
             hint = did_you_mean(bad.group(1), re.findall(r"'([^']*)'", bad.group(2)))
             if message.startswith("argument --format") and not hint:
                 hint = self._picture_format_hint(bad.group(1))
+            words = getattr(self, "_words", [])
+            before = words[:words.index(bad.group(1))] if bad.group(1) in words else []
+            misplaced = unknown_options(self, before)  # `mbody --t-end 3 simulate ...`
+            if message.startswith("argument COMMAND") and misplaced:
+                hint = "; ".join(filter(None, [hint, options_hint("", self, misplaced,
+                                                                  _commands(self))]))
             message += f"; {hint}" if hint else ""
         self.print_usage(sys.stderr)
         sys.stderr.write(f"mbody: error: {message}\n")

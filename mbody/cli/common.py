@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import functools
 import math
+import re
 from collections.abc import Callable, Iterable, Sequence
 from contextvars import ContextVar
 from typing import Any, TextIO
@@ -68,8 +69,6 @@ def byte_size(text: str) -> int:
 def number(x: float) -> str:
     """`x` as %g writes it, with exponents as people write them (1e9, 2.5e-13); an int
     below 10^12 in full, its thousands apart (10 000 000)."""
-    import re
-
     if isinstance(x, int) and abs(x) < 10**12:
         return f"{x:,}".replace(",", " ")
     x = float(x)
@@ -103,6 +102,39 @@ def bounded(what: str, lo: float, hi: float, *, integer: bool = False,
         return x
 
     parse.__name__ = what  # argparse names the type in some messages
+    return parse
+
+
+_TURNS = re.compile(r"\s*([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)\s*(rev|revs|revolutions?)\s*")
+TURNS_MAX = 1e6
+"""Most turns an end time may be given in (``--t-end '1e6 rev'``)."""
+
+
+def seconds_or_turns(lo: float, hi: float, *, lo_open: bool = False
+                     ) -> Callable[[str], tuple[str, float]]:
+    """An argparse type for an end time (``--t-end`` of kinematics and sweep): seconds
+    from `lo` to `hi` (as `bounded`), or turns of the mechanism's turning driver written
+    ``'1 rev'`` (also ``revs``, ``revolution(s)``), above 0 up to `TURNS_MAX`. Gives
+    ``("s", seconds)`` or ``("rev", turns)``; each command says which driver's turn."""
+    seconds = bounded("a time in seconds", lo, hi, lo_open=lo_open)
+
+    def parse(text: str) -> tuple[str, float]:
+        m = _TURNS.fullmatch(text)
+        if m:
+            x = float(m.group(1))
+            if not 0 < x <= TURNS_MAX:
+                raise argparse.ArgumentTypeError(
+                    f"expected a number of turns above 0 up to {number(TURNS_MAX)}, got "
+                    f"{text!r}")
+            return ("rev", x)
+        try:
+            return ("s", seconds(text))
+        except argparse.ArgumentTypeError as exc:  # bounded's "expected ..., got ..."
+            expected = str(exc).rsplit(", got ", 1)[0]
+            raise argparse.ArgumentTypeError(
+                f"{expected}, or turns such as '1 rev', got {text!r}") from None
+
+    parse.__name__ = "an end time"
     return parse
 
 

@@ -12,6 +12,7 @@ from mbody.cli.common import (
     bounded,
     load_model,
     output_stream,
+    seconds_or_turns,
 )
 from mbody.errors import MbodyError
 
@@ -30,10 +31,11 @@ def register(sub: argparse._SubParsersAction) -> None:
         "format plot, animate, export and report read. For a fully driven mechanism this "
         "is its motion; a partly driven one needs 'mbody simulate'.")
     s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
-    s.add_argument("--t-end", type=bounded("a number of seconds", -T_END_MAX, T_END_MAX),
-                   default=None, metavar="SECONDS",
-                   help="the last sample's time, s (default: one revolution of the first "
-                   "driver when it turns at a constant rate, else 1)")
+    s.add_argument("--t-end", type=seconds_or_turns(-T_END_MAX, T_END_MAX),
+                   default=None, metavar="T",
+                   help="the last sample's time, s, or turns after --t-start of the first "
+                   "driver when it turns at a constant rate ('1 rev', as sweep's --t-end) "
+                   "(default: one such turn, else 1 s)")
     s.add_argument("--t-start", type=bounded("a number of seconds", -T_END_MAX, T_END_MAX),
                    default=0.0, metavar="SECONDS", help="the first sample's time, s "
                    "(default 0)")
@@ -73,6 +75,29 @@ def parse_points(pairs: list[str]) -> dict[str, tuple[str, list[float]]]:
     return out
 
 
+def end_time(given: tuple[str, float] | None, t_start: float, turn: float | None) -> float:
+    """The last sample's time (s): `given` by --t-end in seconds or in turns of `turn`
+    s each (the first driver's, when it turns at a constant rate), else one turn, else
+    1 s, after `t_start`. An end in turns is held to --t-end's bound in seconds."""
+    from mbody.cli.sim import T_END_MAX
+
+    if given is not None and given[0] == "s":
+        return given[1]
+    if turn is None:
+        if given is None:
+            return t_start + 1.0
+        raise MbodyError(f"--t-end {given[1]:g} rev: this model's first driver does not turn "
+                         "at a constant rate, so a turn has no fixed time; give the end in "
+                         "seconds")
+    turns = given[1] if given is not None else 1.0
+    t_end = t_start + turns * turn
+    if not abs(t_end) <= T_END_MAX:  # a driver barely turning: 1e-90 rad/s
+        said = f"--t-end {turns:g} rev" if given is not None else "the default end (a turn)"
+        raise MbodyError(f"{said} is t = {t_end:.3g} s ({turns:g} x {turn:.3g} s, the first "
+                         f"driver's turn); at most {T_END_MAX:g} s: give --t-end in seconds")
+    return t_end
+
+
 def kinematics(a: argparse.Namespace) -> int:
     import sys
 
@@ -83,7 +108,7 @@ def kinematics(a: argparse.Namespace) -> int:
     points = parse_points(a.point)
     model = load_model(a.model)
     turn = revolution(model)
-    t_end = a.t_end if a.t_end is not None else a.t_start + (turn if turn else 1.0)
+    t_end = end_time(a.t_end, a.t_start, turn)
     fps = a.fps if a.fps is not None else (360.0 / turn if turn else 100.0)
     if t_end <= a.t_start:
         raise MbodyError(f"--t-end {t_end:g} is not after --t-start {a.t_start:g}")

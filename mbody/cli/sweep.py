@@ -3,16 +3,22 @@
 from __future__ import annotations
 
 import argparse
-import re
 import sys
 import uuid
 
-from mbody.cli.common import EXIT_OK, EXIT_UNMET, MODEL_HELP, bounded, load_model, output_stream
+from mbody.cli.common import (
+    EXIT_OK,
+    EXIT_UNMET,
+    MODEL_HELP,
+    bounded,
+    load_model,
+    output_stream,
+    seconds_or_turns,
+)
 from mbody.errors import MbodyError
 
 RUN_NAMES = ("solve", "kinematics", "simulate", "modes")
 """`mbody.sweep.runs.RUNS` (not imported at start-up; a test keeps them equal)."""
-_REV = re.compile(r"\s*([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)\s*(rev|revs|revolutions?)\s*")
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -41,7 +47,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    metavar="S", help="the random samples' seed (default 0)")
     s.add_argument("--run", dest="run_kind", choices=RUN_NAMES, default="solve",
                    help="what each case computes (default solve)")
-    s.add_argument("--t-end", type=_t_end, metavar="T",
+    s.add_argument("--t-end", type=seconds_or_turns(0.0, 1e9, lo_open=True), metavar="T",
                    help="kinematics, simulate: the end, in seconds or in turns of the first "
                    "driver that turns ('1 rev': one turn at each case's speed)")
     s.add_argument("--steps", type=bounded("a number of instants", 2, 1e6, integer=True),
@@ -68,17 +74,6 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--quiet", action="store_true", help="no progress bar (there is one only "
                    "on a terminal)")
     s.set_defaults(run=sweep)
-
-
-def _t_end(text: str) -> tuple[str, float]:
-    m = _REV.fullmatch(text)
-    if m:
-        x = float(m.group(1))
-        if not 0 < x <= 1e6:
-            raise argparse.ArgumentTypeError(f"expected a number of turns above 0, got {text!r}")
-        return ("rev", x)
-    return ("s", bounded("a time in seconds, or turns such as '1 rev'", 0.0, 1e9,
-                         lo_open=True)(text))
 
 
 def sweep(a: argparse.Namespace) -> int:

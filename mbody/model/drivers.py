@@ -28,8 +28,9 @@ import numpy as np
 
 from mbody import conventions as cv
 from mbody import joint_types
-from mbody.errors import did_you_mean
+from mbody.errors import closest, did_you_mean
 from mbody.model.calculus import derivative
+from mbody.model.checks import MAX_MAGNITUDE
 from mbody.model.expressions import Expression, ExpressionError, compile_expression
 
 if TYPE_CHECKING:
@@ -157,13 +158,25 @@ def _law(c: Checker, p: Path_, d: dict, key: str, motion: joint_types.Motion
         if isinstance(value, str):
             m = _UNIT_NUMBER.fullmatch(value)
             unit = (m.group(2) or "") if m else ""
+            what = "rate" if rotation else "speed"
             if not m or (unit and unit not in units):
                 example = ("10.47, '100 rpm' or '90 deg/s'" if rotation
                            else "0.2 or '200 mm/s'")
-                c.err((*p, key), f"expected a {'rate' if rotation else 'speed'} like "
-                      f"{example}, got '{value}'", f"units: {', '.join(units)}")
+                meant = _unit_meant(unit, units) if m else None
+                c.err((*p, key), f"expected a {what} like {example}, got '{value}'",
+                      (f"did you mean '{m.group(1)} {meant}'? " if m and meant else "")
+                      + f"units: {', '.join(units)}")
                 return None, None
-            return None, float(m.group(1)) * units.get(unit, 1.0)
+            factor = units.get(unit, 1.0)
+            rate = float(m.group(1)) * factor
+            if not abs(rate) <= MAX_MAGNITUDE:  # its law f(0) + rate*t must hold it
+                si = next(iter(units))
+                c.err((*p, key), f"the {what} '{value}' is out of range: expected a "
+                      f"magnitude of at most {MAX_MAGNITUDE:g} {si}"
+                      + (f" ({MAX_MAGNITUDE / factor:.3g} {unit})" if unit != si and unit
+                         else ""))
+                return None, None
+            return None, rate
         x = c.number((*p, key), value)
         return None, x
     if isinstance(value, str):
@@ -177,6 +190,20 @@ def _law(c: Checker, p: Path_, d: dict, key: str, motion: joint_types.Motion
         return Expression(value, e.tree), None  # shown as written (deg and all)
     x = c.number((*p, key), value)
     return (compile_expression(repr(float(x))) if x is not None else None), None
+
+
+def _unit_meant(unit: str, units: dict[str, float]) -> str | None:
+    """The unit of `units` a misspelt `unit` stands for: the same in another case first
+    ('RPM'), a common abbreviation the table writes otherwise ('rps': 'rev/s', which
+    spelling alone would take for 'rpm', 60 times slower), else the closest spelling."""
+    same = _UNIT_ABBREVIATIONS.get(unit.casefold())
+    if same in units and not any(u.casefold() == unit.casefold() for u in units):
+        return same
+    return closest(unit, units)
+
+
+_UNIT_ABBREVIATIONS = {"rps": "rev/s", "r/s": "rev/s", "r/min": "rpm", "1/s": "Hz"}
+"""Rate units written otherwise, read as the table's (in a did-you-mean only)."""
 
 
 @dataclass(frozen=True, eq=False)
