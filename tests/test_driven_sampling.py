@@ -4,6 +4,7 @@ mechanism at rest, and `mbody.kinematics` at a time that is not a number."""
 
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 
@@ -144,6 +145,9 @@ def test_the_warning_is_saved_with_the_run_and_printed_by_both_commands(tmp_path
     assert _sparse(again) and kinematic_summary(again) in printed
     assert main(["kinematics", model, "--fps", "120"]) == 0
     assert "warning: " + SPARSE in capsys.readouterr().out
+    assert main(["kinematics", model, "--fps", "120", "--json"]) == 0  # with the peaks
+    shown = json.loads(capsys.readouterr().out)
+    assert shown["peaks"] and [w[:len(SPARSE)] for w in shown["warnings"]] == [SPARSE]
     assert main(["kinematics", model]) == 0  # one revolution, one sample a degree
     assert "warning" not in capsys.readouterr().out
 

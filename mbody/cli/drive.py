@@ -129,6 +129,7 @@ def kinematics(a: argparse.Namespace) -> int:
                        "load_work": i["load_work"], "energy_change": i["energy_change"],
                        "energy_balance_residual": i["energy_balance_residual"],
                        "power_balance_residual": i["power_balance_residual"],
+                       "warnings": list(i.get("warnings", ())),
                        "output": a.output}, output_stream(a.output) if a.output else sys.stdout)
         return EXIT_OK
     print(summary(traj, a.output), file=output_stream(a.output))

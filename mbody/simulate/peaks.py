@@ -113,5 +113,5 @@ def sampling_warning(model: Model, traj: Trajectory) -> str | None:
             "and the energy check's work, summed over so few samples, is as coarse. "
             f"Use --fps {need} or more ({PEAK_SAMPLES} samples a revolution: a sine's peak "
             f"within {sine:.2g} %)"
-            + (", or mbody kinematics, whose default is one revolution at a sample a "
-               "degree" if traj.info.get("kinematic") else ""))
+            + (", or mbody kinematics without --fps, whose default is one revolution at a "
+               "sample a degree" if traj.info.get("kinematic") else ""))
