@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from mbody.cli.common import EXIT_OK, add_format_option, load_model, output_stream, regular_file
-from mbody.errors import MbodyError, ModelError, did_you_mean
+from mbody.errors import MbodyError, did_you_mean
 
 FORMATS = {".yaml": "yaml", ".yml": "yaml", ".xml": "mjcf", ".mjcf": "mjcf", ".urdf": "urdf"}
 """File extension -> format."""
@@ -36,8 +36,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="the output's format, when OUTPUT's extension does not say it")
     add_format_option(s, ("--from",), what="SOURCE")
     s.add_argument("--keyframe", metavar="NAME", help="MJCF input: the keyframe whose "
-                   "qpos/qvel give the initial state (default: 'initial' when the file has "
-                   "it, as mbody's export writes; else the reference pose at rest)")
+                   "qpos/qvel give the initial state (default, as on every command: "
+                   "'initial' when the file has it, as mbody's export writes; else the "
+                   "reference pose at rest)")
     s.add_argument("--force", action="store_true", help="replace OUTPUT if it exists (even "
                    "SOURCE itself: a model rewritten in place)")
     s.add_argument("--set", action="append", default=[], metavar="PATH=VALUE",
@@ -160,19 +161,11 @@ def _format(path: str, what: str, option: str, choices: tuple[str, ...]) -> str:
 
 
 def _read(path: str, fmt: str, keyframe: str | None) -> Any:
-    """The model document of an MJCF or URDF file (`mbody.io.interop.read_document`)."""
+    """The model document of an MJCF or URDF file (`mbody.io.interop.read_document`),
+    in the state every command reads it in (`mbody.io.interop.mjcf_state.chosen`)."""
     from mbody.io.interop import read_document as read
 
-    if fmt != "mjcf":
-        return read(path, format=fmt)
-    if keyframe is not None:
-        return read(path, format=fmt, keyframe=keyframe)
-    try:
-        return read(path, format=fmt, keyframe="initial")
-    except ModelError as exc:  # no such keyframe: the reference pose, at rest
-        if not any(i.key == "keyframe" for i in exc.issues):
-            raise
-        return read(path, format=fmt)
+    return read(path, format=fmt, **({"keyframe": keyframe} if keyframe is not None else {}))
 
 
 def _model(document: Any, source: str):
