@@ -55,6 +55,7 @@ def convert(a: argparse.Namespace) -> int:
     _old_format_meaning(a)
     src_format = a.model_format or _format(a.source, "SOURCE", "--format",
                                            (".yaml", ".xml", ".urdf"))
+    ensure_writable(a.output)  # the rules of every command's output: a folder refused
     if not a.to and Path(a.output).suffix.lower() == ".urdf":
         raise MbodyError(f"{a.output}: mbody reads URDF but does not write it; write "
                          ".yaml (mbody) or .xml (MJCF)")
@@ -62,10 +63,9 @@ def convert(a: argparse.Namespace) -> int:
     if not os.path.exists(a.source):
         raise MbodyError(f"{a.source}: no such file")
     regular_file(a.source, f"a model file ({NAMES[src_format]})")
-    if os.path.exists(a.output) and not a.force:
+    if _replaces_a_file(a.output) and not a.force:
         raise MbodyError(f"{a.output}: exists; give --force to replace it, or another "
                          "OUTPUT")
-    ensure_writable(a.output)
     if a.set_values:
         return _convert_with_values(a, src_format, out_format)
     if src_format == "yaml":
@@ -132,6 +132,16 @@ def _convert_with_values(a: argparse.Namespace, src_format: str, out_format: str
           f"{NAMES[src_format]} with {len(values)} value(s) set: {_summary(model)})",
           file=output_stream(a.output))
     return EXIT_OK
+
+
+def _replaces_a_file(output: str) -> bool:
+    """Whether writing `output` replaces an existing file, which convert does only with
+    --force (a model file may be the only copy of someone's work). A device or a named
+    pipe (``-o /dev/null``) and standard output (``-o /dev/stdout``) are written through,
+    as by every command (`mbody.util.atomic`): nothing there is replaced."""
+    from mbody.util.atomic import is_standard_output
+
+    return os.path.isfile(output) and not is_standard_output(output)
 
 
 def _old_format_meaning(a: argparse.Namespace) -> None:
