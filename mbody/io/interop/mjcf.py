@@ -26,7 +26,7 @@ import numpy as np
 
 from mbody.errors import Issue, ModelError, did_you_mean
 from mbody.io.interop.attrvalues import BOOLEAN
-from mbody.io.interop.custom import Custom, planar_issues, read_custom, restore
+from mbody.io.interop.custom import Custom, planar_issues, read_custom, reorder, restore
 from mbody.io.interop.mjcf_compiler import z_to_quat
 from mbody.io.interop.mjcf_geoms import GEOM_TYPES, MIN_MASS, Geoms, solid
 from mbody.io.interop.mjcf_source import MAX_INCLUDES, Included, check_names, expand_includes
@@ -176,6 +176,7 @@ class _Reader(Geoms):
             if off_plane:
                 raise ModelError(off_plane)
             restore(doc.data, [doc.marks, doc.key_marks], self.custom, self.springs())
+            reorder(doc, self.custom)
         if self.notes:
             doc.warnings.append(Issue(self.file, 0, 0, "", _summary(self.notes)))
         return doc
