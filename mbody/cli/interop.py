@@ -175,7 +175,7 @@ def _read(path: str, fmt: str, keyframe: str | None) -> Any:
     in the state every command reads it in (`mbody.io.interop.mjcf_state.chosen`)."""
     from mbody.io.interop import read_document as read
 
-    return read(path, format=fmt, **({"keyframe": keyframe} if keyframe is not None else {}))
+    return read(path, format=fmt, keyframe=keyframe)  # None: not given (its default)
 
 
 def _model(document: Any, source: str):
