@@ -19,10 +19,12 @@ It then runs ``mbody check`` and, on what check accepts, ``mbody solve`` through
 ``mbody.cli.main`` in this process, classified as tools/fuzz.py classifies the YAML
 fuzzer's commands (accepted, clean error, crash, hang; its `run_command` and `classify`).
 Every accepted MJCF that MuJoCo also loads is compared with MuJoCo: every body's mass,
-mass centre and inertia at qpos0, and where the model is a tree mbody maps exactly (no
-equality constraints, no mbody entries, no particles; what mbody lists as not imported
-switched off in MuJoCo, as tests/test_interop_import.py does) the mass-centre and
-angular accelerations at the initial state (qpos0, at rest). A difference is a mismatch,
+mass centre and inertia at the state mbody reads by default, and where the model is a
+tree mbody maps exactly (no equality constraints, no mbody entries, no particles; what
+mbody lists as not imported switched off in MuJoCo, as tests/test_interop_import.py
+does) the mass-centre and angular accelerations there. That state is the key 'initial'
+when the file has one, else qpos0 at rest (`mbody.io.interop.mjcf_state.chosen`); MuJoCo
+is reset to the same (`_reset`). A difference is a mismatch,
 counted with the crashes.
 
 Tolerances: masses and mass centres 1e-9 relative (the same sums of the same doubles:
@@ -666,6 +668,7 @@ def compare_with_mujoco(path: Path) -> Outcome:
     names = _mj_names(mj, m)
     index = {n: k for k, n in enumerate(names) if names.count(n) == 1}
     d = mj.MjData(m)
+    _reset(mj, m, d)
     mj.mj_kinematics(m, d)
     compared = 0
     for i, name in enumerate(model.body_names):
@@ -689,8 +692,16 @@ def compare_with_mujoco(path: Path) -> Outcome:
     return Outcome("mujoco", ACCEPTED, 0, detail)
 
 
+def _reset(mj, m, d) -> None:
+    """MuJoCo's `d` at the state mbody reads an MJCF file in when no keyframe is named:
+    the key 'initial' when the file has one, else qpos0 at rest (as MjData starts)."""
+    key = mj.mj_name2id(m, mj.mjtObj.mjOBJ_KEY, "initial")
+    if key >= 0:
+        mj.mj_resetDataKeyframe(m, d, key)
+
+
 def _body_differs(model, i: int, m, d, b: int, pose: bool = True) -> str:
-    """What differs between mbody's body `i` and MuJoCo's body `b` at qpos0 (mass, mass
+    """What differs between mbody's body `i` and MuJoCo's body `b` at the state (mass, mass
     centre, inertia), or ''. The inertia is compared in MuJoCo's principal axes: MuJoCo
     finds them by a Jacobi iteration that stops at a last rotation below 1.5e-6 rad, or
     off-diagonal terms below 1e-12 (``mjuu_eig3``), so the moments agree to second order
@@ -779,7 +790,7 @@ def _exact_tree(mj, text: str, model, m) -> bool:
 
 
 def _accelerations(mj, m, model, index: dict[str, int]) -> tuple[float, float] | None:
-    """(largest difference of the bodies' accelerations at qpos0, at rest, relative to
+    """(largest difference of the bodies' accelerations at the state, relative to
     the largest acceleration; its tolerance), what mbody does not model switched off in
     MuJoCo; None when not comparable. The tolerance is ACC_RTOL plus the error bound of
     mbody's solve, 1e-15 times the condition number of its Schur complement (about
@@ -798,6 +809,7 @@ def _accelerations(mj, m, model, index: dict[str, int]) -> tuple[float, float] |
     m.opt.density = m.opt.viscosity = 0
     m.opt.wind[:] = 0
     d = mj.MjData(m)
+    _reset(mj, m, d)
     mj.mj_kinematics(m, d)
     _exact_inertia(mj, m, d, model, index)
     mj.mj_forward(m, d)

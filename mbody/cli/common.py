@@ -261,7 +261,8 @@ def add_import_options(command: argparse.ArgumentParser) -> None:
     g = command.add_argument_group("MJCF and URDF input")
     add_format_option(g)
     g.add_argument("--keyframe", metavar="NAME", help="MJCF: the <key> whose qpos and qvel "
-                   "give the state (default: the reference pose, at rest)")
+                   "give the state (default: 'initial' when the file has it, as mbody's export "
+                   "writes; else the reference pose, at rest)")
     g.add_argument("--q", action="append", default=[], metavar="JOINT=VALUE",
                    help="URDF: a joint's position, rad or m (30deg for degrees); repeatable; "
                    "other joints at 0")

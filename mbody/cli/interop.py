@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from mbody.cli.common import EXIT_OK, add_format_option, load_model, output_stream, regular_file
-from mbody.errors import MbodyError, ModelError, did_you_mean
+from mbody.errors import MbodyError, did_you_mean
 
 FORMATS = {".yaml": "yaml", ".yml": "yaml", ".xml": "mjcf", ".mjcf": "mjcf", ".urdf": "urdf"}
 """File extension -> format."""
@@ -36,8 +36,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="the output's format, when OUTPUT's extension does not say it")
     add_format_option(s, ("--from",), what="SOURCE")
     s.add_argument("--keyframe", metavar="NAME", help="MJCF input: the keyframe whose "
-                   "qpos/qvel give the initial state (default: 'initial' when the file has "
-                   "it, as mbody's export writes; else the reference pose at rest)")
+                   "qpos/qvel give the initial state (default, as on every command: "
+                   "'initial' when the file has it, as mbody's export writes; else the "
+                   "reference pose at rest)")
     s.add_argument("--force", action="store_true", help="replace OUTPUT if it exists (even "
                    "SOURCE itself: a model rewritten in place)")
     s.add_argument("--set", action="append", default=[], metavar="PATH=VALUE",
@@ -54,6 +55,7 @@ def convert(a: argparse.Namespace) -> int:
     _old_format_meaning(a)
     src_format = a.model_format or _format(a.source, "SOURCE", "--format",
                                            (".yaml", ".xml", ".urdf"))
+    ensure_writable(a.output)  # the rules of every command's output: a folder refused
     if not a.to and Path(a.output).suffix.lower() == ".urdf":
         raise MbodyError(f"{a.output}: mbody reads URDF but does not write it; write "
                          ".yaml (mbody) or .xml (MJCF)")
@@ -61,10 +63,9 @@ def convert(a: argparse.Namespace) -> int:
     if not os.path.exists(a.source):
         raise MbodyError(f"{a.source}: no such file")
     regular_file(a.source, f"a model file ({NAMES[src_format]})")
-    if os.path.exists(a.output) and not a.force:
+    if _replaces_a_file(a.output) and not a.force:
         raise MbodyError(f"{a.output}: exists; give --force to replace it, or another "
                          "OUTPUT")
-    ensure_writable(a.output)
     if a.set_values:
         return _convert_with_values(a, src_format, out_format)
     if src_format == "yaml":
@@ -133,6 +134,16 @@ def _convert_with_values(a: argparse.Namespace, src_format: str, out_format: str
     return EXIT_OK
 
 
+def _replaces_a_file(output: str) -> bool:
+    """Whether writing `output` replaces an existing file, which convert does only with
+    --force (a model file may be the only copy of someone's work). A device or a named
+    pipe (``-o /dev/null``) and standard output (``-o /dev/stdout``) are written through,
+    as by every command (`mbody.util.atomic`): nothing there is replaced."""
+    from mbody.util.atomic import is_standard_output
+
+    return os.path.isfile(output) and not is_standard_output(output)
+
+
 def _old_format_meaning(a: argparse.Namespace) -> None:
     """Before 0.3, `convert --format` named the output's format: `--format mjcf` with a
     .yaml SOURCE most likely still means that. Say so rather than read the YAML file as
@@ -160,19 +171,11 @@ def _format(path: str, what: str, option: str, choices: tuple[str, ...]) -> str:
 
 
 def _read(path: str, fmt: str, keyframe: str | None) -> Any:
-    """The model document of an MJCF or URDF file (`mbody.io.interop.read_document`)."""
+    """The model document of an MJCF or URDF file (`mbody.io.interop.read_document`),
+    in the state every command reads it in (`mbody.io.interop.mjcf_state.chosen`)."""
     from mbody.io.interop import read_document as read
 
-    if fmt != "mjcf":
-        return read(path, format=fmt)
-    if keyframe is not None:
-        return read(path, format=fmt, keyframe=keyframe)
-    try:
-        return read(path, format=fmt, keyframe="initial")
-    except ModelError as exc:  # no such keyframe: the reference pose, at rest
-        if not any(i.key == "keyframe" for i in exc.issues):
-            raise
-        return read(path, format=fmt)
+    return read(path, format=fmt, keyframe=keyframe)  # None: not given (its default)
 
 
 def _model(document: Any, source: str):

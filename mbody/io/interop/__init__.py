@@ -61,8 +61,10 @@ def read_document(path: str | os.PathLike[str], format: str | None = None,
     format : {"mjcf", "urdf"}, optional
         Default: from the extension.
     **options
-        MJCF: ``keyframe``. URDF: ``joint_positions``, ``joint_velocities`` (dicts of
-        joint name to value), ``floating_base``.
+        MJCF: ``keyframe`` (default ``initial`` when the file has such a key, else
+        the reference pose at rest: `mbody.io.interop.mjcf_state.chosen`). URDF:
+        ``joint_positions``, ``joint_velocities`` (dicts of joint name to value),
+        ``floating_base``.
 
     Returns
     -------

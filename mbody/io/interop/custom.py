@@ -26,6 +26,9 @@ name                      element   data
 ``mbody:reaction:R``      text      the same, an expression of t
 ``mbody:driver:D``        text      JSON object of driver D as the model file writes
                                     it, but its name (``{"joint": "O", "speed": 10}``)
+``mbody:order``           text      JSON object: the model file's order of its
+                                    ``bodies`` and ``joints`` (names), which MJCF's
+                                    nesting does not keep
 ========================  ========  ===================================================
 
 A model that `mbody.load` assembles (joint points per body, drivers) is exported at its
@@ -50,7 +53,11 @@ from mbody.io.interop.xmlsource import Element, one_line
 from mbody.model.loader import dotted
 
 PREFIX = "mbody:"
-KINDS = ("dimension", "body", "joint", "load", "reaction", "driver")
+KINDS = ("dimension", "body", "joint", "load", "reaction", "driver", "order")
+WHOLE = ("dimension", "order")
+"""Kinds of one entry for the model, without a key."""
+ORDERED = ("bodies", "joints")
+"""The lists of the model file whose order ``mbody:order`` keeps."""
 
 
 @dataclass
@@ -64,6 +71,7 @@ class Custom:
     loads: list[tuple[str, dict[str, Any], Element]] = field(default_factory=list)
     reactions: dict[str, tuple[float | str, Element]] = field(default_factory=dict)
     drivers: list[tuple[str, dict[str, Any], Element]] = field(default_factory=list)
+    order: tuple[dict[str, list[str]], Element] | None = None
 
     def particle(self, body: str) -> bool:
         """Whether the entries make `body` a particle (``inertia: 0``)."""
@@ -126,9 +134,9 @@ def read_custom(root: Element) -> Custom | None:
                                       did_you_mean(kind, KINDS) or
                                       f"expected mbody:{', mbody:'.join(KINDS)}", "name"))
                 continue
-            if (kind == "dimension") != (key == ""):
+            if (kind in WHOLE) != (key == ""):
                 issues.append(e.issue(f"'{name}': "
-                                      + ("mbody:dimension takes no key" if kind == "dimension"
+                                      + (f"mbody:{kind} takes no key" if kind in WHOLE
                                          else f"mbody:{kind} needs a key (mbody:{kind}:NAME)"),
                                       attr="name"))
                 continue
@@ -172,11 +180,95 @@ def read_custom(root: Element) -> Custom | None:
                 out.joints[key] = (value, e)
             elif kind == "driver":
                 out.drivers.append((key, value, e))
+            elif kind == "order":
+                order = _order(value, e, issues)
+                if order is not None:
+                    out.order = (order, e)
             else:
                 out.loads.append((key, value, e))
     if issues:
         raise ModelError(issues)
     return out if found else None
+
+
+def _order(value: dict[str, Any], e: Element, issues: list[Issue]
+           ) -> dict[str, list[str]] | None:
+    """The lists of names of an ``mbody:order`` entry, or None (the problem in
+    `issues`)."""
+    unknown = [k for k in value if k not in ORDERED]
+    if unknown:
+        issues.append(e.issue(f"mbody:order: unknown key '{unknown[0]}'",
+                              did_you_mean(unknown[0], ORDERED) or
+                              f"expected {' and '.join(ORDERED)}", "data"))
+        return None
+    out: dict[str, list[str]] = {}
+    for key, names in value.items():
+        if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
+            issues.append(e.issue(f"mbody:order: {key} must be a list of names",
+                                  attr="data"))
+            return None
+        if len(set(names)) != len(names):
+            twice = next(n for n in names if names.count(n) > 1)
+            issues.append(e.issue(f"mbody:order: {key} names '{twice}' twice", attr="data"))
+            return None
+        out[key] = names
+    return out
+
+
+def reorder(doc: ImportedDocument, custom: Custom) -> None:
+    """Put the document's bodies and joints back in the model file's order, as the
+    ``mbody:order`` entry lists them (in place, with their marks). MJCF's nesting puts a
+    body after its parent and the joints in the tree's order, so without it a model
+    written to MJCF and read back would have its bodies and joints, hence the rows and
+    columns of its equations, in another order. What the entry does not name (a body
+    added to the file by hand) follows in the file's order; a name the file does not
+    have is an error at the entry."""
+    if custom.order is None:
+        return
+    order, e = custom.order
+    issues: list[Issue] = []
+    for key in ORDERED:
+        items = doc.data.get(key, [])
+        have = [x["name"] for x in items]
+        missing = [n for n in order.get(key, []) if n not in have]
+        if missing:
+            what = key[:-3] + "y" if key == "bodies" else key[:-1]
+            issues.append(e.issue(f"mbody:order: no {what} '{missing[0]}' in the file",
+                                  did_you_mean(missing[0], have), "data"))
+            continue
+        rank = {n: i for i, n in enumerate(order.get(key, []))}
+        perm = sorted(range(len(items)), key=lambda k: (0, rank[have[k]]) if have[k] in rank
+                      else (1, k))
+        if perm != list(range(len(items))):
+            _permute(doc, key, perm)
+    if issues:
+        raise ModelError(issues)
+
+
+def _permute(doc: ImportedDocument, key: str, perm: list[int]) -> None:
+    """``doc.data[key]`` reordered so that its k-th item is the old ``perm[k]``-th, with
+    every mark and file name under it moved along (one left from an item no longer
+    there, after `restore` replaced joints, is dropped)."""
+    doc.data[key] = [doc.data[key][k] for k in perm]
+    new = {old: k for k, old in enumerate(perm)}
+    for table in (doc.marks, doc.key_marks):
+        moved = {p: w for p, w in table.items()
+                 if len(p) > 1 and p[0] == key and isinstance(p[1], int)}
+        for p in moved:
+            del table[p]
+        for p, w in moved.items():
+            if p[1] in new:
+                table[(key, new[p[1]], *p[2:])] = w
+    files = {}
+    for path, file in doc.files.items():
+        head, _, rest = path.partition("]")
+        index = head[len(key) + 1:]
+        if head.startswith(f"{key}[") and index.isdigit() and rest[:1] in ("", ".", "["):
+            if int(index) not in new:
+                continue
+            path = f"{key}[{new[int(index)]}]{rest}"
+        files[path] = file
+    doc.files = files
 
 
 PLANE_TOL = 1e-9

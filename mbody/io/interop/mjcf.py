@@ -26,11 +26,11 @@ import numpy as np
 
 from mbody.errors import Issue, ModelError, did_you_mean
 from mbody.io.interop.attrvalues import BOOLEAN
-from mbody.io.interop.custom import Custom, planar_issues, read_custom, restore
+from mbody.io.interop.custom import Custom, planar_issues, read_custom, reorder, restore
 from mbody.io.interop.mjcf_compiler import z_to_quat
 from mbody.io.interop.mjcf_geoms import GEOM_TYPES, MIN_MASS, Geoms, solid
 from mbody.io.interop.mjcf_source import MAX_INCLUDES, Included, check_names, expand_includes
-from mbody.io.interop.mjcf_state import state
+from mbody.io.interop.mjcf_state import chosen, described, state
 from mbody.io.interop.tree import (
     NQ,
     NV,
@@ -59,7 +59,9 @@ def read_mjcf(source: str | Path, *, keyframe: str | None = None,
         A path to the ``.xml`` file, or the XML text itself (starting with ``<``).
     keyframe : str, optional
         The name (or index) of a ``<key>`` whose ``qpos``/``qvel`` give the state;
-        default: every joint at its reference position (MuJoCo's ``qpos0``), at rest.
+        default: the key ``initial`` when the file has one (the state mbody's export
+        writes), else every joint at its reference position (MuJoCo's ``qpos0``), at
+        rest. The model's description says which.
     file : str, optional
         The name used in messages (default: the path, or ``<string>`` for text); for
         text, ``<include>`` files are found next to it.
@@ -160,10 +162,12 @@ class _Reader(Geoms):
         self.others()
         if self.issues:
             raise ModelError(self.issues)
+        keyframe = chosen(root, keyframe)
         qpos, qvel, q0 = state(self, root, self.bodies, keyframe)
         self.screw_state(qpos, qvel, q0)
         name = root.get("model") or Path(self.file).stem
-        doc = build(name, f"imported from {Path(self.file).name} (MJCF)", self.file,
+        about = f"imported from {Path(self.file).name} (MJCF) {described(root, keyframe)}"
+        doc = build(name, about, self.file,
                     self.bodies, qpos, qvel, q0, gravity, loops, root, "mjcf",
                     self.free_motions(), screws={k: h for k, (h, _) in self.screws.items()},
                     planar=self.custom is not None and self.custom.dimension == 2)
@@ -172,6 +176,7 @@ class _Reader(Geoms):
             if off_plane:
                 raise ModelError(off_plane)
             restore(doc.data, [doc.marks, doc.key_marks], self.custom, self.springs())
+            reorder(doc, self.custom)
         if self.notes:
             doc.warnings.append(Issue(self.file, 0, 0, "", _summary(self.notes)))
         return doc

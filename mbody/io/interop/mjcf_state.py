@@ -1,6 +1,8 @@
-"""The state an MJCF model is read in: every joint at its reference position (MuJoCo's
-``qpos0``) at rest, or a ``<keyframe>``'s ``<key>`` (by name or index) with its ``qpos``
-and ``qvel``."""
+"""The state an MJCF model is read in: a ``<keyframe>``'s ``<key>`` (by name or index)
+with its ``qpos`` and ``qvel``; when none is named, the key ``initial`` if the file has
+one (the file's state, as mbody's export writes it), else every joint at its reference
+position (MuJoCo's ``qpos0``) at rest. This is the one place that default is decided:
+`mbody.load`, every command and ``mbody convert`` read MJCF through it."""
 
 from __future__ import annotations
 
@@ -11,11 +13,36 @@ from mbody.io.interop.mjcf_compiler import Compiler
 from mbody.io.interop.tree import NV, TreeBody, joint_order, qpos0
 from mbody.io.interop.xmlsource import Element
 
+INITIAL = "initial"
+"""The key read when no keyframe is named: mbody's MJCF export writes the model's state
+as the key of this name, so that a file it wrote reads back in the same state."""
+
+
+def chosen(root: Element, keyframe: str | None) -> str | None:
+    """The keyframe the state is read at: `keyframe` when given, else `INITIAL` when the
+    file has a key of that name, else None (the reference pose at rest)."""
+    if keyframe is not None:
+        return keyframe
+    return INITIAL if INITIAL in _keys(root)[1] else None
+
+
+def described(root: Element, keyframe: str | None) -> str:
+    """The state read at `keyframe` (`chosen`'s answer) in words, for a model's
+    description: which state a command's numbers are at. A key given by its index is
+    named by its name when it has one."""
+    if keyframe is None:
+        return "at the reference pose, at rest"
+    keys, names = _keys(root)
+    if keyframe not in names and _index(keyframe) < len(keys):
+        keyframe = names[_index(keyframe)]
+    return f"at the keyframe '{keyframe if len(keyframe) <= 40 else keyframe[:40] + '...'}'"
+
 
 def state(r: Compiler, root: Element, bodies: list[TreeBody], keyframe: str | None
           ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(qpos, qvel, qpos0)`` of the tree `bodies`: at `keyframe`, or at rest at qpos0.
-    Problems are reported in `r`'s issues."""
+    """``(qpos, qvel, qpos0)`` of the tree `bodies`: at `keyframe`, or at rest at qpos0
+    when it is None (`chosen` picks the default). Problems are reported in `r`'s
+    issues."""
     q0 = qpos0(bodies)
     nv = sum(NV[j.type] for _, j in joint_order(bodies))
     for kf in root.findall("keyframe"):  # every key is checked, as MuJoCo checks them
@@ -47,8 +74,7 @@ def values(r: Compiler, k: Element, q0: np.ndarray, nv: int) -> tuple[np.ndarray
 def key(r: Compiler, root: Element, keyframe: str, q0: np.ndarray, nv: int
         ) -> tuple[np.ndarray, np.ndarray]:
     """``(qpos, qvel)`` of the ``<key>`` named (or numbered) `keyframe`."""
-    keys = [k for kf in root.findall("keyframe") for k in kf.findall("key")]
-    names = [k.get("name") or str(i) for i, k in enumerate(keys)]
+    keys, names = _keys(root)
     if keyframe in names:
         k = keys[names.index(keyframe)]
     elif _index(keyframe) < len(keys):
@@ -64,6 +90,12 @@ def key(r: Compiler, root: Element, keyframe: str, q0: np.ndarray, nv: int
         raise ModelError(r.issues)
     return qpos, qvel
 
+
+
+def _keys(root: Element) -> tuple[list[Element], list[str]]:
+    """Every ``<key>`` of the file, and its name (its index when it has none)."""
+    keys = [k for kf in root.findall("keyframe") for k in kf.findall("key")]
+    return keys, [k.get("name") or str(i) for i, k in enumerate(keys)]
 
 
 def _index(text: str) -> int:

@@ -643,6 +643,10 @@ def _custom(w: _Writer, tree: _Tree) -> list[str]:
     if drivers is not None:
         out += [text(f"driver:{name}", _driver_entry(m, k)) for k, name in
                 enumerate(drivers.names)]
+    # the file's order, which the body tree's nesting does not keep: the rows and columns
+    # of the equations follow it
+    out.append(text("order", {"bodies": list(m.body_names),
+                              "joints": [j.name for j in m.joints]}))
     return ["  <!-- What MJCF cannot say, for mbody's reader (MuJoCo ignores it): see",
             "       the mbody documentation, interop, 'The mbody entries'. -->",
             "  <custom>", *("    " + s for s in out), "  </custom>"]
