@@ -18,23 +18,12 @@ import sys
 from pathlib import Path
 
 import pytest
-
-from mbody.cli import main
+from test_cli_options import run  # main() run as a user runs it, argparse exits caught
 
 ROOT = Path(__file__).resolve().parent.parent
 MODELS = ROOT / "models"
 PENDULUM = MODELS / "pendulum.yaml"
 DRIVEN = MODELS / "slider_crank_driven.yaml"
-
-
-def run(capsys, *args) -> tuple[int, str, str]:
-    try:
-        code = main([str(a) for a in args])
-    except SystemExit as exc:  # argparse
-        code = exc.code
-    out, err = capsys.readouterr()
-    assert "Traceback" not in err
-    return code, out, err
 
 
 def usage_and_message(err: str) -> tuple[str, str]:
@@ -115,19 +104,16 @@ def test_a_misspelt_top_level_option(capsys):
     assert message == "unrecognized arguments: --verison; did you mean '--version'?"
 
 
-CHOICES = ("(choose from 'check', 'assemble', 'solve', 'export', 'simulate', 'plot', "
-           "'kinematics', 'fbd', 'graph', 'report', 'animate', 'jacobian', 'equilibrium', "
-           "'verify', 'convert', 'lagrange', 'modes', 'sweep')")
-
-
 def test_an_option_before_the_command_is_told_to_go_after_it(capsys):
     """`mbody --t-end 3 simulate M`: argparse takes '3' for the command."""
     code, _, err = run(capsys, "--t-end", "3", "simulate", PENDULUM)
     usage, message = usage_and_message(err)
     assert code == 2 and usage.startswith("usage: mbody [-h]")
-    assert message == (f"argument COMMAND: invalid choice: '3' {CHOICES}; --t-end is an "
-                       "option of simulate, kinematics, animate, sweep; it goes after the "
-                       "command")
+    # argparse's own words (the invalid choice '3', the choices) are its to change: what
+    # mbody adds is what is checked
+    assert "'3'" in message and message.endswith(
+        "; --t-end is an option of simulate, kinematics, animate, sweep; it goes after the "
+        "command")
     code, _, err = run(capsys, "--t-end=3", "simulate", PENDULUM)
     usage, message = usage_and_message(err)
     assert code == 2 and usage.startswith("usage: mbody simulate ")
@@ -146,8 +132,9 @@ def test_an_option_without_a_command(capsys):
 def test_a_misspelt_commands_own_options_are_not_called_misplaced(capsys):
     code, _, err = run(capsys, "chek", "--set", "bodies.rod.mass=2", PENDULUM)
     assert code == 2
-    assert usage_and_message(err)[1] == (f"argument COMMAND: invalid choice: 'chek' "
-                                         f"{CHOICES}; did you mean 'check'?")
+    message = usage_and_message(err)[1]
+    assert "'chek'" in message and message.endswith("; did you mean 'check'?")
+    assert "is an option of" not in message and "goes after the command" not in message
 
 
 def test_negative_numbers_and_words_after_a_double_dash_are_not_options(capsys):
