@@ -254,6 +254,31 @@ def test_the_command_line(driven_file, tmp_path):
         assert floats([r[i] for r in rows]).tolist() == table.column(name).to_pylist()
 
 
+def test_a_rerun_with_other_settings_says_its_rows_are_the_earlier_ones(driven_file,
+                                                                       tmp_path):
+    """The output records the grid, not --steps: a rerun with other steps runs nothing and
+    says that the rows it kept are the earlier run's (they are: the peaks of 5 instants,
+    not 9); a rerun of a solve sweep, which has no such setting, does not say it."""
+    out = tmp_path / "k.csv"
+
+    def sweep(*args: str) -> subprocess.CompletedProcess:
+        p = mbody_cli("sweep", str(driven_file), "--set", "bodies.rod.mass=0.3:1.2:2",
+                      *args, "--workers", "0", "--quiet")
+        assert p.returncode == 0, p.stderr
+        return p
+
+    first = sweep("--run", "kinematics", "--t-end", "1 rev", "--steps", "5", "--out", str(out))
+    assert "2 run now" in first.stdout and "kept" not in first.stdout
+    rows = read(out)[1]
+    again = sweep("--run", "kinematics", "--t-end", "1 rev", "--steps", "9", "--out", str(out))
+    assert "0 run now (2 kept as the earlier run made them" in again.stdout
+    assert "does not record --t-end or --steps" in again.stdout
+    assert read(out)[1] == rows
+    solved = tmp_path / "s.csv"
+    sweep("--out", str(solved))
+    assert "kept" not in sweep("--out", str(solved)).stdout
+
+
 def test_modes_run_gives_the_pendulums_frequency(tmp_path):
     """The physical pendulum held at 30 deg, linearised there: omega^2 = g a cos(30 deg) /
     ((w^2 + L^2)/12 + a^2) whatever its mass (the mass cancels): both rows give it, and

@@ -21,6 +21,11 @@ RUN_NAMES = ("solve", "kinematics", "simulate", "modes")
 """`mbody.sweep.runs.RUNS` (not imported at start-up; a test keeps them equal)."""
 
 
+UNRECORDED = {"kinematics": "--steps", "simulate": "--fps"}
+"""The runs whose settings (besides --t-end) change their numbers but not their columns,
+so that an output does not say which were used: the setting that is not --t-end."""
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     s = sub.add_parser(
         "sweep", help="run a model over a grid of values (or random samples), on Dask",
@@ -116,8 +121,15 @@ def sweep(a: argparse.Namespace) -> int:
         raise
     path = results.finish()
     failed = sum(1 for r in results.rows.values() if r[-1])
+    kept = len(results.rows) - len(todo)
     print(f"wrote {path}: {len(results.rows)} cases, {len(todo)} run now"
-          + (f", {failed} failed (see their error column)" if failed else ""), file=say)
+          + (f", {failed} failed (see their error column)" if failed else "")
+          # the output records the grid's values, not the run's settings: a rerun with
+          # another --t-end keeps the earlier rows as they are, so say so
+          + (f" ({kept} kept as the earlier run made them: the output does not record "
+             f"--t-end or {UNRECORDED[settings.run]}, so other values need another --out)"
+             if kept and settings.run in UNRECORDED else ""),
+          file=say)
     if todo:
         print(report.text(), file=say)
     warning = not_steady_warning(results.header, results.rows.values(), a.equilibrium)
