@@ -75,14 +75,14 @@ def kinematics(model: Model, t: float = 0.0, *, start: State | None = None) -> S
         The loops cannot close at `t` (which joints, the drivers' values, the distance
         left).
     """
+    given = t
     try:
         t = float(t)
     except (TypeError, ValueError):
-        raise MbodyError(f"t must be a finite number of seconds (the time the drivers' "
-                         f"laws are taken at), got {t!r}") from None
+        t = math.nan  # refused below, with what was given
     if not math.isfinite(t):
         raise MbodyError(f"t must be a finite number of seconds (the time the drivers' "
-                         f"laws are taken at), got {t!r}")
+                         f"laws are taken at), got {given!r}")
     ws = workspace(model)
     state = model.initial if start is None else start
     unknowns = ws.unknowns({})  # every joint and driver holds

@@ -58,6 +58,8 @@ WHOLE = ("dimension", "order")
 """Kinds of one entry for the model, without a key."""
 ORDERED = ("bodies", "joints")
 """The lists of the model file whose order ``mbody:order`` keeps."""
+ONE = {"bodies": "body", "joints": "joint"}
+"""An item of each of `ORDERED`, named in a message."""
 
 
 @dataclass
@@ -232,8 +234,7 @@ def reorder(doc: ImportedDocument, custom: Custom) -> None:
         have = [x["name"] for x in items]
         missing = [n for n in order.get(key, []) if n not in have]
         if missing:
-            what = key[:-3] + "y" if key == "bodies" else key[:-1]
-            issues.append(e.issue(f"mbody:order: no {what} '{missing[0]}' in the file",
+            issues.append(e.issue(f"mbody:order: no {ONE[key]} '{missing[0]}' in the file",
                                   did_you_mean(missing[0], have), "data"))
             continue
         rank = {n: i for i, n in enumerate(order.get(key, []))}
