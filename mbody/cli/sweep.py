@@ -86,7 +86,7 @@ def sweep(a: argparse.Namespace) -> int:
     from mbody.sweep import cluster
     from mbody.sweep.grid import parse_grid
     from mbody.sweep.modes import not_steady_warning
-    from mbody.sweep.runs import Job, Settings, check_settings, columns
+    from mbody.sweep.runs import Job, Settings, check_settings, columns, sampling_warning
     from mbody.sweep.table import Results, output_format
 
     kind = a.run_kind
@@ -132,9 +132,11 @@ def sweep(a: argparse.Namespace) -> int:
           file=say)
     if todo:
         print(report.text(), file=say)
-    warning = not_steady_warning(results.header, results.rows.values(), a.equilibrium)
-    if warning:
-        sys.stderr.write(f"mbody: warning: {warning}\n")
+    for warning in (not_steady_warning(results.header, results.rows.values(), a.equilibrium),
+                    sampling_warning(settings, grid, report.sparse, report.cases,
+                                     report.sparsest)):
+        if warning:
+            sys.stderr.write(f"mbody: warning: {warning}\n")
     if results.rows and failed == len(results.rows):  # nothing computed: say so, exit 1
         first = results.rows[min(results.rows)][-1]
         sys.stderr.write(f"mbody: cannot solve: every case failed; case {min(results.rows)}: "

@@ -79,6 +79,37 @@ def steady_rate(rate: Expression, t: np.ndarray) -> float | None:
     return w
 
 
+def steady_turning(model: Model, t: np.ndarray) -> list[int]:
+    """The drivers that turn a joint (an angle) at a steady rate at the times t
+    (`steady_rate`): those whose samples a revolution `sampling_warning` checks."""
+    d = model.drivers
+    if d is None:
+        return []
+    return [i for i, (component, law) in enumerate(zip(d.component, d.laws, strict=True))
+            if component == "M" and steady_rate(law[1], t) is not None]
+
+
+def samples_a_turn(per_second: float, rate: float) -> float:
+    """Samples a revolution of a driver turning at `rate` (rad/s), `per_second` samples
+    per second."""
+    return 2.0 * math.pi * per_second / abs(rate)
+
+
+def sparse_text(name: str, rate: float, per_turn: float, sampling: str) -> str:
+    """The start of the warning of `PEAK_SAMPLES` not reached: driver `name` turns at
+    `rate` (rad/s) and `sampling` ("60 fps is", "its run has") `per_turn` samples a
+    revolution of it; how low a peak between two samples can read (1 - cos(pi / N) for a
+    sine of the driver's angle)."""
+    n = f"{per_turn:.3g}"
+    low = (f"up to {100.0 * (1.0 - math.cos(math.pi / per_turn)):.2g} % low when the load "
+           f"varies as a sine of {name}'s angle (1 - cos(180 deg / {n})), more with its "
+           "harmonics" if per_turn > 2.0 else
+           "as low as nothing: two samples a revolution or fewer can miss it entirely")
+    return (f"{SPARSE}: {name} turns at {abs(rate) * 30.0 / math.pi:.4g} rpm, and "
+            f"{sampling} {n} samples a revolution; a peak that falls between two samples "
+            f"reads {low}")
+
+
 def sampling_warning(model: Model, traj: Trajectory) -> str | None:
     """The warning of a run sampled fewer than `PEAK_SAMPLES` times a revolution of a
     driver turning at a steady rate (the fastest such driver): its peaks can read low.
@@ -92,25 +123,19 @@ def sampling_warning(model: Model, traj: Trajectory) -> str | None:
     if d is None or not len(d.names) or fps <= 0.0 or len(traj.t) < 2:
         return None
     fastest: tuple[float, str, float] | None = None  # (samples a revolution, name, rad/s)
-    for name, component, law in zip(d.names, d.component, d.laws, strict=True):
-        w = steady_rate(law[1], traj.t) if component == "M" else None
-        if w is not None:
-            per_turn = 2.0 * math.pi * fps / abs(w)
-            if fastest is None or per_turn < fastest[0]:
-                fastest = (per_turn, name, abs(w))
+    for i in steady_turning(model, traj.t):
+        w = steady_rate(d.laws[i][1], traj.t)
+        assert w is not None
+        per_turn = samples_a_turn(fps, w)
+        if fastest is None or per_turn < fastest[0]:
+            fastest = (per_turn, d.names[i], abs(w))
     if fastest is None or fastest[0] >= PEAK_SAMPLES * (1.0 - 1e-9):
         return None
     per_turn, name, w = fastest
-    n = f"{per_turn:.3g}"
-    low = (f"up to {100.0 * (1.0 - math.cos(math.pi / per_turn)):.2g} % low when the load "
-           f"varies as a sine of {name}'s angle (1 - cos(180 deg / {n})), more with its "
-           "harmonics" if per_turn > 2.0 else
-           "as low as nothing: two samples a revolution or fewer can miss it entirely")
     need = math.ceil(PEAK_SAMPLES * w / (2.0 * math.pi) * (1.0 - 1e-12))
     sine = 100.0 * (1.0 - math.cos(math.pi / PEAK_SAMPLES))
-    return (f"{SPARSE}: {name} turns at {w * 30.0 / math.pi:.4g} rpm, and {fps:g} fps is "
-            f"{n} samples a revolution; a peak that falls between two samples reads {low}, "
-            "and the energy check's work, summed over so few samples, is as coarse. "
+    return (sparse_text(name, w, per_turn, f"{fps:g} fps is")
+            + ", and the energy check's work, summed over so few samples, is as coarse. "
             f"Use --fps {need} or more ({PEAK_SAMPLES} samples a revolution: a sine's peak "
             f"within {sine:.2g} %)"
             + (", or mbody kinematics without --fps, whose default is one revolution at a "

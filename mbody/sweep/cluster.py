@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from mbody.errors import MbodyError
-from mbody.sweep.runs import Job, Rows, run_chunk
+from mbody.sweep.runs import Job, Rows, Sparsest, run_chunk
 from mbody.sweep.table import Results
 
 CHUNK_SECONDS = 2.0
@@ -60,6 +60,10 @@ class Report:
     wall: float = 0.0
     start: float = 0.0
     lost: int = 0
+    sparse: int = 0
+    """Cases run whose peaks come from too few samples a revolution (`Rows.sparse`)."""
+    sparsest: Sparsest | None = None
+    """The one of them with the fewest (`Rows.sparsest`)."""
 
     @property
     def busy(self) -> float:
@@ -119,6 +123,10 @@ def run(job: Job, todo: Sequence[int], results: Results, *, scheduler: str | Non
         results.add(rows)
         report.cases += len(rows.indices)
         report.cpu += rows.cpu
+        report.sparse += rows.sparse
+        if rows.sparsest is not None:
+            report.sparsest = (rows.sparsest if report.sparsest is None
+                               else min(report.sparsest, rows.sparsest))
         bar.update(len(rows.indices))
         if on_chunk is not None:
             on_chunk(rows)

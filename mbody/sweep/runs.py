@@ -44,6 +44,7 @@ from mbody.kernel import _core
 from mbody.model.model import Model, State, from_source
 from mbody.model.source import Source
 from mbody.simulate.kinematic import require_fully_driven
+from mbody.simulate.peaks import PEAK_SAMPLES, samples_a_turn, sparse_text, steady_turning
 from mbody.simulate.simulation import simulate
 from mbody.solve.batch import Evaluator, closed
 from mbody.solve.family import Case, Family
@@ -112,6 +113,24 @@ class Rows:
     cpu: float = 0.0
     """The processor seconds the evaluation took (`seconds` is wall-clock: on a shared
     machine, also other programs' time)."""
+    sparse: int = 0
+    """Cases whose ``peak:`` columns come from fewer than `PEAK_SAMPLES` samples a
+    revolution of a driver turning at a steady rate (`sampling`)."""
+    sparsest: Sparsest | None = None
+    """The chunk's case with the fewest samples a revolution, when it has fewer than
+    `PEAK_SAMPLES`."""
+
+
+@dataclass(frozen=True, order=True)
+class Sparsest:
+    """A case sampled fewer than `PEAK_SAMPLES` times a revolution of a driver turning
+    at a steady rate: that many samples (first: the fewest compare lowest), the case, the
+    driver's name and its rate (rad/s)."""
+
+    per_turn: float
+    case: int
+    driver: str
+    rate: float
 
 
 def final_labels(model: Model) -> list[str]:
@@ -201,6 +220,10 @@ class Context:
     """Where the entries of F that a fully driven motion depends on start (joints,
     components, expression numbers: after gravity, bodies, loads and springs)."""
     cache: dict[str, Any] = field(default_factory=dict)
+    turning: list[int] = field(default_factory=list)
+    """The drivers that turn at a steady rate (in the model as read; a case's values set
+    their rates, not their laws' form), whose samples a revolution `sampling` checks, for
+    the runs that report peaks."""
 
 
 _CONTEXTS: dict[str, Context] = {}
@@ -216,7 +239,8 @@ def context(job: Job) -> Context:
         n, k, s = model.n, len(model.forces.names), len(model.springs.names)
         driver = turning_driver(model) if job.settings.revolutions is not None else -1
         ctx = Context(job, model, Family(model, job.grid.paths), Evaluator(model), len(cols),
-                      driver, 3 + _core.BODY_W * n + _core.LOAD_W * k + _core.SPRING_W * s)
+                      driver, 3 + _core.BODY_W * n + _core.LOAD_W * k + _core.SPRING_W * s,
+                      turning=_steady_turning(model, job.settings))
         while len(_CONTEXTS) >= _KEEP:
             _CONTEXTS.pop(next(iter(_CONTEXTS)))
         _CONTEXTS[job.key] = ctx
@@ -232,41 +256,114 @@ def run_chunk(job: Job, indices: Sequence[int]) -> Rows:
     ctx = context(job)
     indices = [int(i) for i in indices]
     values = [job.grid.values(i) for i in indices]
+    cases: list[Case | None]
     try:
-        outputs, errors = _evaluate(ctx, values)
+        made = ctx.family.cases(values)
+        outputs, errors = _evaluate(ctx, values, made)
+        cases = list(made)
     except Exception:  # a bug in one case must not lose the others: each on its own
         outputs = np.full((len(values), ctx.width), np.nan)
-        errors = []
+        errors, cases = [], []
         for k, v in enumerate(values):
+            case = None
             try:
-                out, err = _evaluate(ctx, [v])
+                (case,) = ctx.family.cases([v])
+                out, err = _evaluate(ctx, [v], [case])
                 outputs[k], e = out[0], err[0]
             except Exception as exc:  # noqa: BLE001 - reported in the case's row
                 e = f"internal error (a bug in mbody; please report it): " \
                     f"{type(exc).__name__}: {exc}"
             errors.append(e)
+            cases.append(case)
     for k, e in enumerate(errors):
         if e is not None:
             outputs[k] = np.nan
+    sparse, sparsest = sampling(ctx, indices, cases, errors)
     return Rows(indices, outputs, errors, time.perf_counter() - begin,
-                f"{socket.gethostname()}:{os.getpid()}", time.process_time() - cpu)
+                f"{socket.gethostname()}:{os.getpid()}", time.process_time() - cpu,
+                sparse, sparsest)
 
 
-def _evaluate(ctx: Context, values: list[dict[str, Any]]) -> tuple[np.ndarray, list]:
+def _evaluate(ctx: Context, values: list[dict[str, Any]], cases: list[Case]
+              ) -> tuple[np.ndarray, list]:
+    """(outputs, errors) of the cases with `values` (`cases`: the family's of them)."""
     run = ctx.job.settings.run
     if run == "solve":
-        return _solve(ctx, values)
+        return _solve(ctx, values, cases)
     if run == "kinematics":
-        return _kinematics(ctx, values)
+        return _kinematics(ctx, values, cases)
     if run == "simulate":
-        return _per_model(ctx, values, _simulate)
-    return _per_model(ctx, values, _modes)
+        return _per_model(ctx, values, cases, _simulate)
+    return _per_model(ctx, values, cases, _modes)
+
+
+# -- whether the peaks are sampled closely enough ---------------------------------------
+
+def _steady_turning(model: Model, settings: Settings) -> list[int]:
+    """`Context.turning`: checked over the run's span (one second for a span in turns)."""
+    if settings.run not in ("kinematics", "simulate"):
+        return []
+    span = settings.t_end if settings.t_end is not None else 1.0
+    return steady_turning(model, np.linspace(0.0, span, 11))
+
+
+def sampling(ctx: Context, indices: Sequence[int], cases: Sequence[Case | None],
+             errors: Sequence[str | None]) -> tuple[int, Sparsest | None]:
+    """(how many of the cases that ran have fewer than `PEAK_SAMPLES` samples a
+    revolution of a driver turning at a steady rate, the one with the fewest): a
+    ``kinematics`` run has (steps - 1) / T samples a second, a ``simulate`` run fps; each
+    driver's rate is the case's at t = 0."""
+    s = ctx.job.settings
+    drivers = ctx.model.drivers
+    if not ctx.turning or drivers is None:
+        return 0, None
+    count, sparsest = 0, None
+    for index, case, error in zip(indices, cases, errors, strict=True):
+        if error is not None or case is None or case.extras is None:
+            continue
+        per_second = s.fps if s.run == "simulate" else (s.steps - 1) / _end(ctx, case)
+        fewest = None
+        for d in ctx.turning:
+            rate = float(case.extras[d])
+            if rate == 0.0 or not math.isfinite(rate):
+                continue
+            here = Sparsest(samples_a_turn(per_second, rate), index, drivers.names[d], rate)
+            if here.per_turn < PEAK_SAMPLES * (1.0 - 1e-9):
+                fewest = here if fewest is None else min(fewest, here)
+        if fewest is not None:
+            count += 1
+            sparsest = fewest if sparsest is None else min(sparsest, fewest)
+    return count, sparsest
+
+
+def sampling_warning(settings: Settings, grid: Grid, count: int, ran: int,
+                     sparsest: Sparsest | None) -> str | None:
+    """The warning of a sweep whose `count` of `ran` cases have fewer than `PEAK_SAMPLES`
+    samples a revolution (`sampling`): the sparsest case, how low its peaks can read, and
+    the --steps (kinematics) or --fps (simulate) that gives every case enough."""
+    if not count or sparsest is None:
+        return None
+    values = ", ".join(f"{p}={v}" for p, v in zip(grid.paths, grid.numbers(sparsest.case),
+                                                   strict=True))
+    text = sparse_text(sparsest.driver, sparsest.rate, sparsest.per_turn,
+                       f"case {sparsest.case} ({values}) has")
+    if settings.run == "kinematics":  # (steps - 1) / per_turn turns in that case
+        turns = (settings.steps - 1) / sparsest.per_turn
+        need = f"--steps {math.ceil(PEAK_SAMPLES * turns * (1.0 - 1e-12)) + 1}"
+    else:
+        turns_a_second = abs(sparsest.rate) / (2.0 * math.pi)
+        need = f"--fps {math.ceil(PEAK_SAMPLES * turns_a_second * (1.0 - 1e-12))}"
+    sine = 100.0 * (1.0 - math.cos(math.pi / PEAK_SAMPLES))
+    return (f"{text}. {count} of the {ran} cases run have fewer than {PEAK_SAMPLES} samples a "
+            f"revolution: their peak: columns can read low. Use {need} or more "
+            f"({PEAK_SAMPLES} samples a revolution in every case: a sine's peak within "
+            f"{sine:.2g} %)")
 
 
 # -- solve -------------------------------------------------------------------------------
 
-def _solve(ctx: Context, values: list[dict[str, Any]]) -> tuple[np.ndarray, list]:
-    cases = ctx.family.cases(values)
+def _solve(ctx: Context, values: list[dict[str, Any]], cases: list[Case]
+           ) -> tuple[np.ndarray, list]:
     out = np.full((len(values), ctx.width), np.nan)
     errors: list[str | None] = [c.error for c in cases]
     for ev, ks, F in _groups(ctx, cases):
@@ -328,8 +425,8 @@ def _end(ctx: Context, case: Case) -> float:
     return 2.0 * math.pi * s.revolutions / abs(rate)
 
 
-def _kinematics(ctx: Context, values: list[dict[str, Any]]) -> tuple[np.ndarray, list]:
-    cases = ctx.family.cases(values)
+def _kinematics(ctx: Context, values: list[dict[str, Any]], cases: list[Case]
+                ) -> tuple[np.ndarray, list]:
     out = np.full((len(values), ctx.width), np.nan)
     errors: list[str | None] = [c.error for c in cases]
     for ev, ks, F in _groups(ctx, cases):
@@ -430,8 +527,8 @@ def _state(model: Model, y: np.ndarray) -> State:
 
 # -- simulate and modes: one model per case ----------------------------------------------
 
-def _per_model(ctx: Context, values: list[dict[str, Any]], one) -> tuple[np.ndarray, list]:
-    cases = ctx.family.cases(values)
+def _per_model(ctx: Context, values: list[dict[str, Any]], cases: list[Case], one
+               ) -> tuple[np.ndarray, list]:
     out = np.full((len(values), ctx.width), np.nan)
     errors: list[str | None] = [c.error for c in cases]
     for k, (v, c) in enumerate(zip(values, cases, strict=True)):
