@@ -1,12 +1,16 @@
 """mbody: per-body Newton-Euler equations for multibody models.
 
-    model = mbody.load("models/seed_example_1.yaml")
+    model = mbody.load("models/double_pendulum.yaml")
     asm = mbody.assemble(model)          # M v̇ + b = Q + G λ at the model's state
-    sol = asm.solve(known={"A.Fx": 0})   # accelerations, aligned with asm.coordinates
+    sol = asm.solve()                    # accelerations and the reactions λ
+    sol = asm.solve(known={"A.Fx": 0})   # or with a reaction component given
 
 The public names below are imported on first use (PEP 562), so that `import mbody` and
 the `mbody` command load only what they need (scipy, matplotlib, meshcat and networkx
-are slow to import). Submodules are reachable as attributes too (``mbody.solve.dynamics``).
+are slow to import). Submodules are reachable as attributes too (``mbody.solve.dynamics``),
+except under a name that is also a public function (`assemble`, `animate`, `simulate`,
+`loads`): ``mbody.simulate`` is the function, so a module of its folder is imported from
+it (``from mbody.simulate import peaks``).
 
 The package's folders follow the flow: `model` (file -> validated `Model`), `equations`
 (free bodies and the stacked equations), `solve` (accelerations and reactions),

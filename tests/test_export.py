@@ -349,6 +349,22 @@ def _pendulum_run(tmp_path: Path) -> tuple[Path, np.ndarray]:
     return traj.save(tmp_path / "run.npz"), th
 
 
+def test_the_assembly_at_a_sample_of_a_run_in_memory_or_on_file(tmp_path):
+    """docs/api.md: assembly_from_trajectory(model, run, time) takes the Trajectory itself
+    (a notebook has it in memory) or its file: the same sample's assembly either way."""
+    run, _ = _pendulum_run(tmp_path)
+    model = mbody.load(MODELS / "pendulum.yaml")
+    traj = Trajectory.load(run)
+    (a, where_a), (b, where_b) = (ex.assembly_from_trajectory(model, r, 0.6) for r in (traj, run))
+    assert ex.exported(a).differences(ex.exported(b)) == []
+    assert where_a.endswith("sample 2 at t = 0.5 s (nearest to t = 0.6 s)")
+    assert where_b == f"trajectory {run}, sample 2 at t = 0.5 s (nearest to t = 0.6 s)"
+    with pytest.raises(TypeError, match="run: expected a Trajectory or the path"):
+        ex.assembly_from_trajectory(model, traj.state(0), 0.6)  # type: ignore[arg-type]
+    assert ".columns>" in repr(ex.exported(a))  # what the repr offers exists
+    assert ex.exported(a).columns.records()
+
+
 def test_cli_export_at_a_trajectory_sample(tmp_path):
     run, th = _pendulum_run(tmp_path)
     r = _mbody("export", MODELS / "pendulum.yaml", "--state", run, "--time", 0.6,
@@ -431,3 +447,16 @@ def test_export_solves_like_the_assembly(name, tmp_path):
     b = np.array([got.reactions[r] for r in model.reactions])
     if len(a):
         np.testing.assert_allclose(b, a, rtol=1e-12, atol=1e-12 * np.abs(a).max())
+
+
+def test_an_assemblys_arrays_cannot_be_edited_in_place():
+    """`solve` works from the model and state, an export from M, b, Q and G: an edit in
+    place would make the two disagree, so the arrays refuse it (as a Model's do)."""
+    asm = mbody.assemble(mbody.load(MODELS / "double_pendulum.yaml"))
+    for name in ("b", "Q"):
+        with pytest.raises(ValueError, match="read-only"):
+            getattr(asm, name)[1] += 100.0
+    for name in ("M", "G"):
+        with pytest.raises(ValueError, match="read-only"):
+            getattr(asm, name).data[0] = 1.0
+    assert np.array_equal(ex.exported(asm).solve().accelerations, asm.solve().accelerations)

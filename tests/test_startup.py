@@ -145,6 +145,21 @@ assert mbody.solve.dynamics.__name__ == "mbody.solve.dynamics"  # submodules on 
     assert loaded(code, NEVER_AT_IMPORT) == []
 
 
+def test_the_package_docstrings_example_runs(monkeypatch):
+    """What `help(mbody)` shows first runs as written (from the checkout), and the way it
+    gives to import a module of `mbody.simulate`'s folder works."""
+    doc = mbody.__doc__ or ""
+    lines = [ln[4:] for ln in doc.split("\n\n")[1].splitlines()]
+    assert lines and all(ln.strip() for ln in lines)
+    monkeypatch.chdir(ROOT)
+    ns: dict = {"mbody": mbody}
+    exec("\n".join(lines), ns)
+    assert ns["sol"].reactions["A.Fx"] == 0.0
+    assert "from mbody.simulate import peaks" in doc
+    from mbody.simulate import peaks
+    assert peaks.__name__ == "mbody.simulate.peaks"
+
+
 PLAIN_SIMULATE = ("mbody.equations.symbolic", "mbody.equations.assemble", "mbody.equations.fbd",
                   "mbody.equations.generalized", "mbody.equations.coordinates", "sympy",
                   "scipy", "tqdm", "zipfile")

@@ -12,7 +12,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from functools import cached_property
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, TypeVar
 
 import numpy as np
 
@@ -157,21 +157,27 @@ class Assembly:
         """Reaction values given in the model file."""
         return dict(self.model.known_reactions)
 
+    # M, b, Q and G cannot be written to: `solve` and `generalized` work from the model and
+    # state, not from these arrays, so an edit in place would change what an export of
+    # this assembly holds but not its solution (a "what if" goes through `known=` or
+    # `Model.with_values`)
     @cached_property
     def M(self) -> sp.spmatrix:
-        """(N, N) block-diagonal mass matrix, sparse: m I (kg), then J (body axes, kg m^2)."""
-        return mass_matrix(self.model)
+        """(N, N) block-diagonal mass matrix, sparse: m I (kg), then J (body axes, kg m^2).
+        Read-only."""
+        return _readonly(mass_matrix(self.model))
 
     @cached_property
     def b(self) -> np.ndarray:
-        """(N,) gyroscopic vector: 0 on Newton rows, ω × J ω on Euler rows (N m)."""
-        return _select(self.model, self._b6)
+        """(N,) gyroscopic vector: 0 on Newton rows, ω × J ω on Euler rows (N m).
+        Read-only."""
+        return _readonly(_select(self.model, self._b6))
 
     @cached_property
     def Q(self) -> np.ndarray:
         """(N,) applied generalised forces: net force (world axes, N), moment about G (body
-        axes, N m)."""
-        return _select(self.model, self._Q6)
+        axes, N m). Read-only."""
+        return _readonly(_select(self.model, self._Q6))
 
     @cached_property
     def columns(self) -> ReactionColumns:
@@ -180,9 +186,10 @@ class Assembly:
 
     @cached_property
     def G(self) -> sp.csc_matrix:
-        """(N, m) sparse reaction coupling: column c is the wrench of reaction c per unit."""
+        """(N, m) sparse reaction coupling: column c is the wrench of reaction c per unit.
+        Read-only."""
         G = g_matrix(self.model, self.columns)
-        return G[self.model.rows] if self.model.has_particles else G
+        return _readonly(G[self.model.rows] if self.model.has_particles else G)
 
     def jacobian(self) -> ConstraintJacobian:
         """The constraint Jacobian Gᵀ (m x N) with labelled rows and columns, plus γ and φ.
@@ -472,3 +479,14 @@ def assemble(model: Model, state: State | None = None) -> Assembly:
     """
     return Assembly(model, model.initial if state is None else state)
 
+
+_Array = TypeVar("_Array")
+
+
+def _readonly(a: _Array) -> _Array:
+    """`a` with its numbers (a compressed sparse matrix's data and structure) made
+    read-only."""
+    parts = (a,) if isinstance(a, np.ndarray) else (a.data, a.indices, a.indptr)  # type: ignore[attr-defined]
+    for part in parts:
+        part.flags.writeable = False
+    return a

@@ -181,7 +181,7 @@ class ExportedAssembly:
         N, m = len(self.coordinates), len(self.reactions)
         world = "" if self.T is None else f", T {len(self.world_reactions)}x{m}"
         return (f"<ExportedAssembly of {self.model!r}: M {N}x{N}, G {N}x{m}{world}; state: "
-                f"{self.state_source}; .solve(), .records()>")
+                f"{self.state_source}; .solve(), .columns>")
 
     def solve(self, known: Mapping[str, float] | None = None, *,
               axes: str = "joint") -> Solution:
