@@ -166,3 +166,37 @@ def test_reaction_values_array_is_read_only_and_the_values():
         arr[0] = 3.0
     sol = mbody.assemble(mbody.load(MODELS[0].parent / "double_pendulum.yaml")).solve()
     assert not sol.reactions.array.flags.writeable  # type: ignore[attr-defined]
+
+
+def test_a_verification_and_symbolic_equations_repr_in_a_line():
+    """verify's and symbolic()'s results were dataclass dumps of 2-3 kB (every check's
+    explanation, every term): one line each now, the report on print() as before."""
+    root = MODELS[0].parent
+    v = mbody.verify(root / "pendulum.yaml", root / "answers" / "pendulum.yaml")
+    text = repr(v)
+    assert text.startswith("<Verification of 'physical-pendulum'") and len(text) <= 300
+    assert f"{v.correct} of {len(v.checks)} equations correct" in text
+    assert all(c.diagnosis in text for c in v.checks if not c.correct)
+    assert str(v) == v.text() and "\n" in str(v)
+    assert all(repr(c).startswith(f"<Check [{c.index}] {c.body}: ") for c in v.checks)
+    sym = mbody.assemble(mbody.load(root / "double_pendulum.yaml")).symbolic()
+    shown = [repr(sym), repr(sym["upper"]), *map(repr, sym.rows)]
+    assert all(len(t) <= 300 and t.endswith(">") for t in shown), shown
+    assert shown[0] == ("<SymbolicEquations of 'double-pendulum' at t = 0 s: 2 bodies, 6 rows; "
+                        "print() it, .text(), .latex(), [body]>")
+    assert shown[2] == f"<SymbolicRow upper.x: {sym.rows[0].text()}>"
+
+
+def test_a_linearization_repr_says_when_it_lists_only_some_frequencies():
+    chain = mbody.loads("model: chain\ndimension: 2\ngravity: [0, -9.81]\nbodies:\n"
+                        + "".join(f"  - {{name: b{i}, mass: 1, inertia: 0.1, position: "
+                                  f"[0, {-i - 0.5}]}}\n" for i in range(6))
+                        + "joints:\n" + "".join(
+                            f"  - {{name: J{i}, type: revolute, parent: "
+                            f"{'ground' if i == 0 else f'b{i - 1}'}, child: b{i}, "
+                            f"at: [0, {-i}]}}\n" for i in range(6)))
+    lin = mbody.linearize(chain)
+    assert len(lin.frequencies) == 6
+    assert "…" in repr(lin) and repr(lin).count(",") >= 4
+    two = mbody.linearize(mbody.load(MODELS[0].parent / "double_pendulum.yaml"))
+    assert "…" not in repr(two)

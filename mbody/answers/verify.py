@@ -74,6 +74,9 @@ class Check:
         """Whether the equation is one of the body's rows."""
         return self.diagnosis == CORRECT
 
+    def __repr__(self) -> str:  # the dataclass's would print the explanation and details
+        return f"<Check [{self.index}] {self.body}: {self.eq!r}: {self.diagnosis}>"
+
     def to_dict(self) -> dict[str, Any]:
         """The check as JSON-ready data.
 
@@ -206,6 +209,19 @@ class Verification:
 
     def __str__(self) -> str:
         return self.text()
+
+    def __repr__(self) -> str:  # the dataclass's would print every check in full
+        wrong = sorted({c.diagnosis for c in self.checks if not c.correct})
+        n = len(self.checks)
+        by = f" by {self.student}" if self.student else ""
+        return (f"<Verification of {self.model!r}{by}: {self.correct} of {n} "
+                f"equation{'s' if n != 1 else ''} correct"
+                + (f" ({', '.join(wrong)})" if wrong else "")
+                + f", {self.rows - len(self.uncovered)} of {self.rows} rows covered; "
+                "print() it, .checks, .to_dict()>")
+
+    def _repr_pretty_(self, p, cycle: bool) -> None:  # IPython shows the report
+        p.text(self.text())
 
 
 def verify(model: Model | str | os.PathLike[str], answers: Any, *, tol: float = TOLERANCE,

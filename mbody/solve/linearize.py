@@ -365,7 +365,8 @@ class Linearization:
 
     def __repr__(self) -> str:
         verdict = {True: "stable", False: "unstable", None: "not steady"}[self.stable]
-        f = ", ".join(f"{x:.4g}" for x in self.frequencies[:4])
+        f = ", ".join(f"{x:.4g}" for x in self.frequencies[:4]) + (
+            ", …" if len(self.frequencies) > 4 else "")
         return (f"<Linearization of {self.model.name!r}: {len(self.coordinates)} coordinates, "
                 f"{len(self.frequencies)} oscillation(s)" + (f" ({f} rad/s)" if f else "")
                 + f", {verdict}; .M, .D, .K, .eigenvalues, .modes>")

@@ -167,6 +167,9 @@ class SymbolicRow:
         return (f"{join_terms(self.left, digits, True) or '0'} &= "
                 f"{join_terms(self.right, digits, True) or '0'}")
 
+    def __repr__(self) -> str:  # the dataclass's would print every Term
+        return f"<SymbolicRow {self.label}: {self.text()}>"
+
     def __str__(self) -> str:
         return self.text()
 
@@ -288,6 +291,10 @@ class SymbolicBody:
     def _repr_latex_(self) -> str:  # Jupyter renders the equations
         return "$$" + self.latex() + "$$"
 
+    def __repr__(self) -> str:  # the dataclass's would print every row's terms
+        return (f"<SymbolicBody {self.body!r}: {len(self.rows)} rows; print() it, .rows, "
+                ".evaluate(), .latex()>")
+
     def __str__(self) -> str:
         return self.text()
 
@@ -318,6 +325,11 @@ class SymbolicEquations:
             if b.body == name:
                 return b
         raise KeyError(f"no body named {name!r}")
+
+    def __repr__(self) -> str:  # the dataclass's would print every term
+        return (f"<SymbolicEquations of {self.model!r} at t = {self.t:g} s: "
+                f"{len(self.bodies)} bod{'y' if len(self.bodies) == 1 else 'ies'}, "
+                f"{len(self.rows)} rows; print() it, .text(), .latex(), [body]>")
 
     @property
     def rows(self) -> list[SymbolicRow]:
