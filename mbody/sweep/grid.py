@@ -57,16 +57,28 @@ class Axis:
     unit: str = ""
     listed: bool = False
 
-    def grid_values(self) -> list[Any]:
-        """The axis's values in grid order (as the results' column shows them)."""
+    @property
+    def size(self) -> int:
+        """How many grid values the axis has (known without making them)."""
+        return len(self.values) if self.listed else self.count
+
+    def value(self, k: int) -> Any:
+        """The axis's k-th grid value (as the results' column shows it), made alone: a
+        grid of many values is never held as a list."""
         if self.listed:
-            return list(self.values)
+            return self.values[k]
         lo, hi = self.values
         if self.count == 1:
-            return [lo]
-        # to 15 significant digits, as written: 0.4:0.8:3 gives 0.6, not linspace's
-        # 0.6000000000000001 (a double holds 15 digits exactly)
-        return [float(f"{x:.15g}") for x in np.linspace(lo, hi, self.count).tolist()]
+            return lo
+        # numpy's linspace's k-th value (k step + start, the last exactly stop), to 15
+        # significant digits, as written: 0.4:0.8:3 gives 0.6, not 0.6000000000000001 (a
+        # double holds 15 digits exactly)
+        x = hi if k == self.count - 1 else float(k) * ((hi - lo) / (self.count - 1)) + lo
+        return float(f"{x:.15g}")
+
+    def grid_values(self) -> list[Any]:
+        """The axis's values in grid order (as the results' column shows them)."""
+        return [self.value(k) for k in range(self.size)]
 
     def drawn(self, u: float) -> Any:
         """The value a uniform number u in [0, 1) draws (a random sample)."""
@@ -107,14 +119,15 @@ class Grid:
     def paths(self) -> tuple[str, ...]:
         return tuple(a.path for a in self.axes)
 
-    @cached_property
-    def _columns(self) -> list[list[Any]]:
-        return [a.grid_values() for a in self.axes]
-
-    def __len__(self) -> int:
+    @property
+    def cases(self) -> int:
+        """How many cases (from the axes' counts; any size, as a file may ask)."""
         if self.samples is not None:
             return self.samples
-        return math.prod(len(c) for c in self._columns)
+        return math.prod(a.size for a in self.axes)
+
+    def __len__(self) -> int:
+        return self.cases
 
     @cached_property
     def _draws(self) -> np.ndarray:
@@ -129,9 +142,9 @@ class Grid:
             return [a.drawn(u) for a, u in zip(self.axes, self._draws[index].tolist(),
                                                strict=True)]
         out = []
-        for col in reversed(self._columns):
-            index, r = divmod(index, len(col))
-            out.append(col[r])
+        for axis in reversed(self.axes):
+            index, r = divmod(index, axis.size)
+            out.append(axis.value(r))
         return out[::-1]
 
     def values(self, index: int) -> dict[str, Any]:
@@ -185,11 +198,17 @@ def parse_grid(specs: Sequence[str], samples: int | None = None, seed: int = 0) 
     if samples is not None and samples < 1:
         raise MbodyError(f"--samples: expected at least 1 case, got {samples}")
     grid = Grid(tuple(axes), fixed, samples, seed)
-    size = samples if samples is not None else math.prod(len(a.grid_values()) for a in axes)
+    size = grid.cases  # from the counts: no value is made before this bound
     if size > MAX_CASES:
-        raise MbodyError(f"the sweep has {size:,} cases; at most {MAX_CASES:,} are run "
-                         "(fewer values per axis, or --samples N)".replace(",", " "))
+        raise MbodyError(f"the sweep has {_spaced(size)} cases; at most "
+                         f"{_spaced(MAX_CASES)} are run (fewer values per axis, or "
+                         "--samples N)")
     return grid
+
+
+def _spaced(n: int) -> str:
+    """n with its thousands apart: 100 000 000."""
+    return f"{n:,}".replace(",", " ")
 
 
 def _top_level(text: str, sep: str) -> list[str]:
