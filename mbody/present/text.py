@@ -309,19 +309,22 @@ def reaction_table_text(asm: Assembly, sol: Solution) -> str:
              "+R on the child and -R on the parent"]
     lines += _table(["joint", "comp", "axis (world)", "value", "status"], rows)
     lines.append("net load of each joint at its joint point (world axes):")
+    # each joint's components summed in their order, all joints at once (a mask per
+    # joint was quadratic in the joints: 2.4 s at 8000)
     F_all = np.zeros((len(model.joints), 3))
     C_all = np.zeros((len(model.joints), 3))
-    for jn in range(len(model.joints)):
-        sel = rt.joint == jn
-        F_all[jn] = (lam[sel & ~cols.is_moment, None] * cols.W_e[sel & ~cols.is_moment]).sum(0)
-        C_all[jn] = (lam[sel & cols.is_moment, None] * cols.W_e[sel & cols.is_moment]).sum(0)
+    moment = np.asarray(cols.is_moment, dtype=bool)
+    np.add.at(F_all, rt.joint[~moment], lam[~moment, None] * cols.W_e[~moment])
+    np.add.at(C_all, rt.joint[moment], lam[moment, None] * cols.W_e[moment])
     F_all, C_all = _clean(F_all), _clean(C_all)
+    firsts = np.full(len(model.joints), -1)
+    firsts[rt.joint[::-1]] = np.arange(len(rt.joint))[::-1]  # each joint's first component
     for jn, j in enumerate(model.joints):
-        P = cols.W_P[np.flatnonzero(rt.joint == jn)[0]]
+        first = int(firsts[jn])
+        P = cols.W_P[first]
         F, C = F_all[jn], C_all[jn]
         Cs = _n(C[2]) if dim == cv.PLANAR else _v(C, 3)
         mCs = _n(-C[2]) if dim == cv.PLANAR else _v(-C, 3)
-        first = np.flatnonzero(rt.joint == jn)[0]
         if rt.link[first]:  # a rigid link to a particle: its two ends are apart
             Pp = P + rt.length[first] * cols.W_e[first]
             lines.append(f"  {j.name} (link, {_n(rt.length[first])} m): on child {j.child} "
