@@ -14,6 +14,7 @@ from typing import Any, TypeVar, overload
 
 import numpy as np
 
+from mbody.errors import did_you_mean
 from mbody.model.expressions import Expression
 from mbody.model.reprs import count, name_list, vector_text
 
@@ -178,54 +179,99 @@ T = TypeVar("T")
 
 
 class Records(Sequence[T]):
-    """A read-only sequence of records, each made on first use and then kept.
+    """A read-only sequence of records, each made on first use and then kept; a record is
+    found by its index or by its name (``model.joints["A"]``, as ``model.joints[0]``).
 
     A large model's file is read without making a record per load or joint (a few
     hundred bytes and about a microsecond each); the arrays they view are the model's.
 
     Parameters
     ----------
-    n : int
-        How many records.
+    names : sequence of str
+        The records' names, in order (their number is the sequence's length).
     make : callable
         Index -> its record.
+    noun : tuple of str
+        What a record is, singular and plural (``("joint", "joints")``), for messages.
     """
 
-    __slots__ = ("_n", "_make", "_made")
+    __slots__ = ("_n", "_make", "_made", "_names", "_noun", "_index")
 
-    def __init__(self, n: int, make: Callable[[int], T]):
-        self._n = n
+    def __init__(self, names: Sequence[str], make: Callable[[int], T],
+                 noun: tuple[str, str] = ("record", "records")):
+        self._n = len(names)
+        self._names = names
         self._make = make
-        self._made: list[T | None] = [None] * n
+        self._noun = noun
+        self._made: list[T | None] = [None] * self._n
+        self._index: dict[str, int] | None = None
 
     def __len__(self) -> int:
         return self._n
 
     @overload
-    def __getitem__(self, i: int) -> T: ...
+    def __getitem__(self, i: int | str) -> T: ...
 
     @overload
     def __getitem__(self, i: slice) -> tuple[T, ...]: ...
 
-    def __getitem__(self, i: int | slice) -> T | tuple[T, ...]:
+    def __getitem__(self, i: int | str | slice) -> T | tuple[T, ...]:
         if isinstance(i, slice):
             return tuple(self[k] for k in range(*i.indices(self._n)))
-        k = operator.index(i)
-        if k < 0:
-            k += self._n
-        if not 0 <= k < self._n:
-            raise IndexError(f"record index {i} out of range ({self._n} records)")
+        if isinstance(i, str):
+            k = self.where(i)
+        else:
+            k = position(i, self._n, self._noun, self._names)
         made = self._made[k]
         if made is None:
             made = self._made[k] = self._make(k)
         return made
+
+    def where(self, name: str) -> int:
+        """The index of the record named `name`; KeyError with a did-you-mean."""
+        if self._index is None:
+            self._index = {nm: k for k, nm in enumerate(self._names)}
+        k = self._index.get(name)
+        if k is None:
+            raise missing(self._noun, name, self._names)
+        return k
+
+    def __contains__(self, item: object) -> bool:  # a name, or a record
+        if isinstance(item, str):
+            if self._index is None:
+                self._index = {nm: k for k, nm in enumerate(self._names)}
+            return item in self._index
+        return super().__contains__(item)
 
     def __iter__(self) -> Iterator[T]:
         for k in range(self._n):
             yield self[k]
 
     def __repr__(self) -> str:
-        return f"<{self._n} records; made so far: {self._n - self._made.count(None)}>"
+        if not self._n:
+            return f"<no {self._noun[1]}>"
+        return f"<{count(self._n, *self._noun)}: {name_list(self._names)}>"
+
+
+def position(i: object, n: int, noun: tuple[str, str], names: Sequence[str]) -> int:
+    """`i` as an index 0 .. n - 1 of one of `n` named records (negative counts from the
+    end): IndexError out of range, TypeError for what is neither an index nor a name."""
+    if isinstance(i, bool) or not hasattr(i, "__index__"):
+        raise TypeError(f"{noun[1]} are found by name or by index, got {type(i).__name__}"
+                        + (f" {i!r}" if isinstance(i, float) else ""))
+    k = operator.index(i)
+    if not -n <= k < n:
+        raise IndexError(f"{noun[0]} index {k} out of range ({count(n, *noun)}"
+                         + (f": {name_list(names)}" if n else "") + ")")
+    return k + n if k < 0 else k
+
+
+def missing(noun: tuple[str, str], name: object, names: Sequence[str]) -> KeyError:
+    """The KeyError of a record name that is not there: the closest name, else the names."""
+    hint = did_you_mean(str(name), names)
+    return KeyError(f"no {noun[0]} named {name!r}" + (
+        f"; {hint}" if hint else f" (the {noun[1]}: {name_list(names)})" if names
+        else f" (this model has no {noun[1]})"))
 
 
 class BodyRecords(Mapping[str, Body]):
@@ -263,17 +309,21 @@ class BodyRecords(Mapping[str, Body]):
             return record(Body, fields_, (names[i], i, float(mass[i]), inertia[i], shape[i],
                                           color[i], bool(particle[i])))
 
-        self._records = Records(len(names), make)
+        self._records = Records(names, make, _BODY)
 
     def _where(self, name: object) -> int | None:
         if self._index is None:
             self._index = {nm: i for i, nm in enumerate(self._names)}
         return self._index.get(name) if isinstance(name, str) else None
 
-    def __getitem__(self, name: str) -> Body:
+    def __getitem__(self, name: str | int) -> Body:
+        """The body named `name`, or at index `name` in the stacking order
+        (``model.bodies[0]``); KeyError with a did-you-mean, IndexError with the range."""
+        if not isinstance(name, str):
+            return self._records[position(name, len(self._names), _BODY, self._names)]
         i = self._where(name)
         if i is None:
-            raise KeyError(name)
+            raise missing(_BODY, name, self._names)
         return self._records[i]
 
     def __contains__(self, name: object) -> bool:
@@ -286,4 +336,7 @@ class BodyRecords(Mapping[str, Body]):
         return len(self._names)
 
     def __repr__(self) -> str:
-        return f"<{count(len(self._names), 'body', 'bodies')}: {name_list(self._names)}>"
+        return f"<{count(len(self._names), *_BODY)}: {name_list(self._names)}>"
+
+
+_BODY = ("body", "bodies")
