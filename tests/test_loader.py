@@ -622,3 +622,21 @@ def test_loads_of_a_wrong_type_names_text(text):
         mbody.loads(text)
     if isinstance(text, Path):
         assert "mbody.load(path)" in str(err.value)
+
+
+@pytest.mark.parametrize("text", ["models/pendulum.yaml", "robots/arm.URDF "])
+def test_loads_of_a_path_points_to_load(text):
+    """Before: "expected a model mapping, got the text 'models/pendulum.yaml'"."""
+    with pytest.raises(ModelError) as err:
+        mbody.loads(text)
+    (issue,) = err.value.issues
+    assert "looks like a path" in issue.message and issue.hint == "use mbody.load(path)"
+
+
+@pytest.mark.parametrize("name", ["v1:", "C:\\models\\arm.yaml"])
+def test_a_one_line_name_colon_in_a_path_is_still_a_missing_file(tmp_path, monkeypatch, name):
+    """Only 'key: value' (a blank after the colon) reads as YAML on one line: 'v1:' and
+    'C:\\models' are names of files, looked for as such."""
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(ModelError, match="no such file"):
+        mbody.load(name)

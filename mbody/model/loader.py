@@ -394,7 +394,7 @@ def _near_file(path: Path, most: int = 2000) -> str:
 SOURCE_KINDS = ("a path to a model file (str or os.PathLike) or a dict with a model file's "
                 "content")
 """What `mbody.load`'s `source` accepts, in words (its error messages)."""
-_YAML_START = re.compile(r"\s*(\{|[\w-]+\s*:(\s|$))")
+_YAML_START = re.compile(r"\s*(\{|[\w-]+\s*:\s)")
 
 
 def check_source(source: object, max_bytes: object = None, call: str = "mbody.load"

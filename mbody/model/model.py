@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from mbody import conventions as cv
-from mbody.errors import Issue, MbodyError, wrong_type
+from mbody.errors import Issue, MbodyError, ModelError, wrong_type
 from mbody.model.build import joint_tables, located_loads, point_loads
 from mbody.model.drivers import DriverTable, driver_table
 from mbody.model.expressions import Expression
@@ -510,10 +510,18 @@ def loads(text: str | bytes, file: str = "<string>") -> Model:
     return _build(spec, Source.of_text(text, file, from_file=False))
 
 
+_MODEL_SUFFIXES = (".yaml", ".yml", ".xml", ".mjcf", ".urdf")
+
+
 def model_text(text: object, file: str) -> str:
-    """`loads`' `text` as a str: bytes decoded as UTF-8 (as a file is read); anything else
-    refused with what `loads` takes (a path is `load`'s)."""
+    """`loads`' `text` as a str: bytes decoded as UTF-8 (as a file is read); a path, or
+    anything but text, refused with what `loads` takes (a path is `load`'s)."""
     if isinstance(text, str):
+        if "\n" not in text and text.strip().lower().endswith(_MODEL_SUFFIXES):
+            # a scalar is no model anyway: say what was meant rather than "expected a
+            # model mapping, got the text 'models/pendulum.yaml'"
+            raise ModelError([Issue(file, 0, 0, "text", "this looks like a path to a model "
+                                    "file, not its text", "use mbody.load(path)")])
         return text
     if isinstance(text, bytes | bytearray):
         return decode(bytes(text), file)
