@@ -221,26 +221,45 @@ class Records(Sequence[T]):
         if isinstance(i, str):
             k = self.where(i)
         else:
-            k = position(i, self._n, self._noun, self._names)
+            k = self._position(i)
         made = self._made[k]
         if made is None:
             made = self._made[k] = self._make(k)
         return made
 
+    def _position(self, i: object) -> int:
+        """`i` as an index 0 .. n - 1 (negative counts from the end): IndexError out of
+        range, TypeError for what is neither an index nor a name."""
+        n, noun = self._n, self._noun
+        if isinstance(i, bool) or not hasattr(i, "__index__"):
+            raise TypeError(f"{noun[1]} are found by name or by index, got "
+                            f"{type(i).__name__}" + (f" {i!r}" if isinstance(i, float) else ""))
+        k = operator.index(i)
+        if not -n <= k < n:
+            raise IndexError(f"{noun[0]} index {k} out of range ({count(n, *noun)}"
+                             + (f": {name_list(self._names)}" if n else "") + ")")
+        return k + n if k < 0 else k
+
     def where(self, name: str) -> int:
-        """The index of the record named `name`; KeyError with a did-you-mean."""
-        if self._index is None:
-            self._index = {nm: k for k, nm in enumerate(self._names)}
-        k = self._index.get(name)
+        """The index of the record named `name`; KeyError with the closest name, or the
+        names there are."""
+        k = self._named(name)
         if k is None:
-            raise missing(self._noun, name, self._names)
+            names, (one, many) = self._names, self._noun
+            hint = did_you_mean(name, names)
+            raise KeyError(f"no {one} named {name!r}" + (
+                f"; {hint}" if hint else f" (the {many}: {name_list(names)})" if names
+                else f" (this model has no {many})"))
         return k
+
+    def _named(self, name: str) -> int | None:
+        if self._index is None:  # made on the first look-up by name
+            self._index = {nm: k for k, nm in enumerate(self._names)}
+        return self._index.get(name)
 
     def __contains__(self, item: object) -> bool:  # a name, or a record
         if isinstance(item, str):
-            if self._index is None:
-                self._index = {nm: k for k, nm in enumerate(self._names)}
-            return item in self._index
+            return self._named(item) is not None
         return super().__contains__(item)
 
     def __iter__(self) -> Iterator[T]:
@@ -251,27 +270,6 @@ class Records(Sequence[T]):
         if not self._n:
             return f"<no {self._noun[1]}>"
         return f"<{count(self._n, *self._noun)}: {name_list(self._names)}>"
-
-
-def position(i: object, n: int, noun: tuple[str, str], names: Sequence[str]) -> int:
-    """`i` as an index 0 .. n - 1 of one of `n` named records (negative counts from the
-    end): IndexError out of range, TypeError for what is neither an index nor a name."""
-    if isinstance(i, bool) or not hasattr(i, "__index__"):
-        raise TypeError(f"{noun[1]} are found by name or by index, got {type(i).__name__}"
-                        + (f" {i!r}" if isinstance(i, float) else ""))
-    k = operator.index(i)
-    if not -n <= k < n:
-        raise IndexError(f"{noun[0]} index {k} out of range ({count(n, *noun)}"
-                         + (f": {name_list(names)}" if n else "") + ")")
-    return k + n if k < 0 else k
-
-
-def missing(noun: tuple[str, str], name: object, names: Sequence[str]) -> KeyError:
-    """The KeyError of a record name that is not there: the closest name, else the names."""
-    hint = did_you_mean(str(name), names)
-    return KeyError(f"no {noun[0]} named {name!r}" + (
-        f"; {hint}" if hint else f" (the {noun[1]}: {name_list(names)})" if names
-        else f" (this model has no {noun[1]})"))
 
 
 class BodyRecords(Mapping[str, Body]):
@@ -290,8 +288,7 @@ class BodyRecords(Mapping[str, Body]):
         The point masses.
     """
 
-    __slots__ = ("_names", "_mass", "_inertia", "_shape", "_color", "particle", "_index",
-                 "_records")
+    __slots__ = ("_names", "_mass", "_inertia", "_shape", "_color", "particle", "_records")
 
     def __init__(self, names: tuple[str, ...], mass: np.ndarray, inertia: np.ndarray,
                  shape: list[dict[str, Any] | None], color: list[str | None],
@@ -302,32 +299,21 @@ class BodyRecords(Mapping[str, Body]):
         self._shape = shape
         self._color = color
         self.particle = particle
-        self._index: dict[str, int] | None = None
         fields_ = field_names(Body)
 
         def make(i: int) -> Body:
             return record(Body, fields_, (names[i], i, float(mass[i]), inertia[i], shape[i],
                                           color[i], bool(particle[i])))
 
-        self._records = Records(names, make, _BODY)
-
-    def _where(self, name: object) -> int | None:
-        if self._index is None:
-            self._index = {nm: i for i, nm in enumerate(self._names)}
-        return self._index.get(name) if isinstance(name, str) else None
+        self._records = Records(names, make, ("body", "bodies"))
 
     def __getitem__(self, name: str | int) -> Body:
         """The body named `name`, or at index `name` in the stacking order
         (``model.bodies[0]``); KeyError with a did-you-mean, IndexError with the range."""
-        if not isinstance(name, str):
-            return self._records[position(name, len(self._names), _BODY, self._names)]
-        i = self._where(name)
-        if i is None:
-            raise missing(_BODY, name, self._names)
-        return self._records[i]
+        return self._records[name]
 
-    def __contains__(self, name: object) -> bool:
-        return self._where(name) is not None
+    def __contains__(self, name: object) -> bool:  # a name: the mapping's keys
+        return isinstance(name, str) and name in self._records
 
     def __iter__(self) -> Iterator[str]:
         return iter(self._names)
@@ -336,7 +322,4 @@ class BodyRecords(Mapping[str, Body]):
         return len(self._names)
 
     def __repr__(self) -> str:
-        return f"<{count(len(self._names), *_BODY)}: {name_list(self._names)}>"
-
-
-_BODY = ("body", "bodies")
+        return repr(self._records)
