@@ -148,11 +148,13 @@ class Model:
     initial : State
         The state written in the file.
     bodies : mapping of str to Body
-        Each body by name, in the stacking order (each record is made on first use).
+        Each body by name, in the stacking order (each record is made on first use);
+        ``bodies[0]`` is the first body too.
     loads : sequence of Load
-        The applied loads, in file order.
+        The applied loads, in file order; ``loads["push"]`` finds one by name.
     joints : sequence of Joint
-        The joints, in file order (records made on first use).
+        The joints, in file order (records made on first use); ``joints["A"]`` finds one
+        by name.
     forces, springs : ForceTable, SpringTable
         The loads as arrays, for the vectorised sums.
     reaction_table : ReactionTable
