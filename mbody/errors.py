@@ -6,7 +6,9 @@ in one pass, the way a compiler reports all errors rather than the first.
 
 from __future__ import annotations
 
+import contextlib
 import difflib
+import numbers
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
@@ -111,6 +113,53 @@ class OutputError(MbodyError, OSError):
 
 class TrajectoryFileError(MbodyError):
     """A trajectory file is unreadable, truncated or of the wrong kind."""
+
+
+class WrongTypeError(MbodyError, TypeError):
+    """An argument of a Python call is of the wrong type; the message names the argument,
+    what it accepts and what it got (`wrong_type`). Both an `MbodyError` (what mbody raises
+    on purpose) and a `TypeError` (what Python code expects of a wrong type)."""
+
+
+def wrong_type(argument: str, expected: str, got: object, hint: str = "") -> WrongTypeError:
+    """The `WrongTypeError` "<argument>: expected <expected>, got <what got is>[; <hint>]".
+
+    Parameters
+    ----------
+    argument : str
+        The argument's name as the caller wrote it (``source``, ``values[2]``).
+    expected : str
+        What it accepts, in words.
+    got : object
+        What was given: its type is named (a short string or number is shown too).
+    hint : str, optional
+        How to get what was meant.
+    """
+    return WrongTypeError(f"{argument}: expected {expected}, got {_what(got)}"
+                          + (f"; {hint}" if hint else ""))
+
+
+def _what(value: object) -> str:
+    if value is None:
+        return "None"
+    kind = type(value).__name__
+    if isinstance(value, str):
+        return f"str {value!r}" if len(value) <= 40 else f"a str of {len(value)} characters"
+    if isinstance(value, bool | numbers.Number) and len(repr(value)) <= 40:
+        return f"{kind} {value!r}"
+    return kind
+
+
+def real_number(value: object, argument: str, expected: str = "a number") -> float:
+    """`value` as a float when it is a real number (an int, a float, a numpy scalar; not a
+    bool, nor a number written as a string), else `wrong_type`'s error naming `argument`."""
+    if isinstance(value, numbers.Real) and not isinstance(value, bool):
+        return float(value)
+    hint = ""
+    if isinstance(value, str):
+        with contextlib.suppress(ValueError):
+            hint = f"write it as a number: {float(value)!r}"
+    raise wrong_type(argument, expected, value, hint)
 
 
 def did_you_mean(word: str, choices: Iterable[str]) -> str:

@@ -10,6 +10,7 @@ from __future__ import annotations
 import os
 from typing import Any
 
+from mbody.model.loader import check_source
 from mbody.model.model import Model
 from mbody.model.model import load as read_model
 from mbody.model.model import loads as read_model_text
@@ -47,10 +48,15 @@ def load(source: str | os.PathLike[str] | dict, *, max_bytes: int | None = None,
     Raises
     ------
     mbody.ModelError
-        Listing every problem, each with its file, line and column.
+        Listing every problem, each with its file, line and column; or `source` is YAML
+        text rather than a path (`loads` reads text).
+    mbody.errors.WrongTypeError
+        `source` is neither a path nor a dict (a `TypeError` too: for an open file, give
+        its path or ``loads(f.read())``), or `max_bytes` is not a whole number.
     mbody.solve.kinematics.KinematicsError
         The joints and drivers cannot all close at t = 0.
     """
+    max_bytes = check_source(source, max_bytes)
     if not isinstance(source, dict) and (
             format or options or str(source).lower().endswith((".xml", ".mjcf", ".urdf"))):
         from mbody.io.interop import import_spec  # MJCF, URDF: defusedxml, only for them
@@ -62,6 +68,8 @@ def load(source: str | os.PathLike[str] | dict, *, max_bytes: int | None = None,
     return assembled(with_finish(read_model(source, max_bytes=max_bytes), assembled))
 
 
-def loads(text: str, file: str = "<string>") -> Model:
-    """Like `load`, from YAML text (`file`: the name used in error messages)."""
+def loads(text: str | bytes, file: str = "<string>") -> Model:
+    """Like `load`, from YAML text (bytes: UTF-8, as a file is read); `file` is the name
+    used in error messages. A path is `load`'s; anything but text or bytes raises
+    `mbody.errors.WrongTypeError` (a `TypeError` too)."""
     return assembled(with_finish(read_model_text(text, file), assembled))

@@ -224,6 +224,25 @@ def test_states_and_values_pair_up():
         mbody.solve_many(model, states[:2], values=values)
 
 
+def test_values_of_the_wrong_form_are_refused_by_name():
+    """One mapping where a list of them goes (a case per mapping): a TypeError naming
+    `values` and the list of one that was meant (before: 'dictionary update sequence
+    element #0 has length 1; 2 is required'); a case that is not a mapping, by its index."""
+    model = mbody.load(MODELS / "pendulum.yaml")
+    with pytest.raises(TypeError) as err:
+        mbody.solve_many(model, values={"bodies.rod.mass": 2.0})
+    msg = str(err.value)
+    assert msg.startswith("values: expected a list of mappings, one per case")
+    assert "got dict" in msg and "values=[{...}]" in msg
+    with pytest.raises(TypeError, match=r"^values\[1\]: expected a mapping path -> value"):
+        mbody.solve_many(model, values=[{"bodies.rod.mass": 2.0}, "bodies.rod.mass=3"])
+    with pytest.raises(TypeError, match=r"^values: expected a list of mappings"):
+        mbody.solve_many(model, values="bodies.rod.mass=3")
+    one = mbody.solve_many(model, values=({"bodies.rod.mass": 2.0},))   # any sequence
+    assert np.array_equal(one.accelerations[0], mbody.assemble(
+        model.with_values({"bodies.rod.mass": 2.0})).solve().accelerations)
+
+
 def test_a_heavier_rod_needs_a_larger_torque_in_proportion():
     """Physics, not just agreement: with gravity off, the reactions and motor torque of a
     fully driven mechanism are linear in the masses and inertias; doubling every mass of

@@ -396,6 +396,27 @@ def test_a_kinematic_runs_coupler_curve_equals_freudenstein():
         assert np.abs(path[k] - want).max() <= 1e-10, k
 
 
+def test_kinematic_run_points_in_the_command_lines_text_form_and_wrong_forms():
+    """``{"P": "coupler:0,0.05"}`` (what --point writes after NAME=) follows the same
+    point as ``{"P": ("coupler", [0, 0.05])}``; a list, an entry of another shape, a
+    misspelt body or a count of coordinates that is not the model's is refused by name."""
+    from mbody.simulate.kinematic import kinematic_run
+
+    model = mbody.loads(fourbar(0.3))
+    as_pair = kinematic_run(model, 0.5, 20, points={"P": ("coupler", [0.0, 0.05])})
+    as_text = kinematic_run(model, 0.5, 20, points={"P": "coupler:0,0.05"})
+    assert np.array_equal(as_text.series["point:P"], as_pair.series["point:P"])
+    with pytest.raises(TypeError, match=r"^points: expected a mapping name -> \(body"):
+        kinematic_run(model, 0.5, 20, points=[("coupler", [0.0, 0.05])])
+    with pytest.raises(TypeError, match=r"^points\['P'\]: expected \(body, \[x, y"):
+        kinematic_run(model, 0.5, 20, points={"P": ("coupler", 0.05)})
+    for entry, said in [("coupler", "expected BODY:X,Y"), ("coupler:a,b", "not a list of numbers"),
+                        ("couple:0,0.05", "did you mean 'coupler'?"),
+                        ("coupler:0,0.05,1", "expected 2 finite coordinates")]:
+        with pytest.raises(mbody.MbodyError, match=said):
+            kinematic_run(model, 0.5, 20, points={"P": entry})
+
+
 def test_a_kinematic_run_stops_at_a_dead_centre_with_the_distance_left():
     """The four-bar's rocker driven instead of its crank, at a constant rate: a rocker
     swings between two limits (where crank and coupler line up), so the run stops at

@@ -332,6 +332,36 @@ def test_load_export_rejects_other_json_and_suffixes(tmp_path):
         ex.write_export(mbody.assemble(MODEL_CASES["pendulum"]), tmp_path / "a.xlsx")
 
 
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_an_export_of_a_model_says_to_assemble_it_first(tmp_path, fmt):
+    """A `Model` where an `Assembly` goes: a TypeError naming `asm` and the call that makes
+    one (before: AttributeError "'Model' object has no attribute 'model'"); nothing is
+    written."""
+    with pytest.raises(TypeError) as err:
+        _write(MODEL_CASES["pendulum"], tmp_path, fmt)
+    msg = str(err.value)
+    assert msg.startswith("asm: expected an Assembly (mbody.assemble(model))")
+    assert "got Model" in msg and isinstance(err.value, mbody.MbodyError)
+    assert list(tmp_path.iterdir()) == []
+    with pytest.raises(TypeError, match=r"^asm: expected an Assembly .*got str"):
+        ex.exported("models/pendulum.yaml")
+
+
+def test_load_export_of_a_saved_run_says_how_to_read_or_export_it(tmp_path):
+    """The reverse of `Trajectory.load` of an export: the run is named as such, with the
+    reader and the command that exports one of its samples."""
+    run = mbody.simulate(MODEL_CASES["pendulum"], 0.1, 10)
+    path = run.save(tmp_path / "run.npz")
+    with pytest.raises(mbody.MbodyError) as err:
+        mbody.load_export(path)
+    msg = str(err.value)
+    assert "an mbody trajectory" in msg and "mbody.Trajectory.load" in msg
+    assert "mbody export MODEL --state RUN" in msg and "KeyError" not in msg
+    np.savez(tmp_path / "other.npz", a=np.zeros(2))
+    with pytest.raises(mbody.MbodyError, match="not an mbody export .*no 'format' entry"):
+        mbody.load_export(tmp_path / "other.npz")
+
+
 # -- the command line ------------------------------------------------------------------------
 def _mbody(*args, cwd=None):
     return subprocess.run([sys.executable, "-m", "mbody.cli", *map(str, args)],

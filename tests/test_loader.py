@@ -527,3 +527,116 @@ def test_a_missing_file_names_the_nearest_one_beside_it(tmp_path):
     with pytest.raises(ModelError) as err:
         mbody.load(tmp_path / "nothing_like_it.yaml")
     assert err.value.issues[0].hint == ""
+
+
+# -- the Python entry points' arguments (a notebook user's slips) ---------------------------
+@pytest.mark.parametrize("load", [mbody.load, mbody.model.load], ids=["mbody", "model"])
+@pytest.mark.parametrize("source, got", [(None, "got None"), (3, "got int 3"),
+                                         (b"models/pendulum.yaml", "got bytes"),
+                                         (["a.yaml"], "got list")],
+                         ids=["None", "int", "bytes", "list"])
+def test_load_of_a_wrong_type_names_source_and_what_it_takes(load, source, got):
+    """Neither a path nor a dict: a TypeError (and an MbodyError: exit 2 on the command
+    line) that names `source`, the kinds it takes and the text reader, not pathlib's."""
+    with pytest.raises(TypeError) as err:
+        load(source)
+    assert isinstance(err.value, mbody.MbodyError)
+    msg = str(err.value)
+    assert msg.startswith("source: expected a path")
+    assert "a dict" in msg and "mbody.loads" in msg and got in msg
+
+
+def test_load_of_an_open_file_says_to_give_its_path_or_its_text():
+    with open(MODELS / "pendulum.yaml", encoding="utf-8") as fh, \
+            pytest.raises(TypeError, match=r"source: .*got TextIOWrapper") as err:
+        mbody.load(fh)
+    assert "f.name" in str(err.value) and "mbody.loads(f.read())" in str(err.value)
+
+
+@pytest.mark.parametrize("text", [
+    "dimension: 2\nbodies: []",                     # a line break
+    "{dimension: 2, bodies: []}",                   # a flow mapping on one line
+    "dimension: 2",                                 # a mapping's first key
+], ids=["lines", "flow", "key"])
+def test_yaml_text_given_as_a_path_points_to_loads(text):
+    with pytest.raises(ModelError) as err:
+        mbody.load(text)
+    (issue,) = err.value.issues
+    assert issue.key == "source" and "looks like YAML text" in issue.message
+    assert issue.hint == "use mbody.loads(text)"
+
+
+def test_a_whole_model_file_given_as_a_path_is_not_echoed_back():
+    """Before: 'cannot read the file: File name too long', after the whole text."""
+    text = (MODELS / "pendulum.yaml").read_text(encoding="utf-8")
+    with pytest.raises(ModelError) as err:
+        mbody.load(text)
+    msg = str(err.value)
+    assert "mbody.loads(text)" in msg and len(msg) < 200 and "too long" not in msg
+
+
+def test_a_path_that_looks_like_yaml_but_exists_is_read(tmp_path, monkeypatch):
+    """The YAML test is asked only of a path that does not exist."""
+    monkeypatch.chdir(tmp_path)
+    Path("dimension: 2").write_text("dimension: 2\n" + BODY, encoding="utf-8")
+    assert mbody.load("dimension: 2").n == 1
+
+
+@pytest.mark.parametrize("max_bytes", ["10", 1.5, True, [10]])
+def test_max_bytes_of_a_wrong_type_is_refused_by_name(max_bytes):
+    with pytest.raises(TypeError, match=r"^max_bytes: expected a whole number of bytes"):
+        mbody.load(MODELS / "pendulum.yaml", max_bytes=max_bytes)
+
+
+@pytest.mark.parametrize("max_bytes", [0, -5])
+def test_max_bytes_below_one_byte_is_refused(max_bytes):
+    with pytest.raises(mbody.MbodyError, match=r"^max_bytes: expected a size of at least 1"):
+        mbody.load(MODELS / "pendulum.yaml", max_bytes=max_bytes)
+
+
+def test_max_bytes_as_a_whole_float_or_numpy_integer_is_a_size():
+    import numpy as np
+
+    path = MODELS / "pendulum.yaml"
+    size = path.stat().st_size
+    assert mbody.load(path, max_bytes=float(size)).n == 1
+    assert mbody.load(path, max_bytes=np.int64(size)).n == 1
+    with pytest.raises(ModelError, match="at most"):
+        mbody.load(path, max_bytes=np.int64(size - 1))
+
+
+def test_loads_reads_utf8_bytes_as_a_file_is_read():
+    raw = (MODELS / "pendulum.yaml").read_bytes()
+    assert mbody.loads(raw).n == mbody.load(MODELS / "pendulum.yaml").n == 1
+    bad = b"dimension: 2\nname: caf\xe9\n" + BODY.encode()
+    with pytest.raises(ModelError) as err:
+        mbody.loads(bad, "cafe.yaml")
+    (issue,) = err.value.issues
+    assert (issue.file, issue.line, issue.column) == ("cafe.yaml", 2, 10)
+    assert "not UTF-8" in issue.message
+
+
+@pytest.mark.parametrize("text", [None, 3, MODELS / "pendulum.yaml"], ids=["None", "int", "path"])
+def test_loads_of_a_wrong_type_names_text(text):
+    with pytest.raises(TypeError, match=r"^text: expected a model file's YAML text") as err:
+        mbody.loads(text)
+    if isinstance(text, Path):
+        assert "mbody.load(path)" in str(err.value)
+
+
+@pytest.mark.parametrize("text", ["models/pendulum.yaml", "robots/arm.URDF "])
+def test_loads_of_a_path_points_to_load(text):
+    """Before: "expected a model mapping, got the text 'models/pendulum.yaml'"."""
+    with pytest.raises(ModelError) as err:
+        mbody.loads(text)
+    (issue,) = err.value.issues
+    assert "looks like a path" in issue.message and issue.hint == "use mbody.load(path)"
+
+
+@pytest.mark.parametrize("name", ["v1:", "C:\\models\\arm.yaml"])
+def test_a_one_line_name_colon_in_a_path_is_still_a_missing_file(tmp_path, monkeypatch, name):
+    """Only 'key: value' (a blank after the colon) reads as YAML on one line: 'v1:' and
+    'C:\\models' are names of files, looked for as such."""
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(ModelError, match="no such file"):
+        mbody.load(name)

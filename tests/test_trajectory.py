@@ -54,6 +54,33 @@ def test_planar_round_trip_and_state(tmp_path):
     assert s.t == 0.5 and s.omega[0, 2] == traj.angular_velocity[5, 0]
 
 
+def test_a_sample_out_of_range_or_a_time_where_an_index_goes(run):
+    """state(k) names the sample range (before: numpy's 'index 100 is out of bounds for
+    axis 0'); a float is a time: the message points to state_at, which gives the sample
+    nearest it, never an interpolation."""
+    traj, _ = run   # 21 samples, 0.05 s apart
+    with pytest.raises(IndexError) as err:
+        traj.state(100)
+    assert "sample 100 is out of range" in str(err.value)
+    assert "21 samples, 0..20" in str(err.value)
+    with pytest.raises(IndexError, match="sample -22 is out of range"):
+        traj.state(-22)
+    assert traj.state(-21).t == traj.state(0).t == 0.0
+    assert traj.state(np.int64(20)).t == traj.t[20]
+    with pytest.raises(TypeError) as err:
+        traj.state(0.5)
+    assert str(err.value).startswith("k: expected a sample's index, a whole number 0..20")
+    assert ".state_at(0.5)" in str(err.value)
+    for time, k in ((0.5, 10), (0.51, 10), (0.53, 11), (1.0, 20)):
+        assert traj.nearest_sample(time) == k
+        s = traj.state_at(time)
+        assert s.t == traj.t[k] and np.array_equal(s.position, traj.state(k).position)
+    with pytest.raises(mbody.MbodyError, match=r"outside the trajectory's span \[0, 1\] s"):
+        traj.state_at(1.2)
+    with pytest.raises(TypeError, match="^time: expected a time in seconds"):
+        traj.state_at("0.5")
+
+
 def test_model_travels_with_the_run(run):
     traj, path = run
     model = Trajectory.load(path).model()

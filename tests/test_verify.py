@@ -647,3 +647,37 @@ def test_the_names_offered_for_a_body_are_its_own_reactions(tmp_path):
     assert c.diagnosis == "not_an_equation_of_this_body"
     assert c.details["foreign"] == ["O.Fx"]
     assert "O.Fx is a reaction of a joint that does not touch lower" in c.explanation
+
+
+def test_a_tolerance_that_is_not_a_number_is_refused_by_name():
+    """Before: "'>' not supported between instances of 'str' and 'float'"."""
+    eqs = [{"body": "rod", "eq": "2*a_x = O.Fx"}]
+    with pytest.raises(TypeError) as err:
+        verify(MODELS / "pendulum.yaml", eqs, tol="1e-3")
+    msg = str(err.value)
+    assert msg.startswith("tol: expected a relative tolerance") and "got str '1e-3'" in msg
+    assert isinstance(err.value, mbody.MbodyError)
+    with pytest.raises(TypeError, match="^tol: "):
+        verify(MODELS / "pendulum.yaml", eqs, tol=None)
+    assert verify(MODELS / "pendulum.yaml", eqs, tol=1e-3).tol == 1e-3
+
+
+def test_an_assembly_of_another_model_is_refused():
+    """`asm` is where the true rows come from: another model's (before: "no body named
+    'rod'"), or this model's with another mass (before: checked against it in silence),
+    is refused; the same model read again is accepted and gives the same checks."""
+    model = mbody.load(MODELS / "pendulum.yaml")
+    eqs = [{"body": "rod", "eq": "2*a_x = O.Fx"}]
+    other = mbody.assemble(mbody.load(MODELS / "double_pendulum.yaml"))
+    with pytest.raises(mbody.MbodyError) as err:
+        verify(model, eqs, asm=other)
+    msg = str(err.value)
+    assert msg.startswith("asm: an assembly of model 'double-pendulum'")
+    assert f"not of {model.name!r}" in msg and "leave asm out" in msg
+    heavier = mbody.assemble(model.with_values({"bodies.rod.mass": 3.0}))
+    with pytest.raises(mbody.MbodyError, match=r"with other values \(masses"):
+        verify(model, eqs, asm=heavier)
+    with pytest.raises(TypeError, match=r"^asm: expected an Assembly of the model"):
+        verify(model, eqs, asm=model)
+    again = verify(model, eqs, asm=mbody.assemble(mbody.load(MODELS / "pendulum.yaml")))
+    assert [c.diagnosis for c in again.checks] == [c.diagnosis for c in verify(model, eqs).checks]

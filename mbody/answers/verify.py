@@ -15,6 +15,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
 from mbody.answers.compare import Row
 from mbody.answers.diagnose import CORRECT, DIAGNOSES, NOT_AN_EQUATION, Diagnosis, diagnose
 from mbody.answers.lagrange import LAGRANGE_DIAGNOSES, check_lagrange
@@ -24,9 +26,10 @@ from mbody.answers.parse import EquationError, parse_equation
 from mbody.answers.rows import BodyRows, body_rows
 from mbody.answers.vocabulary import Vocabulary, vocabulary
 from mbody.equations.assemble import Assembly, assemble
-from mbody.errors import Issue, MbodyError, did_you_mean
+from mbody.errors import Issue, MbodyError, did_you_mean, real_number, wrong_type
 from mbody.loading import load
 from mbody.model.model import Model, State
+from mbody.model.reprs import name_list
 
 TOLERANCE = 1e-3
 """Default relative tolerance on each coefficient: numbers written to about four
@@ -224,6 +227,30 @@ class Verification:
         p.text(self.text())
 
 
+def check_assembly_of(model: Model, asm: object) -> None:
+    """Refuse an `asm` that is not an assembly of `model`: another model's (other name,
+    bodies or reaction components), or this one's with other masses, inertias or gravity
+    (`Model.with_values`), whose equations are not the model's."""
+    if not isinstance(asm, Assembly):
+        raise wrong_type("asm", "an Assembly of the model (mbody.assemble(model, state))", asm)
+    other = asm.model
+    if other is model:
+        return
+    fix = "give mbody.assemble(model, state) of this model, or leave asm out"
+    if (other.name, other.dimension, tuple(other.body_names), list(other.reactions)) != (
+            model.name, model.dimension, tuple(model.body_names), list(model.reactions)):
+        raise MbodyError(f"asm: an assembly of model {other.name!r} (bodies "
+                         f"{name_list(other.body_names)}), not of {model.name!r} (bodies "
+                         f"{name_list(model.body_names)}); {fix}")
+    differ = [what for what, a, b in (("masses", other.mass, model.mass),
+                                      ("inertias", other.J, model.J),
+                                      ("gravity", other.gravity, model.gravity))
+              if not np.array_equal(a, b)]
+    if differ:
+        raise MbodyError(f"asm: an assembly of model {model.name!r} with other values "
+                         f"({', '.join(differ)} differ from the model's); {fix}")
+
+
 def verify(model: Model | str | os.PathLike[str], answers: Any, *, tol: float = TOLERANCE,
            state: State | None = None, asm: Assembly | None = None) -> Verification:
     """Check a student's equations against each body's Newton-Euler pair.
@@ -241,7 +268,8 @@ def verify(model: Model | str | os.PathLike[str], answers: Any, *, tol: float = 
     state : State, optional
         The state the equations are written at (default: the model's initial state).
     asm : Assembly, optional
-        The model's assembly at that state, when already made.
+        The model's assembly at that state, when already made (an assembly of another
+        model, or of this one with other masses, inertias or gravity, is refused).
 
     Returns
     -------
@@ -253,7 +281,12 @@ def verify(model: Model | str | os.PathLike[str], answers: Any, *, tol: float = 
     AnswersError
         The answers are invalid: an unknown body or name (with a did-you-mean), an
         equation that cannot be read (with its column); every problem at once.
+    MbodyError
+        `tol` outside (0, 1), or `asm` of another model
+        (`mbody.errors.WrongTypeError`, a `TypeError` too, for a `tol` that is not a
+        number or an `asm` that is not an `Assembly`).
     """
+    tol = real_number(tol, "tol", "a relative tolerance, a number between 0 and 1")
     if not (tol > 0.0 and tol < 1.0):
         raise MbodyError(f"the tolerance must be between 0 and 1 (relative), got {tol!r}")
     if isinstance(model, str | os.PathLike):
@@ -261,6 +294,8 @@ def verify(model: Model | str | os.PathLike[str], answers: Any, *, tol: float = 
     sheet = _answers(answers)
     if asm is None:
         asm = assemble(model, state)
+    else:
+        check_assembly_of(model, asm)
     state = asm.state
     vocab: dict[str, Vocabulary] = {}
     rows: dict[str, BodyRows] = {}

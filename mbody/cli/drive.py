@@ -57,21 +57,18 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def parse_points(pairs: list[str]) -> dict[str, tuple[str, list[float]]]:
     """``["P=coupler:0.1,0.05"]`` -> ``{"P": ("coupler", [0.1, 0.05])}``."""
+    from mbody.simulate.kinematic import body_point
+
     out: dict[str, tuple[str, list[float]]] = {}
     for p in pairs:
         name, sep, rest = p.partition("=")
-        body, sep2, coords = rest.partition(":")
+        body, sep2, _ = rest.partition(":")
         if not (sep and sep2 and name.strip() and body.strip()):
             raise MbodyError(f"--point expects NAME=BODY:X,Y[,Z] (for example "
                              f"P=coupler:0.1,0.05), got {p!r}")
-        try:
-            xs = [float(c) for c in coords.split(",")]
-        except ValueError:
-            raise MbodyError(f"--point {name}: {coords!r} is not a list of numbers (X,Y or "
-                             "X,Y,Z)") from None
         if name.strip() in out:
             raise MbodyError(f"--point {name}: given twice")
-        out[name.strip()] = (body.strip(), xs)
+        out[name.strip()] = body_point(rest, f"--point {name}")
     return out
 
 

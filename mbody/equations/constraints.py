@@ -30,7 +30,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from mbody.equations.joints import ReactionColumns, reaction_columns
+from mbody.errors import did_you_mean
 from mbody.model.model import Model, State
+from mbody.model.reprs import name_list
 from mbody.util.frozen import Frozen
 
 if TYPE_CHECKING:
@@ -83,8 +85,26 @@ class ConstraintJacobian(Frozen):
         return self.matrix.toarray()
 
     def row(self, label: str) -> dict[str, float]:
-        """The nonzero entries of one constraint row, by coordinate label."""
-        r = self.matrix.getrow(self.rows.index(label)).tocoo()
+        """The nonzero entries of one constraint row, by coordinate label.
+
+        Parameters
+        ----------
+        label : str
+            The row's reaction component (``A.Fx``: `rows`).
+
+        Raises
+        ------
+        KeyError
+            No such row (with a did-you-mean, or the rows there are).
+        """
+        try:
+            i = self.rows.index(label)
+        except ValueError:
+            hint = did_you_mean(label, self.rows) if isinstance(label, str) else ""
+            raise KeyError(f"no constraint row {label!r}" + (
+                f"; {hint}" if hint else f" (a row per reaction component, .rows: "
+                f"{name_list(self.rows)})")) from None
+        r = self.matrix.getrow(i).tocoo()
         return {self.columns[j]: float(v) for j, v in zip(r.col, r.data, strict=True)}
 
     def __repr__(self) -> str:  # the dataclass's would print every label and the matrix

@@ -29,7 +29,7 @@ import numpy as np
 
 from mbody.equations.coordinates import CoordinateSet, columns, coordinate_set
 from mbody.equations.workspace import workspace
-from mbody.errors import MbodyError
+from mbody.errors import MbodyError, did_you_mean
 from mbody.kernel import _core
 from mbody.model.model import Model, State
 
@@ -322,7 +322,9 @@ def generalized(model: Model, state: State | None = None,
         given = model.known_reactions_at(state.t)
         for label, v in known.items():
             if label not in model.reaction_index:
-                raise MbodyError(f"no reaction component {label!r} in this model")
+                hint = did_you_mean(label, model.reactions)  # as Assembly.solve's known=
+                raise MbodyError(f"no reaction component {label!r} in this model"
+                                 + (f"; {hint}" if hint else ""))
             given[label] = float(v)
     cs = coordinate_set(model, coordinates, given)
     return evaluate(model, state, cs)

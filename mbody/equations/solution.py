@@ -7,11 +7,13 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
-from mbody.errors import MbodyError, did_you_mean
+from mbody.errors import MbodyError, closest, did_you_mean
 from mbody.model.model import count
+from mbody.model.reprs import name_list
 
 
 class ReactionValues(Mapping):
@@ -39,7 +41,20 @@ class ReactionValues(Mapping):
         return out
 
     def __getitem__(self, label: str) -> float:
-        return float(self._values[self._index[label]])
+        try:
+            return float(self._values[self._index[label]])
+        except (KeyError, TypeError):
+            hint = did_you_mean(label, self._labels) if isinstance(label, str) else ""
+            raise KeyError(f"no reaction component {label!r}"
+                           + (f"; {hint}" if hint else f" (the components: "
+                              f"{name_list(self._labels)})")) from None
+
+    def __contains__(self, label: object) -> bool:  # a Mapping's would make the message
+        return isinstance(label, str) and label in self._index
+
+    def get(self, label: str, default: Any = None) -> Any:
+        i = self._index.get(label) if isinstance(label, str) else None
+        return default if i is None else float(self._values[i])
 
     def __iter__(self):
         return iter(self._labels)
@@ -138,8 +153,25 @@ class Solution:
         try:
             return float(self.accelerations[self.coordinates.index(label)])
         except ValueError:
-            raise KeyError(f"no coordinate {label!r}; "
-                           f"{did_you_mean(label, self.coordinates)}") from None
+            raise KeyError(self._not_a_coordinate(label)) from None
+
+    def _not_a_coordinate(self, label: object) -> str:
+        """What `label` is instead, when not a coordinate: a reaction component (read from
+        `reactions`), close to a coordinate or to a reaction component, or neither."""
+        said = f"no coordinate {label!r}"
+        if not isinstance(label, str):
+            return f"{said}: a coordinate's label is text, such as {self.coordinates[0]!r}" \
+                if self.coordinates else said
+        if label in self.reactions:
+            return (f"{said}: it is a reaction component, read as "
+                    f"sol.reactions[{label!r}]")
+        hint = did_you_mean(label, self.coordinates)
+        if hint:
+            return f"{said}; {hint}"
+        close = closest(label, self.reactions)
+        if close is not None:
+            return f"{said}; did you mean the reaction component sol.reactions[{close!r}]?"
+        return f"{said} (the coordinates: {name_list(self.coordinates)})"
 
     def __repr__(self) -> str:  # the dataclass's would print every value
         return (f"<Solution: {count(len(self.coordinates), 'acceleration')}, "

@@ -25,13 +25,17 @@ from mbody.util.spatial import joint_frame_planar, joint_frame_spatial, quat_to_
 if TYPE_CHECKING:
     from mbody.model.model import State
 
+LOAD, JOINT = ("load", "loads"), ("joint", "joints")
+"""What the records are, for their messages (`Records`)."""
+
 
 def located_loads(specs: list[LoadSpec], idx: dict[str, int]
-                  ) -> tuple[tuple[Load, ...], ForceTable]:
+                  ) -> tuple[Records[Load], ForceTable]:
     """The loads of the located path, and the force table of its point loads."""
-    loads = tuple(Load(ld.name, ld.type, ld.bodies, ld.vector, ld.frame, ld.at,
-                       ld.stiffness, ld.rest_length, ld.damping, dict(ld.expressions))
-                  for ld in specs)
+    made = tuple(Load(ld.name, ld.type, ld.bodies, ld.vector, ld.frame, ld.at,
+                      ld.stiffness, ld.rest_length, ld.damping, dict(ld.expressions))
+                 for ld in specs)
+    loads = Records(tuple(ld.name for ld in made), made.__getitem__, LOAD)
     point = [ld for ld in specs if ld.type in ("force", "torque")]
     forces = ForceTable(
         tuple(ld.name for ld in point),
@@ -62,7 +66,7 @@ def point_loads(t: LoadTable, names: tuple[str, ...]) -> tuple[Records[Load], Fo
         return record(Load, fields_, (load_names[i], types[i], (names[body[i]],), vector[i],
                                       frames[i], (at[i],), 0.0, 0.0, 0.0, {}))
 
-    return Records(len(load_names), make), forces
+    return Records(load_names, make, LOAD), forces
 
 
 def joint_tables(dimension: int, js: JointSpecTable, names: tuple[str, ...],
@@ -166,7 +170,7 @@ def joint_tables(dimension: int, js: JointSpecTable, names: tuple[str, ...],
             axis1[j] if has1[j] else None,
             axis2[j] if has2[j] else None, kinds[j]))
 
-    return Records(nj, make), table
+    return Records(js.names, make, JOINT), table
 
 
 def _frames(axis: np.ndarray, has_axis: np.ndarray, planar: bool) -> np.ndarray:

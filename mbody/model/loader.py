@@ -23,6 +23,8 @@ matters for models with tens of thousands of bodies.
 from __future__ import annotations
 
 import math
+import numbers
+import operator
 import os
 import re
 import select
@@ -48,7 +50,7 @@ from yaml.events import (
     StreamEndEvent,
 )
 
-from mbody.errors import Issue, ModelError, did_you_mean
+from mbody.errors import Issue, MbodyError, ModelError, did_you_mean, wrong_type
 
 # libyaml keeps line marks and is many times faster than the pure-Python parser
 _Loader: type[yaml.SafeLoader] | type[yaml.CSafeLoader] = getattr(
@@ -389,6 +391,59 @@ def _near_file(path: Path, most: int = 2000) -> str:
     return f"did you mean '{found}'?"
 
 
+SOURCE_KINDS = ("a path to a model file (str or os.PathLike) or a dict with a model file's "
+                "content")
+"""What `mbody.load`'s `source` accepts, in words (its error messages)."""
+_YAML_START = re.compile(r"\s*(\{|[\w-]+\s*:\s)")
+
+
+def check_source(source: object, max_bytes: object = None, call: str = "mbody.load"
+                 ) -> int | None:
+    """Refuse, before anything is read, what `call` cannot read from: a `source` that is
+    neither a path nor a dict (`WrongTypeError`), YAML text given where a path goes
+    (`ModelError`: text is `mbody.loads`'), or a `max_bytes` that is not a whole number of
+    bytes, at least 1.
+
+    Returns
+    -------
+    int or None
+        `max_bytes` as an int (None: the current limit).
+    """
+    if isinstance(source, bytes | bytearray):
+        raise wrong_type("source", SOURCE_KINDS, source, "for a model file's content "
+                         "use mbody.loads(text); for a path in bytes, os.fsdecode(path)")
+    if not isinstance(source, str | os.PathLike | dict):
+        hint = ("for an open file, give its path (f.name), or its text to mbody.loads(f.read())"
+                if hasattr(source, "read") else "for YAML text use mbody.loads(text)")
+        raise wrong_type("source", SOURCE_KINDS, source, hint)
+    if isinstance(source, str) and looks_like_yaml(source) and not os.path.exists(source):
+        line = "holds a line break" if "\n" in source else "starts as a YAML mapping does"
+        raise ModelError([Issue(call, 0, 0, "source", f"this looks like YAML text ({line}), "
+                                "not a path to a model file", "use mbody.loads(text)")])
+    if max_bytes is None:
+        return None
+    if isinstance(max_bytes, bool):  # an int to Python, not a size to anyone
+        size = None
+    elif isinstance(max_bytes, numbers.Integral):
+        size = operator.index(max_bytes)
+    elif isinstance(max_bytes, numbers.Real) and float(max_bytes).is_integer():
+        size = int(float(max_bytes))
+    else:
+        size = None
+    if size is None:
+        raise wrong_type("max_bytes", "a whole number of bytes (such as 200 * 2**20)",
+                         max_bytes)
+    if size < 1:
+        raise MbodyError(f"max_bytes: expected a size of at least 1 byte, got {max_bytes!r}")
+    return size
+
+
+def looks_like_yaml(text: str) -> bool:
+    """Whether `text`, given as a path, is rather a model file's text: it holds a line
+    break, or starts as a YAML mapping does (``dimension: 2``, ``{``)."""
+    return "\n" in text or _YAML_START.match(text) is not None
+
+
 def read_file(path: str | os.PathLike[str], max_bytes: int | None = None) -> str:
     """The text of a model file, refusing files over `max_bytes` before reading them.
 
@@ -449,15 +504,20 @@ def read_file(path: str | os.PathLike[str], max_bytes: int | None = None) -> str
     if len(raw) > max_bytes:  # the file grew, or stat() lied (a pipe, /proc)
         raise refuse(f"the file is larger than {max_bytes} bytes, the most that is read "
                      f"({more})")
+    return decode(raw, name)
+
+
+def decode(raw: bytes, name: str) -> str:
+    """A model file's bytes as text; `ModelError` at the line and column of the first byte
+    that is not UTF-8."""
     try:
-        text = raw.decode("utf-8")
+        return raw.decode("utf-8")
     except UnicodeDecodeError as exc:
         line = raw.count(b"\n", 0, exc.start) + 1
         col = exc.start - (raw.rfind(b"\n", 0, exc.start) + 1) + 1
         raise ModelError([Issue(name, line, col, "", f"not UTF-8 text: byte "
                                 f"0x{raw[exc.start]:02x} ({exc.reason}); save the file "
                                 "as UTF-8")]) from None
-    return text
 
 
 def _read_bounded(f: Any, limit: int, size: int) -> bytes:

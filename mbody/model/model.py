@@ -23,13 +23,13 @@ from typing import Any
 import numpy as np
 
 from mbody import conventions as cv
-from mbody.errors import Issue, MbodyError
+from mbody.errors import Issue, MbodyError, ModelError, wrong_type
 from mbody.model.build import joint_tables, located_loads, point_loads
 from mbody.model.drivers import DriverTable, driver_table
 from mbody.model.expressions import Expression
 from mbody.model.fast import fast_spec
 from mbody.model.graph import body_graph
-from mbody.model.loader import Document, load_text, read_file
+from mbody.model.loader import Document, check_source, decode, load_text, read_file
 from mbody.model.records import Body, BodyRecords, Joint, Load, Records
 from mbody.model.reprs import count, name_list
 from mbody.model.source import Source
@@ -148,11 +148,13 @@ class Model:
     initial : State
         The state written in the file.
     bodies : mapping of str to Body
-        Each body by name, in the stacking order (each record is made on first use).
+        Each body by name, in the stacking order (each record is made on first use);
+        ``bodies[0]`` is the first body too.
     loads : sequence of Load
-        The applied loads, in file order.
+        The applied loads, in file order; ``loads["push"]`` finds one by name.
     joints : sequence of Joint
-        The joints, in file order (records made on first use).
+        The joints, in file order (records made on first use); ``joints["A"]`` finds one
+        by name.
     forces, springs : ForceTable, SpringTable
         The loads as arrays, for the vectorised sums.
     reaction_table : ReactionTable
@@ -437,8 +439,13 @@ def load(source: str | os.PathLike[str] | dict, *, max_bytes: int | None = None)
     Raises
     ------
     mbody.ModelError
-        Listing every problem, each with its file, line and column.
+        Listing every problem, each with its file, line and column; or `source` is YAML
+        text rather than a path (`loads` reads text).
+    mbody.errors.WrongTypeError
+        `source` is neither a path nor a dict (a `TypeError` too), or `max_bytes` is not a
+        whole number.
     """
+    max_bytes = check_source(source, max_bytes, "mbody.model.load")
     if isinstance(source, dict):
         doc = Document(source, "<dict>")
         return _build(validate(doc), Source("<dict>", document=dataclasses.replace(
@@ -471,13 +478,13 @@ def from_source(source: Source) -> Model:
     return source.finish(bare) if source.finish is not None else bare
 
 
-def loads(text: str, file: str = "<string>") -> Model:
+def loads(text: str | bytes, file: str = "<string>") -> Model:
     """Like `load`, from YAML text.
 
     Parameters
     ----------
-    text : str
-        The model file's content.
+    text : str or bytes
+        The model file's content (bytes: UTF-8, as a file is read).
     file : str, optional
         The name used in error messages.
 
@@ -485,16 +492,44 @@ def loads(text: str, file: str = "<string>") -> Model:
     -------
     Model
 
+    Raises
+    ------
+    mbody.ModelError
+        Listing every problem, each with its file, line and column.
+    mbody.errors.WrongTypeError
+        `text` is neither text nor bytes (a path goes to `load`).
+
     Notes
     -----
     A large, regular file (block YAML as ``yaml.dump`` writes it) is read and checked in
     bulk (`mbody.model.fast`); anything that path does not handle, and every file with a
     problem, goes through the located path, which reports each problem where it is.
     """
+    text = model_text(text, file)
     spec = fast_spec(text, file)
     if spec is None:
         spec = validate(load_text(text, file))
     return _build(spec, Source.of_text(text, file, from_file=False))
+
+
+_MODEL_SUFFIXES = (".yaml", ".yml", ".xml", ".mjcf", ".urdf")
+
+
+def model_text(text: object, file: str) -> str:
+    """`loads`' `text` as a str: bytes decoded as UTF-8 (as a file is read); a path, or
+    anything but text, refused with what `loads` takes (a path is `load`'s)."""
+    if isinstance(text, str):
+        if "\n" not in text and text.strip().lower().endswith(_MODEL_SUFFIXES):
+            # a scalar is no model anyway: say what was meant rather than "expected a
+            # model mapping, got the text 'models/pendulum.yaml'"
+            raise ModelError([Issue(file, 0, 0, "text", "this looks like a path to a model "
+                                    "file, not its text", "use mbody.load(path)")])
+        return text
+    if isinstance(text, bytes | bytearray):
+        return decode(bytes(text), file)
+    hint = ("a path goes to mbody.load(path)" if isinstance(text, os.PathLike)
+            else "an open file's text is f.read()" if hasattr(text, "read") else "")
+    raise wrong_type("text", "a model file's YAML text (str, or UTF-8 bytes)", text, hint)
 
 
 def _build(spec: Spec, source: Source | None = None) -> Model:

@@ -14,6 +14,7 @@ from typing import Any, TypeVar, overload
 
 import numpy as np
 
+from mbody.errors import did_you_mean
 from mbody.model.expressions import Expression
 from mbody.model.reprs import count, name_list, vector_text
 
@@ -178,54 +179,97 @@ T = TypeVar("T")
 
 
 class Records(Sequence[T]):
-    """A read-only sequence of records, each made on first use and then kept.
+    """A read-only sequence of records, each made on first use and then kept; a record is
+    found by its index or by its name (``model.joints["A"]``, as ``model.joints[0]``).
 
     A large model's file is read without making a record per load or joint (a few
     hundred bytes and about a microsecond each); the arrays they view are the model's.
 
     Parameters
     ----------
-    n : int
-        How many records.
+    names : sequence of str
+        The records' names, in order (their number is the sequence's length).
     make : callable
         Index -> its record.
+    noun : tuple of str
+        What a record is, singular and plural (``("joint", "joints")``), for messages.
     """
 
-    __slots__ = ("_n", "_make", "_made")
+    __slots__ = ("_n", "_make", "_made", "_names", "_noun", "_index")
 
-    def __init__(self, n: int, make: Callable[[int], T]):
-        self._n = n
+    def __init__(self, names: Sequence[str], make: Callable[[int], T],
+                 noun: tuple[str, str] = ("record", "records")):
+        self._n = len(names)
+        self._names = names
         self._make = make
-        self._made: list[T | None] = [None] * n
+        self._noun = noun
+        self._made: list[T | None] = [None] * self._n
+        self._index: dict[str, int] | None = None
 
     def __len__(self) -> int:
         return self._n
 
     @overload
-    def __getitem__(self, i: int) -> T: ...
+    def __getitem__(self, i: int | str) -> T: ...
 
     @overload
     def __getitem__(self, i: slice) -> tuple[T, ...]: ...
 
-    def __getitem__(self, i: int | slice) -> T | tuple[T, ...]:
+    def __getitem__(self, i: int | str | slice) -> T | tuple[T, ...]:
         if isinstance(i, slice):
             return tuple(self[k] for k in range(*i.indices(self._n)))
-        k = operator.index(i)
-        if k < 0:
-            k += self._n
-        if not 0 <= k < self._n:
-            raise IndexError(f"record index {i} out of range ({self._n} records)")
+        if isinstance(i, str):
+            k = self.where(i)
+        else:
+            k = self._position(i)
         made = self._made[k]
         if made is None:
             made = self._made[k] = self._make(k)
         return made
+
+    def _position(self, i: object) -> int:
+        """`i` as an index 0 .. n - 1 (negative counts from the end): IndexError out of
+        range, TypeError for what is neither an index nor a name."""
+        n, noun = self._n, self._noun
+        if isinstance(i, bool) or not hasattr(i, "__index__"):
+            raise TypeError(f"{noun[1]} are found by name or by index, got "
+                            f"{type(i).__name__}" + (f" {i!r}" if isinstance(i, float) else ""))
+        k = operator.index(i)
+        if not -n <= k < n:
+            raise IndexError(f"{noun[0]} index {k} out of range ({count(n, *noun)}"
+                             + (f": {name_list(self._names)}" if n else "") + ")")
+        return k + n if k < 0 else k
+
+    def where(self, name: str) -> int:
+        """The index of the record named `name`; KeyError with the closest name, or the
+        names there are."""
+        k = self._named(name)
+        if k is None:
+            names, (one, many) = self._names, self._noun
+            hint = did_you_mean(name, names)
+            raise KeyError(f"no {one} named {name!r}" + (
+                f"; {hint}" if hint else f" (the {many}: {name_list(names)})" if names
+                else f" (this model has no {many})"))
+        return k
+
+    def _named(self, name: str) -> int | None:
+        if self._index is None:  # made on the first look-up by name
+            self._index = {nm: k for k, nm in enumerate(self._names)}
+        return self._index.get(name)
+
+    def __contains__(self, item: object) -> bool:  # a name, or a record
+        if isinstance(item, str):
+            return self._named(item) is not None
+        return super().__contains__(item)
 
     def __iter__(self) -> Iterator[T]:
         for k in range(self._n):
             yield self[k]
 
     def __repr__(self) -> str:
-        return f"<{self._n} records; made so far: {self._n - self._made.count(None)}>"
+        if not self._n:
+            return f"<no {self._noun[1]}>"
+        return f"<{count(self._n, *self._noun)}: {name_list(self._names)}>"
 
 
 class BodyRecords(Mapping[str, Body]):
@@ -244,8 +288,7 @@ class BodyRecords(Mapping[str, Body]):
         The point masses.
     """
 
-    __slots__ = ("_names", "_mass", "_inertia", "_shape", "_color", "particle", "_index",
-                 "_records")
+    __slots__ = ("_names", "_mass", "_inertia", "_shape", "_color", "particle", "_records")
 
     def __init__(self, names: tuple[str, ...], mass: np.ndarray, inertia: np.ndarray,
                  shape: list[dict[str, Any] | None], color: list[str | None],
@@ -256,28 +299,21 @@ class BodyRecords(Mapping[str, Body]):
         self._shape = shape
         self._color = color
         self.particle = particle
-        self._index: dict[str, int] | None = None
         fields_ = field_names(Body)
 
         def make(i: int) -> Body:
             return record(Body, fields_, (names[i], i, float(mass[i]), inertia[i], shape[i],
                                           color[i], bool(particle[i])))
 
-        self._records = Records(len(names), make)
+        self._records = Records(names, make, ("body", "bodies"))
 
-    def _where(self, name: object) -> int | None:
-        if self._index is None:
-            self._index = {nm: i for i, nm in enumerate(self._names)}
-        return self._index.get(name) if isinstance(name, str) else None
+    def __getitem__(self, name: str | int) -> Body:
+        """The body named `name`, or at index `name` in the stacking order
+        (``model.bodies[0]``); KeyError with a did-you-mean, IndexError with the range."""
+        return self._records[name]
 
-    def __getitem__(self, name: str) -> Body:
-        i = self._where(name)
-        if i is None:
-            raise KeyError(name)
-        return self._records[i]
-
-    def __contains__(self, name: object) -> bool:
-        return self._where(name) is not None
+    def __contains__(self, name: object) -> bool:  # a name: the mapping's keys
+        return isinstance(name, str) and name in self._records
 
     def __iter__(self) -> Iterator[str]:
         return iter(self._names)
@@ -286,4 +322,4 @@ class BodyRecords(Mapping[str, Body]):
         return len(self._names)
 
     def __repr__(self) -> str:
-        return f"<{count(len(self._names), 'body', 'bodies')}: {name_list(self._names)}>"
+        return repr(self._records)

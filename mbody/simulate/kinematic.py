@@ -30,7 +30,7 @@ from mbody.equations.joints import reaction_columns
 from mbody.equations.solution import singular_mass_error
 from mbody.equations.workspace import workspace
 from mbody.equations.world import check_axes
-from mbody.errors import MbodyError, did_you_mean
+from mbody.errors import MbodyError, did_you_mean, wrong_type
 from mbody.kernel import _core
 from mbody.model.model import Model
 from mbody.simulate.axes import world_series
@@ -60,8 +60,12 @@ ROUNDING_UNITS = 8.0
 MAX_SAMPLES = 10_000_000
 """Samples at most in one run (memory: the states and solves of every sample are kept)."""
 
-BodyPoints = Mapping[str, tuple[str, Sequence[float]]]
-"""name -> (body, point in the body's axes from its mass centre, m): points to follow."""
+BodyPoints = Mapping[str, tuple[str, Sequence[float]] | str]
+"""name -> (body, point in the body's axes from its mass centre, m), or the command line's
+``"BODY:X,Y[,Z]"`` text for the same: points to follow."""
+POINTS_FORM = ("a mapping name -> (body, [x, y(, z)]) or name -> 'body:x,y(,z)', such as "
+               "{'P': ('coupler', [0.1, 0.05])}")
+"""What `kinematic_run`'s ``points`` takes, in words (its error messages)."""
 
 
 def sample_times(t_end: float, fps: float, t_start: float = 0.0) -> np.ndarray:
@@ -119,7 +123,9 @@ def kinematic_run(model: Model, t_end: float, fps: float, *, t_start: float = 0.
         The first sample's time (s).
     points : mapping, optional
         Body points to follow, name -> (body, [x, y(, z)] in its axes from its mass
-        centre): their world positions go into ``series['point:<name>']`` (K, d).
+        centre, m), or name -> ``"body:x,y(,z)"`` (the form of the command line's
+        ``--point NAME=BODY:X,Y``): their world positions go into
+        ``series['point:<name>']`` (K, d). Checked before the run.
     axes : {"joint", "world"}
         The reactions' axes (`mbody.equations.world`).
 
@@ -135,7 +141,9 @@ def kinematic_run(model: Model, t_end: float, fps: float, *, t_start: float = 0.
     ------
     MbodyError
         The mechanism is not fully driven (its free coordinates need integrating:
-        `mbody.simulate`).
+        `mbody.simulate`); a point names no body, or has the wrong number of coordinates
+        (`mbody.errors.WrongTypeError`, a `TypeError` too, when `points` or an entry is
+        of another form).
     KinematicsError
         At a sample where the loops cannot close (a dead centre, links that cannot
         reach): its time, the drivers' values and the distance left.
@@ -143,6 +151,7 @@ def kinematic_run(model: Model, t_end: float, fps: float, *, t_start: float = 0.
     check_axes(axes)
     t = sample_times(t_end, fps, t_start)
     require_fully_driven(model)
+    followed = body_points(model, points)
     ws = workspace(model)
     unknowns = ws.file_unknowns
     plan = ws.solve_plan(unknowns)
@@ -158,7 +167,7 @@ def kinematic_run(model: Model, t_end: float, fps: float, *, t_start: float = 0.
                                      info)
     if done < K:
         _failed(model, float(t[done]), y, info)
-    return _trajectory(model, t, Y, OUT, energy, plan, info, points, axes)
+    return _trajectory(model, t, Y, OUT, energy, plan, info, followed, axes)
 
 
 def newton_tolerance(model: Model, t: np.ndarray) -> float:
@@ -194,8 +203,8 @@ def _failed(model: Model, t: float, y: np.ndarray, info: np.ndarray) -> None:
 
 
 def _trajectory(model: Model, t: np.ndarray, Y: np.ndarray, OUT: np.ndarray,
-                energy: np.ndarray, plan, info: np.ndarray, points: BodyPoints | None,
-                axes: str) -> Trajectory:
+                energy: np.ndarray, plan, info: np.ndarray,
+                points: dict[str, tuple[int, np.ndarray]], axes: str) -> Trajectory:
     K, n = len(t), model.n
     planar = model.dimension == cv.PLANAR
     x = Y[:, :3 * n].reshape(K, n, 3)
@@ -232,7 +241,7 @@ def _trajectory(model: Model, t: np.ndarray, Y: np.ndarray, OUT: np.ndarray,
     values_set = model_values(model)
     if values_set:  # what Trajectory.model sets again on the text it carries
         run_info["model_values"] = values_set
-    traj.series.update(_body_points(model, x, q, points))
+    traj.series.update(_body_points(x, q, points, model.dimension))
     traj.series.update(driver_series(model, t))
     run_info["drivers"] = driver_facts(model)
     acc6 = np.zeros((K, n, 6))
@@ -295,22 +304,69 @@ def driver_facts(model: Model) -> list[dict]:
             for name, j, c in zip(d.names, d.joint.tolist(), d.component, strict=True)]
 
 
-def _body_points(model: Model, x: np.ndarray, q: np.ndarray, points: BodyPoints | None
-                 ) -> dict[str, np.ndarray]:
-    """'point:<name>' -> (K, d) world positions of the named body points."""
-    out: dict[str, np.ndarray] = {}
+def body_points(model: Model, points: object) -> dict[str, tuple[int, np.ndarray]]:
+    """`kinematic_run`'s `points` checked against `model`, before the run: name -> (the
+    body's index, (3,) point in its axes from its mass centre, m).
+
+    Raises
+    ------
+    MbodyError
+        A point on no body of the model (with a did-you-mean), or not d finite numbers.
+    mbody.errors.WrongTypeError
+        `points` is not a mapping, or an entry neither (body, coordinates) nor text.
+    """
+    if points is None:
+        return {}
+    if not isinstance(points, Mapping):
+        raise wrong_type("points", POINTS_FORM, points)
     d = model.dimension
-    for name, (body, p) in (points or {}).items():
+    out: dict[str, tuple[int, np.ndarray]] = {}
+    for name, entry in points.items():
+        where = f"points[{name!r}]"
+        if isinstance(entry, str):
+            body, coords = body_point(entry, where)
+        elif (isinstance(entry, Sequence) and len(entry) == 2 and isinstance(entry[0], str)
+              and isinstance(entry[1], Sequence | np.ndarray)
+              and not isinstance(entry[1], str)):
+            body, coords = entry[0], list(entry[1])
+        else:
+            raise wrong_type(where, "(body, [x, y(, z)]) or 'body:x,y(,z)'", entry)
         if body not in model.bodies:
             hint = did_you_mean(body, list(model.body_names))
             raise MbodyError(f"point {name!r}: no body {body!r} in this model"
                              + (f"; {hint}" if hint else ""))
-        r = np.zeros(3)
-        r[:d] = np.asarray(p, dtype=float)[:d]
-        if len(p) != d or not np.isfinite(r).all():
+        try:
+            r = np.array(coords, dtype=float).reshape(-1)
+        except (TypeError, ValueError):
+            r = np.full(0, np.nan)
+        if len(r) != d or not np.isfinite(r).all():
             raise MbodyError(f"point {name!r}: expected {d} finite coordinates in the body's "
-                             f"axes, got {list(p)!r}")
-        i = model.bodies[body].index
+                             f"axes, got {list(coords)!r}")
+        out[str(name)] = (model.bodies[body].index, np.concatenate((r, np.zeros(3 - d))))
+    return out
+
+
+def body_point(text: str, where: str) -> tuple[str, list[float]]:
+    """``"coupler:0.1,0.05"`` -> ``("coupler", [0.1, 0.05])``: a body point as the command
+    line's ``--point NAME=BODY:X,Y[,Z]`` writes it after the name; `where` names it in
+    messages."""
+    body, sep, coords = text.partition(":")
+    if not (sep and body.strip()):
+        raise MbodyError(f"{where}: expected BODY:X,Y[,Z] (for example coupler:0.1,0.05), "
+                         f"got {text!r}")
+    try:
+        xs = [float(c) for c in coords.split(",")]
+    except ValueError:
+        raise MbodyError(f"{where}: {coords!r} is not a list of numbers (X,Y or X,Y,Z)"
+                         ) from None
+    return body.strip(), xs
+
+
+def _body_points(x: np.ndarray, q: np.ndarray, points: dict[str, tuple[int, np.ndarray]],
+                 d: int) -> dict[str, np.ndarray]:
+    """'point:<name>' -> (K, d) world positions of the body points `body_points` checked."""
+    out: dict[str, np.ndarray] = {}
+    for name, (i, r) in points.items():
         R = quat_to_matrix(q[:, i])  # (K, 3, 3)
         out[f"point:{name}"] = (x[:, i] + R @ r)[:, :d]
     return out

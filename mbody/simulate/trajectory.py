@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import functools
 import json
+import numbers
 import os
 import zlib
 from dataclasses import dataclass, field
@@ -32,7 +33,7 @@ from typing import Any
 import numpy as np
 
 from mbody import conventions as cv
-from mbody.errors import TrajectoryFileError
+from mbody.errors import MbodyError, TrajectoryFileError, real_number, wrong_type
 from mbody.model.model import State, count, loads
 from mbody.model.yaml_write import dump_document
 from mbody.util.atomic import atomic_path
@@ -162,19 +163,67 @@ class Trajectory(Frozen):
         Parameters
         ----------
         k : int
-            The sample's index (0 .. K - 1; negative counts from the end).
+            The sample's index (0 .. K - 1; negative counts from the end). A time is
+            `state_at`'s.
 
         Returns
         -------
         State
             Positions, orientations and velocities at ``t[k]``, spatial arrays (planar
             ones in the x-y plane, turning about z).
+
+        Raises
+        ------
+        IndexError
+            `k` outside 0 .. K - 1 (the message gives the range).
+        mbody.errors.WrongTypeError
+            `k` is not a whole number (a `TypeError` too; for a float, the message points
+            to `state_at`).
         """
+        K = len(self.t)
+        if isinstance(k, bool) or not isinstance(k, numbers.Integral):
+            hint = (f"for the sample nearest a time in seconds, use .state_at({k!r})"
+                    if isinstance(k, numbers.Real) and not isinstance(k, bool) else "")
+            raise wrong_type("k", f"a sample's index, a whole number 0..{K - 1}", k, hint)
+        if not -K <= k < K:
+            raise IndexError(f"sample {k} is out of range: the run has {count(K, 'sample')}"
+                             + (f", 0..{K - 1} (negative counts from the end)" if K else ""))
         if self.dimension == cv.PLANAR:
             return State.planar(self.position[k], self.orientation[k], self.velocity[k],
                                 self.angular_velocity[k], float(self.t[k]))
         return State(self.position[k], self.orientation[k], self.velocity[k],
                      self.angular_velocity[k], float(self.t[k]))
+
+    def nearest_sample(self, time: float) -> int:
+        """The index of the sample nearest `time` (s), within the run's span.
+
+        Raises
+        ------
+        mbody.MbodyError
+            The run holds no samples, or `time` lies outside [t[0], t[-1]] (by more than
+            rounding).
+        """
+        t = np.asarray(self.t, dtype=float)
+        time = real_number(time, "time", "a time in seconds")
+        if len(t) == 0:
+            raise MbodyError("the trajectory holds no samples")
+        span = max(abs(t[-1]), abs(t[0]), 1.0) * 1e-9
+        if not (t[0] - span <= time <= t[-1] + span):
+            raise MbodyError(f"time {time:g} s is outside the trajectory's span "
+                             f"[{t[0]:g}, {t[-1]:g}] s")
+        return int(np.argmin(np.abs(t - time)))
+
+    def state_at(self, time: float) -> State:
+        """The `State` at the sample nearest `time` (s): a stored sample, never an
+        interpolation between two (it satisfies the equations and joints as well as the
+        run did). ``state(nearest_sample(time))``; ``t`` of the state says which sample.
+
+        Raises
+        ------
+        mbody.MbodyError
+            `time` outside the run's span, or not a number.
+        """
+        return self.state(self.nearest_sample(time))
 
     @classmethod
     def from_states(cls, t: np.ndarray, pos3: np.ndarray, quat: np.ndarray, vel3: np.ndarray,

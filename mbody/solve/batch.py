@@ -13,7 +13,7 @@ function on the same input: tests compare them), with the file's known reaction 
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -21,7 +21,7 @@ import numpy as np
 
 from mbody.equations.solution import METHODS, ReactionValues, Solution, singular_mass_error
 from mbody.equations.workspace import workspace
-from mbody.errors import MbodyError, did_you_mean
+from mbody.errors import MbodyError, did_you_mean, wrong_type
 from mbody.kernel import _core
 from mbody.model.model import Model, State
 from mbody.solve.family import Family
@@ -255,6 +255,9 @@ def solve_many(model: Model, states: Sequence[State] | State | None = None, *,
     ------
     MbodyError
         States and values of different lengths, or a state of another model's size.
+    mbody.errors.WrongTypeError
+        `values` is not a list of mappings (one mapping alone is one case:
+        ``values=[{...}]``).
     """
     if isinstance(states, State):
         states = [states]
@@ -263,7 +266,7 @@ def solve_many(model: Model, states: Sequence[State] | State | None = None, *,
         states = [model.initial] if states is None else list(states)
         t, Y = _packed(ev, states)
         return _solutions(ev, t, ev.solve(t, Y), [None] * len(t))
-    values = [dict(v) for v in values]
+    values = case_values(values)
     if states is not None and len(states) not in (1, len(values)):
         raise MbodyError(f"{len(states)} states for {len(values)} sets of values: give one "
                          "state, or one per set")
@@ -305,6 +308,23 @@ def solve_many(model: Model, states: Sequence[State] | State | None = None, *,
         if e is not None:
             out[k] = np.nan
     return _solutions(ev, t, out, errors)
+
+
+def case_values(values: object) -> list[dict[str, Any]]:
+    """`solve_many`'s `values` as a list of dicts, one per case; `WrongTypeError` naming
+    the argument (or the case) that is not what it takes."""
+    form = "a list of mappings, one per case (path -> value)"
+    if isinstance(values, Mapping):
+        raise wrong_type("values", form, values, "for one case, a list of one: values=[{...}]")
+    if isinstance(values, str | bytes) or not isinstance(values, Iterable):
+        raise wrong_type("values", form, values)
+    out = []
+    for k, v in enumerate(values):
+        if not isinstance(v, Mapping):
+            raise wrong_type(f"values[{k}]", "a mapping path -> value, such as "
+                             "{'bodies.rod.mass': 2.0}", v)
+        out.append(dict(v))
+    return out
 
 
 def _not_assembled(model: Model, values: Mapping[str, Any]) -> str:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import os
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -26,9 +27,10 @@ from mbody.equations.assemble import Assembly, Solution
 from mbody.equations.pack import pack_columns_model, pack_unknowns_of
 from mbody.equations.solution import METHODS, singular_mass_error
 from mbody.equations.world import check_axes, world_map
-from mbody.errors import MbodyError
+from mbody.errors import MbodyError, wrong_type
 from mbody.kernel import _core
 from mbody.model.model import Model, State
+from mbody.simulate.trajectory import FORMAT as TRAJECTORY_FORMAT
 
 FORMAT = "mbody-export"
 """The format tag every export carries; a reader refuses any other."""
@@ -451,7 +453,14 @@ def exported(asm: Assembly, known: Mapping[str, float] | None = None,
     -------
     ExportedAssembly
         What every export format writes.
+
+    Raises
+    ------
+    mbody.errors.WrongTypeError
+        `asm` is not an `Assembly` (a `Model` is assembled first: ``mbody.assemble(model)``).
     """
+    if not isinstance(asm, Assembly):
+        raise _not_an_assembly(asm, "an Assembly (mbody.assemble(model))")
     model: Model = asm.model
     values = asm.reaction_values(known)
     t = model.reaction_table
@@ -497,8 +506,23 @@ def exported(asm: Assembly, known: Mapping[str, float] | None = None,
 
 def as_export(obj: Assembly | ExportedAssembly, known: Mapping[str, float] | None = None,
               axes: str = "joint") -> ExportedAssembly:
-    """`obj` itself when already exported, else ``exported(obj, known, axes=axes)``."""
-    return obj if isinstance(obj, ExportedAssembly) else exported(obj, known, axes=axes)
+    """`obj` itself when already exported, else ``exported(obj, known, axes=axes)``;
+    `mbody.errors.WrongTypeError` for anything else."""
+    if isinstance(obj, ExportedAssembly):
+        return obj
+    if not isinstance(obj, Assembly):
+        raise _not_an_assembly(obj, "an Assembly (mbody.assemble(model)) or an "
+                               "ExportedAssembly (mbody.load_export(path))")
+    return exported(obj, known, axes=axes)
+
+
+def _not_an_assembly(obj: object, expected: str) -> MbodyError:
+    """The error of an export asked of something else: how to get an assembly of it."""
+    hint = ("assemble the model first: mbody.assemble(model), or "
+            "mbody.assemble(model, state) at another state" if isinstance(obj, Model)
+            else "load and assemble the model first: mbody.assemble(mbody.load(path))"
+            if isinstance(obj, str | os.PathLike) else "")
+    return wrong_type("asm", expected, obj, hint)
 
 
 def flat_arrays(exp: ExportedAssembly) -> dict[str, Any]:
@@ -524,7 +548,13 @@ def flat_arrays(exp: ExportedAssembly) -> dict[str, Any]:
 
 
 def check_format(path: Path, fmt: str, version: int) -> None:
-    """Refuse a file of another format, or of a newer layout than this mbody reads."""
+    """Refuse a file of another format (a saved run: how to read or export it), or of a
+    newer layout than this mbody reads."""
+    if fmt == TRAJECTORY_FORMAT:
+        raise MbodyError(f"{path}: an mbody trajectory (a run saved by simulate or "
+                         "kinematics), not an export; read it with mbody.Trajectory.load("
+                         "path), or export one of its samples: mbody export MODEL --state "
+                         "RUN --time T")
     if fmt != FORMAT:
         raise MbodyError(f"{path}: not an mbody export (format {fmt!r})")
     if version > VERSION:

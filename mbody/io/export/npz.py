@@ -11,7 +11,14 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from mbody.io.export.assembly import ExportedAssembly, build, flat_arrays, text_array
+from mbody.errors import MbodyError
+from mbody.io.export.assembly import (
+    ExportedAssembly,
+    build,
+    check_format,
+    flat_arrays,
+    text_array,
+)
 
 
 def write(exp: ExportedAssembly, path: Path) -> None:
@@ -52,4 +59,9 @@ def read(path: Path) -> ExportedAssembly:
         return sp.csc_matrix((data[f"{name}_data"], data[f"{name}_indices"],
                               data[f"{name}_indptr"]), shape=tuple(data[f"{name}_shape"]))
 
+    if "format" not in data:
+        raise MbodyError(f"{path}: a .npz archive, but not an mbody export (it has no "
+                         f"'format' entry; entries: {', '.join(sorted(data)[:8])})")
+    # the tag before the matrices: a saved run (another mbody .npz) is named as such
+    check_format(path, str(get("format")), int(get("version")) if "version" in data else 0)
     return build(path, get, mat("M"), mat("G"), mat("T") if "T_data" in data else None)

@@ -5,8 +5,6 @@ from __future__ import annotations
 
 import os
 
-import numpy as np
-
 from mbody.equations.assemble import Assembly, assemble
 from mbody.errors import MbodyError
 from mbody.model.model import Model, State
@@ -17,20 +15,15 @@ def state_at(traj: Trajectory, time: float | None) -> tuple[State, int]:
     """The trajectory's sample nearest to `time` (default: its last sample) and its index.
 
     No interpolation: a stored sample is a state the integrator produced, so it satisfies
-    the equations and constraints as well as the run did. Raises `MbodyError` when `time`
-    lies outside the trajectory's time span.
+    the equations and constraints as well as the run did (`Trajectory.state_at`). Raises
+    `MbodyError` when `time` lies outside the trajectory's time span.
     """
-    t = np.asarray(traj.t, dtype=float)
-    if len(t) == 0:
-        raise MbodyError("the trajectory holds no samples")
     if time is None:
-        k = len(t) - 1
+        if len(traj.t) == 0:
+            raise MbodyError("the trajectory holds no samples")
+        k = len(traj.t) - 1
     else:
-        span = max(abs(t[-1]), abs(t[0]), 1.0) * 1e-9
-        if not (t[0] - span <= time <= t[-1] + span):
-            raise MbodyError(f"time {time:g} s is outside the trajectory's span "
-                             f"[{t[0]:g}, {t[-1]:g}] s")
-        k = int(np.argmin(np.abs(t - time)))
+        k = traj.nearest_sample(time)
     return traj.state(k), k
 
 
