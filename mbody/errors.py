@@ -109,6 +109,13 @@ class OutputError(MbodyError, OSError):
         return str(self.args[0])
 
 
+class MbodyTypeError(MbodyError, TypeError):
+    """An argument of the wrong type (a dict where a `State` is expected, text where a
+    number is): the message names the argument and what it takes. An `MbodyError`, so
+    that one ``except`` catches every refusal of mbody's, and a `TypeError`, as Python
+    reports a wrong type."""
+
+
 class TrajectoryFileError(MbodyError):
     """A trajectory file is unreadable, truncated or of the wrong kind."""
 
