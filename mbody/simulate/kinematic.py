@@ -32,6 +32,7 @@ from mbody.equations.workspace import workspace
 from mbody.equations.world import check_axes
 from mbody.errors import MbodyError, did_you_mean
 from mbody.kernel import _core
+from mbody.model.arguments import checked_model, number
 from mbody.model.model import Model
 from mbody.simulate.axes import world_series
 from mbody.simulate.peaks import record_peaks, steady_rate
@@ -140,6 +141,11 @@ def kinematic_run(model: Model, t_end: float, fps: float, *, t_start: float = 0.
         At a sample where the loops cannot close (a dead centre, links that cannot
         reach): its time, the drivers' values and the distance left.
     """
+    if not isinstance(model, Model):
+        model = checked_model(model)
+    t_end = number(t_end, "t_end", "a number of seconds")
+    fps = number(fps, "fps", "a positive number of samples per second")
+    t_start = number(t_start, "t_start", "a number of seconds")
     check_axes(axes)
     t = sample_times(t_end, fps, t_start)
     require_fully_driven(model)

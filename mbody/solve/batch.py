@@ -21,8 +21,9 @@ import numpy as np
 
 from mbody.equations.solution import METHODS, ReactionValues, Solution, singular_mass_error
 from mbody.equations.workspace import workspace
-from mbody.errors import MbodyError, did_you_mean
+from mbody.errors import MbodyError, MbodyTypeError, did_you_mean
 from mbody.kernel import _core
+from mbody.model.arguments import checked_model, checked_state
 from mbody.model.model import Model, State
 from mbody.solve.family import Family
 from mbody.solve.kinematics import CLOSE_RTOL, NEWTON_STEPS, _size
@@ -254,15 +255,31 @@ def solve_many(model: Model, states: Sequence[State] | State | None = None, *,
     Raises
     ------
     MbodyError
-        States and values of different lengths, or a state of another model's size.
+        States and values of different lengths; a state of another model's size or with
+        values that are not finite (`mbody.model.arguments.checked_state`, naming it as
+        ``states[k]``); `states` or `values` of the wrong type (`MbodyTypeError`).
     """
+    if not isinstance(model, Model):
+        model = checked_model(model)
     if isinstance(states, State):
         states = [states]
+    elif states is not None and not isinstance(states, Sequence):
+        raise MbodyTypeError(f"states must be a State or a sequence of them, got "
+                             f"{type(states).__name__}")
+    if values is not None and (isinstance(values, Mapping) or not isinstance(values,
+                                                                          Sequence)):
+        raise MbodyTypeError(f"values must be a sequence of mappings, one per case "
+                             f"([{{'bodies.rod.mass': 2.0}}, ...]), got "
+                             f"{type(values).__name__}")
     if values is None:
         ev = Evaluator(model)
         states = [model.initial] if states is None else list(states)
         t, Y = _packed(ev, states)
         return _solutions(ev, t, ev.solve(t, Y), [None] * len(t))
+    for k, v in enumerate(values):
+        if not isinstance(v, Mapping):
+            raise MbodyTypeError(f"values[{k}] must be a mapping of value path -> value "
+                                 f"({{'bodies.rod.mass': 2.0}}), got {type(v).__name__}")
     values = [dict(v) for v in values]
     if states is not None and len(states) not in (1, len(values)):
         raise MbodyError(f"{len(states)} states for {len(values)} sets of values: give one "
@@ -318,10 +335,8 @@ def _not_assembled(model: Model, values: Mapping[str, Any]) -> str:
 
 def _packed(ev: Evaluator, states: Sequence[State]) -> tuple[np.ndarray, np.ndarray]:
     n = ev.model.n
-    for s in states:
-        if s.position.shape != (n, 3):
-            raise MbodyError(f"a state of {len(s.position)} bodies for model "
-                             f"{ev.model.name!r} of {n}")
+    for k, s in enumerate(states):
+        checked_state(ev.model, s, f"states[{k}]")
     Y = np.stack([ev.ws.pack_state(s) for s in states]) if states else np.zeros((0, 13 * n))
     return np.array([float(s.t) for s in states]), Y
 
