@@ -209,6 +209,41 @@ def test_numbers_given_as_text_or_bools_are_type_errors(pendulum, kwargs, match)
         mbody.simulate(pendulum, **{"t_end": 0.1, "fps": 10, **kwargs})
 
 
+def test_a_last_sample_short_of_t_end_is_warned_with_the_fps_that_samples_it(pendulum):
+    """fps < 1/t_end gave one sample at t = 0 for a one-second run, without a word."""
+    run = mbody.simulate(pendulum, 1.0, 0.5)
+    assert run.t.tolist() == [0.0]
+    assert run.info["warnings"][0] == (
+        "the last sample is at t = 0 s, short of t_end = 1 s: samples are every 1/fps = 2 s, "
+        "and t_end * fps = 0.5 is not a whole number; for a sample at t_end, use fps = 1 (or "
+        "a multiple of it) or t_end = 2")
+    run = mbody.simulate(pendulum, 1.0, 7.5)
+    assert run.t[-1] == pytest.approx(7 / 7.5, rel=1e-15)
+    assert run.info["warnings"][0].startswith("the last sample is at t = 0.933333 s, short of "
+                                              "t_end = 1 s")
+    assert "use fps = 8 (or a multiple of it) or t_end = 1.06667" in run.info["warnings"][0]
+    # quiet where t_end * fps is whole to within rounding (0.1 * 30 = 3.0000000000000004,
+    # 0.3 * 60 = 17.999999999999996)
+    for t_end, fps in ((0.1, 30), (0.3, 60), (1.0, 60)):
+        run = mbody.simulate(pendulum, t_end, fps)
+        assert run.t[-1] == pytest.approx(t_end, rel=1e-12)
+        assert not any(w.startswith("the last sample") for w in run.info["warnings"])
+
+
+def test_a_kinematic_run_short_of_t_end_is_warned_too():
+    """A fully driven mechanism (simulate hands it to kinematic_run) says the same."""
+    model = mbody.load(MODELS / "slider_crank_driven.yaml")
+    for run in (mbody.kinematic_run(model, 0.1, 25), mbody.simulate(model, 0.1, 25)):
+        assert run.t[-1] == pytest.approx(0.08, rel=1e-12)
+        assert run.info["warnings"][0].startswith(
+            "the last sample is at t = 0.08 s, short of t_end = 0.1 s")
+    assert not any(w.startswith("the last sample") for w in
+                   mbody.kinematic_run(model, 0.1, 30).info["warnings"])
+    with pytest.raises(MbodyTypeError, match="^fps must be a positive number of samples per "
+                                             "second, got str '30'$"):
+        mbody.kinematic_run(model, 0.1, "30")
+
+
 # -- known reaction values --------------------------------------------------------------------
 
 def test_known_must_be_a_mapping_of_finite_numbers(pendulum):

@@ -78,6 +78,23 @@ def sample_times(t_end: float, fps: float, t_start: float = 0.0) -> np.ndarray:
     return t_start + np.arange(count) / fps
 
 
+def last_sample_warning(t_end: float, fps: float, t_start: float = 0.0) -> str | None:
+    """The warning of a run whose last sample falls short of `t_end`: the samples are at
+    t_start + k / fps, and (t_end - t_start) · fps is not a whole number (to within the
+    rounding `sample_times` allows); None when it is, the usual case."""
+    span = t_end - t_start
+    x = span * fps
+    whole = math.floor(x + 1e-9)
+    if x - whole <= 1e-9 * max(1.0, x):
+        return None
+    last = t_start + whole / fps
+    return (f"the last sample is at t = {last:.6g} s, short of t_end = {t_end:g} s: samples "
+            f"are every 1/fps = {1 / fps:.6g} s, and {'(t_end - t_start)' if t_start else 't_end'}"
+            f" * fps = {x:.6g} is not a whole number; for a sample at t_end, use fps = "
+            f"{math.ceil(x) / span:.6g} (or a multiple of it) or t_end = "
+            f"{t_start + math.ceil(x) / fps:.6g}")
+
+
 def freedom(model: Model) -> int:
     """The degrees of freedom the joints and drivers leave (the model's coordinates less
     the generic rank of the enforced constraints): 0 for a fully driven mechanism."""
@@ -130,7 +147,8 @@ def kinematic_run(model: Model, t_end: float, fps: float, *, t_start: float = 0.
         Every body's motion; `reactions` by `reaction_labels` (the drivers' efforts
         among them); ``info`` with the Newton steps, the energy check and the peaks,
         and under ``info["warnings"]`` samples too sparse for those peaks
-        (`mbody.simulate.peaks.sampling_warning`).
+        (`mbody.simulate.peaks.sampling_warning`), or a last sample short of `t_end`
+        (`last_sample_warning`).
 
     Raises
     ------
@@ -164,7 +182,11 @@ def kinematic_run(model: Model, t_end: float, fps: float, *, t_start: float = 0.
                                      info)
     if done < K:
         _failed(model, float(t[done]), y, info)
-    return _trajectory(model, t, Y, OUT, energy, plan, info, points, axes)
+    traj = _trajectory(model, t, Y, OUT, energy, plan, info, points, axes)
+    short = last_sample_warning(t_end, fps, t_start)
+    if short:
+        traj.info["warnings"].insert(0, short)
+    return traj
 
 
 def newton_tolerance(model: Model, t: np.ndarray) -> float:

@@ -55,6 +55,7 @@ from mbody.simulate.kinematic import (
     driven_lines,
     fully_driven,
     kinematic_run,
+    last_sample_warning,
 )
 from mbody.simulate.kinematic import summary as kinematic_summary
 from mbody.simulate.mechanism import BAUMGARTE_RATE, conserved_figures, sample_figures
@@ -156,9 +157,11 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
              max_wall: float | None = None, axes: str = "joint") -> Trajectory:
     """Integrate the motion from `initial` (default the model's state) to `t_end` seconds.
 
-    Samples at t = k / fps for k = 0 .. ⌊t_end · fps⌋. Reactions not given in the file
-    or in `known` are solved for at every step, the joints held by projection (DOP853)
-    or Baumgarte's terms (scipy's methods).
+    Samples at t = k / fps for k = 0 .. ⌊t_end · fps⌋: the last sample is at t_end when
+    t_end · fps is a whole number (to within rounding), else before it, and
+    ``info["warnings"]`` then says where and which fps samples t_end. Reactions not given
+    in the file or in `known` are solved for at every step, the joints held by
+    projection (DOP853) or Baumgarte's terms (scipy's methods).
 
     Every argument is checked before any work: numbers must be numbers (not text, not
     bools; an `MbodyTypeError`, also a `TypeError`), in their ranges (`MbodyError`).
@@ -210,7 +213,8 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     Trajectory
         The sampled motion, whose `info` holds the run facts and drift figures, and under
         ``info["warnings"]`` what looked wrong (a cost that exploded, a spin the frame
-        rate aliases, samples too sparse for the drivers' motion to trust its peaks).
+        rate aliases, samples too sparse for the drivers' motion to trust its peaks, a last
+        sample short of t_end).
 
     Raises
     ------
@@ -403,7 +407,8 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
         driven_figures(run_model, traj, Y, lam, rhs.unknowns)
     broken = info.get("initial_joint_errors")
     # a run with drivers has its samples' warning already (driven_figures: record_peaks)
-    info["warnings"] = [w for w in (_broken_start(broken, projecting) if broken else None,
+    info["warnings"] = [w for w in (last_sample_warning(t_end, fps),
+                                    _broken_start(broken, projecting) if broken else None,
                                     rate.warning(), _spin_warning(traj, spin_peak)) if w
                         ] + info.get("warnings", [])
     return traj
