@@ -35,7 +35,8 @@ def load(source: str | os.PathLike[str] | dict, *, max_bytes: int | None = None,
         The state of an imported model: ``keyframe="name"`` (MJCF; default the key
         ``initial`` when the file has one, as mbody's export writes it, else the
         reference pose at rest), ``joint_positions={...}``, ``joint_velocities={...}``
-        and ``floating_base=True`` (URDF; default every joint at 0, the root fixed).
+        and ``floating_base=True`` (URDF, a bool: text such as ``"false"`` is refused;
+        default every joint at 0, the root fixed).
         See `mbody.io.interop.read_document`.
 
     Returns

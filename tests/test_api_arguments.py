@@ -318,3 +318,16 @@ def test_a_path_where_a_model_goes_says_to_load_it(call):
 def test_equilibrium_time_must_be_a_number(pendulum):
     with pytest.raises(MbodyTypeError, match="^t must be a number of seconds, got str '1'$"):
         mbody.equilibrium(pendulum, t="1")
+
+
+# -- URDF floating_base --------------------------------------------------------------------------
+
+def test_floating_base_must_be_a_bool():
+    path = MODELS / "robots" / "two_link_arm.urdf"
+    for value, got in (("false", "str 'false'"), (1, "int 1"), ("True", "str 'True'")):
+        with pytest.raises(MbodyTypeError, match=f"^floating_base must be True or False, got "
+                                                 f"{got}$"):
+            mbody.load(path, floating_base=value)
+    fixed, floating = mbody.load(path, floating_base=False), mbody.load(path, floating_base=True)
+    assert (len(fixed.joints), len(fixed.reactions)) == (3, 16)  # the root welded
+    assert (len(floating.joints), len(floating.reactions)) == (2, 10)
