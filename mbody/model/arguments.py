@@ -114,6 +114,8 @@ def _problem(state: State) -> tuple[str, int, str] | None:
 def number(value: Any, argument: str, what: str) -> float:
     """`value` as a float when it is a real number (not a bool, not text); else an
     `MbodyTypeError`: "`argument` must be `what`, got ..."; the range is the caller's."""
+    if type(value) is float or type(value) is int:  # the usual: no ABC check (~0.3 us)
+        return float(value)
     if isinstance(value, Real) and not isinstance(value, bool):
         return float(value)
     got = f"{type(value).__name__} {value!r}" if isinstance(value, str | bool) else \
