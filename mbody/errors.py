@@ -111,18 +111,19 @@ class OutputError(MbodyError, OSError):
         return str(self.args[0])
 
 
+class MbodyTypeError(MbodyError, TypeError):
+    """An argument of the wrong type (a dict where a `State` is expected, text where a
+    number is): the message names the argument and what it takes. An `MbodyError`, so
+    that one ``except`` catches every refusal of mbody's, and a `TypeError`, as Python
+    reports a wrong type."""
+
+
 class TrajectoryFileError(MbodyError):
     """A trajectory file is unreadable, truncated or of the wrong kind."""
 
 
-class WrongTypeError(MbodyError, TypeError):
-    """An argument of a Python call is of the wrong type; the message names the argument,
-    what it accepts and what it got (`wrong_type`). Both an `MbodyError` (what mbody raises
-    on purpose) and a `TypeError` (what Python code expects of a wrong type)."""
-
-
-def wrong_type(argument: str, expected: str, got: object, hint: str = "") -> WrongTypeError:
-    """The `WrongTypeError` "<argument>: expected <expected>, got <what got is>[; <hint>]".
+def wrong_type(argument: str, expected: str, got: object, hint: str = "") -> MbodyTypeError:
+    """The `MbodyTypeError` "<argument> must be <expected>, got <what got is>[; <hint>]".
 
     Parameters
     ----------
@@ -135,7 +136,7 @@ def wrong_type(argument: str, expected: str, got: object, hint: str = "") -> Wro
     hint : str, optional
         How to get what was meant.
     """
-    return WrongTypeError(f"{argument}: expected {expected}, got {_what(got)}"
+    return MbodyTypeError(f"{argument} must be {expected}, got {_what(got)}"
                           + (f"; {hint}" if hint else ""))
 
 
@@ -152,7 +153,10 @@ def _what(value: object) -> str:
 
 def real_number(value: object, argument: str, expected: str = "a number") -> float:
     """`value` as a float when it is a real number (an int, a float, a numpy scalar; not a
-    bool, nor a number written as a string), else `wrong_type`'s error naming `argument`."""
+    bool, nor a number written as a string), else `wrong_type`'s error naming `argument`
+    (the range is the caller's to check)."""
+    if type(value) is float or type(value) is int:  # the usual: no ABC check (~0.3 us)
+        return float(value)
     if isinstance(value, numbers.Real) and not isinstance(value, bool):
         return float(value)
     hint = ""

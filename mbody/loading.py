@@ -36,7 +36,8 @@ def load(source: str | os.PathLike[str] | dict, *, max_bytes: int | None = None,
         The state of an imported model: ``keyframe="name"`` (MJCF; default the key
         ``initial`` when the file has one, as mbody's export writes it, else the
         reference pose at rest), ``joint_positions={...}``, ``joint_velocities={...}``
-        and ``floating_base=True`` (URDF; default every joint at 0, the root fixed).
+        and ``floating_base=True`` (URDF, a bool: text such as ``"false"`` is refused;
+        default every joint at 0, the root fixed).
         See `mbody.io.interop.read_document`.
 
     Returns
@@ -50,7 +51,7 @@ def load(source: str | os.PathLike[str] | dict, *, max_bytes: int | None = None,
     mbody.ModelError
         Listing every problem, each with its file, line and column; or `source` is YAML
         text rather than a path (`loads` reads text).
-    mbody.errors.WrongTypeError
+    mbody.errors.MbodyTypeError
         `source` is neither a path nor a dict (a `TypeError` too: for an open file, give
         its path or ``loads(f.read())``), or `max_bytes` is not a whole number.
     mbody.solve.kinematics.KinematicsError
@@ -71,5 +72,5 @@ def load(source: str | os.PathLike[str] | dict, *, max_bytes: int | None = None,
 def loads(text: str | bytes, file: str = "<string>") -> Model:
     """Like `load`, from YAML text (bytes: UTF-8, as a file is read); `file` is the name
     used in error messages. A path is `load`'s; anything but text or bytes raises
-    `mbody.errors.WrongTypeError` (a `TypeError` too)."""
+    `mbody.errors.MbodyTypeError` (a `TypeError` too)."""
     return assembled(with_finish(read_model_text(text, file), assembled))

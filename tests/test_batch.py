@@ -232,11 +232,11 @@ def test_values_of_the_wrong_form_are_refused_by_name():
     with pytest.raises(TypeError) as err:
         mbody.solve_many(model, values={"bodies.rod.mass": 2.0})
     msg = str(err.value)
-    assert msg.startswith("values: expected a list of mappings, one per case")
+    assert msg.startswith("values must be a list of mappings, one per case")
     assert "got dict" in msg and "values=[{...}]" in msg
-    with pytest.raises(TypeError, match=r"^values\[1\]: expected a mapping path -> value"):
+    with pytest.raises(TypeError, match=r"^values\[1\] must be a mapping path -> value"):
         mbody.solve_many(model, values=[{"bodies.rod.mass": 2.0}, "bodies.rod.mass=3"])
-    with pytest.raises(TypeError, match=r"^values: expected a list of mappings"):
+    with pytest.raises(TypeError, match=r"^values must be a list of mappings"):
         mbody.solve_many(model, values="bodies.rod.mass=3")
     one = mbody.solve_many(model, values=({"bodies.rod.mass": 2.0},))   # any sequence
     assert np.array_equal(one.accelerations[0], mbody.assemble(

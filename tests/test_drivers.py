@@ -406,9 +406,9 @@ def test_kinematic_run_points_in_the_command_lines_text_form_and_wrong_forms():
     as_pair = kinematic_run(model, 0.5, 20, points={"P": ("coupler", [0.0, 0.05])})
     as_text = kinematic_run(model, 0.5, 20, points={"P": "coupler:0,0.05"})
     assert np.array_equal(as_text.series["point:P"], as_pair.series["point:P"])
-    with pytest.raises(TypeError, match=r"^points: expected a mapping name -> \(body"):
+    with pytest.raises(TypeError, match=r"^points must be a mapping name -> \(body"):
         kinematic_run(model, 0.5, 20, points=[("coupler", [0.0, 0.05])])
-    with pytest.raises(TypeError, match=r"^points\['P'\]: expected \(body, \[x, y"):
+    with pytest.raises(TypeError, match=r"^points\['P'\] must be \(body, \[x, y"):
         kinematic_run(model, 0.5, 20, points={"P": ("coupler", 0.05)})
     for entry, said in [("coupler", "expected BODY:X,Y"), ("coupler:a,b", "not a list of numbers"),
                         ("couple:0,0.05", "did you mean 'coupler'?"),

@@ -340,10 +340,10 @@ def test_an_export_of_a_model_says_to_assemble_it_first(tmp_path, fmt):
     with pytest.raises(TypeError) as err:
         _write(MODEL_CASES["pendulum"], tmp_path, fmt)
     msg = str(err.value)
-    assert msg.startswith("asm: expected an Assembly (mbody.assemble(model))")
+    assert msg.startswith("asm must be an Assembly (mbody.assemble(model))")
     assert "got Model" in msg and isinstance(err.value, mbody.MbodyError)
     assert list(tmp_path.iterdir()) == []
-    with pytest.raises(TypeError, match=r"^asm: expected an Assembly .*got str"):
+    with pytest.raises(TypeError, match=r"^asm must be an Assembly .*got str"):
         ex.exported("models/pendulum.yaml")
 
 

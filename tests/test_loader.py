@@ -542,13 +542,13 @@ def test_load_of_a_wrong_type_names_source_and_what_it_takes(load, source, got):
         load(source)
     assert isinstance(err.value, mbody.MbodyError)
     msg = str(err.value)
-    assert msg.startswith("source: expected a path")
+    assert msg.startswith("source must be a path")
     assert "a dict" in msg and "mbody.loads" in msg and got in msg
 
 
 def test_load_of_an_open_file_says_to_give_its_path_or_its_text():
     with open(MODELS / "pendulum.yaml", encoding="utf-8") as fh, \
-            pytest.raises(TypeError, match=r"source: .*got TextIOWrapper") as err:
+            pytest.raises(TypeError, match=r"source must be .*got TextIOWrapper") as err:
         mbody.load(fh)
     assert "f.name" in str(err.value) and "mbody.loads(f.read())" in str(err.value)
 
@@ -584,7 +584,7 @@ def test_a_path_that_looks_like_yaml_but_exists_is_read(tmp_path, monkeypatch):
 
 @pytest.mark.parametrize("max_bytes", ["10", 1.5, True, [10]])
 def test_max_bytes_of_a_wrong_type_is_refused_by_name(max_bytes):
-    with pytest.raises(TypeError, match=r"^max_bytes: expected a whole number of bytes"):
+    with pytest.raises(TypeError, match=r"^max_bytes must be a whole number of bytes"):
         mbody.load(MODELS / "pendulum.yaml", max_bytes=max_bytes)
 
 
@@ -618,7 +618,7 @@ def test_loads_reads_utf8_bytes_as_a_file_is_read():
 
 @pytest.mark.parametrize("text", [None, 3, MODELS / "pendulum.yaml"], ids=["None", "int", "path"])
 def test_loads_of_a_wrong_type_names_text(text):
-    with pytest.raises(TypeError, match=r"^text: expected a model file's YAML text") as err:
+    with pytest.raises(TypeError, match=r"^text must be a model file's YAML text") as err:
         mbody.loads(text)
     if isinstance(text, Path):
         assert "mbody.load(path)" in str(err.value)

@@ -69,7 +69,7 @@ def test_a_sample_out_of_range_or_a_time_where_an_index_goes(run):
     assert traj.state(np.int64(20)).t == traj.t[20]
     with pytest.raises(TypeError) as err:
         traj.state(0.5)
-    assert str(err.value).startswith("k: expected a sample's index, a whole number 0..20")
+    assert str(err.value).startswith("k must be a sample's index, a whole number 0..20")
     assert ".state_at(0.5)" in str(err.value)
     for time, k in ((0.5, 10), (0.51, 10), (0.53, 11), (1.0, 20)):
         assert traj.nearest_sample(time) == k
@@ -77,7 +77,7 @@ def test_a_sample_out_of_range_or_a_time_where_an_index_goes(run):
         assert s.t == traj.t[k] and np.array_equal(s.position, traj.state(k).position)
     with pytest.raises(mbody.MbodyError, match=r"outside the trajectory's span \[0, 1\] s"):
         traj.state_at(1.2)
-    with pytest.raises(TypeError, match="^time: expected a time in seconds"):
+    with pytest.raises(TypeError, match="^time must be a time in seconds"):
         traj.state_at("0.5")
 
 

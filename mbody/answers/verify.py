@@ -283,7 +283,7 @@ def verify(model: Model | str | os.PathLike[str], answers: Any, *, tol: float = 
         equation that cannot be read (with its column); every problem at once.
     MbodyError
         `tol` outside (0, 1), or `asm` of another model
-        (`mbody.errors.WrongTypeError`, a `TypeError` too, for a `tol` that is not a
+        (`mbody.errors.MbodyTypeError`, a `TypeError` too, for a `tol` that is not a
         number or an `asm` that is not an `Assembly`).
     """
     tol = real_number(tol, "tol", "a relative tolerance, a number between 0 and 1")

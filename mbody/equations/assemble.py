@@ -42,6 +42,7 @@ from mbody.equations.workspace import (
 from mbody.equations.world import world_reactions
 from mbody.errors import MbodyError, did_you_mean
 from mbody.kernel import _core
+from mbody.model.arguments import checked_model, checked_state, known_at
 from mbody.model.model import Model, State, count
 
 if TYPE_CHECKING:
@@ -261,8 +262,10 @@ class Assembly:
 
         Parameters
         ----------
-        known : mapping of str to float, optional
-            Reaction values (N; N m) by label, overriding or adding to the file's.
+        known : mapping of str to float or str, optional
+            Reaction values (N; N m) by label, overriding or adding to the file's: numbers,
+            or expressions of t as text (``"2*t"``, docs/expressions.md), taken at
+            ``state.t`` as the file's are.
 
         Returns
         -------
@@ -272,17 +275,13 @@ class Assembly:
         Raises
         ------
         MbodyError
-            A label of `known` is not a reaction component of the model.
+            `known` is not a mapping (`MbodyTypeError`), a label is not a reaction
+            component of the model, or a value is not a finite number or an expression
+            finite at ``state.t``.
         """
-        values = self.model.known_reactions_at(self.state.t)
-        labels = self.model.reaction_index
-        for label, v in (known or {}).items():
-            if label not in labels:
-                hint = did_you_mean(label, self.reactions)
-                raise MbodyError(f"no reaction component {label!r} in this model"
-                                 + (f"; {hint}" if hint else ""))
-            values[label] = float(v)
-        return values
+        if known is None:
+            return self.model.known_reactions_at(self.state.t)
+        return known_at(self.model, known, self.state.t)
 
     def solve(self, known: Mapping[str, float] | None = None, *,
               condition: bool = False, axes: str = "joint") -> Solution:
@@ -295,8 +294,10 @@ class Assembly:
 
         Parameters
         ----------
-        known : mapping of str to float, optional
+        known : mapping of str to float or str, optional
             Reaction values (N; N m) by label, added to the file's; the rest are solved.
+            A value is a finite number, or an expression of t as text (``"2*t"``), taken
+            at ``state.t`` (`reaction_values`).
         condition : bool
             Also compute the 1-norm condition number of the Schur complement Gᵀ M⁻¹ G
             (`Solution.condition`).
@@ -487,7 +488,8 @@ def assemble(model: Model, state: State | None = None) -> Assembly:
     Parameters
     ----------
     model : Model
-        The model, from `load` or `loads`.
+        The model, from `load` or `loads` (a file's path is refused: read it with
+        ``mbody.load(path)`` first, so that one model serves many calls).
     state : State, optional
         Positions, orientations, velocities and time to write the equations at (default
         ``model.initial``, the file's initial state).
@@ -496,8 +498,19 @@ def assemble(model: Model, state: State | None = None) -> Assembly:
     -------
     Assembly
         The equations ``M v̇ + b = Q + G λ`` at that state.
+
+    Raises
+    ------
+    MbodyError
+        `model` is not a `Model`, or `state` not a `State` (`MbodyTypeError`, also a
+        `TypeError`); a state of another number of bodies, or with values that are not
+        finite (`mbody.model.arguments.checked_state`).
     """
-    return Assembly(model, model.initial if state is None else state)
+    if not isinstance(model, Model):
+        model = checked_model(model)
+    if state is None:
+        return Assembly(model, model.initial)
+    return Assembly(model, checked_state(model, state, "state"))
 
 
 _Array = TypeVar("_Array")

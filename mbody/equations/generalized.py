@@ -29,8 +29,9 @@ import numpy as np
 
 from mbody.equations.coordinates import CoordinateSet, columns, coordinate_set
 from mbody.equations.workspace import workspace
-from mbody.errors import MbodyError, did_you_mean
+from mbody.errors import MbodyError
 from mbody.kernel import _core
+from mbody.model.arguments import checked_state, known_at
 from mbody.model.model import Model, State
 
 if TYPE_CHECKING:
@@ -302,9 +303,10 @@ def generalized(model: Model, state: State | None = None,
         The coordinates by label (one per degree of freedom); default: drivers'
         coordinates, then a spanning tree's joint coordinates, then free bodies' own
         (`mbody.equations.coordinates`).
-    known : mapping of str to float, optional
+    known : mapping of str to float or str, optional
         Reaction values to apply as loads (their joints are then not held), added to the
-        file's.
+        file's: finite numbers, or expressions of t as text taken at ``state.t``
+        (`mbody.model.arguments.known_at`).
 
     Returns
     -------
@@ -314,18 +316,11 @@ def generalized(model: Model, state: State | None = None,
     ------
     MbodyError
         Unknown or dependent coordinates; `CoordinatesSingularError` when they do not
-        determine the motion at this state.
+        determine the motion at this state; a `state` or `known` that is not what it
+        should be (`mbody.model.arguments`).
     """
-    state = model.initial if state is None else state
-    given = None
-    if known:
-        given = model.known_reactions_at(state.t)
-        for label, v in known.items():
-            if label not in model.reaction_index:
-                hint = did_you_mean(label, model.reactions)  # as Assembly.solve's known=
-                raise MbodyError(f"no reaction component {label!r} in this model"
-                                 + (f"; {hint}" if hint else ""))
-            given[label] = float(v)
+    state = model.initial if state is None else checked_state(model, state, "state")
+    given = known_at(model, known, state.t) if known else None
     cs = coordinate_set(model, coordinates, given)
     return evaluate(model, state, cs)
 

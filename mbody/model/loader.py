@@ -400,7 +400,7 @@ _YAML_START = re.compile(r"\s*(\{|[\w-]+\s*:\s)")
 def check_source(source: object, max_bytes: object = None, call: str = "mbody.load"
                  ) -> int | None:
     """Refuse, before anything is read, what `call` cannot read from: a `source` that is
-    neither a path nor a dict (`WrongTypeError`), YAML text given where a path goes
+    neither a path nor a dict (`MbodyTypeError`), YAML text given where a path goes
     (`ModelError`: text is `mbody.loads`'), or a `max_bytes` that is not a whole number of
     bytes, at least 1.
 

@@ -14,16 +14,18 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import math
 import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from functools import cached_property
+from numbers import Real
 from typing import Any
 
 import numpy as np
 
 from mbody import conventions as cv
-from mbody.errors import Issue, MbodyError, ModelError, wrong_type
+from mbody.errors import Issue, MbodyError, MbodyTypeError, ModelError, wrong_type
 from mbody.model.build import joint_tables, located_loads, point_loads
 from mbody.model.drivers import DriverTable, driver_table
 from mbody.model.expressions import Expression
@@ -59,6 +61,19 @@ class State:
         Angular velocities, body axes (rad/s).
     t : float, optional
         Time (s), for loads and known reactions that vary in time.
+
+    Raises
+    ------
+    MbodyError
+        An array of another shape than (n, k) (one row per body, the same n in all four),
+        or a `t` that is not a finite number (`MbodyTypeError` for text or a bool, an
+        array of things that are not numbers). Lists and arrays of other number types
+        are converted to float arrays; a float array is kept as given (not copied).
+
+    Notes
+    -----
+    The values themselves (finite numbers, quaternions that are not 0) are checked
+    against a model where a state enters mbody (`mbody.model.arguments.checked_state`).
     """
 
     position: np.ndarray
@@ -66,6 +81,45 @@ class State:
     velocity: np.ndarray
     omega: np.ndarray
     t: float = 0.0
+
+    def __post_init__(self) -> None:
+        x, q, v, w = self.position, self.quaternion, self.velocity, self.omega
+        f = _FLOAT64  # the usual state: float arrays of the right shapes, kept as they are
+        if not (type(x) is type(q) is type(v) is type(w) is np.ndarray
+                and x.dtype is q.dtype is v.dtype is w.dtype is f and x.ndim == 2
+                and x.shape[1] == 3 and q.shape == (len(x), 4) and v.shape == x.shape
+                and w.shape == x.shape):
+            self._convert()
+        t = self.t
+        if type(t) is not float:
+            if isinstance(t, bool) or not isinstance(t, Real):
+                raise MbodyTypeError(f"State: t must be a number of seconds, got "
+                                     f"{type(t).__name__} {t!r}")
+            t = float(t)
+            object.__setattr__(self, "t", t)
+        if not math.isfinite(t):
+            raise MbodyError(f"State: t must be a finite number of seconds, got {t!r}")
+
+    def _convert(self) -> None:
+        """The arrays as float arrays (lists, other number types), or an error that names
+        the one of the wrong shape."""
+        n = -1
+        for name, width in _STATE_ARRAYS:
+            value = getattr(self, name)
+            if type(value) is not np.ndarray or value.dtype is not _FLOAT64:
+                value = _float_array(value, name, f"(n, {width})")
+                object.__setattr__(self, name, value)  # frozen: set once, here
+            shape = value.shape
+            if len(shape) != 2 or shape[1] != width:
+                raise MbodyError(f"State: {name} must be an (n, {width}) array, one row per "
+                                 f"body, got shape {shape}"
+                                 + (f" (one body: [[{', '.join(['...'] * width)}]])"
+                                    if shape == (width,) else ""))
+            if n < 0:
+                n = shape[0]
+            elif shape[0] != n:
+                raise MbodyError(f"State: position has {n} rows (bodies), {name} "
+                                 f"{shape[0]}: one row per body in each")
 
     @cached_property
     def W_R_B(self) -> np.ndarray:
@@ -91,6 +145,11 @@ class State:
                angular_velocity: np.ndarray, t: float = 0.0) -> State:
         """A planar state: bodies in the world x-y plane, turning about z.
 
+        One body may be written without its row: ``State.planar([0, -0.5], 0.3, [0, 0],
+        0.0)`` (a scalar `angle`, two numbers for `position` and `velocity`). A single
+        number for `position`, `velocity` or `angular_velocity` is every body's (``0``:
+        at rest).
+
         Parameters
         ----------
         position : (n, 2) array
@@ -107,22 +166,68 @@ class State:
         Returns
         -------
         State
+
+        Raises
+        ------
+        MbodyError
+            The arrays disagree on the number of bodies (the message names them and their
+            shapes), or one is not of the shape above.
         """
-        n = len(angle)
+        theta = _float_array(angle, "angle", "(n,)", "State.planar")
+        if theta.ndim > 1:
+            raise MbodyError(f"State.planar: angle must be an (n,) array, one angle per "
+                             f"body, got shape {theta.shape}")
+        theta = theta.reshape(-1)
+        n = len(theta)
+        parts = {}
+        for name, value, width in (("position", position, 2), ("velocity", velocity, 2),
+                                   ("angular_velocity", angular_velocity, 0)):
+            want = (n, width) if width else (n,)
+            a = _float_array(value, name, "(n, 2)" if width else "(n,)", "State.planar")
+            if a.ndim == 0:  # one number for every body (0: at rest), as numpy broadcasts
+                a = np.broadcast_to(a, want)
+            elif n == 1 and a.shape == want[1:]:  # one body written without its row
+                a = a.reshape(want)
+            if a.shape != want:
+                if a.ndim == len(want) and a.shape[1:] == want[1:]:
+                    raise MbodyError(f"State.planar: {name} has {a.shape[0]} rows, angle "
+                                     f"{n}: one per body in each")
+                raise MbodyError(f"State.planar: {name} must be a {want} array (one "
+                                 f"{'row' if width else 'value'} per body; angle gives "
+                                 f"{n}), got shape {a.shape}")
+            parts[name] = a
         pos = np.zeros((n, 3))
-        pos[:, :2] = position
+        pos[:, :2] = parts["position"]
         vel = np.zeros((n, 3))
-        vel[:, :2] = velocity
+        vel[:, :2] = parts["velocity"]
         q = np.zeros((n, 4))
-        q[:, 0] = np.cos(np.asarray(angle) / 2)
-        q[:, 3] = np.sin(np.asarray(angle) / 2)
+        q[:, 0] = np.cos(theta / 2)
+        q[:, 3] = np.sin(theta / 2)
         om = np.zeros((n, 3))
-        om[:, 2] = angular_velocity
+        om[:, 2] = parts["angular_velocity"]
         return cls(pos, q, vel, om, t)
 
     def __repr__(self) -> str:  # the dataclass's would print four (n, k) arrays
         return (f"<State of {count(len(self.position), 'body', 'bodies')} at t = {self.t:g} s; "
                 ".position, .quaternion, .velocity, .omega, .replace(t=...)>")
+
+
+_STATE_ARRAYS = (("position", 3), ("quaternion", 4), ("velocity", 3), ("omega", 3))
+"""A `State`'s arrays and their widths: each (n, width), one row per body."""
+_FLOAT64 = np.dtype(float)
+
+
+def _float_array(value: Any, name: str, shape: str, where: str = "State") -> np.ndarray:
+    """`value` as a float array, or an `MbodyTypeError` naming the argument (text, None or
+    objects that are not numbers)."""
+    if isinstance(value, str | bytes):
+        raise MbodyTypeError(f"{where}: {name} must be an {shape} array of numbers, got "
+                             f"{type(value).__name__} {value!r}")
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise MbodyTypeError(f"{where}: {name} must be an {shape} array of numbers, got "
+                             f"{type(value).__name__} ({exc})") from None
 
 
 @dataclass(frozen=True, eq=False)
@@ -441,7 +546,7 @@ def load(source: str | os.PathLike[str] | dict, *, max_bytes: int | None = None)
     mbody.ModelError
         Listing every problem, each with its file, line and column; or `source` is YAML
         text rather than a path (`loads` reads text).
-    mbody.errors.WrongTypeError
+    mbody.errors.MbodyTypeError
         `source` is neither a path nor a dict (a `TypeError` too), or `max_bytes` is not a
         whole number.
     """
@@ -496,7 +601,7 @@ def loads(text: str | bytes, file: str = "<string>") -> Model:
     ------
     mbody.ModelError
         Listing every problem, each with its file, line and column.
-    mbody.errors.WrongTypeError
+    mbody.errors.MbodyTypeError
         `text` is neither text nor bytes (a path goes to `load`).
 
     Notes

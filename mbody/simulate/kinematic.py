@@ -30,8 +30,9 @@ from mbody.equations.joints import reaction_columns
 from mbody.equations.solution import singular_mass_error
 from mbody.equations.workspace import workspace
 from mbody.equations.world import check_axes
-from mbody.errors import MbodyError, did_you_mean, wrong_type
+from mbody.errors import MbodyError, did_you_mean, real_number, wrong_type
 from mbody.kernel import _core
+from mbody.model.arguments import checked_model
 from mbody.model.model import Model
 from mbody.simulate.axes import world_series
 from mbody.simulate.peaks import record_peaks, steady_rate
@@ -79,6 +80,23 @@ def sample_times(t_end: float, fps: float, t_start: float = 0.0) -> np.ndarray:
         raise MbodyError(f"{count} samples ({t_end - t_start:g} s at {fps:g} fps) is more "
                          f"than {MAX_SAMPLES}; lower --fps or --t-end")
     return t_start + np.arange(count) / fps
+
+
+def last_sample_warning(t_end: float, fps: float, t_start: float = 0.0) -> str | None:
+    """The warning of a run whose last sample falls short of `t_end`: the samples are at
+    t_start + k / fps, and (t_end - t_start) · fps is not a whole number (to within the
+    rounding `sample_times` allows); None when it is, the usual case."""
+    span = t_end - t_start
+    x = span * fps
+    whole = math.floor(x + 1e-9)
+    if x - whole <= 1e-9 * max(1.0, x):
+        return None
+    last = t_start + whole / fps
+    return (f"the last sample is at t = {last:.6g} s, short of t_end = {t_end:g} s: samples "
+            f"are every 1/fps = {1 / fps:.6g} s, and {'(t_end - t_start)' if t_start else 't_end'}"
+            f" * fps = {x:.6g} is not a whole number; for a sample at t_end, use fps = "
+            f"{math.ceil(x) / span:.6g} (or a multiple of it) or t_end = "
+            f"{t_start + math.ceil(x) / fps:.6g}")
 
 
 def freedom(model: Model) -> int:
@@ -135,19 +153,25 @@ def kinematic_run(model: Model, t_end: float, fps: float, *, t_start: float = 0.
         Every body's motion; `reactions` by `reaction_labels` (the drivers' efforts
         among them); ``info`` with the Newton steps, the energy check and the peaks,
         and under ``info["warnings"]`` samples too sparse for those peaks
-        (`mbody.simulate.peaks.sampling_warning`).
+        (`mbody.simulate.peaks.sampling_warning`), or a last sample short of `t_end`
+        (`last_sample_warning`).
 
     Raises
     ------
     MbodyError
         The mechanism is not fully driven (its free coordinates need integrating:
         `mbody.simulate`); a point names no body, or has the wrong number of coordinates
-        (`mbody.errors.WrongTypeError`, a `TypeError` too, when `points` or an entry is
+        (`mbody.errors.MbodyTypeError`, a `TypeError` too, when `points` or an entry is
         of another form).
     KinematicsError
         At a sample where the loops cannot close (a dead centre, links that cannot
         reach): its time, the drivers' values and the distance left.
     """
+    if not isinstance(model, Model):
+        model = checked_model(model)
+    t_end = real_number(t_end, "t_end", "a number of seconds")
+    fps = real_number(fps, "fps", "a positive number of samples per second")
+    t_start = real_number(t_start, "t_start", "a number of seconds")
     check_axes(axes)
     t = sample_times(t_end, fps, t_start)
     require_fully_driven(model)
@@ -167,7 +191,11 @@ def kinematic_run(model: Model, t_end: float, fps: float, *, t_start: float = 0.
                                      info)
     if done < K:
         _failed(model, float(t[done]), y, info)
-    return _trajectory(model, t, Y, OUT, energy, plan, info, followed, axes)
+    traj = _trajectory(model, t, Y, OUT, energy, plan, info, followed, axes)
+    short = last_sample_warning(t_end, fps, t_start)
+    if short:
+        traj.info["warnings"].insert(0, short)
+    return traj
 
 
 def newton_tolerance(model: Model, t: np.ndarray) -> float:
@@ -312,7 +340,7 @@ def body_points(model: Model, points: object) -> dict[str, tuple[int, np.ndarray
     ------
     MbodyError
         A point on no body of the model (with a did-you-mean), or not d finite numbers.
-    mbody.errors.WrongTypeError
+    mbody.errors.MbodyTypeError
         `points` is not a mapping, or an entry neither (body, coordinates) nor text.
     """
     if points is None:

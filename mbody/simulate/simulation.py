@@ -38,12 +38,24 @@ from mbody import conventions as cv
 from mbody.equations.constraints import joint_errors
 from mbody.equations.workspace import Unknowns, workspace
 from mbody.equations.world import check_axes
-from mbody.errors import MbodyError, UnknownReactionsError, did_you_mean
+from mbody.errors import MbodyError, UnknownReactionsError, did_you_mean, real_number
 from mbody.kernel import _core
-from mbody.model.expressions import Expression, check_times, compile_expression, first_nonfinite
+from mbody.model.arguments import (
+    KnownValues,
+    checked_model,
+    checked_state,
+    known_values,
+)
+from mbody.model.expressions import Expression, check_times, first_nonfinite
 from mbody.model.model import Model, State
 from mbody.simulate.axes import world_series
-from mbody.simulate.kinematic import driven_figures, driven_lines, fully_driven, kinematic_run
+from mbody.simulate.kinematic import (
+    driven_figures,
+    driven_lines,
+    fully_driven,
+    kinematic_run,
+    last_sample_warning,
+)
 from mbody.simulate.kinematic import summary as kinematic_summary
 from mbody.simulate.mechanism import BAUMGARTE_RATE, conserved_figures, sample_figures
 from mbody.simulate.projection import STAGE_PIVOT_RTOL, JointProjection
@@ -64,7 +76,7 @@ slider-crank that ran away to 700 rad/s, 24 500): a hundred times that, yet a sm
 mechanism (a few microseconds per step) reaches it in seconds, a large one in minutes."""
 
 
-def known_reaction_dynamics(model: Model, known: Mapping[str, float | str] | None = None
+def known_reaction_dynamics(model: Model, known: KnownValues | None = None
                             ) -> KnownReactionDynamics:
     """The default derivative: every reaction value known (file, then `known`), λ(t) applied.
 
@@ -144,14 +156,20 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
              max_wall: float | None = None, axes: str = "joint") -> Trajectory:
     """Integrate the motion from `initial` (default the model's state) to `t_end` seconds.
 
-    Samples at t = k / fps for k = 0 .. ⌊t_end · fps⌋. Reactions not given in the file
-    or in `known` are solved for at every step, the joints held by projection (DOP853)
-    or Baumgarte's terms (scipy's methods).
+    Samples at t = k / fps for k = 0 .. ⌊t_end · fps⌋: the last sample is at t_end when
+    t_end · fps is a whole number (to within rounding), else before it, and
+    ``info["warnings"]`` then says where and which fps samples t_end. Reactions not given
+    in the file or in `known` are solved for at every step, the joints held by
+    projection (DOP853) or Baumgarte's terms (scipy's methods).
+
+    Every argument is checked before any work: numbers must be numbers (not text, not
+    bools; an `MbodyTypeError`, also a `TypeError`), in their ranges (`MbodyError`).
 
     Parameters
     ----------
     model : Model
-        The model, from `load` or `loads`.
+        The model, from `load` or `loads` (a file's path is refused: read it with
+        ``mbody.load(path)`` first, so that one model serves many runs).
     t_end : float
         End of the run (s), > 0.
     fps : float
@@ -164,7 +182,7 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
         interpolant, the compiled core's; RK45 and RK23 scipy's explicit ones; Radau, BDF
         and LSODA scipy's for stiff problems).
     known : mapping of str to float or str, optional
-        Reaction values by label (N; N m), numbers or expressions of t (text, see
+        Reaction values by label (N; N m), finite numbers or expressions of t (text, see
         docs/expressions.md), added to the file's (replacing its value of that label).
     progress : bool
         Show a progress bar over simulated time on stderr (tqdm).
@@ -172,9 +190,12 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
         Replaces the default accelerations: f(model, state) -> (n, 6) rows [a_G (world,
         m/s²), ω̇ (body axes, rad/s²)] (see `mbody.solve.dynamics.Dynamics`).
     max_step : float
-        Longest integrator step (s); unbounded by default.
+        Longest integrator step (s), > 0; unbounded by default (``math.inf``).
     initial : State, optional
-        The state to start from (default ``model.initial``); the run starts at t = 0.
+        The state to start from (default ``model.initial``); the run starts at t = 0. A
+        `State` of the model's bodies with finite values (`mbody.model.arguments.
+        checked_state`); for the state at given joint coordinates,
+        `mbody.solve.configure.configure`.
     max_steps : int or None
         Budget of integrator steps (None: no limit).
     max_wall : float or None
@@ -191,21 +212,32 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     Trajectory
         The sampled motion, whose `info` holds the run facts and drift figures, and under
         ``info["warnings"]`` what looked wrong (a cost that exploded, a spin the frame
-        rate aliases, samples too sparse for the drivers' motion to trust its peaks).
+        rate aliases, samples too sparse for the drivers' motion to trust its peaks, a last
+        sample short of t_end).
 
     Raises
     ------
     MbodyError
-        An argument out of range, an unknown method or reaction label, or a budget hit.
+        An argument out of range or of the wrong type, an unknown method or reaction
+        label, a state of another model, or a budget hit.
     """
-    t_end, fps = float(t_end), float(fps)
+    if not isinstance(model, Model):
+        model = checked_model(model)
+    t_end = real_number(t_end, "t_end", "a positive number of seconds")
+    fps = real_number(fps, "fps", "a positive number of samples per second")
     if not (math.isfinite(t_end) and t_end > 0):
         raise MbodyError(f"t_end must be a positive number of seconds, got {t_end:g}")
     if not (math.isfinite(fps) and fps > 0):
         raise MbodyError(f"fps must be a positive number of samples per second, got {fps:g}")
+    rtol = real_number(rtol, "rtol", "a number between 0 and 1 (relative tolerance)")
+    atol = real_number(atol, "atol", "a positive number (absolute tolerance)")
     if not (0 < rtol < 1) or not (atol > 0):
         raise MbodyError(f"tolerances must satisfy 0 < rtol < 1 and atol > 0 "
                          f"(got rtol={rtol:g}, atol={atol:g})")
+    max_step = real_number(max_step, "max_step", "a positive number of seconds (inf: no bound)")
+    if not max_step > 0:  # NaN too
+        raise MbodyError(f"max_step must be a positive number of seconds (inf: no bound), "
+                         f"got {max_step:g}")
     check_axes(axes)
     if method not in METHODS:
         raise MbodyError(f"unknown integrator {method!r}; "
@@ -221,13 +253,16 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     K = int(math.floor(t_end * fps + 1e-9)) + 1
     if K > 10_000_000:
         raise MbodyError(f"{K} output samples requested (t_end * fps); at most 10 million")
-    varying = _varying_expressions(model, known)
+    if initial is not None:
+        initial = checked_state(model, initial, "initial")
+    given: KnownValues | None = None if known is None else known_values(model, known)
+    varying = _varying_expressions(model, given)
     _check_span(varying, t_end)
     if dynamics is None and initial is None and fully_driven(model):
         # the drivers fix the motion: each sample's kinematics then its reactions, no
         # integration (mbody.simulate.kinematic)
-        return kinematic_run(with_known(model, known), t_end, fps, axes=axes)
-    rhs = state_derivative(model, known, dynamics)
+        return kinematic_run(with_known(model, given), t_end, fps, axes=axes)
+    rhs = state_derivative(model, given, dynamics)
     run_model = rhs.model  # the model with `known`'s values in its known reactions
     mechanism = dynamics is None and _has_unknown_reactions(run_model, None)
     n = model.n
@@ -333,7 +368,7 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
                       "initial_joint_errors": _initial_joint_errors(model, initial),
                       "projection_evaluations": run.refreshed}
     elif dynamics is None and labels:
-        lam = known_reaction_dynamics(model, known).reactions_at(t_eval)
+        lam = known_reaction_dynamics(model, given).reactions_at(t_eval)
     else:
         lam = np.zeros((K, 0))
     stored, values = labels, lam
@@ -371,7 +406,8 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
         driven_figures(run_model, traj, Y, lam, rhs.unknowns)
     broken = info.get("initial_joint_errors")
     # a run with drivers has its samples' warning already (driven_figures: record_peaks)
-    info["warnings"] = [w for w in (_broken_start(broken, projecting) if broken else None,
+    info["warnings"] = [w for w in (last_sample_warning(t_end, fps),
+                                    _broken_start(broken, projecting) if broken else None,
                                     rate.warning(), _spin_warning(traj, spin_peak)) if w
                         ] + info.get("warnings", [])
     return traj
@@ -486,7 +522,7 @@ INERTIA_SPREAD = 1e10
 (relative 1e-16 of the largest, divided by the smallest) is blamed for short steps."""
 
 
-def _varying_expressions(model: Model, known: Mapping[str, float | str] | None
+def _varying_expressions(model: Model, known: KnownValues | None
                          ) -> list[tuple[str, Expression]]:
     """(what it is, expression) for every load component and known reaction that varies
     in time, `known` included (compiled here, so a bad one is reported before any work)."""
@@ -497,9 +533,9 @@ def _varying_expressions(model: Model, known: Mapping[str, float | str] | None
                 f" {'xyz'[k]}"
             out.append((f"the load '{ld.name}' ({ld.type}{comp} on {ld.bodies[0]})", e))
     exprs = dict(model.known_expressions)
-    for label, v in (known or {}).items():
-        if isinstance(v, str):
-            exprs[label] = compile_expression(v)
+    for label, v in (known_values(model, known) if known else {}).items():
+        if isinstance(v, Expression):
+            exprs[label] = v
         else:
             exprs.pop(label, None)
     out += [(f"the known reaction {label}", e) for label, e in exprs.items()
@@ -660,7 +696,7 @@ def _spin_warning(traj: Trajectory, peak: np.ndarray | None = None) -> str | Non
             f"--fps {need} or more")
 
 
-def state_derivative(model: Model, known: Mapping[str, float | str] | None = None,
+def state_derivative(model: Model, known: KnownValues | None = None,
                      dynamics: Dynamics | None = None) -> StateDerivative:
     """ẏ = f(t, y), what `simulate` integrates (`mbody.solve.dynamics.StateDerivative`): the
     compiled core's, with the reactions not given in the file or in `known` solved at every
@@ -674,27 +710,22 @@ def state_derivative(model: Model, known: Mapping[str, float | str] | None = Non
     return StateDerivative(run_model, unknowns=workspace(run_model).file_unknowns, rate=rate)
 
 
-def with_known(model: Model, known: Mapping[str, float | str] | None) -> Model:
+def with_known(model: Model, known: KnownValues | None) -> Model:
     """`model` with the reaction values `known` (label -> number, or expression of t as
     text) among its known reactions, replacing the file's value of a label; the same model
-    when `known` is empty. Raises `MbodyError` for a label the model does not have."""
+    when `known` is empty. Raises `MbodyError` for a label the model does not have, a
+    value that is not a finite number or an expression (`known_values`)."""
     if not known:
         return model
     values: dict[str, float] = dict(model.known_reactions)
     exprs: dict[str, Expression] = dict(model.known_expressions)
-    for label, v in known.items():
-        if label not in model.reaction_index:
-            hint = did_you_mean(label, model.reactions)
-            raise MbodyError(f"no reaction component {label!r} in this model"
-                             + (f"; {hint}" if hint else ""))
+    for label, v in known_values(model, known).items():
         exprs.pop(label, None)
-        if isinstance(v, str):
-            e = compile_expression(v)
-            values[label] = e.value
-            if not e.constant:
-                exprs[label] = e
+        if isinstance(v, Expression):
+            values[label] = v.value
+            exprs[label] = v
         else:
-            values[label] = float(v)
+            values[label] = v
     return dataclasses.replace(model, known_reactions=values, known_expressions=exprs)
 
 

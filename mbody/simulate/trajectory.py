@@ -176,7 +176,7 @@ class Trajectory(Frozen):
         ------
         IndexError
             `k` outside 0 .. K - 1 (the message gives the range).
-        mbody.errors.WrongTypeError
+        mbody.errors.MbodyTypeError
             `k` is not a whole number (a `TypeError` too; for a float, the message points
             to `state_at`).
         """

@@ -21,8 +21,9 @@ import numpy as np
 
 from mbody.equations.solution import METHODS, ReactionValues, Solution, singular_mass_error
 from mbody.equations.workspace import workspace
-from mbody.errors import MbodyError, did_you_mean, wrong_type
+from mbody.errors import MbodyError, MbodyTypeError, did_you_mean, wrong_type
 from mbody.kernel import _core
+from mbody.model.arguments import checked_model, checked_state
 from mbody.model.model import Model, State
 from mbody.solve.family import Family
 from mbody.solve.kinematics import CLOSE_RTOL, NEWTON_STEPS, _size
@@ -254,13 +255,20 @@ def solve_many(model: Model, states: Sequence[State] | State | None = None, *,
     Raises
     ------
     MbodyError
-        States and values of different lengths, or a state of another model's size.
-    mbody.errors.WrongTypeError
-        `values` is not a list of mappings (one mapping alone is one case:
-        ``values=[{...}]``).
+        States and values of different lengths; a state of another model's size or with
+        values that are not finite (`mbody.model.arguments.checked_state`, naming it as
+        ``states[k]``).
+    mbody.errors.MbodyTypeError
+        `states` of the wrong type; `values` not a list of mappings (one mapping alone
+        is one case: ``values=[{...}]``).
     """
+    if not isinstance(model, Model):
+        model = checked_model(model)
     if isinstance(states, State):
         states = [states]
+    elif states is not None and not isinstance(states, Sequence):
+        raise MbodyTypeError(f"states must be a State or a sequence of them, got "
+                             f"{type(states).__name__}")
     if values is None:
         ev = Evaluator(model)
         states = [model.initial] if states is None else list(states)
@@ -311,7 +319,7 @@ def solve_many(model: Model, states: Sequence[State] | State | None = None, *,
 
 
 def case_values(values: object) -> list[dict[str, Any]]:
-    """`solve_many`'s `values` as a list of dicts, one per case; `WrongTypeError` naming
+    """`solve_many`'s `values` as a list of dicts, one per case; `MbodyTypeError` naming
     the argument (or the case) that is not what it takes."""
     form = "a list of mappings, one per case (path -> value)"
     if isinstance(values, Mapping):
@@ -338,10 +346,8 @@ def _not_assembled(model: Model, values: Mapping[str, Any]) -> str:
 
 def _packed(ev: Evaluator, states: Sequence[State]) -> tuple[np.ndarray, np.ndarray]:
     n = ev.model.n
-    for s in states:
-        if s.position.shape != (n, 3):
-            raise MbodyError(f"a state of {len(s.position)} bodies for model "
-                             f"{ev.model.name!r} of {n}")
+    for k, s in enumerate(states):
+        checked_state(ev.model, s, f"states[{k}]")
     Y = np.stack([ev.ws.pack_state(s) for s in states]) if states else np.zeros((0, 13 * n))
     return np.array([float(s.t) for s in states]), Y
 

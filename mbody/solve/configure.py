@@ -22,6 +22,7 @@ from mbody.equations.generalized import evaluate, state_with_velocities
 from mbody.equations.workspace import workspace
 from mbody.errors import MbodyError
 from mbody.kernel import _core
+from mbody.model.arguments import checked_state
 from mbody.model.model import Model, State
 from mbody.util.spatial import quat_mul
 
@@ -97,7 +98,7 @@ def configure(model: Model, q: Mapping[str, float] | Sequence[float],
     MbodyError
         An unknown label, a value for a quasi-velocity, or a loop that does not close.
     """
-    start = model.initial if start is None else start
+    start = model.initial if start is None else checked_state(model, start, "start")
     if t is not None:
         start = start.replace(t=float(t))
     cs = coordinate_set(model, coordinates)

@@ -25,7 +25,8 @@ import numpy as np
 
 from mbody.equations.coordinates import CoordinateSet
 from mbody.equations.generalized import evaluate, state_with_velocities
-from mbody.errors import MbodyError
+from mbody.errors import MbodyError, real_number
+from mbody.model.arguments import checked_model, checked_state
 from mbody.model.calculus import derivative
 from mbody.model.drivers import DriverTable
 from mbody.model.expressions import compile_expression
@@ -109,8 +110,12 @@ def find_equilibrium(model: Model, *, start: State | None = None, t: float = 0.0
                      ) -> Equilibrium:
     """An equilibrium near `start` (default: the file's pose), the drivers held at time t
     (module doc); `Equilibrium.found` says whether Newton's method converged."""
+    if not isinstance(model, Model):
+        model = checked_model(model)
+    t = real_number(t, "t", "a number of seconds")
+    begin = (model.initial if start is None else checked_state(model, start, "start")
+             ).replace(t=t)
     m = held(model, t)
-    begin = (start if start is not None else model.initial).replace(t=float(t))
     cs = free_coordinates(m)
     zero = np.zeros(len(cs))
     state = _at_rest(m, cs, kinematics(m, float(t), start=begin))
@@ -170,6 +175,8 @@ def equilibrium(model: Model, *, start: State | None = None, t: float = 0.0) -> 
     NoEquilibriumError
         Newton's method did not converge from the start (no equilibrium near it, or
         loads that never balance: a constant torque on a free wheel).
+    MbodyError
+        A `model` or `start` that is not one of this model (`mbody.model.arguments`).
     """
     found = find_equilibrium(model, start=start, t=t)
     if not found.found:

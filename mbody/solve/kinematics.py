@@ -28,6 +28,7 @@ from mbody.equations.joints import g_block, reaction_columns
 from mbody.equations.workspace import workspace
 from mbody.errors import Issue, MbodyError, ModelError
 from mbody.kernel import _core
+from mbody.model.arguments import checked_model, checked_state
 from mbody.model.model import Model, State
 
 NEWTON_STEPS = 60
@@ -70,7 +71,8 @@ def kinematics(model: Model, t: float = 0.0, *, start: State | None = None) -> S
     Raises
     ------
     MbodyError
-        `t` is not a finite number.
+        `t` is not a finite number; a `model` or `start` that is not one of this model
+        (`mbody.model.arguments`).
     KinematicsError
         The loops cannot close at `t` (which joints, the drivers' values, the distance
         left).
@@ -83,8 +85,10 @@ def kinematics(model: Model, t: float = 0.0, *, start: State | None = None) -> S
     if not math.isfinite(t):
         raise MbodyError(f"t must be a finite number of seconds (the time the drivers' "
                          f"laws are taken at), got {given!r}")
+    if not isinstance(model, Model):
+        model = checked_model(model)
     ws = workspace(model)
-    state = model.initial if start is None else start
+    state = model.initial if start is None else checked_state(model, start, "start")
     unknowns = ws.unknowns({})  # every joint and driver holds
     solver = ws.solver(unknowns)
     y = ws.state_vector(state.replace(t=t))

@@ -43,6 +43,7 @@ from mbody.equations.generalized import Generalized, checked, from_output, layou
 from mbody.equations.workspace import workspace
 from mbody.errors import MbodyError
 from mbody.kernel import _core
+from mbody.model.arguments import checked_model, checked_state
 from mbody.model.model import Model, State
 from mbody.solve.configure import move
 
@@ -442,9 +443,12 @@ def linearize(model: Model, state: State | None = None, *,
     Raises
     ------
     MbodyError
-        Unknown or dependent coordinates, or coordinates singular at the state.
+        Unknown or dependent coordinates, or coordinates singular at the state; a
+        `model` or `state` that is not one of this model (`mbody.model.arguments`).
     """
-    state = model.initial if state is None else state
+    if not isinstance(model, Model):
+        model = checked_model(model)
+    state = model.initial if state is None else checked_state(model, state, "state")
     cs = free_coordinates(model, coordinates)
     at = _offsets(len(cs.cols), len(cs))
     out = np.empty(at.end)

@@ -85,7 +85,7 @@ def write_export(asm: Assembly | ExportedAssembly, path: str | os.PathLike[str],
     MbodyError
         For another suffix; `mbody.errors.OutputError` when the file cannot be written
         (nothing is left behind, and an existing file is unchanged);
-        `mbody.errors.WrongTypeError` when `asm` is neither (a `Model` is assembled
+        `mbody.errors.MbodyTypeError` when `asm` is neither (a `Model` is assembled
         first: ``write_export(mbody.assemble(model), path)``).
     """
     path = Path(path)

@@ -456,7 +456,7 @@ def exported(asm: Assembly, known: Mapping[str, float] | None = None,
 
     Raises
     ------
-    mbody.errors.WrongTypeError
+    mbody.errors.MbodyTypeError
         `asm` is not an `Assembly` (a `Model` is assembled first: ``mbody.assemble(model)``).
     """
     if not isinstance(asm, Assembly):
@@ -507,7 +507,7 @@ def exported(asm: Assembly, known: Mapping[str, float] | None = None,
 def as_export(obj: Assembly | ExportedAssembly, known: Mapping[str, float] | None = None,
               axes: str = "joint") -> ExportedAssembly:
     """`obj` itself when already exported, else ``exported(obj, known, axes=axes)``;
-    `mbody.errors.WrongTypeError` for anything else."""
+    `mbody.errors.MbodyTypeError` for anything else."""
     if isinstance(obj, ExportedAssembly):
         return obj
     if not isinstance(obj, Assembly):

@@ -12,7 +12,7 @@ import os
 from pathlib import Path
 from typing import Any
 
-from mbody.errors import MbodyError, did_you_mean
+from mbody.errors import MbodyError, MbodyTypeError, did_you_mean
 from mbody.io.interop.mjcf import read_mjcf
 from mbody.io.interop.tree import ImportedDocument, validate_imported
 from mbody.io.interop.urdf import read_urdf
@@ -87,6 +87,9 @@ def _check_options(fmt: str, options: dict[str, Any]) -> None:
     allowed = {"mjcf": ("keyframe",), "yaml": (),
                "urdf": ("joint_positions", "joint_velocities", "floating_base")}[fmt]
     for k, v in options.items():
+        if k == "floating_base" and not isinstance(v, bool | None):  # "false" is truthy
+            raise MbodyTypeError(f"floating_base must be True or False, got "
+                                 f"{type(v).__name__} {v!r}")
         if v is None or (k == "floating_base" and v is False):
             continue
         if k not in OPTIONS:
