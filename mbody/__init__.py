@@ -41,6 +41,7 @@ _LAZY = {
     "Trajectory": "simulate.trajectory",
     "verify": "answers.verify",
     "solve_many": "solve.batch", "Solutions": "solve.batch",
+    "run_sweep": "sweep.study", "SweepResult": "sweep.study",
 }
 """Public name -> the submodule defining it."""
 
@@ -49,8 +50,9 @@ __all__ = [
     "FreeBodyDiagram", "Generalized", "Linearization", "linearize", "load_export",
     "Issue", "Joint", "Load", "MbodyError", "Model", "ModelError", "Solution", "State",
     "Trajectory", "simulate",
-    "Solutions", "UnknownReactionsError", "animate", "assemble", "draw_fbd", "equilibrium",
-    "kinematic_run", "kinematics", "load", "loads", "solve_many", "verify",
+    "Solutions", "SweepResult", "UnknownReactionsError", "animate", "assemble", "draw_fbd",
+    "equilibrium", "kinematic_run", "kinematics", "load", "loads", "run_sweep", "solve_many",
+    "verify",
 ]
 
 
