@@ -176,7 +176,8 @@ class SweepResult:
             `rows`.
         """
         if name not in self.header:
-            raise KeyError(f"no column {name!r}; {did_you_mean(name, self.header)}")
+            hint = did_you_mean(name, self.header) or f"the columns: {', '.join(self.header)}"
+            raise KeyError(f"no column {name!r}; {hint}")
         at = self.header.index(name)
         out = np.full(len(self.rows), np.nan)
         for k, row in enumerate(self.rows):
