@@ -3,6 +3,7 @@
     model = mbody.load("models/seed_example_1.yaml")
     asm = mbody.assemble(model)          # M v̇ + b = Q + G λ at the model's state
     sol = asm.solve(known={"A.Fx": 0})   # accelerations, aligned with asm.coordinates
+    study = mbody.run_sweep(model, {"bodies.plate.mass": [1, 2]}, "out.csv")  # mbody sweep
 
 The public names below are imported on first use (PEP 562), so that `import mbody` and
 the `mbody` command load only what they need (scipy, matplotlib, meshcat and networkx
