@@ -360,5 +360,5 @@ def run_sweep(model: Model | str | os.PathLike[str],
                                      report.sparsest)):
         if warning:
             said.append(warning)
-    return SweepResult(path, list(results.header), [results.rows[k] for k in sorted(results.rows)],
-                       len(todo), report, said)
+    rows = [results.rows[k] for k in sorted(results.rows)]
+    return SweepResult(path, list(results.header), rows, len(todo), report, said)
