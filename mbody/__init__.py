@@ -5,6 +5,9 @@
     sol = asm.solve()                    # accelerations and the reactions λ
     sol = asm.solve(known={"A.Fx": 0})   # or with a reaction component given
 
+A sweep over values of the file, as ``mbody sweep`` runs it: ``mbody.run_sweep(model,
+{"bodies.upper.mass": [1, 2]}, "out.csv")`` (docs/sweeps.md).
+
 The public names below are imported on first use (PEP 562), so that `import mbody` and
 the `mbody` command load only what they need (scipy, matplotlib, meshcat and networkx
 are slow to import). Submodules are reachable as attributes too (``mbody.solve.dynamics``),
@@ -45,6 +48,7 @@ _LAZY = {
     "Trajectory": "simulate.trajectory",
     "verify": "answers.verify",
     "solve_many": "solve.batch", "Solutions": "solve.batch",
+    "run_sweep": "sweep.study", "SweepResult": "sweep.study",
 }
 """Public name -> the submodule defining it."""
 
@@ -53,8 +57,9 @@ __all__ = [
     "FreeBodyDiagram", "Generalized", "Linearization", "linearize", "load_export",
     "Issue", "Joint", "Load", "MbodyError", "Model", "ModelError", "Solution", "State",
     "Trajectory", "simulate",
-    "Solutions", "UnknownReactionsError", "animate", "assemble", "draw_fbd", "equilibrium",
-    "kinematic_run", "kinematics", "load", "loads", "solve_many", "verify",
+    "Solutions", "SweepResult", "UnknownReactionsError", "animate", "assemble", "draw_fbd",
+    "equilibrium", "kinematic_run", "kinematics", "load", "loads", "run_sweep", "solve_many",
+    "verify",
 ]
 
 

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-import uuid
 
 from mbody.cli.common import (
     EXIT_OK,
@@ -15,7 +14,6 @@ from mbody.cli.common import (
     output_stream,
     seconds_or_turns,
 )
-from mbody.errors import MbodyError
 
 RUN_NAMES = ("solve", "kinematics", "simulate", "modes")
 """`mbody.sweep.runs.RUNS` (not imported at start-up; a test keeps them equal)."""
@@ -82,64 +80,41 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def sweep(a: argparse.Namespace) -> int:
-    from mbody.model.values import edits, entry_names
-    from mbody.sweep import cluster
-    from mbody.sweep.grid import parse_grid
-    from mbody.sweep.modes import not_steady_warning
-    from mbody.sweep.runs import Job, Settings, check_settings, columns, sampling_warning
-    from mbody.sweep.table import Results, output_format
+    """`mbody.sweep.study.run_sweep` with the command's arguments, and what it says."""
+    from mbody.sweep.study import SweepInterrupted, check_request, run_sweep
 
-    kind = a.run_kind
-    output_format(a.output)
-    grid = parse_grid(a.grid, a.samples, a.seed)
-    if a.samples is None and a.seed:
-        raise MbodyError("--seed goes with --samples (a grid has no randomness)")
+    check_request(a.grid, a.output, a.samples, a.seed)  # before the model file is read
     model = load_model(a.model)
-    if grid.fixed:
-        model = model.with_values(grid.fixed)
-    if model.source is None:  # pragma: no cover - every model a command reads has one
-        raise MbodyError("this model has no document to set values in")
-    # every path names something in the file, before any case runs
-    edits(model.source.read(), [(p, None) for p in grid.paths], entry_names(model))
     t_end, revs = None, None
     if a.t_end is not None:
         unit, x = a.t_end
         t_end, revs = (x, None) if unit == "s" else (None, x)
-    settings = Settings(kind, t_end, revs, a.steps, a.fps, a.equilibrium)
-    check_settings(model, settings)
-    results = Results(a.output, columns(model, settings), grid)
-    todo = [k for k in range(len(grid)) if k not in results.rows]
-    job = Job(model.source, grid, settings, uuid.uuid4().hex)
     say = output_stream(a.output)
     try:
-        report = cluster.run(job, todo, results, scheduler=a.scheduler, workers=a.workers,
-                             chunk=a.chunk,
-                             progress=sys.stderr.isatty() and not a.quiet)
-    except KeyboardInterrupt:
-        sys.stderr.write(f"mbody: interrupted: {len(results.rows)} of {len(grid)} cases kept "
-                         f"in {results.journal}; the same command resumes\n")
+        result = run_sweep(model, a.grid, a.output, run=a.run_kind, t_end=t_end,
+                           revolutions=revs, steps=a.steps, fps=a.fps,
+                           equilibrium=a.equilibrium, samples=a.samples, seed=a.seed,
+                           workers=a.workers, scheduler=a.scheduler, chunk=a.chunk,
+                           progress=sys.stderr.isatty() and not a.quiet)
+    except SweepInterrupted as exc:
+        sys.stderr.write(f"mbody: interrupted: {exc.kept} of {exc.cases} cases kept in "
+                         f"{exc.journal}; the same command resumes\n")
         raise
-    path = results.finish()
-    failed = sum(1 for r in results.rows.values() if r[-1])
-    kept = len(results.rows) - len(todo)
-    print(f"wrote {path}: {len(results.rows)} cases, {len(todo)} run now"
+    failed = result.failed
+    print(f"wrote {result.path}: {len(result.rows)} cases, {result.ran} run now"
           + (f", {failed} failed (see their error column)" if failed else "")
           # the output records the grid's values, not the run's settings: a rerun with
           # another --t-end keeps the earlier rows as they are, so say so
-          + (f" ({kept} kept as the earlier run made them: the output does not record "
-             f"--t-end or {UNRECORDED[settings.run]}, so other values need another --out)"
-             if kept and settings.run in UNRECORDED else ""),
+          + (f" ({result.kept} kept as the earlier run made them: the output does not "
+             f"record --t-end or {UNRECORDED[a.run_kind]}, so other values need another "
+             "--out)" if result.kept and a.run_kind in UNRECORDED else ""),
           file=say)
-    if todo:
-        print(report.text(), file=say)
-    for warning in (not_steady_warning(results.header, results.rows.values(), a.equilibrium),
-                    sampling_warning(settings, grid, report.sparse, report.cases,
-                                     report.sparsest)):
-        if warning:
-            sys.stderr.write(f"mbody: warning: {warning}\n")
-    if results.rows and failed == len(results.rows):  # nothing computed: say so, exit 1
-        first = results.rows[min(results.rows)][-1]
-        sys.stderr.write(f"mbody: cannot solve: every case failed; case {min(results.rows)}: "
-                         f"{first}\n")
+    if result.ran:
+        print(result.report.text(), file=say)
+    for warning in result.warnings:
+        sys.stderr.write(f"mbody: warning: {warning}\n")
+    if result.rows and failed == len(result.rows):  # nothing computed: say so, exit 1
+        case, first = next((r[0], r[-1]) for r in result.rows)
+        sys.stderr.write(f"mbody: cannot solve: every case failed; case {case}: {first}\n")
         return EXIT_UNMET
     return EXIT_OK

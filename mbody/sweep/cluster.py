@@ -46,9 +46,36 @@ CONNECT_SECONDS = 30.0
 
 @dataclass
 class Report:
-    """How a sweep ran: cases run here and in chunks, the chunk size, the workers, the
-    seconds of work the chunks took and the wall-clock seconds (`start` of them starting
-    the cluster)."""
+    """How a sweep ran (what `run` returns).
+
+    Parameters
+    ----------
+    cases : int
+        The cases run (here, to measure them, and in chunks).
+    chunks : int
+        The chunks run.
+    chunk : int
+        Cases per chunk.
+    workers : int
+        The worker processes (1: this process).
+    where : str
+        Where the chunks ran: this process, a local cluster, or an existing one.
+    work : float
+        The wall-clock seconds the chunks took, added over the workers.
+    cpu : float
+        The processor seconds the cases took.
+    wall : float
+        The wall-clock seconds of the whole run.
+    start : float
+        The seconds of `wall` spent starting (or reaching) the cluster.
+    lost : int
+        Chunks lost with their workers, their cases written as failed.
+    sparse : int
+        Cases run whose ``peak:`` columns come from too few samples a revolution
+        (`Rows.sparse`).
+    sparsest : Sparsest or None
+        The one of them with the fewest (`Rows.sparsest`).
+    """
 
     cases: int = 0
     chunks: int = 0
@@ -61,9 +88,7 @@ class Report:
     start: float = 0.0
     lost: int = 0
     sparse: int = 0
-    """Cases run whose peaks come from too few samples a revolution (`Rows.sparse`)."""
     sparsest: Sparsest | None = None
-    """The one of them with the fewest (`Rows.sparsest`)."""
 
     @property
     def busy(self) -> float:
@@ -73,6 +98,12 @@ class Report:
         return self.work / span if span > 0 else 1.0
 
     def text(self) -> str:
+        """The summary line ``mbody sweep`` prints.
+
+        Returns
+        -------
+        str
+        """
         return (f"{self.cases} cases in {self.wall:.1f} s on {self.where} "
                 f"({self.chunks} chunk(s) of up to {self.chunk} cases; the workers spent "
                 f"{100 * min(self.busy, 1.0):.0f}% of their time on cases, "

@@ -10,7 +10,8 @@ of the axes (the last one varying fastest), or N random samples (seeded).
     gravity=[0, -1.62]                 one value too: a list is a vector
 
 With ``--samples N --seed S`` each axis is a range ``START:STOP`` drawn uniformly (or a
-list drawn from), N cases. A case is found from its index alone (`Grid.values`), so a
+list drawn from), N cases. From Python the same texts serve, or a mapping path -> values
+(`grid_of`). A case is found from its index alone (`Grid.values`), so a
 process evaluating a chunk of cases needs only the indices.
 """
 
@@ -18,7 +19,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any
@@ -26,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from mbody.errors import MbodyError
-from mbody.model.values import parse_assignment, parse_value
+from mbody.model.values import parse_assignment, parse_value, plain
 
 MAX_CASES = 100_000_000
 """Most cases one sweep holds (a grid's size is the product of its axes' counts)."""
@@ -175,14 +176,87 @@ def parse_grid(specs: Sequence[str], samples: int | None = None, seed: int = 0) 
         A malformed range (with what was expected), a path given twice, no varied path,
         or more than `MAX_CASES` cases.
     """
+    # each spec read as it comes: its errors in the order given
+    return _grid((parse_assignment(spec) for spec in specs), samples, seed)
+
+
+def grid_of(values: Mapping[str, Any] | Sequence[str] | str, samples: int | None = None,
+            seed: int = 0) -> Grid:
+    """The `Grid` of a sweep's values given in Python: ``--set`` options (`parse_grid`),
+    or a mapping path -> values.
+
+    In a mapping, a list, tuple or array is the values one per case, each as the file
+    would hold it (``[0.4, 0.8]``, ``["300 rpm", "600 rpm"]``, ``[[0, -9.81], [0,
+    -1.62]]``); text is what follows ``PATH=`` in ``--set`` (``"0.3:1.2:10"``, ``"300
+    rpm:1200 rpm:4"``, ``"[0, -1.62]"``: a range, or one value for every case); any other
+    value (a number, a mapping) is one value for every case.
+
+    Parameters
+    ----------
+    values : mapping, sequence of str, or str
+        The values (above).
+    samples : int, optional
+        N random cases (then ranges are ``START:STOP``).
+    seed : int
+        Their seed.
+
+    Returns
+    -------
+    Grid
+
+    Raises
+    ------
+    MbodyError
+        As `parse_grid`; also a path that is not text, or an empty list of values.
+    """
+    if isinstance(values, str):
+        values = [values]
+    if not isinstance(values, Mapping):
+        if not (isinstance(values, Sequence) and all(isinstance(v, str) for v in values)):
+            bad = (next(v for v in values if not isinstance(v, str))
+                   if isinstance(values, Sequence) else values)
+            raise MbodyError("the sweep's values: expected a mapping path -> values (such as "
+                             "{'bodies.rod.mass': [0.4, 0.8]}) or --set texts (such as "
+                             f"['bodies.rod.mass=0.3:1.2:10']), got {_shown(bad)}")
+        return parse_grid(values, samples, seed)
+    entries: list[tuple[str, Any]] = []
+    for path, value in values.items():
+        if not isinstance(path, str) or not path.strip():
+            raise MbodyError(f"the sweep's values: a path is text such as 'bodies.rod.mass', "
+                             f"got {_shown(path)}")
+        if isinstance(value, Sequence | np.ndarray) and not isinstance(value, str):
+            value = plain(list(value))  # the values one per case (a range, an array too)
+        elif not isinstance(value, str):
+            value = plain(value)
+        entries.append((path.strip(), value))
+    return _grid(entries, samples, seed)
+
+
+def _shown(value: Any) -> str:
+    """`value` in a message: its repr, cut short, and its type."""
+    text = repr(value)
+    return f"{text[:60]}{'...' if len(text) > 60 else ''} ({type(value).__name__})"
+
+
+def _grid(entries: Iterable[tuple[str, Any]], samples: int | None, seed: int) -> Grid:
+    """The `Grid` of (path, value) pairs: text as ``--set`` writes it after the ``=``, or
+    a Python value (`grid_of`)."""
     axes: list[Axis] = []
     fixed: dict[str, Any] = {}
     seen: set[str] = set()
-    for spec in specs:
-        path, text = parse_assignment(spec)
+    for path, value in entries:
         if path in seen:
             raise MbodyError(f"--set {path} is given twice")
         seen.add(path)
+        if not isinstance(value, str):
+            if not isinstance(value, list):
+                fixed[path] = value
+            elif not value:
+                raise MbodyError(f"--set {path}: no values (an empty list)")
+            else:
+                axes.append(Axis(path, tuple(value), listed=True))
+            continue
+        text = value
         parts = _top_level(text, ",")
         if ":" in text and len(_top_level(text, ":")) > 1:
             axes.append(_range(path, text, samples is not None))

@@ -1,0 +1,364 @@
+"""A whole sweep from Python: `run_sweep`, what ``mbody sweep`` runs (the command calls
+it), and the table it returns (`SweepResult`).
+
+The steps are the command's: the arguments checked (`check_request`, then the numbers),
+the model read (or taken as given), its fixed values set, every varied path checked
+against the file before any case runs, the settings checked against the model, the rows
+of an earlier run of the same sweep kept (`mbody.sweep.table.Results`), the other cases
+run (`mbody.sweep.cluster.run`), the output written, and what the rows need said (a
+modes run's states that are not equilibria, peaks sampled too sparsely).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+import uuid
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from mbody.errors import MbodyError, did_you_mean
+from mbody.loading import load
+from mbody.model.model import Model
+from mbody.model.values import edits, entry_names
+from mbody.sweep import cluster
+from mbody.sweep.grid import Grid, grid_of
+from mbody.sweep.modes import not_steady_warning
+from mbody.sweep.runs import Job, Settings, check_settings, columns, sampling_warning
+from mbody.sweep.table import Results, output_format
+
+
+@dataclass(frozen=True)
+class Limit:
+    """The range of one numeric argument, as the command's option takes it."""
+
+    option: str
+    what: str
+    lo: float
+    hi: float
+    integer: bool = False
+    lo_open: bool = False
+
+    def check(self, value: Any) -> None:
+        """Refuse `value` outside the range (or not a number), naming the option."""
+        kinds = (int, np.integer) if self.integer else (int, float, np.integer, np.floating)
+        if (isinstance(value, bool) or not isinstance(value, kinds)
+                or not math.isfinite(value) or value > self.hi
+                or (value <= self.lo if self.lo_open else value < self.lo)):
+            lo, hi = (_figure(int(x)) if self.integer else _figure(x)
+                      for x in (self.lo, self.hi))
+            span = f"above {lo} up to {hi}" if self.lo_open else f"from {lo} to {hi}"
+            raise MbodyError(f"{self.option}: expected {self.what} {span}"
+                             f"{' (a whole number)' if self.integer else ''}, got {value!r}")
+
+
+def _figure(x: float) -> str:
+    """A bound as the command's messages write it (`mbody.cli.common.number`, a layer
+    above this one): a whole number below 10^12 in full, its thousands apart; else as %g
+    writes it, with its exponent as people write it (1e9)."""
+    if isinstance(x, int) and abs(x) < 10**12:
+        return f"{x:,}".replace(",", " ")
+    return re.sub(r"e\+?(-?)0*(\d)", r"e\1\2", f"{float(x):g}")
+
+
+LIMITS = {
+    "samples": Limit("--samples", "a number of cases", 1, 1e8, integer=True),
+    "seed": Limit("--seed", "a seed", 0, 2**63 - 1, integer=True),
+    "t_end": Limit("--t-end", "a time in seconds", 0.0, 1e9, lo_open=True),
+    "revolutions": Limit("--t-end", "a number of turns", 0.0, 1e6, lo_open=True),
+    "steps": Limit("--steps", "a number of instants", 2, 1e6, integer=True),
+    "fps": Limit("--fps", "samples per second", 0.0, 1e6, lo_open=True),
+    "workers": Limit("--workers", "a number of worker processes", 0, 4096, integer=True),
+    "chunk": Limit("--chunk", "a number of cases", 1, 1e8, integer=True),
+}
+"""`run_sweep`'s numeric arguments, by name: the command's ranges (its argparse types; a
+test keeps them equal)."""
+
+
+class SweepInterrupted(KeyboardInterrupt):
+    """A sweep stopped by an interruption (Ctrl-C): the rows of the cases run so far are
+    kept in the journal beside the output, and the same sweep again resumes from them.
+
+    Parameters
+    ----------
+    kept : int
+        The cases that have a row.
+    cases : int
+        The sweep's cases.
+    journal : Path
+        Where the rows are kept (``<out>.partial``).
+    """
+
+    def __init__(self, kept: int, cases: int, journal: Path):
+        super().__init__(f"{kept} of {cases} cases kept in {journal}; the same sweep "
+                         "resumes")
+        self.kept, self.cases, self.journal = kept, cases, journal
+
+
+@dataclass(frozen=True)
+class SweepResult:
+    """A sweep's rows, as its output file holds them (what `run_sweep` returns).
+
+    Parameters
+    ----------
+    path : Path
+        The output written (``.csv`` or ``.parquet``).
+    header : list of str
+        The columns: ``case``, the varied paths as given, the outputs
+        ``<quantity>:<label>``, then ``error``.
+    rows : list of list of str
+        One row per case, by case number, each cell as the CSV holds it: a number as
+        Python writes it (read back, the same double), an empty cell where a case has no
+        number, ``error`` empty or why the case failed.
+    ran : int
+        The cases run by this call; the others were kept from an earlier run of the same
+        sweep into the same output (its rows are as that run made them: the output does
+        not record ``t_end``, ``revolutions``, ``steps`` or ``fps``).
+    report : mbody.sweep.cluster.Report
+        How the cases ran: where, in how many chunks, how long, and the cases whose
+        ``peak:`` columns come from too few samples a revolution.
+    warnings : list of str
+        What the rows need said (the command prints each as ``mbody: warning: ...``):
+        a model file's own warnings when `run_sweep` read it, then a ``modes`` run's
+        cases linearised about a state that is not an equilibrium
+        (`mbody.sweep.modes.not_steady_warning`), and ``peak:`` columns sampled too
+        sparsely (`mbody.sweep.runs.sampling_warning`).
+    """
+
+    path: Path
+    header: list[str]
+    rows: list[list[str]]
+    ran: int
+    report: cluster.Report
+    warnings: list[str] = field(default_factory=list)
+
+    def __len__(self) -> int:
+        return len(self.rows)
+
+    @property
+    def kept(self) -> int:
+        """The cases whose rows were kept from an earlier run (not run by this call)."""
+        return len(self.rows) - self.ran
+
+    @property
+    def errors(self) -> list[str | None]:
+        """Each case's error, by case (None where it has its numbers)."""
+        return [r[-1] or None for r in self.rows]
+
+    @property
+    def failed(self) -> int:
+        """How many cases have no numbers (their ``error`` says why)."""
+        return sum(1 for r in self.rows if r[-1])
+
+    def column(self, name: str) -> np.ndarray:
+        """One column's numbers, by case (NaN where a case has none).
+
+        Parameters
+        ----------
+        name : str
+            A column of `header` (``frequency:1``, ``peak:motor.M``, a varied path).
+
+        Returns
+        -------
+        (cases,) float array
+
+        Raises
+        ------
+        KeyError
+            No such column.
+        MbodyError
+            The column holds text (``error``, values listed with a unit): read it from
+            `rows`.
+        """
+        if name not in self.header:
+            hint = did_you_mean(name, self.header) or f"the columns: {', '.join(self.header)}"
+            raise KeyError(f"no column {name!r}; {hint}")
+        at = self.header.index(name)
+        out = np.full(len(self.rows), np.nan)
+        for k, row in enumerate(self.rows):
+            cell = row[at]
+            if not cell:
+                continue
+            try:
+                out[k] = float(cell)
+            except ValueError:
+                raise MbodyError(f"column {name!r} holds text ({cell!r} in case {row[0]}), "
+                                 "not numbers: read it from rows") from None
+        return out
+
+    def __repr__(self) -> str:
+        failed = self.failed
+        return (f"<SweepResult {self.path}: {len(self)} cases, {self.ran} run now"
+                + (f", {self.kept} kept from an earlier run" if self.kept else "")
+                + (f", {failed} failed" if failed else "")
+                + (f", {len(self.warnings)} warning(s)" if self.warnings else "")
+                + "; .header, .rows, .column(name), .errors, .report, .warnings>")
+
+
+def check_request(values: Mapping[str, Any] | Sequence[str] | str, out: str | os.PathLike[str],
+                  samples: int | None = None, seed: int = 0) -> Grid:
+    """The checks of a sweep that need no model, made first (a bad output name or grid is
+    refused before a model file is read): the output's format, the grid, the seed.
+
+    Parameters
+    ----------
+    values : mapping, sequence of str, or str
+        The varied values (`run_sweep`).
+    out : str or path-like
+        The output.
+    samples : int, optional
+        Random cases instead of the grid.
+    seed : int
+        Their seed.
+
+    Returns
+    -------
+    Grid
+        The sweep's cases.
+
+    Raises
+    ------
+    MbodyError
+        Any of them wrong.
+    """
+    if not isinstance(out, str | os.PathLike) or not str(out):
+        raise MbodyError(f"the output: expected a file name ending in .csv or .parquet, got "
+                         f"{out!r}")
+    output_format(out)
+    for name, value in (("samples", samples), ("seed", seed)):
+        if value is not None:
+            LIMITS[name].check(value)
+    grid = grid_of(values, samples, seed)
+    if samples is None and seed:
+        raise MbodyError("--seed goes with --samples (a grid has no randomness)")
+    return grid
+
+
+def run_sweep(model: Model | str | os.PathLike[str],
+              values: Mapping[str, Any] | Sequence[str] | str,
+              out: str | os.PathLike[str], *, run: str = "solve",
+              t_end: float | None = None, revolutions: float | None = None,
+              steps: int = 101, fps: float = 60.0, equilibrium: bool = False,
+              samples: int | None = None, seed: int = 0, workers: int | None = None,
+              scheduler: str | None = None, chunk: int | None = None,
+              progress: bool = False) -> SweepResult:
+    """Run a model over a grid (or random samples) of values, as ``mbody sweep`` does,
+    and write one row per case to `out` (docs/sweeps.md).
+
+    Cases run on a local Dask cluster started for the call (`workers` processes), on an
+    existing one (`scheduler`), or with ``workers=0`` in this process, without Dask. An
+    output of the same sweep that is already there (or its ``.partial`` journal, left by
+    an interrupted run) is resumed: only the cases not in it run.
+
+    Parameters
+    ----------
+    model : Model or path
+        The model, or its file (read with `mbody.load`).
+    values : mapping, sequence of str, or str
+        What varies, and what is set in every case. ``--set`` texts
+        (``["bodies.rod.mass=0.3:1.2:10", "gravity=[0, -1.62]"]``: a range
+        ``START:STOP:COUNT``, values listed ``a,b,c``, or one value), or a mapping path
+        -> values: a list, tuple or array is the values one per case, each as the file
+        would hold it (``{"gravity.1": [-9.81, -1.62]}``, ``{"drivers.motor.speed":
+        ["300 rpm", "600 rpm"]}``); text is what follows ``PATH=`` in ``--set``
+        (``"300 rpm:1200 rpm:4"``; ``"[0, -1.62]"``: one vector for every case); a
+        number is one value for every case. The grid is every combination, the last path
+        varying fastest.
+    out : str or path-like
+        The results: ``.csv``, or ``.parquet`` (pyarrow, in the ``sweep`` extra).
+    run : {"solve", "kinematics", "simulate", "modes"}
+        What each case computes (``--run``): a solve at its initial state; the kinematic
+        analysis and a solve at `steps` instants; `mbody.simulate`; the natural
+        frequencies.
+    t_end : float, optional
+        ``kinematics`` and ``simulate``: the end (s).
+    revolutions : float, optional
+        Or the end in turns of the first driver that turns, at each case's own rate
+        (``--t-end "1 rev"`` is ``revolutions=1``).
+    steps : int
+        ``kinematics``: the instants from 0 to the end, both included.
+    fps : float
+        ``simulate``: samples per second.
+    equilibrium : bool
+        ``modes``: about the static equilibrium nearest each case's initial pose (as
+        ``mbody modes --equilibrium``), not about its initial state.
+    samples : int, optional
+        This many random cases instead of the grid, each value uniform in
+        ``START:STOP`` (or drawn from a list).
+    seed : int
+        The random samples' seed.
+    workers : int, optional
+        The local cluster's worker processes (default: one per core); 0: the cases run
+        in this process, without Dask.
+    scheduler : str, optional
+        An existing Dask cluster's scheduler, ``tcp://HOST:PORT``.
+    chunk : int, optional
+        Cases per chunk sent to a worker (default: measured, about 2 s of work).
+    progress : bool
+        A progress bar on standard error.
+
+    Returns
+    -------
+    SweepResult
+        The output's path, its header and rows (every case, by case number), how many
+        cases this call ran, the run's `Report`, and its warnings.
+
+    Raises
+    ------
+    MbodyError
+        A bad argument, before any case runs, with the command's message: the output's
+        extension, a malformed range, a path the model file does not have (located, with
+        a did-you-mean), settings the run or the model cannot take (``kinematics``
+        without an end, of a model not fully driven), an output holding another sweep's
+        rows; or a cluster that cannot be started or reached.
+    SweepInterrupted
+        An interruption (a `KeyboardInterrupt`): the rows so far are kept, and the same
+        call resumes.
+    """
+    grid = check_request(values, out, samples, seed)
+    for name, value in (("t_end", t_end), ("revolutions", revolutions), ("steps", steps),
+                        ("fps", fps), ("workers", workers), ("chunk", chunk)):
+        if value is not None:
+            LIMITS[name].check(value)
+    if t_end is not None and revolutions is not None:
+        raise MbodyError("--t-end: give the end in seconds (t_end) or in turns "
+                         "(revolutions), not both")
+    if scheduler is not None and not isinstance(scheduler, str):
+        raise MbodyError(f"--scheduler: expected an address such as tcp://HOST:PORT, got "
+                         f"{scheduler!r}")
+    said: list[str] = []
+    if not isinstance(model, Model):
+        if not isinstance(model, str | os.PathLike):
+            raise MbodyError(f"the model: expected a Model or a model file's path, got "
+                             f"{type(model).__name__}")
+        model = load(model)
+        said += [str(w) for w in model.warnings]
+    if grid.fixed:
+        model = model.with_values(grid.fixed)
+    if model.source is None:
+        raise MbodyError("this model has no document to set values in")
+    # every path names something in the file, before any case runs
+    edits(model.source.read(), [(p, None) for p in grid.paths], entry_names(model))
+    settings = Settings(run, t_end, revolutions, steps, fps, bool(equilibrium))
+    check_settings(model, settings)
+    results = Results(out, columns(model, settings), grid)
+    todo = [k for k in range(len(grid)) if k not in results.rows]
+    job = Job(model.source, grid, settings, uuid.uuid4().hex)
+    try:
+        report = cluster.run(job, todo, results, scheduler=scheduler, workers=workers,
+                             chunk=chunk, progress=progress)
+    except KeyboardInterrupt:
+        raise SweepInterrupted(len(results.rows), len(grid), results.journal) from None
+    path = results.finish()
+    for warning in (not_steady_warning(results.header, results.rows.values(), equilibrium),
+                    sampling_warning(settings, grid, report.sparse, report.cases,
+                                     report.sparsest)):
+        if warning:
+            said.append(warning)
+    rows = [results.rows[k] for k in sorted(results.rows)]
+    return SweepResult(path, list(results.header), rows, len(todo), report, said)
