@@ -197,6 +197,16 @@ class Trajectory(Frozen):
     def nearest_sample(self, time: float) -> int:
         """The index of the sample nearest `time` (s), within the run's span.
 
+        Parameters
+        ----------
+        time : float
+            A time in seconds, between the first and the last sample's.
+
+        Returns
+        -------
+        int
+            The index k of the sample whose ``t[k]`` is nearest (0 .. K - 1).
+
         Raises
         ------
         mbody.MbodyError
@@ -216,7 +226,17 @@ class Trajectory(Frozen):
     def state_at(self, time: float) -> State:
         """The `State` at the sample nearest `time` (s): a stored sample, never an
         interpolation between two (it satisfies the equations and joints as well as the
-        run did). ``state(nearest_sample(time))``; ``t`` of the state says which sample.
+        run did).
+
+        Parameters
+        ----------
+        time : float
+            A time in seconds, between the first and the last sample's.
+
+        Returns
+        -------
+        State
+            ``state(nearest_sample(time))``: its ``t`` says which sample it is.
 
         Raises
         ------
