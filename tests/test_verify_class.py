@@ -121,3 +121,36 @@ def test_the_command_line(answers, tmp_path):
     p = run("verify", str(MODEL), str(odd), "--summary", str(odd))
     assert p.returncode == 2 and "is the answers file itself" in p.stderr
     assert odd.read_text() == answers[0].read_text()
+
+
+def test_no_text_cell_of_the_csv_is_a_spreadsheet_formula(tmp_path, monkeypatch):
+    # a student's name, a file's name and the error text that repeats it are free text
+    # that a spreadsheet would run when they start with = + - @ (OWASP's CSV injection);
+    # each gets a ' in front, and the count columns stay numbers
+    eqs = "\n".join(f'  - {{body: {b}, eq: "{e}"}}' for b, e in zip(BODIES, RIGHT,
+                                                                  strict=True))
+    names = {"eve": '=HYPERLINK(""http://example.com"",""click"")', "fred": "+1",
+             "gil": "@SUM(A1:A9)", "hal": "-2", "ida": "Ida;=1+2", "jo": "Jo"}
+    files = []
+    for stem, student in names.items():
+        f = tmp_path / f"{stem}.yaml"
+        f.write_text(f'student: "{student}"\nequations:\n{eqs}\n'.replace('""', '\\"'))
+        files.append(f)
+    bad = tmp_path / "=cmd.yaml"
+    bad.write_text('equations:\n  - {body: lowr, eq: "m*a_x = A.Fx"}\n')
+    monkeypatch.chdir(tmp_path)
+    text = grade(mbody.load(MODEL), [*files, "=cmd.yaml"]).csv()
+    rows, _ = tables(text)
+    by_stem = {Path(r[0].lstrip("'")).stem: r for r in rows[1:]}
+    assert by_stem["eve"][1] == "'=HYPERLINK(\"http://example.com\",\"click\")"
+    assert by_stem["fred"][1] == "'+1" and by_stem["gil"][1] == "'@SUM(A1:A9)"
+    assert by_stem["hal"][1] == "'-2"  # a name, not a number: the student column is text
+    assert by_stem["ida"][1] == "Ida;'=1+2"  # where a ';' spreadsheet would start a cell
+    assert by_stem["jo"][1] == "Jo"  # nothing else is changed
+    for r in rows[1:-1]:
+        assert r[2:4] == ["4", "4"], r  # the counts: numbers, never quoted
+    # a file named =cmd.yaml given as such: its file cell and its error text
+    last = rows[-1]
+    assert last[0] == "'=cmd.yaml" and last[1] == "'=cmd"
+    assert last[-1].startswith("'=cmd.yaml") and "no body named 'lowr'" in last[-1]
+    assert not any(c.startswith(("=", "+", "-", "@", "\t", "\r")) for r in rows for c in r)
