@@ -15,6 +15,7 @@ from pathlib import Path
 import pytest
 
 import mbody
+from mbody.answers.lagrange import LAGRANGE_DIAGNOSES, POTENTIAL_GRADIENT_SIGN
 from mbody.answers.summary import grade
 from mbody.present.summary import class_summary_html
 
@@ -154,3 +155,24 @@ def test_no_text_cell_of_the_csv_is_a_spreadsheet_formula(tmp_path, monkeypatch)
     assert last[0] == "'=cmd.yaml" and last[1] == "'=cmd"
     assert last[-1].startswith("'=cmd.yaml") and "no body named 'lowr'" in last[-1]
     assert not any(c.startswith(("=", "+", "-", "@", "\t", "\r")) for r in rows for c in r)
+
+
+def test_a_lagrange_mistake_is_a_mistake_of_the_class(tmp_path):
+    # an entry without a body is a Lagrange equation; its diagnoses are Lagrange's own
+    # (the pendulum: 0.667083 O.angle_ddot = -4.905 with I_O = I_rod + m_rod 0.5^2 and
+    # the weight's moment m_rod g 0.5 sin(30 deg); here of the wrong sign)
+    pendulum = ROOT / "models" / "pendulum.yaml"
+    f = tmp_path / "lg.yaml"
+    f.write_text('equations:\n  - {eq: "(I_rod + m_rod*0.5^2)*O.angle_ddot = '
+                 'm_rod*g*0.5*sin(O.angle)"}\n')
+    summary = grade(mbody.load(pendulum), [f])
+    assert summary.graded[0].wrong[0].diagnosis == POTENTIAL_GRADIENT_SIGN
+    _, mistakes = tables(summary.csv())
+    assert mistakes[1][0] == POTENTIAL_GRADIENT_SIGN
+    assert mistakes[1][-1] == LAGRANGE_DIAGNOSES[POTENTIAL_GRADIENT_SIGN]
+    page = class_summary_html(summary)
+    text = "".join(ET.fromstring(page.split("\n", 1)[1]).itertext())
+    assert LAGRANGE_DIAGNOSES[POTENTIAL_GRADIENT_SIGN] in text
+    for out in ("class.csv", "class.html"):
+        p = run("verify", str(pendulum), str(f), "--summary", str(tmp_path / out))
+        assert p.returncode == 1, p.stderr  # one wrong equation: not an internal error

@@ -20,9 +20,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from mbody.answers.diagnose import DIAGNOSES
 from mbody.answers.load import AnswersError
-from mbody.answers.verify import TOLERANCE, Check, Verification, verify
+from mbody.answers.verify import MEANINGS, TOLERANCE, Check, Verification, verify
 from mbody.equations.assemble import assemble
 from mbody.model.model import Model
 from mbody.util.formatting import spreadsheet_text
@@ -163,7 +162,7 @@ class ClassSummary:
         w.writerow(MISTAKES_HEADER)
         for m in self.mistakes:
             w.writerow(_as_text([m.diagnosis, m.row, m.equations, m.students,
-                                 DIAGNOSES[m.diagnosis]]))
+                                 MEANINGS[m.diagnosis]]))
         return buf.getvalue()
 
     def text(self) -> str:

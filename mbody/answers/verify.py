@@ -31,6 +31,8 @@ from mbody.model.model import Model, State
 TOLERANCE = 1e-3
 """Default relative tolerance on each coefficient: numbers written to about four
 significant figures match."""
+MEANINGS = {**DIAGNOSES, **LAGRANGE_DIAGNOSES}
+"""Every diagnosis a `Check` can have, Newton-Euler's and Lagrange's, with its meaning."""
 
 
 @dataclass(frozen=True)
@@ -192,7 +194,7 @@ class Verification:
         for c in self.checks:
             at = f"  (line {c.line})" if c.line else ""
             out.append(f"[{c.index}] {c.body}: {c.eq}{at}")
-            meaning = {**DIAGNOSES, **LAGRANGE_DIAGNOSES}[c.diagnosis]
+            meaning = MEANINGS[c.diagnosis]
             out.append(f"    {c.diagnosis}" + ("" if c.correct else f": {meaning}"))
             if not c.correct and c.expected:
                 out.append(f"    expected ({c.row}): {c.expected}")
