@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import csv
 import io
+import os
 import subprocess
 import sys
 import xml.etree.ElementTree as ET
@@ -176,3 +177,32 @@ def test_a_lagrange_mistake_is_a_mistake_of_the_class(tmp_path):
     for out in ("class.csv", "class.html"):
         p = run("verify", str(pendulum), str(f), "--summary", str(tmp_path / out))
         assert p.returncode == 1, p.stderr  # one wrong equation: not an internal error
+
+
+def test_a_folder_a_device_or_a_pipe_among_the_files_is_a_row(answers, tmp_path):
+    # each is one student's problem, as a missing file is: a row with its error, and
+    # the class goes on (exit 1, the summary written)
+    folder = tmp_path / "folder.yaml"
+    folder.mkdir()
+    odd = [folder, Path(os.devnull), tmp_path / "missing.yaml"]
+    if hasattr(os, "mkfifo"):  # no writer: nothing comes through it in the wait
+        os.mkfifo(tmp_path / "pipe.yaml")
+        odd.append(tmp_path / "pipe.yaml")
+    out = tmp_path / "class.csv"
+    p = run("verify", str(MODEL), str(answers[0]), *map(str, odd), "--summary", str(out))
+    assert p.returncode == 1, p.stderr
+    assert f"{1 + len(odd)} answers file(s)" in p.stdout and f"wrote {out}" in p.stdout
+    rows, _ = tables(out.read_text())
+    assert rows[1][:4] == [str(answers[0]), "Ana Example", "4", "4"]
+    errors = {Path(r[0]).name: r[-1] for r in rows[2:]}
+    assert all(r[2:4] == ["0", "0"] for r in rows[2:])
+    assert errors["folder.yaml"] == f"{folder}: this is a directory; expected a YAML answers file"
+    assert errors[Path(os.devnull).name].startswith(f"{os.devnull}: this is a character device")
+    assert errors[Path(os.devnull).name].endswith("not a file; expected a YAML answers file")
+    assert errors["missing.yaml"] == f"{tmp_path / 'missing.yaml'}: no such file"
+    if hasattr(os, "mkfifo"):
+        assert errors["pipe.yaml"].startswith(f"{tmp_path / 'pipe.yaml'}: nothing came "
+                                              "through this pipe")
+    # one file alone is the command's input: refused as before (exit 2)
+    p = run("verify", str(MODEL), str(folder))
+    assert p.returncode == 2 and "this is a directory" in p.stderr
