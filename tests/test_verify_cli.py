@@ -86,3 +86,26 @@ def test_report_shows_the_answers(tmp_path):
     html = page.read_text(encoding="utf-8")
     assert '<section id="answers">' in html and "missing_gyroscopic_term" in html
     assert "<code>I_3*alpha_3 = 0</code>" in html
+
+
+def test_an_equation_not_linear_in_the_unknowns_is_said_so_with_its_term(tmp_path):
+    # no mistake of the table can explain a_x^2 (the rows are linear in a_x and the
+    # reactions): the verdict's line says what is wrong with it, not "none of the above"
+    answers = tmp_path / "a.yaml"
+    answers.write_text('equations:\n  - {body: rod, eq: "a_x^2 = O.Fx"}\n'
+                       '  - {body: rod, eq: "alpha*O.Fx = 1"}\n'
+                       '  - {body: rod, eq: "(a_x + O.Fy)^3 = 1"}\n'
+                       '  - {eq: "O.angle_ddot^0.5 = 1"}\n', encoding="utf-8")
+    p = mbody("verify", MODELS / "pendulum.yaml", answers)
+    assert p.returncode == 1, p.stderr
+    lines = p.stdout.splitlines()
+    verdicts = [lines[k + 1] for k, line in enumerate(lines) if line.startswith("[")]
+    head = "    not_an_equation_of_this_body: not linear in the unknowns"
+    assert verdicts == [f"{head} (a_x squared)", f"{head} (a product of unknowns (alpha "
+                        "times O.Fx))", f"{head} (a sum of unknowns (O.Fy, a_x) cubed)",
+                        f"{head} (O.angle_ddot to the power 0.5)"]
+    assert "it has a_x squared" in " ".join(p.stdout.split())
+    doc = json.loads(mbody("verify", MODELS / "pendulum.yaml", answers, "--json").stdout)
+    first = doc["equations"][0]
+    assert first["diagnosis"] == "not_an_equation_of_this_body"  # the contract's name
+    assert first["details"]["not_linear"] == "a_x squared"

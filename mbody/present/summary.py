@@ -24,7 +24,7 @@ def class_summary_html(summary: ClassSummary) -> str:
     """
     rows = []
     for g in summary.graded:
-        wrong = Markup("".join(tag("div", mistake_text(c), title=MEANINGS[c.diagnosis])
+        wrong = Markup("".join(tag("div", mistake_text(c), title=c.meaning)
                                for c in g.wrong))
         rows.append([g.file, g.student, g.equations, g.correct,
                      wrong if g.wrong else "", g.error])
