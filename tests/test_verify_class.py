@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import csv
 import io
+import os
 import subprocess
 import sys
 import xml.etree.ElementTree as ET
@@ -15,6 +16,7 @@ from pathlib import Path
 import pytest
 
 import mbody
+from mbody.answers.lagrange import LAGRANGE_DIAGNOSES, POTENTIAL_GRADIENT_SIGN
 from mbody.answers.summary import grade
 from mbody.present.summary import class_summary_html
 
@@ -121,3 +123,86 @@ def test_the_command_line(answers, tmp_path):
     p = run("verify", str(MODEL), str(odd), "--summary", str(odd))
     assert p.returncode == 2 and "is the answers file itself" in p.stderr
     assert odd.read_text() == answers[0].read_text()
+
+
+def test_no_text_cell_of_the_csv_is_a_spreadsheet_formula(tmp_path, monkeypatch):
+    # a student's name, a file's name and the error text that repeats it are free text
+    # that a spreadsheet would run when they start with = + - @ (OWASP's CSV injection);
+    # each gets a ' in front, and the count columns stay numbers
+    eqs = "\n".join(f'  - {{body: {b}, eq: "{e}"}}' for b, e in zip(BODIES, RIGHT,
+                                                                  strict=True))
+    names = {"eve": '=HYPERLINK(""http://example.com"",""click"")', "fred": "+1",
+             "gil": "@SUM(A1:A9)", "hal": "-2", "ida": "Ida;=1+2", "jo": "Jo"}
+    files = []
+    for stem, student in names.items():
+        f = tmp_path / f"{stem}.yaml"
+        f.write_text(f'student: "{student}"\nequations:\n{eqs}\n'.replace('""', '\\"'))
+        files.append(f)
+    bad = tmp_path / "=cmd.yaml"
+    bad.write_text('equations:\n  - {body: lowr, eq: "m*a_x = A.Fx"}\n')
+    monkeypatch.chdir(tmp_path)
+    text = grade(mbody.load(MODEL), [*files, "=cmd.yaml"]).csv()
+    rows, _ = tables(text)
+    by_stem = {Path(r[0].lstrip("'")).stem: r for r in rows[1:]}
+    assert by_stem["eve"][1] == "'=HYPERLINK(\"http://example.com\",\"click\")"
+    assert by_stem["fred"][1] == "'+1" and by_stem["gil"][1] == "'@SUM(A1:A9)"
+    assert by_stem["hal"][1] == "'-2"  # a name, not a number: the student column is text
+    assert by_stem["ida"][1] == "Ida;'=1+2"  # where a ';' spreadsheet would start a cell
+    assert by_stem["jo"][1] == "Jo"  # nothing else is changed
+    for r in rows[1:-1]:
+        assert r[2:4] == ["4", "4"], r  # the counts: numbers, never quoted
+    # a file named =cmd.yaml given as such: its file cell and its error text
+    last = rows[-1]
+    assert last[0] == "'=cmd.yaml" and last[1] == "'=cmd"
+    assert last[-1].startswith("'=cmd.yaml") and "no body named 'lowr'" in last[-1]
+    assert not any(c.startswith(("=", "+", "-", "@", "\t", "\r")) for r in rows for c in r)
+
+
+def test_a_lagrange_mistake_is_a_mistake_of_the_class(tmp_path):
+    # an entry without a body is a Lagrange equation; its diagnoses are Lagrange's own
+    # (the pendulum: 0.667083 O.angle_ddot = -4.905 with I_O = I_rod + m_rod 0.5^2 and
+    # the weight's moment m_rod g 0.5 sin(30 deg); here of the wrong sign)
+    pendulum = ROOT / "models" / "pendulum.yaml"
+    f = tmp_path / "lg.yaml"
+    f.write_text('equations:\n  - {eq: "(I_rod + m_rod*0.5^2)*O.angle_ddot = '
+                 'm_rod*g*0.5*sin(O.angle)"}\n')
+    summary = grade(mbody.load(pendulum), [f])
+    assert summary.graded[0].wrong[0].diagnosis == POTENTIAL_GRADIENT_SIGN
+    _, mistakes = tables(summary.csv())
+    assert mistakes[1][0] == POTENTIAL_GRADIENT_SIGN
+    assert mistakes[1][-1] == LAGRANGE_DIAGNOSES[POTENTIAL_GRADIENT_SIGN]
+    page = class_summary_html(summary)
+    text = "".join(ET.fromstring(page.split("\n", 1)[1]).itertext())
+    assert LAGRANGE_DIAGNOSES[POTENTIAL_GRADIENT_SIGN] in text
+    for out in ("class.csv", "class.html"):
+        p = run("verify", str(pendulum), str(f), "--summary", str(tmp_path / out))
+        assert p.returncode == 1, p.stderr  # one wrong equation: not an internal error
+
+
+def test_a_folder_a_device_or_a_pipe_among_the_files_is_a_row(answers, tmp_path):
+    # each is one student's problem, as a missing file is: a row with its error, and
+    # the class goes on (exit 1, the summary written)
+    folder = tmp_path / "folder.yaml"
+    folder.mkdir()
+    odd = [folder, Path(os.devnull), tmp_path / "missing.yaml"]
+    if hasattr(os, "mkfifo"):  # no writer: nothing comes through it in the wait
+        os.mkfifo(tmp_path / "pipe.yaml")
+        odd.append(tmp_path / "pipe.yaml")
+    out = tmp_path / "class.csv"
+    p = run("verify", str(MODEL), str(answers[0]), *map(str, odd), "--summary", str(out))
+    assert p.returncode == 1, p.stderr
+    assert f"{1 + len(odd)} answers file(s)" in p.stdout and f"wrote {out}" in p.stdout
+    rows, _ = tables(out.read_text())
+    assert rows[1][:4] == [str(answers[0]), "Ana Example", "4", "4"]
+    errors = {Path(r[0]).name: r[-1] for r in rows[2:]}
+    assert all(r[2:4] == ["0", "0"] for r in rows[2:])
+    assert errors["folder.yaml"] == f"{folder}: this is a directory; expected a YAML answers file"
+    assert errors[Path(os.devnull).name].startswith(f"{os.devnull}: this is a character device")
+    assert errors[Path(os.devnull).name].endswith("not a file; expected a YAML answers file")
+    assert errors["missing.yaml"] == f"{tmp_path / 'missing.yaml'}: no such file"
+    if hasattr(os, "mkfifo"):
+        assert errors["pipe.yaml"].startswith(f"{tmp_path / 'pipe.yaml'}: nothing came "
+                                              "through this pipe")
+    # one file alone is the command's input: refused as before (exit 2)
+    p = run("verify", str(MODEL), str(folder))
+    assert p.returncode == 2 and "this is a directory" in p.stderr

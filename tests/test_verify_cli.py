@@ -86,3 +86,55 @@ def test_report_shows_the_answers(tmp_path):
     html = page.read_text(encoding="utf-8")
     assert '<section id="answers">' in html and "missing_gyroscopic_term" in html
     assert "<code>I_3*alpha_3 = 0</code>" in html
+
+
+def test_an_equation_not_linear_in_the_unknowns_is_said_so_with_its_term(tmp_path):
+    # no mistake of the table can explain a_x^2 (the rows are linear in a_x and the
+    # reactions): the verdict's line says what is wrong with it, not "none of the above"
+    answers = tmp_path / "a.yaml"
+    answers.write_text('equations:\n  - {body: rod, eq: "a_x^2 = O.Fx"}\n'
+                       '  - {body: rod, eq: "alpha*O.Fx = 1"}\n'
+                       '  - {body: rod, eq: "(a_x + O.Fy)^3 = 1"}\n'
+                       '  - {eq: "O.angle_ddot^0.5 = 1"}\n', encoding="utf-8")
+    p = mbody("verify", MODELS / "pendulum.yaml", answers)
+    assert p.returncode == 1, p.stderr
+    lines = p.stdout.splitlines()
+    verdicts = [lines[k + 1] for k, line in enumerate(lines) if line.startswith("[")]
+    head = "    not_an_equation_of_this_body: not linear in the unknowns"
+    assert verdicts == [f"{head} (a_x squared)", f"{head} (a product of unknowns (alpha "
+                        "times O.Fx))", f"{head} (a sum of unknowns (O.Fy, a_x) cubed)",
+                        f"{head} (O.angle_ddot to the power 0.5)"]
+    assert "it has a_x squared" in " ".join(p.stdout.split())
+    doc = json.loads(mbody("verify", MODELS / "pendulum.yaml", answers, "--json").stdout)
+    first = doc["equations"][0]
+    assert first["diagnosis"] == "not_an_equation_of_this_body"  # the contract's name
+    assert first["details"]["not_linear"] == "a_x squared"
+
+
+def test_an_entry_without_body_in_newton_euler_names_asks_for_its_body(tmp_path):
+    # an entry without body: is a Lagrange equation (documented); written with a body's
+    # Newton-Euler names, the error asks for the body: the one whose free body has the
+    # reactions it names, else every body whose equations have its names
+    def error(model: str, *eqs: str) -> list[str]:
+        answers = tmp_path / "a.yaml"
+        answers.write_text("equations:\n" + "".join(f'  - {{eq: "{e}"}}\n' for e in eqs),
+                           encoding="utf-8")
+        p = mbody("verify", MODELS / model, answers)
+        assert p.returncode == 2, p.stdout
+        return [line for line in p.stderr.splitlines() if "equations[" in line]
+
+    why = "an entry without body: is an equation in generalized coordinates"
+    (out,) = error("pendulum.yaml", "m*a_x = O.Fx")
+    assert out.endswith(f"unknown name 'm' in a Lagrange equation (the names: "
+                        f"O.angle_ddot, t, g, m_rod, I_rod) (did you forget body: rod? {why})")
+    out = error("double_pendulum.yaml", "m*a_y = O.Fy - A.Fy - m*g", "m*a_x = A.Fx",
+                "alpha = 0")
+    assert out[0].endswith(f"(did you forget body: upper? {why})")  # O: upper's alone
+    assert out[1].endswith("(did you forget body: NAME? m, a_x, A.Fx are names of the "
+                           f"Newton-Euler equations of upper, lower; {why})")
+    assert out[2].endswith("(did you forget body: NAME? alpha is a name of the "
+                           f"Newton-Euler equations of upper, lower; {why})")
+    # names that are no body's: the error as it was, without the hint
+    for eq in ("O.angle_dd = 0", "I_1*alpha_1 = 0", "m*a_x = B.Fx"):
+        (out,) = error("double_pendulum.yaml", eq)
+        assert "forget" not in out, out

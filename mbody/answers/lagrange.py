@@ -36,9 +36,9 @@ from mbody.answers.compare import CONST, Row, fit, matches
 from mbody.answers.diagnose import CORRECT, NOT_AN_EQUATION, Diagnosis
 from mbody.answers.linear import NotLinear, linear_row
 from mbody.answers.load import Answer, Answers, AnswersError
-from mbody.answers.parse import EquationError, parse_equation
+from mbody.answers.parse import EquationError, names_in, parse_equation
 from mbody.answers.text import num
-from mbody.answers.vocabulary import Vocabulary, name_gravity
+from mbody.answers.vocabulary import Vocabulary, name_gravity, newton_euler_bodies
 from mbody.equations.coordinates import CoordinateSet, columns, coordinate_set
 from mbody.equations.generalized import Generalized, evaluate, generalized
 from mbody.equations.symbolic import load_symbols
@@ -372,6 +372,34 @@ def _diagnose(s: Row, truth: _Truth, tol: float, hint: int | None,
                                             "nor one of the usual mistakes."}
 
 
+def _forgotten_body(model: Model, state: State, vocab: Vocabulary, eq: str,
+                    labels: list[str], cache: dict[str, Vocabulary]) -> str:
+    """The hint for an entry without ``body:`` whose names this Lagrange vocabulary lacks
+    and a body's Newton-Euler equations have (``m*a_x = O.Fx``): "did you forget body:
+    rod?"; '' when no body has them."""
+    foreign = [n for n in names_in(eq, labels) if not _has(vocab, n)]
+    if not foreign:
+        return ""
+    found, more = newton_euler_bodies(model, state, foreign, cache=cache)
+    if not found:
+        return ""
+    why = "an entry without body: is an equation in generalized coordinates"
+    if len(found) == 1 and not more:
+        return f"did you forget body: {found[0]}? {why}"
+    shown = ", ".join(found) + (" ..." if more else "")
+    are = "are names" if len(foreign) > 1 else "is a name"
+    return (f"did you forget body: NAME? {', '.join(foreign)} {are} of the Newton-Euler "
+            f"equations of {shown}; {why}")
+
+
+def _has(vocab: Vocabulary, name: str) -> bool:
+    try:
+        vocab.resolve(name)
+    except KeyError:
+        return False
+    return True
+
+
 def coordinate_names(model: Model, sheet: Answers) -> tuple[tuple[str, ...], tuple[str, ...]]:
     """(the answers' names, the model's labels) of the coordinates: the answers'
     ``coordinates:`` or the model's default ones."""
@@ -406,17 +434,23 @@ def check_lagrange(model: Model, state: State, sheet: Answers, entries: list[Ans
               *vocab.reactions]
     issues: list[Issue] = []
     parsed: list[tuple[Answer, Row | None, str]] = []
+    bodies: dict[str, Vocabulary] = {}  # the bodies' Newton-Euler names, for the hint
     for a in entries:
         if a.coordinate and a.coordinate not in names and a.coordinate not in labels:
             issues.append(sheet.issue(a, f"no coordinate {a.coordinate!r} in the answers' "
                                       f"coordinates ({', '.join(names)})"))
             continue
+        read = False
         try:
             eq = parse_equation(a.eq, dotted)
+            read = True
             parsed.append((a, linear_row(eq, vocab), ""))
         except EquationError as exc:
             reason = exc.reason.replace(f" for body {vocab.body!r}", " in a Lagrange equation")
-            issues.append(sheet.issue(a, reason, position=exc.position, hint=exc.hint))
+            advice = exc.hint
+            if read and len(issues) < AnswersError.SHOWN:  # a name this vocabulary lacks
+                advice = _forgotten_body(model, state, vocab, a.eq, dotted, bodies) or advice
+            issues.append(sheet.issue(a, reason, position=exc.position, hint=advice))
         except NotLinear as exc:
             parsed.append((a, None, exc.why))
     if issues:

@@ -205,7 +205,7 @@ def _operate(kind: str, a: _Form, b: _Form, pos: int, text: str) -> _Form:
             return a
         if p == 0.0:
             return _Form.number(1.0, exact=True)
-        raise NotLinear(pos, f"a power of an unknown ({_names(a)})")
+        raise NotLinear(pos, _power_text(a, p))
     x = a.c
     shown = f"{_num(x) if x >= 0 else f'({_num(x)})'}^{_num(p)}"
     try:
@@ -250,6 +250,14 @@ def _call(name: str, arg: _Form, text: str, pos: int) -> _Form:
     v = math.sqrt(x)
     return _Form({CONST: v}, {CONST: ex / (2 * v) if v > 0 else 0.0},
                  {CONST: math.sqrt(arg.mag.get(CONST, 0.0))})
+
+
+def _power_text(base: _Form, p: float) -> str:
+    """What a power of unknowns is, in words: "a_x squared", "(a_x, O.Fx) cubed"."""
+    power = {2.0: "squared", 3.0: "cubed"}.get(p, f"to the power {_num(p)}")
+    unknowns = [k for k in base.value if k != CONST]
+    return f"{unknowns[0]} {power}" if len(unknowns) == 1 else \
+        f"a sum of unknowns ({_names(base)}) {power}"
 
 
 def _names(form: _Form) -> str:

@@ -21,6 +21,7 @@ problem inside an equation at its character.
 from __future__ import annotations
 
 import os
+import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -207,9 +208,13 @@ def answers_from_data(data: Any, file: str = "<answers>") -> Answers:
 
 def _reword(issue: Issue) -> Issue:
     """The loader speaks of model files; an answers file is not one."""
-    msg = issue.message.replace("expected a YAML model file", "expected a YAML answers file")
-    msg = msg.replace("model file", "answers file")
+    msg = _MODEL_PIPE.sub("", issue.message)
+    msg = msg.replace("a model file", "an answers file").replace("model file", "answers file")
     return Issue(issue.file, issue.line, issue.column, issue.key, msg, issue.hint)
+
+
+_MODEL_PIPE = re.compile(r" \(to read a model from a pipe: [^)]*\)")
+"""The loader's advice on a model read from a pipe (``mbody check /dev/stdin``)."""
 
 
 def _build(data: Any, file: str, doc: Document | None, text: str) -> Answers:

@@ -134,6 +134,25 @@ def parse_equation(text: str, labels: Iterable[str] = ()) -> ParsedEquation:
     return ParsedEquation(text, lhs, rhs, equals)
 
 
+def names_in(text: str, labels: Iterable[str] = ()) -> list[str]:
+    """The names an equation uses (not its functions), each once, in reading order.
+
+    Parameters
+    ----------
+    text : str
+        The equation, as `parse_equation` reads it.
+    labels : iterable of str
+        As `parse_equation`'s: reaction labels read as one name.
+
+    Returns
+    -------
+    list of str
+    """
+    seen = dict.fromkeys(value for kind, value, _ in _tokenise(text, labels)
+                         if kind == "name" and value not in FUNCTIONS)
+    return list(seen)
+
+
 def _tokenise(text: str, labels: Iterable[str]) -> list[tuple[str, str, int]]:
     return tokenise(text.translate(_PASTED), _TOKEN, _label_index(tuple(labels)))
 

@@ -20,11 +20,11 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from mbody.answers.diagnose import DIAGNOSES
 from mbody.answers.load import AnswersError
-from mbody.answers.verify import TOLERANCE, Check, Verification, verify
+from mbody.answers.verify import MEANINGS, TOLERANCE, Check, Verification, verify
 from mbody.equations.assemble import assemble
 from mbody.model.model import Model
+from mbody.util.formatting import spreadsheet_text
 
 HEADER = ("file", "student", "equations", "correct")
 """The first columns of a row; then one ``mistake <k>`` column per wrong equation (as many
@@ -150,16 +150,19 @@ class ClassSummary:
         -------
         str
             The files' table; a blank line; the class's mistakes (`MISTAKES_HEADER`), the
-            most frequent first.
+            most frequent first. A text cell that a spreadsheet would run as a formula (a
+            ``student:`` line or a file name starting with ``=``...) has a ``'`` in front
+            (`mbody.util.formatting.spreadsheet_text`); the counts are numbers as they are.
         """
         buf = io.StringIO()
         w = csv.writer(buf, lineterminator="\n")
         w.writerow(self.header())
-        w.writerows(self.rows())
+        w.writerows(_as_text(r) for r in self.rows())
         w.writerow([])
         w.writerow(MISTAKES_HEADER)
         for m in self.mistakes:
-            w.writerow([m.diagnosis, m.row, m.equations, m.students, DIAGNOSES[m.diagnosis]])
+            w.writerow(_as_text([m.diagnosis, m.row, m.equations, m.students,
+                                 MEANINGS[m.diagnosis]]))
         return buf.getvalue()
 
     def text(self) -> str:
@@ -184,6 +187,11 @@ class ClassSummary:
             lines += [f"  {m.equations:4d} x {m.diagnosis} ({m.row}) in {m.students} file(s)"
                       for m in top]
         return "\n".join(lines)
+
+
+def _as_text(row: list[str | int]) -> list[str | int]:
+    """A CSV row with its text cells safe to open in a spreadsheet (numbers as they are)."""
+    return [spreadsheet_text(c) if isinstance(c, str) else c for c in row]
 
 
 def grade(model: Model, files: Sequence[str | os.PathLike[str]], *,

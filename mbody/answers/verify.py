@@ -34,6 +34,8 @@ from mbody.model.reprs import name_list
 TOLERANCE = 1e-3
 """Default relative tolerance on each coefficient: numbers written to about four
 significant figures match."""
+MEANINGS = {**DIAGNOSES, **LAGRANGE_DIAGNOSES}
+"""Every diagnosis a `Check` can have, Newton-Euler's and Lagrange's, with its meaning."""
 
 
 @dataclass(frozen=True)
@@ -76,6 +78,15 @@ class Check:
     def correct(self) -> bool:
         """Whether the equation is one of the body's rows."""
         return self.diagnosis == CORRECT
+
+    @property
+    def meaning(self) -> str:
+        """What the diagnosis means here: its `MEANINGS` entry, or, for an equation that
+        is not linear in the unknowns (``not_an_equation_of_this_body`` with
+        ``details["not_linear"]``), that and the term: "not linear in the unknowns (a_x
+        squared)"."""
+        why = self.details.get("not_linear")
+        return f"not linear in the unknowns ({why})" if why else MEANINGS[self.diagnosis]
 
     def __repr__(self) -> str:  # the dataclass's would print the explanation and details
         return f"<Check [{self.index}] {self.body}: {self.eq!r}: {self.diagnosis}>"
@@ -195,8 +206,7 @@ class Verification:
         for c in self.checks:
             at = f"  (line {c.line})" if c.line else ""
             out.append(f"[{c.index}] {c.body}: {c.eq}{at}")
-            meaning = {**DIAGNOSES, **LAGRANGE_DIAGNOSES}[c.diagnosis]
-            out.append(f"    {c.diagnosis}" + ("" if c.correct else f": {meaning}"))
+            out.append(f"    {c.diagnosis}" + ("" if c.correct else f": {c.meaning}"))
             if not c.correct and c.expected:
                 out.append(f"    expected ({c.row}): {c.expected}")
             out.extend(wrap.wrap(c.explanation))

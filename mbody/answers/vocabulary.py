@@ -332,6 +332,70 @@ def vocabulary(model: Model, state: State, body: str) -> Vocabulary:
                       {n: why for n, why in absent.items() if n not in values}, acting)
 
 
+NEWTON_EULER_SCAN = 64
+"""Most bodies whose vocabularies `newton_euler_bodies` makes (each costs the body's
+joints and loads): enough to name the bodies of an equation that names a reaction, or
+the first few of a large model's for one that names none."""
+
+
+def newton_euler_bodies(model: Model, state: State, names: list[str], most: int = 5,
+                        cache: dict[str, Vocabulary] | None = None) -> tuple[list[str], bool]:
+    """The bodies whose Newton-Euler equations may use every one of `names` (a reaction
+    only when it acts on the body): what an entry without ``body:`` may have been meant
+    for.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    state : State
+        Its state (a vocabulary's numbers).
+    names : list of str
+        Names as written in an equation.
+    most : int
+        How many bodies to find at most.
+    cache : dict, optional
+        Vocabularies by body, kept between calls.
+
+    Returns
+    -------
+    bodies : list of str
+        Those bodies, in model order, at most `most`.
+    more : bool
+        Whether other bodies may read them too: `most` were found before the end, or
+        only the first `NEWTON_EULER_SCAN` of the bodies to look at were looked at.
+    """
+    cache = {} if cache is None else cache
+    used = [model.reaction_index[n] for n in names if n in model.reaction_index]
+    if used:  # only the bodies every named reaction acts on
+        rt = model.reaction_table
+        bodies = set.intersection(*({int(b) for b in (rt.parent[c], rt.child[c]) if b >= 0}
+                                    for c in used))
+        candidates = sorted(bodies)
+    else:
+        candidates = list(range(model.n))
+    found: list[str] = []
+    for k, i in enumerate(candidates[:NEWTON_EULER_SCAN]):
+        body = model.body_names[i]
+        if body not in cache:
+            cache[body] = vocabulary(model, state, body)
+        if all(_reads(cache[body], n) for n in names):
+            found.append(body)
+            if len(found) == most:
+                return found, k + 1 < len(candidates)
+    return found, len(candidates) > NEWTON_EULER_SCAN
+
+
+def _reads(vocab: Vocabulary, name: str) -> bool:
+    """Whether `name` is a name of `vocab`'s body (another body's reaction is not)."""
+    try:
+        canonical = vocab.resolve(name)
+    except KeyError:
+        return False
+    return canonical in vocab.values or canonical in vocab.accelerations \
+        or canonical in vocab.own_reactions
+
+
 def _planar_angle(W_R_B: np.ndarray) -> float:
     """θ of a planar body from its rotation about z."""
     return float(np.arctan2(W_R_B[1, 0], W_R_B[0, 0]))

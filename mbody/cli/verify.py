@@ -83,8 +83,8 @@ def _class(a: argparse.Namespace) -> int:
             raise MbodyError(f"--summary {a.summary}: the summary is written as .csv or "
                              f".html; got {kind or 'no extension'}")
         ensure_writable(a.summary)
-    for f in a.answers:
-        regular_file(f, "a YAML answers file")
+    # a file that is not an answers file (missing, a folder, a device, a pipe with no
+    # writer, not YAML) is about one student: the reader makes it a row, the class goes on
     model = load_model(a.model)
     summary = grade(model, a.answers, tol=a.tol)
     if a.json:

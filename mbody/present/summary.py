@@ -4,8 +4,8 @@ mistakes with what each means. Self-contained, escaped, offline."""
 
 from __future__ import annotations
 
-from mbody.answers.diagnose import DIAGNOSES
 from mbody.answers.summary import MISTAKES_HEADER, ClassSummary, mistake_text
+from mbody.answers.verify import MEANINGS
 from mbody.present.html import STYLE, Markup, e, table, tag
 
 
@@ -24,14 +24,14 @@ def class_summary_html(summary: ClassSummary) -> str:
     """
     rows = []
     for g in summary.graded:
-        wrong = Markup("".join(tag("div", mistake_text(c), title=DIAGNOSES[c.diagnosis])
+        wrong = Markup("".join(tag("div", mistake_text(c), title=c.meaning)
                                for c in g.wrong))
         rows.append([g.file, g.student, g.equations, g.correct,
                      wrong if g.wrong else "", g.error])
     files = table(["file", "student", "equations", "correct", "mistakes", "error"], rows,
                   numeric=(2, 3))
     mistakes = table(list(MISTAKES_HEADER),
-                     [[m.diagnosis, m.row, m.equations, m.students, DIAGNOSES[m.diagnosis]]
+                     [[m.diagnosis, m.row, m.equations, m.students, MEANINGS[m.diagnosis]]
                       for m in summary.mistakes], numeric=(2, 3))
     head = "\n".join(e(line) for line in summary.text().splitlines()[:1])
     title = f"Answers for model '{summary.model}'"

@@ -31,3 +31,41 @@ def clean(x: np.ndarray, rel: float = 1e-10) -> np.ndarray:
     x = np.asarray(x, dtype=float)
     top = float(np.max(np.abs(x), initial=0.0))
     return np.where(np.abs(x) <= rel * top, 0.0, x)
+
+
+FORMULA_STARTS = ("=", "+", "-", "@", "\t", "\r", "\0")
+"""The first characters that make a spreadsheet (Excel, LibreOffice, Google Sheets) read a
+CSV cell as a formula (OWASP's CSV injection list, with ASVS's NUL)."""
+_SEPARATORS = (";", "\t")
+"""Characters some spreadsheets split a CSV line at (a ';' locale, tab-separated)."""
+
+
+def spreadsheet_text(cell: str) -> str:
+    """A CSV text cell that a spreadsheet shows as text, never runs as a formula.
+
+    A cell that starts with one of `FORMULA_STARTS` gets a ``'`` in front (the
+    spreadsheets' "this is text" mark, as OWASP advises); so does one of ``= + - @``
+    right after a ``;`` or a tab inside the cell, where a spreadsheet that splits lines
+    at those would start a cell. Only text cells are given to it: a number column's -1
+    stays a number.
+
+    Parameters
+    ----------
+    cell : str
+        Free text (a student's name, a file name, an error message).
+
+    Returns
+    -------
+    str
+        `cell`, unchanged unless it holds such a start.
+    """
+    if cell.startswith(FORMULA_STARTS):
+        cell = "'" + cell
+    if any(s in cell for s in _SEPARATORS):
+        out = [cell[0]] if cell else []
+        for prev, ch in zip(cell, cell[1:], strict=False):
+            if prev in _SEPARATORS and ch in "=+-@":
+                out.append("'")
+            out.append(ch)
+        cell = "".join(out)
+    return cell
