@@ -106,32 +106,46 @@ def over_budget(name: str, holds: int, on_disk: int, limit: int, more: str) -> s
             f"is read ({more})")
 
 
-def read_text(path: str | os.PathLike[str], max_bytes: int | None = None,
-              more: str = "mbody.load_export(path, max_bytes=N) reads more",
-              error: type[MbodyError] = MbodyError) -> str:
-    """The UTF-8 text of a data file (a JSON or CSV export), refused unread when it is
-    larger than `max_bytes` (default `TEXT_BYTES`, or `data_bytes_limit`'s), or is not a
+def read_bytes(path: str | os.PathLike[str], max_bytes: int | None = None,
+               more: str = "mbody.load_export(path, max_bytes=N) reads more",
+               error: type[MbodyError] = MbodyError, default: int = DATA_BYTES) -> bytes:
+    """The bytes of a data file (a .mat, JSON or CSV export), refused unread when it is
+    larger than `max_bytes` (default `default`, or `data_bytes_limit`'s), or is not a
     regular file (a pipe would block, a device never end).
 
     Raises
     ------
     error
         Naming the file: too large (the budget and `more`), not a regular file.
-    UnicodeDecodeError
-        The file is not UTF-8 (a `ValueError`).
     """
-    limit = data_limit(max_bytes, TEXT_BYTES)
+    limit = data_limit(max_bytes, default)
     st = os.stat(path)
     if not stat.S_ISREG(st.st_mode):
         raise error(f"{path}: not a regular file (a folder, a device or a pipe); expected "
                     "a file mbody wrote")
     if st.st_size > limit:
         raise error(over_budget(str(path), st.st_size, st.st_size, limit, more))
-    with open(path, "rb") as fh:
-        raw = fh.read(limit + 1)  # no more, if it grew since
+    with open(path, "rb") as fh:  # what stat() said, and a byte to see if it grew since
+        raw = fh.read(st.st_size + 1)  # (read(limit) would allocate the whole limit)
     if len(raw) > limit:
         raise error(over_budget(str(path), len(raw), len(raw), limit, more))
-    return raw.decode("utf-8")
+    return raw
+
+
+def read_text(path: str | os.PathLike[str], max_bytes: int | None = None,
+              more: str = "mbody.load_export(path, max_bytes=N) reads more",
+              error: type[MbodyError] = MbodyError) -> str:
+    """The UTF-8 text of a JSON or CSV export: `read_bytes` with the text budget
+    (`TEXT_BYTES` by default).
+
+    Raises
+    ------
+    error
+        As `read_bytes`.
+    UnicodeDecodeError
+        The file is not UTF-8 (a `ValueError`).
+    """
+    return read_bytes(path, max_bytes, more, error, TEXT_BYTES).decode("utf-8")
 
 
 @dataclass(frozen=True)
