@@ -318,3 +318,12 @@ def test_a_good_run_reads_back_as_it_was_saved(run_data, tmp_path):
     assert traj.run_file == str(run) and len(traj) == 61
     np.testing.assert_array_equal(traj.position, run_data["position"])
     assert traj.model().body_names == ("rod",)
+
+
+def test_sizes_in_messages_say_which_is_larger():
+    from mbody.util.npzfile import over_budget, size_text
+
+    assert size_text(16) == "16 bytes" and size_text(1536) == "1.5 KiB (1,536 bytes)"
+    assert size_text(2**31) == "2 GiB" and size_text(8 * 10**15) == "7.11 PiB"
+    close = over_budget("r.npz", 2**30 + 100, 2**20, 2**30, "more")
+    assert "holds 1,073,741,924 bytes" in close and "at most 1,073,741,824 bytes" in close

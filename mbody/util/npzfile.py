@@ -102,8 +102,10 @@ def over_budget(name: str, holds: int, on_disk: int, limit: int, more: str) -> s
     """The message for a file that holds more than the budget: what it holds (inflated),
     its size on disk, the budget and how to raise it (`more`)."""
     packed = f" once inflated ({size_text(on_disk)} on disk)" if on_disk < holds else ""
-    return (f"{name}: holds {size_text(holds)} of data{packed}; at most {size_text(limit)} "
-            f"is read ({more})")
+    held, most = size_text(holds), size_text(limit)
+    if held == most:  # rounded alike: the bytes say which is more
+        held, most = f"{holds:,} bytes", f"{limit:,} bytes"
+    return f"{name}: holds {held} of data{packed}; at most {most} is read ({more})"
 
 
 def read_bytes(path: str | os.PathLike[str], max_bytes: int | None = None,
