@@ -42,6 +42,7 @@ from mbody.cli.common import (
 from mbody.cli.near_miss import options_hint, unknown_options, unrecognized_message
 from mbody.errors import MbodyError, ModelError, UnknownReactionsError, did_you_mean
 from mbody.model.loader import MAX_BYTES, max_bytes_limit
+from mbody.util.npzfile import DATA_BYTES, data_bytes_limit
 
 COMMAND_MODULES = (core, export, sim, drive, draw, animate, mechanism, statics, verify,
                    interop, lagrange, sweep)
@@ -59,12 +60,21 @@ def build_parser() -> argparse.ArgumentParser:
     sub.required = True
     for module in COMMAND_MODULES:
         module.register(sub)
-    for command in sub.choices.values():  # every command that reads a model file
-        if any(a.dest in ("model", "source") for a in command._get_positional_actions()):
+    for command in sub.choices.values():  # every command that reads a model or run file
+        inputs = {a.dest for a in command._get_positional_actions()}
+        runs = bool(inputs & {"trajectory", "source"}) or "--state" in \
+            command._option_string_actions
+        models = bool(inputs & {"model", "source"})
+        if models or runs:
+            read = " and ".join(filter(None, (
+                f"largest model file read (default {MAX_BYTES // 2**20}M)" if models else "",
+                f"most data a run file may hold once inflated (default {DATA_BYTES // 2**30}G)"
+                if runs else "")))
             command.add_argument(
                 "--max-bytes", type=byte_size, metavar="SIZE",
-                help=f"largest model file read, in bytes or with a unit (200M, 1G); "
-                f"default {MAX_BYTES // 2**20}M, a guard against reading a wrong file whole")
+                help=f"{read}, in bytes or with a unit (200M, 2G): a guard against reading a "
+                "wrong or hostile file whole")
+        if models:
             add_import_options(command)  # --format, --keyframe, --q: MJCF and URDF input
         writes = [o for dest in OUTPUTS for o in _options(command, dest)]
         if writes and "--force" not in command._option_string_actions:
@@ -195,7 +205,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     sys.stdout = out
     try:
         check_paths(args, _subcommand(parser, args))
-        with max_bytes_limit(getattr(args, "max_bytes", None)):
+        limit = getattr(args, "max_bytes", None)
+        with max_bytes_limit(limit), data_bytes_limit(limit):
             code = args.run(args)
         out.flush()  # a full device is reported here, not at exit
         return code

@@ -25,7 +25,7 @@ import functools
 import json
 import numbers
 import os
-import zlib
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -33,11 +33,13 @@ from typing import Any
 import numpy as np
 
 from mbody import conventions as cv
-from mbody.errors import MbodyError, TrajectoryFileError, real_number, wrong_type
+from mbody.errors import Issue, MbodyError, ModelError, TrajectoryFileError, real_number, wrong_type
 from mbody.model.model import State, count, loads
 from mbody.model.yaml_write import dump_document
+from mbody.util import jsontext
 from mbody.util.atomic import atomic_path
 from mbody.util.frozen import Frozen
+from mbody.util.npzfile import Member, NpzArchive
 from mbody.util.spatial import planar_quat
 
 FORMAT = "mbody-trajectory"
@@ -48,6 +50,36 @@ _ARRAYS = ("t", "position", "velocity", "orientation", "angular_velocity", "reac
            "mass", "inertia", "gravity")
 _TEXTS = ("model_name", "model_file", "model_yaml")
 _SERIES = "series/"
+
+
+class StoredModelError(ModelError):
+    """The model text a run carries (`Trajectory.model_yaml`), or a value set on it, is
+    not a valid model. The lines are the stored text's, which need not be the model
+    file's: the message says whose they are.
+
+    Parameters
+    ----------
+    issues : sequence of Issue
+        Every problem, located in the stored text.
+    traj : Trajectory
+        The run (its `run_file` and `model_file` are named).
+    """
+
+    def __init__(self, issues: Sequence[Issue], traj: Trajectory):
+        run = traj.run_file or "the run"
+        self.where = f"the model stored in {run}" + (
+            f" (the text of {traj.model_file} when the run was made, not the file now)"
+            if traj.model_file and not traj.model_file.startswith("<") else "")
+        super().__init__(issues)
+
+    def _text(self) -> str:
+        lines = [f"{'line ' + str(i.line) + ', column ' + str(i.column) + ': ' if i.line else ''}"
+                 f"{i.key + ': ' if i.key else ''}{i.message}" + (f" ({i.hint})" if i.hint else "")
+                 for i in self.issues[:self.SHOWN]]
+        more = len(self.issues) - self.SHOWN
+        if more > 0:
+            lines.append(f"... and {more} more")
+        return f"{self.where} is not a valid model:\n" + "\n".join(lines)
 
 
 @dataclass(eq=False, init=False, repr=False)  # __init__ and __repr__ below; Frozen
@@ -102,6 +134,9 @@ class Trajectory(Frozen):
     series : dict of str to array
         Per-sample quantities computed during the run, e.g. ``'energy'`` (K,),
         ``'potential'`` (K,).
+    run_file : str
+        The run file this trajectory was read from (`load`); '' for one made by a run or
+        in code. Not saved: it says where a message's model text came from.
     """
 
     t: np.ndarray
@@ -123,6 +158,7 @@ class Trajectory(Frozen):
     gravity: np.ndarray = field(default_factory=lambda: np.zeros(3))
     model_yaml: str = ""
     series: dict[str, np.ndarray] = field(default_factory=dict)
+    run_file: str = ""
 
     def __init__(self, t: np.ndarray, position: np.ndarray, velocity: np.ndarray,
                  orientation: np.ndarray, angular_velocity: np.ndarray,
@@ -132,7 +168,7 @@ class Trajectory(Frozen):
                  mass: np.ndarray | None = None, inertia: np.ndarray | None = None,
                  shapes: tuple[dict | None, ...] = (), colors: tuple[str | None, ...] = (),
                  gravity: np.ndarray | None = None, model_yaml: str = "",
-                 series: dict[str, np.ndarray] | None = None) -> None:
+                 series: dict[str, np.ndarray] | None = None, run_file: str = "") -> None:
         # The dataclass's own __init__ would be the same (the fields in this order, those
         # left out at their defaults; None: the field's default_factory), but it is
         # compiled from its source when the class is made: 0.3 ms of every process that
@@ -147,7 +183,8 @@ class Trajectory(Frozen):
             "info": {} if info is None else info, "mass": mass, "inertia": inertia,
             "shapes": shapes, "colors": colors,
             "gravity": np.zeros(3) if gravity is None else gravity,
-            "model_yaml": model_yaml, "series": {} if series is None else series})
+            "model_yaml": model_yaml, "series": {} if series is None else series,
+            "run_file": run_file})
 
     @property
     def n(self) -> int:
@@ -380,16 +417,22 @@ class Trajectory(Frozen):
         ------
         TrajectoryFileError
             The trajectory carries no YAML text (its model was built in code).
+        StoredModelError
+            The text, or a value set on it, is not a valid model (a `ModelError` whose
+            message says that the text is the one stored in the run, not the file).
         """
         if not self.model_yaml:
             raise TrajectoryFileError("this trajectory does not carry its model's YAML text "
                                       "(the model was built in code, not read from a file, "
                                       "a text or a dictionary)")
-        model = loads(self.model_yaml, self.model_file or "<trajectory>")
-        for path, value in self.info.get("model_values", ()):
-            # one at a time, as set: each setting reads the text again with every value
-            # before it, so a later value of a path wins as it did
-            model = model.with_values({path: value})
+        try:
+            model = loads(self.model_yaml, self.model_file or "<trajectory>")
+            for path, value in self.info.get("model_values", ()):
+                # one at a time, as set: each setting reads the text again with every value
+                # before it, so a later value of a path wins as it did
+                model = model.with_values({path: value})
+        except ModelError as exc:  # never the file's lines: the file may say otherwise
+            raise StoredModelError(exc.issues, self) from None
         return model
 
     # -- files -------------------------------------------------------------------------
@@ -428,24 +471,34 @@ class Trajectory(Frozen):
         return Path(path)
 
     @classmethod
-    def load(cls, path: str | os.PathLike[str]) -> Trajectory:
-        """Read a file written by `save`.
+    def load(cls, path: str | os.PathLike[str], *, max_bytes: int | None = None
+             ) -> Trajectory:
+        """Read a file written by `save`, checking it as input that may be hostile (a run
+        from someone else): what it holds is checked before anything is inflated, and
+        every value a reader relies on before it is returned.
 
         Parameters
         ----------
         path : str or os.PathLike
             A trajectory ``.npz`` file (format ``mbody-trajectory``, version at most
             `FORMAT_VERSION`).
+        max_bytes : int, optional
+            The most data read, inflated (default `mbody.util.npzfile.DATA_BYTES`, 1 GiB,
+            or the command line's ``--max-bytes``); a file that holds more is refused
+            before any of it is inflated.
 
         Returns
         -------
         Trajectory
+            With `run_file` set to `path`.
 
         Raises
         ------
         TrajectoryFileError
-            Names what is wrong: no such file, another format, a newer version, missing
-            entries, shapes that disagree, a damaged archive.
+            Names the file and what is wrong: no such file, another format, a newer
+            version, missing entries, shapes that disagree, times that are not finite or
+            do not increase, states that are not finite, a damaged archive (a header that
+            does not fit its size, JSON nested too deeply), more data than `max_bytes`.
         """
         name = str(path)
         p = Path(path)
@@ -453,6 +506,9 @@ class Trajectory(Frozen):
             raise TrajectoryFileError(f"{name}: no such file")
         if p.is_dir():
             raise TrajectoryFileError(f"{name}: is a directory, expected a trajectory .npz file")
+        if not p.is_file():  # opening a pipe would wait for a writer
+            raise TrajectoryFileError(f"{name}: not a regular file (a device or a pipe), "
+                                      "expected a trajectory .npz file")
         try:
             with open(p, "rb") as fh:
                 head = fh.read(4)
@@ -462,80 +518,234 @@ class Trajectory(Frozen):
             kind = ("a YAML model file? run 'mbody simulate MODEL -o run.npz' first"
                     if p.suffix in (".yaml", ".yml") else "not a .npz archive")
             raise TrajectoryFileError(f"{name}: not an mbody trajectory file ({kind})")
-        # here, not at the top: a simulation makes a Trajectory without reading a file, and
-        # zipfile costs a millisecond of its first call in a process
-        import zipfile
+        with NpzArchive(p, "trajectory file", max_bytes=max_bytes, error=TrajectoryFileError,
+                        more=_MORE) as z:
+            fields = _read_run(z)
+        return cls(**fields, run_file=name)
 
-        try:
-            # Open the file here: np.load leaves its own handle open when the zip is bad.
-            with open(p, "rb") as fh, np.load(fh, allow_pickle=False) as z:
-                files = set(z.files)
-                if "format" not in files:
-                    raise TrajectoryFileError(
-                        f"{name}: a .npz archive, but not an mbody trajectory (it has no "
-                        f"'format' entry; entries: {', '.join(sorted(files)[:8])})")
-                fmt = str(z["format"])
-                if fmt != FORMAT:
-                    raise TrajectoryFileError(f"{name}: a '{fmt}' file, not an mbody "
-                                              f"trajectory ('{FORMAT}')")
-                version = int(z["version"]) if "version" in files else -1
-                if version > FORMAT_VERSION or version < 1:
-                    raise TrajectoryFileError(
-                        f"{name}: trajectory format version {version}; this mbody reads "
-                        f"version {FORMAT_VERSION}" + (" (upgrade mbody)"
-                                                       if version > FORMAT_VERSION else ""))
-                missing = [k for k in ("t", "position", "velocity", "orientation",
-                                       "angular_velocity", "dimension", "body_names")
-                           if k not in files]
-                if missing:
-                    raise TrajectoryFileError(f"{name}: incomplete trajectory, missing "
-                                              f"{', '.join(missing)}")
-                arrays = {k: z[k] for k in _ARRAYS if k in files}
-                texts = {k: str(z[k]) for k in _TEXTS if k in files}
-                series = {k[len(_SERIES):]: z[k] for k in files if k.startswith(_SERIES)}
-                traj = cls(
-                    t=arrays["t"], position=arrays["position"], velocity=arrays["velocity"],
-                    orientation=arrays["orientation"],
-                    angular_velocity=arrays["angular_velocity"],
-                    body_names=tuple(str(s) for s in z["body_names"]),
-                    dimension=int(z["dimension"]),
-                    reaction_labels=tuple(str(s) for s in z["reaction_labels"])
-                    if "reaction_labels" in files else (),
-                    reactions=arrays.get("reactions", np.zeros((len(arrays["t"]), 0))),
-                    info=json.loads(str(z["info"])) if "info" in files else {},
-                    mass=arrays.get("mass"), inertia=arrays.get("inertia"),
-                    shapes=tuple(json.loads(str(z["shapes"]))) if "shapes" in files else (),
-                    colors=tuple(json.loads(str(z["colors"]))) if "colors" in files else (),
-                    gravity=arrays.get("gravity", np.zeros(3)),
-                    series=series, **texts)
-        except TrajectoryFileError:
-            raise
-        except (zipfile.BadZipFile, zlib.error, EOFError, ValueError, OSError, KeyError,
-                TypeError, json.JSONDecodeError) as exc:
-            raise TrajectoryFileError(f"{name}: damaged or truncated trajectory file "
-                                      f"({type(exc).__name__}: {exc})") from None
-        traj._check(name)
-        return traj
+_MORE = "--max-bytes N on the command line, or Trajectory.load(path, max_bytes=N), reads more"
+_NEEDED = ("t", "position", "velocity", "orientation", "angular_velocity", "dimension",
+           "body_names")
+_STATE = ("position", "velocity", "orientation", "angular_velocity")
+_NUMBER = "a number"
+_TEXT = "a text"
+_INFO_KINDS = {
+    **dict.fromkeys(("integrator", "angular_momentum_kind", "energy_not_conserved",
+                     "momentum_not_conserved", "angular_momentum_not_conserved"), _TEXT),
+    **dict.fromkeys(("rtol", "atol", "fps", "t_end", "energy_initial", "energy_drift",
+                     "momentum_drift", "angular_momentum_drift"), _NUMBER),
+    **dict.fromkeys(("momentum_initial", "angular_momentum_initial"), "3 numbers"),
+    "warnings": "a list of texts", "reaction_axes": "'joint' or 'world'",
+    "drivers": "a list of drivers, each with a name, joint, kind and effort (texts)",
+    "model_values": "a list of [path, value] pairs, each path a text",
+}
+"""The kind of each ``info`` entry that a reader of runs formats or walks (`plot`, the
+notebook's table, `animate`, `in_world_axes`); other entries are kept as they are."""
 
-    def _check(self, name: str) -> None:
-        """Shapes agree with each other (a file edited by hand or cut short)."""
-        K, n, dim = len(self.t), self.n, self.dimension
-        d = 2 if dim == cv.PLANAR else 3
-        want = {"position": (K, n, d), "velocity": (K, n, d),
-                "orientation": (K, n) if d == 2 else (K, n, 4),
-                "angular_velocity": (K, n) if d == 2 else (K, n, 3)}
-        if dim not in (cv.PLANAR, cv.SPATIAL):
-            raise TrajectoryFileError(f"{name}: dimension {dim}, expected 2 or 3")
-        for k, shape in want.items():
-            if getattr(self, k).shape != shape:
-                raise TrajectoryFileError(f"{name}: '{k}' has shape {getattr(self, k).shape}, "
-                                          f"expected {shape} (K = {K} samples, n = {n} bodies)")
-        if self.mass is not None and self.mass.shape != (n,):
-            raise TrajectoryFileError(f"{name}: 'mass' has shape {self.mass.shape}, expected "
-                                      f"({n},)")
-        if self.inertia is not None and self.inertia.shape != (n, 3, 3):
-            raise TrajectoryFileError(f"{name}: 'inertia' has shape {self.inertia.shape}, "
-                                      f"expected ({n}, 3, 3)")
+
+def _read_run(z: NpzArchive) -> dict[str, Any]:
+    """The fields of the run in the archive `z`, every entry checked before it is used:
+    the format tag and version, the entries there, the arrays' shapes against each other
+    and their kinds (from the headers, before any array is inflated), then their values
+    (finite; times increasing) and the JSON entries (bounded nesting, their kinds)."""
+    name = z.name
+    if "format" not in z:
+        raise TrajectoryFileError(
+            f"{name}: a .npz archive, but not an mbody trajectory (it has no "
+            f"'format' entry; entries: {', '.join(sorted(z.files)[:8])})")
+    fmt = _text(z, "format")
+    if fmt != FORMAT:
+        raise TrajectoryFileError(f"{name}: a '{fmt}' file, not an mbody trajectory "
+                                  f"('{FORMAT}')")
+    version = _whole(z, "version") if "version" in z else -1
+    if version > FORMAT_VERSION or version < 1:
+        raise TrajectoryFileError(
+            f"{name}: trajectory format version {version}; this mbody reads version "
+            f"{FORMAT_VERSION}" + (" (upgrade mbody)" if version > FORMAT_VERSION else ""))
+    missing = [k for k in _NEEDED if k not in z]
+    if missing:
+        raise TrajectoryFileError(f"{name}: incomplete trajectory, missing "
+                                  f"{', '.join(missing)}")
+    dim = _whole(z, "dimension")
+    if dim not in (cv.PLANAR, cv.SPATIAL):
+        raise TrajectoryFileError(f"{name}: dimension {dim}, expected 2 or 3")
+    body_names = _labels(z, "body_names")
+    labels = _labels(z, "reaction_labels") if "reaction_labels" in z else ()
+    series = [k for k in z.files if k.startswith(_SERIES)]
+    _check_shapes(z, len(body_names), dim, len(labels), series)
+    arrays = {k: np.asarray(z.read(k), dtype=float) for k in (*_ARRAYS, *series) if k in z}
+    _check_finite(name, arrays, body_names)
+    K = len(arrays["t"])
+    return {
+        "t": arrays["t"], **{k: arrays[k] for k in _STATE}, "body_names": body_names,
+        "dimension": dim, "reaction_labels": labels,
+        "reactions": arrays.get("reactions", np.zeros((K, 0))),
+        "info": _json(z, "info", dict, _info_problem) if "info" in z else {},
+        "mass": arrays.get("mass"), "inertia": arrays.get("inertia"),
+        "shapes": tuple(_json(z, "shapes", list, _appearance_problem(len(body_names), dict)))
+        if "shapes" in z else (),
+        "colors": tuple(_json(z, "colors", list, _appearance_problem(len(body_names), str)))
+        if "colors" in z else (),
+        "gravity": arrays.get("gravity", np.zeros(3)),
+        "series": {k[len(_SERIES):]: arrays[k] for k in series},
+        **{k: _text(z, k) for k in _TEXTS if k in z},
+    }
+
+
+def _text(z: NpzArchive, key: str) -> str:
+    """Entry `key`: one text (a 0-d string array), as `save` writes it."""
+    m = z.members[key]
+    if m.shape != () or m.dtype.kind != "U":
+        raise z.damaged(f"'{key}' holds {_kind(m)}, expected one text")
+    return str(z.read(key))
+
+
+def _whole(z: NpzArchive, key: str) -> int:
+    """Entry `key`: one whole number (a 0-d integer array), as `save` writes it."""
+    m = z.members[key]
+    if m.shape != () or m.dtype.kind not in "iu":
+        raise z.damaged(f"'{key}' holds {_kind(m)}, expected one whole number")
+    return int(z.read(key))
+
+
+def _labels(z: NpzArchive, key: str) -> tuple[str, ...]:
+    """Entry `key`: a list of names (a 1-d string array), as `save` writes it."""
+    m = z.members[key]
+    if len(m.shape) != 1 or m.dtype.kind != "U":
+        raise z.damaged(f"'{key}' holds {_kind(m)}, expected a list of names")
+    return tuple(str(s) for s in z.read(key))
+
+
+def _kind(m: Member) -> str:
+    """'(61, 1, 2) float64 values': what a member holds, from its header."""
+    return f"{m.shape} {m.dtype} values" if m.shape else f"one {m.dtype} value"
+
+
+def _check_shapes(z: NpzArchive, n: int, dim: int, m: int, series: list[str]) -> None:
+    """The arrays' shapes agree with each other and with the names (a file edited by
+    hand, cut short, or made to claim more than it holds), and they hold numbers: from
+    their headers, before any is inflated."""
+    name = z.name
+    t = z.members["t"]
+    if len(t.shape) != 1:
+        raise TrajectoryFileError(f"{name}: 't' has shape {t.shape}, expected (K,): one "
+                                  "time per sample")
+    K = t.shape[0]
+    d = 2 if dim == cv.PLANAR else 3
+    want = {"position": (K, n, d), "velocity": (K, n, d),
+            "orientation": (K, n) if d == 2 else (K, n, 4),
+            "angular_velocity": (K, n) if d == 2 else (K, n, 3),
+            "mass": (n,), "inertia": (n, 3, 3), "gravity": (3,)}
+    for k, shape in want.items():
+        if k in z and z.shape(k) != shape:
+            raise TrajectoryFileError(f"{name}: '{k}' has shape {z.shape(k)}, expected "
+                                      f"{shape} (K = {K} samples, n = {n} bodies)")
+    if "reactions" in z:
+        got = z.shape("reactions")
+        if got != (K, m) and not (m == 0 and len(got) == 2 and 0 in got):
+            raise TrajectoryFileError(f"{name}: 'reactions' has shape {got}, expected "
+                                      f"{(K, m)} (K = {K} samples, {m} reaction labels)")
+    for k in series:
+        got = z.shape(k)
+        if not got or got[0] != K or (k == _SERIES + "angular_momentum" and got != (K, 3)):
+            expected = "(K, 3)" if k == _SERIES + "angular_momentum" else "(K, ...)"
+            raise TrajectoryFileError(f"{name}: '{k}' has shape {got}, expected {expected}: "
+                                      f"one value per sample (K = {K} samples)")
+    for k in (*_ARRAYS, *series):
+        if k in z and z.members[k].dtype.kind not in "fiu":
+            raise z.damaged(f"'{k}' holds {_kind(z.members[k])}, expected numbers")
+
+
+def _check_finite(name: str, arrays: dict[str, np.ndarray], body_names: tuple[str, ...]
+                  ) -> None:
+    """Times finite and increasing; states, masses, inertias and gravity finite: every
+    reader divides by time steps, fits a camera around the positions, sums energies."""
+    t = arrays["t"]
+    bad = np.flatnonzero(~np.isfinite(t))
+    if len(bad):
+        raise TrajectoryFileError(f"{name}: damaged trajectory file: 't' holds {t[bad[0]]} at "
+                                  f"sample {bad[0]} (a run's times are finite numbers)")
+    back = np.flatnonzero(np.diff(t) <= 0)
+    if len(back):
+        k = int(back[0])
+        raise TrajectoryFileError(f"{name}: damaged trajectory file: the times 't' do not "
+                                  f"increase: sample {k + 1} is at t = {t[k + 1]:g} s, after "
+                                  f"t = {t[k]:g} s at sample {k}")
+    for key in (*_STATE, "mass", "inertia", "gravity"):
+        a = arrays.get(key)
+        if a is None or np.isfinite(a).all():
+            continue
+        at = tuple(int(i) for i in np.argwhere(~np.isfinite(a))[0])
+        if key in _STATE:
+            where = f"at sample {at[0]} (t = {t[at[0]]:g} s), body {body_names[at[1]]!r}"
+        elif key == "gravity":
+            where = f"in component {at[0]}"
+        else:
+            where = f"for body {body_names[at[0]]!r}"
+        raise TrajectoryFileError(f"{name}: damaged trajectory file: '{key}' holds {a[at]} "
+                                  f"{where} (a run's values are finite numbers)")
+
+
+def _json(z: NpzArchive, key: str, kind: type, problem: Any) -> Any:
+    """Entry `key`: JSON text (nesting bounded: `jsontext.loads`) of a `kind` value that
+    `problem(value)` finds nothing wrong with."""
+    try:
+        value = jsontext.loads(_text(z, key))
+    except ValueError as exc:
+        raise z.damaged(f"'{key}' is not JSON that mbody reads: {exc}") from None
+    if not isinstance(value, kind):
+        raise z.damaged(f"'{key}' holds a JSON {type(value).__name__}, expected "
+                        f"{'an object' if kind is dict else 'a list'}")
+    wrong = problem(value)
+    if wrong:
+        raise z.damaged(f"'{key}': {wrong}")
+    return value
+
+
+def _appearance_problem(n: int, kind: type) -> Any:
+    """A check of the `shapes` or `colors` list: one entry per body (or none), each null
+    or a `kind`."""
+    def problem(items: list) -> str:
+        if len(items) not in (0, n):
+            return f"{len(items)} entries for {n} bodies"
+        wrong = [i for i, v in enumerate(items) if v is not None and not isinstance(v, kind)]
+        return (f"entry {wrong[0]} is {items[wrong[0]]!r}, expected null or "
+                f"{'an object' if kind is dict else 'a text'}") if wrong else ""
+    return problem
+
+
+def _info_problem(info: dict) -> str:
+    """What is wrong with the run's `info`: the first entry a reader uses that is not of
+    its kind (`_INFO_KINDS`), or ''."""
+    def number(v: Any) -> bool:
+        return isinstance(v, int | float)
+
+    def text_pair(v: Any) -> bool:
+        return isinstance(v, list) and len(v) == 2 and isinstance(v[0], str)
+
+    def driver(v: Any) -> bool:
+        return isinstance(v, dict) and all(isinstance(v.get(k), str)
+                                           for k in ("name", "joint", "kind", "effort"))
+
+    fits = {_TEXT: lambda v: isinstance(v, str), _NUMBER: number,
+            "3 numbers": lambda v: isinstance(v, list) and len(v) == 3
+            and all(map(number, v)),
+            "a list of texts": lambda v: isinstance(v, list)
+            and all(isinstance(w, str) for w in v),
+            "'joint' or 'world'": lambda v: v in ("joint", "world"),
+            _INFO_KINDS["drivers"]: lambda v: isinstance(v, list) and all(map(driver, v)),
+            _INFO_KINDS["model_values"]: lambda v: isinstance(v, list)
+            and all(map(text_pair, v))}
+    for key, kind in _INFO_KINDS.items():
+        if key in info and not fits[kind](info[key]):
+            return f"its entry {key!r} is {_short(info[key])}, expected {kind}"
+    return ""
+
+
+def _short(value: Any) -> str:
+    """A JSON value in at most 60 characters, for a message."""
+    text = json.dumps(value)
+    return text if len(text) <= 60 else text[:57] + "..."
 
 
 def _jsonable(x: Any) -> Any:

@@ -8,12 +8,16 @@ estimate that is not computed, or infinite because the system is singular). nump
 scalars and arrays become JSON numbers and lists, tuples become lists.
 
     dumps({"condition": float("inf")})     # '{\\n  "condition": null\\n}'
+
+Read the other way, from a file that may be hostile (a run's info, a JSON export),
+`loads` bounds the nesting before Python's parser recurses into it.
 """
 
 from __future__ import annotations
 
 import json
 import math
+import re
 from collections.abc import Mapping
 from typing import IO, Any
 
@@ -83,3 +87,53 @@ def dump(value: Any, fh: IO[str], *, indent: int | None = 2) -> None:
     """
     fh.write(dumps(value, indent=indent))
     fh.write("\n")
+
+
+MAX_DEPTH = 64
+"""Deepest nesting of arrays and objects `loads` parses (as for a model file's YAML,
+`mbody.model.loader.MAX_DEPTH`); what mbody writes nests 4 deep at most."""
+
+_STRING = re.compile(r'"[^"\\]*(?:\\.[^"\\]*)*"')
+_NOT_BRACKETS = bytes(b for b in range(256) if b not in b"[]{}")
+
+
+def nesting(text: str) -> int:
+    """How deep the arrays and objects of JSON `text` nest (brackets inside strings do not
+    count), in time linear in the text: the strings and every other character are
+    dropped by C scans, then the brackets' running depth is one numpy sum."""
+    brackets = _STRING.sub("", text).encode("utf-8", "surrogatepass").translate(
+        None, _NOT_BRACKETS)
+    if not brackets:
+        return 0
+    step = np.frombuffer(brackets, dtype=np.uint8)
+    opens = (step == ord("[")) | (step == ord("{"))
+    return int(np.cumsum(np.where(opens, 1, -1), dtype=np.int64).max())
+
+
+def loads(text: str, *, max_depth: int = MAX_DEPTH) -> Any:
+    """`json.loads(text)` for text that may be hostile: refused before parsing when its
+    arrays and objects nest deeper than `max_depth` (Python's parser recurses once a
+    level, and a file of 10 000 ``[`` would end in a RecursionError).
+
+    Parameters
+    ----------
+    text : str
+        JSON text (``NaN`` and ``Infinity`` are read, as Python's `json` writes them).
+    max_depth : int
+        The deepest nesting accepted.
+
+    Returns
+    -------
+    Any
+        The parsed value.
+
+    Raises
+    ------
+    ValueError
+        The text nests deeper than `max_depth` (saying how deep), or is not JSON
+        (`json.JSONDecodeError`, a `ValueError`).
+    """
+    depth = nesting(text)
+    if depth > max_depth:
+        raise ValueError(f"JSON nested {depth} deep; at most {max_depth} levels are read")
+    return json.loads(text)

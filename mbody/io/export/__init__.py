@@ -99,13 +99,21 @@ def write_export(asm: Assembly | ExportedAssembly, path: str | os.PathLike[str],
     return path
 
 
-def load_export(path: str | os.PathLike[str]) -> ExportedAssembly:
+def load_export(path: str | os.PathLike[str], *, max_bytes: int | None = None
+                ) -> ExportedAssembly:
     """Reload any export (.npz, .mat, .json file, or a CSV folder) as an `ExportedAssembly`.
+
+    The file is read as input that may be hostile (an export from someone else): its
+    size, what it declares and its nesting are checked before it is inflated or parsed.
 
     Parameters
     ----------
     path
         The file, or the folder `write_csv` wrote.
+    max_bytes
+        The most data read: an npz or .mat file's arrays once inflated (default 1 GiB,
+        `mbody.util.npzfile.DATA_BYTES`), a JSON file's or CSV folder's text (default
+        32 MiB, `TEXT_BYTES`); a larger export is refused before it is read.
 
     Returns
     -------
@@ -115,10 +123,10 @@ def load_export(path: str | os.PathLike[str]) -> ExportedAssembly:
     Raises
     ------
     MbodyError
-        For a missing, unreadable or foreign file.
+        For a missing, unreadable, foreign or damaged file, or one over `max_bytes`.
     """
     path = Path(path)
-    reader: Callable[[Path], ExportedAssembly]
+    reader: Callable[[Path, int | None], ExportedAssembly]
     if path.is_dir():
         reader = csvfolder.read
     else:
@@ -130,7 +138,7 @@ def load_export(path: str | os.PathLike[str]) -> ExportedAssembly:
             raise MbodyError(f"{path}: no such file")
         reader = _module(fmt).read
     try:
-        return reader(path)
+        return reader(path, max_bytes)
     except MbodyError:
         raise
     except (OSError, ValueError, KeyError, IndexError, TypeError) as exc:

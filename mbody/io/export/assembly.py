@@ -31,6 +31,7 @@ from mbody.errors import MbodyError, wrong_type
 from mbody.kernel import _core
 from mbody.model.model import Model, State
 from mbody.simulate.trajectory import FORMAT as TRAJECTORY_FORMAT
+from mbody.util import jsontext
 
 FORMAT = "mbody-export"
 """The format tag every export carries; a reader refuses any other."""
@@ -547,6 +548,20 @@ def flat_arrays(exp: ExportedAssembly) -> dict[str, Any]:
     return out
 
 
+MORE = "mbody.load_export(path, max_bytes=N) reads more"
+"""How a larger export is read, for the readers' messages (`mbody.util.npzfile`)."""
+
+
+def check_shape(path: Path, what: str, shape: tuple[int, ...], want: tuple[int, int],
+                of: str) -> None:
+    """Refuse a matrix whose shape does not fit its labels (`of` says which), before it is
+    built: a file's shape is a claim (a sparse matrix of 10^12 columns needs 8 TB for its
+    column pointers alone)."""
+    if tuple(shape) != want:
+        raise MbodyError(f"{path}: {what} is {' x '.join(map(str, shape))}; expected "
+                         f"{want[0]} x {want[1]} ({of})")
+
+
 def check_format(path: Path, fmt: str, version: int) -> None:
     """Refuse a file of another format (a saved run: how to read or export it), or of a
     newer layout than this mbody reads."""
@@ -590,6 +605,9 @@ def build(path: Path, get: Callable[[str], Any], M: sp.spmatrix | np.ndarray,
     check_format(path, str(get("format")), version)
     n = len(get("body_names"))
     m = len(get("reactions"))
+    N = len(get("coordinates"))
+    check_shape(path, "M", M.shape, (N, N), "the coordinates by the coordinates")
+    check_shape(path, "G", G.shape, (N, m), "the coordinates by the reactions")
     world: list[str] = []
     if T is not None:
         if version < 2:
@@ -613,11 +631,10 @@ def build(path: Path, get: Callable[[str], Any], M: sp.spmatrix | np.ndarray,
                       vec("column_known", m), vec("column_gamma", m), vec("column_phi", m))
     state = State(vec("position", n, 3), vec("quaternion", n, 4), vec("velocity", n, 3),
                   vec("omega", n, 3), float(get("t")))
-    N = len(get("coordinates"))
     return ExportedAssembly(
         model=str(get("model")), file=str(get("model_file")), dimension=int(get("dimension")),
         state_source=str(get("state_source")),
-        conventions=json.loads(str(get("conventions_json"))),
+        conventions=jsontext.loads(str(get("conventions_json"))),
         coordinates=[str(s) for s in get("coordinates")],
         reactions=[str(s) for s in get("reactions")], columns=columns,
         body_names=[str(s) for s in get("body_names")], masses=vec("masses", n),

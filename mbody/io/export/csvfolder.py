@@ -20,6 +20,7 @@ of T.csv to the labels info.csv lists under ``world_reactions``.
 from __future__ import annotations
 
 import csv
+import io
 import json
 import os
 from collections.abc import Iterator, Mapping, Sequence
@@ -34,13 +35,16 @@ from mbody.equations.assemble import Assembly
 from mbody.errors import MbodyError
 from mbody.io.export.assembly import (
     FORMAT,
+    MORE,
     VERSION,
     ExportedAssembly,
     as_export,
     build,
     check_format,
 )
+from mbody.util import jsontext
 from mbody.util.atomic import atomic_folder
+from mbody.util.npzfile import TEXT_BYTES, data_limit, over_budget, read_text
 
 CSV_DENSE_LIMIT = 1_000_000
 """M.csv and G.csv are labelled dense tables up to this many cells, else triplets."""
@@ -193,12 +197,15 @@ class _Table:
         return out
 
 
-def _table(path: Path) -> _Table:
+def _table(path: Path, max_bytes: int | None = None) -> _Table:
     if not path.is_file():
         raise MbodyError(f"{path}: no such file (a CSV export is a folder holding "
                          f"{', '.join(FILES)})")
-    with open(path, newline="", encoding="utf-8") as fh:
-        numbered = [(k, r) for k, r in enumerate(csv.reader(fh), start=1) if r]
+    rows = csv.reader(io.StringIO(read_text(path, max_bytes, MORE), newline=""))
+    try:
+        numbered = [(k, r) for k, r in enumerate(rows, start=1) if r]
+    except csv.Error as exc:  # a cell over csv's field size limit, a NUL...
+        raise MbodyError(f"{path}, line {rows.line_num}: {exc}") from None
     if not numbered:
         raise MbodyError(f"{path}: empty (expected a header line)")
     header = numbered[0][1]
@@ -245,10 +252,12 @@ def _matrix(t: _Table, rows: list[str], cols: list[str], what: str,
     return sp.csc_matrix(A)
 
 
-def read(folder: Path) -> ExportedAssembly:
+def read(folder: Path, max_bytes: int | None = None) -> ExportedAssembly:
     """The `ExportedAssembly` stored in the CSV folder `folder`.
 
-    Every column is found by its header name (see the module's docstring).
+    Every column is found by its header name (see the module's docstring). The files
+    hold at most `max_bytes` of text in all (default `mbody.util.npzfile.TEXT_BYTES`),
+    refused before any is read.
 
     Raises
     ------
@@ -256,18 +265,29 @@ def read(folder: Path) -> ExportedAssembly:
         For a missing file, a missing column (naming the file and the column), a cell that
         is not a number, or tables whose labels disagree.
     """
-    info_t = _table(folder / "info.csv")
+    limit = data_limit(max_bytes, TEXT_BYTES)
+    files = [folder / f for f in (*FILES, MAP_FILE) if (folder / f).is_file()]
+    holds = sum(f.stat().st_size for f in files)
+    if holds > limit:
+        raise MbodyError(over_budget(str(folder), holds, holds, limit, MORE))
+    info_t = _table(folder / "info.csv", limit)
     keys, values = info_t.text("key"), info_t.text("value")
-    info = {k: json.loads(v) for k, v in zip(keys, values, strict=True)}
+    info = {}
+    for k, v, line in zip(keys, values, info_t.lines, strict=True):
+        try:
+            info[k] = jsontext.loads(v)
+        except ValueError as exc:
+            raise MbodyError(f"{info_t.path}, line {line}: the value of {k!r} is not JSON "
+                             f"that mbody reads: {exc}") from None
     for key in _INFO_KEYS:
         if key not in info:
             raise MbodyError(f"{info_t.path}: no {key!r} entry in its 'key' column")
     check_format(info_t.path, str(info["format"]), int(info["version"]))
     conventions = {k.split(".", 1)[1]: v for k, v in info.items()
                    if k.startswith("conventions.")}
-    vectors = _table(folder / "vectors.csv")
-    cols = _table(folder / "columns.csv")
-    bodies = _table(folder / "bodies.csv")
+    vectors = _table(folder / "vectors.csv", limit)
+    cols = _table(folder / "columns.csv", limit)
+    bodies = _table(folder / "bodies.csv", limit)
     coordinates, reactions = vectors.text("coordinate"), cols.text("label")
     flat: dict[str, Any] = {k: info[k] for k in _INFO_KEYS}
     flat.update({
@@ -286,12 +306,12 @@ def read(folder: Path) -> ExportedAssembly:
     })
     for head, name in _COLUMN_TEXT.items():
         flat[name] = cols.text(head)
-    M = _matrix(_table(folder / "M.csv"), coordinates, coordinates, "vectors.csv")
-    G = _matrix(_table(folder / "G.csv"), coordinates, reactions, "columns.csv")
+    M = _matrix(_table(folder / "M.csv", limit), coordinates, coordinates, "vectors.csv")
+    G = _matrix(_table(folder / "G.csv", limit), coordinates, reactions, "columns.csv")
     T = None
     if "world_reactions" in info:  # the world-axes map, written when asked for
         world = [str(s) for s in info["world_reactions"]]
         flat["world_reactions"] = world
-        T = _matrix(_table(folder / MAP_FILE), world, reactions, "columns.csv", "world",
+        T = _matrix(_table(folder / MAP_FILE, limit), world, reactions, "columns.csv", "world",
                     "info.csv's world_reactions")
     return build(folder, flat.__getitem__, M, G, T)

@@ -21,8 +21,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from mbody.errors import MbodyError
-from mbody.io.export.assembly import text_array
+from mbody.io.export.assembly import MORE, text_array
+from mbody.io.export.mat import checked
+from mbody.util import jsontext
 from mbody.util.atomic import atomic_path
+from mbody.util.npzfile import NpzArchive, read_text
 
 if TYPE_CHECKING:
     from mbody.equations.generalized import Generalized
@@ -97,14 +100,19 @@ def write_generalized(g: Generalized, path: str | os.PathLike[str]) -> Path:
     return path
 
 
-def read_generalized(path: str | os.PathLike[str]) -> dict[str, Any]:
+def read_generalized(path: str | os.PathLike[str], max_bytes: int | None = None
+                     ) -> dict[str, Any]:
     """An export read back: the fields of `generalized_data` (labels as lists of str,
-    matrices as arrays; .mat effort rows back to 0-based)."""
+    matrices as arrays; .mat effort rows back to 0-based). Read as `mbody.load_export`
+    reads a file, as input that may be hostile: at most `max_bytes` (an npz or .mat
+    file's arrays once inflated, default 1 GiB; a JSON file's text, default 32 MiB),
+    every declared size checked before anything is inflated, nesting bounded."""
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix == ".npz":
-        with np.load(path, allow_pickle=False) as z:
-            out: dict[str, Any] = {k: z[k] for k in z.files}
+        with NpzArchive(path, "export file", max_bytes=max_bytes, more=MORE,
+                        damage="not a readable mbody export") as z:
+            out: dict[str, Any] = {k: z.read(k) for k in z.files}
         for k in _TEXT:
             out[k] = [str(x) for x in out[k]]
         for k in ("model", "model_file", "equation"):
@@ -114,15 +122,14 @@ def read_generalized(path: str | os.PathLike[str]) -> dict[str, Any]:
     if suffix == ".mat":
         import scipy.io  # slow to import: only for .mat files
 
-        raw = scipy.io.loadmat(path, simplify_cells=True)
+        raw = scipy.io.loadmat(checked(path, max_bytes), simplify_cells=True)
         out = {k: v for k, v in raw.items() if not k.startswith("__")}
         for k in _TEXT:
             v = out.get(k, [])
             out[k] = [str(v)] if isinstance(v, str) else [str(x) for x in np.atleast_1d(v)]
         out["effort_rows"] = (np.atleast_1d(out["effort_rows"]) - 1).astype(int).tolist()
         return out
-    with open(path, encoding="utf-8") as fh:
-        doc = json.load(fh)
+    doc = jsontext.loads(read_text(path, max_bytes, MORE))
     for k in ("q", "qdot", "M", "f", "T", "v_e", "a0"):
         doc[k] = np.asarray(doc[k], float)
     return doc

@@ -25,8 +25,10 @@ from mbody.io.export.assembly import (
     ExportedAssembly,
     build,
     check_format,
+    check_shape,
 )
 from mbody.util import jsontext
+from mbody.util.npzfile import read_text
 
 
 def _triplets(A: sp.csc_matrix) -> dict[str, Any]:
@@ -85,10 +87,11 @@ def schema() -> dict[str, Any]:
     return out
 
 
-def read(path: Path) -> ExportedAssembly:
-    """The `ExportedAssembly` stored in the JSON file `path`."""
-    with open(path, encoding="utf-8") as fh:
-        d = json.load(fh)
+def read(path: Path, max_bytes: int | None = None) -> ExportedAssembly:
+    """The `ExportedAssembly` stored in the JSON file `path`: at most `max_bytes` of text
+    (default `mbody.util.npzfile.TEXT_BYTES`), refused before it is read; its nesting
+    bounded before it is parsed (`mbody.util.jsontext.loads`)."""
+    d = jsontext.loads(read_text(path, max_bytes))
     if not isinstance(d, dict):
         raise MbodyError(f"{path}: not an mbody export (not a JSON object)")
     check_format(path, str(d.get("format")), int(d.get("version", 0)))
@@ -125,12 +128,23 @@ def from_json(d: dict[str, Any], path: Path | str = "<json>") -> ExportedAssembl
     for k in COLUMN_TEXT[1:]:
         flat[f"column_{k}"] = [c[k] for c in cols]
 
-    def mat(t: dict[str, Any]) -> sp.csc_matrix:
-        return sp.csc_matrix((t["value"], (t["row"], t["col"])), shape=tuple(t["shape"]))
+    def mat(name: str, t: dict[str, Any], rows: list, of: str) -> sp.csc_matrix:
+        # the shape checked before the matrix is made: its column pointers take 8 bytes
+        # per column the file claims
+        shape = tuple(int(k) for k in t["shape"])
+        check_shape(Path(path), name, shape, (len(rows), len(d["reactions"])), of)
+        return sp.csc_matrix((t["value"], (t["row"], t["col"])), shape=shape)
 
     world = d.get("world")
     if world is not None:
         flat["world_reactions"] = world["reactions"]
-    return build(Path(path), flat.__getitem__, mat(d["M"]), mat(d["G"]),
-                 None if world is None else mat(world["T"]))
+    coords = d["coordinates"]
+    M_shape = tuple(int(k) for k in d["M"]["shape"])
+    check_shape(Path(path), "M", M_shape, (len(coords), len(coords)),
+                "the coordinates by the coordinates")
+    M = sp.csc_matrix((d["M"]["value"], (d["M"]["row"], d["M"]["col"])), shape=M_shape)
+    return build(Path(path), flat.__getitem__, M,
+                 mat("G", d["G"], coords, "the coordinates by the reactions"),
+                 None if world is None else mat("T", world["T"], world["reactions"],
+                                                "the world labels by the reactions"))
 

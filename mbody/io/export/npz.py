@@ -13,12 +13,14 @@ import scipy.sparse as sp
 
 from mbody.errors import MbodyError
 from mbody.io.export.assembly import (
+    MORE,
     ExportedAssembly,
     build,
     check_format,
     flat_arrays,
     text_array,
 )
+from mbody.util.npzfile import NpzArchive
 
 
 def write(exp: ExportedAssembly, path: Path) -> None:
@@ -46,10 +48,13 @@ def write(exp: ExportedAssembly, path: Path) -> None:
         np.savez_compressed(fh, **arrays)
 
 
-def read(path: Path) -> ExportedAssembly:
-    """The `ExportedAssembly` stored in the npz file `path` (never unpickles anything)."""
-    with np.load(path, allow_pickle=False) as z:
-        data = {k: z[k] for k in z.files}
+def read(path: Path, max_bytes: int | None = None) -> ExportedAssembly:
+    """The `ExportedAssembly` stored in the npz file `path` (never unpickles anything;
+    every member's size checked before any is inflated, at most `max_bytes` in all:
+    `mbody.util.npzfile`)."""
+    with NpzArchive(path, "export file", max_bytes=max_bytes, more=MORE,
+                    damage="not a readable mbody export") as z:
+        data = {k: z.read(k) for k in z.files}
 
     def get(k: str) -> Any:
         v = data[k]

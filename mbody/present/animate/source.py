@@ -70,15 +70,24 @@ def _load_trajectory(path: Path) -> Trajectory:
 
 
 def _model_of(traj: Trajectory, path: Path) -> Model:
-    """The run's model: from the YAML text it carries, else from the file it names."""
+    """The run's model: from the YAML text it carries, else from the file it names. The
+    run may come from someone else: a file it names that is not a model is refused
+    without a word of its content (the model reader would quote the text it stumbles
+    on, the first line of any file the run names)."""
 
     if getattr(traj, "model_yaml", ""):
-        return traj.model()
+        return traj.model()  # StoredModelError names the run, not the file it names
     if not traj.model_file:
         raise MbodyError(f"{path} does not say which model it came from: pass --model MODEL")
     for where in (Path(traj.model_file), path.parent / traj.model_file):
         if where.is_file():
-            return load_model(where)
+            try:
+                return load_model(where)
+            except MbodyError:
+                raise MbodyError(
+                    f"{path} carries no model text, and the file it names as its model, "
+                    f"{str(where)!r}, is not a model mbody reads ('mbody check {where}' "
+                    "says why): pass --model MODEL") from None
     raise MbodyError(f"{path} was computed from {traj.model_file}, which is not found: "
                      "pass --model MODEL")
 

@@ -1,0 +1,269 @@
+"""Exports read back as hostile input (review R1, B3/B4 applied to `mbody.load_export`
+and `read_generalized`): nesting, declared sizes and compressed bombs in npz, .mat,
+JSON and CSV files are refused with an `MbodyError` naming the file and what is wrong,
+before anything large is allocated or inflated."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import struct
+import subprocess
+import sys
+import tracemalloc
+import zipfile
+import zlib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import mbody
+from mbody.errors import MbodyError
+from mbody.io.export import write_csv, write_export
+from mbody.io.export.generalized import read_generalized
+
+MODELS = Path(__file__).resolve().parent.parent / "models"
+MIB = 1 << 20
+
+
+@pytest.fixture(scope="module")
+def exports(tmp_path_factory) -> Path:
+    """The pendulum's export in every format, in one folder."""
+    out = tmp_path_factory.mktemp("exports")
+    asm = mbody.assemble(mbody.load(MODELS / "pendulum.yaml"))
+    for suffix in (".npz", ".json", ".mat"):
+        write_export(asm, out / f"p{suffix}")
+    write_csv(asm, out / "p_csv")
+    return out
+
+
+def refused(path: Path, *words: str, **kw) -> str:
+    """The message of `load_export(path)`'s MbodyError: it names `path` and `words`."""
+    with pytest.raises(MbodyError) as exc:
+        mbody.load_export(path, **kw)
+    text = str(exc.value)
+    assert text.startswith(f"{path}"), text
+    for w in words:
+        assert w in text, (w, text)
+    return text
+
+
+def peak_bytes(load, *args, **kw) -> int:
+    """The most memory Python and numpy held while `load(*args, **kw)` ran."""
+    tracemalloc.start()
+    with contextlib.suppress(MbodyError):  # the refusal is checked by the caller
+        load(*args, **kw)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    return peak
+
+
+# -- npz ---------------------------------------------------------------------------------
+
+
+def npz_with(path: Path, data: dict, member: str, header: dict, body: bytes,
+             method: int = zipfile.ZIP_STORED) -> Path:
+    """`data` as an npz whose `member` has the .npy `header` and the bytes `body`."""
+    with zipfile.ZipFile(path, "w", method) as z:
+        for k, v in data.items():
+            b = io.BytesIO()
+            if k == member:
+                np.lib.format.write_array_header_1_0(b, header)
+                b.write(body)
+            else:
+                np.save(b, v)
+            z.writestr(k + ".npy", b.getvalue())
+    return path
+
+
+def test_npz_json_nested_too_deeply(exports, tmp_path):
+    with np.load(exports / "p.npz") as z:
+        data = dict(z)
+    data["conventions_json"] = np.array("[" * 10000)
+    np.savez(tmp_path / "deep.npz", **data)
+    refused(tmp_path / "deep.npz", "nested 10000 deep", "at most 64")
+
+
+def test_npz_header_claiming_more_than_the_member_holds(exports, tmp_path):
+    with np.load(exports / "p.npz") as z:
+        data = dict(z)
+    path = npz_with(tmp_path / "liar.npz", data, "b",
+                    {"descr": "<f8", "fortran_order": False, "shape": (10**15,)}, bytes(16))
+    refused(path, "not a readable mbody export", "member b.npy",
+            "1,000,000,000,000,000 values", "16 bytes")
+
+
+def test_npz_bomb_is_refused_before_it_is_inflated(exports, tmp_path):
+    """b.npy inflates to 64 MiB from about 64 kB: over a 16 MiB budget, it is refused from
+    the zip directory, nothing inflated."""
+    with np.load(exports / "p.npz") as z:
+        data = dict(z)
+    path = npz_with(tmp_path / "bomb.npz", data, "b",
+                    {"descr": "<f8", "fortran_order": False, "shape": (8 * MIB,)},
+                    bytes(64 * MIB), zipfile.ZIP_DEFLATED)
+    assert path.stat().st_size < MIB
+    refused(path, "holds 64 MiB of data once inflated", "at most 16 MiB",
+            "max_bytes=N", max_bytes=16 * MIB)
+    assert peak_bytes(mbody.load_export, path, max_bytes=16 * MIB) < 4 * MIB
+
+
+# -- JSON --------------------------------------------------------------------------------
+
+
+def test_json_nested_too_deeply(tmp_path):
+    path = tmp_path / "deep.json"
+    path.write_text('{"format": "mbody-export", "version": 2, "x": ' + "[" * 100000
+                    + "]" * 100000 + "}")
+    refused(path, "nested 100001 deep", "at most 64")
+
+
+def test_json_matrix_shape_is_checked_before_the_matrix_is_made(exports, tmp_path):
+    """A shape of 10^12 x 10^12 with no entries: its column pointers alone were 8 TB (a
+    MemoryError)."""
+    doc = json.loads((exports / "p.json").read_text())
+    doc["M"]["shape"] = [10**12, 10**12]
+    path = tmp_path / "big.json"
+    path.write_text(json.dumps(doc))
+    refused(path, "M is 1000000000000 x 1000000000000", "expected 3 x 3")
+    doc = json.loads((exports / "p.json").read_text())
+    doc["G"]["shape"] = [3, 10**12]
+    path.write_text(json.dumps(doc))
+    refused(path, "G is 3 x 1000000000000", "expected 3 x 2")
+
+
+def test_json_larger_than_the_budget_is_refused_unread(exports):
+    size = (exports / "p.json").stat().st_size
+    refused(exports / "p.json", f"holds {size / 1024:.3g} KiB ({size:,} bytes) of data",
+            "at most 1 KiB", max_bytes=1024)
+
+
+# -- .mat --------------------------------------------------------------------------------
+
+
+def tag(kind: int, data: bytes) -> bytes:
+    """A MAT 5 data element: type, size, data padded to 8 bytes."""
+    return struct.pack("<II", kind, len(data)) + data + bytes(-len(data) % 8)
+
+
+def array(cls: int, shape: tuple[int, ...], body: bytes = b"", name: bytes = b"") -> bytes:
+    """An miMATRIX element of MATLAB class `cls` (1 cell, 6 double) and `shape`."""
+    return tag(14, tag(6, struct.pack("<II", cls, 0))
+               + tag(5, struct.pack(f"<{len(shape)}i", *shape)) + tag(1, name) + body)
+
+
+def mat_file(path: Path, *variables: bytes, version: bytes = b"5.0") -> Path:
+    """A MAT file of `variables`, each compressed (as scipy writes them)."""
+    text = b"MATLAB " + version + b" MAT-file, written by a test"
+    head = text.ljust(116) + bytes(8) + struct.pack("<H", 0x0100 if version == b"5.0"
+                                                    else 0x0200) + b"IM"
+    body = b"".join(struct.pack("<II", 15, len(c)) + c
+                    for c in (zlib.compress(v) for v in variables))
+    path.write_bytes(head + body)
+    return path
+
+
+def test_the_mat_writer_of_these_tests_writes_what_scipy_reads(tmp_path):
+    import scipy.io
+
+    ones = array(6, (2, 1), tag(9, struct.pack("<2d", 1.0, 2.0)), b"x")
+    got = scipy.io.loadmat(mat_file(tmp_path / "ok.mat", ones))["x"]
+    np.testing.assert_array_equal(got, [[1.0], [2.0]])
+
+
+def test_mat_cells_nested_too_deeply(tmp_path):
+    """scipy's reader recurses once a level, in C: 20 000 cells in cells crashed the
+    process (a segmentation fault), so the file is read in a child process here."""
+    inner = array(6, (0, 0), tag(9, b""))
+    flags_shape_name = (tag(6, struct.pack("<II", 1, 0)) + tag(5, struct.pack("<2i", 1, 1))
+                        + tag(1, b""))
+    depth = 20_000
+    heads = [struct.pack("<II", 14, len(inner) + k * (8 + len(flags_shape_name))
+                         + len(flags_shape_name)) + flags_shape_name
+             for k in range(depth - 1, -1, -1)]  # the outermost first, each around the next
+    path = mat_file(tmp_path / "deep.mat", b"".join([*heads, inner]))
+    child = subprocess.run(
+        [sys.executable, "-c", "import sys, mbody\ntry:\n mbody.load_export(sys.argv[1])\n"
+         "except mbody.MbodyError as e:\n print(e)", str(path)],
+        capture_output=True, text=True, timeout=120)
+    assert child.returncode == 0, child.stderr
+    assert child.stdout.startswith(f"{path}: damaged or truncated .mat export")
+    assert "nested over 64 deep" in child.stdout
+
+
+def test_mat_cell_shape_beyond_its_bytes(tmp_path):
+    """A cell array declaring 2^24 slots in no bytes: scipy allocated the 128 MiB of
+    their pointers (and 2^28 slots, 2 GiB) before it found nothing to put in them."""
+    path = mat_file(tmp_path / "cells.mat", array(1, (2**24, 1), name=b"c"))
+    refused(path, "a cell array of shape (16777216, 1) in 0 bytes")
+    assert peak_bytes(mbody.load_export, path) < 4 * MIB
+
+
+def test_mat_bomb_is_refused_before_it_is_inflated(tmp_path):
+    zeros = array(6, (8 * MIB, 1), tag(9, bytes(64 * MIB)), b"b")
+    path = mat_file(tmp_path / "bomb.mat", zeros)
+    del zeros
+    assert path.stat().st_size < MIB
+    refused(path, "holds 64 MiB of data once inflated", "at most 16 MiB",
+            max_bytes=16 * MIB)
+    assert peak_bytes(mbody.load_export, path, max_bytes=16 * MIB) < 4 * MIB
+
+
+def test_mat_files_of_other_versions_are_refused(tmp_path):
+    """A v7.3 (HDF5) file made scipy raise NotImplementedError (not an MbodyError)."""
+    path = mat_file(tmp_path / "v73.mat", array(6, (0, 0), tag(9, b""), b"x"), version=b"7.3")
+    refused(path, "not a MATLAB 5 .mat file as mbody writes it")
+
+
+def test_a_good_mat_export_reads_back_as_the_npz_one(exports):
+    a, b = mbody.load_export(exports / "p.mat"), mbody.load_export(exports / "p.npz")
+    assert (a.M != b.M).nnz == 0 and (a.G != b.G).nnz == 0
+    assert a.coordinates == b.coordinates and a.conventions == b.conventions
+
+
+# -- CSV ---------------------------------------------------------------------------------
+
+
+def csv_copy(exports: Path, tmp_path: Path) -> Path:
+    out = tmp_path / "csv"
+    out.mkdir()
+    for f in (exports / "p_csv").iterdir():
+        (out / f.name).write_bytes(f.read_bytes())
+    return out
+
+
+def test_csv_info_value_nested_too_deeply(exports, tmp_path):
+    folder = csv_copy(exports, tmp_path)
+    info = folder / "info.csv"
+    info.write_text(info.read_text() + 'deep,"' + "[" * 10000 + '"\n')
+    text = refused(folder, "info.csv, line", "the value of 'deep'", "nested 10000 deep")
+    assert str(info) in text
+
+
+def test_csv_field_over_the_csv_limit_names_file_and_line(exports, tmp_path):
+    """A cell longer than csv's field limit (128 kB) was a csv.Error (not an MbodyError)."""
+    folder = csv_copy(exports, tmp_path)
+    bodies = folder / "bodies.csv"
+    lines = bodies.read_text().splitlines()
+    bodies.write_text("\n".join([*lines, '"' + "x" * 200_000 + '"']) + "\n")
+    text = refused(folder, "field larger than field limit")
+    assert f"{bodies}, line {len(lines) + 1}" in text
+
+
+def test_csv_folder_larger_than_the_budget(exports, tmp_path):
+    refused(exports / "p_csv", "at most 1 KiB", "max_bytes=N", max_bytes=1024)
+
+
+# -- the generalized equations' exports ----------------------------------------------------
+
+
+def test_read_generalized_is_bounded_the_same_way(tmp_path):
+    deep = tmp_path / "g.json"
+    deep.write_text("[" * 10000)
+    with pytest.raises(ValueError, match="nested 10000 deep"):
+        read_generalized(deep)
+    liar = npz_with(tmp_path / "g.npz", {"q": np.zeros(2)}, "q",
+                    {"descr": "<f8", "fortran_order": False, "shape": (10**15,)}, bytes(16))
+    with pytest.raises(MbodyError, match="member q.npy"):
+        read_generalized(liar)

@@ -1,0 +1,187 @@
+"""Benchmark: reading run files (`Trajectory.load`) is linear in what they hold, and a
+hostile file is refused in milliseconds whatever it claims.
+
+Prints two tables:
+
+- good runs of N spatial bodies over K samples (saved by `Trajectory.save`, compressed):
+  the bytes on disk and once inflated, the best load time, and the time per inflated MiB,
+  which stays about constant as the run grows (linear reading);
+- the review's hostile files (R1, B3/B4), built here: a 2 MB zip bomb whose t.npy inflates
+  to 2 GiB, a header that claims 10^15 samples in 16 bytes, an `info` nested 10 000 deep,
+  the same bomb as a .mat export (`mbody.load_export`): the time to the refusal and the
+  peak memory Python and numpy held meanwhile (tracemalloc), with the message's start.
+
+    python tools/bench_run_files.py [--repeat 3] [--largest 200000]
+
+Before the bounds (mbody of review R1), the bomb took 14 s and 2.2 GB of memory to be
+refused, the liar and the nesting ended in a MemoryError or RecursionError (exit 70).
+"""
+
+from __future__ import annotations
+
+import argparse
+import io
+import struct
+import sys
+import tempfile
+import time
+import tracemalloc
+import zipfile
+import zlib
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+if str(ROOT) not in sys.path:  # run from a checkout without installing
+    sys.path.insert(0, str(ROOT))
+if str(ROOT / "tools") not in sys.path:  # tools/timing.py, also when loaded by path
+    sys.path.insert(0, str(ROOT / "tools"))
+
+from timing import best  # noqa: E402
+
+import mbody  # noqa: E402
+from mbody.errors import MbodyError  # noqa: E402
+from mbody.simulate.trajectory import Trajectory  # noqa: E402
+
+MIB = 1 << 20
+
+
+def tumbling(n: int, K: int, seed: int = 0) -> Trajectory:
+    """n free bodies over K samples, each drifting and spinning (random rates): data that
+    compresses as little as a real run's."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(K) / 60.0
+    v, w = rng.uniform(-1, 1, (n, 3)), rng.uniform(-2, 2, (n, 3))
+    pos = t[:, None, None] * v + rng.uniform(-5, 5, (n, 3))
+    angle = t[:, None] * np.linalg.norm(w, axis=1)
+    axis = w / np.linalg.norm(w, axis=1)[:, None]
+    quat = np.concatenate((np.cos(angle / 2)[..., None],
+                           np.sin(angle / 2)[..., None] * axis), axis=2)
+    return Trajectory(t, pos, np.broadcast_to(v, pos.shape).copy(), quat,
+                      np.broadcast_to(w, pos.shape).copy(), tuple(f"b{i}" for i in range(n)),
+                      3, model_name="tumbling", mass=np.ones(n),
+                      inertia=np.broadcast_to(np.eye(3), (n, 3, 3)).copy(),
+                      gravity=np.zeros(3))
+
+
+def inflated(path: Path) -> int:
+    with zipfile.ZipFile(path) as z:
+        return sum(i.file_size for i in z.infolist())
+
+
+def good_runs(folder: Path, repeat: int, largest: int) -> None:
+    print("good runs (Trajectory.load): reading time against what the run holds")
+    print(f"{'bodies x samples':>18} {'on disk':>10} {'inflated':>10} {'load':>9} "
+          f"{'per MiB':>9}")
+    n, samples = 10, 1000
+    while samples <= largest:
+        path = folder / f"run_{n}_{samples}.npz"
+        tumbling(n, samples).save(path)
+        size = inflated(path)
+        t = best(lambda path=path: Trajectory.load(path), repeat)
+        print(f"{n:>8} x {samples:<8} {path.stat().st_size / MIB:>8.2f} M "
+              f"{size / MIB:>8.2f} M {t * 1e3:>7.1f} ms {t * 1e3 / (size / MIB):>6.2f} ms")
+        path.unlink()
+        samples *= 4
+
+
+def bomb_run(path: Path, good: dict[str, np.ndarray], samples: int) -> Path:
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
+        for k, v in good.items():
+            if k == "t":
+                head = io.BytesIO()
+                np.lib.format.write_array_header_1_0(
+                    head, {"descr": "<f8", "fortran_order": False, "shape": (samples,)})
+                with z.open("t.npy", "w", force_zip64=True) as f:
+                    f.write(head.getvalue())
+                    for _ in range(samples * 8 // (16 * MIB)):
+                        f.write(bytes(16 * MIB))
+            else:
+                b = io.BytesIO()
+                np.save(b, v)
+                z.writestr(k + ".npy", b.getvalue())
+    return path
+
+
+def liar_run(path: Path, good: dict[str, np.ndarray]) -> Path:
+    with zipfile.ZipFile(path, "w") as z:
+        for k, v in good.items():
+            b = io.BytesIO()
+            if k == "t":
+                np.lib.format.write_array_header_1_0(
+                    b, {"descr": "<f8", "fortran_order": False, "shape": (10**15,)})
+                b.write(bytes(16))
+            else:
+                np.save(b, v)
+            z.writestr(k + ".npy", b.getvalue())
+    return path
+
+
+def bomb_mat(path: Path, samples: int) -> Path:
+    """A .mat whose one compressed double array inflates to 8 bytes a sample."""
+    def tag(kind: int, size: int) -> bytes:
+        return struct.pack("<II", kind, size)
+
+    data = 8 * samples
+    body = (tag(6, 8) + struct.pack("<II", 6, 0) + tag(5, 8) + struct.pack("<2i", samples, 1)
+            + tag(1, 1) + b"b" + bytes(7) + tag(9, data))
+    deflate = zlib.compressobj()
+    parts = [deflate.compress(tag(14, len(body) + data) + body)]
+    for _ in range(data // (16 * MIB)):
+        parts.append(deflate.compress(bytes(16 * MIB)))
+    parts.append(deflate.flush())
+    packed = b"".join(parts)
+    head = b"MATLAB 5.0 MAT-file".ljust(116) + bytes(8) + struct.pack("<H", 0x0100) + b"IM"
+    path.write_bytes(head + tag(15, len(packed)) + packed)
+    return path
+
+
+def refusal(load, path: Path) -> tuple[float, int, str]:
+    """(seconds to the refusal, peak bytes held, the message's start)."""
+    tracemalloc.start()
+    t0 = time.perf_counter()
+    try:
+        load(path)
+        message = "read (not refused)"
+    except MbodyError as exc:
+        message = str(exc).replace(str(path), path.name)
+    elapsed = time.perf_counter() - t0
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    return elapsed, peak, message
+
+
+def hostile(folder: Path) -> None:
+    run = folder / "run.npz"
+    mbody.simulate(mbody.load(ROOT / "models" / "pendulum.yaml"), t_end=1.0).save(run)
+    with np.load(run) as z:
+        good = dict(z)
+    deep = dict(good)
+    deep["info"] = np.array('{"a":' * 10000)
+    np.savez(folder / "deepinfo.npz", **deep)
+    files = [(Trajectory.load, bomb_run(folder / "bomb.npz", good, 2**28)),
+             (Trajectory.load, liar_run(folder / "liar.npz", good)),
+             (Trajectory.load, folder / "deepinfo.npz"),
+             (mbody.load_export, bomb_mat(folder / "bomb.mat", 2**28))]
+    print("\nhostile files: time to the refusal, peak memory held meanwhile")
+    print(f"{'file':>14} {'on disk':>10} {'time':>9} {'peak':>9}  message")
+    for load, path in files:
+        elapsed, peak, message = refusal(load, path)
+        print(f"{path.name:>14} {path.stat().st_size / MIB:>8.2f} M {elapsed * 1e3:>6.1f} ms "
+              f"{peak / MIB:>6.2f} M  {message[:110]}")
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--repeat", type=int, default=3)
+    p.add_argument("--largest", type=int, default=256_000,
+                   help="most samples of the good runs (10 bodies)")
+    a = p.parse_args()
+    with tempfile.TemporaryDirectory() as tmp:
+        good_runs(Path(tmp), a.repeat, a.largest)
+        hostile(Path(tmp))
+
+
+if __name__ == "__main__":
+    main()
