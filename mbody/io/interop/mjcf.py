@@ -364,6 +364,12 @@ class _Reader(Geoms):
                 b2 = self.body_ref(c, v.get("body2", "world"), "body2")
                 if b1 is None or b2 is None:
                     continue
+                if b1 == b2:  # as MuJoCo refuses it: it would hold nothing
+                    self.fail(c, f"the {c.tag} joins body '{v.get('body1')}' to itself",
+                              "name two different bodies in body1 and body2; body2 is "
+                              "the world when it is not given",
+                              "body2" if "body2" in c.attrib else "body1")
+                    continue
                 anchor = self.attr(c, v, "anchor", 3, np.zeros(3))
                 if c.tag == "weld" and ("relpose" in v or "torquescale" in v):
                     self.note("equality constraints", f"weld '{c.get('name') or ''}' "

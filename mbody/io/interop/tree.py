@@ -415,15 +415,15 @@ def build(name: str, description: str, file: str, bodies: list[TreeBody],
     bare MJCF body) are left out, their children joined to the nearest body kept; a body
     without mass that moves is an error (mbody needs a mass on every moving body).
     """
-    renamed = []
+    warnings: list[Issue] = []
     for b in bodies:  # "ground" names the world in mbody: a body so named is renamed
         if b.name == GROUND:
             taken = {x.name for x in bodies}
             b.name = next(f"{GROUND}_{k}" if k else f"{GROUND}_body" for k in range(
                 len(bodies) + 1) if (f"{GROUND}_{k}" if k else f"{GROUND}_body") not in taken)
-            renamed.append(Issue(file, *b.element.where("name"), "", f"the body "
-                                 f"'{GROUND}' is named '{b.name}' here: mbody's '{GROUND}' "
-                                 "is the fixed world frame"))
+            warnings.append(Issue(file, *b.element.where("name"), "", f"the body "
+                                  f"'{GROUND}' is named '{b.name}' here: mbody's '{GROUND}' "
+                                  "is the fixed world frame"))
     kin = forward(bodies, qpos, qvel, q0)
     scale = float(max([1.0] + [float(np.abs(p).max()) for p in kin.pos]))
     issues: list[Issue] = []
@@ -466,6 +466,20 @@ def build(name: str, description: str, file: str, bodies: list[TreeBody],
                 B = kin.R[o] @ bodies[o].R_inertia
                 T = B.T @ W
                 extra[o] = extra.get(o, 0.0) + T @ b.inertia @ T.T
+    carried: set[int] = set()  # the massless frames a freely moving body with a mass is welded to
+    for i in free:
+        up = bodies[i].parent
+        while up >= 0 and up not in kept:
+            carried.add(up)
+            up = bodies[up].parent
+    for i, o in owner.items():  # a free frame that no body with a mass is welded to
+        if o == floating and i not in carried and bodies[i].joints:
+            e = bodies[i].joints[0].element
+            issues.append(e.issue(
+                f"body '{bodies[i].name}' has no mass but moves on joint "
+                f"'{bodies[i].joints[0].name}'", "mbody needs a mass on every moving body: "
+                "give the body an inertial with a mass, or geoms with one, or weld a body "
+                "with a mass to it"))
     if issues:
         raise ModelError(issues)
     if not kept:
@@ -531,7 +545,12 @@ def build(name: str, description: str, file: str, bodies: list[TreeBody],
             doc.mark((*jp, key), m.element, key if key in ("name", "axis", "type") else None)
     for lp in loops:
         loop = _loop(lp, bodies, kin, owner, kept)
-        if loop is None:
+        if loop is None:  # both ends welded into one body (or the world): it always holds
+            one = _parent_name(bodies, lp.body1, owner, kept)
+            warnings.append(Issue(lp.element.file, *lp.element.where(), "",
+                                  f"the {lp.element.tag} '{lp.name}' joins two parts of "
+                                  f"one rigid body ('{one}'): it always holds, and is left "
+                                  "out"))
             continue
         jp = ("joints", len(out_joints))
         out_joints.append(loop)
@@ -543,7 +562,7 @@ def build(name: str, description: str, file: str, bodies: list[TreeBody],
     doc.marks[()] = (root.line, root.column)
     for key in ("model", "dimension", "gravity", "bodies", "joints"):
         doc.marks[(key,)] = (root.line, root.column)
-    return ImportedDocument(data, file, doc.marks, doc.key_marks, warnings=renamed,
+    return ImportedDocument(data, file, doc.marks, doc.key_marks, warnings=warnings,
                             source_format=fmt, files=doc.files)
 
 

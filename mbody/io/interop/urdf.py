@@ -229,6 +229,7 @@ class _Reader:
                 self.issues.append(ln.issue(f"duplicate link name '{n}'", attr="name"))
             links[n] = ln
         joints_of: dict[str, Element] = {}  # child link -> joint
+        parent_of: dict[str, str] = {}  # child link -> parent link
         children: dict[str, list[str]] = {}
         for j in self.root.findall("joint"):
             jn = j.get("name") or "?"
@@ -250,7 +251,7 @@ class _Reader:
             if cl in joints_of:
                 self.issues.append(child.issue(f"link '{cl}' is the child of two joints",
                                                "URDF describes a tree", "link"))
-            joints_of[cl] = j
+            joints_of[cl], parent_of[cl] = j, pl
             children.setdefault(pl, []).append(cl)
         if self.issues:
             raise ModelError(self.issues)
@@ -268,6 +269,8 @@ class _Reader:
         order = [roots[0]]
         for n in order:  # parents first
             order.extend(children.get(n, []))
+        if len(order) < len(links):
+            raise ModelError(_cycles(links, joints_of, parent_of, set(order), roots[0]))
         for n in order:
             ln = links[n]
             joint = joints_of.get(n)
@@ -433,3 +436,55 @@ class _Reader:
 
 def _name(n: str) -> str:
     return "".join("_" if ch == "." or ch.isspace() else ch for ch in n)
+
+
+def _cycles(links: dict[str, Element], joints_of: dict[str, Element],
+            parent_of: dict[str, str], reached: set[str], root: str) -> list[Issue]:
+    """Each cycle of joints that the links not `reached` from the `root` link hang from.
+
+    Every link but the root is the child of exactly one joint, so following parents from a
+    link the root does not reach never ends at the root: it runs into a cycle. Each cycle
+    is said at its first joint in the file, with every link that is lost with it."""
+    cycle_of: dict[str, int] = {}  # unreached link -> the cycle it hangs from
+    cycles: list[list[str]] = []  # each cycle's links, in the order its joints run
+    for start in links:
+        if start in reached or start in cycle_of:
+            continue
+        path: list[str] = []
+        at: dict[str, int] = {}
+        n = start
+        while n not in cycle_of and n not in at:
+            at[n] = len(path)
+            path.append(n)
+            n = parent_of[n]
+        if n in cycle_of:
+            k = cycle_of[n]
+        else:  # a new cycle: path[at[n]:]
+            k = len(cycles)
+            cycles.append(path[at[n]:])
+        for m in path:
+            cycle_of[m] = k
+    lost: list[list[str]] = [[] for _ in cycles]  # each cycle's links and theirs
+    for n in links:
+        if n in cycle_of:
+            lost[cycle_of[n]].append(n)
+    issues = []
+    for k, ring in enumerate(cycles):
+        joints = sorted((joints_of[n] for n in ring), key=lambda j: (j.line, j.column))
+        names = _listed([f"'{j.get('name') or '?'}'" for j in joints])
+        what = (f"joint {names} has link '{ring[0]}' as its parent and its child"
+                if len(ring) == 1 else f"joints {names} form a cycle")
+        shown = _listed([f"'{n}'" for n in lost[k]])
+        fix = ("name in its <parent> the link it hangs from" if len(ring) == 1 else
+               "one of these joints names the wrong <parent> or <child>")
+        issues.append(joints[0].issue(
+            f"{what}: a URDF describes a tree", f"link{'s' if len(lost[k]) > 1 else ''} "
+            f"{shown} {'are' if len(lost[k]) > 1 else 'is'} not connected to the root link "
+            f"'{root}': {fix}"))
+    return sorted(issues, key=lambda i: (i.file, i.line, i.column))
+
+
+def _listed(items: list[str], most: int = 10) -> str:
+    """The first `most` of `items`, with how many more there are."""
+    return ", ".join(items[:most]) + (f" and {len(items) - most} more"
+                                      if len(items) > most else "")

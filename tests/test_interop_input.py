@@ -1,0 +1,117 @@
+"""Bad MJCF and URDF input (review R1: B5, P7, P8): nothing in the file is dropped in
+silence, nothing written twice is half read, and every message is located and speaks the
+file's own terms (its links, bodies and elements; the options the user typed).
+
+Each test runs the command line or `mbody.load` on a small file and asserts exit 2 (or
+the `ModelError`), the file, line and column, and the names the message gives; never
+another library's wording.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+import mbody
+from mbody.cli.app import main
+from mbody.errors import ModelError
+
+ROBOTS = Path(__file__).resolve().parent.parent / "models" / "robots"
+ARM_URDF = (ROBOTS / "two_link_arm.urdf").read_text()
+
+INERTIAL = ('<inertial><mass value="{m}"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" '
+            'iyz="0"/></inertial>')
+
+
+def _line_of(text: str, needle: str) -> int:
+    """1-based line of the first line of `text` holding `needle`."""
+    return next(k for k, line in enumerate(text.splitlines(), 1) if needle in line)
+
+
+def _refused(argv: list[str], capsys) -> str:
+    """The one-paragraph message of a command that must exit 2."""
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert "Traceback" not in err and "internal error" not in err
+    return err
+
+
+# ---- B5: every link of the file is a body of the model or named in an error -----------
+
+def _cycle_urdf() -> str:
+    return "\n".join([
+        '<robot name="r">', '  <link name="world"/>',
+        '  <joint name="j1" type="continuous"><parent link="world"/><child link="a"/>'
+        '<axis xyz="0 1 0"/></joint>',
+        f'  <link name="a">{INERTIAL.format(m=1)}</link>',
+        f'  <link name="b">{INERTIAL.format(m=5)}</link>',
+        f'  <link name="c">{INERTIAL.format(m=5)}</link>',
+        '  <joint name="j2" type="continuous"><parent link="b"/><child link="c"/>'
+        '<axis xyz="0 1 0"/></joint>',
+        '  <joint name="j3" type="continuous"><parent link="c"/><child link="b"/>'
+        '<axis xyz="0 1 0"/></joint>', "</robot>"])
+
+
+def test_a_urdf_cycle_apart_from_the_root_is_refused_at_its_first_joint(tmp_path, capsys):
+    """Links b and c (10 kg) hang from each other, not from the root: they and their
+    joints were dropped and `check` said OK; `convert` wrote the truncated model."""
+    path = tmp_path / "cycle.urdf"
+    path.write_text(_cycle_urdf())
+    err = _refused(["check", str(path)], capsys)
+    assert err.startswith(f"mbody: error: {path}:7:3: <joint>: joints 'j2', 'j3' form a "
+                          "cycle")
+    assert "links 'b', 'c' are not connected to the root link 'world'" in err
+    out = tmp_path / "out.yaml"
+    _refused(["convert", str(path), "-o", str(out)], capsys)
+    assert not out.exists()
+
+
+def test_the_shipped_arm_with_its_elbow_on_itself_is_refused(tmp_path, capsys):
+    """A one-word slip: the elbow's parent written as its own child lost the 1.2 kg
+    forearm and the tool frame, and `check` said OK."""
+    text = ARM_URDF.replace('<parent link="upper_arm"/>', '<parent link="forearm"/>')
+    path = tmp_path / "arm.urdf"
+    path.write_text(text)
+    with pytest.raises(ModelError) as info:
+        mbody.load(path)
+    (issue,) = info.value.issues
+    assert (issue.line, issue.column) == (_line_of(text, 'joint name="elbow"'), 3)
+    assert "joint 'elbow' has link 'forearm' as its parent and its child" in issue.message
+    assert "links 'forearm', 'tool' are not connected to the root link 'world'" in issue.hint
+
+
+def test_an_mjcf_equality_on_one_body_is_refused_or_said(tmp_path, capsys):
+    """MJCF is nested, so no body can be cut off from the tree; what else joins bodies
+    (an equality) either joins two (a loop), is refused (a body joined to itself, as
+    MuJoCo refuses it) or is said to be left out (both ends welded into one body)."""
+    text = ('<mujoco model="m">\n<worldbody>\n'
+            '<body name="a"><joint name="h"/><geom size="0.1"/><body name="tip"/></body>\n'
+            '</worldbody>\n<equality>\n'
+            '  <connect name="self" body1="a" body2="a" anchor="0 0 0"/>\n'
+            '  <connect name="inside" body1="tip" body2="a" anchor="0 0 0"/>\n'
+            "</equality>\n</mujoco>\n")
+    path = tmp_path / "m.xml"
+    path.write_text(text)
+    err = _refused(["check", str(path)], capsys)
+    assert err.startswith(f"mbody: error: {path}:6:34: <connect body2>: the connect joins "
+                          "body 'a' to itself")
+    path.write_text(text.replace('body2="a" anchor="0 0 0"/>\n  <connect name="inside"',
+                                 'body2="world" anchor="0 0 0"/>\n  <connect name="inside"'))
+    model = mbody.load(path)
+    (said,) = [w for w in model.warnings if "'inside'" in w.message]
+    assert (said.line, said.column) == (7, 3)
+    assert "one rigid body ('a')" in said.message and "left out" in said.message
+
+
+def test_a_massless_free_body_is_refused_not_dropped(tmp_path, capsys):
+    """A body with a free joint and no mass (nor any body with a mass welded to it) was
+    left out with its joint, and the rest of the model said OK."""
+    path = tmp_path / "m.xml"
+    path.write_text('<mujoco model="m">\n<worldbody>\n'
+                    '<body name="a"><joint name="h"/><geom size="0.1"/></body>\n'
+                    '<body name="ghost">\n  <freejoint name="fly"/>\n</body>\n'
+                    "</worldbody>\n</mujoco>\n")
+    err = _refused(["check", str(path)], capsys)
+    assert err.startswith(f"mbody: error: {path}:5:3: <freejoint>: body 'ghost' has no mass "
+                          "but moves on joint 'fly'")
