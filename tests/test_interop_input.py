@@ -115,3 +115,73 @@ def test_a_massless_free_body_is_refused_not_dropped(tmp_path, capsys):
     err = _refused(["check", str(path)], capsys)
     assert err.startswith(f"mbody: error: {path}:5:3: <freejoint>: body 'ghost' has no mass "
                           "but moves on joint 'fly'")
+
+
+# ---- P7: what a format gives once, given twice, is refused, not read in part -----------
+
+def test_a_second_mass_in_a_urdf_inertial_is_refused_at_it(tmp_path, capsys):
+    """The first <mass> (2 kg) silently won; the 3 kg written after it was ignored."""
+    text = ARM_URDF.replace('<mass value="2.0"/>', '<mass value="2.0"/><mass value="3.0"/>')
+    path = tmp_path / "arm.urdf"
+    path.write_text(text)
+    line = _line_of(text, '<mass value="3.0"/>')
+    err = _refused(["check", str(path)], capsys)
+    assert err.startswith(f"mbody: error: {path}:{line}:26: <mass>: a second <mass> in "
+                          f"<inertial> (the first is at line {line}, column 7)")
+
+
+@pytest.mark.parametrize(("old", "new", "said"), [
+    ('<axis xyz="0 1 0"/>\n    <limit', '<axis xyz="0 1 0"/><axis xyz="1 0 0"/>\n    <limit',
+     "a second <axis> in <joint>"),
+    ('<origin xyz="0 0 0.1" rpy="0 0 0"/>', '<origin xyz="0 0 0.1"/><origin xyz="0 0 1"/>',
+     "a second <origin> in <joint>"),
+    ('<geometry><cylinder radius="0.12" length="0.1"/>',
+     '<geometry><cylinder radius="0.12" length="0.1"/><box size="1 1 1"/>',
+     "a second shape <box> in <geometry> (the first, <cylinder>"),
+    ('<joint name="tool_mount"', '<joint name="mount"', "duplicate joint name 'mount'"),
+], ids=["axis", "origin", "shape", "joint name"])
+def test_a_urdf_element_given_twice_is_refused(old, new, said, tmp_path, capsys):
+    text = ARM_URDF.replace(old, new, 1)
+    path = tmp_path / "arm.urdf"
+    path.write_text(text)
+    line = next(k for k, (a, b) in enumerate(zip(text.splitlines(), ARM_URDF.splitlines(),
+                                                 strict=True), 1) if a != b)
+    err = _refused(["check", str(path)], capsys)
+    assert err.startswith(f"mbody: error: {path}:{line}:") and said in err
+
+
+def test_a_second_inertial_in_an_mjcf_body_is_refused_as_mujoco_refuses_it(tmp_path,
+                                                                           capsys):
+    path = tmp_path / "m.xml"
+    path.write_text('<mujoco>\n  <option><flag gravity="disable"/><flag contact="disable"/>'
+                    '</option>\n  <worldbody><body name="a"><joint/>\n'
+                    '    <inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/>\n'
+                    '    <inertial pos="0 0 0" mass="2" diaginertia="1 1 1"/>\n'
+                    "  </body></worldbody>\n</mujoco>\n")
+    err = _refused(["check", str(path)], capsys)
+    assert f"{path}:2:36: <flag>: a second <flag> in <option> (the first is at line 2, " \
+        "column 11)" in err
+    assert f"{path}:5:5: <inertial>: a second <inertial> in <body> (the first is at line " \
+        "4, column 5)" in err
+
+
+def test_the_elements_mjcf_allows_once_are_mujocos():
+    """`UNIQUE` against MuJoCo's own schema: the elements it marks (?) or (!), at the
+    paths `SCHEMA` names them by."""
+    mujoco = pytest.importorskip("mujoco")
+    import re
+
+    from mbody.io.interop.mjcf_schema import SCHEMA, UNIQUE
+
+    stack: list[str] = []
+    once = set()
+    for line in mujoco.mj_printSchema(False, True).splitlines():
+        m = re.match(r"^( *)(\S+) \((.)\)", line)
+        if m is None:
+            continue
+        depth = len(m.group(1)) // 3
+        stack = [*stack[:depth], m.group(2)]
+        if m.group(3) in "?!" and depth > 0:
+            once.add("/".join(stack).replace("(world)body", "body"))
+    assert once == UNIQUE
+    assert UNIQUE.issubset(SCHEMA)

@@ -8,8 +8,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from mbody.errors import Issue, ModelError
-from mbody.io.interop.mjcf_schema import SCHEMA
-from mbody.io.interop.xmlsource import Element, parse_xml, unknown_name
+from mbody.io.interop.mjcf_schema import SCHEMA, UNIQUE
+from mbody.io.interop.xmlsource import Element, parse_xml, second, unknown_name
 from mbody.model.loader import read_file
 
 MAX_INCLUDES = 100
@@ -119,13 +119,19 @@ def check_names(e: Element, path: str, issues: list[Issue]) -> None:
                     issues.append(unknown_name(el, a, attrs, f"attribute of <{el.tag}>", a,
                                                len(issues) < ModelError.SHOWN))
         later = []
+        first: dict[str, Element] = {}  # a child MuJoCo allows once -> where it is
         for c in el.children:
             if p in SCHEMA and c.tag not in kids and not (p == "mujoco/body" and
                                                            c.tag == "frame"):
                 issues.append(unknown_name(c, c.tag, kids, f"element in <{el.tag}>",
                                            hint=len(issues) < ModelError.SHOWN))
                 continue
-            later.append((c, _schema_path(p, c.tag)))
+            child = _schema_path(p, c.tag)
+            if child in UNIQUE:
+                if c.tag in first:
+                    issues.append(second(c, el, first[c.tag], "MuJoCo"))
+                first.setdefault(c.tag, c)
+            later.append((c, child))
         stack.extend(reversed(later))  # in file order: the issues come sorted
     issues.sort(key=lambda i: (i.line, i.column))
 

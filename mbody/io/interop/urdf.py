@@ -32,7 +32,14 @@ from mbody.io.interop.tree import (
     qpos0,
     unit,
 )
-from mbody.io.interop.xmlsource import MAX_ELEMENTS, Element, parse_xml, read_xml, unknown_name
+from mbody.io.interop.xmlsource import (
+    MAX_ELEMENTS,
+    Element,
+    parse_xml,
+    read_xml,
+    second,
+    unknown_name,
+)
 from mbody.util.spatial import quat_to_matrix
 
 _ATTRS: dict[str, tuple[str, ...]] = {
@@ -61,6 +68,14 @@ _CHILDREN: dict[str, tuple[str, ...]] = {
     "joint": ("origin", "parent", "child", "axis", "calibration", "dynamics", "limit",
               "mimic", "safety_controller"),
 }
+_ONCE: dict[str, tuple[str, ...]] = {
+    "link": ("inertial",), "inertial": ("origin", "mass", "inertia"),
+    "visual": ("origin", "geometry", "material"), "collision": ("origin", "geometry"),
+    "material": ("color", "texture"),
+    "joint": ("origin", "parent", "child", "axis", "calibration", "dynamics", "limit",
+              "mimic", "safety_controller"),
+}
+"""The children URDF gives an element at most once; a <geometry> holds one shape."""
 _OPEN = ("transmission", "gazebo", "mujoco")
 """Elements whose content belongs to other tools; not checked."""
 JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
@@ -173,9 +188,20 @@ def _check_names(root: Element, issues: list[Issue], ignored: list[str]) -> None
                 else:
                     note(f"{e.tag} {a}")
         kids = _CHILDREN.get(e.tag, ())
+        once = _ONCE.get(e.tag, ())
+        first: dict[str, Element] = {}
         for c in e.children:
             if c.tag in kids:
                 stack.append(c)
+                if c.tag in once and c.tag in first:
+                    issues.append(second(c, e, first[c.tag], "URDF"))
+                elif e.tag == "geometry" and first:
+                    shape = next(iter(first.values()))
+                    issues.append(c.issue(
+                        f"a second shape <{c.tag}> in <geometry> (the first, <{shape.tag}>, "
+                        f"is at line {shape.line})", "a <geometry> holds one shape: give "
+                        "the other one a <visual> or <collision> of its own"))
+                first.setdefault(c.tag, c)
             elif _misspelt(c.tag, kids):
                 issues.append(unknown_name(c, c.tag, kids, f"element in <{e.tag}>",
                                            hint=len(issues) < ModelError.SHOWN))
@@ -231,8 +257,12 @@ class _Reader:
         joints_of: dict[str, Element] = {}  # child link -> joint
         parent_of: dict[str, str] = {}  # child link -> parent link
         children: dict[str, list[str]] = {}
+        joint_names: set[str] = set()
         for j in self.root.findall("joint"):
             jn = j.get("name") or "?"
+            if j.get("name") and jn in joint_names:
+                self.issues.append(j.issue(f"duplicate joint name '{jn}'", attr="name"))
+            joint_names.add(jn)
             typ = j.get("type")
             if typ not in JOINT_TYPES:
                 self.issues.append(j.issue(f"unknown joint type '{typ}'", did_you_mean(

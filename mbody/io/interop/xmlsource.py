@@ -285,6 +285,15 @@ def unknown_name(e: Element, name: str, known: Iterable[str], what: str,
     return Issue(e.file, line, col, key, one_line(f"unknown {what} '{name}'"), one_line(said))
 
 
+def second(e: Element, parent: Element, first: Element, allows: str) -> Issue:
+    """The issue of `e`, a second child of `parent` like `first` where the format allows
+    one: refused, never read in part (`allows` names who allows one: "URDF")."""
+    at = (f"line {first.line}, column {first.column}" if first.file == e.file
+          else f"{first.file}:{first.line}:{first.column}")
+    return e.issue(f"a second <{e.tag}> in <{parent.tag}> (the first is at {at})",
+                   f"{allows} allows one: merge them, or remove one")
+
+
 _BREAKS = str.maketrans({"\n": "\\n", "\r": "\\r", "\x0b": "\\v", "\x0c": "\\f",
                          "\x1c": "\\x1c", "\x1d": "\\x1d", "\x1e": "\\x1e",
                          "\x85": "\\x85", "\u2028": "\\u2028", "\u2029": "\\u2029"})
