@@ -548,7 +548,7 @@ def test_an_included_files_problems_name_that_file(tmp_path, capsys):
     (issue,) = info.value.issues
     assert (Path(issue.file).name, issue.line, issue.column) == ("parts.xml", 5, 7)
     assert main(["convert", str(tmp_path / "main.xml"), "-o", str(tmp_path / "m.yaml")]) == 2
-    assert "parts.xml:5:7: bodies[0].inertia" in capsys.readouterr().err
+    assert "parts.xml:5:7: body 'a' <inertial>" in capsys.readouterr().err
 
 
 def test_planar_root_says_why_and_a_bad_size_is_said_once():

@@ -185,3 +185,44 @@ def test_the_elements_mjcf_allows_once_are_mujocos():
             once.add("/".join(stack).replace("(world)body", "body"))
     assert once == UNIQUE
     assert UNIQUE.issubset(SCHEMA)
+
+
+# ---- P7: the model checks' findings in the file's own terms ---------------------------
+
+def test_a_urdf_inertia_problem_names_the_link_and_element_not_a_yaml_path(tmp_path,
+                                                                            capsys):
+    """It said "bodies[1].inertia: ... ('inertia: 0' makes a particle)": a YAML path and
+    YAML advice for a file that has neither."""
+    text = ARM_URDF.replace('ixx="0.042" iyy="0.042" izz="0.0016" ixy="0"',
+                            'ixx="0.042" iyy="0.042" izz="0.0016" ixy="0.5"')
+    path = tmp_path / "arm.urdf"
+    path.write_text(text)
+    line = _line_of(text, 'ixy="0.5"')
+    err = _refused(["check", str(path)], capsys)
+    assert err.startswith(f"mbody: error: {path}:{line}:7: link 'upper_arm' <inertia>: the "
+                          "inertia tensor is not positive definite")
+    assert "an <inertia> whose six entries are 0 makes a point mass" in err
+    assert "bodies[" not in err and "inertia: 0" not in err
+
+
+def test_an_mjcf_problem_names_the_body_and_a_name_clash_names_both_links(tmp_path,
+                                                                          capsys):
+    path = tmp_path / "m.xml"
+    path.write_text('<mujoco>\n  <worldbody>\n    <body name="a"><joint name="h"/>\n'
+                    '      <inertial pos="0 0 0" mass="1" fullinertia="1 1 1 2 0 0"/>\n'
+                    "    </body>\n  </worldbody>\n</mujoco>\n")
+    err = _refused(["check", str(path)], capsys)
+    assert err.startswith(f"mbody: error: {path}:4:7: body 'a' <inertial>: the inertia "
+                          "tensor is not positive definite")
+    assert 'an <inertial> with diaginertia="0 0 0" makes a point mass' in err
+    # 'upper.arm' is read as upper_arm (a '.' would break reaction labels): the clash
+    # with the link named so names both links, not "first used by bodies[1]"
+    text = (ARM_URDF.replace("upper_arm", "upper.arm")
+            .replace('<link name="forearm">', '<link name="upper_arm">')
+            .replace('link="forearm"', 'link="upper_arm"'))
+    path = tmp_path / "arm.urdf"
+    path.write_text(text)
+    err = _refused(["check", str(path)], capsys)
+    line = _line_of(text, '<link name="upper_arm">')
+    assert (f"{path}:{line}:9: link 'upper_arm' name: duplicate body name 'upper_arm' (first "
+            "used by link 'upper.arm')") in err

@@ -403,7 +403,7 @@ class _Reader:
             J = np.array([[g["ixx"], g["ixy"], g["ixz"]], [g["ixy"], g["iyy"], g["iyz"]],
                           [g["ixz"], g["iyz"], g["izz"]]])
         b.mass, b.com, b.R_inertia, b.inertia = mass, xyz, quat_to_matrix(quat), J
-        b.mass_element = t if t is not None else m
+        b.mass_element, b.mass_at = (t if t is not None else m), m
 
     def shape(self, ln: Element) -> dict[str, Any] | None:
         best: tuple[float, dict[str, Any]] | None = None
