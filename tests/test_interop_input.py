@@ -226,3 +226,51 @@ def test_an_mjcf_problem_names_the_body_and_a_name_clash_names_both_links(tmp_pa
     line = _line_of(text, '<link name="upper_arm">')
     assert (f"{path}:{line}:9: link 'upper_arm' name: duplicate body name 'upper_arm' (first "
             "used by link 'upper.arm')") in err
+
+
+# ---- P7: an option is named as it was typed -------------------------------------------
+
+@pytest.mark.parametrize(("argv", "said"), [
+    (["check", "models/pendulum.yaml", "--q", "O=1"],
+     "--q sets a URDF model's state; this model is read as YAML"),
+    (["check", "models/pendulum.yaml", "--qd", "O=1"],
+     "--qd sets a URDF model's state; this model is read as YAML"),
+    (["check", "models/pendulum.yaml", "--floating-base"],
+     "--floating-base sets a URDF model's state; this model is read as YAML"),
+    (["check", "models/robots/two_link_arm.urdf", "--keyframe", "swing"],
+     "--keyframe sets an MJCF model's state; this model is read as URDF"),
+    (["convert", "models/robots/two_link_arm.urdf", "--keyframe", "swing", "-o", "OUT"],
+     "--keyframe sets an MJCF model's state; this model is read as URDF"),
+    (["check", "models/robots/two_link_arm.urdf", "--q", "sholder=1"],
+     "models/robots/two_link_arm.urdf: --q: no joint named 'sholder' moves in this model "
+     "(did you mean 'shoulder'?)"),
+    (["check", "models/robots/two_link_arm.xml", "--keyframe", "swng"],
+     "models/robots/two_link_arm.xml: --keyframe: no keyframe named 'swng' (did you mean "
+     "'swing'?)"),
+], ids=["q", "qd", "floating-base", "keyframe", "convert --keyframe", "q joint",
+        "keyframe name"])
+def test_the_command_line_names_the_option_typed_not_the_keyword(argv, said, tmp_path,
+                                                                 capsys, monkeypatch):
+    """It said "'joint_positions' sets a URDF model's state" for --q, "keyframe" for
+    --keyframe: the names of `mbody.load`'s keywords, which a command-line user never
+    typed. `mbody.load` itself still names its keywords."""
+    monkeypatch.chdir(ROBOTS.parent.parent)
+    argv = [str(tmp_path / "out.yaml") if a == "OUT" else a for a in argv]
+    err = _refused(argv, capsys)
+    assert err == f"mbody: error: {said}\n"
+    for keyword in ("joint_positions", "joint_velocities", "floating_base", "'keyframe'"):
+        assert keyword not in err
+
+
+def test_the_floating_base_advice_names_the_flag_or_the_keyword(tmp_path, capsys):
+    path = tmp_path / "drone.urdf"
+    path.write_text(f'<robot name="r"><link name="a">{INERTIAL.format(m=1)}</link></robot>')
+    err = _refused(["check", str(path)], capsys)
+    assert "(--floating-base lets it move freely)" in err
+    assert "floating_base" not in err.replace(str(path), "")
+    with pytest.raises(ModelError) as info:
+        mbody.load(path)
+    assert "(floating_base=True lets it move freely)" in str(info.value)
+    with pytest.raises(mbody.MbodyError, match="^joint_positions sets a URDF model's "
+                       "state; this model is read as YAML$"):
+        mbody.load(ROBOTS.parent / "pendulum.yaml", joint_positions={"O": 1})

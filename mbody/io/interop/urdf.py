@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from mbody.errors import Issue, ModelError, did_you_mean
+from mbody.errors import Issue, ModelError, did_you_mean, option_name
 from mbody.io.interop.attrvalues import read_numbers
 from mbody.io.interop.tree import (
     NV,
@@ -312,15 +312,16 @@ class _Reader:
                                           np.array([0.0, 0, 1]), ln)]
                 elif b.mass > 0:
                     self.note("the root link is fixed to the world (its mass is part of "
-                              "the ground; floating_base=True lets it move)", n)
+                              f"the ground; {option_name('floating_base', 'True')} lets it "
+                              "move)", n)
                     b.mass = 0.0
                     if not any(links[c].find("inertial") is not None for c in joints_of):
                         # nothing else has a mass: a drone's or a free object's one link
                         raise ModelError([ln.issue(
                             f"the root link '{n}' is the only link with a mass, and it "
                             "is fixed to the world (a URDF's root is, unless it floats): "
-                            "nothing moves", "floating_base=True (--floating-base) lets "
-                            "it move freely")])
+                            "nothing moves", f"{option_name('floating_base', 'True')} "
+                            "lets it move freely")])
             else:
                 pos, quat = self.origin(joint)
                 parent_link = joint.find("parent")
@@ -361,9 +362,9 @@ class _Reader:
             return []
         if typ in ("floating", "planar"):
             self.issues.append(j.issue(
-                f"a {typ} joint ('{name}') is not read", "use floating_base=True (--floating"
-                "-base) for a free-floating root link" if typ == "floating" else
-                "mbody has no planar joint", "type"))
+                f"a {typ} joint ('{name}') is not read", f"use "
+                f"{option_name('floating_base', 'True')} for a free-floating root link"
+                if typ == "floating" else "mbody has no planar joint", "type"))
             return []
         axis = self.numbers(j.find("axis"), "xyz", 3, np.array([1.0, 0, 0]))
         if np.linalg.norm(axis) < 1e-12:
@@ -439,8 +440,9 @@ class _Reader:
             v += NV[j.type]
         qpos, qvel = q0.copy(), np.zeros(v)
         problems = []
-        for given, target, what in ((qp, qpos, "joint_positions"), (qv, qvel,
-                                                                     "joint_velocities")):
+        for given, target, keyword in ((qp, qpos, "joint_positions"),
+                                       (qv, qvel, "joint_velocities")):
+            what = option_name(keyword)
             for k, x in given.items():
                 where = names.get(k)
                 if where is None or k.endswith("_free"):
@@ -451,12 +453,12 @@ class _Reader:
                 try:
                     value = float(x)
                 except (TypeError, ValueError):
-                    problems.append(Issue(self.file, 0, 0, f"{what}[{k}]",
-                                          f"expected a number, got {x!r}"))
+                    problems.append(Issue(self.file, 0, 0, what,
+                                          f"joint '{k}': expected a number, got {x!r}"))
                     continue
                 if not math.isfinite(value):
-                    problems.append(Issue(self.file, 0, 0, f"{what}[{k}]",
-                                          "expected a finite number"))
+                    problems.append(Issue(self.file, 0, 0, what,
+                                          f"joint '{k}': expected a finite number"))
                     continue
                 target[where[0] if target is qpos else where[1]] = value
         if problems:
