@@ -9,6 +9,7 @@ another library's wording.
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import pytest
@@ -274,3 +275,62 @@ def test_the_floating_base_advice_names_the_flag_or_the_keyword(tmp_path, capsys
     with pytest.raises(mbody.MbodyError, match="^joint_positions sets a URDF model's "
                        "state; this model is read as YAML$"):
         mbody.load(ROBOTS.parent / "pendulum.yaml", joint_positions={"O": 1})
+
+
+# ---- P7: a file read as the wrong format says which format it is ----------------------
+
+@pytest.mark.parametrize(("model", "fmt", "said", "hint"), [
+    ("robots/two_link_arm.urdf", "yaml", ":4:1: expected an mbody YAML model, got XML "
+     "(<robot>)", "(this is a URDF file: read it as URDF (a .urdf name, or --format urdf))"),
+    ("robots/two_link_arm.xml", "yaml", ":3:1: expected an mbody YAML model, got XML "
+     "(<mujoco>)", "(this is an MJCF file: read it as MJCF (a .xml name, or --format "
+     "mjcf))"),
+    ("pendulum.yaml", "urdf", ":1:1: expected a URDF model file, which is XML (it starts "
+     "with <robot>), got text that does not start with '<'", "(this is an mbody YAML "
+     "file: read it as mbody YAML (a .yaml name, or --format yaml))"),
+    ("pendulum.yaml", "mjcf", ":1:1: expected an MJCF model file, which is XML (it starts "
+     "with <mujoco>), got text that does not start with '<'", "(this is an mbody YAML "
+     "file: read it as mbody YAML (a .yaml name, or --format yaml))"),
+], ids=["urdf as yaml", "mjcf as yaml", "yaml as urdf", "yaml as mjcf"])
+def test_a_model_read_as_another_format_is_told_which_it_is(model, fmt, said, hint, capsys):
+    """--format yaml on a URDF file said "YAML syntax error: mapping values are not
+    allowed in this context"; --format urdf on a YAML file "XML syntax error: not
+    well-formed": only MJCF read as URDF (and the reverse) said what the file was."""
+    path = ROBOTS.parent / model
+    err = _refused(["check", str(path), "--format", fmt], capsys)
+    assert err == f"mbody: error: {path}{said} {hint}\n"
+
+
+# ---- P8: a file that is no file says what it is ---------------------------------------
+
+@pytest.mark.parametrize(("target", "kind"), [
+    ("/dev/zero", "a character device"), (".", "a directory"), ("pipe", "a named pipe")])
+def test_an_include_of_a_folder_device_or_pipe_says_what_it_is(target, kind, tmp_path,
+                                                               capsys):
+    """It said "the included file '/dev/zero' does not exist"."""
+    if target == "pipe":
+        if not hasattr(os, "mkfifo"):
+            pytest.skip("no named pipes on this system")
+        os.mkfifo(tmp_path / "pipe")
+    elif not Path(target).exists():
+        pytest.skip(f"{target} is not on this system")
+    path = tmp_path / "m.xml"
+    path.write_text(f'<mujoco model="m">\n  <include file="{target}"/>\n  <worldbody/>\n'
+                    "</mujoco>\n")
+    err = _refused(["check", str(path)], capsys)
+    assert err.startswith(f"mbody: error: {path}:2:12: <include file>: the included file "
+                          f"'{target}' is {kind}")
+    assert "does not exist" not in err
+
+
+@pytest.mark.parametrize(("fmt", "expected"), [
+    ("mjcf", "an MJCF model file"), ("urdf", "a URDF model file")])
+def test_a_device_or_folder_read_as_mjcf_or_urdf_names_that_format(fmt, expected, tmp_path,
+                                                                   capsys):
+    """`check /dev/urandom --format mjcf` said "expected a YAML model file"."""
+    err = _refused(["check", "/dev/urandom", "--format", fmt], capsys)
+    assert err.startswith("mbody: error: /dev/urandom: this is a character device") and \
+        f"expected {expected} " in err and "YAML" not in err
+    assert f"--format {fmt} <" in err  # the pipe it could be read from, in that format
+    err = _refused(["check", str(tmp_path), "--format", fmt], capsys)
+    assert err == f"mbody: error: {tmp_path}: this is a directory; expected {expected}\n"

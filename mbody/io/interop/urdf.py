@@ -35,8 +35,7 @@ from mbody.io.interop.tree import (
 from mbody.io.interop.xmlsource import (
     MAX_ELEMENTS,
     Element,
-    parse_xml,
-    read_xml,
+    read_model_xml,
     second,
     unknown_name,
 )
@@ -108,18 +107,7 @@ def read_urdf(source: str | Path, *, joint_positions: Mapping[str, float] | None
         Bad XML, an unknown element or attribute (with a did-you-mean), an unknown joint
         name in `joint_positions`, or what mbody cannot express (a planar joint).
     """
-    budget = [MAX_ELEMENTS]
-    if isinstance(source, Path) or not str(source).lstrip().startswith("<"):
-        name = str(source) if file is None else file
-        root = read_xml(Path(source), name, budget)
-    else:
-        name = "<string>" if file is None else file
-        root = parse_xml(str(source), name, budget)
-    if root.tag != "robot":
-        hint = ("this is an MJCF file: read it as MJCF (a .xml name, or --format mjcf)"
-                if root.tag == "mujoco" else "a URDF model starts with <robot>")
-        raise ModelError([root.issue(f"expected <robot> as the root element, got "
-                                     f"<{root.tag}>", hint)])
+    root, name = read_model_xml(source, file, [MAX_ELEMENTS], "urdf")
     issues: list[Issue] = []
     ignored: list[str] = []
     _check_names(root, issues, ignored)
