@@ -9,7 +9,9 @@ from __future__ import annotations
 import contextlib
 import difflib
 import numbers
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
+from contextvars import ContextVar
 from dataclasses import dataclass
 
 
@@ -179,3 +181,28 @@ def closest(word: str, choices: Iterable[str]) -> str | None:
     same = [c for c in names if c.casefold() == str(word).casefold()]
     close = same or difflib.get_close_matches(str(word), names, n=1, cutoff=0.6)
     return close[0] if close else None
+
+
+_FLAGS: ContextVar[Mapping[str, str] | None] = ContextVar("mbody_option_flags", default=None)
+
+
+@contextmanager
+def options_named(flags: Mapping[str, str]) -> Iterator[None]:
+    """Within the block, messages name an option by the command-line flag it was typed
+    as: `flags` maps a keyword argument (``joint_positions``) to its flag (``--q``). The
+    command line sets it around every command."""
+    token = _FLAGS.set(flags)
+    try:
+        yield
+    finally:
+        _FLAGS.reset(token)
+
+
+def option_name(keyword: str, value: str = "") -> str:
+    """How a message names the option `keyword` (set to `value`, when that is what it
+    advises): its flag on the command line (`options_named`: ``--floating-base``), else
+    the keyword argument of the call (``floating_base=True``)."""
+    flag = (_FLAGS.get() or {}).get(keyword)
+    if flag is not None:
+        return flag
+    return f"{keyword}={value}" if value else keyword

@@ -34,13 +34,20 @@ from mbody.cli.common import (
     EXIT_INTERNAL,
     EXIT_OK,
     EXIT_UNMET,
+    IMPORT_FLAGS,
     PICTURE_FORMATS,
     add_import_options,
     byte_size,
     refuse_overwriting_inputs,
 )
 from mbody.cli.near_miss import options_hint, unknown_options, unrecognized_message
-from mbody.errors import MbodyError, ModelError, UnknownReactionsError, did_you_mean
+from mbody.errors import (
+    MbodyError,
+    ModelError,
+    UnknownReactionsError,
+    did_you_mean,
+    options_named,
+)
 from mbody.model.loader import MAX_BYTES, max_bytes_limit
 from mbody.util.npzfile import DATA_BYTES, data_bytes_limit
 
@@ -206,7 +213,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         check_paths(args, _subcommand(parser, args))
         limit = getattr(args, "max_bytes", None)
-        with max_bytes_limit(limit), data_bytes_limit(limit):
+        with max_bytes_limit(limit), data_bytes_limit(limit), options_named(IMPORT_FLAGS):
             code = args.run(args)
         out.flush()  # a full device is reported here, not at exit
         return code

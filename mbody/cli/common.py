@@ -326,6 +326,12 @@ def set_values(pairs: Sequence[str]) -> dict[str, Any]:
     return out
 
 
+IMPORT_FLAGS = {"keyframe": "--keyframe", "joint_positions": "--q",
+                "joint_velocities": "--qd", "floating_base": "--floating-base"}
+"""`mbody.load`'s options of an imported model -> the flags that give them (what the
+messages say within a command: `mbody.errors.options_named`)."""
+
+
 def import_options(a: argparse.Namespace) -> dict[str, Any]:
     """The `mbody.load` options given on the command line (only those given)."""
     out: dict[str, Any] = {}
@@ -333,10 +339,11 @@ def import_options(a: argparse.Namespace) -> dict[str, Any]:
         out["format"] = a.model_format
     if getattr(a, "keyframe", None) is not None:
         out["keyframe"] = a.keyframe
-    for flag, key in (("q", "joint_positions"), ("qd", "joint_velocities")):
-        pairs = getattr(a, flag, None) or []
+    for key in ("joint_positions", "joint_velocities"):
+        flag = IMPORT_FLAGS[key]
+        pairs = getattr(a, flag.removeprefix("--"), None) or []
         if pairs:
-            out[key] = _joint_values(pairs, f"--{flag}", rate=flag == "qd")
+            out[key] = _joint_values(pairs, flag, rate=key == "joint_velocities")
     if getattr(a, "floating_base", False):
         out["floating_base"] = True
     return out

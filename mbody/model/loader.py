@@ -444,10 +444,66 @@ def looks_like_yaml(text: str) -> bool:
     return "\n" in text or _YAML_START.match(text) is not None
 
 
-def read_file(path: str | os.PathLike[str], max_bytes: int | None = None) -> str:
+MODEL_FORMATS = {"yaml": ("mbody YAML", ".yaml", "an mbody YAML file", "a YAML model file"),
+                 "mjcf": ("MJCF", ".xml", "an MJCF file", "an MJCF model file"),
+                 "urdf": ("URDF", ".urdf", "a URDF file", "a URDF model file")}
+"""Each model format: its name, its file extension, what a file of it is called, and
+what a model file of it is called where one was expected."""
+
+
+def read_as(fmt: str) -> str:
+    """The advice for a file of model format `fmt` ("yaml", "mjcf", "urdf") read as
+    another: ``this is a URDF file: read it as URDF (a .urdf name, or --format urdf)``."""
+    name, ext, a_file, _ = MODEL_FORMATS[fmt]
+    return f"this is {a_file}: read it as {name} (a {ext} name, or --format {fmt})"
+
+
+_LEADING_SPACE = re.compile(r"[\ufeff \t\r\n]*")
+_XML_NAME = re.compile(r"<([A-Za-z_][\w:.-]*)")
+_XML_ROOTS = {"mujoco": "mjcf", "robot": "urdf"}
+
+
+def _past_space(text: str, at: int) -> int:
+    """The index of the first character of `text` from `at` that is no space (or BOM)."""
+    m = _LEADING_SPACE.match(text, at)
+    return m.end() if m else at
+
+
+def refuse_xml(text: str, file: str) -> None:
+    """Refuse `text` read as an mbody YAML model when it is XML (its first character is
+    '<', which no YAML mapping starts with), naming the format its root element says:
+    YAML's own message ("mapping values are not allowed here") would not.
+
+    Raises
+    ------
+    ModelError
+        At the root element, with the advice to read it as MJCF or URDF.
+    """
+    at = _past_space(text, 0)
+    if not text.startswith("<", at):
+        return
+    while text.startswith(("<?", "<!"), at):  # the declaration, comments, a doctype
+        end = text.find("-->" if text.startswith("<!--", at) else ">", at)
+        if end < 0:
+            break
+        at = _past_space(text, text.index(">", end) + 1)
+    m = _XML_NAME.match(text, at)
+    tag = m.group(1) if m else ""
+    fmt = _XML_ROOTS.get(tag)
+    line = text.count("\n", 0, at) + 1
+    column = at - (text.rfind("\n", 0, at) + 1) + 1
+    raise ModelError([Issue(file, line, column, "", "expected an mbody YAML model, got XML"
+                            + (f" (<{tag}>)" if tag else ""),
+                            read_as(fmt) if fmt else
+                            "an MJCF model starts with <mujoco>, a URDF model with <robot>")])
+
+
+def read_file(path: str | os.PathLike[str], max_bytes: int | None = None,
+              fmt: str = "yaml") -> str:
     """The text of a model file, refusing files over `max_bytes` before reading them.
 
-    `max_bytes` defaults to `MAX_BYTES`, or the limit set by `max_bytes_limit`.
+    `max_bytes` defaults to `MAX_BYTES`, or the limit set by `max_bytes_limit`; `fmt`
+    is the model format the file is read as (what a refusal says was expected).
 
     A regular file or a pipe (``/dev/stdin`` fed by ``<`` or ``|``, ``<(command)``, a named
     pipe with a writer) is read; anything else (a directory, a terminal, a device, a
@@ -457,6 +513,7 @@ def read_file(path: str | os.PathLike[str], max_bytes: int | None = None) -> str
         max_bytes = _LIMIT.get()
     p = Path(path)
     name = str(path)
+    _, ext, _, expected = MODEL_FORMATS[fmt]
 
     def refuse(message: str, hint: str = "") -> ModelError:
         return ModelError([Issue(name, 0, 0, "", message, hint)])
@@ -467,12 +524,13 @@ def read_file(path: str | os.PathLike[str], max_bytes: int | None = None) -> str
         raise refuse("no such file", _near_file(p)) from None
     except OSError as exc:
         raise refuse(f"cannot read the file: {exc.strerror}") from None
-    kind = _file_kind(st.st_mode)
+    kind = file_kind(st.st_mode)
     if kind == "a directory":
-        raise refuse("this is a directory; expected a YAML model file")
+        raise refuse(f"this is a directory; expected {expected}")
     if kind:
-        raise refuse(f"this is {kind}, not a file; expected a YAML model file (to read a "
-                     "model from a pipe: mbody check /dev/stdin < model.yaml)")
+        given = f" --format {fmt}" if fmt != "yaml" else ""
+        raise refuse(f"this is {kind}, not a file; expected {expected} (to read a model "
+                     f"from a pipe: mbody check /dev/stdin{given} < model{ext})")
     more = "--max-bytes N on the command line, or mbody.load(path, max_bytes=N), reads more"
     if st.st_size > max_bytes:
         exact = f"{max_bytes:,} bytes; " if max_bytes < 2**20 else ""
@@ -484,9 +542,9 @@ def read_file(path: str | os.PathLike[str], max_bytes: int | None = None) -> str
         raise refuse(f"cannot read the file: {exc.strerror}") from None
     try:
         mode = os.fstat(fd).st_mode
-        kind = _file_kind(mode)
+        kind = file_kind(mode)
         if kind:  # replaced since the stat() above
-            raise refuse(f"this is {kind}, not a file; expected a YAML model file")
+            raise refuse(f"this is {kind}, not a file; expected {expected}")
         if stat.S_ISFIFO(mode):
             raw = _read_pipe(fd, max_bytes + 1)
             if raw is None:
@@ -542,7 +600,7 @@ def _read_bounded(f: Any, limit: int, size: int) -> bytes:
     return b"".join(chunks)
 
 
-def _file_kind(mode: int) -> str:
+def file_kind(mode: int) -> str:
     """'' for what may be read (a regular file or a pipe), else what it is."""
     if stat.S_ISREG(mode) or stat.S_ISFIFO(mode):
         return ""

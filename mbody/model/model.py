@@ -31,7 +31,7 @@ from mbody.model.drivers import DriverTable, driver_table
 from mbody.model.expressions import Expression
 from mbody.model.fast import fast_spec
 from mbody.model.graph import body_graph
-from mbody.model.loader import Document, check_source, decode, load_text, read_file
+from mbody.model.loader import Document, check_source, decode, load_text, read_file, refuse_xml
 from mbody.model.records import Body, BodyRecords, Joint, Load, Records
 from mbody.model.reprs import count, name_list
 from mbody.model.source import Source
@@ -556,6 +556,7 @@ def load(source: str | os.PathLike[str] | dict, *, max_bytes: int | None = None)
         return _build(validate(doc), Source("<dict>", document=dataclasses.replace(
             doc, data=copy.deepcopy(source))))
     text = read_file(source, max_bytes)
+    refuse_xml(text, str(source))
     spec = fast_spec(text, str(source)) or validate(load_text(text, str(source)))
     kept = Source.of_text(text, str(source))
     del text  # before the arrays are built: the text is the largest thing held (unless kept)
@@ -611,6 +612,7 @@ def loads(text: str | bytes, file: str = "<string>") -> Model:
     problem, goes through the located path, which reports each problem where it is.
     """
     text = model_text(text, file)
+    refuse_xml(text, file)
     spec = fast_spec(text, file)
     if spec is None:
         spec = validate(load_text(text, file))

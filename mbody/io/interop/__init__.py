@@ -12,7 +12,7 @@ import os
 from pathlib import Path
 from typing import Any
 
-from mbody.errors import MbodyError, MbodyTypeError, did_you_mean
+from mbody.errors import MbodyError, MbodyTypeError, did_you_mean, option_name
 from mbody.io.interop.mjcf import read_mjcf
 from mbody.io.interop.tree import ImportedDocument, validate_imported
 from mbody.io.interop.urdf import read_urdf
@@ -99,7 +99,7 @@ def _check_options(fmt: str, options: dict[str, Any]) -> None:
             which = {"keyframe": "an MJCF model's", "joint_positions": "a URDF model's",
                      "joint_velocities": "a URDF model's",
                      "floating_base": "a URDF model's"}[k]
-            raise MbodyError(f"'{k}' sets {which} state; this model is read as "
+            raise MbodyError(f"{option_name(k)} sets {which} state; this model is read as "
                              f"{fmt.upper()}")
 
 

@@ -40,7 +40,7 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, TypeVar
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
@@ -58,6 +58,7 @@ WHOLE = ("dimension", "order")
 """Kinds of one entry for the model, without a key."""
 ORDERED = ("bodies", "joints")
 """The lists of the model file whose order ``mbody:order`` keeps."""
+T = TypeVar("T")
 ONE = {"bodies": "body", "joints": "joint"}
 """An item of each of `ORDERED`, named in a message."""
 
@@ -260,16 +261,23 @@ def _permute(doc: ImportedDocument, key: str, perm: list[int]) -> None:
         for p, w in moved.items():
             if p[1] in new:
                 table[(key, new[p[1]], *p[2:])] = w
-    files = {}
-    for path, file in doc.files.items():
+    doc.files = _moved(doc.files, key, new)
+    doc.terms = _moved(doc.terms, key, new)
+
+
+def _moved(table: dict[str, T], key: str, new: dict[int, int]) -> dict[str, T]:
+    """`table` (by dotted path) with the paths under ``key[i]`` moved to ``key[new[i]]``
+    (dropped where `new` has no `i`)."""
+    out = {}
+    for path, value in table.items():
         head, _, rest = path.partition("]")
         index = head[len(key) + 1:]
         if head.startswith(f"{key}[") and index.isdigit() and rest[:1] in ("", ".", "["):
             if int(index) not in new:
                 continue
             path = f"{key}[{new[int(index)]}]{rest}"
-        files[path] = file
-    doc.files = files
+        out[path] = value
+    return out
 
 
 PLANE_TOL = 1e-9

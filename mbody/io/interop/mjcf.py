@@ -43,7 +43,7 @@ from mbody.io.interop.tree import (
     joint_order,
     unit,
 )
-from mbody.io.interop.xmlsource import MAX_ELEMENTS, Element, parse_xml, read_xml
+from mbody.io.interop.xmlsource import MAX_ELEMENTS, Element, read_model_xml
 
 __all__ = ["GEOM_TYPES", "MAX_INCLUDES", "MIN_MASS", "read_mjcf", "solid", "z_to_quat"]
 """`read_mjcf`; the rest is re-exported from where it lives now."""
@@ -79,20 +79,11 @@ def read_mjcf(source: str | Path, *, keyframe: str | None = None,
         not a number, or something mbody cannot express (say which element).
     """
     budget = [MAX_ELEMENTS]
+    root, name = read_model_xml(source, file, budget, "mjcf")
     if isinstance(source, Path) or not str(source).lstrip().startswith("<"):
-        path = Path(source)
-        name = str(source) if file is None else file
-        root = read_xml(path, name, budget)
-        base = path.parent
-    else:
-        name = "<string>" if file is None else file
-        root = parse_xml(str(source), name, budget)
+        base = Path(source).parent
+    else:  # text: its includes are next to the file it is named as
         base = Path(file).parent if file is not None else Path.cwd()
-    if root.tag != "mujoco":
-        hint = ("this is a URDF file: read it as URDF (a .urdf name, or --format urdf)"
-                if root.tag == "robot" else "an MJCF model starts with <mujoco>")
-        raise ModelError([root.issue(f"expected <mujoco> as the root element, got "
-                                     f"<{root.tag}>", hint)])
     expand_includes(root, base, budget, Included())
     issues: list[Issue] = []
     check_names(root, "mujoco", issues)
@@ -363,6 +354,12 @@ class _Reader(Geoms):
                 b1 = self.body_ref(c, v.get("body1"), "body1")
                 b2 = self.body_ref(c, v.get("body2", "world"), "body2")
                 if b1 is None or b2 is None:
+                    continue
+                if b1 == b2:  # as MuJoCo refuses it: it would hold nothing
+                    self.fail(c, f"the {c.tag} joins body '{v.get('body1')}' to itself",
+                              "name two different bodies in body1 and body2; body2 is "
+                              "the world when it is not given",
+                              "body2" if "body2" in c.attrib else "body1")
                     continue
                 anchor = self.attr(c, v, "anchor", 3, np.zeros(3))
                 if c.tag == "weld" and ("relpose" in v or "torquescale" in v):

@@ -325,3 +325,16 @@ def _parse(text: str) -> dict[str, tuple[frozenset[str], frozenset[str]]]:
 
 SCHEMA: dict[str, tuple[frozenset[str], frozenset[str]]] = _parse(_TEXT)
 """Element path -> (its attribute names, its child element names)."""
+
+UNIQUE: frozenset[str] = frozenset({
+    "mujoco/compiler/lengthrange", "mujoco/option/flag", "mujoco/body/inertial",
+    *(f"mujoco/visual/{t}" for t in ("global", "quality", "headlight", "map", "scale",
+                                     "rgba")),
+    *(f"mujoco/default/{t}" for t in (
+        "mesh", "texture", "material", "joint", "geom", "site", "camera", "light", "pair",
+        "equality", "tendon", "general", "motor", "position", "velocity", "intvelocity",
+        "orientation", "pid", "damper", "cylinder", "muscle", "adhesion", "dcmotor")),
+    *(f"mujoco/{p}/{t}" for p in ("body/flexcomp", "deformable/flex")
+      for t in ("edge", "elasticity", "contact"))})
+"""Element paths (as `SCHEMA`'s) that MuJoCo's schema allows at most once in their parent
+(its "(?)"): a second one is refused, as MuJoCo refuses it, not read in part."""

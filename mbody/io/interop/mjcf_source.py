@@ -4,13 +4,14 @@ MuJoCo's schema (with did-you-means)."""
 
 from __future__ import annotations
 
+import stat
 from dataclasses import dataclass
 from pathlib import Path
 
 from mbody.errors import Issue, ModelError
-from mbody.io.interop.mjcf_schema import SCHEMA
-from mbody.io.interop.xmlsource import Element, parse_xml, unknown_name
-from mbody.model.loader import read_file
+from mbody.io.interop.mjcf_schema import SCHEMA, UNIQUE
+from mbody.io.interop.xmlsource import Element, parse_xml, second, unknown_name
+from mbody.model.loader import file_kind, read_file
 
 MAX_INCLUDES = 100
 """Most ``<include>`` files read for one model."""
@@ -49,14 +50,21 @@ def expand_includes(e: Element, base: Path, budget: list[int], included: Include
             raise ModelError([c.issue(f"'{rel}' includes itself (through "
                                       f"{' -> '.join(chain)})", attr="file")])
         try:
-            if not path.is_file():
-                raise ModelError([c.issue(f"the included file '{_short(rel)}' does not "
-                                          "exist", f"looked for {_short(str(path))}",
-                                          attr="file")])
-            size = path.stat().st_size
+            st = path.stat()
+        except FileNotFoundError:
+            raise ModelError([c.issue(f"the included file '{_short(rel)}' does not exist",
+                                      f"looked for {_short(str(path))}", attr="file")]
+                             ) from None
         except OSError as exc:  # a name too long, a folder that cannot be read...
             raise ModelError([c.issue(f"cannot read the included file '{_short(rel)}': "
                                       f"{exc.strerror}", attr="file")]) from None
+        # what the model file itself may be, less a pipe: reading one would wait for it
+        kind = "a named pipe" if stat.S_ISFIFO(st.st_mode) else file_kind(st.st_mode)
+        if kind:
+            raise ModelError([c.issue(f"the included file '{_short(rel)}' is {kind}, not a "
+                                      "file", f"it is {_short(str(path))}; an <include> "
+                                      "names an MJCF file", attr="file")])
+        size = st.st_size
         _count(c, rel, included, size)  # refused before it is read
         try:
             text = read_file(path)
@@ -119,13 +127,19 @@ def check_names(e: Element, path: str, issues: list[Issue]) -> None:
                     issues.append(unknown_name(el, a, attrs, f"attribute of <{el.tag}>", a,
                                                len(issues) < ModelError.SHOWN))
         later = []
+        first: dict[str, Element] = {}  # a child MuJoCo allows once -> where it is
         for c in el.children:
             if p in SCHEMA and c.tag not in kids and not (p == "mujoco/body" and
                                                            c.tag == "frame"):
                 issues.append(unknown_name(c, c.tag, kids, f"element in <{el.tag}>",
                                            hint=len(issues) < ModelError.SHOWN))
                 continue
-            later.append((c, _schema_path(p, c.tag)))
+            child = _schema_path(p, c.tag)
+            if child in UNIQUE:
+                if c.tag in first:
+                    issues.append(second(c, el, first[c.tag], "MuJoCo"))
+                first.setdefault(c.tag, c)
+            later.append((c, child))
         stack.extend(reversed(later))  # in file order: the issues come sorted
     issues.sort(key=lambda i: (i.line, i.column))
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from mbody.errors import Issue, ModelError, did_you_mean
+from mbody.errors import Issue, ModelError, did_you_mean, option_name
 from mbody.io.interop.mjcf_compiler import Compiler
 from mbody.io.interop.tree import NV, TreeBody, joint_order, qpos0
 from mbody.io.interop.xmlsource import Element
@@ -83,7 +83,7 @@ def key(r: Compiler, root: Element, keyframe: str, q0: np.ndarray, nv: int
         shown = keyframe if len(keyframe) <= 40 else keyframe[:40] + "..."
         hint = did_you_mean(keyframe, names) or (
             f"the file has: {', '.join(names)}" if names else "the file has no keyframe")
-        raise ModelError([Issue(r.file, 0, 0, "keyframe",
+        raise ModelError([Issue(r.file, 0, 0, option_name("keyframe"),
                                 f"no keyframe named '{shown}'", hint)])
     qpos, qvel = values(r, k, q0, nv)
     if r.issues:

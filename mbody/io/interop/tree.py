@@ -12,15 +12,16 @@ column of the XML it came from.
 from __future__ import annotations
 
 import dataclasses
+import re
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from mbody.errors import Issue, ModelError
-from mbody.io.interop.xmlsource import Element
+from mbody.io.interop.xmlsource import Element, one_line
 from mbody.model.loader import Document, Path_, dotted
-from mbody.model.validate import Spec, validate
+from mbody.model.validate import PARTICLE_HINT, Spec, validate
 from mbody.util.spatial import axis_angle_quat, quat_mul, quat_to_matrix
 
 GROUND = "ground"
@@ -66,6 +67,8 @@ class TreeBody:
     inertia: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
     mass_element: Element | None = None
     """Where the mass was written (``<inertial>``, a geom), for error marks."""
+    mass_at: Element | None = None
+    """Where the mass itself is, when not at `mass_element` (URDF's ``<mass>``)."""
     shape: dict[str, Any] | None = None
     fixed_name: str = ""
     """The name of the fixed joint a body without joints gets (URDF names it)."""
@@ -94,15 +97,106 @@ class ImportedDocument(Document):
     files: dict[str, str] = field(default_factory=dict)
     """Dotted model path (``bodies[2].inertia``) -> the file its mark's line is in: an
     ``<include>``d file's own name, not the main file's."""
+    terms: dict[str, Term] = field(default_factory=dict)
+    """Dotted model path -> what the file has there, in its own terms (``link
+    'upper_arm' <inertia>``), with where that is."""
 
     def locate(self, issue: Issue) -> Issue:
-        """`issue` naming the file its line is in (validation names the main file)."""
-        key = issue.key
+        """`issue` in the file's terms: naming the file its line is in (validation names
+        the main file), what is there as the file says it (not the model path of the
+        YAML form), and advice in the format's words."""
+        file, key = issue.file, issue.key
         while key:
             if key in self.files:
-                return dataclasses.replace(issue, file=self.files[key])
-            key = key[:max(key.rfind("."), key.rfind("["), 0)]
-        return issue
+                file = self.files[key]
+                break
+            key = _parent_key(key)
+        named = self.named(issue.key, file, issue.line, issue.column)
+        hint = _ENTRY.sub(self._entry, issue.hint)
+        return dataclasses.replace(
+            issue, file=file, key=named, message=_ENTRY.sub(self._entry, issue.message),
+            # advice in the file's words for what the file says (not for a value --set)
+            hint=in_words_of(self.source_format, hint) if named != issue.key else hint)
+
+    def _entry(self, m: re.Match[str]) -> str:
+        """A model path in a message (``first used by bodies[1]``) as the file names it,
+        when its term is still what is marked there (an ``mbody:`` entry or the file's
+        order may have replaced or moved it)."""
+        t = self.terms.get(m.group())
+        if t is None or self.files.get(m.group()) != t.file or self.marks.get(
+                (m.group(1), int(m.group(2)))) != (t.line, t.column):
+            return m.group()
+        return t.words
+
+    def named(self, key: str, file: str, line: int, column: int) -> str:
+        """The model path `key`, marked at (`file`, `line`, `column`), as the file names
+        what is there: its nearest path with a term made for that very place (a value an
+        ``mbody:`` entry gives is marked at the entry and keeps its path)."""
+        at = key
+        while at:
+            t = self.terms.get(at)
+            if t is not None and (t.file, t.line, t.column) == (file, line, column):
+                rest = key[len(at):].lstrip(".")
+                return t.words + (f" ({rest})" if rest else "")
+            at = _parent_key(at)
+        return key
+
+
+@dataclass(frozen=True)
+class Term:
+    """What the file has at one place, in its own words, and where that place is."""
+
+    words: str
+    file: str
+    line: int
+    column: int
+
+
+_ENTRY = re.compile(r"\b(bodies|joints)\[(\d+)\]")
+"""A body or joint of the YAML form named by its path in a message."""
+
+
+def _parent_key(key: str) -> str:
+    """``bodies[2].inertia`` -> ``bodies[2]`` -> ``bodies`` -> ``""``."""
+    return key[:max(key.rfind("."), key.rfind("["), 0)]
+
+
+FORMAT_ADVICE: dict[str, dict[str, str]] = {
+    PARTICLE_HINT: {
+        "urdf": "an <inertia> whose six entries are 0 makes a point mass, which nothing "
+                "turns",
+        "mjcf": 'an <inertial> with diaginertia="0 0 0" makes a point mass, which nothing '
+                "turns"},
+}
+"""Advice the model checks give in the YAML file's words -> the same in MJCF's and
+URDF's, for a model read from those."""
+
+
+def in_words_of(fmt: str, hint: str) -> str:
+    """`hint` with its YAML advice in the words of format `fmt` ("urdf", "mjcf")."""
+    for yaml_words, words in FORMAT_ADVICE.items():
+        if fmt in words and yaml_words in hint:
+            hint = hint.replace(yaml_words, words[fmt])
+    return hint
+
+
+def name_of(e: Element) -> str:
+    """How a message names the element `e`: its tag and name (``link 'upper_arm'``), or
+    its tag alone (an unnamed MJCF body: its line and column say which)."""
+    n = e.get("name")
+    if not n:
+        return f"<{e.tag}>"
+    return f"{e.tag} '{one_line(n if len(n) <= 60 else n[:40] + '...' + n[-10:])}'"
+
+
+def term(owner: Element, e: Element, attr: str | None = None) -> str:
+    """What is at `e` (at its attribute `attr` when it has it), `owner`'s part, in the
+    file's words: ``link 'upper_arm' <inertia>``, ``body 'a' <inertial mass>``,
+    ``joint 'elbow' axis``."""
+    a = attr if attr is not None and attr in e.attrib else ""
+    if e is owner:
+        return name_of(owner) + (f" {a}" if a else "")
+    return f"{name_of(owner)} <{e.tag}{' ' + a if a else ''}>"
 
 
 def validate_imported(doc: Document) -> Spec:
@@ -387,13 +481,19 @@ class DocBuilder:
         self.marks: dict[Path_, tuple[int, int]] = {}
         self.key_marks: dict[Path_, tuple[int, int]] = {}
         self.files: dict[str, str] = {}
+        self.terms: dict[str, Term] = {}
 
-    def mark(self, path: Path_, e: Element | None, attr: str | None = None) -> None:
+    def mark(self, path: Path_, e: Element | None, attr: str | None = None,
+             owner: Element | None = None) -> None:
+        """Mark `path` at `e` (its attribute `attr`), part of `owner` (the link, body or
+        joint that messages name it by; none: messages give the path)."""
         if e is None:
             return
         self.marks[path] = e.where(attr)
         self.key_marks[path] = e.where(attr)
         self.files[dotted(path)] = e.file
+        if owner is not None:
+            self.terms[dotted(path)] = Term(term(owner, e, attr), e.file, *e.where(attr))
 
 
 def _floats(v: np.ndarray) -> list[float]:
@@ -415,15 +515,15 @@ def build(name: str, description: str, file: str, bodies: list[TreeBody],
     bare MJCF body) are left out, their children joined to the nearest body kept; a body
     without mass that moves is an error (mbody needs a mass on every moving body).
     """
-    renamed = []
+    warnings: list[Issue] = []
     for b in bodies:  # "ground" names the world in mbody: a body so named is renamed
         if b.name == GROUND:
             taken = {x.name for x in bodies}
             b.name = next(f"{GROUND}_{k}" if k else f"{GROUND}_body" for k in range(
                 len(bodies) + 1) if (f"{GROUND}_{k}" if k else f"{GROUND}_body") not in taken)
-            renamed.append(Issue(file, *b.element.where("name"), "", f"the body "
-                                 f"'{GROUND}' is named '{b.name}' here: mbody's '{GROUND}' "
-                                 "is the fixed world frame"))
+            warnings.append(Issue(file, *b.element.where("name"), "", f"the body "
+                                  f"'{GROUND}' is named '{b.name}' here: mbody's '{GROUND}' "
+                                  "is the fixed world frame"))
     kin = forward(bodies, qpos, qvel, q0)
     scale = float(max([1.0] + [float(np.abs(p).max()) for p in kin.pos]))
     issues: list[Issue] = []
@@ -466,6 +566,20 @@ def build(name: str, description: str, file: str, bodies: list[TreeBody],
                 B = kin.R[o] @ bodies[o].R_inertia
                 T = B.T @ W
                 extra[o] = extra.get(o, 0.0) + T @ b.inertia @ T.T
+    carried: set[int] = set()  # the massless frames a freely moving body with a mass is welded to
+    for i in free:
+        up = bodies[i].parent
+        while up >= 0 and up not in kept:
+            carried.add(up)
+            up = bodies[up].parent
+    for i, o in owner.items():  # a free frame that no body with a mass is welded to
+        if o == floating and i not in carried and bodies[i].joints:
+            e = bodies[i].joints[0].element
+            issues.append(e.issue(
+                f"body '{bodies[i].name}' has no mass but moves on joint "
+                f"'{bodies[i].joints[0].name}'", "mbody needs a mass on every moving body: "
+                "give the body an inertial with a mass, or geoms with one, or weld a body "
+                "with a mass to it"))
     if issues:
         raise ModelError(issues)
     if not kept:
@@ -494,10 +608,11 @@ def build(name: str, description: str, file: str, bodies: list[TreeBody],
             entry["shape"] = b.shape
         out_bodies.append(entry)
         p: Path_ = ("bodies", k)
-        doc.mark(p, b.element)
-        doc.mark((*p, "name"), b.element, "name")
-        for key in ("mass", "inertia"):
-            doc.mark((*p, key), b.mass_element or b.element, key if key == "mass" else None)
+        doc.mark(p, b.element, owner=b.element)
+        doc.mark((*p, "name"), b.element, "name", owner=b.element)
+        doc.mark((*p, "mass"), b.mass_at or b.mass_element or b.element,
+                 "value" if b.mass_at is not None else "mass", owner=b.element)
+        doc.mark((*p, "inertia"), b.mass_element or b.element, owner=b.element)
         m = (map_joints(b, kin, i, scale, planar=planar, screws=screws)
              if i not in free and i not in free_bodies else Mapped(None, ""))
         if i in points:
@@ -526,16 +641,27 @@ def build(name: str, description: str, file: str, bodies: list[TreeBody],
             jd["pitch"] = float(m.pitch)
         jp: Path_ = ("joints", len(out_joints))
         out_joints.append(jd)
-        doc.mark(jp, m.element)
+        je = m.element or b.element
+        doc.mark(jp, je, owner=je)
         for key in jd:
-            doc.mark((*jp, key), m.element, key if key in ("name", "axis", "type") else None)
+            if key in ("name", "type") or key in je.attrib:  # MJCF's axis
+                doc.mark((*jp, key), je, key, owner=je)
+            elif key == "axis" and je.find("axis") is not None:  # URDF's <axis xyz>
+                doc.mark((*jp, key), je.find("axis"), "xyz", owner=je)
+            else:  # the joint's point, its bodies: what the file says of them is the joint
+                doc.mark((*jp, key), je)
     for lp in loops:
         loop = _loop(lp, bodies, kin, owner, kept)
-        if loop is None:
+        if loop is None:  # both ends welded into one body (or the world): it always holds
+            one = _parent_name(bodies, lp.body1, owner, kept)
+            warnings.append(Issue(lp.element.file, *lp.element.where(), "",
+                                  f"the {lp.element.tag} '{lp.name}' joins two parts of "
+                                  f"one rigid body ('{one}'): it always holds, and is left "
+                                  "out"))
             continue
         jp = ("joints", len(out_joints))
         out_joints.append(loop)
-        doc.mark(jp, lp.element)
+        doc.mark(jp, lp.element, owner=lp.element)
     data: dict[str, Any] = {"model": name, "description": description, "dimension": 3,
                             "gravity": _floats(gravity), "bodies": out_bodies}
     if out_joints:
@@ -543,8 +669,8 @@ def build(name: str, description: str, file: str, bodies: list[TreeBody],
     doc.marks[()] = (root.line, root.column)
     for key in ("model", "dimension", "gravity", "bodies", "joints"):
         doc.marks[(key,)] = (root.line, root.column)
-    return ImportedDocument(data, file, doc.marks, doc.key_marks, warnings=renamed,
-                            source_format=fmt, files=doc.files)
+    return ImportedDocument(data, file, doc.marks, doc.key_marks, warnings=warnings,
+                            source_format=fmt, files=doc.files, terms=doc.terms)
 
 
 def _parent_name(bodies: list[TreeBody], parent: int, owner: dict[int, int],

@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from mbody.errors import Issue, ModelError, did_you_mean
+from mbody.errors import Issue, ModelError, did_you_mean, option_name
 from mbody.io.interop.attrvalues import read_numbers
 from mbody.io.interop.tree import (
     NV,
@@ -32,7 +32,13 @@ from mbody.io.interop.tree import (
     qpos0,
     unit,
 )
-from mbody.io.interop.xmlsource import MAX_ELEMENTS, Element, parse_xml, read_xml, unknown_name
+from mbody.io.interop.xmlsource import (
+    MAX_ELEMENTS,
+    Element,
+    read_model_xml,
+    second,
+    unknown_name,
+)
 from mbody.util.spatial import quat_to_matrix
 
 _ATTRS: dict[str, tuple[str, ...]] = {
@@ -61,6 +67,14 @@ _CHILDREN: dict[str, tuple[str, ...]] = {
     "joint": ("origin", "parent", "child", "axis", "calibration", "dynamics", "limit",
               "mimic", "safety_controller"),
 }
+_ONCE: dict[str, tuple[str, ...]] = {
+    "link": ("inertial",), "inertial": ("origin", "mass", "inertia"),
+    "visual": ("origin", "geometry", "material"), "collision": ("origin", "geometry"),
+    "material": ("color", "texture"),
+    "joint": ("origin", "parent", "child", "axis", "calibration", "dynamics", "limit",
+              "mimic", "safety_controller"),
+}
+"""The children URDF gives an element at most once; a <geometry> holds one shape."""
 _OPEN = ("transmission", "gazebo", "mujoco")
 """Elements whose content belongs to other tools; not checked."""
 JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
@@ -93,18 +107,7 @@ def read_urdf(source: str | Path, *, joint_positions: Mapping[str, float] | None
         Bad XML, an unknown element or attribute (with a did-you-mean), an unknown joint
         name in `joint_positions`, or what mbody cannot express (a planar joint).
     """
-    budget = [MAX_ELEMENTS]
-    if isinstance(source, Path) or not str(source).lstrip().startswith("<"):
-        name = str(source) if file is None else file
-        root = read_xml(Path(source), name, budget)
-    else:
-        name = "<string>" if file is None else file
-        root = parse_xml(str(source), name, budget)
-    if root.tag != "robot":
-        hint = ("this is an MJCF file: read it as MJCF (a .xml name, or --format mjcf)"
-                if root.tag == "mujoco" else "a URDF model starts with <robot>")
-        raise ModelError([root.issue(f"expected <robot> as the root element, got "
-                                     f"<{root.tag}>", hint)])
+    root, name = read_model_xml(source, file, [MAX_ELEMENTS], "urdf")
     issues: list[Issue] = []
     ignored: list[str] = []
     _check_names(root, issues, ignored)
@@ -173,9 +176,20 @@ def _check_names(root: Element, issues: list[Issue], ignored: list[str]) -> None
                 else:
                     note(f"{e.tag} {a}")
         kids = _CHILDREN.get(e.tag, ())
+        once = _ONCE.get(e.tag, ())
+        first: dict[str, Element] = {}
         for c in e.children:
             if c.tag in kids:
                 stack.append(c)
+                if c.tag in once and c.tag in first:
+                    issues.append(second(c, e, first[c.tag], "URDF"))
+                elif e.tag == "geometry" and first:
+                    shape = next(iter(first.values()))
+                    issues.append(c.issue(
+                        f"a second shape <{c.tag}> in <geometry> (the first, <{shape.tag}>, "
+                        f"is at line {shape.line})", "a <geometry> holds one shape: give "
+                        "the other one a <visual> or <collision> of its own"))
+                first.setdefault(c.tag, c)
             elif _misspelt(c.tag, kids):
                 issues.append(unknown_name(c, c.tag, kids, f"element in <{e.tag}>",
                                            hint=len(issues) < ModelError.SHOWN))
@@ -229,9 +243,14 @@ class _Reader:
                 self.issues.append(ln.issue(f"duplicate link name '{n}'", attr="name"))
             links[n] = ln
         joints_of: dict[str, Element] = {}  # child link -> joint
+        parent_of: dict[str, str] = {}  # child link -> parent link
         children: dict[str, list[str]] = {}
+        joint_names: set[str] = set()
         for j in self.root.findall("joint"):
             jn = j.get("name") or "?"
+            if j.get("name") and jn in joint_names:
+                self.issues.append(j.issue(f"duplicate joint name '{jn}'", attr="name"))
+            joint_names.add(jn)
             typ = j.get("type")
             if typ not in JOINT_TYPES:
                 self.issues.append(j.issue(f"unknown joint type '{typ}'", did_you_mean(
@@ -250,7 +269,7 @@ class _Reader:
             if cl in joints_of:
                 self.issues.append(child.issue(f"link '{cl}' is the child of two joints",
                                                "URDF describes a tree", "link"))
-            joints_of[cl] = j
+            joints_of[cl], parent_of[cl] = j, pl
             children.setdefault(pl, []).append(cl)
         if self.issues:
             raise ModelError(self.issues)
@@ -268,6 +287,8 @@ class _Reader:
         order = [roots[0]]
         for n in order:  # parents first
             order.extend(children.get(n, []))
+        if len(order) < len(links):
+            raise ModelError(_cycles(links, joints_of, parent_of, set(order), roots[0]))
         for n in order:
             ln = links[n]
             joint = joints_of.get(n)
@@ -279,15 +300,16 @@ class _Reader:
                                           np.array([0.0, 0, 1]), ln)]
                 elif b.mass > 0:
                     self.note("the root link is fixed to the world (its mass is part of "
-                              "the ground; floating_base=True lets it move)", n)
+                              f"the ground; {option_name('floating_base', 'True')} lets it "
+                              "move)", n)
                     b.mass = 0.0
                     if not any(links[c].find("inertial") is not None for c in joints_of):
                         # nothing else has a mass: a drone's or a free object's one link
                         raise ModelError([ln.issue(
                             f"the root link '{n}' is the only link with a mass, and it "
                             "is fixed to the world (a URDF's root is, unless it floats): "
-                            "nothing moves", "floating_base=True (--floating-base) lets "
-                            "it move freely")])
+                            "nothing moves", f"{option_name('floating_base', 'True')} "
+                            "lets it move freely")])
             else:
                 pos, quat = self.origin(joint)
                 parent_link = joint.find("parent")
@@ -328,9 +350,9 @@ class _Reader:
             return []
         if typ in ("floating", "planar"):
             self.issues.append(j.issue(
-                f"a {typ} joint ('{name}') is not read", "use floating_base=True (--floating"
-                "-base) for a free-floating root link" if typ == "floating" else
-                "mbody has no planar joint", "type"))
+                f"a {typ} joint ('{name}') is not read", f"use "
+                f"{option_name('floating_base', 'True')} for a free-floating root link"
+                if typ == "floating" else "mbody has no planar joint", "type"))
             return []
         axis = self.numbers(j.find("axis"), "xyz", 3, np.array([1.0, 0, 0]))
         if np.linalg.norm(axis) < 1e-12:
@@ -370,7 +392,7 @@ class _Reader:
             J = np.array([[g["ixx"], g["ixy"], g["ixz"]], [g["ixy"], g["iyy"], g["iyz"]],
                           [g["ixz"], g["iyz"], g["izz"]]])
         b.mass, b.com, b.R_inertia, b.inertia = mass, xyz, quat_to_matrix(quat), J
-        b.mass_element = t if t is not None else m
+        b.mass_element, b.mass_at = (t if t is not None else m), m
 
     def shape(self, ln: Element) -> dict[str, Any] | None:
         best: tuple[float, dict[str, Any]] | None = None
@@ -406,8 +428,9 @@ class _Reader:
             v += NV[j.type]
         qpos, qvel = q0.copy(), np.zeros(v)
         problems = []
-        for given, target, what in ((qp, qpos, "joint_positions"), (qv, qvel,
-                                                                     "joint_velocities")):
+        for given, target, keyword in ((qp, qpos, "joint_positions"),
+                                       (qv, qvel, "joint_velocities")):
+            what = option_name(keyword)
             for k, x in given.items():
                 where = names.get(k)
                 if where is None or k.endswith("_free"):
@@ -418,12 +441,12 @@ class _Reader:
                 try:
                     value = float(x)
                 except (TypeError, ValueError):
-                    problems.append(Issue(self.file, 0, 0, f"{what}[{k}]",
-                                          f"expected a number, got {x!r}"))
+                    problems.append(Issue(self.file, 0, 0, what,
+                                          f"joint '{k}': expected a number, got {x!r}"))
                     continue
                 if not math.isfinite(value):
-                    problems.append(Issue(self.file, 0, 0, f"{what}[{k}]",
-                                          "expected a finite number"))
+                    problems.append(Issue(self.file, 0, 0, what,
+                                          f"joint '{k}': expected a finite number"))
                     continue
                 target[where[0] if target is qpos else where[1]] = value
         if problems:
@@ -433,3 +456,55 @@ class _Reader:
 
 def _name(n: str) -> str:
     return "".join("_" if ch == "." or ch.isspace() else ch for ch in n)
+
+
+def _cycles(links: dict[str, Element], joints_of: dict[str, Element],
+            parent_of: dict[str, str], reached: set[str], root: str) -> list[Issue]:
+    """Each cycle of joints that the links not `reached` from the `root` link hang from.
+
+    Every link but the root is the child of exactly one joint, so following parents from a
+    link the root does not reach never ends at the root: it runs into a cycle. Each cycle
+    is said at its first joint in the file, with every link that is lost with it."""
+    cycle_of: dict[str, int] = {}  # unreached link -> the cycle it hangs from
+    cycles: list[list[str]] = []  # each cycle's links, in the order its joints run
+    for start in links:
+        if start in reached or start in cycle_of:
+            continue
+        path: list[str] = []
+        at: dict[str, int] = {}
+        n = start
+        while n not in cycle_of and n not in at:
+            at[n] = len(path)
+            path.append(n)
+            n = parent_of[n]
+        if n in cycle_of:
+            k = cycle_of[n]
+        else:  # a new cycle: path[at[n]:]
+            k = len(cycles)
+            cycles.append(path[at[n]:])
+        for m in path:
+            cycle_of[m] = k
+    lost: list[list[str]] = [[] for _ in cycles]  # each cycle's links and theirs
+    for n in links:
+        if n in cycle_of:
+            lost[cycle_of[n]].append(n)
+    issues = []
+    for k, ring in enumerate(cycles):
+        joints = sorted((joints_of[n] for n in ring), key=lambda j: (j.line, j.column))
+        names = _listed([f"'{j.get('name') or '?'}'" for j in joints])
+        what = (f"joint {names} has link '{ring[0]}' as its parent and its child"
+                if len(ring) == 1 else f"joints {names} form a cycle")
+        shown = _listed([f"'{n}'" for n in lost[k]])
+        fix = ("name in its <parent> the link it hangs from" if len(ring) == 1 else
+               "one of these joints names the wrong <parent> or <child>")
+        issues.append(joints[0].issue(
+            f"{what}: a URDF describes a tree", f"link{'s' if len(lost[k]) > 1 else ''} "
+            f"{shown} {'are' if len(lost[k]) > 1 else 'is'} not connected to the root link "
+            f"'{root}': {fix}"))
+    return sorted(issues, key=lambda i: (i.file, i.line, i.column))
+
+
+def _listed(items: list[str], most: int = 10) -> str:
+    """The first `most` of `items`, with how many more there are."""
+    return ", ".join(items[:most]) + (f" and {len(items) - most} more"
+                                      if len(items) > most else "")

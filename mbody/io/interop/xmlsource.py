@@ -18,7 +18,7 @@ from xml.parsers import expat
 from defusedxml import DTDForbidden, EntitiesForbidden, ExternalReferenceForbidden
 
 from mbody.errors import Issue, ModelError, did_you_mean
-from mbody.model.loader import read_file
+from mbody.model.loader import MODEL_FORMATS, read_as, read_file
 
 MAX_DEPTH = 200
 """Deepest element nesting accepted (a robot's body tree is rarely 50 deep)."""
@@ -234,7 +234,7 @@ def _syntax_hint(what: str) -> str:
 
 
 def read_xml(path: str | Path, file: str | None = None,
-             budget: list[int] | None = None) -> Element:
+             budget: list[int] | None = None, fmt: str = "mjcf") -> Element:
     """Read and parse the XML file at `path` (size-limited as model files are).
 
     Parameters
@@ -245,13 +245,54 @@ def read_xml(path: str | Path, file: str | None = None,
         The name used in marks (default: `path` as given).
     budget : list of one int, optional
         As for `parse_xml`.
+    fmt : {"mjcf", "urdf"}, optional
+        The model format it is read as (what a refusal says was expected).
 
     Returns
     -------
     Element
     """
-    text = read_file(path, None)
+    text = read_file(path, None, fmt)
     return parse_xml(text, str(path) if file is None else file, budget)
+
+
+ROOTS = {"mjcf": "mujoco", "urdf": "robot"}
+"""The root element of each XML model format."""
+_YAML_KEY = re.compile(r"(?:[ \t]*(?:#[^\n]*)?\r?\n)*[ \t]*[\w-]+[ \t]*:(?:[ \t]|\r?\n|$)")
+"""A YAML file's first entry ("model: pendulum"), after blank and comment lines."""
+
+
+def read_model_xml(source: str | Path, file: str | None, budget: list[int],
+                   fmt: str) -> tuple[Element, str]:
+    """The root element of an MJCF or URDF model (`fmt`), and the name its messages give
+    the file.
+
+    `source` is a path, or XML text (starting with ``<``). A file that is no XML, or XML
+    of the other format, is refused with the advice to read it as what it is.
+    """
+    text_given = not isinstance(source, Path) and str(source).lstrip().startswith("<")
+    name = (("<string>" if text_given else str(source)) if file is None else file)
+    text = str(source) if text_given else read_file(Path(source), None, fmt)
+    start = len(text) - len(text.lstrip("\ufeff \t\r\n"))
+    if start == len(text):
+        raise ModelError([Issue(name, 1, 1, "", f"the file is empty; expected "
+                                f"{MODEL_FORMATS[fmt][3]} (it starts with <{ROOTS[fmt]}>)")])
+    if text[start] != "<":
+        line = text.count("\n", 0, start) + 1
+        column = start - (text.rfind("\n", 0, start) + 1) + 1
+        raise ModelError([Issue(
+            name, line, column, "", f"expected {MODEL_FORMATS[fmt][3]}, which is XML (it "
+            f"starts with <{ROOTS[fmt]}>), got text that does not start with '<'",
+            read_as("yaml") if _YAML_KEY.match(text, start) or text.startswith("#", start)
+            else "")])
+    root = parse_xml(text, name, budget)
+    if root.tag != ROOTS[fmt]:
+        other = next((f for f, tag in ROOTS.items() if tag == root.tag), None)
+        raise ModelError([root.issue(
+            f"expected <{ROOTS[fmt]}> as the root element, got <{root.tag}>",
+            read_as(other) if other else f"{'an MJCF' if fmt == 'mjcf' else 'a URDF'} "
+            f"model starts with <{ROOTS[fmt]}>")])
+    return root, name
 
 
 def unknown_name(e: Element, name: str, known: Iterable[str], what: str,
@@ -283,6 +324,15 @@ def unknown_name(e: Element, name: str, known: Iterable[str], what: str,
     line, col = e.where(attr)
     key = f"<{e.tag}>" if attr is None else f"<{e.tag} {attr}>"
     return Issue(e.file, line, col, key, one_line(f"unknown {what} '{name}'"), one_line(said))
+
+
+def second(e: Element, parent: Element, first: Element, allows: str) -> Issue:
+    """The issue of `e`, a second child of `parent` like `first` where the format allows
+    one: refused, never read in part (`allows` names who allows one: "URDF")."""
+    at = (f"line {first.line}, column {first.column}" if first.file == e.file
+          else f"{first.file}:{first.line}:{first.column}")
+    return e.issue(f"a second <{e.tag}> in <{parent.tag}> (the first is at {at})",
+                   f"{allows} allows one: merge them, or remove one")
 
 
 _BREAKS = str.maketrans({"\n": "\\n", "\r": "\\r", "\x0b": "\\v", "\x0c": "\\f",
