@@ -173,38 +173,18 @@ class State:
             The arrays disagree on the number of bodies (the message names them and their
             shapes), or one is not of the shape above.
         """
-        theta = _float_array(angle, "angle", "(n,)", "State.planar")
-        if theta.ndim > 1:
-            raise MbodyError(f"State.planar: angle must be an (n,) array, one angle per "
-                             f"body, got shape {theta.shape}")
-        theta = theta.reshape(-1)
+        theta, position, velocity, angular_velocity = _planar_arrays(
+            angle, position, velocity, angular_velocity)
         n = len(theta)
-        parts = {}
-        for name, value, width in (("position", position, 2), ("velocity", velocity, 2),
-                                   ("angular_velocity", angular_velocity, 0)):
-            want = (n, width) if width else (n,)
-            a = _float_array(value, name, "(n, 2)" if width else "(n,)", "State.planar")
-            if a.ndim == 0:  # one number for every body (0: at rest), as numpy broadcasts
-                a = np.broadcast_to(a, want)
-            elif n == 1 and a.shape == want[1:]:  # one body written without its row
-                a = a.reshape(want)
-            if a.shape != want:
-                if a.ndim == len(want) and a.shape[1:] == want[1:]:
-                    raise MbodyError(f"State.planar: {name} has {a.shape[0]} rows, angle "
-                                     f"{n}: one per body in each")
-                raise MbodyError(f"State.planar: {name} must be a {want} array (one "
-                                 f"{'row' if width else 'value'} per body; angle gives "
-                                 f"{n}), got shape {a.shape}")
-            parts[name] = a
         pos = np.zeros((n, 3))
-        pos[:, :2] = parts["position"]
+        pos[:, :2] = position
         vel = np.zeros((n, 3))
-        vel[:, :2] = parts["velocity"]
+        vel[:, :2] = velocity
         q = np.zeros((n, 4))
         q[:, 0] = np.cos(theta / 2)
         q[:, 3] = np.sin(theta / 2)
         om = np.zeros((n, 3))
-        om[:, 2] = parts["angular_velocity"]
+        om[:, 2] = angular_velocity
         return cls(pos, q, vel, om, t)
 
     def __repr__(self) -> str:  # the dataclass's would print four (n, k) arrays
@@ -228,6 +208,44 @@ def _float_array(value: Any, name: str, shape: str, where: str = "State") -> np.
     except (TypeError, ValueError) as exc:
         raise MbodyTypeError(f"{where}: {name} must be an {shape} array of numbers, got "
                              f"{type(value).__name__} ({exc})") from None
+
+
+def _planar_arrays(angle: Any, position: Any, velocity: Any, angular_velocity: Any
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """`State.planar`'s arguments as float arrays (n,), (n, 2), (n, 2), (n,), n from
+    `angle`: a body written without its row and a single number for every body taken,
+    any other shape refused with the argument named."""
+    a = angle
+    if (type(a) is np.ndarray and a.dtype is _FLOAT64 and a.ndim == 1
+            and type(position) is type(velocity) is type(angular_velocity) is np.ndarray
+            and position.dtype is velocity.dtype is angular_velocity.dtype is _FLOAT64
+            and position.shape == velocity.shape == (len(a), 2)
+            and angular_velocity.shape == a.shape):  # the usual call: nothing to convert
+        return a, position, velocity, angular_velocity
+    theta = _float_array(angle, "angle", "(n,)", "State.planar")
+    if theta.ndim > 1:
+        raise MbodyError(f"State.planar: angle must be an (n,) array, one angle per "
+                         f"body, got shape {theta.shape}")
+    theta = theta.reshape(-1)
+    n = len(theta)
+    parts = []
+    for name, value, width in (("position", position, 2), ("velocity", velocity, 2),
+                               ("angular_velocity", angular_velocity, 0)):
+        want = (n, width) if width else (n,)
+        x = _float_array(value, name, "(n, 2)" if width else "(n,)", "State.planar")
+        if x.ndim == 0:  # one number for every body (0: at rest), as numpy broadcasts
+            x = np.broadcast_to(x, want)
+        elif n == 1 and x.shape == want[1:]:  # one body written without its row
+            x = x.reshape(want)
+        if x.shape != want:
+            if x.ndim == len(want) and x.shape[1:] == want[1:]:
+                raise MbodyError(f"State.planar: {name} has {x.shape[0]} rows, angle "
+                                 f"{n}: one per body in each")
+            raise MbodyError(f"State.planar: {name} must be a {want} array (one "
+                             f"{'row' if width else 'value'} per body; angle gives "
+                             f"{n}), got shape {x.shape}")
+        parts.append(x)
+    return theta, parts[0], parts[1], parts[2]
 
 
 @dataclass(frozen=True, eq=False)
