@@ -47,6 +47,7 @@ from mbody.model.expressions import (
     first_nonfinite,
 )
 from mbody.model.loader import Document, Path_, Unrepresentable
+from mbody.util import colours
 from mbody.util.spatial import euler_to_quat, matrix_to_quat, quat_to_matrix, shape_inertia
 
 TOP_KEYS = ("model", "dimension", "gravity", "bodies", "loads", "joints", "reactions",
@@ -434,7 +435,10 @@ def _bodies(c: Checker, value: Any) -> list[BodySpec]:
             _particle_pose(c, p, b, q, omega)
         color = b.get("color")
         if color is not None and not isinstance(color, str):
-            c.err((*p, "color"), f"expected a colour name or '#rrggbb', got {_kind(color)}")
+            c.err((*p, "color"), f"expected {colours.EXPECTED}, got {_kind(color)}")
+            color = None
+        elif color is not None and colours.colour_hex(color) is None:
+            c.err((*p, "color"), f"{_quoted(color)} is not a colour", colours.colour_hint(color))
             color = None
         if name is None or mass is None or inertia is None or pos is None or vel is None:
             continue
