@@ -56,3 +56,25 @@ def test_colour_names_and_forms_that_draw_are_accepted(tmp_path, capsys):
         good.write_text(text.replace('    color: "#d35400"', f'    color: "{colour}"'))
         code, out, err = run(capsys, "check", good)
         assert (code, err) == (0, ""), colour
+
+
+# == P4: a spring whose ends coincide while it has tension ====================================
+
+SMD = MODELS / "spring_mass_damper.yaml"
+TOUCHING = "bodies.block.position=[0,-0.05]"  # the block's top (0, 0.05) on the ceiling point
+
+
+def test_coincident_spring_ends_with_tension_warn_at_the_spring(capsys):
+    code, out, err = run(capsys, "solve", SMD, "--set", TOUCHING)
+    line = line_of(SMD, "type: spring") - 1  # the entry starts on its '- name:' line
+    assert code == 0
+    assert f"mbody: warning: {SMD}:{line}:5: loads[0]: the spring's ends coincide" in err
+    assert "k(L − L0) = 800 × (0 − 0.5) = -400 N is not zero" in err  # k = 800, L0 = 0.5
+    code, out, err = run(capsys, "check", SMD, "--set", TOUCHING)
+    assert code == 0 and "loads[0]: the spring's ends coincide" in out
+
+
+def test_coincident_spring_ends_without_rest_length_lose_nothing(capsys):
+    code, out, err = run(capsys, "solve", SMD, "--set", TOUCHING,
+                         "--set", "loads.suspension.rest_length=0")
+    assert (code, err) == (0, "")

@@ -296,6 +296,7 @@ def validate(doc: Document) -> Spec:
     loads, joints, reactions, reaction_expressions, drivers = rest(c, bodies, None)
     if not getattr(doc, "source_format", ""):  # what a person wrote (docstring of the check)
         _far_joint_points(c, bodies, joints)
+    _coincident_springs(c, bodies, loads)
     return Spec(str(name), doc.file, c.dim, gravity, bodies, loads, joints, reactions,
                 description, c.warnings, reaction_expressions, drivers=drivers)
 
@@ -997,6 +998,38 @@ def _far_joint_points(c: Checker, bodies: list[BodySpec], joints: list[JointSpec
                + " and ".join(parts),
                "'at' is in world coordinates, where the bodies meet at the pose the file "
                "gives them; check it and the bodies' positions and angles")
+
+
+SPRING_COINCIDENT = 1e-12
+"""Spring ends closer than this (m) have no direction: the compiled core (loads.c,
+`spring_state`) then applies no force, whatever the tension."""
+
+
+def _coincident_springs(c: Checker, bodies: list[BodySpec], loads: list[LoadSpec]) -> None:
+    """Warn where a spring's ends coincide at the file's pose while its tension k(L − L0)
+    is not zero: the force has no direction there, and none is applied (a spring whose
+    rest length is 0 has no tension there, and loses nothing). `loads` are the file's
+    loads in its order (`rest` raised on any problem)."""
+    at = {b.name: (b.position, quat_to_matrix(b.quaternion[None])[0]) for b in bodies}
+    for i, ld in enumerate(loads):
+        if ld.type != "spring" or ld.stiffness * ld.rest_length == 0.0:
+            continue
+        ends = []
+        for body, point in zip(ld.bodies, ld.at, strict=True):
+            if body == "ground":
+                ends.append(point)
+            else:
+                pos, R = at[body]
+                ends.append(pos + R @ point)
+        length = float(np.linalg.norm(ends[1] - ends[0]))
+        if length > SPRING_COINCIDENT:
+            continue
+        tension = ld.stiffness * (length - ld.rest_length)
+        c.warn(("loads", i), f"the spring's ends coincide while its tension k(L − L0) = "
+               f"{ld.stiffness:g} × (0 − {ld.rest_length:g}) = {tension:.6g} N is not zero: "
+               "the force has no direction there, so none is applied while they coincide",
+               "move a body or an attachment point so that the ends are apart, or give "
+               "rest_length: 0 if they are meant to meet")
 
 
 PARTICLE_JOINTS = {cv.PLANAR: ("revolute",), cv.SPATIAL: ("revolute", "spherical")}
