@@ -5,6 +5,7 @@ key or option, and what was expected, before any output is written.
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import pytest
@@ -78,3 +79,41 @@ def test_coincident_spring_ends_without_rest_length_lose_nothing(capsys):
     code, out, err = run(capsys, "solve", SMD, "--set", TOUCHING,
                          "--set", "loads.suspension.rest_length=0")
     assert (code, err) == (0, "")
+
+
+# == P5: a kinematic run that cannot end at --t-end says so =====================================
+
+CRANK = MODELS / "slider_crank_driven.yaml"
+
+
+def test_kinematics_stopping_short_of_t_end_warns_with_the_fps_that_ends_there(capsys):
+    code, out, err = run(capsys, "kinematics", CRANK, "--t-end", 0.1, "--fps", 15)
+    assert code == 0
+    # samples at 0 and 1/15 s; the next, 2/15 s, is past 0.1 s; 20 fps divides 0.1 s
+    assert "2 samples, t = 0 .. 0.0666667 s at 15 per second" in out
+    warning = next(ln for ln in out.splitlines() if "the last sample" in ln)
+    assert "t = 0.0666667 s, 0.0333333 s before the end asked for, t_end = 0.1 s" in warning
+    assert "(fps = 20 ends at t_end)" in warning
+    code, out, err = run(capsys, "kinematics", CRANK, "--t-end", 0.1, "--fps", 20)
+    assert code == 0 and "the last sample" not in out
+
+
+def test_kinematics_json_reports_the_fps_asked_for(capsys):
+    code, out, err = run(capsys, "kinematics", CRANK, "--fps", 1e-6, "--json")
+    assert code == 0
+    doc = json.loads(out)
+    assert (doc["samples"], doc["fps"]) == (1, 1e-6)
+    assert any("the last sample is at t = 0 s" in w for w in doc["warnings"])
+
+
+def test_kinematic_run_from_python_warns_as_the_command_does():
+    import mbody
+    from mbody.simulate.kinematic import kinematic_run
+
+    traj = kinematic_run(mbody.load(CRANK), 0.1, 15)
+    assert traj.info["fps"] == 15
+    assert [w for w in traj.info["warnings"] if "the last sample" in w] == [
+        "the last sample is at t = 0.0666667 s, 0.0333333 s before the end asked for, "
+        "t_end = 0.1 s: 0.1 s is not a whole number of sample intervals (1/fps = "
+        "0.0666667 s), so the run, its peaks and its energy check stop at 0.0666667 s "
+        "(fps = 20 ends at t_end)"]

@@ -33,9 +33,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
     s.add_argument("--t-end", type=seconds_or_turns(-T_END_MAX, T_END_MAX),
                    default=None, metavar="T",
-                   help="the last sample's time, s, or turns after --t-start of the first "
-                   "driver when it turns at a constant rate ('1 rev', as sweep's --t-end) "
-                   "(default: one such turn, else 1 s)")
+                   help="the run's end, s, or turns after --t-start of the first driver "
+                   "when it turns at a constant rate ('1 rev', as sweep's --t-end) "
+                   "(default: one such turn, else 1 s); the samples are --t-start + k/fps, "
+                   "and a warning names the last one when it falls before T")
     s.add_argument("--t-start", type=bounded("a number of seconds", -T_END_MAX, T_END_MAX),
                    default=0.0, metavar="SECONDS", help="the first sample's time, s "
                    "(default 0)")

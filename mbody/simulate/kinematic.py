@@ -114,7 +114,9 @@ def kinematic_run(model: Model, t_end: float, fps: float, *, t_start: float = 0.
     model : Model
         A fully driven mechanism: its drivers leave it no freedom (`freedom` is 0).
     t_end, fps : float
-        The last time (s) and the samples per second.
+        The end (s) and the samples per second: the samples are t_start + k / fps up to
+        t_end; when the span is not a whole number of them, the last falls before t_end
+        and ``info["warnings"]`` says so (`short_end`).
     t_start : float
         The first sample's time (s).
     points : mapping, optional
@@ -158,7 +160,26 @@ def kinematic_run(model: Model, t_end: float, fps: float, *, t_start: float = 0.
                                      info)
     if done < K:
         _failed(model, float(t[done]), y, info)
-    return _trajectory(model, t, Y, OUT, energy, plan, info, points, axes)
+    traj = _trajectory(model, t, Y, OUT, energy, plan, info, points, axes, fps)
+    short = short_end(float(t[-1]), t_end, t_start, fps)
+    if short:
+        traj.info["warnings"].append(short)
+    return traj
+
+
+def short_end(t_last: float, t_end: float, t_start: float, fps: float) -> str:
+    """Why a run sampled at k / fps from `t_start` stops short of `t_end` (its last
+    sample at `t_last`), or '' when it ends there (within `sample_times`' slack): the
+    span is not a whole number of sample intervals. Names the fps that ends at t_end."""
+    span = t_end - t_start
+    intervals = span * fps
+    if intervals - math.floor(intervals + 1e-9) <= 1e-9:
+        return ""
+    whole = math.ceil(intervals)
+    return (f"the last sample is at t = {t_last:g} s, {t_end - t_last:.6g} s before the end "
+            f"asked for, t_end = {t_end:g} s: {span:g} s is not a whole number of sample "
+            f"intervals (1/fps = {1.0 / fps:.6g} s), so the run, its peaks and its energy "
+            f"check stop at {t_last:g} s (fps = {whole / span:.6g} ends at t_end)")
 
 
 def newton_tolerance(model: Model, t: np.ndarray) -> float:
@@ -195,7 +216,7 @@ def _failed(model: Model, t: float, y: np.ndarray, info: np.ndarray) -> None:
 
 def _trajectory(model: Model, t: np.ndarray, Y: np.ndarray, OUT: np.ndarray,
                 energy: np.ndarray, plan, info: np.ndarray, points: BodyPoints | None,
-                axes: str) -> Trajectory:
+                axes: str, fps: float) -> Trajectory:
     K, n = len(t), model.n
     planar = model.dimension == cv.PLANAR
     x = Y[:, :3 * n].reshape(K, n, 3)
@@ -214,7 +235,7 @@ def _trajectory(model: Model, t: np.ndarray, Y: np.ndarray, OUT: np.ndarray,
     pose = ((x[..., :2], v[..., :2], Y[:, 13 * n:], w[..., 2]) if planar else (x, v, q, w))
     run_info = {
         "integrator": "none (kinematic run: every sample's positions by Newton's method)",
-        "t_end": float(t[-1]), "fps": float(1.0 / (t[1] - t[0])) if K > 1 else 0.0,
+        "t_end": float(t[-1]), "fps": float(fps),
         "samples": K, "steps": 0, "evaluations": K,
         "newton_steps": int(info[_core.KR_NEWTON]),
         "newton_steps_most": int(info[_core.KR_WORST]),
