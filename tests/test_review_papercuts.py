@@ -117,3 +117,43 @@ def test_kinematic_run_from_python_warns_as_the_command_does():
         "t_end = 0.1 s: 0.1 s is not a whole number of sample intervals (1/fps = "
         "0.0666667 s), so the run, its peaks and its energy check stop at 0.0666667 s "
         "(fps = 20 ends at t_end)"]
+
+
+# == P9: a unit hint fits the key's quantity ====================================================
+
+def planar_model(tmp_path: Path, gravity: str) -> Path:
+    path = tmp_path / "g.yaml"
+    path.write_text(f"model: g\ndimension: 2\ngravity: [0, {gravity}]\nbodies:\n"
+                    "  - {name: b, mass: 1, inertia: 1}\n")
+    return path
+
+
+def test_gravity_in_g_is_converted_as_an_acceleration(tmp_path, capsys):
+    path = planar_model(tmp_path, '"-1 g"')
+    code, _, err = run(capsys, "check", path)
+    assert code == 2
+    # standard gravity is 9.80665 m/s^2 by definition (CGPM 1901)
+    assert (f"{path}:3:14: gravity[1]: expected a number, got the text '-1 g' (numbers are "
+            "in SI units, written without the unit: -1 g is -9.80665 m/s^2)") in err
+
+
+def test_a_unit_of_another_quantity_is_named_not_converted(tmp_path, capsys):
+    path = planar_model(tmp_path, '"1 kg"')
+    code, _, err = run(capsys, "check", path)
+    assert code == 2
+    assert ("gravity[1]: expected a number, got the text '1 kg' (this number is an "
+            "acceleration in m/s^2, written without the unit; kg measures a mass)") in err
+    code, _, err = run(capsys, "check", PENDULUM, "--set", "bodies.rod.position.0=3 s")
+    assert code == 2
+    assert "this number is a length in m, written without the unit; s measures a time" in err
+
+
+def test_a_planar_zero_axis_gets_a_planar_example(tmp_path, capsys):
+    text = PENDULUM.read_text()
+    assert "name: O, type: revolute," in text
+    path = tmp_path / "ax.yaml"
+    path.write_text(text.replace("name: O, type: revolute,", "name: O, axis: [0, 0], "
+                                 "type: revolute,"))
+    code, _, err = run(capsys, "check", path)
+    assert code == 2
+    assert "joints[0].axis: the axis is the zero vector (give a direction, such as [1, 0])" in err

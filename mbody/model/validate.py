@@ -1072,7 +1072,8 @@ def _axis(c: Checker, path: Path_, value: Any) -> np.ndarray | None:
         return None
     n = float(vec_norm(a))
     if n < MIN_NORM:
-        c.err(path, "the axis is the zero vector", "give a direction, such as [0, 0, 1]")
+        c.err(path, "the axis is the zero vector", "give a direction, such as "
+              + ("[1, 0]" if c.dim == cv.PLANAR else "[0, 0, 1]"))
         return None
     return a / n
 
