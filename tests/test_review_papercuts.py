@@ -157,3 +157,28 @@ def test_a_planar_zero_axis_gets_a_planar_example(tmp_path, capsys):
     code, _, err = run(capsys, "check", path)
     assert code == 2
     assert "joints[0].axis: the axis is the zero vector (give a direction, such as [1, 0])" in err
+
+
+# == P10: a NAME=VALUE option given twice for one name is refused, by every command ============
+
+ARM = MODELS / "robots" / "two_link_arm.urdf"
+
+
+@pytest.mark.parametrize(("args", "message"), [
+    (("solve", PENDULUM, "--known", "O.Fx=3", "--known", "O.Fx=4"), "--known O.Fx"),
+    (("check", ARM, "--q", "shoulder=1", "--q", "shoulder=2"), "--q shoulder"),
+    (("check", ARM, "--qd", "elbow=1", "--qd", " elbow = 2"), "--qd elbow"),
+    (("check", PENDULUM, "--set", "bodies.rod.mass=2", "--set", "bodies.rod.mass=3"),
+     "--set bodies.rod.mass"),
+    (("kinematics", CRANK, "--point", "P=crank:0,0", "--point", "P=crank:0.1,0"),
+     "--point P"),
+])
+def test_an_option_given_twice_for_one_name_is_refused(capsys, args, message):
+    code, out, err = run(capsys, *args)
+    assert (code, out) == (2, "")
+    assert err == f"mbody: error: {message} is given twice\n"
+
+
+def test_the_same_option_for_different_names_is_taken(capsys):
+    code, out, err = run(capsys, "check", ARM, "--q", "shoulder=1", "--q", "elbow=2")
+    assert (code, err) == (0, "")

@@ -15,7 +15,7 @@ from collections.abc import Callable, Iterable, Sequence
 from contextvars import ContextVar
 from typing import Any, TextIO
 
-from mbody.errors import MbodyError
+from mbody.errors import MbodyError, given_twice
 
 EXIT_OK, EXIT_UNMET, EXIT_INPUT, EXIT_INTERNAL = 0, 1, 2, 70
 
@@ -222,6 +222,8 @@ def assignments(pairs: Sequence[str], flag: str, form: str,
             raise MbodyError(f"{flag} {name}: {value!r} is not a number") from None
         if not math.isfinite(x):
             raise MbodyError(f"{flag} {name}: expected a finite number, got {value!r}")
+        if name.strip() in out:
+            raise given_twice(flag, name.strip())
         out[name.strip()] = x
     return out
 
@@ -316,12 +318,14 @@ def _with_import_options(run: Callable[[argparse.Namespace], int]
 
 def set_values(pairs: Sequence[str]) -> dict[str, Any]:
     """``--set`` options -> ``{path: value}``, each value read as the model file would
-    read it (`mbody.model.values.parse_value`); a path given twice keeps the last."""
+    read it (`mbody.model.values.parse_value`); a path given twice is refused."""
     from mbody.model.values import parse_assignment, parse_value
 
     out: dict[str, Any] = {}
     for pair in pairs:
         path, text = parse_assignment(pair)
+        if path in out:
+            raise given_twice("--set", path)
         out[path] = parse_value(text, path)
     return out
 

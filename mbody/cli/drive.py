@@ -14,7 +14,7 @@ from mbody.cli.common import (
     output_stream,
     seconds_or_turns,
 )
-from mbody.errors import MbodyError
+from mbody.errors import MbodyError, given_twice
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -71,7 +71,7 @@ def parse_points(pairs: list[str]) -> dict[str, tuple[str, list[float]]]:
             raise MbodyError(f"--point {name}: {coords!r} is not a list of numbers (X,Y or "
                              "X,Y,Z)") from None
         if name.strip() in out:
-            raise MbodyError(f"--point {name}: given twice")
+            raise given_twice("--point", name.strip())
         out[name.strip()] = (body.strip(), xs)
     return out
 
