@@ -182,3 +182,40 @@ def test_an_option_given_twice_for_one_name_is_refused(capsys, args, message):
 def test_the_same_option_for_different_names_is_taken(capsys):
     code, out, err = run(capsys, "check", ARM, "--q", "shoulder=1", "--q", "elbow=2")
     assert (code, err) == (0, "")
+
+
+# == P11: option values within a model file's bounds; modes --view checked as fbd's ============
+
+@pytest.mark.parametrize(("args", "message"), [
+    # a model file's angle is at most 1e9 rad, any other number at most 1e100
+    (("check", ARM, "--q", "shoulder=1e300"), "--q shoulder: expected a number of magnitude "
+     "at most 1e100"),
+    (("check", ARM, "--q", "shoulder=1e20"), "joint_positions[shoulder]: expected an angle of "
+     "at most 1e+09 rad in magnitude"),
+    (("check", ARM, "--qd", "elbow=1e101"), "--qd elbow: expected a number of magnitude at "
+     "most 1e100"),
+    (("solve", PENDULUM, "--known", "O.Fx=-1e101"), "--known O.Fx: expected a number of "
+     "magnitude at most 1e100"),
+    (("kinematics", CRANK, "--point", "P=crank:1e300,0"), "point 'P': expected coordinates "
+     "of magnitude at most 1e+100 m"),
+])
+def test_option_numbers_obey_the_model_files_bounds(capsys, args, message):
+    code, out, err = run(capsys, *args)
+    assert (code, out) == (2, "")
+    assert message in err
+
+
+def test_within_the_bounds_they_are_taken(capsys):
+    code, out, err = run(capsys, "check", ARM, "--q", "shoulder=1e9", "--qd", "elbow=1e99")
+    assert (code, err) == (0, "")
+
+
+@pytest.mark.parametrize("view", ["diag", "nan,nan"])
+def test_modes_refuses_a_view_as_fbd_does(tmp_path, capsys, view):
+    model = MODELS / "double_pendulum.yaml"
+    code, _, fbd_err = run(capsys, "fbd", model, "--view", view, "-o", tmp_path / "f")
+    assert code == 2
+    picture = tmp_path / "m.svg"
+    code, out, err = run(capsys, "modes", model, "--view", view, "--picture", picture)
+    assert (code, out, err) == (2, "", fbd_err)
+    assert f"unknown view '{view}'" in err and not picture.exists()

@@ -207,7 +207,10 @@ def parse_known(pairs: Sequence[str]) -> dict[str, float]:
 def assignments(pairs: Sequence[str], flag: str, form: str,
                 degrees: str | None = None) -> dict[str, float]:
     """``NAME=VALUE`` options -> ``{NAME: value}``; a value ending in `degrees` (``deg``,
-    ``deg/s``) is converted to radians. Anything else is a clear `MbodyError`."""
+    ``deg/s``) is converted to radians. Anything else is a clear `MbodyError`, and so is
+    a number beyond a model file's bound (`mbody.model.checks.MAX_MAGNITUDE`)."""
+    from mbody.model.checks import MAX_MAGNITUDE
+
     out = {}
     for p in pairs:
         name, sep, value = p.partition("=")
@@ -222,6 +225,9 @@ def assignments(pairs: Sequence[str], flag: str, form: str,
             raise MbodyError(f"{flag} {name}: {value!r} is not a number") from None
         if not math.isfinite(x):
             raise MbodyError(f"{flag} {name}: expected a finite number, got {value!r}")
+        if abs(x) > MAX_MAGNITUDE:
+            raise MbodyError(f"{flag} {name}: expected a number of magnitude at most "
+                             f"{number(MAX_MAGNITUDE)}, as in a model file, got {value!r}")
         if name.strip() in out:
             raise given_twice(flag, name.strip())
         out[name.strip()] = x

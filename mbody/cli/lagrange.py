@@ -126,6 +126,10 @@ def modes(a: argparse.Namespace) -> int:
     from mbody.solve.linearize import linearize
     from mbody.util.atomic import ensure_writable
 
+    if a.view is not None:  # checked as fbd and report check it, before any work
+        from mbody.present.draw import parse_view
+
+        parse_view(a.view)
     if a.picture:
         ensure_writable(a.picture)
     model = load_model(a.model)

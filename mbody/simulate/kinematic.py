@@ -32,6 +32,7 @@ from mbody.equations.workspace import workspace
 from mbody.equations.world import check_axes
 from mbody.errors import MbodyError, did_you_mean
 from mbody.kernel import _core
+from mbody.model.checks import MAX_MAGNITUDE
 from mbody.model.model import Model
 from mbody.simulate.axes import world_series
 from mbody.simulate.peaks import record_peaks, steady_rate
@@ -145,6 +146,7 @@ def kinematic_run(model: Model, t_end: float, fps: float, *, t_start: float = 0.
     check_axes(axes)
     t = sample_times(t_end, fps, t_start)
     require_fully_driven(model)
+    body_points = _checked_points(model, points)  # before the run, not after it
     ws = workspace(model)
     unknowns = ws.file_unknowns
     plan = ws.solve_plan(unknowns)
@@ -160,7 +162,7 @@ def kinematic_run(model: Model, t_end: float, fps: float, *, t_start: float = 0.
                                      info)
     if done < K:
         _failed(model, float(t[done]), y, info)
-    traj = _trajectory(model, t, Y, OUT, energy, plan, info, points, axes, fps)
+    traj = _trajectory(model, t, Y, OUT, energy, plan, info, body_points, axes, fps)
     short = short_end(float(t[-1]), t_end, t_start, fps)
     if short:
         traj.info["warnings"].append(short)
@@ -215,8 +217,9 @@ def _failed(model: Model, t: float, y: np.ndarray, info: np.ndarray) -> None:
 
 
 def _trajectory(model: Model, t: np.ndarray, Y: np.ndarray, OUT: np.ndarray,
-                energy: np.ndarray, plan, info: np.ndarray, points: BodyPoints | None,
-                axes: str, fps: float) -> Trajectory:
+                energy: np.ndarray, plan, info: np.ndarray,
+                points: dict[str, tuple[int, np.ndarray]], axes: str, fps: float
+                ) -> Trajectory:
     K, n = len(t), model.n
     planar = model.dimension == cv.PLANAR
     x = Y[:, :3 * n].reshape(K, n, 3)
@@ -316,10 +319,11 @@ def driver_facts(model: Model) -> list[dict]:
             for name, j, c in zip(d.names, d.joint.tolist(), d.component, strict=True)]
 
 
-def _body_points(model: Model, x: np.ndarray, q: np.ndarray, points: BodyPoints | None
-                 ) -> dict[str, np.ndarray]:
-    """'point:<name>' -> (K, d) world positions of the named body points."""
-    out: dict[str, np.ndarray] = {}
+def _checked_points(model: Model, points: BodyPoints | None
+                    ) -> dict[str, tuple[int, np.ndarray]]:
+    """name -> (body index, the point in its axes padded to 3-D), each checked: a body of
+    the model, and d finite coordinates within a model file's bound (`MAX_MAGNITUDE`)."""
+    out: dict[str, tuple[int, np.ndarray]] = {}
     d = model.dimension
     for name, (body, p) in (points or {}).items():
         if body not in model.bodies:
@@ -331,10 +335,19 @@ def _body_points(model: Model, x: np.ndarray, q: np.ndarray, points: BodyPoints 
         if len(p) != d or not np.isfinite(r).all():
             raise MbodyError(f"point {name!r}: expected {d} finite coordinates in the body's "
                              f"axes, got {list(p)!r}")
-        i = model.bodies[body].index
-        R = quat_to_matrix(q[:, i])  # (K, 3, 3)
-        out[f"point:{name}"] = (x[:, i] + R @ r)[:, :d]
+        if np.abs(r).max() > MAX_MAGNITUDE:
+            raise MbodyError(f"point {name!r}: expected coordinates of magnitude at most "
+                             f"{MAX_MAGNITUDE:g} m, as a model file's, got {list(p)!r}")
+        out[name] = (model.bodies[body].index, r)
     return out
+
+
+def _body_points(model: Model, x: np.ndarray, q: np.ndarray,
+                 points: dict[str, tuple[int, np.ndarray]]) -> dict[str, np.ndarray]:
+    """'point:<name>' -> (K, d) world positions of the body points (`_checked_points`)."""
+    d = model.dimension
+    return {f"point:{name}": (x[:, i] + quat_to_matrix(q[:, i]) @ r)[:, :d]
+            for name, (i, r) in points.items()}
 
 
 def energy_balance(model: Model, traj: Trajectory, Y: np.ndarray, acc6: np.ndarray,
