@@ -219,3 +219,48 @@ def test_modes_refuses_a_view_as_fbd_does(tmp_path, capsys, view):
     code, out, err = run(capsys, "modes", model, "--view", view, "--picture", picture)
     assert (code, out, err) == (2, "", fbd_err)
     assert f"unknown view '{view}'" in err and not picture.exists()
+
+
+# == P12: an output named for another format is refused, with the name meant =================
+
+@pytest.mark.parametrize(("args", "name", "message"), [
+    (("assemble", PENDULUM, "--latex"), "x.pdf",
+     "--latex {out}: the name says PDF (.pdf), but --latex writes LaTeX; did you mean "
+     "'{stem}.tex'?"),
+    (("lagrange", PENDULUM, "--latex"), "x.pdf",
+     "--latex {out}: the name says PDF (.pdf), but --latex writes LaTeX; did you mean "
+     "'{stem}.tex'?"),
+    (("convert", PENDULUM, "--to", "yaml", "-o"), "q.xml",
+     "-o {out}: the name says XML (.xml), but -o writes mbody YAML (--to yaml); did you "
+     "mean '{stem}.yaml'?"),
+    (("convert", PENDULUM, "--to", "mjcf", "-o"), "q.yaml",
+     "-o {out}: the name says YAML (.yaml), but -o writes MJCF (--to mjcf); did you mean "
+     "'{stem}.xml'?"),
+    (("simulate", PENDULUM, "--t-end", 0.01, "-o"), "run.csv",
+     "-o {out}: the name says CSV (.csv), but -o writes a run file (.npz); did you mean "
+     "'{stem}.npz'?"),
+    (("kinematics", CRANK, "--t-end", 0.01, "-o"), "run.txt",
+     "-o {out}: the name says text (.txt), but -o writes a run file (.npz); did you mean "
+     "'{stem}.npz'?"),
+    (("report", PENDULUM, "-o"), "r.pdf",
+     "-o {out}: the name says PDF (.pdf), but -o writes an HTML page; did you mean "
+     "'{stem}.html'?"),
+    (("animate", PENDULUM, "--t-end", 0.1, "-o"), "a.svg",
+     "-o {out}: the name says SVG (.svg), but -o writes an HTML page; did you mean "
+     "'{stem}.html'?"),
+])
+def test_an_output_named_for_another_format_is_refused(tmp_path, capsys, args, name,
+                                                       message):
+    out = tmp_path / name
+    code, stdout, err = run(capsys, *args, out)
+    assert (code, stdout) == (2, "")
+    stem = str(out.with_suffix(""))
+    assert err.startswith(f"mbody: error: {message.format(out=out, stem=stem)}")
+    assert "--force" in err and not out.exists()
+
+
+def test_an_output_without_a_format_suffix_is_written_as_asked(tmp_path, capsys):
+    out = tmp_path / "equations"
+    code, stdout, err = run(capsys, "assemble", PENDULUM, "--latex", out)
+    assert (code, err) == (0, "")
+    assert out.read_text().startswith("\\documentclass")

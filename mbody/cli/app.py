@@ -71,7 +71,8 @@ def build_parser() -> argparse.ArgumentParser:
             command.add_argument(
                 "--force", action="store_true",
                 help=f"write {' or '.join(writes)} even when it is one of this command's "
-                "input files (the same file, however named), replacing that input")
+                "input files (the same file, however named), replacing that input, or when "
+                "its suffix names another format than the one written")
     return p
 
 

@@ -13,6 +13,7 @@ import math
 import re
 from collections.abc import Callable, Iterable, Sequence
 from contextvars import ContextVar
+from pathlib import Path
 from typing import Any, TextIO
 
 from mbody.errors import MbodyError, given_twice
@@ -149,6 +150,35 @@ def output_stream(*targets: str | None) -> TextIO:
     if any(t is not None and t != "-" and is_standard_output(t) for t in targets):
         return sys.stderr
     return sys.stdout
+
+
+SUFFIX_FORMATS = {
+    ".tex": "LaTeX", ".pdf": "PDF", ".png": "PNG", ".svg": "SVG", ".jpg": "JPEG",
+    ".jpeg": "JPEG", ".gif": "GIF", ".html": "HTML", ".htm": "HTML", ".yaml": "YAML",
+    ".yml": "YAML", ".xml": "XML", ".mjcf": "MJCF", ".urdf": "URDF", ".json": "JSON",
+    ".csv": "CSV", ".npz": "NumPy .npz", ".npy": "NumPy .npy", ".mat": "MATLAB",
+    ".txt": "text", ".md": "Markdown", ".parquet": "Parquet", ".py": "Python"}
+"""Suffixes that name a format, as programs open files by them."""
+
+
+def output_suffix(path: str | None, option: str, written: str,
+                  suffixes: Sequence[str], force: bool) -> None:
+    """Refuse, before any work, an output whose suffix names another format than the
+    `written` one the command puts there (`assemble --latex x.pdf`: LaTeX source in a
+    file every program opens as a PDF), with the name it was probably meant to have
+    (`suffixes[0]`), unless `force` (``--force``: written under that name). A name
+    without a suffix, or with one that names no format (`eqs`, `run.dat`), is written as
+    asked, as are standard output (``-``) and devices. Commands whose suffix chooses
+    the format (`export`, `graph`, `plot`) refuse an unknown one themselves."""
+    if path is None or path == "-" or force:
+        return
+    suffix = Path(path).suffix.lower()
+    if not suffix or suffix in suffixes or suffix not in SUFFIX_FORMATS:
+        return
+    meant = str(Path(path).with_suffix(suffixes[0]))
+    raise MbodyError(f"{option} {path}: the name says {SUFFIX_FORMATS[suffix]} ({suffix}), "
+                     f"but {option} writes {written}; did you mean {meant!r}? (or --force "
+                     "to write it under that name)")
 
 
 def refuse_overwriting_inputs(outputs: Iterable[tuple[str, str]],

@@ -16,6 +16,7 @@ from mbody.cli.common import (
     bounded,
     load_model,
     output_stream,
+    output_suffix,
     refuse_overwriting_inputs,
     regular_file,
 )
@@ -159,6 +160,7 @@ def report(a: argparse.Namespace) -> int:
     from mbody.present.report import write_report
 
     parse_view(a.view)
+    output_suffix(a.output, "-o", "an HTML page", (".html", ".htm"), a.force)
     model = load_model(a.model)
     answers = None
     if a.answers is not None:

@@ -12,6 +12,7 @@ from mbody.cli.common import (
     bounded,
     load_model,
     output_stream,
+    output_suffix,
     seconds_or_turns,
 )
 from mbody.errors import MbodyError, given_twice
@@ -107,6 +108,7 @@ def kinematics(a: argparse.Namespace) -> int:
     from mbody.util import jsontext
 
     points = parse_points(a.point)
+    output_suffix(a.output, "-o", "a run file (.npz)", (".npz",), a.force)
     model = load_model(a.model)
     turn = revolution(model)
     t_end = end_time(a.t_end, a.t_start, turn)

@@ -9,7 +9,14 @@ import json
 import sys
 from collections.abc import Iterator
 
-from mbody.cli.common import EXIT_OK, MODEL_HELP, VIEW_HELP, load_model, parse_known
+from mbody.cli.common import (
+    EXIT_OK,
+    MODEL_HELP,
+    VIEW_HELP,
+    load_model,
+    output_suffix,
+    parse_known,
+)
 from mbody.errors import MbodyError, OutputError
 
 
@@ -97,6 +104,7 @@ def lagrange(a: argparse.Namespace) -> int:
 
     for out in a.output:
         ensure_writable(out)
+    output_suffix(a.latex, "--latex", "LaTeX", (".tex",), a.force)
     if a.latex not in (None, "-"):
         ensure_writable(a.latex)
     model = load_model(a.model)

@@ -14,6 +14,7 @@ from mbody.cli.common import (
     load_model,
     number,
     output_stream,
+    output_suffix,
     parse_known,
     regular_file,
 )
@@ -113,6 +114,7 @@ def simulate(a: argparse.Namespace) -> int:
 
     max_steps = DEFAULT_MAX_STEPS if a.max_steps is None else int(a.max_steps)
     check_samples(a.t_end, a.fps)
+    output_suffix(a.output, "-o", "a run file (.npz)", (".npz",), a.force)
     model = load_model(a.model)
     if a.output:  # fail now, not after a long integration
         from mbody.util.atomic import ensure_writable
