@@ -264,3 +264,50 @@ def test_an_output_without_a_format_suffix_is_written_as_asked(tmp_path, capsys)
     code, stdout, err = run(capsys, "assemble", PENDULUM, "--latex", out)
     assert (code, err) == (0, "")
     assert out.read_text().startswith("\\documentclass")
+
+
+# == P13: --force is offered only where it helps ==============================================
+
+@pytest.mark.parametrize(("args", "why"), [
+    (("export", "{m}", "--csv", "{m}"), "--csv writes a folder; give a folder's name"),
+    (("fbd", "{m}", "-o", "{m}"), "-o writes a folder; give a folder's name"),
+    (("export", "{m}", "-o", "{m}"), "-o writes a file ending in .npz, .mat, .json; give "
+     "another output file"),
+    (("graph", "{m}", "-o", "{m}"), "-o writes a file ending in .svg, .png, .pdf; give "
+     "another output file"),
+    (("plot", "{run}", "-o", "{run}"), "-o writes a file ending in .svg, .png, .pdf; give "
+     "another output file"),
+])
+def test_an_input_as_an_output_force_cannot_write_is_refused_without_offering_force(
+        tmp_path, capsys, args, why):
+    m = tmp_path / "q.yaml"
+    m.write_text(PENDULUM.read_text())
+    run_file = tmp_path / "run.npz"
+    assert run(capsys, "simulate", PENDULUM, "--t-end", 0.05, "--no-progress", "-o",
+               run_file)[0] == 0
+    files = {p: p.read_bytes() for p in (m, run_file)}
+    given = [a.format(m=m, run=run_file) for a in args]
+    target, what = Path(given[-1]), "the model" if given[-1] == str(m) else "the run file"
+    for force in ((), ("--force",)):  # the same answer: --force could not help
+        code, out, err = run(capsys, *given, *force)
+        assert (code, out) == (2, "")
+        assert err == (f"mbody: error: {given[-2]} {target} is {what} itself ({target}): "
+                       f"{why}\n")
+    assert {p: p.read_bytes() for p in files} == files
+
+
+def test_an_input_as_an_output_force_can_write_offers_force(tmp_path, capsys):
+    m = tmp_path / "q.yaml"
+    m.write_text(PENDULUM.read_text())
+    code, out, err = run(capsys, "assemble", m, "--latex", m)
+    assert code == 2 and err.endswith("or --force to replace it\n")
+    code, out, err = run(capsys, "assemble", m, "--latex", m, "--force")
+    assert code == 0 and m.read_text().startswith("\\documentclass")
+
+
+def test_the_command_lines_export_suffixes_are_the_exports():
+    from mbody.cli.common import EXPORT_SUFFIXES
+    from mbody.io.export import SUFFIXES
+    from mbody.io.export.generalized import SUFFIXES as GENERALIZED
+
+    assert set(EXPORT_SUFFIXES) == set(SUFFIXES) == set(GENERALIZED)

@@ -11,7 +11,7 @@ import argparse
 import functools
 import math
 import re
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Container, Iterable, Mapping, Sequence
 from contextvars import ContextVar
 from pathlib import Path
 from typing import Any, TextIO
@@ -182,15 +182,32 @@ def output_suffix(path: str | None, option: str, written: str,
 
 
 def refuse_overwriting_inputs(outputs: Iterable[tuple[str, str]],
-                              inputs: Iterable[tuple[str, str]], force: bool) -> None:
+                              inputs: Iterable[tuple[str, str]], force: bool,
+                              folders: Container[str] = (),
+                              suffixes: Mapping[str, Sequence[str]] | None = None) -> None:
     """Refuse (unless `force`) an output that is one of the command's own inputs: the
     same file, compared by identity (device and inode: a link or another spelling of
     the path is the same file), not by name. `outputs` and `inputs` are (what, path)
-    pairs: ``("-o", "m.yaml")``, ``("the model", "m.yaml")``."""
+    pairs: ``("-o", "m.yaml")``, ``("the model", "m.yaml")``. Where `force` cannot help,
+    the message does not offer it, and `force` does not pass it: an output whose option
+    is in `folders` writes a folder, which cannot take a file's place; one whose option's
+    suffix chooses the format (`suffixes`: option -> the suffixes it writes) and whose
+    name has none of them is refused by the command anyway."""
     import os
     import stat
 
-    if force:
+    def stuck(flag: str, path: str) -> str:
+        """Why `force` cannot help writing `path` there, or ''."""
+        if flag in folders:
+            return f"{flag} writes a folder; give a folder's name"
+        allowed = (suffixes or {}).get(flag)
+        if allowed and Path(path).suffix.lower() not in allowed:
+            return (f"{flag} writes a file ending in {', '.join(allowed)}; give another "
+                    "output file")
+        return ""
+
+    outputs = [(flag, path) for flag, path in outputs if not force or stuck(flag, path)]
+    if not outputs:
         return
     seen = []
     for what, path in inputs:
@@ -208,6 +225,9 @@ def refuse_overwriting_inputs(outputs: Iterable[tuple[str, str]],
         for what, source, st_in in seen:
             if os.path.samestat(st, st_in):
                 same = "" if source == path else ", the same file"
+                why = stuck(flag, path)
+                if why:
+                    raise MbodyError(f"{flag} {path} is {what} itself ({source}{same}): {why}")
                 raise MbodyError(f"{flag} {path} is {what} itself ({source}{same}): writing "
                                  "there would replace the input; give another output file, "
                                  "or --force to replace it")
@@ -324,6 +344,11 @@ def add_import_options(command: argparse.ArgumentParser) -> None:
 PICTURE_FORMATS = ("svg", "png", "pdf")
 """`mbody.present.draw.FORMATS`, without importing matplotlib at start-up (a test keeps
 them equal)."""
+PICTURE_SUFFIXES = tuple(f".{f}" for f in PICTURE_FORMATS)
+"""A picture's file name ends in one of these: it chooses the format."""
+EXPORT_SUFFIXES = (".npz", ".mat", ".json")
+"""What `export -o` and `lagrange -o` write, each format by its suffix
+(`mbody.io.export.SUFFIXES`, without importing it at start-up: a test keeps them equal)."""
 MODEL_FORMATS = ("yaml", "mjcf", "urdf")
 """What ``--format`` names on every command: the format of the model file read."""
 

@@ -11,6 +11,7 @@ from mbody.cli.common import (
     EXIT_OK,
     MODEL_HELP,
     PICTURE_FORMATS,
+    PICTURE_SUFFIXES,
     VIEW_HELP,
     add_axes_option,
     bounded,
@@ -55,7 +56,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.add_argument("-o", "--output", metavar="FILE",
                    help="draw the graph into this picture; its extension (.svg, .png, .pdf) "
                    "sets the format")
-    s.set_defaults(run=graph)
+    s.set_defaults(run=graph, output_suffixes={"-o": PICTURE_SUFFIXES})
 
     s = sub.add_parser("report", help="write one self-contained HTML page for the model",
                        description="One offline HTML page: the model summary, the topology "

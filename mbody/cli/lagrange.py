@@ -11,7 +11,9 @@ from collections.abc import Iterator
 
 from mbody.cli.common import (
     EXIT_OK,
+    EXPORT_SUFFIXES,
     MODEL_HELP,
+    PICTURE_SUFFIXES,
     VIEW_HELP,
     load_model,
     output_suffix,
@@ -54,7 +56,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "or .json (repeatable)")
     s.add_argument("--known", metavar="LABEL=VALUE", action="append", default=[],
                    help="a known reaction value applied as a load (its joint then not held)")
-    s.set_defaults(run=lagrange)
+    s.set_defaults(run=lagrange, output_suffixes={"-o": EXPORT_SUFFIXES})
 
     s = sub.add_parser(
         "modes", help="natural frequencies, damping ratios, mode shapes and stability",
@@ -75,7 +77,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="draw the mode shapes to FILE (.svg, .png or .pdf)")
     s.add_argument("--view", metavar="VIEW", help="the --picture's view of " + VIEW_HELP)
     s.add_argument("--json", action="store_true", help="machine-readable output")
-    s.set_defaults(run=modes)
+    s.set_defaults(run=modes, output_suffixes={"--picture": PICTURE_SUFFIXES})
 
 
 @contextlib.contextmanager

@@ -9,6 +9,7 @@ import sys
 from mbody.cli.common import (
     EXIT_OK,
     MODEL_HELP,
+    PICTURE_SUFFIXES,
     add_axes_option,
     bounded,
     load_model,
@@ -105,7 +106,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="a run with drivers: plot the bodies' motion, energy and momentum "
                    "instead of the drivers' figure")
     add_axes_option(s, saved=True)
-    s.set_defaults(run=plot)
+    s.set_defaults(run=plot, output_suffixes={"-o": PICTURE_SUFFIXES})
 
 
 def simulate(a: argparse.Namespace) -> int:
