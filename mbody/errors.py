@@ -168,6 +168,14 @@ def real_number(value: object, argument: str, expected: str = "a number") -> flo
     raise wrong_type(argument, expected, value, hint)
 
 
+def given_twice(flag: str, name: str) -> MbodyError:
+    """A repeatable NAME=VALUE option given twice for one name (``--known O.Fx=3 --known
+    O.Fx=4``): which value was meant is a guess, so every command refuses it, in these
+    words (``--set``, ``--known``, ``--q``, ``--qd``, ``kinematics --point``, ``sweep
+    --set``)."""
+    return MbodyError(f"{flag} {name} is given twice")
+
+
 def did_you_mean(word: str, choices: Iterable[str]) -> str:
     """A 'did you mean ...?' hint for a misspelt name, or '' when nothing is close (a
     name that differs only in case is the closest: 'dop853' for 'DOP853')."""

@@ -322,9 +322,8 @@ def test_page_is_self_contained(spinner, tmp_path):
 
 def test_bad_colour_and_body(spinner):
     model, traj = spinner
-    bad = mbody.loads(SPIN_YAML.replace("color: red", "color: blurple"))
-    with pytest.raises(MbodyError, match="'blurple' is not a colour"):
-        build_scene(traj, bad)
+    with pytest.raises(MbodyError, match="'blurple' is not a colour"):  # refused as read
+        build_scene(traj, mbody.loads(SPIN_YAML.replace("color: red", "color: blurple")))
     with pytest.raises(MbodyError, match="unknown body 'brik'.*did you mean 'brick'"):
         build_scene(traj, model, bodies=["brik"])
     other = mbody.loads(SPIN_YAML.replace("name: rotor", "name: wheel"))

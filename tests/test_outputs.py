@@ -218,17 +218,16 @@ def test_dev_stdout_gets_the_data_and_the_messages_go_to_stderr(tmp_path):
     (["simulate", "{m}", "--t-end", "0.1", "-o", "{m}"], "-o", "the model"),
     (["report", "{m}", "-o", "{m}"], "-o", "the model"),
     (["assemble", "{m}", "--latex", "{m}"], "--latex", "the model"),
-    (["export", "{m}", "-o", "{m}"], "-o", "the model"),
-    (["graph", "{m}", "-o", "{m}"], "-o", "the model"),
     (["convert", "{m}", "-o", "{m}"], "-o", "the input"),
     (["animate", "{run}", "-o", "{run}"], "-o", "the input"),
-    (["plot", "{run}", "-o", "{run}"], "-o", "the run file"),
     (["report", "{m}", "--answers", "{a}", "-o", "{a}"], "-o", "the answers file"),
     (["export", "{m}", "--state", "{run}", "-o", "{run}"], "-o", "the run file"),
     (["animate", "{run}", "--model", "{m}", "-o", "{m}"], "-o", "the model"),
 ])
 def test_an_output_onto_an_input_is_refused_unless_forced(tmp_path, capsys, run_file, args,
                                                           flag, what):
+    # export -o, graph -o and plot -o onto an input whose suffix they cannot write:
+    # tests/test_review_papercuts.py (--force is not offered where it cannot help)
     m = tmp_path / "m.yaml"
     m.write_text(PENDULUM.read_text())
     answers = tmp_path / "a.yaml"

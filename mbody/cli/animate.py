@@ -16,6 +16,7 @@ from mbody.cli.common import (
     bounded,
     number,
     output_stream,
+    output_suffix,
     refuse_overwriting_inputs,
     regular_file,
 )
@@ -143,6 +144,8 @@ def animate(a: argparse.Namespace) -> int:
     out = a.output or (None if a.live or not source.name else source.with_suffix(".html").name)
     if out:  # fail now, not after simulating
         from mbody.util.atomic import ensure_writable
+
+        output_suffix(out, "-o", "an HTML page", (".html", ".htm"), a.force)
 
         refuse_overwriting_inputs([("-o", out)], [("the input", a.source)]
                                   + ([("the model", a.model)] if a.model else []), a.force)

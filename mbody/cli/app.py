@@ -88,7 +88,8 @@ def build_parser() -> argparse.ArgumentParser:
             command.add_argument(
                 "--force", action="store_true",
                 help=f"write {' or '.join(writes)} even when it is one of this command's "
-                "input files (the same file, however named), replacing that input")
+                "input files (the same file, however named), replacing that input, or when "
+                "its suffix names another format than the one written")
     return p
 
 
@@ -139,7 +140,10 @@ def check_paths(args: argparse.Namespace,
         return own[0] if own else OUTPUTS[dest]
 
     outputs = [(flag(dest), p) for dest in OUTPUTS for p in _paths(getattr(args, dest, None))]
-    refuse_overwriting_inputs(outputs, inputs, getattr(args, "force", False))
+    folders = {a.option_strings[0] for a in (command._actions if command is not None else ())
+               if a.dest in OUTPUTS and a.option_strings and a.metavar == "DIR"}
+    refuse_overwriting_inputs(outputs, inputs, getattr(args, "force", False), folders,
+                              getattr(args, "output_suffixes", None))
 
 
 class _Parser(argparse.ArgumentParser):

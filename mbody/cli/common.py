@@ -11,11 +11,12 @@ import argparse
 import functools
 import math
 import re
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Container, Iterable, Mapping, Sequence
 from contextvars import ContextVar
+from pathlib import Path
 from typing import Any, TextIO
 
-from mbody.errors import MbodyError
+from mbody.errors import MbodyError, given_twice
 
 EXIT_OK, EXIT_UNMET, EXIT_INPUT, EXIT_INTERNAL = 0, 1, 2, 70
 
@@ -151,16 +152,62 @@ def output_stream(*targets: str | None) -> TextIO:
     return sys.stdout
 
 
+SUFFIX_FORMATS = {
+    ".tex": "LaTeX", ".pdf": "PDF", ".png": "PNG", ".svg": "SVG", ".jpg": "JPEG",
+    ".jpeg": "JPEG", ".gif": "GIF", ".html": "HTML", ".htm": "HTML", ".yaml": "YAML",
+    ".yml": "YAML", ".xml": "XML", ".mjcf": "MJCF", ".urdf": "URDF", ".json": "JSON",
+    ".csv": "CSV", ".npz": "NumPy .npz", ".npy": "NumPy .npy", ".mat": "MATLAB",
+    ".txt": "text", ".md": "Markdown", ".parquet": "Parquet", ".py": "Python"}
+"""Suffixes that name a format, as programs open files by them."""
+
+
+def output_suffix(path: str | None, option: str, written: str,
+                  suffixes: Sequence[str], force: bool) -> None:
+    """Refuse, before any work, an output whose suffix names another format than the
+    `written` one the command puts there (`assemble --latex x.pdf`: LaTeX source in a
+    file every program opens as a PDF), with the name it was probably meant to have
+    (`suffixes[0]`), unless `force` (``--force``: written under that name). A name
+    without a suffix, or with one that names no format (`eqs`, `run.dat`), is written as
+    asked, as are standard output (``-``) and devices. Commands whose suffix chooses
+    the format (`export`, `graph`, `plot`) refuse an unknown one themselves."""
+    if path is None or path == "-" or force:
+        return
+    suffix = Path(path).suffix.lower()
+    if not suffix or suffix in suffixes or suffix not in SUFFIX_FORMATS:
+        return
+    meant = str(Path(path).with_suffix(suffixes[0]))
+    raise MbodyError(f"{option} {path}: the name says {SUFFIX_FORMATS[suffix]} ({suffix}), "
+                     f"but {option} writes {written}; did you mean {meant!r}? (or --force "
+                     "to write it under that name)")
+
+
 def refuse_overwriting_inputs(outputs: Iterable[tuple[str, str]],
-                              inputs: Iterable[tuple[str, str]], force: bool) -> None:
+                              inputs: Iterable[tuple[str, str]], force: bool,
+                              folders: Container[str] = (),
+                              suffixes: Mapping[str, Sequence[str]] | None = None) -> None:
     """Refuse (unless `force`) an output that is one of the command's own inputs: the
     same file, compared by identity (device and inode: a link or another spelling of
     the path is the same file), not by name. `outputs` and `inputs` are (what, path)
-    pairs: ``("-o", "m.yaml")``, ``("the model", "m.yaml")``."""
+    pairs: ``("-o", "m.yaml")``, ``("the model", "m.yaml")``. Where `force` cannot help,
+    the message does not offer it, and `force` does not pass it: an output whose option
+    is in `folders` writes a folder, which cannot take a file's place; one whose option's
+    suffix chooses the format (`suffixes`: option -> the suffixes it writes) and whose
+    name has none of them is refused by the command anyway."""
     import os
     import stat
 
-    if force:
+    def stuck(flag: str, path: str) -> str:
+        """Why `force` cannot help writing `path` there, or ''."""
+        if flag in folders:
+            return f"{flag} writes a folder; give a folder's name"
+        allowed = (suffixes or {}).get(flag)
+        if allowed and Path(path).suffix.lower() not in allowed:
+            return (f"{flag} writes a file ending in {', '.join(allowed)}; give another "
+                    "output file")
+        return ""
+
+    outputs = [(flag, path) for flag, path in outputs if not force or stuck(flag, path)]
+    if not outputs:
         return
     seen = []
     for what, path in inputs:
@@ -178,6 +225,9 @@ def refuse_overwriting_inputs(outputs: Iterable[tuple[str, str]],
         for what, source, st_in in seen:
             if os.path.samestat(st, st_in):
                 same = "" if source == path else ", the same file"
+                why = stuck(flag, path)
+                if why:
+                    raise MbodyError(f"{flag} {path} is {what} itself ({source}{same}): {why}")
                 raise MbodyError(f"{flag} {path} is {what} itself ({source}{same}): writing "
                                  "there would replace the input; give another output file, "
                                  "or --force to replace it")
@@ -207,7 +257,10 @@ def parse_known(pairs: Sequence[str]) -> dict[str, float]:
 def assignments(pairs: Sequence[str], flag: str, form: str,
                 degrees: str | None = None) -> dict[str, float]:
     """``NAME=VALUE`` options -> ``{NAME: value}``; a value ending in `degrees` (``deg``,
-    ``deg/s``) is converted to radians. Anything else is a clear `MbodyError`."""
+    ``deg/s``) is converted to radians. Anything else is a clear `MbodyError`, and so is
+    a number beyond a model file's bound (`mbody.model.checks.MAX_MAGNITUDE`)."""
+    from mbody.model.checks import MAX_MAGNITUDE
+
     out = {}
     for p in pairs:
         name, sep, value = p.partition("=")
@@ -222,6 +275,11 @@ def assignments(pairs: Sequence[str], flag: str, form: str,
             raise MbodyError(f"{flag} {name}: {value!r} is not a number") from None
         if not math.isfinite(x):
             raise MbodyError(f"{flag} {name}: expected a finite number, got {value!r}")
+        if abs(x) > MAX_MAGNITUDE:
+            raise MbodyError(f"{flag} {name}: expected a number of magnitude at most "
+                             f"{number(MAX_MAGNITUDE)}, as in a model file, got {value!r}")
+        if name.strip() in out:
+            raise given_twice(flag, name.strip())
         out[name.strip()] = x
     return out
 
@@ -286,6 +344,11 @@ def add_import_options(command: argparse.ArgumentParser) -> None:
 PICTURE_FORMATS = ("svg", "png", "pdf")
 """`mbody.present.draw.FORMATS`, without importing matplotlib at start-up (a test keeps
 them equal)."""
+PICTURE_SUFFIXES = tuple(f".{f}" for f in PICTURE_FORMATS)
+"""A picture's file name ends in one of these: it chooses the format."""
+EXPORT_SUFFIXES = (".npz", ".mat", ".json")
+"""What `export -o` and `lagrange -o` write, each format by its suffix
+(`mbody.io.export.SUFFIXES`, without importing it at start-up: a test keeps them equal)."""
 MODEL_FORMATS = ("yaml", "mjcf", "urdf")
 """What ``--format`` names on every command: the format of the model file read."""
 
@@ -316,12 +379,14 @@ def _with_import_options(run: Callable[[argparse.Namespace], int]
 
 def set_values(pairs: Sequence[str]) -> dict[str, Any]:
     """``--set`` options -> ``{path: value}``, each value read as the model file would
-    read it (`mbody.model.values.parse_value`); a path given twice keeps the last."""
+    read it (`mbody.model.values.parse_value`); a path given twice is refused."""
     from mbody.model.values import parse_assignment, parse_value
 
     out: dict[str, Any] = {}
     for pair in pairs:
         path, text = parse_assignment(pair)
+        if path in out:
+            raise given_twice("--set", path)
         out[path] = parse_value(text, path)
     return out
 

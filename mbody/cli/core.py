@@ -11,6 +11,7 @@ from mbody.cli.common import (
     add_axes_option,
     load_model,
     output_stream,
+    output_suffix,
     parse_known,
 )
 from mbody.errors import MbodyError
@@ -75,6 +76,7 @@ def assemble(a: argparse.Namespace) -> int:
     from mbody.equations.assemble import assemble as _assemble
     from mbody.present.text import assembly_text, body_text
 
+    output_suffix(a.latex, "--latex", "LaTeX", (".tex",), a.force)
     model = load_model(a.model)
     asm = _assemble(model)
     if a.symbolic:

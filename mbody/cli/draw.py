@@ -11,11 +11,13 @@ from mbody.cli.common import (
     EXIT_OK,
     MODEL_HELP,
     PICTURE_FORMATS,
+    PICTURE_SUFFIXES,
     VIEW_HELP,
     add_axes_option,
     bounded,
     load_model,
     output_stream,
+    output_suffix,
     refuse_overwriting_inputs,
     regular_file,
 )
@@ -54,7 +56,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.add_argument("-o", "--output", metavar="FILE",
                    help="draw the graph into this picture; its extension (.svg, .png, .pdf) "
                    "sets the format")
-    s.set_defaults(run=graph)
+    s.set_defaults(run=graph, output_suffixes={"-o": PICTURE_SUFFIXES})
 
     s = sub.add_parser("report", help="write one self-contained HTML page for the model",
                        description="One offline HTML page: the model summary, the topology "
@@ -159,6 +161,7 @@ def report(a: argparse.Namespace) -> int:
     from mbody.present.report import write_report
 
     parse_view(a.view)
+    output_suffix(a.output, "-o", "an HTML page", (".html", ".htm"), a.force)
     model = load_model(a.model)
     answers = None
     if a.answers is not None:

@@ -12,9 +12,10 @@ from mbody.cli.common import (
     bounded,
     load_model,
     output_stream,
+    output_suffix,
     seconds_or_turns,
 )
-from mbody.errors import MbodyError
+from mbody.errors import MbodyError, given_twice
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -33,9 +34,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
     s.add_argument("--t-end", type=seconds_or_turns(-T_END_MAX, T_END_MAX),
                    default=None, metavar="T",
-                   help="the last sample's time, s, or turns after --t-start of the first "
-                   "driver when it turns at a constant rate ('1 rev', as sweep's --t-end) "
-                   "(default: one such turn, else 1 s)")
+                   help="the run's end, s, or turns after --t-start of the first driver "
+                   "when it turns at a constant rate ('1 rev', as sweep's --t-end) "
+                   "(default: one such turn, else 1 s); the samples are --t-start + k/fps, "
+                   "and a warning names the last one when it falls before T")
     s.add_argument("--t-start", type=bounded("a number of seconds", -T_END_MAX, T_END_MAX),
                    default=0.0, metavar="SECONDS", help="the first sample's time, s "
                    "(default 0)")
@@ -67,7 +69,7 @@ def parse_points(pairs: list[str]) -> dict[str, tuple[str, list[float]]]:
             raise MbodyError(f"--point expects NAME=BODY:X,Y[,Z] (for example "
                              f"P=coupler:0.1,0.05), got {p!r}")
         if name.strip() in out:
-            raise MbodyError(f"--point {name}: given twice")
+            raise given_twice("--point", name.strip())
         out[name.strip()] = body_point(rest, f"--point {name}")
     return out
 
@@ -103,6 +105,7 @@ def kinematics(a: argparse.Namespace) -> int:
     from mbody.util import jsontext
 
     points = parse_points(a.point)
+    output_suffix(a.output, "-o", "a run file (.npz)", (".npz",), a.force)
     model = load_model(a.model)
     turn = revolution(model)
     t_end = end_time(a.t_end, a.t_start, turn)

@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING
 
 from mbody.cli.common import (
     EXIT_OK,
+    EXPORT_SUFFIXES,
     MODEL_HELP,
     bounded,
     load_model,
@@ -53,7 +54,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "reaction values, the columns of G, to each joint's force and moment on "
                    "its child along world x, y, z at the state, with their labels (T.csv "
                    "in a CSV folder); 'joint' (default): M, b, Q, G alone")
-    s.set_defaults(run=export)
+    s.set_defaults(run=export, output_suffixes={"-o": EXPORT_SUFFIXES})
 
 
 def export(a: argparse.Namespace) -> int:

@@ -8,7 +8,14 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from mbody.cli.common import EXIT_OK, add_format_option, load_model, output_stream, regular_file
+from mbody.cli.common import (
+    EXIT_OK,
+    add_format_option,
+    load_model,
+    output_stream,
+    output_suffix,
+    regular_file,
+)
 from mbody.errors import MbodyError, did_you_mean
 
 FORMATS = {".yaml": "yaml", ".yml": "yaml", ".xml": "mjcf", ".mjcf": "mjcf", ".urdf": "urdf"}
@@ -16,6 +23,8 @@ FORMATS = {".yaml": "yaml", ".yml": "yaml", ".xml": "mjcf", ".mjcf": "mjcf", ".u
 WRITTEN = ("yaml", "mjcf")
 """Formats `mbody convert` writes (URDF is read only)."""
 NAMES = {"yaml": "mbody YAML", "mjcf": "MJCF", "urdf": "URDF"}
+SUFFIXES = {"yaml": (".yaml", ".yml"), "mjcf": (".xml", ".mjcf")}
+"""The suffixes of each format written, the usual first."""
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -40,7 +49,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "'initial' when the file has it, as mbody's export writes; else the "
                    "reference pose at rest)")
     s.add_argument("--force", action="store_true", help="replace OUTPUT if it exists (even "
-                   "SOURCE itself: a model rewritten in place)")
+                   "SOURCE itself: a model rewritten in place), or write it when its "
+                   "extension names another format than --to")
     s.add_argument("--set", action="append", default=[], metavar="PATH=VALUE",
                    dest="set_values", help="change a value of SOURCE's model (paths of its "
                    "YAML form, as for every command: bodies.<name>.<key>...) before it is "
@@ -60,6 +70,8 @@ def convert(a: argparse.Namespace) -> int:
         raise MbodyError(f"{a.output}: mbody reads URDF but does not write it; write "
                          ".yaml (mbody) or .xml (MJCF)")
     out_format = a.to or _format(a.output, "OUTPUT", "--to", (".yaml", ".xml"))
+    output_suffix(a.output, "-o", f"{NAMES[out_format]} (--to {out_format})",
+                  SUFFIXES[out_format], a.force)
     if not os.path.exists(a.source):
         raise MbodyError(f"{a.source}: no such file")
     regular_file(a.source, f"a model file ({NAMES[src_format]})")

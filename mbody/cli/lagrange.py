@@ -9,7 +9,16 @@ import json
 import sys
 from collections.abc import Iterator
 
-from mbody.cli.common import EXIT_OK, MODEL_HELP, VIEW_HELP, load_model, parse_known
+from mbody.cli.common import (
+    EXIT_OK,
+    EXPORT_SUFFIXES,
+    MODEL_HELP,
+    PICTURE_SUFFIXES,
+    VIEW_HELP,
+    load_model,
+    output_suffix,
+    parse_known,
+)
 from mbody.errors import MbodyError, OutputError
 
 
@@ -47,7 +56,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "or .json (repeatable)")
     s.add_argument("--known", metavar="LABEL=VALUE", action="append", default=[],
                    help="a known reaction value applied as a load (its joint then not held)")
-    s.set_defaults(run=lagrange)
+    s.set_defaults(run=lagrange, output_suffixes={"-o": EXPORT_SUFFIXES})
 
     s = sub.add_parser(
         "modes", help="natural frequencies, damping ratios, mode shapes and stability",
@@ -68,7 +77,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="draw the mode shapes to FILE (.svg, .png or .pdf)")
     s.add_argument("--view", metavar="VIEW", help="the --picture's view of " + VIEW_HELP)
     s.add_argument("--json", action="store_true", help="machine-readable output")
-    s.set_defaults(run=modes)
+    s.set_defaults(run=modes, output_suffixes={"--picture": PICTURE_SUFFIXES})
 
 
 @contextlib.contextmanager
@@ -97,6 +106,7 @@ def lagrange(a: argparse.Namespace) -> int:
 
     for out in a.output:
         ensure_writable(out)
+    output_suffix(a.latex, "--latex", "LaTeX", (".tex",), a.force)
     if a.latex not in (None, "-"):
         ensure_writable(a.latex)
     model = load_model(a.model)
@@ -126,6 +136,10 @@ def modes(a: argparse.Namespace) -> int:
     from mbody.solve.linearize import linearize
     from mbody.util.atomic import ensure_writable
 
+    if a.view is not None:  # checked as fbd and report check it, before any work
+        from mbody.present.draw import parse_view
+
+        parse_view(a.view)
     if a.picture:
         ensure_writable(a.picture)
     model = load_model(a.model)

@@ -9,11 +9,13 @@ import sys
 from mbody.cli.common import (
     EXIT_OK,
     MODEL_HELP,
+    PICTURE_SUFFIXES,
     add_axes_option,
     bounded,
     load_model,
     number,
     output_stream,
+    output_suffix,
     parse_known,
     regular_file,
 )
@@ -104,7 +106,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="a run with drivers: plot the bodies' motion, energy and momentum "
                    "instead of the drivers' figure")
     add_axes_option(s, saved=True)
-    s.set_defaults(run=plot)
+    s.set_defaults(run=plot, output_suffixes={"-o": PICTURE_SUFFIXES})
 
 
 def simulate(a: argparse.Namespace) -> int:
@@ -113,6 +115,7 @@ def simulate(a: argparse.Namespace) -> int:
 
     max_steps = DEFAULT_MAX_STEPS if a.max_steps is None else int(a.max_steps)
     check_samples(a.t_end, a.fps)
+    output_suffix(a.output, "-o", "a run file (.npz)", (".npz",), a.force)
     model = load_model(a.model)
     if a.output:  # fail now, not after a long integration
         from mbody.util.atomic import ensure_writable

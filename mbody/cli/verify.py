@@ -9,6 +9,9 @@ import sys
 from mbody.cli.common import EXIT_OK, EXIT_UNMET, MODEL_HELP, load_model, regular_file
 from mbody.errors import MbodyError
 
+SUMMARY_SUFFIXES = (".csv", ".html", ".htm")
+"""A class summary's file name ends in one of these: it chooses the format."""
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     s = sub.add_parser(
@@ -36,7 +39,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--tol", type=_tolerance, default=1e-3, metavar="REL",
                    help="relative tolerance on each coefficient (default 1e-3: numbers "
                    "written to about four significant figures match)")
-    s.set_defaults(run=verify)
+    s.set_defaults(run=verify, output_suffixes={"--summary": SUMMARY_SUFFIXES})
 
 
 def _tolerance(text: str) -> float:
@@ -79,7 +82,7 @@ def _class(a: argparse.Namespace) -> int:
     kind = None
     if a.summary is not None:
         kind = Path(a.summary).suffix.lower()
-        if kind not in (".csv", ".html", ".htm"):
+        if kind not in SUMMARY_SUFFIXES:
             raise MbodyError(f"--summary {a.summary}: the summary is written as .csv or "
                              f".html; got {kind or 'no extension'}")
         ensure_writable(a.summary)

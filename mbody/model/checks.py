@@ -169,7 +169,8 @@ class Checker:
             self._out_of_range(path, value.shown, value.large)  # never silently 0 or inf
             return None
         if isinstance(value, bool) or not isinstance(value, int | float):
-            self.err(path, f"expected a number, got {_kind(value)}", _number_hint(value))
+            self.err(path, f"expected a number, got {_kind(value)}",
+                     _number_hint(value, key_unit(path)))
             return None
         try:
             x = float(value)
@@ -333,33 +334,55 @@ _ANGLE_WORDS = re.compile(r"\s*([-+]?[\d.eE+-]+)\s*(°|degrees?|degs|grad|radian
                           re.IGNORECASE)
 
 
-def _number_hint(value: Any) -> str:
-    """What was probably meant by text where a number goes: '1,5', '1.5 kg'."""
+def _number_hint(value: Any, expected: str | None = None) -> str:
+    """What was probably meant by text where a number goes: '1,5', '1.5 kg'. `expected`
+    is the SI unit the key's number is in (`key_unit`: '' for a pure number), None when
+    not known: a unit of another quantity is then named as such, never converted into
+    a value of the wrong kind (gravity '-1 g' is -9.80665 m/s^2, not -0.001 kg)."""
     if not isinstance(value, str):
         return ""
     m = _DECIMAL_COMMA.fullmatch(value)
     if m:
         return f"a decimal comma? write {m.group(1)}.{m.group(2)}"
     m = _WITH_UNIT.fullmatch(value)
-    if m and len(value) < 40:
-        number, unit = m.group(1), " ".join(m.group(2).replace("·", " ").split())
-        if unit in _SI_UNITS:
-            return f"numbers are in SI units, written without the unit: {number}"
-        if unit in _TO_SI:
-            factor, si = _TO_SI[unit]
-            return (f"numbers are in SI units, written without the unit: {number} {unit} "
-                    f"is {float(number) * factor:.6g} {si}")
-        return (f"numbers are in SI units (kg, m, s, N, rad), written without the unit: "
-                f"convert {value.strip()!r} to SI first")
-    return ""
+    if not (m and len(value) < 40):
+        return ""
+    number, unit = m.group(1), " ".join(m.group(2).replace("·", " ").split())
+    bare = "numbers are in SI units, written without the unit"
+    si = _SI_UNITS.get(unit)
+    conversion = _BY_QUANTITY.get((unit, expected or "")) or _TO_SI.get(unit)
+    measured = si if si is not None else conversion[1] if conversion else None
+    if expected == "":
+        return f"this is a pure number: write {number} without '{unit}'"
+    if expected is not None and measured is not None and measured != expected:
+        return (f"this number is {_QUANTITY[expected]} in {expected}, written without the "
+                f"unit; {unit} measures {_QUANTITY[measured]}")
+    if si is not None:
+        return f"{bare}: {number}"
+    if conversion is not None:
+        factor, to = conversion
+        return f"{bare}: {number} {unit} is {float(number) * factor:.6g} {to}"
+    return (f"numbers are in SI units (kg, m, s, N, rad), written without the unit: "
+            f"convert {value.strip()!r} to SI first")
+
+
+def key_unit(path: Path_) -> str | None:
+    """The SI unit of the number at `path` in a model file, by its key (the last name in
+    the path: ``bodies[0].inertia[1]`` is in kg m^2), '' for a pure number, None when the
+    key does not say (a known reaction's value, a driver's parameter)."""
+    key = next((k for k in reversed(path) if isinstance(k, str)), None)
+    return _KEY_UNITS.get(key) if key is not None else None
 
 
 # Units a newcomer writes after a number. An SI one is dropped as it is; a common other
 # one is converted in the hint (its bare number would be off by its factor: 500 g is
-# 0.5, not 500).
-_SI_UNITS = frozenset((
-    "kg", "m", "s", "N", "N m", "Nm", "m/s", "m/s^2", "m/s²", "rad", "rad/s", "rad/s^2",
-    "rad/s²", "kg m^2", "kg m²", "kgm^2", "kgm²", "N/m", "N s/m", "Ns/m", "J", "W", "Pa"))
+# 0.5, not 500). Each is mapped to its SI unit as the hints write it.
+_SI_UNITS: dict[str, str] = {
+    "kg": "kg", "m": "m", "s": "s", "N": "N", "N m": "N m", "Nm": "N m", "m/s": "m/s",
+    "m/s^2": "m/s^2", "m/s²": "m/s^2", "rad": "rad", "rad/s": "rad/s",
+    "rad/s^2": "rad/s^2", "rad/s²": "rad/s^2", "kg m^2": "kg m^2", "kg m²": "kg m^2",
+    "kgm^2": "kg m^2", "kgm²": "kg m^2", "N/m": "N/m", "N s/m": "N s/m", "Ns/m": "N s/m",
+    "J": "J", "W": "W", "Pa": "Pa"}
 _TO_SI: dict[str, tuple[float, str]] = {
     "g": (1e-3, "kg"), "mg": (1e-6, "kg"), "lb": (0.45359237, "kg"),
     "lbs": (0.45359237, "kg"), "mm": (1e-3, "m"), "cm": (1e-2, "m"), "km": (1e3, "m"),
@@ -373,13 +396,31 @@ _TO_SI: dict[str, tuple[float, str]] = {
     "kg cm²": (1e-4, "kg m^2"), "g cm^2": (1e-7, "kg m^2"), "g cm²": (1e-7, "kg m^2"),
     "N/mm": (1e3, "N/m"),
 }
+_BY_QUANTITY: dict[tuple[str, str], tuple[float, str]] = {
+    ("g", "m/s^2"): (9.80665, "m/s^2"),  # standard gravity, where an acceleration goes
+}
+"""(unit, the key's SI unit) -> a meaning of the unit for that quantity alone."""
+_QUANTITY = {
+    "kg": "a mass", "m": "a length", "s": "a time", "N": "a force", "N m": "a moment",
+    "m/s": "a velocity", "m/s^2": "an acceleration", "rad": "an angle",
+    "rad/s": "an angular rate", "rad/s^2": "an angular acceleration",
+    "kg m^2": "a moment of inertia", "N/m": "a stiffness", "N s/m": "a damping rate",
+    "J": "an energy", "W": "a power", "Pa": "a pressure"}
+_LENGTH_KEYS = ("position", "at", "rest_length", "pitch", "box", "disc", "sphere",
+                "cylinder", "ellipsoid", "radius", "length")
+_KEY_UNITS: dict[str, str] = {
+    "mass": "kg", "inertia": "kg m^2", "velocity": "m/s", "gravity": "m/s^2",
+    "force": "N", "torque": "N m", "stiffness": "N/m", "damping": "N s/m",
+    "angular_velocity": "rad/s", "axis": "", "axis2": "", "quaternion": "",
+    "matrix": "", **dict.fromkeys(_LENGTH_KEYS, "m")}
+"""A model file's keys whose numbers have one unit (docs/model-format.md's tables)."""
 
 
 def _angle_hint(value: str, unit: str) -> str:
     """'30°', '30 degrees' -> write '30 deg'."""
     m = _ANGLE_WORDS.fullmatch(value)
     if not m:
-        return _number_hint(value)
+        return _number_hint(value, "rad" if unit == "deg" else "rad/s")
     word = "rad" if m.group(2).lower().startswith("rad") else "deg"
     return f"write '{m.group(1)} {word}{unit[3:]}'"
 

@@ -47,6 +47,7 @@ from mbody.model.expressions import (
     first_nonfinite,
 )
 from mbody.model.loader import Document, Path_, Unrepresentable
+from mbody.util import colours
 from mbody.util.spatial import euler_to_quat, matrix_to_quat, quat_to_matrix, shape_inertia
 
 TOP_KEYS = ("model", "dimension", "gravity", "bodies", "loads", "joints", "reactions",
@@ -295,6 +296,7 @@ def validate(doc: Document) -> Spec:
     loads, joints, reactions, reaction_expressions, drivers = rest(c, bodies, None)
     if not getattr(doc, "source_format", ""):  # what a person wrote (docstring of the check)
         _far_joint_points(c, bodies, joints)
+    _coincident_springs(c, bodies, loads)
     return Spec(str(name), doc.file, c.dim, gravity, bodies, loads, joints, reactions,
                 description, c.warnings, reaction_expressions, drivers=drivers)
 
@@ -434,7 +436,10 @@ def _bodies(c: Checker, value: Any) -> list[BodySpec]:
             _particle_pose(c, p, b, q, omega)
         color = b.get("color")
         if color is not None and not isinstance(color, str):
-            c.err((*p, "color"), f"expected a colour name or '#rrggbb', got {_kind(color)}")
+            c.err((*p, "color"), f"expected {colours.EXPECTED}, got {_kind(color)}")
+            color = None
+        elif color is not None and colours.colour_hex(color) is None:
+            c.err((*p, "color"), f"{_quoted(color)} is not a colour", colours.colour_hint(color))
             color = None
         if name is None or mass is None or inertia is None or pos is None or vel is None:
             continue
@@ -995,6 +1000,38 @@ def _far_joint_points(c: Checker, bodies: list[BodySpec], joints: list[JointSpec
                "gives them; check it and the bodies' positions and angles")
 
 
+SPRING_COINCIDENT = 1e-12
+"""Spring ends closer than this (m) have no direction: the compiled core (loads.c,
+`spring_state`) then applies no force, whatever the tension."""
+
+
+def _coincident_springs(c: Checker, bodies: list[BodySpec], loads: list[LoadSpec]) -> None:
+    """Warn where a spring's ends coincide at the file's pose while its tension k(L − L0)
+    is not zero: the force has no direction there, and none is applied (a spring whose
+    rest length is 0 has no tension there, and loses nothing). `loads` are the file's
+    loads in its order (`rest` raised on any problem)."""
+    at = {b.name: (b.position, quat_to_matrix(b.quaternion[None])[0]) for b in bodies}
+    for i, ld in enumerate(loads):
+        if ld.type != "spring" or ld.stiffness * ld.rest_length == 0.0:
+            continue
+        ends = []
+        for body, point in zip(ld.bodies, ld.at, strict=True):
+            if body == "ground":
+                ends.append(point)
+            else:
+                pos, R = at[body]
+                ends.append(pos + R @ point)
+        length = float(np.linalg.norm(ends[1] - ends[0]))
+        if length > SPRING_COINCIDENT:
+            continue
+        tension = ld.stiffness * (length - ld.rest_length)
+        c.warn(("loads", i), f"the spring's ends coincide while its tension k(L − L0) = "
+               f"{ld.stiffness:g} × (0 − {ld.rest_length:g}) = {tension:.6g} N is not zero: "
+               "the force has no direction there, so none is applied while they coincide",
+               "move a body or an attachment point so that the ends are apart, or give "
+               "rest_length: 0 if they are meant to meet")
+
+
 PARTICLE_JOINTS = {cv.PLANAR: ("revolute",), cv.SPATIAL: ("revolute", "spherical")}
 """Joint types that may connect a particle (they constrain its position only)."""
 PARTICLE_RTOL = 1e-9
@@ -1035,7 +1072,8 @@ def _axis(c: Checker, path: Path_, value: Any) -> np.ndarray | None:
         return None
     n = float(vec_norm(a))
     if n < MIN_NORM:
-        c.err(path, "the axis is the zero vector", "give a direction, such as [0, 0, 1]")
+        c.err(path, "the axis is the zero vector", "give a direction, such as "
+              + ("[1, 0]" if c.dim == cv.PLANAR else "[0, 0, 1]"))
         return None
     return a / n
 

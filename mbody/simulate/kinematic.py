@@ -33,6 +33,7 @@ from mbody.equations.world import check_axes
 from mbody.errors import MbodyError, did_you_mean, real_number, wrong_type
 from mbody.kernel import _core
 from mbody.model.arguments import checked_model
+from mbody.model.checks import MAX_MAGNITUDE
 from mbody.model.model import Model
 from mbody.simulate.axes import world_series
 from mbody.simulate.peaks import record_peaks, steady_rate
@@ -191,7 +192,7 @@ def kinematic_run(model: Model, t_end: float, fps: float, *, t_start: float = 0.
                                      info)
     if done < K:
         _failed(model, float(t[done]), y, info)
-    traj = _trajectory(model, t, Y, OUT, energy, plan, info, followed, axes)
+    traj = _trajectory(model, t, Y, OUT, energy, plan, info, followed, axes, fps)
     short = last_sample_warning(t_end, fps, t_start)
     if short:
         traj.info["warnings"].insert(0, short)
@@ -232,7 +233,8 @@ def _failed(model: Model, t: float, y: np.ndarray, info: np.ndarray) -> None:
 
 def _trajectory(model: Model, t: np.ndarray, Y: np.ndarray, OUT: np.ndarray,
                 energy: np.ndarray, plan, info: np.ndarray,
-                points: dict[str, tuple[int, np.ndarray]], axes: str) -> Trajectory:
+                points: dict[str, tuple[int, np.ndarray]], axes: str, fps: float
+                ) -> Trajectory:
     K, n = len(t), model.n
     planar = model.dimension == cv.PLANAR
     x = Y[:, :3 * n].reshape(K, n, 3)
@@ -251,7 +253,7 @@ def _trajectory(model: Model, t: np.ndarray, Y: np.ndarray, OUT: np.ndarray,
     pose = ((x[..., :2], v[..., :2], Y[:, 13 * n:], w[..., 2]) if planar else (x, v, q, w))
     run_info = {
         "integrator": "none (kinematic run: every sample's positions by Newton's method)",
-        "t_end": float(t[-1]), "fps": float(1.0 / (t[1] - t[0])) if K > 1 else 0.0,
+        "t_end": float(t[-1]), "fps": fps,
         "samples": K, "steps": 0, "evaluations": K,
         "newton_steps": int(info[_core.KR_NEWTON]),
         "newton_steps_most": int(info[_core.KR_WORST]),
@@ -370,6 +372,9 @@ def body_points(model: Model, points: object) -> dict[str, tuple[int, np.ndarray
         if len(r) != d or not np.isfinite(r).all():
             raise MbodyError(f"point {name!r}: expected {d} finite coordinates in the body's "
                              f"axes, got {list(coords)!r}")
+        if np.abs(r).max() > MAX_MAGNITUDE:
+            raise MbodyError(f"point {name!r}: expected coordinates of magnitude at most "
+                             f"{MAX_MAGNITUDE:g} m, as a model file's, got {list(coords)!r}")
         out[str(name)] = (model.bodies[body].index, np.concatenate((r, np.zeros(3 - d))))
     return out
 

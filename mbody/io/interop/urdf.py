@@ -39,6 +39,7 @@ from mbody.io.interop.xmlsource import (
     second,
     unknown_name,
 )
+from mbody.model.checks import MAX_ANGLE, MAX_MAGNITUDE
 from mbody.util.spatial import quat_to_matrix
 
 _ATTRS: dict[str, tuple[str, ...]] = {
@@ -421,9 +422,12 @@ class _Reader:
     def state(self, bodies: list[TreeBody], q0: np.ndarray, qp: dict[str, float],
               qv: dict[str, float]) -> tuple[np.ndarray, np.ndarray]:
         names: dict[str, tuple[int, int]] = {}
+        hinges = set()  # their positions are angles: bounded as a model file's angles are
         a = v = 0
         for _, j in joint_order(bodies):
             names[j.name] = (a, v)
+            if j.type == "hinge":
+                hinges.add(j.name)
             a += 4 if j.type == "ball" else 7 if j.type == "free" else 1
             v += NV[j.type]
         qpos, qvel = q0.copy(), np.zeros(v)
@@ -447,6 +451,14 @@ class _Reader:
                 if not math.isfinite(value):
                     problems.append(Issue(self.file, 0, 0, what,
                                           f"joint '{k}': expected a finite number"))
+                    continue
+                angle = target is qpos and k in hinges
+                limit = MAX_ANGLE if angle else MAX_MAGNITUDE
+                if abs(value) > limit:
+                    problems.append(Issue(self.file, 0, 0, f"{what}[{k}]", (
+                        f"expected an angle of at most {limit:g} rad in magnitude"
+                        if angle else f"expected a number of magnitude at most {limit:g}")
+                        + f", as in a model file, got {value:g}"))
                     continue
                 target[where[0] if target is qpos else where[1]] = value
         if problems:

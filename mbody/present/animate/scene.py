@@ -19,7 +19,6 @@ sent as Float32Arrays (`mbody.present.animate.wire`).
 from __future__ import annotations
 
 import math
-import re
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from types import ModuleType
@@ -34,6 +33,7 @@ from mbody.errors import MbodyError, did_you_mean
 from mbody.model.model import Body, Model
 from mbody.present.animate.wire import load_meshcat
 from mbody.simulate.trajectory import Trajectory
+from mbody.util.colours import colour_hex, colour_hint
 from mbody.util.spatial import box_equivalent, matvec, planar_quat, quat_to_matrix
 
 ROOT = "/meshcat/mbody"
@@ -56,8 +56,6 @@ FILL, ASPECT = 0.85, 4 / 3
 the live viewer's camera assumes a view ASPECT (width / height) wide, the offline page
 refits it to its window (`CameraFit.js`)."""
 CAMERA = "/Cameras/default/rotated/<object>"
-
-_HEX = re.compile(r"#[0-9a-fA-F]{6}")
 
 
 @dataclass(frozen=True)
@@ -256,17 +254,13 @@ def _homogeneous(R: np.ndarray | None = None, p: Sequence[float] | np.ndarray | 
 
 
 def _color(value: str | None, i: int) -> int:
-    """A colour name or '#rrggbb' -> 0xRRGGBB (meshcat wants a Python int)."""
+    """A colour name or '#rrggbb' -> 0xRRGGBB (meshcat wants a Python int). A model's
+    colour was checked when it was read; a run file's is checked here."""
     text = value if value is not None else PALETTE[i % len(PALETTE)]
-    if _HEX.fullmatch(text):  # the palette and most files: no need to load matplotlib
-        return int(text[1:], 16)
-    from matplotlib.colors import to_hex
-
-    try:
-        return int(to_hex(text)[1:], 16)
-    except ValueError:
-        raise MbodyError(f"{text!r} is not a colour: give a name such as 'orange' or "
-                         "'#rrggbb'") from None
+    rgb = colour_hex(text)
+    if rgb is None:
+        raise MbodyError(f"{text!r} is not a colour: {colour_hint(text)}")
+    return int(rgb[1:], 16)
 
 
 @dataclass(frozen=True)
