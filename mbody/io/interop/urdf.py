@@ -188,8 +188,9 @@ def _check_names(root: Element, issues: list[Issue], ignored: list[str]) -> None
                     shape = next(iter(first.values()))
                     issues.append(c.issue(
                         f"a second shape <{c.tag}> in <geometry> (the first, <{shape.tag}>, "
-                        f"is at line {shape.line})", "a <geometry> holds one shape: give "
-                        "the other one a <visual> or <collision> of its own"))
+                        f"is at line {shape.line}, column {shape.column})", "a <geometry> "
+                        "holds one shape: give the other one a <visual> or <collision> of "
+                        "its own"))
                 first.setdefault(c.tag, c)
             elif _misspelt(c.tag, kids):
                 issues.append(unknown_name(c, c.tag, kids, f"element in <{e.tag}>",

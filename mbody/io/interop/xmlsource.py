@@ -233,29 +233,6 @@ def _syntax_hint(what: str) -> str:
     return ""
 
 
-def read_xml(path: str | Path, file: str | None = None,
-             budget: list[int] | None = None, fmt: str = "mjcf") -> Element:
-    """Read and parse the XML file at `path` (size-limited as model files are).
-
-    Parameters
-    ----------
-    path : str or Path
-        The file.
-    file : str, optional
-        The name used in marks (default: `path` as given).
-    budget : list of one int, optional
-        As for `parse_xml`.
-    fmt : {"mjcf", "urdf"}, optional
-        The model format it is read as (what a refusal says was expected).
-
-    Returns
-    -------
-    Element
-    """
-    text = read_file(path, None, fmt)
-    return parse_xml(text, str(path) if file is None else file, budget)
-
-
 ROOTS = {"mjcf": "mujoco", "urdf": "robot"}
 """The root element of each XML model format."""
 _YAML_KEY = re.compile(r"(?:[ \t]*(?:#[^\n]*)?\r?\n)*[ \t]*[\w-]+[ \t]*:(?:[ \t]|\r?\n|$)")
