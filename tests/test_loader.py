@@ -200,7 +200,7 @@ def test_max_bytes_on_the_command_line(tmp_path, capsys):
     path.write_text("dimension: 2\n" + BODY + "# padding\n" * 1000)  # about 10 kB
     assert main(["check", str(path), "--max-bytes", "4k"]) == 2
     err = capsys.readouterr().err
-    assert "at most 0.00391 MiB is read" in err and "--max-bytes N" in err
+    assert "mbody reads at most 4 KiB" in err and "--max-bytes N" in err
     assert main(["check", str(path), "--max-bytes", "1M"]) == 0
     assert main(["check", str(path), "--max-bytes", "20000"]) == 0
     assert loader._LIMIT.get() == loader.MAX_BYTES  # set around the command only

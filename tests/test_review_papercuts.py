@@ -309,3 +309,41 @@ def test_the_command_lines_export_suffixes_are_the_exports():
     from mbody.io.export.generalized import SUFFIXES as GENERALIZED
 
     assert set(EXPORT_SUFFIXES) == set(SUFFIXES) == set(GENERALIZED)
+
+
+# == P15: sizes in the unit they are read in; fbd with a body name too long for a file ==========
+
+def test_a_small_size_limit_is_told_in_kib_and_bytes(capsys):
+    path = PENDULUM
+    assert path.stat().st_size == 1042  # 1042 / 1024 = 1.0176 KiB
+    code, out, err = run(capsys, "check", path, "--max-bytes", "1k")
+    assert (code, out) == (2, "")
+    assert err.startswith(f"mbody: error: {path}: the file is 1.02 KiB (1,042 bytes); mbody "
+                          "reads at most 1 KiB (")
+    code, out, err = run(capsys, "check", path, "--max-bytes", "100")
+    assert "the file is 1.02 KiB (1,042 bytes); mbody reads at most 100 bytes (" in err
+
+
+def test_fbd_of_bodies_named_beyond_a_file_names_length(tmp_path, capsys):
+    long = "a" * 300  # check accepts it; a file name holds at most 255 bytes
+    text = (MODELS / "double_pendulum.yaml").read_text()
+    text = text.replace("upper", long + "_upper").replace("lower", long + "_lower")
+    model = tmp_path / "long.yaml"
+    model.write_text(text)
+    code, out, err = run(capsys, "fbd", model, "-o", tmp_path / "pictures")
+    assert (code, err) == (0, "")
+    files = sorted(p.name for p in (tmp_path / "pictures").iterdir())
+    assert len(files) == 2 and all(len(f) <= 255 for f in files)  # apart, though alike
+    assert all(f.startswith("fbd_aaaa") and f.endswith(".svg") for f in files)
+    for f, body in zip(files, (long + "_lower", long + "_upper"), strict=False):
+        assert f"wrote {tmp_path / 'pictures' / f}  (body {body})" in out
+
+
+def test_fbd_file_names_keep_numbering_repeats(tmp_path, capsys):
+    text = (MODELS / "double_pendulum.yaml").read_text()
+    model = tmp_path / "two.yaml"  # 'a+b' and 'a_b' both make fbd_a_b
+    model.write_text(text.replace("upper", "a+b").replace("lower", "a_b"))
+    code, out, err = run(capsys, "fbd", model, "-o", tmp_path / "pictures")
+    assert (code, err) == (0, "")
+    assert sorted(p.name for p in (tmp_path / "pictures").iterdir()) == [
+        "fbd_a_b.svg", "fbd_a_b_2.svg"]

@@ -4,6 +4,7 @@ one self-contained HTML page with all of it."""
 from __future__ import annotations
 
 import argparse
+import hashlib
 import re
 from pathlib import Path
 
@@ -74,9 +75,20 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.set_defaults(run=report)
 
 
+FILE_STEM_MAX = 100
+"""Longest picture file name fbd makes, before its number and extension, in characters
+(ASCII, so bytes too): a file system allows 255 bytes a name, and a body's name may be
+longer (`check` accepts a 300-character name)."""
+
+
 def _file_name(body: str, taken: set[str]) -> str:
-    """fbd_<body> with only portable characters, unique within one run."""
+    """fbd_<body> with only portable characters, unique within one run (a repeat numbered
+    _2, _3...); a name too long for a file (`FILE_STEM_MAX`) cut short with 8 hex digits
+    of the body's whole name, so that two long names that begin alike stay apart."""
     stem = "fbd_" + (re.sub(r"[^A-Za-z0-9._-]+", "_", body).strip("._") or "body")
+    if len(stem) > FILE_STEM_MAX:
+        digest = hashlib.sha256(body.encode("utf-8", "surrogatepass")).hexdigest()[:8]
+        stem = f"{stem[:FILE_STEM_MAX - 9]}_{digest}"
     name, k = stem, 2
     while name.lower() in taken:
         name, k = f"{stem}_{k}", k + 1

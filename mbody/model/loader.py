@@ -368,10 +368,15 @@ FIFO_WAIT = 1.0
 """Seconds a named pipe with no writer is given for one to appear before it is refused."""
 
 
-def _size(n: int) -> str:
-    """A file size in MiB, with the exact bytes when under 1 MiB ("0.0 MiB" says nothing)."""
-    mib = f"{n / 2**20:.1f} MiB"
-    return mib if n >= 2**20 else f"{mib} ({n:,} bytes)"
+def _size(n: int, mib: str = ".1f") -> str:
+    """A size of `n` bytes as people read it: MiB (`mib`, the format of the number) from
+    1 MiB, else KiB with the exact bytes, else bytes ("0.0 MiB" says nothing)."""
+    if n >= 2**20:
+        return f"{n / 2**20:{mib}} MiB"
+    if n < 2**10:
+        return f"{n:,} byte{'' if n == 1 else 's'}"
+    kib = f"{n / 2**10:.3g} KiB"
+    return kib if n % 2**10 == 0 else f"{kib} ({n:,} bytes)"
 
 
 def _near_file(path: Path, most: int = 2000) -> str:
@@ -533,9 +538,8 @@ def read_file(path: str | os.PathLike[str], max_bytes: int | None = None,
                      f"from a pipe: mbody check /dev/stdin{given} < model{ext})")
     more = "--max-bytes N on the command line, or mbody.load(path, max_bytes=N), reads more"
     if st.st_size > max_bytes:
-        exact = f"{max_bytes:,} bytes; " if max_bytes < 2**20 else ""
-        raise refuse(f"the file is {_size(st.st_size)}; at most "
-                     f"{max_bytes / 2**20:.3g} MiB is read ({exact}{more})")
+        raise refuse(f"the file is {_size(st.st_size)}; mbody reads at most "
+                     f"{_size(max_bytes, '.3g')} ({more})")
     try:  # never blocks in open(): a named pipe with no writer would wait forever there
         fd = os.open(p, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
     except OSError as exc:
