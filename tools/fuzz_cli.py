@@ -274,6 +274,10 @@ def make_case(seed: int, index: int, commands: dict[str, argparse.ArgumentParser
         argv += ["--t-end", rng.choice(LIGHT["t_end"])]
     if name == "simulate" and "max_wall" not in given:
         argv += ["--max-wall", "5"]
+    if name == "plot" and "output" not in given and rng.random() < 0.5:
+        # its required -o (a picture), often not drawn among 7 options: else mostly usage
+        # errors
+        argv += ["-o", rng.choice(["out.png", "out.svg", "out.pdf"])]
     if name == "sweep":  # its two required options, when not drawn: else only usage errors
         if "workers" not in given:
             argv += ["--workers", "0"]  # in this process: a local cluster per case is slow

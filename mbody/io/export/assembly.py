@@ -562,6 +562,14 @@ def check_shape(path: Path, what: str, shape: tuple[int, ...], want: tuple[int, 
                          f"{want[0]} x {want[1]} ({of})")
 
 
+def check_map(path: Path, shape: tuple[int, ...], world: int, m: int) -> None:
+    """Refuse a world-axes map T whose shape is not its `world` labels by the `m`
+    reactions (a reader calls it before it makes T from a file's triplets, too)."""
+    if tuple(shape) != (world, m):
+        raise MbodyError(f"{path}: the world-axes map T is {'x'.join(map(str, shape))}; "
+                         f"expected {world}x{m} (its labels by the reactions)")
+
+
 def check_format(path: Path, fmt: str, version: int) -> None:
     """Refuse a file of another format (a saved run: how to read or export it), or of a
     newer layout than this mbody reads."""
@@ -614,9 +622,7 @@ def build(path: Path, get: Callable[[str], Any], M: sp.spmatrix | np.ndarray,
             raise MbodyError(f"{path}: a version {version} export holds no world-axes map, "
                              "yet this one has one (an edited file?)")
         world = [str(s) for s in get("world_reactions")]
-        if tuple(T.shape) != (len(world), m):
-            raise MbodyError(f"{path}: the world-axes map T is {T.shape[0]}x{T.shape[1]}; "
-                             f"expected {len(world)}x{m} (its labels by the reactions)")
+        check_map(path, tuple(T.shape), len(world), m)
 
     def vec(name: str, *shape: int) -> np.ndarray:
         return np.asarray(get(name), dtype=float).reshape(shape)

@@ -25,6 +25,7 @@ from mbody.io.export.assembly import (
     ExportedAssembly,
     build,
     check_format,
+    check_map,
     check_shape,
 )
 from mbody.util import jsontext
@@ -128,23 +129,23 @@ def from_json(d: dict[str, Any], path: Path | str = "<json>") -> ExportedAssembl
     for k in COLUMN_TEXT[1:]:
         flat[f"column_{k}"] = [c[k] for c in cols]
 
-    def mat(name: str, t: dict[str, Any], rows: list, of: str) -> sp.csc_matrix:
-        # the shape checked before the matrix is made: its column pointers take 8 bytes
-        # per column the file claims
-        shape = tuple(int(k) for k in t["shape"])
-        check_shape(Path(path), name, shape, (len(rows), len(d["reactions"])), of)
+    def mat(t: dict[str, Any], shape: tuple[int, ...]) -> sp.csc_matrix:
+        # made after its shape is checked against the labels: the column pointers alone
+        # take 8 bytes per column a file claims
         return sp.csc_matrix((t["value"], (t["row"], t["col"])), shape=shape)
 
+    def shape(t: dict[str, Any]) -> tuple[int, ...]:
+        return tuple(int(k) for k in t["shape"])
+
+    N, m = len(d["coordinates"]), len(d["reactions"])
+    check_shape(Path(path), "M", shape(d["M"]), (N, N), "the coordinates by the coordinates")
+    check_shape(Path(path), "G", shape(d["G"]), (N, m), "the coordinates by the reactions")
     world = d.get("world")
+    T = None
     if world is not None:
         flat["world_reactions"] = world["reactions"]
-    coords = d["coordinates"]
-    M_shape = tuple(int(k) for k in d["M"]["shape"])
-    check_shape(Path(path), "M", M_shape, (len(coords), len(coords)),
-                "the coordinates by the coordinates")
-    M = sp.csc_matrix((d["M"]["value"], (d["M"]["row"], d["M"]["col"])), shape=M_shape)
-    return build(Path(path), flat.__getitem__, M,
-                 mat("G", d["G"], coords, "the coordinates by the reactions"),
-                 None if world is None else mat("T", world["T"], world["reactions"],
-                                                "the world labels by the reactions"))
+        check_map(Path(path), shape(world["T"]), len(world["reactions"]), m)
+        T = mat(world["T"], shape(world["T"]))
+    M = mat(d["M"], shape(d["M"]))
+    return build(Path(path), flat.__getitem__, M, mat(d["G"], shape(d["G"])), T)
 
