@@ -285,6 +285,10 @@ def make_case(seed: int, index: int, commands: dict[str, argparse.ArgumentParser
             argv += ["--set", rng.choice(TEXT["grid"][:3] + ["bodies.rod.mass=1:2:2"] * 3)]
         if "output" not in given:
             argv += ["--out", rng.choice(["out.csv", "out.csv", "out.parquet"])]
+    if name == "convert" and "output" not in given:  # its required -o, as sweep's above:
+        # an output named as --to or SOURCE's format says, or any other (refused with a
+        # did-you-mean when its extension names another format)
+        argv += ["-o", rng.choice(["out.yaml", "out.xml", "out.yml", *OUTPUTS])]
     if rng.random() < 0.04:
         argv.insert(rng.randrange(1, len(argv) + 1), rng.choice(UNKNOWN))
     if rng.random() < 0.03:
