@@ -10,21 +10,11 @@ from pathlib import Path
 
 import pytest
 
-from mbody.cli import main
+from tests.test_cli_options import run
 
 ROOT = Path(__file__).resolve().parent.parent
 MODELS = ROOT / "models"
 PENDULUM = MODELS / "pendulum.yaml"
-
-
-def run(capsys, *args) -> tuple[int, str, str]:
-    try:
-        code = main([str(a) for a in args])
-    except SystemExit as exc:  # argparse
-        code = exc.code
-    out, err = capsys.readouterr()
-    assert "Traceback" not in err
-    return code, out, err
 
 
 def line_of(path: Path, text: str) -> int:
