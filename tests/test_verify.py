@@ -298,7 +298,9 @@ def test_seed_example_answer_files_end_to_end():
     assert v.checks[2].line == 7
     d = v.to_dict()
     assert [e["index"] for e in d["equations"]] == [1, 2, 3, 4, 5]
-    assert d["summary"] == {"equations": 5, "correct": 4, "rows": 6, "uncovered": 3}
+    # equation 4 (alpha_1 = -3) gives body.w1 again, as equation 1 did
+    assert d["summary"] == {"equations": 5, "correct": 4, "rows": 6, "uncovered": 3,
+                            "duplicates": 1, "required": "answered"}
     assert "body.w3" in str(v) and "missing_gyroscopic_term" in str(v)
 
 
@@ -327,8 +329,13 @@ def test_bad_answers_are_reported_with_file_line_column_and_did_you_mean(tmp_pat
             "  - {body: rod, eqn: \"a_x = 0\"}\n")
     out = errors("pendulum", text, tmp_path)
     f = str(tmp_path / "answers.yaml")
-    assert out[0].startswith(f"{f}:7:17: equations[4].eqn: unknown key 'eqn'")
-    assert "did you mean 'eq'?" in out[0]
+    # every problem at once, in the file's order: an entry's unknown key does not hide
+    # the other equations' problems (review R4, F5)
+    assert [o.split(": ")[0] for o in out] == [f"{f}:{at}" for at in (
+        "2:12", "3:39", "4:30", "6:17", "7:5", "7:17")]
+    assert out[4].startswith(f"{f}:7:5: equations[4]: missing eq")
+    assert out[5].startswith(f"{f}:7:17: equations[4].eqn: unknown key 'eqn'")
+    assert "did you mean 'eq'?" in out[5]
     out = errors("pendulum", text.replace("eqn", "eq"), tmp_path)
     assert out[0].startswith(f"{f}:2:12: equations[0].body: no body named 'rdo'")
     assert "did you mean 'rod'?" in out[0]

@@ -48,7 +48,8 @@ def test_verify_json_has_one_entry_per_equation_in_file_order(tmp_path):
     assert all(e["diagnosis"] in DIAGNOSES for e in d["equations"])
     assert d["equations"][0]["expected"] == "0.167083 alpha = -0.433013 O.Fx - 0.25 O.Fy"
     assert [u["row"] for u in d["uncovered"]] == ["rod.x", "rod.theta"]
-    assert d["summary"] == {"equations": 3, "correct": 1, "rows": 3, "uncovered": 2}
+    assert d["summary"] == {"equations": 3, "correct": 1, "rows": 3, "uncovered": 2,
+                            "duplicates": 0, "required": "answered"}
 
 
 def test_verify_exits_0_when_every_equation_is_correct_and_tol_applies(tmp_path):
