@@ -26,7 +26,7 @@ from dataclasses import dataclass
 from mbody.answers.load import Answers
 from mbody.answers.text import equation_text
 from mbody.equations.assemble import Assembly
-from mbody.errors import MbodyError, did_you_mean
+from mbody.errors import MbodyError, did_you_mean, option_name
 from mbody.model.model import Model
 
 ALL, ANSWERED, LAGRANGE = "all", "answered", "lagrange"
@@ -166,13 +166,14 @@ def requirement(model: Model, require: str | Sequence[str] | None) -> Requiremen
         return require
     given = [require] if isinstance(require, str) else list(require)
     words: list[str] = []
+    flag = option_name("require")
     for g in given:
         if not isinstance(g, str):
-            raise MbodyError(f"require: expected words such as 'all' or 'lower,upper.theta', "
+            raise MbodyError(f"{flag}: expected words such as 'all' or 'lower,upper.theta', "
                              f"got {type(g).__name__}")
         words += [w.strip() for w in g.split(",") if w.strip()]
     if not words:
-        raise MbodyError("require: no rows named; give all, answered, lagrange, a body's "
+        raise MbodyError(f"{flag}: no rows named; give all, answered, lagrange, a body's "
                          "name or a row's label (upper.theta)")
     rows = _row_labels(model)
     for w in words:
@@ -180,7 +181,7 @@ def requirement(model: Model, require: str | Sequence[str] | None) -> Requiremen
             continue
         choices = [*KEYWORDS, *model.body_names, *rows]
         hint = did_you_mean(w, choices)
-        raise MbodyError(f"require: {w!r} is no body or row of model '{model.name}' (give "
+        raise MbodyError(f"{flag}: {w!r} is no body or row of model '{model.name}' (give "
                          f"{', '.join(KEYWORDS)}, a body such as {model.body_names[0]!r} "
                          f"or a row such as {next(iter(rows))!r})"
                          + (f"; {hint}" if hint else ""))

@@ -325,6 +325,20 @@ def check_assembly_of(model: Model, asm: object) -> None:
                          f"({', '.join(differ)} differ from the model's); {fix}")
 
 
+def tolerance(tol: Any) -> float:
+    """`tol` checked: a relative tolerance, a number strictly between 0 and 1.
+
+    Raises
+    ------
+    MbodyError
+        Outside (0, 1) (`mbody.errors.MbodyTypeError` for what is not a number).
+    """
+    tol = real_number(tol, "tol", "a relative tolerance, a number between 0 and 1")
+    if not (tol > 0.0 and tol < 1.0):
+        raise MbodyError(f"the tolerance must be between 0 and 1 (relative), got {tol!r}")
+    return tol
+
+
 def verify(model: Model | str | os.PathLike[str], answers: Any, *, tol: float = TOLERANCE,
            state: State | None = None, asm: Assembly | None = None,
            require: str | Sequence[str] | None = None,
@@ -374,9 +388,7 @@ def verify(model: Model | str | os.PathLike[str], answers: Any, *, tol: float = 
         model (`mbody.errors.MbodyTypeError`, a `TypeError` too, for a `tol` that is not
         a number or an `asm` that is not an `Assembly`).
     """
-    tol = real_number(tol, "tol", "a relative tolerance, a number between 0 and 1")
-    if not (tol > 0.0 and tol < 1.0):
-        raise MbodyError(f"the tolerance must be between 0 and 1 (relative), got {tol!r}")
+    tol = tolerance(tol)
     if isinstance(model, str | os.PathLike):
         model = load(model)
     sheet = _answers(answers)
