@@ -97,7 +97,7 @@ INPUTS = {"model": "the model", "source": "the input", "trajectory": "the run fi
           "answers": "the answers file", "state": "the run file"}
 """Argument destinations that name a file a command reads, and how a message calls it."""
 OUTPUTS = {"output": "-o", "latex": "--latex", "csv": "--csv", "summary": "--summary",
-           "picture": "--picture"}
+           "picture": "--picture", "answers_key": "--answers-key"}
 """Argument destinations that name a file (or folder) a command writes, and its option."""
 
 
