@@ -110,11 +110,10 @@ def _sum(terms: list[tuple[float, str]]) -> str:
     """``[(2.0, "a_x"), (-1.0, "O.Fx"), (19.62, "")]`` -> ``2*a_x - O.Fx + 19.62``."""
     out = ""
     for c, name in terms:
-        c = float(f"{float(c):.{DIGITS}g}")  # a numpy number's repr is not its text
-        if c == 0.0:
+        mag = f"{abs(float(c)):.{DIGITS}g}"
+        if float(mag) == 0.0:
             continue
-        mag = abs(c)
-        text = repr(mag) if not name else name if mag == 1.0 else f"{mag!r}*{name}"
+        text = mag if not name else name if mag == "1" else f"{mag}*{name}"
         if not out:
             out = f"-{text}" if c < 0 else text
         else:

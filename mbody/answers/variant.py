@@ -46,10 +46,13 @@ def variant(model: Model, sheet: Answers) -> Model:
     Raises
     ------
     AnswersError
-        A path that names nothing in the model file, or a value it could not hold,
-        located in the answers file; or a model built in Python, which has no file to
-        set values in.
+        A ``set:`` that could not be read, a path that names nothing in the model file,
+        or a value it could not hold, located in the answers file; or a model built in
+        Python, which has no file to set values in.
     """
+    unread = [i for i in sheet.problems if i.key == "set" or i.key.startswith("set.")]
+    if unread:  # a value that could not be read: the numbers would not be the student's
+        raise AnswersError(unread)
     if not sheet.settings:
         return model
     src = model.source

@@ -447,7 +447,7 @@ def check(model: Model, sheet: Answers, *, tol: float, asm: Assembly,
     state = asm.state
     vocab: dict[str, Vocabulary] = {}
     rows: dict[str, BodyRows] = {}
-    issues: list[Issue] = [*sheet.problems, *problems]
+    issues: list[Issue] = [*sheet.problems, *(p for p in problems if p not in sheet.problems)]
     parsed: list[tuple[Answer, Row | None, NotLinear | None]] = []
     lagrange = [a for a in sheet.equations if a.lagrange]
     for a in sheet.equations:
