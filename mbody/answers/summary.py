@@ -34,11 +34,14 @@ from mbody.model.model import Model
 from mbody.model.values import plain
 from mbody.util.formatting import spreadsheet_text
 
-HEADER = ("file", "student", "equations", "correct", "rows covered", "rows asked",
-          "duplicates", "set")
+HEADER = ("file", "student", "equations", "correct")
 """The first columns of a row; then one ``mistake <k>`` column per wrong equation (as many
-as the file with the most), then ``error`` (why a file, or some of its entries, could not
-be checked)."""
+as the file with the most), then `COVERAGE_HEADER`, then ``error`` (why a file, or some of
+its entries, could not be checked). The columns of the model-format contract come first,
+in its order; the later ones were added after it."""
+COVERAGE_HEADER = ("rows covered", "rows asked", "duplicates", "set")
+"""The rows asked for that a correct equation gave, the rows asked for, the correct
+equations that repeat a row, the values the file set."""
 VARIANTS_KEPT = 64
 """Most variants of the model (answers' ``set:`` values) kept assembled at once."""
 MISTAKES_HEADER = ("mistake", "row", "equations", "students", "meaning")
@@ -148,12 +151,13 @@ class ClassSummary:
         The model's name.
     graded : tuple of Graded
         One per answers file.
+    required : str
+        What each file was asked for, in words (`mbody.answers.coverage`).
     """
 
     model: str
     graded: tuple[Graded, ...]
     required: str = "every row of the model"
-    """What each file was asked for, in words (`mbody.answers.coverage`)."""
 
     @property
     def mistakes(self) -> list[Mistake]:
@@ -178,9 +182,10 @@ class ClassSummary:
         Returns
         -------
         list of str
-            `HEADER`, ``mistake 1`` ... (`width` of them), ``error``.
+            `HEADER`, ``mistake 1`` ... (`width` of them), `COVERAGE_HEADER`, ``error``.
         """
-        return [*HEADER, *(f"mistake {k + 1}" for k in range(self.width)), "error"]
+        return [*HEADER, *(f"mistake {k + 1}" for k in range(self.width)), *COVERAGE_HEADER,
+                "error"]
 
     def rows(self) -> list[list[str | int]]:
         """The files' table.
@@ -193,9 +198,9 @@ class ClassSummary:
         out: list[list[str | int]] = []
         for g in self.graded:
             cells = [mistake_text(c) for c in g.wrong]
-            out.append([g.file, g.student, g.equations, g.correct, g.covered, g.asked,
-                        g.duplicates, g.values, *cells,
-                        *([""] * (self.width - len(cells))), g.problems])
+            out.append([g.file, g.student, g.equations, g.correct, *cells,
+                        *([""] * (self.width - len(cells))), g.covered, g.asked,
+                        g.duplicates, g.values, g.problems])
         return out
 
     def csv(self) -> str:

@@ -43,9 +43,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="a YAML answers file, or several (answers/*.yaml)")
     s.add_argument("--summary", metavar="FILE",
                    help="a class's summary: .csv (one row per answers file: file, student, "
-                   "equations, correct, rows covered, rows asked, duplicates, set, each "
-                   "wrong equation's diagnosis, error; then the most frequent mistakes "
-                   "with counts) or .html (the same as a page)")
+                   "equations, correct, each wrong equation's diagnosis, rows covered, rows "
+                   "asked, duplicates, set, error; then the most frequent mistakes with "
+                   "counts) or .html (the same as a page)")
     s.add_argument("--require", action="append", metavar="ROWS",
                    help="the rows each file must give to be all correct: all (every row of "
                    "every body; for a file in generalized coordinates, every Lagrange "

@@ -5,7 +5,7 @@ with what each means. Self-contained, escaped, offline."""
 
 from __future__ import annotations
 
-from mbody.answers.summary import MISTAKES_HEADER, ClassSummary, mistake_text
+from mbody.answers.summary import COVERAGE_HEADER, MISTAKES_HEADER, ClassSummary, mistake_text
 from mbody.answers.verify import MEANINGS
 from mbody.present.html import STYLE, Markup, table, tag
 
@@ -30,10 +30,10 @@ def class_summary_html(summary: ClassSummary) -> str:
         problems = g.verification.errors if g.verification else ()
         error = Markup("".join(tag("div", str(i)) for i in problems)) if problems else \
             g.error
-        rows.append([g.file, g.student, g.equations, g.correct, g.covered, g.asked,
-                     g.duplicates, g.values, wrong if g.wrong else "", error])
-    files = table(["file", "student", "equations", "correct", "rows covered", "rows asked",
-                   "duplicates", "set", "mistakes", "error"], rows, numeric=(2, 3, 4, 5, 6))
+        rows.append([g.file, g.student, g.equations, g.correct, wrong if g.wrong else "",
+                     g.covered, g.asked, g.duplicates, g.values, error])
+    files = table(["file", "student", "equations", "correct", "mistakes",
+                   *COVERAGE_HEADER, "error"], rows, numeric=(2, 3, 5, 6, 7))
     mistakes = table(list(MISTAKES_HEADER),
                      [[m.diagnosis, m.row, m.equations, m.students, MEANINGS[m.diagnosis]]
                       for m in summary.mistakes], numeric=(2, 3))
