@@ -22,7 +22,7 @@ from collections.abc import Sequence
 from mbody.answers.compare import CONST
 from mbody.answers.rows import body_rows
 from mbody.equations.assemble import assemble
-from mbody.errors import MbodyError, did_you_mean
+from mbody.errors import MbodyError, not_found
 from mbody.model.model import Model, State
 from mbody.model.values import plain
 
@@ -59,10 +59,8 @@ def answer_key(model: Model, *, bodies: Sequence[str] | None = None,
     """
     names = list(model.body_names if bodies is None else bodies)
     for b in names:
-        if b not in model.index:
-            hint = did_you_mean(b, model.body_names)
-            raise MbodyError(f"no body named {b!r} in model '{model.name}'"
-                             + (f"; {hint}" if hint else ""))
+        if b not in model.index:  # an argument, not a lookup: MbodyError, in lookups' words
+            raise MbodyError(not_found("body named", b, model.body_names, "bodies").args[0])
     asm = assemble(model, state)
     where = f" ({model.file})" if model.file else ""
     which = "every body" if bodies is None else \
