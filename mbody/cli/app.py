@@ -48,8 +48,7 @@ from mbody.errors import (
     did_you_mean,
     options_named,
 )
-from mbody.model.loader import MAX_BYTES, max_bytes_limit
-from mbody.util.npzfile import DATA_BYTES, data_bytes_limit
+from mbody.util.budget import DATA_BYTES, MAX_BYTES, byte_budget
 
 COMMAND_MODULES = (core, export, sim, drive, draw, animate, mechanism, statics, verify,
                    interop, lagrange, sweep)
@@ -217,7 +216,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         check_paths(args, _subcommand(parser, args))
         limit = getattr(args, "max_bytes", None)
-        with max_bytes_limit(limit), data_bytes_limit(limit), options_named(IMPORT_FLAGS):
+        with byte_budget(limit), options_named(IMPORT_FLAGS):
             code = args.run(args)
         out.flush()  # a full device is reported here, not at exit
         return code

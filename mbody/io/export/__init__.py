@@ -112,7 +112,7 @@ def load_export(path: str | os.PathLike[str], *, max_bytes: int | None = None
         The file, or the folder `write_csv` wrote.
     max_bytes
         The most data read: an npz or .mat file's arrays once inflated (default 1 GiB,
-        `mbody.util.npzfile.DATA_BYTES`), a JSON file's or CSV folder's text (default
+        `mbody.util.budget.DATA_BYTES`), a JSON file's or CSV folder's text (default
         32 MiB, `TEXT_BYTES`); a larger export is refused before it is read.
 
     Returns

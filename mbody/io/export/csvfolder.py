@@ -44,7 +44,8 @@ from mbody.io.export.assembly import (
 )
 from mbody.util import jsontext
 from mbody.util.atomic import atomic_folder
-from mbody.util.npzfile import TEXT_BYTES, data_limit, over_budget, read_text
+from mbody.util.budget import TEXT_BYTES, byte_limit
+from mbody.util.npzfile import over_budget, read_text
 
 CSV_DENSE_LIMIT = 1_000_000
 """M.csv and G.csv are labelled dense tables up to this many cells, else triplets."""
@@ -256,7 +257,7 @@ def read(folder: Path, max_bytes: int | None = None) -> ExportedAssembly:
     """The `ExportedAssembly` stored in the CSV folder `folder`.
 
     Every column is found by its header name (see the module's docstring). The files
-    hold at most `max_bytes` of text in all (default `mbody.util.npzfile.TEXT_BYTES`),
+    hold at most `max_bytes` of text in all (default `mbody.util.budget.TEXT_BYTES`),
     refused before any is read.
 
     Raises
@@ -265,7 +266,7 @@ def read(folder: Path, max_bytes: int | None = None) -> ExportedAssembly:
         For a missing file, a missing column (naming the file and the column), a cell that
         is not a number, or tables whose labels disagree.
     """
-    limit = data_limit(max_bytes, TEXT_BYTES)
+    limit = byte_limit(max_bytes, TEXT_BYTES)
     files = [folder / f for f in (*FILES, MAP_FILE) if (folder / f).is_file()]
     holds = sum(f.stat().st_size for f in files)
     if holds > limit:
