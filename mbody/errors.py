@@ -193,6 +193,13 @@ def closest(word: str, choices: Iterable[str]) -> str | None:
 
 _FLAGS: ContextVar[Mapping[str, str] | None] = ContextVar("mbody_option_flags", default=None)
 
+# How a message names an argument: each surface in its own spelling. The functions below
+# build a message's words for an argument; within `options_named` (the command line sets
+# it around every command, from the command's own options) they give the flag the user
+# typed (``--t-end``, ``--known A.Fx``), elsewhere the keyword of the Python call
+# (``t_end``, ``known['A.Fx']``). A keyword the command has no option for keeps its
+# Python spelling.
+
 
 @contextmanager
 def options_named(flags: Mapping[str, str]) -> Iterator[None]:
@@ -214,3 +221,22 @@ def option_name(keyword: str, value: str = "") -> str:
     if flag is not None:
         return flag
     return f"{keyword}={value}" if value else keyword
+
+
+def option_setting(keyword: str, value: object) -> str:
+    """The option `keyword` set to `value`, as a message says what was given or advises:
+    ``--max-steps 1000`` on the command line (a switch, `value` True, by its flag alone:
+    ``--equilibrium``), ``max_steps=1000`` in Python (text quoted as Python writes it:
+    ``method='Radau'``; a float as %g writes it)."""
+    flag = (_FLAGS.get() or {}).get(keyword)
+    shown = f"{value:g}" if isinstance(value, float) else str(value)
+    if flag is None:
+        return f"{keyword}={value!r}" if isinstance(value, str) else f"{keyword}={shown}"
+    return flag if value is True else f"{flag} {shown}"
+
+
+def option_entry(keyword: str, key: str) -> str:
+    """One entry of a mapping argument, as a message names it: ``--known A.Fx`` on the
+    command line (a repeatable NAME=VALUE option), ``known['A.Fx']`` in Python."""
+    flag = (_FLAGS.get() or {}).get(keyword)
+    return f"{flag} {key}" if flag is not None else f"{keyword}[{key!r}]"

@@ -106,6 +106,22 @@ def _options(command: argparse.ArgumentParser, dest: str) -> list[str]:
             for a in command._actions if a.dest == dest]
 
 
+def option_flags(command: argparse.ArgumentParser | None,
+                 args: argparse.Namespace) -> dict[str, str]:
+    """What messages call an argument within `command` (`mbody.errors.options_named`):
+    each of its options by destination, by its long name (``t_end`` -> ``--t-end``,
+    ``known`` -> ``--known``); the Python keywords that are not the destination of their
+    option (``args.keywords``, from the command's ``set_defaults``: sweep's ``values`` is
+    ``--set``); and those of an imported model (`IMPORT_FLAGS`: ``joint_positions`` is
+    ``--q``)."""
+    flags: dict[str, str] = {}
+    for action in command._actions if command is not None else ():
+        names = action.option_strings
+        if names and action.dest != "help":
+            flags[action.dest] = next((n for n in names if n.startswith("--")), names[0])
+    return {**flags, **getattr(args, "keywords", {}), **IMPORT_FLAGS}
+
+
 def _commands(parser: argparse.ArgumentParser) -> dict[str, argparse.ArgumentParser]:
     """The sub-commands' parsers of `parser`, by name ({} when it has none)."""
     sub = next((a for a in parser._actions if a.dest == "command"), None)
@@ -214,9 +230,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     out = _Stdout(sys.stdout)
     sys.stdout = out
     try:
-        check_paths(args, _subcommand(parser, args))
+        command = _subcommand(parser, args)
+        check_paths(args, command)
         limit = getattr(args, "max_bytes", None)
-        with byte_budget(limit), options_named(IMPORT_FLAGS):
+        with byte_budget(limit), options_named(option_flags(command, args)):
             code = args.run(args)
         out.flush()  # a full device is reported here, not at exit
         return code
