@@ -31,7 +31,7 @@ from mbody.equations.coordinates import CoordinateSet, columns, coordinate_set
 from mbody.equations.workspace import workspace
 from mbody.errors import MbodyError
 from mbody.kernel import _core
-from mbody.model.arguments import checked_state, known_at
+from mbody.model.arguments import KnownValues, checked_state, known_at
 from mbody.model.model import Model, State
 
 if TYPE_CHECKING:
@@ -290,7 +290,7 @@ def layout(N: int, k: int) -> tuple[int, ...]:
 
 def generalized(model: Model, state: State | None = None,
                 coordinates: Sequence[str] | None = None,
-                known: Mapping[str, float] | None = None) -> Generalized:
+                known: KnownValues | None = None) -> Generalized:
     """The equations of `model` in generalized coordinates at `state` (module doc).
 
     Parameters

@@ -23,7 +23,7 @@ import csv
 import io
 import json
 import os
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -42,6 +42,7 @@ from mbody.io.export.assembly import (
     build,
     check_format,
 )
+from mbody.model.arguments import KnownValues
 from mbody.util import jsontext
 from mbody.util.atomic import atomic_folder
 from mbody.util.budget import TEXT_BYTES, byte_limit
@@ -74,7 +75,7 @@ _INFO_KEYS = ("format", "version", "model", "model_file", "dimension", "t", "sta
 
 # -- writing --------------------------------------------------------------------------------
 def write_csv(asm: Assembly | ExportedAssembly, folder: str | os.PathLike[str],
-              known: Mapping[str, float] | None = None, axes: str = "joint") -> Path:
+              known: KnownValues | None = None, axes: str = "joint") -> Path:
     """Write the export as CSV tables in `folder` (created if needed), atomically.
 
     Parameters
@@ -86,7 +87,8 @@ def write_csv(asm: Assembly | ExportedAssembly, folder: str | os.PathLike[str],
         info.csv into (and T.csv when the export holds the world-axes map); other files
         in it are left alone.
     known
-        Reaction values to record as known, with an `Assembly`.
+        Reaction values to record as known, with an `Assembly` (numbers, or expressions
+        of t taken at its state's time: `Assembly.reaction_values`).
     axes
         "world": add the world-axes map T (with an `Assembly`; an export has its own).
 
