@@ -214,13 +214,21 @@ def options_named(flags: Mapping[str, str]) -> Iterator[None]:
 
 
 def option_name(keyword: str, value: str = "") -> str:
-    """How a message names the option `keyword` (set to `value`, when that is what it
-    advises): its flag on the command line (`options_named`: ``--floating-base``), else
-    the keyword argument of the call (``floating_base=True``)."""
+    """How a message names the option `keyword` (set to `value`, as typed, when that is
+    what it advises): its flag on the command line (`options_named`: ``--floating-base``
+    for ``"True"``, a switch; ``--samples N`` for ``"N"``), else the keyword argument of
+    the call (``floating_base=True``, ``samples=N``)."""
     flag = (_FLAGS.get() or {}).get(keyword)
     if flag is not None:
-        return flag
+        return f"{flag} {value}" if value and value != "True" else flag
     return f"{keyword}={value}" if value else keyword
+
+
+def option_names() -> dict[str, str]:
+    """The flags `options_named` set around this call ({} outside a command): what a
+    piece of work done elsewhere (a sweep's cases on a cluster's workers) names its
+    arguments by, to say it as the caller would."""
+    return dict(_FLAGS.get() or {})
 
 
 def option_setting(keyword: str, value: object) -> str:

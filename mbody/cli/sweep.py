@@ -76,7 +76,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "about 2 s of work)")
     s.add_argument("--quiet", action="store_true", help="no progress bar (there is one only "
                    "on a terminal)")
-    s.set_defaults(run=sweep)
+    s.set_defaults(run=sweep, keywords={"values": "--set", "run": "--run",
+                                        "revolutions": "--t-end", "out": "--out"})
 
 
 def sweep(a: argparse.Namespace) -> int:
