@@ -9,6 +9,7 @@ from __future__ import annotations
 import contextlib
 import difflib
 import numbers
+import re
 from collections.abc import Iterable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from contextvars import ContextVar
@@ -213,14 +214,14 @@ def options_named(flags: Mapping[str, str]) -> Iterator[None]:
         _FLAGS.reset(token)
 
 
-def option_name(keyword: str, value: str = "") -> str:
-    """How a message names the option `keyword` (set to `value`, as typed, when that is
-    what it advises): its flag on the command line (`options_named`: ``--floating-base``
-    for ``"True"``, a switch; ``--samples N`` for ``"N"``), else the keyword argument of
-    the call (``floating_base=True``, ``samples=N``)."""
+def option_name(keyword: str, value: str = "", typed: str = "") -> str:
+    """How a message names the option `keyword` (set to `value` in Python, `typed` on the
+    command line, when that is what it advises): its flag on the command line
+    (`options_named`: ``--floating-base``; ``--samples N`` with `typed` ``"N"``), else
+    the keyword argument of the call (``floating_base=True``, ``samples=N``)."""
     flag = (_FLAGS.get() or {}).get(keyword)
     if flag is not None:
-        return f"{flag} {value}" if value and value != "True" else flag
+        return f"{flag} {typed}" if typed else flag
     return f"{keyword}={value}" if value else keyword
 
 
@@ -235,9 +236,11 @@ def option_setting(keyword: str, value: object) -> str:
     """The option `keyword` set to `value`, as a message says what was given or advises:
     ``--max-steps 1000`` on the command line (a switch, `value` True, by its flag alone:
     ``--equilibrium``), ``max_steps=1000`` in Python (text quoted as Python writes it:
-    ``method='Radau'``; a float as %g writes it)."""
+    ``method='Radau'``; a float as %g writes it, its exponent as people write it:
+    ``1e-6``)."""
     flag = (_FLAGS.get() or {}).get(keyword)
-    shown = f"{value:g}" if isinstance(value, float) else str(value)
+    shown = (re.sub(r"e\+?(-?)0*(\d)", r"e\1\2", f"{value:g}") if isinstance(value, float)
+             else str(value))
     if flag is None:
         return f"{keyword}={value!r}" if isinstance(value, str) else f"{keyword}={shown}"
     return flag if value is True else f"{flag} {shown}"

@@ -278,7 +278,7 @@ def _grid(entries: Iterable[tuple[str, Any]], samples: int | None, seed: int) ->
     if size > MAX_CASES:
         raise MbodyError(f"the sweep has {_spaced(size)} cases; at most "
                          f"{_spaced(MAX_CASES)} are run (fewer values per axis, or "
-                         f"{option_name('samples', 'N')})")
+                         f"{option_name('samples', 'N', 'N')})")
     return grid
 
 

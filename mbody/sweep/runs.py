@@ -185,7 +185,7 @@ def turning_driver(model: Model) -> int:
             return i
     raise MbodyError(f"an end in turns ({turns_end('N')}) needs a driver that turns a joint "
                      "(an angle or a speed about an axis); this model has none: give the time "
-                     f"in seconds ({option_name('t_end', 'SECONDS')})")
+                     f"in seconds ({option_name('t_end', 'SECONDS', 'SECONDS')})")
 
 
 def _an_end() -> str:
