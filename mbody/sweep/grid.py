@@ -177,7 +177,8 @@ def parse_grid(specs: Sequence[str], samples: int | None = None, seed: int = 0) 
         or more than `MAX_CASES` cases.
     """
     # each spec read as it comes: its errors in the order given
-    return _grid((parse_assignment(spec) for spec in specs), samples, seed)
+    return _grid((parse_assignment(spec, option_name("values")) for spec in specs), samples,
+                 seed)
 
 
 def grid_of(values: Mapping[str, Any] | Sequence[str] | str, samples: int | None = None,
