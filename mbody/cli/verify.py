@@ -6,15 +6,8 @@ import argparse
 import math
 import sys
 
-from mbody.cli.common import (
-    EXIT_OK,
-    EXIT_UNMET,
-    IMPORT_FLAGS,
-    MODEL_HELP,
-    load_model,
-    regular_file,
-)
-from mbody.errors import MbodyError, options_named
+from mbody.cli.common import EXIT_OK, EXIT_UNMET, MODEL_HELP, load_model, regular_file
+from mbody.errors import MbodyError
 
 SUMMARY_SUFFIXES = (".csv", ".html", ".htm")
 """A class summary's file name ends in one of these: it chooses the format."""
@@ -74,11 +67,6 @@ def _tolerance(text: str) -> float:
 
 
 def verify(a: argparse.Namespace) -> int:
-    with options_named({**IMPORT_FLAGS, "require": "--require"}):
-        return _run(a)
-
-
-def _run(a: argparse.Namespace) -> int:
     from mbody.answers.verify import verify as _verify
     from mbody.util import jsontext
 
