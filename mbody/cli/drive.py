@@ -31,9 +31,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         "close every joint and driver (Newton's method from the previous sample, on the "
         "branch of the file's pose), the velocities and accelerations they impose, and the "
         "reactions and drivers' efforts that take them (kinetostatics). Prints each "
-        "reaction's and effort's peak and an energy check; saves the run with -o in the "
-        "format plot, animate, export and report read. For a fully driven mechanism this "
-        "is its motion; a partly driven one needs 'mbody simulate'.")
+        "reaction's and effort's peak and an energy check, and with --at or --every their "
+        "values at the instants asked (each solved there); saves the run with -o in the "
+        "format plot, animate, export and report read, and a table with --csv. For a fully "
+        "driven mechanism this is its motion; a partly driven one needs 'mbody simulate'.")
     s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
     s.add_argument("--t-end", type=seconds_or_turns(-T_END_MAX, T_END_MAX),
                    default=None, metavar="T",
