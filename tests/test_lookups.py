@@ -9,6 +9,7 @@ from pathlib import Path
 import pytest
 
 import mbody
+from mbody.errors import MbodyTypeError
 
 MODELS = Path(__file__).resolve().parent.parent / "models"
 
@@ -90,8 +91,22 @@ def test_bodies_and_joints_are_found_by_name_and_by_index(dp):
         dp.bodies[2]
     with pytest.raises(IndexError, match=r"joint index -3 out of range \(2 joints: O, A\)"):
         dp.joints[-3]
-    with pytest.raises(TypeError, match="joints are found by name or by index, got float"):
+    # an MbodyTypeError (was a plain TypeError "joints are found by name or by index"):
+    # one wrong-type error across the API (review R3, B6)
+    with pytest.raises(MbodyTypeError) as err:
         dp.joints[0.0]
+    assert message(err) == ("joints[key] must be a name (str) or an index (int), got "
+                            "float 0.0")
+
+
+def test_bodies_get_is_by_name_as_the_mapping_keys_are():
+    """`model.bodies` is a mapping of names: `get` agrees with `in` (an index is for
+    ``bodies[0]``, not a key), and returns the default for anything not a name there."""
+    dp = mbody.load(MODELS / "double_pendulum.yaml")
+    assert 0 not in dp.bodies and dp.bodies.get(0) is None
+    assert dp.bodies.get(5, "none") == "none" and dp.bodies.get(1.5, "none") == "none"
+    assert dp.bodies.get("upper") is dp.bodies["upper"] is dp.bodies[0]
+    assert dp.bodies.get("uper", "none") == "none"
 
 
 @pytest.mark.parametrize("path", ["located", "fast"])
