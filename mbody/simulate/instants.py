@@ -209,6 +209,7 @@ class Asked:
     driver: int | None
     value: float
     source: str = ""
+    t: float | None = None  # its time in the run, once found
 
 
 def kinematic_at(model: Model, at: object = None, *, every: object = None,
@@ -437,6 +438,8 @@ def _check_run(model: Model, run: object) -> None:
 def _time(model: Model, run: Trajectory, a: Asked) -> float:
     """The time of instant `a` in the run: as asked, or the first at which its driver's
     coordinate is the value asked (an angle modulo a turn)."""
+    if a.t is not None:
+        return a.t
     t = run.t
     lo, hi = float(t[0]), float(t[-1])
     if a.driver is None:
@@ -541,10 +544,11 @@ def _every(model: Model, run: Trajectory, step: Asked) -> list[Asked]:
     out = []
     for k in range(first, last + 1):
         x = k * step.value
-        if first_reach(d.laws[step.driver][0], t, x, TURN if angle else None) is None:
+        found = first_reach(d.laws[step.driver][0], t, x, TURN if angle else None)
+        if found is None:
             continue  # an end of the range the samples reach only to its rounding
         shown = f"{math.degrees(x):.10g} deg" if angle else f"{x:.10g} m"
-        out.append(Asked(shown, step.driver, x))
+        out.append(Asked(shown, step.driver, x, step.source, found))
     _check_count(len(out), step)
     return out
 
