@@ -490,5 +490,5 @@ def test_a_local_cluster_that_cannot_start_is_a_clean_error(tmp_path, monkeypatc
     results = Results(tmp_path / "c.csv", columns(base, job.settings), job.grid,
                       record(job.settings, base))
     with pytest.raises(MbodyError, match=r"could not start a local Dask cluster of 2 .*"
-                                         r"--workers 0"):
+                                         r"workers=0"):  # Python's spelling (here)
         cluster.run(job, [0, 1, 2], results, workers=2, progress=False)

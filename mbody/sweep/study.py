@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from mbody.errors import MbodyError, did_you_mean
+from mbody.errors import MbodyError, did_you_mean, option_name, option_names
 from mbody.loading import load
 from mbody.model.model import Model
 from mbody.model.values import edits, entry_names
@@ -38,9 +38,11 @@ from mbody.util.atomic import refuse_overwriting_inputs
 
 @dataclass(frozen=True)
 class Limit:
-    """The range of one numeric argument, as the command's option takes it."""
+    """The range of one numeric argument, as the command's option `option` takes it; a
+    message names it as the caller does (`mbody.errors.option_name` of `keyword`)."""
 
     option: str
+    keyword: str
     what: str
     lo: float
     hi: float
@@ -56,7 +58,7 @@ class Limit:
             lo, hi = (_figure(int(x)) if self.integer else _figure(x)
                       for x in (self.lo, self.hi))
             span = f"above {lo} up to {hi}" if self.lo_open else f"from {lo} to {hi}"
-            raise MbodyError(f"{self.option}: expected {self.what} {span}"
+            raise MbodyError(f"{option_name(self.keyword)}: expected {self.what} {span}"
                              f"{' (a whole number)' if self.integer else ''}, got {value!r}")
 
 
@@ -70,14 +72,16 @@ def _figure(x: float) -> str:
 
 
 LIMITS = {
-    "samples": Limit("--samples", "a number of cases", 1, 1e8, integer=True),
-    "seed": Limit("--seed", "a seed", 0, 2**63 - 1, integer=True),
-    "t_end": Limit("--t-end", "a time in seconds", 0.0, 1e9, lo_open=True),
-    "revolutions": Limit("--t-end", "a number of turns", 0.0, 1e6, lo_open=True),
-    "steps": Limit("--steps", "a number of instants", 2, 1e6, integer=True),
-    "fps": Limit("--fps", "samples per second", 0.0, 1e6, lo_open=True),
-    "workers": Limit("--workers", "a number of worker processes", 0, 4096, integer=True),
-    "chunk": Limit("--chunk", "a number of cases", 1, 1e8, integer=True),
+    "samples": Limit("--samples", "samples", "a number of cases", 1, 1e8, integer=True),
+    "seed": Limit("--seed", "seed", "a seed", 0, 2**63 - 1, integer=True),
+    "t_end": Limit("--t-end", "t_end", "a time in seconds", 0.0, 1e9, lo_open=True),
+    "revolutions": Limit("--t-end", "revolutions", "a number of turns", 0.0, 1e6,
+                         lo_open=True),
+    "steps": Limit("--steps", "steps", "a number of instants", 2, 1e6, integer=True),
+    "fps": Limit("--fps", "fps", "samples per second", 0.0, 1e6, lo_open=True),
+    "workers": Limit("--workers", "workers", "a number of worker processes", 0, 4096,
+                     integer=True),
+    "chunk": Limit("--chunk", "chunk", "a number of cases", 1, 1e8, integer=True),
 }
 """`run_sweep`'s numeric arguments, by name: the command's ranges (its argparse types; a
 test keeps them equal)."""
@@ -248,7 +252,8 @@ def check_request(values: Mapping[str, Any] | Sequence[str] | str, out: str | os
             LIMITS[name].check(value)
     grid = grid_of(values, samples, seed)
     if samples is None and seed:
-        raise MbodyError("--seed goes with --samples (a grid has no randomness)")
+        raise MbodyError(f"{option_name('seed')} goes with {option_name('samples')} (a grid "
+                         "has no randomness)")
     return grid
 
 
@@ -381,11 +386,11 @@ def run_sweep(model: Model | str | os.PathLike[str],
         if value is not None:
             LIMITS[name].check(value)
     if t_end is not None and revolutions is not None:
-        raise MbodyError("--t-end: give the end in seconds (t_end) or in turns "
-                         "(revolutions), not both")
+        raise MbodyError("give the end in seconds (t_end) or in turns (revolutions), not "
+                         "both")
     if scheduler is not None and not isinstance(scheduler, str):
-        raise MbodyError(f"--scheduler: expected an address such as tcp://HOST:PORT, got "
-                         f"{scheduler!r}")
+        raise MbodyError(f"{option_name('scheduler')}: expected an address such as "
+                         f"tcp://HOST:PORT, got {scheduler!r}")
     said: list[str] = []
     if not isinstance(model, Model):
         if not isinstance(model, str | os.PathLike):
@@ -407,7 +412,7 @@ def run_sweep(model: Model | str | os.PathLike[str],
     recorded = record(settings, model)
     results = Results(out, columns(model, settings), grid, recorded, force=bool(force))
     todo = [k for k in range(len(grid)) if k not in results.rows]
-    job = Job(model.source, grid, settings, uuid.uuid4().hex)
+    job = Job(model.source, grid, settings, uuid.uuid4().hex, option_names())
     try:
         report = cluster.run(job, todo, results, scheduler=scheduler, workers=workers,
                              chunk=chunk, progress=progress)
