@@ -216,17 +216,17 @@ def test_csv_never_replaces_an_input(slider_crank, capsys):
 
 
 @pytest.mark.parametrize(("args", "words"), [
-    (["--at", "90"], "--at '90': give its unit: an angle of driver 'motor'"),
+    (["--at", "90"], "--at 90: give its unit: an angle of driver 'motor'"),
     (["--at", "90 degrees"], "write '90 deg'"),
     (["--at", "20 mm"], "driver 'motor' drives an angle (deg, rad or rev), and '20 mm' is "
                         "a displacement"),
     (["--at", "mtor=90 deg"], "no driver named 'mtor' in 'my-slider-crank' (did you mean "
                               "'motor'?)"),
-    (["--at", "1 s"], "--at '1 s': t = 1 s is outside the run, t = 0 .. 0.2 s; lengthen "
+    (["--at", "1 s"], "--at 1 s: t = 1 s is outside the run, t = 0 .. 0.2 s; lengthen "
                       "the run (--t-end)"),
-    (["--at", "90 deg", "--t-end", "0.01"], "--at '90 deg': motor = 90 deg is not reached "
+    (["--at", "90 deg", "--t-end", "0.01"], "--at 90 deg: motor = 90 deg is not reached "
                                             "in the run: motor goes from 30 to 48 deg"),
-    (["--every", "0 deg"], "--every '0 deg': expected a step above 0"),
+    (["--every", "0 deg"], "--every 0 deg: expected a step above 0"),
     (["--at", "90 deg", "--every", "30 deg"], "give the instants one way"),
 ])
 def test_bad_instants_exit_2_with_what_was_expected(slider_crank, capsys, args, words):

@@ -15,10 +15,7 @@ from mbody.cli.common import (
     output_suffix,
     seconds_or_turns,
 )
-from mbody.errors import MbodyError, given_twice, options_named
-
-FLAGS = {"at": "--at", "every": "--every", "t_end": "--t-end"}
-"""`mbody.kinematic_at`'s keywords -> the flags that give them (its messages name these)."""
+from mbody.errors import MbodyError, given_twice
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -135,8 +132,7 @@ def kinematics(a: argparse.Namespace) -> int:
     model = load_model(a.model)
     at = a.at or None
     if at or a.every is not None:  # a bad value is reported before the run
-        with options_named(FLAGS):
-            asked_instants(model, at, every=a.every)
+        asked_instants(model, at, every=a.every)
     turn = revolution(model)
     t_end = end_time(a.t_end, a.t_start, turn)
     fps = a.fps if a.fps is not None else default_sampling(model)[1]
@@ -147,9 +143,8 @@ def kinematics(a: argparse.Namespace) -> int:
         if target:
             ensure_writable(target)
     traj = kinematic_run(model, t_end, fps, t_start=a.t_start, points=points, axes=a.axes)
-    with options_named(FLAGS):
-        rows = (kinematic_at(model, at, every=a.every, axes=a.axes, run=traj)
-                if at or a.every is not None else None)
+    rows = (kinematic_at(model, at, every=a.every, axes=a.axes, run=traj)
+            if at or a.every is not None else None)
     if a.output:
         traj.save(a.output)
     if a.csv:

@@ -27,7 +27,15 @@ from pathlib import Path
 import numpy as np
 
 from mbody.equations.world import check_axes
-from mbody.errors import MbodyError, did_you_mean, option_name, real_number, wrong_type
+from mbody.errors import (
+    MbodyError,
+    did_you_mean,
+    not_found,
+    option_name,
+    option_setting,
+    real_number,
+    wrong_type,
+)
 from mbody.model.arguments import checked_model
 from mbody.model.checks import angle_spelling, si_quantity
 from mbody.model.model import Model
@@ -105,10 +113,7 @@ class Instants(Frozen):
     def __getitem__(self, label: str) -> np.ndarray:
         """(K,) one reaction's or effort's values at the instants, by its label."""
         if label not in self.labels:
-            hint = did_you_mean(str(label), list(self.labels))
-            raise KeyError(f"no reaction or effort {label!r} here"
-                           + (f" ({hint})" if hint else "") + "; the labels are "
-                           + ", ".join(self.labels[:20]))
+            raise not_found("reaction or effort", label, self.labels, "reactions and efforts")
         return self.values[:, self.labels.index(label)]
 
     @property
@@ -318,7 +323,7 @@ def asked_instants(model: Model, at: object = None, *, every: object = None,
         return [], _asked(model, every, first, "every", step=True)
     asked = [_asked(model, x, first, "at") for x in _entries(at, "at")]
     asked += [Asked(f"t = {x:g} s", None, real_number(x, "times", "a number of seconds"),
-                    f"times {x!r}") for x in _entries(times, "times")]
+                    option_setting("times", x)) for x in _entries(times, "times")]
     return asked, None
 
 
@@ -354,7 +359,7 @@ def _asked(model: Model, entry: object, first: int, option: str, step: bool = Fa
     d = model.drivers
     assert d is not None
     kinds = _kinds(model)
-    where = f"{option_name(option)} {entry!r}"
+    where = option_setting(option, entry)
     if isinstance(entry, numbers.Real) and not isinstance(entry, bool):
         x = real_number(entry, option, "a number")
         quantity, index = kinds[first], first
