@@ -19,11 +19,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from mbody import joint_types
-from mbody.answers.compare import CONST, Fit, Row, fit, fit_on, matches, same
+from mbody.answers.compare import CONST, Fit, Row, consensus, matches, rounded_off, same
 from mbody.answers.kinematics import Relation
 from mbody.answers.rows import BodyRows, MomentPoint, TrueRow
+from mbody.answers.text import differences, rounding, row_text
 from mbody.answers.text import num as _num
-from mbody.answers.text import row_text
 from mbody.answers.text import terms as _terms
 
 CORRECT = "correct"
@@ -66,9 +66,6 @@ DIAGNOSES = {
     NOT_AN_EQUATION: "none of the above explains it",
 }
 """The fixed vocabulary of diagnoses, in the order they are tried, with their meaning."""
-ROUNDING = 0.03
-"""A coefficient within this fraction of the row's (and beyond the tolerance) in an
-equation with every term in place is a number rounded too coarsely."""
 
 
 @dataclass(frozen=True)
@@ -725,22 +722,13 @@ class _Diagnoser:
         return out
 
     def rounded(self) -> Diagnosis | None:
-        """Every term of a row in place, each coefficient within `ROUNDING` of the row's
+        """Every term of a row in place, each coefficient within `compare.ROUNDING` of the row's
         and some beyond the tolerance: a number written with too few figures."""
         best: tuple | None = None
-        s = self.s
         for r, t, written, words, text, kinematic in self.comparisons():
-            if s.keys != t.keys:
-                continue
-            f = self.consensus(t, r.acc, s)
-            if f is None:
-                continue
-            wrong = f.wrong(self.tol)
-            off = {}
-            for k in wrong:
-                want = f.times(t.get(k))
-                off[k] = abs(s.get(k) - want) / abs(want) if want != 0.0 else np.inf
-            if not wrong or max(off.values()) > ROUNDING:
+            f = self.consensus(t, r.acc)
+            off = rounded_off(self.s, t, f, self.tol) if f is not None else None
+            if off is None:
                 continue
             rank = (kinematic, max(off.values()))
             if best is None or rank < best[0]:
@@ -748,20 +736,12 @@ class _Diagnoser:
         if best is None:
             return None
         (kinematic, _), r, t, written, words, text, f, off = best
-        ref = min(1.0, max((abs(v) for v in s.coef.values()), default=1.0))
-        parts = [f"{'the constant' if k == CONST else k} has {_num(s.get(k), ref)} where "
-                 f"{_num(f.times(t.get(k)), ref)} is expected ({_percent(off[k])} off)"
-                 for k in sorted(off, key=lambda k: -off[k])[:3]]
-        how = ""
-        if kinematic:
-            how = ", " + self.kinematics_words(written)
+        how = ", " + self.kinematics_words(written) if kinematic else ""
         return Diagnosis(
             ROUNDED_TOO_COARSELY, text, r.label,
             f"This is {words}{how}, with every term in place, but "
-            + "; ".join(parts) + f": a number rounded too coarsely? Each coefficient must "
-            f"match to {_percent(self.tol)}; write numbers to about four significant "
-            "figures, or use the model's names for them (m, I_G, g...).",
-            {"rounded": {k: {"have": s.get(k), "expected": f.times(t.get(k)),
+            + rounding(self.s, t, f, off, self.tol) + " (m, I_G, g...).",
+            {"rounded": {k: {"have": self.s.get(k), "expected": f.times(t.get(k)),
                              "relative": v} for k, v in off.items()}})
 
     def closest(self) -> Diagnosis:
@@ -788,20 +768,6 @@ class _Diagnoser:
                              f"any of {self.br.body}'s Newton-Euler rows.", {})
         key, r, t, written, words, text, f, wrong = best
         kinematic = key[3]
-        parts = []
-        # numbers at the student's scale: noise only against the row's own magnitude
-        ref = min(1.0, max((abs(v) for v in s.coef.values()), default=1.0))
-        for k in wrong[:3]:
-            have, want = s.get(k), f.times(t.get(k))
-            name = "the constant" if k == CONST else k
-            if have == 0.0:
-                parts.append(f"{name} is missing (expected {_num(want, ref)})")
-            elif want == 0.0:
-                parts.append(f"{name} does not belong here (you have {_num(have, ref)})")
-            else:
-                parts.append(f"{name} has {_num(have, ref)} where {_num(want, ref)} is "
-                             "expected")
-        more = f", and {len(wrong) - 3} more" if len(wrong) > 3 else ""
         combo = self.combination()
         details: dict = {"differs": {k: {"have": s.get(k), "expected": f.times(t.get(k))}
                                      for k in wrong}}
@@ -813,8 +779,8 @@ class _Diagnoser:
         return Diagnosis(
             NOT_AN_EQUATION, text, r.label,
             (combo + " " if combo else "")
-            + f"Closest is {words}; {how}, at your equation's scale: " + "; ".join(parts)
-            + more + ".", details)
+            + f"Closest is {words}; {how}, at your equation's scale: "
+            + differences(s, t, f, wrong) + ".", details)
 
     def mixed(self, wrong: list[str]) -> bool:
         """Whether the terms that differ are both accelerations and forces (or the
@@ -861,17 +827,9 @@ class _Diagnoser:
         return None
 
     def consensus(self, t: Row, acc: str, s: Row | None = None) -> Fit | None:
-        """The fit of `s` (default: the student's row) whose scale most of its terms agree
-        with (the row's own acceleration breaking ties), so that the minority of wrong
-        terms stands out."""
-        s = self.s if s is None else s
-        best: tuple | None = None
-        for key in sorted(s.keys & t.keys):
-            fk = fit_on(s, t, key)
-            score = (len(fk.wrong(self.tol)), key != acc, fk.error)
-            if best is None or score < best[0]:
-                best = (score, fk)
-        return best[1] if best is not None else fit(s, t)
+        """`mbody.answers.compare.consensus` of `s` (default: the student's row) and `t`,
+        the row's own acceleration `acc` breaking ties."""
+        return consensus(self.s if s is None else s, t, self.tol, acc)
 
     def combination(self) -> str:
         """A sentence when the equation holds but mixes several rows, else ''."""
@@ -899,11 +857,6 @@ def _is_moment(label: str) -> bool:
 def _point(p: MomentPoint) -> str:
     where = ", ".join(_num(c) for c in (p.W_P if abs(p.W_P[2]) > 0 else p.W_P[:2]))
     return f"{p.name} ({where})"
-
-
-def _percent(x: float) -> str:
-    """0.00698 -> '0.7 %'."""
-    return f"{100.0 * x:.2g} %"
 
 
 def _sources(sources: tuple[str, ...]) -> str:
