@@ -34,7 +34,7 @@ from mbody.answers.compare import CONST, Row
 from mbody.answers.text import num, terms
 from mbody.equations.assemble import Assembly
 
-MAX_COORDINATES = 600
+MAX_COORDINATES = 300
 """At most this many coordinates (of the body and the bodies joined to it) enter the
 elimination: a dense SVD of the joints' rows over them."""
 _RANK = 1e-9
