@@ -183,6 +183,41 @@ def did_you_mean(word: str, choices: Iterable[str]) -> str:
     return f"did you mean '{close}'?" if close is not None else ""
 
 
+def name_list(names: Iterable[object], most: int = 5) -> str:
+    """The first `most` names, and how many more ('O, A, … 3 more')."""
+    texts = [str(n) for n in names]
+    more = len(texts) - most
+    return ", ".join(texts[:most]) + (f", … {more} more" if more > 0 else "")
+
+
+def not_found(what: str, name: object, names: Sequence[str], many: str,
+              none: str = "") -> KeyError:
+    """The one KeyError of every lookup by name: "no <what> <name!r>", then a did-you-mean,
+    else the names there are ("(the <many>: a, b, … 3 more)"), else `none` ("(there are no
+    <many>)" by default).
+
+    Parameters
+    ----------
+    what : str
+        What was looked for, as the message names it ("body named", "reaction component").
+    name : object
+        What was asked for.
+    names : sequence of str
+        The names there are.
+    many : str
+        Their plural ("bodies").
+    none : str, optional
+        What to say when there are none.
+    """
+    said = f"no {what} {name!r}"
+    hint = did_you_mean(name, names) if isinstance(name, str) else ""
+    if hint:
+        return KeyError(f"{said}; {hint}")
+    if len(names):
+        return KeyError(f"{said} (the {many}: {name_list(names)})")
+    return KeyError(f"{said} ({none or f'there are no {many}'})")
+
+
 def closest(word: str, choices: Iterable[str]) -> str | None:
     """The choice `word` was probably meant to be (`did_you_mean`'s), or None."""
     names = [str(c) for c in choices]

@@ -352,11 +352,12 @@ def test_a_parquet_output_from_python(driven_file, tmp_path):
     csv = mbody.run_sweep(driven_file, GRID, tmp_path / "r.csv", workers=0)
     table = pq.read_table(result.path)
     assert table.column_names == result.header == csv.header
-    for i, name in enumerate(result.header[:-1]):
+    for i, name in enumerate(result.header[:-2]):
         assert table.column(name).to_pylist() == floats([r[i] for r in csv.rows]).tolist()
+    assert table.column("settings").to_pylist() == [csv.settings] * 6
     again = mbody.run_sweep(driven_file, GRID, tmp_path / "r.parquet", workers=0)
     assert again.ran == 0 and again.kept == 6
-    for name in result.header[1:-1]:
+    for name in result.header[1:-2]:
         assert again.column(name).tolist() == csv.column(name).tolist()
 
 
@@ -370,5 +371,6 @@ def test_a_local_cluster_from_python(driven_file, tmp_path):
     assert there.report.where == "a local cluster of 1 worker processes"
     assert there.header == here.header
     for a, b in zip(there.rows, here.rows, strict=True):
-        x, y = floats(a[3:-1]), floats(b[3:-1])
+        x, y = floats(a[3:-2]), floats(b[3:-2])
         assert a[:3] == b[:3] and np.abs(x - y).max() <= 1e-12 * np.abs(y).max()
+        assert a[-2:] == b[-2:] == ["", here.settings]

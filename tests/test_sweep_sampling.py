@@ -15,6 +15,7 @@ import mbody
 from mbody.simulate.peaks import PEAK_SAMPLES, SPARSE
 from mbody.sweep import cluster
 from mbody.sweep.grid import parse_grid
+from mbody.sweep.record import record
 from mbody.sweep.runs import Settings, columns, sampling_warning
 from mbody.sweep.table import Results
 from tests.test_sweep import SLIDER, driven_text, floats, job_of, mbody_cli, read
@@ -28,7 +29,7 @@ def sweep(tmp_path: Path, settings: Settings, text: str | None = None,
     model = mbody.loads(text or driven_text("600 rpm"), "driven.yaml")
     job = job_of(model, specs, settings)
     out = tmp_path / f"{uuid.uuid4().hex}.csv"
-    results = Results(out, columns(model, settings), job.grid)
+    results = Results(out, columns(model, settings), job.grid, record(settings, model))
     report = cluster.run(job, range(len(job.grid)), results, progress=False, workers=0)
     results.finish()
     return (report, *read(out))

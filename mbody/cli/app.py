@@ -38,7 +38,6 @@ from mbody.cli.common import (
     PICTURE_FORMATS,
     add_import_options,
     byte_size,
-    refuse_overwriting_inputs,
 )
 from mbody.cli.near_miss import options_hint, unknown_options, unrecognized_message
 from mbody.errors import (
@@ -49,6 +48,7 @@ from mbody.errors import (
     options_named,
 )
 from mbody.model.loader import MAX_BYTES, max_bytes_limit
+from mbody.util.atomic import refuse_overwriting_inputs
 from mbody.util.npzfile import DATA_BYTES, data_bytes_limit
 
 COMMAND_MODULES = (core, export, sim, drive, draw, animate, mechanism, statics, verify,
@@ -128,8 +128,10 @@ def check_paths(args: argparse.Namespace,
                 command: argparse.ArgumentParser | None = None) -> None:
     """Refuse an empty file name (an output '' would be no output, or the current folder;
     an input '' the current folder), then an output of the command that is one of its
-    input files, unless --force (`mbody.cli.common.refuse_overwriting_inputs`). An output
-    is named by `command`'s own first option for it (sweep's ``--out``), else OUTPUTS'."""
+    input files, unless --force (`mbody.util.atomic.refuse_overwriting_inputs`). An output
+    is named by `command`'s own first option for it (sweep's ``--out``), else OUTPUTS'.
+    A command's ``output_suffixes`` and ``output_resumed`` defaults say where --force
+    cannot help."""
     for dest, what in (*OUTPUTS.items(), *INPUTS.items()):
         values = getattr(args, dest, None)
         if "" in (values if isinstance(values, list) else [values]):
@@ -143,7 +145,8 @@ def check_paths(args: argparse.Namespace,
     folders = {a.option_strings[0] for a in (command._actions if command is not None else ())
                if a.dest in OUTPUTS and a.option_strings and a.metavar == "DIR"}
     refuse_overwriting_inputs(outputs, inputs, getattr(args, "force", False), folders,
-                              getattr(args, "output_suffixes", None))
+                              getattr(args, "output_suffixes", None),
+                              getattr(args, "output_resumed", ()))
 
 
 class _Parser(argparse.ArgumentParser):

@@ -11,7 +11,7 @@ import argparse
 import functools
 import math
 import re
-from collections.abc import Callable, Container, Iterable, Mapping, Sequence
+from collections.abc import Callable, Sequence
 from contextvars import ContextVar
 from pathlib import Path
 from typing import Any, TextIO
@@ -179,58 +179,6 @@ def output_suffix(path: str | None, option: str, written: str,
     raise MbodyError(f"{option} {path}: the name says {SUFFIX_FORMATS[suffix]} ({suffix}), "
                      f"but {option} writes {written}; did you mean {meant!r}? (or --force "
                      "to write it under that name)")
-
-
-def refuse_overwriting_inputs(outputs: Iterable[tuple[str, str]],
-                              inputs: Iterable[tuple[str, str]], force: bool,
-                              folders: Container[str] = (),
-                              suffixes: Mapping[str, Sequence[str]] | None = None) -> None:
-    """Refuse (unless `force`) an output that is one of the command's own inputs: the
-    same file, compared by identity (device and inode: a link or another spelling of
-    the path is the same file), not by name. `outputs` and `inputs` are (what, path)
-    pairs: ``("-o", "m.yaml")``, ``("the model", "m.yaml")``. Where `force` cannot help,
-    the message does not offer it, and `force` does not pass it: an output whose option
-    is in `folders` writes a folder, which cannot take a file's place; one whose option's
-    suffix chooses the format (`suffixes`: option -> the suffixes it writes) and whose
-    name has none of them is refused by the command anyway."""
-    import os
-    import stat
-
-    def stuck(flag: str, path: str) -> str:
-        """Why `force` cannot help writing `path` there, or ''."""
-        if flag in folders:
-            return f"{flag} writes a folder; give a folder's name"
-        allowed = (suffixes or {}).get(flag)
-        if allowed and Path(path).suffix.lower() not in allowed:
-            return (f"{flag} writes a file ending in {', '.join(allowed)}; give another "
-                    "output file")
-        return ""
-
-    outputs = [(flag, path) for flag, path in outputs if not force or stuck(flag, path)]
-    if not outputs:
-        return
-    seen = []
-    for what, path in inputs:
-        try:
-            st = os.stat(path)
-        except (OSError, ValueError):
-            continue
-        if stat.S_ISREG(st.st_mode):
-            seen.append((what, path, st))
-    for flag, path in outputs:
-        try:
-            st = os.stat(path)
-        except (OSError, ValueError):
-            continue  # a new file: nothing to lose
-        for what, source, st_in in seen:
-            if os.path.samestat(st, st_in):
-                same = "" if source == path else ", the same file"
-                why = stuck(flag, path)
-                if why:
-                    raise MbodyError(f"{flag} {path} is {what} itself ({source}{same}): {why}")
-                raise MbodyError(f"{flag} {path} is {what} itself ({source}{same}): writing "
-                                 "there would replace the input; give another output file, "
-                                 "or --force to replace it")
 
 
 def regular_file(path: str, what: str) -> None:

@@ -19,10 +19,10 @@ from mbody.cli.common import (
     load_model,
     output_stream,
     output_suffix,
-    refuse_overwriting_inputs,
     regular_file,
 )
 from mbody.errors import MbodyError, did_you_mean
+from mbody.util.atomic import refuse_overwriting_inputs
 
 DPI = (10, 600)
 """The resolutions `fbd --dpi` accepts (dots per inch): below 10 FreeType cannot draw the

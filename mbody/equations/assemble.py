@@ -40,7 +40,7 @@ from mbody.equations.workspace import (
     workspace,
 )
 from mbody.equations.world import world_reactions
-from mbody.errors import MbodyError, did_you_mean
+from mbody.errors import MbodyError, not_found
 from mbody.kernel import _core
 from mbody.model.arguments import checked_model, checked_state, known_at
 from mbody.model.model import Model, State, count
@@ -351,8 +351,7 @@ class _LazyBodies(Mapping[str, "BodyEquations"]):
     def __getitem__(self, name: str) -> BodyEquations:
         if name not in self._cache:
             if name not in self._asm.model.index:
-                hint = did_you_mean(name, self._asm.model.body_names)
-                raise KeyError(f"no body named {name!r}" + (f"; {hint}" if hint else ""))
+                raise not_found("body named", name, self._asm.model.body_names, "bodies")
             self._cache[name] = self._build(self._asm, self._asm.model.index[name])
         return self._cache[name]
 

@@ -173,6 +173,8 @@ def kinematic_run(model: Model, t_end: float, fps: float, *, t_start: float = 0.
     t_end = real_number(t_end, "t_end", "a number of seconds")
     fps = real_number(fps, "fps", "a positive number of samples per second")
     t_start = real_number(t_start, "t_start", "a number of seconds")
+    if not math.isfinite(t_start):  # else sample_times would blame t_end
+        raise MbodyError(f"t_start must be a finite number of seconds, got {t_start:g}")
     check_axes(axes)
     t = sample_times(t_end, fps, t_start)
     require_fully_driven(model)

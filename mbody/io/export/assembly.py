@@ -27,7 +27,7 @@ from mbody.equations.assemble import Assembly, Solution
 from mbody.equations.pack import pack_columns_model, pack_unknowns_of
 from mbody.equations.solution import METHODS, singular_mass_error
 from mbody.equations.world import check_axes, world_map
-from mbody.errors import MbodyError, wrong_type
+from mbody.errors import MbodyError, not_found, wrong_type
 from mbody.kernel import _core
 from mbody.model.model import Model, State
 from mbody.simulate.trajectory import FORMAT as TRAJECTORY_FORMAT
@@ -79,7 +79,8 @@ class Columns:
         if isinstance(i, str):
             hits = np.flatnonzero(self.labels == i)
             if not len(hits):
-                raise KeyError(f"no reaction column {i!r}")
+                raise not_found("reaction column", i, [str(x) for x in self.labels],
+                                "reaction columns")
             i = int(hits[0])
         out: dict[str, Any] = {"label": str(self.labels[i])}
         out.update({k: str(getattr(self, k)[i]) for k in COLUMN_TEXT[1:]})
