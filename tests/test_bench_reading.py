@@ -90,5 +90,8 @@ def test_growth_and_its_verdict():
     assert linear_verdict(n, [x ** 1.2 for x in n]).endswith(
         "PASS (linear: exponent at most 1.3)")
     assert "FAIL" in linear_verdict(n, [x ** 1.5 for x in n])
-    assert "FAIL" in linear_verdict(n[:2], [1.0, 2.0], stopped=True)
+    assert linear_verdict(n[:2], [1.0, 4.0], stopped=True).startswith("fit: t ~ n^2.00")
+    assert linear_verdict(n[:2], [1.0, 2.0], stopped=True).endswith(
+        "PASS (linear: exponent at most 1.3) (stopped at the time limit)")
+    assert linear_verdict(n[:1], [40.0], stopped=True).endswith("time limit: FAIL")
     assert linear_verdict([1.0], [1.0]) == "fit: too few sizes for a fit"

@@ -33,7 +33,8 @@ is timed up to its error. Columns: the input's size, the best time of --repeat r
 ratio is linear; a quadratic one doubles with each doubling), and the growth exponent
 from the size before (1 linear, 2 quadratic). Under each case, the verdict: the exponent
 of a least-squares fit of log t against log n, PASS when at most 1.3 (tools/timing.py).
-A read longer than --limit seconds ends its case, which FAILs.
+A read longer than --limit seconds ends its case (its verdict is the fit over the sizes
+read; FAIL if only one was).
 
 Then the refusals (`REFUSALS`): files that would cost minutes, or forever, if read as
 they ask, which `mbody.load` refuses (tests/test_loader.py and tests/test_hardening.py

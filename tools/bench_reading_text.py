@@ -28,7 +28,8 @@ unit of size, and the growth: log(t2/t1) / log(n2/n1) between a size and the one
 (1 is linear, 2 quadratic; small sizes are noisy). Under each case, the verdict: the
 exponent of a least-squares fit of log t against log n over its sizes, PASS when at most
 1.3 (tools/timing.py, `LINEAR`). A size whose read takes longer than --limit seconds ends
-its case, which FAILs (the larger ones would take minutes if it is not linear).
+its case (the larger ones would take minutes if it is not linear); the verdict is then
+the fit over the sizes run, and FAIL if only one was.
 
 To be merged into tools/bench_reading.py (the same table for the other readers).
 """
