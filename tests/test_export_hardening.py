@@ -247,8 +247,8 @@ def test_csv_field_over_the_csv_limit_names_file_and_line(exports, tmp_path):
     bodies = folder / "bodies.csv"
     lines = bodies.read_text().splitlines()
     bodies.write_text("\n".join([*lines, '"' + "x" * 200_000 + '"']) + "\n")
-    text = refused(folder, "field larger than field limit")
-    assert f"{bodies}, line {len(lines) + 1}" in text
+    text = refused(folder, "a cell longer than 131,072 characters")
+    assert f"{bodies}, line {len(lines) + 1}: " in text
 
 
 def test_csv_folder_larger_than_the_budget(exports, tmp_path):
