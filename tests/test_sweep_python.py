@@ -5,6 +5,7 @@ messages before any case runs, and the warnings returned, not printed."""
 
 from __future__ import annotations
 
+import argparse
 import math
 from pathlib import Path
 
@@ -17,7 +18,8 @@ from mbody.cli.app import build_parser
 from mbody.errors import MbodyError
 from mbody.simulate.peaks import SPARSE
 from mbody.sweep import cluster, runs
-from mbody.sweep.study import LIMITS, SweepInterrupted, SweepResult
+from mbody.sweep.limits import LIMITS
+from mbody.sweep.study import SweepInterrupted, SweepResult
 from tests.test_sweep import SLIDER, driven_text, floats, mbody_cli, read
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -243,7 +245,7 @@ def test_the_ranges_are_the_commands():
     def cli_takes(option: str, text: str) -> bool:
         try:
             actions[option].type(text)
-        except Exception:  # noqa: BLE001 - argparse's ArgumentTypeError
+        except argparse.ArgumentTypeError:  # what a type raises for a value it refuses
             return False
         return True
 
@@ -262,6 +264,24 @@ def test_the_ranges_are_the_commands():
             x = int(x) if limit.integer else float(x)
             text = f"{x!r} rev" if name == "revolutions" else repr(x)
             assert cli_takes(limit.option, text) == python_takes(name, x), (name, x)
+
+
+@pytest.mark.parametrize("name", sorted(LIMITS))
+def test_the_command_and_python_say_one_range(name):
+    """The option's type is built from `LIMITS` (Y3 of review R3: the ranges were written
+    twice, kept equal by a test): beyond its upper end, the command and `run_sweep` refuse
+    a value in the same words."""
+    limit = LIMITS[name]
+    option = next(a for a in build_parser()._subparsers._group_actions[0]
+                  .choices["sweep"]._actions if limit.option in a.option_strings)
+    over = int(limit.hi) + 1 if limit.integer else 2 * limit.hi
+    expected = f"expected {limit.what} {limit.span}"
+    with pytest.raises(argparse.ArgumentTypeError) as cli:
+        option.type(f"{over!r} rev" if name == "revolutions" else repr(over))
+    with pytest.raises(MbodyError) as python:
+        limit.check(over)
+    assert str(cli.value).startswith(expected), str(cli.value)
+    assert str(python.value).startswith(f"{limit.option}: {expected}")
 
 
 def test_warnings_are_returned_and_the_command_prints_them(tmp_path):

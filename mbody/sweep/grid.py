@@ -77,10 +77,6 @@ class Axis:
         x = hi if k == self.count - 1 else float(k) * ((hi - lo) / (self.count - 1)) + lo
         return float(f"{x:.15g}")
 
-    def grid_values(self) -> list[Any]:
-        """The axis's values in grid order (as the results' column shows them)."""
-        return [self.value(k) for k in range(self.size)]
-
     def drawn(self, u: float) -> Any:
         """The value a uniform number u in [0, 1) draws (a random sample)."""
         if self.listed:

@@ -12,9 +12,7 @@ run's states that are not equilibria, peaks sampled too sparsely).
 
 from __future__ import annotations
 
-import math
 import os
-import re
 import uuid
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -29,58 +27,12 @@ from mbody.model.model import Model
 from mbody.model.values import edits, entry_names
 from mbody.sweep import cluster
 from mbody.sweep.grid import Grid, grid_of
+from mbody.sweep.limits import LIMITS
 from mbody.sweep.modes import not_steady_warning
 from mbody.sweep.record import record
 from mbody.sweep.runs import Job, Settings, check_settings, columns, sampling_warning
 from mbody.sweep.table import ERROR, Results, journal_of, output_format
 from mbody.util.atomic import refuse_overwriting_inputs
-
-
-@dataclass(frozen=True)
-class Limit:
-    """The range of one numeric argument, as the command's option takes it."""
-
-    option: str
-    what: str
-    lo: float
-    hi: float
-    integer: bool = False
-    lo_open: bool = False
-
-    def check(self, value: Any) -> None:
-        """Refuse `value` outside the range (or not a number), naming the option."""
-        kinds = (int, np.integer) if self.integer else (int, float, np.integer, np.floating)
-        if (isinstance(value, bool) or not isinstance(value, kinds)
-                or not math.isfinite(value) or value > self.hi
-                or (value <= self.lo if self.lo_open else value < self.lo)):
-            lo, hi = (_figure(int(x)) if self.integer else _figure(x)
-                      for x in (self.lo, self.hi))
-            span = f"above {lo} up to {hi}" if self.lo_open else f"from {lo} to {hi}"
-            raise MbodyError(f"{self.option}: expected {self.what} {span}"
-                             f"{' (a whole number)' if self.integer else ''}, got {value!r}")
-
-
-def _figure(x: float) -> str:
-    """A bound as the command's messages write it (`mbody.cli.common.number`, a layer
-    above this one): a whole number below 10^12 in full, its thousands apart; else as %g
-    writes it, with its exponent as people write it (1e9)."""
-    if isinstance(x, int) and abs(x) < 10**12:
-        return f"{x:,}".replace(",", " ")
-    return re.sub(r"e\+?(-?)0*(\d)", r"e\1\2", f"{float(x):g}")
-
-
-LIMITS = {
-    "samples": Limit("--samples", "a number of cases", 1, 1e8, integer=True),
-    "seed": Limit("--seed", "a seed", 0, 2**63 - 1, integer=True),
-    "t_end": Limit("--t-end", "a time in seconds", 0.0, 1e9, lo_open=True),
-    "revolutions": Limit("--t-end", "a number of turns", 0.0, 1e6, lo_open=True),
-    "steps": Limit("--steps", "a number of instants", 2, 1e6, integer=True),
-    "fps": Limit("--fps", "samples per second", 0.0, 1e6, lo_open=True),
-    "workers": Limit("--workers", "a number of worker processes", 0, 4096, integer=True),
-    "chunk": Limit("--chunk", "a number of cases", 1, 1e8, integer=True),
-}
-"""`run_sweep`'s numeric arguments, by name: the command's ranges (its argparse types; a
-test keeps them equal)."""
 
 
 class SweepInterrupted(KeyboardInterrupt):
