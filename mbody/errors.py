@@ -168,12 +168,13 @@ def real_number(value: object, argument: str, expected: str = "a number") -> flo
     raise wrong_type(argument, expected, value, hint)
 
 
-def given_twice(flag: str, name: str) -> MbodyError:
+def given_twice(flag: str, name: str, how: str = "") -> MbodyError:
     """A repeatable NAME=VALUE option given twice for one name (``--known O.Fx=3 --known
     O.Fx=4``): which value was meant is a guess, so every command refuses it, in these
     words (``--set``, ``--known``, ``--q``, ``--qd``, ``kinematics --point``, ``sweep
-    --set``)."""
-    return MbodyError(f"{flag} {name} is given twice")
+    --set``; from Python, `mbody.run_sweep`'s ``values`` mapping, whose keys name one path
+    once their spaces are dropped); `how`, when given, says how it was given twice."""
+    return MbodyError(f"{flag} {name} is given twice" + (f" ({how})" if how else ""))
 
 
 def did_you_mean(word: str, choices: Iterable[str]) -> str:

@@ -182,8 +182,12 @@ def refused_by_the_command(tmp_path: Path, model: Path, *args: str) -> str:
     (["--set", "bodies.rdo.mass=0.3:1.2:3"], {"values": {"bodies.rdo.mass": "0.3:1.2:3"}}),
     (["--set", "bodies.rod.mass=0.3:1.2:3", "--out", "x.txt"],
      {"out": "x.txt"}),
+    (["--set", "bodies.rod.mass=0.3:x:3"], {"values": ["bodies.rod.mass=0.3:x:3"]}),
     (["--set", "bodies.rod.mass=0.3:x:3"], {"values": {"bodies.rod.mass": "0.3:x:3"}}),
     (["--set", "bodies.rod.mass=0.4:0.8:1"], {"values": ["bodies.rod.mass=0.4:0.8:1"]}),
+    (["--set", "bodies.rod.mass=1,.nan"], {"values": {"bodies.rod.mass": [1, math.nan]}}),
+    (["--set", "bodies.rod.mass=1:2:2", "--set", "bodies.rod.mass=3"],
+     {"values": ["bodies.rod.mass=1:2:2", "bodies.rod.mass=3"]}),
     (["--set", "bodies.rod.mass=2"], {"values": {"bodies.rod.mass": 2}}),
     (["--set", "bodies.rod.mass=1:2:2", "--seed", "3"], {"seed": 3}),
     (["--set", "bodies.rod.mass=1:2:2", "--run", "kinematics"], {"run": "kinematics"}),
@@ -192,7 +196,8 @@ def refused_by_the_command(tmp_path: Path, model: Path, *args: str) -> str:
      {"run": "kinematics", "revolutions": 1.0, "model": SLIDER}),
     (["--set", "bodies.rod.mass=1:2:2", "--run", "kinematics", "--t-end", "0.1"],
      {"run": "kinematics", "t_end": 0.1, "model": SLIDER}),
-], ids=["path", "path in a mapping", "extension", "range", "count of 1", "nothing varies",
+], ids=["path", "path in a mapping", "extension", "range", "range in a mapping", "count of 1",
+        "not finite", "given twice", "nothing varies",
         "seed without samples", "no end", "equilibrium without modes", "no turning driver",
         "not fully driven"])
 def test_bad_arguments_are_refused_with_the_commands_message(driven_file, tmp_path, args, kw):
@@ -200,6 +205,9 @@ def test_bad_arguments_are_refused_with_the_commands_message(driven_file, tmp_pa
     model = kw.pop("model", driven_file)
     given = {"values": [a for a in args[1:2]], "out": tmp_path / "refused.csv", **kw}
     said = refused_by_the_command(tmp_path, model, *args)
+    if isinstance(given["values"], dict):  # an entry of the mapping is named as its key
+        for path in given["values"]:
+            said = said.replace(f"--set {path}:", f"values[{path!r}]:")
     with pytest.raises(MbodyError) as refused:
         mbody.run_sweep(model, workers=0, **given)
     assert str(refused.value) == said
@@ -223,7 +231,16 @@ def test_bad_arguments_are_refused_with_the_commands_message(driven_file, tmp_pa
     ({"seed": -1, "samples": 3}, "--seed: expected a seed from 0"),
     ({"run": "simulation"}, "unknown run 'simulation'; expected one of solve, kinematics"),
     ({"values": [3]}, "expected a mapping path -> values .* got 3 \\(int\\)"),
-    ({"values": {"bodies.rod.mass": []}}, "no values"),
+    ({"values": {"bodies.rod.mass": []}}, r"^values\['bodies.rod.mass'\]: no values"),
+    ({"values": {"bodies.rod.mass": [1.0, math.nan]}},
+     r"^values\['bodies.rod.mass'\]: expected a finite number, got nan \(value 2 of 2\)$"),
+    ({"values": {"gravity": [[0, -9.81], [0, -math.inf]]}},
+     r"^values\['gravity'\]: expected a finite number, got -inf \(value 2 of 2: \[0, -inf\]\)$"),
+    ({"values": {"bodies.rod.mass": [1, 2], " bodies.rod.mass ": [3]}},
+     r"^values 'bodies.rod.mass' is given twice \(as 'bodies.rod.mass' and ' bodies.rod.mass '\)$"),
+    ({"equilibrium": "no", "run": "modes"}, r"^--equilibrium: expected True or False, got 'no'$"),
+    ({"force": 1}, r"^--force: expected True or False, got 1$"),
+    ({"progress": "yes"}, r"^progress: expected True or False, got 'yes'$"),
     ({"model": 3}, "expected a Model or a model file's path, got int"),
     ({"out": None}, "the output: expected a file name"),
     ({"scheduler": 8786}, "--scheduler: expected an address"),

@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from mbody.errors import MbodyError
+from mbody.errors import MbodyError, given_twice
 from mbody.model.values import parse_assignment, parse_value, plain
 
 MAX_CASES = 100_000_000
@@ -173,7 +173,7 @@ def parse_grid(specs: Sequence[str], samples: int | None = None, seed: int = 0) 
         or more than `MAX_CASES` cases.
     """
     # each spec read as it comes: its errors in the order given
-    return _grid((parse_assignment(spec) for spec in specs), samples, seed)
+    return _grid(((*parse_assignment(spec), None) for spec in specs), samples, seed)
 
 
 def grid_of(values: Mapping[str, Any] | Sequence[str] | str, samples: int | None = None,
@@ -203,7 +203,8 @@ def grid_of(values: Mapping[str, Any] | Sequence[str] | str, samples: int | None
     Raises
     ------
     MbodyError
-        As `parse_grid`; also a path that is not text, or an empty list of values.
+        As `parse_grid` (a mapping's entry named as given, ``values['bodies.rod.mass']``,
+        not as ``--set``); also a path that is not text, or an empty list of values.
     """
     if isinstance(values, str):
         values = [values]
@@ -215,7 +216,7 @@ def grid_of(values: Mapping[str, Any] | Sequence[str] | str, samples: int | None
                              "{'bodies.rod.mass': [0.4, 0.8]}) or --set texts (such as "
                              f"['bodies.rod.mass=0.3:1.2:10']), got {_shown(bad)}")
         return parse_grid(values, samples, seed)
-    entries: list[tuple[str, Any]] = []
+    entries: list[tuple[str, Any, str]] = []
     for path, value in values.items():
         if not isinstance(path, str) or not path.strip():
             raise MbodyError(f"the sweep's values: a path is text such as 'bodies.rod.mass', "
@@ -224,7 +225,7 @@ def grid_of(values: Mapping[str, Any] | Sequence[str] | str, samples: int | None
             value = plain(list(value))  # the values one per case (a range, an array too)
         elif not isinstance(value, str):
             value = plain(value)
-        entries.append((path.strip(), value))
+        entries.append((path.strip(), value, path))
     return _grid(entries, samples, seed)
 
 
@@ -234,32 +235,39 @@ def _shown(value: Any) -> str:
     return f"{text[:60]}{'...' if len(text) > 60 else ''} ({type(value).__name__})"
 
 
-def _grid(entries: Iterable[tuple[str, Any]], samples: int | None, seed: int) -> Grid:
-    """The `Grid` of (path, value) pairs: text as ``--set`` writes it after the ``=``, or
-    a Python value (`grid_of`)."""
+def _grid(entries: Iterable[tuple[str, Any, str | None]], samples: int | None, seed: int
+          ) -> Grid:
+    """The `Grid` of (path, value, key) triples: text as ``--set`` writes it after the
+    ``=``, or a Python value; `key` is a mapping's key as given (`grid_of`: its entries
+    are named ``values[key]`` in messages), None for a ``--set`` text."""
     axes: list[Axis] = []
     fixed: dict[str, Any] = {}
-    seen: set[str] = set()
-    for path, value in entries:
+    seen: dict[str, str | None] = {}
+    for path, value, key in entries:
+        named = f"--set {path}" if key is None else f"values[{key!r}]"
         if path in seen:
-            raise MbodyError(f"--set {path} is given twice")
-        seen.add(path)
+            if key is None:
+                raise given_twice("--set", path)
+            # keys that differ only in the spaces around them
+            raise given_twice("values", repr(path), f"as {seen[path]!r} and {key!r}")
+        seen[path] = key
         if not isinstance(value, str):
             if not isinstance(value, list):
                 fixed[path] = value
             elif not value:
-                raise MbodyError(f"--set {path}: no values (an empty list)")
+                raise MbodyError(f"{named}: no values (an empty list)")
             else:
-                axes.append(Axis(path, tuple(value), listed=True))
+                axes.append(Axis(path, tuple(_finite(value, named)), listed=True))
             continue
         text = value
         parts = _top_level(text, ",")
         if ":" in text and len(_top_level(text, ":")) > 1:
-            axes.append(_range(path, text, samples is not None))
+            axes.append(_range(path, text, samples is not None, named))
         elif len(parts) > 1:
             if any(not p.strip() for p in parts):
-                raise MbodyError(f"--set {path}: an empty value in the list {text!r}")
-            axes.append(Axis(path, tuple(parse_value(p, path) for p in parts), listed=True))
+                raise MbodyError(f"{named}: an empty value in the list {text!r}")
+            listed = [parse_value(p, path) for p in parts]
+            axes.append(Axis(path, tuple(_finite(listed, named)), listed=True))
         else:
             fixed[path] = parse_value(text, path)
     if not axes:
@@ -274,6 +282,25 @@ def _grid(entries: Iterable[tuple[str, Any]], samples: int | None, seed: int) ->
                          f"{_spaced(MAX_CASES)} are run (fewer values per axis, or "
                          "--samples N)")
     return grid
+
+
+def _finite(values: list[Any], named: str) -> list[Any]:
+    """`values` (one per case), refused at the first number in one that is not finite
+    (NaN, inf; also inside a vector), as a range's end is: such a case could only fail."""
+    def bad(x: Any) -> Any:
+        if isinstance(x, float) and not math.isfinite(x):
+            return x
+        items = x.values() if isinstance(x, dict) else x if isinstance(x, list) else ()
+        return next((b for b in map(bad, items) if b is not None), None)
+
+    for k, value in enumerate(values):
+        x = bad(value)
+        if x is not None:
+            where = (f" (value {k + 1} of {len(values)}"
+                     + (f": {value!r}" if value is not x else "") + ")"
+                     if len(values) > 1 else "")
+            raise MbodyError(f"{named}: expected a finite number, got {x!r}{where}")
+    return values
 
 
 def _spaced(n: int) -> str:
@@ -299,39 +326,43 @@ def _top_level(text: str, sep: str) -> list[str]:
     return [*parts, text[start:]]
 
 
-def _range(path: str, text: str, random: bool) -> Axis:
+def _range(path: str, text: str, random: bool, named: str) -> Axis:
+    """The axis of a range ``START:STOP:COUNT`` (``START:STOP`` when `random`) given for
+    `path` (`named`: how messages name the entry)."""
     parts = text.split(":")
     form = "START:STOP" if random else "START:STOP:COUNT"
     example = f"{path}=0.3:1.2" if random else f"{path}=0.3:1.2:10"
     if len(parts) != (2 if random else 3):
         extra = " (with --samples, the count is the number of samples)" if random else ""
-        raise MbodyError(f"--set {path}: expected {form}, such as {example}; got {text!r}"
+        raise MbodyError(f"{named}: expected {form}, such as {example}; got {text!r}"
                          + extra)
     ends, units = [], []
     for part in parts[:2]:
         m = _NUMBER.fullmatch(part)
         if not m:
-            raise MbodyError(f"--set {path}: {part.strip()!r} is not a number (a range is "
+            raise MbodyError(f"{named}: {part.strip()!r} is not a number (a range is "
                              f"{form}, such as {example})")
         x = float(m.group(1))
         if not math.isfinite(x):
-            raise MbodyError(f"--set {path}: expected a finite number, got {part.strip()!r}")
+            raise MbodyError(f"{named}: expected a finite number, got {part.strip()!r}")
         ends.append(x)
         units.append(m.group(2) or "")
     if units[0] != units[1]:
-        raise MbodyError(f"--set {path}: the range's ends have different units "
+        raise MbodyError(f"{named}: the range's ends have different units "
                          f"({units[0] or 'none'} and {units[1] or 'none'})")
     count = 0
     if not random:
         try:
             count = int(parts[2].strip())
         except ValueError:
-            raise MbodyError(f"--set {path}: the count {parts[2].strip()!r} is not a whole "
+            raise MbodyError(f"{named}: the count {parts[2].strip()!r} is not a whole "
                              f"number (a range is {form})") from None
         if count < 1:
-            raise MbodyError(f"--set {path}: expected a count of at least 1, got {count}")
+            raise MbodyError(f"{named}: expected a count of at least 1, got {count}")
         if count == 1 and ends[0] != ends[1]:  # one value cannot span both ends
-            raise MbodyError(f"--set {path}: a count of 1 is one value, and {parts[0].strip()}"
-                             f" and {parts[1].strip()} are two; give a count of 2 or more, or "
-                             f"the value alone (--set {path}={parts[0].strip()})")
+            first = parts[0].strip()
+            alone = f"--set {path}={first}" if named.startswith("--set") else repr(first)
+            raise MbodyError(f"{named}: a count of 1 is one value, and {first} and "
+                             f"{parts[1].strip()} are two; give a count of 2 or more, or "
+                             f"the value alone ({alone})")
     return Axis(path, (ends[0], ends[1]), count, units[0])

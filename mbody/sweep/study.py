@@ -316,13 +316,16 @@ def run_sweep(model: Model | str | os.PathLike[str],
     Raises
     ------
     MbodyError
-        A bad argument, before any case runs, with the command's message: the output's
-        extension, a malformed range, a path the model file does not have (located, with
-        a did-you-mean), settings the run or the model cannot take (``kinematics``
-        without an end, of a model not fully driven), an output that is the model's file
-        (however named) or a folder, an output holding another sweep's rows or rows
-        computed with other settings (without `force`); or a cluster that cannot be
-        started or reached.
+        A bad argument, before any case runs, with the command's message (an entry of
+        a `values` mapping named as its key, ``values['bodies.rod.mass']``, where the
+        command says ``--set bodies.rod.mass``): the output's extension, a malformed
+        range, a value listed that is not finite (NaN, inf), a path given twice, a path
+        the model file does not have (located, with a did-you-mean), `equilibrium`,
+        `progress` or `force` not True or False, settings the run or the model cannot
+        take (``kinematics`` without an end, of a model not fully driven), an output
+        that is the model's file (however named) or a folder, an output holding another
+        sweep's rows or rows computed with other settings (without `force`); or a
+        cluster that cannot be started or reached.
     SweepInterrupted
         An interruption (a `KeyboardInterrupt`): the rows so far are kept, and the same
         call resumes.
@@ -335,6 +338,10 @@ def run_sweep(model: Model | str | os.PathLike[str],
     if t_end is not None and revolutions is not None:
         raise MbodyError("--t-end: give the end in seconds (t_end) or in turns "
                          "(revolutions), not both")
+    for flag, value in (("--equilibrium", equilibrium), ("--force", force),
+                        ("progress", progress)):
+        if not isinstance(value, bool | np.bool_):  # 'no' would be taken as True
+            raise MbodyError(f"{flag}: expected True or False, got {value!r}")
     if scheduler is not None and not isinstance(scheduler, str):
         raise MbodyError(f"--scheduler: expected an address such as tcp://HOST:PORT, got "
                          f"{scheduler!r}")
