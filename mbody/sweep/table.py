@@ -27,11 +27,11 @@ from typing import Any
 
 import numpy as np
 
-from mbody.errors import MbodyError
+from mbody.errors import MbodyError, OutputError
 from mbody.sweep.grid import Grid
 from mbody.sweep.record import SETTINGS, differences
 from mbody.sweep.runs import Rows
-from mbody.util.atomic import ensure_writable, refuse_special, write_atomic
+from mbody.util.atomic import ensure_writable, make_folders, refuse_special, write_atomic
 
 FORMATS = {".csv": "csv", ".parquet": "parquet"}
 """The output's formats, by its extension."""
@@ -222,8 +222,20 @@ class Results:
     # -- adding and writing ----------------------------------------------------------------
     def add(self, rows: Rows) -> None:
         """A chunk's rows, kept and appended to the journal (flushed)."""
+        try:
+            self._append(rows)
+        except OutputError:
+            raise
+        except OSError as exc:  # a full disk, a quota: the journal beside --out
+            raise OutputError(f"cannot write {str(self.journal)!r}, the journal beside "
+                              f"--out {self.path}: {exc.strerror or exc}", exc,
+                              str(self.journal)) from None
+
+    def _append(self, rows: Rows) -> None:
         if self._out is None:
-            self.journal.parent.mkdir(parents=True, exist_ok=True)  # the output's folder
+            # the output's folder, as writing the output would make it: a folder that
+            # cannot be made is the output's problem, and named so
+            make_folders(self.path, self.journal.parent)
             # a journal holding rows of another sweep (dropped with force) is begun anew,
             # with the rows kept so far: it never holds two sweeps' rows
             fresh = (self._stale_journal or not self.journal.exists()
