@@ -379,8 +379,40 @@ def test_failed_cases_and_the_columns(driven_file, tmp_path):
     with pytest.raises(KeyError, match="did you mean 'reaction:O.Fx'"):
         result.column("reaction:O.fx")
     with pytest.raises(MbodyError, match="holds text"):
-        result.column("drivers.motor.speed")
+        result.column("settings")
+    # values listed in one unit: numbers, the unit in the column's name (F15 of review
+    # R4: they were text, '60 rpm'); found by the path alone too
+    assert result.header[1:3] == ["bodies.rod.mass", "drivers.motor.speed [rpm]"]
+    speeds = result.column("drivers.motor.speed")
+    assert speeds.tolist() == [60.0, 120.0, 60.0, 120.0]
+    assert result.column("drivers.motor.speed [rpm]").tolist() == speeds.tolist()
     assert "2 failed" in repr(result) and "4 cases, 4 run now" in repr(result)
+
+
+def test_a_varied_value_is_a_number_in_the_unit_it_was_written_in(driven_file, tmp_path):
+    """F15 of review R4: the column of a speed swept as '30 rpm:60 rpm:2' held 30.0 with
+    no unit. The unit is the one typed, in the column's name (not the file's: this file
+    gives the speed in rad/s); the rows are the cases at those speeds in rpm. Values
+    listed in one unit are numbers the same way: the command's range and Python's list
+    give one file."""
+    result = mbody.run_sweep(driven_file, {"drivers.motor.speed": ["30 rpm", "60 rpm"],
+                                           "bodies.rod.mass": "0.4:0.8:2"},
+                             tmp_path / "u.csv", workers=0)
+    assert result.header[1:3] == ["drivers.motor.speed [rpm]", "bodies.rod.mass"]
+    assert [r[1:3] for r in result.rows] == [["30.0", "0.4"], ["30.0", "0.8"],
+                                             ["60.0", "0.4"], ["60.0", "0.8"]]
+    model = mbody.load(driven_file)
+    for row, fx in zip(result.rows, result.column("reaction:O.Fx"), strict=True):
+        case = model.with_values({"drivers.motor.speed": f"{row[1]} rpm",
+                                  "bodies.rod.mass": float(row[2])})
+        assert fx == pytest.approx(mbody.assemble(case).solve().reactions["O.Fx"], rel=1e-12)
+    # O.Fx is all inertia at constant speed (gravity acts along y): it scales as the
+    # speed squared, four times 30 rpm's at 60 rpm
+    fx = result.column("reaction:O.Fx")
+    assert fx[2] / fx[0] == pytest.approx(4.0, rel=1e-9)
+    header, rows, _ = cli_rows(tmp_path, driven_file, ["drivers.motor.speed=30 rpm:60 rpm:2",
+                                                       "bodies.rod.mass=0.4:0.8:2"])
+    assert (header, rows) == (result.header, result.rows)
 
 
 def test_a_parquet_output_from_python(driven_file, tmp_path):

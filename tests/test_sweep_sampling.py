@@ -51,7 +51,7 @@ def test_kinematics_cases_sampled_too_sparsely_are_counted(tmp_path):
     assert s.rate == pytest.approx(100.0 * math.pi, rel=1e-12)
     text = warning(report, settings)
     assert text is not None and text.startswith(f"{SPARSE}: motor turns at 3000 rpm")
-    assert "case 3 (drivers.motor.speed=3000.0) has 20 samples a revolution" in text
+    assert "case 3 (drivers.motor.speed=3000.0 rpm) has 20 samples a revolution" in text
     assert "2 of the 4 cases run" in text
     # 36 a revolution at 5 revolutions in 0.1 s: 5 * 36 intervals
     assert "Use --steps 181 or more" in text

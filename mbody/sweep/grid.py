@@ -31,7 +31,10 @@ from mbody.model.values import parse_assignment, parse_value, plain
 
 MAX_CASES = 100_000_000
 """Most cases one sweep holds (a grid's size is the product of its axes' counts)."""
-_NUMBER = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S.*?)?\s*")
+_NUMBER = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*"
+                     r"([A-Za-z°µ][\w°µ²/^ ]*?)?\s*")
+"""A number, and the unit written after it (``300 rpm``, ``2 kg m^2``; a unit starts with a
+letter: ``2*t`` is an expression, not 2 in a unit ``*t``)."""
 
 
 @dataclass(frozen=True)
@@ -47,7 +50,9 @@ class Axis:
     count : int
         A range's number of grid values (0: drawn at random, or a listed axis).
     unit : str
-        A range's unit as written (``rpm``), '' for none.
+        The unit the values were written in (``rpm``: a range ``300 rpm:1200 rpm:4``, or
+        values listed each with it, ``300 rpm,600 rpm``), '' for none: the values are
+        then numbers, the unit in the column's name (`column`).
     listed : bool
         The values are listed (``[a, b, c]``), not a range.
     """
@@ -57,6 +62,12 @@ class Axis:
     count: int = 0
     unit: str = ""
     listed: bool = False
+
+    @property
+    def column(self) -> str:
+        """The results' column of the axis: its path as given, with the unit its values
+        were written in, ``drivers.motor.speed [rpm]`` (the column holds numbers)."""
+        return f"{self.path} [{self.unit}]" if self.unit else self.path
 
     @property
     def size(self) -> int:
@@ -115,6 +126,16 @@ class Grid:
     @property
     def paths(self) -> tuple[str, ...]:
         return tuple(a.path for a in self.axes)
+
+    @property
+    def columns(self) -> tuple[str, ...]:
+        """The results' columns of the axes (`Axis.column`: a unit in the name)."""
+        return tuple(a.column for a in self.axes)
+
+    def shown(self, index: int) -> str:
+        """Case `index`'s values in a message: ``drivers.motor.speed=3000.0 rpm, ...``."""
+        return ", ".join(f"{a.path}={a.for_file(x)}" for a, x in
+                         zip(self.axes, self.numbers(index), strict=True))
 
     @property
     def cases(self) -> int:
@@ -257,7 +278,7 @@ def _grid(entries: Iterable[tuple[str, Any, str | None]], samples: int | None, s
             elif not value:
                 raise MbodyError(f"{named}: no values (an empty list)")
             else:
-                axes.append(Axis(path, tuple(_finite(value, named)), listed=True))
+                axes.append(_listed(path, _finite(value, named)))
             continue
         text = value
         parts = _top_level(text, ",")
@@ -267,7 +288,7 @@ def _grid(entries: Iterable[tuple[str, Any, str | None]], samples: int | None, s
             if any(not p.strip() for p in parts):
                 raise MbodyError(f"{named}: an empty value in the list {text!r}")
             listed = [parse_value(p, path) for p in parts]
-            axes.append(Axis(path, tuple(_finite(listed, named)), listed=True))
+            axes.append(_listed(path, _finite(listed, named)))
         else:
             fixed[path] = parse_value(text, path)
     if not axes:
@@ -282,6 +303,22 @@ def _grid(entries: Iterable[tuple[str, Any, str | None]], samples: int | None, s
                          f"{_spaced(MAX_CASES)} are run (fewer values per axis, or "
                          "--samples N)")
     return grid
+
+
+def _listed(path: str, values: list[Any]) -> Axis:
+    """The axis of values listed for `path`: each written with one unit (``300 rpm``,
+    ``600 rpm``) is that number, the unit in the column's name, as a range's; else the
+    values as given (numbers, vectors, expressions, units that differ)."""
+    units, numbers = set(), []
+    for value in values:
+        m = _NUMBER.fullmatch(value) if isinstance(value, str) else None
+        if m is None or not m.group(2):
+            return Axis(path, tuple(values), listed=True)
+        units.add(m.group(2))
+        numbers.append(float(m.group(1)))
+    if len(units) != 1 or not all(map(math.isfinite, numbers)):
+        return Axis(path, tuple(values), listed=True)
+    return Axis(path, tuple(numbers), unit=units.pop(), listed=True)
 
 
 def _finite(values: list[Any], named: str) -> list[Any]:

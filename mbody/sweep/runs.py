@@ -343,10 +343,8 @@ def sampling_warning(settings: Settings, grid: Grid, count: int, ran: int,
     the --steps (kinematics) or --fps (simulate) that gives every case enough."""
     if not count or sparsest is None:
         return None
-    values = ", ".join(f"{p}={v}" for p, v in zip(grid.paths, grid.numbers(sparsest.case),
-                                                   strict=True))
     text = sparse_text(sparsest.driver, sparsest.rate, sparsest.per_turn,
-                       f"case {sparsest.case} ({values}) has")
+                       f"case {sparsest.case} ({grid.shown(sparsest.case)}) has")
     if settings.run == "kinematics":  # (steps - 1) / per_turn turns in that case
         turns = (settings.steps - 1) / sparsest.per_turn
         need = f"--steps {math.ceil(PEAK_SAMPLES * turns * (1.0 - 1e-12)) + 1}"

@@ -125,7 +125,9 @@ class SweepResult:
         Parameters
         ----------
         name : str
-            A column of `header` (``frequency:1``, ``peak:motor.M``, a varied path).
+            A column of `header` (``frequency:1``, ``peak:motor.M``, a varied path); a
+            varied path whose values were given in a unit is found without it too
+            (``drivers.motor.speed`` for ``drivers.motor.speed [rpm]``).
 
         Returns
         -------
@@ -136,13 +138,10 @@ class SweepResult:
         KeyError
             No such column.
         MbodyError
-            The column holds text (``error``, ``settings``, values listed with a unit):
-            read it from `rows`.
+            The column holds text (``error``, ``settings``, values listed that are not
+            numbers in one unit: expressions, units that differ): read it from `rows`.
         """
-        if name not in self.header:
-            hint = did_you_mean(name, self.header) or f"the columns: {', '.join(self.header)}"
-            raise KeyError(f"no column {name!r}; {hint}")
-        at = self.header.index(name)
+        at = self._index(name)
         out = np.full(len(self.rows), np.nan)
         for k, row in enumerate(self.rows):
             cell = row[at]
@@ -154,6 +153,17 @@ class SweepResult:
                 raise MbodyError(f"column {name!r} holds text ({cell!r} in case {row[0]}), "
                                  "not numbers: read it from rows") from None
         return out
+
+    def _index(self, name: str) -> int:
+        """Where column `name` is in `header` (a varied path also without its unit)."""
+        if name in self.header:
+            return self.header.index(name)
+        with_unit = [k for k, h in enumerate(self.header)
+                     if h.startswith(f"{name} [") and h.endswith("]")]
+        if len(with_unit) == 1:
+            return with_unit[0]
+        hint = did_you_mean(name, self.header) or f"the columns: {', '.join(self.header)}"
+        raise KeyError(f"no column {name!r}; {hint}")
 
     def __repr__(self) -> str:
         failed = self.failed

@@ -100,7 +100,7 @@ class Results:
         self.outputs = list(outputs)
         self.settings = settings
         self.force = force
-        self.header = ["case", *grid.paths, *outputs, ERROR, SETTINGS]
+        self.header = ["case", *grid.columns, *outputs, ERROR, SETTINGS]
         self.rows: dict[int, list[str]] = {}
         self.journal = journal_of(path)
         ensure_writable(self.path)  # a folder, a socket: refused before any case runs
