@@ -258,6 +258,8 @@ def test_each_row_records_its_settings(driven):
         (Settings("kinematics", revolutions=1.0, steps=360),
          "run=kinematics; t-end=1 rev; steps=360"),
         (Settings("kinematics", t_end=0.1, steps=11), "run=kinematics; t-end=0.1; steps=11"),
+        # no --steps: mbody kinematics' sampling, one a degree of the crank's steady turn
+        (Settings("kinematics", t_end=0.1), "run=kinematics; t-end=0.1; steps=360 a turn"),
         (Settings("simulate", t_end=2.5, fps=60.0), "run=simulate; t-end=2.5; fps=60"),
         (Settings("modes"), "run=modes; equilibrium=no"),
         (Settings("modes", equilibrium=True, steps=3), "run=modes; equilibrium=yes"),
@@ -279,6 +281,9 @@ def test_the_differences_are_named():
         "--t-end 0.1 (this sweep: 0.2)", "--steps 11 (this sweep: 21)"]
     assert differences(a, "run=simulate; t-end=0.1; fps=60; model=sha256:0123456789abcdef"
                        ) == ["--run kinematics (this sweep: simulate)"]
+    # the default sampling changed from 101 instants: such rows are another sweep's
+    assert differences(a.replace("=11", "=101"), a.replace("=11", "=360 a turn")) == [
+        "--steps 101 (this sweep: 360 a turn)"]
     assert differences(a, a.replace("0123", "3210")) == [
         "another model (another file, the file changed since, or other values set for every "
         "case)"]

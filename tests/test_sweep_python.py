@@ -319,20 +319,24 @@ def test_warnings_are_returned_and_the_command_prints_them(tmp_path):
     model.write_text(driven_text("600 rpm"))
     speeds = {"drivers.motor.speed": "300 rpm:3000 rpm:4"}
     sparse = mbody.run_sweep(model, speeds, tmp_path / "k.csv", run="kinematics", t_end=0.1,
-                             workers=0)
+                             steps=101, workers=0)
     (text,) = sparse.warnings
     assert text.startswith(f"{SPARSE}: motor turns at 3000 rpm") and "--steps 181" in text
-    assert text == runs.sampling_warning(runs.Settings("kinematics", 0.1), _grid(speeds),
-                                         sparse.report.sparse, sparse.report.cases,
-                                         sparse.report.sparsest)
+    assert text == runs.sampling_warning(runs.Settings("kinematics", 0.1, steps=101),
+                                         _grid(speeds), sparse.report.sparse,
+                                         sparse.report.cases, sparse.report.sparsest)
     assert sparse.report.sparse == 2
     p = mbody_cli("sweep", str(model), "--set", "drivers.motor.speed=300 rpm:3000 rpm:4",
-                  "--run", "kinematics", "--t-end", "0.1", "--workers", "0", "--quiet",
-                  "--out", str(tmp_path / "kc.csv"))
+                  "--run", "kinematics", "--t-end", "0.1", "--steps", "101", "--workers",
+                  "0", "--quiet", "--out", str(tmp_path / "kc.csv"))
     assert p.returncode == 0 and p.stderr == f"mbody: warning: {text}\n"
     enough = mbody.run_sweep(model, speeds, tmp_path / "k181.csv", run="kinematics",
                              t_end=0.1, steps=181, workers=0)
     assert enough.warnings == []
+    # by default (no steps: 101 were the default) each case is sampled 360 times a turn
+    default = mbody.run_sweep(model, speeds, tmp_path / "kd.csv", run="kinematics",
+                              t_end=0.1, workers=0)
+    assert default.warnings == []
 
 
 def _grid(values):

@@ -45,6 +45,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                                          lo_open=True),
                    default=None, metavar="N", help="samples per second (default: 360 per "
                    "revolution of a constant-rate driver, one a degree; else 100)")
+    # those defaults are mbody.simulate.kinematic.default_fps's (a test keeps them equal)
     s.add_argument("--point", action="append", default=[], metavar="NAME=BODY:X,Y[,Z]",
                    help="a body point to follow (repeatable), in the body's axes from its "
                    "mass centre, e.g. --point P=coupler:0.1,0.05; saved with the run "
@@ -101,7 +102,7 @@ def kinematics(a: argparse.Namespace) -> int:
     import sys
 
     from mbody.cli.sim import check_samples
-    from mbody.simulate.kinematic import kinematic_run, revolution, summary
+    from mbody.simulate.kinematic import default_fps, kinematic_run, revolution, summary
     from mbody.util import jsontext
 
     points = parse_points(a.point)
@@ -109,7 +110,7 @@ def kinematics(a: argparse.Namespace) -> int:
     model = load_model(a.model)
     turn = revolution(model)
     t_end = end_time(a.t_end, a.t_start, turn)
-    fps = a.fps if a.fps is not None else (360.0 / turn if turn else 100.0)
+    fps = a.fps if a.fps is not None else default_fps(turn)
     if t_end <= a.t_start:
         raise MbodyError(f"--t-end {t_end:g} is not after --t-start {a.t_start:g}")
     check_samples(t_end - a.t_start, fps)

@@ -67,9 +67,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--t-end", type=_end_time(), metavar="T",
                    help="kinematics, simulate: the end, in seconds or in turns of the first "
                    "driver that turns ('1 rev': one turn at each case's speed)")
-    s.add_argument("--steps", type=limited("steps"),
-                   default=101, metavar="K",
-                   help="kinematics: instants from 0 to the end, both included (default 101)")
+    s.add_argument("--steps", type=limited("steps"), metavar="K",
+                   help="kinematics: K instants evenly spaced from 0 to the end, both "
+                   "included (default: as mbody kinematics samples, 360 a revolution of "
+                   "the first driver at each case's speed when it turns at a constant "
+                   "rate, else 100 a second; and the end)")
+    # those defaults are mbody.simulate.kinematic.default_fps's (a test keeps them equal)
     s.add_argument("--fps", type=limited("fps"),
                    default=60.0, metavar="F", help="simulate: samples per second (default 60)")
     s.add_argument("--equilibrium", action="store_true",

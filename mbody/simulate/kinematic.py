@@ -507,6 +507,23 @@ def revolution(model: Model) -> float | None:
     return None if w is None else 2.0 * math.pi / abs(w)
 
 
+SAMPLES_A_TURN = 360
+"""A kinematic run's samples a revolution by default (`default_fps`): one a degree of the
+first driver when it turns at a constant rate, ten times `mbody.simulate.peaks`'
+PEAK_SAMPLES (a sine's peak read within 0.004 %)."""
+FPS_WITHOUT_TURN = 100.0
+"""A kinematic run's samples a second by default when the first driver does not turn at
+a constant rate (no revolution to count samples by)."""
+
+
+def default_fps(turn: float | None) -> float:
+    """The samples a second of a kinematic run by default, what ``mbody kinematics`` and a
+    sweep's ``--run kinematics`` take without ``--fps``, ``--steps``: `SAMPLES_A_TURN` a
+    revolution of the first driver, `turn` s long (`revolution`), else
+    `FPS_WITHOUT_TURN`."""
+    return SAMPLES_A_TURN / turn if turn else FPS_WITHOUT_TURN
+
+
 def summary(traj: Trajectory, path: str | None = None) -> str:
     """A kinematic run in a few lines: the samples, Newton's work, each reaction's and
     effort's peak (with the first driver's coordinate then), and the energy check."""

@@ -250,7 +250,7 @@ def run_sweep(model: Model | str | os.PathLike[str],
               values: Mapping[str, Any] | Sequence[str] | str,
               out: str | os.PathLike[str], *, run: str = "solve",
               t_end: float | None = None, revolutions: float | None = None,
-              steps: int = 101, fps: float = 60.0, equilibrium: bool = False,
+              steps: int | None = None, fps: float = 60.0, equilibrium: bool = False,
               samples: int | None = None, seed: int = 0, workers: int | None = None,
               scheduler: str | None = None, chunk: int | None = None,
               progress: bool = False, force: bool = False) -> SweepResult:
@@ -283,15 +283,19 @@ def run_sweep(model: Model | str | os.PathLike[str],
         The results: ``.csv``, or ``.parquet`` (pyarrow, in the ``sweep`` extra).
     run : {"solve", "kinematics", "simulate", "modes"}
         What each case computes (``--run``): a solve at its initial state; the kinematic
-        analysis and a solve at `steps` instants; `mbody.simulate`; the natural
+        analysis and a solve at each instant (`steps`); `mbody.simulate`; the natural
         frequencies.
     t_end : float, optional
         ``kinematics`` and ``simulate``: the end (s).
     revolutions : float, optional
         Or the end in turns of the first driver that turns, at each case's own rate
         (``--t-end "1 rev"`` is ``revolutions=1``).
-    steps : int
-        ``kinematics``: the instants from 0 to the end, both included.
+    steps : int, optional
+        ``kinematics``: this many instants evenly spaced from 0 to the end, both
+        included. By default each case is sampled as ``mbody kinematics`` samples it:
+        360 times a revolution of the first driver at the case's own rate when it turns
+        at a constant rate, else 100 times a second
+        (`mbody.simulate.kinematic.default_fps`), and at the end itself.
     fps : float
         ``simulate``: samples per second.
     equilibrium : bool
