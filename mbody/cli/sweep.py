@@ -45,9 +45,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         "simulation, or the natural frequencies (with whether the state is an equilibrium "
         "and stable, as mbody modes says). One row per case in --out: the varied paths, "
         "then <quantity>:<label> columns (acceleration:, reaction:, final:, peak:, "
-        "frequency:; steady, stable), error, and settings (the run, its settings that change "
-        "the numbers, and the model's digest). Cases run on a local Dask cluster started "
-        "for the command (--workers), or on an existing one (--scheduler). An interrupted "
+        "frequency:, growth:; steady, stable as true or false), error, and settings (the "
+        "run, its settings that change the numbers, and the model's digest). Cases run on "
+        "a local Dask cluster started for the command (--workers), or on an existing one "
+        "(--scheduler). An interrupted "
         "sweep resumes: the same command runs only the cases not in --out yet; rows of "
         "other settings are refused (--force runs them again).")
     s.add_argument("model", metavar="MODEL", help=MODEL_HELP)

@@ -12,8 +12,9 @@ output columns.
 - ``simulate``: `mbody.simulate` to T; the same columns.
 - ``modes``: the natural frequencies about the initial state (or, with `equilibrium`,
   about the static equilibrium nearest it), and what ``mbody modes`` says with them;
-  columns ``frequency:<k>``, ``steady`` and ``stable`` (`mbody.sweep.modes`), and with
-  `equilibrium` the equilibrium's position coordinates ``equilibrium:<coordinate>``.
+  columns ``frequency:<k>``, ``growth:<k>``, ``steady`` and ``stable``
+  (`mbody.sweep.modes`), and with `equilibrium` the equilibrium's position coordinates
+  ``equilibrium:<coordinate>``.
 
 ``final:`` is the last instant's position coordinate (planar ``x``, ``y`` in m and
 ``theta`` in rad, in (−π, π]; spatial ``x``, ``y``, ``z`` and the attitude's quaternion
@@ -179,8 +180,7 @@ def columns(model: Model, settings: Settings) -> list[str]:
         return ([f"acceleration:{c}" for c in model.coordinates]
                 + [f"reaction:{r}" for r in model.reactions])
     if settings.run == "modes":
-        return ([f"frequency:{k + 1}" for k in range(modes.mode_count(model))]
-                + [modes.STEADY, modes.STABLE]
+        return (modes.columns(model)
                 + ([f"{modes.POSE}{c}" for c in final_labels(model)]
                    if settings.equilibrium else []))
     return ([f"final:{c}" for c in final_labels(model)]
@@ -619,14 +619,19 @@ def _simulate(ctx: Context, model: Model, case: Case) -> np.ndarray:
 
 
 def _modes(ctx: Context, model: Model, case: Case) -> np.ndarray:
-    """frequency:1 ... (NaN beyond the oscillations), steady, stable, then the
-    equilibrium's pose when the run is about it."""
+    """frequency:1 ... (NaN beyond the oscillations), growth:1 ... (NaN beyond the modes
+    that grow), steady, stable, then the equilibrium's pose when the run is about it."""
     lin = modes.linearization(model, ctx.job.settings.equilibrium)
     k = len(lin.coordinates)
     f = np.asarray(lin.frequencies, dtype=float)  # ascending, at most one a coordinate
     row = np.full(k, np.nan)
     row[:len(f)] = f
-    parts = [row, np.array(modes.verdict_values(lin))]
+    # the k fastest: more modes than coordinates grow only under forces that do work
+    # on their own (a follower load), and `stable` says so whatever the count
+    g = modes.growth_rates(lin)[:k]
+    growth = np.full(k, np.nan)
+    growth[:len(g)] = g
+    parts = [row, growth, np.array(modes.verdict_values(lin))]
     if ctx.job.settings.equilibrium:
         parts.append(pose_values(model, lin.state))
     return np.concatenate(parts)

@@ -55,6 +55,10 @@ class SweepInterrupted(KeyboardInterrupt):
         self.kept, self.cases, self.journal = kept, cases, journal
 
 
+_YES_NO = {"true": 1.0, "false": 0.0}
+"""A yes-or-no cell's number (`SweepResult.column`)."""
+
+
 @dataclass(frozen=True)
 class SweepResult:
     """A sweep's rows, as its output file holds them (what `run_sweep` returns).
@@ -120,7 +124,8 @@ class SweepResult:
         return sum(1 for e in self.errors if e)
 
     def column(self, name: str) -> np.ndarray:
-        """One column's numbers, by case (NaN where a case has none).
+        """One column's numbers, by case (NaN where a case has none; a yes-or-no column,
+        ``steady`` or ``stable``, as 1.0 for true and 0.0 for false).
 
         Parameters
         ----------
@@ -148,7 +153,7 @@ class SweepResult:
             if not cell:
                 continue
             try:
-                out[k] = float(cell)
+                out[k] = _YES_NO[cell] if cell in _YES_NO else float(cell)
             except ValueError:
                 raise MbodyError(f"column {name!r} holds text ({cell!r} in case {row[0]}), "
                                  "not numbers: read it from rows") from None
