@@ -205,7 +205,7 @@ def test_random_samples_are_seeded_and_in_range():
     (["drivers.motor.speed=10 rpm:20:3"], {}, "different units"),
     (["bodies.rod.mass=2"], {}, "varies at least one value"),
     (["bodies.rod.mass=1:2:3", "bodies.rod.mass=1:2:3"], {},
-     "^--set bodies.rod.mass is given twice$"),
+     r"^values\['bodies.rod.mass'\] is given twice$"),  # from Python: the keyword's spelling
     (["bodies.rod.mass=1,,2"], {}, "an empty value"),
     (["bodies.rod.mass=0:1:20000", "bodies.crank.mass=0:1:20000"], {}, "at most"),
 ])
@@ -491,5 +491,5 @@ def test_a_local_cluster_that_cannot_start_is_a_clean_error(tmp_path, monkeypatc
     results = Results(tmp_path / "c.csv", columns(base, job.settings), job.grid,
                       record(job.settings, base))
     with pytest.raises(MbodyError, match=r"could not start a local Dask cluster of 2 .*"
-                                         r"--workers 0"):
+                                         r"workers=0"):  # Python's spelling (here)
         cluster.run(job, [0, 1, 2], results, workers=2, progress=False)

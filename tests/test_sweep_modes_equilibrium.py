@@ -191,7 +191,7 @@ def test_a_case_without_an_equilibrium_is_a_row_with_mbody_equilibriums_message(
 
 def test_equilibrium_goes_with_the_modes_run_only():
     pend = mbody.load(PENDULUM)
-    with pytest.raises(MbodyError, match="--equilibrium goes with --run modes"):
+    with pytest.raises(MbodyError, match="^equilibrium=True goes with run='modes'"):
         check_settings(pend, Settings("solve", equilibrium=True))
     check_settings(pend, Settings("modes", equilibrium=True))
 

@@ -225,8 +225,8 @@ def _failing(monkeypatch, errno_: int, what: str) -> None:
 @pytest.mark.parametrize(("what", "said"), [
     ("mkdir", "cannot write 'new/r.csv': cannot make the folder 'new' (No space left on "
               "device)"),
-    ("open", "cannot write 'new/r.csv.partial', the journal beside --out new/r.csv: No "
-             "space left on device"),
+    ("open", "cannot write 'new/r.csv.partial', the journal beside the output new/r.csv: "
+             "No space left on device"),
 ])
 def test_an_output_whose_folder_or_journal_cannot_be_written(driven, capsys, monkeypatch,
                                                                what, said):

@@ -1,7 +1,8 @@
 """`mbody.run_sweep`, a whole sweep from Python, is what `mbody sweep` runs: the same rows
 as the command for the same sweep (solve, kinematics, modes; in this process and on a
 local cluster), a resumed output from Python, bad arguments refused with the command's
-messages before any case runs, and the warnings returned, not printed."""
+messages before any case runs (each naming the arguments in its own spelling: ``--steps``
+on the command line, ``steps`` in Python), and the warnings returned, not printed."""
 
 from __future__ import annotations
 
@@ -14,8 +15,8 @@ import pytest
 
 import mbody
 import mbody.cli
-from mbody.cli.app import build_parser
-from mbody.errors import MbodyError
+from mbody.cli.app import build_parser, option_flags
+from mbody.errors import MbodyError, options_named
 from mbody.simulate.peaks import SPARSE
 from mbody.sweep import cluster, runs
 from mbody.sweep.limits import LIMITS
@@ -46,6 +47,15 @@ def cli_rows(tmp_path: Path, model: Path, specs: list[str], *options: str
     return (*read(out), p.stderr)
 
 
+def as_the_command_names_them():
+    """Within the block, messages name run_sweep's arguments as `mbody sweep` does (what
+    `mbody.cli.app.main` sets around the command): ``--set``, ``--steps``, ``--t-end``."""
+    parser = build_parser()
+    args = parser.parse_args(["sweep", "m.yaml", "--set", "x=1", "--out", "o.csv"])
+    return options_named(option_flags(parser._subparsers._group_actions[0].choices["sweep"],
+                                      args))
+
+
 def printed(warnings: list[str]) -> str:
     """What the command writes on standard error for these warnings."""
     return "".join(f"mbody: warning: {w}\n" for w in warnings)
@@ -68,8 +78,11 @@ def test_the_rows_are_the_commands(driven_file, tmp_path, specs, options, kw):
     assert read(result.path) == (header, rows) and result.path == tmp_path / "py.csv"
     assert len(result) == result.ran == 6 and result.kept == 0 and result.failed == 0
     assert result.errors == [None] * 6
-    # 10 instants over 0.05 s: the 240 rad/s cases turn 1.9 times, 5 samples a turn
-    assert len(result.warnings) == ("t_end" in kw) and stderr == printed(result.warnings)
+    # 10 instants over 0.05 s: the 240 rad/s cases turn 1.9 times, 5 samples a turn; the
+    # command names the option it advises as typed (--steps 12), Python the keyword
+    assert len(result.warnings) == ("t_end" in kw)
+    assert stderr == printed(result.warnings).replace("Use steps=", "Use --steps ")
+    assert "--" not in "".join(result.warnings)
     assert result.report.cases == 6 and result.report.where == "this process"
 
 
@@ -205,45 +218,48 @@ def test_bad_arguments_are_refused_with_the_commands_message(driven_file, tmp_pa
     model = kw.pop("model", driven_file)
     given = {"values": [a for a in args[1:2]], "out": tmp_path / "refused.csv", **kw}
     said = refused_by_the_command(tmp_path, model, *args)
-    if isinstance(given["values"], dict):  # an entry of the mapping is named as its key
-        for path in given["values"]:
-            said = said.replace(f"--set {path}:", f"values[{path!r}]:")
-    with pytest.raises(MbodyError) as refused:
+    with as_the_command_names_them(), pytest.raises(MbodyError) as refused:
         mbody.run_sweep(model, workers=0, **given)
     assert str(refused.value) == said
+    with pytest.raises(MbodyError) as refused:  # Python names the keywords it was given
+        mbody.run_sweep(model, workers=0, **given)
+    assert not any(f in str(refused.value) for f in ("--set", "--seed", "--samples",
+                                                     "--equilibrium", "--run", "--t-end"))
     assert not (tmp_path / "refused.csv").exists()
     assert not (tmp_path / "refused.csv.partial").exists()
 
 
 @pytest.mark.parametrize(("kw", "pattern"), [
-    ({"steps": 1}, "--steps: expected a number of instants from 2 to 1 000 000 "
+    ({"steps": 1}, "^steps: expected a number of instants from 2 to 1 000 000 "
                    r"\(a whole number\), got 1"),
-    ({"steps": 10.5}, "--steps: expected"),
-    ({"t_end": 0.0}, "--t-end: expected a time in seconds above 0 up to 1e9, got 0.0"),
-    ({"t_end": math.nan}, "--t-end: expected"),
-    ({"revolutions": -1}, "--t-end: expected a number of turns above 0"),
+    ({"steps": 10.5}, "^steps: expected"),
+    ({"t_end": 0.0}, "^t_end: expected a time in seconds above 0 up to 1e9, got 0.0"),
+    ({"t_end": math.nan}, "^t_end: expected"),
+    ({"revolutions": -1}, "^revolutions: expected a number of turns above 0"),
     ({"t_end": 1.0, "revolutions": 1.0}, "in seconds .* or in turns .*not both"),
-    ({"fps": "60"}, "--fps: expected samples per second"),
-    ({"workers": -1}, "--workers: expected"),
-    ({"workers": True}, "--workers: expected"),
-    ({"chunk": 0}, "--chunk: expected a number of cases from 1"),
-    ({"samples": 0}, "--samples: expected a number of cases from 1"),
-    ({"seed": -1, "samples": 3}, "--seed: expected a seed from 0"),
+    ({"fps": "60"}, "^fps: expected samples per second"),
+    ({"workers": -1}, "^workers: expected"),
+    ({"workers": True}, "^workers: expected"),
+    ({"chunk": 0}, "^chunk: expected a number of cases from 1"),
+    ({"samples": 0}, "^samples: expected a number of cases from 1"),
+    ({"seed": -1, "samples": 3}, "^seed: expected a seed from 0"),
     ({"run": "simulation"}, "unknown run 'simulation'; expected one of solve, kinematics"),
     ({"values": [3]}, "expected a mapping path -> values .* got 3 \\(int\\)"),
     ({"values": {"bodies.rod.mass": []}}, r"^values\['bodies.rod.mass'\]: no values"),
     ({"values": {"bodies.rod.mass": [1.0, math.nan]}},
      r"^values\['bodies.rod.mass'\]: expected a finite number, got nan \(value 2 of 2\)$"),
     ({"values": {"gravity": [[0, -9.81], [0, -math.inf]]}},
-     r"^values\['gravity'\]: expected a finite number, got -inf \(value 2 of 2: \[0, -inf\]\)$"),
+     r"^values\['gravity'\]: expected a finite number, got -inf "
+     r"\(value 2 of 2: \[0, -inf\]\)$"),
     ({"values": {"bodies.rod.mass": [1, 2], " bodies.rod.mass ": [3]}},
-     r"^values 'bodies.rod.mass' is given twice \(as 'bodies.rod.mass' and ' bodies.rod.mass '\)$"),
-    ({"equilibrium": "no", "run": "modes"}, r"^--equilibrium: expected True or False, got 'no'$"),
-    ({"force": 1}, r"^--force: expected True or False, got 1$"),
+     r"^values\['bodies.rod.mass'\] is given twice \(as 'bodies.rod.mass' and "
+     r"' bodies.rod.mass '\)$"),
+    ({"equilibrium": "no", "run": "modes"}, r"^equilibrium: expected True or False, got 'no'$"),
+    ({"force": 1}, r"^force: expected True or False, got 1$"),
     ({"progress": "yes"}, r"^progress: expected True or False, got 'yes'$"),
     ({"model": 3}, "expected a Model or a model file's path, got int"),
     ({"out": None}, "the output: expected a file name"),
-    ({"scheduler": 8786}, "--scheduler: expected an address"),
+    ({"scheduler": 8786}, "^scheduler: expected an address"),
 ])
 def test_python_arguments_are_checked(driven_file, tmp_path, kw, pattern):
     given = {"model": driven_file, "values": {"bodies.rod.mass": [1, 2]},
@@ -297,14 +313,19 @@ def test_the_command_and_python_say_one_range(name):
         option.type(f"{over!r} rev" if name == "revolutions" else repr(over))
     with pytest.raises(MbodyError) as python:
         limit.check(over)
+    with as_the_command_names_them(), pytest.raises(MbodyError) as named:
+        limit.check(over)
     assert str(cli.value).startswith(expected), str(cli.value)
-    assert str(python.value).startswith(f"{limit.option}: {expected}")
+    assert str(python.value).startswith(f"{limit.keyword}: {expected}")
+    assert str(named.value).startswith(f"{limit.option}: {expected}")
 
 
 def test_warnings_are_returned_and_the_command_prints_them(tmp_path):
     """A modes sweep about the release (not an equilibrium) and a kinematics sweep whose
     fast cases are sampled too sparsely: the result carries each warning; the command
-    prints the same text, once, as mbody: warning: ..."""
+    prints the same text, once, as mbody: warning: ..., naming the option it advises as
+    typed (--equilibrium, --steps 181) where Python names the keyword (equilibrium=True,
+    steps=181)."""
     modes = mbody.run_sweep(PENDULUM, {"gravity.1": [-9.81, -1.62]}, tmp_path / "m.csv",
                             run="modes", workers=0)
     assert len(modes.warnings) == 1
@@ -313,7 +334,9 @@ def test_warnings_are_returned_and_the_command_prints_them(tmp_path):
     assert np.isnan(modes.column("stable")).all()
     p = mbody_cli("sweep", str(PENDULUM), "--set", "gravity.1=-9.81,-1.62", "--run", "modes",
                   "--workers", "0", "--quiet", "--out", str(tmp_path / "mc.csv"))
-    assert p.returncode == 0 and p.stderr == f"mbody: warning: {modes.warnings[0]}\n"
+    assert "equilibrium=True linearises each" in modes.warnings[0]
+    assert p.returncode == 0 and p.stderr == "mbody: warning: " + modes.warnings[0].replace(
+        "equilibrium=True", "--equilibrium") + "\n"
 
     model = tmp_path / "driven.yaml"
     model.write_text(driven_text("600 rpm"))
@@ -321,7 +344,7 @@ def test_warnings_are_returned_and_the_command_prints_them(tmp_path):
     sparse = mbody.run_sweep(model, speeds, tmp_path / "k.csv", run="kinematics", t_end=0.1,
                              steps=101, workers=0)
     (text,) = sparse.warnings
-    assert text.startswith(f"{SPARSE}: motor turns at 3000 rpm") and "--steps 181" in text
+    assert text.startswith(f"{SPARSE}: motor turns at 3000 rpm") and "steps=181" in text
     assert text == runs.sampling_warning(runs.Settings("kinematics", 0.1, steps=101),
                                          _grid(speeds), sparse.report.sparse,
                                          sparse.report.cases, sparse.report.sparsest)
@@ -329,7 +352,8 @@ def test_warnings_are_returned_and_the_command_prints_them(tmp_path):
     p = mbody_cli("sweep", str(model), "--set", "drivers.motor.speed=300 rpm:3000 rpm:4",
                   "--run", "kinematics", "--t-end", "0.1", "--steps", "101", "--workers",
                   "0", "--quiet", "--out", str(tmp_path / "kc.csv"))
-    assert p.returncode == 0 and p.stderr == f"mbody: warning: {text}\n"
+    assert p.returncode == 0 and p.stderr == "mbody: warning: " + text.replace(
+        "steps=181", "--steps 181") + "\n"
     enough = mbody.run_sweep(model, speeds, tmp_path / "k181.csv", run="kinematics",
                              t_end=0.1, steps=181, workers=0)
     assert enough.warnings == []

@@ -56,7 +56,7 @@ def test_kinematics_cases_sampled_too_sparsely_are_counted(tmp_path):
     assert "case 3 (drivers.motor.speed=3000.0 rpm) has 20 samples a revolution" in text
     assert "2 of the 4 cases run" in text
     # 36 a revolution at 5 revolutions in 0.1 s: 5 * 36 intervals
-    assert "Use --steps 181 or more" in text
+    assert "Use steps=181 or more" in text  # from Python (the command: --steps 181, below)
 
 
 @pytest.mark.parametrize("steps, sparse", [(181, 0), (180, 1)])
@@ -71,7 +71,7 @@ def test_turns_give_every_case_the_same_samples_a_revolution(tmp_path):
     assert report.sparse == 4
     assert report.sparsest is not None
     assert report.sparsest.per_turn == pytest.approx(10.0, rel=1e-12)
-    assert "Use --steps 361 or more" in (warning(report, settings) or "")
+    assert "Use steps=361 or more" in (warning(report, settings) or "")
     report, _, _ = sweep(tmp_path, Settings("kinematics", revolutions=10.0, steps=361))
     assert report.sparse == 0
 
@@ -101,7 +101,7 @@ def test_simulate_cases_are_checked_at_their_fps(tmp_path):
     assert report.sparsest is not None and report.sparsest.case == 3
     assert report.sparsest.per_turn == pytest.approx(1.2, rel=1e-12)
     text = warning(report, settings) or ""
-    assert "can miss it entirely" in text and "Use --fps 1800 or more" in text
+    assert "can miss it entirely" in text and "Use fps=1800 or more" in text
     report, _, _ = sweep(tmp_path, Settings("simulate", 0.05, fps=PEAK_SAMPLES * 50.0))
     assert report.sparse == 0
 
@@ -188,9 +188,9 @@ def test_a_default_sampling_too_long_is_a_failed_case(tmp_path):
     path.write_text(driven_text("600 rpm"))
     result = mbody.run_sweep(path, {"bodies.rod.mass": [0.4, 0.8]}, tmp_path / "k.csv",
                              run="kinematics", t_end=300.0, workers=0)
-    assert result.errors == ["--t-end 300 s at 3600 samples a second (mbody kinematics' "
+    assert result.errors == ["an end of 300 s at 3600 samples a second (mbody kinematics' "
                              "sampling) is 1 080 001 instants; at most 1 000 000 a case: "
-                             "give --steps, or a shorter --t-end"] * 2
+                             "give steps, or an earlier end"] * 2  # Python's spelling
 
 
 def test_the_help_says_the_default_sampling():

@@ -189,19 +189,26 @@ def regular_file(path: str, what: str) -> None:
         raise MbodyError(f"{path}: this is {kind}, not a file; expected {what}")
 
 
-def parse_known(pairs: Sequence[str]) -> dict[str, float]:
-    """``["A.Fx=3", ...]`` -> ``{"A.Fx": 3.0}`` (labels are checked later, with hints)."""
-    return assignments(pairs, "--known", "LABEL=VALUE (for example A.Fx=3)")
+def parse_known(pairs: Sequence[str]) -> dict[str, float | str]:
+    """``["A.Fx=3", "A.Fy=2*sin(t)", ...]`` -> ``{"A.Fx": 3.0, "A.Fy": "2*sin(t)"}``: a
+    number as `assignments` reads it, anything else kept as text, an expression of t that
+    the function it goes to reads as its Python ``known=`` (`mbody.model.arguments.
+    known_values`: the labels checked with a did-you-mean, the expression parsed, taken at
+    the state's time), naming it ``--known LABEL`` in its messages."""
+    return assignments(pairs, "--known", "LABEL=VALUE (for example A.Fx=3)",
+                       expressions=True)
 
 
-def assignments(pairs: Sequence[str], flag: str, form: str,
-                degrees: str | None = None) -> dict[str, float]:
+def assignments(pairs: Sequence[str], flag: str, form: str, degrees: str | None = None,
+                expressions: bool = False) -> dict[str, Any]:
     """``NAME=VALUE`` options -> ``{NAME: value}``; a value ending in `degrees` (``deg``,
     ``deg/s``) is converted to radians. Anything else is a clear `MbodyError`, and so is
-    a number beyond a model file's bound (`mbody.model.checks.MAX_MAGNITUDE`)."""
+    a number beyond a model file's bound (`mbody.model.checks.MAX_MAGNITUDE`); with
+    `expressions`, a value that is not a number is kept as its text (stripped), for the
+    caller to read as an expression of t."""
     from mbody.model.checks import MAX_MAGNITUDE
 
-    out = {}
+    out: dict[str, Any] = {}
     for p in pairs:
         name, sep, value = p.partition("=")
         if not sep or not name.strip():
@@ -209,19 +216,33 @@ def assignments(pairs: Sequence[str], flag: str, form: str,
         text, scale = value.strip(), 1.0
         if degrees and text.endswith(degrees):
             text, scale = text[:-len(degrees)], math.pi / 180
+        x: float | str
         try:
             x = float(text) * scale
         except ValueError:
-            raise MbodyError(f"{flag} {name}: {value!r} is not a number") from None
-        if not math.isfinite(x):
+            if not expressions:
+                raise MbodyError(f"{flag} {name}: {value!r} is not a number") from None
+            x = text
+        if isinstance(x, float) and not math.isfinite(x):
             raise MbodyError(f"{flag} {name}: expected a finite number, got {value!r}")
-        if abs(x) > MAX_MAGNITUDE:
+        if isinstance(x, float) and abs(x) > MAX_MAGNITUDE:
             raise MbodyError(f"{flag} {name}: expected a number of magnitude at most "
                              f"{number(MAX_MAGNITUDE)}, as in a model file, got {value!r}")
         if name.strip() in out:
-            raise given_twice(flag, name.strip())
+            raise given_twice(f"{flag} {name.strip()}")
         out[name.strip()] = x
     return out
+
+
+def add_known_option(command: argparse.ArgumentParser, use: str, when: str) -> None:
+    """``--known LABEL=VALUE`` (repeatable): a known reaction value, a number or an
+    expression of t (`parse_known`); `use` says what the command does with it, `when`
+    at which time an expression is taken."""
+    command.add_argument(
+        "--known", metavar="LABEL=VALUE", action="append", default=[],
+        help=f"a known reaction value (N or N m), {use}: a number, or an expression of t "
+        f"{when} (docs/expressions.md), e.g. --known A.Fx=3 or --known 'A.Fx=2*sin(t)'; "
+        "repeatable")
 
 
 def add_axes_option(command: argparse.ArgumentParser, saved: bool = False) -> None:
@@ -326,7 +347,7 @@ def set_values(pairs: Sequence[str]) -> dict[str, Any]:
     for pair in pairs:
         path, text = parse_assignment(pair)
         if path in out:
-            raise given_twice("--set", path)
+            raise given_twice(f"--set {path}")
         out[path] = parse_value(text, path)
     return out
 

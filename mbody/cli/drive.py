@@ -70,7 +70,7 @@ def parse_points(pairs: list[str]) -> dict[str, tuple[str, list[float]]]:
             raise MbodyError(f"--point expects NAME=BODY:X,Y[,Z] (for example "
                              f"P=coupler:0.1,0.05), got {p!r}")
         if name.strip() in out:
-            raise given_twice("--point", name.strip())
+            raise given_twice(f"--point {name.strip()}")
         out[name.strip()] = body_point(rest, f"--point {name}")
     return out
 

@@ -100,7 +100,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "or written by an mbody that did not record the settings; without it "
                    "such an output is refused. --out is never the model file, even so")
     # --out is read back to resume, with the model: --force never lets it be the model
-    s.set_defaults(run=sweep, output_resumed=("--out",))
+    s.set_defaults(run=sweep, output_resumed=("--out",),
+                   keywords={"values": "--set", "run": "--run", "revolutions": "--t-end",
+                             "out": "--out"})
 
 
 def sweep(a: argparse.Namespace) -> int:

@@ -14,7 +14,7 @@ from typing import Any, TypeVar, overload
 
 import numpy as np
 
-from mbody.errors import did_you_mean, wrong_type
+from mbody.errors import not_found, wrong_type
 from mbody.model.expressions import Expression
 from mbody.model.reprs import count, name_list, vector_text
 
@@ -244,11 +244,8 @@ class Records(Sequence[T]):
         names there are."""
         k = self._named(name)
         if k is None:
-            names, (one, many) = self._names, self._noun
-            hint = did_you_mean(name, names)
-            raise KeyError(f"no {one} named {name!r}" + (
-                f"; {hint}" if hint else f" (the {many}: {name_list(names)})" if names
-                else f" (this model has no {many})"))
+            one, many = self._noun
+            raise not_found(f"{one} named", name, self._names, many, f"this model has no {many}")
         return k
 
     def _named(self, name: str) -> int | None:

@@ -30,7 +30,7 @@ from mbody.equations.joints import reaction_columns
 from mbody.equations.solution import singular_mass_error
 from mbody.equations.workspace import workspace
 from mbody.equations.world import check_axes
-from mbody.errors import MbodyError, did_you_mean, real_number, wrong_type
+from mbody.errors import MbodyError, did_you_mean, option_name, real_number, wrong_type
 from mbody.kernel import _core
 from mbody.model.arguments import checked_model
 from mbody.model.checks import MAX_MAGNITUDE
@@ -79,7 +79,8 @@ def sample_times(t_end: float, fps: float, t_start: float = 0.0) -> np.ndarray:
     count = int(math.floor((t_end - t_start) * fps + 1e-9)) + 1
     if count > MAX_SAMPLES:
         raise MbodyError(f"{count} samples ({t_end - t_start:g} s at {fps:g} fps) is more "
-                         f"than {MAX_SAMPLES}; lower --fps or --t-end")
+                         f"than {MAX_SAMPLES}; lower {option_name('fps')} or "
+                         f"{option_name('t_end')}")
     return t_start + np.arange(count) / fps
 
 

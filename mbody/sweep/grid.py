@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from mbody.errors import MbodyError, given_twice
+from mbody.errors import MbodyError, given_twice, option_entry, option_name
 from mbody.model.values import parse_assignment, parse_value, plain
 
 MAX_CASES = 100_000_000
@@ -194,7 +194,8 @@ def parse_grid(specs: Sequence[str], samples: int | None = None, seed: int = 0) 
         or more than `MAX_CASES` cases.
     """
     # each spec read as it comes: its errors in the order given
-    return _grid(((*parse_assignment(spec), None) for spec in specs), samples, seed)
+    return _grid(((*parse_assignment(spec, option_name("values")), None)
+                  for spec in specs), samples, seed)
 
 
 def grid_of(values: Mapping[str, Any] | Sequence[str] | str, samples: int | None = None,
@@ -224,8 +225,7 @@ def grid_of(values: Mapping[str, Any] | Sequence[str] | str, samples: int | None
     Raises
     ------
     MbodyError
-        As `parse_grid` (a mapping's entry named as given, ``values['bodies.rod.mass']``,
-        not as ``--set``); also a path that is not text, or an empty list of values.
+        As `parse_grid`; also a path that is not text, or an empty list of values.
     """
     if isinstance(values, str):
         values = [values]
@@ -259,49 +259,50 @@ def _shown(value: Any) -> str:
 def _grid(entries: Iterable[tuple[str, Any, str | None]], samples: int | None, seed: int
           ) -> Grid:
     """The `Grid` of (path, value, key) triples: text as ``--set`` writes it after the
-    ``=``, or a Python value; `key` is a mapping's key as given (`grid_of`: its entries
-    are named ``values[key]`` in messages), None for a ``--set`` text."""
+    ``=``, or a Python value; `key` is a mapping's key as given (`grid_of`), None for a
+    ``--set`` text. Messages name an entry as the caller gives it (``--set PATH`` on the
+    command line, ``values['PATH']`` in Python: `mbody.errors.option_entry`)."""
     axes: list[Axis] = []
     fixed: dict[str, Any] = {}
     seen: dict[str, str | None] = {}
     for path, value, key in entries:
-        named = f"--set {path}" if key is None else f"values[{key!r}]"
         if path in seen:
-            if key is None:
-                raise given_twice("--set", path)
-            # keys that differ only in the spaces around them
-            raise given_twice("values", repr(path), f"as {seen[path]!r} and {key!r}")
+            # keys of a mapping that differ only in the spaces around them
+            how = f"as {seen[path]!r} and {key!r}" if key is not None else ""
+            raise given_twice(option_entry("values", path), how)
         seen[path] = key
         if not isinstance(value, str):
             if not isinstance(value, list):
                 fixed[path] = value
             elif not value:
-                raise MbodyError(f"{named}: no values (an empty list)")
+                raise MbodyError(f"{option_entry('values', path)}: no values (an empty list)")
             else:
-                axes.append(_listed(path, _finite(value, named)))
+                axes.append(_listed(path, _finite(value, path)))
             continue
         text = value
         parts = _top_level(text, ",")
         if ":" in text and len(_top_level(text, ":")) > 1:
-            axes.append(_range(path, text, samples is not None, named))
+            axes.append(_range(path, text, samples is not None))
         elif len(parts) > 1:
             if any(not p.strip() for p in parts):
-                raise MbodyError(f"{named}: an empty value in the list {text!r}")
+                raise MbodyError(f"{option_entry('values', path)}: an empty value in the list "
+                                 f"{text!r}")
             listed = [parse_value(p, path) for p in parts]
-            axes.append(_listed(path, _finite(listed, named)))
+            axes.append(_listed(path, _finite(listed, path)))
         else:
             fixed[path] = parse_value(text, path)
     if not axes:
-        raise MbodyError("a sweep varies at least one value: --set PATH=START:STOP:COUNT "
-                         "(for example bodies.rod.mass=0.3:1.2:10)")
+        raise MbodyError(f"a sweep varies at least one value: "
+                         f"{option_entry('values', 'PATH')}=START:STOP:COUNT (for example "
+                         "bodies.rod.mass=0.3:1.2:10)")
     if samples is not None and samples < 1:
-        raise MbodyError(f"--samples: expected at least 1 case, got {samples}")
+        raise MbodyError(f"{option_name('samples')}: expected at least 1 case, got {samples}")
     grid = Grid(tuple(axes), fixed, samples, seed)
     size = grid.cases  # from the counts: no value is made before this bound
     if size > MAX_CASES:
         raise MbodyError(f"the sweep has {_spaced(size)} cases; at most "
                          f"{_spaced(MAX_CASES)} are run (fewer values per axis, or "
-                         "--samples N)")
+                         f"{option_name('samples', 'N', 'N')})")
     return grid
 
 
@@ -321,9 +322,10 @@ def _listed(path: str, values: list[Any]) -> Axis:
     return Axis(path, tuple(numbers), unit=units.pop(), listed=True)
 
 
-def _finite(values: list[Any], named: str) -> list[Any]:
-    """`values` (one per case), refused at the first number in one that is not finite
-    (NaN, inf; also inside a vector), as a range's end is: such a case could only fail."""
+def _finite(values: list[Any], path: str) -> list[Any]:
+    """`values` (one per case) of `path`, refused at the first number in one that is not
+    finite (NaN, inf; also inside a vector), as a range's end is: such a case could only
+    fail."""
     def bad(x: Any) -> Any:
         if isinstance(x, float) and not math.isfinite(x):
             return x
@@ -336,7 +338,8 @@ def _finite(values: list[Any], named: str) -> list[Any]:
             where = (f" (value {k + 1} of {len(values)}"
                      + (f": {value!r}" if value is not x else "") + ")"
                      if len(values) > 1 else "")
-            raise MbodyError(f"{named}: expected a finite number, got {x!r}{where}")
+            raise MbodyError(f"{option_entry('values', path)}: expected a finite number, got "
+                             f"{x!r}{where}")
     return values
 
 
@@ -363,43 +366,41 @@ def _top_level(text: str, sep: str) -> list[str]:
     return [*parts, text[start:]]
 
 
-def _range(path: str, text: str, random: bool, named: str) -> Axis:
-    """The axis of a range ``START:STOP:COUNT`` (``START:STOP`` when `random`) given for
-    `path` (`named`: how messages name the entry)."""
+def _range(path: str, text: str, random: bool) -> Axis:
+    entry = option_entry("values", path)  # --set PATH on the command line
     parts = text.split(":")
     form = "START:STOP" if random else "START:STOP:COUNT"
     example = f"{path}=0.3:1.2" if random else f"{path}=0.3:1.2:10"
     if len(parts) != (2 if random else 3):
-        extra = " (with --samples, the count is the number of samples)" if random else ""
-        raise MbodyError(f"{named}: expected {form}, such as {example}; got {text!r}"
+        extra = (f" (with {option_name('samples')}, the count is the number of samples)"
+                 if random else "")
+        raise MbodyError(f"{entry}: expected {form}, such as {example}; got {text!r}"
                          + extra)
     ends, units = [], []
     for part in parts[:2]:
         m = _NUMBER.fullmatch(part)
         if not m:
-            raise MbodyError(f"{named}: {part.strip()!r} is not a number (a range is "
+            raise MbodyError(f"{entry}: {part.strip()!r} is not a number (a range is "
                              f"{form}, such as {example})")
         x = float(m.group(1))
         if not math.isfinite(x):
-            raise MbodyError(f"{named}: expected a finite number, got {part.strip()!r}")
+            raise MbodyError(f"{entry}: expected a finite number, got {part.strip()!r}")
         ends.append(x)
         units.append(m.group(2) or "")
     if units[0] != units[1]:
-        raise MbodyError(f"{named}: the range's ends have different units "
+        raise MbodyError(f"{entry}: the range's ends have different units "
                          f"({units[0] or 'none'} and {units[1] or 'none'})")
     count = 0
     if not random:
         try:
             count = int(parts[2].strip())
         except ValueError:
-            raise MbodyError(f"{named}: the count {parts[2].strip()!r} is not a whole "
+            raise MbodyError(f"{entry}: the count {parts[2].strip()!r} is not a whole "
                              f"number (a range is {form})") from None
         if count < 1:
-            raise MbodyError(f"{named}: expected a count of at least 1, got {count}")
+            raise MbodyError(f"{entry}: expected a count of at least 1, got {count}")
         if count == 1 and ends[0] != ends[1]:  # one value cannot span both ends
-            first = parts[0].strip()
-            alone = f"--set {path}={first}" if named.startswith("--set") else repr(first)
-            raise MbodyError(f"{named}: a count of 1 is one value, and {first} and "
-                             f"{parts[1].strip()} are two; give a count of 2 or more, or "
-                             f"the value alone ({alone})")
+            raise MbodyError(f"{entry}: a count of 1 is one value, and {parts[0].strip()}"
+                             f" and {parts[1].strip()} are two; give a count of 2 or more, or "
+                             f"the value alone ({entry}={parts[0].strip()})")
     return Axis(path, (ends[0], ends[1]), count, units[0])

@@ -14,7 +14,7 @@ import numbers
 from dataclasses import dataclass
 from typing import Any
 
-from mbody.errors import MbodyError
+from mbody.errors import MbodyError, option_name
 from mbody.util.formatting import number
 
 
@@ -25,7 +25,10 @@ class Limit:
     Parameters
     ----------
     option : str
-        The command's option (``--steps``), as messages name it.
+        The command's option (``--steps``), whose argparse type is built from this.
+    keyword : str
+        `run_sweep`'s keyword (``steps``); a message names the argument as the caller
+        does (`mbody.errors.option_name`: ``--steps`` on the command line).
     what : str
         What the number is (``"a number of instants"``).
     lo, hi : float
@@ -37,6 +40,7 @@ class Limit:
     """
 
     option: str
+    keyword: str
     what: str
     lo: float
     hi: float
@@ -66,18 +70,20 @@ class Limit:
     def check(self, value: Any) -> None:
         """Refuse `value` outside the range (or not a number), naming the option."""
         if not self.takes(value):
-            raise MbodyError(f"{self.option}: expected {self.what} {self.span}"
+            raise MbodyError(f"{option_name(self.keyword)}: expected {self.what} {self.span}"
                              f"{' (a whole number)' if self.integer else ''}, got {value!r}")
 
 
 LIMITS = {
-    "samples": Limit("--samples", "a number of cases", 1, 1e8, integer=True),
-    "seed": Limit("--seed", "a seed", 0, 2**63 - 1, integer=True),
-    "t_end": Limit("--t-end", "a time in seconds", 0.0, 1e9, lo_open=True),
-    "revolutions": Limit("--t-end", "a number of turns", 0.0, 1e6, lo_open=True),
-    "steps": Limit("--steps", "a number of instants", 2, 1e6, integer=True),
-    "fps": Limit("--fps", "samples per second", 0.0, 1e6, lo_open=True),
-    "workers": Limit("--workers", "a number of worker processes", 0, 4096, integer=True),
-    "chunk": Limit("--chunk", "a number of cases", 1, 1e8, integer=True),
+    "samples": Limit("--samples", "samples", "a number of cases", 1, 1e8, integer=True),
+    "seed": Limit("--seed", "seed", "a seed", 0, 2**63 - 1, integer=True),
+    "t_end": Limit("--t-end", "t_end", "a time in seconds", 0.0, 1e9, lo_open=True),
+    "revolutions": Limit("--t-end", "revolutions", "a number of turns", 0.0, 1e6,
+                         lo_open=True),
+    "steps": Limit("--steps", "steps", "a number of instants", 2, 1e6, integer=True),
+    "fps": Limit("--fps", "fps", "samples per second", 0.0, 1e6, lo_open=True),
+    "workers": Limit("--workers", "workers", "a number of worker processes", 0, 4096,
+                     integer=True),
+    "chunk": Limit("--chunk", "chunk", "a number of cases", 1, 1e8, integer=True),
 }
 """`run_sweep`'s numeric keywords, by name, and the command's options built from them."""

@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from mbody.errors import MbodyError, did_you_mean
+from mbody.errors import MbodyError, not_found, option_name, option_names
 from mbody.loading import load
 from mbody.model.model import Model
 from mbody.model.values import edits, entry_names
@@ -167,8 +167,7 @@ class SweepResult:
                      if h.startswith(f"{name} [") and h.endswith("]")]
         if len(with_unit) == 1:
             return with_unit[0]
-        hint = did_you_mean(name, self.header) or f"the columns: {', '.join(self.header)}"
-        raise KeyError(f"no column {name!r}; {hint}")
+        raise not_found("column", name, self.header, "columns")
 
     def __repr__(self) -> str:
         failed = self.failed
@@ -215,7 +214,8 @@ def check_request(values: Mapping[str, Any] | Sequence[str] | str, out: str | os
             LIMITS[name].check(value)
     grid = grid_of(values, samples, seed)
     if samples is None and seed:
-        raise MbodyError("--seed goes with --samples (a grid has no randomness)")
+        raise MbodyError(f"{option_name('seed')} goes with {option_name('samples')} (a grid "
+                         "has no randomness)")
     return grid
 
 
@@ -355,15 +355,16 @@ def run_sweep(model: Model | str | os.PathLike[str],
         if value is not None:
             LIMITS[name].check(value)
     if t_end is not None and revolutions is not None:
-        raise MbodyError("--t-end: give the end in seconds (t_end) or in turns "
-                         "(revolutions), not both")
-    for flag, value in (("--equilibrium", equilibrium), ("--force", force),
-                        ("progress", progress)):
+        raise MbodyError("give the end in seconds (t_end) or in turns (revolutions), not "
+                         "both")
+    for keyword, value in (("equilibrium", equilibrium), ("force", force),
+                           ("progress", progress)):
         if not isinstance(value, bool | np.bool_):  # 'no' would be taken as True
-            raise MbodyError(f"{flag}: expected True or False, got {value!r}")
+            raise MbodyError(f"{option_name(keyword)}: expected True or False, got "
+                             f"{value!r}")
     if scheduler is not None and not isinstance(scheduler, str):
-        raise MbodyError(f"--scheduler: expected an address such as tcp://HOST:PORT, got "
-                         f"{scheduler!r}")
+        raise MbodyError(f"{option_name('scheduler')}: expected an address such as "
+                         f"tcp://HOST:PORT, got {scheduler!r}")
     said: list[str] = []
     if not isinstance(model, Model):
         if not isinstance(model, str | os.PathLike):
@@ -385,7 +386,7 @@ def run_sweep(model: Model | str | os.PathLike[str],
     recorded = record(settings, model)
     results = Results(out, columns(model, settings), grid, recorded, force=bool(force))
     todo = [k for k in range(len(grid)) if k not in results.rows]
-    job = Job(model.source, grid, settings, uuid.uuid4().hex)
+    job = Job(model.source, grid, settings, uuid.uuid4().hex, option_names())
     try:
         report = cluster.run(job, todo, results, scheduler=scheduler, workers=workers,
                              chunk=chunk, progress=progress)

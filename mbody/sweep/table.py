@@ -232,7 +232,7 @@ class Results:
             raise
         except OSError as exc:  # a full disk, a quota: the journal beside --out
             raise OutputError(f"cannot write {str(self.journal)!r}, the journal beside "
-                              f"--out {self.path}: {exc.strerror or exc}", exc,
+                              f"the output {self.path}: {exc.strerror or exc}", exc,
                               str(self.journal)) from None
 
     def _append(self, rows: Rows) -> None:
