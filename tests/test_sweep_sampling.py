@@ -13,7 +13,7 @@ import pytest
 
 import mbody
 from mbody.cli.app import build_parser
-from mbody.simulate.kinematic import FPS_WITHOUT_TURN, SAMPLES_A_TURN, default_fps, revolution
+from mbody.simulate.kinematic import DEFAULT_FPS, SAMPLES_A_TURN, default_fps, revolution
 from mbody.simulate.peaks import PEAK_SAMPLES, SPARSE
 from mbody.sweep import cluster
 from mbody.sweep.grid import parse_grid
@@ -165,7 +165,7 @@ def test_by_default_each_case_is_sampled_as_mbody_kinematics_samples_it(tmp_path
             assert fps == pytest.approx(SAMPLES_A_TURN * float(value.split()[0]) / 60.0,
                                         rel=1e-12)
         else:
-            assert fps == FPS_WITHOUT_TURN
+            assert fps == DEFAULT_FPS
         run = mbody.kinematic_run(case, t_end, fps)
         for label, peak in zip(run.reaction_labels, np.abs(run.reactions).max(axis=0),
                                strict=True):
@@ -201,6 +201,6 @@ def test_the_help_says_the_default_sampling():
         parser = build_parser()._subparsers._group_actions[0].choices[command]
         options[command] = next(a.help for a in parser._actions if flag in a.option_strings)
     assert f"{SAMPLES_A_TURN} per revolution" in options["kinematics"]
-    assert f"else {FPS_WITHOUT_TURN:g})" in options["kinematics"]
+    assert f"else {DEFAULT_FPS:g})" in options["kinematics"]
     assert f"{SAMPLES_A_TURN} a revolution" in options["sweep"]
-    assert f"else {FPS_WITHOUT_TURN:g} a second" in options["sweep"]
+    assert f"else {DEFAULT_FPS:g} a second" in options["sweep"]

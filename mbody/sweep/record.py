@@ -28,7 +28,7 @@ import hashlib
 from typing import TYPE_CHECKING
 
 from mbody.model.values import apply, edits, entry_names
-from mbody.simulate.kinematic import FPS_WITHOUT_TURN, SAMPLES_A_TURN, revolution
+from mbody.simulate.kinematic import DEFAULT_FPS, SAMPLES_A_TURN, revolution
 from mbody.sweep.runs import Settings
 
 if TYPE_CHECKING:
@@ -71,7 +71,7 @@ def sampling(settings: Settings, model: Model) -> str:
         return str(int(settings.steps))
     if revolution(model) is not None:
         return f"{SAMPLES_A_TURN} a turn"
-    return f"{_number(FPS_WITHOUT_TURN)} a second"
+    return f"{_number(DEFAULT_FPS)} a second"
 
 
 def record(settings: Settings, model: Model) -> str:
