@@ -65,6 +65,7 @@ def plot_trajectory(traj: Trajectory, bodies: list[str] | None = None) -> Figure
     a run with joint reactions their force and moment components. A panel with nothing to
     show (no moment components: a planar revolute joint, a spherical one) is left out, not
     drawn as empty axes; an odd last panel spans its row."""
+    traj.need_samples()
     names = list(bodies) if bodies else list(traj.body_names[:MAX_BODIES])
     unknown = [b for b in names if b not in traj.body_names]
     if unknown:

@@ -11,7 +11,9 @@ unless
 
 - each member is stored or deflated (what numpy writes), not encrypted, and named once;
 - its header's shape and dtype account for exactly the member's size in the zip
-  directory, which is also the most that member can inflate to (`zipfile` stops there);
+  directory, which is also the most that member can inflate to (`zipfile` stops there),
+  and its values are at least a byte wide (values of 0 bytes would claim any number of
+  them in no bytes at all);
 - the members' sizes add up to at most the byte budget (`mbody.util.budget`: 1 GiB by
   default).
 
@@ -241,7 +243,15 @@ class NpzArchive:
         if dtype.hasobject:
             raise self.damaged(f"{where} holds Python objects, which mbody never "
                                "unpickles")
-        data = math.prod(shape) * dtype.itemsize
+        values = math.prod(shape)
+        if dtype.itemsize == 0 and values:
+            # the size check below says nothing of how many values such a member claims,
+            # and each may become a Python object (a text of 0 characters: 10^12 of them
+            # in a file of 5 kB); numpy writes even an empty text 1 character wide
+            raise self.damaged(f"{where}'s header says it holds {_shape_text(shape)} values "
+                               f"of 0 bytes each, dtype {dtype.str}: numpy writes every value "
+                               "at least a byte wide")
+        data = values * dtype.itemsize
         if header + data != info.file_size:
             raise self.damaged(
                 f"{where}'s header says it holds {_shape_text(shape)} values of "

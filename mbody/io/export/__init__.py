@@ -37,6 +37,7 @@ from mbody.io.export.assembly import (
     ExportedAssembly,
     as_export,
     exported,
+    unreadable,
 )
 from mbody.io.export.csvfolder import CSV_DENSE_LIMIT, write_csv
 from mbody.io.export.jsonfile import from_json, schema, to_json
@@ -139,10 +140,5 @@ def load_export(path: str | os.PathLike[str], *, max_bytes: int | None = None
         if not path.exists():
             raise MbodyError(f"{path}: no such file")
         reader = _module(fmt).read
-    try:
+    with unreadable(path):
         return reader(path, max_bytes)
-    except MbodyError:
-        raise
-    except (OSError, ValueError, KeyError, IndexError, TypeError) as exc:
-        raise MbodyError(f"{path}: not a readable mbody export ({type(exc).__name__}: "
-                         f"{exc})") from None

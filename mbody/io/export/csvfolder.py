@@ -207,8 +207,13 @@ def _table(path: Path, max_bytes: int | None = None) -> _Table:
     rows = csv.reader(io.StringIO(read_text(path, max_bytes, MORE), newline=""))
     try:
         numbered = [(k, r) for k, r in enumerate(rows, start=1) if r]
-    except csv.Error as exc:  # a cell over csv's field size limit, a NUL...
-        raise MbodyError(f"{path}, line {rows.line_num}: {exc}") from None
+    except csv.Error as exc:
+        # read from text split into lines, the csv module has one complaint left: a cell
+        # over its field size limit (a process-wide setting, left as it is)
+        limit = csv.field_size_limit()
+        problem = (f"a cell longer than {limit:,} characters, the most a cell is read"
+                   if "limit" in str(exc) else f"not CSV that mbody reads ({exc})")
+        raise MbodyError(f"{path}, line {rows.line_num}: {problem}") from None
     if not numbered:
         raise MbodyError(f"{path}: empty (expected a header line)")
     header = numbered[0][1]

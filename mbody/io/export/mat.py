@@ -22,7 +22,14 @@ from typing import Any
 import numpy as np
 
 from mbody.errors import MbodyError
-from mbody.io.export.assembly import COLUMN_TEXT, MORE, ExportedAssembly, build, flat_arrays
+from mbody.io.export.assembly import (
+    COLUMN_TEXT,
+    MORE,
+    ExportedAssembly,
+    build,
+    check_sparse,
+    flat_arrays,
+)
 from mbody.util.budget import DATA_BYTES, byte_limit
 from mbody.util.npzfile import over_budget, read_bytes
 
@@ -68,11 +75,47 @@ def write(exp: ExportedAssembly, path: Path) -> None:
     scipy.io.savemat(path, arrs, oned_as="column", do_compression=True)
 
 
-def read(path: Path, max_bytes: int | None = None) -> ExportedAssembly:
-    """The `ExportedAssembly` stored in the .mat file `path` (`checked` first)."""
+def load(path: Path, max_bytes: int | None = None, simplify_cells: bool = False
+         ) -> dict[str, Any]:
+    """`scipy.io.loadmat` of the .mat file `path` as input that may be hostile: `checked`
+    first, and then every sparse matrix in it (in cells and structs too) checked
+    (`check_sparse`) before anything uses it."""
     import scipy.io
 
-    data = scipy.io.loadmat(checked(path, max_bytes), simplify_cells=False)
+    stream = checked(path, max_bytes)
+    try:
+        data = scipy.io.loadmat(stream, simplify_cells=simplify_cells)
+    except (scipy.io.matlab.MatReadError, OverflowError, TypeError, ValueError, IndexError,
+            KeyError) as exc:  # what the walk does not look into (a sparse matrix whose
+        # column pointers end below 0: an OverflowError)
+        raise MbodyError(f"{path}: damaged or truncated .mat export (scipy cannot read "
+                         f"it: {type(exc).__name__}: {exc})") from None
+
+    def walk(name: str, value: Any) -> None:  # nested at most MAX_DEPTH (`checked`)
+        if isinstance(value, dict):
+            for key, v in value.items():
+                walk(f"{name}.{key}", v)
+        elif isinstance(value, list | tuple):
+            for v in value:
+                walk(f"{name} (in a cell)", v)
+        elif isinstance(value, np.ndarray) and value.dtype == object:
+            for v in value.flat:
+                walk(f"{name} (in a cell)", v)
+        elif isinstance(value, np.ndarray) and value.dtype.names:  # a struct array
+            for v in value.flat:
+                for field in value.dtype.names:
+                    walk(f"{name}.{field}", v[field])
+        else:
+            check_sparse(path, name, value)
+
+    for key, value in data.items():
+        walk(key, value)
+    return data
+
+
+def read(path: Path, max_bytes: int | None = None) -> ExportedAssembly:
+    """The `ExportedAssembly` stored in the .mat file `path` (`load`)."""
+    data = load(path, max_bytes)
 
     def unstr(v: Any) -> str:
         v = np.asarray(v)
@@ -104,6 +147,8 @@ _CLASS_ITEM = {4: 4, 6: 8, 7: 4, 8: 1, 9: 1, 10: 2, 11: 2, 12: 4, 13: 4, 14: 8, 
 """Bytes per element of each numeric or char array class in memory (mxCHAR as numpy's
 4-byte characters), what scipy allocates for a declared shape."""
 _CELL, _STRUCT, _CHAR, _SPARSE = 1, 2, 4, 5
+_INT8 = 1
+"""The MAT type of names and field names (miINT8)."""
 
 
 class _Walk:
@@ -157,13 +202,25 @@ class _Walk:
         if min(shape) < 0:
             raise self.fail(f"an array of shape {shape}")
         count = math.prod(shape)
-        _, _, _, pos = self.element(buf, pos, end)  # the name
+        # every element's type is checked: scipy's compiled reader looks a type up in a
+        # table of the known ones unchecked (a sparse matrix's row indices of type 5637
+        # crashed the process, review R3)
+        kind, _, at, pos = self.element(buf, pos, end)
+        if kind != _INT8:
+            raise self.fail(f"an array whose name at byte {at} is of MAT type {kind}, "
+                            "expected text (miINT8)")
         if cls in (_CELL, _STRUCT):
             fields = 1
             if cls == _STRUCT:
-                _, _, at, pos = self.element(buf, pos, end)
+                kind, size, at, pos = self.element(buf, pos, end)
+                if kind != 5 or size != 4:  # one int32, as MATLAB and scipy write it
+                    raise self.fail(f"a struct without the width of its field names at "
+                                    f"byte {at}")
                 width = struct.unpack_from(self.order + "i", buf, at)[0]
-                _, size, _, pos = self.element(buf, pos, end)
+                kind, size, at, pos = self.element(buf, pos, end)
+                if kind != _INT8:
+                    raise self.fail(f"a struct whose field names at byte {at} are of MAT "
+                                    f"type {kind}, expected text (miINT8)")
                 if width <= 0 or size % width:
                     raise self.fail("a struct whose field names do not fit their width")
                 fields = size // width
@@ -179,7 +236,10 @@ class _Walk:
                 self.matrix(buf, at, at + size, depth + 1)
         elif cls == _SPARSE:
             for _ in range(2 + parts):  # row indices, column pointers, values (real, imag)
-                _, size, _, pos = self.element(buf, pos, end)
+                kind, size, at, pos = self.element(buf, pos, end)
+                if kind not in _ITEM:
+                    raise self.fail(f"a sparse array whose data at byte {at} is of MAT type "
+                                    f"{kind}, not numbers")
                 self.spend(2 * size)  # scipy's copy and the matrix's own
         elif cls in _CLASS_ITEM:
             for _ in range(parts):
@@ -220,28 +280,41 @@ def checked(path: Path, max_bytes: int | None = None) -> io.BytesIO:
     out = [raw[:116], bytes(8), raw[124:_HEADER]]  # no subsystem data
     pos = _HEADER
     while pos < len(raw):
-        kind, size, at, after = walk.element(raw, pos, len(raw))
-        if kind == _COMPRESSED:
-            inflate = zlib.decompressobj()
-            head = inflate.decompress(raw[at:at + size], 8)
-            if len(head) < 8:
-                raise walk.fail(f"a compressed variable at byte {pos} is cut short")
-            inner, inner_size = struct.unpack_from(order + "II", head)
-            walk.spend(inner_size + 8)  # before it is inflated
-            # (a max_length of 0 would be no limit at all)
-            body = head + (inflate.decompress(inflate.unconsumed_tail, inner_size)
-                           if inner_size else b"")
-            if inner != _MATRIX or len(body) != inner_size + 8:
-                raise walk.fail(f"the compressed variable at byte {pos} does not hold the "
-                                f"{inner_size:,} bytes of an array it says it holds")
-            after = at + size
-        elif kind == _MATRIX:
-            body = raw[pos:at + size]
-            walk.spend(size + 8)
-        else:
-            raise walk.fail(f"an element of MAT type {kind} at byte {pos}, where a "
-                            "variable was expected")
-        walk.matrix(body, 8, len(body), 0)
+        try:
+            body, pos = _variable(walk, raw, pos)
+        except zlib.error as exc:
+            raise walk.fail(f"the compressed variable at byte {pos} does not inflate: "
+                            f"{exc}") from None
+        except struct.error as exc:  # each size is checked before it is unpacked
+            raise walk.fail(f"an element in the variable at byte {pos} is cut short: "
+                            f"{exc}") from None
         out += [body, bytes(-len(body) % 8)]
-        pos = after
     return io.BytesIO(b"".join(out))
+
+
+def _variable(walk: _Walk, raw: bytes, pos: int) -> tuple[bytes, int]:
+    """The variable at byte `pos` of the file `raw`, inflated and walked, and where the
+    next one starts."""
+    kind, size, at, after = walk.element(raw, pos, len(raw))
+    if kind == _COMPRESSED:
+        inflate = zlib.decompressobj()
+        head = inflate.decompress(raw[at:at + size], 8)
+        if len(head) < 8:
+            raise walk.fail(f"a compressed variable at byte {pos} is cut short")
+        inner, inner_size = struct.unpack_from(walk.order + "II", head)
+        walk.spend(inner_size + 8)  # before it is inflated
+        # (a max_length of 0 would be no limit at all)
+        body = head + (inflate.decompress(inflate.unconsumed_tail, inner_size)
+                       if inner_size else b"")
+        if inner != _MATRIX or len(body) != inner_size + 8:
+            raise walk.fail(f"the compressed variable at byte {pos} does not hold the "
+                            f"{inner_size:,} bytes of an array it says it holds")
+        after = at + size
+    elif kind == _MATRIX:
+        body = raw[pos:at + size]
+        walk.spend(size + 8)
+    else:
+        raise walk.fail(f"an element of MAT type {kind} at byte {pos}, where a "
+                        "variable was expected")
+    walk.matrix(body, 8, len(body), 0)
+    return body, after

@@ -19,9 +19,7 @@ def state_at(traj: Trajectory, time: float | None) -> tuple[State, int]:
     `MbodyError` when `time` lies outside the trajectory's time span.
     """
     if time is None:
-        if len(traj.t) == 0:
-            raise MbodyError("the trajectory holds no samples")
-        k = len(traj.t) - 1
+        k = traj.need_samples() - 1
     else:
         k = traj.nearest_sample(time)
     return traj.state(k), k

@@ -409,8 +409,7 @@ def build_scene(traj: Trajectory, model: Model, *, forces: bool = False,
             hint = did_you_mean(name, traj_names)
             raise MbodyError(f"unknown body {name!r}: the trajectory has "
                              f"{', '.join(traj_names)}" + (f" ({hint})" if hint else ""))
-    if len(traj.t) < 1:
-        raise MbodyError("the trajectory has no samples")
+    traj.need_samples()
     t = np.asarray(traj.t, dtype=np.float64)
     if np.any(np.diff(t) <= 0):
         raise MbodyError("the trajectory's times do not increase")
