@@ -169,12 +169,15 @@ def real_number(value: object, argument: str, expected: str = "a number") -> flo
     raise wrong_type(argument, expected, value, hint)
 
 
-def given_twice(flag: str, name: str) -> MbodyError:
+def given_twice(entry: str, how: str = "") -> MbodyError:
     """A repeatable NAME=VALUE option given twice for one name (``--known O.Fx=3 --known
     O.Fx=4``): which value was meant is a guess, so every command refuses it, in these
     words (``--set``, ``--known``, ``--q``, ``--qd``, ``kinematics --point``, ``sweep
-    --set``)."""
-    return MbodyError(f"{flag} {name} is given twice")
+    --set``; from Python, `mbody.run_sweep`'s values, whose mapping's keys name one path
+    once the spaces around them are dropped). `entry` is the option and its name as the
+    caller gives them (``--known O.Fx``; `option_entry`: ``values['bodies.rod.mass']``
+    from Python); `how`, when given, says how it was given twice."""
+    return MbodyError(f"{entry} is given twice" + (f" ({how})" if how else ""))
 
 
 def did_you_mean(word: str, choices: Iterable[str]) -> str:

@@ -204,7 +204,8 @@ def test_random_samples_are_seeded_and_in_range():
     (["bodies.rod.mass=0.3:1.2:0"], {}, "a count of at least 1"),
     (["drivers.motor.speed=10 rpm:20:3"], {}, "different units"),
     (["bodies.rod.mass=2"], {}, "varies at least one value"),
-    (["bodies.rod.mass=1:2:3", "bodies.rod.mass=1:2:3"], {}, "given twice"),
+    (["bodies.rod.mass=1:2:3", "bodies.rod.mass=1:2:3"], {},
+     r"^values\['bodies.rod.mass'\] is given twice$"),  # from Python: the keyword's spelling
     (["bodies.rod.mass=1,,2"], {}, "an empty value"),
     (["bodies.rod.mass=0:1:20000", "bodies.crank.mass=0:1:20000"], {}, "at most"),
 ])

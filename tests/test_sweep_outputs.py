@@ -19,6 +19,7 @@ settings mixed with this sweep's.
 from __future__ import annotations
 
 import csv
+import errno
 import math
 import os
 import re
@@ -29,7 +30,7 @@ import pytest
 
 import mbody
 from mbody.cli import main
-from mbody.errors import MbodyError
+from mbody.errors import MbodyError, OutputError
 from mbody.sweep import cluster
 from mbody.sweep.record import differences, parse, record
 from mbody.sweep.runs import Settings
@@ -202,6 +203,48 @@ def test_an_output_in_a_new_folder(driven):
     assert sorted(p.name for p in Path("new/dir").iterdir()) == ["r.csv"]
 
 
+def _failing(monkeypatch, errno_: int, what: str) -> None:
+    """`Path.mkdir` (what == "mkdir") or the journal's opening fails with `errno_`, as on a
+    file system that refuses (/proc lets root through os.access, then refuses mkdir)."""
+    if what == "mkdir":
+        def mkdir(self, *args, **kwargs):
+            raise OSError(errno_, os.strerror(errno_), str(self))
+
+        monkeypatch.setattr(Path, "mkdir", mkdir)
+        return
+    real = open
+
+    def opening(file, *args, **kwargs):
+        if str(file).endswith(".partial"):
+            raise OSError(errno_, os.strerror(errno_), str(file))
+        return real(file, *args, **kwargs)
+
+    monkeypatch.setattr("builtins.open", opening)
+
+
+@pytest.mark.parametrize(("what", "said"), [
+    ("mkdir", "cannot write 'new/r.csv': cannot make the folder 'new' (No space left on "
+              "device)"),
+    ("open", "cannot write 'new/r.csv.partial', the journal beside the output new/r.csv: "
+             "No space left on device"),
+])
+def test_an_output_whose_folder_or_journal_cannot_be_written(driven, capsys, monkeypatch,
+                                                               what, said):
+    """B4 of review R3: a folder that cannot be made was a FileNotFoundError naming the
+    journal from run_sweep (and the command's message named the journal alone). Now the
+    output --out is named, in the words every command uses for its output, as an
+    OutputError (an MbodyError and an OSError) from Python and exit 2 from the command."""
+    if what == "open":
+        Path("new").mkdir()
+    _failing(monkeypatch, errno.ENOSPC, what)
+    with pytest.raises(OutputError) as refused:
+        mbody.run_sweep(driven, MASSES, "new/r.csv", workers=0)
+    assert str(refused.value) == said and refused.value.errno == errno.ENOSPC
+    code, _, err = command(capsys, driven, "--set", MASSES[0], "--out", "new/r.csv")
+    assert (code, err) == (2, f"mbody: error: {said}\n")
+    assert not Path("new/r.csv").exists()
+
+
 # == the settings each row was computed with ==================================================
 
 def test_each_row_records_its_settings(driven):
@@ -215,6 +258,8 @@ def test_each_row_records_its_settings(driven):
         (Settings("kinematics", revolutions=1.0, steps=360),
          "run=kinematics; t-end=1 rev; steps=360"),
         (Settings("kinematics", t_end=0.1, steps=11), "run=kinematics; t-end=0.1; steps=11"),
+        # no --steps: mbody kinematics' sampling, one a degree of the crank's steady turn
+        (Settings("kinematics", t_end=0.1), "run=kinematics; t-end=0.1; steps=360 a turn"),
         (Settings("simulate", t_end=2.5, fps=60.0), "run=simulate; t-end=2.5; fps=60"),
         (Settings("modes"), "run=modes; equilibrium=no"),
         (Settings("modes", equilibrium=True, steps=3), "run=modes; equilibrium=yes"),
@@ -236,6 +281,9 @@ def test_the_differences_are_named():
         "--t-end 0.1 (this sweep: 0.2)", "--steps 11 (this sweep: 21)"]
     assert differences(a, "run=simulate; t-end=0.1; fps=60; model=sha256:0123456789abcdef"
                        ) == ["--run kinematics (this sweep: simulate)"]
+    # the default sampling changed from 101 instants: such rows are another sweep's
+    assert differences(a.replace("=11", "=101"), a.replace("=11", "=360 a turn")) == [
+        "--steps 101 (this sweep: 360 a turn)"]
     assert differences(a, a.replace("0123", "3210")) == [
         "another model (another file, the file changed since, or other values set for every "
         "case)"]

@@ -6,6 +6,7 @@ on the command line, ``steps`` in Python), and the warnings returned, not printe
 
 from __future__ import annotations
 
+import argparse
 import math
 from pathlib import Path
 
@@ -18,7 +19,8 @@ from mbody.cli.app import build_parser, option_flags
 from mbody.errors import MbodyError, options_named
 from mbody.simulate.peaks import SPARSE
 from mbody.sweep import cluster, runs
-from mbody.sweep.study import LIMITS, SweepInterrupted, SweepResult
+from mbody.sweep.limits import LIMITS
+from mbody.sweep.study import SweepInterrupted, SweepResult
 from tests.test_sweep import SLIDER, driven_text, floats, mbody_cli, read
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -193,8 +195,12 @@ def refused_by_the_command(tmp_path: Path, model: Path, *args: str) -> str:
     (["--set", "bodies.rdo.mass=0.3:1.2:3"], {"values": {"bodies.rdo.mass": "0.3:1.2:3"}}),
     (["--set", "bodies.rod.mass=0.3:1.2:3", "--out", "x.txt"],
      {"out": "x.txt"}),
+    (["--set", "bodies.rod.mass=0.3:x:3"], {"values": ["bodies.rod.mass=0.3:x:3"]}),
     (["--set", "bodies.rod.mass=0.3:x:3"], {"values": {"bodies.rod.mass": "0.3:x:3"}}),
     (["--set", "bodies.rod.mass=0.4:0.8:1"], {"values": ["bodies.rod.mass=0.4:0.8:1"]}),
+    (["--set", "bodies.rod.mass=1,.nan"], {"values": {"bodies.rod.mass": [1, math.nan]}}),
+    (["--set", "bodies.rod.mass=1:2:2", "--set", "bodies.rod.mass=3"],
+     {"values": ["bodies.rod.mass=1:2:2", "bodies.rod.mass=3"]}),
     (["--set", "bodies.rod.mass=2"], {"values": {"bodies.rod.mass": 2}}),
     (["--set", "bodies.rod.mass=1:2:2", "--seed", "3"], {"seed": 3}),
     (["--set", "bodies.rod.mass=1:2:2", "--run", "kinematics"], {"run": "kinematics"}),
@@ -203,7 +209,8 @@ def refused_by_the_command(tmp_path: Path, model: Path, *args: str) -> str:
      {"run": "kinematics", "revolutions": 1.0, "model": SLIDER}),
     (["--set", "bodies.rod.mass=1:2:2", "--run", "kinematics", "--t-end", "0.1"],
      {"run": "kinematics", "t_end": 0.1, "model": SLIDER}),
-], ids=["path", "path in a mapping", "extension", "range", "count of 1", "nothing varies",
+], ids=["path", "path in a mapping", "extension", "range", "range in a mapping", "count of 1",
+        "not finite", "given twice", "nothing varies",
         "seed without samples", "no end", "equilibrium without modes", "no turning driver",
         "not fully driven"])
 def test_bad_arguments_are_refused_with_the_commands_message(driven_file, tmp_path, args, kw):
@@ -238,7 +245,18 @@ def test_bad_arguments_are_refused_with_the_commands_message(driven_file, tmp_pa
     ({"seed": -1, "samples": 3}, "^seed: expected a seed from 0"),
     ({"run": "simulation"}, "unknown run 'simulation'; expected one of solve, kinematics"),
     ({"values": [3]}, "expected a mapping path -> values .* got 3 \\(int\\)"),
-    ({"values": {"bodies.rod.mass": []}}, "no values"),
+    ({"values": {"bodies.rod.mass": []}}, r"^values\['bodies.rod.mass'\]: no values"),
+    ({"values": {"bodies.rod.mass": [1.0, math.nan]}},
+     r"^values\['bodies.rod.mass'\]: expected a finite number, got nan \(value 2 of 2\)$"),
+    ({"values": {"gravity": [[0, -9.81], [0, -math.inf]]}},
+     r"^values\['gravity'\]: expected a finite number, got -inf "
+     r"\(value 2 of 2: \[0, -inf\]\)$"),
+    ({"values": {"bodies.rod.mass": [1, 2], " bodies.rod.mass ": [3]}},
+     r"^values\['bodies.rod.mass'\] is given twice \(as 'bodies.rod.mass' and "
+     r"' bodies.rod.mass '\)$"),
+    ({"equilibrium": "no", "run": "modes"}, r"^equilibrium: expected True or False, got 'no'$"),
+    ({"force": 1}, r"^force: expected True or False, got 1$"),
+    ({"progress": "yes"}, r"^progress: expected True or False, got 'yes'$"),
     ({"model": 3}, "expected a Model or a model file's path, got int"),
     ({"out": None}, "the output: expected a file name"),
     ({"scheduler": 8786}, "^scheduler: expected an address"),
@@ -260,7 +278,7 @@ def test_the_ranges_are_the_commands():
     def cli_takes(option: str, text: str) -> bool:
         try:
             actions[option].type(text)
-        except Exception:  # noqa: BLE001 - argparse's ArgumentTypeError
+        except argparse.ArgumentTypeError:  # what a type raises for a value it refuses
             return False
         return True
 
@@ -279,6 +297,27 @@ def test_the_ranges_are_the_commands():
             x = int(x) if limit.integer else float(x)
             text = f"{x!r} rev" if name == "revolutions" else repr(x)
             assert cli_takes(limit.option, text) == python_takes(name, x), (name, x)
+
+
+@pytest.mark.parametrize("name", sorted(LIMITS))
+def test_the_command_and_python_say_one_range(name):
+    """The option's type is built from `LIMITS` (Y3 of review R3: the ranges were written
+    twice, kept equal by a test): beyond its upper end, the command and `run_sweep` refuse
+    a value in the same words."""
+    limit = LIMITS[name]
+    option = next(a for a in build_parser()._subparsers._group_actions[0]
+                  .choices["sweep"]._actions if limit.option in a.option_strings)
+    over = int(limit.hi) + 1 if limit.integer else 2 * limit.hi
+    expected = f"expected {limit.what} {limit.span}"
+    with pytest.raises(argparse.ArgumentTypeError) as cli:
+        option.type(f"{over!r} rev" if name == "revolutions" else repr(over))
+    with pytest.raises(MbodyError) as python:
+        limit.check(over)
+    with as_the_command_names_them(), pytest.raises(MbodyError) as named:
+        limit.check(over)
+    assert str(cli.value).startswith(expected), str(cli.value)
+    assert str(python.value).startswith(f"{limit.keyword}: {expected}")
+    assert str(named.value).startswith(f"{limit.option}: {expected}")
 
 
 def test_warnings_are_returned_and_the_command_prints_them(tmp_path):
@@ -303,21 +342,25 @@ def test_warnings_are_returned_and_the_command_prints_them(tmp_path):
     model.write_text(driven_text("600 rpm"))
     speeds = {"drivers.motor.speed": "300 rpm:3000 rpm:4"}
     sparse = mbody.run_sweep(model, speeds, tmp_path / "k.csv", run="kinematics", t_end=0.1,
-                             workers=0)
+                             steps=101, workers=0)
     (text,) = sparse.warnings
     assert text.startswith(f"{SPARSE}: motor turns at 3000 rpm") and "steps=181" in text
-    assert text == runs.sampling_warning(runs.Settings("kinematics", 0.1), _grid(speeds),
-                                         sparse.report.sparse, sparse.report.cases,
-                                         sparse.report.sparsest)
+    assert text == runs.sampling_warning(runs.Settings("kinematics", 0.1, steps=101),
+                                         _grid(speeds), sparse.report.sparse,
+                                         sparse.report.cases, sparse.report.sparsest)
     assert sparse.report.sparse == 2
     p = mbody_cli("sweep", str(model), "--set", "drivers.motor.speed=300 rpm:3000 rpm:4",
-                  "--run", "kinematics", "--t-end", "0.1", "--workers", "0", "--quiet",
-                  "--out", str(tmp_path / "kc.csv"))
+                  "--run", "kinematics", "--t-end", "0.1", "--steps", "101", "--workers",
+                  "0", "--quiet", "--out", str(tmp_path / "kc.csv"))
     assert p.returncode == 0 and p.stderr == "mbody: warning: " + text.replace(
         "steps=181", "--steps 181") + "\n"
     enough = mbody.run_sweep(model, speeds, tmp_path / "k181.csv", run="kinematics",
                              t_end=0.1, steps=181, workers=0)
     assert enough.warnings == []
+    # by default (no steps: 101 were the default) each case is sampled 360 times a turn
+    default = mbody.run_sweep(model, speeds, tmp_path / "kd.csv", run="kinematics",
+                              t_end=0.1, workers=0)
+    assert default.warnings == []
 
 
 def _grid(values):
@@ -364,8 +407,40 @@ def test_failed_cases_and_the_columns(driven_file, tmp_path):
     with pytest.raises(KeyError, match="did you mean 'reaction:O.Fx'"):
         result.column("reaction:O.fx")
     with pytest.raises(MbodyError, match="holds text"):
-        result.column("drivers.motor.speed")
+        result.column("settings")
+    # values listed in one unit: numbers, the unit in the column's name (F15 of review
+    # R4: they were text, '60 rpm'); found by the path alone too
+    assert result.header[1:3] == ["bodies.rod.mass", "drivers.motor.speed [rpm]"]
+    speeds = result.column("drivers.motor.speed")
+    assert speeds.tolist() == [60.0, 120.0, 60.0, 120.0]
+    assert result.column("drivers.motor.speed [rpm]").tolist() == speeds.tolist()
     assert "2 failed" in repr(result) and "4 cases, 4 run now" in repr(result)
+
+
+def test_a_varied_value_is_a_number_in_the_unit_it_was_written_in(driven_file, tmp_path):
+    """F15 of review R4: the column of a speed swept as '30 rpm:60 rpm:2' held 30.0 with
+    no unit. The unit is the one typed, in the column's name (not the file's: this file
+    gives the speed in rad/s); the rows are the cases at those speeds in rpm. Values
+    listed in one unit are numbers the same way: the command's range and Python's list
+    give one file."""
+    result = mbody.run_sweep(driven_file, {"drivers.motor.speed": ["30 rpm", "60 rpm"],
+                                           "bodies.rod.mass": "0.4:0.8:2"},
+                             tmp_path / "u.csv", workers=0)
+    assert result.header[1:3] == ["drivers.motor.speed [rpm]", "bodies.rod.mass"]
+    assert [r[1:3] for r in result.rows] == [["30.0", "0.4"], ["30.0", "0.8"],
+                                             ["60.0", "0.4"], ["60.0", "0.8"]]
+    model = mbody.load(driven_file)
+    for row, fx in zip(result.rows, result.column("reaction:O.Fx"), strict=True):
+        case = model.with_values({"drivers.motor.speed": f"{row[1]} rpm",
+                                  "bodies.rod.mass": float(row[2])})
+        assert fx == pytest.approx(mbody.assemble(case).solve().reactions["O.Fx"], rel=1e-12)
+    # O.Fx is all inertia at constant speed (gravity acts along y): it scales as the
+    # speed squared, four times 30 rpm's at 60 rpm
+    fx = result.column("reaction:O.Fx")
+    assert fx[2] / fx[0] == pytest.approx(4.0, rel=1e-9)
+    header, rows, _ = cli_rows(tmp_path, driven_file, ["drivers.motor.speed=30 rpm:60 rpm:2",
+                                                       "bodies.rod.mass=0.4:0.8:2"])
+    assert (header, rows) == (result.header, result.rows)
 
 
 def test_a_parquet_output_from_python(driven_file, tmp_path):

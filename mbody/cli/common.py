@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any, TextIO
 
 from mbody.errors import MbodyError, given_twice
+from mbody.util.formatting import number
 
 EXIT_OK, EXIT_UNMET, EXIT_INPUT, EXIT_INTERNAL = 0, 1, 2, 70
 
@@ -67,15 +68,6 @@ def byte_size(text: str) -> int:
     return size
 
 
-def number(x: float) -> str:
-    """`x` as %g writes it, with exponents as people write them (1e9, 2.5e-13); an int
-    below 10^12 in full, its thousands apart (10 000 000)."""
-    if isinstance(x, int) and abs(x) < 10**12:
-        return f"{x:,}".replace(",", " ")
-    x = float(x)
-    return re.sub(r"e\+?(-?)0*(\d)", r"e\1\2", f"{x:g}")
-
-
 def bounded(what: str, lo: float, hi: float, *, integer: bool = False,
             lo_open: bool = False, zero: str | None = None) -> Callable[[str], float]:
     """An argparse type: `what` (``"a number of seconds"``), from `lo` to `hi` (`lo`
@@ -111,11 +103,11 @@ TURNS_MAX = 1e6
 """Most turns an end time may be given in (``--t-end '1e6 rev'``)."""
 
 
-def seconds_or_turns(lo: float, hi: float, *, lo_open: bool = False
-                     ) -> Callable[[str], tuple[str, float]]:
+def seconds_or_turns(lo: float, hi: float, *, lo_open: bool = False,
+                     turns_max: float = TURNS_MAX) -> Callable[[str], tuple[str, float]]:
     """An argparse type for an end time (``--t-end`` of kinematics and sweep): seconds
     from `lo` to `hi` (as `bounded`), or turns of the mechanism's turning driver written
-    ``'1 rev'`` (also ``revs``, ``revolution(s)``), above 0 up to `TURNS_MAX`. Gives
+    ``'1 rev'`` (also ``revs``, ``revolution(s)``), above 0 up to `turns_max`. Gives
     ``("s", seconds)`` or ``("rev", turns)``; each command says which driver's turn."""
     seconds = bounded("a time in seconds", lo, hi, lo_open=lo_open)
 
@@ -123,9 +115,9 @@ def seconds_or_turns(lo: float, hi: float, *, lo_open: bool = False
         m = _TURNS.fullmatch(text)
         if m:
             x = float(m.group(1))
-            if not 0 < x <= TURNS_MAX:
+            if not 0 < x <= turns_max:
                 raise argparse.ArgumentTypeError(
-                    f"expected a number of turns above 0 up to {number(TURNS_MAX)}, got "
+                    f"expected a number of turns above 0 up to {number(turns_max)}, got "
                     f"{text!r}")
             return ("rev", x)
         try:
@@ -237,7 +229,7 @@ def assignments(pairs: Sequence[str], flag: str, form: str, degrees: str | None 
             raise MbodyError(f"{flag} {name}: expected a number of magnitude at most "
                              f"{number(MAX_MAGNITUDE)}, as in a model file, got {value!r}")
         if name.strip() in out:
-            raise given_twice(flag, name.strip())
+            raise given_twice(f"{flag} {name.strip()}")
         out[name.strip()] = x
     return out
 
@@ -355,7 +347,7 @@ def set_values(pairs: Sequence[str]) -> dict[str, Any]:
     for pair in pairs:
         path, text = parse_assignment(pair)
         if path in out:
-            raise given_twice("--set", path)
+            raise given_twice(f"--set {path}")
         out[path] = parse_value(text, path)
     return out
 

@@ -46,6 +46,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                                          lo_open=True),
                    default=None, metavar="N", help="samples per second (default: 360 per "
                    "revolution of a constant-rate driver, one a degree; else 100)")
+    # those defaults are mbody.simulate.kinematic.default_fps's (a test keeps them equal)
     s.add_argument("--point", action="append", default=[], metavar="NAME=BODY:X,Y[,Z]",
                    help="a body point to follow (repeatable), in the body's axes from its "
                    "mass centre, e.g. --point P=coupler:0.1,0.05; saved with the run "
@@ -84,7 +85,7 @@ def parse_points(pairs: list[str]) -> dict[str, tuple[str, list[float]]]:
             raise MbodyError(f"--point expects NAME=BODY:X,Y[,Z] (for example "
                              f"P=coupler:0.1,0.05), got {p!r}")
         if name.strip() in out:
-            raise given_twice("--point", name.strip())
+            raise given_twice(f"--point {name.strip()}")
         out[name.strip()] = body_point(rest, f"--point {name}")
     return out
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Callable
 
 from mbody.cli.common import (
     EXIT_OK,
@@ -14,9 +15,26 @@ from mbody.cli.common import (
     output_stream,
     seconds_or_turns,
 )
+from mbody.sweep.limits import LIMITS
 
 RUN_NAMES = ("solve", "kinematics", "simulate", "modes")
 """`mbody.sweep.runs.RUNS` (not imported at start-up; a test keeps them equal)."""
+
+
+def limited(name: str) -> Callable[[str], float]:
+    """The argparse type of `run_sweep`'s keyword `name`: its range (`LIMITS`), as
+    `run_sweep` checks it."""
+    limit = LIMITS[name]
+    return bounded(limit.what, limit.lo, limit.hi, integer=limit.integer,
+                   lo_open=limit.lo_open)
+
+
+def _end_time() -> Callable[[str], tuple[str, float]]:
+    """--t-end's type: seconds or turns, each in `run_sweep`'s range (``t_end``,
+    ``revolutions``)."""
+    seconds, turns = LIMITS["t_end"], LIMITS["revolutions"]
+    return seconds_or_turns(seconds.lo, seconds.hi, lo_open=seconds.lo_open,
+                            turns_max=turns.hi)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -27,9 +45,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         "simulation, or the natural frequencies (with whether the state is an equilibrium "
         "and stable, as mbody modes says). One row per case in --out: the varied paths, "
         "then <quantity>:<label> columns (acceleration:, reaction:, final:, peak:, "
-        "frequency:; steady, stable), error, and settings (the run, its settings that change "
-        "the numbers, and the model's digest). Cases run on a local Dask cluster started "
-        "for the command (--workers), or on an existing one (--scheduler). An interrupted "
+        "frequency:, growth:; steady, stable as true or false), error, and settings (the "
+        "run, its settings that change the numbers, and the model's digest). Cases run on "
+        "a local Dask cluster started for the command (--workers), or on an existing one "
+        "(--scheduler). An interrupted "
         "sweep resumes: the same command runs only the cases not in --out yet; rows of "
         "other settings are refused (--force runs them again).")
     s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
@@ -39,20 +58,23 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "a unit as the file reads it: '100 rpm:3000 rpm:30'), or listed "
                    "(PATH=a,b,c); PATH=VALUE sets one value for every case; "
                    "repeatable: the cases are the grid of all of them")
-    s.add_argument("--samples", type=bounded("a number of cases", 1, 1e8, integer=True),
-                   metavar="N", help="N random cases instead of the grid, each value "
-                   "uniform in START:STOP (or drawn from a list)")
-    s.add_argument("--seed", type=bounded("a seed", 0, 2**63 - 1, integer=True), default=0,
-                   metavar="S", help="the random samples' seed (default 0)")
+    s.add_argument("--samples", type=limited("samples"), metavar="N",
+                   help="N random cases instead of the grid, each value uniform in "
+                   "START:STOP (or drawn from a list)")
+    s.add_argument("--seed", type=limited("seed"), default=0, metavar="S",
+                   help="the random samples' seed (default 0)")
     s.add_argument("--run", dest="run_kind", choices=RUN_NAMES, default="solve",
                    help="what each case computes (default solve)")
-    s.add_argument("--t-end", type=seconds_or_turns(0.0, 1e9, lo_open=True), metavar="T",
+    s.add_argument("--t-end", type=_end_time(), metavar="T",
                    help="kinematics, simulate: the end, in seconds or in turns of the first "
                    "driver that turns ('1 rev': one turn at each case's speed)")
-    s.add_argument("--steps", type=bounded("a number of instants", 2, 1e6, integer=True),
-                   default=101, metavar="K",
-                   help="kinematics: instants from 0 to the end, both included (default 101)")
-    s.add_argument("--fps", type=bounded("samples per second", 0.0, 1e6, lo_open=True),
+    s.add_argument("--steps", type=limited("steps"), metavar="K",
+                   help="kinematics: K instants evenly spaced from 0 to the end, both "
+                   "included (default: as mbody kinematics samples, 360 a revolution of "
+                   "the first driver at each case's speed when it turns at a constant "
+                   "rate, else 100 a second; and the end)")
+    # those defaults are mbody.simulate.kinematic.default_fps's (a test keeps them equal)
+    s.add_argument("--fps", type=limited("fps"),
                    default=60.0, metavar="F", help="simulate: samples per second (default 60)")
     s.add_argument("--equilibrium", action="store_true",
                    help="modes: linearise each case about the static equilibrium nearest its "
@@ -63,12 +85,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--scheduler", metavar="ADDRESS",
                    help="an existing Dask cluster's scheduler, tcp://HOST:PORT (default: a "
                    "local cluster started and stopped by the command)")
-    s.add_argument("--workers", type=bounded("a number of worker processes", 0, 4096,
-                                             integer=True), metavar="N",
+    s.add_argument("--workers", type=limited("workers"), metavar="N",
                    help="the local cluster's worker processes (default: one per core); 0 "
                    "runs the cases in this process, without Dask")
-    s.add_argument("--chunk", type=bounded("a number of cases", 1, 1e8, integer=True),
-                   metavar="N", help="cases per chunk sent to a worker (default: measured, "
+    s.add_argument("--chunk", type=limited("chunk"), metavar="N",
+                   help="cases per chunk sent to a worker (default: measured, "
                    "about 2 s of work)")
     s.add_argument("--quiet", action="store_true", help="no progress bar (there is one only "
                    "on a terminal)")

@@ -562,13 +562,22 @@ DEFAULT_SPAN, DEFAULT_FPS = 1.0, 100.0
 rate."""
 
 
+def default_fps(turn: float | None) -> float:
+    """A kinematic run's samples a second by default: `SAMPLES_A_TURN` a revolution of the
+    first driver when it turns at a constant rate, a revolution `turn` s long
+    (`revolution`), else `DEFAULT_FPS`. What ``mbody kinematics`` takes without --fps
+    (`default_sampling`), and a sweep's ``--run kinematics`` without --steps, for each
+    case at its own rate."""
+    return SAMPLES_A_TURN / turn if turn else DEFAULT_FPS
+
+
 def default_sampling(model: Model) -> tuple[float, float]:
     """(span, fps): what a kinematic run of `model` covers by default (`mbody kinematics`
     without --t-end and --fps, `kinematic_at` without a run): one revolution of the first
     driver at `SAMPLES_A_TURN` samples when it turns at a constant rate, else
-    `DEFAULT_SPAN` at `DEFAULT_FPS`."""
+    `DEFAULT_SPAN` at `DEFAULT_FPS` (`default_fps`)."""
     turn = revolution(model)
-    return (turn, SAMPLES_A_TURN / turn) if turn else (DEFAULT_SPAN, DEFAULT_FPS)
+    return (turn or DEFAULT_SPAN, default_fps(turn))
 
 
 def summary(traj: Trajectory, path: str | None = None) -> str:

@@ -8,9 +8,10 @@ holds the last two, as ``name=value`` pairs joined by ``; ``::
     run=kinematics; t-end=1 rev; steps=360; model=sha256:2c4f0e9b61d7a835
 
 - ``run``: always; ``t-end`` (seconds, or ``N rev``) for ``kinematics`` and
-  ``simulate``; ``steps`` for ``kinematics``; ``fps`` for ``simulate``; ``equilibrium``
-  (``yes`` or ``no``) for ``modes``. A setting a run does not use is not recorded, so it
-  can change without making the rows another sweep's.
+  ``simulate``; ``steps`` for ``kinematics`` (the number given, or the default
+  sampling, ``360 a turn`` or ``100 a second``: `sampling`); ``fps`` for ``simulate``;
+  ``equilibrium`` (``yes`` or ``no``) for ``modes``. A setting a run does not use is
+  not recorded, so it can change without making the rows another sweep's.
 - ``model``: the first 16 hexadecimal digits of the SHA-256 of the model's document
   (the file as parsed: comments and layout aside) with the values set for every case
   (``--set PATH=VALUE``, `Model.with_values`) written in, and the step `mbody.load`
@@ -27,6 +28,7 @@ import hashlib
 from typing import TYPE_CHECKING
 
 from mbody.model.values import apply, edits, entry_names
+from mbody.simulate.kinematic import DEFAULT_FPS, SAMPLES_A_TURN, revolution
 from mbody.sweep.runs import Settings
 
 if TYPE_CHECKING:
@@ -60,6 +62,18 @@ def model_digest(model: Model) -> str:
     return f"sha256:{digest[:DIGITS]}"
 
 
+def sampling(settings: Settings, model: Model) -> str:
+    """A ``kinematics`` run's instants as recorded: ``--steps`` given (``360``), else
+    ``mbody kinematics``' sampling of the model (`mbody.sweep.runs.instants`):
+    ``360 a turn`` of its first driver, or ``100 a second`` when it does not turn at a
+    constant rate."""
+    if settings.steps is not None:
+        return str(int(settings.steps))
+    if revolution(model) is not None:
+        return f"{SAMPLES_A_TURN} a turn"
+    return f"{_number(DEFAULT_FPS)} a second"
+
+
 def record(settings: Settings, model: Model) -> str:
     """The ``settings`` cell of the rows of a sweep of `model` run with `settings`."""
     pairs = [("run", settings.run)]
@@ -68,7 +82,7 @@ def record(settings: Settings, model: Model) -> str:
                else _number(settings.t_end) if settings.t_end is not None else "")
         pairs.append(("t-end", end))
     if settings.run == "kinematics":
-        pairs.append(("steps", str(int(settings.steps))))
+        pairs.append(("steps", sampling(settings, model)))
     if settings.run == "simulate":
         pairs.append(("fps", _number(settings.fps)))
     if settings.run == "modes":

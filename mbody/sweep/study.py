@@ -12,9 +12,7 @@ run's states that are not equilibria, peaks sampled too sparsely).
 
 from __future__ import annotations
 
-import math
 import os
-import re
 import uuid
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -23,68 +21,18 @@ from typing import Any
 
 import numpy as np
 
-from mbody.errors import MbodyError, did_you_mean, option_name, option_names
+from mbody.errors import MbodyError, not_found, option_name, option_names
 from mbody.loading import load
 from mbody.model.model import Model
 from mbody.model.values import edits, entry_names
 from mbody.sweep import cluster
 from mbody.sweep.grid import Grid, grid_of
+from mbody.sweep.limits import LIMITS
 from mbody.sweep.modes import not_steady_warning
 from mbody.sweep.record import record
 from mbody.sweep.runs import Job, Settings, check_settings, columns, sampling_warning
 from mbody.sweep.table import ERROR, Results, journal_of, output_format
 from mbody.util.atomic import refuse_overwriting_inputs
-
-
-@dataclass(frozen=True)
-class Limit:
-    """The range of one numeric argument, as the command's option `option` takes it; a
-    message names it as the caller does (`mbody.errors.option_name` of `keyword`)."""
-
-    option: str
-    keyword: str
-    what: str
-    lo: float
-    hi: float
-    integer: bool = False
-    lo_open: bool = False
-
-    def check(self, value: Any) -> None:
-        """Refuse `value` outside the range (or not a number), naming the option."""
-        kinds = (int, np.integer) if self.integer else (int, float, np.integer, np.floating)
-        if (isinstance(value, bool) or not isinstance(value, kinds)
-                or not math.isfinite(value) or value > self.hi
-                or (value <= self.lo if self.lo_open else value < self.lo)):
-            lo, hi = (_figure(int(x)) if self.integer else _figure(x)
-                      for x in (self.lo, self.hi))
-            span = f"above {lo} up to {hi}" if self.lo_open else f"from {lo} to {hi}"
-            raise MbodyError(f"{option_name(self.keyword)}: expected {self.what} {span}"
-                             f"{' (a whole number)' if self.integer else ''}, got {value!r}")
-
-
-def _figure(x: float) -> str:
-    """A bound as the command's messages write it (`mbody.cli.common.number`, a layer
-    above this one): a whole number below 10^12 in full, its thousands apart; else as %g
-    writes it, with its exponent as people write it (1e9)."""
-    if isinstance(x, int) and abs(x) < 10**12:
-        return f"{x:,}".replace(",", " ")
-    return re.sub(r"e\+?(-?)0*(\d)", r"e\1\2", f"{float(x):g}")
-
-
-LIMITS = {
-    "samples": Limit("--samples", "samples", "a number of cases", 1, 1e8, integer=True),
-    "seed": Limit("--seed", "seed", "a seed", 0, 2**63 - 1, integer=True),
-    "t_end": Limit("--t-end", "t_end", "a time in seconds", 0.0, 1e9, lo_open=True),
-    "revolutions": Limit("--t-end", "revolutions", "a number of turns", 0.0, 1e6,
-                         lo_open=True),
-    "steps": Limit("--steps", "steps", "a number of instants", 2, 1e6, integer=True),
-    "fps": Limit("--fps", "fps", "samples per second", 0.0, 1e6, lo_open=True),
-    "workers": Limit("--workers", "workers", "a number of worker processes", 0, 4096,
-                     integer=True),
-    "chunk": Limit("--chunk", "chunk", "a number of cases", 1, 1e8, integer=True),
-}
-"""`run_sweep`'s numeric arguments, by name: the command's ranges (its argparse types; a
-test keeps them equal)."""
 
 
 class SweepInterrupted(KeyboardInterrupt):
@@ -105,6 +53,10 @@ class SweepInterrupted(KeyboardInterrupt):
         super().__init__(f"{kept} of {cases} cases kept in {journal}; the same sweep "
                          "resumes")
         self.kept, self.cases, self.journal = kept, cases, journal
+
+
+_YES_NO = {"true": 1.0, "false": 0.0}
+"""A yes-or-no cell's number (`SweepResult.column`)."""
 
 
 @dataclass(frozen=True)
@@ -172,12 +124,15 @@ class SweepResult:
         return sum(1 for e in self.errors if e)
 
     def column(self, name: str) -> np.ndarray:
-        """One column's numbers, by case (NaN where a case has none).
+        """One column's numbers, by case (NaN where a case has none; a yes-or-no column,
+        ``steady`` or ``stable``, as 1.0 for true and 0.0 for false).
 
         Parameters
         ----------
         name : str
-            A column of `header` (``frequency:1``, ``peak:motor.M``, a varied path).
+            A column of `header` (``frequency:1``, ``peak:motor.M``, a varied path); a
+            varied path whose values were given in a unit is found without it too
+            (``drivers.motor.speed`` for ``drivers.motor.speed [rpm]``).
 
         Returns
         -------
@@ -188,24 +143,31 @@ class SweepResult:
         KeyError
             No such column.
         MbodyError
-            The column holds text (``error``, ``settings``, values listed with a unit):
-            read it from `rows`.
+            The column holds text (``error``, ``settings``, values listed that are not
+            numbers in one unit: expressions, units that differ): read it from `rows`.
         """
-        if name not in self.header:
-            hint = did_you_mean(name, self.header) or f"the columns: {', '.join(self.header)}"
-            raise KeyError(f"no column {name!r}; {hint}")
-        at = self.header.index(name)
+        at = self._index(name)
         out = np.full(len(self.rows), np.nan)
         for k, row in enumerate(self.rows):
             cell = row[at]
             if not cell:
                 continue
             try:
-                out[k] = float(cell)
+                out[k] = _YES_NO[cell] if cell in _YES_NO else float(cell)
             except ValueError:
                 raise MbodyError(f"column {name!r} holds text ({cell!r} in case {row[0]}), "
                                  "not numbers: read it from rows") from None
         return out
+
+    def _index(self, name: str) -> int:
+        """Where column `name` is in `header` (a varied path also without its unit)."""
+        if name in self.header:
+            return self.header.index(name)
+        with_unit = [k for k, h in enumerate(self.header)
+                     if h.startswith(f"{name} [") and h.endswith("]")]
+        if len(with_unit) == 1:
+            return with_unit[0]
+        raise not_found("column", name, self.header, "columns")
 
     def __repr__(self) -> str:
         failed = self.failed
@@ -293,7 +255,7 @@ def run_sweep(model: Model | str | os.PathLike[str],
               values: Mapping[str, Any] | Sequence[str] | str,
               out: str | os.PathLike[str], *, run: str = "solve",
               t_end: float | None = None, revolutions: float | None = None,
-              steps: int = 101, fps: float = 60.0, equilibrium: bool = False,
+              steps: int | None = None, fps: float = 60.0, equilibrium: bool = False,
               samples: int | None = None, seed: int = 0, workers: int | None = None,
               scheduler: str | None = None, chunk: int | None = None,
               progress: bool = False, force: bool = False) -> SweepResult:
@@ -326,15 +288,19 @@ def run_sweep(model: Model | str | os.PathLike[str],
         The results: ``.csv``, or ``.parquet`` (pyarrow, in the ``sweep`` extra).
     run : {"solve", "kinematics", "simulate", "modes"}
         What each case computes (``--run``): a solve at its initial state; the kinematic
-        analysis and a solve at `steps` instants; `mbody.simulate`; the natural
+        analysis and a solve at each instant (`steps`); `mbody.simulate`; the natural
         frequencies.
     t_end : float, optional
         ``kinematics`` and ``simulate``: the end (s).
     revolutions : float, optional
         Or the end in turns of the first driver that turns, at each case's own rate
         (``--t-end "1 rev"`` is ``revolutions=1``).
-    steps : int
-        ``kinematics``: the instants from 0 to the end, both included.
+    steps : int, optional
+        ``kinematics``: this many instants evenly spaced from 0 to the end, both
+        included. By default each case is sampled as ``mbody kinematics`` samples it:
+        360 times a revolution of the first driver at the case's own rate when it turns
+        at a constant rate, else 100 times a second
+        (`mbody.simulate.kinematic.default_fps`), and at the end itself.
     fps : float
         ``simulate``: samples per second.
     equilibrium : bool
@@ -369,13 +335,16 @@ def run_sweep(model: Model | str | os.PathLike[str],
     Raises
     ------
     MbodyError
-        A bad argument, before any case runs, with the command's message: the output's
-        extension, a malformed range, a path the model file does not have (located, with
-        a did-you-mean), settings the run or the model cannot take (``kinematics``
-        without an end, of a model not fully driven), an output that is the model's file
-        (however named) or a folder, an output holding another sweep's rows or rows
-        computed with other settings (without `force`); or a cluster that cannot be
-        started or reached.
+        A bad argument, before any case runs, with the command's message (an entry of
+        a `values` mapping named as its key, ``values['bodies.rod.mass']``, where the
+        command says ``--set bodies.rod.mass``): the output's extension, a malformed
+        range, a value listed that is not finite (NaN, inf), a path given twice, a path
+        the model file does not have (located, with a did-you-mean), `equilibrium`,
+        `progress` or `force` not True or False, settings the run or the model cannot
+        take (``kinematics`` without an end, of a model not fully driven), an output
+        that is the model's file (however named) or a folder, an output holding another
+        sweep's rows or rows computed with other settings (without `force`); or a
+        cluster that cannot be started or reached.
     SweepInterrupted
         An interruption (a `KeyboardInterrupt`): the rows so far are kept, and the same
         call resumes.
@@ -388,6 +357,11 @@ def run_sweep(model: Model | str | os.PathLike[str],
     if t_end is not None and revolutions is not None:
         raise MbodyError("give the end in seconds (t_end) or in turns (revolutions), not "
                          "both")
+    for keyword, value in (("equilibrium", equilibrium), ("force", force),
+                           ("progress", progress)):
+        if not isinstance(value, bool | np.bool_):  # 'no' would be taken as True
+            raise MbodyError(f"{option_name(keyword)}: expected True or False, got "
+                             f"{value!r}")
     if scheduler is not None and not isinstance(scheduler, str):
         raise MbodyError(f"{option_name('scheduler')}: expected an address such as "
                          f"tcp://HOST:PORT, got {scheduler!r}")

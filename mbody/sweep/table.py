@@ -1,8 +1,9 @@
 """A sweep's results file: one row per case, ``case``, the varied paths (named as given),
 the outputs (``<quantity>:<label>``), ``error`` (empty, or why the case has no numbers),
 then ``settings`` (how the row was computed: `mbody.sweep.record`), sorted by case. CSV
-(numbers as Python writes them: read back, each is the same double) or Parquet
-(``.parquet``; needs pyarrow, in the ``sweep`` extra).
+(numbers as Python writes them: read back, each is the same double; a yes-or-no column,
+`mbody.sweep.modes.FLAGS`, as ``true`` or ``false``) or Parquet (``.parquet``, its
+yes-or-no columns boolean; needs pyarrow, in the ``sweep`` extra).
 
 Nothing is lost on the way: rows are appended, as chunks finish, to a journal beside
 the output (``<out>.partial``, CSV, flushed per chunk), and the output itself is written
@@ -27,11 +28,12 @@ from typing import Any
 
 import numpy as np
 
-from mbody.errors import MbodyError
+from mbody.errors import MbodyError, OutputError
 from mbody.sweep.grid import Grid
+from mbody.sweep.modes import FLAGS
 from mbody.sweep.record import SETTINGS, differences
 from mbody.sweep.runs import Rows
-from mbody.util.atomic import ensure_writable, refuse_special, write_atomic
+from mbody.util.atomic import ensure_writable, make_folders, refuse_special, write_atomic
 
 FORMATS = {".csv": "csv", ".parquet": "parquet"}
 """The output's formats, by its extension."""
@@ -58,7 +60,8 @@ def journal_of(path: str | os.PathLike[str]) -> Path:
 
 
 def cell(value: Any) -> str:
-    """A value as the CSV holds it: a number as Python writes it (exact), NaN empty."""
+    """A value as the CSV holds it: a number as Python writes it (exact), NaN empty, a
+    bool ``true`` or ``false``."""
     if isinstance(value, bool):
         return str(value).lower()
     if isinstance(value, float | np.floating):
@@ -100,7 +103,8 @@ class Results:
         self.outputs = list(outputs)
         self.settings = settings
         self.force = force
-        self.header = ["case", *grid.paths, *outputs, ERROR, SETTINGS]
+        self.header = ["case", *grid.columns, *outputs, ERROR, SETTINGS]
+        self._flags = [name in FLAGS for name in outputs]
         self.rows: dict[int, list[str]] = {}
         self.journal = journal_of(path)
         ensure_writable(self.path)  # a folder, a socket: refused before any case runs
@@ -222,8 +226,20 @@ class Results:
     # -- adding and writing ----------------------------------------------------------------
     def add(self, rows: Rows) -> None:
         """A chunk's rows, kept and appended to the journal (flushed)."""
+        try:
+            self._append(rows)
+        except OutputError:
+            raise
+        except OSError as exc:  # a full disk, a quota: the journal beside --out
+            raise OutputError(f"cannot write {str(self.journal)!r}, the journal beside "
+                              f"the output {self.path}: {exc.strerror or exc}", exc,
+                              str(self.journal)) from None
+
+    def _append(self, rows: Rows) -> None:
         if self._out is None:
-            self.journal.parent.mkdir(parents=True, exist_ok=True)  # the output's folder
+            # the output's folder, as writing the output would make it: a folder that
+            # cannot be made is the output's problem, and named so
+            make_folders(self.path, self.journal.parent)
             # a journal holding rows of another sweep (dropped with force) is begun anew,
             # with the rows kept so far: it never holds two sweeps' rows
             fresh = (self._stale_journal or not self.journal.exists()
@@ -240,7 +256,9 @@ class Results:
             if case in self.rows:  # a chunk run twice (a worker lost after it finished)
                 continue
             row = [str(case), *(cell(x) for x in self.grid.numbers(case)),
-                   *(cell(x) for x in out.tolist()), err or "", self.settings]
+                   *(flag(x) if yes_no else cell(x)
+                     for x, yes_no in zip(out.tolist(), self._flags, strict=True)),
+                   err or "", self.settings]
             self.rows[case] = row
             self._writer.writerow(row)
         self._out.flush()
@@ -267,6 +285,12 @@ class Results:
                          binary=True)
         self.journal.unlink(missing_ok=True)
         return self.path
+
+
+def flag(value: float) -> str:
+    """A yes-or-no output (1.0 or 0.0 in a chunk's rows, NaN for none) as the CSV holds
+    it: ``true``, ``false`` or empty."""
+    return "" if math.isnan(value) else cell(bool(value))
 
 
 def _same(a: str, b: str) -> bool:
@@ -304,6 +328,9 @@ def _write_parquet(fh: Any, header: list[str], rows: list[list[str]]) -> None:
             columns[name] = pa.array([int(x) for x in texts], pa.int64())
         elif name in (ERROR, SETTINGS):
             columns[name] = pa.array(texts, pa.string())
+        elif name in FLAGS:
+            columns[name] = pa.array([None if not x else x == "true" for x in texts],
+                                     pa.bool_())
         else:
             try:
                 columns[name] = pa.array([float(x) if x else math.nan for x in texts],

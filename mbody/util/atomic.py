@@ -223,17 +223,21 @@ def refuse_overwriting_inputs(outputs: Iterable[tuple[str, str]],
                                  "or --force to replace it")
 
 
-def _make_folders(target: Path, folder: Path) -> list[Path]:
-    """Make `folder` with its missing parents; return those made (deepest first)."""
+def make_folders(target: str | os.PathLike[str], folder: Path) -> list[Path]:
+    """Make `folder` (where `target`, or a file beside it, is written) with its missing
+    parents; return those made (deepest first). A folder that cannot be made is an
+    `OutputError` naming `target`, the output the user gave."""
     try:
         missing = _missing_folders(folder)
         folder.mkdir(parents=True, exist_ok=True)
     except MbodyError as exc:
         raise MbodyError(f"cannot write {str(target)!r}: {exc}") from None
     except OSError as exc:
-        raise MbodyError(f"cannot write {str(target)!r}: cannot make the folder "
-                         f"{str(folder)!r} ({exc.strerror or exc})") from None
+        raise OutputError(f"cannot write {str(target)!r}: cannot make the folder "
+                          f"{str(folder)!r} ({exc.strerror or exc})", exc, str(folder)
+                          ) from None
     return missing
+
 
 
 def _remove_folders(made: list[Path]) -> None:
@@ -261,7 +265,7 @@ def atomic_path(target: str | os.PathLike[str], suffix: str = "") -> Iterator[Pa
     how, real = _plan(target)
     made: list[Path] = []
     if how == "rename":
-        made = _make_folders(target, real.parent)
+        made = make_folders(target, real.parent)
         where: str | None = str(real.parent)
     else:  # written through: the whole output is made first, away from the device
         where = None
@@ -417,7 +421,7 @@ def atomic_folder(target: str | os.PathLike[str]) -> Iterator[Path]:
     if target.exists() and not target.is_dir():
         raise MbodyError(f"{target}: exists and is not a folder")
     parent = target.parent if str(target.parent) else Path(".")
-    made = _make_folders(target, parent)
+    made = make_folders(target, parent)
     try:
         tmp = Path(tempfile.mkdtemp(prefix=_prefix(target), dir=parent))
     except OSError as exc:

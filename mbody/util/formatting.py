@@ -3,6 +3,8 @@ rounding noise as 0."""
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 
 
@@ -11,6 +13,16 @@ def num(x: float) -> str:
     x = 0.0 if abs(x) < 1e-12 else x
     s = f"{x:.6g}"
     return "0" if s in ("-0", "0") else s
+
+
+def number(x: float) -> str:
+    """`x` as a message states a bound or a count: as %g writes it, with exponents as
+    people write them (1e9, 2.5e-13); an int below 10^12 in full, its thousands apart
+    (10 000 000)."""
+    if isinstance(x, int) and abs(x) < 10**12:
+        return f"{x:,}".replace(",", " ")
+    x = float(x)
+    return re.sub(r"e\+?(-?)0*(\d)", r"e\1\2", f"{x:g}")
 
 
 def vec(x: np.ndarray, dim: int) -> str:
