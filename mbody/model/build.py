@@ -154,8 +154,8 @@ def joint_tables(dimension: int, js: JointSpecTable, names: tuple[str, ...],
                                            np.arange(len(row_joint)) - first[row_joint]]
     free_turn = np.array([any(c.kind == TILT for c in registry[typ].components)
                           for typ in types], dtype=bool)
-    directed = js.has_axis | np.array([_default_axis(registry[typ]) for typ in types],
-                                      dtype=bool).reshape(nj)
+    defaults = {typ: _default_axis(registry[typ]) for typ in set(types)}
+    directed = js.has_axis | np.array([defaults[typ] for typ in types], dtype=bool).reshape(nj)
     per_joint = JointTable(tuple(js.names), p, c, readonly(B_r_child), readonly(B_r_parent),
                            readonly(P_E), readonly(C_E), readonly(C_axis2), first, link, p_particle,
                            readonly(length), free_turn, readonly(js.pitch),
