@@ -87,3 +87,14 @@ def test_equilibrium_prints_the_rest_angle_as_zero(pendulum, capsys):
     angle = 2 * math.atan2(q[3], q[0])
     assert angle != 0.0 and abs(angle) < 1e-8  # kept as solved: the solver's tolerance
 
+
+def test_check_says_the_file_pose_needs_no_assembly(tmp_path, capsys):
+    path = tmp_path / "holds.yaml"
+    path.write_text("dimension: 2\ngravity: [0, -9.81]\n"
+                    "bodies: [{name: rod, mass: 1, inertia: 0.1, position: [0.5, 0]}]\n"
+                    "joints: [{name: O, type: revolute, parent: ground, child: rod, "
+                    "at: [[0, 0], [-0.5, 0]]}]\n")
+    assert main(["check", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert ("assembled pose: the file's pose already satisfies every joint and driver at "
+            "t = 0\n") in out

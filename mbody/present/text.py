@@ -102,7 +102,8 @@ def model_summary(model: Model, topo: Topology) -> str:
     if model.file_state is not None:  # assembled at load (joint points per body, drivers)
         moved = assembly_moves(model)
         out.append("assembled pose (every joint and driver holds at t = 0): "
-                   + ("; ".join(moved) if moved else "the file's pose already did"))
+                   + "; ".join(moved) if moved else "assembled pose: the file's pose already "
+                   "satisfies every joint and driver at t = 0")
         changed = assembly_velocity_changes(model)
         if changed:  # the drivers' rates, or velocities the joints did not allow
             out.append("assembled velocities (every joint's and driver's rate holds at "
