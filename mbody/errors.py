@@ -9,6 +9,7 @@ from __future__ import annotations
 import contextlib
 import difflib
 import numbers
+import re
 from collections.abc import Iterable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from contextvars import ContextVar
@@ -228,6 +229,41 @@ def synonym(word: str, choices: Sequence[str], synonyms: Mapping[str, str] | Non
     return None
 
 
+def name_list(names: Iterable[object], most: int = 5) -> str:
+    """The first `most` names, and how many more ('O, A, … 3 more')."""
+    texts = [str(n) for n in names]
+    more = len(texts) - most
+    return ", ".join(texts[:most]) + (f", … {more} more" if more > 0 else "")
+
+
+def not_found(what: str, name: object, names: Sequence[str], many: str,
+              none: str = "") -> KeyError:
+    """The one KeyError of every lookup by name: "no <what> <name!r>", then a did-you-mean,
+    else the names there are ("(the <many>: a, b, … 3 more)"), else `none` ("(there are no
+    <many>)" by default).
+
+    Parameters
+    ----------
+    what : str
+        What was looked for, as the message names it ("body named", "reaction component").
+    name : object
+        What was asked for.
+    names : sequence of str
+        The names there are.
+    many : str
+        Their plural ("bodies").
+    none : str, optional
+        What to say when there are none.
+    """
+    said = f"no {what} {name!r}"
+    hint = did_you_mean(name, names) if isinstance(name, str) else ""
+    if hint:
+        return KeyError(f"{said}; {hint}")
+    if len(names):
+        return KeyError(f"{said} (the {many}: {name_list(names)})")
+    return KeyError(f"{said} ({none or f'there are no {many}'})")
+
+
 def closest(word: str, choices: Iterable[str]) -> str | None:
     """The choice `word` was probably meant to be (`did_you_mean`'s), or None: one that
     differs only in case, else difflib's closest match when it is a misspelling rather
@@ -274,6 +310,13 @@ def _edits(a: str, b: str) -> int:
 
 _FLAGS: ContextVar[Mapping[str, str] | None] = ContextVar("mbody_option_flags", default=None)
 
+# How a message names an argument: each surface in its own spelling. The functions below
+# build a message's words for an argument; within `options_named` (the command line sets
+# it around every command, from the command's own options) they give the flag the user
+# typed (``--t-end``, ``--known A.Fx``), elsewhere the keyword of the Python call
+# (``t_end``, ``known['A.Fx']``). A keyword the command has no option for keeps its
+# Python spelling.
+
 
 @contextmanager
 def options_named(flags: Mapping[str, str]) -> Iterator[None]:
@@ -287,11 +330,40 @@ def options_named(flags: Mapping[str, str]) -> Iterator[None]:
         _FLAGS.reset(token)
 
 
-def option_name(keyword: str, value: str = "") -> str:
-    """How a message names the option `keyword` (set to `value`, when that is what it
-    advises): its flag on the command line (`options_named`: ``--floating-base``), else
-    the keyword argument of the call (``floating_base=True``)."""
+def option_name(keyword: str, value: str = "", typed: str = "") -> str:
+    """How a message names the option `keyword` (set to `value` in Python, `typed` on the
+    command line, when that is what it advises): its flag on the command line
+    (`options_named`: ``--floating-base``; ``--samples N`` with `typed` ``"N"``), else
+    the keyword argument of the call (``floating_base=True``, ``samples=N``)."""
     flag = (_FLAGS.get() or {}).get(keyword)
     if flag is not None:
-        return flag
+        return f"{flag} {typed}" if typed else flag
     return f"{keyword}={value}" if value else keyword
+
+
+def option_names() -> dict[str, str]:
+    """The flags `options_named` set around this call ({} outside a command): what a
+    piece of work done elsewhere (a sweep's cases on a cluster's workers) names its
+    arguments by, to say it as the caller would."""
+    return dict(_FLAGS.get() or {})
+
+
+def option_setting(keyword: str, value: object) -> str:
+    """The option `keyword` set to `value`, as a message says what was given or advises:
+    ``--max-steps 1000`` on the command line (a switch, `value` True, by its flag alone:
+    ``--equilibrium``), ``max_steps=1000`` in Python (text quoted as Python writes it:
+    ``method='Radau'``; a float as %g writes it, its exponent as people write it:
+    ``1e-6``)."""
+    flag = (_FLAGS.get() or {}).get(keyword)
+    shown = (re.sub(r"e\+?(-?)0*(\d)", r"e\1\2", f"{value:g}") if isinstance(value, float)
+             else str(value))
+    if flag is None:
+        return f"{keyword}={value!r}" if isinstance(value, str) else f"{keyword}={shown}"
+    return flag if value is True else f"{flag} {shown}"
+
+
+def option_entry(keyword: str, key: str) -> str:
+    """One entry of a mapping argument, as a message names it: ``--known A.Fx`` on the
+    command line (a repeatable NAME=VALUE option), ``known['A.Fx']`` in Python."""
+    flag = (_FLAGS.get() or {}).get(keyword)
+    return f"{flag} {key}" if flag is not None else f"{keyword}[{key!r}]"

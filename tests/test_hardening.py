@@ -508,7 +508,7 @@ def test_a_known_reaction_given_to_simulate_is_checked_too():
     assert str(err.value) == ("the known reaction fork.Fx = \"log(0.5-t)\" is not finite at "
                               "t = 0.5 s (-inf), within the simulated span 0 .. 1 s: the "
                               "integration could not go past it. Change the expression, or "
-                              "simulate a shorter span (--t-end below 0.5).")
+                              "simulate a shorter span (t_end below 0.5).")
 
 
 def test_a_singularity_between_samples_is_named_when_the_run_stops(tmp_path, capsys):

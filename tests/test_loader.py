@@ -16,6 +16,7 @@ import yaml
 import mbody
 from mbody.errors import Issue, ModelError
 from mbody.model import loader
+from mbody.util.budget import byte_budget, byte_limit
 
 MODELS = Path(__file__).resolve().parent.parent / "models"
 
@@ -203,7 +204,7 @@ def test_max_bytes_on_the_command_line(tmp_path, capsys):
     assert "mbody reads at most 4 KiB" in err and "--max-bytes N" in err
     assert main(["check", str(path), "--max-bytes", "1M"]) == 0
     assert main(["check", str(path), "--max-bytes", "20000"]) == 0
-    assert loader._LIMIT.get() == loader.MAX_BYTES  # set around the command only
+    assert byte_limit(None, loader.MAX_BYTES) == loader.MAX_BYTES  # set around the command only
 
 
 @pytest.mark.parametrize("text, size", [("100", 100), ("4k", 4096), ("200M", 200 * 2**20),
@@ -238,10 +239,10 @@ def test_every_command_that_reads_a_model_takes_max_bytes():
 def test_max_bytes_limit_is_scoped(tmp_path):
     path = tmp_path / "m.yaml"
     path.write_text("dimension: 2\n" + BODY + "# padding\n" * 1000)
-    with loader.max_bytes_limit(1000), pytest.raises(ModelError, match="at most"):
+    with byte_budget(1000), pytest.raises(ModelError, match="at most"):
         mbody.load(path)
     assert mbody.load(path).n == 1
-    with loader.max_bytes_limit(1000):
+    with byte_budget(1000):
         assert mbody.load(path, max_bytes=10**6).n == 1  # the call's own limit wins
 
 

@@ -20,7 +20,7 @@ import mbody
 from mbody.cli import main
 from mbody.errors import MbodyError, ModelError, TrajectoryFileError
 from mbody.simulate.trajectory import Trajectory
-from mbody.util.npzfile import data_bytes_limit
+from mbody.util.budget import byte_budget
 
 MODELS = Path(__file__).resolve().parent.parent / "models"
 MIB = 1 << 20
@@ -215,11 +215,11 @@ def test_a_member_over_the_budget_is_refused_before_it_is_inflated(run_data, tmp
     16 MiB budget it is refused from the zip directory, before anything is inflated."""
     run = bomb(tmp_path / "bomb.npz", run_data, 8 * MIB)
     assert run.stat().st_size < MIB
-    with data_bytes_limit(16 * MIB), pytest.raises(TrajectoryFileError) as exc:
+    with byte_budget(16 * MIB), pytest.raises(TrajectoryFileError) as exc:
         Trajectory.load(run)
     assert str(exc.value).startswith(f"{run}: holds 64 MiB of data once inflated")
     assert "at most 16 MiB is read" in str(exc.value) and "--max-bytes N" in str(exc.value)
-    with data_bytes_limit(16 * MIB):
+    with byte_budget(16 * MIB):
         assert peak_bytes(Trajectory.load, run) < 4 * MIB
     with pytest.raises(TrajectoryFileError, match="at most 1 KiB"):
         Trajectory.load(tmp_path / "bomb.npz", max_bytes=1024)

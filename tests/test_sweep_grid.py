@@ -41,4 +41,4 @@ def test_a_grid_too_large_is_refused_from_its_counts(monkeypatch, specs, cases):
         parse_grid(specs)
     assert MAX_CASES == 100_000_000
     assert str(info.value) == (f"the sweep has {cases} cases; at most 100 000 000 are run "
-                               "(fewer values per axis, or --samples N)")
+                               "(fewer values per axis, or samples=N)")  # Python's spelling

@@ -26,6 +26,7 @@ import mbody
 from mbody.errors import MbodyError
 from mbody.sweep import cluster
 from mbody.sweep.grid import parse_grid
+from mbody.sweep.record import record
 from mbody.sweep.runs import Job, Settings, check_settings, columns
 from mbody.sweep.table import Results
 
@@ -57,7 +58,7 @@ def sweep_here(model: mbody.Model, specs: list[str], settings: Settings, out: Pa
                ) -> tuple[list[str], list[dict[str, str]]]:
     """The sweep run in this process through the Python API; rows as {column: cell}."""
     job = Job(model.source, parse_grid(specs), settings, uuid.uuid4().hex)
-    results = Results(out, columns(model, settings), job.grid)
+    results = Results(out, columns(model, settings), job.grid, record(settings, model))
     cluster.run(job, range(len(job.grid)), results, workers=0, progress=False)
     results.finish()
     header, rows = read(out)
@@ -81,7 +82,8 @@ def test_about_the_initial_state_the_rows_say_it_is_not_an_equilibrium(tmp_path)
     pend = mbody.load(PENDULUM)
     header, rows = sweep_here(pend, ["bodies.rod.mass=1:3:3"], Settings("modes"),
                               tmp_path / "m.csv")
-    assert header == ["case", "bodies.rod.mass", "frequency:1", "steady", "stable", "error"]
+    assert header == ["case", "bodies.rod.mass", "frequency:1", "steady", "stable", "error",
+                      "settings"]
     for row in rows:
         case = pend.with_values({"bodies.rod.mass": float(row["bodies.rod.mass"])})
         lin = mbody.linearize(case)
@@ -101,7 +103,7 @@ def test_about_the_equilibrium_the_rows_give_the_natural_frequency(tmp_path):
                               Settings("modes", equilibrium=True), tmp_path / "e.csv")
     assert header == ["case", "bodies.rod.mass", "frequency:1", "steady", "stable",
                       "equilibrium:rod.x", "equilibrium:rod.y", "equilibrium:rod.theta",
-                      "error"]
+                      "error", "settings"]
     for row in rows:
         case = pend.with_values({"bodies.rod.mass": float(row["bodies.rod.mass"])})
         rest = mbody.equilibrium(case)
@@ -180,7 +182,7 @@ def test_a_case_without_an_equilibrium_is_a_row_with_mbody_equilibriums_message(
 
 def test_equilibrium_goes_with_the_modes_run_only():
     pend = mbody.load(PENDULUM)
-    with pytest.raises(MbodyError, match="--equilibrium goes with --run modes"):
+    with pytest.raises(MbodyError, match="^equilibrium=True goes with run='modes'"):
         check_settings(pend, Settings("solve", equilibrium=True))
     check_settings(pend, Settings("modes", equilibrium=True))
 
@@ -252,8 +254,9 @@ def test_a_local_cluster_gives_the_numbers_of_this_process(tmp_path):
     got_header, got = read(out)
     assert got_header == header and len(got) == len(here) == 6
     for a, b in zip(got, here, strict=True):
-        x = np.array([float(c) for c in a[1:-1]])
-        y = np.array([float(b[c]) for c in header[1:-1]])
-        assert a[0] == b["case"] and a[-1] == b["error"] == ""
+        x = np.array([float(c) for c in a[1:-2]])
+        y = np.array([float(b[c]) for c in header[1:-2]])
+        assert a[0] == b["case"] and a[-2] == b["error"] == ""
+        assert a[-1] == b["settings"]
         # the same computation in another process: equal up to its rounding
         assert np.abs(x - y).max() <= 1e-12 * np.abs(y).max()

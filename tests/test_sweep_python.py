@@ -1,7 +1,8 @@
 """`mbody.run_sweep`, a whole sweep from Python, is what `mbody sweep` runs: the same rows
 as the command for the same sweep (solve, kinematics, modes; in this process and on a
 local cluster), a resumed output from Python, bad arguments refused with the command's
-messages before any case runs, and the warnings returned, not printed."""
+messages before any case runs (each naming the arguments in its own spelling: ``--steps``
+on the command line, ``steps`` in Python), and the warnings returned, not printed."""
 
 from __future__ import annotations
 
@@ -13,8 +14,8 @@ import pytest
 
 import mbody
 import mbody.cli
-from mbody.cli.app import build_parser
-from mbody.errors import MbodyError
+from mbody.cli.app import build_parser, option_flags
+from mbody.errors import MbodyError, options_named
 from mbody.simulate.peaks import SPARSE
 from mbody.sweep import cluster, runs
 from mbody.sweep.study import LIMITS, SweepInterrupted, SweepResult
@@ -44,6 +45,15 @@ def cli_rows(tmp_path: Path, model: Path, specs: list[str], *options: str
     return (*read(out), p.stderr)
 
 
+def as_the_command_names_them():
+    """Within the block, messages name run_sweep's arguments as `mbody sweep` does (what
+    `mbody.cli.app.main` sets around the command): ``--set``, ``--steps``, ``--t-end``."""
+    parser = build_parser()
+    args = parser.parse_args(["sweep", "m.yaml", "--set", "x=1", "--out", "o.csv"])
+    return options_named(option_flags(parser._subparsers._group_actions[0].choices["sweep"],
+                                      args))
+
+
 def printed(warnings: list[str]) -> str:
     """What the command writes on standard error for these warnings."""
     return "".join(f"mbody: warning: {w}\n" for w in warnings)
@@ -66,8 +76,11 @@ def test_the_rows_are_the_commands(driven_file, tmp_path, specs, options, kw):
     assert read(result.path) == (header, rows) and result.path == tmp_path / "py.csv"
     assert len(result) == result.ran == 6 and result.kept == 0 and result.failed == 0
     assert result.errors == [None] * 6
-    # 10 instants over 0.05 s: the 240 rad/s cases turn 1.9 times, 5 samples a turn
-    assert len(result.warnings) == ("t_end" in kw) and stderr == printed(result.warnings)
+    # 10 instants over 0.05 s: the 240 rad/s cases turn 1.9 times, 5 samples a turn; the
+    # command names the option it advises as typed (--steps 12), Python the keyword
+    assert len(result.warnings) == ("t_end" in kw)
+    assert stderr == printed(result.warnings).replace("Use steps=", "Use --steps ")
+    assert "--" not in "".join(result.warnings)
     assert result.report.cases == 6 and result.report.where == "this process"
 
 
@@ -198,33 +211,37 @@ def test_bad_arguments_are_refused_with_the_commands_message(driven_file, tmp_pa
     model = kw.pop("model", driven_file)
     given = {"values": [a for a in args[1:2]], "out": tmp_path / "refused.csv", **kw}
     said = refused_by_the_command(tmp_path, model, *args)
-    with pytest.raises(MbodyError) as refused:
+    with as_the_command_names_them(), pytest.raises(MbodyError) as refused:
         mbody.run_sweep(model, workers=0, **given)
     assert str(refused.value) == said
+    with pytest.raises(MbodyError) as refused:  # Python names the keywords it was given
+        mbody.run_sweep(model, workers=0, **given)
+    assert not any(f in str(refused.value) for f in ("--set", "--seed", "--samples",
+                                                     "--equilibrium", "--run", "--t-end"))
     assert not (tmp_path / "refused.csv").exists()
     assert not (tmp_path / "refused.csv.partial").exists()
 
 
 @pytest.mark.parametrize(("kw", "pattern"), [
-    ({"steps": 1}, "--steps: expected a number of instants from 2 to 1 000 000 "
+    ({"steps": 1}, "^steps: expected a number of instants from 2 to 1 000 000 "
                    r"\(a whole number\), got 1"),
-    ({"steps": 10.5}, "--steps: expected"),
-    ({"t_end": 0.0}, "--t-end: expected a time in seconds above 0 up to 1e9, got 0.0"),
-    ({"t_end": math.nan}, "--t-end: expected"),
-    ({"revolutions": -1}, "--t-end: expected a number of turns above 0"),
+    ({"steps": 10.5}, "^steps: expected"),
+    ({"t_end": 0.0}, "^t_end: expected a time in seconds above 0 up to 1e9, got 0.0"),
+    ({"t_end": math.nan}, "^t_end: expected"),
+    ({"revolutions": -1}, "^revolutions: expected a number of turns above 0"),
     ({"t_end": 1.0, "revolutions": 1.0}, "in seconds .* or in turns .*not both"),
-    ({"fps": "60"}, "--fps: expected samples per second"),
-    ({"workers": -1}, "--workers: expected"),
-    ({"workers": True}, "--workers: expected"),
-    ({"chunk": 0}, "--chunk: expected a number of cases from 1"),
-    ({"samples": 0}, "--samples: expected a number of cases from 1"),
-    ({"seed": -1, "samples": 3}, "--seed: expected a seed from 0"),
+    ({"fps": "60"}, "^fps: expected samples per second"),
+    ({"workers": -1}, "^workers: expected"),
+    ({"workers": True}, "^workers: expected"),
+    ({"chunk": 0}, "^chunk: expected a number of cases from 1"),
+    ({"samples": 0}, "^samples: expected a number of cases from 1"),
+    ({"seed": -1, "samples": 3}, "^seed: expected a seed from 0"),
     ({"run": "simulation"}, "unknown run 'simulation'; expected one of solve, kinematics"),
     ({"values": [3]}, "expected a mapping path -> values .* got 3 \\(int\\)"),
     ({"values": {"bodies.rod.mass": []}}, "no values"),
     ({"model": 3}, "expected a Model or a model file's path, got int"),
     ({"out": None}, "the output: expected a file name"),
-    ({"scheduler": 8786}, "--scheduler: expected an address"),
+    ({"scheduler": 8786}, "^scheduler: expected an address"),
 ])
 def test_python_arguments_are_checked(driven_file, tmp_path, kw, pattern):
     given = {"model": driven_file, "values": {"bodies.rod.mass": [1, 2]},
@@ -267,7 +284,9 @@ def test_the_ranges_are_the_commands():
 def test_warnings_are_returned_and_the_command_prints_them(tmp_path):
     """A modes sweep about the release (not an equilibrium) and a kinematics sweep whose
     fast cases are sampled too sparsely: the result carries each warning; the command
-    prints the same text, once, as mbody: warning: ..."""
+    prints the same text, once, as mbody: warning: ..., naming the option it advises as
+    typed (--equilibrium, --steps 181) where Python names the keyword (equilibrium=True,
+    steps=181)."""
     modes = mbody.run_sweep(PENDULUM, {"gravity.1": [-9.81, -1.62]}, tmp_path / "m.csv",
                             run="modes", workers=0)
     assert len(modes.warnings) == 1
@@ -276,7 +295,9 @@ def test_warnings_are_returned_and_the_command_prints_them(tmp_path):
     assert np.isnan(modes.column("stable")).all()
     p = mbody_cli("sweep", str(PENDULUM), "--set", "gravity.1=-9.81,-1.62", "--run", "modes",
                   "--workers", "0", "--quiet", "--out", str(tmp_path / "mc.csv"))
-    assert p.returncode == 0 and p.stderr == f"mbody: warning: {modes.warnings[0]}\n"
+    assert "equilibrium=True linearises each" in modes.warnings[0]
+    assert p.returncode == 0 and p.stderr == "mbody: warning: " + modes.warnings[0].replace(
+        "equilibrium=True", "--equilibrium") + "\n"
 
     model = tmp_path / "driven.yaml"
     model.write_text(driven_text("600 rpm"))
@@ -284,7 +305,7 @@ def test_warnings_are_returned_and_the_command_prints_them(tmp_path):
     sparse = mbody.run_sweep(model, speeds, tmp_path / "k.csv", run="kinematics", t_end=0.1,
                              workers=0)
     (text,) = sparse.warnings
-    assert text.startswith(f"{SPARSE}: motor turns at 3000 rpm") and "--steps 181" in text
+    assert text.startswith(f"{SPARSE}: motor turns at 3000 rpm") and "steps=181" in text
     assert text == runs.sampling_warning(runs.Settings("kinematics", 0.1), _grid(speeds),
                                          sparse.report.sparse, sparse.report.cases,
                                          sparse.report.sparsest)
@@ -292,7 +313,8 @@ def test_warnings_are_returned_and_the_command_prints_them(tmp_path):
     p = mbody_cli("sweep", str(model), "--set", "drivers.motor.speed=300 rpm:3000 rpm:4",
                   "--run", "kinematics", "--t-end", "0.1", "--workers", "0", "--quiet",
                   "--out", str(tmp_path / "kc.csv"))
-    assert p.returncode == 0 and p.stderr == f"mbody: warning: {text}\n"
+    assert p.returncode == 0 and p.stderr == "mbody: warning: " + text.replace(
+        "steps=181", "--steps 181") + "\n"
     enough = mbody.run_sweep(model, speeds, tmp_path / "k181.csv", run="kinematics",
                              t_end=0.1, steps=181, workers=0)
     assert enough.warnings == []
@@ -352,11 +374,12 @@ def test_a_parquet_output_from_python(driven_file, tmp_path):
     csv = mbody.run_sweep(driven_file, GRID, tmp_path / "r.csv", workers=0)
     table = pq.read_table(result.path)
     assert table.column_names == result.header == csv.header
-    for i, name in enumerate(result.header[:-1]):
+    for i, name in enumerate(result.header[:-2]):
         assert table.column(name).to_pylist() == floats([r[i] for r in csv.rows]).tolist()
+    assert table.column("settings").to_pylist() == [csv.settings] * 6
     again = mbody.run_sweep(driven_file, GRID, tmp_path / "r.parquet", workers=0)
     assert again.ran == 0 and again.kept == 6
-    for name in result.header[1:-1]:
+    for name in result.header[1:-2]:
         assert again.column(name).tolist() == csv.column(name).tolist()
 
 
@@ -370,5 +393,6 @@ def test_a_local_cluster_from_python(driven_file, tmp_path):
     assert there.report.where == "a local cluster of 1 worker processes"
     assert there.header == here.header
     for a, b in zip(there.rows, here.rows, strict=True):
-        x, y = floats(a[3:-1]), floats(b[3:-1])
+        x, y = floats(a[3:-2]), floats(b[3:-2])
         assert a[:3] == b[:3] and np.abs(x - y).max() <= 1e-12 * np.abs(y).max()
+        assert a[-2:] == b[-2:] == ["", here.settings]

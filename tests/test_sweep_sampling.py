@@ -15,6 +15,7 @@ import mbody
 from mbody.simulate.peaks import PEAK_SAMPLES, SPARSE
 from mbody.sweep import cluster
 from mbody.sweep.grid import parse_grid
+from mbody.sweep.record import record
 from mbody.sweep.runs import Settings, columns, sampling_warning
 from mbody.sweep.table import Results
 from tests.test_sweep import SLIDER, driven_text, floats, job_of, mbody_cli, read
@@ -28,7 +29,7 @@ def sweep(tmp_path: Path, settings: Settings, text: str | None = None,
     model = mbody.loads(text or driven_text("600 rpm"), "driven.yaml")
     job = job_of(model, specs, settings)
     out = tmp_path / f"{uuid.uuid4().hex}.csv"
-    results = Results(out, columns(model, settings), job.grid)
+    results = Results(out, columns(model, settings), job.grid, record(settings, model))
     report = cluster.run(job, range(len(job.grid)), results, progress=False, workers=0)
     results.finish()
     return (report, *read(out))
@@ -53,7 +54,7 @@ def test_kinematics_cases_sampled_too_sparsely_are_counted(tmp_path):
     assert "case 3 (drivers.motor.speed=3000.0) has 20 samples a revolution" in text
     assert "2 of the 4 cases run" in text
     # 36 a revolution at 5 revolutions in 0.1 s: 5 * 36 intervals
-    assert "Use --steps 181 or more" in text
+    assert "Use steps=181 or more" in text  # from Python (the command: --steps 181, below)
 
 
 @pytest.mark.parametrize("steps, sparse", [(181, 0), (180, 1)])
@@ -68,7 +69,7 @@ def test_turns_give_every_case_the_same_samples_a_revolution(tmp_path):
     assert report.sparse == 4
     assert report.sparsest is not None
     assert report.sparsest.per_turn == pytest.approx(10.0, rel=1e-12)
-    assert "Use --steps 361 or more" in (warning(report, settings) or "")
+    assert "Use steps=361 or more" in (warning(report, settings) or "")
     report, _, _ = sweep(tmp_path, Settings("kinematics", revolutions=10.0, steps=361))
     assert report.sparse == 0
 
@@ -98,7 +99,7 @@ def test_simulate_cases_are_checked_at_their_fps(tmp_path):
     assert report.sparsest is not None and report.sparsest.case == 3
     assert report.sparsest.per_turn == pytest.approx(1.2, rel=1e-12)
     text = warning(report, settings) or ""
-    assert "can miss it entirely" in text and "Use --fps 1800 or more" in text
+    assert "can miss it entirely" in text and "Use fps=1800 or more" in text
     report, _, _ = sweep(tmp_path, Settings("simulate", 0.05, fps=PEAK_SAMPLES * 50.0))
     assert report.sparse == 0
 

@@ -101,9 +101,11 @@ def test_an_equation_not_linear_in_the_unknowns_is_said_so_with_its_term(tmp_pat
     lines = p.stdout.splitlines()
     verdicts = [lines[k + 1] for k, line in enumerate(lines) if line.startswith("[")]
     head = "    not_an_equation_of_this_body: not linear in the unknowns"
+    # an entry without a body (a Lagrange equation) has the model's label, not a body's
+    lagrange = "    not_an_equation_of_this_model: not linear in the unknowns"
     assert verdicts == [f"{head} (a_x squared)", f"{head} (a product of unknowns (alpha "
                         "times O.Fx))", f"{head} (a sum of unknowns (O.Fy, a_x) cubed)",
-                        f"{head} (O.angle_ddot to the power 0.5)"]
+                        f"{lagrange} (O.angle_ddot to the power 0.5)"]
     assert "it has a_x squared" in " ".join(p.stdout.split())
     doc = json.loads(mbody("verify", MODELS / "pendulum.yaml", answers, "--json").stdout)
     first = doc["equations"][0]

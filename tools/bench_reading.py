@@ -56,7 +56,7 @@ from timing import best  # noqa: E402
 
 import mbody  # noqa: E402
 from mbody.errors import MbodyError  # noqa: E402
-from mbody.model.loader import max_bytes_limit  # noqa: E402
+from mbody.util.budget import byte_budget  # noqa: E402
 
 MB = 2**20
 
@@ -157,7 +157,7 @@ def measure(make: Callable[[int], Input], size: int, repeat: int, folder: Path
     path = folder / f"input{item.suffix}"
     data = item.text.encode("utf-8")
     path.write_bytes(data)
-    with max_bytes_limit(max(len(data) + 1, 32 * MB)):
+    with byte_budget(max(len(data) + 1, 32 * MB)):
         seconds = best(lambda: item.read(path), repeat, budget=0.0)
     return len(data), seconds
 

@@ -53,7 +53,8 @@ class Check:
     line : int
         Its line in the answers file (0 when not from a file).
     diagnosis : str
-        One of `mbody.answers.diagnose.DIAGNOSES`.
+        A key of `MEANINGS`: one of `mbody.answers.diagnose.DIAGNOSES`, or of
+        `mbody.answers.lagrange.LAGRANGE_DIAGNOSES` for an equation of no body.
     expected : str
         The row it was compared with, as text ('' when none is close).
     row : str
@@ -82,7 +83,8 @@ class Check:
     @property
     def meaning(self) -> str:
         """What the diagnosis means here: its `MEANINGS` entry, or, for an equation that
-        is not linear in the unknowns (``not_an_equation_of_this_body`` with
+        is not linear in the unknowns (``not_an_equation_of_this_body``, or
+        ``not_an_equation_of_this_model`` for one of no body, with
         ``details["not_linear"]``), that and the term: "not linear in the unknowns (a_x
         squared)"."""
         why = self.details.get("not_linear")

@@ -9,6 +9,7 @@ from mbody.cli.common import (
     EXIT_OK,
     MODEL_HELP,
     add_axes_option,
+    add_known_option,
     load_model,
     output_stream,
     output_suffix,
@@ -46,8 +47,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                        "G^T v_dot = gamma) and printed as a reaction table, with the backward "
                        "error, a condition estimate and any redundant constraints named.")
     s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
-    s.add_argument("--known", metavar="LABEL=VALUE", action="append", default=[],
-                   help="a known reaction value, e.g. --known A.Fx=3 (repeatable)")
+    add_known_option(s, "applied as a load", "taken at the state's time (t = 0 s for the "
+                     "model's initial state)")
     s.add_argument("--json", action="store_true", help="machine-readable output")
     add_axes_option(s)
     s.set_defaults(run=solve)

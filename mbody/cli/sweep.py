@@ -19,11 +19,6 @@ RUN_NAMES = ("solve", "kinematics", "simulate", "modes")
 """`mbody.sweep.runs.RUNS` (not imported at start-up; a test keeps them equal)."""
 
 
-UNRECORDED = {"kinematics": "--steps", "simulate": "--fps"}
-"""The runs whose settings (besides --t-end) change their numbers but not their columns,
-so that an output does not say which were used: the setting that is not --t-end."""
-
-
 def register(sub: argparse._SubParsersAction) -> None:
     s = sub.add_parser(
         "sweep", help="run a model over a grid of values (or random samples), on Dask",
@@ -32,10 +27,11 @@ def register(sub: argparse._SubParsersAction) -> None:
         "simulation, or the natural frequencies (with whether the state is an equilibrium "
         "and stable, as mbody modes says). One row per case in --out: the varied paths, "
         "then <quantity>:<label> columns (acceleration:, reaction:, final:, peak:, "
-        "frequency:; steady, stable) and error. Cases run on a local Dask cluster started "
+        "frequency:; steady, stable), error, and settings (the run, its settings that change "
+        "the numbers, and the model's digest). Cases run on a local Dask cluster started "
         "for the command (--workers), or on an existing one (--scheduler). An interrupted "
-        "sweep resumes: "
-        "the same command runs only the cases not in --out yet.")
+        "sweep resumes: the same command runs only the cases not in --out yet; rows of "
+        "other settings are refused (--force runs them again).")
     s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
     s.add_argument("--set", dest="grid", action="append", default=[], required=True,
                    metavar="PATH=START:STOP:COUNT",
@@ -76,7 +72,16 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "about 2 s of work)")
     s.add_argument("--quiet", action="store_true", help="no progress bar (there is one only "
                    "on a terminal)")
-    s.set_defaults(run=sweep)
+    s.add_argument("--force", action="store_true",
+                   help="run again, and replace, the rows of --out (and its journal) that "
+                   "are not this sweep's: computed with other settings (--run, --t-end, "
+                   "--steps, --fps, --equilibrium, the model's content) or other values, "
+                   "or written by an mbody that did not record the settings; without it "
+                   "such an output is refused. --out is never the model file, even so")
+    # --out is read back to resume, with the model: --force never lets it be the model
+    s.set_defaults(run=sweep, output_resumed=("--out",),
+                   keywords={"values": "--set", "run": "--run", "revolutions": "--t-end",
+                             "out": "--out"})
 
 
 def sweep(a: argparse.Namespace) -> int:
@@ -95,26 +100,27 @@ def sweep(a: argparse.Namespace) -> int:
                            revolutions=revs, steps=a.steps, fps=a.fps,
                            equilibrium=a.equilibrium, samples=a.samples, seed=a.seed,
                            workers=a.workers, scheduler=a.scheduler, chunk=a.chunk,
-                           progress=sys.stderr.isatty() and not a.quiet)
+                           progress=sys.stderr.isatty() and not a.quiet, force=a.force)
     except SweepInterrupted as exc:
         sys.stderr.write(f"mbody: interrupted: {exc.kept} of {exc.cases} cases kept in "
                          f"{exc.journal}; the same command resumes\n")
         raise
     failed = result.failed
+    notes = [f"{result.kept} kept from an earlier run with the same settings"] \
+        if result.kept else []
+    if result.replaced:
+        notes.append(f"{result.replaced} earlier rows of other settings or values "
+                     "replaced, as --force asks")
     print(f"wrote {result.path}: {len(result.rows)} cases, {result.ran} run now"
           + (f", {failed} failed (see their error column)" if failed else "")
-          # the output records the grid's values, not the run's settings: a rerun with
-          # another --t-end keeps the earlier rows as they are, so say so
-          + (f" ({result.kept} kept as the earlier run made them: the output does not "
-             f"record --t-end or {UNRECORDED[a.run_kind]}, so other values need another "
-             "--out)" if result.kept and a.run_kind in UNRECORDED else ""),
-          file=say)
+          + (f" ({'; '.join(notes)})" if notes else ""), file=say)
     if result.ran:
         print(result.report.text(), file=say)
     for warning in result.warnings:
         sys.stderr.write(f"mbody: warning: {warning}\n")
     if result.rows and failed == len(result.rows):  # nothing computed: say so, exit 1
-        case, first = next((r[0], r[-1]) for r in result.rows)
+        case, first = next((r[0], e) for r, e in zip(result.rows, result.errors,
+                                                      strict=True))
         sys.stderr.write(f"mbody: cannot solve: every case failed; case {case}: {first}\n")
         return EXIT_UNMET
     return EXIT_OK

@@ -485,7 +485,7 @@ class Trajectory(Frozen):
             A trajectory ``.npz`` file (format ``mbody-trajectory``, version at most
             `FORMAT_VERSION`).
         max_bytes : int, optional
-            The most data read, inflated (default `mbody.util.npzfile.DATA_BYTES`, 1 GiB,
+            The most data read, inflated (default `mbody.util.budget.DATA_BYTES`, 1 GiB,
             or the command line's ``--max-bytes``); a file that holds more is refused
             before any of it is inflated.
 

@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from mbody.errors import MbodyError
+from mbody.errors import MbodyError, option_entry, option_name
 from mbody.model.values import parse_assignment, parse_value, plain
 
 MAX_CASES = 100_000_000
@@ -177,7 +177,8 @@ def parse_grid(specs: Sequence[str], samples: int | None = None, seed: int = 0) 
         or more than `MAX_CASES` cases.
     """
     # each spec read as it comes: its errors in the order given
-    return _grid((parse_assignment(spec) for spec in specs), samples, seed)
+    return _grid((parse_assignment(spec, option_name("values")) for spec in specs), samples,
+                 seed)
 
 
 def grid_of(values: Mapping[str, Any] | Sequence[str] | str, samples: int | None = None,
@@ -246,13 +247,13 @@ def _grid(entries: Iterable[tuple[str, Any]], samples: int | None, seed: int) ->
     seen: set[str] = set()
     for path, value in entries:
         if path in seen:
-            raise MbodyError(f"--set {path} is given twice")
+            raise MbodyError(f"{option_entry('values', path)} is given twice")
         seen.add(path)
         if not isinstance(value, str):
             if not isinstance(value, list):
                 fixed[path] = value
             elif not value:
-                raise MbodyError(f"--set {path}: no values (an empty list)")
+                raise MbodyError(f"{option_entry('values', path)}: no values (an empty list)")
             else:
                 axes.append(Axis(path, tuple(value), listed=True))
             continue
@@ -262,21 +263,23 @@ def _grid(entries: Iterable[tuple[str, Any]], samples: int | None, seed: int) ->
             axes.append(_range(path, text, samples is not None))
         elif len(parts) > 1:
             if any(not p.strip() for p in parts):
-                raise MbodyError(f"--set {path}: an empty value in the list {text!r}")
+                raise MbodyError(f"{option_entry('values', path)}: an empty value in the list "
+                                 f"{text!r}")
             axes.append(Axis(path, tuple(parse_value(p, path) for p in parts), listed=True))
         else:
             fixed[path] = parse_value(text, path)
     if not axes:
-        raise MbodyError("a sweep varies at least one value: --set PATH=START:STOP:COUNT "
-                         "(for example bodies.rod.mass=0.3:1.2:10)")
+        raise MbodyError(f"a sweep varies at least one value: "
+                         f"{option_entry('values', 'PATH')}=START:STOP:COUNT (for example "
+                         "bodies.rod.mass=0.3:1.2:10)")
     if samples is not None and samples < 1:
-        raise MbodyError(f"--samples: expected at least 1 case, got {samples}")
+        raise MbodyError(f"{option_name('samples')}: expected at least 1 case, got {samples}")
     grid = Grid(tuple(axes), fixed, samples, seed)
     size = grid.cases  # from the counts: no value is made before this bound
     if size > MAX_CASES:
         raise MbodyError(f"the sweep has {_spaced(size)} cases; at most "
                          f"{_spaced(MAX_CASES)} are run (fewer values per axis, or "
-                         "--samples N)")
+                         f"{option_name('samples', 'N', 'N')})")
     return grid
 
 
@@ -304,38 +307,40 @@ def _top_level(text: str, sep: str) -> list[str]:
 
 
 def _range(path: str, text: str, random: bool) -> Axis:
+    entry = option_entry("values", path)  # --set PATH on the command line
     parts = text.split(":")
     form = "START:STOP" if random else "START:STOP:COUNT"
     example = f"{path}=0.3:1.2" if random else f"{path}=0.3:1.2:10"
     if len(parts) != (2 if random else 3):
-        extra = " (with --samples, the count is the number of samples)" if random else ""
-        raise MbodyError(f"--set {path}: expected {form}, such as {example}; got {text!r}"
+        extra = (f" (with {option_name('samples')}, the count is the number of samples)"
+                 if random else "")
+        raise MbodyError(f"{entry}: expected {form}, such as {example}; got {text!r}"
                          + extra)
     ends, units = [], []
     for part in parts[:2]:
         m = _NUMBER.fullmatch(part)
         if not m:
-            raise MbodyError(f"--set {path}: {part.strip()!r} is not a number (a range is "
+            raise MbodyError(f"{entry}: {part.strip()!r} is not a number (a range is "
                              f"{form}, such as {example})")
         x = float(m.group(1))
         if not math.isfinite(x):
-            raise MbodyError(f"--set {path}: expected a finite number, got {part.strip()!r}")
+            raise MbodyError(f"{entry}: expected a finite number, got {part.strip()!r}")
         ends.append(x)
         units.append(m.group(2) or "")
     if units[0] != units[1]:
-        raise MbodyError(f"--set {path}: the range's ends have different units "
+        raise MbodyError(f"{entry}: the range's ends have different units "
                          f"({units[0] or 'none'} and {units[1] or 'none'})")
     count = 0
     if not random:
         try:
             count = int(parts[2].strip())
         except ValueError:
-            raise MbodyError(f"--set {path}: the count {parts[2].strip()!r} is not a whole "
+            raise MbodyError(f"{entry}: the count {parts[2].strip()!r} is not a whole "
                              f"number (a range is {form})") from None
         if count < 1:
-            raise MbodyError(f"--set {path}: expected a count of at least 1, got {count}")
+            raise MbodyError(f"{entry}: expected a count of at least 1, got {count}")
         if count == 1 and ends[0] != ends[1]:  # one value cannot span both ends
-            raise MbodyError(f"--set {path}: a count of 1 is one value, and {parts[0].strip()}"
+            raise MbodyError(f"{entry}: a count of 1 is one value, and {parts[0].strip()}"
                              f" and {parts[1].strip()} are two; give a count of 2 or more, or "
-                             f"the value alone (--set {path}={parts[0].strip()})")
+                             f"the value alone ({entry}={parts[0].strip()})")
     return Axis(path, (ends[0], ends[1]), count, units[0])

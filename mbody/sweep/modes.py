@@ -16,6 +16,7 @@ from collections.abc import Iterable, Sequence
 
 import numpy as np
 
+from mbody.errors import option_name
 from mbody.model.model import Model
 from mbody.solve.equilibrium import equilibrium as equilibrium_state
 from mbody.solve.linearize import Linearization, free_coordinates, linearize
@@ -69,8 +70,8 @@ def not_steady_warning(header: Sequence[str], rows: Iterable[Sequence[str]],
     if not count:
         return None
     about = "the equilibrium found" if equilibrium else "the initial state"
-    hint = "" if equilibrium else ("; --equilibrium linearises each about the static "
-                                   "equilibrium nearest its initial pose")
+    hint = "" if equilibrium else (f"; {option_name('equilibrium', 'True')} linearises each "
+                                   "about the static equilibrium nearest its initial pose")
     return (f"{about} of {count} of {len(rows)} cases is not an equilibrium or a steady "
             f"motion ({STEADY} = 0): their frequencies are those of the tangent system at "
             f"that instant, and there is no verdict ({STABLE} empty){hint}")

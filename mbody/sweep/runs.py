@@ -39,7 +39,7 @@ import numpy as np
 
 from mbody import conventions as cv
 from mbody.equations.solution import singular_mass_error
-from mbody.errors import MbodyError
+from mbody.errors import MbodyError, option_name, option_setting, options_named
 from mbody.kernel import _core
 from mbody.model.model import Model, State, from_source
 from mbody.model.source import Source
@@ -98,6 +98,9 @@ class Job:
     grid: Grid
     settings: Settings
     key: str
+    names: dict[str, str] = field(default_factory=dict)
+    """How the caller names the arguments (`mbody.errors.option_names`: the command's
+    flags, or {} from Python): a case's error reads the same on every worker."""
 
 
 @dataclass
@@ -180,9 +183,24 @@ def turning_driver(model: Model) -> int:
     for i, comp in enumerate(drivers.component if drivers is not None else ()):
         if comp == "M":
             return i
-    raise MbodyError("--t-end in revolutions needs a driver that turns a joint (an angle "
-                     "or a speed about an axis); this model has none: give the time in "
-                     "seconds")
+    raise MbodyError(f"an end in turns ({turns_end('N')}) needs a driver that turns a joint "
+                     "(an angle or a speed about an axis); this model has none: give the time "
+                     f"in seconds ({option_name('t_end', 'SECONDS', 'SECONDS')})")
+
+
+def _an_end() -> str:
+    """The arguments that give a run its end, as the caller names them."""
+    seconds, turns = option_name("t_end"), option_name("revolutions")
+    if seconds == turns:  # the command line's one --t-end takes both
+        return f"{seconds} (seconds, or '1 rev')"
+    return f"{seconds} (seconds) or {turns} (turns)"
+
+
+def turns_end(n: str) -> str:
+    """An end of `n` turns as the caller gives it: ``--t-end 'N rev'`` on the command
+    line, ``revolutions=N`` in Python (`mbody.errors.option_name`)."""
+    flag = option_name("revolutions")
+    return f"{flag} '{n} rev'" if flag != "revolutions" else f"revolutions={n}"
 
 
 def check_settings(model: Model, settings: Settings) -> None:
@@ -190,16 +208,18 @@ def check_settings(model: Model, settings: Settings) -> None:
     if settings.run not in RUNS:
         raise MbodyError(f"unknown run {settings.run!r}; expected one of {', '.join(RUNS)}")
     if settings.equilibrium and settings.run != "modes":
-        raise MbodyError(f"--equilibrium goes with --run modes (it linearises each case about "
+        raise MbodyError(f"{option_name('equilibrium', 'True')} goes with "
+                         f"{option_setting('run', 'modes')} (it linearises each case about "
                          f"its static equilibrium); the {settings.run} run starts from each "
                          "case's initial state")
     if settings.run in ("kinematics", "simulate"):
         if settings.t_end is None and settings.revolutions is None:
-            raise MbodyError(f"the {settings.run} run needs --t-end (seconds, or '1 rev')")
+            raise MbodyError(f"the {settings.run} run needs {_an_end()}")
         if settings.revolutions is not None:
             turning_driver(model)
     if settings.run == "kinematics" and settings.steps < 2:
-        raise MbodyError(f"--steps: expected at least 2 instants, got {settings.steps}")
+        raise MbodyError(f"{option_name('steps')}: expected at least 2 instants, got "
+                         f"{settings.steps}")
     if settings.run == "kinematics":  # as `mbody kinematics` refuses it (--run simulate)
         require_fully_driven(model)
 
@@ -248,7 +268,13 @@ def context(job: Job) -> Context:
 
 
 def run_chunk(job: Job, indices: Sequence[int]) -> Rows:
-    """Evaluate cases `indices` of `job` (what a worker runs)."""
+    """Evaluate cases `indices` of `job` (what a worker runs), its errors naming the
+    arguments as the caller does (`Job.names`), wherever it runs."""
+    with options_named(job.names):
+        return _run_chunk(job, indices)
+
+
+def _run_chunk(job: Job, indices: Sequence[int]) -> Rows:
     import os
     import socket
 
@@ -349,10 +375,10 @@ def sampling_warning(settings: Settings, grid: Grid, count: int, ran: int,
                        f"case {sparsest.case} ({values}) has")
     if settings.run == "kinematics":  # (steps - 1) / per_turn turns in that case
         turns = (settings.steps - 1) / sparsest.per_turn
-        need = f"--steps {math.ceil(PEAK_SAMPLES * turns * (1.0 - 1e-12)) + 1}"
+        need = option_setting("steps", math.ceil(PEAK_SAMPLES * turns * (1.0 - 1e-12)) + 1)
     else:
         turns_a_second = abs(sparsest.rate) / (2.0 * math.pi)
-        need = f"--fps {math.ceil(PEAK_SAMPLES * turns_a_second * (1.0 - 1e-12))}"
+        need = option_setting("fps", math.ceil(PEAK_SAMPLES * turns_a_second * (1.0 - 1e-12)))
     sine = 100.0 * (1.0 - math.cos(math.pi / PEAK_SAMPLES))
     return (f"{text}. {count} of the {ran} cases run have fewer than {PEAK_SAMPLES} samples a "
             f"revolution: their peak: columns can read low. Use {need} or more "
@@ -420,8 +446,8 @@ def _end(ctx: Context, case: Case) -> float:
         return float(s.t_end)  # type: ignore[arg-type]
     rate = float(case.extras[ctx.driver])  # type: ignore[index]
     if rate == 0.0 or not math.isfinite(rate):
-        raise MbodyError(f"--t-end {s.revolutions:g} rev: the driver does not turn at t = 0 "
-                         f"(its rate is {rate:g} rad/s) with these values")
+        raise MbodyError(f"{turns_end(f'{s.revolutions:g}')}: the driver does not turn at "
+                         f"t = 0 (its rate is {rate:g} rad/s) with these values")
     return 2.0 * math.pi * s.revolutions / abs(rate)
 
 

@@ -2,11 +2,12 @@
 it), and the table it returns (`SweepResult`).
 
 The steps are the command's: the arguments checked (`check_request`, then the numbers),
-the model read (or taken as given), its fixed values set, every varied path checked
-against the file before any case runs, the settings checked against the model, the rows
-of an earlier run of the same sweep kept (`mbody.sweep.table.Results`), the other cases
-run (`mbody.sweep.cluster.run`), the output written, and what the rows need said (a
-modes run's states that are not equilibria, peaks sampled too sparsely).
+the output checked not to be the model file (`check_outputs`), the model read (or taken
+as given), its fixed values set, every varied path checked against the file before any
+case runs, the settings checked against the model, the rows of an earlier run of the same
+sweep with the same settings kept (`mbody.sweep.table.Results`), the other cases run
+(`mbody.sweep.cluster.run`), the output written, and what the rows need said (a modes
+run's states that are not equilibria, peaks sampled too sparsely).
 """
 
 from __future__ import annotations
@@ -22,22 +23,26 @@ from typing import Any
 
 import numpy as np
 
-from mbody.errors import MbodyError, did_you_mean
+from mbody.errors import MbodyError, did_you_mean, option_name, option_names
 from mbody.loading import load
 from mbody.model.model import Model
 from mbody.model.values import edits, entry_names
 from mbody.sweep import cluster
 from mbody.sweep.grid import Grid, grid_of
 from mbody.sweep.modes import not_steady_warning
+from mbody.sweep.record import record
 from mbody.sweep.runs import Job, Settings, check_settings, columns, sampling_warning
-from mbody.sweep.table import Results, output_format
+from mbody.sweep.table import ERROR, Results, journal_of, output_format
+from mbody.util.atomic import refuse_overwriting_inputs
 
 
 @dataclass(frozen=True)
 class Limit:
-    """The range of one numeric argument, as the command's option takes it."""
+    """The range of one numeric argument, as the command's option `option` takes it; a
+    message names it as the caller does (`mbody.errors.option_name` of `keyword`)."""
 
     option: str
+    keyword: str
     what: str
     lo: float
     hi: float
@@ -53,7 +58,7 @@ class Limit:
             lo, hi = (_figure(int(x)) if self.integer else _figure(x)
                       for x in (self.lo, self.hi))
             span = f"above {lo} up to {hi}" if self.lo_open else f"from {lo} to {hi}"
-            raise MbodyError(f"{self.option}: expected {self.what} {span}"
+            raise MbodyError(f"{option_name(self.keyword)}: expected {self.what} {span}"
                              f"{' (a whole number)' if self.integer else ''}, got {value!r}")
 
 
@@ -67,14 +72,16 @@ def _figure(x: float) -> str:
 
 
 LIMITS = {
-    "samples": Limit("--samples", "a number of cases", 1, 1e8, integer=True),
-    "seed": Limit("--seed", "a seed", 0, 2**63 - 1, integer=True),
-    "t_end": Limit("--t-end", "a time in seconds", 0.0, 1e9, lo_open=True),
-    "revolutions": Limit("--t-end", "a number of turns", 0.0, 1e6, lo_open=True),
-    "steps": Limit("--steps", "a number of instants", 2, 1e6, integer=True),
-    "fps": Limit("--fps", "samples per second", 0.0, 1e6, lo_open=True),
-    "workers": Limit("--workers", "a number of worker processes", 0, 4096, integer=True),
-    "chunk": Limit("--chunk", "a number of cases", 1, 1e8, integer=True),
+    "samples": Limit("--samples", "samples", "a number of cases", 1, 1e8, integer=True),
+    "seed": Limit("--seed", "seed", "a seed", 0, 2**63 - 1, integer=True),
+    "t_end": Limit("--t-end", "t_end", "a time in seconds", 0.0, 1e9, lo_open=True),
+    "revolutions": Limit("--t-end", "revolutions", "a number of turns", 0.0, 1e6,
+                         lo_open=True),
+    "steps": Limit("--steps", "steps", "a number of instants", 2, 1e6, integer=True),
+    "fps": Limit("--fps", "fps", "samples per second", 0.0, 1e6, lo_open=True),
+    "workers": Limit("--workers", "workers", "a number of worker processes", 0, 4096,
+                     integer=True),
+    "chunk": Limit("--chunk", "chunk", "a number of cases", 1, 1e8, integer=True),
 }
 """`run_sweep`'s numeric arguments, by name: the command's ranges (its argparse types; a
 test keeps them equal)."""
@@ -110,15 +117,15 @@ class SweepResult:
         The output written (``.csv`` or ``.parquet``).
     header : list of str
         The columns: ``case``, the varied paths as given, the outputs
-        ``<quantity>:<label>``, then ``error``.
+        ``<quantity>:<label>``, ``error``, then ``settings``.
     rows : list of list of str
         One row per case, by case number, each cell as the CSV holds it: a number as
         Python writes it (read back, the same double), an empty cell where a case has no
-        number, ``error`` empty or why the case failed.
+        number, ``error`` empty or why the case failed, ``settings`` how the row was
+        computed (`settings`).
     ran : int
         The cases run by this call; the others were kept from an earlier run of the same
-        sweep into the same output (its rows are as that run made them: the output does
-        not record ``t_end``, ``revolutions``, ``steps`` or ``fps``).
+        sweep, with the same settings, into the same output.
     report : mbody.sweep.cluster.Report
         How the cases ran: where, in how many chunks, how long, and the cases whose
         ``peak:`` columns come from too few samples a revolution.
@@ -128,6 +135,12 @@ class SweepResult:
         cases linearised about a state that is not an equilibrium
         (`mbody.sweep.modes.not_steady_warning`), and ``peak:`` columns sampled too
         sparsely (`mbody.sweep.runs.sampling_warning`).
+    settings : str
+        What every row's ``settings`` cell records: the run, those of its settings that
+        change its numbers, and the model's digest (`mbody.sweep.record`).
+    replaced : int
+        The earlier rows that were not this sweep's (other settings, other values),
+        replaced by this call's as ``force=True`` asks.
     """
 
     path: Path
@@ -136,6 +149,8 @@ class SweepResult:
     ran: int
     report: cluster.Report
     warnings: list[str] = field(default_factory=list)
+    settings: str = ""
+    replaced: int = 0
 
     def __len__(self) -> int:
         return len(self.rows)
@@ -148,12 +163,13 @@ class SweepResult:
     @property
     def errors(self) -> list[str | None]:
         """Each case's error, by case (None where it has its numbers)."""
-        return [r[-1] or None for r in self.rows]
+        at = self.header.index(ERROR)
+        return [r[at] or None for r in self.rows]
 
     @property
     def failed(self) -> int:
         """How many cases have no numbers (their ``error`` says why)."""
-        return sum(1 for r in self.rows if r[-1])
+        return sum(1 for e in self.errors if e)
 
     def column(self, name: str) -> np.ndarray:
         """One column's numbers, by case (NaN where a case has none).
@@ -172,8 +188,8 @@ class SweepResult:
         KeyError
             No such column.
         MbodyError
-            The column holds text (``error``, values listed with a unit): read it from
-            `rows`.
+            The column holds text (``error``, ``settings``, values listed with a unit):
+            read it from `rows`.
         """
         if name not in self.header:
             hint = did_you_mean(name, self.header) or f"the columns: {', '.join(self.header)}"
@@ -195,6 +211,7 @@ class SweepResult:
         failed = self.failed
         return (f"<SweepResult {self.path}: {len(self)} cases, {self.ran} run now"
                 + (f", {self.kept} kept from an earlier run" if self.kept else "")
+                + (f", {self.replaced} earlier rows replaced" if self.replaced else "")
                 + (f", {failed} failed" if failed else "")
                 + (f", {len(self.warnings)} warning(s)" if self.warnings else "")
                 + "; .header, .rows, .column(name), .errors, .report, .warnings>")
@@ -235,8 +252,41 @@ def check_request(values: Mapping[str, Any] | Sequence[str] | str, out: str | os
             LIMITS[name].check(value)
     grid = grid_of(values, samples, seed)
     if samples is None and seed:
-        raise MbodyError("--seed goes with --samples (a grid has no randomness)")
+        raise MbodyError(f"{option_name('seed')} goes with {option_name('samples')} (a grid "
+                         "has no randomness)")
     return grid
+
+
+JOURNAL_OPTION = "--out's journal"
+"""How a message names the journal beside the output (``<out>.partial``)."""
+
+
+def check_outputs(out: str | os.PathLike[str], model_file: str | os.PathLike[str] | None
+                  ) -> None:
+    """Refuse an output of the sweep that is its model file, however named (a link,
+    another spelling of the path, a hard link): the results (`out`) and their journal
+    beside it (``<out>.partial``), which a rerun reads back to resume, and which needs the
+    model as it was (`mbody.util.atomic.refuse_overwriting_inputs`, the check of every
+    command; ``force`` cannot pass it). The journal is not the output either.
+
+    Parameters
+    ----------
+    out : str or path-like
+        The output.
+    model_file : str, path-like or None
+        The model's file (None: a model without one, from a dictionary or text).
+
+    Raises
+    ------
+    MbodyError
+        Naming the output, the input and the file they both are.
+    """
+    resumed = ("--out", JOURNAL_OPTION)
+    inputs = [("the model", os.fspath(model_file))] if model_file is not None else []
+    refuse_overwriting_inputs([("--out", os.fspath(out))], inputs, False, resumed=resumed)
+    refuse_overwriting_inputs([(JOURNAL_OPTION, str(journal_of(out)))],
+                              [*inputs, ("the output", os.fspath(out))], False,
+                              resumed=resumed)
 
 
 def run_sweep(model: Model | str | os.PathLike[str],
@@ -246,14 +296,17 @@ def run_sweep(model: Model | str | os.PathLike[str],
               steps: int = 101, fps: float = 60.0, equilibrium: bool = False,
               samples: int | None = None, seed: int = 0, workers: int | None = None,
               scheduler: str | None = None, chunk: int | None = None,
-              progress: bool = False) -> SweepResult:
+              progress: bool = False, force: bool = False) -> SweepResult:
     """Run a model over a grid (or random samples) of values, as ``mbody sweep`` does,
     and write one row per case to `out` (docs/sweeps.md).
 
     Cases run on a local Dask cluster started for the call (`workers` processes), on an
     existing one (`scheduler`), or with ``workers=0`` in this process, without Dask. An
     output of the same sweep that is already there (or its ``.partial`` journal, left by
-    an interrupted run) is resumed: only the cases not in it run.
+    an interrupted run) is resumed: only the cases not in it run. Its rows are reused
+    only when they are this sweep's: the same values, and computed with the same
+    settings (each row records them in its ``settings`` cell); an output holding other
+    rows is refused, naming what differs, unless `force`.
 
     Parameters
     ----------
@@ -301,6 +354,11 @@ def run_sweep(model: Model | str | os.PathLike[str],
         Cases per chunk sent to a worker (default: measured, about 2 s of work).
     progress : bool
         A progress bar on standard error.
+    force : bool
+        Run again, and replace, the earlier rows of `out` (and its journal) that are not
+        this sweep's: computed with other settings (``t_end``, ``steps``, ``fps``, the
+        run, the model's content), for other values, or by an mbody that did not record
+        the settings (``--force``). Without it such an output is refused.
 
     Returns
     -------
@@ -314,8 +372,10 @@ def run_sweep(model: Model | str | os.PathLike[str],
         A bad argument, before any case runs, with the command's message: the output's
         extension, a malformed range, a path the model file does not have (located, with
         a did-you-mean), settings the run or the model cannot take (``kinematics``
-        without an end, of a model not fully driven), an output holding another sweep's
-        rows; or a cluster that cannot be started or reached.
+        without an end, of a model not fully driven), an output that is the model's file
+        (however named) or a folder, an output holding another sweep's rows or rows
+        computed with other settings (without `force`); or a cluster that cannot be
+        started or reached.
     SweepInterrupted
         An interruption (a `KeyboardInterrupt`): the rows so far are kept, and the same
         call resumes.
@@ -326,18 +386,21 @@ def run_sweep(model: Model | str | os.PathLike[str],
         if value is not None:
             LIMITS[name].check(value)
     if t_end is not None and revolutions is not None:
-        raise MbodyError("--t-end: give the end in seconds (t_end) or in turns "
-                         "(revolutions), not both")
+        raise MbodyError("give the end in seconds (t_end) or in turns (revolutions), not "
+                         "both")
     if scheduler is not None and not isinstance(scheduler, str):
-        raise MbodyError(f"--scheduler: expected an address such as tcp://HOST:PORT, got "
-                         f"{scheduler!r}")
+        raise MbodyError(f"{option_name('scheduler')}: expected an address such as "
+                         f"tcp://HOST:PORT, got {scheduler!r}")
     said: list[str] = []
     if not isinstance(model, Model):
         if not isinstance(model, str | os.PathLike):
             raise MbodyError(f"the model: expected a Model or a model file's path, got "
                              f"{type(model).__name__}")
+        check_outputs(out, model)  # before the model is even read
         model = load(model)
         said += [str(w) for w in model.warnings]
+    elif model.source is not None:
+        check_outputs(out, model.source.file)  # '<string>', '<dict>': no such file
     if grid.fixed:
         model = model.with_values(grid.fixed)
     if model.source is None:
@@ -346,9 +409,10 @@ def run_sweep(model: Model | str | os.PathLike[str],
     edits(model.source.read(), [(p, None) for p in grid.paths], entry_names(model))
     settings = Settings(run, t_end, revolutions, steps, fps, bool(equilibrium))
     check_settings(model, settings)
-    results = Results(out, columns(model, settings), grid)
+    recorded = record(settings, model)
+    results = Results(out, columns(model, settings), grid, recorded, force=bool(force))
     todo = [k for k in range(len(grid)) if k not in results.rows]
-    job = Job(model.source, grid, settings, uuid.uuid4().hex)
+    job = Job(model.source, grid, settings, uuid.uuid4().hex, option_names())
     try:
         report = cluster.run(job, todo, results, scheduler=scheduler, workers=workers,
                              chunk=chunk, progress=progress)
@@ -361,4 +425,5 @@ def run_sweep(model: Model | str | os.PathLike[str],
         if warning:
             said.append(warning)
     rows = [results.rows[k] for k in sorted(results.rows)]
-    return SweepResult(path, list(results.header), rows, len(todo), report, said)
+    return SweepResult(path, list(results.header), rows, len(todo), report, said, recorded,
+                       results.replaced)

@@ -27,8 +27,9 @@ from mbody.equations.assemble import Assembly, Solution
 from mbody.equations.pack import pack_columns_model, pack_unknowns_of
 from mbody.equations.solution import METHODS, singular_mass_error
 from mbody.equations.world import check_axes, world_map
-from mbody.errors import MbodyError, wrong_type
+from mbody.errors import MbodyError, not_found, wrong_type
 from mbody.kernel import _core
+from mbody.model.arguments import KnownValues
 from mbody.model.model import Model, State
 from mbody.simulate.trajectory import FORMAT as TRAJECTORY_FORMAT
 from mbody.util import jsontext
@@ -79,7 +80,8 @@ class Columns:
         if isinstance(i, str):
             hits = np.flatnonzero(self.labels == i)
             if not len(hits):
-                raise KeyError(f"no reaction column {i!r}")
+                raise not_found("reaction column", i, [str(x) for x in self.labels],
+                                "reaction columns")
             i = int(hits[0])
         out: dict[str, Any] = {"label": str(self.labels[i])}
         out.update({k: str(getattr(self, k)[i]) for k in COLUMN_TEXT[1:]})
@@ -429,7 +431,7 @@ def text_array(values: Sequence[str]) -> np.ndarray:
     return np.array(values, dtype=str) if values else np.zeros(0, dtype="<U1")
 
 
-def exported(asm: Assembly, known: Mapping[str, float] | None = None,
+def exported(asm: Assembly, known: KnownValues | None = None,
              state_source: str = "", axes: str = "joint") -> ExportedAssembly:
     """Collect the matrices, labels and per-column joint data of `asm` for export.
 
@@ -442,7 +444,8 @@ def exported(asm: Assembly, known: Mapping[str, float] | None = None,
     asm
         The assembly at the state to export.
     known
-        Reaction values added to the model file's (labels are checked).
+        Reaction values added to the model file's (labels are checked): numbers, or
+        expressions of t as text taken at the state's time (`Assembly.reaction_values`).
     state_source
         Where the state came from; by default the model's initial state.
     axes
@@ -505,7 +508,7 @@ def exported(asm: Assembly, known: Mapping[str, float] | None = None,
     )
 
 
-def as_export(obj: Assembly | ExportedAssembly, known: Mapping[str, float] | None = None,
+def as_export(obj: Assembly | ExportedAssembly, known: KnownValues | None = None,
               axes: str = "joint") -> ExportedAssembly:
     """`obj` itself when already exported, else ``exported(obj, known, axes=axes)``;
     `mbody.errors.MbodyTypeError` for anything else."""

@@ -7,7 +7,7 @@ files.
 A .mat file is read as input that may be hostile (`checked`): scipy allocates the arrays
 a file declares, recurses into nested cells as deep as they go and inflates each
 compressed variable whole, so the file's structure is walked first, within a byte budget
-(`mbody.util.npzfile.data_limit`), and scipy reads the walked, inflated copy."""
+(`mbody.util.budget.byte_limit`), and scipy reads the walked, inflated copy."""
 
 from __future__ import annotations
 
@@ -23,7 +23,8 @@ import numpy as np
 
 from mbody.errors import MbodyError
 from mbody.io.export.assembly import COLUMN_TEXT, MORE, ExportedAssembly, build, flat_arrays
-from mbody.util.npzfile import data_limit, over_budget, read_bytes
+from mbody.util.budget import DATA_BYTES, byte_limit
+from mbody.util.npzfile import over_budget, read_bytes
 
 
 def _cell(values: Iterable[Any]) -> np.ndarray:
@@ -198,7 +199,7 @@ class _Walk:
 def checked(path: Path, max_bytes: int | None = None) -> io.BytesIO:
     """The MAT 5 file `path` walked and inflated, as an uncompressed MAT 5 stream for
     `scipy.io.loadmat`: every variable's declared size counted against `max_bytes`
-    (default `mbody.util.npzfile.DATA_BYTES`) before it is inflated, every array's shape
+    (default `mbody.util.budget.DATA_BYTES`) before it is inflated, every array's shape
     against the bytes that hold it, nesting at most `MAX_DEPTH`. scipy then allocates only
     what the bytes there hold, and never inflates anything itself.
 
@@ -208,7 +209,7 @@ def checked(path: Path, max_bytes: int | None = None) -> io.BytesIO:
         Naming the file and what is wrong: not a MAT 5 file (v4 and v7.3/HDF5 files are
         not read), more than the budget, an element or shape that does not fit.
     """
-    limit = data_limit(max_bytes)
+    limit = byte_limit(max_bytes, DATA_BYTES)
     raw = read_bytes(path, limit, MORE)
     order = {b"IM": "<", b"MI": ">"}.get(raw[126:128])
     if (len(raw) < _HEADER or order is None or not raw.startswith(b"MATLAB 5.0")
