@@ -180,11 +180,56 @@ def given_twice(entry: str, how: str = "") -> MbodyError:
     return MbodyError(f"{entry} is given twice" + (f" ({how})" if how else ""))
 
 
-def did_you_mean(word: str, choices: Iterable[str]) -> str:
-    """A 'did you mean ...?' hint for a misspelt name, or '' when nothing is close (a
-    name that differs only in case is the closest: 'dop853' for 'DOP853')."""
-    close = closest(word, choices)
+SYNONYMS: Mapping[str, tuple[str, str]] = {
+    "omega": ("angular_velocity", ""), "w": ("angular_velocity", ""),
+    "v": ("velocity", ""), "pos": ("position", ""), "theta": ("angle", ""),
+    "point": ("at", ""), "location": ("at", ""), "position": ("at", ""),
+    "I": ("inertia", ""), "I_G": ("inertia", ""), "J": ("inertia", ""),
+    "moment_of_inertia": ("inertia", ""), "m": ("mass", ""),
+    "moment": ("torque", "a couple, a pure moment"),
+    "couple": ("torque", "a couple, a pure moment"),
+    "k": ("stiffness", ""), "spring_constant": ("stiffness", ""), "c": ("damping", ""),
+    "free_length": ("rest_length", ""), "L0": ("rest_length", ""),
+    "quat": ("quaternion", ""), "g": ("gravity", ""),
+}
+"""Words a textbook or another program uses for what mbody names otherwise: word ->
+(mbody's name, a note). A hint names mbody's word only where it is one of the choices
+(`did_you_mean`): ``position`` on a load means its ``at``, on a body it is the key."""
+
+
+def did_you_mean(word: str, choices: Iterable[str],
+                 synonyms: Mapping[str, str] | None = None) -> str:
+    """A hint for a name that is not one of `choices`, or '' when nothing is close.
+
+    A word mbody calls otherwise (`SYNONYMS`, or `synonyms`: another program's names,
+    such as a joint type's aliases) gets "mbody calls it '...'"; a misspelt one "did you
+    mean '...'?" (a name that differs only in case is the closest: 'dop853' for
+    'DOP853'), unless every choice is far from it (`closest`)."""
+    names = [str(c) for c in choices]
+    meant = synonym(word, names, synonyms)
+    if meant is not None:
+        return meant
+    close = closest(word, names)
     return f"did you mean '{close}'?" if close is not None else ""
+
+
+def synonym(word: str, choices: Sequence[str], synonyms: Mapping[str, str] | None = None
+            ) -> str | None:
+    """"mbody calls it '...'" when `word` is another name of one of `choices` (`synonyms`
+    first, then `SYNONYMS`; the exact word, else its case folded), else None."""
+    text = str(word)
+    tables: tuple[Mapping[str, str | tuple[str, str]], ...] = (synonyms or {}, SYNONYMS)
+    for table in tables:
+        entry = table.get(text)
+        if entry is None:
+            entry = next((v for k, v in table.items() if k.casefold() == text.casefold()),
+                         None)
+        if entry is None:
+            continue
+        target, note = (entry, "") if isinstance(entry, str) else entry
+        if target in choices:
+            return f"mbody calls it '{target}'" + (f": {note}" if note else "")
+    return None
 
 
 def name_list(names: Iterable[object], most: int = 5) -> str:
@@ -223,11 +268,47 @@ def not_found(what: str, name: object, names: Sequence[str], many: str,
 
 
 def closest(word: str, choices: Iterable[str]) -> str | None:
-    """The choice `word` was probably meant to be (`did_you_mean`'s), or None."""
+    """The choice `word` was probably meant to be (`did_you_mean`'s), or None: one that
+    differs only in case, else difflib's closest match when it is a misspelling rather
+    than another word: it starts with the same letter (a misspelling keeps it: 'bodys',
+    'damp', 'veloctiy'), or it is a few edits away (`_EDITS_PER_LETTER`: 'ngle' for
+    'angle'). 'frame' is not taken for 'name': two edits in five letters, and another
+    first letter."""
     names = [str(c) for c in choices]
-    same = [c for c in names if c.casefold() == str(word).casefold()]
-    close = same or difflib.get_close_matches(str(word), names, n=1, cutoff=0.6)
-    return close[0] if close else None
+    text = str(word)
+    same = [c for c in names if c.casefold() == text.casefold()]
+    if same:
+        return same[0]
+    close = difflib.get_close_matches(text, names, n=1, cutoff=0.6)
+    if not close:
+        return None
+    meant = close[0]
+    if text[:1].casefold() == meant[:1].casefold() or _edits(text, meant) <= max(
+            1, max(len(text), len(meant)) // _EDITS_PER_LETTER):
+        return meant
+    return None
+
+
+_EDITS_PER_LETTER = 4
+"""A suggestion that starts with another letter is at most one edit (a letter added,
+dropped, changed, or two swapped) per this many letters away, one at least."""
+
+
+def _edits(a: str, b: str) -> int:
+    """The optimal string alignment distance: letters inserted, deleted, substituted, or
+    two neighbours transposed (counted once), to make `a` into `b`."""
+    if abs(len(a) - len(b)) > max(len(a), len(b)) // _EDITS_PER_LETTER + 1:
+        return abs(len(a) - len(b))  # too far apart for a suggestion: no table needed
+    rows = [list(range(len(b) + 1))]
+    for i in range(1, len(a) + 1):
+        row = [i] + [0] * len(b)
+        for j in range(1, len(b) + 1):
+            cost = a[i - 1] != b[j - 1]
+            row[j] = min(rows[-1][j] + 1, row[j - 1] + 1, rows[-1][j - 1] + cost)
+            if i > 1 and j > 1 and a[i - 1] == b[j - 2] and a[i - 2] == b[j - 1]:
+                row[j] = min(row[j], rows[-2][j - 2] + 1)
+        rows.append(row)
+    return rows[-1][-1]
 
 
 _FLAGS: ContextVar[Mapping[str, str] | None] = ContextVar("mbody_option_flags", default=None)

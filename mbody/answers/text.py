@@ -12,6 +12,7 @@ from collections.abc import Mapping
 
 from mbody.answers.compare import CONST, Fit, Row
 from mbody.equations.fbd import Equation
+from mbody.util import formatting
 
 
 def num(x: float, ref: float = 1.0) -> str:
@@ -29,10 +30,7 @@ def num(x: float, ref: float = 1.0) -> str:
     -------
     str
     """
-    x = float(x)
-    x = 0.0 if abs(x) < 1e-12 * ref else x
-    s = f"{x:.6g}"
-    return "0" if s in ("-0", "0") else s
+    return formatting.num(float(x), formatting.NOISE * ref)
 
 
 def terms(coef: Mapping[str, float]) -> str:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -129,6 +130,9 @@ class Checker:
         """Every joint with a valid name and type, even one with other problems."""
         self.particles: set[str] = set()
         """Names of the bodies given `inertia: 0` (point masses)."""
+        self.meant: set[tuple[Path_, str]] = set()
+        """(mapping's path, key) of each key an unknown key's hint names: a rule that
+        asks for the key says nothing more there (the hint said it)."""
 
     # -- reporting -------------------------------------------------------------------
     def err(self, path: Path_, message: str, hint: str = "", *, key: bool = False) -> None:
@@ -151,6 +155,7 @@ class Checker:
                 hint = did_you_mean(k, allowed)
                 if hint:
                     meant.add(hint.split("'")[1])
+                    self.meant.add((tuple(path), hint.split("'")[1]))
                 self.err((*path, k), f"unknown key '{k}'",
                          hint or f"expected one of: {', '.join(allowed)}", key=True)
         for k in required:
@@ -287,10 +292,14 @@ class Checker:
             return None
         return value
 
-    def choice(self, path: Path_, value: Any, choices: tuple[str, ...], what: str) -> str | None:
+    def choice(self, path: Path_, value: Any, choices: tuple[str, ...], what: str,
+               synonyms: Mapping[str, str] | None = None) -> str | None:
+        """`value` if it is one of `choices`, else None and an error with a hint
+        (`did_you_mean`; `synonyms`: other programs' names of the choices)."""
         if not isinstance(value, str) or value not in choices:
+            hint = did_you_mean(value, choices, synonyms)
             self.err(path, f"unknown {what} {_quoted(value)}",
-                     did_you_mean(value, choices) or f"expected one of: {', '.join(choices)}")
+                     hint or f"expected one of: {', '.join(choices)}")
             return None
         return value
 

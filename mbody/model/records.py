@@ -125,9 +125,11 @@ class Joint:
     parent, child : str
         The bodies it joins (``ground`` for the world).
     at : (3,) array
-        The joint point at the initial pose, world axes (m).
+        The joint point at the file's pose, world axes (m) (with points given on each
+        body: the child's); `Model.joint_table` has it in each body's axes.
     W_E0 : (3, 3) array
-        The joint frame at the initial pose, axes as columns (world).
+        The joint frame at the initial pose, axes as columns (world): the file's pose, or
+        the assembled one when `mbody.load` assembled the model.
     components : tuple of str
         Its reaction components (``Fx``, ``Fy``, ``Mz``...), the columns of G in order.
     axis, axis2 : (3,) array, optional
@@ -140,7 +142,7 @@ class Joint:
     type: str
     parent: str
     child: str
-    at: np.ndarray  # (3,) world, initial pose
+    at: np.ndarray  # (3,) world, the file's pose
     W_E0: np.ndarray  # (3, 3) joint frame at the initial pose, axes as columns (world)
     components: tuple[str, ...]
     axis: np.ndarray | None = None

@@ -34,7 +34,8 @@ import numpy as np
 
 from mbody import conventions as cv
 from mbody.errors import Issue, MbodyError, ModelError, TrajectoryFileError, real_number, wrong_type
-from mbody.model.model import State, count, loads
+from mbody.loading import loads
+from mbody.model.model import State, count
 from mbody.model.yaml_write import dump_document
 from mbody.util import jsontext
 from mbody.util.atomic import atomic_path
@@ -434,7 +435,8 @@ class Trajectory(Frozen):
     def model(self):
         """Rebuild the `Model` from the YAML text stored with the run, with the values
         that were set on it (``info["model_values"]``: `Model.with_values`, ``--set``)
-        set again: the model the run integrated.
+        set again: the model the run integrated (as `mbody.loads` reads the text: at its
+        assembled pose, with the joint frames taken there).
 
         Returns
         -------
