@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 import mbody
-from mbody.errors import MbodyError
+from mbody.errors import MbodyError, MbodyTypeError
 from mbody.io.export import write_csv, write_export
 from mbody.io.export.generalized import read_generalized
 
@@ -353,3 +353,73 @@ def test_read_generalized_is_bounded_the_same_way(tmp_path):
                     {"descr": "<f8", "fortran_order": False, "shape": (10**15,)}, bytes(16))
     with pytest.raises(MbodyError, match="member q.npy"):
         read_generalized(liar)
+
+
+# -- every reader's max_bytes, checked by one function (review R3 B3) -------------------------
+
+
+@pytest.fixture(scope="module")
+def readers(exports) -> dict[str, tuple]:
+    """Each public reader with a budget, beside a file it reads."""
+    from mbody.equations.generalized import generalized
+    from mbody.io.export.generalized import write_generalized
+    from mbody.simulate.trajectory import Trajectory
+
+    model = mbody.load(MODELS / "pendulum.yaml")
+    run = exports / "run.npz"
+    mbody.simulate(model, t_end=0.1, fps=10).save(run)
+    equations = write_generalized(generalized(model), exports / "g.json")
+    return {"mbody.load": (mbody.load, MODELS / "pendulum.yaml"),
+            "Trajectory.load": (Trajectory.load, run),
+            "load_export npz": (mbody.load_export, exports / "p.npz"),
+            "load_export mat": (mbody.load_export, exports / "p.mat"),
+            "load_export csv": (mbody.load_export, exports / "p_csv"),
+            "read_generalized": (read_generalized, equations)}
+
+
+READERS = ["mbody.load", "Trajectory.load", "load_export npz", "load_export mat",
+           "load_export csv", "read_generalized"]
+
+
+@pytest.mark.parametrize("reader", READERS)
+@pytest.mark.parametrize(("given", "shown"), [
+    ("1G", "str '1G'"), (1.5, "float 1.5"), (True, "bool True"), ([10], "list"),
+    (float("nan"), "float nan")])
+def test_max_bytes_that_is_not_a_whole_number_is_refused_by_name(readers, reader, given,
+                                                                  shown):
+    """Before: '1G' a raw ValueError (Trajectory.load) or blamed on the file (load_export),
+    1.5 and True read as a budget of 1 byte."""
+    load, path = readers[reader]
+    with pytest.raises(MbodyTypeError) as exc:
+        load(path, max_bytes=given)
+    text = str(exc.value)
+    assert text.startswith("max_bytes must be a whole number of bytes (such as 200 * 2**20), "
+                           f"got {shown}"), text
+    assert str(path) not in text  # the argument is at fault, not the file
+    if isinstance(given, str):
+        assert "2**30" in text and "--max-bytes" in text
+
+
+@pytest.mark.parametrize("reader", READERS)
+@pytest.mark.parametrize("given", [0, -5])
+def test_max_bytes_below_one_byte_is_refused_by_every_reader(readers, reader, given):
+    """Before: Trajectory.load(..., max_bytes=-5) said 'at most -5 bytes is read'."""
+    load, path = readers[reader]
+    with pytest.raises(MbodyError) as exc:
+        load(path, max_bytes=given)
+    assert str(exc.value) == f"max_bytes: expected a size of at least 1 byte, got {given}"
+
+
+@pytest.mark.parametrize("reader", READERS)
+def test_max_bytes_as_a_whole_float_or_numpy_integer_reads(readers, reader):
+    load, path = readers[reader]
+    assert load(path, max_bytes=float(2**30)) is not None
+    assert load(path, max_bytes=np.int64(2**30)) is not None
+
+
+def test_the_budget_set_around_a_block_is_checked_the_same_way():
+    from mbody.util.budget import byte_budget
+
+    with pytest.raises(MbodyTypeError, match="^max_bytes must be a whole number"), \
+            byte_budget(True):  # type: ignore[arg-type]
+        pass

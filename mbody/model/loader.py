@@ -23,8 +23,6 @@ matters for models with tens of thousands of bodies.
 from __future__ import annotations
 
 import math
-import numbers
-import operator
 import os
 import re
 import select
@@ -47,8 +45,8 @@ from yaml.events import (
     StreamEndEvent,
 )
 
-from mbody.errors import Issue, MbodyError, ModelError, did_you_mean, wrong_type
-from mbody.util.budget import MAX_BYTES, byte_limit
+from mbody.errors import Issue, ModelError, did_you_mean, wrong_type
+from mbody.util.budget import MAX_BYTES, byte_limit, checked_max_bytes
 
 # libyaml keeps line marks and is many times faster than the pure-Python parser
 _Loader: type[yaml.SafeLoader] | type[yaml.CSafeLoader] = getattr(
@@ -379,7 +377,7 @@ def check_source(source: object, max_bytes: object = None, call: str = "mbody.lo
     """Refuse, before anything is read, what `call` cannot read from: a `source` that is
     neither a path nor a dict (`MbodyTypeError`), YAML text given where a path goes
     (`ModelError`: text is `mbody.loads`'), or a `max_bytes` that is not a whole number of
-    bytes, at least 1.
+    bytes, at least 1 (`mbody.util.budget.checked_max_bytes`, every reader's check).
 
     Returns
     -------
@@ -397,22 +395,7 @@ def check_source(source: object, max_bytes: object = None, call: str = "mbody.lo
         line = "holds a line break" if "\n" in source else "starts as a YAML mapping does"
         raise ModelError([Issue(call, 0, 0, "source", f"this looks like YAML text ({line}), "
                                 "not a path to a model file", "use mbody.loads(text)")])
-    if max_bytes is None:
-        return None
-    if isinstance(max_bytes, bool):  # an int to Python, not a size to anyone
-        size = None
-    elif isinstance(max_bytes, numbers.Integral):
-        size = operator.index(max_bytes)
-    elif isinstance(max_bytes, numbers.Real) and float(max_bytes).is_integer():
-        size = int(float(max_bytes))
-    else:
-        size = None
-    if size is None:
-        raise wrong_type("max_bytes", "a whole number of bytes (such as 200 * 2**20)",
-                         max_bytes)
-    if size < 1:
-        raise MbodyError(f"max_bytes: expected a size of at least 1 byte, got {max_bytes!r}")
-    return size
+    return checked_max_bytes(max_bytes)
 
 
 def looks_like_yaml(text: str) -> bool:

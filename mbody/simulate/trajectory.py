@@ -39,6 +39,7 @@ from mbody.model.model import State, count
 from mbody.model.yaml_write import dump_document
 from mbody.util import jsontext
 from mbody.util.atomic import atomic_path
+from mbody.util.budget import checked_max_bytes
 from mbody.util.frozen import Frozen
 from mbody.util.npzfile import Member, NpzArchive, size_text
 from mbody.util.spatial import planar_quat
@@ -529,6 +530,7 @@ class Trajectory(Frozen):
             do not increase, states that are not finite, a damaged archive (a header that
             does not fit its size, JSON nested too deeply), more data than `max_bytes`.
         """
+        max_bytes = checked_max_bytes(max_bytes)  # the argument's fault, before the file's
         name = str(path)
         p = Path(path)
         if not p.exists():
