@@ -66,8 +66,9 @@ def byte_limit(max_bytes: int | None, default: int) -> int:
     """The budget of one read: `max_bytes` if given (the call's own), else the one
     `byte_budget` set around it, else `default` (the kind's: `MAX_BYTES`, `DATA_BYTES`
     or `TEXT_BYTES`)."""
-    if max_bytes is not None:
-        return checked_max_bytes(max_bytes)
+    size = checked_max_bytes(max_bytes)
+    if size is not None:
+        return size
     given = _GIVEN.get()
     return default if given is None else given
 
