@@ -437,7 +437,8 @@ def test_a_good_run_reads_back_as_it_was_saved(run_data, tmp_path):
 
 
 def test_sizes_in_messages_say_which_is_larger():
-    from mbody.util.npzfile import over_budget, size_text
+    from mbody.util.formatting import size_text
+    from mbody.util.npzfile import over_budget
 
     assert size_text(16) == "16 bytes" and size_text(1536) == "1.5 KiB (1,536 bytes)"
     assert size_text(2**31) == "2 GiB" and size_text(8 * 10**15) == "7.11 PiB"

@@ -47,6 +47,7 @@ from yaml.events import (
 
 from mbody.errors import Issue, ModelError, did_you_mean, wrong_type
 from mbody.util.budget import MAX_BYTES, byte_limit, checked_max_bytes
+from mbody.util.formatting import sizes_apart
 
 # libyaml keeps line marks and is many times faster than the pure-Python parser
 _Loader: type[yaml.SafeLoader] | type[yaml.CSafeLoader] = getattr(
@@ -338,17 +339,6 @@ FIFO_WAIT = 1.0
 """Seconds a named pipe with no writer is given for one to appear before it is refused."""
 
 
-def _size(n: int, mib: str = ".1f") -> str:
-    """A size of `n` bytes as people read it: MiB (`mib`, the format of the number) from
-    1 MiB, else KiB with the exact bytes, else bytes ("0.0 MiB" says nothing)."""
-    if n >= 2**20:
-        return f"{n / 2**20:{mib}} MiB"
-    if n < 2**10:
-        return f"{n:,} byte{'' if n == 1 else 's'}"
-    kib = f"{n / 2**10:.3g} KiB"
-    return kib if n % 2**10 == 0 else f"{kib} ({n:,} bytes)"
-
-
 def _near_file(path: Path, most: int = 2000) -> str:
     """A did-you-mean among the files beside a missing `path` (at most `most` entries of
     its folder are looked at: a huge folder costs no more), or ''."""
@@ -493,8 +483,8 @@ def read_file(path: str | os.PathLike[str], max_bytes: int | None = None,
                      f"from a pipe: mbody check /dev/stdin{given} < model{ext})")
     more = "--max-bytes N on the command line, or mbody.load(path, max_bytes=N), reads more"
     if st.st_size > max_bytes:
-        raise refuse(f"the file is {_size(st.st_size)}; mbody reads at most "
-                     f"{_size(max_bytes, '.3g')} ({more})")
+        size, most = sizes_apart(st.st_size, max_bytes)
+        raise refuse(f"the file is {size}; mbody reads at most {most} ({more})")
     try:  # never blocks in open(): a named pipe with no writer would wait forever there
         fd = os.open(p, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
     except OSError as exc:

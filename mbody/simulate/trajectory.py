@@ -40,8 +40,9 @@ from mbody.model.yaml_write import dump_document
 from mbody.util import jsontext
 from mbody.util.atomic import atomic_path
 from mbody.util.budget import checked_max_bytes
+from mbody.util.formatting import size_text
 from mbody.util.frozen import Frozen
-from mbody.util.npzfile import Member, NpzArchive, size_text
+from mbody.util.npzfile import Member, NpzArchive
 from mbody.util.spatial import planar_quat
 
 FORMAT = "mbody-trajectory"
