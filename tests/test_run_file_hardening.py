@@ -153,6 +153,9 @@ def test_times_not_finite_or_not_increasing_are_refused(run_data, tmp_path, caps
 
 @pytest.mark.parametrize(("key", "value", "expected"), [
     ("rtol", "x", "a number"),
+    ("rtol", True, "a number"),  # JSON true is a Python int: taken as 1 before (review R3 Y10)
+    ("energy_drift", False, "a number"),
+    ("momentum_initial", [0.0, True, 0.0], "3 numbers"),
     ("warnings", 3, "a list of texts"),
     ("reaction_axes", "sideways", "'joint' or 'world'"),
     ("model_values", [["bodies.rod.mass"]], "[path, value] pairs"),

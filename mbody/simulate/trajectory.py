@@ -758,8 +758,8 @@ def _appearance_problem(n: int, kind: type) -> Any:
 def _info_problem(info: dict) -> str:
     """What is wrong with the run's `info`: the first entry a reader uses that is not of
     its kind (`_INFO_KINDS`), or ''."""
-    def number(v: Any) -> bool:
-        return isinstance(v, int | float)
+    def number(v: Any) -> bool:  # JSON's true and false are Python ints, not numbers here
+        return isinstance(v, int | float) and not isinstance(v, bool)
 
     def text_pair(v: Any) -> bool:
         return isinstance(v, list) and len(v) == 2 and isinstance(v[0], str)
