@@ -98,7 +98,7 @@ def allowed(path: str, patterns: Sequence[str]) -> bool:
 
 def variant(model: Model, sheet: Answers, allow: Sequence[str] | None = None) -> Model:
     """`model` with the values of `sheet`'s ``set:`` (module doc); `model` itself when
-    the answers set none. `allow`: the paths a student may set (`allow_list`; None: any).
+    the answers set none.
 
     Parameters
     ----------
@@ -107,6 +107,8 @@ def variant(model: Model, sheet: Answers, allow: Sequence[str] | None = None) ->
         answers' values are set on top of them, so the answers' own win).
     sheet : Answers
         A student's answers.
+    allow : sequence of str, optional
+        The paths the answers may set (`allow_list`); None: any.
 
     Returns
     -------
