@@ -169,3 +169,35 @@ def test_accelerations_and_reactions_equal_mujocos(chain):
     assert np.abs(couple - c_mj).max() / L <= tol * r_scale
     if kind == "mixed":  # a ball joint transmits no couple
         assert np.abs(c_mj[~parts["revolute"]]).max() / L <= tol * r_scale
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_the_order_brings_a_fresh_body_with_each_joint_of_a_tree(seed):
+    """`band_order` on random forests (some trees held by the ground, some floating),
+    components labelled in a random order: a permutation in which each joint's first
+    component acts on a body no earlier component touches (so its pivot measures that
+    joint), the ground counting as touched."""
+    from mbody.equations.pack import band_order
+
+    rng = np.random.default_rng(seed)
+    n = 200
+    parent = np.array([-1 if b == 0 or rng.random() < 0.05 else int(rng.integers(0, b))
+                       for b in range(n)])
+    floating = np.flatnonzero((parent == -1) & (rng.random(n) < 0.5))
+    joints = [b for b in range(n) if b not in set(floating)]  # a floating root: no joint
+    per = rng.integers(1, 6, len(joints))  # components of each joint
+    joint = np.repeat(joints, per)
+    labels = rng.permutation(len(joint))
+    child, par = joint[labels], parent[joint[labels]]
+    order = band_order(child, par, n)
+    assert np.array_equal(np.sort(order), np.arange(len(child)))
+    touched = np.zeros(n, bool)
+    seen: set[int] = set()
+    for k in order:
+        c, p = int(child[k]), int(par[k])
+        if c not in seen:  # the joint's first component
+            assert not touched[c] or (p >= 0 and not touched[p])
+            seen.add(c)
+        touched[c] = True
+        if p >= 0:
+            touched[p] = True
