@@ -19,9 +19,10 @@ assembly keeps what the joints allow). Per size, best of --repeat (`tools/timing
 - route: the solve's route (`Solution.method`).
 
 A straight chain is the case where a long chain looked singular: before the unknowns were
-ordered from the ground (`mbody.equations.pack.band_order`), the ground joint came last in
-the order, its pivot ratio fell as 1/n, and past n = 100 every load took the dense route
-(see docs/performance.md). The verdict line fits t ~ n^p over the sizes run
+ordered from the ground (`mbody.equations.pack.band_order`), the ground joint could come
+last in the order (where reverse Cuthill-McKee put it), its pivot ratio then fell as 1/n
+(1/n³ with parallel revolute axes), and the load took the dense route (see
+docs/performance.md, "Long chains"). The verdict line fits t ~ n^p over the sizes run
 (`timing.linear_verdict`); a size that takes longer than --limit ends its kind.
 """
 
