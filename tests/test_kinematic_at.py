@@ -351,3 +351,10 @@ def test_a_run_short_of_a_turn_labels_the_laws_angle(slider_crank):
     table = mbody.kinematic_at(model, ["40 deg", "400 deg", "-320 deg"], times=[10 / 1800],
                                run=run)
     np.testing.assert_allclose(np.degrees(table.coordinates[:, 0]), 40.0, rtol=1e-14)
+
+
+def test_a_run_of_too_many_samples_says_how_many_in_a_few_words(slider_crank):
+    with pytest.raises(MbodyError) as refused:
+        mbody.kinematic_run(mbody.load(slider_crank), 1e300, 3600)
+    assert str(refused.value).startswith("3.6e303 samples (1e300 s at 3600 fps) is more than "
+                                         "10 000 000; lower fps or t_end")
