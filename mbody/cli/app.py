@@ -86,9 +86,10 @@ def build_parser() -> argparse.ArgumentParser:
         if writes and "--force" not in command._option_string_actions:
             command.add_argument(
                 "--force", action="store_true",
-                help=f"write {' or '.join(writes)} even when its suffix names another "
-                "format than the one written (an output is never one of this command's "
-                "input files, nor another of its outputs, --force or not)")
+                help=f"write {' or '.join(writes)} even when its name's suffix names "
+                "another format than the one written, which is otherwise refused as a "
+                "likely slip (an output is never one of this command's input files, nor "
+                "another of its outputs, --force or not)")
     return p
 
 

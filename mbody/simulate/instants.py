@@ -245,7 +245,9 @@ def kinematic_at(model: Model, at: object = None, *, every: object = None,
         The instants: a driver's coordinate with its unit (``"90 deg"``, ``"0.5 rev"``,
         ``"20 mm"``), or a time (``"0.01 s"``, ``"10 ms"``), as ``mbody kinematics --at``
         takes them; ``"NAME=90 deg"`` names the driver (default `driver`, else the
-        model's first). A number is that driver's coordinate in rad or m.
+        model's first). A number is that driver's coordinate in rad or m. An angle is
+        taken less whole turns in the unit it is written in (exact: ``"1e20 deg"`` is 280
+        deg); one in rad (or a number) is at most `MAX_ANGLE`, 1e9 rad.
     every : str or number, optional
         Instead of `at`, a table over one cycle with a row every step of the driver's
         coordinate (``"30 deg"``: 0, 30, ... 330 deg when the run turns it a full turn;
@@ -274,8 +276,10 @@ def kinematic_at(model: Model, at: object = None, *, every: object = None,
     ------
     MbodyError
         An instant without a unit, in a unit that is not the driver's quantity, on a
-        driver the model does not have, or that the run does not reach (its range is
-        said); a run of another model or other drivers' laws; not fully driven.
+        driver the model does not have, an angle in rad beyond `MAX_ANGLE`, or that the
+        run does not reach (its range is said), or a time later than a run made here can
+        reach; a step giving more than `MAX_INSTANTS` rows; a run of another model or
+        other drivers' laws; not fully driven.
     KinematicsError
         The loops cannot close at an instant.
     """
