@@ -109,6 +109,23 @@ def test_json_nested_too_deeply(tmp_path):
     refused(path, "nested 100001 deep", "at most 64")
 
 
+def test_json_whole_number_of_millions_of_digits(exports, tmp_path):
+    """Python converts at most 4300 digits of a whole number by default (the time grows as
+    their square); beyond that the message says so in its own words (review R5-9), not
+    Python's advice to raise the interpreter's limit, which stays as it was."""
+    from mbody.util import jsontext
+
+    limit = sys.get_int_max_str_digits()
+    assert limit == 4300  # Python's default (PYTHONINTMAXSTRDIGITS not set)
+    path = tmp_path / "bigint.json"
+    path.write_text('{"format": "mbody-export", "version": 2, "M": ' + "9" * 5_000_000 + "}")
+    text = refused(path, "not a readable mbody export",
+                   "a whole number of 5 000 000 digits; at most 4 300 are read")
+    assert "sys." not in text and "set_int_max_str_digits" not in text
+    assert sys.get_int_max_str_digits() == limit
+    assert jsontext.loads("[-" + "9" * 4300 + "]") == [-int("9" * 4300)]  # at the bound
+
+
 def test_json_matrix_shape_is_checked_before_the_matrix_is_made(exports, tmp_path):
     """A shape of 10^12 x 10^12 with no entries: its column pointers alone were 8 TB (a
     MemoryError)."""

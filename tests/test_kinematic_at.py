@@ -205,8 +205,8 @@ def test_csv_never_replaces_an_input(slider_crank, capsys):
     (["--at", "90 degrees"], "write '90 deg'"),
     (["--at", "20 mm"], "driver 'motor' drives an angle (deg, rad or rev), and '20 mm' is "
                         "a displacement"),
-    (["--at", "mtor=90 deg"], "no driver named 'mtor' in 'my-slider-crank' (did you mean "
-                              "'motor'?)"),
+    (["--at", "mtor=90 deg"], "--at mtor=90 deg: no driver named 'mtor'; did you mean "
+                              "'motor'?"),
     (["--at", "1 s"], "--at 1 s: t = 1 s is outside the run, t = 0 .. 0.2 s; lengthen "
                       "the run (--t-end)"),
     (["--at", "90 deg", "--t-end", "0.01"], "--at 90 deg: motor = 90 deg is not reached "
@@ -251,3 +251,95 @@ def test_first_reach_brackets_then_bisects():
     assert first_reach(law, t, -0.25 + 2 * math.pi, 2 * math.pi) == pytest.approx(
         math.pi + math.asin(0.5), abs=1e-15)
     assert first_reach(law, t, 0.75, None) is None
+
+
+# == review R5-4, R5-5, R5-11: tiny steps, huge angles, one labelling ======================
+
+@pytest.mark.parametrize("step", ["1e-310 s", "1e-310 deg", "5e-324 rad", "1e-300 s"])
+def test_a_tiny_step_is_refused_with_a_short_count(slider_crank, capsys, step):
+    """A step whose quotient overflows (or is astronomically large) is exit 2, its count
+    written as a number is (1e299, not 300 digits), from the command and from Python."""
+    assert main(["kinematics", str(slider_crank), "--every", step]) == 2
+    err = capsys.readouterr().err
+    assert f"--every {step}: " in err and "a table has at most 100 000; take a larger step" \
+        in err and "Traceback" not in err and len(err) < 200
+    with pytest.raises(MbodyError, match="a table has at most 100 000") as refused:
+        mbody.kinematic_at(mbody.load(slider_crank), every=step)
+    assert len(str(refused.value)) < 200
+
+
+def test_a_time_beyond_any_run_made_here_is_refused_in_a_few_words(slider_crank):
+    with pytest.raises(MbodyError) as refused:
+        mbody.kinematic_at(mbody.load(slider_crank), times=[1e300])
+    text = str(refused.value)
+    assert text.startswith("times=1e300: t = 1e+300 s is later than the run made here "
+                           "reaches (at most 10 000 000 samples") and len(text) < 300
+    assert "run=mbody.kinematic_run(model, t_end, fps)" in text
+
+
+@pytest.mark.parametrize("huge", ["1e20 deg", "1e16 deg", "-1e20 deg", "1e17 rev"])
+def test_a_huge_angle_is_that_angle_less_whole_turns_in_its_unit(crank, huge):
+    """1e20 deg is 280 deg plus whole turns (the double 1e20 is a whole number, reduced
+    here exactly in Python's integers); the row is that of the angle, labelled with it, as
+    if it had been asked so, and the closed form's."""
+    value, unit = huge.split()
+    turn = 360 if unit == "deg" else 1
+    exact = int(float(value)) % turn  # the float's exact value, reduced in integers
+    angle = exact if unit == "deg" else exact * 360.0
+    model = mbody.load(crank)
+    table = mbody.kinematic_at(model, [huge, f"{angle} deg"])
+    assert table.t[0] == table.t[1]
+    np.testing.assert_array_equal(table.values[0], table.values[1])
+    assert math.degrees(table.coordinates[0, 0]) == pytest.approx(angle, abs=1e-12)
+    Fx, Fy, torque = crank_closed_form(math.radians(angle))
+    assert table["motor.M"][0] == pytest.approx(torque, abs=RTOL * (M * W * W * R + M * G0) * R)
+
+
+def test_an_angle_in_rad_beyond_a_model_files_bound_is_refused(crank, capsys):
+    with pytest.raises(MbodyError, match=r"at='1e20 rad': expected an angle of at most 1e9 "
+                                         r"rad .* write it in deg or rev"):
+        mbody.kinematic_at(mbody.load(crank), "1e20 rad")
+    with pytest.raises(MbodyError, match="at most 1e9 rad"):
+        mbody.kinematic_at(mbody.load(crank), 1e10)  # a number is in rad
+    assert main(["kinematics", str(crank), "--at", "2e9 rad"]) == 2
+    assert "--at 2e9 rad: expected an angle of at most 1e9 rad" in capsys.readouterr().err
+
+
+def test_one_instant_has_one_label_however_it_is_asked(slider_crank, capsys):
+    """The slider-crank starts at 30 deg and turns at 300 rpm: at t = 330/1800 s it is at
+    360 deg. Asked as that time, as 0, 360 or 720 deg, or as a row of --every, the row is
+    labelled 0 deg (a run over a whole turn: less whole turns, 0 .. 360)."""
+    model = mbody.load(slider_crank)
+    t = 330 / 1800
+    table = mbody.kinematic_at(model, ["0 deg", "360 deg", "720 deg", "-360 deg", "1 rev"],
+                               times=[t])
+    every = mbody.kinematic_at(model, every="90 deg")
+    assert every.asked[0] == "0 deg" and every.t[0] == pytest.approx(t, abs=1e-12)
+    labels = [*np.degrees(table.coordinates[:, 0]), math.degrees(every.coordinates[0, 0])]
+    assert labels[:5] == [0.0] * 5 and labels[-1] == 0.0  # the value asked, exactly
+    assert labels[5] == pytest.approx(0.0, abs=1e-9)  # the law's, to its rounding
+    # 450 deg and 0.2 s (30 + 360 deg) are 90 and 30 deg, as --every labels them
+    again = mbody.kinematic_at(model, ["450 deg"], times=[0.2])
+    np.testing.assert_allclose(np.degrees(again.coordinates[:, 0]), [90.0, 30.0], atol=1e-9)
+    assert main(["kinematics", str(slider_crank), "--at", "0.2 s", "--at", "390 deg",
+                 "--at", "30 deg"]) == 0
+    rows = capsys.readouterr().out.splitlines()[-3:]
+    assert [r.split()[0] for r in rows] == ["30", "30", "30"]
+
+
+def test_a_run_short_of_a_turn_labels_the_laws_angle(slider_crank):
+    """Over 0 .. 0.01 s the crank turns from 30 to 48 deg, less than a turn: a row is
+    labelled with the law's angle there (40 deg), asked as 40, 400 or -320 deg or as the
+    time it is at 40 deg."""
+    model = mbody.load(slider_crank)
+    run = mbody.kinematic_run(model, 0.01, 3600)
+    table = mbody.kinematic_at(model, ["40 deg", "400 deg", "-320 deg"], times=[10 / 1800],
+                               run=run)
+    np.testing.assert_allclose(np.degrees(table.coordinates[:, 0]), 40.0, rtol=1e-14)
+
+
+def test_a_run_of_too_many_samples_says_how_many_in_a_few_words(slider_crank):
+    with pytest.raises(MbodyError) as refused:
+        mbody.kinematic_run(mbody.load(slider_crank), 1e300, 3600)
+    assert str(refused.value).startswith("3.6e303 samples (1e300 s at 3600 fps) is more than "
+                                         "10 000 000; lower fps or t_end")

@@ -6,8 +6,9 @@ command's own input, never half-written.
   /dev/null would turn the device into a regular file for every program on the machine.
   A block device and a socket are refused. A symbolic link is followed: the file it names
   is replaced and the link stays.
-- An output that is the command's own input (the same file, however named) is refused
-  unless --force, with exit code 2 and both names.
+- An output that is the command's own input (the same file, however named) is refused,
+  with or without --force (review R5-6), with exit code 2 and both names; so are two
+  outputs of one command that are one file.
 - A write that fails (a full disk) is exit 2 with the system's reason, and leaves nothing:
   no temporary file, no half-written picture set, no folder made for it.
 """
@@ -224,8 +225,8 @@ def test_dev_stdout_gets_the_data_and_the_messages_go_to_stderr(tmp_path):
     (["export", "{m}", "--state", "{run}", "-o", "{run}"], "-o", "the run file"),
     (["animate", "{run}", "--model", "{m}", "-o", "{m}"], "-o", "the model"),
 ])
-def test_an_output_onto_an_input_is_refused_unless_forced(tmp_path, capsys, run_file, args,
-                                                          flag, what):
+def test_an_output_onto_an_input_is_refused_even_forced(tmp_path, capsys, run_file, args,
+                                                        flag, what):
     # export -o, graph -o and plot -o onto an input whose suffix they cannot write:
     # tests/test_review_papercuts.py (--force is not offered where it cannot help)
     m = tmp_path / "m.yaml"
@@ -238,11 +239,13 @@ def test_an_output_onto_an_input_is_refused_unless_forced(tmp_path, capsys, run_
     names = {"m": m, "a": answers, "run": run}
     argv = [a.format(**names) for a in args]
     target = Path(argv[argv.index(flag) + 1])
-    code = main(argv)
-    err = capsys.readouterr().err
-    assert (code, err) == (2, f"mbody: error: {flag} {target} is {what} itself ({target}): "
-                           "writing there would replace the input; give another output "
-                           "file, or --force to replace it\n")
+    for force in ([], ["--force"]):  # --force never replaces an input (it once did)
+        code = main(argv + force)
+        err = capsys.readouterr().err
+        assert (code, err) == (2, f"mbody: error: {flag} {target} is {what} itself "
+                               f"({target}): writing there would replace the input, which "
+                               "no option allows (--force neither); give another output "
+                               "file\n")
     assert {p: p.read_bytes() for p in files} == files  # every input as it was
 
 
@@ -258,22 +261,80 @@ def test_the_same_file_under_another_name_is_the_same_file(tmp_path, capsys):
                                                           tmp_path / "sub" / ".." / "m.yaml")):
         code, _, err = run(capsys, "report", m, "-o", output)
         assert (code, err) == (2, f"mbody: error: -o {spelled} is the model itself ({m}, the "
-                               "same file): writing there would replace the input; give "
-                               "another output file, or --force to replace it\n")
+                               "same file): writing there would replace the input, which "
+                               "no option allows (--force neither); give another output "
+                               "file\n")
     assert m.read_text() == PENDULUM.read_text()
 
 
-def test_force_replaces_the_input(tmp_path, capsys):
+def test_force_never_replaces_the_input(tmp_path, capsys):
+    """Review R5-6: --force once replaced the model with the LaTeX, the CSV or the
+    converted model (convert "in place"); an input is never an output now."""
     m = tmp_path / "m.yaml"
     m.write_text(PENDULUM.read_text())
-    code, out, err = run(capsys, "assemble", m, "--latex", m, "--force")
-    assert code == 0, err
-    assert m.read_text().startswith("\\documentclass")
-    # convert rewrites a model in place with --force (YAML in the shipped layout)
+    answers = tmp_path / "b2.csv"  # an answers file under a CSV's name
+    answers.write_text("equations:\n  - {body: rod, eq: \"a_x = 0\"}\n")
+    crank = tmp_path / "crank.yaml"
+    crank.write_text((PENDULUM.parent / "slider_crank_driven.yaml").read_text())
+    before = {p: p.read_bytes() for p in (m, answers, crank)}
+    for argv, flag, target, what in [
+            (["assemble", m, "--latex", m], "--latex", m, "the model"),
+            (["convert", m, "-o", m], "-o", m, "the input"),
+            (["convert", m, "--to", "mjcf", "-o", m], "-o", m, "the input"),
+            (["verify", m, answers, "--summary", answers], "--summary", answers,
+             "the answers file"),
+            (["kinematics", crank, "--every", "90 deg", "--csv", crank], "--csv", crank,
+             "the model")]:
+        code, out, err = run(capsys, *argv, "--force")
+        assert (code, out) == (2, ""), err
+        assert err.startswith(f"mbody: error: {flag} {target} is {what} itself ({target}): ")
+        assert err.endswith("(--force neither); give another output file\n")
+    assert {p: p.read_bytes() for p in before} == before
+
+
+@pytest.mark.parametrize(("args", "message"), [
+    (["kinematics", "{crank}", "--t-end", "0.05", "--csv", "{d}/x.npz", "-o", "{d}/x.npz"],
+     "-o and --csv are both {d}/x.npz"),
+    (["kinematics", "{crank}", "--t-end", "0.05", "--csv", "{d}/link.csv", "-o",
+      "{d}/x.npz"], "--csv {d}/link.csv is -o {d}/x.npz, the same file"),
+    (["export", "{m}", "-o", "{d}/e.json", "-o", "{d}/sub/../e.json"],
+     "-o {d}/sub/../e.json is -o {d}/e.json, the same file"),
+    (["export", "{m}", "-o", "{d}/e.json", "-o", "{d}/e.json"], "-o {d}/e.json is given "
+     "twice"),
+    (["lagrange", "{m}", "--latex", "{d}/hard.tex", "-o", "{d}/l.tex"],
+     "--latex {d}/hard.tex is -o {d}/l.tex, the same file"),
+])
+def test_two_outputs_of_one_command_are_never_one_file(tmp_path, capsys, args, message):
+    """Review R5-6: `-o x.npz --csv x.npz --force` wrote the run, then the CSV over it.
+    Two outputs that are one file (as named, through a link to a file to be made, as a
+    hard link, spelt another way) are refused, --force or not, before any work."""
+    m = tmp_path / "m.yaml"
     m.write_text(PENDULUM.read_text())
-    code, out, err = run(capsys, "convert", m, "-o", m, "--force")
+    crank = tmp_path / "crank.yaml"
+    crank.write_text((PENDULUM.parent / "slider_crank_driven.yaml").read_text())
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "link.csv").symlink_to(tmp_path / "x.npz")  # x.npz is not there yet
+    (tmp_path / "l.tex").write_text("old")
+    os.link(tmp_path / "l.tex", tmp_path / "hard.tex")
+    argv = [a.format(d=tmp_path, m=m, crank=crank) for a in args]
+    for force in ([], ["--force"]):
+        code, out, err = run(capsys, *argv, *force)
+        assert (code, out) == (2, "")
+        assert err == (f"mbody: error: {message.format(d=tmp_path)}: one output would "
+                       "replace the other; give each output its own file\n")
+    assert not (tmp_path / "x.npz").exists() and not (tmp_path / "e.json").exists()
+    assert (tmp_path / "l.tex").read_text() == "old"
+
+
+def test_two_outputs_onto_one_device_are_written_through(tmp_path, capsys):
+    """/dev/null twice is not one file replaced by the other: both are written through."""
+    if not DEVNULL.exists():
+        pytest.skip("no /dev/null")
+    crank = tmp_path / "crank.yaml"
+    crank.write_text((PENDULUM.parent / "slider_crank_driven.yaml").read_text())
+    code, out, err = run(capsys, "kinematics", crank, "--t-end", "0.05", "--csv", DEVNULL,
+                         "-o", DEVNULL)
     assert code == 0, err
-    assert mbody.load(m).body_names == ("rod",)
 
 
 def test_every_command_that_writes_has_force():

@@ -285,13 +285,15 @@ def test_an_input_as_an_output_force_cannot_write_is_refused_without_offering_fo
     assert {p: p.read_bytes() for p in files} == files
 
 
-def test_an_input_as_an_output_force_can_write_offers_force(tmp_path, capsys):
+def test_an_input_as_an_output_is_never_offered_force(tmp_path, capsys):
+    """--force once replaced the input (review R5-6): it is not offered, nor passes."""
     m = tmp_path / "q.yaml"
     m.write_text(PENDULUM.read_text())
-    code, out, err = run(capsys, "assemble", m, "--latex", m)
-    assert code == 2 and err.endswith("or --force to replace it\n")
-    code, out, err = run(capsys, "assemble", m, "--latex", m, "--force")
-    assert code == 0 and m.read_text().startswith("\\documentclass")
+    for force in ((), ("--force",)):
+        code, out, err = run(capsys, "assemble", m, "--latex", m, *force)
+        assert code == 2 and err.endswith("which no option allows (--force neither); give "
+                                          "another output file\n")
+    assert m.read_text() == PENDULUM.read_text()
 
 
 def test_the_command_lines_export_suffixes_are_the_exports():

@@ -148,7 +148,7 @@ def animate(a: argparse.Namespace) -> int:
         output_suffix(out, "-o", "an HTML page", (".html", ".htm"), a.force)
 
         refuse_overwriting_inputs([("-o", out)], [("the input", a.source)]
-                                  + ([("the model", a.model)] if a.model else []), a.force)
+                                  + ([("the model", a.model)] if a.model else []))
         ensure_writable(out)
     if not a.source.lower().endswith((".yaml", ".yml")):  # a model may come through a pipe
         regular_file(a.source, "a model (.yaml) or a run file (.npz)")

@@ -47,7 +47,7 @@ from mbody.errors import (
     did_you_mean,
     options_named,
 )
-from mbody.util.atomic import refuse_overwriting_inputs
+from mbody.util.atomic import refuse_one_file_twice, refuse_overwriting_inputs
 from mbody.util.budget import DATA_BYTES, MAX_BYTES, byte_budget
 
 COMMAND_MODULES = (core, export, sim, drive, draw, animate, mechanism, statics, verify,
@@ -86,9 +86,10 @@ def build_parser() -> argparse.ArgumentParser:
         if writes and "--force" not in command._option_string_actions:
             command.add_argument(
                 "--force", action="store_true",
-                help=f"write {' or '.join(writes)} even when it is one of this command's "
-                "input files (the same file, however named), replacing that input, or when "
-                "its suffix names another format than the one written")
+                help=f"write {' or '.join(writes)} even when its name's suffix names "
+                "another format than the one written, which is otherwise refused as a "
+                "likely slip (an output is never one of this command's input files, nor "
+                "another of its outputs, --force or not)")
     return p
 
 
@@ -143,10 +144,11 @@ def check_paths(args: argparse.Namespace,
                 command: argparse.ArgumentParser | None = None) -> None:
     """Refuse an empty file name (an output '' would be no output, or the current folder;
     an input '' the current folder), then an output of the command that is one of its
-    input files, unless --force (`mbody.util.atomic.refuse_overwriting_inputs`). An output
-    is named by `command`'s own first option for it (sweep's ``--out``), else OUTPUTS'.
-    A command's ``output_suffixes`` and ``output_resumed`` defaults say where --force
-    cannot help."""
+    input files (`mbody.util.atomic.refuse_overwriting_inputs`) or the file of another of
+    its outputs (`refuse_one_file_twice`), --force or not. An output is named by
+    `command`'s own first option for it (sweep's ``--out``), else OUTPUTS'. A command's
+    ``output_suffixes`` and ``output_resumed`` defaults say why such an output could not be
+    written there anyway."""
     for dest, what in (*OUTPUTS.items(), *INPUTS.items()):
         values = getattr(args, dest, None)
         if "" in (values if isinstance(values, list) else [values]):
@@ -159,9 +161,9 @@ def check_paths(args: argparse.Namespace,
     outputs = [(flag(dest), p) for dest in OUTPUTS for p in _paths(getattr(args, dest, None))]
     folders = {a.option_strings[0] for a in (command._actions if command is not None else ())
                if a.dest in OUTPUTS and a.option_strings and a.metavar == "DIR"}
-    refuse_overwriting_inputs(outputs, inputs, getattr(args, "force", False), folders,
-                              getattr(args, "output_suffixes", None),
+    refuse_overwriting_inputs(outputs, inputs, folders, getattr(args, "output_suffixes", None),
                               getattr(args, "output_resumed", ()))
+    refuse_one_file_twice(outputs)
 
 
 class _Parser(argparse.ArgumentParser):

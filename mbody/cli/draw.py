@@ -121,7 +121,7 @@ def fbd(a: argparse.Namespace) -> int:
     taken = set[str]()
     files = [(name, f"{_file_name(name, taken)}.{a.image_format}") for name in names]
     refuse_overwriting_inputs([("-o", str(out / f)) for _, f in files],
-                              [("the model", a.model)], a.force)
+                              [("the model", a.model)])
     with atomic_folder(out) as tmp:  # every picture, or none
         for name, file in files:
             fig = fbd_scene(asm.bodies[name].fbd, view=a.view, equations=not a.no_equations)

@@ -48,9 +48,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "qpos/qvel give the initial state (default, as on every command: "
                    "'initial' when the file has it, as mbody's export writes; else the "
                    "reference pose at rest)")
-    s.add_argument("--force", action="store_true", help="replace OUTPUT if it exists (even "
-                   "SOURCE itself: a model rewritten in place), or write it when its "
-                   "extension names another format than --to")
+    s.add_argument("--force", action="store_true", help="replace OUTPUT if it exists (never "
+                   "SOURCE itself: write the converted model beside it), or write it when "
+                   "its extension names another format than --to")
     s.add_argument("--set", action="append", default=[], metavar="PATH=VALUE",
                    dest="set_values", help="change a value of SOURCE's model (paths of its "
                    "YAML form, as for every command: bodies.<name>.<key>...) before it is "

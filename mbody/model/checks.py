@@ -383,6 +383,16 @@ def key_unit(path: Path_) -> str | None:
     return _KEY_UNITS.get(key) if key is not None else None
 
 
+def written_quantity(text: str) -> tuple[float, str] | None:
+    """A number followed by a unit, as written: ``"90 deg"`` -> (90.0, 'deg'), ``"1e20
+    deg"`` -> (1e+20, 'deg'), the unit's spaces made single (``"N·m"`` -> 'N m'); None
+    for text that is not a number and a unit (`si_quantity` says which units it knows)."""
+    m = _WITH_UNIT.fullmatch(text) if len(text) < 80 else None
+    if not m:
+        return None
+    return float(m.group(1)), " ".join(m.group(2).replace("·", " ").split())
+
+
 def si_quantity(text: str) -> tuple[float, str] | None:
     """A number followed by its unit, in SI: ``"90 deg"`` -> (1.5708, 'rad'), ``"20 mm"``
     -> (0.02, 'm'), ``"10 ms"`` -> (0.01, 's'), ``"0.25 rev"`` -> (1.5708, 'rad'). The
@@ -390,11 +400,10 @@ def si_quantity(text: str) -> tuple[float, str] | None:
     `_TO_SI` converts) and ``deg``, as a model file writes an angle. None for text that is
     not a number with such a unit (a bare number, a misspelt unit): the caller says what
     it expected."""
-    m = _WITH_UNIT.fullmatch(text) if len(text) < 80 else None
-    if not m:
+    written = written_quantity(text)
+    if written is None:
         return None
-    x = float(m.group(1))
-    unit = " ".join(m.group(2).replace("·", " ").split())
+    x, unit = written
     if unit == "deg":
         return math.radians(x), "rad"
     if unit in _SI_UNITS:

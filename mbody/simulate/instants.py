@@ -4,12 +4,19 @@ there, not interpolated between a run's samples.
 
 An instant asked by a driver's coordinate is the first time in the run at which the
 driver's law reaches that value: an angle modulo a turn (the crank at 90 deg is also at
-450 deg), a displacement as it is. It is found between the two samples that bracket it,
+450 deg; reduced in the unit it is written in, so that 1e20 deg is exactly 280 deg), a
+displacement as it is. It is found between the two samples that bracket it,
 then by bisection on the law itself, to the rounding of the time. The mechanism is then
 carried there from the sample just before it, as the run carries one sample to the next
 (`mbody.simulate.kinematic.carry`: the Taylor step, Newton's method on the sample's
 branch, the solve), so its positions, velocities, reactions and efforts are those of
 that instant.
+
+Each row is labelled with each driver's coordinate there, one way whichever way the
+instant was asked (a time, a coordinate, a step of ``every``): the law's value at that
+instant, less whole turns, 0 <= angle < 360 deg, for an angle driver the run turns through
+a whole turn or more (whose every angle it reaches); else the law's value as it is (a
+driver that swings between -30 and 30 deg reads -30, not 330).
 
     table = kinematic_at(model, ["90 deg", "180 deg"], axes="world")
     table["motor.M"]                  # (2,) N m, at 90 and 180 deg
@@ -18,6 +25,8 @@ that instant.
 
 from __future__ import annotations
 
+import csv
+import io
 import math
 import numbers
 from collections.abc import Sequence
@@ -29,7 +38,6 @@ import numpy as np
 from mbody.equations.world import check_axes
 from mbody.errors import (
     MbodyError,
-    did_you_mean,
     not_found,
     option_name,
     option_setting,
@@ -37,10 +45,11 @@ from mbody.errors import (
     wrong_type,
 )
 from mbody.model.arguments import checked_model
-from mbody.model.checks import angle_spelling, si_quantity
+from mbody.model.checks import MAX_ANGLE, angle_spelling, si_quantity, written_quantity
 from mbody.model.model import Model
 from mbody.simulate.axes import sample_states, world_series
 from mbody.simulate.kinematic import (
+    MAX_SAMPLES,
     carry,
     default_sampling,
     kinematic_run,
@@ -49,12 +58,17 @@ from mbody.simulate.kinematic import (
 from mbody.simulate.peaks import reaction_unit
 from mbody.simulate.trajectory import Trajectory
 from mbody.util.atomic import write_atomic
-from mbody.util.formatting import spreadsheet_text
+from mbody.util.formatting import NOISE, num, number, spreadsheet_text
 from mbody.util.frozen import Frozen
 
 MAX_INSTANTS = 100_000
 """Rows at most in one table (``every`` a tiny step): each row is a Newton solve."""
 TURN = 2.0 * math.pi
+TURN_IN = {"deg": 360.0, "rev": 1.0}
+"""Angle units whose turn is a whole number: an angle written in one is reduced modulo a
+turn there, exactly (`math.fmod`), whatever its size. One in rad (or a bare number) is at
+most `mbody.model.checks.MAX_ANGLE`, a model file's bound: a double's rounding of 2 pi
+would shift a larger angle's reduction by more than 4e-8 rad."""
 UNITS = {"angle": "deg, rad or rev", "displacement": "m, mm or cm", "time": "s or ms"}
 """The units an instant is asked in, as the messages list them (any that
 `mbody.model.checks.si_quantity` reads is taken)."""
@@ -73,8 +87,10 @@ class Instants(Frozen):
     drivers : tuple of str
         The model's drivers; ``kinds`` says of each "angle" or "displacement".
     coordinates : (K, k) array
-        Each driver's coordinate at each instant (rad or m): its law there, or for the
-        driver an instant was asked by, the value asked (the law's, less whole turns).
+        Each driver's coordinate at each instant (rad or m), the rows' labels: its law's
+        value there, less whole turns (0 <= angle < 2 pi) for an angle driver that the
+        run turns through a whole turn (module doc); the same however the instant was
+        asked. `of_run` keeps the law's values, as the run does.
     labels : tuple of str
         The reactions and drivers' efforts (``O.Fx``, ``motor.M``), in ``axes``.
     values : (K, m) array
@@ -155,13 +171,17 @@ class Instants(Frozen):
 
     def text(self) -> str:
         """The table as `mbody kinematics --at` prints it: a row per instant, the columns'
-        names over their units; values at 6 significant digits, those below 1e-12 of the
-        largest in the table (rounding beside it) as 0."""
+        names over their units; values at 6 significant digits, those below `NOISE` of
+        the largest (rounding beside it) as 0: of the reactions and efforts in the table,
+        or of a driver's column, at least a turn for an angle (a law's 1.5e-13 deg at its
+        360 deg, less a turn)."""
         head = self.header()
         data = self.rows()
         big = float(np.abs(self.values).max(initial=0.0))
-        cells = [[_cell(x, big if c > len(self.drivers) else 0.0) for c, x in enumerate(r)]
-                 for r in data]  # the reactions' columns: rounding beside the largest as 0
+        scale = [float(np.abs(data[:, c]).max(initial=360.0 if kind == "angle" else 0.0))
+                 for c, kind in enumerate(self.kinds)] + [0.0] \
+            + [big] * len(self.labels)  # an angle's scale at least a turn; the time as it is
+        cells = [[num(x, NOISE * s) for x, s in zip(r, scale, strict=True)] for r in data]
         table = [[n for n, _ in head], [u for _, u in head], *cells]
         widths = [max(len(r[c]) for r in table) for c in range(len(head))]
         return "\n".join("  " + "  ".join(x.ljust(w) for x, w in zip(r, widths, strict=True))
@@ -170,9 +190,11 @@ class Instants(Frozen):
     def csv(self) -> str:
         """The table as CSV: a header of ``name (unit)`` cells, then a row per instant,
         numbers to 17 significant digits (a double read back is the same double)."""
-        head = ",".join(_csv_cell(spreadsheet_text(f"{n} ({u})")) for n, u in self.header())
-        lines = [head] + [",".join(repr(float(x)) for x in r) for r in self.rows()]
-        return "\n".join(lines) + "\n"
+        buf = io.StringIO()
+        w = csv.writer(buf, lineterminator="\n")
+        w.writerow([spreadsheet_text(f"{n} ({u})") for n, u in self.header()])
+        w.writerows([repr(float(x)) for x in r] for r in self.rows())
+        return buf.getvalue()
 
     def write_csv(self, path: str | Path) -> Path:
         """Write `csv` to `path` atomically (`mbody.util.atomic.write_atomic`)."""
@@ -187,14 +209,6 @@ class Instants(Frozen):
                  "drivers": {n: float(x) for n, x in zip(self.drivers, r[:k], strict=True)},
                  "values": {lb: float(x) for lb, x in zip(self.labels, r[k + 1:], strict=True)}}
                 for r, a in zip(data, self.asked, strict=True)]
-
-
-def _cell(x: float, big: float) -> str:
-    return "0" if abs(x) <= 1e-12 * big or x == 0 else f"{x:.6g}"
-
-
-def _csv_cell(text: str) -> str:
-    return '"' + text.replace('"', '""') + '"' if any(c in text for c in ',"\n\r') else text
 
 
 def _kinds(model: Model) -> tuple[str, ...]:
@@ -231,7 +245,9 @@ def kinematic_at(model: Model, at: object = None, *, every: object = None,
         The instants: a driver's coordinate with its unit (``"90 deg"``, ``"0.5 rev"``,
         ``"20 mm"``), or a time (``"0.01 s"``, ``"10 ms"``), as ``mbody kinematics --at``
         takes them; ``"NAME=90 deg"`` names the driver (default `driver`, else the
-        model's first). A number is that driver's coordinate in rad or m.
+        model's first). A number is that driver's coordinate in rad or m. An angle is
+        taken less whole turns in the unit it is written in (exact: ``"1e20 deg"`` is 280
+        deg); one in rad (or a number) is at most `MAX_ANGLE`, 1e9 rad.
     every : str or number, optional
         Instead of `at`, a table over one cycle with a row every step of the driver's
         coordinate (``"30 deg"``: 0, 30, ... 330 deg when the run turns it a full turn;
@@ -260,8 +276,10 @@ def kinematic_at(model: Model, at: object = None, *, every: object = None,
     ------
     MbodyError
         An instant without a unit, in a unit that is not the driver's quantity, on a
-        driver the model does not have, or that the run does not reach (its range is
-        said); a run of another model or other drivers' laws; not fully driven.
+        driver the model does not have, an angle in rad beyond `MAX_ANGLE`, or that the
+        run does not reach (its range is said), or a time later than a run made here can
+        reach; a step giving more than `MAX_INSTANTS` rows; a run of another model or
+        other drivers' laws; not fully driven.
     KinematicsError
         The loops cannot close at an instant.
     """
@@ -273,6 +291,7 @@ def kinematic_at(model: Model, at: object = None, *, every: object = None,
     if run is None:
         span, fps = default_sampling(model)
         late = max([a.value for a in asked if a.driver is None], default=t_start)
+        _check_reachable(late, t_start, fps, [a for a in asked if a.value == late])
         run = kinematic_run(model, max(t_start + span, late), fps, t_start=t_start,
                             axes=axes)
     else:
@@ -289,13 +308,51 @@ def kinematic_at(model: Model, at: object = None, *, every: object = None,
         labels, values = world_series(model, t, Y, lam)
     d = model.drivers
     assert d is not None  # fully driven
-    coords = np.stack([np.asarray(law[0](t), dtype=float) * np.ones(len(t)) for law in d.laws],
-                      axis=1) if len(t) else np.zeros((0, len(d.names)))
+    return Instants(t, d.names, _kinds(model), _labels(model, run, t, asked), labels, values,
+                    axes, [a.text for a in asked], model.name)
+
+
+def _labels(model: Model, run: Trajectory, t: np.ndarray, asked: Sequence[Asked]
+            ) -> np.ndarray:
+    """(K, k) each driver's coordinate at the instants `t` (rad or m), as the rows are
+    labelled (module doc): the law's value, less whole turns for an angle driver the run
+    turns through a whole turn; for the driver an instant was asked by, the value asked
+    (already less whole turns) plus the turns the law has made there, so that the label
+    is the exact value asked rather than the law's rounding of it."""
+    d = model.drivers
+    assert d is not None
+    if not len(t):
+        return np.zeros((0, len(d.names)))
+    coords = np.stack([np.asarray(law[0](t), dtype=float) * np.ones(len(t))
+                       for law in d.laws], axis=1)
+    whole = [kind == "angle" and _turns_fully(law[0], run.t)
+             for kind, law in zip(_kinds(model), d.laws, strict=True)]
+    for i, w in enumerate(whole):
+        if w:
+            coords[:, i] = [_turn_part(x, TURN) for x in coords[:, i]]
     for r, a in enumerate(asked):
-        if a.driver is not None:
-            coords[r, a.driver] = a.value
-    return Instants(t, d.names, _kinds(model), coords, labels, values, axes,
-                    [a.text for a in asked], model.name)
+        j = a.driver
+        if j is None:
+            continue
+        angle = d.component[j] == "M"
+        turns = round((coords[r, j] - a.value) / TURN) if angle and not whole[j] else 0
+        coords[r, j] = a.value + turns * TURN
+    return coords
+
+
+def _turns_fully(law, t: np.ndarray) -> bool:
+    """Whether the angle `law` turns through a whole turn or more over the times `t` (then
+    it reaches every angle, and a table over one cycle runs 0 .. 360 deg)."""
+    F = np.asarray(law(t), dtype=float) * np.ones(len(t))
+    return bool(F.max() - F.min() >= TURN * (1 - 1e-12))
+
+
+def _turn_part(x: float, turn: float) -> float:
+    """`x` less whole `turn`s: 0 <= result < turn (Python's float % is exact), where a
+    result within `NOISE` of a turn below it is 0 (a tiny negative `x` gives `turn` itself,
+    rounded; a law's rounding of its 360 deg, 359.99999999999994)."""
+    r = x % turn
+    return 0.0 if r >= turn * (1.0 - NOISE) else r
 
 
 def asked_instants(model: Model, at: object = None, *, every: object = None,
@@ -318,7 +375,8 @@ def asked_instants(model: Model, at: object = None, *, every: object = None,
     if at is None and every is None and times is None:
         raise MbodyError("give the instants: at=['90 deg'] (a driver's coordinate or a "
                          "time), every='30 deg' (a table over one cycle) or times=[0.01]")
-    first = _driver_index(model, driver) if driver is not None else 0
+    first = (_driver_index(model, driver, option_setting("driver", driver))
+             if driver is not None else 0)
     if every is not None:
         return [], _asked(model, every, first, "every", step=True)
     asked = [_asked(model, x, first, "at") for x in _entries(at, "at")]
@@ -341,14 +399,14 @@ def _entries(value: object, name: str) -> list:
     raise wrong_type(name, "a value such as '90 deg' or '0.01 s', or a list of them", value)
 
 
-def _driver_index(model: Model, name: str) -> int:
+def _driver_index(model: Model, name: str, where: str) -> int:
+    """The index of the driver `name` of `model`; asked at `where` (an option and its
+    entry, for the message)."""
     d = model.drivers
     names = list(d.names) if d is not None else []
     if name not in names:
-        hint = did_you_mean(name, names)
-        raise MbodyError(f"no driver named {name!r} in {model.name!r}"
-                         + (f" ({hint})" if hint else "")
-                         + f"; its drivers: {', '.join(names) or 'none'}")
+        raise MbodyError(f"{where}: " + not_found("driver named", name, names, "drivers",
+                                                  f"{model.name!r} has no drivers").args[0])
     return names.index(name)
 
 
@@ -364,9 +422,11 @@ def _asked(model: Model, entry: object, first: int, option: str, step: bool = Fa
         x = real_number(entry, option, "a number")
         quantity, index = kinds[first], first
         shown = (f"{math.degrees(x):g} deg" if kinds[first] == "angle" else f"{x:g} m")
+        written: tuple[float, str] | None = None  # in rad or m
     elif isinstance(entry, str):
         name, sep, rest = entry.partition("=")
-        index, text = (_driver_index(model, name.strip()), rest) if sep else (first, entry)
+        index, text = (_driver_index(model, name.strip(), where), rest) if sep else \
+            (first, entry)
         got = si_quantity(text)
         if got is None:
             raise MbodyError(f"{where}: {_unit_expected(model, index, text, step)}")
@@ -382,6 +442,7 @@ def _asked(model: Model, entry: object, first: int, option: str, step: bool = Fa
                              + (f"a quantity in {si}" if not quantity else f"a {quantity}")
                              + f"; or give a time ({UNITS['time']})")
         shown = " ".join(text.split())
+        written = written_quantity(text)
     else:
         raise wrong_type(option, "a value such as '90 deg' or '0.01 s', or a number (the "
                          "driver's coordinate, rad or m)", entry)
@@ -391,7 +452,26 @@ def _asked(model: Model, entry: object, first: int, option: str, step: bool = Fa
         raise MbodyError(f"{where}: expected a step above 0")
     if quantity == "time":
         return Asked(shown if step else f"t = {shown}", None, x, where)
+    if quantity == "angle" and not step:
+        x = _angle_in_turn(x, written, where)
     return Asked(shown, index, x, where)
+
+
+def _angle_in_turn(x: float, written: tuple[float, str] | None, where: str) -> float:
+    """The angle asked, `x` rad (`written`: its number and unit as given), less whole
+    turns: 0 <= result < 2 pi. Reduced in the unit it was written in when a turn is a
+    whole number there (`TURN_IN`), which is exact however large the value; in rad, at
+    most `MAX_ANGLE` (else refused, saying so)."""
+    if written is not None and written[1] in TURN_IN:
+        value, unit = written
+        part = _turn_part(value, TURN_IN[unit])
+        x = math.radians(part) if unit == "deg" else part * TURN
+    elif abs(x) > MAX_ANGLE:
+        raise MbodyError(f"{where}: expected an angle of at most {number(MAX_ANGLE)} rad in "
+                         "magnitude (beyond it a double's 2 pi puts the angle asked off by "
+                         "more than 4e-8 rad once whole turns are taken off); write it in deg "
+                         "or rev, which are taken modulo a turn exactly, however large")
+    return _turn_part(x, TURN)
 
 
 def _unit_expected(model: Model, index: int, text: str, step: bool) -> str:
@@ -468,6 +548,19 @@ def _time(model: Model, run: Trajectory, a: Asked) -> float:
     return found
 
 
+def _check_reachable(late: float, t_start: float, fps: float, asked: Sequence[Asked]
+                     ) -> None:
+    """Refuse, before making it, a run to the time `late` (asked by `asked`) that would
+    take more than `MAX_SAMPLES` samples at `fps` (`kinematic_at` without a run)."""
+    if not asked or (late - t_start) * fps < MAX_SAMPLES:
+        return
+    reach = t_start + (MAX_SAMPLES - 1) / fps
+    raise MbodyError(f"{asked[0].source}: {asked[0].text} is later than the run made here "
+                     f"reaches (at most {number(MAX_SAMPLES)} samples at {number(fps)} a "
+                     f"second, to t = {number(reach)} s); give a run that reaches it "
+                     "(run=mbody.kinematic_run(model, t_end, fps) with a lower fps)")
+
+
 def _longer() -> str:
     """How to make the run longer: --t-end on the command line, else a longer run."""
     flag = option_name("t_end")
@@ -529,23 +622,26 @@ def _every(model: Model, run: Trajectory, step: Asked) -> list[Asked]:
     """The instants of a table with a row every `step` over the run's cycle (`kinematic_at`'s
     ``every``)."""
     t = run.t
-    if step.driver is None:
-        count = int(math.floor((float(t[-1]) - float(t[0])) / step.value * (1 + 1e-12))) + 1
-        _check_count(count, step)
+    if step.driver is None:  # the quotients are checked as floats: a tiny step's is inf
+        q = (float(t[-1]) - float(t[0])) / step.value * (1 + 1e-12)
+        _check_count(q + 1, step)
+        steps = math.floor(q) + 1
         return [Asked(f"t = {float(t[0]) + k * step.value:g} s", None,
                        min(float(t[0]) + k * step.value, float(t[-1])))
-                for k in range(count)]
+                for k in range(steps)]
     d = model.drivers
     assert d is not None
     angle = d.component[step.driver] == "M"
     F = np.asarray(d.laws[step.driver][0](t), dtype=float) * np.ones(len(t))
     lo, hi = float(F.min()), float(F.max())
-    if angle and hi - lo >= TURN * (1 - 1e-12):  # a full turn: 0 up to 360 deg
-        first, last = 0, math.ceil(TURN / step.value * (1 - 1e-12)) - 1
+    if angle and _turns_fully(d.laws[step.driver][0], t):  # a full turn: 0 up to 360 deg
+        first = 0
+        last = math.ceil(_check_count(TURN / step.value * (1 - 1e-12), step)) - 1
     else:
-        first = math.ceil(lo / step.value - 1e-9)
-        last = math.floor(hi / step.value + 1e-9)
-    _check_count(last - first + 1, step)
+        a, b = lo / step.value - 1e-9, hi / step.value + 1e-9
+        _check_count(b - a + 1, step)
+        first, last = math.ceil(a), math.floor(b)
+        _check_count(last - first + 1, step)
     out = []
     for k in range(first, last + 1):
         x = k * step.value
@@ -558,10 +654,14 @@ def _every(model: Model, run: Trajectory, step: Asked) -> list[Asked]:
     return out
 
 
-def _check_count(count: int, step: Asked) -> None:
-    if count > MAX_INSTANTS:
-        raise MbodyError(f"{step.source}: {count} rows is more than {MAX_INSTANTS}; take a "
-                         "larger step")
+def _check_count(count: float, step: Asked) -> float:
+    """`count`, the rows of a table with a row every `step` (a quotient of floats, which a
+    tiny step makes infinite, or nan), if it is at least 1 and at most `MAX_INSTANTS`."""
+    if not count <= MAX_INSTANTS:
+        rows = number(count) if math.isfinite(count) else "more than 1e308"
+        raise MbodyError(f"{step.source}: {rows} rows, and a table has at most "
+                         f"{number(MAX_INSTANTS)}; take a larger step")
     if count < 1:
         raise MbodyError(f"{step.source}: the run reaches no multiple of it; "
                          f"{_longer()}")
+    return count

@@ -51,6 +51,7 @@ from mbody.solve.kinematics import (
     _size,
     _state,
 )
+from mbody.util.formatting import number
 from mbody.util.spatial import quat_to_matrix
 
 MAX_NEWTON = 60
@@ -76,12 +77,13 @@ def sample_times(t_end: float, fps: float, t_start: float = 0.0) -> np.ndarray:
     if not (math.isfinite(t_end) and math.isfinite(fps) and fps > 0 and t_end > t_start):
         raise MbodyError(f"a kinematic run needs t_end > {t_start:g} s and fps > 0, got "
                          f"t_end {t_end!r}, fps {fps!r}")
-    count = int(math.floor((t_end - t_start) * fps + 1e-9)) + 1
-    if count > MAX_SAMPLES:
-        raise MbodyError(f"{count} samples ({t_end - t_start:g} s at {fps:g} fps) is more "
-                         f"than {MAX_SAMPLES}; lower {option_name('fps')} or "
+    steps = (t_end - t_start) * fps + 1e-9  # a float: compared before it is an int
+    if not steps + 1 <= MAX_SAMPLES:
+        many = number(steps + 1) if math.isfinite(steps) else "more than 1e308"
+        raise MbodyError(f"{many} samples ({number(t_end - t_start)} s at {number(fps)} fps) "
+                         f"is more than {number(MAX_SAMPLES)}; lower {option_name('fps')} or "
                          f"{option_name('t_end')}")
-    return t_start + np.arange(count) / fps
+    return t_start + np.arange(int(math.floor(steps)) + 1) / fps
 
 
 def last_sample_warning(t_end: float, fps: float, t_start: float = 0.0) -> str | None:

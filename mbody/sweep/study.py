@@ -245,10 +245,9 @@ def check_outputs(out: str | os.PathLike[str], model_file: str | os.PathLike[str
     """
     resumed = ("--out", JOURNAL_OPTION)
     inputs = [("the model", os.fspath(model_file))] if model_file is not None else []
-    refuse_overwriting_inputs([("--out", os.fspath(out))], inputs, False, resumed=resumed)
+    refuse_overwriting_inputs([("--out", os.fspath(out))], inputs, resumed=resumed)
     refuse_overwriting_inputs([(JOURNAL_OPTION, str(journal_of(out)))],
-                              [*inputs, ("the output", os.fspath(out))], False,
-                              resumed=resumed)
+                              [*inputs, ("the output", os.fspath(out))], resumed=resumed)
 
 
 def run_sweep(model: Model | str | os.PathLike[str],

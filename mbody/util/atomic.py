@@ -10,9 +10,10 @@ that a writer's failure sends nothing); the command's own standard output (``-o
 /dev/stdout``) is written through its descriptor; a block device, a socket or a folder
 is refused. Folders made for an output are removed again when the output fails.
 
-An output is never one of the command's own inputs, however named
-(`refuse_overwriting_inputs`), and never a folder or a device where a regular file is
-meant (`ensure_writable`, `refuse_special`).
+An output is never one of the command's own inputs, however named, whatever the options
+(`refuse_overwriting_inputs`), nor the file of another of its outputs
+(`refuse_one_file_twice`), and never a folder or a device where a regular file is meant
+(`ensure_writable`, `refuse_special`).
 """
 
 from __future__ import annotations
@@ -168,23 +169,24 @@ def refuse_special(target: str | os.PathLike[str], what: str) -> None:
 
 
 def refuse_overwriting_inputs(outputs: Iterable[tuple[str, str]],
-                              inputs: Iterable[tuple[str, str]], force: bool,
+                              inputs: Iterable[tuple[str, str]],
                               folders: Container[str] = (),
                               suffixes: Mapping[str, Sequence[str]] | None = None,
                               resumed: Container[str] = ()) -> None:
-    """Refuse (unless `force`) an output that is one of the command's own inputs: the
-    same file, compared by identity (device and inode: a link or another spelling of
-    the path is the same file), not by name. `outputs` and `inputs` are (what, path)
-    pairs: ``("-o", "m.yaml")``, ``("the model", "m.yaml")``. Where `force` cannot help,
-    the message does not offer it, and `force` does not pass it: an output whose option
-    is in `folders` writes a folder, which cannot take a file's place; one whose option's
-    suffix chooses the format (`suffixes`: option -> the suffixes it writes) and whose
-    name has none of them is refused by the command anyway; one whose option is in
-    `resumed` is read back to resume the run (a sweep's results and their journal),
-    which needs its inputs as they were."""
+    """Refuse an output that is one of the command's own inputs: the same file, compared
+    by identity (device and inode: a link or another spelling of the path is the same
+    file), not by name. No option passes it (``--force`` neither): an input written over
+    is lost, and the command, which reads it first, would not have it to read again.
+    `outputs` and `inputs` are (what, path) pairs: ``("-o", "m.yaml")``, ``("the model",
+    "m.yaml")``. The message says which output, which input, and what to do; where the
+    output could not be written there anyway it says why: an output whose option is in
+    `folders` writes a folder; one whose option's suffix chooses the format (`suffixes`:
+    option -> the suffixes it writes) has a name without one of them; one whose option
+    is in `resumed` is read back to resume the run (a sweep's results and their
+    journal), which needs its inputs as they were."""
 
-    def stuck(flag: str, path: str, what: str = "its inputs") -> str:
-        """Why `force` cannot help writing `path` (`what`) there, or ''."""
+    def why(flag: str, path: str, what: str) -> str:
+        """What to do instead of writing `path` (`what`) with `flag`."""
         if flag in folders:
             return f"{flag} writes a folder; give a folder's name"
         if flag in resumed:
@@ -194,11 +196,9 @@ def refuse_overwriting_inputs(outputs: Iterable[tuple[str, str]],
         if allowed and Path(path).suffix.lower() not in allowed:
             return (f"{flag} writes a file ending in {', '.join(allowed)}; give another "
                     "output file")
-        return ""
+        return ("writing there would replace the input, which no option allows (--force "
+                "neither); give another output file")
 
-    outputs = [(flag, path) for flag, path in outputs if not force or stuck(flag, path)]
-    if not outputs:
-        return
     seen = []
     for what, path in inputs:
         try:
@@ -215,12 +215,37 @@ def refuse_overwriting_inputs(outputs: Iterable[tuple[str, str]],
         for what, source, st_in in seen:
             if os.path.samestat(st, st_in):
                 same = "" if source == path else ", the same file"
-                why = stuck(flag, path, what)
-                if why:
-                    raise MbodyError(f"{flag} {path} is {what} itself ({source}{same}): {why}")
-                raise MbodyError(f"{flag} {path} is {what} itself ({source}{same}): writing "
-                                 "there would replace the input; give another output file, "
-                                 "or --force to replace it")
+                raise MbodyError(f"{flag} {path} is {what} itself ({source}{same}): "
+                                 f"{why(flag, path, what)}")
+
+
+def refuse_one_file_twice(outputs: Iterable[tuple[str, str]]) -> None:
+    """Refuse two outputs of one command that are one file, whatever the options (the
+    second written would replace the first): compared by identity where the file is
+    there (a link, a hard link, another spelling of the path), else by the path with its
+    links followed. `outputs` are (option, path) pairs, as `refuse_overwriting_inputs`
+    takes them. A device or a named pipe is written through, not replaced: two outputs
+    there (``/dev/null``) pass."""
+    seen: dict[object, tuple[str, str]] = {}
+    for flag, path in outputs:
+        try:
+            st = os.stat(path)
+        except FileNotFoundError:
+            key: object = os.path.normcase(os.path.realpath(path))  # new: where it will be
+        except (OSError, ValueError):
+            continue  # refused, with its reason, where it is written
+        else:
+            if not (stat.S_ISREG(st.st_mode) or stat.S_ISDIR(st.st_mode)):
+                continue
+            key = (st.st_dev, st.st_ino)
+        if key in seen:
+            first, where = seen[key]
+            both = (f"{flag} {path} is given twice" if (first, where) == (flag, path) else
+                    f"{first} and {flag} are both {path}" if where == path else
+                    f"{flag} {path} is {first} {where}, the same file")
+            raise MbodyError(f"{both}: one output would replace the other; give each output "
+                             "its own file")
+        seen[key] = (flag, path)
 
 
 def make_folders(target: str | os.PathLike[str], folder: Path) -> list[Path]:

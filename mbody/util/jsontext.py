@@ -17,10 +17,13 @@ from __future__ import annotations
 
 import json
 import math
+import sys
 from collections.abc import Mapping
 from typing import IO, Any
 
 import numpy as np
+
+from mbody.util.formatting import number
 
 
 def plain(value: Any) -> Any:
@@ -142,10 +145,30 @@ def loads(text: str, *, max_depth: int = MAX_DEPTH) -> Any:
     Raises
     ------
     ValueError
-        The text nests deeper than `max_depth` (saying how deep), or is not JSON
+        The text nests deeper than `max_depth` (saying how deep), holds a whole number of
+        more digits than Python converts (saying how many), or is not JSON
         (`json.JSONDecodeError`, a `ValueError`).
     """
     depth = nesting(text)
     if depth > max_depth:
         raise ValueError(f"JSON nested {depth} deep; at most {max_depth} levels are read")
-    return json.loads(text)
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError:
+        raise
+    except ValueError:  # json's other ValueError: a whole number longer than Python reads
+        json.loads(text, parse_int=_bounded_int)  # read again, only now: raises why
+        raise
+
+
+def _bounded_int(digits: str) -> int:
+    """A JSON whole number, or a ValueError saying it is too long in words, rather than
+    Python's advice to raise its limit (`sys.set_int_max_str_digits`, a setting of the
+    interpreter, not of a file being read): the limit bounds the time of the conversion,
+    which grows as the square of the digits."""
+    limit = sys.get_int_max_str_digits()  # 0: none
+    size = len(digits.lstrip("-"))
+    if limit and size > limit:
+        raise ValueError(f"a whole number of {number(size)} digits; at most "
+                         f"{number(limit)} are read")
+    return int(digits)
