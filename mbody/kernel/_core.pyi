@@ -4,6 +4,7 @@ Every array argument is a C-contiguous float64 (int64 for F/I/Iu: I and Iu) buff
 exactly the size the model implies; a wrong one raises ValueError naming it.
 """
 
+from collections.abc import Callable
 from typing import Any, overload
 
 import numpy as np
@@ -180,6 +181,14 @@ LI_UNCONVERGED: int
 LI_RESTING: int
 LI_NORM: int
 LINEARIZE_INFO: int
+STAGE_GENERALIZED: int
+STAGE_DAMPING: int
+STAGE_STIFFNESS: int
+STAGE_SYSTEM: int
+STAGE_HESSENBERG: int
+STAGE_SCHUR: int
+STAGE_VECTORS: int
+STAGES: int
 
 def solve_layout(n: int, m: int, planar: bool) -> tuple[int, int, int]: ...
 
@@ -231,6 +240,7 @@ class Unknowns:
     def generalized_perturbed(self, t: float, y: _F, lam: _F, Iq: _I, cols: _I, qdot: _F,
                               P: _F, out: _F) -> None: ...
     def linearize(self, t: float, y: _F, lam: _F, Iq: _I, cols: _I, scales: _F, quasi: _I,
-                  skip: _I, params: _F, out: _F) -> None: ...
+                  skip: _I, params: _F, out: _F,
+                  progress: Callable[[int, int, int], object] | None = None) -> None: ...
     def differences(self, t: float, y: _F, lam: _F, Iq: _I, cols: _I, qdot: _F, h: _F,
                     hu: _F, fscale: _F, rounding: float, skip: _I, out: _F) -> None: ...

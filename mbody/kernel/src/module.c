@@ -60,6 +60,19 @@ static int check_nargs(Py_ssize_t nargs, Py_ssize_t want, const char *name) {
     return 0;
 }
 
+/* A long call's progress (kernel.h, mb_progress) in Python: ctx is a callable taking (stage,
+ * done, total), or NULL. Ctrl-C (a pending signal) or an exception from the callable stops
+ * the call; its error is then the one set. */
+static int report_progress(void *ctx, int stage, int64_t done, int64_t total) {
+    if (PyErr_CheckSignals() < 0) return 1;
+    if (ctx == NULL) return 0;
+    PyObject *r = PyObject_CallFunction((PyObject *)ctx, "iLL", stage, (long long)done,
+                                        (long long)total);
+    if (r == NULL) return 1;
+    Py_DECREF(r);
+    return 0;
+}
+
 /* -- Model --------------------------------------------------------------------------- */
 
 typedef struct {
@@ -882,6 +895,7 @@ static PyObject *Unknowns_differences(UnknownsObject *self, PyObject *const *arg
         return NULL;
     }
     Py_ssize_t nq = Iq.len / 8 / MB_GQ_W, N = cols.len / 8;
+    mb_progress signals = {report_progress, NULL};
     int got = 0, ok = 1;
     for (; got < 4; got++)
         if (get_buffer(args[5 + got], &v[got], 0, 1, nq, names[got]) < 0) break;
@@ -893,7 +907,7 @@ static PyObject *Unknowns_differences(UnknownsObject *self, PyObject *const *arg
     if (ok) {
         status = mb_differences(md, &self->u, self->w, t, y.buf, lam.buf, nq, Iq.buf, N,
                                 cols.buf, v[0].buf, v[1].buf, v[2].buf, v[3].buf, NULL,
-                                rounding, skip.buf, out.buf);
+                                rounding, skip.buf, &signals, out.buf);
         PyBuffer_Release(&out);
     }
     if (have_skip) PyBuffer_Release(&skip);
@@ -902,24 +916,35 @@ static PyObject *Unknowns_differences(UnknownsObject *self, PyObject *const *arg
     PyBuffer_Release(&Iq);
     PyBuffer_Release(&lam);
     PyBuffer_Release(&y);
-    if (!ok) return NULL;
+    if (!ok || status == MB_STOPPED) return NULL;
     if (status < 0) return PyErr_NoMemory();
     Py_RETURN_NONE;
 }
 
 PyDoc_STRVAR(linearize_doc,
-"linearize(t, y, lam, Iq, cols, scales, quasi, skip, params, out)\n\nThe linearisation "
-"about (t, y) (kernel.h, mb_linearize): out [generalized's out | K | K_err\n| D | D_err | "
-"q'' | left out | A ((2 nq)^2 slot) | info (LINEARIZE_INFO)]; scales (nq):\n1 or the model's "
-"length; quasi, skip (nq, int64); params (LINEARIZE_PARAMS).");
+"linearize(t, y, lam, Iq, cols, scales, quasi, skip, params, out, progress=None)\n\nThe "
+"linearisation about (t, y) (kernel.h, mb_linearize): out [generalized's out | K |\nK_err "
+"| D | D_err | q'' | left out | A ((2 nq)^2 slot) | info (LINEARIZE_INFO)]; scales\n(nq): 1 "
+"or the model's length; quasi, skip (nq, int64); params (LINEARIZE_PARAMS).\nprogress: "
+"called as progress(stage, done, total) before each step (STAGE_*);\nan exception it "
+"raises, or Ctrl-C, stops the call.");
 
 static PyObject *Unknowns_linearize(UnknownsObject *self, PyObject *const *args,
                                     Py_ssize_t nargs) {
     Py_buffer y, lam, Iq, cols, scales, quasi, skip, params, out;
     double t;
-    if (unknowns_ready(self) < 0 || check_nargs(nargs, 10, "linearize") < 0 ||
-        get_double(args[0], &t, "t") < 0)
+    if (unknowns_ready(self) < 0 || get_double(args[0], &t, "t") < 0) return NULL;
+    if (nargs != 10 && nargs != 11) {
+        PyErr_Format(PyExc_TypeError, "linearize() takes 10 or 11 arguments (%zd given)",
+                     nargs);
         return NULL;
+    }
+    PyObject *callback = nargs == 11 && args[10] != Py_None ? args[10] : NULL;
+    if (callback != NULL && !PyCallable_Check(callback)) {
+        PyErr_SetString(PyExc_TypeError, "progress: expected a callable or None");
+        return NULL;
+    }
+    mb_progress progress = {report_progress, callback};
     const mb_model *md = &self->model->md;
     if (get_state(md, args[1], &y, 0, 0) < 0) return NULL;
     if (get_buffer(args[2], &lam, 0, 1, md->m, "lam") < 0) {
@@ -943,7 +968,7 @@ static PyObject *Unknowns_linearize(UnknownsObject *self, PyObject *const *args,
     if (stage == 4 && get_buffer(args[9], &out, 1, 1, size, "out") == 0) stage = 5;
     if (stage == 5) {
         status = mb_linearize(md, &self->u, self->w, t, y.buf, lam.buf, nq, Iq.buf, N, cols.buf,
-                              scales.buf, quasi.buf, skip.buf, params.buf, out.buf);
+                              scales.buf, quasi.buf, skip.buf, params.buf, &progress, out.buf);
         PyBuffer_Release(&out);
     }
     if (stage >= 4) PyBuffer_Release(&params);
@@ -954,7 +979,7 @@ static PyObject *Unknowns_linearize(UnknownsObject *self, PyObject *const *args,
     PyBuffer_Release(&Iq);
     PyBuffer_Release(&lam);
     PyBuffer_Release(&y);
-    if (stage < 5) return NULL;
+    if (stage < 5 || status == MB_STOPPED) return NULL;
     if (status < 0) return PyErr_NoMemory();
     Py_RETURN_NONE;
 }
@@ -1379,9 +1404,11 @@ static PyObject *spectrum(PyObject *mod, PyObject *const *args, Py_ssize_t nargs
         PyBuffer_Release(&A);
         return NULL;
     }
-    int status = mb_spectrum(A.buf, n, dA, tol, out.buf);
+    mb_progress signals = {report_progress, NULL};
+    int status = mb_spectrum(A.buf, n, dA, tol, &signals, out.buf);
     PyBuffer_Release(&out);
     PyBuffer_Release(&A);
+    if (status == MB_STOPPED) return NULL;
     if (status < 0) return PyErr_NoMemory();
     return PyLong_FromLong(status);
 }
@@ -1491,6 +1518,10 @@ PyMODINIT_FUNC PyInit__core(void) {
         {"MODE_NEUTRAL", MB_MODE_NEUTRAL}, {"MODE_OSCILLATION", MB_MODE_OSCILLATION},
         {"MODE_GROWTH", MB_MODE_GROWTH}, {"MODE_DECAY", MB_MODE_DECAY},
         {"LINEARIZE_INFO", MB_LINEARIZE_INFO},
+        {"STAGE_GENERALIZED", MB_STAGE_GENERALIZED}, {"STAGE_DAMPING", MB_STAGE_DAMPING},
+        {"STAGE_STIFFNESS", MB_STAGE_STIFFNESS}, {"STAGE_SYSTEM", MB_STAGE_SYSTEM},
+        {"STAGE_HESSENBERG", MB_STAGE_HESSENBERG}, {"STAGE_SCHUR", MB_STAGE_SCHUR},
+        {"STAGE_VECTORS", MB_STAGE_VECTORS}, {"STAGES", MB_STAGES},
     };
     for (size_t i = 0; i < sizeof(constants) / sizeof(constants[0]); i++)
         if (PyModule_AddIntConstant(m, constants[i].name, constants[i].value) < 0) goto fail;

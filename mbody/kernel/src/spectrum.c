@@ -85,9 +85,11 @@ static void reflect_cols(double *H, int64_t n, const double *v, double beta, int
     }
 }
 
-/* H <- Z^T H Z upper Hessenberg, Z (n x n) orthogonal accumulated. */
-static void hessenberg(double *H, int64_t n, double *Z, double *x, double *v) {
+/* H <- Z^T H Z upper Hessenberg, Z (n x n) orthogonal accumulated. 0, or MB_STOPPED. */
+static int hessenberg(double *H, int64_t n, double *Z, double *x, double *v,
+                      const mb_progress *progress) {
     for (int64_t k = 0; k + 2 < n; k++) {
+        if (mb_report(progress, MB_STAGE_HESSENBERG, k, n)) return MB_STOPPED;
         int64_t len = n - k - 1;
         for (int64_t i = 0; i < len; i++) x[i] = H[(k + 1 + i) * n + k];
         double beta = householder(x, len, v);
@@ -97,6 +99,7 @@ static void hessenberg(double *H, int64_t n, double *Z, double *x, double *v) {
         reflect_cols(Z, n, v, beta, len, k + 1, 0, n - 1);
         for (int64_t i = k + 2; i < n; i++) H[i * n + k] = 0.0;
     }
+    return 0;
 }
 
 /* One Francis double-shift step on the active window l..m of H (full Schur updates: the
@@ -152,13 +155,15 @@ static void block_eigenvalues(double a, double b, double c, double d, double *wr
 }
 
 /* Real Schur form by Francis steps: T in H, Z accumulated; the eigenvalues in wr, wi and
- * each row's block start in start (the row itself for a 1 x 1 block). 0, or -1 when the
- * iteration did not converge. */
-static int schur(double *H, int64_t n, double *Z, double *wr, double *wi, int64_t *start) {
+ * each row's block start in start (the row itself for a 1 x 1 block). 0, -1 when the
+ * iteration did not converge, or MB_STOPPED. */
+static int schur(double *H, int64_t n, double *Z, double *wr, double *wi, int64_t *start,
+                 const mb_progress *progress) {
     double norm = 0.0;
     for (int64_t i = 0; i < n * n; i++) norm = fmax(norm, fabs(H[i]));
     int64_t m = n - 1, its = 0;
     while (m >= 0) {
+        if (its == 0 && mb_report(progress, MB_STAGE_SCHUR, n - 1 - m, n)) return MB_STOPPED;
         int64_t l = m;
         for (; l > 0; l--) { /* a negligible subdiagonal splits the problem */
             double s = fabs(H[(l - 1) * n + l - 1]) + fabs(H[l * n + l]);
@@ -297,7 +302,8 @@ static void stable_order(int64_t n, const double *first, const double *second,
     }
 }
 
-int mb_spectrum(const double *A, int64_t n, double dA, double tol, double *out) {
+int mb_spectrum(const double *A, int64_t n, double dA, double tol,
+                const mb_progress *progress, double *out) {
     double complex *w_out = (double complex *)out, *V_out = w_out + n;
     double *err_out = out + 2 * (n + n * n);
     if (n == 0) return 0;
@@ -321,14 +327,19 @@ int mb_spectrum(const double *A, int64_t n, double dA, double tol, double *out) 
     balance(H, n, d);
     for (int64_t i = 0; i < n * n; i++) Z[i] = 0.0;
     for (int64_t i = 0; i < n; i++) Z[i * n + i] = 1.0;
-    hessenberg(H, n, Z, tmp, tmp2);
-    if (schur(H, n, Z, wr, wi, start) < 0) {
+    int status = hessenberg(H, n, Z, tmp, tmp2, progress);
+    if (status == 0) status = schur(H, n, Z, wr, wi, start, progress);
+    if (status != 0) {
         free(buf);
-        return 1;
+        return status == MB_STOPPED ? MB_STOPPED : 1;
     }
     double normT = 0.0;
     for (int64_t i = 0; i < n * n; i++) normT = fmax(normT, fabs(H[i]));
     for (int64_t k = 0; k < n; k++) {
+        if (mb_report(progress, MB_STAGE_VECTORS, k, n)) {
+            free(buf);
+            return MB_STOPPED;
+        }
         if (wi[k] < 0.0) continue; /* the conjugate of the one before it */
         double complex lam = wr[k] + wi[k] * _Complex_I;
         double smin = fmax(DBL_EPSILON * fmax(cabs(lam), normT), DBL_MIN);
