@@ -766,6 +766,62 @@ int mb_generalized_perturbed(const mb_model *md, const mb_unknowns *u, mb_work *
     return 0;
 }
 
+int mb_independence(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
+                    const double *y, int64_t nq, const int64_t *Iq, int64_t nc,
+                    const int64_t *cols, const double *colscale, double *out) {
+    gen_scratch s;
+    if (scratch_new(&s, md, u, nq, nc, cols) < 0) return -1;
+    int64_t N = nc, n = md->n, r = s.r, nq1 = nq > 0 ? nq : 1, cc[nq1], cp[nq1];
+    double *g = malloc(sizeof(double) * (size_t)((r > N ? r : N) + r + 1));
+    if (g == NULL) {
+        scratch_free(&s);
+        return -1;
+    }
+    double *rownorm = g + (r > N ? r : N);
+    memcpy(s.y, y, sizeof(double) * 13 * n);
+    mb_eval_all(md, w, t);
+    double ratio = factor(md, u, w, &s, nq, Iq, cc, cp, NULL);
+    out[r] = r == N ? ratio : 0.0;
+    for (int64_t i = 0; i < r; i++) out[i] = 0.0;
+    if (r == N && ratio > 0.0) {
+        /* |(C S)_i| from the rows as factor put them (C's columns are scaled since: undo) */
+        for (int64_t i = 0; i < r; i++) rownorm[i] = 0.0;
+        for (int64_t i = 0; i < r; i++) {
+            double row[12];
+            int64_t c, p;
+            if (i < s.mu) {
+                int64_t comp = u->U[i], j = md->comps_i[4 * comp];
+                memcpy(row, w->child6 + 6 * comp, 6 * sizeof(double));
+                memcpy(row + 6, w->parent6 + 6 * comp, 6 * sizeof(double));
+                c = md->joints_i[3 * j + 1], p = md->joints_i[3 * j];
+            } else {
+                memcpy(row, s.arow + 12 * (i - s.mu), 12 * sizeof(double));
+                c = cc[i - s.mu], p = cp[i - s.mu];
+            }
+            for (int side = 0; side < 2; side++) {
+                int64_t b = side ? p : c;
+                if (b < 0) continue;
+                for (int a = 0; a < 6; a++) {
+                    int64_t j = s.col_of[6 * b + a];
+                    if (j >= 0) rownorm[i] += row[6 * side + a] * colscale[j] * row[6 * side + a] * colscale[j];
+                }
+            }
+            rownorm[i] = sqrt(rownorm[i]);
+        }
+        for (int64_t i = 0; i < r; i++) { /* column i of C^-1, in the scaled units */
+            for (int64_t k = 0; k < r; k++) g[k] = k == i;
+            qr_solve(&s, g);
+            double sum = 0.0;
+            for (int64_t k = 0; k < N; k++) sum += (g[k] / colscale[k]) * (g[k] / colscale[k]);
+            double norm = rownorm[i] * sqrt(sum);
+            out[i] = norm > 0.0 ? 1.0 / norm : 0.0;
+        }
+    }
+    free(g);
+    scratch_free(&s);
+    return 0;
+}
+
 int mb_coordinate_rows(const mb_model *md, mb_work *w, double t, const double *y, int64_t nq,
                        const int64_t *Iq, int64_t nc, const int64_t *cols, double *rows,
                        double *values) {

@@ -324,6 +324,14 @@ int mb_coordinate_rows(const mb_model *md, mb_work *w, double t, const double *y
 int mb_generalized(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
                    const double *y, const double *lam, int64_t nq, const int64_t *Iq,
                    int64_t nc, const int64_t *cols, const double *qdot, double *out);
+/* How far each of the rows of B = D_r [G_U^T; A^T] S (S = diag(colscale), D_r scaling each
+ * row to unit length) is from the span of the others, for a square B: out (r + 1) [d_i =
+ * 1 / |B^-1 e_i| (0: B singular) | the pivot ratio of mb_generalized's QR (0: B not square
+ * or singular)], at the band's cost per row. A lower bound on B's smallest singular value
+ * is 1 / sqrt(sum 1 / d_i^2). Returns 0, or -1 when memory ran out. */
+int mb_independence(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
+                    const double *y, int64_t nq, const int64_t *Iq, int64_t nc,
+                    const int64_t *cols, const double *colscale, double *out);
 /* f_q at np perturbed states, P (np x 2 nq) rows [dq | du]: the positions of y0 moved along
  * v = T(y0) dq for a unit time (x + v, q (x) exp(w / 2)), the rates q0' + du: fout (np x
  * nq). For the linearisation's differences (its curves have the tangents T e_k). */

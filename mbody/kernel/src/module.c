@@ -819,6 +819,46 @@ y_:
     return NULL;
 }
 
+PyDoc_STRVAR(independence_doc,
+"independence(t, y, Iq, cols, colscale, out)\n\nHow far each row of B = D_r [G_U^T; A^T] S "
+"(S = diag(colscale), rows\nscaled to unit length) is from the span of the others, for a "
+"square B (kernel.h,\nmb_independence): out (r + 1) [1 / |B^-1 e_i| | the QR's pivot ratio], "
+"0 where B\nis singular or not square.");
+
+static PyObject *Unknowns_independence(UnknownsObject *self, PyObject *const *args,
+                                       Py_ssize_t nargs) {
+    Py_buffer y, Iq, cols, scale, out;
+    double t;
+    if (unknowns_ready(self) < 0 || check_nargs(nargs, 6, "independence") < 0 ||
+        get_double(args[0], &t, "t") < 0)
+        return NULL;
+    const mb_model *md = &self->model->md;
+    if (get_state(md, args[1], &y, 0, 0) < 0) return NULL;
+    if (get_coordinates(md, args[2], args[3], &Iq, &cols) < 0) {
+        PyBuffer_Release(&y);
+        return NULL;
+    }
+    Py_ssize_t nq = Iq.len / 8 / MB_GQ_W, N = cols.len / 8;
+    int ok = get_buffer(args[4], &scale, 0, 1, N, "colscale") == 0;
+    if (ok && get_buffer(args[5], &out, 1, 1, self->u.mu + nq + 1, "out") < 0) {
+        PyBuffer_Release(&scale);
+        ok = 0;
+    }
+    int status = 0;
+    if (ok) {
+        status = mb_independence(md, &self->u, self->w, t, y.buf, nq, Iq.buf, N, cols.buf,
+                                 scale.buf, out.buf);
+        PyBuffer_Release(&out);
+        PyBuffer_Release(&scale);
+    }
+    PyBuffer_Release(&cols);
+    PyBuffer_Release(&Iq);
+    PyBuffer_Release(&y);
+    if (!ok) return NULL;
+    if (status < 0) return PyErr_NoMemory();
+    Py_RETURN_NONE;
+}
+
 PyDoc_STRVAR(generalized_perturbed_doc,
 "generalized_perturbed(t, y, lam, Iq, cols, qdot, P, out)\n\nf_q at perturbed states "
 "(kernel.h, mb_generalized_perturbed): P (np x 2 nq) rows\n[dq | du]: y's positions moved "
@@ -1321,6 +1361,8 @@ static PyMethodDef Unknowns_methods[] = {
     {"schur", (PyCFunction)(void (*)(void))Unknowns_schur, METH_FASTCALL, schur_doc},
     {"generalized", (PyCFunction)(void (*)(void))Unknowns_generalized, METH_FASTCALL,
      generalized_doc},
+    {"independence", (PyCFunction)(void (*)(void))Unknowns_independence, METH_FASTCALL,
+     independence_doc},
     {"generalized_perturbed", (PyCFunction)(void (*)(void))Unknowns_generalized_perturbed,
      METH_FASTCALL, generalized_perturbed_doc},
     {"differences", (PyCFunction)(void (*)(void))Unknowns_differences, METH_FASTCALL,
