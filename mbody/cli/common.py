@@ -306,6 +306,24 @@ VIEW_HELP = ("spatial models: iso (default), front, top, side, or ELEV,AZIM in d
 """The --view option's help: how a spatial model's picture is seen (fbd, report, modes)."""
 
 
+def add_progress_options(command: argparse.ArgumentParser, what: str = "the progress bar"
+                         ) -> None:
+    """``--progress`` and ``--no-progress``: a long command's bars on standard error
+    (`mbody.util.progress`), by default when it is a terminal (`show_progress`)."""
+    command.add_argument("--progress", action="store_true",
+                         help=f"show {what} on stderr even when it is not a terminal")
+    command.add_argument("--no-progress", action="store_true",
+                         help=f"no {what.removeprefix('the ')} on stderr")
+
+
+def show_progress(a: argparse.Namespace) -> bool:
+    """Whether `add_progress_options`'s bars are drawn: ``--progress``, or standard error
+    is a terminal, unless ``--no-progress``."""
+    import sys
+
+    return (a.progress or sys.stderr.isatty()) and not a.no_progress
+
+
 def add_import_options(command: argparse.ArgumentParser) -> None:
     """Give a command that reads a model the options of MJCF and URDF input, and make its
     handler pass them to `load_model`. A command that has a ``--keyframe`` of its own

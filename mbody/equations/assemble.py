@@ -235,7 +235,8 @@ class Assembly:
         return assembly_symbolic(self, bodies)
 
     def generalized(self, coordinates: Sequence[str] | None = None,
-                    known: Mapping[str, float] | None = None) -> Generalized:
+                    known: Mapping[str, float] | None = None, *,
+                    progress: bool = False) -> Generalized:
         """The equations in generalized coordinates, ``M_q q'' = f_q``: these equations
         multiplied by Tᵀ, where v = T q' + v_e, which removes the reactions
         (`mbody.equations.generalized`).
@@ -248,13 +249,16 @@ class Assembly:
             tree's joint coordinates, then a free body's own.
         known : mapping of str to float, optional
             Reaction values applied as loads (their joints not held), added to the file's.
+        progress : bool
+            Say on standard error what is being computed, once it has taken a second
+            (`mbody.util.progress`).
 
         Returns
         -------
         Generalized
             ``M``, ``f``, ``T``, ``q``, ``qdot``, ``accelerations()``, ``symbolic()``.
         """
-        return generalized(self.model, self.state, coordinates, known)
+        return generalized(self.model, self.state, coordinates, known, progress=progress)
 
     # -- solving -----------------------------------------------------------------------
     def reaction_values(self, known: Mapping[str, float] | None = None) -> dict[str, float]:

@@ -492,19 +492,22 @@ def choose(model: Model, state: State | None = None, labels: Sequence[str] | Non
             chosen_idx.append(by_label[lab])
         free = [d for d, lab in enumerate(driver_labels) if lab in labels]
         held = _held(model, known, free)
-        rows = _Rows(model, state, cands, held.U)
-        dof = rows.N - rows.rank
-        if len(chosen_idx) != dof:
-            raise MbodyError(f"{len(chosen_idx)} coordinate(s) given for {dof} degree(s) of "
-                             f"freedom of model '{model.name}'"
-                             + (" (with its drivers held)" if n_drivers > len(free) else "")
-                             + f": give {dof}")
-        for k in chosen_idx:
-            if not rows.adds(k):
-                raise MbodyError(f"coordinate {cands[k].label!r} does not add a motion the "
-                                 "joints and the coordinates before it leave free at this "
-                                 "state: choose another")
         items = tuple(cands[k] for k in chosen_idx)
+        if _independent(model, state, held, list(items)):
+            dof = len(items)
+        else:
+            rows = _Rows(model, state, cands, held.U)
+            dof = rows.N - rows.rank
+            if len(chosen_idx) != dof:
+                raise MbodyError(f"{len(chosen_idx)} coordinate(s) given for {dof} degree(s) "
+                                 f"of freedom of model '{model.name}'"
+                                 + (" (with its drivers held)" if n_drivers > len(free) else "")
+                                 + f": give {dof}")
+            for k in chosen_idx:
+                if not rows.adds(k):
+                    raise MbodyError(f"coordinate {cands[k].label!r} does not add a motion "
+                                     "the joints and the coordinates before it leave free at "
+                                     "this state: choose another")
         efforts = tuple((model.reactions[first_driver + d],
                          labels.index(driver_labels[d])) for d in free)
         return CoordinateSet(items, held, efforts, dof, columns(model), size(model))

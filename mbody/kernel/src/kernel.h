@@ -374,10 +374,15 @@ int mb_differences(const mb_model *md, const mb_unknowns *u, mb_work *w, double 
  * K | K_err | D | D_err (nq x nq each) | q'' (nq) | left out (nq, 0/1) | A (nz x nz in a
  * slot of (2 nq)^2) | info (MB_LINEARIZE_INFO) | spectrum (of nz, in a slot of
  * 6 nq + 8 nq^2) | modes (of nz, in a slot of 12 nq + 4 nq^2) | the OSCILLATIONS modes'
- * frequencies, then their damping ratios (in a slot of 4 nq)], nz = kept + nq. Its
+ * frequencies, then their damping ratios (in a slot of 4 nq)], nz = kept + nq.
+ * params[MB_LP_STOP]: MB_STOP_STIFFNESS stops once K, D, q'' and the left-out flags are
+ * made (info's STEADY, UNSTEADY, RESTING, KEPT and SINGULAR set: what a Newton step for an
+ * equilibrium needs, without A and its O(nz^3) spectrum); MB_STOP_SYSTEM once A and its
+ * info (TOL, DA, NORM) are (the caller finds the spectrum: LAPACK's, for a large A). Its
  * stages are reported (MB_STAGE_*). Returns 0, MB_STOPPED, or -1 when memory ran out. */
 enum { MB_LP_STEP = 0, MB_LP_ROUNDING = 1, MB_LP_STEADY = 2, MB_LP_MOVING = 3,
-       MB_LINEARIZE_PARAMS = 4 };
+       MB_LP_STOP = 4, MB_LINEARIZE_PARAMS = 5 };
+enum { MB_STOP_NONE = 0, MB_STOP_STIFFNESS = 1, MB_STOP_SYSTEM = 2 };
 enum { MB_LI_STEADY = 0, MB_LI_UNSTEADY = 1, MB_LI_TOL = 2, MB_LI_KEPT = 3,
        MB_LI_SINGULAR = 4, MB_LI_DA = 5, MB_LI_NORM = 6, MB_LI_RESTING = 7,
        MB_LI_GROWING = 8, MB_LI_MODES = 9, MB_LI_UNCONVERGED = 10, MB_LI_OSCILLATIONS = 11,

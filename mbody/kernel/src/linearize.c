@@ -100,6 +100,13 @@ int mb_linearize(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
         if (moving && !cyclic && unsteady == 0) unsteady = j + 1;
     }
     if (unsteady) steady = 0;
+    if (params[MB_LP_STOP] == MB_STOP_STIFFNESS) { /* K and what comes with it only */
+        info[MB_LI_STEADY] = steady;
+        info[MB_LI_UNSTEADY] = (double)unsteady;
+        info[MB_LI_KEPT] = (double)nk;
+        free(buf);
+        return 0;
+    }
     /* A = [[0, E], [-M^-1 K_kept, -M^-1 D]] (nz = nk + k); tolerance sqrt(dA |A|) */
     int64_t nz = nk + k;
     memset(A, 0, sizeof(double) * nz * nz);
@@ -180,6 +187,10 @@ int mb_linearize(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
     info[MB_LI_KEPT] = (double)nk;
     info[MB_LI_DA] = minv * (errK + errD);
     info[MB_LI_NORM] = nA;
+    if (params[MB_LP_STOP] == MB_STOP_SYSTEM) {
+        free(buf);
+        return 0;
+    }
     /* the spectrum of A and its modes, in the same call (the verdict needs them all) */
     double *spec = info + MB_LINEARIZE_INFO, *modes = spec + 6 * k + 8 * kk;
     int64_t *kept = (int64_t *)x; /* x's k doubles are free now */
