@@ -183,11 +183,24 @@ def did_you_mean(word: str, choices: Iterable[str]) -> str:
     return f"did you mean '{close}'?" if close is not None else ""
 
 
+CLOSE_CUTOFF = 0.6
+"""difflib's similarity a did-you-mean needs (its default)."""
+
+
 def closest(word: str, choices: Iterable[str]) -> str | None:
     """The choice `word` was probably meant to be (`did_you_mean`'s), or None."""
+    word = str(word)
     names = [str(c) for c in choices]
-    same = [c for c in names if c.casefold() == str(word).casefold()]
-    close = same or difflib.get_close_matches(str(word), names, n=1, cutoff=0.6)
+    folded = word.casefold()
+    same = [c for c in names if c.casefold() == folded]
+    if same:
+        return same[0]
+    # the choices whose lengths alone allow the similarity (difflib's real_quick_ratio,
+    # its first test, in its own arithmetic): the same answer, without difflib's per-choice
+    # work on the others (a large model's names are thousands)
+    n = len(word)
+    names = [c for c in names if 2.0 * min(n, len(c)) / (n + len(c)) >= CLOSE_CUTOFF]
+    close = difflib.get_close_matches(word, names, n=1, cutoff=CLOSE_CUTOFF)
     return close[0] if close else None
 
 

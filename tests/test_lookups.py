@@ -131,3 +131,24 @@ def test_generalized_known_gets_the_did_you_mean_solve_gives(dp):
     with pytest.raises(mbody.MbodyError) as solved:
         asm.solve(known={"A.fx": 1.0})
     assert str(solved.value) == str(err.value)
+
+
+def test_the_closest_name_is_difflibs_among_a_thousand():
+    # closest() skips the names whose lengths alone rule out difflib's cutoff (its first
+    # test, in its own arithmetic) before difflib looks at the rest: the same answer as
+    # difflib's over all of them, ties and near-misses included
+    import difflib
+    import random
+
+    from mbody.errors import CLOSE_CUTOFF, closest
+
+    rng = random.Random(7)
+    names = ["".join(rng.choice("jl_.012angle") for _ in range(rng.randint(1, 16)))
+             for _ in range(1000)]
+    words = [w[:-1] for w in names[:40]] + [w + "x" for w in names[40:80]] + \
+        ["", "m", "a_x", "j12.angle_dd", "ANGLE", "q" * 30]
+    for word in words:
+        same = [c for c in names if c.casefold() == word.casefold()]
+        expected = same[:1] or difflib.get_close_matches(word, names, n=1,
+                                                         cutoff=CLOSE_CUTOFF)
+        assert closest(word, names) == (expected[0] if expected else None), word

@@ -35,7 +35,7 @@ from mbody import conventions as cv
 from mbody.answers.compare import CONST, Row, fit, matches
 from mbody.answers.diagnose import CORRECT, NOT_AN_EQUATION, Diagnosis
 from mbody.answers.linear import NotLinear, linear_row
-from mbody.answers.load import Answer, Answers, AnswersError
+from mbody.answers.load import Answer, Answers, AnswersError, hinted
 from mbody.answers.parse import EquationError, names_in, parse_equation
 from mbody.answers.text import num
 from mbody.answers.vocabulary import Vocabulary, name_gravity, newton_euler_bodies
@@ -393,11 +393,7 @@ def _forgotten_body(model: Model, state: State, vocab: Vocabulary, eq: str,
 
 
 def _has(vocab: Vocabulary, name: str) -> bool:
-    try:
-        vocab.resolve(name)
-    except KeyError:
-        return False
-    return True
+    return vocab.canonical(name) is not None
 
 
 def coordinate_names(model: Model, sheet: Answers) -> tuple[tuple[str, ...], tuple[str, ...]]:
@@ -429,9 +425,9 @@ def check_lagrange(model: Model, state: State, sheet: Answers, entries: list[Ans
         raise AnswersError([Issue(sheet.file, 0, 0, "coordinates", f"the answers' coordinates: "
                                   f"{exc}")]) from None
     vocab = vocabulary(model, state, truth)
-    dotted = [*labels, *(f"{lab}_dot" for lab in labels), *(f"{lab}_ddot" for lab in labels),
+    dotted = (*labels, *(f"{lab}_dot" for lab in labels), *(f"{lab}_ddot" for lab in labels),
               *(f"{lab}dot" for lab in labels), *(f"{lab}ddot" for lab in labels),
-              *vocab.reactions]
+              *vocab.reactions)
     issues: list[Issue] = []
     parsed: list[tuple[Answer, Row | None, str]] = []
     bodies: dict[str, Vocabulary] = {}  # the bodies' Newton-Euler names, for the hint
@@ -444,11 +440,11 @@ def check_lagrange(model: Model, state: State, sheet: Answers, entries: list[Ans
         try:
             eq = parse_equation(a.eq, dotted)
             read = True
-            parsed.append((a, linear_row(eq, vocab), ""))
+            parsed.append((a, linear_row(eq, vocab if hinted(issues) else vocab.quiet), ""))
         except EquationError as exc:
             reason = exc.reason.replace(f" for body {vocab.body!r}", " in a Lagrange equation")
             advice = exc.hint
-            if read and len(issues) < AnswersError.SHOWN:  # a name this vocabulary lacks
+            if read and hinted(issues):  # a name this vocabulary lacks
                 advice = _forgotten_body(model, state, vocab, a.eq, dotted, bodies) or advice
             issues.append(sheet.issue(a, reason, position=exc.position, hint=advice))
         except NotLinear as exc:

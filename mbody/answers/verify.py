@@ -21,7 +21,14 @@ from mbody.answers.compare import Row
 from mbody.answers.diagnose import CORRECT, DIAGNOSES, NOT_AN_EQUATION, Diagnosis, diagnose
 from mbody.answers.lagrange import LAGRANGE_DIAGNOSES, check_lagrange
 from mbody.answers.linear import NotLinear, linear_row
-from mbody.answers.load import Answer, Answers, AnswersError, answers_from_data, read_answers
+from mbody.answers.load import (
+    Answer,
+    Answers,
+    AnswersError,
+    answers_from_data,
+    hinted,
+    read_answers,
+)
 from mbody.answers.parse import EquationError, parse_equation
 from mbody.answers.rows import BodyRows, body_rows
 from mbody.answers.vocabulary import Vocabulary, vocabulary
@@ -316,7 +323,7 @@ def verify(model: Model | str | os.PathLike[str], answers: Any, *, tol: float = 
         if a.lagrange:  # an equation in generalized coordinates: checked below
             continue
         if a.body not in model.index:
-            hint = did_you_mean(a.body, model.body_names)
+            hint = did_you_mean(a.body, model.body_names) if hinted(issues) else ""
             shown = ", ".join(model.body_names[:10]) + (" ..." if model.n > 10 else "")
             issues.append(sheet.issue(a, f"no body named {a.body!r} in model "
                                       f"'{model.name}' (its bodies: {shown})",
@@ -326,7 +333,7 @@ def verify(model: Model | str | os.PathLike[str], answers: Any, *, tol: float = 
             vocab[a.body] = vocabulary(model, state, a.body)
         try:
             eq = parse_equation(a.eq, model.reactions)
-            row = linear_row(eq, vocab[a.body])
+            row = linear_row(eq, vocab[a.body] if hinted(issues) else vocab[a.body].quiet)
             parsed.append((a, row, None))
         except EquationError as exc:
             issues.append(sheet.issue(a, exc.reason, position=exc.position, hint=exc.hint))
