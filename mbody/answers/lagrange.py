@@ -25,7 +25,7 @@ other coordinate).
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -373,7 +373,7 @@ def _diagnose(s: Row, truth: _Truth, tol: float, hint: int | None,
 
 
 def _forgotten_body(model: Model, state: State, vocab: Vocabulary, eq: str,
-                    labels: list[str], cache: dict[str, Vocabulary]) -> str:
+                    labels: Sequence[str], cache: dict[str, Vocabulary]) -> str:
     """The hint for an entry without ``body:`` whose names this Lagrange vocabulary lacks
     and a body's Newton-Euler equations have (``m*a_x = O.Fx``): "did you forget body:
     rod?"; '' when no body has them."""
