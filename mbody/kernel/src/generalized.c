@@ -52,6 +52,10 @@ int mb_coordinates_check(const mb_model *md, int64_t nq, const int64_t *Iq, int6
     return 0;
 }
 
+/* Columns of T and M_q are solved for one at a time and written BLOCK at a time across
+ * their rows (row-major outputs: a column's entries are nq apart, a cache line each). */
+#define BLOCK 8
+
 /* The scratch of one evaluation (allocated per call). C = [G_U^T; A^T] (r x N) is kept by
  * columns, its rows in the order of their first column (`pos`: an original row's place), so
  * that the Householder QR below works only within the band that the bodies' order leaves
@@ -60,6 +64,8 @@ int mb_coordinates_check(const mb_model *md, int64_t nq, const int64_t *Iq, int6
 typedef struct {
     int64_t n, N, nq, mu, r;
     double *C, *B, *fp, *scale, *beta, *rdiag, *y, *arow, *agam, *r6, *Ma, *lam, *tmp;
+    double *block; /* BLOCK (N + nq): a few columns of T or M_q gathered before they are
+                    * written across their rows */
     int64_t *col_of;       /* 6 n: active column index, or -1 */
     int64_t *bfirst, *blast; /* n: a body's first and last column (-1: none) */
     int64_t *pos, *first, *last; /* r: a row's place; by place, its first and last column */
@@ -67,12 +73,14 @@ typedef struct {
     int64_t *vend, *rend, *rbeg; /* N: reflector k's last row, R's row k's last column,
                                   * R's column k's first row */
     int64_t *clo, *chi, *count; /* N: the rows of column j written; N + 2: the sort's */
+    int64_t *off, W; /* N: column j holds rows off_j .. off_j + W - 1 (`band`), at C + j W */
 } gen_scratch;
 
 static void scratch_free(gen_scratch *s) {
     free(s->C), free(s->B), free(s->fp), free(s->scale), free(s->beta), free(s->rdiag);
     free(s->y), free(s->arow), free(s->agam), free(s->r6), free(s->Ma), free(s->lam);
     free(s->tmp), free(s->col_of), free(s->bfirst), free(s->pos), free(s->vend), free(s->clo);
+    free(s->block), free(s->off);
 }
 
 static int scratch_new(gen_scratch *s, const mb_model *md, const mb_unknowns *u, int64_t nq,
@@ -80,8 +88,7 @@ static int scratch_new(gen_scratch *s, const mb_model *md, const mb_unknowns *u,
     memset(s, 0, sizeof(*s));
     s->n = md->n, s->N = nc, s->nq = nq, s->mu = u->mu, s->r = u->mu + nq;
     int64_t r = s->r > 0 ? s->r : 1, N = nc > 0 ? nc : 1, n = md->n > 0 ? md->n : 1;
-    /* calloc: the pages of C outside the band are never touched, so never mapped */
-    s->C = calloc((size_t)(r * N), sizeof(double));
+    s->off = calloc((size_t)N, sizeof(int64_t)); /* C: made by `band`, with its width */
     s->B = calloc((size_t)(3 * r + N), sizeof(double));
     s->fp = calloc((size_t)r, sizeof(double));
     s->scale = calloc((size_t)N, sizeof(double));
@@ -94,13 +101,15 @@ static int scratch_new(gen_scratch *s, const mb_model *md, const mb_unknowns *u,
     s->Ma = calloc((size_t)(6 * n), sizeof(double));
     s->lam = calloc((size_t)(md->m > 0 ? md->m : 1), sizeof(double));
     s->tmp = calloc((size_t)r, sizeof(double));
+    s->block = calloc((size_t)(BLOCK * (N + (nq > 0 ? nq : 1))), sizeof(double));
     s->col_of = calloc((size_t)(6 * n), sizeof(int64_t));
     s->bfirst = calloc((size_t)(2 * n), sizeof(int64_t));
     s->pos = calloc((size_t)(5 * r), sizeof(int64_t));
     s->vend = calloc((size_t)(3 * N), sizeof(int64_t));
     s->clo = calloc((size_t)(3 * N + 2), sizeof(int64_t));
-    if (!s->C || !s->B || !s->fp || !s->scale || !s->beta || !s->rdiag || !s->y || !s->arow ||
-        !s->agam || !s->r6 || !s->Ma || !s->lam || !s->tmp || !s->col_of || !s->bfirst ||
+    if (!s->off || !s->B || !s->fp || !s->scale || !s->beta || !s->rdiag || !s->y || !s->arow ||
+        !s->agam || !s->r6 || !s->Ma || !s->lam || !s->tmp || !s->block || !s->col_of ||
+        !s->bfirst ||
         !s->pos || !s->vend || !s->clo) {
         scratch_free(s);
         return -1;
@@ -222,8 +231,10 @@ static void coordinate_row(const mb_model *md, const mb_work *w, const double *y
     }
 }
 
-/* C (r x N) is kept by columns (column j at C + j r): each step of the QR below runs down
- * columns, so that its loops read memory in order. */
+/* C (r x N) is kept by columns, each in W doubles: column j's rows off_j .. off_j + W - 1
+ * (`band`: every row it holds from its first entry to the last the QR's fill reaches), so
+ * that a banded C takes N W doubles, a chain's a few columns wide, and the QR below runs
+ * down short columns that sit side by side in memory. */
 
 /* Row i of C (original order: the held components, then the coordinates) touches the
  * columns of bodies c and p (p < 0: none): its first and last column (first N: none). */
@@ -250,6 +261,43 @@ static void sort_rows(gen_scratch *s) {
     }
 }
 
+/* The rows each column of C holds while it is factored, from the rows' spans alone (their
+ * places and first and last columns, sort_rows's): a row's entries from its first column
+ * to its last, and each QR step's rows in the columns it reaches (the fill): off and W,
+ * then C of N W doubles. Once per scratch: the spans are those of the bodies, whatever
+ * the positions. Returns 0, or -1 when memory ran out. */
+static int band(gen_scratch *s) {
+    int64_t r = s->r, N = s->N, *off = s->off, *top = s->clo, *last = s->rhi;
+    for (int64_t j = 0; j < N; j++) off[j] = INT64_MAX, top[j] = -1;
+    for (int64_t p = 0; p < r; p++)
+        for (int64_t c = s->first[p]; c <= s->last[p] && c < N; c++) {
+            if (p < off[c]) off[c] = p;
+            if (p > top[c]) top[c] = p;
+        }
+    if (r >= N) { /* qr_factor's steps, without the arithmetic (rhi: free until row_span) */
+        memcpy(last, s->last, sizeof(int64_t) * (size_t)r);
+        for (int64_t k = 0, e = -1; k < N; k++) {
+            while (e + 1 < r && s->first[e + 1] <= k) e++;
+            int64_t hi = e > k ? e : k, L = k;
+            for (int64_t p = k; p <= hi; p++) L = last[p] > L ? last[p] : L;
+            for (int64_t c = k; c <= L; c++) {
+                if (k < off[c]) off[c] = k;
+                if (hi > top[c]) top[c] = hi;
+            }
+            for (int64_t p = k; p <= hi; p++) last[p] = L;
+        }
+    }
+    int64_t W = 1;
+    for (int64_t j = 0; j < N; j++) {
+        if (top[j] < 0) off[j] = 0, top[j] = 0; /* holds nothing */
+        if (top[j] - off[j] + 1 > W) W = top[j] - off[j] + 1;
+    }
+    s->W = W;
+    for (int64_t j = 0; j < N; j++) s->clo[j] = 0, s->chi[j] = -1; /* nothing written */
+    s->C = calloc((size_t)(N > 0 ? N : 1) * (size_t)W, sizeof(double));
+    return s->C != NULL ? 0 : -1;
+}
+
 /* Adds a row (child side [0..5] on body c, parent side [6..11] on body p) into C's row at
  * place `at`, noting the rows each column holds. */
 static void put_c_row(gen_scratch *s, int64_t at, const double *row, int64_t c, int64_t p) {
@@ -259,7 +307,7 @@ static void put_c_row(gen_scratch *s, int64_t at, const double *row, int64_t c, 
         for (int a = 0; a < 6; a++) {
             int64_t j = s->col_of[6 * b + a];
             if (j < 0) continue;
-            s->C[j * s->r + at] += row[6 * side + a];
+            s->C[j * s->W + at - s->off[j]] += row[6 * side + a];
             if (at < s->clo[j] || s->chi[j] < s->clo[j]) s->clo[j] = at;
             if (at > s->chi[j]) s->chi[j] = at;
         }
@@ -270,7 +318,7 @@ static void put_c_row(gen_scratch *s, int64_t at, const double *row, int64_t c, 
 static void clear_c(gen_scratch *s) {
     for (int64_t j = 0; j < s->N; j++) {
         if (s->chi[j] >= s->clo[j])
-            memset(s->C + j * s->r + s->clo[j], 0,
+            memset(s->C + j * s->W + s->clo[j] - s->off[j], 0,
                    sizeof(double) * (size_t)(s->chi[j] - s->clo[j] + 1));
         s->clo[j] = 0, s->chi[j] = -1;
     }
@@ -286,16 +334,18 @@ static void clear_c(gen_scratch *s) {
  * numbers of the dense QR of C's rows in this order. Returns the smallest |R_kk| over the
  * largest (0 when r < N), which does not depend on the rows' order (R^T R = C^T C). */
 static double qr_factor(gen_scratch *s) {
-    int64_t r = s->r, N = s->N;
+    int64_t r = s->r, N = s->N, W = s->W;
+    const int64_t *off = s->off;
     double *C = s->C;
     for (int64_t j = 0; j < N; j++) {
-        double sum = 0.0, *col = C + j * r;
+        double sum = 0.0, *col = C + j * W;
+        int64_t o = off[j];
         s->rdiag[j] = 0.0, s->beta[j] = 0.0;
         s->vend[j] = j - 1, s->rend[j] = j, s->rbeg[j] = j;
-        for (int64_t i = s->clo[j]; i <= s->chi[j]; i++) sum += col[i] * col[i];
+        for (int64_t i = s->clo[j]; i <= s->chi[j]; i++) sum += col[i - o] * col[i - o];
         sum = sum > 0.0 ? 1.0 / sqrt(sum) : 1.0;
         s->scale[j] = sum;
-        for (int64_t i = s->clo[j]; i <= s->chi[j]; i++) col[i] *= sum;
+        for (int64_t i = s->clo[j]; i <= s->chi[j]; i++) col[i - o] *= sum;
     }
     if (r < N) return 0.0; /* fewer rows than columns: the motion is not determined */
     double big = 0.0, small = INFINITY;
@@ -304,20 +354,21 @@ static double qr_factor(gen_scratch *s) {
         while (e + 1 < r && s->first[e + 1] <= k) e++;
         int64_t hi = e > k ? e : k, L = k;
         for (int64_t p = k; p <= hi; p++) L = s->last[p] > L ? s->last[p] : L;
-        double *v = C + k * r, norm = 0.0;
-        for (int64_t i = k; i <= hi; i++) norm += v[i] * v[i];
+        double *v = C + k * W + k - off[k], norm = 0.0; /* v[i - k]: row i */
+        int64_t h = hi - k;
+        for (int64_t i = 0; i <= h; i++) norm += v[i] * v[i];
         norm = sqrt(norm);
-        double x0 = v[k];
+        double x0 = v[0];
         double alpha = x0 >= 0.0 ? -norm : norm;
-        v[k] = x0 - alpha;
+        v[0] = x0 - alpha;
         double vv = 0.0;
-        for (int64_t i = k; i <= hi; i++) vv += v[i] * v[i];
+        for (int64_t i = 0; i <= h; i++) vv += v[i] * v[i];
         double bk = vv > 0.0 ? 2.0 / vv : 0.0;
         for (int64_t c = k + 1; c <= L; c++) {
-            double sum = 0.0, *col = C + c * r;
-            for (int64_t i = k; i <= hi; i++) sum += v[i] * col[i];
+            double sum = 0.0, *col = C + c * W + k - off[c]; /* col[i - k]: row i */
+            for (int64_t i = 0; i <= h; i++) sum += v[i] * col[i];
             sum *= bk;
-            for (int64_t i = k; i <= hi; i++) col[i] -= sum * v[i];
+            for (int64_t i = 0; i <= h; i++) col[i] -= sum * v[i];
             if (s->chi[c] < s->clo[c] || k < s->clo[c]) s->clo[c] = k;
             if (hi > s->chi[c]) s->chi[c] = hi;
             if (s->rbeg[c] == c) s->rbeg[c] = k; /* the first step to reach column c */
@@ -336,21 +387,24 @@ static double qr_factor(gen_scratch *s) {
  * in its first N entries, with the factors of qr_factor. Returns the residual's norm (the
  * part of b outside C's range: 0 for a consistent system). */
 static double qr_solve(const gen_scratch *s, double *b) {
-    int64_t r = s->r, N = s->N;
+    int64_t r = s->r, N = s->N, W = s->W;
+    const int64_t *off = s->off;
     const double *C = s->C;
     double *t = s->tmp, resid = 0.0;
     for (int64_t i = 0; i < r; i++) t[s->pos[i]] = b[i];
     for (int64_t k = 0; k < N; k++) { /* Q^T b */
-        const double *v = C + k * r;
-        double sum = 0.0;
-        for (int64_t i = k; i <= s->vend[k]; i++) sum += v[i] * t[i];
+        int64_t h = s->vend[k] - k;
+        if (h < 0) continue; /* no reflector (not factored) */
+        const double *v = C + k * W + k - off[k];
+        double sum = 0.0, *tk = t + k;
+        for (int64_t i = 0; i <= h; i++) sum += v[i] * tk[i];
         sum *= s->beta[k];
-        for (int64_t i = k; i <= s->vend[k]; i++) t[i] -= sum * v[i];
+        for (int64_t i = 0; i <= h; i++) tk[i] -= sum * v[i];
     }
     for (int64_t i = N; i < r; i++) resid += t[i] * t[i];
     for (int64_t k = N - 1; k >= 0; k--) {
         double sum = t[k];
-        for (int64_t j = k + 1; j <= s->rend[k]; j++) sum -= C[j * r + k] * b[j];
+        for (int64_t j = k + 1; j <= s->rend[k]; j++) sum -= C[j * W + k - off[j]] * b[j];
         b[k] = s->rdiag[k] != 0.0 ? sum / s->rdiag[k] : 0.0;
     }
     for (int64_t k = 0; k < N; k++) b[k] *= s->scale[k];
@@ -361,21 +415,25 @@ static double qr_solve(const gen_scratch *s, double *b) {
  * restricted to the coordinates' rows, i.e. T^T x when T is C^+ [0; I] (the transposed
  * solve: one vector instead of nq columns of T). */
 static void qr_transposed(const gen_scratch *s, const double *x, double *out, double *work) {
-    int64_t r = s->r, N = s->N;
+    int64_t r = s->r, N = s->N, W = s->W;
+    const int64_t *off = s->off;
     const double *C = s->C;
     for (int64_t k = 0; k < N; k++) { /* R^T z = D x, forward */
-        const double *col = C + k * r;
+        const double *col = C + k * W;
+        int64_t o = off[k];
         double sum = s->scale[k] * x[k];
-        for (int64_t j = s->rbeg[k]; j < k; j++) sum -= col[j] * work[j];
+        for (int64_t j = s->rbeg[k]; j < k; j++) sum -= col[j - o] * work[j];
         work[k] = s->rdiag[k] != 0.0 ? sum / s->rdiag[k] : 0.0;
     }
     for (int64_t i = N; i < r; i++) work[i] = 0.0;
     for (int64_t k = N - 1; k >= 0; k--) { /* Q [z; 0] = H_0 ... H_{N-1} [z; 0] */
-        const double *v = C + k * r;
-        double sum = 0.0;
-        for (int64_t i = k; i <= s->vend[k]; i++) sum += v[i] * work[i];
+        int64_t h = s->vend[k] - k;
+        if (h < 0) continue; /* no reflector (not factored) */
+        const double *v = C + k * W + k - off[k];
+        double sum = 0.0, *wk = work + k;
+        for (int64_t i = 0; i <= h; i++) sum += v[i] * wk[i];
         sum *= s->beta[k];
-        for (int64_t i = k; i <= s->vend[k]; i++) work[i] -= sum * v[i];
+        for (int64_t i = 0; i <= h; i++) wk[i] -= sum * v[i];
     }
     for (int64_t k = 0; k < s->nq; k++) out[k] = work[s->pos[s->mu + k]];
 }
@@ -423,7 +481,8 @@ static void rows_at(const mb_model *md, mb_work *w, gen_scratch *s, int64_t nq,
 
 /* Stage 1 at positions s->y: rotations, the rows and C's QR (kept in s), the coordinates'
  * rows and bodies (cc, cp) and values; the drivers' rates f' of the held components into
- * s->fp. Returns the pivot ratio. */
+ * s->fp. Returns the pivot ratio, or -1 when memory ran out (C is made on the first call:
+ * after that, never). */
 static double factor(const mb_model *md, const mb_unknowns *u, mb_work *w, gen_scratch *s,
                      int64_t nq, const int64_t *Iq, int64_t *cc, int64_t *cp, double *qval) {
     int64_t n = md->n, mu = s->mu;
@@ -436,6 +495,7 @@ static double factor(const mb_model *md, const mb_unknowns *u, mb_work *w, gen_s
     }
     for (int64_t k = 0; k < nq; k++) row_span(s, mu + k, cc[k], cp[k]);
     sort_rows(s);
+    if (s->C == NULL && band(s) < 0) return -1.0; /* no memory: the caller's error */
     for (int64_t k = 0; k < mu; k++) {
         int64_t i = u->U[k], j = md->comps_i[4 * i];
         double row[12];
@@ -525,54 +585,59 @@ static void forces(const mb_model *md, const mb_unknowns *u, mb_work *w, gen_scr
     qr_transposed(s, x, fq, work);
 }
 
-/* T (N x nq) from the factors: C T = [0; I]; returns the residual's norm (0 on the
- * configuration manifold). */
-static double transformation(gen_scratch *s, int64_t nq, double *T) {
+/* T (N x nq) from the factors: C T = [0; I], row-major (the output's layout), or
+ * by_columns (T's column k at T + k N: what the perturbed states read); returns the
+ * residual's norm (0 on the configuration manifold). */
+static double transformation(gen_scratch *s, int64_t nq, double *T, int by_columns) {
     int64_t N = s->N, mu = s->mu, r = s->r;
     double *g = s->B, resid = 0.0;
-    for (int64_t k = 0; k < nq; k++) {
-        memset(g, 0, sizeof(double) * r);
-        g[mu + k] = 1.0;
-        double e = qr_solve(s, g);
-        resid += e * e;
-        for (int64_t i = 0; i < N; i++) T[i * nq + k] = g[i];
+    for (int64_t k0 = 0; k0 < nq; k0 += BLOCK) {
+        int64_t w = nq - k0 < BLOCK ? nq - k0 : BLOCK;
+        for (int64_t b = 0; b < w; b++) {
+            memset(g, 0, sizeof(double) * r);
+            g[mu + k0 + b] = 1.0;
+            double e = qr_solve(s, g);
+            resid += e * e;
+            memcpy(by_columns ? T + (k0 + b) * N : s->block + b * N, g, sizeof(double) * N);
+        }
+        if (!by_columns)
+            for (int64_t i = 0; i < N; i++)
+                for (int64_t b = 0; b < w; b++) T[i * nq + k0 + b] = s->block[b * N + i];
     }
     return sqrt(resid);
 }
 
 /* M_q = T^T M T a column at a time: M_q e_l = T^T (M T e_l) by the transposed solve
  * (qr_transposed), at the band's cost per column rather than T's size (a chain's T is
- * half full). Returns 0, or -1 when memory ran out. */
-static int mass(const mb_model *md, gen_scratch *s, int64_t nq, const double *T, double *Mq) {
-    int64_t r = s->r;
-    double *x = s->B + r, *work = s->B + 2 * r;
-    double *col = malloc(sizeof(double) * (size_t)(nq > 0 ? nq : 1));
-    if (col == NULL) return -1;
-    for (int64_t l = 0; l < nq; l++) {
-        for (int64_t b = 0; b < md->n; b++) {
+ * half full); BLOCK columns read and written at a time. */
+static void mass(const mb_model *md, gen_scratch *s, int64_t nq, const double *T, double *Mq) {
+    int64_t N = s->N, r = s->r;
+    double *work = s->B + 2 * r, *xs = s->block, *cols = s->block + BLOCK * N;
+    for (int64_t l0 = 0; l0 < nq; l0 += BLOCK) {
+        int64_t w = nq - l0 < BLOCK ? nq - l0 : BLOCK;
+        for (int64_t b = 0; b < md->n; b++) { /* M T e_l for BLOCK columns l */
             const double *body = md->bodies + MB_BODY_W * b, *J = body + B_J;
             int64_t jc[6];
-            double tc[6];
-            for (int a = 0; a < 6; a++) {
-                jc[a] = s->col_of[6 * b + a];
-                tc[a] = jc[a] >= 0 ? T[jc[a] * nq + l] : 0.0;
-            }
-            for (int a = 0; a < 3; a++) {
-                if (jc[a] >= 0) x[jc[a]] = body[B_MASS] * tc[a];
-                if (jc[3 + a] >= 0)
-                    x[jc[3 + a]] = J[3 * a] * tc[3] + J[3 * a + 1] * tc[4] + J[3 * a + 2] * tc[5];
+            for (int a = 0; a < 6; a++) jc[a] = s->col_of[6 * b + a];
+            for (int64_t c = 0; c < w; c++) {
+                double tc[6], *x = xs + c * N;
+                for (int a = 0; a < 6; a++) tc[a] = jc[a] >= 0 ? T[jc[a] * nq + l0 + c] : 0.0;
+                for (int a = 0; a < 3; a++) {
+                    if (jc[a] >= 0) x[jc[a]] = body[B_MASS] * tc[a];
+                    if (jc[3 + a] >= 0)
+                        x[jc[3 + a]] = J[3 * a] * tc[3] + J[3 * a + 1] * tc[4] + J[3 * a + 2] * tc[5];
+                }
             }
         }
-        qr_transposed(s, x, col, work);
-        for (int64_t k = 0; k < nq; k++) Mq[k * nq + l] = col[k];
+        for (int64_t c = 0; c < w; c++) qr_transposed(s, xs + c * N, cols + c * nq, work);
+        for (int64_t k = 0; k < nq; k++)
+            for (int64_t c = 0; c < w; c++) Mq[k * nq + l0 + c] = cols[c * nq + k];
     }
-    free(col);
     for (int64_t k = 0; k < nq; k++) /* symmetric in exact arithmetic: made so */
         for (int64_t l = k + 1; l < nq; l++) {
             double m = 0.5 * (Mq[k * nq + l] + Mq[l * nq + k]);
             Mq[k * nq + l] = Mq[l * nq + k] = m;
         }
-    return 0;
 }
 
 int mb_generalized(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
@@ -586,14 +651,15 @@ int mb_generalized(const mb_model *md, const mb_unknowns *u, mb_work *w, double 
     double *T = out, *ve = T + N * nq, *a0 = ve + N, *Mq = a0 + N, *fq = Mq + nq * nq;
     double *qv = fq + nq, *qd = qv + nq, *scale = qd + nq, *info = scale + nq;
     double ratio = factor(md, u, w, &s, nq, Iq, cc, cp, qv);
-    for (int64_t k = 0; k < nq; k++)
-        qd[k] = qdot ? qdot[k] : row_dot_v(s.arow + 12 * k, cc[k], cp[k], y, n, s.col_of);
-    double resid = transformation(&s, nq, T);
-    forces(md, u, w, &s, nq, Iq, qd, lam, ve, a0, fq);
-    if (mass(md, &s, nq, T, Mq) < 0) {
+    if (ratio < 0.0) {
         scratch_free(&s);
         return -1;
     }
+    for (int64_t k = 0; k < nq; k++)
+        qd[k] = qdot ? qdot[k] : row_dot_v(s.arow + 12 * k, cc[k], cp[k], y, n, s.col_of);
+    double resid = transformation(&s, nq, T, 0);
+    forces(md, u, w, &s, nq, Iq, qd, lam, ve, a0, fq);
+    mass(md, &s, nq, T, Mq);
     info[MB_GI_RANK] = ratio;
     info[MB_GI_RESIDUAL] = resid;
     /* the magnitude of the terms that make each f_q (what its rounding is relative to):
@@ -715,8 +781,11 @@ static int perturber_new(perturber *e, const mb_model *md, const mb_unknowns *u,
     mb_eval_all(md, w, t);
     memcpy(e->s.y, y0, sizeof(double) * 13 * n);
     memcpy(e->ystart, y0, sizeof(double) * 13 * n);
-    factor(md, u, w, &e->s, nq, Iq, e->cc, e->cp, NULL);
-    transformation(&e->s, nq, e->T0);
+    if (factor(md, u, w, &e->s, nq, Iq, e->cc, e->cp, NULL) < 0.0) {
+        perturber_free(e);
+        return -1;
+    }
+    transformation(&e->s, nq, e->T0, 1); /* by columns */
     e->factored = 1;
     return 0;
 }
@@ -735,13 +804,13 @@ static void perturbed_f(perturber *e, const mb_model *md, const mb_unknowns *u, 
     else
         moved = hq != 0.0;
     if (moved || !e->factored) {
-        for (int64_t i = 0; i < N; i++) {
-            double x = 0.0;
-            if (dq != NULL)
-                for (int64_t k = 0; k < nq; k++) x += e->T0[i * nq + k] * dq[k];
-            else if (moved)
-                x += e->T0[i * nq + j] * hq;
-            e->d[i] = x;
+        /* d = T0 dq, T0 by columns: each d_i sums over k in order, as a row times dq */
+        for (int64_t i = 0; i < N; i++) e->d[i] = 0.0;
+        if (dq != NULL) {
+            for (int64_t k = 0; k < nq; k++)
+                for (int64_t i = 0; i < N; i++) e->d[i] += e->T0[k * N + i] * dq[k];
+        } else if (moved) {
+            for (int64_t i = 0; i < N; i++) e->d[i] += e->T0[j * N + i] * hq;
         }
         move(md, s, e->ystart, e->d, s->y);
         factor(md, u, w, s, nq, Iq, e->cc, e->cp, NULL);
@@ -781,6 +850,11 @@ int mb_independence(const mb_model *md, const mb_unknowns *u, mb_work *w, double
     memcpy(s.y, y, sizeof(double) * 13 * n);
     mb_eval_all(md, w, t);
     double ratio = factor(md, u, w, &s, nq, Iq, cc, cp, NULL);
+    if (ratio < 0.0) {
+        free(g);
+        scratch_free(&s);
+        return -1;
+    }
     out[r] = r == N ? ratio : 0.0;
     for (int64_t i = 0; i < r; i++) out[i] = 0.0;
     if (r == N && ratio > 0.0) {
