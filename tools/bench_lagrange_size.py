@@ -9,8 +9,8 @@ seconds of process CPU time (these machines are shared: wall time in brackets), 
 of --repeat runs:
 
 - load: ``mbody.load`` of its YAML file;
-- choose: the default coordinates (`coordinate_set`: the compiled core proves the tree's
-  angles independent, `mb_independence`);
+- choose: the default coordinates (`mbody.equations.coordinates.choose`: the compiled core
+  proves the tree's angles independent, `mb_independence`);
 - generalized: ``generalized(model)``, the coordinates chosen (T, M_q, f_q by the core's
   banded QR), and the ``mbody lagrange`` text (`generalized_text`, bounded above 200
   coordinates);
@@ -52,7 +52,7 @@ if str(ROOT) not in sys.path:  # run from a checkout without installing
 
 import mbody  # noqa: E402
 from mbody.answers import AnswersError  # noqa: E402
-from mbody.equations.coordinates import coordinate_set  # noqa: E402
+from mbody.equations.coordinates import choose  # noqa: E402
 from mbody.equations.generalized import generalized  # noqa: E402
 from mbody.kernel import _core  # noqa: E402
 from mbody.present.lagrange import generalized_text  # noqa: E402
@@ -204,8 +204,7 @@ def chains(sizes: list[int], modes_up_to: int, repeat: int, limit: float,
         table.run("load", lambda p=path: mbody.load(p))
         model = mbody.load(path)
         check(model)
-        # a fresh model per run: the coordinate set is kept with the model once chosen
-        table.run("choose", lambda p=path: coordinate_set(mbody.load(p)) and None, 1)
+        table.run("choose", lambda m=model: choose(m))  # not kept with the model
         g = generalized(model)
         table.run("gen", lambda m=model: generalized(m))
         table.run("text", lambda g=g: generalized_text(g))
