@@ -128,8 +128,7 @@ def lagrange(a: argparse.Namespace) -> int:
         sym = None
         if a.symbolic:
             _need_sympy()
-            bar.step("the equations in symbols (sympy)")
-            sym = g.symbolic()
+            sym = g.symbolic(progress=bar)
         for out in a.output:
             bar.step(f"writing {out}")
             with _writing(out):

@@ -237,9 +237,15 @@ class Generalized:
         """The state with its velocities v = T q' + v_e (those the equations use)."""
         return state_with_velocities(self.model, self.state, self.velocities())
 
-    def symbolic(self) -> SymbolicLagrange:
+    def symbolic(self, progress: bool | Progress = False) -> SymbolicLagrange:
         """M(q) and f(q, q') in symbols, for a planar tree (needs sympy): see
         `mbody.equations.symbolic.lagrange`.
+
+        Parameters
+        ----------
+        progress : bool or Progress
+            Say on standard error which rows are being made, once it has taken a second
+            (`mbody.util.progress`): sympy takes seconds for ten coordinates.
 
         Returns
         -------
@@ -248,7 +254,8 @@ class Generalized:
         """
         from mbody.equations.symbolic.lagrange import symbolic_lagrange  # sympy: slow
 
-        return symbolic_lagrange(self.model, self.coordinate_set)
+        with progress_of(progress, f"symbolic {self.model.name}") as bar:
+            return symbolic_lagrange(self.model, self.coordinate_set, bar)
 
     def __repr__(self) -> str:
         k = len(self.f)
