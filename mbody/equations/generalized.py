@@ -337,6 +337,8 @@ def generalized(model: Model, state: State | None = None,
     """
     state = model.initial if state is None else checked_state(model, state, "state")
     given = known_at(model, known, state.t) if known else None
+    if progress is False:  # the usual call: no bars to set up (a small model's takes µs)
+        return evaluate(model, state, coordinate_set(model, coordinates, given))
     with progress_of(progress, f"generalized {model.name}") as bar:
         bar.step("choosing the coordinates")
         cs = coordinate_set(model, coordinates, given)

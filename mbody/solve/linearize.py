@@ -479,6 +479,8 @@ def linearize(model: Model, state: State | None = None, *,
     if not isinstance(model, Model):
         model = checked_model(model)
     state = model.initial if state is None else checked_state(model, state, "state")
+    if progress is False:  # the usual call: no bars to set up (a small model's takes µs)
+        return linearized(model, state, free_coordinates(model, coordinates))
     with progress_of(progress, f"linearize {model.name}", STAGES) as bar:
         bar.step("choosing the coordinates")
         cs = free_coordinates(model, coordinates)

@@ -74,52 +74,61 @@ typedef struct {
                                   * R's column k's first row */
     int64_t *clo, *chi, *count; /* N: the rows of column j written; N + 2: the sort's */
     int64_t *off, W; /* N: column j holds rows off_j .. off_j + W - 1 (`band`), at C + j W */
+    double *dbuf;    /* the doubles above but C */
+    int64_t *ibuf;   /* the indices above */
 } gen_scratch;
 
-static void scratch_free(gen_scratch *s) {
-    free(s->C), free(s->B), free(s->fp), free(s->scale), free(s->beta), free(s->rdiag);
-    free(s->y), free(s->arow), free(s->agam), free(s->r6), free(s->Ma), free(s->lam);
-    free(s->tmp), free(s->col_of), free(s->bfirst), free(s->pos), free(s->vend), free(s->clo);
-    free(s->block), free(s->off);
-}
+static void scratch_free(gen_scratch *s) { free(s->C), free(s->dbuf), free(s->ibuf); }
 
+/* The scratch's arrays, carved from two allocations (one of doubles, one of indices: a
+ * small model's evaluation costs a few microseconds, and each allocation a little of it);
+ * C is made by `band` on the first factorisation. 0, or -1 when memory ran out. */
 static int scratch_new(gen_scratch *s, const mb_model *md, const mb_unknowns *u, int64_t nq,
                        int64_t nc, const int64_t *cols) {
     memset(s, 0, sizeof(*s));
     s->n = md->n, s->N = nc, s->nq = nq, s->mu = u->mu, s->r = u->mu + nq;
     int64_t r = s->r > 0 ? s->r : 1, N = nc > 0 ? nc : 1, n = md->n > 0 ? md->n : 1;
-    s->off = calloc((size_t)N, sizeof(int64_t)); /* C: made by `band`, with its width */
-    s->B = calloc((size_t)(3 * r + N), sizeof(double));
-    s->fp = calloc((size_t)r, sizeof(double));
-    s->scale = calloc((size_t)N, sizeof(double));
-    s->beta = calloc((size_t)N, sizeof(double));
-    s->rdiag = calloc((size_t)N, sizeof(double));
-    s->y = calloc((size_t)(13 * n), sizeof(double));
-    s->arow = calloc((size_t)(12 * (nq > 0 ? nq : 1)), sizeof(double));
-    s->agam = calloc((size_t)(nq > 0 ? nq : 1), sizeof(double));
-    s->r6 = calloc((size_t)(6 * n), sizeof(double));
-    s->Ma = calloc((size_t)(6 * n), sizeof(double));
-    s->lam = calloc((size_t)(md->m > 0 ? md->m : 1), sizeof(double));
-    s->tmp = calloc((size_t)r, sizeof(double));
-    s->block = calloc((size_t)(BLOCK * (N + (nq > 0 ? nq : 1))), sizeof(double));
-    s->col_of = calloc((size_t)(6 * n), sizeof(int64_t));
-    s->bfirst = calloc((size_t)(2 * n), sizeof(int64_t));
-    s->pos = calloc((size_t)(5 * r), sizeof(int64_t));
-    s->vend = calloc((size_t)(3 * N), sizeof(int64_t));
-    s->clo = calloc((size_t)(3 * N + 2), sizeof(int64_t));
-    if (!s->off || !s->B || !s->fp || !s->scale || !s->beta || !s->rdiag || !s->y || !s->arow ||
-        !s->agam || !s->r6 || !s->Ma || !s->lam || !s->tmp || !s->block || !s->col_of ||
-        !s->bfirst ||
-        !s->pos || !s->vend || !s->clo) {
+    int64_t q1 = nq > 0 ? nq : 1, m1 = md->m > 0 ? md->m : 1;
+    int64_t nd = (3 * r + N) + r + 3 * N + 13 * n + 13 * q1 + 12 * n + m1 + r +
+                 BLOCK * (N + q1);
+    int64_t ni = 8 * n + 5 * r + 7 * N + 2;
+    s->dbuf = calloc((size_t)nd, sizeof(double));
+    s->ibuf = calloc((size_t)ni, sizeof(int64_t));
+    if (s->dbuf == NULL || s->ibuf == NULL) {
         scratch_free(s);
         return -1;
     }
-    s->blast = s->bfirst + n;
-    s->first = s->pos + r, s->last = s->first + r;
-    s->rlo = s->last + r, s->rhi = s->rlo + r;
-    s->rend = s->vend + N, s->rbeg = s->rend + N;
-    s->chi = s->clo + N, s->count = s->chi + N;
-    for (int64_t i = 0; i < 6 * md->n; i++) s->col_of[i] = -1;
+    double *d = s->dbuf;
+    s->B = d, d += 3 * r + N;
+    s->fp = d, d += r;
+    s->scale = d, d += N;
+    s->beta = d, d += N;
+    s->rdiag = d, d += N;
+    s->y = d, d += 13 * n;
+    s->arow = d, d += 12 * q1;
+    s->agam = d, d += q1;
+    s->r6 = d, d += 6 * n;
+    s->Ma = d, d += 6 * n;
+    s->lam = d, d += m1;
+    s->tmp = d, d += r;
+    s->block = d;
+    int64_t *i = s->ibuf;
+    s->col_of = i, i += 6 * n;
+    s->bfirst = i, i += n;
+    s->blast = i, i += n;
+    s->pos = i, i += r;
+    s->first = i, i += r;
+    s->last = i, i += r;
+    s->rlo = i, i += r;
+    s->rhi = i, i += r;
+    s->vend = i, i += N;
+    s->rend = i, i += N;
+    s->rbeg = i, i += N;
+    s->clo = i, i += N;
+    s->chi = i, i += N;
+    s->count = i, i += N + 2;
+    s->off = i;
+    for (int64_t k = 0; k < 6 * md->n; k++) s->col_of[k] = -1;
     for (int64_t j = 0; j < nc; j++) s->col_of[cols[j]] = j;
     for (int64_t b = 0; b < md->n; b++) {
         s->bfirst[b] = s->blast[b] = -1;
