@@ -42,6 +42,7 @@ _LAZY = {
     "Model": "model.model", "State": "model.model", "load": "loading",
     "loads": "loading", "kinematics": "solve.kinematics",
     "equilibrium": "solve.equilibrium", "kinematic_run": "simulate.kinematic",
+    "kinematic_at": "simulate.instants", "Instants": "simulate.instants",
     "linearize": "solve.linearize", "Linearization": "solve.linearize",
     "Generalized": "equations.generalized",
     "simulate": "simulate.simulation",
@@ -54,11 +55,12 @@ _LAZY = {
 
 __all__ = [
     "Assembly", "Body", "BodyEquations", "Equation", "ExportedAssembly", "ForceOnBody",
-    "FreeBodyDiagram", "Generalized", "Linearization", "linearize", "load_export",
+    "FreeBodyDiagram", "Generalized", "Instants", "Linearization", "linearize", "load_export",
     "Issue", "Joint", "Load", "MbodyError", "Model", "ModelError", "Solution", "State",
     "Trajectory", "simulate",
     "Solutions", "SweepResult", "UnknownReactionsError", "animate", "assemble", "draw_fbd",
-    "equilibrium", "kinematic_run", "kinematics", "load", "loads", "run_sweep", "solve_many",
+    "equilibrium", "kinematic_at", "kinematic_run", "kinematics", "load", "loads",
+    "run_sweep", "solve_many",
     "verify",
 ]
 

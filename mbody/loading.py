@@ -28,7 +28,7 @@ def load(source: str | os.PathLike[str] | dict, *, max_bytes: int | None = None,
         A path to a model file: mbody YAML, MJCF (``.xml``) or URDF (``.urdf``); or a
         dict with a YAML file's content (for scripts).
     max_bytes : int, optional
-        The largest file read (default `mbody.model.loader.MAX_BYTES`, 32 MiB, or the
+        The largest file read (default `mbody.util.budget.MAX_BYTES`, 32 MiB, or the
         command line's ``--max-bytes``); a larger file is refused before it is read.
     format : {"yaml", "mjcf", "urdf"}, optional
         The file's format, when its extension does not say it.

@@ -244,6 +244,10 @@ def test_a_kinematic_run_short_of_t_end_is_warned_too():
     with pytest.raises(MbodyTypeError, match="^fps must be a positive number of samples per "
                                              "second, got str '30'; write it as a number: 30.0$"):
         mbody.kinematic_run(model, 0.1, "30")
+    for bad in (math.nan, math.inf):  # the argument at fault is named (review R3, B9)
+        with pytest.raises(mbody.MbodyError, match="^t_start must be a finite number of "
+                                                   "seconds, got (nan|inf)$"):
+            mbody.kinematic_run(model, 1.0, 10, t_start=bad)
 
 
 # -- known reaction values --------------------------------------------------------------------

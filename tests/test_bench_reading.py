@@ -1,11 +1,13 @@
 """tools/bench_reading.py, kept honest without timing anything: each case makes the input
 it says it makes (one line, many attributes, a '>' in a value...), of about the size
-asked, that mbody reads to the end it should (a model, or a located refusal); and the
-table has a row per size for every case."""
+asked, that mbody reads to the end it should (a model, or a located refusal); the table
+has a row per size and a verdict for every case; each of the refusals is refused; the
+growth exponent is the slope it should be."""
 
 from __future__ import annotations
 
 import importlib.util
+import os
 import sys
 from pathlib import Path
 
@@ -52,5 +54,44 @@ def test_the_table(bench, capsys):
     assert len(bench.CASES) == 7
     assert bench.main(["--sizes", "0.005,0.01", "--repeat", "1", "--only", "URDF"]) == 0
     out = capsys.readouterr().out
-    # per case: its name, the header, a row per size; then the note on growth
-    assert out.count("size (MB)") == 2 and len(out.splitlines()) == 2 * (2 + 2) + 1
+    # per case: its name, the header, a row per size, the fit's verdict; then the note on
+    # growth (no refusal is named like URDF)
+    assert out.count("size (MB)") == 2 and len(out.splitlines()) == 2 * (2 + 2 + 1) + 1
+    assert out.count("  fit: t ~ n^") == 2 and "Refusals" not in out
+
+
+@pytest.mark.parametrize("index", range(5))
+def test_each_refusal_is_refused_with_a_reference(bench, index, monkeypatch, tmp_path):
+    """Each hostile file is refused (`refused` raises AssertionError if it is read), and
+    set against a reference that took time."""
+    from mbody.model import loader
+
+    monkeypatch.setattr(loader, "FIFO_WAIT", 0.05)
+    refusal = bench.REFUSALS[index]
+    if "pipe" in refusal.name and not hasattr(os, "mkfifo"):
+        pytest.skip("no named pipes")
+    seconds, reference, of = refusal.run(tmp_path, 1)
+    assert seconds > 0 and reference > 0 and of and refusal.bound >= 1
+
+
+def test_refused_says_when_a_file_was_read(bench):
+    with pytest.raises(AssertionError, match="was read, not refused"):
+        bench.refused(ROOT / "models" / "pendulum.yaml")
+
+
+def test_growth_and_its_verdict():
+    sys.path.insert(0, str(ROOT / "tools"))
+    from timing import growth, linear_verdict
+
+    n = [1.0, 2.0, 4.0, 8.0]
+    assert growth(n, [3 * x for x in n]) == pytest.approx(1.0)
+    assert growth(n, [x * x for x in n]) == pytest.approx(2.0)
+    assert growth(n, [5.0] * 4) == pytest.approx(0.0)
+    assert linear_verdict(n, [x ** 1.2 for x in n]).endswith(
+        "PASS (linear: exponent at most 1.3)")
+    assert "FAIL" in linear_verdict(n, [x ** 1.5 for x in n])
+    assert linear_verdict(n[:2], [1.0, 4.0], stopped=True).startswith("fit: t ~ n^2.00")
+    assert linear_verdict(n[:2], [1.0, 2.0], stopped=True).endswith(
+        "PASS (linear: exponent at most 1.3) (stopped at the time limit)")
+    assert linear_verdict(n[:1], [40.0], stopped=True).endswith("time limit: FAIL")
+    assert linear_verdict([1.0], [1.0]) == "fit: too few sizes for a fit"

@@ -373,6 +373,31 @@ def test_fbd_command_writes_one_picture_per_body(tmp_path, capsys):
     assert "fbd_top.png" in capsys.readouterr().out
 
 
+def test_fbd_no_equations_is_the_diagram_without_its_newton_euler_pair(tmp_path):
+    """A handout: `--no-equations` (`equations=False`) drops the body's rows, and only
+    them: the arrows, their labels and the legend are the same as with the rows."""
+    rows = [str(e) for e in body("slider_crank.yaml", "rod").equations]
+    files = {}
+    for flag in ([], ["--no-equations"]):
+        out = tmp_path / ("bare" if flag else "full")
+        assert main(["fbd", "models/slider_crank.yaml", "-o", str(out), "--body", "rod",
+                     *flag]) == 0
+        files[bool(flag)] = (out / "fbd_rod.svg").read_text()
+    ids = {k: set(re.findall(r'<(?:g|polyline|polygon|circle) id="([^"]+)"', v))
+           for k, v in files.items()}  # drawn elements (not the glyphs' paths)
+    assert "equations" in ids[False] and "equations" not in ids[True]
+    assert ids[False] - ids[True] == {"equations"}  # nothing else is left out
+    assert all(f"{r} -->" in files[False] and r not in files[True] for r in rows)
+    height = {k: float(re.search(r'<svg[^>]* height="([0-9.]+)pt"', v).group(1))
+              for k, v in files.items()}
+    assert height[True] < height[False]  # no room kept for the rows
+
+    fbd = body("slider_crank.yaml", "rod").fbd
+    gids = {k: {t.get_gid() for t in mbody.draw_fbd(fbd, equations=k).texts}
+            for k in (True, False)}
+    assert "equations" in gids[True] and "equations" not in gids[False]
+
+
 def test_fbd_command_bad_body_and_view_exit_2(tmp_path, capsys):
     assert main(["fbd", "models/slider_crank.yaml", "-o", str(tmp_path), "--body",
                  "pistn"]) == 2

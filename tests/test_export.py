@@ -17,6 +17,7 @@ from randmodels import planar_model, spatial_model
 
 import mbody
 import mbody.io.export as ex
+from mbody.errors import MbodyTypeError
 from mbody.io.export import csvfolder
 from mbody.simulate.trajectory import Trajectory
 
@@ -389,7 +390,9 @@ def test_the_assembly_at_a_sample_of_a_run_in_memory_or_on_file(tmp_path):
     assert ex.exported(a).differences(ex.exported(b)) == []
     assert where_a.endswith("sample 2 at t = 0.5 s (nearest to t = 0.6 s)")
     assert where_b == f"trajectory {run}, sample 2 at t = 0.5 s (nearest to t = 0.6 s)"
-    with pytest.raises(TypeError, match="run: expected a Trajectory or the path"):
+    # an MbodyTypeError since review R3 (B7), still a TypeError
+    with pytest.raises(MbodyTypeError,
+                       match="run must be a Trajectory or the path of its .npz file, got State"):
         ex.assembly_from_trajectory(model, traj.state(0), 0.6)  # type: ignore[arg-type]
     assert ".columns>" in repr(ex.exported(a))  # what the repr offers exists
     assert ex.exported(a).columns.records()

@@ -153,13 +153,16 @@ def array(cls: int, shape: tuple[int, ...], body: bytes = b"", name: bytes = b""
                + tag(5, struct.pack(f"<{len(shape)}i", *shape)) + tag(1, name) + body)
 
 
-def mat_file(path: Path, *variables: bytes, version: bytes = b"5.0") -> Path:
-    """A MAT file of `variables`, each compressed (as scipy writes them)."""
+def mat_file(path: Path, *variables: bytes, version: bytes = b"5.0",
+             compress: bool = True) -> Path:
+    """A MAT file of `variables`, each compressed (as scipy writes them), or each element
+    as it is given (`compress` False)."""
     text = b"MATLAB " + version + b" MAT-file, written by a test"
     head = text.ljust(116) + bytes(8) + struct.pack("<H", 0x0100 if version == b"5.0"
                                                     else 0x0200) + b"IM"
     body = b"".join(struct.pack("<II", 15, len(c)) + c
-                    for c in (zlib.compress(v) for v in variables))
+                    for c in (zlib.compress(v) for v in variables)) if compress \
+        else b"".join(variables)
     path.write_bytes(head + body)
     return path
 
@@ -198,6 +201,89 @@ def test_mat_cell_shape_beyond_its_bytes(tmp_path):
     path = mat_file(tmp_path / "cells.mat", array(1, (2**24, 1), name=b"c"))
     refused(path, "a cell array of shape (16777216, 1) in 0 bytes")
     assert peak_bytes(mbody.load_export, path) < 4 * MIB
+
+
+def refused_by_both(path: Path, *words: str) -> None:
+    """`load_export` and `read_generalized` each refuse `path` with an MbodyError that
+    names it and `words`."""
+    refused(path, *words)
+    with pytest.raises(MbodyError) as exc:
+        read_generalized(path)
+    assert str(exc.value).startswith(f"{path}: ") and all(w in str(exc.value) for w in words)
+
+
+def test_mat_struct_without_the_width_of_its_field_names(tmp_path):
+    """Review R3, B1: the width's element held 0 bytes, and reading its 4 was a
+    struct.error from both readers."""
+    path = mat_file(tmp_path / "s.mat", array(2, (1, 1), tag(5, b""), b"x"))
+    refused_by_both(path, "damaged or truncated .mat export", "a struct without the width "
+                    "of its field names")
+
+
+def test_mat_compressed_variable_that_does_not_inflate(tmp_path):
+    """Review R3, B1: a zlib header and then no deflate stream was a zlib.error."""
+    garbage = struct.pack("<II", 15, 32) + b"\x78\x9c" + b"\xff" * 30
+    path = mat_file(tmp_path / "z.mat", garbage, compress=False)
+    refused_by_both(path, "damaged or truncated .mat export", "the compressed variable "
+                    "at byte 128 does not inflate")
+
+
+def sparse(shape: tuple[int, int], rows: list[int], columns: list[int], values: list[float],
+           name: bytes, row_type: int = 5) -> bytes:
+    """A sparse miMATRIX: row indices (of MAT type `row_type`), column pointers, values."""
+    return array(5, shape, tag(row_type, struct.pack(f"<{len(rows)}i", *rows))
+                 + tag(5, struct.pack(f"<{len(columns)}i", *columns))
+                 + tag(9, struct.pack(f"<{len(values)}d", *values)), name)
+
+
+def test_what_scipy_reads_unchecked_is_checked_first(exports, tmp_path):
+    """Found while fuzzing the fixes of review R3, B1 (byte flips in real exports):
+    scipy's compiled reader, and scipy.sparse's routines after it, trust a file's types
+    and indices. A sparse matrix whose row indices were of MAT type 5637 crashed the
+    process (a bus error); a row index outside the matrix crashed it in
+    `eliminate_zeros` (a segmentation fault), from a .mat or an npz export. Each file is
+    read in a child process: a crash there is a failure here, not the end of the run."""
+    files = {
+        "type.mat": (sparse((2, 2), [0, 1], [0, 1, 2], [1.0, 2.0], b"M", row_type=5637),
+                     "a sparse array whose data at byte 64 is of MAT type 5637, not "
+                     "numbers"),
+        "name.mat": (tag(14, tag(6, struct.pack("<II", 6, 0)) + tag(5, struct.pack(
+            "<2i", 1, 1)) + tag(7, b"x") + tag(9, bytes(8))),  # a name of MAT type 7
+            "an array whose name at byte 48 is of MAT type 7, expected text (miINT8)"),
+        "pointers.mat": (sparse((2, 2), [0, 1], [0, 1, -5], [1.0, 2.0], b"M"),
+                         "damaged or truncated .mat export (scipy cannot read it"),
+    }
+    for name, (variable, _) in files.items():
+        mat_file(tmp_path / name, variable)
+    with np.load(exports / "p.npz") as z:  # the stacked export, M's row indices moved out
+        data = dict(z)
+    np.savez(tmp_path / "rows.npz", **{**data, "M_indices": data["M_indices"] + 10**8})
+    import scipy.io
+    import scipy.sparse as sp
+
+    raw = scipy.io.loadmat(exports / "p.mat")
+    M = raw["M"].tocsc()
+    raw["M"] = sp.csc_matrix((M.data, M.indices + 10**8, M.indptr), shape=M.shape)
+    scipy.io.savemat(tmp_path / "rows.mat", {k: v for k, v in raw.items()
+                                            if not k.startswith("__")})
+    files["rows.npz"] = (b"", "the sparse matrix M is damaged")
+    files["rows.mat"] = (b"", "the sparse matrix M is damaged")
+    script = ("import sys, mbody\nfrom mbody.io.export.generalized import read_generalized"
+              "\nfor path in sys.argv[1:]:\n for read in (mbody.load_export, read_generalized):"
+              "\n  try:\n   read(path)\n   print('read', path)\n  except mbody.MbodyError as e:"
+              "\n   print(str(e).replace(chr(10), ' '))")
+    child = subprocess.run([sys.executable, "-c", script,
+                            *(str(tmp_path / name) for name in files)],
+                           capture_output=True, text=True, timeout=300)
+    assert child.returncode == 0, child.stderr
+    lines = child.stdout.splitlines()
+    assert len(lines) == 2 * len(files), child.stdout
+    for k, (name, (_, words)) in enumerate(files.items()):
+        load, generalized = lines[2 * k:2 * k + 2]
+        assert load.startswith(f"{tmp_path / name}: ") and words in load, load
+        if name == "rows.npz":  # the stacked equations' export: its tag is read first
+            words = "an export of the stacked equations (mbody export)"
+        assert generalized.startswith(f"{tmp_path / name}: ") and words in generalized
 
 
 def test_mat_bomb_is_refused_before_it_is_inflated(tmp_path):
@@ -247,8 +333,8 @@ def test_csv_field_over_the_csv_limit_names_file_and_line(exports, tmp_path):
     bodies = folder / "bodies.csv"
     lines = bodies.read_text().splitlines()
     bodies.write_text("\n".join([*lines, '"' + "x" * 200_000 + '"']) + "\n")
-    text = refused(folder, "field larger than field limit")
-    assert f"{bodies}, line {len(lines) + 1}" in text
+    text = refused(folder, "a cell longer than 131,072 characters")
+    assert f"{bodies}, line {len(lines) + 1}: " in text
 
 
 def test_csv_folder_larger_than_the_budget(exports, tmp_path):
@@ -261,7 +347,7 @@ def test_csv_folder_larger_than_the_budget(exports, tmp_path):
 def test_read_generalized_is_bounded_the_same_way(tmp_path):
     deep = tmp_path / "g.json"
     deep.write_text("[" * 10000)
-    with pytest.raises(ValueError, match="nested 10000 deep"):
+    with pytest.raises(MbodyError, match="nested 10000 deep"):  # a ValueError before R3
         read_generalized(deep)
     liar = npz_with(tmp_path / "g.npz", {"q": np.zeros(2)}, "q",
                     {"descr": "<f8", "fortran_order": False, "shape": (10**15,)}, bytes(16))

@@ -619,10 +619,10 @@ def test_a_round_trip_that_loses_something_is_caught():
 
 
 def test_the_file_pose_entries_are_what_keeps_an_assembled_model():
-    """A model assembled at load is written at its assembled pose; its joint frames were
-    fixed to the parents at the file's pose. Read back without the file's pose (the
-    mbody:body entries removed), the helical chain's pin frame is the one the joint frame
-    rule gives at the assembled pose, turned about the axis from the file's: G differs."""
+    """A model assembled at load is written at its assembled pose; its joints' axes (the
+    mbody:joint entries) are in world axes at the file's pose. Read back without the
+    file's pose (the mbody:body entries removed), the helical chain's pin axis is taken at
+    the assembled pose, another direction in the carriage: G differs."""
     model = _load("helical_chain.yaml")
     xml = to_mjcf(model)
     assert "Assembled pose:" in xml and xml.count('name="mbody:body:') == 2

@@ -110,3 +110,45 @@ def test_every_json_output_of_every_shipped_model_is_strict_json(capsys, tmp_pat
                        capture_output=True, text=True, timeout=120)
     assert p.returncode == 0, p.stderr
     assert p.stdout.strip().endswith(f"parsed {len(texts)}, refused 0"), p.stdout
+
+
+# -- the nesting bound of text read back (review R3, S2) ----------------------------------
+
+
+def depth(value) -> int:
+    """How deep a parsed value nests (objects read as lists of their values, so that a
+    key given twice still counts)."""
+    if isinstance(value, list):
+        return 1 + max(map(depth, value), default=0)
+    return 0
+
+
+def parsed_depth(text: str) -> int:
+    return depth(json.loads(text, object_pairs_hook=lambda pairs: [v for _, v in pairs]))
+
+
+@pytest.mark.parametrize("text", [
+    "1", '"[{"', "[]", "[[]]", '{"a": {"b": [1, {}]}}',
+    r'["a\\", ["]"], {"k\"[": [1]}]',  # an escaped backslash: the quote ends it
+    r'["\\\"[", "\\\\", [["\\"]]]',  # three, then four backslashes
+    r'{"\\": "]]]", "x": [["\"{\"", {"\\\\\"": []}]]}',
+    '["\\u005c", ["\\u0022["]]',  # escapes by number: other characters here
+    '[' * 70 + ']' * 70, '{"a":' * 30 + "1" + "}" * 30,
+])
+def test_nesting_counts_the_brackets_outside_strings_as_the_parser_reads_them(text):
+    assert jsontext.nesting(text) == parsed_depth(text)
+
+
+def test_many_escaped_quotes_are_scanned_once():
+    """Review R3, S2: a string of escaped quotes that never ends made the string pattern
+    run from each quote to the end of the text (64 kB took 21 s; these 400 kB some 14
+    minutes). Not timed: read once, the answers come in milliseconds."""
+    text = '"' + '\\"' * 200_000
+    assert jsontext.nesting(text) == 0
+    with pytest.raises(json.JSONDecodeError) as exc:  # the string that never ends
+        jsontext.loads(text)
+    assert exc.value.pos == 0
+    closed = text + '"' + "[" * 100 + "]" * 100  # the last quote ends it: 100 deep after
+    assert jsontext.nesting(closed) == 100
+    with pytest.raises(ValueError, match="JSON nested 100 deep; at most 64 levels"):
+        jsontext.loads(closed)

@@ -4,11 +4,13 @@ other kind says where it is read."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import pytest
 
 import mbody
+from mbody.errors import MbodyTypeError
 
 MODELS = Path(__file__).resolve().parent.parent / "models"
 
@@ -60,11 +62,16 @@ def test_a_misspelt_constraint_row_gets_a_did_you_mean(dp):
     assert message(err) == "no constraint row 'A.fx'; did you mean 'A.Fx'?"
     with pytest.raises(KeyError) as err:
         jac.row("upper.x")
-    assert "a row per reaction component, .rows: O.Fx, O.Fy, A.Fx, A.Fy" in message(err)
+    # worded by the one lookup error since review R3 (Y5; was "(a row per reaction
+    # component, .rows: ...)")
+    assert message(err) == ("no constraint row 'upper.x' (the rows, one per reaction "
+                            "component: O.Fx, O.Fy, A.Fx, A.Fy)")
     # the pin O holds the upper rod's end on the ground: its x row is the rod's v_x, less
-    # omega times the end's height above the mass centre (0.25 cos 30 deg)
-    assert jac.row("O.Fx") == pytest.approx({"upper.x": 1.0, "upper.theta": -0.2165063509},
-                                            rel=1e-9)
+    # omega times the end's height above the mass centre (0.25 cos 30 deg). The model file
+    # gives the mass centre to 15 digits (a relative 2e-15 here): 1e-12 is rounding only
+    height = 0.25 * math.cos(math.radians(30))
+    assert jac.row("O.Fx") == pytest.approx({"upper.x": 1.0, "upper.theta": -height},
+                                            rel=1e-12)
 
 
 def test_bodies_and_joints_are_found_by_name_and_by_index(dp):
@@ -90,8 +97,22 @@ def test_bodies_and_joints_are_found_by_name_and_by_index(dp):
         dp.bodies[2]
     with pytest.raises(IndexError, match=r"joint index -3 out of range \(2 joints: O, A\)"):
         dp.joints[-3]
-    with pytest.raises(TypeError, match="joints are found by name or by index, got float"):
+    # an MbodyTypeError (was a plain TypeError "joints are found by name or by index"):
+    # one wrong-type error across the API (review R3, B6)
+    with pytest.raises(MbodyTypeError) as err:
         dp.joints[0.0]
+    assert message(err) == ("joints[key] must be a name (str) or an index (int), got "
+                            "float 0.0")
+
+
+def test_bodies_get_is_by_name_as_the_mapping_keys_are():
+    """`model.bodies` is a mapping of names: `get` agrees with `in` (an index is for
+    ``bodies[0]``, not a key), and returns the default for anything not a name there."""
+    dp = mbody.load(MODELS / "double_pendulum.yaml")
+    assert 0 not in dp.bodies and dp.bodies.get(0) is None
+    assert dp.bodies.get(5, "none") == "none" and dp.bodies.get(1.5, "none") == "none"
+    assert dp.bodies.get("upper") is dp.bodies["upper"] is dp.bodies[0]
+    assert dp.bodies.get("uper", "none") == "none"
 
 
 @pytest.mark.parametrize("path", ["located", "fast"])
@@ -133,22 +154,58 @@ def test_generalized_known_gets_the_did_you_mean_solve_gives(dp):
     assert str(solved.value) == str(err.value)
 
 
+def test_every_lookup_by_name_says_the_same_way_what_is_there():
+    """One KeyError for every lookup by name (`mbody.errors.not_found`): a did-you-mean,
+    else the names there are; never a dangling '; ' (review R3, Y5)."""
+    dp = mbody.load(MODELS / "double_pendulum.yaml")
+    asm = mbody.assemble(dp)
+    sol = asm.solve()
+    cases = [
+        (lambda: asm.bodies["uppr"], "no body named 'uppr'; did you mean 'upper'?"),
+        (lambda: asm.bodies["zz"], "no body named 'zz' (the bodies: upper, lower)"),
+        (lambda: sol.reactions["o.fx"], "no reaction component 'o.fx'; did you mean 'O.Fx'?"),
+        (lambda: sol.reactions["zz"], "no reaction component 'zz' (the components: O.Fx, "
+                                      "O.Fy, A.Fx, A.Fy)"),
+        (lambda: mbody.solve_many(dp, [dp.initial]).reaction("zz"),
+         "no reaction 'zz' (the reactions: O.Fx, O.Fy, A.Fx, A.Fy)"),
+    ]
+    for call, expected in cases:
+        with pytest.raises(KeyError) as err:
+            call()
+        assert message(err) == expected
+
+
 def test_the_closest_name_is_difflibs_among_a_thousand():
     # closest() skips the names whose lengths alone rule out difflib's cutoff (its first
     # test, in its own arithmetic) before difflib looks at the rest: the same answer as
-    # difflib's over all of them, ties and near-misses included
+    # difflib's over all of them, ties and near-misses included (then the same test of a
+    # misspelling: the first letter, or a few edits)
     import difflib
     import random
 
-    from mbody.errors import CLOSE_CUTOFF, closest
+    from mbody.errors import _EDITS_PER_LETTER, CLOSE_CUTOFF, _edits, closest
+
+    def reference(word: str, names: list[str]) -> str | None:
+        same = [c for c in names if c.casefold() == word.casefold()]
+        if same:
+            return same[0]
+        close = difflib.get_close_matches(word, names, n=1, cutoff=CLOSE_CUTOFF)
+        if not close:
+            return None
+        meant = close[0]
+        if word[:1].casefold() == meant[:1].casefold() or _edits(word, meant) <= max(
+                1, max(len(word), len(meant)) // _EDITS_PER_LETTER):
+            return meant
+        return None
 
     rng = random.Random(7)
     names = ["".join(rng.choice("jl_.012angle") for _ in range(rng.randint(1, 16)))
              for _ in range(1000)]
     words = [w[:-1] for w in names[:40]] + [w + "x" for w in names[40:80]] + \
         ["", "m", "a_x", "j12.angle_dd", "ANGLE", "q" * 30]
+    found = 0
     for word in words:
-        same = [c for c in names if c.casefold() == word.casefold()]
-        expected = same[:1] or difflib.get_close_matches(word, names, n=1,
-                                                         cutoff=CLOSE_CUTOFF)
-        assert closest(word, names) == (expected[0] if expected else None), word
+        expected = reference(word, names)
+        assert closest(word, names) == expected, word
+        found += expected is not None
+    assert found >= 60

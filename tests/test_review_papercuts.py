@@ -178,8 +178,9 @@ def test_the_same_option_for_different_names_is_taken(capsys):
     # a model file's angle is at most 1e9 rad, any other number at most 1e100
     (("check", ARM, "--q", "shoulder=1e300"), "--q shoulder: expected a number of magnitude "
      "at most 1e100"),
-    (("check", ARM, "--q", "shoulder=1e20"), "--q[shoulder]: expected an angle of at most "
-     "1e+09 rad in magnitude"),
+    # worded as its siblings in the URDF reader (review R3, Y7; was "--q[shoulder]: ...")
+    (("check", ARM, "--q", "shoulder=1e20"), "--q: joint 'shoulder': expected an angle of at "
+     "most 1e+09 rad in magnitude"),
     (("check", ARM, "--qd", "elbow=1e101"), "--qd elbow: expected a number of magnitude at "
      "most 1e100"),
     (("solve", PENDULUM, "--known", "O.Fx=-1e101"), "--known O.Fx: expected a number of "

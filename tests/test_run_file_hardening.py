@@ -7,6 +7,7 @@ named as the run's, and a file a run names is never echoed."""
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import io
 import json
 import tracemalloc
@@ -20,7 +21,7 @@ import mbody
 from mbody.cli import main
 from mbody.errors import MbodyError, ModelError, TrajectoryFileError
 from mbody.simulate.trajectory import Trajectory
-from mbody.util.npzfile import data_bytes_limit
+from mbody.util.budget import byte_budget
 
 MODELS = Path(__file__).resolve().parent.parent / "models"
 MIB = 1 << 20
@@ -177,6 +178,121 @@ def test_arrays_that_are_not_numbers_or_texts_are_refused(run_data, tmp_path):
             Trajectory.load(tampered(tmp_path, run_data, **changes))
 
 
+def members(path: Path, data: dict[str, np.ndarray | bytes | None]) -> Path:
+    """An npz of `data`: an array saved as numpy saves it, bytes as the member's whole
+    content (a raw .npy header, `npy_header`), None left out."""
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
+        for k, v in data.items():
+            if isinstance(v, bytes):
+                z.writestr(k + ".npy", v)
+            elif v is not None:
+                b = io.BytesIO()
+                np.save(b, v)
+                z.writestr(k + ".npy", b.getvalue())
+    return path
+
+
+def npy_header(shape: tuple[int, ...], descr: str) -> bytes:
+    """A .npy header for `shape` values of `descr`, and no data."""
+    b = io.BytesIO()
+    np.lib.format.write_array_header_1_0(b, {"descr": descr, "fortran_order": False,
+                                             "shape": shape})
+    return b.getvalue()
+
+
+PER_SAMPLE = ("t", "position", "velocity", "orientation", "angular_velocity", "reactions")
+
+
+def without_samples(run_data: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """The run with every per-sample array cut to no samples."""
+    return {k: v[:0] if k in PER_SAMPLE or k.startswith("series/") else v
+            for k, v in run_data.items()}
+
+
+@pytest.mark.parametrize("command", COMMANDS)
+def test_values_of_no_bytes_are_refused_whatever_they_claim(run_data, tmp_path, capsys,
+                                                            command):
+    """Review R3, S1: 10^12 body names of width 0 ('<U0') held no bytes, so the header
+    agreed with its size; with no samples every state array held none either, and the
+    5 kB file made plot build 10^12 texts (106 s, 3.6 GB, a MemoryError: exit 70)."""
+    n = 10**12
+    data: dict[str, np.ndarray | bytes | None] = {
+        **without_samples(run_data), "body_names": npy_header((n,), "<U0"),
+        "position": npy_header((0, n, 2), "<f8"), "velocity": npy_header((0, n, 2), "<f8"),
+        "orientation": npy_header((0, n), "<f8"),
+        "angular_velocity": npy_header((0, n), "<f8"), "mass": None, "inertia": None}
+    run = members(tmp_path / "u0.npz", data)
+    assert run.stat().st_size < 10_000
+    err = refused(capsys, tmp_path, command, run)
+    assert "member body_names.npy's header says it holds 1,000,000,000,000 values of " \
+           "0 bytes each, dtype <U0" in err
+    assert peak_bytes(Trajectory.load, run) < MIB
+
+
+def test_any_member_of_zero_width_values_is_refused(run_data, tmp_path):
+    """Not only texts: a void or field-less record type is 0 bytes wide too; an empty
+    array of them claims nothing and is read as before."""
+    for descr in ("|V0", "<U0"):
+        run = members(tmp_path / "v0.npz", {**run_data, "series/energy":
+                                            npy_header((61,), descr)})
+        with pytest.raises(TrajectoryFileError, match=r"member series/energy.npy's header "
+                           r"says it holds 61 values of 0 bytes each"):
+            Trajectory.load(run)
+    empty = members(tmp_path / "empty.npz", {**run_data, "reaction_labels":
+                                             npy_header((0,), "<U0"), "reactions":
+                                             run_data["reactions"][:, :0]})
+    assert Trajectory.load(empty).reaction_labels == ()
+
+
+@pytest.mark.parametrize("command", COMMANDS)
+def test_a_run_without_samples_is_refused_when_it_is_read(run_data, tmp_path, capsys,
+                                                          command):
+    """Review R3, B2: plot took the minimum of no energies (exit 70); animate and export
+    each refused it in words of their own."""
+    run = tampered(tmp_path, without_samples(run_data), "k0.npz")
+    err = refused(capsys, tmp_path, command, run)
+    assert "'t' holds no samples (a run holds at least one sample)" in err
+
+
+def test_a_trajectory_made_without_samples_is_refused_by_every_reader(run_data, tmp_path):
+    """A trajectory made in code is not read from a file: each reader that needs a sample
+    asks `need_samples`, one wording for all."""
+    from mbody.io.export import state_at
+    from mbody.present.animate import build_scene
+    from mbody.present.plot import plot_trajectory
+
+    good = Trajectory.load(tampered(tmp_path, run_data, "good.npz"))
+    assert good.need_samples() == 61
+    d = {f.name: getattr(good, f.name) for f in dataclasses.fields(good)}
+    empty = Trajectory(**{**d, **{k: d[k][:0] for k in PER_SAMPLE}})
+    for read in (empty.need_samples, lambda: empty.state_at(0.0),
+                 lambda: state_at(empty, None), lambda: plot_trajectory(empty),
+                 lambda: build_scene(empty, good.model())):
+        with pytest.raises(MbodyError, match=r"^the trajectory holds no samples \(a run "
+                           r"holds at least one sample\)$"):
+            read()
+
+
+def test_more_names_than_one_per_kib_of_the_budget_are_refused_unread(run_data, tmp_path):
+    """Each name becomes a Python text of some 60 bytes where the file spends 4: the
+    names a run holds are bounded by the budget (`NAME_BYTES`), from their header."""
+    n = 2000
+    data = {**run_data, "t": run_data["t"][:1], "body_names": np.array(["b"] * n),
+            "position": np.zeros((1, n, 2)), "velocity": np.zeros((1, n, 2)),
+            "orientation": np.zeros((1, n)), "angular_velocity": np.zeros((1, n)),
+            "reactions": run_data["reactions"][:1], "mass": np.ones(n),
+            "inertia": np.broadcast_to(np.eye(3), (n, 3, 3)).copy(),
+            "shapes": np.array("[]"), "colors": np.array("[]")}
+    data = {k: v for k, v in data.items() if not k.startswith("series/")}
+    run = members(tmp_path / "names.npz", data)
+    with pytest.raises(TrajectoryFileError) as exc:
+        Trajectory.load(run, max_bytes=MIB)
+    assert str(exc.value).startswith(f"{run}: 'body_names' holds 2,000 names; at most "
+                                     "1,024 are read, one per KiB of the budget of 1 MiB")
+    assert "--max-bytes N" in str(exc.value)
+    assert Trajectory.load(run, max_bytes=2 * MIB).n == n
+
+
 # -- B4: bounded work ---------------------------------------------------------------------
 
 
@@ -215,11 +331,11 @@ def test_a_member_over_the_budget_is_refused_before_it_is_inflated(run_data, tmp
     16 MiB budget it is refused from the zip directory, before anything is inflated."""
     run = bomb(tmp_path / "bomb.npz", run_data, 8 * MIB)
     assert run.stat().st_size < MIB
-    with data_bytes_limit(16 * MIB), pytest.raises(TrajectoryFileError) as exc:
+    with byte_budget(16 * MIB), pytest.raises(TrajectoryFileError) as exc:
         Trajectory.load(run)
     assert str(exc.value).startswith(f"{run}: holds 64 MiB of data once inflated")
     assert "at most 16 MiB is read" in str(exc.value) and "--max-bytes N" in str(exc.value)
-    with data_bytes_limit(16 * MIB):
+    with byte_budget(16 * MIB):
         assert peak_bytes(Trajectory.load, run) < 4 * MIB
     with pytest.raises(TrajectoryFileError, match="at most 1 KiB"):
         Trajectory.load(tmp_path / "bomb.npz", max_bytes=1024)

@@ -56,7 +56,7 @@ def test_step_budget_stops_the_cli_with_one_paragraph_and_exit_2(tmp_path, capsy
 
 def test_step_budget_from_python_and_a_run_that_fits():
     model = _model("torque_free_asymmetric")
-    with pytest.raises(mbody.MbodyError, match=r"step budget: 10 steps \(--max-steps 10\)"):
+    with pytest.raises(mbody.MbodyError, match=r"step budget: 10 steps \(max_steps=10\)"):
         mbody.simulate(model, t_end=5.0, max_steps=10)
     traj = mbody.simulate(model, t_end=5.0, max_steps=69)  # exactly its 69 steps
     assert traj.info["steps"] == 69 and traj.t[-1] == 5.0
@@ -66,12 +66,14 @@ def test_step_budget_from_python_and_a_run_that_fits():
 
 def test_wall_time_budget(capsys):
     # Any step takes longer than a nanosecond: the budget is hit after the first step.
-    with pytest.raises(mbody.MbodyError, match=r"wall-time budget: .* \(--max-wall 1e-09\), "
-                       r"at t = .* s of 10 s: .*raise --max-wall\.$"):
+    # each surface names the budget as it was given: max_wall=1e-9 in Python, --max-wall
+    with pytest.raises(mbody.MbodyError, match=r"wall-time budget: .* \(max_wall=1e-9\), "
+                       r"at t = .* s of 10 s: .*raise max_wall\.$"):
         mbody.simulate(_model("pendulum"), max_wall=1e-9)
     assert main(["simulate", str(MODELS / "pendulum.yaml"), "--max-wall", "1e-9"]) == 2
     err = capsys.readouterr().err
     assert "mbody: error: the simulation stopped at the wall-time budget" in err
+    assert "(--max-wall 1e-9)" in err and err.endswith("raise --max-wall.\n")
     assert "Traceback" not in err and err.count("\n") == 1
 
 

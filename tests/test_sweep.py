@@ -1,7 +1,8 @@
 """`mbody sweep`: its rows equal the same cases run one by one through the public API; the
 local cluster, an existing cluster and this process give the same numbers; a worker
 killed mid-run loses nothing and repeats nothing; failed cases are rows; an interrupted
-sweep resumes; the grid, samples and errors of the command line."""
+sweep resumes; the grid, samples and errors of the command line (a rerun with other
+settings: tests/test_sweep_outputs.py)."""
 
 from __future__ import annotations
 
@@ -23,6 +24,7 @@ import mbody
 from mbody.errors import MbodyError
 from mbody.sweep import cluster
 from mbody.sweep.grid import parse_grid
+from mbody.sweep.record import record
 from mbody.sweep.runs import RUNS, Job, Settings, columns, final_values
 from mbody.sweep.table import Results
 
@@ -67,7 +69,7 @@ def job_of(model: mbody.Model, grid_specs: list[str], settings: Settings, **kw) 
 
 def run_here(job: Job, out: Path, **kw) -> tuple[list[str], list[list[str]]]:
     model = mbody.loads(driven_text(), "driven.yaml")
-    results = Results(out, columns(model, job.settings), job.grid)
+    results = Results(out, columns(model, job.settings), job.grid, record(job.settings, model))
     cluster.run(job, [k for k in range(len(job.grid)) if k not in results.rows], results,
                 progress=False, **kw)
     results.finish()
@@ -85,13 +87,14 @@ def test_solve_rows_are_the_cases_solved_one_by_one(tmp_path):
     header, rows = run_here(job, tmp_path / "r.csv", workers=0)
     assert header == ["case", "drivers.motor.speed", "bodies.rod.mass",
                       *[f"acceleration:{c}" for c in base.coordinates],
-                      *[f"reaction:{r}" for r in base.reactions], "error"]
+                      *[f"reaction:{r}" for r in base.reactions], "error", "settings"]
     assert [int(r[0]) for r in rows] == list(range(6))
     for row in rows:
         values = {"drivers.motor.speed": float(row[1]), "bodies.rod.mass": float(row[2])}
         sol = mbody.assemble(base.with_values(values)).solve()
         want = [*sol.accelerations, *(sol.reactions[r] for r in base.reactions)]
-        assert floats(row[3:-1]).tolist() == want and row[-1] == ""
+        assert floats(row[3:-2]).tolist() == want and row[-2] == ""
+        assert row[-1] == record(job.settings, base)
     # the grid: the last axis fastest, both ends included
     assert [(float(r[1]), float(r[2])) for r in rows] == [
         (60.0, 0.3), (60.0, 1.2), (150.0, 0.3), (150.0, 1.2), (240.0, 0.3), (240.0, 1.2)]
@@ -124,12 +127,12 @@ def test_kinematics_rows_are_the_cases_run_one_by_one(tmp_path):
     for row in rows:
         values = {"drivers.motor.speed": float(row[1]), "bodies.rod.mass": float(row[2])}
         want = one_by_one(base, values, 1.0, 37)
-        got = floats(row[3:-1])
+        got = floats(row[3:-2])
         assert np.abs(got[:nf] - want[:nf]).max() <= 1e-11
         peaks, ref = got[nf:], want[nf:]
         assert np.abs(peaks - ref).max() <= 1e-9 * ref.max(), values
     # physics: a heavier rod needs more torque at the same speed; a faster crank more still
-    torque = {(float(r[1]), float(r[2])): float(r[-2]) for r in rows}
+    torque = {(float(r[1]), float(r[2])): float(r[-3]) for r in rows}
     assert torque[(150.0, 1.2)] > torque[(150.0, 0.3)]
     assert torque[(240.0, 0.3)] > torque[(150.0, 0.3)] > torque[(60.0, 0.3)]
     # after one turn the crank is back where it started (its angle, within rounding)
@@ -141,9 +144,9 @@ def test_a_failed_case_is_a_row_with_its_message(tmp_path):
     job = job_of(base, ["bodies.rod.mass=-0.5:1.5:3"], Settings("solve"))
     _, rows = run_here(job, tmp_path / "f.csv", workers=0)
     assert len(rows) == 3
-    assert "bodies.rod.mass" in rows[0][-1] and "expected a number > 0" in rows[0][-1]
-    assert all(c == "" for c in rows[0][2:-1])
-    assert rows[1][-1] == "" == rows[2][-1]
+    assert "bodies.rod.mass" in rows[0][-2] and "expected a number > 0" in rows[0][-2]
+    assert all(c == "" for c in rows[0][2:-2])
+    assert rows[1][-2] == "" == rows[2][-2]
 
 
 def test_an_interrupted_sweep_resumes(tmp_path):
@@ -154,7 +157,7 @@ def test_an_interrupted_sweep_resumes(tmp_path):
     specs = ["drivers.motor.speed=60:240:4", "bodies.rod.mass=0.3:1.2:3"]
     job = job_of(base, specs, Settings("solve"))
     out = tmp_path / "resume.csv"
-    results = Results(out, columns(base, job.settings), job.grid)
+    results = Results(out, columns(base, job.settings), job.grid, record(job.settings, base))
 
     def stop(rows):
         raise KeyboardInterrupt
@@ -163,7 +166,7 @@ def test_an_interrupted_sweep_resumes(tmp_path):
         cluster.run(job, range(12), results, workers=0, chunk=5, progress=False,
                     on_chunk=stop)
     assert not out.exists() and results.journal.exists()
-    again = Results(out, columns(base, job.settings), job.grid)
+    again = Results(out, columns(base, job.settings), job.grid, record(job.settings, base))
     assert sorted(again.done) == list(range(5))
     ran = []
     cluster.run(job, [k for k in range(12) if k not in again.rows], again, workers=0,
@@ -178,7 +181,7 @@ def test_an_interrupted_sweep_resumes(tmp_path):
     other = job_of(base, ["drivers.motor.speed=70:240:4", "bodies.rod.mass=0.3:1.2:3"],
                    Settings("solve"))
     with pytest.raises(MbodyError, match="another sweep"):
-        Results(out, columns(base, other.settings), other.grid)
+        Results(out, columns(base, other.settings), other.grid, record(other.settings, base))
 
 
 def test_random_samples_are_seeded_and_in_range():
@@ -201,7 +204,8 @@ def test_random_samples_are_seeded_and_in_range():
     (["bodies.rod.mass=0.3:1.2:0"], {}, "a count of at least 1"),
     (["drivers.motor.speed=10 rpm:20:3"], {}, "different units"),
     (["bodies.rod.mass=2"], {}, "varies at least one value"),
-    (["bodies.rod.mass=1:2:3", "bodies.rod.mass=1:2:3"], {}, "given twice"),
+    (["bodies.rod.mass=1:2:3", "bodies.rod.mass=1:2:3"], {},
+     r"^values\['bodies.rod.mass'\] is given twice$"),  # from Python: the keyword's spelling
     (["bodies.rod.mass=1,,2"], {}, "an empty value"),
     (["bodies.rod.mass=0:1:20000", "bodies.crank.mass=0:1:20000"], {}, "at most"),
 ])
@@ -250,33 +254,10 @@ def test_the_command_line(driven_file, tmp_path):
     sweep_to("c.parquet")
     table = pq.read_table(tmp_path / "c.parquet")
     assert table.column_names == header
-    for i, name in enumerate(header[:-1]):
+    for i, name in enumerate(header[:-2]):
         assert floats([r[i] for r in rows]).tolist() == table.column(name).to_pylist()
-
-
-def test_a_rerun_with_other_settings_says_its_rows_are_the_earlier_ones(driven_file,
-                                                                       tmp_path):
-    """The output records the grid, not --steps: a rerun with other steps runs nothing and
-    says that the rows it kept are the earlier run's (they are: the peaks of 5 instants,
-    not 9); a rerun of a solve sweep, which has no such setting, does not say it."""
-    out = tmp_path / "k.csv"
-
-    def sweep(*args: str) -> subprocess.CompletedProcess:
-        p = mbody_cli("sweep", str(driven_file), "--set", "bodies.rod.mass=0.3:1.2:2",
-                      *args, "--workers", "0", "--quiet")
-        assert p.returncode == 0, p.stderr
-        return p
-
-    first = sweep("--run", "kinematics", "--t-end", "1 rev", "--steps", "5", "--out", str(out))
-    assert "2 run now" in first.stdout and "kept" not in first.stdout
-    rows = read(out)[1]
-    again = sweep("--run", "kinematics", "--t-end", "1 rev", "--steps", "9", "--out", str(out))
-    assert "0 run now (2 kept as the earlier run made them" in again.stdout
-    assert "does not record --t-end or --steps" in again.stdout
-    assert read(out)[1] == rows
-    solved = tmp_path / "s.csv"
-    sweep("--out", str(solved))
-    assert "kept" not in sweep("--out", str(solved)).stdout
+    for name in ("error", "settings"):  # text
+        assert table.column(name).to_pylist() == [r[header.index(name)] for r in rows]
 
 
 def test_modes_run_gives_the_pendulums_frequency(tmp_path):
@@ -286,7 +267,8 @@ def test_modes_run_gives_the_pendulums_frequency(tmp_path):
     pend = mbody.load(ROOT / "models" / "pendulum.yaml")
     job = Job(pend.source, parse_grid(["bodies.rod.mass=1:3:2"]), Settings("modes"),
               uuid.uuid4().hex)
-    results = Results(tmp_path / "m.csv", columns(pend, job.settings), job.grid)
+    results = Results(tmp_path / "m.csv", columns(pend, job.settings), job.grid,
+                      record(job.settings, pend))
     cluster.run(job, [0, 1], results, workers=0, progress=False)
     results.finish()
     header, rows = read(tmp_path / "m.csv")
@@ -382,7 +364,8 @@ def test_a_worker_killed_mid_run_loses_and_repeats_nothing(dask_cluster, tmp_pat
     # a chunk of one case, some 0.1 s of work: both workers busy whenever one is killed
     settings = Settings("kinematics", revolutions=0.5, steps=20000)
     job = job_of(base, specs, settings)
-    results = Results(tmp_path / "killed.csv", columns(base, settings), job.grid)
+    results = Results(tmp_path / "killed.csv", columns(base, settings), job.grid,
+                      record(settings, base))
     by_case: dict[int, list[str]] = {}
     victim = procs[1]
     lost: list[str] = []
@@ -406,7 +389,7 @@ def test_a_worker_killed_mid_run_loses_and_repeats_nothing(dask_cluster, tmp_pat
     _, rows = read(tmp_path / "killed.csv")
     assert [int(r[0]) for r in rows] == list(range(len(job.grid)))  # each once, in order
     assert all(len(w) == 1 for w in by_case.values()) and len(by_case) == len(job.grid)
-    assert all(r[-1] == "" for r in rows) and report.lost == 0
+    assert all(r[-2] == "" for r in rows) and report.lost == 0
     survivors = {w for ws in by_case.values() for w in ws}
     for key in lost:  # the killed worker's chunk (one case) was run again, by the other
         k = int(str(key).rsplit("-", 1)[1])
@@ -414,8 +397,8 @@ def test_a_worker_killed_mid_run_loses_and_repeats_nothing(dask_cluster, tmp_pat
     assert len(survivors) == 2  # rows came from both workers
     _, here = run_here(job_of(base, specs, settings), tmp_path / "here.csv", workers=0)
     for a, b in zip(rows, here, strict=True):
-        assert a[:3] == b[:3]
-        x, y = floats(a[3:-1]), floats(b[3:-1])
+        assert a[:3] == b[:3] and a[-1] == b[-1]
+        x, y = floats(a[3:-2]), floats(b[3:-2])
         assert np.abs(x - y).max() <= 1e-12 * np.abs(y).max()
 
 
@@ -436,8 +419,9 @@ def test_the_local_cluster_gives_the_numbers_of_this_process(driven_file, tmp_pa
     header, here = run_here(job, tmp_path / "here.csv", workers=0)
     assert read(out)[0] == header
     for a, b in zip(read(out)[1], here, strict=True):
-        x, y = floats(a[3:-1]), floats(b[3:-1])
+        x, y = floats(a[3:-2]), floats(b[3:-2])
         assert a[:3] == b[:3] and np.abs(x - y).max() <= 1e-12 * np.abs(y).max()
+        assert a[-1] == b[-1]  # the same settings recorded, wherever the case ran
 
 
 def test_simulate_rows_are_the_cases_simulated_one_by_one(tmp_path):
@@ -447,7 +431,8 @@ def test_simulate_rows_are_the_cases_simulated_one_by_one(tmp_path):
     base = mbody.load(ROOT / "models" / "pendulum.yaml")
     job = Job(base.source, parse_grid(["bodies.rod.mass=1:3:3"]),
               Settings("simulate", t_end=0.5, fps=40), uuid.uuid4().hex)
-    results = Results(tmp_path / "s.csv", columns(base, job.settings), job.grid)
+    results = Results(tmp_path / "s.csv", columns(base, job.settings), job.grid,
+                      record(job.settings, base))
     cluster.run(job, range(3), results, workers=0, progress=False)
     results.finish()
     header, rows = read(tmp_path / "s.csv")
@@ -459,10 +444,10 @@ def test_simulate_rows_are_the_cases_simulated_one_by_one(tmp_path):
         peaks = np.abs(traj.reactions).max(axis=0)
         want = [*final_values(model, y)[0],
                 *(peaks[list(traj.reaction_labels).index(r)] for r in model.reactions)]
-        assert floats(row[2:-1]).tolist() == want
+        assert floats(row[2:-2]).tolist() == want
     finals = np.array([floats(r[2:5]) for r in rows])
     assert np.abs(finals - finals[0]).max() <= 1e-12
-    loads = np.array([floats(r[5:-1]) for r in rows])
+    loads = np.array([floats(r[5:-2]) for r in rows])
     assert np.allclose(loads / loads[0], np.array([[1.0], [2.0], [3.0]]), rtol=1e-9)
 
 
@@ -503,7 +488,8 @@ def test_a_local_cluster_that_cannot_start_is_a_clean_error(tmp_path, monkeypatc
     base = mbody.load(SLIDER)
     job = Job(base.source, parse_grid(["bodies.rod.mass=1:2:3"]), Settings("solve"),
               uuid.uuid4().hex)
-    results = Results(tmp_path / "c.csv", columns(base, job.settings), job.grid)
+    results = Results(tmp_path / "c.csv", columns(base, job.settings), job.grid,
+                      record(job.settings, base))
     with pytest.raises(MbodyError, match=r"could not start a local Dask cluster of 2 .*"
-                                         r"--workers 0"):
+                                         r"workers=0"):  # Python's spelling (here)
         cluster.run(job, [0, 1, 2], results, workers=2, progress=False)

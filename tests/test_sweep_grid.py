@@ -17,8 +17,9 @@ from mbody.sweep.grid import MAX_CASES, Axis, parse_grid
 def test_each_value_is_linspaces_to_15_digits(lo, hi, count):
     axis = Axis("p", (lo, hi), count)
     want = [float(f"{x:.15g}") for x in np.linspace(lo, hi, count).tolist()]
-    assert axis.grid_values() == want  # bit for bit: the same operations as linspace's
-    assert axis.grid_values()[-1] == float(f"{hi:.15g}")
+    got = [axis.value(k) for k in range(axis.size)]
+    assert got == want  # bit for bit: the same operations as linspace's
+    assert got[-1] == float(f"{hi:.15g}")
 
 
 def test_a_case_is_made_from_its_index():
@@ -41,4 +42,27 @@ def test_a_grid_too_large_is_refused_from_its_counts(monkeypatch, specs, cases):
         parse_grid(specs)
     assert MAX_CASES == 100_000_000
     assert str(info.value) == (f"the sweep has {cases} cases; at most 100 000 000 are run "
-                               "(fewer values per axis, or --samples N)")
+                               "(fewer values per axis, or samples=N)")  # Python's spelling
+
+
+def test_a_unit_goes_in_the_column_name_and_the_values_are_numbers():
+    """A range in a unit, or values listed each in one unit: numbers in the cells, the
+    unit in the column's name, written back with it for the file. Values that are not
+    numbers in one unit (two units, an expression, a plain number) stay as given."""
+    grid = parse_grid(["drivers.motor.speed=300 rpm:900 rpm:3", "joints.O.angle=5 deg,10 deg",
+                       "bodies.rod.mass=0.4,0.8", "drivers.m2.speed=1 rpm,2 Hz",
+                       "loads.f.force.0=2*t,3*t"])
+    assert grid.columns == ("drivers.motor.speed [rpm]", "joints.O.angle [deg]",
+                            "bodies.rod.mass", "drivers.m2.speed", "loads.f.force.0")
+    assert grid.numbers(31) == [600.0, 10.0, 0.8, "2 Hz", "3*t"]  # each axis's second value
+    assert grid.values(31) == {"drivers.motor.speed": "600.0 rpm", "joints.O.angle": "10.0 deg",
+                               "bodies.rod.mass": 0.8, "drivers.m2.speed": "2 Hz",
+                               "loads.f.force.0": "3*t"}
+    assert grid.shown(31) == ("drivers.motor.speed=600.0 rpm, joints.O.angle=10.0 deg, "
+                              "bodies.rod.mass=0.8, drivers.m2.speed=2 Hz, loads.f.force.0=3*t")
+
+
+def test_an_expression_is_not_a_number_in_a_unit():
+    """'2*t' was read as 2 in the unit '*t' by a range (and written back as '2.0 *t')."""
+    with pytest.raises(MbodyError, match="'2\\*t' is not a number"):
+        parse_grid(["loads.f.force.0=2*t:3*t:2"])

@@ -48,7 +48,8 @@ def test_verify_json_has_one_entry_per_equation_in_file_order(tmp_path):
     assert all(e["diagnosis"] in DIAGNOSES for e in d["equations"])
     assert d["equations"][0]["expected"] == "0.167083 alpha = -0.433013 O.Fx - 0.25 O.Fy"
     assert [u["row"] for u in d["uncovered"]] == ["rod.x", "rod.theta"]
-    assert d["summary"] == {"equations": 3, "correct": 1, "rows": 3, "uncovered": 2}
+    assert d["summary"] == {"equations": 3, "correct": 1, "rows": 3, "uncovered": 2,
+                            "duplicates": 0, "required": "answered"}
 
 
 def test_verify_exits_0_when_every_equation_is_correct_and_tol_applies(tmp_path):
@@ -101,9 +102,11 @@ def test_an_equation_not_linear_in_the_unknowns_is_said_so_with_its_term(tmp_pat
     lines = p.stdout.splitlines()
     verdicts = [lines[k + 1] for k, line in enumerate(lines) if line.startswith("[")]
     head = "    not_an_equation_of_this_body: not linear in the unknowns"
+    # an entry without a body (a Lagrange equation) has the model's label, not a body's
+    lagrange = "    not_an_equation_of_this_model: not linear in the unknowns"
     assert verdicts == [f"{head} (a_x squared)", f"{head} (a product of unknowns (alpha "
                         "times O.Fx))", f"{head} (a sum of unknowns (O.Fy, a_x) cubed)",
-                        f"{head} (O.angle_ddot to the power 0.5)"]
+                        f"{lagrange} (O.angle_ddot to the power 0.5)"]
     assert "it has a_x squared" in " ".join(p.stdout.split())
     doc = json.loads(mbody("verify", MODELS / "pendulum.yaml", answers, "--json").stdout)
     first = doc["equations"][0]

@@ -11,17 +11,23 @@ and relative angles mixed) is named, and only on its own equation.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from test_generalized import dp_state
 
 import mbody
 from mbody.answers import AnswersError
+from mbody.answers.compare import CONST
 from mbody.answers.lagrange import (
     ANGLES_MIXED,
+    LAGRANGE_DIAGNOSES,
     MASS_MATRIX_NOT_SYMMETRIC,
     MISSING_COUPLING_TERM,
+    MISSING_PARALLEL_AXIS_TERM,
     MISSING_VELOCITY_TERM,
+    NOT_AN_EQUATION_OF_THIS_MODEL,
     POTENTIAL_GRADIENT_SIGN,
 )
 
@@ -162,6 +168,81 @@ def test_answers_file_reads_coordinates(tmp_path):
     assert v.checks[0].correct and v.checks[0].line == 4
     assert [u.row for u in v.uncovered] == ["theta1"]
     assert np.isclose(v.rows, 2)
+
+
+# == review R4, F6: the feedback a Newton-Euler equation gets ==============================
+
+PENDULUM = Path(__file__).resolve().parent.parent / "models" / "pendulum.yaml"
+
+
+def pendulum(eq: str):
+    answers = {"coordinates": {"th": "O.angle"}, "equations": [{"eq": eq}]}
+    return mbody.verify(mbody.load(PENDULUM), answers).checks[0]
+
+
+def test_i_g_for_i_o_is_the_missing_parallel_axis_term():
+    # the review's equation: the rod's inertia about G (1/6 kg m²) where the inertia
+    # about the pin, I_G + m d² = 1/6 + 2·0.5² = 2/3, belongs
+    c = pendulum("I_rod*th_ddot + m_rod*g*0.5*sin(th) = 0")
+    assert (c.diagnosis, c.row) == (MISSING_PARALLEL_AXIS_TERM, "O.angle"), c.explanation
+    assert c.details["bodies"] == ["rod"]
+    assert c.details["term"] == pytest.approx(2 * 0.5**2, rel=1e-9)
+    assert "rod's m d² = 2·0.5² = 0.5 kg m²" in " ".join(c.explanation.split())
+    assert c.meaning == LAGRANGE_DIAGNOSES[MISSING_PARALLEL_AXIS_TERM]
+
+
+@pytest.mark.parametrize("coordinates, right, wrong, bodies", [
+    # absolute angles: each rod's own term in its own coordinate's mass
+    (ABSOLUTE, 0, ABS1.replace(" + m_upper*0.27^2", ""), ["upper"]),
+    (ABSOLUTE, 1, ABS2.replace(M22, "I_lower"), ["lower"]),
+    # relative angles: theta1 turns both rods about O; theta2 the lower about A
+    (RELATIVE, 0, REL1.replace(" + m_upper*0.27^2", ""), ["upper"]),
+    (RELATIVE, 0, REL1.replace(R11, "(I_upper + I_lower + m_upper*0.27^2)"), ["lower"]),
+    (RELATIVE, 1, REL2.replace("(I_lower + m_lower*0.33^2)*theta2_ddot",
+                               "I_lower*theta2_ddot"), ["lower"]),
+])
+def test_the_parallel_axis_term_of_each_body(coordinates, right, wrong, bodies):
+    state = dp_state([0.4, -0.9], [1.3, -2.1], DP)
+    equations = [ABS1, ABS2] if coordinates is ABSOLUTE else [REL1, REL2]
+    v = check(coordinates, [equations[right], wrong], state)
+    assert [c.diagnosis for c in v.checks] == ["correct", MISSING_PARALLEL_AXIS_TERM], v.text()
+    assert v.checks[1].details["bodies"] == bodies
+    assert v.checks[1].details["coordinate"] == list(coordinates)[right]
+
+
+def test_a_term_the_coordinate_only_moves_is_not_a_parallel_axis():
+    # in absolute angles phi1 moves the lower rod's G (by 0.62 m) without turning it:
+    # m_lower*0.62^2 is its translation, not a parallel-axis term
+    state = dp_state([0.4, -0.9], [1.3, -2.1], DP)
+    v = check(ABSOLUTE, [ABS1.replace(" + m_lower*0.62^2", "")], state)
+    assert v.checks[0].diagnosis == NOT_AN_EQUATION_OF_THIS_MODEL, v.text()
+    assert "phi1_ddot has" in " ".join(v.checks[0].explanation.split())
+
+
+def test_an_equation_nothing_explains_gets_its_terms_compared():
+    # sin(th) taken as th at 30 degrees: the constant is named, at the equation's scale
+    c = pendulum("(I_rod + m_rod*0.5^2)*th_ddot + m_rod*g*0.5*th = 0")
+    assert c.diagnosis == NOT_AN_EQUATION_OF_THIS_MODEL and c.row == "O.angle"
+    text = " ".join(c.explanation.split())
+    assert "Closest is the equation of th" in text
+    assert f"the constant has {2 * 9.81 * 0.5 * np.pi / 6:.6g} where 4.905 is expected" in text
+    assert c.details["differs"][CONST]["expected"] == pytest.approx(4.905, rel=1e-9)
+    # the label says no body: the entry has none
+    assert "body" not in c.meaning
+    assert pendulum("th_dot = 3").diagnosis == NOT_AN_EQUATION_OF_THIS_MODEL
+    c = pendulum("th_ddot^2 = 3")
+    assert c.diagnosis == NOT_AN_EQUATION_OF_THIS_MODEL and "squared" in c.meaning
+
+
+def test_a_number_rounded_too_coarsely_in_a_lagrange_equation():
+    # two terms: at the scale of the coordinate's own acceleration, as written, the
+    # constant is 1 % off (4.905 where 0.66/0.666667 of it is expected)
+    c = pendulum("0.66*th_ddot + m_rod*g*0.5*sin(th) = 0")
+    assert c.diagnosis == "rounded_too_coarsely", c.explanation
+    mass = float(mbody.load(PENDULUM).J[0][2, 2]) + 2 * 0.5**2  # I_O = I_G + m d²
+    assert f"the constant has 4.905 where {4.905 * 0.66 / mass:.6g} is expected (1.1 % off)" \
+        in " ".join(c.explanation.split())
+    assert pendulum("0.6671*th_ddot + m_rod*g*0.5*sin(th) = 0").correct
 
 
 def _chain_yaml(n: int) -> str:

@@ -16,10 +16,20 @@ growing with the square of their size:
   whole (pin-3.Fx): each character of each equation tried every label (a quarter of a
   second an equation with 1000 labels).
 
+And inputs the tests refuse or read, whose speed they once checked with a clock
+(tests/test_hardening.py, tests/test_loader.py): an integer of thousands of digits (int()
+of a long text is quadratic), a list of over a million values (refused at the
+millionth), nesting 100 000 levels deep in three shapes (refused at 64 levels), and
+10 000 bodies one a line through the located reader (`mbody.model.loader.load_text`,
+which keeps every line mark).
+
 For each case and size the table shows the best time of --repeat runs, the time per
 unit of size, and the growth: log(t2/t1) / log(n2/n1) between a size and the one before
-(1 is linear, 2 quadratic; small sizes are noisy). A size whose read takes longer than
---limit seconds ends its case (the larger ones would take minutes if it is not linear).
+(1 is linear, 2 quadratic; small sizes are noisy). Under each case, the verdict: the
+exponent of a least-squares fit of log t against log n over its sizes, PASS when at most
+1.3 (tools/timing.py, `LINEAR`). A size whose read takes longer than --limit seconds ends
+its case (the larger ones would take minutes if it is not linear); the verdict is then
+the fit over the sizes run, and FAIL if only one was.
 
 To be merged into tools/bench_reading.py (the same table for the other readers).
 """
@@ -42,10 +52,11 @@ if str(ROOT) not in sys.path:  # run from a checkout without installing
 if str(ROOT / "tools") not in sys.path:  # tools/timing.py, also when loaded by path
     sys.path.insert(0, str(ROOT / "tools"))
 
-from timing import best  # noqa: E402
+from timing import best, linear_verdict  # noqa: E402
 
 import mbody  # noqa: E402
 from mbody.errors import MbodyError  # noqa: E402
+from mbody.model.loader import load_text  # noqa: E402
 
 PENDULUM = (ROOT / "models" / "pendulum.yaml").read_text(encoding="utf-8")
 
@@ -54,6 +65,24 @@ def model_with(value: str, key: str = "mass: 2.0") -> str:
     """The pendulum model with `key` (a line of it) replaced by `value`."""
     assert key in PENDULUM
     return PENDULUM.replace(key, value)
+
+
+def nested(nest: str) -> str:
+    """A model whose bodies are `nest`, nested deeper than `loader.MAX_DEPTH` (refused)."""
+    return "dimension: 2\nbodies: " + nest + "\n"
+
+
+def many_values(n: int) -> str:
+    """A one-body model whose gravity lists n zeros (over 1 000 000 values is refused)."""
+    return ("dimension: 2\nbodies: [{name: a, mass: 1, inertia: 1}]\ngravity: ["
+            + ", ".join(["0"] * n) + "]\n")
+
+
+def bodies_one_a_line(n: int) -> str:
+    """n spatial bodies, each a flow mapping on its line (tests/test_loader.py's 10 000)."""
+    body = ("  - {name: b%d, mass: 1.5, inertia: [2, 3, 4], position: [%d, 0, 0], "
+            "angular_velocity: [1, 2, 3], orientation: {quaternion: [1, 0, 0, 0]}}\n")
+    return "dimension: 3\nbodies:\n" + "".join(body % (i, i) for i in range(n))
 
 
 def chain(n: int) -> str:
@@ -73,7 +102,8 @@ class Case:
     for an answers case, the model's text (default: models/pendulum.yaml)."""
 
     name: str
-    kind: str  # "model" (read by mbody.loads) or "answers" (checked by mbody.verify)
+    kind: str  # "model" (read by mbody.loads), "text" (by the located reader alone,
+    # mbody.model.loader.load_text) or "answers" (checked by mbody.verify)
     make: Callable[[int], str]
     unit: str = "kB"
     sizes: tuple[int, ...] = (10_000, 20_000, 40_000, 80_000)
@@ -95,6 +125,17 @@ CASES: list[Case] = [
     Case("digits 'e' digits 'e'…", "model", lambda n: model_with(f"mass: {'1e' * (n // 2)}")),
     Case("unknown key of n letters", "model",
          lambda n: model_with(f"{'m' * n}ass: 2.0")),
+    Case("a list of n values", "model", many_values, unit="1000 values",
+         sizes=(137_500, 275_000, 550_000, 1_100_000)),
+    Case("nesting '[' n levels deep", "model", lambda n: nested("[" * n + "]" * n),
+         unit="1000 levels", sizes=(12_500, 25_000, 50_000, 100_000)),
+    Case("nesting '- ' n levels deep", "model", lambda n: nested("\n  " + "- " * n + "x"),
+         unit="1000 levels", sizes=(12_500, 25_000, 50_000, 100_000)),
+    Case("nesting '{a: ' n levels deep", "model",
+         lambda n: nested("{a: " * n + "1" + "}" * n), unit="1000 levels",
+         sizes=(1250, 2500, 5000, 10_000)),
+    Case("n bodies one a line, located", "text", bodies_one_a_line, unit="1000 bodies",
+         sizes=(1250, 2500, 5000, 10_000)),
     Case("equations 'm*a_x = O.Fx'", "answers", lambda n: "equations:\n" + "".join(
         f'  - {{body: rod, eq: "m*a_x = O.Fx + {k}"}}\n' for k in range(n)),
         unit="1000 equations", sizes=(2000, 4000, 8000, 16000)),
@@ -117,6 +158,11 @@ def reader(case: Case, folder: Path) -> Callable[[str], None]:
             with contextlib.suppress(MbodyError):
                 mbody.loads(text)
         return read
+    if case.kind == "text":
+        def located(text: str) -> None:
+            with contextlib.suppress(MbodyError):
+                load_text(text)
+        return located
     model = mbody.loads(case.model) if case.model else mbody.load(
         ROOT / "models" / "pendulum.yaml")
     path = folder / "answers.yaml"
@@ -134,6 +180,8 @@ def run(case: Case, repeat: int, limit: float, quick: bool, folder: Path) -> lis
     per = 1000 if case.unit.startswith("1000") or case.unit == "kB" else 1
     rows = []
     last: tuple[int, float] | None = None
+    measured: tuple[list[float], list[float]] = ([], [])
+    stopped = False
     for n in sizes:
         text = case.make(n)
         t0 = time.perf_counter()
@@ -145,9 +193,13 @@ def run(case: Case, repeat: int, limit: float, quick: bool, folder: Path) -> lis
         rows.append(f"  {case.name:<32} {n:>7} {t * 1e3:10.1f} ms {t / (n / per) * 1e3:9.2f} "
                     f"ms/{case.unit:<15} {growth}")
         last = (n, t)
+        measured[0].append(n)
+        measured[1].append(t)
         if once > limit:
             rows.append(f"  {'':<32} stopped: one read took {once:.1f} s (> --limit)")
+            stopped = True
             break
+    rows.append(f"  {'':<32} {linear_verdict(*measured, stopped=stopped)}")
     return rows
 
 

@@ -1,7 +1,7 @@
 """Benchmark: reading run files (`Trajectory.load`) is linear in what they hold, and a
 hostile file is refused in milliseconds whatever it claims.
 
-Prints two tables:
+Prints three tables:
 
 - good runs of N spatial bodies over K samples (saved by `Trajectory.save`, compressed):
   the bytes on disk and once inflated, the best load time, and the time per inflated MiB,
@@ -9,18 +9,27 @@ Prints two tables:
 - the review's hostile files (R1, B3/B4), built here: a 2 MB zip bomb whose t.npy inflates
   to 2 GiB, a header that claims 10^15 samples in 16 bytes, an `info` nested 10 000 deep,
   the same bomb as a .mat export (`mbody.load_export`): the time to the refusal and the
-  peak memory Python and numpy held meanwhile (tracemalloc), with the message's start.
+  peak memory Python and numpy held meanwhile (tracemalloc), with the message's start;
+  and review R3's: 10^12 body names of 0 bytes each in a 5 kB run (S1), a string of
+  escaped quotes that never ends as a run's `info` and as a JSON export (S2);
+- the nesting bound every JSON text read back goes through (`jsontext.nesting`: a run's
+  `info`, `shapes` and `colors`, JSON exports, CSV `info.csv` cells): its time against
+  the text's size, for JSON like an export's and for that string of escaped quotes; the
+  time per MB stays about constant (linear).
 
     python tools/bench_run_files.py [--repeat 3] [--largest 200000]
 
 Before the bounds (mbody of review R1), the bomb took 14 s and 2.2 GB of memory to be
 refused, the liar and the nesting ended in a MemoryError or RecursionError (exit 70).
+Before review R3, the names of 0 bytes took 106 s and 3.6 GB to a MemoryError (exit 70),
+and the nesting bound was quadratic on escaped quotes: 64 kB of them took 21 s.
 """
 
 from __future__ import annotations
 
 import argparse
 import io
+import json
 import struct
 import sys
 import tempfile
@@ -43,6 +52,7 @@ from timing import best  # noqa: E402
 import mbody  # noqa: E402
 from mbody.errors import MbodyError  # noqa: E402
 from mbody.simulate.trajectory import Trajectory  # noqa: E402
+from mbody.util.jsontext import nesting  # noqa: E402
 
 MIB = 1 << 20
 
@@ -137,6 +147,38 @@ def bomb_mat(path: Path, samples: int) -> Path:
     return path
 
 
+def npy_header(shape: tuple[int, ...], descr: str) -> bytes:
+    """A .npy header for `shape` values of `descr`, and no data."""
+    b = io.BytesIO()
+    np.lib.format.write_array_header_1_0(b, {"descr": descr, "fortran_order": False,
+                                             "shape": shape})
+    return b.getvalue()
+
+
+def weightless_run(path: Path, good: dict[str, np.ndarray]) -> Path:
+    """Review R3, S1: 10^12 body names of '<U0' (0 bytes each) and no samples."""
+    n = 10**12
+    raw = {"body_names": npy_header((n,), "<U0"), "position": npy_header((0, n, 2), "<f8"),
+           "velocity": npy_header((0, n, 2), "<f8"), "orientation": npy_header((0, n), "<f8"),
+           "angular_velocity": npy_header((0, n), "<f8")}
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
+        for k, v in good.items():
+            if k in ("mass", "inertia") or k.startswith("series/"):
+                continue
+            if k in raw:
+                z.writestr(k + ".npy", raw[k])
+                continue
+            b = io.BytesIO()
+            np.save(b, v[:0] if k in ("t", "reactions") else v)
+            z.writestr(k + ".npy", b.getvalue())
+    return path
+
+
+def escaped_quotes(n: int) -> str:
+    """Review R3, S2: a string of `n` escaped quotes that never ends."""
+    return '"' + '\\"' * n
+
+
 def refusal(load, path: Path) -> tuple[float, int, str]:
     """(seconds to the refusal, peak bytes held, the message's start)."""
     tracemalloc.start()
@@ -160,16 +202,45 @@ def hostile(folder: Path) -> None:
     deep = dict(good)
     deep["info"] = np.array('{"a":' * 10000)
     np.savez(folder / "deepinfo.npz", **deep)
+    quoted = dict(good)
+    quoted["info"] = np.array(escaped_quotes(32_000))
+    np.savez_compressed(folder / "quotes.npz", **quoted)
+    (folder / "quotes.json").write_text(escaped_quotes(4_000_000))
     files = [(Trajectory.load, bomb_run(folder / "bomb.npz", good, 2**28)),
              (Trajectory.load, liar_run(folder / "liar.npz", good)),
              (Trajectory.load, folder / "deepinfo.npz"),
-             (mbody.load_export, bomb_mat(folder / "bomb.mat", 2**28))]
+             (mbody.load_export, bomb_mat(folder / "bomb.mat", 2**28)),
+             (Trajectory.load, weightless_run(folder / "names0.npz", good)),
+             (Trajectory.load, folder / "quotes.npz"),
+             (mbody.load_export, folder / "quotes.json")]
     print("\nhostile files: time to the refusal, peak memory held meanwhile")
     print(f"{'file':>14} {'on disk':>10} {'time':>9} {'peak':>9}  message")
     for load, path in files:
         elapsed, peak, message = refusal(load, path)
         print(f"{path.name:>14} {path.stat().st_size / MIB:>8.2f} M {elapsed * 1e3:>6.1f} ms "
               f"{peak / MIB:>6.2f} M  {message[:110]}")
+
+
+def export_like(chars: int) -> str:
+    """JSON text of about `chars` characters nested as an export is: objects of names,
+    numbers and texts with escaped quotes and brackets in them."""
+    row = {"name": "b0", "mass": 1.25, "inertia": [[0.1, 0.0, 0.0], [0.0, 0.2, 0.0],
+                                                     [0.0, 0.0, 0.3]],
+           "source": 'run "a" [t = 0.5 s] {rod}\\', "known": None}
+    one = len(json.dumps(row)) + 2
+    return json.dumps({"format": "mbody-export", "bodies": [row] * max(1, chars // one)})
+
+
+def json_scan(repeat: int) -> None:
+    print("\nthe JSON nesting bound (jsontext.nesting): time against the text's size")
+    print(f"{'characters':>12} {'export-like':>12} {'per MB':>9} {'escaped quotes':>15} "
+          f"{'per MB':>9}")
+    for chars in (64_000, 256_000, 1_024_000, 4_096_000, 16_384_000):
+        texts = (export_like(chars), escaped_quotes(chars // 2))
+        times = [best(lambda text=text: nesting(text), repeat) for text in texts]
+        cells = [f"{t * 1e3:>9.2f} ms {t * 1e3 / (len(x) / 1e6):>6.2f} ms"
+                 for t, x in zip(times, texts, strict=True)]
+        print(f"{chars:>12,} {cells[0]:>22} {cells[1]:>25}")
 
 
 def main() -> None:
@@ -181,6 +252,7 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         good_runs(Path(tmp), a.repeat, a.largest)
         hostile(Path(tmp))
+    json_scan(a.repeat)
 
 
 if __name__ == "__main__":

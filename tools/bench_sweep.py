@@ -238,9 +238,11 @@ def check_study(out: Path) -> None:
           f"{'PASS' if worst < 1e-9 and not errors else 'MISS'}")
 
 
-def grade_class(folder: Path, students: int = 200) -> float:
+def grade_class(folder: Path, students: int = 200, variants: int = 0) -> float:
     """200 answers files of the double pendulum, each its four equations, some with a
-    mistake of the course (a sign, a missing reaction, a missing weight)."""
+    mistake of the course (a sign, a missing reaction, a missing weight); with
+    `variants`, each file sets its own lower rod's mass (``set:``), `variants` masses in
+    all (the model assembled once per mass)."""
     model = ROOT / "models" / "double_pendulum.yaml"
     right = ["m*a_x = A.Fx", "m*a_y = A.Fy - m*g", "m*a_x = O.Fx - A.Fx",
              "m*a_y = O.Fy - A.Fy - m*g"]
@@ -252,7 +254,10 @@ def grade_class(folder: Path, students: int = 200) -> float:
     rng = np.random.default_rng(1)
     for k in range(students):
         eqs = [wrong[i] if rng.random() < 0.3 else right[i] for i in range(4)]
-        lines = [f"student: Student {k:03d}", "equations:"]
+        lines = [f"student: Student {k:03d}"]
+        if variants:
+            lines.append(f"set: {{bodies.lower.mass: {1 + (k % variants) / 10}}}")
+        lines.append("equations:")
         lines += [f'  - {{body: {b}, eq: "{e}"}}' for b, e in zip(bodies, eqs, strict=True)]
         (answers / f"s{k:03d}.yaml").write_text("\n".join(lines) + "\n")
     files = sorted(str(p) for p in answers.glob("*.yaml"))
@@ -317,6 +322,11 @@ def main() -> int:
             wall = grade_class(Path(tmp))
             print(f"\n4. a class: mbody verify of 200 answers files with --summary: "
                   f"{wall:.1f} s wall  {'PASS' if wall <= 30 else 'MISS'} (target 30 s)")
+        with tempfile.TemporaryDirectory() as tmp:
+            mixed = grade_class(Path(tmp), variants=20)
+            print(f"   the same with each file's own values (set:), 20 variants: "
+                  f"{mixed:.1f} s wall ({mixed / wall:.2f}x)  "
+                  f"{'PASS' if mixed <= 30 else 'MISS'} (target 30 s)")
     return 0
 
 

@@ -323,6 +323,69 @@ _FLOOR = 1e-150
 still a normal double)."""
 
 
+def consensus(s: Row, t: Row, tol: float, prefer: str = "") -> Fit | None:
+    """The fit of `s` to `t` whose factor most of their common terms agree with (each
+    term's coefficients made equal in turn, `fit_on`), the key `prefer` breaking ties
+    (a row's own acceleration), so that the minority of wrong terms stands out; the
+    least-squares `fit` when they share no term.
+
+    Parameters
+    ----------
+    s, t : Row
+        The student's row and a true row (or a variant).
+    tol : float
+        Relative tolerance on each coefficient.
+    prefer : str
+        The key whose factor wins a tie.
+
+    Returns
+    -------
+    Fit or None
+    """
+    best: tuple | None = None
+    for key in sorted(s.keys & t.keys):
+        fk = fit_on(s, t, key)
+        score = (len(fk.wrong(tol)), key != prefer, fk.error)
+        if best is None or score < best[0]:
+            best = (score, fk)
+    return best[1] if best is not None else fit(s, t)
+
+
+ROUNDING = 0.03
+"""A coefficient within this fraction of the row's (and beyond the tolerance) in an
+equation with every term in place is a number rounded too coarsely."""
+
+
+def rounded_off(s: Row, t: Row, f: Fit, tol: float) -> dict[str, float] | None:
+    """How far each differing coefficient of `s` is from ``k·t`` (the fit `f`), relative,
+    when `s` has exactly the terms of `t` and each is within `ROUNDING`: a number
+    written with too few figures; else None.
+
+    Parameters
+    ----------
+    s, t : Row
+        The student's row and the row it is compared with.
+    f : Fit
+        Their fit (`consensus`).
+    tol : float
+        The relative tolerance.
+
+    Returns
+    -------
+    dict of str to float or None
+        Key -> |s − k t| / |k t|, for the keys beyond the tolerance.
+    """
+    if s.keys != t.keys:
+        return None
+    off = {}
+    for key in f.wrong(tol):
+        want = f.times(t.get(key))
+        off[key] = abs(s.get(key) - want) / abs(want) if want != 0.0 else math.inf
+    if not off or max(off.values()) > ROUNDING:
+        return None
+    return off
+
+
 def matches(s: Row, t: Row, tol: float, free: Iterable[str] = ()) -> Fit | None:
     """`fit` when it is within `tol`, else None.
 

@@ -19,10 +19,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from mbody import joint_types
-from mbody.answers.compare import CONST, Fit, Row, fit, fit_on, matches, same
+from mbody.answers.compare import CONST, Fit, Row, consensus, matches, rounded_off, same
+from mbody.answers.kinematics import Relation
 from mbody.answers.rows import BodyRows, MomentPoint, TrueRow
+from mbody.answers.text import differences, rounding, row_text
 from mbody.answers.text import num as _num
-from mbody.answers.text import row_text
 from mbody.answers.text import terms as _terms
 
 CORRECT = "correct"
@@ -35,6 +36,9 @@ REACTION_SIGN = "reaction_sign"
 SINGLE_INERTIA_IN_SPACE = "single_inertia_in_space"
 MISSING_PRODUCTS_OF_INERTIA = "missing_products_of_inertia"
 MISSING_APPLIED_LOAD = "missing_applied_load"
+APPLIED_LOAD_SIGN = "applied_load_sign"
+LEVER_ARM_SIGN = "lever_arm_sign"
+ROUNDED_TOO_COARSELY = "rounded_too_coarsely"
 NOT_AN_EQUATION = "not_an_equation_of_this_body"
 
 DIAGNOSES = {
@@ -52,8 +56,13 @@ DIAGNOSES = {
                         "and without the transport term",
     MISSING_REACTION: "an unknown reaction left out",
     REACTION_SIGN: "a reaction with the wrong sign (the third law: −R on the parent)",
+    LEVER_ARM_SIGN: "a reaction's moment about G with the wrong sign (r × F: r from G to "
+                    "the joint, in that order)",
     MISSING_APPLIED_LOAD: "an applied force or moment (or gravity) left out",
+    APPLIED_LOAD_SIGN: "an applied force or moment (or gravity) with the wrong sign",
     REACTION_TREATED_AS_KNOWN: "an unknown reaction replaced by a number",
+    ROUNDED_TOO_COARSELY: "right but for a number rounded too coarsely (a few percent off, "
+                          "beyond the tolerance)",
     NOT_AN_EQUATION: "none of the above explains it",
 }
 """The fixed vocabulary of diagnoses, in the order they are tried, with their meaning."""
@@ -147,15 +156,69 @@ class _Diagnoser:
         for step in (self.no_unknowns, self.foreign, self.correct, self.gyroscopic,
                      self.gyroscopic_sign, self.products_of_inertia, self.single_inertia,
                      self.moment_point, self.missing_reaction, self.reaction_sign,
-                     self.missing_load, self.treated_as_known):
+                     self.missing_load, self.load_sign, self.treated_as_known):
             found = step()
             if found is not None:
                 return found
-        return self.closest()
+        kin = self.br.kinematics
+        if kin is not None:
+            # the same mistakes in an equation that writes accelerations from the joints'
+            # kinematics: those that change a reaction or the constant, which the
+            # kinematics cannot (the others change acceleration terms, which they do)
+            self.kinematic = True
+            for step in (self.gyroscopic, self.gyroscopic_sign, self.missing_reaction,
+                         self.reaction_sign, self.missing_load, self.load_sign):
+                self.last = None
+                found = step()
+                if found is not None:
+                    return self.with_kinematics(found)
+            self.kinematic = False
+        return self.rounded() or self.closest()
 
     # -- helpers -----------------------------------------------------------------------
+    kinematic = False
+    """Whether the mistakes are tried with the joints' kinematics put in the rows."""
+    last: Row | None = None
+    """The variant of the last match in that mode."""
+
     def match(self, t: Row, free: tuple[str, ...] = ()) -> Fit | None:
-        return matches(self.s, t, self.tol, free)
+        if not self.kinematic:
+            return matches(self.s, t, self.tol, free)
+        if not (t.unknowns & set(self.br.joints)):
+            # nothing anchors it: with the kinematics put in, a body with one degree of
+            # freedom makes every reaction-free row a multiple of its equation of motion
+            # (m a_y = 0 would be Newton's x row without O.Fx: 0.866 alpha = 0)
+            return None
+        t2 = self.kinematic_row(t)
+        if t2 is None or any(k in self.dependent() and k not in self.s.unknowns
+                             for k in free):
+            return None  # a coefficient left open that the kinematics replace
+        f = matches(self.s, t2, self.tol, free)
+        if f is not None:
+            self.last = t
+        return f
+
+    def kinematic_row(self, t: Row) -> Row | None:
+        """`t` with the joints' kinematics put in for the accelerations the student did
+        not write; None when the student writes one the kinematics replace that `t`
+        lacks (m a_y = ... is Newton's row along y, not along x with a_y put in)."""
+        kin = self.br.kinematics
+        if kin is None:
+            return None
+        kept = self.s.unknowns & kin.dependent
+        if not kept <= t.keys:
+            return None
+        return kin.substitute(t, keep=kept)
+
+    def with_kinematics(self, d: Diagnosis) -> Diagnosis:
+        """`d`, found with the joints' kinematics put in, saying so."""
+        if self.last is None:
+            return d
+        t = self.last
+        return Diagnosis(d.diagnosis, d.expected, d.row,
+                         f"{d.explanation} Your equation writes the rest of the row "
+                         f"right, {self.kinematics_words(t)}.",
+                         {**d.details, **self.kinematics_details(t)})
 
     def words(self, r: TrueRow) -> str:
         return describe_row(r, self.planar)
@@ -200,10 +263,8 @@ class _Diagnoser:
             f = self.match(r.row)
             if f is not None:
                 return Diagnosis(CORRECT, r.text, r.label,
-                                 f"This is {self.words(r)}"
-                                 + (", scaled" if abs(abs(f.k) - 1.0) > self.tol else "")
-                                 + (" and rearranged" if f.k < 0 else "") + ".",
-                                 {"scale": f.k})
+                                 f"This is {self.words(r)}{self.scaled(f)}.", {"scale": f.k})
+        kin = self.br.kinematics
         for e in self.br.euler:
             for p in self.br.points:
                 t = self.br.transport(e, p, keep_acc=True)
@@ -213,14 +274,85 @@ class _Diagnoser:
                         f"These are moments about {_point(p)}, with the transport term "
                         f"r × m a_G: the same law as {self.words(e)}, taken about another "
                         "point.", {"point": p.name, "form": "transport"})
-                if p.fixed and self.match(self.br.about_fixed_point(e, p)) is not None:
+                # the pivot's kinematics are the joint's: only where the joint is held
+                if p.fixed and kin is not None and \
+                        self.match(self.br.about_fixed_point(e, p)) is not None:
                     return Diagnosis(
                         CORRECT, row_text(self.br.about_fixed_point(e, p)), e.label,
                         f"These are moments about {_point(p)}, a fixed pivot, with the "
                         f"inertia about it (I_P = I_G + m d²): {self.words(e)} combined with "
                         "Newton's through the pivot's kinematics.",
                         {"point": p.name, "form": "fixed_pivot"})
+        return self.correct_by_kinematics()
+
+    def correct_by_kinematics(self) -> Diagnosis | None:
+        """A row, or the moments about a point, plus relations the joints impose on the
+        accelerations (`mbody.answers.kinematics`): a_G written from a pivot's
+        kinematics. Such relations hold for every motion the joints allow and carry no
+        reaction, so the reactions must be the row's and the rest equal once they are
+        put in for the accelerations the student did not write."""
+        if self.br.kinematics is None:
+            return None
+        for r in self.br.rows:
+            t = self.kinematic_row(r.row)
+            if t is None or self.unanchored(r.row, r.acc):
+                continue
+            f = matches(self.s, t, self.tol)
+            if f is not None:
+                return Diagnosis(CORRECT, r.text, r.label,
+                                 f"This is {self.words(r)}{self.scaled(f)}, "
+                                 f"{self.kinematics_words(r.row)}.",
+                                 {"scale": f.k, **self.kinematics_details(r.row)})
+        for e in self.br.euler:
+            for p in self.br.points:
+                written = self.br.transport(e, p, keep_acc=True)
+                t = self.kinematic_row(written)
+                if t is None or self.unanchored(written, e.acc):
+                    continue
+                if matches(self.s, t, self.tol) is None:
+                    continue
+                return Diagnosis(
+                    CORRECT, row_text(written), e.label,
+                    f"These are moments about {_point(p)}, with the transport term r × m "
+                    f"a_G (the same law as {self.words(e)}, taken about another point), "
+                    f"{self.kinematics_words(written)}.",
+                    {"point": p.name, "form": "transport",
+                     **self.kinematics_details(written)})
         return None
+
+    def unanchored(self, t: Row, acc: str) -> bool:
+        """Whether `t` has no unknown reaction and the student's equation lacks its
+        acceleration `acc`: then, with the kinematics put in, any true relation of a body
+        with one degree of freedom would match it (moments about the pivot leave no
+        reaction): a moment equation about the pivot keeps its angular acceleration, as
+        I_P α = M_P does."""
+        return not (t.unknowns & set(self.br.joints)) and self.s.get(acc) == 0.0
+
+    def scaled(self, f: Fit) -> str:
+        return ((", scaled" if abs(abs(f.k) - 1.0) > self.tol else "")
+                + (" and rearranged" if f.k < 0 else ""))
+
+    def replaced(self, t: Row) -> list[Relation]:
+        """The relations put into `t` (a true row as written) for the student."""
+        kin = self.br.kinematics
+        assert kin is not None
+        return kin.replaced(t, keep=self.s.unknowns)
+
+    def kinematics_words(self, t: Row) -> str:
+        """"with a_x written from the kinematics of joint O (a_x = 0.433013 alpha at
+        this state)"."""
+        kin = self.br.kinematics
+        assert kin is not None
+        used = self.replaced(t) or list(kin.relations)
+        accs = ", ".join(rel.acc for rel in used)
+        return (f"with {accs} written from the kinematics of {_sources(kin.sources)} "
+                f"({'; '.join(rel.text for rel in used)} at this state)")
+
+    def kinematics_details(self, t: Row) -> dict:
+        kin = self.br.kinematics
+        assert kin is not None
+        used = self.replaced(t) or list(kin.relations)
+        return {"kinematics": [rel.text for rel in used], "joints": list(kin.sources)}
 
     def gyroscopic(self) -> Diagnosis | None:
         for e in self.br.euler:
@@ -443,9 +575,11 @@ class _Diagnoser:
                         f"+{flip[0]}" if side > 0 else
                         f"{self.br.body} is the parent of joint {joint}, so it feels "
                         f"−{flip[0]}")
+                label = REACTION_SIGN
                 if r.euler and side > 0:
                     # the child feels +R, so a flipped moment is r × F's sign, not the
                     # third law's (telling it "it feels +R" beside "-0.43 O.Fx" confuses)
+                    label = LEVER_ARM_SIGN
                     rule = (f"the moment of a force about G is r × F, with r from G to "
                             f"where it acts (joint {joint}), and {self.br.body}, the child "
                             f"of joint {joint}, feels +R there")
@@ -454,7 +588,7 @@ class _Diagnoser:
                     role += f", whose moment about G is r × (−R), r from G to joint {joint}"
                 terms = _terms({k: -r.row.get(k) for k in flip})
                 return Diagnosis(
-                    REACTION_SIGN, r.text, r.label,
+                    label, r.text, r.label,
                     f"{', '.join(flip)} {'has' if len(flip) == 1 else 'have'} the wrong sign "
                     f"in {self.words(r)}: {rule}; {role}. The right side should read "
                     f"{terms}.", {"reactions": flip, "term": terms})
@@ -555,91 +689,147 @@ class _Diagnoser:
                 return True
         return False
 
-    def closest(self) -> Diagnosis:
-        candidates = [(r, r.row, self.words(r), r.text) for r in self.br.rows]
+    def candidates(self) -> list[tuple[TrueRow, Row, str, str]]:
+        """What an equation that is none of the mistakes is compared with: (the row, the
+        row or moment form, its words, its text)."""
+        out = [(r, r.row, self.words(r), r.text) for r in self.br.rows]
         if self.s.unknowns & {"a_x", "a_y", "a_z"} and any(
                 k.startswith("alpha") for k in self.s.unknowns):
             for e in self.br.euler:
                 for p in self.br.points:
                     t = self.br.transport(e, p, keep_acc=True)
-                    candidates.append((e, t, f"the moment equation about {_point(p)} (with "
-                                       "the transport term r × m a_G)", row_text(t)))
+                    out.append((e, t, f"the moment equation about {_point(p)} (with "
+                                "the transport term r × m a_G)", row_text(t)))
         if any(k.startswith("alpha") for k in self.s.unknowns):
             for e in self.br.euler:
                 for p in self.br.points:
                     if p.fixed:
                         t = self.br.about_fixed_point(e, p)
-                        candidates.append((e, t, f"the moment equation about the fixed pivot "
-                                           f"{_point(p)} (with I_P = I_G + m d²)", row_text(t)))
-        flipped = self.wrong_sign()
-        if flipped is not None:
-            return flipped
+                        out.append((e, t, f"the moment equation about the fixed pivot "
+                                    f"{_point(p)} (with I_P = I_G + m d²)", row_text(t)))
+        return out
+
+    def comparisons(self) -> list[tuple[TrueRow, Row, Row, str, str, bool]]:
+        """Each candidate as (row, candidate compared, candidate as written, words, text,
+        with the kinematics put in): as written, then (when the joints relate the body's
+        accelerations) with the joints' kinematics put in."""
+        out = [(r, t, t, words, text, False) for r, t, words, text in self.candidates()]
+        if self.br.kinematics is not None:
+            for r, t, _, words, text, _ in list(out):
+                t2 = self.kinematic_row(t)
+                if t2 is not None and self.replaced(t):
+                    out.append((r, t2, t, words, text, True))
+        return out
+
+    def rounded(self) -> Diagnosis | None:
+        """Every term of a row in place, each coefficient within `compare.ROUNDING` of the row's
+        and some beyond the tolerance: a number written with too few figures."""
         best: tuple | None = None
-        for r, t, words, text in candidates:
+        for r, t, written, words, text, kinematic in self.comparisons():
             f = self.consensus(t, r.acc)
+            off = rounded_off(self.s, t, f, self.tol) if f is not None else None
+            if off is None:
+                continue
+            rank = (kinematic, max(off.values()))
+            if best is None or rank < best[0]:
+                best = (rank, r, t, written, words, text, f, off)
+        if best is None:
+            return None
+        (kinematic, _), r, t, written, words, text, f, off = best
+        how = ", " + self.kinematics_words(written) if kinematic else ""
+        return Diagnosis(
+            ROUNDED_TOO_COARSELY, text, r.label,
+            f"This is {words}{how}, with every term in place, but "
+            + rounding(self.s, t, f, off, self.tol) + " (m, I_G, g...).",
+            {"rounded": {k: {"have": self.s.get(k), "expected": f.times(t.get(k)),
+                             "relative": v} for k, v in off.items()}})
+
+    def closest(self) -> Diagnosis:
+        best: tuple | None = None
+        s = self.s
+        for r, t, written, words, text, kinematic in self.comparisons():
+            f = self.consensus(t, r.acc, s)
             if f is None:
                 continue
             wrong = f.wrong(self.tol)
-            shared = len(self.s.unknowns & t.unknowns)
+            if kinematic and (self.mixed(wrong) or self.misread(s, t, f, wrong)):
+                continue
+            shared = len(s.unknowns & t.unknowns)
             # a row about an acceleration the student did not write comes last: an
             # equation in alpha is a moment equation, however many reactions it shares
-            # with a Newton row
-            key = (r.acc not in self.s.unknowns, len(wrong) - shared, len(wrong), f.error)
+            # with a Newton row (with the kinematics put in, the row's acceleration may be
+            # one they replace); a row as written before the same with the kinematics
+            away = r.acc not in s.unknowns and not (kinematic and r.acc in self.dependent())
+            key = (away, len(wrong) - shared, len(wrong), kinematic, f.error)
             if best is None or key < best[0]:
-                best = (key, r, t, words, text, f, wrong)
+                best = (key, r, t, written, words, text, f, wrong)
         if best is None:
             return Diagnosis(NOT_AN_EQUATION, "", "", "This equation shares no term with "
                              f"any of {self.br.body}'s Newton-Euler rows.", {})
-        _, r, t, words, text, f, wrong = best
-        parts = []
-        # numbers at the student's scale: noise only against the row's own magnitude
-        ref = min(1.0, max((abs(v) for v in self.s.coef.values()), default=1.0))
-        for key in wrong[:3]:
-            have, want = self.s.get(key), f.times(t.get(key))
-            name = "the constant" if key == CONST else key
-            if have == 0.0:
-                parts.append(f"{name} is missing (expected {_num(want, ref)})")
-            elif want == 0.0:
-                parts.append(f"{name} does not belong here (you have {_num(have, ref)})")
-            else:
-                parts.append(f"{name} has {_num(have, ref)} where {_num(want, ref)} is "
-                             "expected")
-        more = f", and {len(wrong) - 3} more" if len(wrong) > 3 else ""
+        key, r, t, written, words, text, f, wrong = best
+        kinematic = key[3]
         combo = self.combination()
+        details: dict = {"differs": {k: {"have": s.get(k), "expected": f.times(t.get(k))}
+                                     for k in wrong}}
+        how = "with every term on the left side"
+        if kinematic:
+            words += ", " + self.kinematics_words(written)
+            how += " and those put in"
+            details["kinematics"] = self.kinematics_details(written)["kinematics"]
         return Diagnosis(
             NOT_AN_EQUATION, text, r.label,
             (combo + " " if combo else "")
-            + f"Closest is {words}; with every term on the left side, at your "
-            "equation's scale: " + "; ".join(parts) + more + ".",
-            {"differs": {k: {"have": self.s.get(k), "expected": f.times(t.get(k))}
-                         for k in wrong}})
+            + f"Closest is {words}; {how}, at your equation's scale: "
+            + differences(s, t, f, wrong) + ".", details)
 
-    def wrong_sign(self) -> Diagnosis | None:
-        """A row with one applied load or gravity of the wrong sign: no mistake of the
-        table, but a common slip, so it is named (the gyroscopic term's sign is a
-        diagnosis of its own: `gyroscopic_sign`)."""
+    def mixed(self, wrong: list[str]) -> bool:
+        """Whether the terms that differ are both accelerations and forces (or the
+        constant): with the kinematics put in, a row is taken as the closest only when
+        one side of it is right, the accelerations written from the kinematics or the
+        forces; else a moment equation whose lever arms are wrong would be read as
+        Newton's row with a_G from the kinematics (I_G α = -60 - 0.025 O.Fy + 0.025 A.Fy
+        has O.Fy and A.Fy in the ratio of the crank's Newton row along y)."""
+        acc = [k for k in wrong if k != CONST and k not in self.br.joints]
+        return bool(acc) and len(acc) < len(wrong)
+
+    def misread(self, s: Row, t: Row, f: Fit, wrong: list[str]) -> bool:
+        """Whether an acceleration term differs in size, not only in sign, with the
+        kinematics put in: the student did not write them (I_G α = -0.43 O.Fx is a
+        moment equation, not Newton's along x with a_x = 0.433 α), and the row as
+        written is the better comparison."""
+        for k in wrong:
+            if k == CONST or k in self.br.joints:
+                continue
+            have, want = abs(s.get(k)), abs(f.times(t.get(k)))
+            if abs(have - want) > self.tol * max(s.err(k), want):
+                return True
+        return False
+
+    def dependent(self) -> set[str]:
+        kin = self.br.kinematics
+        return {rel.acc for rel in kin.relations} if kin is not None else set()
+
+    def load_sign(self) -> Diagnosis | None:
+        """A row with one applied load or gravity of the wrong sign (the gyroscopic
+        term's sign is a diagnosis of its own: `gyroscopic_sign`)."""
         for r in self.br.rows:
             for x in r.loads:
                 change = -2.0 * x.value  # Q's share: −value in lhs − rhs
                 t = r.row.with_term(CONST, r.row.get(CONST) - change, r.row.err(CONST))
-                if self.match(t) is None:
+                if same(t, r.row, self.tol) or self.match(t) is None:
                     continue
                 return Diagnosis(
-                    NOT_AN_EQUATION, r.text, r.label,
+                    APPLIED_LOAD_SIGN, r.text, r.label,
                     f"This is {self.words(r)} with {_load_words(x, r.euler)} of the wrong "
-                    f"sign. The row reads: {r.text}.", {"wrong_sign": x.name})
+                    f"sign: each load acts on the free body in its own direction, gravity "
+                    f"downward, whichever way the body moves. The row reads: {r.text}.",
+                    {"wrong_sign": x.name, "loads": [x.name], "value": x.value})
         return None
 
-    def consensus(self, t: Row, acc: str) -> Fit | None:
-        """The fit whose scale most of the student's terms agree with (the row's own
-        acceleration breaking ties), so that the minority of wrong terms stands out."""
-        best: tuple | None = None
-        for key in sorted(self.s.keys & t.keys):
-            fk = fit_on(self.s, t, key)
-            score = (len(fk.wrong(self.tol)), key != acc, fk.error)
-            if best is None or score < best[0]:
-                best = (score, fk)
-        return best[1] if best is not None else fit(self.s, t)
+    def consensus(self, t: Row, acc: str, s: Row | None = None) -> Fit | None:
+        """`mbody.answers.compare.consensus` of `s` (default: the student's row) and `t`,
+        the row's own acceleration `acc` breaking ties."""
+        return consensus(self.s if s is None else s, t, self.tol, acc)
 
     def combination(self) -> str:
         """A sentence when the equation holds but mixes several rows, else ''."""
@@ -667,6 +857,19 @@ def _is_moment(label: str) -> bool:
 def _point(p: MomentPoint) -> str:
     where = ", ".join(_num(c) for c in (p.W_P if abs(p.W_P[2]) > 0 else p.W_P[:2]))
     return f"{p.name} ({where})"
+
+
+def _sources(sources: tuple[str, ...]) -> str:
+    """("joint O", "joint A", "driver motor") -> "joints O and A and driver motor"."""
+    kinds: dict[str, list[str]] = {}
+    for words in sources:
+        kind, _, name = words.partition(" ")
+        kinds.setdefault(kind, []).append(name)
+    parts = []
+    for kind, names in kinds.items():
+        listed = names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
+        parts.append(f"{kind}{'s' if len(names) > 1 else ''} {listed}")
+    return " and ".join(parts)
 
 
 def _load_words(x, euler: bool) -> str:

@@ -17,10 +17,13 @@ Each equation, with the model's numbers put in, is one linear row in the acceler
 (`mbody.answers.compare`), then with the course's mistakes, each a variant of a true
 row: a velocity-squared term left out (all of them, or one ``q'_i q'_j`` monomial), a
 potential's gradient with the wrong sign (gravity, a spring, or both), an inertial
-coupling term left out, absolute and relative angles mixed (the formulas of one kind of
-angle evaluated at the other kind's values), and a mass matrix that is not symmetric
-(a coupling coefficient that differs from its transpose in the answers' equation of the
-other coordinate).
+coupling term left out, a body's parallel-axis term left out of the generalized mass
+(I_G where I_P = I_G + m d² belongs), absolute and relative angles mixed (the formulas of
+one kind of angle evaluated at the other kind's values), and a mass matrix that is not
+symmetric (a coupling coefficient that differs from its transpose in the answers'
+equation of the other coordinate). An equation none of these explains is compared term by
+term with the closest row, as a Newton-Euler one is: a number rounded too coarsely is
+said so, else the terms that differ are named (`not_an_equation_of_this_model`).
 """
 
 from __future__ import annotations
@@ -32,12 +35,12 @@ from functools import cached_property
 import numpy as np
 
 from mbody import conventions as cv
-from mbody.answers.compare import CONST, Row, fit, matches
-from mbody.answers.diagnose import CORRECT, NOT_AN_EQUATION, Diagnosis
+from mbody.answers.compare import CONST, Row, consensus, fit, matches, rounded_off
+from mbody.answers.diagnose import CORRECT, ROUNDED_TOO_COARSELY, Diagnosis
 from mbody.answers.linear import NotLinear, linear_row
 from mbody.answers.load import Answer, Answers, AnswersError, hinted
 from mbody.answers.parse import EquationError, names_in, parse_equation
-from mbody.answers.text import num
+from mbody.answers.text import differences, num, rounding
 from mbody.answers.vocabulary import Vocabulary, name_gravity, newton_euler_bodies
 from mbody.equations.coordinates import CoordinateSet, columns, coordinate_set
 from mbody.equations.generalized import Generalized, evaluate, generalized
@@ -49,8 +52,10 @@ from mbody.solve.configure import configure
 MISSING_VELOCITY_TERM = "missing_velocity_term"
 POTENTIAL_GRADIENT_SIGN = "potential_gradient_sign"
 MISSING_COUPLING_TERM = "missing_coupling_term"
+MISSING_PARALLEL_AXIS_TERM = "missing_parallel_axis_term"
 ANGLES_MIXED = "absolute_relative_angles_mixed"
 MASS_MATRIX_NOT_SYMMETRIC = "mass_matrix_not_symmetric"
+NOT_AN_EQUATION_OF_THIS_MODEL = "not_an_equation_of_this_model"
 
 LAGRANGE_DIAGNOSES = {
     MISSING_VELOCITY_TERM: "a velocity-squared term (centripetal, Coriolis or gyroscopic) "
@@ -59,13 +64,22 @@ LAGRANGE_DIAGNOSES = {
                              "spring pulling the wrong way)",
     MISSING_COUPLING_TERM: "an inertial coupling term (another coordinate's acceleration) "
                            "left out",
+    MISSING_PARALLEL_AXIS_TERM: "a body's inertia about its mass centre where the inertia "
+                                "about the axis the coordinate turns it about belongs: the "
+                                "parallel-axis term m d² left out of the generalized mass",
     ANGLES_MIXED: "absolute and relative angles mixed: the formulas of one kind of angle "
                   "with the other kind's values",
     MASS_MATRIX_NOT_SYMMETRIC: "a coupling coefficient that differs from its transpose in "
                                "the equation of the other coordinate: the mass matrix is "
                                "not symmetric",
+    NOT_AN_EQUATION_OF_THIS_MODEL: "none of the above explains it (an equation in "
+                                   "generalized coordinates: the closest and the terms that "
+                                   "differ are named)",
 }
-"""The diagnoses of Lagrange equations, in the order they are tried (after `CORRECT`)."""
+"""The diagnoses of Lagrange equations, in the order they are tried (after `CORRECT`; a
+number rounded too coarsely, `mbody.answers.diagnose.ROUNDED_TOO_COARSELY`, before the
+last). An entry of no body that nothing explains is `NOT_AN_EQUATION_OF_THIS_MODEL`, the
+Newton-Euler label's twin."""
 
 
 @dataclass(frozen=True)
@@ -168,6 +182,30 @@ class _Truth:
                 share = c * qd[i] * qd[j]  # c is 2 C_ij off the diagonal: the whole term
                 if np.any(np.abs(share) > 1e-12 * np.maximum(self.g.f_scale, 1e-300)):
                     out.append((words, share))
+        return out
+
+    @cached_property
+    def parallel(self) -> list[list[tuple[str, float, float, float]]]:
+        """Per coordinate k, each body it turns and whose mass centre it moves: (name,
+        m, d, m |∂x_G/∂q_k|²), d the distance of G from the axis the coordinate turns
+        the body about (|∂x_G/∂q_k| / |∂θ/∂q_k|): the parallel-axis term of M_kk."""
+        model = self.model
+        cols = columns(model)
+        body, part = np.divmod(cols, 6)
+        T = self.g.T
+        out = []
+        for k in range(T.shape[1]):
+            size = max(1.0, float(np.abs(T[:, k]).max(initial=0.0)))
+            items = []
+            for i, name in enumerate(model.body_names):
+                moves = T[(body == i) & (part < 3), k]
+                turns = float(np.linalg.norm(T[(body == i) & (part >= 3), k]))
+                v2 = float(moves @ moves)
+                if turns <= 1e-9 * size or v2 <= (1e-9 * size) ** 2:
+                    continue  # a particle, a body the coordinate only slides or only turns
+                m = float(model.mass[i])
+                items.append((name, m, float(np.sqrt(v2)) / turns, m * v2))
+            out.append(items)
         return out
 
     @cached_property
@@ -287,6 +325,12 @@ def _explain(d: str, details: Mapping, rows: LagrangeRows, k: int) -> str:
                 "(relative, from the parent body), or the other way round: write every angle "
                 "in one convention (cos(θ2 − θ1) with absolute angles is cos(θ2) with a "
                 "relative θ2).")
+    if d == MISSING_PARALLEL_AXIS_TERM:
+        acc = f"{name}_ddot"
+        return (f"The coefficient of {acc} in your {name} equation lacks {details['words']}: "
+                f"the kinetic energy of a body that {name} turns is ½ I_G ω² + ½ m v_G², and "
+                f"with G at d from the axis it turns about, that is ½ (I_G + m d²) ω²: the "
+                f"inertia about the axis (the parallel-axis theorem), not about G.")
     if d == MASS_MATRIX_NOT_SYMMETRIC:
         return (f"Your coefficient of {details['other']}_ddot here ({details['here']}) "
                 f"differs from that of {name}_ddot in your {details['other']} equation "
@@ -301,7 +345,7 @@ def _diagnose(s: Row, truth: _Truth, tol: float, hint: int | None,
     order = ([hint] if hint is not None else []) + [k for k in range(len(rows)) if k != hint]
     accs = {truth.acc(j) for j in range(len(rows))}
     if not (s.unknowns & accs):
-        return NOT_AN_EQUATION, hint if hint is not None else 0, {
+        return NOT_AN_EQUATION_OF_THIS_MODEL, hint if hint is not None else 0, {
             "why": "This has no generalized acceleration: Lagrange's equation of a "
                    "coordinate holds d/dt(∂T/∂q'), which brings the accelerations."}
     for k in order:
@@ -334,6 +378,17 @@ def _diagnose(s: Row, truth: _Truth, tol: float, hint: int | None,
             if matches(s, variant, tol):
                 return MISSING_COUPLING_TERM, k, {
                     "coupling": ", ".join(f"{truth.names[j]}_ddot" for j in drop)}
+    for k in order:  # a body's parallel-axis term left out of the generalized mass
+        row, acc = rows[k], truth.acc(k)
+        items = truth.parallel[k]
+        for parts in [[x] for x in items] + ([items] if len(items) > 1 else []):
+            term = sum(x[3] for x in parts)
+            variant = row.with_term(acc, row.get(acc) - term, row.err(acc))
+            if matches(s, variant, tol):
+                words = " and ".join(f"{body}'s m d² = {num(m)}·{num(dist)}² = {num(md2)} "
+                                     "kg m²" for body, m, dist, md2 in parts)
+                return MISSING_PARALLEL_AXIS_TERM, k, {
+                    "bodies": [x[0] for x in parts], "term": float(term), "words": words}
     mixed = truth.mixed
     if mixed is not None:
         for k in order:
@@ -360,16 +415,45 @@ def _diagnose(s: Row, truth: _Truth, tol: float, hint: int | None,
                  and abs(s.get(truth.acc(j)) / f.k - rows[k].get(truth.acc(j)))
                  > tol * max(rows[k].err(truth.acc(j)), 1e-300)]
         if wrong:
-            return NOT_AN_EQUATION, k, {"why": f"Its coupling coefficient(s) of "
-                                        f"{', '.join(w + '_ddot' for w in wrong)} are not "
-                                        "those of the mass matrix."}
-    best, best_k = np.inf, order[0]
+            return NOT_AN_EQUATION_OF_THIS_MODEL, k, {
+                "why": f"Its coupling coefficient(s) of "
+                       f"{', '.join(w + '_ddot' for w in wrong)} are not those of the mass "
+                       "matrix."}
+    return _closest(s, truth, tol, order)
+
+
+def _closest(s: Row, truth: _Truth, tol: float, order: list[int]) -> tuple[str, int, dict]:
+    """The row the student's row is closest to, by the fewest terms that differ (the
+    coordinate's own acceleration breaking ties): a number rounded too coarsely when
+    every term is in place, else the terms that differ, as for a Newton-Euler row."""
+    rows = truth.rows.rows
+    best: tuple | None = None
     for k in order:
-        f = fit(s, rows[k])
-        if f is not None and f.error < best:
-            best, best_k = f.error, k
-    return NOT_AN_EQUATION, best_k, {"why": "It is none of the model's Lagrange equations, "
-                                            "nor one of the usual mistakes."}
+        f = consensus(s, rows[k], tol, truth.acc(k))
+        if f is None:
+            continue
+        wrong = f.wrong(tol)
+        key = (len(wrong), f.error)
+        if best is None or key < best[0]:
+            best = (key, k, f, wrong)
+    if best is None:
+        return NOT_AN_EQUATION_OF_THIS_MODEL, order[0], {
+            "why": "It shares no term with the model's Lagrange equations."}
+    _, k, f, wrong = best
+    name, t = truth.names[k], rows[k]
+    off = rounded_off(s, t, f, tol)
+    if off is not None:
+        return ROUNDED_TOO_COARSELY, k, {
+            "why": f"This is Lagrange's equation for {name}, with every term in place, but "
+                   + rounding(s, t, f, off, tol) + " (m_<body>, I_<body>, g...).",
+            "rounded": {key: {"have": s.get(key), "expected": f.times(t.get(key)),
+                              "relative": v} for key, v in off.items()}}
+    return NOT_AN_EQUATION_OF_THIS_MODEL, k, {
+        "why": "It is none of the model's Lagrange equations, nor one of the usual "
+               f"mistakes. Closest is the equation of {name}; with every term on the left "
+               "side, at your equation's scale: " + differences(s, t, f, wrong) + ".",
+        "differs": {key: {"have": s.get(key), "expected": f.times(t.get(key))}
+                    for key in wrong}}
 
 
 def _forgotten_body(model: Model, state: State, vocab: Vocabulary, eq: str,
@@ -468,7 +552,8 @@ def check_lagrange(model: Model, state: State, sheet: Answers, entries: list[Ans
             hint = names.index(a.coordinate) if a.coordinate in names else \
                 labels.index(a.coordinate)
         if row is None:
-            d = Diagnosis(NOT_AN_EQUATION, "", "", f"This is not linear in the accelerations: "
+            d = Diagnosis(NOT_AN_EQUATION_OF_THIS_MODEL, "", "",
+                          f"This is not linear in the accelerations: "
                           f"it has {why}. Lagrange's equations are linear in q''.",
                           {"not_linear": why})
             out.append((a, d, a.coordinate))

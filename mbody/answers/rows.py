@@ -5,7 +5,8 @@ written ``lhs − rhs = 0``: accelerations times M, plus b, minus Q, minus G λ 
 unknown reactions (a known reaction's value joins the constant). Beside the row are the
 pieces a mistake changes: each applied load's share of Q (gravity too), the gyroscopic
 part b, each reaction's coefficient; and the points a student may take moments about
-(the body's joint points, the world origin) with the rows that moments about them give.
+(the body's joint points, the world origin) with the rows that moments about them give;
+and what the joints say about the body's accelerations (`mbody.answers.kinematics`).
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ import numpy as np
 from mbody import conventions as cv
 from mbody import joint_types
 from mbody.answers.compare import CONST, Row
+from mbody.answers.kinematics import BodyKinematics, body_kinematics
 from mbody.answers.text import equation_text
 from mbody.answers.vocabulary import PLANAR_ACCELERATIONS, SPATIAL_ACCELERATIONS, joints_of
 from mbody.equations.assemble import Assembly
@@ -131,6 +133,8 @@ class BodyRows:
     joints : dict of str to tuple
         Unknown reaction label -> (joint name, +1 on the child / −1 on the parent,
         the other body).
+    kinematics : BodyKinematics or None
+        What the enforced joints say about the body's accelerations (None: nothing).
     """
 
     body: str
@@ -143,6 +147,7 @@ class BodyRows:
     omega: np.ndarray
     points: tuple[MomentPoint, ...]
     joints: dict[str, tuple[str, float, str]]
+    kinematics: BodyKinematics | None = None
 
     @property
     def newton(self) -> list[TrueRow]:
@@ -326,9 +331,11 @@ def body_rows(asm: Assembly, body: str) -> BodyRows:
     if np.linalg.norm(x) > 1e-12 and not any(np.allclose(origin, q) for q in seen):
         points.append(MomentPoint("the origin", origin, False))
     omega = np.asarray(asm.state.omega[i], dtype=float)
+    kinematics = body_kinematics(asm, body, tuple(r.label for r in rows),
+                                 tuple(r.acc for r in rows))
     return BodyRows(body, planar, tuple(rows), float(model.mass[i]),
                     np.asarray(fbd.inertia, dtype=float), np.asarray(fbd.W_R_B, dtype=float),
-                    x, omega, tuple(points), joints)
+                    x, omega, tuple(points), joints, kinematics)
 
 
 def _acc_name(planar: bool, euler: bool, axis: int) -> str:

@@ -6,8 +6,13 @@ frequent mistakes.
                                    # class.csv`` writes
 
 Every file is checked as `mbody.answers.verify.verify` checks one, against one assembly
-of the model (its rows made once for the class). A file that cannot be read is a row
-with its problem, never the end of the class.
+of the model (its rows made once for the class; once per variant, for answers that set
+their own values with ``set:``). An entry that cannot be read is that entry's problem:
+the file's other entries are checked, and the problem shown in the file's ``error``
+cell. A file that cannot be read at all is a row with its problem, never the end of the
+class. A file is all correct when every equation is right, every entry could be read,
+and the rows asked for (`mbody.answers.coverage`; by default every row of the model)
+are all given.
 """
 
 from __future__ import annotations
@@ -20,15 +25,25 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from mbody.answers.load import AnswersError
-from mbody.answers.verify import MEANINGS, TOLERANCE, Check, Verification, verify
-from mbody.equations.assemble import assemble
+from mbody.answers.coverage import ALL, requirement
+from mbody.answers.load import AnswersError, read_answers
+from mbody.answers.variant import variant
+from mbody.answers.verify import MEANINGS, TOLERANCE, Check, Verification, check, tolerance
+from mbody.equations.assemble import Assembly, assemble
 from mbody.model.model import Model
+from mbody.model.values import plain
 from mbody.util.formatting import spreadsheet_text
 
 HEADER = ("file", "student", "equations", "correct")
 """The first columns of a row; then one ``mistake <k>`` column per wrong equation (as many
-as the file with the most), then ``error`` (why a file could not be checked)."""
+as the file with the most), then `COVERAGE_HEADER`, then ``error`` (why a file, or some of
+its entries, could not be checked). The columns of the model-format contract come first,
+in its order; the later ones were added after it."""
+COVERAGE_HEADER = ("rows covered", "rows asked", "duplicates", "set")
+"""The rows asked for that a correct equation gave, the rows asked for, the correct
+equations that repeat a row, the values the file set."""
+VARIANTS_KEPT = 64
+"""Most variants of the model (answers' ``set:`` values) kept assembled at once."""
 MISTAKES_HEADER = ("mistake", "row", "equations", "students", "meaning")
 """The columns of the table of the class's mistakes."""
 
@@ -56,11 +71,51 @@ class Graded:
 
     @property
     def equations(self) -> int:
-        return len(self.verification.checks) if self.verification else 0
+        """How many equations the file gives (its entries, checked or not)."""
+        return self.verification.equations if self.verification else 0
 
     @property
     def correct(self) -> int:
         return self.verification.correct if self.verification else 0
+
+    @property
+    def covered(self) -> int:
+        """How many of the rows asked for a correct equation gave."""
+        return self.verification.covered if self.verification else 0
+
+    @property
+    def asked(self) -> int:
+        """How many rows were asked for (0 when the file could not be checked)."""
+        return self.verification.rows if self.verification else 0
+
+    @property
+    def duplicates(self) -> int:
+        """Correct equations that repeat a row an earlier one gave."""
+        return self.verification.duplicates if self.verification else 0
+
+    @property
+    def values(self) -> str:
+        """The values the file set (``set:``), as ``--set`` writes them."""
+        v = self.verification
+        return "; ".join(f"{p}={plain(x)}" for p, x in v.values) if v else ""
+
+    @property
+    def problems(self) -> str:
+        """Why the file, or some of its entries, could not be checked ('' when all was)."""
+        if self.error or self.verification is None:
+            return self.error
+        return "; ".join(str(i) for i in self.verification.errors)
+
+    @property
+    def all_correct(self) -> bool:
+        """Every equation right, every entry read, every row asked for given."""
+        return self.verification is not None and self.verification.all_correct
+
+    @property
+    def incomplete(self) -> bool:
+        """Every equation right and every entry read, but rows asked for missing."""
+        v = self.verification
+        return v is not None and v.ok and not v.complete
 
     @property
     def wrong(self) -> list[Check]:
@@ -96,10 +151,13 @@ class ClassSummary:
         The model's name.
     graded : tuple of Graded
         One per answers file.
+    required : str
+        What each file was asked for, in words (`mbody.answers.coverage`).
     """
 
     model: str
     graded: tuple[Graded, ...]
+    required: str = "every row of the model"
 
     @property
     def mistakes(self) -> list[Mistake]:
@@ -124,9 +182,10 @@ class ClassSummary:
         Returns
         -------
         list of str
-            `HEADER`, ``mistake 1`` ... (`width` of them), ``error``.
+            `HEADER`, ``mistake 1`` ... (`width` of them), `COVERAGE_HEADER`, ``error``.
         """
-        return [*HEADER, *(f"mistake {k + 1}" for k in range(self.width)), "error"]
+        return [*HEADER, *(f"mistake {k + 1}" for k in range(self.width)), *COVERAGE_HEADER,
+                "error"]
 
     def rows(self) -> list[list[str | int]]:
         """The files' table.
@@ -139,8 +198,9 @@ class ClassSummary:
         out: list[list[str | int]] = []
         for g in self.graded:
             cells = [mistake_text(c) for c in g.wrong]
-            out.append([g.file, g.student, g.equations, g.correct,
-                        *cells, *([""] * (self.width - len(cells))), g.error])
+            out.append([g.file, g.student, g.equations, g.correct, *cells,
+                        *([""] * (self.width - len(cells))), g.covered, g.asked,
+                        g.duplicates, g.values, g.problems])
         return out
 
     def csv(self) -> str:
@@ -171,16 +231,25 @@ class ClassSummary:
         Returns
         -------
         str
-            The class's counts and its five most frequent mistakes.
+            The class's counts (files all correct, incomplete, partly or not read;
+            equations; rows asked for and given) and its five most frequent mistakes.
         """
         n = len(self.graded)
-        ok = sum(1 for g in self.graded if g.verification and g.verification.ok)
-        bad = sum(1 for g in self.graded if g.error)
+        ok = sum(1 for g in self.graded if g.all_correct)
+        short = sum(1 for g in self.graded if g.incomplete)
+        partly = sum(1 for g in self.graded if g.verification and g.verification.errors)
+        bad = sum(1 for g in self.graded if g.verification is None)
         eqs = sum(g.equations for g in self.graded)
         right = sum(g.correct for g in self.graded)
         lines = [f"{n} answers file(s) for model '{self.model}': {ok} all correct"
+                 + (f", {short} incomplete (every equation right, rows missing)"
+                    if short else "")
+                 + (f", {partly} with entries that could not be read" if partly else "")
                  + (f", {bad} could not be checked" if bad else "")
-                 + f"; {right} of {eqs} equations correct"]
+                 + f"; {right} of {eqs} equations correct",
+                 f"rows asked for: {self.required}; "
+                 f"{sum(g.covered for g in self.graded)} of "
+                 f"{sum(g.asked for g in self.graded)} given"]
         top = self.mistakes[:5]
         if top:
             lines.append("most frequent mistakes:")
@@ -195,7 +264,8 @@ def _as_text(row: list[str | int]) -> list[str | int]:
 
 
 def grade(model: Model, files: Sequence[str | os.PathLike[str]], *,
-          tol: float = TOLERANCE) -> ClassSummary:
+          tol: float = TOLERANCE, require: str | Sequence[str] | None = ALL
+          ) -> ClassSummary:
     """Check every answers file against `model` (module doc).
 
     Parameters
@@ -206,19 +276,39 @@ def grade(model: Model, files: Sequence[str | os.PathLike[str]], *,
         The answers files.
     tol : float
         Relative tolerance on each coefficient (as `verify`'s).
+    require : str or sequence of str, optional
+        The rows each file is asked to give (`mbody.answers.coverage`): default
+        ``"all"``, every row of the model (or every Lagrange equation, for a file in
+        generalized coordinates); None: the rows of the bodies each file answers.
 
     Returns
     -------
     ClassSummary
+
+    Raises
+    ------
+    MbodyError
+        `tol` outside (0, 1), or `require` naming nothing in the model (a file's own
+        problem never raises: it is that file's row).
     """
-    asm = assemble(model)
+    tol = tolerance(tol)
+    wanted = requirement(model, require)
+    variants: dict[tuple, tuple[Model, Assembly]] = {}
     graded = []
     for f in files:
         stem = Path(f).stem
         try:
-            v = verify(model, f, tol=tol, asm=asm)
+            sheet = read_answers(f, partial=True)
+            key = tuple((s.path, repr(plain(s.value))) for s in sheet.settings)
+            if key not in variants:
+                if len(variants) >= VARIANTS_KEPT:
+                    variants.pop(next(iter(variants)))
+                changed = variant(model, sheet)
+                variants[key] = (changed, assemble(changed))
+            changed, asm = variants[key]
+            v = check(changed, sheet, tol=tol, asm=asm, require=wanted, partial=True)
         except AnswersError as exc:
             graded.append(Graded(str(f), stem, None, " ".join(str(exc).split())))
             continue
         graded.append(Graded(str(f), v.student or stem, v))
-    return ClassSummary(model.name, tuple(graded))
+    return ClassSummary(model.name, tuple(graded), wanted.describe())

@@ -10,8 +10,9 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
-from mbody.answers.compare import CONST, Row
+from mbody.answers.compare import CONST, Fit, Row
 from mbody.equations.fbd import Equation
+from mbody.util import formatting
 
 
 def num(x: float, ref: float = 1.0) -> str:
@@ -29,10 +30,7 @@ def num(x: float, ref: float = 1.0) -> str:
     -------
     str
     """
-    x = float(x)
-    x = 0.0 if abs(x) < 1e-12 * ref else x
-    s = f"{x:.6g}"
-    return "0" if s in ("-0", "0") else s
+    return formatting.num(float(x), formatting.NOISE * ref)
 
 
 def terms(coef: Mapping[str, float]) -> str:
@@ -106,3 +104,57 @@ def row_text(row: Row) -> str:
     right = _join(num(-row.get(CONST)), terms({k: -v for k, v in row.coef.items()
                                                 if "." in k}))
     return f"{left} = {right}"
+
+
+def differences(s: Row, t: Row, f: Fit, wrong: list[str], shown: int = 3) -> str:
+    """The terms in which the student's row `s` differs from ``k·t`` (the fit `f`), at
+    the student's scale: "the constant has -80 where -40 is expected; O.Fy is missing
+    (expected 1.29904), and 2 more".
+
+    Parameters
+    ----------
+    s, t : Row
+        The student's row and the row it is compared with.
+    f : Fit
+        Their fit (`mbody.answers.compare.consensus`).
+    wrong : list of str
+        The keys that differ, worst first.
+    shown : int
+        How many are written out.
+
+    Returns
+    -------
+    str
+    """
+    parts = []
+    # numbers at the student's scale: noise only against the row's own magnitude
+    ref = min(1.0, max((abs(v) for v in s.coef.values()), default=1.0))
+    for key in wrong[:shown]:
+        have, want = s.get(key), f.times(t.get(key))
+        name = "the constant" if key == CONST else key
+        if have == 0.0:
+            parts.append(f"{name} is missing (expected {num(want, ref)})")
+        elif want == 0.0:
+            parts.append(f"{name} does not belong here (you have {num(have, ref)})")
+        else:
+            parts.append(f"{name} has {num(have, ref)} where {num(want, ref)} is expected")
+    more = f", and {len(wrong) - shown} more" if len(wrong) > shown else ""
+    return "; ".join(parts) + more
+
+
+def percent(x: float) -> str:
+    """0.00698 -> '0.7 %'."""
+    return f"{100.0 * x:.2g} %"
+
+
+def rounding(s: Row, t: Row, f: Fit, off: Mapping[str, float], tol: float) -> str:
+    """"O.Fx has 0.43 where 0.433013 is expected (0.7 % off): a number rounded too
+    coarsely? ..." for the keys of `off` (`mbody.answers.compare.rounded_off`)."""
+    ref = min(1.0, max((abs(v) for v in s.coef.values()), default=1.0))
+    parts = [f"{'the constant' if k == CONST else k} has {num(s.get(k), ref)} where "
+             f"{num(f.times(t.get(k)), ref)} is expected ({percent(off[k])} off)"
+             for k in sorted(off, key=lambda k: -off[k])[:3]]
+    more = f", and {len(off) - 3} more" if len(off) > 3 else ""
+    return ("; ".join(parts) + more + ": a number rounded too coarsely? Each coefficient "
+            f"must match to {percent(tol)}; write numbers to about four significant "
+            "figures, or use the model's names for them")

@@ -11,15 +11,16 @@ from __future__ import annotations
 
 import os
 import textwrap
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from mbody.answers.compare import Row
+from mbody.answers.coverage import Asked, Requirement, requirement
 from mbody.answers.diagnose import CORRECT, DIAGNOSES, NOT_AN_EQUATION, Diagnosis, diagnose
-from mbody.answers.lagrange import LAGRANGE_DIAGNOSES, check_lagrange
+from mbody.answers.lagrange import LAGRANGE_DIAGNOSES, check_lagrange, coordinate_names
 from mbody.answers.linear import NotLinear, linear_row
 from mbody.answers.load import (
     Answer,
@@ -31,6 +32,7 @@ from mbody.answers.load import (
 )
 from mbody.answers.parse import EquationError, parse_equation
 from mbody.answers.rows import BodyRows, body_rows
+from mbody.answers.variant import variant
 from mbody.answers.vocabulary import Vocabulary, vocabulary
 from mbody.equations.assemble import Assembly, assemble
 from mbody.errors import Issue, MbodyError, did_you_mean, real_number, wrong_type
@@ -60,7 +62,8 @@ class Check:
     line : int
         Its line in the answers file (0 when not from a file).
     diagnosis : str
-        One of `mbody.answers.diagnose.DIAGNOSES`.
+        A key of `MEANINGS`: one of `mbody.answers.diagnose.DIAGNOSES`, or of
+        `mbody.answers.lagrange.LAGRANGE_DIAGNOSES` for an equation of no body.
     expected : str
         The row it was compared with, as text ('' when none is close).
     row : str
@@ -89,7 +92,8 @@ class Check:
     @property
     def meaning(self) -> str:
         """What the diagnosis means here: its `MEANINGS` entry, or, for an equation that
-        is not linear in the unknowns (``not_an_equation_of_this_body`` with
+        is not linear in the unknowns (``not_an_equation_of_this_body``, or
+        ``not_an_equation_of_this_model`` for one of no body, with
         ``details["not_linear"]``), that and the term: "not linear in the unknowns (a_x
         squared)"."""
         why = self.details.get("not_linear")
@@ -149,9 +153,21 @@ class Verification:
     checks : tuple of Check
         One per equation, in file order.
     uncovered : tuple of Uncovered
-        Rows of the bodies that have answers, not given by any correct equation.
+        Rows asked for (by default those of the bodies that have answers) that no correct
+        equation gave.
     rows : int
-        How many rows those bodies have.
+        How many rows are asked for.
+    required : str
+        What was asked for, in words ('' for the rows of the bodies answered:
+        `mbody.answers.coverage`).
+    errors : tuple of Issue
+        The problems of the entries that could not be checked (and of the file's other
+        keys), each located; only when checked with ``partial=True`` (otherwise they are
+        raised).
+    entries : int
+        How many equations the answers give, checked or not (0: as `checks`).
+    values : tuple of (str, object)
+        The values the answers set on the model (``set:``), path and value.
     """
 
     model: str
@@ -162,16 +178,46 @@ class Verification:
     checks: tuple[Check, ...]
     uncovered: tuple[Uncovered, ...]
     rows: int
+    required: str = ""
+    errors: tuple[Issue, ...] = ()
+    entries: int = 0
+    values: tuple[tuple[str, Any], ...] = ()
 
     @property
     def ok(self) -> bool:
-        """Whether every equation is correct."""
-        return all(c.correct for c in self.checks)
+        """Whether every equation is correct (and every entry could be checked)."""
+        return all(c.correct for c in self.checks) and not self.errors
 
     @property
     def correct(self) -> int:
         """How many equations are correct."""
         return sum(c.correct for c in self.checks)
+
+    @property
+    def equations(self) -> int:
+        """How many equations the answers give: the checked ones and those that could
+        not be read."""
+        return max(self.entries, len(self.checks))
+
+    @property
+    def duplicates(self) -> int:
+        """How many correct equations give a row that an earlier correct one gave."""
+        return len(_repeats(self.checks))
+
+    @property
+    def covered(self) -> int:
+        """How many of the rows asked for a correct equation gave."""
+        return self.rows - len(self.uncovered)
+
+    @property
+    def complete(self) -> bool:
+        """Whether every row asked for was given by a correct equation."""
+        return not self.uncovered
+
+    @property
+    def all_correct(self) -> bool:
+        """Every equation correct, every entry checked and every row asked for given."""
+        return self.ok and self.complete
 
     def to_dict(self) -> dict[str, Any]:
         """What ``mbody verify --json`` prints.
@@ -184,11 +230,17 @@ class Verification:
         """
         return {"model": self.model, "model_file": self.model_file,
                 "answers": self.answers_file, "student": self.student, "tol": self.tol,
+                "set": {path: _plain(value) for path, value in self.values},
                 "equations": [c.to_dict() for c in self.checks],
+                "errors": [{"line": i.line, "column": i.column, "key": i.key,
+                            "message": i.message, "hint": i.hint, "text": str(i)}
+                           for i in self.errors],
                 "uncovered": [{"body": u.body, "row": u.row, "expected": u.expected}
                               for u in self.uncovered],
-                "summary": {"equations": len(self.checks), "correct": self.correct,
-                            "rows": self.rows, "uncovered": len(self.uncovered)}}
+                "summary": {"equations": self.equations, "correct": self.correct,
+                            "rows": self.rows, "uncovered": len(self.uncovered),
+                            "duplicates": self.duplicates,
+                            "required": self.required or "answered"}}
 
     def text(self, width: int = 88) -> str:
         """The report `mbody verify` prints: a paragraph per equation, then the rows
@@ -205,7 +257,9 @@ class Verification:
             The report (no final newline).
         """
         where = f" ({self.model_file})" if self.model_file else ""
-        out = [f"model '{self.model}'{where}; answers {self.answers_file}"
+        values = ", ".join(f"{p}={v}" for p, v in self.values)
+        out = [f"model '{self.model}'{where}" + (f" with {values}" if values else "")
+               + f"; answers {self.answers_file}"
                + (f" by {self.student}" if self.student else "")
                + f"; tolerance {self.tol:g} on each coefficient", ""]
         wrap = textwrap.TextWrapper(width=width, initial_indent="    ",
@@ -218,13 +272,25 @@ class Verification:
                 out.append(f"    expected ({c.row}): {c.expected}")
             out.extend(wrap.wrap(c.explanation))
             out.append("")
+        if self.errors:
+            unread = self.equations - len(self.checks)
+            out.append("problems in the answers" + (f" ({unread} equation"
+                       f"{'s' if unread != 1 else ''} not checked)" if unread else "") + ":")
+            out += [f"    {i}" for i in self.errors]
+            out.append("")
+        again = _repeats(self.checks)
+        if again:
+            out.append("equations that repeat a row an earlier correct equation gave:")
+            out += [f"    [{c.index}] {c.row} (as [{first}])" for c, first in again]
+            out.append("")
         if self.uncovered:
-            out.append("rows no correct equation gave:")
+            out.append("rows no correct equation gave"
+                       + (f" ({self.required})" if self.required else "") + ":")
             out += [f"    {u.row}: {u.expected}" for u in self.uncovered]
             out.append("")
-        n = len(self.checks)
+        n = self.equations
         out.append(f"{self.correct} of {n} equation{'s' if n != 1 else ''} correct; "
-                   f"{self.rows - len(self.uncovered)} of {self.rows} rows covered.")
+                   f"{self.covered} of {self.rows} rows covered.")
         return "\n".join(out)
 
     def __str__(self) -> str:
@@ -268,8 +334,24 @@ def check_assembly_of(model: Model, asm: object) -> None:
                          f"({', '.join(differ)} differ from the model's); {fix}")
 
 
+def tolerance(tol: Any) -> float:
+    """`tol` checked: a relative tolerance, a number strictly between 0 and 1.
+
+    Raises
+    ------
+    MbodyError
+        Outside (0, 1) (`mbody.errors.MbodyTypeError` for what is not a number).
+    """
+    tol = real_number(tol, "tol", "a relative tolerance, a number between 0 and 1")
+    if not (tol > 0.0 and tol < 1.0):
+        raise MbodyError(f"the tolerance must be between 0 and 1 (relative), got {tol!r}")
+    return tol
+
+
 def verify(model: Model | str | os.PathLike[str], answers: Any, *, tol: float = TOLERANCE,
-           state: State | None = None, asm: Assembly | None = None) -> Verification:
+           state: State | None = None, asm: Assembly | None = None,
+           require: str | Sequence[str] | None = None,
+           partial: bool = False) -> Verification:
     """Check a student's equations against each body's Newton-Euler pair.
 
     Parameters
@@ -278,15 +360,24 @@ def verify(model: Model | str | os.PathLike[str], answers: Any, *, tol: float = 
         The model, or its file.
     answers : Answers, str, path-like, mapping or sequence
         An answers file's path, `Answers`, or the same as data: ``{"equations": [{"body":
-        "rod", "eq": "2*a_y = O.Fy - 19.62"}, ...]}`` or the list itself.
+        "rod", "eq": "2*a_y = O.Fy - 19.62"}, ...]}`` or the list itself. Values the
+        answers set (``set: {bodies.rod.mass: 2.5}``) are set on the model first
+        (`mbody.answers.variant`).
     tol : float
         Relative tolerance on each coefficient (numbers written by a student are
         rounded); default 1e-3.
     state : State, optional
-        The state the equations are written at (default: the model's initial state).
+        The state the equations are written at (default: the model's initial state,
+        with the answers' values).
     asm : Assembly, optional
         The model's assembly at that state, when already made (an assembly of another
         model, or of this one with other masses, inertias or gravity, is refused).
+    require : str or sequence of str, optional
+        The rows the answers are asked to give (`mbody.answers.coverage`): ``"all"``,
+        a body's name, a row's label...; default: the rows of the bodies answered.
+    partial : bool
+        Check the entries that can be read and list the problems of the others in
+        `Verification.errors`, instead of raising them (what a class's summary does).
 
     Returns
     -------
@@ -297,26 +388,75 @@ def verify(model: Model | str | os.PathLike[str], answers: Any, *, tol: float = 
     ------
     AnswersError
         The answers are invalid: an unknown body or name (with a did-you-mean), an
-        equation that cannot be read (with its column); every problem at once.
+        equation that cannot be read (with its column), a key that is not an answers
+        file's, a value ``set:`` that the model file could not hold; every problem at
+        once. With `partial`, only a file that is no answers file, or whose ``set:``
+        cannot be applied.
     MbodyError
-        `tol` outside (0, 1), or `asm` of another model
-        (`mbody.errors.MbodyTypeError`, a `TypeError` too, for a `tol` that is not a
-        number or an `asm` that is not an `Assembly`).
+        `tol` outside (0, 1), `require` naming nothing in the model, or `asm` of another
+        model (`mbody.errors.MbodyTypeError`, a `TypeError` too, for a `tol` that is not
+        a number or an `asm` that is not an `Assembly`).
     """
-    tol = real_number(tol, "tol", "a relative tolerance, a number between 0 and 1")
-    if not (tol > 0.0 and tol < 1.0):
-        raise MbodyError(f"the tolerance must be between 0 and 1 (relative), got {tol!r}")
+    tol = tolerance(tol)
     if isinstance(model, str | os.PathLike):
         model = load(model)
     sheet = _answers(answers)
+    wanted = requirement(model, require)
+    problems: list[Issue] = []
+    try:
+        model = variant(model, sheet)
+    except AnswersError as exc:
+        if partial:  # every number depends on them: the file cannot be checked
+            raise
+        problems = list(exc.issues)  # reported with the equations' problems
+        asm = None
     if asm is None:
         asm = assemble(model, state)
     else:
         check_assembly_of(model, asm)
+    return check(model, sheet, tol=tol, asm=asm, require=wanted, partial=partial,
+                 problems=problems)
+
+
+def check(model: Model, sheet: Answers, *, tol: float, asm: Assembly,
+          require: Requirement, partial: bool = False,
+          problems: Sequence[Issue] = ()) -> Verification:
+    """`verify`'s work once the answers are read, their values set on `model` and the
+    model assembled: what a class's summary calls for each file, with each variant's
+    assembly made once.
+
+    Parameters
+    ----------
+    model : Model
+        The model with the answers' values (`mbody.answers.variant.variant`).
+    sheet : Answers
+        The answers (read with ``partial=True``: their problems are reported with the
+        equations').
+    tol : float
+        Relative tolerance on each coefficient, in (0, 1).
+    asm : Assembly
+        `model`'s assembly at the state the answers are for.
+    require : Requirement
+        The rows asked for (`mbody.answers.coverage.requirement`).
+    partial : bool
+        As `verify`'s.
+    problems : sequence of Issue
+        Further problems found before (the answers' ``set:``).
+
+    Returns
+    -------
+    Verification
+
+    Raises
+    ------
+    AnswersError
+        Without `partial`: every problem of the answers, structure and equations, in
+        the file's order.
+    """
     state = asm.state
     vocab: dict[str, Vocabulary] = {}
     rows: dict[str, BodyRows] = {}
-    issues: list[Issue] = []
+    issues: list[Issue] = [*sheet.problems, *(p for p in problems if p not in sheet.problems)]
     parsed: list[tuple[Answer, Row | None, NotLinear | None]] = []
     lagrange = [a for a in sheet.equations if a.lagrange]
     for a in sheet.equations:
@@ -339,8 +479,12 @@ def verify(model: Model | str | os.PathLike[str], answers: Any, *, tol: float = 
             issues.append(sheet.issue(a, exc.reason, position=exc.position, hint=exc.hint))
         except NotLinear as exc:
             parsed.append((a, None, exc))
-    if issues:
-        raise AnswersError(issues)
+    lagrange_result = None
+    if lagrange:
+        lagrange_result, lost = _lagrange(model, state, sheet, lagrange, tol, partial)
+        issues += lost
+    if issues and not partial:
+        raise AnswersError(_in_file_order(issues))
 
     solved: list[Mapping[str, float] | None] = []
 
@@ -365,28 +509,93 @@ def verify(model: Model | str | os.PathLike[str], answers: Any, *, tol: float = 
                                                                  reactions))
         checks.append(Check(a.index, a.body, a.eq, a.line, d.diagnosis, d.expected, d.row,
                             d.explanation, d.details))
-    covered = {c.row for c in checks if c.correct}
-    uncovered = [Uncovered(b, r.label, r.text) for b, br in rows.items()
-                 for r in br.rows if r.label not in covered]
-    n_rows = sum(len(br.rows) for br in rows.values())
-    if lagrange:
-        verdicts, missing, n = check_lagrange(model, state, sheet, lagrange, tol)
-        checks += [Check(a.index, name, a.eq, a.line, d.diagnosis, d.expected, d.row,
-                         d.explanation, d.details) for a, d, name in verdicts]
-        checks.sort(key=lambda c: c.index)
-        uncovered += [Uncovered(name, name, text) for name, text in missing]
-        n_rows += n
+    covered = {(False, c.row) for c in checks if c.correct}
+    missing: list[tuple[str, str]] = []
+    if lagrange_result is not None:
+        verdicts, missing, _ = lagrange_result
+        more = [Check(a.index, name, a.eq, a.line, d.diagnosis, d.expected, d.row,
+                      d.explanation, d.details) for a, d, name in verdicts]
+        covered |= {(True, c.row) for c in more if c.correct}
+        checks = sorted([*checks, *more], key=lambda c: c.index)
+
+    def generalized() -> list[Asked]:
+        """Every Lagrange equation: from the check when the answers have some."""
+        names, labels = coordinate_names(model, sheet)
+        if lagrange_result is None:
+            try:
+                _, left, _ = check_lagrange(model, state, sheet, [], tol)
+            except AnswersError:
+                if partial:  # the answers' coordinates, reported with their entries
+                    return []
+                raise
+        else:
+            left = missing
+        text = dict(left)
+        text.update((c.body, c.expected) for c in checks
+                    if c.correct and (True, c.row) in covered and c.body in names)
+        return [Asked(n, lab, text.get(n, ""), True) for n, lab in zip(names, labels,
+                                                                          strict=True)]
+
+    asked = require.rows(asm, sheet, generalized)
+    uncovered = [Uncovered(r.body, r.body if r.lagrange else r.label, r.text) for r in asked
+                 if (r.lagrange, r.label) not in covered]
     return Verification(model.name, model.file or "", sheet.file, sheet.student, tol,
-                        tuple(checks), tuple(uncovered), n_rows)
+                        tuple(checks), tuple(uncovered), len(asked),
+                        "" if require.answered else require.describe(),
+                        tuple(_in_file_order(issues)), sheet.given,
+                        tuple((s.path, s.value) for s in sheet.settings))
+
+
+def _lagrange(model: Model, state: State, sheet: Answers, entries: list[Answer], tol: float,
+              partial: bool) -> tuple[Any, list[Issue]]:
+    """`check_lagrange` of `entries`, and the problems found; with `partial`, the entries
+    that cannot be read are left out and the others checked (None when none can be)."""
+    try:
+        return check_lagrange(model, state, sheet, entries, tol), []
+    except AnswersError as exc:
+        if not partial:
+            return None, list(exc.issues)
+        lost = list(exc.issues)
+    bad = {i.key for i in lost}
+    rest = [a for a in entries if a.key not in bad]
+    if not rest or len(rest) == len(entries):  # the coordinates themselves: no entry read
+        return None, lost
+    try:
+        return check_lagrange(model, state, sheet, rest, tol), lost
+    except AnswersError as exc:
+        return None, [*lost, *exc.issues]
+
+
+def _in_file_order(issues: Sequence[Issue]) -> list[Issue]:
+    """Issues by line and column (those without a line, such as answers given as data,
+    in the order found, after the others)."""
+    return sorted(issues, key=lambda i: (i.line == 0, i.line, i.column))
+
+
+def _repeats(checks: Sequence[Check]) -> list[tuple[Check, int]]:
+    """Each correct equation that gives a row an earlier correct one gave, with the
+    earlier one's index."""
+    first: dict[tuple[str, str], int] = {}
+    out = []
+    for c in checks:
+        if not c.correct:
+            continue
+        key = (c.body, c.row)
+        if key in first:
+            out.append((c, first[key]))
+        else:
+            first[key] = c.index
+    return out
 
 
 def _answers(answers: Any) -> Answers:
+    """The answers, read partially: their problems are reported with the equations'."""
     if isinstance(answers, Answers):
         return answers
     if isinstance(answers, str | os.PathLike):
-        return read_answers(answers)
+        return read_answers(answers, partial=True)
     if isinstance(answers, Mapping | list | tuple):
-        return answers_from_data(answers)
+        return answers_from_data(answers, partial=True)
     raise AnswersError([Issue("<answers>", 0, 0, "", f"expected an answers file or a list "
                               f"of {{body, eq}} entries, got {type(answers).__name__}")])
 

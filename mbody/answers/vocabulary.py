@@ -31,9 +31,8 @@ import numpy as np
 
 from mbody import conventions as cv
 from mbody.equations.symbolic import load_symbols
-from mbody.errors import did_you_mean
+from mbody.errors import did_you_mean, name_list
 from mbody.model.model import Model, State
-from mbody.model.reprs import name_list
 
 PLANAR_ACCELERATIONS = ("a_x", "a_y", "alpha")
 SPATIAL_ACCELERATIONS = ("a_x", "a_y", "a_z", "alpha_1", "alpha_2", "alpha_3")

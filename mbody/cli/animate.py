@@ -17,11 +17,11 @@ from mbody.cli.common import (
     number,
     output_stream,
     output_suffix,
-    refuse_overwriting_inputs,
     regular_file,
 )
 from mbody.cli.sim import T_END_MAX, T_END_MIN
 from mbody.errors import MbodyError
+from mbody.util.atomic import refuse_overwriting_inputs
 
 T_END, FPS = 10.0, 60.0
 """`mbody.simulate`'s defaults, which a MODEL is simulated with (tests keep them equal;

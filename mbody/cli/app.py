@@ -38,7 +38,6 @@ from mbody.cli.common import (
     PICTURE_FORMATS,
     add_import_options,
     byte_size,
-    refuse_overwriting_inputs,
 )
 from mbody.cli.near_miss import options_hint, unknown_options, unrecognized_message
 from mbody.errors import (
@@ -48,8 +47,8 @@ from mbody.errors import (
     did_you_mean,
     options_named,
 )
-from mbody.model.loader import MAX_BYTES, max_bytes_limit
-from mbody.util.npzfile import DATA_BYTES, data_bytes_limit
+from mbody.util.atomic import refuse_overwriting_inputs
+from mbody.util.budget import DATA_BYTES, MAX_BYTES, byte_budget
 
 COMMAND_MODULES = (core, export, sim, drive, draw, animate, mechanism, statics, verify,
                    interop, lagrange, sweep)
@@ -97,7 +96,7 @@ INPUTS = {"model": "the model", "source": "the input", "trajectory": "the run fi
           "answers": "the answers file", "state": "the run file"}
 """Argument destinations that name a file a command reads, and how a message calls it."""
 OUTPUTS = {"output": "-o", "latex": "--latex", "csv": "--csv", "summary": "--summary",
-           "picture": "--picture"}
+           "picture": "--picture", "answers_key": "--answers-key"}
 """Argument destinations that name a file (or folder) a command writes, and its option."""
 
 
@@ -105,6 +104,22 @@ def _options(command: argparse.ArgumentParser, dest: str) -> list[str]:
     """The option strings (or metavar, for a positional) of `command`'s `dest`."""
     return [a.option_strings[0] if a.option_strings else str(a.metavar)
             for a in command._actions if a.dest == dest]
+
+
+def option_flags(command: argparse.ArgumentParser | None,
+                 args: argparse.Namespace) -> dict[str, str]:
+    """What messages call an argument within `command` (`mbody.errors.options_named`):
+    each of its options by destination, by its long name (``t_end`` -> ``--t-end``,
+    ``known`` -> ``--known``); the Python keywords that are not the destination of their
+    option (``args.keywords``, from the command's ``set_defaults``: sweep's ``values`` is
+    ``--set``); and those of an imported model (`IMPORT_FLAGS`: ``joint_positions`` is
+    ``--q``)."""
+    flags: dict[str, str] = {}
+    for action in command._actions if command is not None else ():
+        names = action.option_strings
+        if names and action.dest != "help":
+            flags[action.dest] = next((n for n in names if n.startswith("--")), names[0])
+    return {**flags, **getattr(args, "keywords", {}), **IMPORT_FLAGS}
 
 
 def _commands(parser: argparse.ArgumentParser) -> dict[str, argparse.ArgumentParser]:
@@ -128,8 +143,10 @@ def check_paths(args: argparse.Namespace,
                 command: argparse.ArgumentParser | None = None) -> None:
     """Refuse an empty file name (an output '' would be no output, or the current folder;
     an input '' the current folder), then an output of the command that is one of its
-    input files, unless --force (`mbody.cli.common.refuse_overwriting_inputs`). An output
-    is named by `command`'s own first option for it (sweep's ``--out``), else OUTPUTS'."""
+    input files, unless --force (`mbody.util.atomic.refuse_overwriting_inputs`). An output
+    is named by `command`'s own first option for it (sweep's ``--out``), else OUTPUTS'.
+    A command's ``output_suffixes`` and ``output_resumed`` defaults say where --force
+    cannot help."""
     for dest, what in (*OUTPUTS.items(), *INPUTS.items()):
         values = getattr(args, dest, None)
         if "" in (values if isinstance(values, list) else [values]):
@@ -143,7 +160,8 @@ def check_paths(args: argparse.Namespace,
     folders = {a.option_strings[0] for a in (command._actions if command is not None else ())
                if a.dest in OUTPUTS and a.option_strings and a.metavar == "DIR"}
     refuse_overwriting_inputs(outputs, inputs, getattr(args, "force", False), folders,
-                              getattr(args, "output_suffixes", None))
+                              getattr(args, "output_suffixes", None),
+                              getattr(args, "output_resumed", ()))
 
 
 class _Parser(argparse.ArgumentParser):
@@ -215,9 +233,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     out = _Stdout(sys.stdout)
     sys.stdout = out
     try:
-        check_paths(args, _subcommand(parser, args))
+        command = _subcommand(parser, args)
+        check_paths(args, command)
         limit = getattr(args, "max_bytes", None)
-        with max_bytes_limit(limit), data_bytes_limit(limit), options_named(IMPORT_FLAGS):
+        with byte_budget(limit), options_named(option_flags(command, args)):
             code = args.run(args)
         out.flush()  # a full device is reported here, not at exit
         return code

@@ -11,12 +11,13 @@ import argparse
 import functools
 import math
 import re
-from collections.abc import Callable, Container, Iterable, Mapping, Sequence
+from collections.abc import Callable, Sequence
 from contextvars import ContextVar
 from pathlib import Path
 from typing import Any, TextIO
 
 from mbody.errors import MbodyError, given_twice
+from mbody.util.formatting import number
 
 EXIT_OK, EXIT_UNMET, EXIT_INPUT, EXIT_INTERNAL = 0, 1, 2, 70
 
@@ -67,15 +68,6 @@ def byte_size(text: str) -> int:
     return size
 
 
-def number(x: float) -> str:
-    """`x` as %g writes it, with exponents as people write them (1e9, 2.5e-13); an int
-    below 10^12 in full, its thousands apart (10 000 000)."""
-    if isinstance(x, int) and abs(x) < 10**12:
-        return f"{x:,}".replace(",", " ")
-    x = float(x)
-    return re.sub(r"e\+?(-?)0*(\d)", r"e\1\2", f"{x:g}")
-
-
 def bounded(what: str, lo: float, hi: float, *, integer: bool = False,
             lo_open: bool = False, zero: str | None = None) -> Callable[[str], float]:
     """An argparse type: `what` (``"a number of seconds"``), from `lo` to `hi` (`lo`
@@ -111,11 +103,11 @@ TURNS_MAX = 1e6
 """Most turns an end time may be given in (``--t-end '1e6 rev'``)."""
 
 
-def seconds_or_turns(lo: float, hi: float, *, lo_open: bool = False
-                     ) -> Callable[[str], tuple[str, float]]:
+def seconds_or_turns(lo: float, hi: float, *, lo_open: bool = False,
+                     turns_max: float = TURNS_MAX) -> Callable[[str], tuple[str, float]]:
     """An argparse type for an end time (``--t-end`` of kinematics and sweep): seconds
     from `lo` to `hi` (as `bounded`), or turns of the mechanism's turning driver written
-    ``'1 rev'`` (also ``revs``, ``revolution(s)``), above 0 up to `TURNS_MAX`. Gives
+    ``'1 rev'`` (also ``revs``, ``revolution(s)``), above 0 up to `turns_max`. Gives
     ``("s", seconds)`` or ``("rev", turns)``; each command says which driver's turn."""
     seconds = bounded("a time in seconds", lo, hi, lo_open=lo_open)
 
@@ -123,9 +115,9 @@ def seconds_or_turns(lo: float, hi: float, *, lo_open: bool = False
         m = _TURNS.fullmatch(text)
         if m:
             x = float(m.group(1))
-            if not 0 < x <= TURNS_MAX:
+            if not 0 < x <= turns_max:
                 raise argparse.ArgumentTypeError(
-                    f"expected a number of turns above 0 up to {number(TURNS_MAX)}, got "
+                    f"expected a number of turns above 0 up to {number(turns_max)}, got "
                     f"{text!r}")
             return ("rev", x)
         try:
@@ -181,58 +173,6 @@ def output_suffix(path: str | None, option: str, written: str,
                      "to write it under that name)")
 
 
-def refuse_overwriting_inputs(outputs: Iterable[tuple[str, str]],
-                              inputs: Iterable[tuple[str, str]], force: bool,
-                              folders: Container[str] = (),
-                              suffixes: Mapping[str, Sequence[str]] | None = None) -> None:
-    """Refuse (unless `force`) an output that is one of the command's own inputs: the
-    same file, compared by identity (device and inode: a link or another spelling of
-    the path is the same file), not by name. `outputs` and `inputs` are (what, path)
-    pairs: ``("-o", "m.yaml")``, ``("the model", "m.yaml")``. Where `force` cannot help,
-    the message does not offer it, and `force` does not pass it: an output whose option
-    is in `folders` writes a folder, which cannot take a file's place; one whose option's
-    suffix chooses the format (`suffixes`: option -> the suffixes it writes) and whose
-    name has none of them is refused by the command anyway."""
-    import os
-    import stat
-
-    def stuck(flag: str, path: str) -> str:
-        """Why `force` cannot help writing `path` there, or ''."""
-        if flag in folders:
-            return f"{flag} writes a folder; give a folder's name"
-        allowed = (suffixes or {}).get(flag)
-        if allowed and Path(path).suffix.lower() not in allowed:
-            return (f"{flag} writes a file ending in {', '.join(allowed)}; give another "
-                    "output file")
-        return ""
-
-    outputs = [(flag, path) for flag, path in outputs if not force or stuck(flag, path)]
-    if not outputs:
-        return
-    seen = []
-    for what, path in inputs:
-        try:
-            st = os.stat(path)
-        except (OSError, ValueError):
-            continue
-        if stat.S_ISREG(st.st_mode):
-            seen.append((what, path, st))
-    for flag, path in outputs:
-        try:
-            st = os.stat(path)
-        except (OSError, ValueError):
-            continue  # a new file: nothing to lose
-        for what, source, st_in in seen:
-            if os.path.samestat(st, st_in):
-                same = "" if source == path else ", the same file"
-                why = stuck(flag, path)
-                if why:
-                    raise MbodyError(f"{flag} {path} is {what} itself ({source}{same}): {why}")
-                raise MbodyError(f"{flag} {path} is {what} itself ({source}{same}): writing "
-                                 "there would replace the input; give another output file, "
-                                 "or --force to replace it")
-
-
 def regular_file(path: str, what: str) -> None:
     """Refuse, before anything opens it, a `path` that exists but is not a regular file: a
     named pipe without a writer would block numpy's open() forever, a device never end."""
@@ -249,19 +189,26 @@ def regular_file(path: str, what: str) -> None:
         raise MbodyError(f"{path}: this is {kind}, not a file; expected {what}")
 
 
-def parse_known(pairs: Sequence[str]) -> dict[str, float]:
-    """``["A.Fx=3", ...]`` -> ``{"A.Fx": 3.0}`` (labels are checked later, with hints)."""
-    return assignments(pairs, "--known", "LABEL=VALUE (for example A.Fx=3)")
+def parse_known(pairs: Sequence[str]) -> dict[str, float | str]:
+    """``["A.Fx=3", "A.Fy=2*sin(t)", ...]`` -> ``{"A.Fx": 3.0, "A.Fy": "2*sin(t)"}``: a
+    number as `assignments` reads it, anything else kept as text, an expression of t that
+    the function it goes to reads as its Python ``known=`` (`mbody.model.arguments.
+    known_values`: the labels checked with a did-you-mean, the expression parsed, taken at
+    the state's time), naming it ``--known LABEL`` in its messages."""
+    return assignments(pairs, "--known", "LABEL=VALUE (for example A.Fx=3)",
+                       expressions=True)
 
 
-def assignments(pairs: Sequence[str], flag: str, form: str,
-                degrees: str | None = None) -> dict[str, float]:
+def assignments(pairs: Sequence[str], flag: str, form: str, degrees: str | None = None,
+                expressions: bool = False) -> dict[str, Any]:
     """``NAME=VALUE`` options -> ``{NAME: value}``; a value ending in `degrees` (``deg``,
     ``deg/s``) is converted to radians. Anything else is a clear `MbodyError`, and so is
-    a number beyond a model file's bound (`mbody.model.checks.MAX_MAGNITUDE`)."""
+    a number beyond a model file's bound (`mbody.model.checks.MAX_MAGNITUDE`); with
+    `expressions`, a value that is not a number is kept as its text (stripped), for the
+    caller to read as an expression of t."""
     from mbody.model.checks import MAX_MAGNITUDE
 
-    out = {}
+    out: dict[str, Any] = {}
     for p in pairs:
         name, sep, value = p.partition("=")
         if not sep or not name.strip():
@@ -269,19 +216,33 @@ def assignments(pairs: Sequence[str], flag: str, form: str,
         text, scale = value.strip(), 1.0
         if degrees and text.endswith(degrees):
             text, scale = text[:-len(degrees)], math.pi / 180
+        x: float | str
         try:
             x = float(text) * scale
         except ValueError:
-            raise MbodyError(f"{flag} {name}: {value!r} is not a number") from None
-        if not math.isfinite(x):
+            if not expressions:
+                raise MbodyError(f"{flag} {name}: {value!r} is not a number") from None
+            x = text
+        if isinstance(x, float) and not math.isfinite(x):
             raise MbodyError(f"{flag} {name}: expected a finite number, got {value!r}")
-        if abs(x) > MAX_MAGNITUDE:
+        if isinstance(x, float) and abs(x) > MAX_MAGNITUDE:
             raise MbodyError(f"{flag} {name}: expected a number of magnitude at most "
                              f"{number(MAX_MAGNITUDE)}, as in a model file, got {value!r}")
         if name.strip() in out:
-            raise given_twice(flag, name.strip())
+            raise given_twice(f"{flag} {name.strip()}")
         out[name.strip()] = x
     return out
+
+
+def add_known_option(command: argparse.ArgumentParser, use: str, when: str) -> None:
+    """``--known LABEL=VALUE`` (repeatable): a known reaction value, a number or an
+    expression of t (`parse_known`); `use` says what the command does with it, `when`
+    at which time an expression is taken."""
+    command.add_argument(
+        "--known", metavar="LABEL=VALUE", action="append", default=[],
+        help=f"a known reaction value (N or N m), {use}: a number, or an expression of t "
+        f"{when} (docs/expressions.md), e.g. --known A.Fx=3 or --known 'A.Fx=2*sin(t)'; "
+        "repeatable")
 
 
 def add_axes_option(command: argparse.ArgumentParser, saved: bool = False) -> None:
@@ -404,7 +365,7 @@ def set_values(pairs: Sequence[str]) -> dict[str, Any]:
     for pair in pairs:
         path, text = parse_assignment(pair)
         if path in out:
-            raise given_twice("--set", path)
+            raise given_twice(f"--set {path}")
         out[path] = parse_value(text, path)
     return out
 

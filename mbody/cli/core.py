@@ -9,6 +9,7 @@ from mbody.cli.common import (
     EXIT_OK,
     MODEL_HELP,
     add_axes_option,
+    add_known_option,
     load_model,
     output_stream,
     output_suffix,
@@ -37,7 +38,12 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="write each body's pair with symbols (m, I_G or I_1, w_1, loads by "
                    "name, reaction labels) instead of numbers; with --latex, as a LaTeX "
                    "document (needs sympy: the 'symbolic' extra)")
-    s.set_defaults(run=assemble)
+    s.add_argument("--answers-key", metavar="FILE",
+                   help="write every body's rows (or --body's) as an answers file (.yaml) "
+                   "that mbody verify finds all correct: the answer key, to test a grading "
+                   "before giving out an assignment; --set values go in its set:; '-' for "
+                   "standard output")
+    s.set_defaults(run=assemble, output_suffixes={"--answers-key": (".yaml", ".yml")})
 
     s = sub.add_parser("solve", help="accelerations of every body and the unknown reactions",
                        description="Accelerations of every body. Reaction values given in "
@@ -46,8 +52,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                        "G^T v_dot = gamma) and printed as a reaction table, with the backward "
                        "error, a condition estimate and any redundant constraints named.")
     s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
-    s.add_argument("--known", metavar="LABEL=VALUE", action="append", default=[],
-                   help="a known reaction value, e.g. --known A.Fx=3 (repeatable)")
+    add_known_option(s, "applied as a load", "taken at the state's time (t = 0 s for the "
+                     "model's initial state)")
     s.add_argument("--json", action="store_true", help="machine-readable output")
     add_axes_option(s)
     s.set_defaults(run=solve)
@@ -77,6 +83,8 @@ def assemble(a: argparse.Namespace) -> int:
     from mbody.present.text import assembly_text, body_text
 
     output_suffix(a.latex, "--latex", "LaTeX", (".tex",), a.force)
+    if a.answers_key is not None:
+        return _answers_key(a)
     model = load_model(a.model)
     asm = _assemble(model)
     if a.symbolic:
@@ -92,6 +100,28 @@ def assemble(a: argparse.Namespace) -> int:
             raise MbodyError(exc.args[0]) from None
     else:
         print(assembly_text(asm))
+    return EXIT_OK
+
+
+def _answers_key(a: argparse.Namespace) -> int:
+    """`mbody assemble MODEL --answers-key FILE [--body NAME]`."""
+    from mbody.answers.key import answer_key
+    from mbody.util.atomic import ensure_writable, write_atomic
+
+    if a.latex is not None or a.symbolic:
+        raise MbodyError("--answers-key writes the rows as an answers file; give it "
+                         "without --latex and --symbolic")
+    output_suffix(a.answers_key, "--answers-key", "YAML", (".yaml", ".yml"), a.force)
+    if a.answers_key != "-":
+        ensure_writable(a.answers_key)  # before the work
+    model = load_model(a.model)
+    text = answer_key(model, bodies=None if a.body is None else [a.body])
+    if a.answers_key == "-":
+        sys.stdout.write(text)
+        return EXIT_OK
+    n = text.count("\n  - {body: ")
+    print(f"wrote {write_atomic(a.answers_key, text)}  ({n} equation{'s' if n != 1 else ''})",
+          file=output_stream(a.answers_key))
     return EXIT_OK
 
 

@@ -19,10 +19,10 @@ from mbody.cli.common import (
     load_model,
     output_stream,
     output_suffix,
-    refuse_overwriting_inputs,
     regular_file,
 )
 from mbody.errors import MbodyError, did_you_mean
+from mbody.util.atomic import refuse_overwriting_inputs
 
 DPI = (10, 600)
 """The resolutions `fbd --dpi` accepts (dots per inch): below 10 FreeType cannot draw the
@@ -34,8 +34,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                        description="Write one picture per body (or only --body NAME): its "
                        "outline, mass centre and axes, applied forces, gravity, couples and "
                        "reaction components (dashed), with the body's Newton-Euler pair "
-                       "under the drawing. Files are named fbd_<body>.<format>; all of them "
-                       "are written, or none (a failure leaves the folder as it was).")
+                       "under the drawing (--no-equations: without it, for a handout). Files "
+                       "are named fbd_<body>.<format>; all of them are written, or none (a "
+                       "failure leaves the folder as it was).")
     s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
     s.add_argument("-o", "--output", metavar="DIR", default=".",
                    help="folder for the pictures (created if missing; default: .)")
@@ -46,6 +47,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--dpi", type=bounded("a whole number of dots per inch", *DPI, integer=True),
                    default=150, metavar="N",
                    help=f"resolution of png pictures, {DPI[0]} to {DPI[1]} (default 150)")
+    s.add_argument("--no-equations", action="store_true",
+                   help="leave the body's Newton-Euler pair out from under the drawing: the "
+                   "diagram alone, for an assignment's handout")
     s.set_defaults(run=fbd)
 
     s = sub.add_parser("graph", help="the body/joint graph: as text, or drawn with -o",
@@ -120,7 +124,7 @@ def fbd(a: argparse.Namespace) -> int:
                               [("the model", a.model)], a.force)
     with atomic_folder(out) as tmp:  # every picture, or none
         for name, file in files:
-            fig = fbd_scene(asm.bodies[name].fbd, view=a.view)
+            fig = fbd_scene(asm.bodies[name].fbd, view=a.view, equations=not a.no_equations)
             save_figure(fig, tmp / file, a.image_format, dpi=a.dpi)
     for name, file in files:
         print(f"wrote {out / file}  (body {name})")

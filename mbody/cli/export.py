@@ -14,6 +14,7 @@ from mbody.cli.common import (
     EXIT_OK,
     EXPORT_SUFFIXES,
     MODEL_HELP,
+    add_known_option,
     bounded,
     load_model,
     output_stream,
@@ -47,8 +48,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="with --state: use the stored "
                    "sample nearest to time T in seconds (default: the last sample); samples "
                    "are not interpolated")
-    s.add_argument("--known", metavar="LABEL=VALUE", action="append", default=[],
-                   help="a known reaction value recorded in the export, e.g. --known A.Fx=3")
+    add_known_option(s, "recorded in the export", "taken at the state's time (the run's "
+                     "sample with --state)")
     s.add_argument("--axes", choices=("joint", "world"), default="joint",
                    help="'world': add the map T (world = T lambda) from the joint-frame "
                    "reaction values, the columns of G, to each joint's force and moment on "

@@ -15,6 +15,7 @@ from mbody.cli.common import (
     MODEL_HELP,
     PICTURE_SUFFIXES,
     VIEW_HELP,
+    add_known_option,
     add_progress_options,
     load_model,
     output_suffix,
@@ -56,8 +57,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.add_argument("-o", "--output", metavar="FILE", action="append", default=[],
                    help="export q, M, f, T... with their labels: a file ending in .npz, .mat "
                    "or .json (repeatable)")
-    s.add_argument("--known", metavar="LABEL=VALUE", action="append", default=[],
-                   help="a known reaction value applied as a load (its joint then not held)")
+    add_known_option(s, "applied as a load, its joint then not held",
+                     "taken at the state's time")
     add_progress_options(s, "what a long computation is doing")
     s.set_defaults(run=lagrange, output_suffixes={"-o": EXPORT_SUFFIXES})
 

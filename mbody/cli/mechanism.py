@@ -6,6 +6,7 @@ import argparse
 import sys
 
 from mbody.cli.common import EXIT_OK, MODEL_HELP, load_model
+from mbody.util.formatting import num
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -20,8 +21,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _n(x: float) -> str:
-    s = f"{0.0 if abs(x) < 1e-12 else x:.6g}"
-    return "0" if s == "-0" else s
+    return num(x)
 
 
 def jacobian(a: argparse.Namespace) -> int:

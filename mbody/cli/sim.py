@@ -10,6 +10,7 @@ from mbody.cli.common import (
     MODEL_HELP,
     PICTURE_SUFFIXES,
     add_axes_option,
+    add_known_option,
     add_progress_options,
     bounded,
     load_model,
@@ -65,8 +66,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    f"{number(ATOL[0])} to {number(ATOL[1])})")
     s.add_argument("--method", default="DOP853",
                    help="integrator: DOP853 (default), RK45, RK23, Radau, BDF, LSODA")
-    s.add_argument("--known", metavar="LABEL=VALUE", action="append", default=[],
-                   help="a known reaction value, e.g. --known A.Fx=3 (repeatable)")
+    add_known_option(s, "applied as a load through the run", "that varies as the run goes")
     s.add_argument("--max-steps", default=None, metavar="N",
                    type=bounded("a whole number of steps", 1, MAX_STEPS, integer=True,
                                 zero="no limit"),

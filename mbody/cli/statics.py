@@ -30,6 +30,7 @@ def equilibrium(a: argparse.Namespace) -> int:
     from mbody.equations.assemble import assemble
     from mbody.present.text import pose_text, reaction_table_text, world_reaction_text
     from mbody.solve.equilibrium import find_equilibrium
+    from mbody.solve.linearize import STEADY_RTOL
     from mbody.util import jsontext
 
     model = load_model(a.model)
@@ -55,7 +56,7 @@ def equilibrium(a: argparse.Namespace) -> int:
         return EXIT_UNMET
     if a.json:
         return EXIT_OK
-    print(pose_text(model, state))
+    print(pose_text(model, state, STEADY_RTOL))
     if len(found.stiffness):
         print("stiffness eigenvalues, M^-1 K: the squared frequencies of small oscillations "
               "about it (1/s^2; negative: a direction it falls away along): "

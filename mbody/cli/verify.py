@@ -21,19 +21,33 @@ def register(sub: argparse._SubParsersAction) -> None:
         "Newton-Euler rows (any scaling or rearrangement counts) or which mistake of the "
         "course explains the difference: missing_gyroscopic_term, gyroscopic_term_sign, "
         "missing_products_of_inertia, single_inertia_in_space, wrong_moment_point, "
-        "missing_reaction, reaction_sign, missing_applied_load, reaction_treated_as_known, "
-        "not_an_equation_of_this_body. "
-        "Then list the rows no correct equation gave. Several answers files (a class): "
-        "each checked in turn; --summary writes one row per file and the class's most "
-        "frequent mistakes. Exit code 0 when every equation is correct, 1 when some are "
-        "not (or a class's file cannot be read), 2 for a bad model or answers file.")
+        "missing_reaction, reaction_sign, lever_arm_sign, missing_applied_load, "
+        "applied_load_sign, reaction_treated_as_known, rounded_too_coarsely, "
+        "not_an_equation_of_this_body (an entry without a body is a Lagrange equation: "
+        "not_an_equation_of_this_model). "
+        "Then list the rows no correct equation gave. An answers file may set its own "
+        "values of the model (set: {bodies.rod.mass: 2.5}, the paths of --set). Several "
+        "answers files (a class): each checked in turn, an entry that cannot be read "
+        "reported as that entry's problem; --summary writes one row per file (with the "
+        "rows asked for and given) and the class's most frequent mistakes. Exit code 0 "
+        "when every equation is correct (in a class, or with --require: and every row "
+        "asked for given), 1 when not (or a class's file cannot be read), 2 for a bad "
+        "model, option or answers file.")
     s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
     s.add_argument("answers", metavar="ANSWERS", nargs="+",
                    help="a YAML answers file, or several (answers/*.yaml)")
     s.add_argument("--summary", metavar="FILE",
                    help="a class's summary: .csv (one row per answers file: file, student, "
-                   "equations, correct, each wrong equation's diagnosis; then the most "
-                   "frequent mistakes with counts) or .html (the same as a page)")
+                   "equations, correct, each wrong equation's diagnosis, rows covered, rows "
+                   "asked, duplicates, set, error; then the most frequent mistakes with "
+                   "counts) or .html (the same as a page)")
+    s.add_argument("--require", action="append", metavar="ROWS",
+                   help="the rows each file must give to be all correct: all (every row of "
+                   "every body; for a file in generalized coordinates, every Lagrange "
+                   "equation), answered (the rows of the bodies it answers), lagrange, a "
+                   "body's name or a row's label (upper.theta); comma-separated or "
+                   "repeated. Default: all for a class (several files or --summary), "
+                   "answered for one file")
     s.add_argument("--json", action="store_true",
                    help="machine-readable output: one entry per equation, in file order")
     s.add_argument("--tol", type=_tolerance, default=1e-3, metavar="REL",
@@ -63,12 +77,13 @@ def verify(a: argparse.Namespace) -> int:
     answers = a.answers[0]
     regular_file(answers, "a YAML answers file")
     model = load_model(a.model)
-    result = _verify(model, answers, tol=a.tol)
+    result = _verify(model, answers, tol=a.tol, require=a.require)
     if a.json:
         jsontext.dump(result.to_dict(), sys.stdout)
     else:
         print(result.text())
-    return EXIT_OK if result.ok else EXIT_UNMET
+    passed = result.all_correct if a.require else result.ok
+    return EXIT_OK if passed else EXIT_UNMET
 
 
 def _class(a: argparse.Namespace) -> int:
@@ -89,7 +104,7 @@ def _class(a: argparse.Namespace) -> int:
     # a file that is not an answers file (missing, a folder, a device, a pipe with no
     # writer, not YAML) is about one student: the reader makes it a row, the class goes on
     model = load_model(a.model)
-    summary = grade(model, a.answers, tol=a.tol)
+    summary = grade(model, a.answers, tol=a.tol, require=a.require or "all")
     if a.json:
         jsontext.dump([{"file": g.file, "student": g.student, "error": g.error,
                         **(g.verification.to_dict() if g.verification else {})}
@@ -109,5 +124,5 @@ def _class(a: argparse.Namespace) -> int:
         say = sys.stderr if a.json else sys.stdout
         print(summary.text(), file=say)
         print(f"wrote {a.summary}", file=say)
-    every = all(g.verification is not None and g.verification.ok for g in summary.graded)
+    every = all(g.all_correct for g in summary.graded)
     return EXIT_OK if every else EXIT_UNMET

@@ -40,9 +40,9 @@ from mbody.equations.workspace import (
     workspace,
 )
 from mbody.equations.world import world_reactions
-from mbody.errors import MbodyError, did_you_mean
+from mbody.errors import MbodyError, not_found
 from mbody.kernel import _core
-from mbody.model.arguments import checked_model, checked_state, known_at
+from mbody.model.arguments import KnownValues, checked_model, checked_state, known_at
 from mbody.model.model import Model, State, count
 
 if TYPE_CHECKING:
@@ -235,7 +235,7 @@ class Assembly:
         return assembly_symbolic(self, bodies)
 
     def generalized(self, coordinates: Sequence[str] | None = None,
-                    known: Mapping[str, float] | None = None, *,
+                    known: KnownValues | None = None, *,
                     progress: bool = False) -> Generalized:
         """The equations in generalized coordinates, ``M_q q'' = f_q``: these equations
         multiplied by Tᵀ, where v = T q' + v_e, which removes the reactions
@@ -247,8 +247,9 @@ class Assembly:
             One coordinate per degree of freedom by label (``O.angle``, ``P.displacement``,
             a body's ``rod.theta``...); default: each driver's coordinate, a spanning
             tree's joint coordinates, then a free body's own.
-        known : mapping of str to float, optional
-            Reaction values applied as loads (their joints not held), added to the file's.
+        known : mapping of str to float or str, optional
+            Reaction values applied as loads (their joints not held), added to the file's:
+            numbers, or expressions of t as text taken at ``state.t`` (`reaction_values`).
         progress : bool
             Say on standard error what is being computed, once it has taken a second
             (`mbody.util.progress`).
@@ -261,7 +262,7 @@ class Assembly:
         return generalized(self.model, self.state, coordinates, known, progress=progress)
 
     # -- solving -----------------------------------------------------------------------
-    def reaction_values(self, known: Mapping[str, float] | None = None) -> dict[str, float]:
+    def reaction_values(self, known: KnownValues | None = None) -> dict[str, float]:
         """The file's known reaction values updated with `known`; labels are checked.
 
         Parameters
@@ -287,7 +288,7 @@ class Assembly:
             return self.model.known_reactions_at(self.state.t)
         return known_at(self.model, known, self.state.t)
 
-    def solve(self, known: Mapping[str, float] | None = None, *,
+    def solve(self, known: KnownValues | None = None, *,
               condition: bool = False, axes: str = "joint") -> Solution:
         """Accelerations, and the reactions not given (from the file or `known`).
 
@@ -355,8 +356,7 @@ class _LazyBodies(Mapping[str, "BodyEquations"]):
     def __getitem__(self, name: str) -> BodyEquations:
         if name not in self._cache:
             if name not in self._asm.model.index:
-                hint = did_you_mean(name, self._asm.model.body_names)
-                raise KeyError(f"no body named {name!r}" + (f"; {hint}" if hint else ""))
+                raise not_found("body named", name, self._asm.model.body_names, "bodies")
             self._cache[name] = self._build(self._asm, self._asm.model.index[name])
         return self._cache[name]
 

@@ -30,9 +30,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from mbody.equations.joints import ReactionColumns, reaction_columns
-from mbody.errors import did_you_mean
+from mbody.errors import not_found
 from mbody.model.model import Model, State
-from mbody.model.reprs import name_list
 from mbody.util.frozen import Frozen
 
 if TYPE_CHECKING:
@@ -100,10 +99,8 @@ class ConstraintJacobian(Frozen):
         try:
             i = self.rows.index(label)
         except ValueError:
-            hint = did_you_mean(label, self.rows) if isinstance(label, str) else ""
-            raise KeyError(f"no constraint row {label!r}" + (
-                f"; {hint}" if hint else f" (a row per reaction component, .rows: "
-                f"{name_list(self.rows)})")) from None
+            raise not_found("constraint row", label, self.rows,
+                            "rows, one per reaction component") from None
         r = self.matrix.getrow(i).tocoo()
         return {self.columns[j]: float(v) for j, v in zip(r.col, r.data, strict=True)}
 

@@ -35,7 +35,7 @@ import numpy as np
 from mbody import conventions as cv
 from mbody import joint_types
 from mbody.equations.workspace import Unknowns, workspace
-from mbody.errors import MbodyError, did_you_mean
+from mbody.errors import MbodyError, did_you_mean, option_name
 from mbody.kernel import _core
 from mbody.model.model import Model, State
 
@@ -539,7 +539,8 @@ def choose(model: Model, state: State | None = None, labels: Sequence[str] | Non
                 chosen.add(k)
     if len(taken) < dof:  # cannot happen: the bodies' own coordinates span everything
         raise MbodyError(f"could not choose {dof} independent coordinates for model "
-                         f"'{model.name}' at this state; name them with coordinates=")
+                         f"'{model.name}' at this state; name them with "
+                         f"{option_name('coordinates', '[...]')}")
     items = tuple(cands[k] for k in taken)
     efforts = tuple((model.reactions[first_driver + d], taken.index(by_label[lab]))
                     for d, lab in enumerate(driver_labels))

@@ -19,6 +19,8 @@ from mbody.conventions import APPLIED, GRAVITY, REACTION
 from mbody.equations.fbd_text import body_text
 from mbody.equations.joints import g_block
 from mbody.equations.symbolic import body_symbolic
+from mbody.util.formatting import num as _num
+from mbody.util.formatting import quiet
 
 if TYPE_CHECKING:
     from mbody.equations.assemble import Assembly
@@ -128,6 +130,16 @@ class FreeBodyDiagram:
     shape: dict | None
     forces: tuple[ForceOnBody, ...]
     equations: tuple[Equation, ...] = ()  # the body's Newton-Euler rows, shown under drawings
+
+    @property
+    def size(self) -> float:
+        """The body's extent as its free body shows it (m): the farthest point a force
+        acts at from the mass centre, or its radius of gyration when that is larger
+        (0 for a particle with every force at its mass centre)."""
+        arms = max((float(np.linalg.norm(fo.B_r)) for fo in self.forces), default=0.0)
+        gyration = (float(np.sqrt(np.trace(self.inertia) / (2.0 * self.mass)))
+                    if self.mass > 0 else 0.0)
+        return max(arms, gyration)
 
     @property
     def applied(self) -> list[ForceOnBody]:
@@ -268,12 +280,6 @@ class BodyEquations:
         return body_latex(self)
 
 
-def _num(x: float) -> str:
-    x = 0.0 if abs(x) < 1e-12 else x  # rounding noise from rotations
-    s = f"{x:.6g}"
-    return "0" if s in ("-0", "0") else s
-
-
 def _vec(x: np.ndarray) -> str:
     return "(" + ", ".join(_num(v) for v in x) + ")"
 
@@ -281,7 +287,7 @@ def _vec(x: np.ndarray) -> str:
 def _terms(pairs: list[tuple[float, str]]) -> str:
     out = ""
     for coef, name in pairs:
-        if abs(coef) < 1e-12:  # rounding noise from rotations, not a term
+        if quiet(coef) == 0.0:  # rounding noise from rotations, not a term
             continue
         mag = abs(coef)
         txt = name if _num(mag) == "1" else f"{_num(mag)} {name}"  # 0.9999999 is 1

@@ -9,6 +9,7 @@ import numpy as np
 
 from mbody import conventions as cv
 from mbody.conventions import REACTION
+from mbody.util.formatting import LENGTH_RTOL, NOISE
 from mbody.util.formatting import num as _n
 from mbody.util.formatting import table as _table
 from mbody.util.formatting import vec as _v
@@ -16,7 +17,8 @@ from mbody.util.formatting import vec as _v
 if TYPE_CHECKING:
     from mbody.equations.fbd import BodyEquations, ForceOnBody
 
-def force_cells(fo: ForceOnBody, dimension: int, minus: str = "-") -> list[str]:
+def force_cells(fo: ForceOnBody, dimension: int, minus: str = "-", size: float = 0.0
+                ) -> list[str]:
     """One free-body row as the picture draws it: name, point, components with unit,
     moment about G.
 
@@ -33,6 +35,9 @@ def force_cells(fo: ForceOnBody, dimension: int, minus: str = "-") -> list[str]:
         2 (planar) or 3 (spatial).
     minus : str
         The minus of a parent-side name: ``-`` in text, ``−`` (U+2212) in HTML, as drawn.
+    size : float
+        The body's size (m, `FreeBodyDiagram.size`): a point's coordinate below
+        `LENGTH_RTOL` of it prints as 0 (the file's rounding, not a dimension).
 
     Returns
     -------
@@ -51,7 +56,7 @@ def force_cells(fo: ForceOnBody, dimension: int, minus: str = "-") -> list[str]:
     comp = _n(vec[2]) if fo.couple and dimension == cv.PLANAR else _v(vec, dimension)
     if fo.unknown:
         comp = "unit " + comp
-    point = "-" if fo.couple else _v(fo.B_r, dimension)
+    point = "-" if fo.couple else _v(fo.B_r, dimension, max(NOISE, LENGTH_RTOL * size))
     moment = _n(mom[2]) if dimension == cv.PLANAR else _v(mom, 3)
     return [name, point, f"{comp} {unit}", moment]
 
@@ -62,7 +67,7 @@ def body_text(eq: BodyEquations, dimension: int) -> str:
     out.append("free body:")
     rows = []
     for fo in f.forces:
-        name, point, comp, mom = force_cells(fo, dimension)
+        name, point, comp, mom = force_cells(fo, dimension, size=f.size)
         label = "reaction" if fo.kind == REACTION else "couple" if fo.couple else fo.kind
         rows.append([name, label, point, comp, mom])
     if f.forces:

@@ -29,9 +29,9 @@ import numpy as np
 
 from mbody.equations.coordinates import CoordinateSet, columns, coordinate_set
 from mbody.equations.workspace import workspace
-from mbody.errors import MbodyError
+from mbody.errors import MbodyError, option_name
 from mbody.kernel import _core
-from mbody.model.arguments import checked_state, known_at
+from mbody.model.arguments import KnownValues, checked_state, known_at
 from mbody.model.model import Model, State
 from mbody.util.progress import Progress, progress_of
 
@@ -301,7 +301,7 @@ def layout(N: int, k: int) -> tuple[int, ...]:
 
 def generalized(model: Model, state: State | None = None,
                 coordinates: Sequence[str] | None = None,
-                known: Mapping[str, float] | None = None, *,
+                known: KnownValues | None = None, *,
                 progress: bool | Progress = False) -> Generalized:
     """The equations of `model` in generalized coordinates at `state` (module doc).
 
@@ -368,7 +368,7 @@ def checked(model: Model, state: State, cs: CoordinateSet, out: np.ndarray
         raise CoordinatesSingularError(
             f"the coordinates {', '.join(cs.labels)} do not determine the motion of "
             f"'{model.name}' at t = {state.t:g} s (a singular position for them: pivot "
-            f"ratio {rank:.1e}); choose others with coordinates= (--coordinates)")
+            f"ratio {rank:.1e}); choose others with {option_name('coordinates', '[...]')}")
     residual = float(out[o[8] + _core.GI_RESIDUAL])
     warnings: tuple[str, ...] = ()
     if residual > 1e-6:

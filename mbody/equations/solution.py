@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from mbody.errors import MbodyError, closest, did_you_mean
+from mbody.errors import MbodyError, closest, did_you_mean, not_found
 from mbody.model.model import count
 from mbody.model.reprs import name_list
 
@@ -44,10 +44,7 @@ class ReactionValues(Mapping):
         try:
             return float(self._values[self._index[label]])
         except (KeyError, TypeError):
-            hint = did_you_mean(label, self._labels) if isinstance(label, str) else ""
-            raise KeyError(f"no reaction component {label!r}"
-                           + (f"; {hint}" if hint else f" (the components: "
-                              f"{name_list(self._labels)})")) from None
+            raise not_found("reaction component", label, self._labels, "components") from None
 
     def __contains__(self, label: object) -> bool:  # a Mapping's would make the message
         return isinstance(label, str) and label in self._index

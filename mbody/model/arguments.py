@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from mbody.errors import MbodyError, MbodyTypeError, did_you_mean
+from mbody.errors import MbodyError, MbodyTypeError, did_you_mean, option_entry
 from mbody.model.expressions import Expression, ExpressionError, compile_expression
 from mbody.model.model import Model, State
 from mbody.model.reprs import count, name_list
@@ -117,7 +117,9 @@ def known_values(model: Model, known: Any, *, expressions: bool = True,
     value a finite number or an expression (compiled here: a constant one becomes its
     number, one that is not finite refused); `expressions` False: numbers only.
 
-    Returns label -> float or `Expression` (those of t), in `known`'s order.
+    Returns label -> float or `Expression` (those of t), in `known`'s order. A message
+    names a value as the surface it came from spells it (`mbody.errors.option_entry`):
+    ``known['A.Fx']`` in Python, ``--known A.Fx`` on the command line.
     """
     if not isinstance(known, Mapping):
         raise MbodyTypeError(f"{argument} must be a mapping of reaction label -> number"
@@ -135,7 +137,7 @@ def known_values(model: Model, known: Any, *, expressions: bool = True,
             try:
                 v = compile_expression(v)
             except ExpressionError as exc:
-                raise MbodyError(f"{argument}[{label!r}]: {exc}") from None
+                raise MbodyError(f"{option_entry(argument, label)}: {exc}") from None
         if isinstance(v, Expression):
             if v.constant:
                 v = v.value
@@ -147,13 +149,13 @@ def known_values(model: Model, known: Any, *, expressions: bool = True,
                 type(v).__name__ + (f" of shape {v.shape}" if isinstance(v, np.ndarray)
                                     else "")
             raise MbodyTypeError(
-                f"{argument}[{label!r}] must be a number (N or N m)"
+                f"{option_entry(argument, label)} must be a number (N or N m)"
                 + (" or an expression of t as text ('2*t')" if expressions else "")
                 + f", got {got}")
         value = float(v)
         if not math.isfinite(value):
-            raise MbodyError(f"{argument}[{label!r}] must be a finite number (N or N m), "
-                             f"got {value!r}")
+            raise MbodyError(f"{option_entry(argument, label)} must be a finite number "
+                             f"(N or N m), got {value!r}")
         out[label] = value
     return out
 
@@ -167,8 +169,8 @@ def known_at(model: Model, known: Any, t: float, argument: str = "known") -> dic
         if isinstance(v, Expression):
             x = float(v(t))
             if not math.isfinite(x):
-                raise MbodyError(f"{argument}[{label!r}] = {v.text!r} is not finite at the "
-                                 f"state's t = {t:g} s ({x})")
+                raise MbodyError(f"{option_entry(argument, label)} = {v.text!r} is not finite "
+                                 f"at the state's t = {t:g} s ({x})")
             v = x
         values[label] = v
     return values

@@ -3,11 +3,14 @@
 `located_loads` and `point_loads` make the `ForceTable` (and the `Load` records) of the
 located and the fast path; `joint_tables` computes every joint's frame and points in each
 body's axes at once, the `ReactionTable`, and the `Joint` records made on first use.
-`mbody.model.model` puts them together into a `Model`.
+`mbody.model.model` puts them together into a `Model`. `frames_at` takes the frames again
+at the pose `mbody.load` assembles a model to, when that turned a joint's parent.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from dataclasses import replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -20,7 +23,16 @@ from mbody.model.expressions import ExpressionTable
 from mbody.model.records import Joint, Load, Records, field_names, record
 from mbody.model.tables import ForceTable, JointTable, ReactionTable, readonly
 from mbody.model.validate import JointSpecTable, LoadSpec, LoadTable
-from mbody.util.spatial import joint_frame_planar, joint_frame_spatial, quat_to_matrix
+from mbody.util.spatial import (
+    FRAME_TIE,
+    joint_frame_planar,
+    joint_frame_spatial,
+    joint_frames_spatial,
+    least_aligned,
+    quat_conj,
+    quat_mul,
+    quat_to_matrix,
+)
 
 if TYPE_CHECKING:
     from mbody.model.model import State
@@ -142,11 +154,13 @@ def joint_tables(dimension: int, js: JointSpecTable, names: tuple[str, ...],
                                            np.arange(len(row_joint)) - first[row_joint]]
     free_turn = np.array([any(c.kind == TILT for c in registry[typ].components)
                           for typ in types], dtype=bool)
+    defaults = {typ: _default_axis(registry[typ]) for typ in set(types)}
+    directed = js.has_axis | np.array([defaults[typ] for typ in types], dtype=bool).reshape(nj)
     per_joint = JointTable(tuple(js.names), p, c, readonly(B_r_child), readonly(B_r_parent),
                            readonly(P_E), readonly(C_E), readonly(C_axis2), first, link, p_particle,
                            readonly(length), free_turn, readonly(js.pitch),
                            np.zeros(nj, dtype=bool) if js.body_points is None
-                           else np.asarray(js.body_points, dtype=bool))
+                           else np.asarray(js.body_points, dtype=bool), directed)
     if drivers is not None and len(drivers):  # the drivers' efforts: last components
         row_joint = np.concatenate((row_joint, drivers.joint))
         component = np.concatenate((component, [joint_types.COMPONENT_CODE[c]
@@ -171,6 +185,82 @@ def joint_tables(dimension: int, js: JointSpecTable, names: tuple[str, ...],
             axis2[j] if has2[j] else None, kinds[j]))
 
     return Records(js.names, make, JOINT), table
+
+
+def _default_axis(typ: joint_types.JointType) -> bool:
+    """Whether a joint of type `typ` without an `axis` has one all the same (a planar
+    prismatic's or slot's slide direction, world x at the file's pose)."""
+    prm = typ.param("axis")
+    return prm is not None and prm.default is not None
+
+
+def frames_at(joints: Sequence[Joint], table: ReactionTable, dimension: int,
+              file_pose: State, pose: State, turn_tol: float
+              ) -> tuple[Sequence[Joint], ReactionTable]:
+    """The joint frames by the contract's rule at `pose` (the pose `mbody.load` assembles
+    the model to, `mbody.solve.kinematics.assembled`) rather than at `file_pose`, where
+    `joint_tables` took them: `joints` and `table` with those frames (themselves when no
+    frame changes).
+
+    A frame is fixed in its parent, so only a joint whose parent turned between the two
+    poses (by more than `turn_tol`, rad: the assembly's own resolution, below which the
+    file's pose already held the joint) can change:
+
+    - without a direction (no `axis`, no default one), the frame is the world axes at
+      `pose`;
+    - with one, the direction is fixed in the parent (as the file gives it, world axes at
+      the file's pose) and turned with it to `pose`, and the rule is applied there. In
+      the plane that is the frame turned with its parent: nothing changes. In space z is
+      the turned axis and x is the world axis that the rule chose for the axis as the
+      file gives it, with its component along z removed: a small turn in assembly does
+      not swap world x for world y when the axis is along a world axis (where the rule's
+      choice is a tie) or close to such a tie. Only a turn so large that the turned
+      axis is more aligned with that world axis than 1/√3 (the least aligned world
+      axis never is) takes the rule's own choice at `pose`.
+
+    The child's frame C_E3 turns with the parent's, ``C_E3 Q`` where ``P_E3 Q`` is the new
+    parent frame: the two still coincide at the file's pose, so the relative turn a
+    driver or a generalized coordinate measures from there is unchanged (for a joint that
+    turns about an axis, Q turns about it too), and the constraints span the same
+    motions."""
+    jt = table.per_joint
+    p = jt.parent
+    # the parents' turns from file_pose to pose: 2 |vector part| of the relative
+    # quaternion is the angle to within its cube
+    turn = 2.0 * np.linalg.norm(
+        quat_mul(pose.quaternion, quat_conj(file_pose.quaternion))[:, 1:], axis=1)
+    planar = dimension == cv.PLANAR
+    moved = (p >= 0) & (turn[np.maximum(p, 0)] > turn_tol) if len(p) else np.zeros(0, bool)
+    if planar:  # a direction turned with its parent is the rule's frame there already
+        moved &= ~jt.directed
+    k = np.flatnonzero(moved)
+    if not len(k):
+        return joints, table
+    P_old = jt.P_E3[k]
+    R_p = quat_to_matrix(pose.quaternion[p[k]])
+    W = np.tile(np.eye(3), (len(k), 1, 1))  # no direction: the world axes at `pose`
+    along = jt.directed[k]
+    if along.any():  # spatial, with a direction
+        z_file = (quat_to_matrix(file_pose.quaternion[p[k[along]]]) @ P_old[along])[:, :, 2]
+        z = (R_p[along] @ P_old[along])[:, :, 2]
+        z /= np.linalg.norm(z, axis=1, keepdims=True)
+        choice = least_aligned(z_file)
+        far = np.abs(z[np.arange(len(z)), choice]) > 1.0 / np.sqrt(3.0) + FRAME_TIE
+        choice[far] = least_aligned(z[far])
+        W[along] = joint_frames_spatial(z, choice)
+    P_new = R_p.transpose(0, 2, 1) @ W
+    P_E3, C_E3 = jt.P_E3.copy(), jt.C_E3.copy()
+    C_E3[k] = C_E3[k] @ (P_old.transpose(0, 2, 1) @ P_new)
+    P_E3[k] = P_new
+    new_table = replace(table, per_joint=replace(jt, P_E3=readonly(P_E3),
+                                                 C_E3=readonly(C_E3)))
+    W_E0 = dict(zip(k.tolist(), W, strict=True))
+
+    def make(j: int) -> Joint:
+        old = joints[j]
+        return replace(old, W_E0=readonly(W_E0[j])) if j in W_E0 else old
+
+    return Records(jt.names, make, JOINT), new_table
 
 
 def _frames(axis: np.ndarray, has_axis: np.ndarray, planar: bool) -> np.ndarray:

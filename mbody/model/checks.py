@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -129,6 +130,9 @@ class Checker:
         """Every joint with a valid name and type, even one with other problems."""
         self.particles: set[str] = set()
         """Names of the bodies given `inertia: 0` (point masses)."""
+        self.meant: set[tuple[Path_, str]] = set()
+        """(mapping's path, key) of each key an unknown key's hint names: a rule that
+        asks for the key says nothing more there (the hint said it)."""
 
     # -- reporting -------------------------------------------------------------------
     def err(self, path: Path_, message: str, hint: str = "", *, key: bool = False) -> None:
@@ -151,6 +155,7 @@ class Checker:
                 hint = did_you_mean(k, allowed)
                 if hint:
                     meant.add(hint.split("'")[1])
+                    self.meant.add((tuple(path), hint.split("'")[1]))
                 self.err((*path, k), f"unknown key '{k}'",
                          hint or f"expected one of: {', '.join(allowed)}", key=True)
         for k in required:
@@ -287,10 +292,14 @@ class Checker:
             return None
         return value
 
-    def choice(self, path: Path_, value: Any, choices: tuple[str, ...], what: str) -> str | None:
+    def choice(self, path: Path_, value: Any, choices: tuple[str, ...], what: str,
+               synonyms: Mapping[str, str] | None = None) -> str | None:
+        """`value` if it is one of `choices`, else None and an error with a hint
+        (`did_you_mean`; `synonyms`: other programs' names of the choices)."""
         if not isinstance(value, str) or value not in choices:
+            hint = did_you_mean(value, choices, synonyms)
             self.err(path, f"unknown {what} {_quoted(value)}",
-                     did_you_mean(value, choices) or f"expected one of: {', '.join(choices)}")
+                     hint or f"expected one of: {', '.join(choices)}")
             return None
         return value
 
@@ -374,6 +383,26 @@ def key_unit(path: Path_) -> str | None:
     return _KEY_UNITS.get(key) if key is not None else None
 
 
+def si_quantity(text: str) -> tuple[float, str] | None:
+    """A number followed by its unit, in SI: ``"90 deg"`` -> (1.5708, 'rad'), ``"20 mm"``
+    -> (0.02, 'm'), ``"10 ms"`` -> (0.01, 's'), ``"0.25 rev"`` -> (1.5708, 'rad'). The
+    units are those this module's hints know (the SI ones, and the common others
+    `_TO_SI` converts) and ``deg``, as a model file writes an angle. None for text that is
+    not a number with such a unit (a bare number, a misspelt unit): the caller says what
+    it expected."""
+    m = _WITH_UNIT.fullmatch(text) if len(text) < 80 else None
+    if not m:
+        return None
+    x = float(m.group(1))
+    unit = " ".join(m.group(2).replace("·", " ").split())
+    if unit == "deg":
+        return math.radians(x), "rad"
+    if unit in _SI_UNITS:
+        return x, _SI_UNITS[unit]
+    factor, si = _TO_SI.get(unit, (None, ""))
+    return (x * factor, si) if factor is not None else None
+
+
 # Units a newcomer writes after a number. An SI one is dropped as it is; a common other
 # one is converted in the hint (its bare number would be off by its factor: 500 g is
 # 0.5, not 500). Each is mapped to its SI unit as the hints write it.
@@ -418,11 +447,20 @@ _KEY_UNITS: dict[str, str] = {
 
 def _angle_hint(value: str, unit: str) -> str:
     """'30°', '30 degrees' -> write '30 deg'."""
-    m = _ANGLE_WORDS.fullmatch(value)
+    written = angle_spelling(value, unit)
+    return f"write '{written}'" if written else _number_hint(
+        value, "rad" if unit == "deg" else "rad/s")
+
+
+def angle_spelling(value: str, unit: str = "deg") -> str | None:
+    """An angle (or with `unit` 'deg/s', a rate) written another way, as mbody reads it:
+    ``'30°'``, ``'30 degrees'`` -> ``'30 deg'``, ``'2 radians'`` -> ``'2 rad'``; None for
+    anything else."""
+    m = _ANGLE_WORDS.fullmatch(value) if len(value) < 80 else None
     if not m:
-        return _number_hint(value, "rad" if unit == "deg" else "rad/s")
+        return None
     word = "rad" if m.group(2).lower().startswith("rad") else "deg"
-    return f"write '{m.group(1)} {word}{unit[3:]}'"
+    return f"{m.group(1)} {word}{unit[3:]}"
 
 
 def _quoted(value: Any) -> str:

@@ -25,7 +25,7 @@ from typing import Any, NamedTuple, NoReturn, overload
 
 import numpy as np
 
-from mbody.errors import MbodyError
+from mbody.errors import MbodyError, closest
 
 FUNCTIONS: dict[str, Callable[[Any], Any]] = {
     "sin": np.sin, "cos": np.cos, "tan": np.tan, "exp": np.exp,
@@ -366,9 +366,8 @@ class _Parser(OperatorParser):
                 self.take()
                 node = _fold(("call", value, arg))
             else:
-                hint = ("the only variable is t (time, s)" if len(value) == 1 else
-                        "known names: t, pi, " + ", ".join(FUNCTIONS))
-                raise ExpressionError(self.text, pos, f"unknown name '{value}'", hint)
+                raise ExpressionError(self.text, pos, f"unknown name '{value}'",
+                                      _unknown_name_hint(value))
         elif kind == "op" and value == "(":
             node = self.expr(depth + 1)
             if self.peek()[1] != ")":
@@ -381,6 +380,27 @@ class _Parser(OperatorParser):
             raise ExpressionError(self.text, pos, f"unexpected {_describe(kind, value)}")
         self.no_implicit_product("2*t")
         return node
+
+
+_MEANT = {"ln": "log", "time": "t"}
+"""Names other notations use for one of ours that neither its start nor
+`mbody.errors.closest` finds (a name that differs only in case, ``Sin`` or ``T``, it
+finds)."""
+
+
+def _unknown_name_hint(name: str) -> str:
+    """What a name the grammar does not know was probably meant to be: a function or `t`,
+    `pi` (a did-you-mean: a name ours starts, ``cosine`` or ``sqrtf``, first), or a number
+    (``nan``, ``inf``: no such value is allowed)."""
+    if name.casefold() in ("nan", "inf", "infinity"):
+        return "a value must be a finite number"
+    known = [VARIABLE, *CONSTANTS, *FUNCTIONS]
+    starts = [k for k in known if len(k) > 1 and name.casefold().startswith(k)]
+    meant = (_MEANT.get(name.casefold()) or max(starts, key=len, default=None)
+             or closest(name, known))
+    listed = ("the only variable is t (time, s)" if len(name) == 1 and meant is None else
+              "known names: " + ", ".join(known))
+    return f"did you mean '{meant}'? {listed}" if meant else listed
 
 
 def _fold(node: Node) -> Node:

@@ -30,9 +30,6 @@ import re
 import select
 import stat
 import time
-from collections.abc import Iterator
-from contextlib import contextmanager
-from contextvars import ContextVar
 from dataclasses import dataclass, field
 from decimal import Decimal
 from pathlib import Path
@@ -51,37 +48,12 @@ from yaml.events import (
 )
 
 from mbody.errors import Issue, MbodyError, ModelError, did_you_mean, wrong_type
+from mbody.util.budget import MAX_BYTES, byte_limit
 
 # libyaml keeps line marks and is many times faster than the pure-Python parser
 _Loader: type[yaml.SafeLoader] | type[yaml.CSafeLoader] = getattr(
     yaml, "CSafeLoader", yaml.SafeLoader)
 
-MAX_BYTES = 32 * 1024 * 1024
-"""Largest model file read by default, in bytes (a 10 000-body model written by
-``yaml.dump`` is about 8 MB). A size limit keeps a mistaken path (a log, a disk image)
-from being read whole; ``mbody.load(path, max_bytes=N)`` or ``--max-bytes N`` on the
-command line reads larger models."""
-_LIMIT: ContextVar[int] = ContextVar("mbody_max_bytes", default=MAX_BYTES)
-
-
-@contextmanager
-def max_bytes_limit(max_bytes: int | None) -> Iterator[None]:
-    """Within the block, files are read up to `max_bytes` unless a call says otherwise.
-
-    The command line's ``--max-bytes`` sets it around a command, so that every model
-    the command reads (also through a run file) gets the same limit.
-
-    Parameters
-    ----------
-    max_bytes : int or None
-        The limit, in bytes; None keeps the current one.
-    """
-    token = _LIMIT.set(max_bytes) if max_bytes is not None else None
-    try:
-        yield
-    finally:
-        if token is not None:
-            _LIMIT.reset(token)
 MAX_ALIAS_NODES = 100_000
 """Most nodes that alias expansion may add before the file is refused."""
 MAX_DEPTH = 64
@@ -507,15 +479,15 @@ def read_file(path: str | os.PathLike[str], max_bytes: int | None = None,
               fmt: str = "yaml") -> str:
     """The text of a model file, refusing files over `max_bytes` before reading them.
 
-    `max_bytes` defaults to `MAX_BYTES`, or the limit set by `max_bytes_limit`; `fmt`
+    `max_bytes` defaults to `MAX_BYTES`, or the budget set by
+    `mbody.util.budget.byte_budget` (the command line's ``--max-bytes``); `fmt`
     is the model format the file is read as (what a refusal says was expected).
 
     A regular file or a pipe (``/dev/stdin`` fed by ``<`` or ``|``, ``<(command)``, a named
     pipe with a writer) is read; anything else (a directory, a terminal, a device, a
     socket) is refused without reading, so that nothing can block forever.
     """
-    if max_bytes is None:
-        max_bytes = _LIMIT.get()
+    max_bytes = byte_limit(max_bytes, MAX_BYTES)
     p = Path(path)
     name = str(path)
     _, ext, _, expected = MODEL_FORMATS[fmt]

@@ -551,7 +551,7 @@ def load(source: str | os.PathLike[str] | dict, *, max_bytes: int | None = None)
         A path to an mbody YAML model file; or a dict with a YAML file's content (for
         scripts).
     max_bytes : int, optional
-        The largest file read (default `mbody.model.loader.MAX_BYTES`, 32 MiB, or the
+        The largest file read (default `mbody.util.budget.MAX_BYTES`, 32 MiB, or the
         command line's ``--max-bytes``); a larger file is refused before it is read.
         Raise it for very large models (a 100 000-body file is about 80 MB).
 

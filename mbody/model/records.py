@@ -14,7 +14,7 @@ from typing import Any, TypeVar, overload
 
 import numpy as np
 
-from mbody.errors import did_you_mean
+from mbody.errors import not_found, wrong_type
 from mbody.model.expressions import Expression
 from mbody.model.reprs import count, name_list, vector_text
 
@@ -125,9 +125,11 @@ class Joint:
     parent, child : str
         The bodies it joins (``ground`` for the world).
     at : (3,) array
-        The joint point at the initial pose, world axes (m).
+        The joint point at the file's pose, world axes (m) (with points given on each
+        body: the child's); `Model.joint_table` has it in each body's axes.
     W_E0 : (3, 3) array
-        The joint frame at the initial pose, axes as columns (world).
+        The joint frame at the initial pose, axes as columns (world): the file's pose, or
+        the assembled one when `mbody.load` assembled the model.
     components : tuple of str
         Its reaction components (``Fx``, ``Fy``, ``Mz``...), the columns of G in order.
     axis, axis2 : (3,) array, optional
@@ -140,7 +142,7 @@ class Joint:
     type: str
     parent: str
     child: str
-    at: np.ndarray  # (3,) world, initial pose
+    at: np.ndarray  # (3,) world, the file's pose
     W_E0: np.ndarray  # (3, 3) joint frame at the initial pose, axes as columns (world)
     components: tuple[str, ...]
     axis: np.ndarray | None = None
@@ -232,8 +234,7 @@ class Records(Sequence[T]):
         range, TypeError for what is neither an index nor a name."""
         n, noun = self._n, self._noun
         if isinstance(i, bool) or not hasattr(i, "__index__"):
-            raise TypeError(f"{noun[1]} are found by name or by index, got "
-                            f"{type(i).__name__}" + (f" {i!r}" if isinstance(i, float) else ""))
+            raise wrong_type(f"{noun[1]}[key]", "a name (str) or an index (int)", i)
         k = operator.index(i)
         if not -n <= k < n:
             raise IndexError(f"{noun[0]} index {k} out of range ({count(n, *noun)}"
@@ -245,11 +246,8 @@ class Records(Sequence[T]):
         names there are."""
         k = self._named(name)
         if k is None:
-            names, (one, many) = self._names, self._noun
-            hint = did_you_mean(name, names)
-            raise KeyError(f"no {one} named {name!r}" + (
-                f"; {hint}" if hint else f" (the {many}: {name_list(names)})" if names
-                else f" (this model has no {many})"))
+            one, many = self._noun
+            raise not_found(f"{one} named", name, self._names, many, f"this model has no {many}")
         return k
 
     def _named(self, name: str) -> int | None:
@@ -314,6 +312,11 @@ class BodyRecords(Mapping[str, Body]):
 
     def __contains__(self, name: object) -> bool:  # a name: the mapping's keys
         return isinstance(name, str) and name in self._records
+
+    def get(self, name: object, default: Any = None) -> Any:
+        """The body named `name`, else `default`: a mapping's `get`, by name only (its keys
+        are the names; ``model.bodies[0]`` is by index)."""
+        return self._records[name] if isinstance(name, str) and name in self else default
 
     def __iter__(self) -> Iterator[str]:
         return iter(self._names)

@@ -4,12 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from mbody.errors import name_list
 
-def name_list(names, most: int = 5) -> str:
-    """The first `most` names, and how many more (for short reprs)."""
-    names = list(names)
-    more = len(names) - most
-    return ", ".join(names[:most]) + (f", … {more} more" if more > 0 else "")
+__all__ = ["count", "name_list", "vector_text"]
 
 
 def count(k: int, word: str, plural: str = "") -> str:

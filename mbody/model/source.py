@@ -20,7 +20,8 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from mbody.errors import MbodyError
-from mbody.model.loader import MAX_BYTES, Document, load_text, read_file
+from mbody.model.loader import Document, load_text, read_file
+from mbody.util.budget import MAX_BYTES
 
 if TYPE_CHECKING:
     from mbody.model.model import Model

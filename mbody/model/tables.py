@@ -89,7 +89,9 @@ class JointTable:
 
     names: (J,) joint names; parent, child: (J,) body index (-1 = ground); B_r_child,
     B_r_parent: (J, 3) the joint point in each body's axes (world for ground); P_E3, C_E3:
-    (J, 3, 3) the joint frame fixed in the parent and in the child; C_axis2: (J, 3) a
+    (J, 3, 3) the joint frame fixed in the parent and in the child (the contract's rule at
+    the initial pose: the assembled one when `mbody.load` assembled the model,
+    `mbody.model.build.frames_at`); C_axis2: (J, 3) a
     universal joint's child axis (else 0). first: (J,) the joint's first column of G (its
     components are consecutive). link: (J,) a particle link (its first component is T);
     particle_parent: (J,) the parent is a particle; length: (J,) the link's length (0
@@ -113,6 +115,10 @@ class JointTable:
     pitch: np.ndarray
     body_points: np.ndarray
     """(J,) the file gives the joint's point on each body (not one world point)."""
+    directed: np.ndarray
+    """(J,) the frame follows a direction fixed in the parent: the file's `axis`, or its
+    type's default one (a planar prismatic's or slot's slide direction); else the frame
+    is the world axes at the initial pose (then fixed in the parent)."""
 
     def __repr__(self) -> str:  # the dataclass's would print every array
         return (f"<JointTable: {len(self.names)} joints ({', '.join(self.names[:4])}"
@@ -136,7 +142,7 @@ class ReactionTable:
     C_axis2: (m, 3) a universal joint's child axis, child body axes (else 0).
     B_r_parent: (m, 3) the joint point on the parent, parent body axes (world for ground).
     P_E3, C_E3: (m, 3, 3) the whole joint frame fixed in the parent and in the child
-    (they coincide at the initial pose); used for position-level constraint errors.
+    (they coincide at the file's pose); used for position-level constraint errors.
     is_moment: (m,) the value is a moment (N m). link: (m,) True for a particle link's
     tension T: the force along the line from the child's attachment point to the
     parent's, constraint |P_c − P_p| = L. particle_parent: (m,) True when the parent is a

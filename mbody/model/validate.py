@@ -397,7 +397,7 @@ def _bodies(c: Checker, value: Any) -> list[BodySpec]:
             inertia = _inertia(c, (*p, "inertia"), b["inertia"])
         elif "mass" in b:
             if shape is None:
-                if "shape" not in b:
+                if "shape" not in b and (p, "inertia") not in c.meant:
                     c.err(p, "missing required key 'inertia'",
                           "give 'inertia', or a 'shape' to use a uniform solid's inertia")
             elif mass is not None:
@@ -810,12 +810,9 @@ def _joints(c: Checker, value: Any, names: dict[str, int],
             here, there = ("planar", "spatial") if c.dim == cv.PLANAR else ("spatial", "planar")
             c.err((*p, "type"), f"'{j['type']}' is a {there} joint type; a {here} model "
                   f"(dimension: {c.dim}) has: {', '.join(types)}")
-        elif isinstance(j.get("type"), str) and synonyms.get(j["type"]) in types:
-            c.err((*p, "type"), f"unknown {'planar' if c.dim == 2 else 'spatial'} joint type "
-                  f"'{j['type']}'", f"mbody calls it '{synonyms[j['type']]}'")
         elif "type" in j:
             typ = c.choice((*p, "type"), j["type"], types,
-                           f"{'planar' if c.dim == 2 else 'spatial'} joint type")
+                           f"{'planar' if c.dim == 2 else 'spatial'} joint type", synonyms)
         parent = c.body_ref((*p, "parent"), j["parent"], names, True) if "parent" in j else None
         child = c.body_ref((*p, "child"), j["child"], names, True) if "child" in j else None
         if child == cv.GROUND:

@@ -18,7 +18,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from mbody import joint_types
-from mbody.errors import MbodyError, did_you_mean
+from mbody.errors import MbodyError, did_you_mean, option_name, option_setting
 from mbody.present.draw.fonts import drawable
 from mbody.simulate.trajectory import Trajectory
 
@@ -37,14 +37,14 @@ def plot_driven(traj: Trajectory, against: str | None = None) -> Figure:
     the first driver)."""
     drivers = drivers_of(traj)
     if not drivers:
-        raise MbodyError("this run has no drivers: plot it without --against")
+        raise MbodyError(f"this run has no drivers: plot it without {option_name('against')}")
     names = [d["name"] for d in drivers]
     if against is None:
         against = names[0]
     if against != "time" and against not in names:
         hint = did_you_mean(against, ["time", *names])
-        raise MbodyError(f"--against {against!r}: expected 'time' or a driver of this run "
-                         f"({', '.join(names)})" + (f"; {hint}" if hint else ""))
+        raise MbodyError(f"{option_setting('against', against)}: expected 'time' or a driver "
+                         f"of this run ({', '.join(names)})" + (f"; {hint}" if hint else ""))
     x, xlabel = _abscissa(traj, drivers, against)
     fig = Figure(figsize=(11, 8), layout="constrained")
     FigureCanvasAgg(fig)

@@ -19,6 +19,7 @@ import numpy as np
 from mbody import conventions as cv
 from mbody.equations.assemble import Assembly
 from mbody.equations.fbd import REACTION, BodyEquations, Equation
+from mbody.util.formatting import quiet
 
 MAX_FULL = 12
 """Matrices with more rows or columns than this are shown in block form."""
@@ -55,8 +56,7 @@ def escape(text: str) -> str:
 
 def number(x: float, digits: int = 6) -> str:
     """A float as LaTeX: 6 significant digits, ``1.5\\times10^{-7}`` for exponents."""
-    x = 0.0 if abs(x) < 1e-12 else float(x)  # rounding noise from rotations
-    s = f"{x:.{digits}g}"
+    s = f"{quiet(float(x)):.{digits}g}"  # rounding noise from rotations as 0
     if s in ("-0", "0"):
         return "0"
     m = re.fullmatch(r"(-?[\d.]+)e([+-])0*(\d+)", s)

@@ -24,7 +24,7 @@ from matplotlib.figure import Figure
 from mbody import conventions as cv
 from mbody import joint_types
 from mbody.equations.world import check_axes
-from mbody.errors import MbodyError
+from mbody.errors import MbodyError, option_name, option_setting
 from mbody.present.draw.fonts import drawable
 from mbody.simulate.axes import in_world_axes
 from mbody.simulate.trajectory import Trajectory
@@ -65,6 +65,7 @@ def plot_trajectory(traj: Trajectory, bodies: list[str] | None = None) -> Figure
     a run with joint reactions their force and moment components. A panel with nothing to
     show (no moment components: a planar revolute joint, a spherical one) is left out, not
     drawn as empty axes; an odd last panel spans its row."""
+    traj.need_samples()
     names = list(bodies) if bodies else list(traj.body_names[:MAX_BODIES])
     unknown = [b for b in names if b not in traj.body_names]
     if unknown:
@@ -209,13 +210,14 @@ def save_plot(traj: Trajectory, path: str | os.PathLike[str], bodies: list[str] 
         if axes == "world":
             traj = in_world_axes(traj)
         elif saved == "world" and len(traj.reaction_labels):
+            world = option_setting("axes", "world")
             raise MbodyError("this run stores its reactions in world axes (it was made with "
-                             "--axes world), which do not give back the joint-frame "
-                             "components; plot it without --axes joint, or run it again "
-                             "without --axes world")
+                             f"{world}), which do not give back the joint-frame "
+                             f"components; plot it without {option_setting('axes', 'joint')}, "
+                             f"or run it again without {world}")
     if against is not None and (motion or not drivers_of(traj)):
-        raise MbodyError("--against applies to a run with drivers (their figure), not to "
-                         "the motion's")
+        raise MbodyError(f"{option_name('against')} applies to a run with drivers (their "
+                         "figure), not to the motion's")
     fig = (plot_driven(traj, against) if drivers_of(traj) and not motion
            else plot_trajectory(traj, bodies))
     # drawn in memory first: a writer failing half-way (a full disk) must meet a complete

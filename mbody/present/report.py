@@ -26,6 +26,7 @@ from mbody.present.answers import answers_section
 from mbody.present.draw import fbd_scene, figure_svg, graph_scene
 from mbody.present.text import body_text, joint_status, model_summary
 from mbody.util.atomic import write_atomic
+from mbody.util.formatting import num
 
 if TYPE_CHECKING:
     from mbody.answers.verify import Verification
@@ -147,8 +148,7 @@ _SYMBOLS = {"x": "a<sub>x</sub>", "y": "a<sub>y</sub>", "z": "a<sub>z</sub>",
 
 def _num(x: float) -> str:
     """As `mbody solve` prints numbers: 6 significant digits, rounding noise as 0."""
-    s = f"{0.0 if abs(x) < 1e-12 else x:.6g}"
-    return "0" if s in ("-0", "0") else s
+    return num(x)
 
 
 def _quiet(x: np.ndarray, rel: float = 1e-10) -> np.ndarray:

@@ -35,6 +35,7 @@ from mbody.present import latex, text
 from mbody.present.animate import build_scene, page_html
 from mbody.present.html import Markup, block, table, tag
 from mbody.simulate.simulation import conserved_lines
+from mbody.util.formatting import num
 
 if TYPE_CHECKING:
     from mbody.equations.assemble import Assembly, Solution
@@ -65,10 +66,8 @@ def _prefix() -> str:
 
 
 def _n(x: float) -> str:
-    """6 significant digits; rounding noise (|x| < 1e-12) written 0."""
-    x = 0.0 if abs(x) < 1e-12 else float(x)
-    s = f"{x:.6g}"
-    return "0" if s in ("-0", "0") else s
+    """6 significant digits; rounding noise written 0 (`mbody.util.formatting.num`)."""
+    return num(float(x))
 
 
 def _v(x: Any, dim: int) -> str:
@@ -182,7 +181,7 @@ def _body_parts(eq: BodyEquations, view: str = "iso") -> list[object]:
     f, dim = eq.fbd, eq.fbd.dimension
     rows = []
     for fo in f.forces:
-        name, point, comp, mom = text.force_cells(fo, dim, minus="−")  # as drawn
+        name, point, comp, mom = text.force_cells(fo, dim, minus="−", size=f.size)  # drawn
         what = (("reaction, unknown" if fo.value is None else "reaction, given")
                 if fo.kind == REACTION else "couple" if fo.couple else fo.kind)
         rows.append([name, what, point, comp, mom])

@@ -6,9 +6,11 @@ import numpy as np
 
 from mbody import conventions as cv
 from mbody.equations.assemble import Assembly, Solution
+from mbody.equations.coordinates import size
 from mbody.equations.fbd_text import body_text, force_cells
 from mbody.equations.topology import Topology
 from mbody.model.model import Model, State
+from mbody.util.formatting import LENGTH_RTOL, NOISE, quiet
 from mbody.util.formatting import clean as _clean
 from mbody.util.formatting import num as _n
 from mbody.util.formatting import table as _table
@@ -100,7 +102,8 @@ def model_summary(model: Model, topo: Topology) -> str:
     if model.file_state is not None:  # assembled at load (joint points per body, drivers)
         moved = assembly_moves(model)
         out.append("assembled pose (every joint and driver holds at t = 0): "
-                   + ("; ".join(moved) if moved else "the file's pose already did"))
+                   + "; ".join(moved) if moved else "assembled pose: the file's pose already "
+                   "satisfies every joint and driver at t = 0")
         changed = assembly_velocity_changes(model)
         if changed:  # the drivers' rates, or velocities the joints did not allow
             out.append("assembled velocities (every joint's and driver's rate holds at "
@@ -147,17 +150,21 @@ def assembly_velocity_changes(model: Model) -> list[str]:
     return out
 
 
-def pose_text(model: Model, state: State) -> str:
+def pose_text(model: Model, state: State, angle_tol: float = NOISE) -> str:
     """Each body's mass centre (world, m) and orientation at `state`: the angle about z
-    (deg) in a planar model, the quaternion (w, x, y, z) in a spatial one."""
+    (deg) in a planar model, the quaternion (w, x, y, z) in a spatial one. What the pose
+    was solved to prints as 0 below the solver's tolerance: a coordinate below
+    `LENGTH_RTOL` of the model's size, an angle (rad; a quaternion's component, half one)
+    below `angle_tol` (an equilibrium's: `mbody.solve.linearize.STEADY_RTOL`)."""
     rows = []
     planar = model.dimension == cv.PLANAR
+    length_tol = max(NOISE, LENGTH_RTOL * size(model))
     for i, name in enumerate(model.body_names):
-        x = _clean(state.position[i])
         q = state.quaternion[i]
-        turn = (f"{_n(np.degrees(2.0 * np.arctan2(q[3], q[0])))} deg" if planar
-                else "(" + ", ".join(_n(c) for c in _clean(q)) + ")")
-        rows.append([name, _v(x, model.dimension), turn])
+        angle = quiet(float(2.0 * np.arctan2(q[3], q[0])), angle_tol)
+        turn = (f"{_n(np.degrees(angle))} deg" if planar
+                else "(" + ", ".join(_n(c, angle_tol) for c in q) + ")")
+        rows.append([name, _v(state.position[i], model.dimension, length_tol), turn])
     lines = ["pose (mass centres in world axes, m):"]
     lines += _table(["body", "position", "angle" if planar else "quaternion (w, x, y, z)"],
                     rows)

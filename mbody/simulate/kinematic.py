@@ -30,7 +30,7 @@ from mbody.equations.joints import reaction_columns
 from mbody.equations.solution import singular_mass_error
 from mbody.equations.workspace import workspace
 from mbody.equations.world import check_axes
-from mbody.errors import MbodyError, did_you_mean, real_number, wrong_type
+from mbody.errors import MbodyError, did_you_mean, option_name, real_number, wrong_type
 from mbody.kernel import _core
 from mbody.model.arguments import checked_model
 from mbody.model.checks import MAX_MAGNITUDE
@@ -79,7 +79,8 @@ def sample_times(t_end: float, fps: float, t_start: float = 0.0) -> np.ndarray:
     count = int(math.floor((t_end - t_start) * fps + 1e-9)) + 1
     if count > MAX_SAMPLES:
         raise MbodyError(f"{count} samples ({t_end - t_start:g} s at {fps:g} fps) is more "
-                         f"than {MAX_SAMPLES}; lower --fps or --t-end")
+                         f"than {MAX_SAMPLES}; lower {option_name('fps')} or "
+                         f"{option_name('t_end')}")
     return t_start + np.arange(count) / fps
 
 
@@ -173,6 +174,8 @@ def kinematic_run(model: Model, t_end: float, fps: float, *, t_start: float = 0.
     t_end = real_number(t_end, "t_end", "a number of seconds")
     fps = real_number(fps, "fps", "a positive number of samples per second")
     t_start = real_number(t_start, "t_start", "a number of seconds")
+    if not math.isfinite(t_start):  # else sample_times would blame t_end
+        raise MbodyError(f"t_start must be a finite number of seconds, got {t_start:g}")
     check_axes(axes)
     t = sample_times(t_end, fps, t_start)
     require_fully_driven(model)
@@ -197,6 +200,52 @@ def kinematic_run(model: Model, t_end: float, fps: float, *, t_start: float = 0.
     if short:
         traj.info["warnings"].insert(0, short)
     return traj
+
+
+def carry(model: Model, t_from: np.ndarray, Y_from: np.ndarray, t_to: np.ndarray
+          ) -> tuple[np.ndarray, np.ndarray]:
+    """Each state ``Y_from[k]`` (the core's layout: a run's sample, `sample_states`) at
+    ``t_from[k]`` carried to ``t_to[k]`` as `kinematic_run` carries a sample to the next:
+    the Taylor step along its velocities and accelerations, Newton's method until every
+    joint and driver closes at ``t_to[k]`` (on the sample's branch), then the solve there.
+    Exact at ``t_to[k]``, not an interpolation; best from the sample just before it.
+
+    Returns
+    -------
+    (Y, lam)
+        (K, state size) the states at ``t_to``, (K, m) the reactions and drivers' efforts
+        there in joint axes (``model.reactions`` order).
+
+    Raises
+    ------
+    KinematicsError
+        The loops cannot close at one of the times (as `kinematic_run`).
+    """
+    ws = workspace(model)
+    unknowns = ws.file_unknowns
+    plan = ws.solve_plan(unknowns)
+    K, S, m = len(t_to), ws.state_size, len(model.reactions)
+    if np.any(np.asarray(t_to) < np.asarray(t_from)):
+        raise MbodyError("carry: every time to carry to must be at or after its sample's")
+    Y = np.empty((K, S))
+    lam = np.empty((K, m))
+    two_Y, two_out = np.empty((2, S)), np.empty((2, plan.o_info + _core.INFO))
+    energy, info = np.empty((2, 3)), np.empty(_core.KR_INFO)
+    for k in range(K):
+        # the core takes increasing times: at the sample itself, Newton there alone
+        t = (np.array([t_from[k], t_to[k]], dtype=float) if t_to[k] > t_from[k]
+             else np.array([t_to[k]], dtype=float))
+        y = np.array(Y_from[k], dtype=float)
+        done = plan.solver.kinematic_run(t, y, unknowns.lam, MAX_NEWTON,
+                                         newton_tolerance(model, t), two_Y[:len(t)],
+                                         two_out[:len(t)], energy[:len(t)], info)
+        if done < len(t):
+            _failed(model, float(t[done]), y, info)
+        Y[k] = two_Y[len(t) - 1]
+        lam[k] = two_out[len(t) - 1, plan.o_lam:plan.o_lam + m]
+    if model.dimension == cv.PLANAR:
+        keep_planar_angles(Y, model.n)
+    return Y, lam
 
 
 def newton_tolerance(model: Model, t: np.ndarray) -> float:
@@ -503,6 +552,32 @@ def revolution(model: Model) -> float | None:
         return None
     w = steady_rate(d.laws[0][1], np.array([0.0, 0.37, 1.1, 7.3]))
     return None if w is None else 2.0 * math.pi / abs(w)
+
+
+SAMPLES_A_TURN = 360
+"""A run's default samples a revolution of a first driver turning at a constant rate: one
+a degree (its peaks then read within 0.004 % of a sine's: `mbody.simulate.peaks`)."""
+DEFAULT_SPAN, DEFAULT_FPS = 1.0, 100.0
+"""A run's default span (s) and samples per second when no driver turns at a constant
+rate."""
+
+
+def default_fps(turn: float | None) -> float:
+    """A kinematic run's samples a second by default: `SAMPLES_A_TURN` a revolution of the
+    first driver when it turns at a constant rate, a revolution `turn` s long
+    (`revolution`), else `DEFAULT_FPS`. What ``mbody kinematics`` takes without --fps
+    (`default_sampling`), and a sweep's ``--run kinematics`` without --steps, for each
+    case at its own rate."""
+    return SAMPLES_A_TURN / turn if turn else DEFAULT_FPS
+
+
+def default_sampling(model: Model) -> tuple[float, float]:
+    """(span, fps): what a kinematic run of `model` covers by default (`mbody kinematics`
+    without --t-end and --fps, `kinematic_at` without a run): one revolution of the first
+    driver at `SAMPLES_A_TURN` samples when it turns at a constant rate, else
+    `DEFAULT_SPAN` at `DEFAULT_FPS` (`default_fps`)."""
+    turn = revolution(model)
+    return (turn or DEFAULT_SPAN, default_fps(turn))
 
 
 def summary(traj: Trajectory, path: str | None = None) -> str:

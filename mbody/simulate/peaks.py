@@ -30,6 +30,12 @@ SPARSE = "peaks sampled too sparsely"
 """How the warning of samples too sparse for the drivers' motion begins."""
 
 
+def reaction_unit(label: str) -> str:
+    """The unit of a run's reaction or effort by its label: "N m" for a moment (a
+    component ``M...``: ``O.Mz``, ``motor.M``), else "N"."""
+    return "N m" if label.rsplit(".", 1)[-1].startswith("M") else "N"
+
+
 def peaks(model: Model, traj: Trajectory) -> list[dict]:
     """Each reaction's and effort's largest magnitude over the run: label, value (signed),
     unit, time, and the first driver's coordinate then (its law at that time: degrees
@@ -44,7 +50,7 @@ def peaks(model: Model, traj: Trajectory) -> list[dict]:
         k = int(at[c])
         tk = float(traj.t[k])
         entry = {"label": label, "value": float(R[k, c]),
-                 "unit": "N m" if label.rsplit(".", 1)[-1].startswith("M") else "N",
+                 "unit": reaction_unit(label),
                  "t": tk}
         if d is not None and len(d.names):
             value = float(d.laws[0][0](tk))

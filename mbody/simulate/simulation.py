@@ -38,7 +38,14 @@ from mbody import conventions as cv
 from mbody.equations.constraints import joint_errors
 from mbody.equations.workspace import Unknowns, workspace
 from mbody.equations.world import check_axes
-from mbody.errors import MbodyError, UnknownReactionsError, did_you_mean, real_number
+from mbody.errors import (
+    MbodyError,
+    UnknownReactionsError,
+    did_you_mean,
+    option_name,
+    option_setting,
+    real_number,
+)
 from mbody.kernel import _core
 from mbody.model.arguments import (
     KnownValues,
@@ -318,10 +325,12 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
                              max_wall, time.perf_counter() - wall)
                 if max_steps is not None and steps >= max_steps:
                     raise MbodyError(_budget_message(
-                        f"the step budget: {steps} steps (--max-steps {max_steps})",
+                        f"the step budget: {steps} steps "
+                        f"({option_setting('max_steps', max_steps)})",
                         run.t, t_end, steps, rate, f"at that rate the whole run needs "
                         f"about {steps * t_end / run.t:.2g} steps" if run.t > 0 else
-                        "the steps do not advance the time", "raise --max-steps"))
+                        "the steps do not advance the time",
+                        f"raise {option_name('max_steps')}"))
                 if max_wall is not None:
                     now = time.perf_counter()
                     if first is None:  # the pace is timed from here: no start-up costs
@@ -330,11 +339,12 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
                         pace = ((now - first[1]) / (run.t - first[0]) if run.t > first[0]
                                 else (now - wall) / run.t if run.t > 0 else math.inf)
                         raise MbodyError(_budget_message(
-                            f"the wall-time budget: {now - wall:.3g} s (--max-wall "
-                            f"{max_wall:g})", run.t, t_end, steps, rate,
-                            f"at that pace the rest of the run takes about "
+                            f"the wall-time budget: {now - wall:.3g} s "
+                            f"({option_setting('max_wall', float(max_wall))})", run.t, t_end,
+                            steps, rate, f"at that pace the rest of the run takes about "
                             f"{pace * (t_end - run.t):.2g} s more" if math.isfinite(pace)
-                            else "no simulated time has passed yet", "raise --max-wall"))
+                            else "no simulated time has passed yet",
+                            f"raise {option_name('max_wall')}"))
     finally:
         bar.close()
     wall = time.perf_counter() - wall
@@ -453,12 +463,12 @@ def _predict(model: Model, method: str, t: float, t_end: float, steps: int, rate
     need_wall = elapsed * t_end / t
     if max_steps is not None and need_steps > PREDICT_FACTOR * max_steps:
         over = (f"about {need_steps:.2g} steps, more than {PREDICT_FACTOR:g} times the budget "
-                f"(--max-steps {max_steps})")
-        raise_it = "raise --max-steps"
+                f"({option_setting('max_steps', max_steps)})")
+        raise_it = f"raise {option_name('max_steps')}"
     elif max_wall is not None and need_wall > PREDICT_FACTOR * max_wall:
         over = (f"about {need_wall:.2g} s, more than {PREDICT_FACTOR:g} times the budget "
-                f"(--max-wall {max_wall:g})")
-        raise_it = "raise --max-wall"
+                f"({option_setting('max_wall', float(max_wall))})")
+        raise_it = f"raise {option_name('max_wall')}"
     else:
         return
     cause, remedies = _cost_cause(model, steps / t, method)
@@ -466,7 +476,7 @@ def _predict(model: Model, method: str, t: float, t_end: float, steps: int, rate
         f"the simulation was stopped early: after {steps} steps it is at t = {t:.3g} s of "
         f"{t_end:g} s ({rate.so_far(t, steps)}); at that rate the whole run needs {over}. "
         f"{cause} To go on: {remedies}, or {raise_it}. No trajectory is kept (rerun with "
-        f"--t-end {t:.3g} to see the motion up to here).")
+        f"{option_setting('t_end', _figure(t))} to see the motion up to here).")
 
 
 def _cost_cause(model: Model, steps_per_second: float, method: str) -> tuple[str, str]:
@@ -481,8 +491,8 @@ def _cost_cause(model: Model, steps_per_second: float, method: str) -> tuple[str
         return (f"The steps follow the fastest motion: '{model.body_names[i]}' spins at "
                 f"{spin:.3g} rad/s ({spin / (2 * math.pi):.3g} rev/s), and any integrator "
                 "must take steps shorter than a turn, so a stiff integrator would not help.",
-                "a shorter --t-end (the cost grows with it), a looser --rtol (e.g. 1e-6), "
-                "a slower spin")
+                f"a shorter {option_name('t_end')} (the cost grows with it), a looser "
+                f"{option_name('rtol')} (e.g. 1e-6), a slower spin")
     moments = np.linalg.eigvalsh(np.asarray(model.J)) if model.n else np.ones((1, 3))
     smallest = np.min(np.where(moments > 0, moments, np.inf), axis=1)  # a zero is no scale
     spread = np.where(np.isfinite(smallest), moments[:, 2] / smallest, 1.0)
@@ -494,21 +504,22 @@ def _cost_cause(model: Model, steps_per_second: float, method: str) -> tuple[str
                 "large moments by the small one, and the steps shrink to follow that noise; "
                 "no integrator steps over it.",
                 "a realistic smallest moment (a thin rod's m r^2 / 2 with its real radius), "
-                "a shorter --t-end")
+                f"a shorter {option_name('t_end')}")
     if steps_per_second <= MODEST_STEP_RATE:
         return (f"The steps are not short ({steps_per_second:.4g} per simulated second, as "
                 "smooth motion takes at these tolerances): the run is long, and its cost "
-                "grows with --t-end; a stiff integrator would not help.",
-                "a shorter --t-end, a looser --rtol (e.g. 1e-6)")
+                f"grows with {option_name('t_end')}; a stiff integrator would not help.",
+                f"a shorter {option_name('t_end')}, a looser {option_name('rtol')} (e.g. 1e-6)")
     fastest = f"{spin:.3g} rad/s" if spin > 0 else "none"
     cause = (f"That is far more steps than the motion explains (the fastest spin at the "
              f"start: {fastest}): the model is stiff (time scales far apart, such as a very "
              "stiff spring on a light body)")
     if method in IMPLICIT:
         return (cause + f", and even {method} needs short steps.",
-                "a shorter --t-end, a looser --rtol (e.g. 1e-6)")
+                f"a shorter {option_name('t_end')}, a looser {option_name('rtol')} (e.g. 1e-6)")
     return (cause + ", and an explicit integrator must resolve the fastest of them.",
-            "a stiff integrator (--method LSODA, BDF or Radau), a shorter --t-end")
+            f"a stiff integrator ({option_name('method')} LSODA, BDF or Radau), a shorter "
+            f"{option_name('t_end')}")
 
 
 MODEST_STEP_RATE = 2000.0
@@ -553,8 +564,8 @@ def _check_span(varying: list[tuple[str, Expression]], t_end: float) -> None:
                 f"{what} = \"{e.text}\" is not finite at t = {t:g} s ({bad[1]}), within the "
                 f"simulated span 0 .. {t_end:g} s: the integration could not go past it. "
                 + ("Change the expression (it is sampled every millisecond)." if t == 0 else
-                   f"Change the expression, or simulate a shorter span (--t-end below "
-                   f"{t:g})."))
+                   f"Change the expression, or simulate a shorter span ("
+                   f"{option_name('t_end')} below {t:g})."))
 
 
 def _blame_expression(varying: list[tuple[str, Expression]], t0: float, t1: float,
@@ -662,11 +673,18 @@ class _StepRate:
 def _budget_message(what: str, t: float, t_end: float, steps: int, rate: _StepRate,
                     estimate: str, raise_it: str) -> str:
     """The one paragraph a run stopped by a budget reports."""
+    t_end_ = option_name("t_end")
     return (f"the simulation stopped at {what}, at t = {t:.6g} s of {t_end:g} s: "
             f"{rate.so_far(t, steps)}; {estimate}. No trajectory is kept (rerun with "
-            f"--t-end {t:.3g} to see the motion up to here). To go on: a shorter --t-end, a "
-            "looser --rtol (e.g. 1e-8), a stiff integrator such as --method Radau if the "
-            f"model is stiff (very stiff springs), or {raise_it}.")
+            f"{option_setting('t_end', _figure(t))} to see the motion up to here). To go on: "
+            f"a shorter {t_end_}, a looser {option_name('rtol')} (e.g. 1e-8), a stiff "
+            f"integrator such as {option_setting('method', 'Radau')} if the model is stiff "
+            f"(very stiff springs), or {raise_it}.")
+
+
+def _figure(t: float) -> float:
+    """`t` to the three figures a message gives it (an end time to rerun with)."""
+    return float(f"{t:.3g}")
 
 
 def _spin_warning(traj: Trajectory, peak: np.ndarray | None = None) -> str | None:

@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from mbody.errors import MbodyError
+from mbody.errors import MbodyError, option_name, option_setting
 from mbody.kernel import _core
 from mbody.kernel.dop853 import DOP853, TOO_SMALL_STEP
 from mbody.simulate.projection import ITERATIONS, STAGE_ITERATIONS, STAGE_PIVOT_RTOL
@@ -221,8 +221,9 @@ class ScipyRun:
             raise MbodyError(
                 f"the integrator {self.method} failed at t = {solver.t:.6g} s: {exc} (its "
                 "numerical Jacobian broke down, as it can where the state barely changes). "
-                f"Try another stiff integrator (--method {others}) or looser tolerances "
-                "(e.g. --rtol 1e-6 --atol 1e-9)") from None
+                f"Try another stiff integrator ({option_name('method')} {others}) or looser "
+                f"tolerances (e.g. {option_setting('rtol', 1e-6)} "
+                f"{option_setting('atol', 1e-9)})") from None
         if solver.status == "failed":
             return k, msg
         self._steps += 1

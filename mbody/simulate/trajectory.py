@@ -34,17 +34,27 @@ import numpy as np
 
 from mbody import conventions as cv
 from mbody.errors import Issue, MbodyError, ModelError, TrajectoryFileError, real_number, wrong_type
-from mbody.model.model import State, count, loads
+from mbody.loading import loads
+from mbody.model.model import State, count
 from mbody.model.yaml_write import dump_document
 from mbody.util import jsontext
 from mbody.util.atomic import atomic_path
 from mbody.util.frozen import Frozen
-from mbody.util.npzfile import Member, NpzArchive
+from mbody.util.npzfile import Member, NpzArchive, size_text
 from mbody.util.spatial import planar_quat
 
 FORMAT = "mbody-trajectory"
 FORMAT_VERSION = 1
 """Version of the .npz layout; `load` refuses files written by a newer layout."""
+AT_LEAST_ONE_SAMPLE = "a run holds at least one sample"
+"""Why a trajectory without samples is refused (`Trajectory.need_samples`, `load`)."""
+NAME_BYTES = 1024
+"""Bytes of the read budget per name a run file may hold (its body names, its reaction
+labels): 1 Mi names at the default 1 GiB, more than a model file of the default size has
+keys and values (`mbody.model.loader.MAX_NODES`), so more than any such model has bodies
+or reaction components. Each name read becomes a Python text of some 60 bytes beyond its
+characters (where the file spends 4 bytes a character): the two lists take at most an
+eighth of the budget in memory beyond it. ``--max-bytes`` raises both."""
 
 _ARRAYS = ("t", "position", "velocity", "orientation", "angular_velocity", "reactions",
            "mass", "inertia", "gravity")
@@ -231,6 +241,25 @@ class Trajectory(Frozen):
         return State(self.position[k], self.orientation[k], self.velocity[k],
                      self.angular_velocity[k], float(self.t[k]))
 
+    def need_samples(self) -> int:
+        """K, the number of samples, for a reader that draws, exports or sums from them.
+
+        Returns
+        -------
+        int
+            K >= 1.
+
+        Raises
+        ------
+        mbody.MbodyError
+            The trajectory holds no samples: one made in code (`load` refuses a file that
+            holds none).
+        """
+        K = len(self.t)
+        if K == 0:
+            raise MbodyError(f"the trajectory holds no samples ({AT_LEAST_ONE_SAMPLE})")
+        return K
+
     def nearest_sample(self, time: float) -> int:
         """The index of the sample nearest `time` (s), within the run's span.
 
@@ -250,10 +279,9 @@ class Trajectory(Frozen):
             The run holds no samples, or `time` lies outside [t[0], t[-1]] (by more than
             rounding).
         """
-        t = np.asarray(self.t, dtype=float)
         time = real_number(time, "time", "a time in seconds")
-        if len(t) == 0:
-            raise MbodyError("the trajectory holds no samples")
+        self.need_samples()
+        t = np.asarray(self.t, dtype=float)
         span = max(abs(t[-1]), abs(t[0]), 1.0) * 1e-9
         if not (t[0] - span <= time <= t[-1] + span):
             raise MbodyError(f"time {time:g} s is outside the trajectory's span "
@@ -407,7 +435,8 @@ class Trajectory(Frozen):
     def model(self):
         """Rebuild the `Model` from the YAML text stored with the run, with the values
         that were set on it (``info["model_values"]``: `Model.with_values`, ``--set``)
-        set again: the model the run integrated.
+        set again: the model the run integrated (as `mbody.loads` reads the text: at its
+        assembled pose, with the joint frames taken there).
 
         Returns
         -------
@@ -483,7 +512,7 @@ class Trajectory(Frozen):
             A trajectory ``.npz`` file (format ``mbody-trajectory``, version at most
             `FORMAT_VERSION`).
         max_bytes : int, optional
-            The most data read, inflated (default `mbody.util.npzfile.DATA_BYTES`, 1 GiB,
+            The most data read, inflated (default `mbody.util.budget.DATA_BYTES`, 1 GiB,
             or the command line's ``--max-bytes``); a file that holds more is refused
             before any of it is inflated.
 
@@ -609,11 +638,17 @@ def _whole(z: NpzArchive, key: str) -> int:
 
 
 def _labels(z: NpzArchive, key: str) -> tuple[str, ...]:
-    """Entry `key`: a list of names (a 1-d string array), as `save` writes it."""
+    """Entry `key`: a list of names (a 1-d string array), as `save` writes it, of at most
+    one name per `NAME_BYTES` of the budget (from its header, before it is read)."""
     m = z.members[key]
     if len(m.shape) != 1 or m.dtype.kind != "U":
         raise z.damaged(f"'{key}' holds {_kind(m)}, expected a list of names")
-    return tuple(str(s) for s in z.read(key))
+    most = z.limit // NAME_BYTES
+    if m.shape[0] > most:
+        raise TrajectoryFileError(
+            f"{z.name}: '{key}' holds {m.shape[0]:,} names; at most {most:,} are read, one "
+            f"per KiB of the budget of {size_text(z.limit)} ({_MORE})")
+    return tuple(z.read(key).tolist())
 
 
 def _kind(m: Member) -> str:
@@ -631,6 +666,9 @@ def _check_shapes(z: NpzArchive, n: int, dim: int, m: int, series: list[str]) ->
         raise TrajectoryFileError(f"{name}: 't' has shape {t.shape}, expected (K,): one "
                                   "time per sample")
     K = t.shape[0]
+    if K == 0:  # every reader draws, exports or sums from a sample
+        raise TrajectoryFileError(f"{name}: damaged trajectory file: 't' holds no samples "
+                                  f"({AT_LEAST_ONE_SAMPLE})")
     d = 2 if dim == cv.PLANAR else 3
     want = {"position": (K, n, d), "velocity": (K, n, d),
             "orientation": (K, n) if d == 2 else (K, n, 4),

@@ -21,7 +21,7 @@ import numpy as np
 
 from mbody.equations.solution import METHODS, ReactionValues, Solution, singular_mass_error
 from mbody.equations.workspace import workspace
-from mbody.errors import MbodyError, MbodyTypeError, did_you_mean, wrong_type
+from mbody.errors import MbodyError, MbodyTypeError, not_found, wrong_type
 from mbody.kernel import _core
 from mbody.model.arguments import checked_model, checked_state
 from mbody.model.model import Model, State
@@ -218,7 +218,7 @@ class Solutions:
         (K,) array
         """
         if label not in self.reactions:
-            raise KeyError(f"no reaction {label!r}; {did_you_mean(label, self.reactions)}")
+            raise not_found("reaction", label, self.reactions, "reactions")
         return self.values[:, self.reactions.index(label)]
 
     def __repr__(self) -> str:

@@ -34,6 +34,7 @@ from mbody.errors import MbodyError
 from mbody.kernel import _core
 from mbody.model.model import Model, State
 from mbody.model.values import plain
+from mbody.solve.kinematics import assembled, placed
 
 
 @dataclass(frozen=True, eq=False)
@@ -181,16 +182,22 @@ class Family:
 
     def _probe_model(self, values: Mapping[str, Any]) -> Packed:
         """The model with `values` set, read and checked in full, packed. Its last step
-        (`Model.with_values`' assembly at t = 0, which also checks that the drivers are
-        independent of the joints) is left to the core when the joints and the pose are
-        the base's (then it says nothing new, and its state is not what is packed: the
-        file's is); otherwise it is taken, and any problem it finds refuses the value."""
+        is `Model.with_values`' assembly at t = 0, which checks that the drivers are
+        independent of the joints, moves the bodies (the state packed is the file's all
+        the same: the core assembles a case itself) and takes the joint frames at the
+        assembled pose (`mbody.model.build.frames_at`): those are packed. When the joints
+        and the pose are the base's, the check says nothing new and is skipped
+        (`mbody.solve.kinematics.placed`); the frames are still taken, since the
+        assembled pose depends on the masses and the drivers' values too. Any problem the
+        step finds refuses the value."""
         model = self.model.edited(values)
         got = pack(model, self.base)
-        if got.ranks is self.base.ranks:  # the base's geometry: nothing new to check
-            return got
         finish = model.source.finish if model.source is not None else None
-        return pack(finish(model), self.base) if finish is not None else got
+        if finish is None:
+            return got
+        if got.ranks is self.base.ranks and finish is assembled:  # the base's geometry
+            return pack(placed(model), self.base)
+        return pack(finish(model), self.base)
 
     def _overlap(self, paths: Sequence[str]) -> bool:
         """Whether two of `paths` touch a common entry (then they may not act apart)."""

@@ -29,6 +29,7 @@ from mbody.equations.workspace import workspace
 from mbody.errors import Issue, MbodyError, ModelError
 from mbody.kernel import _core
 from mbody.model.arguments import checked_model, checked_state
+from mbody.model.build import frames_at
 from mbody.model.model import Model, State
 
 NEWTON_STEPS = 60
@@ -193,12 +194,26 @@ def assembled(model: Model) -> Model:
     the file asks for it: joint points given on each body, or drivers (whose laws at 0
     may differ from the file's pose). Otherwise `model` itself: a model written with
     world joint points is where the file puts it (`check` warns when it breaks a joint).
-    The file's own state is kept as `model.file_state`."""
-    needs = (model.drivers is not None and len(model.drivers) > 0) or bool(
-        model.joint_table.body_points.any())
-    if not needs or not len(model.reactions):
+    The file's own state is kept as `model.file_state`; the joint frames are the
+    contract's rule at the assembled pose (`mbody.model.build.frames_at`)."""
+    if not _assembles(model):
         return model
     check_drivers(model)
+    return placed(model)
+
+
+def _assembles(model: Model) -> bool:
+    """Whether `mbody.load` assembles `model` (`assembled`)."""
+    return ((model.drivers is not None and len(model.drivers) > 0)
+            or bool(model.joint_table.body_points.any())) and bool(len(model.reactions))
+
+
+def placed(model: Model) -> Model:
+    """`assembled` without its check that each driver adds an independent constraint (a
+    caller that knows it: `mbody.solve.family`, for a model whose joints and file pose
+    are those of one already checked)."""
+    if not _assembles(model):
+        return model
     try:
         state = kinematics(model, 0.0)
     except KinematicsError as exc:
@@ -211,4 +226,7 @@ def assembled(model: Model) -> Model:
             model.file, line, col, key, str(exc),
             "check the joints' points on each body and the drivers' values at t = 0")]
         ) from None
-    return dataclasses.replace(model, initial=state, file_state=model.initial)
+    joints, table = frames_at(model.joints, model.reaction_table, model.dimension,
+                              model.initial, state, CLOSE_RTOL)
+    return dataclasses.replace(model, initial=state, file_state=model.initial, joints=joints,
+                               reaction_table=table)

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mbody.errors import MbodyError
+from mbody.errors import MbodyError, option_name, option_setting
 from mbody.sweep.runs import Job, Rows, Sparsest, run_chunk
 from mbody.sweep.table import Results
 
@@ -215,7 +215,8 @@ def _on_dask(job: Job, todo: list[int], per_case: float, chunk: int | None,
         from dask.distributed import Client, LocalCluster, as_completed
     except ImportError:
         raise MbodyError("sweeps run on Dask (dask.distributed): pip install 'mbody[sweep]' "
-                         "(or --workers 0 to run them in this process)") from None
+                         f"(or {option_setting('workers', 0)} to run them in this process)"
+                         ) from None
     cluster = None
     try:
         if scheduler is None:
@@ -232,17 +233,17 @@ def _on_dask(job: Job, todo: list[int], per_case: float, chunk: int | None,
             except (RuntimeError, OSError, TimeoutError) as exc:  # a worker that never came up
                 raise MbodyError(
                     f"could not start a local Dask cluster of {n} worker process(es) ({exc}); "
-                    "the machine may be short of memory or busy: give fewer --workers, or "
-                    "--workers 0 to run the cases in this process (the same command "
-                    "resumes)") from None
+                    "the machine may be short of memory or busy: give fewer "
+                    f"{option_name('workers')}, or {option_setting('workers', 0)} to run the "
+                    "cases in this process (the same sweep resumes)") from None
             report.where = f"a local cluster of {n} worker processes"
         else:
             try:
                 client = Client(scheduler, timeout=CONNECT_SECONDS, set_as_default=False)
                 client.wait_for_workers(1, timeout=CONNECT_SECONDS)
             except (OSError, TimeoutError) as exc:
-                raise MbodyError(f"--scheduler {scheduler}: no cluster answered ({exc})"
-                                 ) from None
+                raise MbodyError(f"{option_setting('scheduler', scheduler)}: no cluster "
+                                 f"answered ({exc})") from None
             n = len(client.scheduler_info()["workers"])
             report.where = f"the cluster at {scheduler} ({n} workers)"
         report.workers = n

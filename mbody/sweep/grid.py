@@ -26,12 +26,15 @@ from typing import Any
 
 import numpy as np
 
-from mbody.errors import MbodyError
+from mbody.errors import MbodyError, given_twice, option_entry, option_name
 from mbody.model.values import parse_assignment, parse_value, plain
 
 MAX_CASES = 100_000_000
 """Most cases one sweep holds (a grid's size is the product of its axes' counts)."""
-_NUMBER = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S.*?)?\s*")
+_NUMBER = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*"
+                     r"([A-Za-z°µ][\w°µ²/^ ]*?)?\s*")
+"""A number, and the unit written after it (``300 rpm``, ``2 kg m^2``; a unit starts with a
+letter: ``2*t`` is an expression, not 2 in a unit ``*t``)."""
 
 
 @dataclass(frozen=True)
@@ -47,7 +50,9 @@ class Axis:
     count : int
         A range's number of grid values (0: drawn at random, or a listed axis).
     unit : str
-        A range's unit as written (``rpm``), '' for none.
+        The unit the values were written in (``rpm``: a range ``300 rpm:1200 rpm:4``, or
+        values listed each with it, ``300 rpm,600 rpm``), '' for none: the values are
+        then numbers, the unit in the column's name (`column`).
     listed : bool
         The values are listed (``[a, b, c]``), not a range.
     """
@@ -57,6 +62,12 @@ class Axis:
     count: int = 0
     unit: str = ""
     listed: bool = False
+
+    @property
+    def column(self) -> str:
+        """The results' column of the axis: its path as given, with the unit its values
+        were written in, ``drivers.motor.speed [rpm]`` (the column holds numbers)."""
+        return f"{self.path} [{self.unit}]" if self.unit else self.path
 
     @property
     def size(self) -> int:
@@ -76,10 +87,6 @@ class Axis:
         # double holds 15 digits exactly)
         x = hi if k == self.count - 1 else float(k) * ((hi - lo) / (self.count - 1)) + lo
         return float(f"{x:.15g}")
-
-    def grid_values(self) -> list[Any]:
-        """The axis's values in grid order (as the results' column shows them)."""
-        return [self.value(k) for k in range(self.size)]
 
     def drawn(self, u: float) -> Any:
         """The value a uniform number u in [0, 1) draws (a random sample)."""
@@ -119,6 +126,16 @@ class Grid:
     @property
     def paths(self) -> tuple[str, ...]:
         return tuple(a.path for a in self.axes)
+
+    @property
+    def columns(self) -> tuple[str, ...]:
+        """The results' columns of the axes (`Axis.column`: a unit in the name)."""
+        return tuple(a.column for a in self.axes)
+
+    def shown(self, index: int) -> str:
+        """Case `index`'s values in a message: ``drivers.motor.speed=3000.0 rpm, ...``."""
+        return ", ".join(f"{a.path}={a.for_file(x)}" for a, x in
+                         zip(self.axes, self.numbers(index), strict=True))
 
     @property
     def cases(self) -> int:
@@ -177,7 +194,8 @@ def parse_grid(specs: Sequence[str], samples: int | None = None, seed: int = 0) 
         or more than `MAX_CASES` cases.
     """
     # each spec read as it comes: its errors in the order given
-    return _grid((parse_assignment(spec) for spec in specs), samples, seed)
+    return _grid(((*parse_assignment(spec, option_name("values")), None)
+                  for spec in specs), samples, seed)
 
 
 def grid_of(values: Mapping[str, Any] | Sequence[str] | str, samples: int | None = None,
@@ -219,7 +237,7 @@ def grid_of(values: Mapping[str, Any] | Sequence[str] | str, samples: int | None
                              "{'bodies.rod.mass': [0.4, 0.8]}) or --set texts (such as "
                              f"['bodies.rod.mass=0.3:1.2:10']), got {_shown(bad)}")
         return parse_grid(values, samples, seed)
-    entries: list[tuple[str, Any]] = []
+    entries: list[tuple[str, Any, str]] = []
     for path, value in values.items():
         if not isinstance(path, str) or not path.strip():
             raise MbodyError(f"the sweep's values: a path is text such as 'bodies.rod.mass', "
@@ -228,7 +246,7 @@ def grid_of(values: Mapping[str, Any] | Sequence[str] | str, samples: int | None
             value = plain(list(value))  # the values one per case (a range, an array too)
         elif not isinstance(value, str):
             value = plain(value)
-        entries.append((path.strip(), value))
+        entries.append((path.strip(), value, path))
     return _grid(entries, samples, seed)
 
 
@@ -238,23 +256,28 @@ def _shown(value: Any) -> str:
     return f"{text[:60]}{'...' if len(text) > 60 else ''} ({type(value).__name__})"
 
 
-def _grid(entries: Iterable[tuple[str, Any]], samples: int | None, seed: int) -> Grid:
-    """The `Grid` of (path, value) pairs: text as ``--set`` writes it after the ``=``, or
-    a Python value (`grid_of`)."""
+def _grid(entries: Iterable[tuple[str, Any, str | None]], samples: int | None, seed: int
+          ) -> Grid:
+    """The `Grid` of (path, value, key) triples: text as ``--set`` writes it after the
+    ``=``, or a Python value; `key` is a mapping's key as given (`grid_of`), None for a
+    ``--set`` text. Messages name an entry as the caller gives it (``--set PATH`` on the
+    command line, ``values['PATH']`` in Python: `mbody.errors.option_entry`)."""
     axes: list[Axis] = []
     fixed: dict[str, Any] = {}
-    seen: set[str] = set()
-    for path, value in entries:
+    seen: dict[str, str | None] = {}
+    for path, value, key in entries:
         if path in seen:
-            raise MbodyError(f"--set {path} is given twice")
-        seen.add(path)
+            # keys of a mapping that differ only in the spaces around them
+            how = f"as {seen[path]!r} and {key!r}" if key is not None else ""
+            raise given_twice(option_entry("values", path), how)
+        seen[path] = key
         if not isinstance(value, str):
             if not isinstance(value, list):
                 fixed[path] = value
             elif not value:
-                raise MbodyError(f"--set {path}: no values (an empty list)")
+                raise MbodyError(f"{option_entry('values', path)}: no values (an empty list)")
             else:
-                axes.append(Axis(path, tuple(value), listed=True))
+                axes.append(_listed(path, _finite(value, path)))
             continue
         text = value
         parts = _top_level(text, ",")
@@ -262,22 +285,62 @@ def _grid(entries: Iterable[tuple[str, Any]], samples: int | None, seed: int) ->
             axes.append(_range(path, text, samples is not None))
         elif len(parts) > 1:
             if any(not p.strip() for p in parts):
-                raise MbodyError(f"--set {path}: an empty value in the list {text!r}")
-            axes.append(Axis(path, tuple(parse_value(p, path) for p in parts), listed=True))
+                raise MbodyError(f"{option_entry('values', path)}: an empty value in the list "
+                                 f"{text!r}")
+            listed = [parse_value(p, path) for p in parts]
+            axes.append(_listed(path, _finite(listed, path)))
         else:
             fixed[path] = parse_value(text, path)
     if not axes:
-        raise MbodyError("a sweep varies at least one value: --set PATH=START:STOP:COUNT "
-                         "(for example bodies.rod.mass=0.3:1.2:10)")
+        raise MbodyError(f"a sweep varies at least one value: "
+                         f"{option_entry('values', 'PATH')}=START:STOP:COUNT (for example "
+                         "bodies.rod.mass=0.3:1.2:10)")
     if samples is not None and samples < 1:
-        raise MbodyError(f"--samples: expected at least 1 case, got {samples}")
+        raise MbodyError(f"{option_name('samples')}: expected at least 1 case, got {samples}")
     grid = Grid(tuple(axes), fixed, samples, seed)
     size = grid.cases  # from the counts: no value is made before this bound
     if size > MAX_CASES:
         raise MbodyError(f"the sweep has {_spaced(size)} cases; at most "
                          f"{_spaced(MAX_CASES)} are run (fewer values per axis, or "
-                         "--samples N)")
+                         f"{option_name('samples', 'N', 'N')})")
     return grid
+
+
+def _listed(path: str, values: list[Any]) -> Axis:
+    """The axis of values listed for `path`: each written with one unit (``300 rpm``,
+    ``600 rpm``) is that number, the unit in the column's name, as a range's; else the
+    values as given (numbers, vectors, expressions, units that differ)."""
+    units, numbers = set(), []
+    for value in values:
+        m = _NUMBER.fullmatch(value) if isinstance(value, str) else None
+        if m is None or not m.group(2):
+            return Axis(path, tuple(values), listed=True)
+        units.add(m.group(2))
+        numbers.append(float(m.group(1)))
+    if len(units) != 1 or not all(map(math.isfinite, numbers)):
+        return Axis(path, tuple(values), listed=True)
+    return Axis(path, tuple(numbers), unit=units.pop(), listed=True)
+
+
+def _finite(values: list[Any], path: str) -> list[Any]:
+    """`values` (one per case) of `path`, refused at the first number in one that is not
+    finite (NaN, inf; also inside a vector), as a range's end is: such a case could only
+    fail."""
+    def bad(x: Any) -> Any:
+        if isinstance(x, float) and not math.isfinite(x):
+            return x
+        items = x.values() if isinstance(x, dict) else x if isinstance(x, list) else ()
+        return next((b for b in map(bad, items) if b is not None), None)
+
+    for k, value in enumerate(values):
+        x = bad(value)
+        if x is not None:
+            where = (f" (value {k + 1} of {len(values)}"
+                     + (f": {value!r}" if value is not x else "") + ")"
+                     if len(values) > 1 else "")
+            raise MbodyError(f"{option_entry('values', path)}: expected a finite number, got "
+                             f"{x!r}{where}")
+    return values
 
 
 def _spaced(n: int) -> str:
@@ -304,38 +367,40 @@ def _top_level(text: str, sep: str) -> list[str]:
 
 
 def _range(path: str, text: str, random: bool) -> Axis:
+    entry = option_entry("values", path)  # --set PATH on the command line
     parts = text.split(":")
     form = "START:STOP" if random else "START:STOP:COUNT"
     example = f"{path}=0.3:1.2" if random else f"{path}=0.3:1.2:10"
     if len(parts) != (2 if random else 3):
-        extra = " (with --samples, the count is the number of samples)" if random else ""
-        raise MbodyError(f"--set {path}: expected {form}, such as {example}; got {text!r}"
+        extra = (f" (with {option_name('samples')}, the count is the number of samples)"
+                 if random else "")
+        raise MbodyError(f"{entry}: expected {form}, such as {example}; got {text!r}"
                          + extra)
     ends, units = [], []
     for part in parts[:2]:
         m = _NUMBER.fullmatch(part)
         if not m:
-            raise MbodyError(f"--set {path}: {part.strip()!r} is not a number (a range is "
+            raise MbodyError(f"{entry}: {part.strip()!r} is not a number (a range is "
                              f"{form}, such as {example})")
         x = float(m.group(1))
         if not math.isfinite(x):
-            raise MbodyError(f"--set {path}: expected a finite number, got {part.strip()!r}")
+            raise MbodyError(f"{entry}: expected a finite number, got {part.strip()!r}")
         ends.append(x)
         units.append(m.group(2) or "")
     if units[0] != units[1]:
-        raise MbodyError(f"--set {path}: the range's ends have different units "
+        raise MbodyError(f"{entry}: the range's ends have different units "
                          f"({units[0] or 'none'} and {units[1] or 'none'})")
     count = 0
     if not random:
         try:
             count = int(parts[2].strip())
         except ValueError:
-            raise MbodyError(f"--set {path}: the count {parts[2].strip()!r} is not a whole "
+            raise MbodyError(f"{entry}: the count {parts[2].strip()!r} is not a whole "
                              f"number (a range is {form})") from None
         if count < 1:
-            raise MbodyError(f"--set {path}: expected a count of at least 1, got {count}")
+            raise MbodyError(f"{entry}: expected a count of at least 1, got {count}")
         if count == 1 and ends[0] != ends[1]:  # one value cannot span both ends
-            raise MbodyError(f"--set {path}: a count of 1 is one value, and {parts[0].strip()}"
+            raise MbodyError(f"{entry}: a count of 1 is one value, and {parts[0].strip()}"
                              f" and {parts[1].strip()} are two; give a count of 2 or more, or "
-                             f"the value alone (--set {path}={parts[0].strip()})")
+                             f"the value alone ({entry}={parts[0].strip()})")
     return Axis(path, (ends[0], ends[1]), count, units[0])

@@ -1,6 +1,7 @@
-"""The ``modes`` run: a case's natural frequencies and what `mbody modes` says with them:
-whether the state linearised about is an equilibrium (or a steady motion), and if so
-whether it is stable.
+"""The ``modes`` run: a case's natural frequencies, the rates at which its modes that
+grow grow, and what `mbody modes` says with them: whether the state linearised about is
+an equilibrium (or a steady motion), and if so whether it is stable (``true`` or
+``false`` in the results, empty when there is no verdict).
 
 By default each case is linearised about its initial state (`mbody.linearize`), as
 ``mbody modes MODEL`` does: when that state is not at rest (a pendulum released from 30
@@ -16,16 +17,26 @@ from collections.abc import Iterable, Sequence
 
 import numpy as np
 
+from mbody.errors import option_name
 from mbody.model.model import Model
 from mbody.solve.equilibrium import equilibrium as equilibrium_state
 from mbody.solve.linearize import Linearization, free_coordinates, linearize
 
+FREQUENCY = "frequency:"
+"""The prefix of the natural frequencies' columns, ``frequency:1`` ... (rad/s,
+ascending; empty beyond the oscillations)."""
+GROWTH = "growth:"
+"""The prefix of the growth rates' columns, ``growth:1`` ... (1/s, largest first; empty
+beyond the modes that grow, so all empty when none does): Re λ of each mode that grows,
+a small motion's e-folding rate (`growth_rates`)."""
 STEADY = "steady"
-"""The column: 1 when the state is an equilibrium or a steady motion (`Linearization.
-steady`), 0 when not (no verdict: the tangent system at that instant)."""
+"""The column: true when the state is an equilibrium or a steady motion (`Linearization.
+steady`), false when not (no verdict: the tangent system at that instant)."""
 STABLE = "stable"
-"""The column: 1 stable, 0 unstable (a mode grows), empty when there is no verdict
-(`Linearization.stable` None)."""
+"""The column: true stable, false unstable (a mode grows), empty when there is no
+verdict (`Linearization.stable` None)."""
+FLAGS = (STEADY, STABLE)
+"""The columns written ``true`` or ``false`` (or empty), not as numbers."""
 POSE = "equilibrium:"
 """The prefix of the equilibrium's position coordinates (``equilibrium`` runs only)."""
 
@@ -45,12 +56,31 @@ def linearization(model: Model, equilibrium: bool = False) -> Linearization:
 
 def mode_count(model: Model) -> int:
     """How many natural frequencies the model can have: one per free coordinate (its
-    degrees of freedom less its drivers), the columns ``frequency:1`` ... of a sweep."""
+    degrees of freedom less its drivers), the columns ``frequency:1`` ... of a sweep, and
+    as many ``growth:`` columns."""
     return len(free_coordinates(model))
 
 
+def columns(model: Model) -> list[str]:
+    """The ``modes`` run's columns before the equilibrium's pose: ``frequency:k``,
+    ``growth:k``, `STEADY`, `STABLE`."""
+    k = mode_count(model)
+    return ([f"{FREQUENCY}{i + 1}" for i in range(k)] + [f"{GROWTH}{i + 1}" for i in range(k)]
+            + [STEADY, STABLE])
+
+
+def growth_rates(lin: Linearization) -> np.ndarray:
+    """Re λ (1/s) of each mode that grows, largest first: a real λ > 0 (a motion that
+    runs away, as a spin about the intermediate axis) or an oscillation whose amplitude
+    grows, each beyond its eigenvalue's error bound (what makes `Linearization.stable`
+    False). A small motion of that mode grows as e^(Re λ t)."""
+    rates = [m.eigenvalue.real for m in lin.modes if m.eigenvalue.real > 0.0]
+    return np.array(sorted(rates, reverse=True), dtype=float)
+
+
 def verdict_values(lin: Linearization) -> tuple[float, float]:
-    """(steady, stable) as a row holds them: 1.0 or 0.0, and NaN for no verdict."""
+    """(steady, stable) as a row holds them: 1.0 (true) or 0.0 (false), NaN for no
+    verdict; the results write them as `FLAGS`."""
     stable = lin.stable
     return (1.0 if lin.steady else 0.0,
             np.nan if stable is None else (1.0 if stable else 0.0))
@@ -65,12 +95,12 @@ def not_steady_warning(header: Sequence[str], rows: Iterable[Sequence[str]],
         return None
     at = list(header).index(STEADY)
     rows = list(rows)
-    count = sum(1 for r in rows if r[at] not in ("", "1.0", "1"))
+    count = sum(1 for r in rows if r[at] == "false")
     if not count:
         return None
     about = "the equilibrium found" if equilibrium else "the initial state"
-    hint = "" if equilibrium else ("; --equilibrium linearises each about the static "
-                                   "equilibrium nearest its initial pose")
+    hint = "" if equilibrium else (f"; {option_name('equilibrium', 'True')} linearises each "
+                                   "about the static equilibrium nearest its initial pose")
     return (f"{about} of {count} of {len(rows)} cases is not an equilibrium or a steady "
-            f"motion ({STEADY} = 0): their frequencies are those of the tangent system at "
+            f"motion ({STEADY} = false): their frequencies are those of the tangent system at "
             f"that instant, and there is no verdict ({STABLE} empty){hint}")

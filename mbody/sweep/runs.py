@@ -3,14 +3,18 @@ output columns.
 
 - ``solve``: one solve at each case's initial state; columns ``acceleration:<coordinate>``
   and ``reaction:<label>``.
-- ``kinematics``: the kinematic analysis at `steps` instants from 0 to T, each from the
-  previous one, then a solve at each (a driven mechanism's kinetostatics); columns
-  ``final:<coordinate>`` and ``peak:<label>``.
+- ``kinematics``: the kinematic analysis at instants from 0 to T, each from the previous
+  one, then a solve at each (a driven mechanism's kinetostatics); columns
+  ``final:<coordinate>`` and ``peak:<label>``. The instants are ``mbody kinematics``'s
+  by default (`instants`: one a degree of the first driver, at each case's own rate,
+  when it turns at a constant rate, else 100 a second; and T), or `steps` of them evenly
+  spaced.
 - ``simulate``: `mbody.simulate` to T; the same columns.
 - ``modes``: the natural frequencies about the initial state (or, with `equilibrium`,
   about the static equilibrium nearest it), and what ``mbody modes`` says with them;
-  columns ``frequency:<k>``, ``steady`` and ``stable`` (`mbody.sweep.modes`), and with
-  `equilibrium` the equilibrium's position coordinates ``equilibrium:<coordinate>``.
+  columns ``frequency:<k>``, ``growth:<k>``, ``steady`` and ``stable``
+  (`mbody.sweep.modes`), and with `equilibrium` the equilibrium's position coordinates
+  ``equilibrium:<coordinate>``.
 
 ``final:`` is the last instant's position coordinate (planar ``x``, ``y`` in m and
 ``theta`` in rad, in (−π, π]; spatial ``x``, ``y``, ``z`` and the attitude's quaternion
@@ -39,11 +43,17 @@ import numpy as np
 
 from mbody import conventions as cv
 from mbody.equations.solution import singular_mass_error
-from mbody.errors import MbodyError
+from mbody.errors import MbodyError, option_name, option_setting, options_named
 from mbody.kernel import _core
 from mbody.model.model import Model, State, from_source
 from mbody.model.source import Source
-from mbody.simulate.kinematic import require_fully_driven
+from mbody.simulate.kinematic import (
+    default_fps,
+    last_sample_warning,
+    require_fully_driven,
+    revolution,
+    sample_times,
+)
 from mbody.simulate.peaks import PEAK_SAMPLES, samples_a_turn, sparse_text, steady_turning
 from mbody.simulate.simulation import simulate
 from mbody.solve.batch import Evaluator, closed
@@ -51,6 +61,8 @@ from mbody.solve.family import Case, Family
 from mbody.solve.kinematics import kinematics as kinematics_at
 from mbody.sweep import modes
 from mbody.sweep.grid import Grid
+from mbody.sweep.limits import LIMITS
+from mbody.util.formatting import number
 
 RUNS = ("solve", "kinematics", "simulate", "modes")
 """What ``--run`` names."""
@@ -71,8 +83,9 @@ class Settings:
     revolutions : float or None
         Or the end as turns of the first driver that turns (``--t-end "1 rev"``): the
         time it takes at its rate at t = 0, in each case.
-    steps : int
-        The ``kinematics`` run's instants, from 0 to the end (both included).
+    steps : int or None
+        The ``kinematics`` run's instants, from 0 to the end (both included), evenly
+        spaced; None: as ``mbody kinematics`` samples each case (`instants`).
     fps : float
         The ``simulate`` run's samples per second.
     equilibrium : bool
@@ -83,7 +96,7 @@ class Settings:
     run: str = "solve"
     t_end: float | None = None
     revolutions: float | None = None
-    steps: int = 101
+    steps: int | None = None
     fps: float = 60.0
     equilibrium: bool = False
 
@@ -98,6 +111,9 @@ class Job:
     grid: Grid
     settings: Settings
     key: str
+    names: dict[str, str] = field(default_factory=dict)
+    """How the caller names the arguments (`mbody.errors.option_names`: the command's
+    flags, or {} from Python): a case's error reads the same on every worker."""
 
 
 @dataclass
@@ -125,12 +141,13 @@ class Rows:
 class Sparsest:
     """A case sampled fewer than `PEAK_SAMPLES` times a revolution of a driver turning
     at a steady rate: that many samples (first: the fewest compare lowest), the case, the
-    driver's name and its rate (rad/s)."""
+    driver's name, its rate (rad/s) and the case's run (s)."""
 
     per_turn: float
     case: int
     driver: str
     rate: float
+    span: float = 0.0
 
 
 def final_labels(model: Model) -> list[str]:
@@ -166,8 +183,7 @@ def columns(model: Model, settings: Settings) -> list[str]:
         return ([f"acceleration:{c}" for c in model.coordinates]
                 + [f"reaction:{r}" for r in model.reactions])
     if settings.run == "modes":
-        return ([f"frequency:{k + 1}" for k in range(modes.mode_count(model))]
-                + [modes.STEADY, modes.STABLE]
+        return (modes.columns(model)
                 + ([f"{modes.POSE}{c}" for c in final_labels(model)]
                    if settings.equilibrium else []))
     return ([f"final:{c}" for c in final_labels(model)]
@@ -180,9 +196,24 @@ def turning_driver(model: Model) -> int:
     for i, comp in enumerate(drivers.component if drivers is not None else ()):
         if comp == "M":
             return i
-    raise MbodyError("--t-end in revolutions needs a driver that turns a joint (an angle "
-                     "or a speed about an axis); this model has none: give the time in "
-                     "seconds")
+    raise MbodyError(f"an end in turns ({turns_end('N')}) needs a driver that turns a joint "
+                     "(an angle or a speed about an axis); this model has none: give the time "
+                     f"in seconds ({option_name('t_end', 'SECONDS', 'SECONDS')})")
+
+
+def _an_end() -> str:
+    """The arguments that give a run its end, as the caller names them."""
+    seconds, turns = option_name("t_end"), option_name("revolutions")
+    if seconds == turns:  # the command line's one --t-end takes both
+        return f"{seconds} (seconds, or '1 rev')"
+    return f"{seconds} (seconds) or {turns} (turns)"
+
+
+def turns_end(n: str) -> str:
+    """An end of `n` turns as the caller gives it: ``--t-end 'N rev'`` on the command
+    line, ``revolutions=N`` in Python (`mbody.errors.option_name`)."""
+    flag = option_name("revolutions")
+    return f"{flag} '{n} rev'" if flag != "revolutions" else f"revolutions={n}"
 
 
 def check_settings(model: Model, settings: Settings) -> None:
@@ -190,16 +221,18 @@ def check_settings(model: Model, settings: Settings) -> None:
     if settings.run not in RUNS:
         raise MbodyError(f"unknown run {settings.run!r}; expected one of {', '.join(RUNS)}")
     if settings.equilibrium and settings.run != "modes":
-        raise MbodyError(f"--equilibrium goes with --run modes (it linearises each case about "
+        raise MbodyError(f"{option_name('equilibrium', 'True')} goes with "
+                         f"{option_setting('run', 'modes')} (it linearises each case about "
                          f"its static equilibrium); the {settings.run} run starts from each "
                          "case's initial state")
     if settings.run in ("kinematics", "simulate"):
         if settings.t_end is None and settings.revolutions is None:
-            raise MbodyError(f"the {settings.run} run needs --t-end (seconds, or '1 rev')")
+            raise MbodyError(f"the {settings.run} run needs {_an_end()}")
         if settings.revolutions is not None:
             turning_driver(model)
-    if settings.run == "kinematics" and settings.steps < 2:
-        raise MbodyError(f"--steps: expected at least 2 instants, got {settings.steps}")
+    if settings.run == "kinematics" and settings.steps is not None and settings.steps < 2:
+        raise MbodyError(f"{option_name('steps')}: expected at least 2 instants, got "
+                         f"{settings.steps}")
     if settings.run == "kinematics":  # as `mbody kinematics` refuses it (--run simulate)
         require_fully_driven(model)
 
@@ -220,6 +253,10 @@ class Context:
     """Where the entries of F that a fully driven motion depends on start (joints,
     components, expression numbers: after gravity, bodies, loads and springs)."""
     cache: dict[str, Any] = field(default_factory=dict)
+    turns_steadily: bool = False
+    """The first driver turns at a constant rate (`revolution`): a ``kinematics`` run
+    without `Settings.steps` samples each case `SAMPLES_A_TURN` times a revolution of it,
+    at the case's own rate (its values set the rate, not the law's form)."""
     turning: list[int] = field(default_factory=list)
     """The drivers that turn at a steady rate (in the model as read; a case's values set
     their rates, not their laws' form), whose samples a revolution `sampling` checks, for
@@ -240,7 +277,8 @@ def context(job: Job) -> Context:
         driver = turning_driver(model) if job.settings.revolutions is not None else -1
         ctx = Context(job, model, Family(model, job.grid.paths), Evaluator(model), len(cols),
                       driver, 3 + _core.BODY_W * n + _core.LOAD_W * k + _core.SPRING_W * s,
-                      turning=_steady_turning(model, job.settings))
+                      turning=_steady_turning(model, job.settings),
+                      turns_steadily=revolution(model) is not None)
         while len(_CONTEXTS) >= _KEEP:
             _CONTEXTS.pop(next(iter(_CONTEXTS)))
         _CONTEXTS[job.key] = ctx
@@ -248,7 +286,13 @@ def context(job: Job) -> Context:
 
 
 def run_chunk(job: Job, indices: Sequence[int]) -> Rows:
-    """Evaluate cases `indices` of `job` (what a worker runs)."""
+    """Evaluate cases `indices` of `job` (what a worker runs), its errors naming the
+    arguments as the caller does (`Job.names`), wherever it runs."""
+    with options_named(job.names):
+        return _run_chunk(job, indices)
+
+
+def _run_chunk(job: Job, indices: Sequence[int]) -> Rows:
     import os
     import socket
 
@@ -311,8 +355,8 @@ def sampling(ctx: Context, indices: Sequence[int], cases: Sequence[Case | None],
              errors: Sequence[str | None]) -> tuple[int, Sparsest | None]:
     """(how many of the cases that ran have fewer than `PEAK_SAMPLES` samples a
     revolution of a driver turning at a steady rate, the one with the fewest): a
-    ``kinematics`` run has (steps - 1) / T samples a second, a ``simulate`` run fps; each
-    driver's rate is the case's at t = 0."""
+    ``kinematics`` run has (steps - 1) / T samples a second, or its default's
+    (`per_second`), a ``simulate`` run fps; each driver's rate is the case's at t = 0."""
     s = ctx.job.settings
     drivers = ctx.model.drivers
     if not ctx.turning or drivers is None:
@@ -321,13 +365,15 @@ def sampling(ctx: Context, indices: Sequence[int], cases: Sequence[Case | None],
     for index, case, error in zip(indices, cases, errors, strict=True):
         if error is not None or case is None or case.extras is None:
             continue
-        per_second = s.fps if s.run == "simulate" else (s.steps - 1) / _end(ctx, case)
+        span = _end(ctx, case)
+        per_second = s.fps if s.run == "simulate" else _per_second(ctx, case, span)
         fewest = None
         for d in ctx.turning:
             rate = float(case.extras[d])
             if rate == 0.0 or not math.isfinite(rate):
                 continue
-            here = Sparsest(samples_a_turn(per_second, rate), index, drivers.names[d], rate)
+            here = Sparsest(samples_a_turn(per_second, rate), index, drivers.names[d], rate,
+                            span)
             if here.per_turn < PEAK_SAMPLES * (1.0 - 1e-9):
                 fewest = here if fewest is None else min(fewest, here)
         if fewest is not None:
@@ -343,16 +389,14 @@ def sampling_warning(settings: Settings, grid: Grid, count: int, ran: int,
     the --steps (kinematics) or --fps (simulate) that gives every case enough."""
     if not count or sparsest is None:
         return None
-    values = ", ".join(f"{p}={v}" for p, v in zip(grid.paths, grid.numbers(sparsest.case),
-                                                   strict=True))
     text = sparse_text(sparsest.driver, sparsest.rate, sparsest.per_turn,
-                       f"case {sparsest.case} ({values}) has")
-    if settings.run == "kinematics":  # (steps - 1) / per_turn turns in that case
-        turns = (settings.steps - 1) / sparsest.per_turn
-        need = f"--steps {math.ceil(PEAK_SAMPLES * turns * (1.0 - 1e-12)) + 1}"
+                       f"case {sparsest.case} ({grid.shown(sparsest.case)}) has")
+    if settings.run == "kinematics":  # the driver's turns in that case's run
+        turns = sparsest.span * abs(sparsest.rate) / (2.0 * math.pi)
+        need = option_setting("steps", math.ceil(PEAK_SAMPLES * turns * (1.0 - 1e-12)) + 1)
     else:
         turns_a_second = abs(sparsest.rate) / (2.0 * math.pi)
-        need = f"--fps {math.ceil(PEAK_SAMPLES * turns_a_second * (1.0 - 1e-12))}"
+        need = option_setting("fps", math.ceil(PEAK_SAMPLES * turns_a_second * (1.0 - 1e-12)))
     sine = 100.0 * (1.0 - math.cos(math.pi / PEAK_SAMPLES))
     return (f"{text}. {count} of the {ran} cases run have fewer than {PEAK_SAMPLES} samples a "
             f"revolution: their peak: columns can read low. Use {need} or more "
@@ -420,9 +464,47 @@ def _end(ctx: Context, case: Case) -> float:
         return float(s.t_end)  # type: ignore[arg-type]
     rate = float(case.extras[ctx.driver])  # type: ignore[index]
     if rate == 0.0 or not math.isfinite(rate):
-        raise MbodyError(f"--t-end {s.revolutions:g} rev: the driver does not turn at t = 0 "
-                         f"(its rate is {rate:g} rad/s) with these values")
+        raise MbodyError(f"{turns_end(f'{s.revolutions:g}')}: the driver does not turn at "
+                         f"t = 0 (its rate is {rate:g} rad/s) with these values")
     return 2.0 * math.pi * s.revolutions / abs(rate)
+
+
+def _turn(ctx: Context, case: Case) -> float | None:
+    """The time of one revolution (s) of the case's first driver when it turns at a
+    constant rate (`revolution` of the case's model), else None."""
+    if case.model is not None:  # built in full: its own law
+        return revolution(case.model)
+    if not ctx.turns_steadily or case.extras is None:
+        return None
+    rate = float(case.extras[0])  # the case's rate, of the family's law
+    return 2.0 * math.pi / abs(rate) if rate != 0.0 and math.isfinite(rate) else None
+
+
+def _per_second(ctx: Context, case: Case, span: float) -> float:
+    """The samples a second of a case's ``kinematics`` run of `span` s (`instants`)."""
+    steps = ctx.job.settings.steps
+    return (steps - 1) / span if steps is not None else default_fps(_turn(ctx, case))
+
+
+def instants(ctx: Context, case: Case, span: float) -> np.ndarray:
+    """The instants of a case's ``kinematics`` run from 0 to `span` s: `Settings.steps`
+    of them evenly spaced, or by default ``mbody kinematics``'s samples, k / fps with
+    fps its default for the case (`default_fps`: `SAMPLES_A_TURN` a revolution of the
+    first driver at the case's rate, when it turns at a constant one), and `span` itself
+    when they fall short of it (so that ``final:`` is the end's, as with `steps`)."""
+    steps = ctx.job.settings.steps
+    if steps is not None:
+        return np.linspace(0.0, span, steps)
+    fps = _per_second(ctx, case, span)
+    count = math.floor(span * fps + 1e-9) + 1  # as `sample_times` counts
+    most = LIMITS["steps"]
+    if count > most.hi:
+        raise MbodyError(f"an end of {span:g} s at {fps:g} samples a second (mbody "
+                         f"kinematics' sampling) is {number(count)} instants; at most "
+                         f"{number(int(most.hi))} a case: give {option_name('steps')}, or "
+                         "an earlier end")
+    t = sample_times(span, fps)
+    return np.append(t, span) if last_sample_warning(span, fps) else t
 
 
 def _kinematics(ctx: Context, values: list[dict[str, Any]], cases: list[Case]
@@ -430,27 +512,27 @@ def _kinematics(ctx: Context, values: list[dict[str, Any]], cases: list[Case]
     out = np.full((len(values), ctx.width), np.nan)
     errors: list[str | None] = [c.error for c in cases]
     for ev, ks, F in _groups(ctx, cases):
-        ends: dict[int, float] = {}
+        times: dict[int, np.ndarray] = {}
         for k in ks:
             try:
-                ends[k] = _end(ctx, cases[k])
+                times[k] = instants(ctx, cases[k], _end(ctx, cases[k]))
             except MbodyError as exc:
                 errors[k] = str(exc)
-        keep = [i for i, k in enumerate(ks) if k in ends]
+        keep = [i for i, k in enumerate(ks) if k in times]
         ks = [ks[i] for i in keep]
         Fk = None if F is None else F[keep]
         if ks:
-            _kinetostatics(ctx, ev, ks, Fk, cases, values, ends, out, errors)
+            _kinetostatics(ctx, ev, ks, Fk, cases, values, times, out, errors)
     return out, errors
 
 
 def _kinetostatics(ctx: Context, ev: Evaluator, ks: list[int], F: np.ndarray | None,
-                   cases: list[Case], values: list[dict[str, Any]], ends: dict[int, float],
-                   out: np.ndarray, errors: list[str | None]) -> None:
+                   cases: list[Case], values: list[dict[str, Any]],
+                   times: dict[int, np.ndarray], out: np.ndarray,
+                   errors: list[str | None]) -> None:
     """Cases `ks` (F: their rows, or None for a model of its own): each assembled at
     t = 0, its instants' kinematic analysis (one per distinct motion), then every
     instant's solve; their final positions and peaks into `out`."""
-    steps = ctx.job.settings.steps
     Y0, ok = ev.assemble(np.stack([cases[k].start for k in ks]),  # type: ignore[misc]
                          F, None if F is None else np.arange(len(ks)))
     motions: dict[bytes, list[int]] = {}
@@ -459,12 +541,13 @@ def _kinetostatics(ctx: Context, ev: Evaluator, ks: list[int], F: np.ndarray | N
             errors[k] = _load_error(ctx, values[k])
             continue
         key = _motion_key(ctx, ev, None if F is None else F[j], cases[k].start,  # type: ignore
-                          ends[k], j)
+                          times[k], j)
         motions.setdefault(key, []).append(j)
-    per_call = max(1, SOLVE_BLOCK // steps)
     for js in motions.values():
         j0 = js[0]
-        t = np.linspace(0.0, ends[ks[j0]], steps)
+        t = times[ks[j0]]
+        steps = len(t)
+        per_call = max(1, SOLVE_BLOCK // steps)
         Y = np.ascontiguousarray(np.tile(Y0[j0], (steps, 1)))
         chain = np.ones(steps, dtype=np.int64)
         chain[0] = 0
@@ -491,7 +574,7 @@ def _kinetostatics(ctx: Context, ev: Evaluator, ks: list[int], F: np.ndarray | N
 
 
 def _motion_key(ctx: Context, ev: Evaluator, F: np.ndarray | None, start: np.ndarray,
-                end: float, j: int) -> bytes:
+                t: np.ndarray, j: int) -> bytes:
     """What a case's motion depends on: for a fully driven mechanism its joints, drivers
     and expressions (F from `kin_from` on), the file's pose (the branch it starts on) and
     the instants; for any other, the case itself (masses and loads move it too)."""
@@ -501,7 +584,7 @@ def _motion_key(ctx: Context, ev: Evaluator, F: np.ndarray | None, start: np.nda
     if F is not None:
         h.update(F[ctx.kin_from:].tobytes())
     h.update(start[:7 * ev.model.n].tobytes())
-    h.update(np.float64(end).tobytes())
+    h.update(np.ascontiguousarray(t, dtype=float).tobytes())
     return h.digest()
 
 
@@ -563,14 +646,19 @@ def _simulate(ctx: Context, model: Model, case: Case) -> np.ndarray:
 
 
 def _modes(ctx: Context, model: Model, case: Case) -> np.ndarray:
-    """frequency:1 ... (NaN beyond the oscillations), steady, stable, then the
-    equilibrium's pose when the run is about it."""
+    """frequency:1 ... (NaN beyond the oscillations), growth:1 ... (NaN beyond the modes
+    that grow), steady, stable, then the equilibrium's pose when the run is about it."""
     lin = modes.linearization(model, ctx.job.settings.equilibrium)
     k = len(lin.coordinates)
     f = np.asarray(lin.frequencies, dtype=float)  # ascending, at most one a coordinate
     row = np.full(k, np.nan)
     row[:len(f)] = f
-    parts = [row, np.array(modes.verdict_values(lin))]
+    # the k fastest: more modes than coordinates grow only under forces that do work
+    # on their own (a follower load), and `stable` says so whatever the count
+    g = modes.growth_rates(lin)[:k]
+    growth = np.full(k, np.nan)
+    growth[:len(g)] = g
+    parts = [row, growth, np.array(modes.verdict_values(lin))]
     if ctx.job.settings.equilibrium:
         parts.append(pose_values(model, lin.state))
     return np.concatenate(parts)

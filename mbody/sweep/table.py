@@ -1,14 +1,19 @@
 """A sweep's results file: one row per case, ``case``, the varied paths (named as given),
-the outputs (``<quantity>:<label>``), then ``error`` (empty, or why the case has no
-numbers), sorted by case. CSV (numbers as Python writes them: read back, each is the
-same double) or Parquet (``.parquet``; needs pyarrow, in the ``sweep`` extra).
+the outputs (``<quantity>:<label>``), ``error`` (empty, or why the case has no numbers),
+then ``settings`` (how the row was computed: `mbody.sweep.record`), sorted by case. CSV
+(numbers as Python writes them: read back, each is the same double; a yes-or-no column,
+`mbody.sweep.modes.FLAGS`, as ``true`` or ``false``) or Parquet (``.parquet``, its
+yes-or-no columns boolean; needs pyarrow, in the ``sweep`` extra).
 
 Nothing is lost on the way: rows are appended, as chunks finish, to a journal beside
 the output (``<out>.partial``, CSV, flushed per chunk), and the output itself is written
 once, at the end, through a temporary file renamed into place; then the journal goes.
 A sweep started again with the same output resumes: the cases already in the output or
-its journal are not run again (a file of another sweep, whose case numbers do not hold
-the same values, is refused).
+its journal are not run again. An earlier row is reused only when it is this sweep's:
+the same columns, the same values under its case number, the same settings. A file
+holding anything else (another sweep's rows, rows of other settings, a file of an mbody
+that did not record the settings) is refused, naming what differs, or with ``force``
+those rows are run again and replaced.
 """
 
 from __future__ import annotations
@@ -23,15 +28,22 @@ from typing import Any
 
 import numpy as np
 
-from mbody.errors import MbodyError
+from mbody.errors import MbodyError, OutputError
 from mbody.sweep.grid import Grid
+from mbody.sweep.modes import FLAGS
+from mbody.sweep.record import SETTINGS, differences
 from mbody.sweep.runs import Rows
-from mbody.util.atomic import write_atomic
+from mbody.util.atomic import ensure_writable, make_folders, refuse_special, write_atomic
 
 FORMATS = {".csv": "csv", ".parquet": "parquet"}
 """The output's formats, by its extension."""
 JOURNAL = ".partial"
 """The journal's suffix, after the output's name."""
+ERROR = "error"
+"""The column of each case's error (empty when it has its numbers)."""
+AGAIN = ("give another --out to keep it, or --force to run those cases again and replace "
+         "their rows")
+"""What to do with an output that holds rows that are not this sweep's."""
 
 
 def output_format(path: str | os.PathLike[str]) -> str:
@@ -48,7 +60,8 @@ def journal_of(path: str | os.PathLike[str]) -> Path:
 
 
 def cell(value: Any) -> str:
-    """A value as the CSV holds it: a number as Python writes it (exact), NaN empty."""
+    """A value as the CSV holds it: a number as Python writes it (exact), NaN empty, a
+    bool ``true`` or ``false``."""
     if isinstance(value, bool):
         return str(value).lower()
     if isinstance(value, float | np.floating):
@@ -70,9 +83,15 @@ class Results:
         The output columns.
     grid : Grid
         The sweep's cases (their values are the path columns).
+    settings : str
+        This sweep's record (`mbody.sweep.record.record`), every row's ``settings`` cell.
+    force : bool
+        Earlier rows that are not this sweep's are dropped (their cases run again), not
+        refused.
     """
 
-    def __init__(self, path: str | os.PathLike[str], outputs: Sequence[str], grid: Grid):
+    def __init__(self, path: str | os.PathLike[str], outputs: Sequence[str], grid: Grid,
+                 settings: str, *, force: bool = False):
         self.path = Path(path)
         self.format = output_format(path)
         if self.format == "parquet":  # refused before any case runs, not after them all
@@ -82,10 +101,21 @@ class Results:
                 raise MbodyError(_NO_PYARROW)
         self.grid = grid
         self.outputs = list(outputs)
-        self.header = ["case", *grid.paths, *outputs, "error"]
+        self.settings = settings
+        self.force = force
+        self.header = ["case", *grid.columns, *outputs, ERROR, SETTINGS]
+        self._flags = [name in FLAGS for name in outputs]
         self.rows: dict[int, list[str]] = {}
         self.journal = journal_of(path)
+        ensure_writable(self.path)  # a folder, a socket: refused before any case runs
+        refuse_special(self.journal, "the journal beside --out")
+        ensure_writable(self.journal)
+        self._dropped: set[object] = set()
+        self._stale_journal = False
         self._resume()
+        self.replaced = len({d for d in self._dropped if d not in self.rows})
+        """The earlier rows dropped, with `force`, as not this sweep's (their cases run
+        again, and this sweep's rows replace them)."""
         self._out: io.TextIOWrapper | None = None
         self._writer: Any = None
 
@@ -96,7 +126,9 @@ class Results:
 
     # -- resuming ------------------------------------------------------------------------
     def _resume(self) -> None:
-        if self.path.exists():
+        # an output that is a device or a named pipe is written through, never read back:
+        # a pipe's reader would wait for a writer, a terminal for its user
+        if self.path.is_file():
             self._take(self._read_output(), str(self.path))
         if self.journal.exists():
             self._take(_read_csv(self.journal), str(self.journal), journal=True)
@@ -120,51 +152,113 @@ class Results:
             yield [cell(v) for v in values]
 
     def _take(self, lines: Iterator[list[str]], where: str, journal: bool = False) -> None:
+        """Keep the rows of `lines` (a file's, its header first) that are this sweep's;
+        refuse the file at the first that is not, or with `force` drop that row."""
         header = next(lines, None)
         if header is None:
             return
-        if header != self.header:
-            raise MbodyError(f"{where} holds another sweep's results (its columns differ "
-                             "from this sweep's); remove it or give another --out")
+        problem = self._header_problem(header, where)
+        if problem:
+            if not self.force:
+                raise MbodyError(problem)
+            for n, row in enumerate(lines, 2):  # every row dropped
+                self._drop(row, where, n, journal)
+            return
         width = len(self.header)
         for n, row in enumerate(lines, 2):
-            if len(row) != width:
-                if journal:  # a row cut short by an interruption: run that case again
-                    continue
-                raise MbodyError(f"{where}:{n}: {len(row)} cells, expected {width}")
-            try:
-                case = int(row[0])
-            except ValueError:
-                raise MbodyError(f"{where}:{n}: case {row[0]!r} is not a case number") from None
-            if not 0 <= case < len(self.grid):
-                raise MbodyError(f"{where}:{n}: case {case} is not a case of this sweep "
-                                 f"(it has {len(self.grid)}); remove the file or give "
-                                 "another --out")
-            want = [cell(x) for x in self.grid.numbers(case)]
-            got = row[1:1 + len(want)]
-            if not all(map(_same, got, want)):
-                bad = next(i for i, (a, b) in enumerate(zip(got, want, strict=True))
-                           if not _same(a, b))
-                raise MbodyError(f"{where}:{n}: case {case} has {self.header[1 + bad]} = "
-                                 f"{row[1 + bad]} there but {want[bad]} in this sweep: the file "
-                                 "holds another sweep's results; remove it or give another "
-                                 "--out")
-            self.rows[case] = row
+            if len(row) != width and journal:  # cut short by an interruption: run it again
+                continue
+            problem = self._row_problem(row, where, n)
+            if problem:
+                if not self.force:
+                    raise MbodyError(problem)
+                self._drop(row, where, n, journal)
+                continue
+            self.rows[int(row[0])] = row
+
+    def _header_problem(self, header: list[str], where: str) -> str:
+        """Why the rows under `header` cannot be this sweep's, or ''."""
+        if header == self.header:
+            return ""
+        if header == self.header[:-1]:
+            return (f"{where} was written by an earlier mbody, which did not record the "
+                    "settings its rows were computed with (the run's --t-end, --steps or "
+                    "--fps, the model): they cannot be told to be this sweep's; " + AGAIN)
+        return (f"{where} holds another sweep's results (its columns differ from this "
+                f"sweep's); {AGAIN}")
+
+    def _row_problem(self, row: list[str], where: str, n: int) -> str:
+        """Why `row` (line `n` of `where`) is not a row of this sweep, or ''."""
+        width = len(self.header)
+        if len(row) != width:
+            return f"{where}:{n}: {len(row)} cells, expected {width}"
+        try:
+            case = int(row[0])
+        except ValueError:
+            return f"{where}:{n}: case {row[0]!r} is not a case number"
+        if not 0 <= case < len(self.grid):
+            return (f"{where}:{n}: case {case} is not a case of this sweep (it has "
+                    f"{len(self.grid)}): the file holds another sweep's results; {AGAIN}")
+        want = [cell(x) for x in self.grid.numbers(case)]
+        got = row[1:1 + len(want)]
+        if not all(map(_same, got, want)):
+            bad = next(i for i, (a, b) in enumerate(zip(got, want, strict=True))
+                       if not _same(a, b))
+            return (f"{where}:{n}: case {case} has {self.header[1 + bad]} = {row[1 + bad]} "
+                    f"there but {want[bad]} in this sweep: the file holds another sweep's "
+                    f"results; {AGAIN}")
+        if row[-1] != self.settings:
+            said = " and ".join(differences(row[-1], self.settings)) or "other settings"
+            return (f"{where}:{n}: case {case} was computed with {said}: the file holds "
+                    f"the results of other settings, which are not this sweep's; {AGAIN}")
+        return ""
+
+    def _drop(self, row: list[str], where: str, n: int, journal: bool) -> None:
+        """Forget an earlier row that is not this sweep's (`force`): its case runs again,
+        and a journal holding it is written anew."""
+        try:
+            self._dropped.add(int(row[0]))
+        except (ValueError, IndexError):
+            self._dropped.add((where, n))
+        if journal:
+            self._stale_journal = True
 
     # -- adding and writing ----------------------------------------------------------------
     def add(self, rows: Rows) -> None:
         """A chunk's rows, kept and appended to the journal (flushed)."""
+        try:
+            self._append(rows)
+        except OutputError:
+            raise
+        except OSError as exc:  # a full disk, a quota: the journal beside --out
+            raise OutputError(f"cannot write {str(self.journal)!r}, the journal beside "
+                              f"the output {self.path}: {exc.strerror or exc}", exc,
+                              str(self.journal)) from None
+
+    def _append(self, rows: Rows) -> None:
         if self._out is None:
-            fresh = not self.journal.exists() or self.journal.stat().st_size == 0
-            self._out = open(self.journal, "a", newline="", encoding="utf-8")  # noqa: SIM115
+            # the output's folder, as writing the output would make it: a folder that
+            # cannot be made is the output's problem, and named so
+            make_folders(self.path, self.journal.parent)
+            # a journal holding rows of another sweep (dropped with force) is begun anew,
+            # with the rows kept so far: it never holds two sweeps' rows
+            fresh = (self._stale_journal or not self.journal.exists()
+                     or self.journal.stat().st_size == 0)
+            self._out = open(self.journal, "w" if fresh else "a", newline="",  # noqa: SIM115
+                             encoding="utf-8")
             self._writer = csv.writer(self._out)
             if fresh:
                 self._writer.writerow(self.header)
+                if self._stale_journal:
+                    self._writer.writerows(self.rows[k] for k in sorted(self.rows))
+                self._stale_journal = False
         for case, out, err in zip(rows.indices, rows.outputs, rows.errors, strict=True):
             if case in self.rows:  # a chunk run twice (a worker lost after it finished)
                 continue
             row = [str(case), *(cell(x) for x in self.grid.numbers(case)),
-                   *(cell(x) for x in out.tolist()), err or ""]
+                   *(flag(x) if yes_no else cell(x)
+                     for x, yes_no in zip(out.tolist(), self._flags, strict=True)),
+                   err or "", self.settings]
             self.rows[case] = row
             self._writer.writerow(row)
         self._out.flush()
@@ -191,6 +285,12 @@ class Results:
                          binary=True)
         self.journal.unlink(missing_ok=True)
         return self.path
+
+
+def flag(value: float) -> str:
+    """A yes-or-no output (1.0 or 0.0 in a chunk's rows, NaN for none) as the CSV holds
+    it: ``true``, ``false`` or empty."""
+    return "" if math.isnan(value) else cell(bool(value))
 
 
 def _same(a: str, b: str) -> bool:
@@ -226,8 +326,11 @@ def _write_parquet(fh: Any, header: list[str], rows: list[list[str]]) -> None:
         texts = [r[i] for r in rows]
         if name == "case":
             columns[name] = pa.array([int(x) for x in texts], pa.int64())
-        elif name == "error":
+        elif name in (ERROR, SETTINGS):
             columns[name] = pa.array(texts, pa.string())
+        elif name in FLAGS:
+            columns[name] = pa.array([None if not x else x == "true" for x in texts],
+                                     pa.bool_())
         else:
             try:
                 columns[name] = pa.array([float(x) if x else math.nan for x in texts],

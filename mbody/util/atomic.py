@@ -9,6 +9,10 @@ named pipe is written through (opened and written, from a complete temporary cop
 that a writer's failure sends nothing); the command's own standard output (``-o
 /dev/stdout``) is written through its descriptor; a block device, a socket or a folder
 is refused. Folders made for an output are removed again when the output fails.
+
+An output is never one of the command's own inputs, however named
+(`refuse_overwriting_inputs`), and never a folder or a device where a regular file is
+meant (`ensure_writable`, `refuse_special`).
 """
 
 from __future__ import annotations
@@ -21,7 +25,7 @@ import stat
 import sys
 import tempfile
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Container, Iterable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import IO, Any
 
@@ -148,17 +152,92 @@ def ensure_writable(target: str | os.PathLike[str]) -> Path:
     return folder
 
 
-def _make_folders(target: Path, folder: Path) -> list[Path]:
-    """Make `folder` with its missing parents; return those made (deepest first)."""
+def refuse_special(target: str | os.PathLike[str], what: str) -> None:
+    """Refuse a `target` that exists and is not a regular file (after following links),
+    for an output that is appended to and read back (a sweep's journal): a named pipe
+    would block the read, a device never hold the rows. A missing `target` passes."""
+    try:
+        mode = os.stat(target).st_mode
+    except FileNotFoundError:
+        return
+    except OSError as exc:
+        raise MbodyError(f"cannot write {str(target)!r}: {exc.strerror or exc}") from None
+    if not stat.S_ISREG(mode):
+        raise MbodyError(f"cannot write {str(target)!r}: it is {_kind(mode)}, and {what} "
+                         "must be a regular file; remove it or give another output")
+
+
+def refuse_overwriting_inputs(outputs: Iterable[tuple[str, str]],
+                              inputs: Iterable[tuple[str, str]], force: bool,
+                              folders: Container[str] = (),
+                              suffixes: Mapping[str, Sequence[str]] | None = None,
+                              resumed: Container[str] = ()) -> None:
+    """Refuse (unless `force`) an output that is one of the command's own inputs: the
+    same file, compared by identity (device and inode: a link or another spelling of
+    the path is the same file), not by name. `outputs` and `inputs` are (what, path)
+    pairs: ``("-o", "m.yaml")``, ``("the model", "m.yaml")``. Where `force` cannot help,
+    the message does not offer it, and `force` does not pass it: an output whose option
+    is in `folders` writes a folder, which cannot take a file's place; one whose option's
+    suffix chooses the format (`suffixes`: option -> the suffixes it writes) and whose
+    name has none of them is refused by the command anyway; one whose option is in
+    `resumed` is read back to resume the run (a sweep's results and their journal),
+    which needs its inputs as they were."""
+
+    def stuck(flag: str, path: str, what: str = "its inputs") -> str:
+        """Why `force` cannot help writing `path` (`what`) there, or ''."""
+        if flag in folders:
+            return f"{flag} writes a folder; give a folder's name"
+        if flag in resumed:
+            return (f"{flag} is read back to resume the run, which needs {what} as it was; "
+                    "give another output file")
+        allowed = (suffixes or {}).get(flag)
+        if allowed and Path(path).suffix.lower() not in allowed:
+            return (f"{flag} writes a file ending in {', '.join(allowed)}; give another "
+                    "output file")
+        return ""
+
+    outputs = [(flag, path) for flag, path in outputs if not force or stuck(flag, path)]
+    if not outputs:
+        return
+    seen = []
+    for what, path in inputs:
+        try:
+            st = os.stat(path)
+        except (OSError, ValueError):
+            continue
+        if stat.S_ISREG(st.st_mode):
+            seen.append((what, path, st))
+    for flag, path in outputs:
+        try:
+            st = os.stat(path)
+        except (OSError, ValueError):
+            continue  # a new file: nothing to lose
+        for what, source, st_in in seen:
+            if os.path.samestat(st, st_in):
+                same = "" if source == path else ", the same file"
+                why = stuck(flag, path, what)
+                if why:
+                    raise MbodyError(f"{flag} {path} is {what} itself ({source}{same}): {why}")
+                raise MbodyError(f"{flag} {path} is {what} itself ({source}{same}): writing "
+                                 "there would replace the input; give another output file, "
+                                 "or --force to replace it")
+
+
+def make_folders(target: str | os.PathLike[str], folder: Path) -> list[Path]:
+    """Make `folder` (where `target`, or a file beside it, is written) with its missing
+    parents; return those made (deepest first). A folder that cannot be made is an
+    `OutputError` naming `target`, the output the user gave."""
     try:
         missing = _missing_folders(folder)
         folder.mkdir(parents=True, exist_ok=True)
     except MbodyError as exc:
         raise MbodyError(f"cannot write {str(target)!r}: {exc}") from None
     except OSError as exc:
-        raise MbodyError(f"cannot write {str(target)!r}: cannot make the folder "
-                         f"{str(folder)!r} ({exc.strerror or exc})") from None
+        raise OutputError(f"cannot write {str(target)!r}: cannot make the folder "
+                          f"{str(folder)!r} ({exc.strerror or exc})", exc, str(folder)
+                          ) from None
     return missing
+
 
 
 def _remove_folders(made: list[Path]) -> None:
@@ -186,7 +265,7 @@ def atomic_path(target: str | os.PathLike[str], suffix: str = "") -> Iterator[Pa
     how, real = _plan(target)
     made: list[Path] = []
     if how == "rename":
-        made = _make_folders(target, real.parent)
+        made = make_folders(target, real.parent)
         where: str | None = str(real.parent)
     else:  # written through: the whole output is made first, away from the device
         where = None
@@ -342,7 +421,7 @@ def atomic_folder(target: str | os.PathLike[str]) -> Iterator[Path]:
     if target.exists() and not target.is_dir():
         raise MbodyError(f"{target}: exists and is not a folder")
     parent = target.parent if str(target.parent) else Path(".")
-    made = _make_folders(target, parent)
+    made = make_folders(target, parent)
     try:
         tmp = Path(tempfile.mkdtemp(prefix=_prefix(target), dir=parent))
     except OSError as exc:

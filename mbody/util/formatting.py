@@ -1,22 +1,55 @@
 """Numbers, vectors and tables as the text outputs print them: 6 significant digits,
-rounding noise as 0."""
+rounding noise as 0.
+
+One rule for the noise (`quiet`): a value smaller than the tolerance of the computation
+that gave it prints as 0. The data (JSON, npz, the Python objects) keep every value as
+computed; only the text rounds. The tolerance is the caller's, in the value's units:
+`NOISE` for a number with no scale of its own, `LENGTH_RTOL` times the body's (or the
+model's) size for a length, a solver's own tolerance for what it solved for.
+"""
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 
+NOISE = 1e-12
+"""A magnitude below which a number with no scale of its own is rounding (a rotation's
+-2.4e-17), not data."""
+LENGTH_RTOL = 1e-9
+"""A length below this fraction of its body's or model's size is not a dimension: mbody
+takes a joint to hold when its points are that close (`mbody.solve.kinematics`, 1000
+``CLOSE_RTOL`` of the model's size), so a coordinate that small comes from the file's
+rounding (a position written to 10 digits puts a pin 4e-12 m off a 0.5 m rod's axis)."""
 
-def num(x: float) -> str:
-    """6 significant digits; |x| below 1e-12 (rounding from rotations, -2.4e-17) as 0."""
-    x = 0.0 if abs(x) < 1e-12 else x
-    s = f"{x:.6g}"
+
+def quiet(x: float, tol: float = NOISE) -> float:
+    """`x`, or 0 when |x| is below `tol` (the module's rule)."""
+    return 0.0 if abs(x) < tol else x
+
+
+def num(x: float, tol: float = NOISE) -> str:
+    """6 significant digits; |x| below `tol` as 0 (`quiet`), never -0."""
+    s = f"{quiet(x, tol):.6g}"
     return "0" if s in ("-0", "0") else s
 
 
-def vec(x: np.ndarray, dim: int) -> str:
-    """``(x, y)`` of a planar model's vector (its first two components), ``(x, y, z)``."""
+def number(x: float) -> str:
+    """`x` as a message states a bound or a count: as %g writes it, with exponents as
+    people write them (1e9, 2.5e-13); an int below 10^12 in full, its thousands apart
+    (10 000 000)."""
+    if isinstance(x, int) and abs(x) < 10**12:
+        return f"{x:,}".replace(",", " ")
+    x = float(x)
+    return re.sub(r"e\+?(-?)0*(\d)", r"e\1\2", f"{x:g}")
+
+
+def vec(x: np.ndarray, dim: int, tol: float = NOISE) -> str:
+    """``(x, y)`` of a planar model's vector (its first two components), ``(x, y, z)``;
+    each component below `tol` as 0."""
     x = np.asarray(x)[:2] if dim == 2 else np.asarray(x)  # a planar model's
-    return "(" + ", ".join(num(v) for v in x) + ")"
+    return "(" + ", ".join(num(v, tol) for v in x) + ")"
 
 
 def table(header: list[str], rows: list[list[str]], indent: str = "  ") -> list[str]:

@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import json
 import math
-import re
 from collections.abc import Mapping
 from typing import IO, Any
 
@@ -93,21 +92,34 @@ MAX_DEPTH = 64
 """Deepest nesting of arrays and objects `loads` parses (as for a model file's YAML,
 `mbody.model.loader.MAX_DEPTH`); what mbody writes nests 4 deep at most."""
 
-_STRING = re.compile(r'"[^"\\]*(?:\\.[^"\\]*)*"')
-_NOT_BRACKETS = bytes(b for b in range(256) if b not in b"[]{}")
+_NOT_MARKS = bytes(b for b in range(256) if b not in b'"[]{}')
 
 
 def nesting(text: str) -> int:
     """How deep the arrays and objects of JSON `text` nest (brackets inside strings do not
-    count), in time linear in the text: the strings and every other character are
-    dropped by C scans, then the brackets' running depth is one numpy sum."""
-    brackets = _STRING.sub("", text).encode("utf-8", "surrogatepass").translate(
-        None, _NOT_BRACKETS)
-    if not brackets:
+    count), in one pass of C scans over the text, then numpy over the quotes and brackets
+    left: time linear in the text, whatever it holds.
+
+    Escapes first: a run of backslashes is pairs (each an escaped backslash), and one
+    more when the run is odd, which escapes the character after it; so dropping every
+    pair and then every backslash-quote leaves exactly the quotes that begin and end
+    strings. A bracket is inside a string when an odd number of those come before it.
+    In valid JSON a backslash is only ever inside a string, so the count is exact; in
+    text that is not JSON it is exact up to the first error, where the parser stops.
+    (A regular expression for a string with its escapes inside ran from every quote of
+    ``"\\"\\"\\"...``, a string that never ends, to the end of the text: time quadratic in
+    its length, 21 s for 64 kB.)"""
+    unescaped = text.replace("\\\\", "").replace('\\"', "")
+    marks = np.frombuffer(unescaped.encode("utf-8", "surrogatepass").translate(
+        None, _NOT_MARKS), dtype=np.uint8)
+    if not len(marks):
         return 0
-    step = np.frombuffer(brackets, dtype=np.uint8)
-    opens = (step == ord("[")) | (step == ord("{"))
-    return int(np.cumsum(np.where(opens, 1, -1), dtype=np.int64).max())
+    quote = marks == ord('"')
+    brackets = marks[~(quote | np.logical_xor.accumulate(quote))]
+    if not len(brackets):
+        return 0
+    opens = (brackets == ord("[")) | (brackets == ord("{"))
+    return int(np.cumsum(opens.astype(np.int32) * 2 - 1, dtype=np.int64).max())
 
 
 def loads(text: str, *, max_depth: int = MAX_DEPTH) -> Any:

@@ -1,6 +1,6 @@
 """A ``.npz`` archive read as input that may be hostile: what it holds is known, and
-checked, before anything is inflated; and the byte budget of every data file mbody reads
-back (a run file, an export).
+checked, before anything is inflated; and a data file (a run file, an export) read within
+its byte budget (`mbody.util.budget`).
 
 A run file (`mbody.Trajectory.save`) and an npz export are zip archives of ``.npy``
 arrays, files that people pass around. `numpy.load` trusts what they say: a member's
@@ -11,8 +11,11 @@ unless
 
 - each member is stored or deflated (what numpy writes), not encrypted, and named once;
 - its header's shape and dtype account for exactly the member's size in the zip
-  directory, which is also the most that member can inflate to (`zipfile` stops there);
-- the members' sizes add up to at most the byte budget (`data_limit`: 1 GiB by default).
+  directory, which is also the most that member can inflate to (`zipfile` stops there),
+  and its values are at least a byte wide (values of 0 bytes would claim any number of
+  them in no bytes at all);
+- the members' sizes add up to at most the byte budget (`mbody.util.budget`: 1 GiB by
+  default).
 
 Only then is an array read: reading an archive costs time and memory in proportion to
 what it holds, at most the budget, whatever its headers claim.
@@ -28,64 +31,23 @@ import math
 import os
 import stat
 import zlib
-from collections.abc import Iterator
-from contextlib import contextmanager
-from contextvars import ContextVar
-from dataclasses import dataclass
 from types import TracebackType
 from typing import IO, TYPE_CHECKING
 
 import numpy as np
 
 from mbody.errors import MbodyError
+from mbody.util.budget import DATA_BYTES, TEXT_BYTES, byte_limit
+from mbody.util.frozen import Frozen
 
 if TYPE_CHECKING:
     import zipfile
-
-DATA_BYTES = 1 << 30
-"""Most bytes of arrays a run or npz/.mat export may hold once inflated, read by default
-(1 GiB: a run of 100 spatial bodies over 70 000 samples, with their reactions). Like a
-model file's size limit, it keeps a wrong or hostile file from taking the machine's
-memory; ``--max-bytes N`` on the command line (`data_bytes_limit`), or ``max_bytes=N`` to
-the reader (`mbody.Trajectory.load`, `mbody.load_export`), reads more."""
-TEXT_BYTES = 32 << 20
-"""Largest JSON or CSV export read by default, in bytes of text: a model file's limit
-(`mbody.model.loader.MAX_BYTES`), since a value read from text takes up to tens of times
-its characters in memory. The same settings raise it."""
-_LIMIT: ContextVar[int | None] = ContextVar("mbody_data_bytes", default=None)
 
 HEADER_CHARS = 10_000
 """Longest ``.npy`` header read (numpy's own default): the header is a Python literal."""
 
 _METHODS = (0, 8)
 """The zip methods numpy writes: stored, deflated."""
-
-
-@contextmanager
-def data_bytes_limit(max_bytes: int | None) -> Iterator[None]:
-    """Within the block, run and export files are read up to `max_bytes` (inflated)
-    unless a call says otherwise; the command line's ``--max-bytes`` sets it.
-
-    Parameters
-    ----------
-    max_bytes : int or None
-        The budget, in bytes; None keeps the current one.
-    """
-    token = _LIMIT.set(max_bytes) if max_bytes is not None else None
-    try:
-        yield
-    finally:
-        if token is not None:
-            _LIMIT.reset(token)
-
-
-def data_limit(max_bytes: int | None = None, default: int = DATA_BYTES) -> int:
-    """`max_bytes` if given, else the budget set by `data_bytes_limit`, else `default`
-    (`DATA_BYTES` for arrays, `TEXT_BYTES` for a text file)."""
-    if max_bytes is not None:
-        return int(max_bytes)
-    given = _LIMIT.get()
-    return default if given is None else given
 
 
 def size_text(n: int) -> str:
@@ -112,15 +74,15 @@ def read_bytes(path: str | os.PathLike[str], max_bytes: int | None = None,
                more: str = "mbody.load_export(path, max_bytes=N) reads more",
                error: type[MbodyError] = MbodyError, default: int = DATA_BYTES) -> bytes:
     """The bytes of a data file (a .mat, JSON or CSV export), refused unread when it is
-    larger than `max_bytes` (default `default`, or `data_bytes_limit`'s), or is not a
-    regular file (a pipe would block, a device never end).
+    larger than its budget (`mbody.util.budget.byte_limit` of `max_bytes` and `default`),
+    or is not a regular file (a pipe would block, a device never end).
 
     Raises
     ------
     error
         Naming the file: too large (the budget and `more`), not a regular file.
     """
-    limit = data_limit(max_bytes, default)
+    limit = byte_limit(max_bytes, default)
     st = os.stat(path)
     if not stat.S_ISREG(st.st_mode):
         raise error(f"{path}: not a regular file (a folder, a device or a pipe); expected "
@@ -150,9 +112,11 @@ def read_text(path: str | os.PathLike[str], max_bytes: int | None = None,
     return read_bytes(path, max_bytes, more, error, TEXT_BYTES).decode("utf-8")
 
 
-@dataclass(frozen=True)
-class Member:
-    """One ``.npy`` member as its header and the zip directory describe it.
+class Member(Frozen):
+    """One ``.npy`` member as its header and the zip directory describe it (frozen:
+    `Frozen`). A plain class, not a dataclass: a dataclass compiles its methods from
+    source when the class is made, 0.25 ms (0.5 ms frozen) of every process that
+    simulates, since `Trajectory` imports this module.
 
     Parameters
     ----------
@@ -171,6 +135,13 @@ class Member:
     dtype: np.dtype
     nbytes: int
 
+    def __init__(self, name: str, shape: tuple[int, ...], dtype: np.dtype, nbytes: int):
+        self.__dict__.update(name=name, shape=shape, dtype=dtype, nbytes=nbytes)
+
+    def __repr__(self) -> str:
+        return (f"Member(name={self.name!r}, shape={self.shape!r}, dtype={self.dtype!r}, "
+                f"nbytes={self.nbytes!r})")
+
 
 class NpzArchive:
     """An ``.npz`` archive whose every member is checked before any is read (module doc).
@@ -182,7 +153,8 @@ class NpzArchive:
     what : str
         What the file is, for messages ("trajectory file", "export file").
     max_bytes : int, optional
-        The budget (default `data_limit`).
+        The budget (default `mbody.util.budget.DATA_BYTES`, or the one set around the
+        call: `mbody.util.budget.byte_limit`).
     more : str
         How a user reads a larger file, quoted when the budget refuses it.
     error : type of MbodyError
@@ -207,7 +179,7 @@ class NpzArchive:
         self.what = what
         self.damage = damage or f"damaged or truncated {what}"
         self.error = error
-        self.limit = data_limit(max_bytes)
+        self.limit = byte_limit(max_bytes, DATA_BYTES)
         # here, not at the top: a simulation imports this module without reading a file,
         # and zipfile (with bz2, lzma, shutil) costs milliseconds of its first import
         import zipfile
@@ -271,7 +243,15 @@ class NpzArchive:
         if dtype.hasobject:
             raise self.damaged(f"{where} holds Python objects, which mbody never "
                                "unpickles")
-        data = math.prod(shape) * dtype.itemsize
+        values = math.prod(shape)
+        if dtype.itemsize == 0 and values:
+            # the size check below says nothing of how many values such a member claims,
+            # and each may become a Python object (a text of 0 characters: 10^12 of them
+            # in a file of 5 kB); numpy writes even an empty text 1 character wide
+            raise self.damaged(f"{where}'s header says it holds {_shape_text(shape)} values "
+                               f"of 0 bytes each, dtype {dtype.str}: numpy writes every value "
+                               "at least a byte wide")
+        data = values * dtype.itemsize
         if header + data != info.file_size:
             raise self.damaged(
                 f"{where}'s header says it holds {_shape_text(shape)} values of "

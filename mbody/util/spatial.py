@@ -163,12 +163,31 @@ def joint_frame_spatial(axis: np.ndarray | None) -> np.ndarray:
     """
     z = np.array([0.0, 0.0, 1.0]) if axis is None else np.asarray(axis, float)
     z = z / np.linalg.norm(z)
-    a = np.abs(z)
-    i = int(np.flatnonzero(a <= a.min() + FRAME_TIE)[0])  # the first on a tie
+    i = int(least_aligned(z))
     x = np.eye(3)[i] - z[i] * z
     x /= np.linalg.norm(x)
     y = np.cross(z, x)
     return np.column_stack((x, y, z))
+
+
+def least_aligned(z: np.ndarray) -> np.ndarray:
+    """(...,) the index of the world axis least aligned with each unit vector of (..., 3)
+    `z`: the smallest |z_i|, the first of x, y, z within `FRAME_TIE` of it (the spatial
+    frame rule's choice)."""
+    a = np.abs(np.asarray(z, dtype=float))
+    return np.argmax(a <= a.min(axis=-1, keepdims=True) + FRAME_TIE, axis=-1)
+
+
+def joint_frames_spatial(z: np.ndarray, world_axis: np.ndarray) -> np.ndarray:
+    """(k, 3, 3) the spatial rule's frames of the unit axes (k, 3) `z`, each with its x
+    from the world axis `world_axis` (k,) (0-2) given rather than chosen: x = that axis
+    with its component along z removed, normalised; y = z × x. Axes as columns."""
+    z = np.asarray(z, dtype=float)
+    k = np.arange(len(z))
+    x = -z[k, world_axis][:, None] * z
+    x[k, world_axis] += 1.0
+    x /= np.linalg.norm(x, axis=1, keepdims=True)
+    return np.stack((x, np.cross(z, x), z), axis=2)
 
 
 def joint_frame_planar(axis: np.ndarray | None) -> np.ndarray:

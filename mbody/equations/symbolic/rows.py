@@ -29,6 +29,7 @@ from mbody.equations.symbolic.terms import (
     REACTION,
     Term,
 )
+from mbody.errors import not_found
 
 
 @dataclass(frozen=True)
@@ -324,7 +325,7 @@ class SymbolicEquations:
         for b in self.bodies:
             if b.body == name:
                 return b
-        raise KeyError(f"no body named {name!r}")
+        raise not_found("body named", name, [b.body for b in self.bodies], "bodies")
 
     def __repr__(self) -> str:  # the dataclass's would print every term
         return (f"<SymbolicEquations of {self.model!r} at t = {self.t:g} s: "

@@ -22,7 +22,7 @@ by suffix. Floats are written so that they read back exactly.
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 from pathlib import Path
 from types import ModuleType
 
@@ -37,10 +37,12 @@ from mbody.io.export.assembly import (
     ExportedAssembly,
     as_export,
     exported,
+    unreadable,
 )
 from mbody.io.export.csvfolder import CSV_DENSE_LIMIT, write_csv
 from mbody.io.export.jsonfile import from_json, schema, to_json
 from mbody.io.export.sample import assembly_from_trajectory, state_at
+from mbody.model.arguments import KnownValues
 from mbody.util.atomic import atomic_path
 
 __all__ = [
@@ -60,7 +62,7 @@ def _module(fmt: str) -> ModuleType:
 
 
 def write_export(asm: Assembly | ExportedAssembly, path: str | os.PathLike[str],
-                 known: Mapping[str, float] | None = None, axes: str = "joint") -> Path:
+                 known: KnownValues | None = None, axes: str = "joint") -> Path:
     """Write an export whose format follows the suffix of `path`, atomically.
 
     Parameters
@@ -70,7 +72,8 @@ def write_export(asm: Assembly | ExportedAssembly, path: str | os.PathLike[str],
     path
         A file name ending in .npz, .mat or .json.
     known
-        Reaction values to record as known, with an `Assembly`.
+        Reaction values to record as known, with an `Assembly` (numbers, or expressions
+        of t taken at its state's time: `Assembly.reaction_values`).
     axes
         "world": add the map T from the joint-frame reaction values to the world-axes
         ones (`ExportedAssembly.T`), with an `Assembly` (an export has its own).
@@ -112,7 +115,7 @@ def load_export(path: str | os.PathLike[str], *, max_bytes: int | None = None
         The file, or the folder `write_csv` wrote.
     max_bytes
         The most data read: an npz or .mat file's arrays once inflated (default 1 GiB,
-        `mbody.util.npzfile.DATA_BYTES`), a JSON file's or CSV folder's text (default
+        `mbody.util.budget.DATA_BYTES`), a JSON file's or CSV folder's text (default
         32 MiB, `TEXT_BYTES`); a larger export is refused before it is read.
 
     Returns
@@ -137,10 +140,5 @@ def load_export(path: str | os.PathLike[str], *, max_bytes: int | None = None
         if not path.exists():
             raise MbodyError(f"{path}: no such file")
         reader = _module(fmt).read
-    try:
+    with unreadable(path):
         return reader(path, max_bytes)
-    except MbodyError:
-        raise
-    except (OSError, ValueError, KeyError, IndexError, TypeError) as exc:
-        raise MbodyError(f"{path}: not a readable mbody export ({type(exc).__name__}: "
-                         f"{exc})") from None

@@ -12,7 +12,8 @@ from __future__ import annotations
 import dataclasses
 import json
 import os
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import SimpleNamespace
@@ -27,14 +28,19 @@ from mbody.equations.assemble import Assembly, Solution
 from mbody.equations.pack import pack_columns_model, pack_unknowns_of
 from mbody.equations.solution import METHODS, singular_mass_error
 from mbody.equations.world import check_axes, world_map
-from mbody.errors import MbodyError, wrong_type
+from mbody.errors import MbodyError, not_found, wrong_type
 from mbody.kernel import _core
+from mbody.model.arguments import KnownValues
 from mbody.model.model import Model, State
 from mbody.simulate.trajectory import FORMAT as TRAJECTORY_FORMAT
 from mbody.util import jsontext
 
 FORMAT = "mbody-export"
 """The format tag every export carries; a reader refuses any other."""
+GENERALIZED_FORMAT = "mbody-generalized"
+"""The format tag of an export of the equations in generalized coordinates (`mbody
+lagrange -o`, `mbody.io.export.generalized`): named here, where a reader of the other
+exports tells it apart."""
 VERSION = 2
 """The newest export layout this mbody writes and reads. Version 2 added the world-axes
 map (`ExportedAssembly.T`, written when asked for); version 1 files read as before."""
@@ -79,7 +85,8 @@ class Columns:
         if isinstance(i, str):
             hits = np.flatnonzero(self.labels == i)
             if not len(hits):
-                raise KeyError(f"no reaction column {i!r}")
+                raise not_found("reaction column", i, [str(x) for x in self.labels],
+                                "reaction columns")
             i = int(hits[0])
         out: dict[str, Any] = {"label": str(self.labels[i])}
         out.update({k: str(getattr(self, k)[i]) for k in COLUMN_TEXT[1:]})
@@ -429,7 +436,7 @@ def text_array(values: Sequence[str]) -> np.ndarray:
     return np.array(values, dtype=str) if values else np.zeros(0, dtype="<U1")
 
 
-def exported(asm: Assembly, known: Mapping[str, float] | None = None,
+def exported(asm: Assembly, known: KnownValues | None = None,
              state_source: str = "", axes: str = "joint") -> ExportedAssembly:
     """Collect the matrices, labels and per-column joint data of `asm` for export.
 
@@ -442,7 +449,8 @@ def exported(asm: Assembly, known: Mapping[str, float] | None = None,
     asm
         The assembly at the state to export.
     known
-        Reaction values added to the model file's (labels are checked).
+        Reaction values added to the model file's (labels are checked): numbers, or
+        expressions of t as text taken at the state's time (`Assembly.reaction_values`).
     state_source
         Where the state came from; by default the model's initial state.
     axes
@@ -505,7 +513,7 @@ def exported(asm: Assembly, known: Mapping[str, float] | None = None,
     )
 
 
-def as_export(obj: Assembly | ExportedAssembly, known: Mapping[str, float] | None = None,
+def as_export(obj: Assembly | ExportedAssembly, known: KnownValues | None = None,
               axes: str = "joint") -> ExportedAssembly:
     """`obj` itself when already exported, else ``exported(obj, known, axes=axes)``;
     `mbody.errors.MbodyTypeError` for anything else."""
@@ -552,6 +560,20 @@ MORE = "mbody.load_export(path, max_bytes=N) reads more"
 """How a larger export is read, for the readers' messages (`mbody.util.npzfile`)."""
 
 
+@contextmanager
+def unreadable(path: Path, what: str = "mbody export") -> Iterator[None]:
+    """Within the block, reading the file `path`: an error that is not an `MbodyError`
+    (an entry missing or of another kind, text that is not JSON, a file that cannot be
+    read) becomes one naming the file, "not a readable `what`", and what went wrong."""
+    try:
+        yield
+    except MbodyError:
+        raise
+    except (OSError, ValueError, KeyError, IndexError, TypeError) as exc:
+        raise MbodyError(f"{path}: not a readable {what} ({type(exc).__name__}: {exc})"
+                         ) from None
+
+
 def check_shape(path: Path, what: str, shape: tuple[int, ...], want: tuple[int, int],
                 of: str) -> None:
     """Refuse a matrix whose shape does not fit its labels (`of` says which), before it is
@@ -560,6 +582,29 @@ def check_shape(path: Path, what: str, shape: tuple[int, ...], want: tuple[int, 
     if tuple(shape) != want:
         raise MbodyError(f"{path}: {what} is {' x '.join(map(str, shape))}; expected "
                          f"{want[0]} x {want[1]} ({of})")
+
+
+def check_sparse(path: Path | str, what: str, A: Any) -> None:
+    """Refuse a sparse matrix read from a file whose structure is not one: its index
+    arrays not whole numbers, a row index outside the matrix, column pointers that go
+    back. scipy's compiled routines (`eliminate_zeros`, conversions, products) index
+    memory with them unchecked: a crafted row index crashed the process (review R3).
+    Anything else (a dense array) passes.
+
+    Raises
+    ------
+    MbodyError
+        Naming the file and the matrix `what`.
+    """
+    if not (sp.issparse(A) and A.format in ("csc", "csr")):
+        return
+    try:
+        if A.indices.dtype.kind not in "iu" or A.indptr.dtype.kind not in "iu":
+            raise ValueError(f"its index arrays hold {A.indices.dtype} and {A.indptr.dtype} "
+                             "values, expected whole numbers")
+        A.check_format(full_check=True)
+    except ValueError as exc:
+        raise MbodyError(f"{path}: the sparse matrix {what} is damaged ({exc})") from None
 
 
 def check_map(path: Path, shape: tuple[int, ...], world: int, m: int) -> None:
@@ -578,6 +623,10 @@ def check_format(path: Path, fmt: str, version: int) -> None:
                          "kinematics), not an export; read it with mbody.Trajectory.load("
                          "path), or export one of its samples: mbody export MODEL --state "
                          "RUN --time T")
+    if fmt == GENERALIZED_FORMAT:
+        raise MbodyError(f"{path}: an export of the equations in generalized coordinates "
+                         "(mbody lagrange -o), not of the stacked ones; read it with "
+                         "mbody.io.export.generalized.read_generalized(path)")
     if fmt != FORMAT:
         raise MbodyError(f"{path}: not an mbody export (format {fmt!r})")
     if version > VERSION:
@@ -611,6 +660,8 @@ def build(path: Path, get: Callable[[str], Any], M: sp.spmatrix | np.ndarray,
     """
     version = int(get("version"))
     check_format(path, str(get("format")), version)
+    for what, A in (("M", M), ("G", G), ("T", T)):
+        check_sparse(path, what, A)
     n = len(get("body_names"))
     m = len(get("reactions"))
     N = len(get("coordinates"))

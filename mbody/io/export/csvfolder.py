@@ -23,7 +23,7 @@ import csv
 import io
 import json
 import os
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -42,9 +42,11 @@ from mbody.io.export.assembly import (
     build,
     check_format,
 )
+from mbody.model.arguments import KnownValues
 from mbody.util import jsontext
 from mbody.util.atomic import atomic_folder
-from mbody.util.npzfile import TEXT_BYTES, data_limit, over_budget, read_text
+from mbody.util.budget import TEXT_BYTES, byte_limit
+from mbody.util.npzfile import over_budget, read_text
 
 CSV_DENSE_LIMIT = 1_000_000
 """M.csv and G.csv are labelled dense tables up to this many cells, else triplets."""
@@ -73,7 +75,7 @@ _INFO_KEYS = ("format", "version", "model", "model_file", "dimension", "t", "sta
 
 # -- writing --------------------------------------------------------------------------------
 def write_csv(asm: Assembly | ExportedAssembly, folder: str | os.PathLike[str],
-              known: Mapping[str, float] | None = None, axes: str = "joint") -> Path:
+              known: KnownValues | None = None, axes: str = "joint") -> Path:
     """Write the export as CSV tables in `folder` (created if needed), atomically.
 
     Parameters
@@ -85,7 +87,8 @@ def write_csv(asm: Assembly | ExportedAssembly, folder: str | os.PathLike[str],
         info.csv into (and T.csv when the export holds the world-axes map); other files
         in it are left alone.
     known
-        Reaction values to record as known, with an `Assembly`.
+        Reaction values to record as known, with an `Assembly` (numbers, or expressions
+        of t taken at its state's time: `Assembly.reaction_values`).
     axes
         "world": add the world-axes map T (with an `Assembly`; an export has its own).
 
@@ -204,8 +207,13 @@ def _table(path: Path, max_bytes: int | None = None) -> _Table:
     rows = csv.reader(io.StringIO(read_text(path, max_bytes, MORE), newline=""))
     try:
         numbered = [(k, r) for k, r in enumerate(rows, start=1) if r]
-    except csv.Error as exc:  # a cell over csv's field size limit, a NUL...
-        raise MbodyError(f"{path}, line {rows.line_num}: {exc}") from None
+    except csv.Error as exc:
+        # read from text split into lines, the csv module has one complaint left: a cell
+        # over its field size limit (a process-wide setting, left as it is)
+        limit = csv.field_size_limit()
+        problem = (f"a cell longer than {limit:,} characters, the most a cell is read"
+                   if "limit" in str(exc) else f"not CSV that mbody reads ({exc})")
+        raise MbodyError(f"{path}, line {rows.line_num}: {problem}") from None
     if not numbered:
         raise MbodyError(f"{path}: empty (expected a header line)")
     header = numbered[0][1]
@@ -256,7 +264,7 @@ def read(folder: Path, max_bytes: int | None = None) -> ExportedAssembly:
     """The `ExportedAssembly` stored in the CSV folder `folder`.
 
     Every column is found by its header name (see the module's docstring). The files
-    hold at most `max_bytes` of text in all (default `mbody.util.npzfile.TEXT_BYTES`),
+    hold at most `max_bytes` of text in all (default `mbody.util.budget.TEXT_BYTES`),
     refused before any is read.
 
     Raises
@@ -265,7 +273,7 @@ def read(folder: Path, max_bytes: int | None = None) -> ExportedAssembly:
         For a missing file, a missing column (naming the file and the column), a cell that
         is not a number, or tables whose labels disagree.
     """
-    limit = data_limit(max_bytes, TEXT_BYTES)
+    limit = byte_limit(max_bytes, TEXT_BYTES)
     files = [folder / f for f in (*FILES, MAP_FILE) if (folder / f).is_file()]
     holds = sum(f.stat().st_size for f in files)
     if holds > limit:

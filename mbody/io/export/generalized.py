@@ -8,7 +8,10 @@ columns of M, the rows of f), ``units``, ``quasi`` (1 for a quasi-velocity), ``q
 equations' coordinates), ``T``, ``v_e``, ``a0`` (v = T q' + v_e, v' = T q'' + a0),
 ``efforts`` and ``effort_rows`` (a chosen driver's effort and the coordinate it acts on),
 ``held`` (the reaction components held as constraints), ``model``, ``model_file``, ``t``,
-``equation`` ("M q'' = f (+ efforts on their rows)"). Written atomically.
+``equation`` ("M q'' = f (+ efforts on their rows)"), and the tag ``format``
+("mbody-generalized") with its ``version`` (files written before the tag have neither,
+and read as before). Written atomically; read back (`read_generalized`) as input that
+may be hostile, as `mbody.load_export` reads the other exports.
 """
 
 from __future__ import annotations
@@ -21,8 +24,15 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from mbody.errors import MbodyError
-from mbody.io.export.assembly import MORE, text_array
-from mbody.io.export.mat import checked
+from mbody.io.export.assembly import FORMAT as EXPORT_FORMAT
+from mbody.io.export.assembly import (
+    GENERALIZED_FORMAT,
+    MORE,
+    TRAJECTORY_FORMAT,
+    text_array,
+    unreadable,
+)
+from mbody.io.export.mat import load as load_mat
 from mbody.util import jsontext
 from mbody.util.atomic import atomic_path
 from mbody.util.npzfile import NpzArchive, read_text
@@ -32,6 +42,8 @@ if TYPE_CHECKING:
 
 SUFFIXES = (".npz", ".mat", ".json")
 EQUATION = "M q'' = f + efforts (each effort on its row); v = T q' + v_e; v' = T q'' + a0"
+VERSION = 1
+"""The layout this mbody writes and reads (tagged ``format``: `GENERALIZED_FORMAT`)."""
 
 
 def generalized_data(g: Generalized) -> dict[str, Any]:
@@ -41,6 +53,7 @@ def generalized_data(g: Generalized) -> dict[str, Any]:
     rows = [cs.labels.index(c) for c in g.efforts.values()]
     held = [r for r, h in zip(g.model.reactions, cs.held.mask, strict=True) if h]
     return {
+        "format": GENERALIZED_FORMAT, "version": VERSION,
         "model": g.model.name, "model_file": g.model.file or "", "t": float(g.state.t),
         "equation": EQUATION,
         "coordinates": list(g.coordinates), "units": list(g.units),
@@ -106,30 +119,99 @@ def read_generalized(path: str | os.PathLike[str], max_bytes: int | None = None
     matrices as arrays; .mat effort rows back to 0-based). Read as `mbody.load_export`
     reads a file, as input that may be hostile: at most `max_bytes` (an npz or .mat
     file's arrays once inflated, default 1 GiB; a JSON file's text, default 32 MiB),
-    every declared size checked before anything is inflated, nesting bounded."""
+    every declared size checked before anything is inflated, nesting bounded; the format
+    tag checked before the fields are read.
+
+    Raises
+    ------
+    MbodyError
+        Naming the file and what is wrong: no such file, another suffix, another kind
+        of file (a saved run, an export of the stacked equations), a newer version, a
+        missing entry, a damaged file, more than `max_bytes`.
+    """
     path = Path(path)
     suffix = path.suffix.lower()
-    if suffix == ".npz":
-        with NpzArchive(path, "export file", max_bytes=max_bytes, more=MORE,
-                        damage="not a readable mbody export") as z:
-            out: dict[str, Any] = {k: z.read(k) for k in z.files}
+    if suffix not in SUFFIXES:
+        raise MbodyError(f"{path}: not an export of the generalized equations (expected "
+                         "a name ending in .npz, .mat or .json)")
+    if not path.exists():
+        raise MbodyError(f"{path}: no such file")
+    with unreadable(path, "export of the generalized equations"):
+        if suffix == ".npz":
+            out = _read_npz(path, max_bytes)
+        elif suffix == ".mat":
+            out = _read_mat(path, max_bytes)
+        else:
+            out = jsontext.loads(read_text(path, max_bytes, MORE))
+            if not isinstance(out, dict):
+                raise MbodyError(f"{path}: not an export of the generalized equations (a "
+                                 f"JSON {type(out).__name__}, expected an object)")
+            _check_tag(path, out)
+        missing = [k for k in _FIELDS if k not in out]
+        if missing:
+            raise MbodyError(f"{path}: an export of the generalized equations without "
+                             f"{', '.join(map(repr, missing))}")
         for k in _TEXT:
-            out[k] = [str(x) for x in out[k]]
+            v = out[k]
+            out[k] = [str(v)] if isinstance(v, str) else [str(x) for x in np.atleast_1d(v)]
         for k in ("model", "model_file", "equation"):
             out[k] = str(out[k])
         out["t"] = float(out["t"])
+        out["format"] = GENERALIZED_FORMAT  # also for a file written before the tag
+        out["version"] = int(np.asarray(out.get("version", VERSION)).ravel()[0])
+        for k in _MATRICES:
+            out[k] = np.asarray(out[k], float)
+        rows = np.asarray(out["effort_rows"], float).ravel() - (1 if suffix == ".mat" else 0)
+        out["effort_rows"] = rows.astype(int).tolist()
         return out
-    if suffix == ".mat":
-        import scipy.io  # slow to import: only for .mat files
 
-        raw = scipy.io.loadmat(checked(path, max_bytes), simplify_cells=True)
-        out = {k: v for k, v in raw.items() if not k.startswith("__")}
-        for k in _TEXT:
-            v = out.get(k, [])
-            out[k] = [str(v)] if isinstance(v, str) else [str(x) for x in np.atleast_1d(v)]
-        out["effort_rows"] = (np.atleast_1d(out["effort_rows"]) - 1).astype(int).tolist()
-        return out
-    doc = jsontext.loads(read_text(path, max_bytes, MORE))
-    for k in ("q", "qdot", "M", "f", "T", "v_e", "a0"):
-        doc[k] = np.asarray(doc[k], float)
-    return doc
+
+_FIELDS = ("coordinates", "units", "quasi", "q", "qdot", "M", "f", "body_coordinates", "T",
+           "v_e", "a0", "efforts", "effort_rows", "held", "model", "model_file", "t",
+           "equation")
+_MATRICES = ("q", "qdot", "M", "f", "T", "v_e", "a0")
+
+
+def _check_tag(path: Path, data: Any) -> None:
+    """Refuse a file that is not an export of the generalized equations (`data`: what it
+    holds by name), or a newer one. A file written before the tag has the ``equation``
+    entry every version writes."""
+    if "format" not in data:
+        if "equation" in data:
+            return
+        raise MbodyError(f"{path}: not an export of the generalized equations (it has no "
+                         "'format' entry; mbody lagrange -o writes them)")
+    fmt = str(data["format"])
+    if fmt == TRAJECTORY_FORMAT:
+        raise MbodyError(f"{path}: an mbody trajectory (a run saved by simulate or "
+                         "kinematics), not an export of the generalized equations; read it "
+                         "with mbody.Trajectory.load(path)")
+    if fmt == EXPORT_FORMAT:
+        raise MbodyError(f"{path}: an export of the stacked equations (mbody export), not "
+                         "of the generalized ones; read it with mbody.load_export(path)")
+    if fmt != GENERALIZED_FORMAT:
+        raise MbodyError(f"{path}: not an export of the generalized equations (format "
+                         f"{fmt!r})")
+    version = int(np.asarray(data.get("version", 0)).ravel()[0])
+    if version > VERSION:
+        raise MbodyError(f"{path}: generalized export version {version} is newer than this "
+                         f"mbody reads ({VERSION}); upgrade mbody")
+
+
+def _read_npz(path: Path, max_bytes: int | None) -> dict[str, Any]:
+    """The npz file's entries, its tag read (and checked) before the rest is inflated."""
+    with NpzArchive(path, "export file", max_bytes=max_bytes, more=MORE,
+                    damage="not a readable mbody export") as z:
+        tag = {k: z.read(k) for k in ("format", "version", "equation") if k in z}
+        if "format" in tag and (tag["format"].shape != () or tag["format"].dtype.kind != "U"):
+            raise z.damaged("'format' is not one text")
+        _check_tag(path, tag)
+        return {k: z.read(k) for k in z.files}
+
+
+def _read_mat(path: Path, max_bytes: int | None) -> dict[str, Any]:
+    """The .mat file's variables (`mbody.io.export.mat.load`, cells as lists)."""
+    out = {k: v for k, v in load_mat(path, max_bytes, simplify_cells=True).items()
+           if not k.startswith("__")}
+    _check_tag(path, out)
+    return out

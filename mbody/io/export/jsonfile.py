@@ -90,7 +90,7 @@ def schema() -> dict[str, Any]:
 
 def read(path: Path, max_bytes: int | None = None) -> ExportedAssembly:
     """The `ExportedAssembly` stored in the JSON file `path`: at most `max_bytes` of text
-    (default `mbody.util.npzfile.TEXT_BYTES`), refused before it is read; its nesting
+    (default `mbody.util.budget.TEXT_BYTES`), refused before it is read; its nesting
     bounded before it is parsed (`mbody.util.jsontext.loads`)."""
     d = jsontext.loads(read_text(path, max_bytes))
     if not isinstance(d, dict):

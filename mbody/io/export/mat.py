@@ -7,7 +7,7 @@ files.
 A .mat file is read as input that may be hostile (`checked`): scipy allocates the arrays
 a file declares, recurses into nested cells as deep as they go and inflates each
 compressed variable whole, so the file's structure is walked first, within a byte budget
-(`mbody.util.npzfile.data_limit`), and scipy reads the walked, inflated copy."""
+(`mbody.util.budget.byte_limit`), and scipy reads the walked, inflated copy."""
 
 from __future__ import annotations
 
@@ -22,8 +22,16 @@ from typing import Any
 import numpy as np
 
 from mbody.errors import MbodyError
-from mbody.io.export.assembly import COLUMN_TEXT, MORE, ExportedAssembly, build, flat_arrays
-from mbody.util.npzfile import data_limit, over_budget, read_bytes
+from mbody.io.export.assembly import (
+    COLUMN_TEXT,
+    MORE,
+    ExportedAssembly,
+    build,
+    check_sparse,
+    flat_arrays,
+)
+from mbody.util.budget import DATA_BYTES, byte_limit
+from mbody.util.npzfile import over_budget, read_bytes
 
 
 def _cell(values: Iterable[Any]) -> np.ndarray:
@@ -67,11 +75,47 @@ def write(exp: ExportedAssembly, path: Path) -> None:
     scipy.io.savemat(path, arrs, oned_as="column", do_compression=True)
 
 
-def read(path: Path, max_bytes: int | None = None) -> ExportedAssembly:
-    """The `ExportedAssembly` stored in the .mat file `path` (`checked` first)."""
+def load(path: Path, max_bytes: int | None = None, simplify_cells: bool = False
+         ) -> dict[str, Any]:
+    """`scipy.io.loadmat` of the .mat file `path` as input that may be hostile: `checked`
+    first, and then every sparse matrix in it (in cells and structs too) checked
+    (`check_sparse`) before anything uses it."""
     import scipy.io
 
-    data = scipy.io.loadmat(checked(path, max_bytes), simplify_cells=False)
+    stream = checked(path, max_bytes)
+    try:
+        data = scipy.io.loadmat(stream, simplify_cells=simplify_cells)
+    except (scipy.io.matlab.MatReadError, OverflowError, TypeError, ValueError, IndexError,
+            KeyError) as exc:  # what the walk does not look into (a sparse matrix whose
+        # column pointers end below 0: an OverflowError)
+        raise MbodyError(f"{path}: damaged or truncated .mat export (scipy cannot read "
+                         f"it: {type(exc).__name__}: {exc})") from None
+
+    def walk(name: str, value: Any) -> None:  # nested at most MAX_DEPTH (`checked`)
+        if isinstance(value, dict):
+            for key, v in value.items():
+                walk(f"{name}.{key}", v)
+        elif isinstance(value, list | tuple):
+            for v in value:
+                walk(f"{name} (in a cell)", v)
+        elif isinstance(value, np.ndarray) and value.dtype == object:
+            for v in value.flat:
+                walk(f"{name} (in a cell)", v)
+        elif isinstance(value, np.ndarray) and value.dtype.names:  # a struct array
+            for v in value.flat:
+                for field in value.dtype.names:
+                    walk(f"{name}.{field}", v[field])
+        else:
+            check_sparse(path, name, value)
+
+    for key, value in data.items():
+        walk(key, value)
+    return data
+
+
+def read(path: Path, max_bytes: int | None = None) -> ExportedAssembly:
+    """The `ExportedAssembly` stored in the .mat file `path` (`load`)."""
+    data = load(path, max_bytes)
 
     def unstr(v: Any) -> str:
         v = np.asarray(v)
@@ -103,6 +147,8 @@ _CLASS_ITEM = {4: 4, 6: 8, 7: 4, 8: 1, 9: 1, 10: 2, 11: 2, 12: 4, 13: 4, 14: 8, 
 """Bytes per element of each numeric or char array class in memory (mxCHAR as numpy's
 4-byte characters), what scipy allocates for a declared shape."""
 _CELL, _STRUCT, _CHAR, _SPARSE = 1, 2, 4, 5
+_INT8 = 1
+"""The MAT type of names and field names (miINT8)."""
 
 
 class _Walk:
@@ -156,13 +202,25 @@ class _Walk:
         if min(shape) < 0:
             raise self.fail(f"an array of shape {shape}")
         count = math.prod(shape)
-        _, _, _, pos = self.element(buf, pos, end)  # the name
+        # every element's type is checked: scipy's compiled reader looks a type up in a
+        # table of the known ones unchecked (a sparse matrix's row indices of type 5637
+        # crashed the process, review R3)
+        kind, _, at, pos = self.element(buf, pos, end)
+        if kind != _INT8:
+            raise self.fail(f"an array whose name at byte {at} is of MAT type {kind}, "
+                            "expected text (miINT8)")
         if cls in (_CELL, _STRUCT):
             fields = 1
             if cls == _STRUCT:
-                _, _, at, pos = self.element(buf, pos, end)
+                kind, size, at, pos = self.element(buf, pos, end)
+                if kind != 5 or size != 4:  # one int32, as MATLAB and scipy write it
+                    raise self.fail(f"a struct without the width of its field names at "
+                                    f"byte {at}")
                 width = struct.unpack_from(self.order + "i", buf, at)[0]
-                _, size, _, pos = self.element(buf, pos, end)
+                kind, size, at, pos = self.element(buf, pos, end)
+                if kind != _INT8:
+                    raise self.fail(f"a struct whose field names at byte {at} are of MAT "
+                                    f"type {kind}, expected text (miINT8)")
                 if width <= 0 or size % width:
                     raise self.fail("a struct whose field names do not fit their width")
                 fields = size // width
@@ -178,7 +236,10 @@ class _Walk:
                 self.matrix(buf, at, at + size, depth + 1)
         elif cls == _SPARSE:
             for _ in range(2 + parts):  # row indices, column pointers, values (real, imag)
-                _, size, _, pos = self.element(buf, pos, end)
+                kind, size, at, pos = self.element(buf, pos, end)
+                if kind not in _ITEM:
+                    raise self.fail(f"a sparse array whose data at byte {at} is of MAT type "
+                                    f"{kind}, not numbers")
                 self.spend(2 * size)  # scipy's copy and the matrix's own
         elif cls in _CLASS_ITEM:
             for _ in range(parts):
@@ -198,7 +259,7 @@ class _Walk:
 def checked(path: Path, max_bytes: int | None = None) -> io.BytesIO:
     """The MAT 5 file `path` walked and inflated, as an uncompressed MAT 5 stream for
     `scipy.io.loadmat`: every variable's declared size counted against `max_bytes`
-    (default `mbody.util.npzfile.DATA_BYTES`) before it is inflated, every array's shape
+    (default `mbody.util.budget.DATA_BYTES`) before it is inflated, every array's shape
     against the bytes that hold it, nesting at most `MAX_DEPTH`. scipy then allocates only
     what the bytes there hold, and never inflates anything itself.
 
@@ -208,7 +269,7 @@ def checked(path: Path, max_bytes: int | None = None) -> io.BytesIO:
         Naming the file and what is wrong: not a MAT 5 file (v4 and v7.3/HDF5 files are
         not read), more than the budget, an element or shape that does not fit.
     """
-    limit = data_limit(max_bytes)
+    limit = byte_limit(max_bytes, DATA_BYTES)
     raw = read_bytes(path, limit, MORE)
     order = {b"IM": "<", b"MI": ">"}.get(raw[126:128])
     if (len(raw) < _HEADER or order is None or not raw.startswith(b"MATLAB 5.0")
@@ -219,28 +280,41 @@ def checked(path: Path, max_bytes: int | None = None) -> io.BytesIO:
     out = [raw[:116], bytes(8), raw[124:_HEADER]]  # no subsystem data
     pos = _HEADER
     while pos < len(raw):
-        kind, size, at, after = walk.element(raw, pos, len(raw))
-        if kind == _COMPRESSED:
-            inflate = zlib.decompressobj()
-            head = inflate.decompress(raw[at:at + size], 8)
-            if len(head) < 8:
-                raise walk.fail(f"a compressed variable at byte {pos} is cut short")
-            inner, inner_size = struct.unpack_from(order + "II", head)
-            walk.spend(inner_size + 8)  # before it is inflated
-            # (a max_length of 0 would be no limit at all)
-            body = head + (inflate.decompress(inflate.unconsumed_tail, inner_size)
-                           if inner_size else b"")
-            if inner != _MATRIX or len(body) != inner_size + 8:
-                raise walk.fail(f"the compressed variable at byte {pos} does not hold the "
-                                f"{inner_size:,} bytes of an array it says it holds")
-            after = at + size
-        elif kind == _MATRIX:
-            body = raw[pos:at + size]
-            walk.spend(size + 8)
-        else:
-            raise walk.fail(f"an element of MAT type {kind} at byte {pos}, where a "
-                            "variable was expected")
-        walk.matrix(body, 8, len(body), 0)
+        try:
+            body, pos = _variable(walk, raw, pos)
+        except zlib.error as exc:
+            raise walk.fail(f"the compressed variable at byte {pos} does not inflate: "
+                            f"{exc}") from None
+        except struct.error as exc:  # each size is checked before it is unpacked
+            raise walk.fail(f"an element in the variable at byte {pos} is cut short: "
+                            f"{exc}") from None
         out += [body, bytes(-len(body) % 8)]
-        pos = after
     return io.BytesIO(b"".join(out))
+
+
+def _variable(walk: _Walk, raw: bytes, pos: int) -> tuple[bytes, int]:
+    """The variable at byte `pos` of the file `raw`, inflated and walked, and where the
+    next one starts."""
+    kind, size, at, after = walk.element(raw, pos, len(raw))
+    if kind == _COMPRESSED:
+        inflate = zlib.decompressobj()
+        head = inflate.decompress(raw[at:at + size], 8)
+        if len(head) < 8:
+            raise walk.fail(f"a compressed variable at byte {pos} is cut short")
+        inner, inner_size = struct.unpack_from(walk.order + "II", head)
+        walk.spend(inner_size + 8)  # before it is inflated
+        # (a max_length of 0 would be no limit at all)
+        body = head + (inflate.decompress(inflate.unconsumed_tail, inner_size)
+                       if inner_size else b"")
+        if inner != _MATRIX or len(body) != inner_size + 8:
+            raise walk.fail(f"the compressed variable at byte {pos} does not hold the "
+                            f"{inner_size:,} bytes of an array it says it holds")
+        after = at + size
+    elif kind == _MATRIX:
+        body = raw[pos:at + size]
+        walk.spend(size + 8)
+    else:
+        raise walk.fail(f"an element of MAT type {kind} at byte {pos}, where a "
+                        "variable was expected")
+    walk.matrix(body, 8, len(body), 0)
+    return body, after

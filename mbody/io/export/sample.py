@@ -6,7 +6,7 @@ from __future__ import annotations
 import os
 
 from mbody.equations.assemble import Assembly, assemble
-from mbody.errors import MbodyError
+from mbody.errors import MbodyError, wrong_type
 from mbody.model.model import Model, State
 from mbody.simulate.trajectory import Trajectory
 
@@ -19,9 +19,7 @@ def state_at(traj: Trajectory, time: float | None) -> tuple[State, int]:
     `MbodyError` when `time` lies outside the trajectory's time span.
     """
     if time is None:
-        if len(traj.t) == 0:
-            raise MbodyError("the trajectory holds no samples")
-        k = len(traj.t) - 1
+        k = traj.need_samples() - 1
     else:
         k = traj.nearest_sample(time)
     return traj.state(k), k
@@ -53,8 +51,7 @@ def assembly_from_trajectory(model: Model, run: Trajectory | str | os.PathLike[s
     elif isinstance(run, str | os.PathLike):
         traj, where = Trajectory.load(run), f"trajectory {run}"
     else:
-        raise TypeError(f"run: expected a Trajectory or the path of its .npz file, got "
-                        f"{type(run).__name__}")
+        raise wrong_type("run", "a Trajectory or the path of its .npz file", run)
     if tuple(traj.body_names) != tuple(model.body_names) or traj.dimension != model.dimension:
         raise MbodyError(f"{where}: this trajectory is of another model (bodies "
                          f"{', '.join(list(traj.body_names)[:5])}..., dimension "

@@ -16,8 +16,8 @@ from mbody.errors import MbodyError, MbodyTypeError, did_you_mean, option_name
 from mbody.io.interop.mjcf import read_mjcf
 from mbody.io.interop.tree import ImportedDocument, validate_imported
 from mbody.io.interop.urdf import read_urdf
-from mbody.model.loader import max_bytes_limit
 from mbody.model.validate import Spec
+from mbody.util.budget import byte_budget
 
 FORMATS = ("yaml", "mjcf", "urdf")
 """The model formats `mbody.load` and every command read."""
@@ -128,7 +128,7 @@ def import_spec(path: str | os.PathLike[str], format: str | None = None, *,
     if fmt == "yaml":
         _check_options(fmt, options)
         return None
-    with max_bytes_limit(max_bytes):
+    with byte_budget(max_bytes):
         doc = read_document(path, fmt, **options)
     spec = validate_imported(doc)
     spec.warnings[:0] = doc.warnings

@@ -40,10 +40,10 @@ from mbody import __version__, joint_types
 from mbody import conventions as cv
 from mbody.io.interop.custom import numeric, text
 from mbody.joint_types.base import SCREW
+from mbody.model.drawn import inertia_box
 from mbody.model.model import Joint, Model, count
 from mbody.util.atomic import write_atomic
 from mbody.util.spatial import (
-    box_equivalent,
     matrix_to_quat,
     quat_conj,
     quat_mul,
@@ -485,27 +485,25 @@ def _inertial(m: Model, i: int, scale: float) -> str:
 
 
 def _geom(m: Model, i: int) -> str:
-    """The body's shape as a geom in body axes (its equivalent box when it has none), as
-    the drawings show it (`mbody.present.draw.outline`)."""
+    """The body's shape as a geom in body axes; its inertia box when it has none
+    (`mbody.model.drawn.inertia_box`: centred at G with the body's inertia, as the geom is
+    read back as its shape; the pictures draw a bar through its points instead when it
+    has two)."""
     body = m.bodies[m.body_names[i]]
     planar = m.dimension == cv.PLANAR
     rgba = _rgba(body.color)
     # shapes are for viewing only: contacts would add forces mbody does not have
     color = ' contype="0" conaffinity="0"' + (f' rgba="{rgba}"' if rgba else "")
     shape = body.shape
-    if shape is None:
+    if shape is None:  # the inertia box, not a bar: read back, a geom is the body's shape
         if body.particle:
             return ""
-        J = np.asarray(body.inertia, dtype=float)
+        box = inertia_box(m.dimension, body.mass, body.inertia)
         if planar:
-            side = math.sqrt(6.0 * J[2, 2] / body.mass)
+            side = float(box.size[0])
             return f'<geom type="box" size="{_vec([side / 2, side / 2, side / 10])}"{color}/>'
-        moments, axes = np.linalg.eigh(J)
-        if np.linalg.det(axes) < 0:
-            axes[:, 2] *= -1.0
-        edges = box_equivalent(moments, body.mass)
-        return (f'<geom type="box" size="{_vec(edges / 2)}" quat="{_vec(_matrix_quat(axes))}"'
-                f"{color}/>")
+        return (f'<geom type="box" size="{_vec(box.size / 2)}" '
+                f'quat="{_vec(_matrix_quat(box.axes))}"{color}/>')
     kind, v = next(iter(shape.items()))
     if kind in ("box", "ellipsoid"):
         dims = [float(x) for x in v]

@@ -71,9 +71,7 @@ _CHILDREN: dict[str, tuple[str, ...]] = {
 _ONCE: dict[str, tuple[str, ...]] = {
     "link": ("inertial",), "inertial": ("origin", "mass", "inertia"),
     "visual": ("origin", "geometry", "material"), "collision": ("origin", "geometry"),
-    "material": ("color", "texture"),
-    "joint": ("origin", "parent", "child", "axis", "calibration", "dynamics", "limit",
-              "mimic", "safety_controller"),
+    "material": ("color", "texture"), "joint": _CHILDREN["joint"],
 }
 """The children URDF gives an element at most once; a <geometry> holds one shape."""
 _OPEN = ("transmission", "gazebo", "mujoco")
@@ -456,10 +454,10 @@ class _Reader:
                 angle = target is qpos and k in hinges
                 limit = MAX_ANGLE if angle else MAX_MAGNITUDE
                 if abs(value) > limit:
-                    problems.append(Issue(self.file, 0, 0, f"{what}[{k}]", (
-                        f"expected an angle of at most {limit:g} rad in magnitude"
-                        if angle else f"expected a number of magnitude at most {limit:g}")
-                        + f", as in a model file, got {value:g}"))
+                    problems.append(Issue(self.file, 0, 0, what, f"joint '{k}': " + (
+                        f"expected an angle of at most {limit:.6g} rad in magnitude"
+                        if angle else f"expected a number of magnitude at most {limit:.6g}")
+                        + f", as in a model file, got {value:.6g}"))
                     continue
                 target[where[0] if target is qpos else where[1]] = value
         if problems:

@@ -30,11 +30,12 @@ from mbody import conventions as cv
 from mbody.equations.joints import reaction_columns
 from mbody.equations.loads import applied_loads
 from mbody.errors import MbodyError, did_you_mean
+from mbody.model.drawn import body_box
 from mbody.model.model import Body, Model
 from mbody.present.animate.wire import load_meshcat
 from mbody.simulate.trajectory import Trajectory
 from mbody.util.colours import colour_hex, colour_hint
-from mbody.util.spatial import box_equivalent, matvec, planar_quat, quat_to_matrix
+from mbody.util.spatial import matvec, planar_quat, quat_to_matrix
 
 ROOT = "/meshcat/mbody"
 """Scene path of the model's frame; bodies are at ROOT/bodies/<name>."""
@@ -266,32 +267,37 @@ def _color(value: str | None, i: int) -> int:
 @dataclass(frozen=True)
 class _Extent:
     """A shape for bounding: kind ('box', 'ellipsoid' or 'cylinder' along its z), the
-    rotation from its own axes to body axes, and its half-extents (radii; for a
-    cylinder [r, r, length / 2]) in its own axes."""
+    rotation from its own axes to body axes, its half-extents (radii; for a cylinder
+    [r, r, length / 2]) in its own axes, and its centre from the mass centre (body axes:
+    a bar through a body's points, `mbody.model.drawn`, need not be centred at G)."""
 
     kind: str
     axes: np.ndarray
     half: np.ndarray
+    centre: np.ndarray = field(default_factory=lambda: np.zeros(3))
 
     def body_half(self) -> np.ndarray:
-        """Half-extents of a box in body axes that holds the shape."""
-        return np.abs(self.axes) @ self.half
+        """Half-extents of a box in body axes, centred at G, that holds the shape."""
+        return np.abs(self.axes) @ self.half + np.abs(self.centre)
 
     def reach(self, R: np.ndarray) -> np.ndarray:
-        """(K, 3) half-extents along world axes of the shape turned by R (K, 3, 3),
-        exact for each kind: a box spans |R| h, an ellipsoid sqrt(Σ_j (R_ij r_j)²), a
-        cylinder of axis a spans r sqrt(1 − a_i²) + (length / 2) |a_i|."""
+        """(K, 3) half-extents along world axes, about the mass centre, of the shape
+        turned by R (K, 3, 3), exact for each kind about its own centre: a box spans
+        |R| h, an ellipsoid sqrt(Σ_j (R_ij r_j)²), a cylinder of axis a spans
+        r sqrt(1 − a_i²) + (length / 2) |a_i|; plus how far R puts that centre from G."""
         Rs = R @ self.axes
+        off = np.abs(R @ self.centre)
         if self.kind == "box":
-            return np.abs(Rs) @ self.half
+            return np.abs(Rs) @ self.half + off
         if self.kind == "ellipsoid":
-            return np.sqrt((Rs * Rs) @ (self.half * self.half))
+            return np.sqrt((Rs * Rs) @ (self.half * self.half)) + off
         a = Rs[..., 2]
         return (self.half[0] * np.sqrt(np.clip(1.0 - a * a, 0.0, None))
-                + self.half[2] * np.abs(a))
+                + self.half[2] * np.abs(a)) + off
 
 
-def _shape(g: ModuleType, body: Body, dimension: int) -> tuple[Any, np.ndarray, _Extent]:
+def _shape(g: ModuleType, model: Model, body: Body, dimension: int
+           ) -> tuple[Any, np.ndarray, _Extent]:
     """meshcat geometry of a body, its fixed transform in body axes, its extent.
 
     meshcat's cylinder axis is its local +y (three.js); turning it by +90° about x puts it
@@ -300,17 +306,13 @@ def _shape(g: ModuleType, body: Body, dimension: int) -> tuple[Any, np.ndarray, 
     to_z = _homogeneous(_rot_x(math.pi / 2))
     eye, I3 = np.eye(4), np.eye(3)
     shape = body.shape
-    if shape is None:  # the uniform box with the body's inertia, along its principal axes
+    if shape is None:  # a bar through its points, or the box with its inertia
+        box = body_box(model, body.index)
+        dims = [float(e) for e in box.size]
         if dimension == cv.PLANAR:
-            side = math.sqrt(6.0 * body.I_G / body.mass)
-            dims = [side, side, 0.2 * side]
-            return g.Box(dims), eye, _Extent("box", I3, np.array(dims) / 2)
-        moments, axes = np.linalg.eigh(np.asarray(body.inertia, dtype=np.float64))
-        if np.linalg.det(axes) < 0:
-            axes[:, 2] *= -1.0
-        edges = box_equivalent(moments, body.mass)
-        return (g.Box([float(e) for e in edges]), _homogeneous(axes),
-                _Extent("box", axes, np.asarray(edges, dtype=np.float64) / 2))
+            dims.append(0.2 * min(dims))
+        return (g.Box(dims), _homogeneous(box.axes, box.centre),
+                _Extent("box", box.axes, np.array(dims) / 2, box.centre))
     kind, v = next(iter(shape.items()))
     if kind == "box":
         dims = [float(x) for x in v]
@@ -407,8 +409,7 @@ def build_scene(traj: Trajectory, model: Model, *, forces: bool = False,
             hint = did_you_mean(name, traj_names)
             raise MbodyError(f"unknown body {name!r}: the trajectory has "
                              f"{', '.join(traj_names)}" + (f" ({hint})" if hint else ""))
-    if len(traj.t) < 1:
-        raise MbodyError("the trajectory has no samples")
+    traj.need_samples()
     t = np.asarray(traj.t, dtype=np.float64)
     if np.any(np.diff(t) <= 0):
         raise MbodyError("the trajectory's times do not increase")
@@ -425,7 +426,7 @@ def build_scene(traj: Trajectory, model: Model, *, forces: bool = False,
     geoms, extents = [], []
     for nm in shown:
         body = model.bodies[nm]
-        geom, T_shape, ext = _shape(g, body, traj.dimension)
+        geom, T_shape, ext = _shape(g, model, body, traj.dimension)
         extents.append(ext)
         geoms.append((nm, geom, T_shape, ext.body_half(), _color(body.color, body.index)))
     lo, hi = _motion_box(pos[:, idx], quat[:, idx], extents)

@@ -6,7 +6,7 @@ import os
 from pathlib import Path
 
 import mbody
-from mbody.errors import MbodyError
+from mbody.errors import MbodyError, option_name
 from mbody.loading import load as load_model
 from mbody.model.model import Model
 from mbody.simulate.trajectory import Trajectory
@@ -78,7 +78,7 @@ def _model_of(traj: Trajectory, path: Path) -> Model:
     if getattr(traj, "model_yaml", ""):
         return traj.model()  # StoredModelError names the run, not the file it names
     if not traj.model_file:
-        raise MbodyError(f"{path} does not say which model it came from: pass --model MODEL")
+        raise MbodyError(f"{path} does not say which model it came from: pass {_model()}")
     for where in (Path(traj.model_file), path.parent / traj.model_file):
         if where.is_file():
             try:
@@ -87,9 +87,14 @@ def _model_of(traj: Trajectory, path: Path) -> Model:
                 raise MbodyError(
                     f"{path} carries no model text, and the file it names as its model, "
                     f"{str(where)!r}, is not a model mbody reads ('mbody check {where}' "
-                    "says why): pass --model MODEL") from None
+                    f"says why): pass {_model()}") from None
     raise MbodyError(f"{path} was computed from {traj.model_file}, which is not found: "
-                     "pass --model MODEL")
+                     f"pass {_model()}")
+
+
+def _model() -> str:
+    """The argument that gives a run's model, as the caller names it."""
+    return option_name("model", "mbody.load(path)", "MODEL")
 
 
 def _simulate(model: Model, t_end: float | None, fps: float | None) -> Trajectory:

@@ -27,6 +27,7 @@ from mbody.conventions import GRAVITY, REACTION
 from mbody.model.drivers import EFFORT as DRIVER_EFFORT
 from mbody.present.draw.style import COLORS, DASHES, EFFORT
 from mbody.present.draw.views import eye
+from mbody.util.formatting import quiet
 
 if TYPE_CHECKING:
     from mbody.equations.fbd import ForceOnBody, FreeBodyDiagram
@@ -75,8 +76,7 @@ class Arrow:
 
 def fmt(x: float) -> str:
     """A number in 4 significant digits, with a true minus sign and no -0."""
-    x = 0.0 if abs(x) < 1e-12 else x
-    s = f"{x:.4g}"
+    s = f"{quiet(x):.4g}"
     return "0" if s in ("-0", "0") else s.replace("-", "−")
 
 

@@ -1,17 +1,18 @@
 """Body outlines in world coordinates: a body's shape (box, cylinder, disc, sphere,
-ellipsoid), else its equivalent box, or a dot for a particle, with visible and hidden
-edges for a given eye direction."""
+ellipsoid), else the box `mbody.model.drawn` draws it as (a bar through the points where
+its joints and loads act, or its inertia box), or a dot for a particle, with visible and
+hidden edges for a given eye direction."""
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from mbody import conventions as cv
-from mbody.util.spatial import box_equivalent
+from mbody.conventions import APPLIED, REACTION
+from mbody.model.drawn import drawn_box
 
 if TYPE_CHECKING:
     from mbody.equations.fbd import FreeBodyDiagram
@@ -37,9 +38,19 @@ def circle(n: int = 72) -> np.ndarray:
     return np.column_stack((np.cos(t), np.sin(t)))
 
 
+def drawn_points(fbd: FreeBodyDiagram) -> np.ndarray:
+    """(k, 3) the points of the body where the diagram's joints and loads act (the joint
+    and load points it draws), in body axes from G: what a body without a shape is drawn
+    through (`mbody.model.drawn`)."""
+    pts = [fo.B_r for fo in fbd.forces
+           if fo.kind == REACTION or (fo.kind == APPLIED and not fo.couple)]
+    return np.array(pts, dtype=float).reshape(-1, 3)
+
+
 def outline(fbd: FreeBodyDiagram, eye: np.ndarray) -> Outline:
-    """The outline of `fbd`'s body (its shape, else a dot or its equivalent box), with
-    edges split into the stretches seen and hidden from `eye` (unit vector toward it)."""
+    """The outline of `fbd`'s body (its shape, else a dot or `mbody.model.drawn`'s box),
+    with edges split into the stretches seen and hidden from `eye` (unit vector toward
+    it)."""
     x, R = fbd.W_position, fbd.W_R_B
     shape = fbd.shape
     planar = fbd.dimension == cv.PLANAR
@@ -47,16 +58,10 @@ def outline(fbd: FreeBodyDiagram, eye: np.ndarray) -> Outline:
     v: Any  # the shape's sizes: a list of lengths or a dict of named ones
     if shape is None and not np.any(fbd.inertia):  # a particle: a dot
         kind, v = "sphere", {"radius": PARTICLE_DOT}
-    elif shape is None:  # a uniform box with the same principal inertias
-        if planar:
-            side = math.sqrt(6.0 * fbd.inertia[2, 2] / fbd.mass)
-            kind, v = "box", [side, side]
-        else:
-            J_p, V = np.linalg.eigh(fbd.inertia)
-            if np.linalg.det(V) < 0:
-                V[:, 2] *= -1
-            R = R @ V
-            kind, v = "box", list(box_equivalent(J_p, fbd.mass))
+    elif shape is None:  # a bar through its points, or the box with its inertia
+        box = drawn_box(fbd.dimension, fbd.mass, fbd.inertia, drawn_points(fbd))
+        x, R = x + R @ box.centre, R @ box.axes
+        kind, v = "box", list(box.size)
     else:
         kind, v = next(iter(shape.items()))
 

@@ -1,0 +1,304 @@
+"""`mbody.verify` with a_G written from the joints' kinematics (review R4, F1).
+
+A student who writes a pinned body's Newton rows with a_G = α × r − ω² r put in writes a
+true equation: the row plus relations the joints impose at acceleration level (Gᵀ v̇ =
+γ), which hold for every motion the joints allow and carry no reaction. These tests
+check the relations against closed forms and against solved motions, accept every row
+of every shipped model written that way (naming the row it is), and keep every usual
+mistake diagnosed as it was without the relations.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import mbody
+from mbody.answers import verify
+from mbody.answers.compare import CONST, Row
+from mbody.answers.diagnose import diagnose
+from mbody.answers.rows import body_rows
+
+ROOT = Path(__file__).resolve().parent.parent
+MODELS = ROOT / "models"
+
+# the reviewer's pendulum (/tmp/r4x/s/pend.yaml): 2 kg, 1 m rod pinned at O, at 30 deg
+# from the downward vertical, turning at 3 rad/s (its velocity is ω × r_OG)
+MOVING = """\
+model: my-pend
+dimension: 2
+gravity: [0, -9.81]
+bodies:
+  - name: rod
+    mass: 2
+    inertia: 0.1666666667
+    angle: 30 deg
+    position: [0.25, -0.4330127019]
+    angular_velocity: 3
+    velocity: [1.299038106, 0.75]
+joints:
+  - {name: O, type: revolute, parent: ground, child: rod, at: [0, 0]}
+"""
+
+
+@pytest.fixture(scope="module")
+def moving() -> mbody.Model:
+    return mbody.loads(MOVING)
+
+
+def one(model, body: str, eq: str):
+    return verify(model, [{"body": body, "eq": eq}]).checks[0]
+
+
+# == the review's reproductions ===========================================================
+
+def test_newton_rows_with_a_g_from_the_pin_at_rest_are_correct():
+    # the shipped pendulum at rest: a_x = 0.433013 alpha, a_y = 0.25 alpha
+    v = verify(MODELS / "pendulum.yaml", [
+        {"body": "rod", "eq": "m*0.433013*alpha = O.Fx"},
+        {"body": "rod", "eq": "m*0.25*alpha = O.Fy - m*g"}])
+    assert [c.diagnosis for c in v.checks] == ["correct", "correct"]
+    assert [c.row for c in v.checks] == ["rod.x", "rod.y"]  # the grader's rows
+    assert "Newton's equation along world x" in v.checks[0].explanation
+    assert "a_x written from the kinematics of joint O" in v.checks[0].explanation
+    assert v.checks[0].details["kinematics"] == ["a_x = 0.433013 alpha"]
+    assert v.checks[0].details["joints"] == ["joint O"]
+    # the equations hold: the solution's a_x is 0.433013 alpha
+    sol = mbody.assemble(mbody.load(MODELS / "pendulum.yaml")).solve()
+    assert sol["rod.x"] == pytest.approx(0.4330127 * sol["rod.theta"], rel=1e-6)
+
+
+def test_newton_rows_with_the_centripetal_term_are_correct(moving):
+    v = verify(moving, [
+        {"body": "rod", "eq": "m*(0.433013*alpha - w^2*0.25) = O.Fx"},
+        {"body": "rod", "eq": "m*(0.25*alpha + w^2*0.433013) = O.Fy - m*g"},
+        {"body": "rod", "eq": "(I_G + m*0.25)*alpha = -m*g*0.5*sin(theta)"}])
+    assert [c.diagnosis for c in v.checks] == ["correct"] * 3
+    assert [c.row for c in v.checks] == ["rod.x", "rod.y", "rod.theta"]
+    # a_G = α × r − ω² r with r = G − O = (0.25, −0.433013): the relations' numbers
+    assert v.checks[0].details["kinematics"] == ["a_x = 0.433013 alpha - 2.25"]
+    assert v.checks[1].details["kinematics"] == ["a_y = 0.25 alpha + 3.89711"]
+    assert v.checks[2].details["form"] == "fixed_pivot"  # as before: its own words
+    assert not v.uncovered
+
+
+def test_the_class_summary_counts_them_correct(moving, tmp_path):
+    from mbody.answers.summary import grade
+
+    f = tmp_path / "cleo.yaml"
+    f.write_text("student: Cleo\nequations:\n"
+                 '  - {body: rod, eq: "m*(0.433013*alpha - w^2*0.25) = O.Fx"}\n'
+                 '  - {body: rod, eq: "m*(0.25*alpha + w^2*0.433013) = O.Fy - m*g"}\n'
+                 '  - {body: rod, eq: "(I_G + m*0.25)*alpha = -m*g*0.5*sin(theta)"}\n')
+    g = grade(moving, [f]).graded[0]
+    assert (g.equations, g.correct, g.wrong) == (3, 3, [])
+
+
+# == the relations themselves =============================================================
+
+def test_the_pendulums_relations_are_a_g_of_a_fixed_pivot(moving):
+    br = body_rows(mbody.assemble(moving), "rod")
+    rel = {r.acc: r for r in br.kinematics.relations}
+    d = br.W_x[:2]                     # G − O, O at the origin
+    w = 3.0
+    # a_G = α × d − ω² d: a_x = −d_y α − ω² d_x, a_y = d_x α − ω² d_y
+    assert rel["a_x"].coef == {"alpha": pytest.approx(-d[1], rel=1e-12)}
+    assert rel["a_x"].const == pytest.approx(-w * w * d[0], rel=1e-12)
+    assert rel["a_y"].coef == {"alpha": pytest.approx(d[0], rel=1e-12)}
+    assert rel["a_y"].const == pytest.approx(-w * w * d[1], rel=1e-12)
+
+
+def _models_with_joints():
+    for path in sorted(MODELS.glob("*.yaml")):
+        m = mbody.load(path)
+        if len(m.reactions):
+            yield path.name, m
+
+
+@pytest.mark.parametrize("name", [n for n, _ in _models_with_joints()])
+def test_every_relation_holds_for_two_different_motions(name):
+    """The relations are the joints' kinematics, not the loads': they hold for the
+    solved accelerations at the model's state, and again with gravity tripled (another
+    motion the joints allow from the same positions and velocities)."""
+    m = mbody.load(MODELS / name)
+    g = [3.0 * x + 1.0 for x in np.asarray(m.gravity)[: m.dimension]]
+    for model in (m, m.with_values({"gravity": g})):
+        asm = mbody.assemble(model, m.initial)
+        sol = asm.solve()
+        for b in model.body_names:
+            br = body_rows(asm, b)
+            if br.kinematics is None:
+                continue
+            coordinate = {r.acc: r.label for r in br.rows}
+            for rel in br.kinematics.relations:
+                lhs = sol[coordinate[rel.acc]]
+                rhs = rel.const + sum(c * sol[coordinate[z]] for z, c in rel.coef.items())
+                size = abs(rel.const) + sum(abs(c * sol[coordinate[z]])
+                                            for z, c in rel.coef.items())
+                assert lhs == pytest.approx(rhs, abs=1e-9 * max(1.0, size)), (name, b,
+                                                                              rel.text)
+
+
+def _written(row: Row, fmt: str = ".6g") -> str:
+    parts = [f"({format(v, fmt)})" + ("" if key == CONST else f"*{key}")
+             for key, v in row.coef.items() if v != 0.0]
+    return " + ".join(parts or ["0"]) + " = 0"
+
+
+@pytest.mark.parametrize("name", [n for n, _ in _models_with_joints()])
+def test_every_row_with_the_kinematics_put_in_is_correct_and_that_row(name):
+    """Each Newton-Euler row of every shipped model with joints, every acceleration the
+    joints relate replaced by its relation and the numbers rounded to six figures, is
+    `correct`, attributed to the row it came from."""
+    m = mbody.load(MODELS / name)
+    asm = mbody.assemble(m)
+    answers, rows = [], []
+    for b in m.body_names:
+        br = body_rows(asm, b)
+        if br.kinematics is None:
+            continue
+        for r in br.rows:
+            t = br.kinematics.substitute(r.row)
+            if not (t.unknowns & set(br.joints)) or t.keys == r.row.keys:
+                continue  # nothing replaced, or nothing left that says which row
+            answers.append({"body": b, "eq": _written(t)})
+            rows.append(r.label)
+    if not answers:
+        pytest.skip("no row that the joints' kinematics change")
+    v = verify(m, answers, asm=asm)
+    for c, label in zip(v.checks, rows, strict=True):
+        assert c.correct and c.row == label, (name, c.eq, c.diagnosis, c.explanation)
+
+
+# == what must not become correct =========================================================
+
+def _mistakes(br):
+    """(what, the student's row) for the usual mistakes made on each row of `br`."""
+    for r in br.rows:
+        row = r.row
+        if r.euler and r.gyro:
+            yield f"{r.label} without gyro", row.with_term(CONST, row.get(CONST) - r.gyro)
+            yield f"{r.label} gyro sign", row.with_term(CONST, row.get(CONST) - 2 * r.gyro)
+        for x in r.loads:
+            yield f"{r.label} without {x.name}", row.with_term(CONST, row.get(CONST) + x.value)
+            yield f"{r.label} {x.name} sign", row.with_term(CONST,
+                                                           row.get(CONST) + 2 * x.value)
+        for k in sorted(row.unknowns & set(br.joints)):
+            yield f"{r.label} without {k}", row.without([k])
+            yield f"{r.label} {k} sign", row.with_term(k, -row.get(k))
+        if r.euler:
+            for p in br.points:
+                yield f"{r.label} about {p.name} with I_G", br.transport(r, p, keep_acc=False)
+
+
+def _holds(model: mbody.Model, body: str, s: Row) -> bool:
+    """Whether row `s` of `body` holds at the model's solution (accelerations and
+    reactions from `Assembly.solve`, not from the checker)."""
+    asm = mbody.assemble(model)
+    coordinate = {r.acc: r.label for r in body_rows(asm, body).rows}
+    sol = asm.solve()
+    terms = [v * (1.0 if k == CONST else sol.reactions[k] if k in sol.reactions
+                  else sol[coordinate[k]]) for k, v in s.coef.items()]
+    return abs(sum(terms)) <= 1e-9 * max(1.0, sum(map(abs, terms)))
+
+
+@pytest.mark.parametrize("name", [n for n, _ in _models_with_joints()])
+def test_the_usual_mistakes_stay_diagnosed_as_without_the_kinematics(name):
+    """Every usual mistake on every row of a shipped model with joints gets the same
+    diagnosis and row with the joints' kinematics known as without them. One becomes
+    `correct` only where the term it changes is zero for every motion the joints allow
+    (the transport term r × m a_G where the joints hold a_G at 0 or along r; a fixed
+    pivot's row that says I_P alpha_2 = 0, as before): the equation then holds at the
+    solved state."""
+    m = mbody.load(MODELS / name)
+    asm = mbody.assemble(m)
+    seen = now_true = 0
+    for b in m.body_names:
+        br = body_rows(asm, b)
+        if br.kinematics is None:
+            continue
+        bare = dataclasses.replace(br, kinematics=None)
+        for what, s in _mistakes(br):
+            before, after = diagnose(s, bare, 1e-3), diagnose(s, br, 1e-3)
+            if before.diagnosis == "correct":
+                continue  # a "mistake" that changes nothing here (a zero term)
+            seen += 1
+            if after.diagnosis == "correct":
+                assert "kinematics" in after.details or \
+                    after.details.get("form") == "fixed_pivot", (name, what)
+                assert _holds(m, b, s), (name, what, after.explanation)
+                now_true += 1
+            elif before.diagnosis != "not_an_equation_of_this_body":
+                assert (after.diagnosis, after.row) == (before.diagnosis, before.row), (
+                    name, what, after.explanation)
+    if not seen:
+        pytest.skip("no body whose accelerations the joints relate")
+    assert now_true < seen
+
+
+def test_a_reversed_reaction_where_the_joints_hold_the_acceleration_at_zero():
+    # the flyball governor's arm: the joints hold a_y at 0, so Newton's row along y
+    # says hinge_a.Fz = 0; writing a_y with the reaction reversed is still that mistake
+    m = mbody.load(MODELS / "flyball_governor.yaml")
+    br = body_rows(mbody.assemble(m), "arm_a")
+    assert "a_y = 0" in [r.text for r in br.kinematics.relations]
+    row = next(r for r in br.rows if r.label == "arm_a.y").row
+    c = one(m, "arm_a", _written(row.with_term("hinge_a.Fz", -row.get("hinge_a.Fz"))))
+    assert c.diagnosis == "reaction_sign", c.explanation
+    # leaving the zero acceleration out is right: the joints hold it
+    c = one(m, "arm_a", _written(row.without(["a_y"])))
+    assert c.correct and c.details["kinematics"] == ["a_y = 0"], c.explanation
+
+
+def test_kinematics_with_a_wrong_term_are_diagnosed_with_them(moving):
+    # the sign of alpha x r: not correct, and compared with Newton's row along x
+    c = one(moving, "rod", "m*(-alpha*0.433013 - w^2*0.25) = O.Fx")
+    assert c.diagnosis == "not_an_equation_of_this_body" and c.row == "rod.x"
+    assert "alpha has -0.866026 where 0.866025 is expected" in " ".join(c.explanation.split())
+    assert c.details["kinematics"] == ["a_x = 0.433013 alpha - 2.25"]
+    # the centripetal term left out: the constant is what is missing
+    c = one(moving, "rod", "m*0.433013*alpha = O.Fx")
+    assert c.diagnosis == "not_an_equation_of_this_body" and c.row == "rod.x"
+    assert "the constant is missing (expected -4.5)" in " ".join(c.explanation.split())
+    # a mistake of the table made with the kinematics right: named, and the rest said
+    c = one(moving, "rod", "m*(0.433013*alpha - w^2*0.25) = -O.Fx")
+    assert c.diagnosis == "reaction_sign" and c.row == "rod.x"
+    assert "writes the rest of the row right, with a_x written" in \
+        " ".join(c.explanation.split())
+    c = one(moving, "rod", "m*(0.25*alpha + w^2*0.433013) = O.Fy + m*g")
+    assert c.diagnosis == "applied_load_sign" and c.row == "rod.y"
+
+
+def test_a_reaction_replaced_by_its_solved_value_is_not_made_a_pivot_equation():
+    # without the pivot's angular acceleration, a reaction-free equation of a body
+    # with one degree of freedom is not taken as the moment about the pivot
+    c = one(mbody.load(MODELS / "pendulum.yaml"), "rod", "2*a_y = 15.9435 - 19.62")
+    assert c.diagnosis == "reaction_treated_as_known", c.explanation
+
+
+def test_a_moment_equation_is_not_read_as_a_newton_row_with_kinematics():
+    c = one(mbody.load(MODELS / "slider_crank.yaml"), "crank",
+            "I_G*alpha = -60 - 0.025*O.Fy + 0.025*A.Fy")
+    assert c.row == "crank.theta" and "kinematics" not in c.details
+
+
+def test_a_reaction_the_model_gives_holds_no_joint():
+    # the spinning disc's bearings A and B have their forces given: the disc is free,
+    # and its rows are compared as written
+    br = body_rows(mbody.assemble(mbody.load(MODELS / "spinning_disc_bearings.yaml")), "disc")
+    assert br.kinematics is None
+
+
+def test_beyond_the_bound_fewer_relations_never_a_wrong_one(monkeypatch):
+    from mbody.answers import kinematics
+
+    m = mbody.load(MODELS / "double_pendulum.yaml")
+    asm = mbody.assemble(m)
+    full = body_rows(asm, "lower").kinematics
+    assert full is not None and full.sources == ("joint O", "joint A")
+    monkeypatch.setattr(kinematics, "MAX_COORDINATES", 3)  # the lower rod alone
+    assert body_rows(asm, "lower").kinematics is None
+    assert body_rows(asm, "upper").kinematics.sources == ("joint O",)
