@@ -346,8 +346,13 @@ def _with_import_options(run: Callable[[argparse.Namespace], int]
                          ) -> Callable[[argparse.Namespace], int]:
     @functools.wraps(run)
     def wrapped(a: argparse.Namespace) -> int:
-        token = _IMPORT.set(import_options(a))
-        given = _VALUES.set(set_values(getattr(a, "set_values", None) or []))
+        # both read before either is set: a refused one (a --set path given twice) must
+        # not leave the other set for whatever this process runs next (`mbody convert`
+        # after it read a YAML model with the last command's --keyframe)
+        options = import_options(a)
+        values = set_values(getattr(a, "set_values", None) or [])
+        token = _IMPORT.set(options)
+        given = _VALUES.set(values)
         try:
             return run(a)
         finally:
