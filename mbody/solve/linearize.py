@@ -329,7 +329,9 @@ class Linearization:
     def eigenvalue_errors(self) -> np.ndarray:
         """A bound on each eigenvalue's error (1/s), in `eigenvalues`' order: κ_i ‖δA‖ for
         a simple one (κ_i its condition ‖x_i‖ ‖y_i‖ / |y_iᴴ x_i|), at most `tolerance`
-        (the bound of a double one); at least 1e3 ε ‖A‖."""
+        (the bound of a double one); where that exceeds `LOOSE` of an eigenvalue and every
+        coordinate is kept, the smaller of it and the bound from the modes of K's
+        symmetric part (`mbody.solve.modal_bounds`: free of ‖M⁻¹‖); at least 1e3 ε ‖A‖."""
         return self._spectrum[2]
 
     @cached_property
@@ -499,7 +501,7 @@ def linearized(model: Model, state: State, cs: CoordinateSet, bar: Progress | No
                                  cs.cols, cs.scales, cs.quasi_int, _skip(model, cs),
                                  _SYSTEM_PARAMS if large else _PARAMS, out,
                                  bar.callback if bar is not None else None)
-    _, _, warnings = checked(model, state, cs, out[:at.ngen])
+    pivot, _, warnings = checked(model, state, cs, out[:at.ngen])
     info = out[at.info:at.spectrum].tolist()
     if info[_core.LI_SINGULAR]:
         raise MbodyError(f"the generalized mass of '{model.name}' is not positive definite "
@@ -509,6 +511,8 @@ def linearized(model: Model, state: State, cs: CoordinateSet, bar: Progress | No
     if info[_core.LI_UNCONVERGED]:
         raise MbodyError(f"the eigenvalues of '{model.name}'s linearisation did not converge "
                          "(the QR iteration's limit)")
+    if _tightened(out, at, info, ROUNDING / max(pivot, np.finfo(float).tiny), bar):
+        _modes_here(out, at, info)
     if not info[_core.LI_RESTING]:
         residual = out[at.resid:at.resid + at.k]
         worst = int(np.argmax(np.abs(residual)))
@@ -545,6 +549,15 @@ def _spectrum_here(out: np.ndarray, at: _Offsets, info: list[float],
         return
     if bar is not None:
         bar.step(f"mode shapes ({nz} eigenvalues)")
+    _modes_here(out, at, info)
+
+
+def _modes_here(out: np.ndarray, at: _Offsets, info: list[float]) -> None:
+    """`mb_linearize`'s last steps from A's spectrum in `out`: the growing count, the
+    modes (``mb_modes``), the oscillations' frequencies and damping ratios."""
+    k = at.k
+    nz = int(info[_core.LI_KEPT]) + k
+    spec = out[at.spectrum:at.spectrum + 3 * nz + 2 * nz * nz]
     w, err = spec[:2 * nz].view(complex), spec[2 * nz + 2 * nz * nz:]
     info[_core.LI_GROWING] = float(np.count_nonzero(~(w.real <= err)))
     kept = np.flatnonzero(out[at.resid + k:at.resid + 2 * k] == 0).astype(np.int64)
@@ -557,6 +570,42 @@ def _spectrum_here(out: np.ndarray, at: _Offsets, info: list[float],
     out[at.oscillations:at.oscillations + count] = osc[:, _core.MODE_FREQUENCY]
     out[at.oscillations + count:at.oscillations + 2 * count] = osc[:, _core.MODE_DAMPING]
     info[_core.LI_OSCILLATIONS] = float(count)
+
+
+LOOSE = 1e-6
+"""A first-order system's bound above this fraction of its eigenvalue is loose enough to
+be worth `_tightened`'s (an O(k³) computation a small model's call does without)."""
+
+
+def _tightened(out: np.ndarray, at: _Offsets, info: list[float], m_rel: float,
+               bar: Progress | None) -> bool:
+    """Whether the eigenvalues' bounds in `out` were lowered to the modal bounds of K's
+    symmetric part (`mbody.solve.modal_bounds`; both are bounds: the smaller is kept):
+    tried when every coordinate is kept and a bound is `LOOSE`."""
+    k = at.k
+    nz = int(info[_core.LI_KEPT]) + k
+    if k == 0 or nz != 2 * k:
+        return False
+    spec = out[at.spectrum:at.spectrum + 3 * nz + 2 * nz * nz]
+    w, err = spec[:2 * nz].view(complex), spec[2 * nz + 2 * nz * nz:]
+    d = out[at.ngen:at.ngen + 4 * k * k].reshape(4, k, k)
+    if not np.any(err > LOOSE * np.abs(w)) or not np.all(np.diagonal(d[0]) > 0.0):
+        return False  # tight already, or K not positive definite (a free or cyclic motion)
+    from mbody.solve.modal_bounds import modal_bounds
+
+    if bar is not None:
+        bar.step(f"error bounds from the modes of K's symmetric part ({k} x {k})")
+    M = out[at.M:at.M + k * k].reshape(k, k)
+    modal = modal_bounds(M, d[0], d[1], d[2], d[3], m_rel, w)
+    if modal is None:
+        return False
+    A = out[at.resid + 2 * k:at.resid + 2 * k + nz * nz].reshape(nz, nz)
+    floor = 1e3 * np.finfo(float).eps * float(np.abs(A).sum(axis=1).max())  # as the core's
+    tighter = np.maximum(np.minimum(err, modal), floor)
+    if not np.any(tighter < err):
+        return False
+    err[:] = tighter
+    return True
 
 
 def _lapack_spectrum(A: np.ndarray, dA: float, tol: float, spec: np.ndarray,
