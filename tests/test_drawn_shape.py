@@ -21,21 +21,9 @@ from mbody.present.draw.scene import Disc, Poly
 from mbody.simulate.trajectory import Trajectory
 
 ROOT = Path(__file__).resolve().parent.parent
+DATA = Path(__file__).resolve().parent / "data"
 
-SLIDER_CRANK = """model: sc
-dimension: 2
-gravity: [0, -9.81]
-bodies:
-  - {name: crank, mass: 1, inertia: 0.000833333, position: [0.0433, 0.025], angle: 30 deg}
-  - {name: rod, mass: 2, inertia: 0.015, position: [0.2345, 0.025], angle: -9.6 deg}
-  - {name: piston, mass: 0.5, inertia: 0.001, position: [0.3824, 0]}
-joints:
-  - {name: O, type: revolute, parent: ground, child: crank, at: [[0, 0], [-0.05, 0]]}
-  - {name: A, type: revolute, parent: crank, child: rod, at: [[0.05, 0], [-0.15, 0]]}
-  - {name: B, type: revolute, parent: rod, child: piston, at: [[0.15, 0], [0, 0]]}
-  - {name: P, type: prismatic, parent: ground, child: piston, at: [[0.3824, 0], [0, 0]],
-     axis: [1, 0]}
-"""
+SLIDER_CRANK = (DATA / "review_slider_crank.yaml").read_text(encoding="utf-8")
 """The course review's model (R4, F12): a 0.3 m rod (I_G = 0.015, so its inertia square
 is 0.21 m wide) pinned at ±0.15 m, which fell outside the square."""
 

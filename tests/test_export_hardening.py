@@ -6,26 +6,33 @@ before anything large is allocated or inflated."""
 from __future__ import annotations
 
 import contextlib
-import io
 import json
 import struct
 import subprocess
 import sys
 import tracemalloc
-import zipfile
-import zlib
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 import mbody
-from mbody.errors import MbodyError
+from mbody.errors import MbodyError, MbodyTypeError
 from mbody.io.export import write_csv, write_export
 from mbody.io.export.generalized import read_generalized
 
-MODELS = Path(__file__).resolve().parent.parent / "models"
+ROOT = Path(__file__).resolve().parent.parent
+MODELS = ROOT / "models"
 MIB = 1 << 20
+sys.path.insert(0, str(ROOT / "tools"))
+from crafted_files import (  # noqa: E402  (the builders the benchmark of refusals uses)
+    mat_array,
+    mat_bomb,
+    mat_file,
+    mat_tag,
+    npz_bomb,
+    npz_with,
+)
 
 
 @pytest.fixture(scope="module")
@@ -63,21 +70,6 @@ def peak_bytes(load, *args, **kw) -> int:
 # -- npz ---------------------------------------------------------------------------------
 
 
-def npz_with(path: Path, data: dict, member: str, header: dict, body: bytes,
-             method: int = zipfile.ZIP_STORED) -> Path:
-    """`data` as an npz whose `member` has the .npy `header` and the bytes `body`."""
-    with zipfile.ZipFile(path, "w", method) as z:
-        for k, v in data.items():
-            b = io.BytesIO()
-            if k == member:
-                np.lib.format.write_array_header_1_0(b, header)
-                b.write(body)
-            else:
-                np.save(b, v)
-            z.writestr(k + ".npy", b.getvalue())
-    return path
-
-
 def test_npz_json_nested_too_deeply(exports, tmp_path):
     with np.load(exports / "p.npz") as z:
         data = dict(z)
@@ -100,9 +92,7 @@ def test_npz_bomb_is_refused_before_it_is_inflated(exports, tmp_path):
     the zip directory, nothing inflated."""
     with np.load(exports / "p.npz") as z:
         data = dict(z)
-    path = npz_with(tmp_path / "bomb.npz", data, "b",
-                    {"descr": "<f8", "fortran_order": False, "shape": (8 * MIB,)},
-                    bytes(64 * MIB), zipfile.ZIP_DEFLATED)
+    path = npz_bomb(tmp_path / "bomb.npz", data, 8 * MIB, member="b")
     assert path.stat().st_size < MIB
     refused(path, "holds 64 MiB of data once inflated", "at most 16 MiB",
             "max_bytes=N", max_bytes=16 * MIB)
@@ -142,35 +132,10 @@ def test_json_larger_than_the_budget_is_refused_unread(exports):
 # -- .mat --------------------------------------------------------------------------------
 
 
-def tag(kind: int, data: bytes) -> bytes:
-    """A MAT 5 data element: type, size, data padded to 8 bytes."""
-    return struct.pack("<II", kind, len(data)) + data + bytes(-len(data) % 8)
-
-
-def array(cls: int, shape: tuple[int, ...], body: bytes = b"", name: bytes = b"") -> bytes:
-    """An miMATRIX element of MATLAB class `cls` (1 cell, 6 double) and `shape`."""
-    return tag(14, tag(6, struct.pack("<II", cls, 0))
-               + tag(5, struct.pack(f"<{len(shape)}i", *shape)) + tag(1, name) + body)
-
-
-def mat_file(path: Path, *variables: bytes, version: bytes = b"5.0",
-             compress: bool = True) -> Path:
-    """A MAT file of `variables`, each compressed (as scipy writes them), or each element
-    as it is given (`compress` False)."""
-    text = b"MATLAB " + version + b" MAT-file, written by a test"
-    head = text.ljust(116) + bytes(8) + struct.pack("<H", 0x0100 if version == b"5.0"
-                                                    else 0x0200) + b"IM"
-    body = b"".join(struct.pack("<II", 15, len(c)) + c
-                    for c in (zlib.compress(v) for v in variables)) if compress \
-        else b"".join(variables)
-    path.write_bytes(head + body)
-    return path
-
-
 def test_the_mat_writer_of_these_tests_writes_what_scipy_reads(tmp_path):
     import scipy.io
 
-    ones = array(6, (2, 1), tag(9, struct.pack("<2d", 1.0, 2.0)), b"x")
+    ones = mat_array(6, (2, 1), mat_tag(9, struct.pack("<2d", 1.0, 2.0)), b"x")
     got = scipy.io.loadmat(mat_file(tmp_path / "ok.mat", ones))["x"]
     np.testing.assert_array_equal(got, [[1.0], [2.0]])
 
@@ -178,9 +143,9 @@ def test_the_mat_writer_of_these_tests_writes_what_scipy_reads(tmp_path):
 def test_mat_cells_nested_too_deeply(tmp_path):
     """scipy's reader recurses once a level, in C: 20 000 cells in cells crashed the
     process (a segmentation fault), so the file is read in a child process here."""
-    inner = array(6, (0, 0), tag(9, b""))
-    flags_shape_name = (tag(6, struct.pack("<II", 1, 0)) + tag(5, struct.pack("<2i", 1, 1))
-                        + tag(1, b""))
+    inner = mat_array(6, (0, 0), mat_tag(9, b""))
+    flags_shape_name = (mat_tag(6, struct.pack("<II", 1, 0)) + mat_tag(5, struct.pack("<2i", 1, 1))
+                        + mat_tag(1, b""))
     depth = 20_000
     heads = [struct.pack("<II", 14, len(inner) + k * (8 + len(flags_shape_name))
                          + len(flags_shape_name)) + flags_shape_name
@@ -198,7 +163,7 @@ def test_mat_cells_nested_too_deeply(tmp_path):
 def test_mat_cell_shape_beyond_its_bytes(tmp_path):
     """A cell array declaring 2^24 slots in no bytes: scipy allocated the 128 MiB of
     their pointers (and 2^28 slots, 2 GiB) before it found nothing to put in them."""
-    path = mat_file(tmp_path / "cells.mat", array(1, (2**24, 1), name=b"c"))
+    path = mat_file(tmp_path / "cells.mat", mat_array(1, (2**24, 1), name=b"c"))
     refused(path, "a cell array of shape (16777216, 1) in 0 bytes")
     assert peak_bytes(mbody.load_export, path) < 4 * MIB
 
@@ -215,7 +180,7 @@ def refused_by_both(path: Path, *words: str) -> None:
 def test_mat_struct_without_the_width_of_its_field_names(tmp_path):
     """Review R3, B1: the width's element held 0 bytes, and reading its 4 was a
     struct.error from both readers."""
-    path = mat_file(tmp_path / "s.mat", array(2, (1, 1), tag(5, b""), b"x"))
+    path = mat_file(tmp_path / "s.mat", mat_array(2, (1, 1), mat_tag(5, b""), b"x"))
     refused_by_both(path, "damaged or truncated .mat export", "a struct without the width "
                     "of its field names")
 
@@ -231,9 +196,9 @@ def test_mat_compressed_variable_that_does_not_inflate(tmp_path):
 def sparse(shape: tuple[int, int], rows: list[int], columns: list[int], values: list[float],
            name: bytes, row_type: int = 5) -> bytes:
     """A sparse miMATRIX: row indices (of MAT type `row_type`), column pointers, values."""
-    return array(5, shape, tag(row_type, struct.pack(f"<{len(rows)}i", *rows))
-                 + tag(5, struct.pack(f"<{len(columns)}i", *columns))
-                 + tag(9, struct.pack(f"<{len(values)}d", *values)), name)
+    return mat_array(5, shape, mat_tag(row_type, struct.pack(f"<{len(rows)}i", *rows))
+                     + mat_tag(5, struct.pack(f"<{len(columns)}i", *columns))
+                     + mat_tag(9, struct.pack(f"<{len(values)}d", *values)), name)
 
 
 def test_what_scipy_reads_unchecked_is_checked_first(exports, tmp_path):
@@ -247,8 +212,8 @@ def test_what_scipy_reads_unchecked_is_checked_first(exports, tmp_path):
         "type.mat": (sparse((2, 2), [0, 1], [0, 1, 2], [1.0, 2.0], b"M", row_type=5637),
                      "a sparse array whose data at byte 64 is of MAT type 5637, not "
                      "numbers"),
-        "name.mat": (tag(14, tag(6, struct.pack("<II", 6, 0)) + tag(5, struct.pack(
-            "<2i", 1, 1)) + tag(7, b"x") + tag(9, bytes(8))),  # a name of MAT type 7
+        "name.mat": (mat_tag(14, mat_tag(6, struct.pack("<II", 6, 0)) + mat_tag(5, struct.pack(
+            "<2i", 1, 1)) + mat_tag(7, b"x") + mat_tag(9, bytes(8))),  # a name of MAT type 7
             "an array whose name at byte 48 is of MAT type 7, expected text (miINT8)"),
         "pointers.mat": (sparse((2, 2), [0, 1], [0, 1, -5], [1.0, 2.0], b"M"),
                          "damaged or truncated .mat export (scipy cannot read it"),
@@ -287,9 +252,7 @@ def test_what_scipy_reads_unchecked_is_checked_first(exports, tmp_path):
 
 
 def test_mat_bomb_is_refused_before_it_is_inflated(tmp_path):
-    zeros = array(6, (8 * MIB, 1), tag(9, bytes(64 * MIB)), b"b")
-    path = mat_file(tmp_path / "bomb.mat", zeros)
-    del zeros
+    path = mat_bomb(tmp_path / "bomb.mat", 8 * MIB)
     assert path.stat().st_size < MIB
     refused(path, "holds 64 MiB of data once inflated", "at most 16 MiB",
             max_bytes=16 * MIB)
@@ -298,7 +261,8 @@ def test_mat_bomb_is_refused_before_it_is_inflated(tmp_path):
 
 def test_mat_files_of_other_versions_are_refused(tmp_path):
     """A v7.3 (HDF5) file made scipy raise NotImplementedError (not an MbodyError)."""
-    path = mat_file(tmp_path / "v73.mat", array(6, (0, 0), tag(9, b""), b"x"), version=b"7.3")
+    path = mat_file(tmp_path / "v73.mat", mat_array(6, (0, 0), mat_tag(9, b""), b"x"),
+                    version=b"7.3")
     refused(path, "not a MATLAB 5 .mat file as mbody writes it")
 
 
@@ -353,3 +317,73 @@ def test_read_generalized_is_bounded_the_same_way(tmp_path):
                     {"descr": "<f8", "fortran_order": False, "shape": (10**15,)}, bytes(16))
     with pytest.raises(MbodyError, match="member q.npy"):
         read_generalized(liar)
+
+
+# -- every reader's max_bytes, checked by one function (review R3 B3) -------------------------
+
+
+@pytest.fixture(scope="module")
+def readers(exports) -> dict[str, tuple]:
+    """Each public reader with a budget, beside a file it reads."""
+    from mbody.equations.generalized import generalized
+    from mbody.io.export.generalized import write_generalized
+    from mbody.simulate.trajectory import Trajectory
+
+    model = mbody.load(MODELS / "pendulum.yaml")
+    run = exports / "run.npz"
+    mbody.simulate(model, t_end=0.1, fps=10).save(run)
+    equations = write_generalized(generalized(model), exports / "g.json")
+    return {"mbody.load": (mbody.load, MODELS / "pendulum.yaml"),
+            "Trajectory.load": (Trajectory.load, run),
+            "load_export npz": (mbody.load_export, exports / "p.npz"),
+            "load_export mat": (mbody.load_export, exports / "p.mat"),
+            "load_export csv": (mbody.load_export, exports / "p_csv"),
+            "read_generalized": (read_generalized, equations)}
+
+
+READERS = ["mbody.load", "Trajectory.load", "load_export npz", "load_export mat",
+           "load_export csv", "read_generalized"]
+
+
+@pytest.mark.parametrize("reader", READERS)
+@pytest.mark.parametrize(("given", "shown"), [
+    ("1G", "str '1G'"), (1.5, "float 1.5"), (True, "bool True"), ([10], "list"),
+    (float("nan"), "float nan")])
+def test_max_bytes_that_is_not_a_whole_number_is_refused_by_name(readers, reader, given,
+                                                                  shown):
+    """Before: '1G' a raw ValueError (Trajectory.load) or blamed on the file (load_export),
+    1.5 and True read as a budget of 1 byte."""
+    load, path = readers[reader]
+    with pytest.raises(MbodyTypeError) as exc:
+        load(path, max_bytes=given)
+    text = str(exc.value)
+    assert text.startswith("max_bytes must be a whole number of bytes (such as 200 * 2**20), "
+                           f"got {shown}"), text
+    assert str(path) not in text  # the argument is at fault, not the file
+    if isinstance(given, str):
+        assert "2**30" in text and "--max-bytes" in text
+
+
+@pytest.mark.parametrize("reader", READERS)
+@pytest.mark.parametrize("given", [0, -5])
+def test_max_bytes_below_one_byte_is_refused_by_every_reader(readers, reader, given):
+    """Before: Trajectory.load(..., max_bytes=-5) said 'at most -5 bytes is read'."""
+    load, path = readers[reader]
+    with pytest.raises(MbodyError) as exc:
+        load(path, max_bytes=given)
+    assert str(exc.value) == f"max_bytes: expected a size of at least 1 byte, got {given}"
+
+
+@pytest.mark.parametrize("reader", READERS)
+def test_max_bytes_as_a_whole_float_or_numpy_integer_reads(readers, reader):
+    load, path = readers[reader]
+    assert load(path, max_bytes=float(2**30)) is not None
+    assert load(path, max_bytes=np.int64(2**30)) is not None
+
+
+def test_the_budget_set_around_a_block_is_checked_the_same_way():
+    from mbody.util.budget import byte_budget
+
+    with pytest.raises(MbodyTypeError, match="^max_bytes must be a whole number"), \
+            byte_budget(True):  # type: ignore[arg-type]
+        pass

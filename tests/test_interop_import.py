@@ -776,10 +776,12 @@ def test_included_files_are_bounded_together(tmp_path, capsys, monkeypatch):
                          "\n</mujoco>\n")
     assert main(["check", str(main_file)]) == 2
     err = capsys.readouterr().err
+    size = part.stat().st_size
     assert re.search(rf"^mbody: error: {re.escape(str(main_file))}:5:12: <include file>: "
                      r"including 'part.xml' brings the included files to 15\.\d KiB "
-                     r"together \(include number 4\); at most 11\.\d KiB of included "
-                     "files is read for one model", err), err
+                     rf"\({4 * size:,} bytes\) together \(include number 4\); at most "
+                     rf"11\.\d KiB \({3 * size:,} bytes\) of included files is read for one "
+                     "model", err), err
     main_file.write_text(main_file.read_text().replace('  <include file="part.xml"/>\n',
                                                        "", 1))
     assert main(["check", str(main_file)]) == 0

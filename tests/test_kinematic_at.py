@@ -32,24 +32,9 @@ drivers:
 """
 """A crank of mass M whose mass centre is R from its pivot, turned at a steady rate."""
 
-SLIDER_CRANK = """model: my-slider-crank
-dimension: 2
-gravity: [0, -9.81]
-bodies:
-  - {name: crank, mass: 1, inertia: 0.000833333, position: [0.0433, 0.025], angle: 30 deg}
-  - {name: rod, mass: 2, inertia: 0.015, position: [0.2345, 0.025], angle: -9.6 deg}
-  - {name: piston, mass: 0.5, inertia: 0.001, position: [0.3824, 0]}
-loads:
-  - {name: gas, type: force, body: piston, force: [-100, 0]}
-joints:
-  - {name: O, type: revolute, parent: ground, child: crank, at: [[0, 0], [-0.05, 0]]}
-  - {name: A, type: revolute, parent: crank, child: rod, at: [[0.05, 0], [-0.15, 0]]}
-  - {name: B, type: revolute, parent: rod, child: piston, at: [[0.15, 0], [0, 0]]}
-  - {name: P, type: prismatic, parent: ground, child: piston, at: [[0.3824, 0], [0, 0]],
-     axis: [1, 0]}
-drivers:
-  - {name: motor, joint: O, speed: "300 rpm"}
-"""
+DATA = Path(__file__).resolve().parent / "data"
+
+SLIDER_CRANK = (DATA / "review_slider_crank.yaml").read_text(encoding="utf-8")
 """The course review's slider-crank (R4, F7): loads that do not vary in time, so the
 `solve --set` route (the file's pose turned to the angle, at t = 0) is the same instant."""
 

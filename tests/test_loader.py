@@ -226,7 +226,7 @@ def test_file_over_max_bytes_is_refused_before_reading(tmp_path, monkeypatch):
     # reading a small model: tools/bench_reading.py, "refusals")
     (i,) = err.value.issues
     assert i.file == str(path)
-    assert "200.0 MiB" in i.message and "at most 32 MiB" in i.message
+    assert "the file is 200 MiB; mbody reads at most 32 MiB" in i.message
 
 
 def test_max_bytes_argument(tmp_path):

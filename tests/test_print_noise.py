@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import pytest
 
@@ -18,21 +19,9 @@ import mbody
 from mbody.cli.app import main
 from mbody.util.formatting import LENGTH_RTOL, NOISE, num, quiet, vec
 
-PENDULUM = """
-model: my-pend
-dimension: 2
-gravity: [0, -9.81]
-bodies:
-  - name: rod
-    mass: 2
-    inertia: 0.1666666667
-    angle: 30 deg
-    position: [0.25, -0.4330127019]
-    angular_velocity: 3
-    velocity: [1.299038106, 0.75]
-joints:
-  - {name: O, type: revolute, parent: ground, child: rod, at: [0, 0]}
-"""
+DATA = Path(__file__).resolve().parent / "data"
+
+PENDULUM = (DATA / "review_pendulum.yaml").read_text(encoding="utf-8")
 """The reviewer's pendulum: a 1 m rod at 30 deg, its mass centre written to 10 digits,
 so that the pin at (0, 0) is 3.9e-12 m off the rod's axis in its body axes."""
 

@@ -10,6 +10,7 @@ import contextlib
 import dataclasses
 import io
 import json
+import sys
 import tracemalloc
 import zipfile
 from pathlib import Path
@@ -23,8 +24,11 @@ from mbody.errors import MbodyError, ModelError, TrajectoryFileError
 from mbody.simulate.trajectory import Trajectory
 from mbody.util.budget import byte_budget
 
-MODELS = Path(__file__).resolve().parent.parent / "models"
+ROOT = Path(__file__).resolve().parent.parent
+MODELS = ROOT / "models"
 MIB = 1 << 20
+sys.path.insert(0, str(ROOT / "tools"))
+from crafted_files import npy_header, npz_bomb, npz_members  # noqa: E402  (as the benchmark)
 
 
 @pytest.fixture(scope="module")
@@ -153,6 +157,9 @@ def test_times_not_finite_or_not_increasing_are_refused(run_data, tmp_path, caps
 
 @pytest.mark.parametrize(("key", "value", "expected"), [
     ("rtol", "x", "a number"),
+    ("rtol", True, "a number"),  # JSON true is a Python int: taken as 1 before (review R3 Y10)
+    ("energy_drift", False, "a number"),
+    ("momentum_initial", [0.0, True, 0.0], "3 numbers"),
     ("warnings", 3, "a list of texts"),
     ("reaction_axes", "sideways", "'joint' or 'world'"),
     ("model_values", [["bodies.rod.mass"]], "[path, value] pairs"),
@@ -178,28 +185,6 @@ def test_arrays_that_are_not_numbers_or_texts_are_refused(run_data, tmp_path):
             Trajectory.load(tampered(tmp_path, run_data, **changes))
 
 
-def members(path: Path, data: dict[str, np.ndarray | bytes | None]) -> Path:
-    """An npz of `data`: an array saved as numpy saves it, bytes as the member's whole
-    content (a raw .npy header, `npy_header`), None left out."""
-    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
-        for k, v in data.items():
-            if isinstance(v, bytes):
-                z.writestr(k + ".npy", v)
-            elif v is not None:
-                b = io.BytesIO()
-                np.save(b, v)
-                z.writestr(k + ".npy", b.getvalue())
-    return path
-
-
-def npy_header(shape: tuple[int, ...], descr: str) -> bytes:
-    """A .npy header for `shape` values of `descr`, and no data."""
-    b = io.BytesIO()
-    np.lib.format.write_array_header_1_0(b, {"descr": descr, "fortran_order": False,
-                                             "shape": shape})
-    return b.getvalue()
-
-
 PER_SAMPLE = ("t", "position", "velocity", "orientation", "angular_velocity", "reactions")
 
 
@@ -221,7 +206,7 @@ def test_values_of_no_bytes_are_refused_whatever_they_claim(run_data, tmp_path, 
         "position": npy_header((0, n, 2), "<f8"), "velocity": npy_header((0, n, 2), "<f8"),
         "orientation": npy_header((0, n), "<f8"),
         "angular_velocity": npy_header((0, n), "<f8"), "mass": None, "inertia": None}
-    run = members(tmp_path / "u0.npz", data)
+    run = npz_members(tmp_path / "u0.npz", data)
     assert run.stat().st_size < 10_000
     err = refused(capsys, tmp_path, command, run)
     assert "member body_names.npy's header says it holds 1,000,000,000,000 values of " \
@@ -233,12 +218,12 @@ def test_any_member_of_zero_width_values_is_refused(run_data, tmp_path):
     """Not only texts: a void or field-less record type is 0 bytes wide too; an empty
     array of them claims nothing and is read as before."""
     for descr in ("|V0", "<U0"):
-        run = members(tmp_path / "v0.npz", {**run_data, "series/energy":
+        run = npz_members(tmp_path / "v0.npz", {**run_data, "series/energy":
                                             npy_header((61,), descr)})
         with pytest.raises(TrajectoryFileError, match=r"member series/energy.npy's header "
                            r"says it holds 61 values of 0 bytes each"):
             Trajectory.load(run)
-    empty = members(tmp_path / "empty.npz", {**run_data, "reaction_labels":
+    empty = npz_members(tmp_path / "empty.npz", {**run_data, "reaction_labels":
                                              npy_header((0,), "<U0"), "reactions":
                                              run_data["reactions"][:, :0]})
     assert Trajectory.load(empty).reaction_labels == ()
@@ -284,7 +269,7 @@ def test_more_names_than_one_per_kib_of_the_budget_are_refused_unread(run_data, 
             "inertia": np.broadcast_to(np.eye(3), (n, 3, 3)).copy(),
             "shapes": np.array("[]"), "colors": np.array("[]")}
     data = {k: v for k, v in data.items() if not k.startswith("series/")}
-    run = members(tmp_path / "names.npz", data)
+    run = npz_members(tmp_path / "names.npz", data)
     with pytest.raises(TrajectoryFileError) as exc:
         Trajectory.load(run, max_bytes=MIB)
     assert str(exc.value).startswith(f"{run}: 'body_names' holds 2,000 names; at most "
@@ -294,26 +279,6 @@ def test_more_names_than_one_per_kib_of_the_budget_are_refused_unread(run_data, 
 
 
 # -- B4: bounded work ---------------------------------------------------------------------
-
-
-def bomb(path: Path, data: dict[str, np.ndarray], samples: int) -> Path:
-    """`data` with t.npy deflated from `samples` zeros: 8 bytes a sample once inflated,
-    about 1/1000 of that on disk."""
-    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
-        for k, v in data.items():
-            if k != "t":
-                b = io.BytesIO()
-                np.save(b, v)
-                z.writestr(k + ".npy", b.getvalue())
-                continue
-            head = io.BytesIO()
-            np.lib.format.write_array_header_1_0(
-                head, {"descr": "<f8", "fortran_order": False, "shape": (samples,)})
-            with z.open("t.npy", "w", force_zip64=True) as f:
-                f.write(head.getvalue())
-                for _ in range(samples * 8 // MIB):
-                    f.write(bytes(MIB))
-    return path
 
 
 def peak_bytes(load, *args) -> int:
@@ -329,7 +294,7 @@ def peak_bytes(load, *args) -> int:
 def test_a_member_over_the_budget_is_refused_before_it_is_inflated(run_data, tmp_path):
     """The reviewer's bomb, scaled down: t.npy inflates to 64 MiB from about 64 kB; with a
     16 MiB budget it is refused from the zip directory, before anything is inflated."""
-    run = bomb(tmp_path / "bomb.npz", run_data, 8 * MIB)
+    run = npz_bomb(tmp_path / "bomb.npz", run_data, 8 * MIB)
     assert run.stat().st_size < MIB
     with byte_budget(16 * MIB), pytest.raises(TrajectoryFileError) as exc:
         Trajectory.load(run)
@@ -345,7 +310,7 @@ def test_shapes_are_checked_against_each_other_before_any_array_is_inflated(run_
                                                                             tmp_path):
     """Under the budget, a t.npy of 8 Mi samples beside 61 positions is refused from the
     headers: the 64 MiB are never inflated."""
-    run = bomb(tmp_path / "bomb.npz", run_data, 8 * MIB)
+    run = npz_bomb(tmp_path / "bomb.npz", run_data, 8 * MIB)
     with pytest.raises(TrajectoryFileError, match=r"'position' has shape \(61, 1, 2\), "
                        r"expected \(8388608, 1, 2\)"):
         Trajectory.load(run)
@@ -437,7 +402,8 @@ def test_a_good_run_reads_back_as_it_was_saved(run_data, tmp_path):
 
 
 def test_sizes_in_messages_say_which_is_larger():
-    from mbody.util.npzfile import over_budget, size_text
+    from mbody.util.formatting import size_text
+    from mbody.util.npzfile import over_budget
 
     assert size_text(16) == "16 bytes" and size_text(1536) == "1.5 KiB (1,536 bytes)"
     assert size_text(2**31) == "2 GiB" and size_text(8 * 10**15) == "7.11 PiB"

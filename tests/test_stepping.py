@@ -17,7 +17,7 @@ from mechanism_reference import Callbacks
 import mbody
 from mbody.equations.workspace import workspace
 from mbody.kernel.dop853 import DOP853
-from mbody.simulate import state_derivative
+from mbody.simulate import simulation, state_derivative
 from mbody.simulate.projection import STAGE_PIVOT_RTOL, JointProjection
 from mbody.simulate.simulation import _has_unknown_reactions
 from mbody.simulate.stepping import CoreRun
@@ -265,3 +265,42 @@ def test_a_driven_joint_is_followed_by_the_run():
     drift = np.zeros(2)
     _core.samples(solver, np.zeros(m), t, Y, None, None, drift)
     assert drift[0] <= 1e-13 and drift[1] <= 1e-12
+
+
+def test_a_call_comes_back_after_its_wall_time_with_the_same_steps():
+    """`return_after`: a call of the core comes back after the first step that ends past
+    its wall time (here at once: one step a call), and the run is the same, sample for
+    sample, as one whole call (the steps do not depend on where the calls end)."""
+    model = mbody.load(MODELS / "double_pendulum.yaml")
+    rhs = state_derivative(model)
+    y0 = initial_state(model)
+    t_eval = np.arange(21) / 20.0
+    runs = []
+    for seconds in (0.0, 1e-12):
+        run = CoreRun(rhs, y0, 1.0, 1e-10, 1e-12, math.inf)
+        run.return_after(seconds)
+        Y = np.empty((len(t_eval), len(y0)))
+        Y[0] = y0
+        k, calls = 1, 0
+        while run.status == "running":
+            k, why = run.advance(1.0, 10_000, t_eval, k, Y)
+            assert why is None
+            calls += 1
+        runs.append((calls, run.steps, Y))
+    (calls_once, steps, whole), (calls_each, steps_each, stepwise) = runs
+    assert calls_once == 1 and steps > 20
+    assert (calls_each, steps_each) == (steps, steps)  # one step per call
+    assert np.array_equal(whole, stepwise)
+
+
+def test_simulate_is_the_same_however_often_it_comes_back(monkeypatch):
+    """`simulate`'s loop looks at its budgets between calls of the core timed by
+    `CHUNK_WALL`; a call that came back after every step gives the same trajectory."""
+    model = mbody.load(MODELS / "slider_crank.yaml")
+    whole = mbody.simulate(model, 0.5, 40)
+    monkeypatch.setattr(simulation, "CHUNK_WALL", 1e-12)
+    stepwise = mbody.simulate(model, 0.5, 40)
+    assert whole.info["steps"] == stepwise.info["steps"] > 40
+    for a, b in ((whole.position, stepwise.position), (whole.velocity, stepwise.velocity),
+                 (whole.reactions, stepwise.reactions)):
+        assert np.array_equal(a, b)

@@ -18,6 +18,7 @@ settings mixed with this sweep's.
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import errno
 import math
@@ -30,7 +31,7 @@ import pytest
 
 import mbody
 from mbody.cli import main
-from mbody.errors import MbodyError, OutputError
+from mbody.errors import MbodyError, OutputError, options_named
 from mbody.sweep import cluster
 from mbody.sweep.record import differences, parse, record
 from mbody.sweep.runs import Settings
@@ -274,19 +275,45 @@ def test_each_row_records_its_settings(driven):
     assert parse(result.settings)["t-end"] == "0.05"
 
 
-def test_the_differences_are_named():
+SWEEP_FLAGS = {"run": "--run", "t_end": "--t-end", "revolutions": "--t-end",
+               "steps": "--steps", "fps": "--fps", "equilibrium": "--equilibrium"}
+"""The flags `mbody sweep` names its settings by (as `mbody.cli.app.option_flags` gives
+them; the command's own wording is checked end to end below)."""
+
+
+@pytest.mark.parametrize("surface", ["command line", "Python"])
+def test_the_differences_are_named(surface):
+    """As the caller names each setting: the command's flags, run_sweep's keywords (before,
+    the flags from Python too: '--steps 11', where run_sweep takes steps=11)."""
     a = "run=kinematics; t-end=0.1; steps=11; model=sha256:0123456789abcdef"
-    assert differences(a, a) == []
-    assert differences(a, a.replace("0.1", "0.2").replace("=11", "=21")) == [
-        "--t-end 0.1 (this sweep: 0.2)", "--steps 11 (this sweep: 21)"]
-    assert differences(a, "run=simulate; t-end=0.1; fps=60; model=sha256:0123456789abcdef"
-                       ) == ["--run kinematics (this sweep: simulate)"]
-    # the default sampling changed from 101 instants: such rows are another sweep's
-    assert differences(a.replace("=11", "=101"), a.replace("=11", "=360 a turn")) == [
-        "--steps 101 (this sweep: 360 a turn)"]
-    assert differences(a, a.replace("0123", "3210")) == [
-        "another model (another file, the file changed since, or other values set for every "
-        "case)"]
+    cli = surface == "command line"
+    with options_named(SWEEP_FLAGS) if cli else contextlib.nullcontext():
+        assert differences(a, a) == []
+        assert differences(a, a.replace("0.1", "0.2").replace("=11", "=21")) == (
+            ["--t-end 0.1 (this sweep: 0.2)", "--steps 11 (this sweep: 21)"] if cli else
+            ["t_end=0.1 (this sweep: t_end=0.2)", "steps=11 (this sweep: steps=21)"])
+        assert differences(a, a.replace("t-end=0.1", "t-end=1 rev")) == (
+            ["--t-end 0.1 (this sweep: 1 rev)"] if cli else
+            ["t_end=0.1 (this sweep: revolutions=1)"])
+        assert differences(a, "run=simulate; t-end=0.1; fps=60; model=sha256:0123456789abcdef"
+                           ) == (["--run kinematics (this sweep: simulate)"] if cli else
+                                 ["run='kinematics' (this sweep: run='simulate')"])
+        # the default sampling changed from 101 instants: such rows are another sweep's
+        assert differences(a.replace("=11", "=101"), a.replace("=11", "=360 a turn")) == (
+            ["--steps 101 (this sweep: 360 a turn)"] if cli else
+            ["steps=101 (this sweep: steps=None (360 a turn))"])
+        modes = "run=modes; equilibrium=no; model=sha256:0123456789abcdef"
+        assert differences(modes, modes.replace("=no", "=yes")) == (
+            ["--equilibrium no (this sweep: yes)"] if cli else
+            ["equilibrium=False (this sweep: equilibrium=True)"])
+        assert differences(a, a.replace("steps=11; ", "")) == (
+            ["--steps 11 (this sweep has none)"] if cli else ["steps=11 (this sweep has none)"])
+        assert differences(a.replace("steps=11; ", ""), a) == (
+            ["no --steps recorded (this sweep: --steps 11)"] if cli else
+            ["no steps recorded (this sweep: steps=11)"])
+        assert differences(a, a.replace("0123", "3210")) == [
+            "another model (another file, the file changed since, or other values set for "
+            "every case)"]
 
 
 def test_a_rerun_with_another_t_end_does_not_keep_the_earlier_rows(driven, capsys):
@@ -329,22 +356,29 @@ def test_a_rerun_with_another_t_end_does_not_keep_the_earlier_rows(driven, capsy
 
 
 SLIDER_KIN = {"run": "kinematics", "t_end": 0.05, "steps": 11}
+RERUNS = [
+    (SLIDER_KIN, {**SLIDER_KIN, "steps": 21}, "steps=11 (this sweep: steps=21)",
+     "--steps 11 (this sweep: 21)"),
+    (SLIDER_KIN, {**SLIDER_KIN, "t_end": None, "revolutions": 1.0},
+     "t_end=0.05 (this sweep: revolutions=1)", "--t-end 0.05 (this sweep: 1 rev)"),
+    (SLIDER_KIN, {**SLIDER_KIN, "run": "simulate", "fps": 200.0},
+     "run='kinematics' (this sweep: run='simulate')", "--run kinematics (this sweep: simulate)"),
+    ({"run": "simulate", "t_end": 0.02, "fps": 100.0},
+     {"run": "simulate", "t_end": 0.02, "fps": 400.0}, "fps=100 (this sweep: fps=400)",
+     "--fps 100 (this sweep: 400)"),
+]
+RERUN_IDS = ["steps", "seconds to turns", "run", "fps"]
 
 
 @pytest.mark.parametrize(("first", "then", "said"), [
-    (SLIDER_KIN, {**SLIDER_KIN, "steps": 21}, "--steps 11 (this sweep: 21)"),
-    (SLIDER_KIN, {**SLIDER_KIN, "t_end": None, "revolutions": 1.0},
-     "--t-end 0.05 (this sweep: 1 rev)"),
-    (SLIDER_KIN, {**SLIDER_KIN, "run": "simulate", "fps": 200.0},
-     "--run kinematics (this sweep: simulate)"),
-    ({"run": "simulate", "t_end": 0.02, "fps": 100.0},
-     {"run": "simulate", "t_end": 0.02, "fps": 400.0}, "--fps 100 (this sweep: 400)"),
+    *((first, then, said) for first, then, said, _ in RERUNS),
     ({}, {"fixed": "gravity=[0, -1.62]"}, "another model"),
     ({}, {"edit": ("mass: 0.5", "mass: 0.6")}, "another model"),
-], ids=["steps", "seconds to turns", "run", "fps", "a value for every case", "the file"])
+], ids=[*RERUN_IDS, "a value for every case", "the file"])
 def test_a_rerun_with_other_settings_is_refused_or_run_again(driven, first, then, said):
     """From Python: each setting that changes the numbers, the run, the model's content;
-    the message names it; force=True gives a fresh sweep's rows."""
+    the message names it as run_sweep takes it (before: by the command's flags, '--steps
+    11', '--force'); force=True gives a fresh sweep's rows."""
     def sweep(kw: dict, out: str, force: bool = False):
         kw = dict(kw)
         values = [*MASSES, *([kw.pop("fixed")] if "fixed" in kw else [])]
@@ -360,14 +394,42 @@ def test_a_rerun_with_other_settings_is_refused_or_run_again(driven, first, then
     with pytest.raises(MbodyError) as refused:
         sweep(then, "r.csv")
     assert f"r.csv:2: case 0 was computed with {said}" in str(refused.value)
-    assert str(refused.value).endswith("give another --out to keep it, or --force to run "
+    assert str(refused.value).endswith("give another out=... to keep it, or force=True to run "
                                        "those cases again and replace their rows")
+    assert "--" not in str(refused.value)
     assert Path("r.csv").read_bytes() == before
     forced = sweep(then, "r.csv", force=True)
     assert (forced.ran, forced.kept, forced.replaced) == (2, 0, 2)
     fresh = sweep(then, "fresh.csv")
     assert forced.rows == fresh.rows == read(Path("r.csv"))[1]
     assert forced.settings == fresh.settings != read_settings(before)
+
+
+def flags(settings: dict) -> list[str]:
+    """run_sweep's keyword arguments as `mbody sweep`'s options."""
+    out = []
+    for key, value in settings.items():
+        if key == "revolutions":
+            out += ["--t-end", f"{value:g} rev"]
+        elif value is not None:
+            out += [f"--{key.replace('_', '-')}", f"{value:g}" if isinstance(value, float)
+                    else str(value)]
+    return out
+
+
+@pytest.mark.parametrize(("first", "then", "said"), [(f, t, s) for f, t, _, s in RERUNS],
+                         ids=RERUN_IDS)
+def test_a_rerun_with_other_settings_names_the_command_s_options(driven, capsys, first,
+                                                                  then, said):
+    """The same reruns from the command line: the options as typed."""
+    code, out, err = command(capsys, driven, "--set", MASSES[0], *flags(first), "-o", "r.csv")
+    assert code == 0, err
+    code, out, err = command(capsys, driven, "--set", MASSES[0], *flags(then), "-o", "r.csv")
+    assert (code, out) == (2, ""), err
+    assert err == (f"mbody: error: r.csv:2: case 0 was computed with {said}: the file holds "
+                   "the results of other settings, which are not this sweep's; give another "
+                   "--out to keep it, or --force to run those cases again and replace their "
+                   "rows\n")
 
 
 def read_settings(data: bytes) -> str:
@@ -406,7 +468,12 @@ def test_an_old_results_file_is_refused_with_what_to_do(driven, capsys):
             "run those cases again and replace their rows")
     with pytest.raises(MbodyError) as refused:
         mbody.run_sweep(driven, MASSES, "r.csv", workers=0)
-    assert str(refused.value) == said
+    # in Python, by run_sweep's keywords (before: the command's flags)
+    assert str(refused.value) == (
+        "r.csv was written by an earlier mbody, which did not record the settings its rows "
+        "were computed with (the run's t_end, steps or fps, the model): they cannot be told "
+        "to be this sweep's; give another out=... to keep it, or force=True to run those "
+        "cases again and replace their rows")
     code, out, err = command(capsys, driven, "--set", MASSES[0], "--out", "r.csv")
     assert (code, out, err) == (2, "", f"mbody: error: {said}\n")
     assert Path("r.csv").read_bytes() == before
@@ -436,7 +503,7 @@ def test_an_interrupted_run_with_other_settings_is_not_resumed(driven, monkeypat
     journal = Path("r.csv.partial")
     assert len(read(journal)[1]) == 2
     with pytest.raises(MbodyError, match=r"^r\.csv\.partial:2: case 0 was computed with "
-                                         r"--t-end 0\.05 \(this sweep: 0\.1\)"):
+                                         r"t_end=0\.05 \(this sweep: t_end=0\.1\)"):
         mbody.run_sweep(driven, grid, "r.csv", t_end=0.1, **kw)
     with pytest.raises(SweepInterrupted):
         mbody.run_sweep(driven, grid, "r.csv", t_end=0.1, force=True, **kw)

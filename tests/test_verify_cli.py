@@ -141,3 +141,34 @@ def test_an_entry_without_body_in_newton_euler_names_asks_for_its_body(tmp_path)
     for eq in ("O.angle_dd = 0", "I_1*alpha_1 = 0", "m*a_x = B.Fx"):
         (out,) = error("double_pendulum.yaml", eq)
         assert "forget" not in out, out
+
+
+def test_report_draws_the_model_the_answers_set_values_on(tmp_path):
+    """With answers that `set:` values, the verdicts are the student's model's; the page
+    drew the class's (the file's mass, angle and solution) beside them."""
+    answers = tmp_path / "a.yaml"
+    answers.write_text("set: {bodies.rod.mass: 5, bodies.rod.angle: 40 deg}\n"
+                       "equations:\n  - {body: rod, eq: 'm*a_x = O.Fx'}\n", encoding="utf-8")
+    pages = {}
+    for name, args in {"answers": ["--answers", answers],
+                       "set": ["--set", "bodies.rod.mass=5", "--set", "bodies.rod.angle=40 deg"],
+                       "class": []}.items():
+        pages[name] = tmp_path / f"{name}.html"
+        p = mbody("report", MODELS / "pendulum.yaml", "-o", pages[name], *args)
+        assert p.returncode == 0, p.stderr
+
+    def drawn(page: Path) -> str:
+        """The page from the model summary on, without the answers' section."""
+        text = page.read_text(encoding="utf-8")
+        text = text[text.index('<section id="summary">'):]
+        if '<section id="answers">' in text:
+            start = text.index('<section id="answers">')
+            end = text.index("</section>", start) + len("</section>\n")
+            text = text[:start] + text[end:]
+        return text
+
+    assert drawn(pages["answers"]) == drawn(pages["set"]) != drawn(pages["class"])
+    head = pages["answers"].read_text(encoding="utf-8")
+    assert ("with the answers' values <code>bodies.rod.mass=5</code>, "
+            "<code>bodies.rod.angle=40 deg</code>") in head
+    assert "(m = 5 kg," in head and "(m = 2 kg," in pages["class"].read_text(encoding="utf-8")

@@ -24,24 +24,11 @@ from mbody.answers.rows import body_rows
 
 ROOT = Path(__file__).resolve().parent.parent
 MODELS = ROOT / "models"
+DATA = Path(__file__).resolve().parent / "data"
 
 # the reviewer's pendulum (/tmp/r4x/s/pend.yaml): 2 kg, 1 m rod pinned at O, at 30 deg
 # from the downward vertical, turning at 3 rad/s (its velocity is ω × r_OG)
-MOVING = """\
-model: my-pend
-dimension: 2
-gravity: [0, -9.81]
-bodies:
-  - name: rod
-    mass: 2
-    inertia: 0.1666666667
-    angle: 30 deg
-    position: [0.25, -0.4330127019]
-    angular_velocity: 3
-    velocity: [1.299038106, 0.75]
-joints:
-  - {name: O, type: revolute, parent: ground, child: rod, at: [0, 0]}
-"""
+MOVING = (DATA / "review_pendulum.yaml").read_text(encoding="utf-8")
 
 
 @pytest.fixture(scope="module")

@@ -28,15 +28,12 @@ and the nesting bound was quadratic on escaped quotes: 64 kB of them took 21 s.
 from __future__ import annotations
 
 import argparse
-import io
 import json
-import struct
 import sys
 import tempfile
 import time
 import tracemalloc
 import zipfile
-import zlib
 from pathlib import Path
 
 import numpy as np
@@ -47,6 +44,7 @@ if str(ROOT) not in sys.path:  # run from a checkout without installing
 if str(ROOT / "tools") not in sys.path:  # tools/timing.py, also when loaded by path
     sys.path.insert(0, str(ROOT / "tools"))
 
+from crafted_files import mat_bomb, npy_header, npz_bomb, npz_members, npz_with  # noqa: E402
 from timing import best  # noqa: E402
 
 import mbody  # noqa: E402
@@ -96,82 +94,15 @@ def good_runs(folder: Path, repeat: int, largest: int) -> None:
         samples *= 4
 
 
-def bomb_run(path: Path, good: dict[str, np.ndarray], samples: int) -> Path:
-    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
-        for k, v in good.items():
-            if k == "t":
-                head = io.BytesIO()
-                np.lib.format.write_array_header_1_0(
-                    head, {"descr": "<f8", "fortran_order": False, "shape": (samples,)})
-                with z.open("t.npy", "w", force_zip64=True) as f:
-                    f.write(head.getvalue())
-                    for _ in range(samples * 8 // (16 * MIB)):
-                        f.write(bytes(16 * MIB))
-            else:
-                b = io.BytesIO()
-                np.save(b, v)
-                z.writestr(k + ".npy", b.getvalue())
-    return path
-
-
-def liar_run(path: Path, good: dict[str, np.ndarray]) -> Path:
-    with zipfile.ZipFile(path, "w") as z:
-        for k, v in good.items():
-            b = io.BytesIO()
-            if k == "t":
-                np.lib.format.write_array_header_1_0(
-                    b, {"descr": "<f8", "fortran_order": False, "shape": (10**15,)})
-                b.write(bytes(16))
-            else:
-                np.save(b, v)
-            z.writestr(k + ".npy", b.getvalue())
-    return path
-
-
-def bomb_mat(path: Path, samples: int) -> Path:
-    """A .mat whose one compressed double array inflates to 8 bytes a sample."""
-    def tag(kind: int, size: int) -> bytes:
-        return struct.pack("<II", kind, size)
-
-    data = 8 * samples
-    body = (tag(6, 8) + struct.pack("<II", 6, 0) + tag(5, 8) + struct.pack("<2i", samples, 1)
-            + tag(1, 1) + b"b" + bytes(7) + tag(9, data))
-    deflate = zlib.compressobj()
-    parts = [deflate.compress(tag(14, len(body) + data) + body)]
-    for _ in range(data // (16 * MIB)):
-        parts.append(deflate.compress(bytes(16 * MIB)))
-    parts.append(deflate.flush())
-    packed = b"".join(parts)
-    head = b"MATLAB 5.0 MAT-file".ljust(116) + bytes(8) + struct.pack("<H", 0x0100) + b"IM"
-    path.write_bytes(head + tag(15, len(packed)) + packed)
-    return path
-
-
-def npy_header(shape: tuple[int, ...], descr: str) -> bytes:
-    """A .npy header for `shape` values of `descr`, and no data."""
-    b = io.BytesIO()
-    np.lib.format.write_array_header_1_0(b, {"descr": descr, "fortran_order": False,
-                                             "shape": shape})
-    return b.getvalue()
-
-
 def weightless_run(path: Path, good: dict[str, np.ndarray]) -> Path:
     """Review R3, S1: 10^12 body names of '<U0' (0 bytes each) and no samples."""
     n = 10**12
     raw = {"body_names": npy_header((n,), "<U0"), "position": npy_header((0, n, 2), "<f8"),
            "velocity": npy_header((0, n, 2), "<f8"), "orientation": npy_header((0, n), "<f8"),
            "angular_velocity": npy_header((0, n), "<f8")}
-    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
-        for k, v in good.items():
-            if k in ("mass", "inertia") or k.startswith("series/"):
-                continue
-            if k in raw:
-                z.writestr(k + ".npy", raw[k])
-                continue
-            b = io.BytesIO()
-            np.save(b, v[:0] if k in ("t", "reactions") else v)
-            z.writestr(k + ".npy", b.getvalue())
-    return path
+    return npz_members(path, {k: raw.get(k, v[:0] if k in ("t", "reactions") else v)
+                              for k, v in good.items()
+                              if k not in ("mass", "inertia") and not k.startswith("series/")})
 
 
 def escaped_quotes(n: int) -> str:
@@ -206,10 +137,11 @@ def hostile(folder: Path) -> None:
     quoted["info"] = np.array(escaped_quotes(32_000))
     np.savez_compressed(folder / "quotes.npz", **quoted)
     (folder / "quotes.json").write_text(escaped_quotes(4_000_000))
-    files = [(Trajectory.load, bomb_run(folder / "bomb.npz", good, 2**28)),
-             (Trajectory.load, liar_run(folder / "liar.npz", good)),
+    files = [(Trajectory.load, npz_bomb(folder / "bomb.npz", good, 2**28)),
+             (Trajectory.load, npz_with(folder / "liar.npz", good, "t", {
+                 "descr": "<f8", "fortran_order": False, "shape": (10**15,)}, bytes(16))),
              (Trajectory.load, folder / "deepinfo.npz"),
-             (mbody.load_export, bomb_mat(folder / "bomb.mat", 2**28)),
+             (mbody.load_export, mat_bomb(folder / "bomb.mat", 2**28)),
              (Trajectory.load, weightless_run(folder / "names0.npz", good)),
              (Trajectory.load, folder / "quotes.npz"),
              (mbody.load_export, folder / "quotes.json")]

@@ -27,7 +27,7 @@ from pathlib import Path
 
 from mbody.answers.coverage import ALL, requirement
 from mbody.answers.load import AnswersError, read_answers
-from mbody.answers.variant import variant
+from mbody.answers.variant import allow_list, variant
 from mbody.answers.verify import MEANINGS, TOLERANCE, Check, Verification, check, tolerance
 from mbody.equations.assemble import Assembly, assemble
 from mbody.model.model import Model
@@ -153,11 +153,15 @@ class ClassSummary:
         One per answers file.
     required : str
         What each file was asked for, in words (`mbody.answers.coverage`).
+    allowed : tuple of str or None
+        The paths a file's ``set:`` could name (`mbody.answers.variant.allow_list`); None:
+        any.
     """
 
     model: str
     graded: tuple[Graded, ...]
     required: str = "every row of the model"
+    allowed: tuple[str, ...] | None = None
 
     @property
     def mistakes(self) -> list[Mistake]:
@@ -232,7 +236,9 @@ class ClassSummary:
         -------
         str
             The class's counts (files all correct, incomplete, partly or not read;
-            equations; rows asked for and given) and its five most frequent mistakes.
+            equations; rows asked for and given, in the files checked; the files that set
+            their own values, and which paths they could) and its five most frequent
+            mistakes.
         """
         n = len(self.graded)
         ok = sum(1 for g in self.graded if g.all_correct)
@@ -247,9 +253,17 @@ class ClassSummary:
                  + (f", {partly} with entries that could not be read" if partly else "")
                  + (f", {bad} could not be checked" if bad else "")
                  + f"; {right} of {eqs} equations correct",
-                 f"rows asked for: {self.required}; "
+                 f"rows asked for: {self.required.removeprefix('the rows asked for: ')}; "
                  f"{sum(g.covered for g in self.graded)} of "
-                 f"{sum(g.asked for g in self.graded)} given"]
+                 f"{sum(g.asked for g in self.graded)} given"
+                 + (f" in the {n - bad} file(s) checked" if bad else "")]
+        setting = sum(1 for g in self.graded if g.values)
+        if setting or self.allowed is not None:
+            lines.append(f"{setting} file(s) set their own values (the set column); "
+                         + (f"a file may set {', '.join(self.allowed) or 'none'}"
+                            if self.allowed is not None else
+                            "any path was allowed: --allow-set PATHS says which a "
+                            "student may set"))
         top = self.mistakes[:5]
         if top:
             lines.append("most frequent mistakes:")
@@ -264,8 +278,8 @@ def _as_text(row: list[str | int]) -> list[str | int]:
 
 
 def grade(model: Model, files: Sequence[str | os.PathLike[str]], *,
-          tol: float = TOLERANCE, require: str | Sequence[str] | None = ALL
-          ) -> ClassSummary:
+          tol: float = TOLERANCE, require: str | Sequence[str] | None = ALL,
+          allow_set: str | Sequence[str] | None = None) -> ClassSummary:
     """Check every answers file against `model` (module doc).
 
     Parameters
@@ -280,6 +294,9 @@ def grade(model: Model, files: Sequence[str | os.PathLike[str]], *,
         The rows each file is asked to give (`mbody.answers.coverage`): default
         ``"all"``, every row of the model (or every Lagrange equation, for a file in
         generalized coordinates); None: the rows of the bodies each file answers.
+    allow_set : str or sequence of str, optional
+        The paths a file's ``set:`` may name (`mbody.answers.variant.allow_list`); None:
+        any (the summary's first line then counts the files that set values).
 
     Returns
     -------
@@ -288,27 +305,30 @@ def grade(model: Model, files: Sequence[str | os.PathLike[str]], *,
     Raises
     ------
     MbodyError
-        `tol` outside (0, 1), or `require` naming nothing in the model (a file's own
-        problem never raises: it is that file's row).
+        `tol` outside (0, 1), or `require` or `allow_set` naming nothing in the model (a
+        file's own problem never raises: it is that file's row).
     """
     tol = tolerance(tol)
     wanted = requirement(model, require)
+    allow = allow_list(model, allow_set)
     variants: dict[tuple, tuple[Model, Assembly]] = {}
     graded = []
     for f in files:
         stem = Path(f).stem
+        sheet = None
         try:
             sheet = read_answers(f, partial=True)
             key = tuple((s.path, repr(plain(s.value))) for s in sheet.settings)
             if key not in variants:
                 if len(variants) >= VARIANTS_KEPT:
                     variants.pop(next(iter(variants)))
-                changed = variant(model, sheet)
+                changed = variant(model, sheet, allow)
                 variants[key] = (changed, assemble(changed))
             changed, asm = variants[key]
             v = check(changed, sheet, tol=tol, asm=asm, require=wanted, partial=True)
-        except AnswersError as exc:
-            graded.append(Graded(str(f), stem, None, " ".join(str(exc).split())))
+        except AnswersError as exc:  # the student's name when the file said it
+            who = sheet.student if sheet is not None and sheet.student else stem
+            graded.append(Graded(str(f), who, None, " ".join(str(exc).split())))
             continue
         graded.append(Graded(str(f), v.student or stem, v))
-    return ClassSummary(model.name, tuple(graded), wanted.describe())
+    return ClassSummary(model.name, tuple(graded), wanted.describe(), allow)

@@ -14,19 +14,89 @@ the same way, by `mbody.Model.with_values`: the model file read again with the v
 place and every rule of the file checked. A problem is reported in the answers file, at
 the path (a path that names nothing in the model, with a did-you-mean) or at the value
 (a value the model file could not hold), with the model's reason.
+
+A ``set:`` can change anything the model file holds, gravity included, so a grader says
+which paths a student may set (``--allow-set``, `allow_list`): a path no pattern allows
+is an error of that file, and its equations are not checked against numbers the
+instructor never gave.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import replace
+from fnmatch import fnmatchcase
 
 from mbody.answers.load import Answers, AnswersError, Setting
-from mbody.errors import Issue, MbodyError, ModelError
+from mbody.errors import (
+    Issue,
+    MbodyError,
+    MbodyTypeError,
+    ModelError,
+    option_name,
+    option_setting,
+)
 from mbody.model.model import Model
 from mbody.model.values import apply, edits, entry_names, resolve
 
+WILDCARDS = "*?["
+"""The characters that make a pattern of `allow_list` match several paths (fnmatch's)."""
 
-def variant(model: Model, sheet: Answers) -> Model:
+
+def allow_list(model: Model, patterns: str | Sequence[str] | None
+               ) -> tuple[str, ...] | None:
+    """The paths a student's ``set:`` may name, checked against `model`: None (any path)
+    when `patterns` is None, else the patterns, each a ``--set`` path
+    (``bodies.lower.mass``; a whole entry's key allows its components,
+    ``gravity`` allows ``gravity.1``, ``bodies.lower`` every key of that body) or one
+    with fnmatch's wildcards (``bodies.*.mass``). A comma separates patterns in one text.
+
+    Raises
+    ------
+    MbodyError
+        A pattern without wildcards that names nothing in the model file (with the
+        model's did-you-mean), or an empty pattern; `mbody.errors.MbodyTypeError` for
+        what is not text.
+    """
+    if patterns is None:
+        return None
+    if isinstance(patterns, str):
+        patterns = [patterns]
+    out: list[str] = []
+    for given in patterns:
+        if not isinstance(given, str):
+            raise MbodyTypeError(f"{option_name('allow_set')}: expected paths such as "
+                                 f"bodies.rod.mass, got {type(given).__name__}")
+        out += [p.strip() for p in given.split(",")]
+    if any(not p for p in out):
+        raise MbodyError(f"{option_name('allow_set')}: an empty path; expected paths such "
+                         "as bodies.rod.mass, separated by commas")
+    src = model.source
+    if src is not None:
+        doc = src.read()
+        names = entry_names(model)
+        for p in out:
+            if any(c in p for c in WILDCARDS):
+                continue  # a pattern: it may match no student's path, which is no error
+            head, _, name = p.partition(".")
+            if name in names.get(head, ()):
+                continue  # a whole entry (bodies.lower): every key of it
+            try:
+                resolve(doc, p, names)
+            except ModelError as exc:
+                i = exc.issues[0]
+                raise MbodyError(f"{option_setting('allow_set', p)}: {i.message}"
+                                 + (f" ({i.hint})" if i.hint else "")) from None
+    return tuple(dict.fromkeys(out))
+
+
+def allowed(path: str, patterns: Sequence[str]) -> bool:
+    """Whether the ``set:`` path `path` is one `patterns` (`allow_list`) allow."""
+    return any(fnmatchcase(path, p) or path.startswith((p + ".", p + "["))
+               for p in patterns)
+
+
+def variant(model: Model, sheet: Answers, allow: Sequence[str] | None = None) -> Model:
     """`model` with the values of `sheet`'s ``set:`` (module doc); `model` itself when
     the answers set none.
 
@@ -37,6 +107,8 @@ def variant(model: Model, sheet: Answers) -> Model:
         answers' values are set on top of them, so the answers' own win).
     sheet : Answers
         A student's answers.
+    allow : sequence of str, optional
+        The paths the answers may set (`allow_list`); None: any.
 
     Returns
     -------
@@ -47,14 +119,23 @@ def variant(model: Model, sheet: Answers) -> Model:
     ------
     AnswersError
         A ``set:`` that could not be read, a path that names nothing in the model file,
-        or a value it could not hold, located in the answers file; or a model built in
-        Python, which has no file to set values in.
+        a path `allow` does not allow, or a value the model file could not hold, located
+        in the answers file; or a model built in Python, which has no file to set values
+        in.
     """
     unread = [i for i in sheet.problems if i.key == "set" or i.key.startswith("set.")]
     if unread:  # a value that could not be read: the numbers would not be the student's
         raise AnswersError(unread)
     if not sheet.settings:
         return model
+    if allow is not None:
+        refused = [s for s in sheet.settings if not allowed(s.path, allow)]
+        if refused:  # every number would depend on values the instructor never gave
+            may = (f"only {', '.join(allow)}" if allow else "no value")
+            raise AnswersError([Issue(
+                sheet.file, s.key_line, s.key_column, f"set.{s.path}",
+                f"a student may set {may} here ({option_name('allow_set')}); this path is "
+                "not among them", "use the values the assignment gives you") for s in refused])
     src = model.source
     if src is None:
         s = sheet.settings[0]

@@ -32,7 +32,7 @@ from mbody.answers.load import (
 )
 from mbody.answers.parse import EquationError, parse_equation
 from mbody.answers.rows import BodyRows, body_rows
-from mbody.answers.variant import variant
+from mbody.answers.variant import allow_list, variant
 from mbody.answers.vocabulary import Vocabulary, vocabulary
 from mbody.equations.assemble import Assembly, assemble
 from mbody.errors import Issue, MbodyError, did_you_mean, real_number, wrong_type
@@ -351,7 +351,8 @@ def tolerance(tol: Any) -> float:
 def verify(model: Model | str | os.PathLike[str], answers: Any, *, tol: float = TOLERANCE,
            state: State | None = None, asm: Assembly | None = None,
            require: str | Sequence[str] | None = None,
-           partial: bool = False) -> Verification:
+           partial: bool = False, allow_set: str | Sequence[str] | None = None
+           ) -> Verification:
     """Check a student's equations against each body's Newton-Euler pair.
 
     Parameters
@@ -378,6 +379,9 @@ def verify(model: Model | str | os.PathLike[str], answers: Any, *, tol: float = 
     partial : bool
         Check the entries that can be read and list the problems of the others in
         `Verification.errors`, instead of raising them (what a class's summary does).
+    allow_set : str or sequence of str, optional
+        The paths the answers' ``set:`` may name (`mbody.answers.variant.allow_list`:
+        ``"bodies.*.mass"``...); default None: any path.
 
     Returns
     -------
@@ -393,7 +397,8 @@ def verify(model: Model | str | os.PathLike[str], answers: Any, *, tol: float = 
         once. With `partial`, only a file that is no answers file, or whose ``set:``
         cannot be applied.
     MbodyError
-        `tol` outside (0, 1), `require` naming nothing in the model, or `asm` of another
+        `tol` outside (0, 1), `require` or `allow_set` naming nothing in the model, or
+        `asm` of another
         model (`mbody.errors.MbodyTypeError`, a `TypeError` too, for a `tol` that is not
         a number or an `asm` that is not an `Assembly`).
     """
@@ -402,9 +407,10 @@ def verify(model: Model | str | os.PathLike[str], answers: Any, *, tol: float = 
         model = load(model)
     sheet = _answers(answers)
     wanted = requirement(model, require)
+    allow = allow_list(model, allow_set)
     problems: list[Issue] = []
     try:
-        model = variant(model, sheet)
+        model = variant(model, sheet, allow)
     except AnswersError as exc:
         if partial:  # every number depends on them: the file cannot be checked
             raise

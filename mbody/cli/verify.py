@@ -48,6 +48,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "body's name or a row's label (upper.theta); comma-separated or "
                    "repeated. Default: all for a class (several files or --summary), "
                    "answered for one file")
+    s.add_argument("--allow-set", action="append", metavar="PATHS",
+                   help="the model paths an answers file's set: may name, comma-separated, "
+                        "fnmatch wildcards allowed (bodies.*.mass); repeatable; default: any "
+                        "(a set: can change gravity too: give this when grading)")
     s.add_argument("--json", action="store_true",
                    help="machine-readable output: one entry per equation, in file order")
     s.add_argument("--tol", type=_tolerance, default=1e-3, metavar="REL",
@@ -77,7 +81,7 @@ def verify(a: argparse.Namespace) -> int:
     answers = a.answers[0]
     regular_file(answers, "a YAML answers file")
     model = load_model(a.model)
-    result = _verify(model, answers, tol=a.tol, require=a.require)
+    result = _verify(model, answers, tol=a.tol, require=a.require, allow_set=a.allow_set)
     if a.json:
         jsontext.dump(result.to_dict(), sys.stdout)
     else:
@@ -104,7 +108,8 @@ def _class(a: argparse.Namespace) -> int:
     # a file that is not an answers file (missing, a folder, a device, a pipe with no
     # writer, not YAML) is about one student: the reader makes it a row, the class goes on
     model = load_model(a.model)
-    summary = grade(model, a.answers, tol=a.tol, require=a.require or "all")
+    summary = grade(model, a.answers, tol=a.tol, require=a.require or "all",
+                    allow_set=a.allow_set)
     if a.json:
         jsontext.dump([{"file": g.file, "student": g.student, "error": g.error,
                         **(g.verification.to_dict() if g.verification else {})}

@@ -139,6 +139,11 @@ class DOP853:
         self.state[_core.DOP_MARK_WIDTH] = width
         self.state[_core.DOP_MARK_NEXT] = (math.floor(self.t / width) + 1) * width
 
+    def return_after(self, seconds: float) -> None:
+        """`sampled` and `sampled_marks` calls also return after the first step that ends
+        `seconds` (wall time, > 0; 0: never) after the call began."""
+        self.state[_core.DOP_RETURN_AFTER] = seconds
+
     @property
     def core_time(self) -> float:
         """Seconds the core spent starting the run (f(t0, y0), the first step's size)

@@ -23,8 +23,6 @@ matters for models with tens of thousands of bodies.
 from __future__ import annotations
 
 import math
-import numbers
-import operator
 import os
 import re
 import select
@@ -47,8 +45,9 @@ from yaml.events import (
     StreamEndEvent,
 )
 
-from mbody.errors import Issue, MbodyError, ModelError, did_you_mean, wrong_type
-from mbody.util.budget import MAX_BYTES, byte_limit
+from mbody.errors import Issue, ModelError, did_you_mean, wrong_type
+from mbody.util.budget import MAX_BYTES, byte_limit, checked_max_bytes
+from mbody.util.formatting import sizes_apart
 
 # libyaml keeps line marks and is many times faster than the pure-Python parser
 _Loader: type[yaml.SafeLoader] | type[yaml.CSafeLoader] = getattr(
@@ -340,17 +339,6 @@ FIFO_WAIT = 1.0
 """Seconds a named pipe with no writer is given for one to appear before it is refused."""
 
 
-def _size(n: int, mib: str = ".1f") -> str:
-    """A size of `n` bytes as people read it: MiB (`mib`, the format of the number) from
-    1 MiB, else KiB with the exact bytes, else bytes ("0.0 MiB" says nothing)."""
-    if n >= 2**20:
-        return f"{n / 2**20:{mib}} MiB"
-    if n < 2**10:
-        return f"{n:,} byte{'' if n == 1 else 's'}"
-    kib = f"{n / 2**10:.3g} KiB"
-    return kib if n % 2**10 == 0 else f"{kib} ({n:,} bytes)"
-
-
 def _near_file(path: Path, most: int = 2000) -> str:
     """A did-you-mean among the files beside a missing `path` (at most `most` entries of
     its folder are looked at: a huge folder costs no more), or ''."""
@@ -379,7 +367,7 @@ def check_source(source: object, max_bytes: object = None, call: str = "mbody.lo
     """Refuse, before anything is read, what `call` cannot read from: a `source` that is
     neither a path nor a dict (`MbodyTypeError`), YAML text given where a path goes
     (`ModelError`: text is `mbody.loads`'), or a `max_bytes` that is not a whole number of
-    bytes, at least 1.
+    bytes, at least 1 (`mbody.util.budget.checked_max_bytes`, every reader's check).
 
     Returns
     -------
@@ -397,22 +385,7 @@ def check_source(source: object, max_bytes: object = None, call: str = "mbody.lo
         line = "holds a line break" if "\n" in source else "starts as a YAML mapping does"
         raise ModelError([Issue(call, 0, 0, "source", f"this looks like YAML text ({line}), "
                                 "not a path to a model file", "use mbody.loads(text)")])
-    if max_bytes is None:
-        return None
-    if isinstance(max_bytes, bool):  # an int to Python, not a size to anyone
-        size = None
-    elif isinstance(max_bytes, numbers.Integral):
-        size = operator.index(max_bytes)
-    elif isinstance(max_bytes, numbers.Real) and float(max_bytes).is_integer():
-        size = int(float(max_bytes))
-    else:
-        size = None
-    if size is None:
-        raise wrong_type("max_bytes", "a whole number of bytes (such as 200 * 2**20)",
-                         max_bytes)
-    if size < 1:
-        raise MbodyError(f"max_bytes: expected a size of at least 1 byte, got {max_bytes!r}")
-    return size
+    return checked_max_bytes(max_bytes)
 
 
 def looks_like_yaml(text: str) -> bool:
@@ -510,8 +483,8 @@ def read_file(path: str | os.PathLike[str], max_bytes: int | None = None,
                      f"from a pipe: mbody check /dev/stdin{given} < model{ext})")
     more = "--max-bytes N on the command line, or mbody.load(path, max_bytes=N), reads more"
     if st.st_size > max_bytes:
-        raise refuse(f"the file is {_size(st.st_size)}; mbody reads at most "
-                     f"{_size(max_bytes, '.3g')} ({more})")
+        size, most = sizes_apart(st.st_size, max_bytes)
+        raise refuse(f"the file is {size}; mbody reads at most {most} ({more})")
     try:  # never blocks in open(): a named pipe with no writer would wait forever there
         fd = os.open(p, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
     except OSError as exc:

@@ -17,6 +17,7 @@ import numpy as np
 
 from mbody import __version__, joint_types
 from mbody import conventions as cv
+from mbody.answers.verify import check_assembly_of
 from mbody.equations.assemble import Assembly, Solution, assemble
 from mbody.equations.topology import topology
 from mbody.equations.world import check_axes
@@ -63,10 +64,18 @@ def report_html(model: Model, *, asm: Assembly | None = None,
                 max_bodies: int = MAX_BODIES, answers: Verification | None = None,
                 axes: str = "joint") -> str:
     """The report page as one HTML string (UTF-8, no external resources); with `answers`
-    (what `mbody.verify` found), a student's equations beside the expected rows; `axes`:
+    (what `mbody.verify` found), a student's equations beside the expected rows, and the
+    whole page of the model the verdicts are of (with the answers' ``set:`` values, if
+    any; an `asm` given must be of that model); `axes`:
     the solution's reactions along their joint frames ("joint") or, each joint's force
     and moment on its child, in world axes ("world")."""
     check_axes(axes)
+    if answers is not None and answers.values:
+        # the verdicts are of the model with the answers' `set:` values: the pictures, the
+        # equations and the solution are of that model too, not of the class's
+        model = model.with_values(dict(answers.values))
+        if asm is not None:
+            check_assembly_of(model, asm)
     asm = assemble(model) if asm is None else asm
     topo = topology(model, asm.G if model.reactions else None)
     planar = model.dimension == cv.PLANAR
@@ -79,6 +88,9 @@ def report_html(model: Model, *, asm: Assembly | None = None,
            f"<h1>{_e(model.name)}</h1>",
            f'<p class="muted">{"planar" if planar else "spatial"} model'
            + (f" from <code>{_e(model.file)}</code>" if model.file else "")
+           + (" with the answers' values " + ", ".join(f"<code>{_e(p)}={_e(v)}</code>"
+                                                      for p, v in answers.values)
+              if answers is not None and answers.values else "")
            + f"; free-body diagrams and Newton-Euler equations by mbody {_e(__version__)}."
            " Equations: M v̇ + b = Q + G λ, one block of rows per body in file order"
            + (" (x, y, θ)." if planar else

@@ -297,9 +297,10 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
         # Python at each one (scipy's runs come back after every step anyway). A wall-time
         # budget is checked in Python, so such a run still comes back at every window.
         marking = max_wall is None and run.mark_windows(rate.width)
+        run.return_after(CHUNK_WALL)
         status = run.status
         while status == "running":
-            limit = min(CHUNK_STEPS, max(1, check_at - steps))
+            limit = max(1, check_at - steps)
             if max_steps is not None:
                 limit = min(limit, max(1, max_steps - steps))
             k, msg = run.advance(t_end if marking else min(rate.next, t_end), limit, t_eval,
@@ -439,8 +440,10 @@ def _broken_start(broken: list[str], projected: bool) -> str:
 
 PROJECTION_TEXT = ("coordinate projection after every step: positions by Gauss-Newton, "
                    "velocities mass-orthogonal")
-CHUNK_STEPS = 200
-"""Most steps one compiled call takes before the loop looks at its budgets and progress."""
+CHUNK_WALL = 0.1
+"""Seconds of wall time after which a compiled call comes back for the loop to look at its
+budgets, progress and Ctrl-C: a steady pace whatever a step costs (a fixed count of steps
+was either many round trips on a cheap model or seconds between looks on a dear one)."""
 
 PREDICT_FROM = 1000
 """Steps after which (and after twice, four times as many...) a run's total cost is

@@ -85,6 +85,11 @@ class CoreRun:
         self._marking = True
         return True
 
+    def return_after(self, seconds: float) -> None:
+        """Each `advance` also comes back after the first step that ends `seconds` of wall
+        time after it began, however many steps that is (the core's clock)."""
+        self.solver.return_after(seconds)
+
     def marks(self) -> list[list[float]]:
         """The [t, steps] the last `advance` noted (`mark_windows`)."""
         return self._marks[:self._marked].tolist()
@@ -199,6 +204,9 @@ class ScipyRun:
     def mark_windows(self, width: float) -> bool:
         """False: one step per `advance`, the caller follows the windows itself."""
         return False
+
+    def return_after(self, seconds: float) -> None:
+        """Nothing to do: each `advance` is one step."""
 
     def marks(self) -> list[list[float]]:
         return []

@@ -39,8 +39,10 @@ from mbody.model.model import State, count
 from mbody.model.yaml_write import dump_document
 from mbody.util import jsontext
 from mbody.util.atomic import atomic_path
+from mbody.util.budget import checked_max_bytes
+from mbody.util.formatting import size_text
 from mbody.util.frozen import Frozen
-from mbody.util.npzfile import Member, NpzArchive, size_text
+from mbody.util.npzfile import Member, NpzArchive
 from mbody.util.spatial import planar_quat
 
 FORMAT = "mbody-trajectory"
@@ -529,6 +531,7 @@ class Trajectory(Frozen):
             do not increase, states that are not finite, a damaged archive (a header that
             does not fit its size, JSON nested too deeply), more data than `max_bytes`.
         """
+        max_bytes = checked_max_bytes(max_bytes)  # the argument's fault, before the file's
         name = str(path)
         p = Path(path)
         if not p.exists():
@@ -755,8 +758,8 @@ def _appearance_problem(n: int, kind: type) -> Any:
 def _info_problem(info: dict) -> str:
     """What is wrong with the run's `info`: the first entry a reader uses that is not of
     its kind (`_INFO_KINDS`), or ''."""
-    def number(v: Any) -> bool:
-        return isinstance(v, int | float)
+    def number(v: Any) -> bool:  # JSON's true and false are Python ints, not numbers here
+        return isinstance(v, int | float) and not isinstance(v, bool)
 
     def text_pair(v: Any) -> bool:
         return isinstance(v, list) and len(v) == 2 and isinstance(v[0], str)

@@ -27,6 +27,7 @@ from __future__ import annotations
 import hashlib
 from typing import TYPE_CHECKING
 
+from mbody.errors import option_name
 from mbody.model.values import apply, edits, entry_names
 from mbody.simulate.kinematic import DEFAULT_FPS, SAMPLES_A_TURN, revolution
 from mbody.sweep.runs import Settings
@@ -39,9 +40,10 @@ SETTINGS = "settings"
 DIGITS = 16
 """Hexadecimal digits of the model's digest kept (64 bits: a changed model is told apart
 from the earlier one but for a chance of 1 in 10^19)."""
-OPTIONS = {"run": "--run", "t-end": "--t-end", "steps": "--steps", "fps": "--fps",
-           "equilibrium": "--equilibrium", "model": "the model"}
-"""How a message names each recorded setting (the command's options)."""
+KEYWORDS = {"run": "run", "t-end": "t_end", "steps": "steps", "fps": "fps",
+            "equilibrium": "equilibrium"}
+"""The keyword argument of `mbody.run_sweep` (the command's option's destination) that
+sets each recorded setting; ``t-end`` in turns is ``revolutions``."""
 
 
 def _number(x: float) -> str:
@@ -101,10 +103,35 @@ def parse(text: str) -> dict[str, str]:
     return out
 
 
+def _python(name: str, value: str) -> str:
+    """The recorded setting `name` with its recorded `value` as `mbody.run_sweep` takes it:
+    ``t_end=0.1``, ``revolutions=1`` (``1 rev``), ``run='kinematics'``, ``steps=None
+    (360 a turn)`` (the default sampling), ``equilibrium=True``."""
+    if name == "run":
+        return f"run={value!r}"
+    if name == "t-end":
+        if value.endswith(" rev"):
+            return f"revolutions={value[:-len(' rev')]}"
+        return f"t_end={value or None}"
+    if name == "steps" and not value.isdigit():
+        return f"steps=None ({value})"
+    if name == "equilibrium":
+        return f"equilibrium={value == 'yes'}"
+    return f"{KEYWORDS.get(name, name)}={value}"
+
+
+def _said(name: str, value: str, flag: str) -> str:
+    """The recorded setting `name` at `value` as the caller gives it: ``--steps 11`` by
+    the command line's `flag`, ``steps=11`` in Python (`_python`)."""
+    return _python(name, value) if flag == KEYWORDS.get(name, name) else f"{flag} {value}"
+
+
 def differences(earlier: str, ours: str) -> list[str]:
     """How the record `earlier` (a row's) differs from `ours` (this sweep's), one phrase
-    per setting: ``--t-end 0.1 (this sweep: 0.2)``, ``another model``... Another run is
-    said alone (with the model): its other settings are other settings anyway."""
+    per setting, named as the caller names it (`mbody.errors.option_name`): on the command
+    line ``--t-end 0.1 (this sweep: 0.2)``, in Python ``t_end=0.1 (this sweep:
+    t_end=0.2)``; ``another model``... Another run is said alone (with the model): its
+    other settings are other settings anyway."""
     theirs, mine = parse(earlier), parse(ours)
     out = []
     names = [*mine, *(k for k in theirs if k not in mine)]
@@ -114,15 +141,18 @@ def differences(earlier: str, ours: str) -> list[str]:
         a, b = theirs.get(name), mine.get(name)
         if a == b:
             continue
-        option = OPTIONS.get(name, name or "a setting")
         if name == "model":
             out.append("another model (another file, the file changed since, or other "
                        "values set for every case)" if a is not None
                        else "no record of the model")
-        elif a is None:
-            out.append(f"no {option} recorded (this sweep: {option} {b})")
+            continue
+        keyword = KEYWORDS.get(name, name or "a setting")
+        flag = option_name(keyword)  # the command's flag; the keyword itself in Python
+        if a is None:
+            out.append(f"no {flag} recorded (this sweep: {_said(name, b or '', flag)})")
         elif b is None:
-            out.append(f"{option} {a} (this sweep has none)")
-        else:
-            out.append(f"{option} {a} (this sweep: {b})")
+            out.append(f"{_said(name, a, flag)} (this sweep has none)")
+        else:  # the command line's value as typed; Python's keyword again, as a call says it
+            again = b if flag != keyword else _said(name, b, flag)
+            out.append(f"{_said(name, a, flag)} (this sweep: {again})")
     return out

@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from mbody.errors import MbodyError, OutputError
+from mbody.errors import MbodyError, OutputError, option_name, option_setting
 from mbody.sweep.grid import Grid
 from mbody.sweep.modes import FLAGS
 from mbody.sweep.record import SETTINGS, differences
@@ -41,9 +41,15 @@ JOURNAL = ".partial"
 """The journal's suffix, after the output's name."""
 ERROR = "error"
 """The column of each case's error (empty when it has its numbers)."""
-AGAIN = ("give another --out to keep it, or --force to run those cases again and replace "
-         "their rows")
-"""What to do with an output that holds rows that are not this sweep's."""
+
+
+def again() -> str:
+    """What to do with an output that holds rows that are not this sweep's, as the caller
+    names the arguments (`mbody.errors.option_name`): ``--out``, ``--force`` on the
+    command line; ``out=...``, ``force=True`` in Python."""
+    return (f"give another {option_name('out', '...')} to keep it, or "
+            f"{option_setting('force', True)} to run those cases again and replace their "
+            "rows")
 
 
 def output_format(path: str | os.PathLike[str]) -> str:
@@ -182,10 +188,11 @@ class Results:
             return ""
         if header == self.header[:-1]:
             return (f"{where} was written by an earlier mbody, which did not record the "
-                    "settings its rows were computed with (the run's --t-end, --steps or "
-                    "--fps, the model): they cannot be told to be this sweep's; " + AGAIN)
+                    "settings its rows were computed with (the run's "
+                    f"{option_name('t_end')}, {option_name('steps')} or {option_name('fps')}, "
+                    "the model): they cannot be told to be this sweep's; " + again())
         return (f"{where} holds another sweep's results (its columns differ from this "
-                f"sweep's); {AGAIN}")
+                f"sweep's); {again()}")
 
     def _row_problem(self, row: list[str], where: str, n: int) -> str:
         """Why `row` (line `n` of `where`) is not a row of this sweep, or ''."""
@@ -198,7 +205,7 @@ class Results:
             return f"{where}:{n}: case {row[0]!r} is not a case number"
         if not 0 <= case < len(self.grid):
             return (f"{where}:{n}: case {case} is not a case of this sweep (it has "
-                    f"{len(self.grid)}): the file holds another sweep's results; {AGAIN}")
+                    f"{len(self.grid)}): the file holds another sweep's results; {again()}")
         want = [cell(x) for x in self.grid.numbers(case)]
         got = row[1:1 + len(want)]
         if not all(map(_same, got, want)):
@@ -206,11 +213,11 @@ class Results:
                        if not _same(a, b))
             return (f"{where}:{n}: case {case} has {self.header[1 + bad]} = {row[1 + bad]} "
                     f"there but {want[bad]} in this sweep: the file holds another sweep's "
-                    f"results; {AGAIN}")
+                    f"results; {again()}")
         if row[-1] != self.settings:
             said = " and ".join(differences(row[-1], self.settings)) or "other settings"
             return (f"{where}:{n}: case {case} was computed with {said}: the file holds "
-                    f"the results of other settings, which are not this sweep's; {AGAIN}")
+                    f"the results of other settings, which are not this sweep's; {again()}")
         return ""
 
     def _drop(self, row: list[str], where: str, n: int, journal: bool) -> None:

@@ -17,9 +17,13 @@ kind's default (`byte_limit`).
 
 from __future__ import annotations
 
+import numbers
+import operator
 from collections.abc import Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
+
+from mbody.errors import MbodyError, wrong_type
 
 MAX_BYTES = 32 * 1024 * 1024
 """Largest model file read by default, in bytes (a 10 000-body model written by
@@ -49,7 +53,8 @@ def byte_budget(max_bytes: int | None) -> Iterator[None]:
     max_bytes : int or None
         The budget, in bytes; None keeps the current one.
     """
-    token = _GIVEN.set(int(max_bytes)) if max_bytes is not None else None
+    size = checked_max_bytes(max_bytes)
+    token = _GIVEN.set(size) if size is not None else None
     try:
         yield
     finally:
@@ -61,7 +66,49 @@ def byte_limit(max_bytes: int | None, default: int) -> int:
     """The budget of one read: `max_bytes` if given (the call's own), else the one
     `byte_budget` set around it, else `default` (the kind's: `MAX_BYTES`, `DATA_BYTES`
     or `TEXT_BYTES`)."""
-    if max_bytes is not None:
-        return int(max_bytes)
+    size = checked_max_bytes(max_bytes)
+    if size is not None:
+        return size
     given = _GIVEN.get()
     return default if given is None else given
+
+
+def checked_max_bytes(max_bytes: object, argument: str = "max_bytes") -> int | None:
+    """A reader's `max_bytes` as the byte count it names, checked where it comes in: the
+    one check of every reader's budget argument (`mbody.load`, `mbody.Trajectory.load`,
+    `mbody.load_export`, `read_generalized`, and `byte_limit` under them all).
+
+    A whole number of bytes, at least 1: an int (a numpy integer too), or a float with
+    no fraction (``2.0 ** 30``). A bool is refused (an int to Python, not a size to
+    anyone), as are a fraction of a byte and a size with a unit (``'1G'`` is the command
+    line's ``--max-bytes``; in Python, ``2**30``).
+
+    Returns
+    -------
+    int or None
+        The budget in bytes; None when `max_bytes` is None (the current budget).
+
+    Raises
+    ------
+    MbodyTypeError
+        Not a whole number (the argument named, what was given, what is expected).
+    MbodyError
+        Below 1 byte.
+    """
+    if max_bytes is None:
+        return None
+    size: int | None = None
+    if isinstance(max_bytes, bool):
+        pass
+    elif isinstance(max_bytes, numbers.Integral):
+        size = operator.index(max_bytes)
+    elif isinstance(max_bytes, numbers.Real) and float(max_bytes).is_integer():
+        size = int(float(max_bytes))
+    if size is None:
+        hint = ("a size with a unit is the command line's --max-bytes; in Python, write "
+                "2**30 for 1 GiB" if isinstance(max_bytes, str) else "")
+        raise wrong_type(argument, "a whole number of bytes (such as 200 * 2**20)",
+                         max_bytes, hint)
+    if size < 1:
+        raise MbodyError(f"{argument}: expected a size of at least 1 byte, got {max_bytes!r}")
+    return size

@@ -45,6 +45,39 @@ def number(x: float) -> str:
     return re.sub(r"e\+?(-?)0*(\d)", r"e\1\2", f"{x:g}")
 
 
+_BINARY_UNITS = ("KiB", "MiB", "GiB", "TiB", "PiB", "EiB")
+
+
+def size_text(n: int) -> str:
+    """A count of `n` bytes as a message gives it to people: the one wording of a size
+    (a model file's, a run's, an export's, a budget).
+
+    Below 1 KiB the count itself, singular for one: '1 byte', '1,023 bytes'. From 1 KiB,
+    3 significant digits in the largest binary unit (1024) whose figure is at least 1,
+    and the next unit once the figure rounds to 1000, so that a size never prints with an
+    exponent: 1,024,000 bytes (1000 KiB) is '0.977 MiB (1,024,000 bytes)', 1,048,575
+    bytes (1023.999 KiB) '1 MiB (1,048,575 bytes)'. Under 1 MiB the exact count follows
+    in brackets, where the rounded figure says little: '1 KiB (1,024 bytes)', '1.5 KiB
+    (1,536 bytes)'; from 1 MiB the figure alone: '1 MiB', '2 GiB', '7.11 PiB' (two sizes
+    compared: `sizes_apart`).
+    """
+    if n < 1024:
+        return "1 byte" if n == 1 else f"{n:,} bytes"
+    value, unit = n / 1024, 0
+    while float(f"{value:.3g}") >= 1000 and unit < len(_BINARY_UNITS) - 1:
+        value, unit = value / 1024, unit + 1
+    figure = f"{value:.3g}" if value < 999.5 else f"{value:,.0f}"  # beyond EiB: whole
+    text = f"{figure} {_BINARY_UNITS[unit]}"
+    return f"{text} ({n:,} bytes)" if n < 2**20 else text
+
+
+def sizes_apart(a: int, b: int) -> tuple[str, str]:
+    """Two sizes as `size_text` gives them, or as exact byte counts when they round
+    alike ('1 GiB' against '1 GiB' would not say which is more)."""
+    ta, tb = size_text(a), size_text(b)
+    return (ta, tb) if ta != tb or a == b else (f"{a:,} bytes", f"{b:,} bytes")
+
+
 def vec(x: np.ndarray, dim: int, tol: float = NOISE) -> str:
     """``(x, y)`` of a planar model's vector (its first two components), ``(x, y, z)``;
     each component below `tol` as 0."""

@@ -38,6 +38,7 @@ import numpy as np
 
 from mbody.errors import MbodyError
 from mbody.util.budget import DATA_BYTES, TEXT_BYTES, byte_limit
+from mbody.util.formatting import size_text, sizes_apart
 from mbody.util.frozen import Frozen
 
 if TYPE_CHECKING:
@@ -50,23 +51,11 @@ _METHODS = (0, 8)
 """The zip methods numpy writes: stored, deflated."""
 
 
-def size_text(n: int) -> str:
-    """A byte count people read: '16 bytes', '1.5 KiB (1,536 bytes)', '2 GiB', '7.11 PiB'
-    (the exact count too under 1 MiB, where the rounded one says little)."""
-    if n < 1024:
-        return f"{n:,} bytes"
-    unit = min(int(math.log(n, 1024)), 6)
-    text = f"{n / 1024 ** unit:.3g} {'KMGTPE'[unit - 1]}iB"
-    return f"{text} ({n:,} bytes)" if n < 2**20 else text
-
-
 def over_budget(name: str, holds: int, on_disk: int, limit: int, more: str) -> str:
     """The message for a file that holds more than the budget: what it holds (inflated),
     its size on disk, the budget and how to raise it (`more`)."""
     packed = f" once inflated ({size_text(on_disk)} on disk)" if on_disk < holds else ""
-    held, most = size_text(holds), size_text(limit)
-    if held == most:  # rounded alike: the bytes say which is more
-        held, most = f"{holds:,} bytes", f"{limit:,} bytes"
+    held, most = sizes_apart(holds, limit)
     return f"{name}: holds {held} of data{packed}; at most {most} is read ({more})"
 
 

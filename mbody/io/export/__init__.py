@@ -44,6 +44,7 @@ from mbody.io.export.jsonfile import from_json, schema, to_json
 from mbody.io.export.sample import assembly_from_trajectory, state_at
 from mbody.model.arguments import KnownValues
 from mbody.util.atomic import atomic_path
+from mbody.util.budget import checked_max_bytes
 
 __all__ = [
     "COLUMN_TEXT", "CSV_DENSE_LIMIT", "FORMAT", "SUFFIXES", "VERSION", "Columns",
@@ -126,8 +127,10 @@ def load_export(path: str | os.PathLike[str], *, max_bytes: int | None = None
     Raises
     ------
     MbodyError
-        For a missing, unreadable, foreign or damaged file, or one over `max_bytes`.
+        For a missing, unreadable, foreign or damaged file, or one over `max_bytes`; a
+        `max_bytes` that is not a whole number of bytes, at least 1.
     """
+    max_bytes = checked_max_bytes(max_bytes)  # the argument's fault, not the file's
     path = Path(path)
     reader: Callable[[Path, int | None], ExportedAssembly]
     if path.is_dir():

@@ -35,6 +35,7 @@ from mbody.io.export.assembly import (
 from mbody.io.export.mat import load as load_mat
 from mbody.util import jsontext
 from mbody.util.atomic import atomic_path
+from mbody.util.budget import checked_max_bytes
 from mbody.util.npzfile import NpzArchive, read_text
 
 if TYPE_CHECKING:
@@ -127,8 +128,10 @@ def read_generalized(path: str | os.PathLike[str], max_bytes: int | None = None
     MbodyError
         Naming the file and what is wrong: no such file, another suffix, another kind
         of file (a saved run, an export of the stacked equations), a newer version, a
-        missing entry, a damaged file, more than `max_bytes`.
+        missing entry, a damaged file, more than `max_bytes`; a `max_bytes` that is not a
+        whole number of bytes, at least 1.
     """
+    max_bytes = checked_max_bytes(max_bytes)  # the argument's fault, not the file's
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix not in SUFFIXES:

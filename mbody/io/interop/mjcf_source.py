@@ -12,6 +12,7 @@ from mbody.errors import Issue, ModelError
 from mbody.io.interop.mjcf_schema import SCHEMA, UNIQUE
 from mbody.io.interop.xmlsource import Element, parse_xml, second, unknown_name
 from mbody.model.loader import file_kind, read_file
+from mbody.util.formatting import sizes_apart
 
 MAX_INCLUDES = 100
 """Most ``<include>`` files read for one model."""
@@ -91,9 +92,10 @@ def _count(c: Element, rel: str, included: Included, more: int) -> None:
     `MAX_INCLUDED_BYTES`."""
     total = included.bytes + more
     if total > MAX_INCLUDED_BYTES:
+        size, most = sizes_apart(total, MAX_INCLUDED_BYTES)
         raise ModelError([c.issue(
-            f"including '{rel}' brings the included files to {_amount(total)} together "
-            f"(include number {included.files}); at most {_amount(MAX_INCLUDED_BYTES)} "
+            f"including '{rel}' brings the included files to {size} together "
+            f"(include number {included.files}); at most {most} "
             "of included files is read for one model",
             "include each file once, or merge the model into fewer, smaller files",
             "file")])
@@ -101,10 +103,6 @@ def _count(c: Element, rel: str, included: Included, more: int) -> None:
 
 def _short(text: str) -> str:
     return text if len(text) <= 200 else text[:100] + "..." + text[-40:]
-
-
-def _amount(n: int) -> str:
-    return f"{n / 2**20:.1f} MiB" if n >= 2**20 else f"{n / 2**10:.1f} KiB"
 
 
 def _schema_path(path: str, tag: str) -> str:

@@ -490,6 +490,9 @@ int mb_dop853_sampled(const mb_ode *p, double t_stop, int64_t max_steps, const d
     const int marking = marks != NULL && width > 0.0 && marks_cap > 0;
     int status = (int)state[MB_DOP_STATUS];
     if (marking && *count >= marks_cap) return status;
+    const double return_after = state[MB_DOP_RETURN_AFTER];
+    const int timed = p->clock != NULL && return_after > 0.0;
+    const double deadline = timed ? p->clock() + return_after : 0.0;
     for (int64_t taken = 0; taken < max_steps && status == MB_DOP_RUNNING; taken++) {
         const double before = state[MB_DOP_STEPS];
         status = mb_dop853_run(p, t_stop, 1, state, work);
@@ -516,6 +519,7 @@ int mb_dop853_sampled(const mb_ode *p, double t_stop, int64_t max_steps, const d
             if (*count >= marks_cap) break;
         }
         if (status == MB_DOP_RUNNING && direction * (t - t_stop) >= 0.0) break;
+        if (timed && p->clock() >= deadline) break;
     }
     return status;
 }

@@ -57,6 +57,8 @@ typedef struct {
     mb_tangent_fn tangent;  /* optional: filtered steps' error estimates */
     void *ctx;              /* handed to every callback */
     const double *atol;     /* n absolute tolerances, or NULL: state[MB_DOP_ATOL] for all */
+    double (*clock)(void);  /* optional: a monotonic clock in seconds (mb_dop853_sampled's
+                             * MB_DOP_RETURN_AFTER) */
 } mb_ode;
 
 /* Slots of `state`. The caller writes the settings (mb_dop853_settings writes them with
@@ -85,6 +87,8 @@ enum {
     MB_DOP_WALL,        /* seconds spent in the binding's calls of _start and _sampled */
     MB_DOP_MARK_WIDTH,  /* the marks' window (mb_dop853_sampled; 0: no marks) */
     MB_DOP_MARK_NEXT,   /* the next mark's time (the caller sets the first) */
+    MB_DOP_RETURN_AFTER, /* mb_dop853_sampled returns after the first step past this many
+                          * seconds of its call (by p->clock; 0: no limit) */
     MB_DOP_INFO,        /* the last projection's info (MB_DOP_PROJECT_INFO slots) */
     MB_DOP_STATE_SIZE = MB_DOP_INFO + 4
 };
@@ -135,6 +139,10 @@ int mb_dop853_dense(const mb_ode *p, const double *t, int64_t m, double *out,
  * (floor(t / w) + 1) w. The run returns when *count reaches marks_cap. These are the
  * points at which a caller stepping window by window (t_stop at each window's end) would
  * have been called back, without the round trips (mbody.simulate's step-rate windows).
+ * With state[MB_DOP_RETURN_AFTER] = s > 0 and a clock in p, the call also returns after
+ * the first accepted step that ends s seconds or more after the call began: a caller
+ * that looks at its budgets and progress between calls does so at a steady pace, however
+ * cheap or dear a step is.
  * Returns the status, as mb_dop853_run. */
 int mb_dop853_sampled(const mb_ode *p, double t_stop, int64_t max_steps, const double *t_eval,
                       int64_t m, int64_t *k, double *out, int project_samples, double *state,

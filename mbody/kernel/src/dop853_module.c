@@ -269,6 +269,7 @@ static int problem_read(PyObject *tuple, int64_t n, problem *pr, mb_ode *ode) {
         return -1;
     pr->n = ode->n = n;
     ode->ctx = pr;
+    ode->clock = now_seconds;
     if (PyLong_Check(rhs)) {
         long s = PyLong_AsLong(rhs);
         if (s < 0 || s >= SYSTEMS) {
@@ -677,7 +678,8 @@ static PyMethodDef dop853_methods[] = {
      "moved by project when project_samples; k: the first row not yet written. With "
      "marks (a float64 buffer of rows (t, steps)): -> (status, k, count), the first count "
      "rows written at each step reaching DOP_MARK_NEXT or t_bound (dop853.h); the seconds "
-     "spent are added to state[DOP_WALL] (as dop853_start's)."},
+     "spent are added to state[DOP_WALL] (as dop853_start's). state[DOP_RETURN_AFTER] > 0: "
+     "the call also returns after the first step ending that many seconds after it began."},
     {"samples", py_samples, METH_VARARGS,
      "samples(unknowns, lam, t, Y, reactions, lengths, drift): a run's figures at its K "
      "output samples (Y: K rows of the packed state at the times t): reactions (K x m, or "
@@ -721,7 +723,8 @@ int mb_dop853_register(PyObject *m) {
         {"DOP_FILTER", MB_DOP_FILTER}, {"DOP_FILTER_NEXT", MB_DOP_FILTER_NEXT},
         {"DOP_DENSE", MB_DOP_DENSE}, {"DOP_DENSE_NFEV", MB_DOP_DENSE_NFEV},
         {"DOP_WALL", MB_DOP_WALL}, {"DOP_MARK_WIDTH", MB_DOP_MARK_WIDTH},
-        {"DOP_MARK_NEXT", MB_DOP_MARK_NEXT}, {"DOP_INFO", MB_DOP_INFO},
+        {"DOP_MARK_NEXT", MB_DOP_MARK_NEXT}, {"DOP_RETURN_AFTER", MB_DOP_RETURN_AFTER},
+        {"DOP_INFO", MB_DOP_INFO},
         {"MECH_RATE", MB_MECH_RATE}, {"MECH_ROBUST", MB_MECH_ROBUST},
         {"MECH_ITERS", MB_MECH_ITERS}, {"MECH_STAGE_ITERS", MB_MECH_STAGE_ITERS},
         {"MECH_PARAMS", MB_MECH_PARAMS},
