@@ -38,11 +38,21 @@ scaled by τ from 0 (μ = ±iω̂_i exactly) to 1, so a connected union of m dis
 eigenvalues: a computed eigenvalue λ̂ whose nearest centre is iω̂_i is within
 |λ̂ − iω̂_i| plus the farthest point of iω̂_i's union of a true eigenvalue.
 
+A disc apart. The row sums count every mode's coupling to mode i at first order, though
+its effect on ω̂_i is of second order. The same theorem holds for S⁻¹ (μ² P + μ G + Q) S
+with S diagonal: at s_i = 1/t, row i's off-diagonal bounds are multiplied by t and column
+i's by 1/t. When disc i at that scaling lies apart from every other row's disc (their
+discs at the same scaling, (2) holding for each), it holds exactly one eigenvalue (the
+discs shrink with τ as before), and its radius bounds that eigenvalue: the smallest such
+radius over t in `SCALINGS` is kept where it is below the union's.
+
 Measured on the hanging chains of `tests/test_lagrange_large.py` (rods in their joints'
-angles): the bounds are below 1e-6 of each frequency up to 100 rods and below 1e-2 at 200,
-where the first-order system's exceed the eigenvalues (all modes then read neutral);
-(2) fails past about 250 rods, where N's rounding model reaches a quarter (the bounds are
-then the first-order system's).
+angles), the largest bound over its eigenvalue: 1.4e-7 at 40 rods, 1.1e-5 at 100, 1.2e-4
+at 150 (the first-order system's: 0.03, 2.8 and 23); up to 180 rods every mode is decided
+an oscillation. Past that the highest modes' discs (mostly M's rounding) overlap even
+scaled, a bound spans the whole overlap and those modes read neutral again; (2) fails
+between 250 and 300 rods, where the first-order system's bounds are all there is
+(docs/modes.md).
 """
 
 from __future__ import annotations
@@ -102,18 +112,22 @@ def modal_bounds(M: np.ndarray, K: np.ndarray, K_err: np.ndarray, D: np.ndarray,
     R[np.diag_indices(k)] -= lam
     N = X.T @ (M @ X)
     N[np.diag_indices(k)] -= 1.0
-    r = np.abs(R).sum(axis=1) + sandwich(K_err + 0.5 * np.abs(K - K.T) + gamma * np.abs(Ks))
+    K_off = K_err + 0.5 * np.abs(K - K.T) + gamma * np.abs(Ks)
+    r = np.abs(R).sum(axis=1) + sandwich(K_off)
     n = np.abs(N).sum(axis=1) + sandwich(gamma * np.abs(M)) + m_rel * (aX.T @ s) * (s @ ones)
     g = sandwich(np.abs(D) + D_err)
     safety = 1.0 + 8 * k * EPS  # the rounding of these sums of non-negative terms
-    r, n, g = r * safety, n * safety, g * safety
-    if not np.all((1.0 - 4.0 * n) * lam - 2.0 * g * omega - r > 0.0):  # (2)
+    d = _radius(n * safety, g * safety, r * safety, lam, omega)
+    if not np.all(np.isfinite(d)):  # (2) fails for a mode
         return None
-    b = 2.0 * omega * (1.0 - n) - g  # φ(d) = −(1 + n) d² + b d − c
-    c = n * lam + g * omega + r
-    d = 2.0 * c / (b + np.sqrt(np.maximum(b * b - 4.0 * (1.0 + n) * c, 0.0)))  # smaller root
-    d *= safety
-    reach = _union_reach(omega, d)
+    reach = _union_reach(omega, d * safety + EPS * omega)
+    # a disc apart at a scaling (module doc): the full bounds, entry by entry
+    a = aX.T @ s
+    Nb = (np.abs(N) + aX.T @ (gamma * np.abs(M)) @ aX + m_rel * np.outer(a, a)) * safety
+    Rb = (np.abs(R) + aX.T @ K_off @ aX) * safety
+    Gb = (aX.T @ (np.abs(D) + D_err) @ aX) * safety
+    apart = _apart(Nb, Gb, Rb, lam, omega)
+    reach = np.minimum(reach, apart * safety + EPS * omega)
     # each eigenvalue's nearest centre iω_i (a conjugate's: the mirror's), among the two
     # whose ω bracket its imaginary part (ω ascending)
     up = eigenvalues.real + 1j * np.abs(eigenvalues.imag)
@@ -122,6 +136,50 @@ def modal_bounds(M: np.ndarray, K: np.ndarray, K_err: np.ndarray, D: np.ndarray,
     far_above, far_below = np.abs(up - 1j * omega[above]), np.abs(up - 1j * omega[below])
     return np.where(far_above <= far_below, far_above + reach[above],
                     far_below + reach[below])
+
+
+def _radius(n: np.ndarray, g: np.ndarray, r: np.ndarray, lam: np.ndarray,
+            omega: np.ndarray) -> np.ndarray:
+    """d: the smaller root of φ(d) = −(1 + n) d² + b d − c, b = 2ω (1 − n) − g, c = n ω² +
+    g ω + r (module doc), where (2) holds; inf where it does not."""
+    ok = (1.0 - 4.0 * n) * lam - 2.0 * g * omega - r > 0.0
+    b = 2.0 * omega * (1.0 - n) - g
+    c = n * lam + g * omega + r
+    with np.errstate(invalid="ignore", divide="ignore"):
+        d = 2.0 * c / (b + np.sqrt(np.maximum(b * b - 4.0 * (1.0 + n) * c, 0.0)))
+    return np.where(ok, d, np.inf)
+
+
+SCALINGS = (0.3, 0.1, 0.03, 0.01, 3e-3, 1e-3, 3e-4, 1e-4)
+"""The factors t tried on a disc's row (module doc: a disc apart)."""
+
+
+def _apart(Nb: np.ndarray, Gb: np.ndarray, Rb: np.ndarray, lam: np.ndarray,
+           omega: np.ndarray) -> np.ndarray:
+    """Each disc's smallest radius at a scaling that sets it apart from every other row's
+    disc (module doc), or inf: the row's off-diagonal bounds times t, the column's over
+    t, for each t of `SCALINGS`."""
+    n, g, r = Nb.sum(axis=1), Gb.sum(axis=1), Rb.sum(axis=1)
+    dn, dg, dr = np.diagonal(Nb), np.diagonal(Gb), np.diagonal(Rb)
+    k = len(omega)
+    best = np.full(k, np.inf)
+    for start in range(0, k, BLOCK):  # discs start.. at a time: (BLOCK, k) arrays
+        i = np.arange(start, min(k, start + BLOCK))
+        gap = np.abs(omega[i, None] - omega[None, :])
+        gap[np.arange(len(i)), i] = np.inf  # not apart from itself
+        for t in SCALINGS:
+            own = _radius(dn[i] + t * (n[i] - dn[i]), dg[i] + t * (g[i] - dg[i]),
+                          dr[i] + t * (r[i] - dr[i]), lam[i], omega[i])
+            more = 1.0 / t - 1.0  # row j for disc i: + (1/t − 1) times its entry (j, i)
+            others = _radius(n[None, :] + more * Nb[:, i].T, g[None, :] + more * Gb[:, i].T,
+                             r[None, :] + more * Rb[:, i].T, lam[None, :], omega[None, :])
+            alone = np.all(gap > own[:, None] + others, axis=1) & np.isfinite(own)
+            best[i] = np.where(alone, np.minimum(best[i], own), best[i])
+    return best
+
+
+BLOCK = 256
+"""Discs whose scalings `_apart` tries at once (memory: a few (BLOCK, k) arrays)."""
 
 
 def _union_reach(omega: np.ndarray, d: np.ndarray) -> np.ndarray:
