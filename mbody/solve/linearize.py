@@ -46,6 +46,7 @@ from mbody.kernel import _core
 from mbody.model.arguments import checked_model, checked_state
 from mbody.model.model import Model, State
 from mbody.solve.configure import move
+from mbody.solve.modal_bounds import modal_bounds
 from mbody.util.progress import Progress, progress_of
 
 STEP = 1e-2
@@ -591,8 +592,6 @@ def _tightened(out: np.ndarray, at: _Offsets, info: list[float], m_rel: float,
     d = out[at.ngen:at.ngen + 4 * k * k].reshape(4, k, k)
     if not np.any(err > LOOSE * np.abs(w)) or not np.all(np.diagonal(d[0]) > 0.0):
         return False  # tight already, or K not positive definite (a free or cyclic motion)
-    from mbody.solve.modal_bounds import modal_bounds
-
     if bar is not None:
         bar.step(f"error bounds from the modes of K's symmetric part ({k} x {k})")
     M = out[at.M:at.M + k * k].reshape(k, k)
