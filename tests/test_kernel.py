@@ -520,8 +520,9 @@ def test_a_bar_pinned_twice_is_redundant_and_its_solve_consistent(dimension):
 
 
 def test_many_unknowns_are_band_ordered():
-    """A chain of 16 rods on revolute joints (80 unknowns): pack_unknowns orders them by
-    reverse Cuthill-McKee, so S's half band stays that of a chain whatever the labels."""
+    """A chain of 16 rods on revolute joints (80 unknowns): pack_unknowns orders them
+    breadth-first from the ground joint, so S's half band stays that of a chain whatever
+    the labels."""
     model = mbody.load(chain16())
     k = Kernel(model)
     cu, lam = file_unknowns(k)
