@@ -267,6 +267,10 @@ def not_found(what: str, name: object, names: Sequence[str], many: str,
     return KeyError(f"{said} ({none or f'there are no {many}'})")
 
 
+CLOSE_CUTOFF = 0.6
+"""difflib's similarity a did-you-mean needs (its default)."""
+
+
 def closest(word: str, choices: Iterable[str]) -> str | None:
     """The choice `word` was probably meant to be (`did_you_mean`'s), or None: one that
     differs only in case, else difflib's closest match when it is a misspelling rather
@@ -276,10 +280,16 @@ def closest(word: str, choices: Iterable[str]) -> str | None:
     first letter."""
     names = [str(c) for c in choices]
     text = str(word)
-    same = [c for c in names if c.casefold() == text.casefold()]
+    folded = text.casefold()
+    same = [c for c in names if c.casefold() == folded]
     if same:
         return same[0]
-    close = difflib.get_close_matches(text, names, n=1, cutoff=0.6)
+    # the choices whose lengths alone allow the similarity (difflib's real_quick_ratio,
+    # its first test, in its own arithmetic): the same answer, without difflib's per-choice
+    # work on the others (a large model's names are thousands)
+    n = len(text)
+    names = [c for c in names if 2.0 * min(n, len(c)) / (n + len(c)) >= CLOSE_CUTOFF]
+    close = difflib.get_close_matches(text, names, n=1, cutoff=CLOSE_CUTOFF)
     if not close:
         return None
     meant = close[0]

@@ -13,7 +13,7 @@ import json
 
 import numpy as np
 import pytest
-from test_cli import MODELS, fails, succeeds
+from test_cli import MODELS, fails, mbody, succeeds
 
 from mbody.io.export.generalized import read_generalized
 
@@ -103,3 +103,24 @@ def test_modes_of_a_fully_driven_mechanism_says_nothing_oscillates():
     assert "no free coordinate" in out and "coordinates: \n" in out
     data = json.loads(succeeds("modes", str(MODELS / "slider_crank_driven.yaml"), "--json"))
     assert data["coordinates"] == [] and "no free coordinate" in data["verdict"]
+
+
+def test_a_large_models_equations_are_bounded_and_its_progress_said(tmp_path):
+    # 201 rods: the equations' 201^2 terms are not printed (the exports hold them), no
+    # LaTeX document of them is written, and --progress draws the steps on stderr once a
+    # second has passed (here, quicker: no bar at all)
+    from test_lagrange_large import chain_yaml
+
+    model = tmp_path / "chain.yaml"
+    model.write_text(chain_yaml(201, 0.1), encoding="utf-8")
+    out = succeeds("lagrange", model, "--no-progress")
+    assert "(201 equations of up to 201 terms each: not written out above 200 " \
+        "coordinates; -o FILE.npz, .mat or .json exports M, f and T)" in out
+    assert "j200.angle  " in out and "so: j0.angle'' = " in out
+    err = fails(2, "lagrange", model, "--latex", tmp_path / "eq.tex")
+    assert "the equations of 201 coordinates (up to 201 terms each) are too many for a " \
+        "document: --latex writes at most 200" in err
+    assert not (tmp_path / "eq.tex").exists()
+    p = mbody("lagrange", model, "-o", tmp_path / "eq.npz", "--progress")
+    assert p.returncode == 0 and p.stderr == ""
+    assert read_generalized(tmp_path / "eq.npz")["M"].shape == (201, 201)

@@ -279,3 +279,14 @@ def test_animate_forces_need_the_runs_own_model(tmp_path, capsys):
                                 f"run {run_file} does not have (crank, piston): its forces and "
                                 "reactions cannot be drawn on that run; give the model the run "
                                 "was computed from\n")
+
+
+def test_a_refused_set_leaves_no_import_option_to_the_next_command(tmp_path, capsys):
+    # `--set` given twice is refused after the command read its --keyframe: the next
+    # command of the same process (the test suite, a notebook) must not inherit it (a YAML
+    # model converted was refused, its --keyframe taken for the last command's)
+    code, _, err = run(capsys, "check", PENDULUM, "--keyframe", "swing", "--set",
+                       "bodies.rod.mass=2", "--set", "bodies.rod.mass=2")
+    assert code == 2 and "given twice" in err
+    code, _, err = run(capsys, "convert", PENDULUM, "-o", tmp_path / "p.xml")
+    assert code == 0, err

@@ -173,3 +173,39 @@ def test_every_lookup_by_name_says_the_same_way_what_is_there():
         with pytest.raises(KeyError) as err:
             call()
         assert message(err) == expected
+
+
+def test_the_closest_name_is_difflibs_among_a_thousand():
+    # closest() skips the names whose lengths alone rule out difflib's cutoff (its first
+    # test, in its own arithmetic) before difflib looks at the rest: the same answer as
+    # difflib's over all of them, ties and near-misses included (then the same test of a
+    # misspelling: the first letter, or a few edits)
+    import difflib
+    import random
+
+    from mbody.errors import _EDITS_PER_LETTER, CLOSE_CUTOFF, _edits, closest
+
+    def reference(word: str, names: list[str]) -> str | None:
+        same = [c for c in names if c.casefold() == word.casefold()]
+        if same:
+            return same[0]
+        close = difflib.get_close_matches(word, names, n=1, cutoff=CLOSE_CUTOFF)
+        if not close:
+            return None
+        meant = close[0]
+        if word[:1].casefold() == meant[:1].casefold() or _edits(word, meant) <= max(
+                1, max(len(word), len(meant)) // _EDITS_PER_LETTER):
+            return meant
+        return None
+
+    rng = random.Random(7)
+    names = ["".join(rng.choice("jl_.012angle") for _ in range(rng.randint(1, 16)))
+             for _ in range(1000)]
+    words = [w[:-1] for w in names[:40]] + [w + "x" for w in names[40:80]] + \
+        ["", "m", "a_x", "j12.angle_dd", "ANGLE", "q" * 30]
+    found = 0
+    for word in words:
+        expected = reference(word, names)
+        assert closest(word, names) == expected, word
+        found += expected is not None
+    assert found >= 60

@@ -243,3 +243,57 @@ def test_a_number_rounded_too_coarsely_in_a_lagrange_equation():
     assert f"the constant has 4.905 where {4.905 * 0.66 / mass:.6g} is expected (1.1 % off)" \
         in " ".join(c.explanation.split())
     assert pendulum("0.6671*th_ddot + m_rod*g*0.5*sin(th) = 0").correct
+
+
+def _chain_yaml(n: int) -> str:
+    """A hanging planar chain of n rods (0.1 m, 1 kg), each pinned to the one above."""
+    bodies = "".join(f"  - {{name: l{i}, mass: 1, inertia: 0.001, "
+                     f"position: [0, {-0.1 * i - 0.05!r}]}}\n" for i in range(n))
+    joints = "".join(f"  - {{name: j{i}, type: revolute, parent: "
+                     f"{'ground' if i == 0 else f'l{i - 1}'}, child: l{i}, "
+                     f"at: [0, {-0.1 * i!r}]}}\n" for i in range(n))
+    return (f"model: chain\ndimension: 2\ngravity: [0, -9.81]\nbodies:\n{bodies}"
+            f"joints:\n{joints}")
+
+
+def test_thousands_of_entries_without_body_are_refused_with_the_first_explained(tmp_path):
+    # a class's sheet pasted without body: on a large model: every entry is a problem
+    # (Newton-Euler names in a Lagrange equation), each counted; the message shows the
+    # first AnswersError.SHOWN, each located with what is wrong and the body it was meant
+    # for (the did-you-mean, a pass over thousands of names, is for those alone), and
+    # lists the names it takes up to SUMMARY_NAMES, then how many more
+    from mbody.answers.vocabulary import SUMMARY_NAMES
+
+    n, entries = 400, 2000
+    (tmp_path / "chain.yaml").write_text(_chain_yaml(n), encoding="utf-8")
+    sheet = tmp_path / "answers.yaml"
+    sheet.write_text("equations:\n" + "".join(
+        f'  - {{eq: "m*a_x = j{i % n}.Fx - j{i % n + 1}.Fx"}}\n' for i in range(entries)),
+        encoding="utf-8")
+    model = mbody.load(tmp_path / "chain.yaml")
+    with pytest.raises(AnswersError) as info:
+        mbody.verify(model, sheet)
+    err = info.value
+    assert len(err.issues) == entries
+    shown = AnswersError.SHOWN
+    lines = str(err).splitlines()
+    assert lines[0] == f"{entries} problems in the answers:"
+    assert lines[-1] == f"... and {entries - shown} more"
+    assert len(lines) == shown + 2
+    # every entry's problem at its line and column: the 'm' of its equation
+    for k, issue in enumerate(err.issues):
+        assert (issue.line, issue.column, issue.key) == (k + 2, 11, f"equations[{k}].eq")
+        assert issue.message.startswith("unknown name 'm' in a Lagrange equation (the names: ")
+    # the names: the coordinates' accelerations, t, g and each body's m_, I_ (not more
+    # than SUMMARY_NAMES of them written out)
+    names = n + 2 + 2 * n
+    assert all(i.message.endswith(f", … {names - SUMMARY_NAMES} more)") for i in err.issues)
+    written = err.issues[0].message.split("(the names: ")[1].split(", …")[0].split(", ")
+    assert written[:3] == ["j0.angle_ddot", "j1.angle_ddot", "j2.angle_ddot"]
+    assert len(written) == SUMMARY_NAMES
+    # the shown ones say which body's equation it is: j_i.Fx and j_(i+1).Fx both act on
+    # rod l_i alone
+    for k, issue in enumerate(err.issues[:shown]):
+        assert issue.hint.startswith(f"did you forget body: l{k % n}? "), issue.hint
+        assert str(issue) == lines[k + 1]
+    assert not any(i.hint for i in err.issues[shown:])

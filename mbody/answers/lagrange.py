@@ -28,7 +28,7 @@ said so, else the terms that differ are named (`not_an_equation_of_this_model`).
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -38,7 +38,7 @@ from mbody import conventions as cv
 from mbody.answers.compare import CONST, Row, consensus, fit, matches, rounded_off
 from mbody.answers.diagnose import CORRECT, ROUNDED_TOO_COARSELY, Diagnosis
 from mbody.answers.linear import NotLinear, linear_row
-from mbody.answers.load import Answer, Answers, AnswersError
+from mbody.answers.load import Answer, Answers, AnswersError, hinted
 from mbody.answers.parse import EquationError, names_in, parse_equation
 from mbody.answers.text import differences, num, rounding
 from mbody.answers.vocabulary import Vocabulary, name_gravity, newton_euler_bodies
@@ -457,7 +457,7 @@ def _closest(s: Row, truth: _Truth, tol: float, order: list[int]) -> tuple[str, 
 
 
 def _forgotten_body(model: Model, state: State, vocab: Vocabulary, eq: str,
-                    labels: list[str], cache: dict[str, Vocabulary]) -> str:
+                    labels: Sequence[str], cache: dict[str, Vocabulary]) -> str:
     """The hint for an entry without ``body:`` whose names this Lagrange vocabulary lacks
     and a body's Newton-Euler equations have (``m*a_x = O.Fx``): "did you forget body:
     rod?"; '' when no body has them."""
@@ -477,11 +477,7 @@ def _forgotten_body(model: Model, state: State, vocab: Vocabulary, eq: str,
 
 
 def _has(vocab: Vocabulary, name: str) -> bool:
-    try:
-        vocab.resolve(name)
-    except KeyError:
-        return False
-    return True
+    return vocab.canonical(name) is not None
 
 
 def coordinate_names(model: Model, sheet: Answers) -> tuple[tuple[str, ...], tuple[str, ...]]:
@@ -513,9 +509,9 @@ def check_lagrange(model: Model, state: State, sheet: Answers, entries: list[Ans
         raise AnswersError([Issue(sheet.file, 0, 0, "coordinates", f"the answers' coordinates: "
                                   f"{exc}")]) from None
     vocab = vocabulary(model, state, truth)
-    dotted = [*labels, *(f"{lab}_dot" for lab in labels), *(f"{lab}_ddot" for lab in labels),
+    dotted = (*labels, *(f"{lab}_dot" for lab in labels), *(f"{lab}_ddot" for lab in labels),
               *(f"{lab}dot" for lab in labels), *(f"{lab}ddot" for lab in labels),
-              *vocab.reactions]
+              *vocab.reactions)
     issues: list[Issue] = []
     parsed: list[tuple[Answer, Row | None, str]] = []
     bodies: dict[str, Vocabulary] = {}  # the bodies' Newton-Euler names, for the hint
@@ -528,11 +524,11 @@ def check_lagrange(model: Model, state: State, sheet: Answers, entries: list[Ans
         try:
             eq = parse_equation(a.eq, dotted)
             read = True
-            parsed.append((a, linear_row(eq, vocab), ""))
+            parsed.append((a, linear_row(eq, vocab if hinted(issues) else vocab.quiet), ""))
         except EquationError as exc:
             reason = exc.reason.replace(f" for body {vocab.body!r}", " in a Lagrange equation")
             advice = exc.hint
-            if read and len(issues) < AnswersError.SHOWN:  # a name this vocabulary lacks
+            if read and hinted(issues):  # a name this vocabulary lacks
                 advice = _forgotten_body(model, state, vocab, a.eq, dotted, bodies) or advice
             issues.append(sheet.issue(a, reason, position=exc.position, hint=advice))
         except NotLinear as exc:

@@ -50,7 +50,8 @@ class AnswersError(ModelError):
     Parameters
     ----------
     issues : sequence of Issue
-        Every problem found, each with its file, line and column.
+        Every problem found, each with its file, line and column; the first `SHOWN` (those
+        the message writes out) with a did-you-mean where there is one (`hinted`).
     """
 
     def _text(self) -> str:
@@ -59,6 +60,15 @@ class AnswersError(ModelError):
         if n > self.SHOWN:
             body += f"\n... and {n - self.SHOWN} more"
         return f"{n} problems in the answers:\n{body}" if n > 1 else body
+
+
+def hinted(issues: Sequence[Issue]) -> bool:
+    """Whether the next problem found in an answers file gets a did-you-mean: only the
+    first `AnswersError.SHOWN`, those its message writes out, do. A did-you-mean is a pass
+    over the model's names (thousands for a large model's Lagrange equations), so that a
+    file of thousands of bad entries is refused in time linear in it, the problems past
+    those shown still counted ("... and N more"), as a model file's are (`ModelError`)."""
+    return len(issues) < AnswersError.SHOWN
 
 
 @dataclass(frozen=True)

@@ -22,7 +22,14 @@ from mbody.answers.coverage import Asked, Requirement, requirement
 from mbody.answers.diagnose import CORRECT, DIAGNOSES, NOT_AN_EQUATION, Diagnosis, diagnose
 from mbody.answers.lagrange import LAGRANGE_DIAGNOSES, check_lagrange, coordinate_names
 from mbody.answers.linear import NotLinear, linear_row
-from mbody.answers.load import Answer, Answers, AnswersError, answers_from_data, read_answers
+from mbody.answers.load import (
+    Answer,
+    Answers,
+    AnswersError,
+    answers_from_data,
+    hinted,
+    read_answers,
+)
 from mbody.answers.parse import EquationError, parse_equation
 from mbody.answers.rows import BodyRows, body_rows
 from mbody.answers.variant import allow_list, variant
@@ -462,7 +469,7 @@ def check(model: Model, sheet: Answers, *, tol: float, asm: Assembly,
         if a.lagrange:  # an equation in generalized coordinates: checked below
             continue
         if a.body not in model.index:
-            hint = did_you_mean(a.body, model.body_names)
+            hint = did_you_mean(a.body, model.body_names) if hinted(issues) else ""
             shown = ", ".join(model.body_names[:10]) + (" ..." if model.n > 10 else "")
             issues.append(sheet.issue(a, f"no body named {a.body!r} in model "
                                       f"'{model.name}' (its bodies: {shown})",
@@ -472,7 +479,7 @@ def check(model: Model, sheet: Answers, *, tol: float, asm: Assembly,
             vocab[a.body] = vocabulary(model, state, a.body)
         try:
             eq = parse_equation(a.eq, model.reactions)
-            row = linear_row(eq, vocab[a.body])
+            row = linear_row(eq, vocab[a.body] if hinted(issues) else vocab[a.body].quiet)
             parsed.append((a, row, None))
         except EquationError as exc:
             issues.append(sheet.issue(a, exc.reason, position=exc.position, hint=exc.hint))

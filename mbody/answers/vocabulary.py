@@ -22,6 +22,7 @@ Aliases (``omega``, ``ω``, ``α``, ``ax``, ``theta_ddot``...) map onto these na
 
 from __future__ import annotations
 
+import dataclasses
 import re
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -30,7 +31,7 @@ import numpy as np
 
 from mbody import conventions as cv
 from mbody.equations.symbolic import load_symbols
-from mbody.errors import did_you_mean
+from mbody.errors import did_you_mean, name_list
 from mbody.model.model import Model, State
 
 PLANAR_ACCELERATIONS = ("a_x", "a_y", "alpha")
@@ -56,6 +57,9 @@ _ALIASES_SPATIAL = {
     **{f"I{k}": f"I_{k}" for k in (1, 2, 3)},
     **{f"I{j}{k}": f"I_{j}{k}" for j in (1, 2, 3) for k in (1, 2, 3)},
 }
+
+SUMMARY_NAMES = 40
+"""Most names an unknown name's message lists (`Vocabulary.summary`), then how many more."""
 
 _SUBSCRIPT = re.compile("_?[\u2080-\u2089]+")
 _DIGITS = str.maketrans("\u2080\u2081\u2082\u2083\u2084\u2085\u2086\u2087\u2088\u2089",
@@ -106,6 +110,11 @@ class Vocabulary:
         The unknown reaction labels of the joints that touch this body (the ones on its
         free body): the only ones an error's list of names and suggestions offer.
         Defaults to `reactions`.
+    hinted : bool
+        Whether an unknown name's error carries a did-you-mean (`resolve`); `quiet` is the
+        same vocabulary without: what an answers file's problems past those its error
+        shows use (each did-you-mean is a pass over the names: thousands for a large
+        model's Lagrange equations).
     """
 
     body: str
@@ -116,6 +125,12 @@ class Vocabulary:
     aliases: dict[str, str] = field(default_factory=dict)
     absent: dict[str, str] = field(default_factory=dict)
     acting: tuple[str, ...] | None = None
+    hinted: bool = True
+
+    @cached_property
+    def quiet(self) -> Vocabulary:
+        """This vocabulary, its errors without a did-you-mean (`hinted`)."""
+        return self if not self.hinted else dataclasses.replace(self, hinted=False)
 
     @property
     def own_reactions(self) -> tuple[str, ...]:
@@ -149,16 +164,14 @@ class Vocabulary:
         ------
         KeyError
             The name is not in the vocabulary; the message says why, with a
-            did-you-mean over the vocabulary.
+            did-you-mean over the vocabulary (when `hinted`).
         """
-        name = _SUBSCRIPT.sub(lambda mo: "_" + mo.group(0).lstrip("_").translate(_DIGITS),
-                              name)
-        name = self.aliases.get(name, name)
+        name = self._spelt(name)
         if name in self.values or name in self._unknown_set:
             return name
         if name in self.absent:
             raise KeyError(self.absent[name])
-        hint = self._hint(name)
+        hint = self._hint(name) if self.hinted else ""
         joint = name.partition(".")[0] + "."
         if "." in name and not hint and any(r.startswith(joint) for r in self.reactions) \
                 and not any(r.startswith(joint) for r in self.own_reactions):
@@ -168,6 +181,18 @@ class Vocabulary:
                 f"unknown name {name!r} for body {self.body!r}")
         raise KeyError(what + (f"; {hint}" if hint else "")
                        + f" (the names: {self.summary()})")
+
+    def canonical(self, name: str) -> str | None:
+        """`resolve`'s answer, or None for a name outside the vocabulary (no message, no
+        did-you-mean: a membership test)."""
+        name = self._spelt(name)
+        return name if name in self.values or name in self._unknown_set else None
+
+    def _spelt(self, name: str) -> str:
+        """`name` with subscript digits as _1 and an alias as its canonical name."""
+        name = _SUBSCRIPT.sub(lambda mo: "_" + mo.group(0).lstrip("_").translate(_DIGITS),
+                              name)
+        return self.aliases.get(name, name)
 
     def _hint(self, name: str) -> str:
         """A way to fix an unknown `name`: a product written without '*', a body axis
@@ -202,18 +227,23 @@ class Vocabulary:
         return frozenset(self.unknowns)  # once: a model may have thousands of reactions
 
     def summary(self) -> str:
-        """The canonical names in one line (for error messages).
+        """The canonical names in one line (for error messages): at most `SUMMARY_NAMES`
+        of them, and how many more (a large model's Lagrange equations have thousands).
 
         Returns
         -------
         str
         """
+        return self._summary
+
+    @cached_property
+    def _summary(self) -> str:  # once: every unknown name's message repeats it
         shown = list(self.accelerations)
         own = self.own_reactions
         if own:
             shown.append(", ".join(own[:6]) + (" ..." if len(own) > 6 else ""))
         shown += [n for n in self.values if "." not in n and n != "pi"]
-        return ", ".join(shown)
+        return name_list(shown, SUMMARY_NAMES)
 
 
 def name_gravity(model: Model, values: dict[str, float], absent: dict[str, str]) -> None:
@@ -388,9 +418,8 @@ def newton_euler_bodies(model: Model, state: State, names: list[str], most: int 
 
 def _reads(vocab: Vocabulary, name: str) -> bool:
     """Whether `name` is a name of `vocab`'s body (another body's reaction is not)."""
-    try:
-        canonical = vocab.resolve(name)
-    except KeyError:
+    canonical = vocab.canonical(name)
+    if canonical is None:
         return False
     return canonical in vocab.values or canonical in vocab.accelerations \
         or canonical in vocab.own_reactions

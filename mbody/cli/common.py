@@ -267,6 +267,24 @@ VIEW_HELP = ("spatial models: iso (default), front, top, side, or ELEV,AZIM in d
 """The --view option's help: how a spatial model's picture is seen (fbd, report, modes)."""
 
 
+def add_progress_options(command: argparse.ArgumentParser, what: str = "the progress bar"
+                         ) -> None:
+    """``--progress`` and ``--no-progress``: a long command's bars on standard error
+    (`mbody.util.progress`), by default when it is a terminal (`show_progress`)."""
+    command.add_argument("--progress", action="store_true",
+                         help=f"show {what} on stderr even when it is not a terminal")
+    command.add_argument("--no-progress", action="store_true",
+                         help=f"no {what.removeprefix('the ')} on stderr")
+
+
+def show_progress(a: argparse.Namespace) -> bool:
+    """Whether `add_progress_options`'s bars are drawn: ``--progress``, or standard error
+    is a terminal, unless ``--no-progress``."""
+    import sys
+
+    return (a.progress or sys.stderr.isatty()) and not a.no_progress
+
+
 def add_import_options(command: argparse.ArgumentParser) -> None:
     """Give a command that reads a model the options of MJCF and URDF input, and make its
     handler pass them to `load_model`. A command that has a ``--keyframe`` of its own
@@ -328,8 +346,13 @@ def _with_import_options(run: Callable[[argparse.Namespace], int]
                          ) -> Callable[[argparse.Namespace], int]:
     @functools.wraps(run)
     def wrapped(a: argparse.Namespace) -> int:
-        token = _IMPORT.set(import_options(a))
-        given = _VALUES.set(set_values(getattr(a, "set_values", None) or []))
+        # both read before either is set: a refused one (a --set path given twice) must
+        # not leave the other set for whatever this process runs next (`mbody convert`
+        # after it read a YAML model with the last command's --keyframe)
+        options = import_options(a)
+        values = set_values(getattr(a, "set_values", None) or [])
+        token = _IMPORT.set(options)
+        given = _VALUES.set(values)
         try:
             return run(a)
         finally:

@@ -16,9 +16,11 @@ from mbody.cli.common import (
     PICTURE_SUFFIXES,
     VIEW_HELP,
     add_known_option,
+    add_progress_options,
     load_model,
     output_suffix,
     parse_known,
+    show_progress,
 )
 from mbody.errors import MbodyError, OutputError
 
@@ -57,6 +59,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "or .json (repeatable)")
     add_known_option(s, "applied as a load, its joint then not held",
                      "taken at the state's time")
+    add_progress_options(s, "what a long computation is doing")
     s.set_defaults(run=lagrange, output_suffixes={"-o": EXPORT_SUFFIXES})
 
     s = sub.add_parser(
@@ -78,6 +81,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="draw the mode shapes to FILE (.svg, .png or .pdf)")
     s.add_argument("--view", metavar="VIEW", help="the --picture's view of " + VIEW_HELP)
     s.add_argument("--json", action="store_true", help="machine-readable output")
+    add_progress_options(s, "what a long computation is doing")
     s.set_defaults(run=modes, output_suffixes={"--picture": PICTURE_SUFFIXES})
 
 
@@ -100,10 +104,16 @@ def _need_sympy() -> None:
 
 
 def lagrange(a: argparse.Namespace) -> int:
-    from mbody.equations.assemble import assemble
+    from mbody.equations.generalized import generalized
     from mbody.io.export.generalized import write_generalized
-    from mbody.present.lagrange import generalized_document, generalized_text, symbolic_text
+    from mbody.present.lagrange import (
+        generalized_document,
+        generalized_text,
+        symbolic_text,
+        too_many_to_write,
+    )
     from mbody.util.atomic import ensure_writable, write_atomic
+    from mbody.util.progress import Progress
 
     for out in a.output:
         ensure_writable(out)
@@ -111,24 +121,33 @@ def lagrange(a: argparse.Namespace) -> int:
     if a.latex not in (None, "-"):
         ensure_writable(a.latex)
     model = load_model(a.model)
-    g = assemble(model).generalized(_coordinates(a.coordinates), parse_known(a.known) or None)
-    sym = None
-    if a.symbolic:
-        _need_sympy()
-        sym = g.symbolic()
-    for out in a.output:
-        with _writing(out):
-            print(f"wrote {write_generalized(g, out)}", file=sys.stderr if a.latex == "-"
-                  else sys.stdout)
-    if a.latex is not None:
-        doc = generalized_document(g, sym)
-        if a.latex == "-":
-            sys.stdout.write(doc)
-        else:
-            with _writing(a.latex):
-                print(f"wrote {write_atomic(a.latex, doc)}")
-        return EXIT_OK
-    print(symbolic_text(sym) if sym is not None else generalized_text(g))
+    with Progress(show_progress(a), f"lagrange {model.name}") as bar:
+        g = generalized(model, None, _coordinates(a.coordinates),
+                        parse_known(a.known) or None, progress=bar)
+        if a.latex is not None and not a.symbolic and too_many_to_write(len(g.f)):
+            raise MbodyError(too_many_to_write(len(g.f)))
+        sym = None
+        if a.symbolic:
+            _need_sympy()
+            sym = g.symbolic(progress=bar)
+        for out in a.output:
+            bar.step(f"writing {out}")
+            with _writing(out):
+                path = write_generalized(g, out)
+            bar.close()
+            print(f"wrote {path}", file=sys.stderr if a.latex == "-" else sys.stdout)
+        bar.step("writing the equations")
+        if a.latex is not None:
+            doc = generalized_document(g, sym)
+            bar.close()
+            if a.latex == "-":
+                sys.stdout.write(doc)
+            else:
+                with _writing(a.latex):
+                    print(f"wrote {write_atomic(a.latex, doc)}")
+            return EXIT_OK
+        text = symbolic_text(sym) if sym is not None else generalized_text(g)
+    print(text)
     return EXIT_OK
 
 
@@ -136,6 +155,7 @@ def modes(a: argparse.Namespace) -> int:
     from mbody.present.modes import modes_text, verdict
     from mbody.solve.linearize import linearize
     from mbody.util.atomic import ensure_writable
+    from mbody.util.progress import Progress
 
     if a.view is not None:  # checked as fbd and report check it, before any work
         from mbody.present.draw import parse_view
@@ -145,34 +165,40 @@ def modes(a: argparse.Namespace) -> int:
         ensure_writable(a.picture)
     model = load_model(a.model)
     state, about = None, f"its initial state (t = {model.initial.t:g} s)"
-    if a.equilibrium:
-        from mbody.solve.equilibrium import equilibrium
+    with Progress(show_progress(a), f"modes {model.name}") as bar:
+        if a.equilibrium:
+            from mbody.solve.equilibrium import equilibrium
 
-        state = equilibrium(model)
-        about = "the static equilibrium nearest its initial pose"
-    lin = linearize(model, state, coordinates=_coordinates(a.coordinates))
-    if a.picture:
-        from mbody.present.draw import save_figure
-        from mbody.present.draw.modes import modes_figure
+            state = equilibrium(model, progress=bar)
+            about = "the static equilibrium nearest its initial pose"
+        lin = linearize(model, state, coordinates=_coordinates(a.coordinates), progress=bar)
+        if a.picture:
+            from mbody.present.draw import save_figure
+            from mbody.present.draw.modes import modes_figure
 
-        with _writing(a.picture):
-            path = save_figure(modes_figure(lin, view=a.view), a.picture)
-        print(f"wrote {path}", file=sys.stderr if a.json else sys.stdout)
-    if a.json:
-        doc = {"model": model.name, "about": about, "coordinates": lin.coordinates,
-               "left_out": list(lin.left_out), "steady": lin.steady, "stable": lin.stable,
-               "verdict": verdict(lin), "tolerance": lin.tolerance,
-               "modes": [{"kind": m.kind, "eigenvalue": [m.eigenvalue.real, m.eigenvalue.imag],
-                          "frequency_rad_s": _finite(m.frequency),
-                          "frequency_hz": _finite(m.frequency_hz),
-                          "damping_ratio": _finite(m.damping_ratio),
-                          "shape": [[z.real, z.imag] for z in m.shape]} for m in lin.modes],
-               "M": lin.M.tolist(), "D": lin.D.tolist(), "K": lin.K.tolist(),
-               "warnings": list(lin.warnings)}
-        json.dump(doc, sys.stdout, indent=2)
-        print()
-        return EXIT_OK
-    print(modes_text(lin, about))
+            bar.step(f"drawing {a.picture}")
+            with _writing(a.picture):
+                path = save_figure(modes_figure(lin, view=a.view), a.picture)
+            bar.close()
+            print(f"wrote {path}", file=sys.stderr if a.json else sys.stdout)
+        bar.step("writing the modes")
+        if a.json:
+            doc = {"model": model.name, "about": about, "coordinates": lin.coordinates,
+                   "left_out": list(lin.left_out), "steady": lin.steady,
+                   "stable": lin.stable, "verdict": verdict(lin), "tolerance": lin.tolerance,
+                   "modes": [{"kind": m.kind,
+                              "eigenvalue": [m.eigenvalue.real, m.eigenvalue.imag],
+                              "frequency_rad_s": _finite(m.frequency),
+                              "frequency_hz": _finite(m.frequency_hz),
+                              "damping_ratio": _finite(m.damping_ratio),
+                              "shape": [[z.real, z.imag] for z in m.shape]}
+                             for m in lin.modes],
+                   "M": lin.M.tolist(), "D": lin.D.tolist(), "K": lin.K.tolist(),
+                   "warnings": list(lin.warnings)}
+            text = json.dumps(doc, indent=2)
+        else:
+            text = modes_text(lin, about)
+    print(text)
     return EXIT_OK
 
 

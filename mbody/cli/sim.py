@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import sys
 
 from mbody.cli.common import (
     EXIT_OK,
@@ -12,6 +11,7 @@ from mbody.cli.common import (
     PICTURE_SUFFIXES,
     add_axes_option,
     add_known_option,
+    add_progress_options,
     bounded,
     load_model,
     number,
@@ -19,6 +19,7 @@ from mbody.cli.common import (
     output_suffix,
     parse_known,
     regular_file,
+    show_progress,
 )
 from mbody.errors import MbodyError
 
@@ -75,9 +76,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    default=None, metavar="SECONDS",
                    help="stop with a message after this much wall-clock time (default: no "
                    f"limit; at most {number(MAX_WALL)} s)")
-    s.add_argument("--progress", action="store_true",
-                   help="show the progress bar on stderr even when it is not a terminal")
-    s.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    add_progress_options(s)
     add_axes_option(s)
     s.set_defaults(run=simulate)
 
@@ -126,7 +125,7 @@ def simulate(a: argparse.Namespace) -> int:
                      rtol=DEFAULT_RTOL if a.rtol is None else a.rtol,
                      atol=DEFAULT_ATOL if a.atol is None else a.atol, method=a.method,
                      known=known,
-                     progress=(a.progress or sys.stderr.isatty()) and not a.no_progress,
+                     progress=show_progress(a),
                      max_steps=max_steps or None, max_wall=a.max_wall, axes=a.axes)
     if a.output:
         traj.save(a.output)

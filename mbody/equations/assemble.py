@@ -235,7 +235,8 @@ class Assembly:
         return assembly_symbolic(self, bodies)
 
     def generalized(self, coordinates: Sequence[str] | None = None,
-                    known: KnownValues | None = None) -> Generalized:
+                    known: KnownValues | None = None, *,
+                    progress: bool = False) -> Generalized:
         """The equations in generalized coordinates, ``M_q q'' = f_q``: these equations
         multiplied by Tᵀ, where v = T q' + v_e, which removes the reactions
         (`mbody.equations.generalized`).
@@ -249,13 +250,16 @@ class Assembly:
         known : mapping of str to float or str, optional
             Reaction values applied as loads (their joints not held), added to the file's:
             numbers, or expressions of t as text taken at ``state.t`` (`reaction_values`).
+        progress : bool
+            Say on standard error what is being computed, once it has taken a second
+            (`mbody.util.progress`).
 
         Returns
         -------
         Generalized
             ``M``, ``f``, ``T``, ``q``, ``qdot``, ``accelerations()``, ``symbolic()``.
         """
-        return generalized(self.model, self.state, coordinates, known)
+        return generalized(self.model, self.state, coordinates, known, progress=progress)
 
     # -- solving -----------------------------------------------------------------------
     def reaction_values(self, known: KnownValues | None = None) -> dict[str, float]:

@@ -320,15 +320,20 @@ def held_rows(model: Model, state: State, U: np.ndarray) -> np.ndarray:
     ws.core.columns(float(state.t), ws.pack_state(state), child6, parent6, W_e, W_P, gamma,
                     phi, gtv)
     jt = model.joint_table
-    joint = model.reaction_table.joint
-    full = np.zeros((len(U), 6 * n))
-    for r, i in enumerate(np.asarray(U, dtype=np.intp)):
-        j = int(joint[i])
-        c, p = int(jt.child[j]), int(jt.parent[j])
-        full[r, 6 * c:6 * c + 6] += child6[i]
-        if p >= 0:
-            full[r, 6 * p:6 * p + 6] += parent6[i]
-    return full[:, columns(model)]
+    U = np.asarray(U, dtype=np.intp)
+    joint = np.asarray(model.reaction_table.joint)[U]
+    cols = columns(model)
+    where = np.full(6 * n, -1, dtype=np.intp)  # a body's 6 components -> their column
+    where[cols] = np.arange(len(cols))
+    out = np.zeros((len(U), len(cols)))
+    rows = np.arange(len(U))[:, None]
+    # a child and its parent are two bodies: each entry gets one value at most
+    for body, six in ((np.asarray(jt.child)[joint], child6[U]),
+                      (np.asarray(jt.parent)[joint], parent6[U])):
+        at = where[6 * np.maximum(body, 0)[:, None] + np.arange(6)]
+        keep = (at >= 0) & (body >= 0)[:, None]
+        out[np.broadcast_to(rows, at.shape)[keep], at[keep]] = six[keep]
+    return out
 
 
 class _Rows:
@@ -348,15 +353,21 @@ class _Rows:
         scale = np.where(cols % 6 >= 3, 1.0 / L, 1.0)
         self.rows = rows * scale
         G = held_rows(model, state, held) * scale
-        self.basis = np.zeros((0, len(cols)))
+        self.N = len(cols)
+        self._basis = np.zeros((self.N, self.N))  # filled row by row: no copies
         self.rank = 0
         if len(G):
             norms = np.linalg.norm(G, axis=1)
             G = G[norms > 0] / norms[norms > 0, None]
             _, s, Vt = np.linalg.svd(G, full_matrices=False)
             self.rank = int(np.count_nonzero(s > RANK_RTOL * max(s[0], 1.0))) if len(s) else 0
-            self.basis = Vt[:self.rank]
-        self.N = len(cols)
+            self._basis[:self.rank] = Vt[:self.rank]
+        self._size = self.rank
+
+    @property
+    def basis(self) -> np.ndarray:
+        """The orthonormal rows spanning the held rows and the candidates taken."""
+        return self._basis[:self._size]
 
     def adds(self, k: int) -> bool:
         """Take candidate k if it adds a motion (then it joins the basis)."""
@@ -364,13 +375,57 @@ class _Rows:
         norm = float(np.linalg.norm(a))
         if norm == 0.0:
             return False
-        r = a - self.basis.T @ (self.basis @ a)
-        r = r - self.basis.T @ (self.basis @ r)  # twice is enough (Kahan, Parlett)
+        basis = self.basis
+        r = a - basis.T @ (basis @ a)
+        r = r - basis.T @ (basis @ r)  # twice is enough (Kahan, Parlett)
         nr = float(np.linalg.norm(r))
         if nr <= INDEPENDENT_RTOL * norm:
             return False
-        self.basis = np.vstack((self.basis, r / nr))
+        self._basis[self._size] = r / nr
+        self._size += 1
         return True
+
+
+def _first_distinct(order: list[int], count: int) -> list[int]:
+    """The first `count` distinct entries of `order` (fewer when it has fewer)."""
+    out: list[int] = []
+    seen: set[int] = set()
+    for k in order:
+        if len(out) >= count:
+            break
+        if k not in seen:
+            seen.add(k)
+            out.append(k)
+    return out
+
+
+def _independent(model: Model, state: State, held: Unknowns, items: list[Coordinate]) -> bool:
+    """Whether `choose`'s tests would take every one of `items`, in order, after the held
+    rows, and find the held rows independent: proved without those tests, whose dense
+    orthogonal bases cost the cube of the model's size (a chain of a thousand bodies: minutes).
+
+    With B the held rows and the items' rows stacked (each scaled as `_Rows` scales it, to
+    unit length), square, the compiled core gives each row's distance from the span of all
+    the others, d_i = 1/|B⁻¹ e_i|, at the band's cost (`mb_independence`). An item's
+    distance from the rows before it is at least its d_i: above `INDEPENDENT_RTOL` (twice,
+    for the rounding of both) it is taken. The held rows' smallest singular value is at
+    least B's, at least 1/√(Σ 1/d_i²): above `RANK_RTOL` √m (twice) the SVD finds all m
+    independent. When either bound falls short, `choose` runs its own tests."""
+    cols = columns(model)
+    m, k = len(held.U), len(items)
+    if m + k != len(cols) or k == 0:
+        return False
+    scale = np.where(cols % 6 >= 3, 1.0 / size(model), 1.0)
+    Iq = np.array([c.row for c in items], dtype=np.int64).reshape(-1, _core.GQ_W)
+    out = np.empty(m + k + 1)
+    ws = workspace(model)
+    ws.solver(held).independence(float(state.t), ws.pack_state(state), Iq, cols, scale, out)
+    d = out[:-1]
+    if not out[-1] > 0.0 or not np.all(d > 0.0):
+        return False
+    sigma = 1.0 / float(np.sqrt(np.sum(1.0 / d**2)))
+    return bool(np.all(d[m:] > 2.0 * INDEPENDENT_RTOL)
+                and sigma > 2.0 * RANK_RTOL * max(np.sqrt(m), 1.0))
 
 
 def _held(model: Model, known: dict[str, float], free_drivers: Sequence[int]) -> Unknowns:
@@ -437,27 +492,28 @@ def choose(model: Model, state: State | None = None, labels: Sequence[str] | Non
             chosen_idx.append(by_label[lab])
         free = [d for d, lab in enumerate(driver_labels) if lab in labels]
         held = _held(model, known, free)
-        rows = _Rows(model, state, cands, held.U)
-        dof = rows.N - rows.rank
-        if len(chosen_idx) != dof:
-            raise MbodyError(f"{len(chosen_idx)} coordinate(s) given for {dof} degree(s) of "
-                             f"freedom of model '{model.name}'"
-                             + (" (with its drivers held)" if n_drivers > len(free) else "")
-                             + f": give {dof}")
-        for k in chosen_idx:
-            if not rows.adds(k):
-                raise MbodyError(f"coordinate {cands[k].label!r} does not add a motion the "
-                                 "joints and the coordinates before it leave free at this "
-                                 "state: choose another")
         items = tuple(cands[k] for k in chosen_idx)
+        if _independent(model, state, held, list(items)):
+            dof = len(items)
+        else:
+            rows = _Rows(model, state, cands, held.U)
+            dof = rows.N - rows.rank
+            if len(chosen_idx) != dof:
+                raise MbodyError(f"{len(chosen_idx)} coordinate(s) given for {dof} degree(s) "
+                                 f"of freedom of model '{model.name}'"
+                                 + (" (with its drivers held)" if n_drivers > len(free) else "")
+                                 + f": give {dof}")
+            for k in chosen_idx:
+                if not rows.adds(k):
+                    raise MbodyError(f"coordinate {cands[k].label!r} does not add a motion "
+                                     "the joints and the coordinates before it leave free at "
+                                     "this state: choose another")
         efforts = tuple((model.reactions[first_driver + d],
                          labels.index(driver_labels[d])) for d in free)
         return CoordinateSet(items, held, efforts, dof, columns(model), size(model))
     # the default: drivers' coordinates, the tree's motions, the floating parts' roots
     tree, roots = spanning_tree(model)
     held = _held(model, known, range(n_drivers))
-    rows = _Rows(model, state, cands, held.U)
-    dof = rows.N - rows.rank
     order: list[int] = [by_label[lab] for lab in driver_labels]
     tree_names = {model.joints[j].name for j in tree}
     order += [k for k, c in enumerate(cands) if c.kind != _core.GQ_BODY and c.source in tree_names]
@@ -465,13 +521,22 @@ def choose(model: Model, state: State | None = None, labels: Sequence[str] | Non
     particles = {model.body_names[i] for i in np.flatnonzero(model.particle)}
     order += [k for k, c in enumerate(cands) if c.kind == _core.GQ_BODY
               and (c.source in root_names or c.source in particles)]
-    order += [k for k in range(len(cands)) if k not in set(order)]  # anything else, last
-    taken: list[int] = []
-    for k in order:
-        if len(taken) == dof:
-            break
-        if k not in taken and rows.adds(k):
-            taken.append(k)
+    listed = set(order)
+    order += [k for k in range(len(cands)) if k not in listed]  # anything else, last
+    first = _first_distinct(order, len(columns(model)) - len(held.U))
+    if _independent(model, state, held, [cands[k] for k in first]):
+        taken, dof = first, len(first)
+    else:
+        rows = _Rows(model, state, cands, held.U)
+        dof = rows.N - rows.rank
+        taken = []
+        chosen: set[int] = set()
+        for k in order:
+            if len(taken) == dof:
+                break
+            if k not in chosen and rows.adds(k):
+                taken.append(k)
+                chosen.add(k)
     if len(taken) < dof:  # cannot happen: the bodies' own coordinates span everything
         raise MbodyError(f"could not choose {dof} independent coordinates for model "
                          f"'{model.name}' at this state; name them with "

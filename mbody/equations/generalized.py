@@ -33,6 +33,7 @@ from mbody.errors import MbodyError, option_name
 from mbody.kernel import _core
 from mbody.model.arguments import KnownValues, checked_state, known_at
 from mbody.model.model import Model, State
+from mbody.util.progress import Progress, progress_of
 
 if TYPE_CHECKING:
     from mbody.equations.symbolic.lagrange import SymbolicLagrange
@@ -217,13 +218,16 @@ class Generalized:
             ws.core.load_wrenches(float(state.t), y, rows)
             names = list(model.forces.names) + [nm for nm in model.springs.names
                                                 for _ in range(2)]
+            where = np.full(6 * n, -1)  # a body's components -> their rows of T
+            where[cols] = np.arange(len(cols))
             for name, row in zip(names, rows, strict=True):
                 b = int(row[0])
                 if b < 0:
                     continue
-                w6 = np.zeros(6 * n)
-                w6[6 * b:6 * b + 6] = row[1:]
-                out[name] = out.get(name, 0.0) + T.T @ w6[cols]
+                # the load's wrench is on one body: T's rows of that body alone
+                at = where[6 * b:6 * b + 6]
+                on = at >= 0
+                out[name] = out.get(name, 0.0) + T[at[on]].T @ row[1:][on]
         rest = self.f - sum(out.values(), np.zeros(len(self.f)))
         out["velocity terms"] = rest
         return out
@@ -233,9 +237,15 @@ class Generalized:
         """The state with its velocities v = T q' + v_e (those the equations use)."""
         return state_with_velocities(self.model, self.state, self.velocities())
 
-    def symbolic(self) -> SymbolicLagrange:
+    def symbolic(self, progress: bool | Progress = False) -> SymbolicLagrange:
         """M(q) and f(q, q') in symbols, for a planar tree (needs sympy): see
         `mbody.equations.symbolic.lagrange`.
+
+        Parameters
+        ----------
+        progress : bool or Progress
+            Say on standard error which rows are being made, once it has taken a second
+            (`mbody.util.progress`): sympy takes seconds for ten coordinates.
 
         Returns
         -------
@@ -244,7 +254,8 @@ class Generalized:
         """
         from mbody.equations.symbolic.lagrange import symbolic_lagrange  # sympy: slow
 
-        return symbolic_lagrange(self.model, self.coordinate_set)
+        with progress_of(progress, f"symbolic {self.model.name}") as bar:
+            return symbolic_lagrange(self.model, self.coordinate_set, bar)
 
     def __repr__(self) -> str:
         k = len(self.f)
@@ -290,7 +301,8 @@ def layout(N: int, k: int) -> tuple[int, ...]:
 
 def generalized(model: Model, state: State | None = None,
                 coordinates: Sequence[str] | None = None,
-                known: KnownValues | None = None) -> Generalized:
+                known: KnownValues | None = None, *,
+                progress: bool | Progress = False) -> Generalized:
     """The equations of `model` in generalized coordinates at `state` (module doc).
 
     Parameters
@@ -307,6 +319,10 @@ def generalized(model: Model, state: State | None = None,
         Reaction values to apply as loads (their joints are then not held), added to the
         file's: finite numbers, or expressions of t as text taken at ``state.t``
         (`mbody.model.arguments.known_at`).
+    progress : bool or Progress
+        Say on standard error what is being computed once it has taken a second (a
+        model of a thousand bodies takes seconds): tqdm bars (`mbody.util.progress`), or
+        the steps on a `Progress` of the caller's.
 
     Returns
     -------
@@ -321,8 +337,13 @@ def generalized(model: Model, state: State | None = None,
     """
     state = model.initial if state is None else checked_state(model, state, "state")
     given = known_at(model, known, state.t) if known else None
-    cs = coordinate_set(model, coordinates, given)
-    return evaluate(model, state, cs)
+    if progress is False:  # the usual call: no bars to set up (a small model's takes µs)
+        return evaluate(model, state, coordinate_set(model, coordinates, given))
+    with progress_of(progress, f"generalized {model.name}") as bar:
+        bar.step("choosing the coordinates")
+        cs = coordinate_set(model, coordinates, given)
+        bar.step(f"projecting the equations: T ({len(cs.cols)} x {len(cs)}), M, f")
+        return evaluate(model, state, cs)
 
 
 def evaluate(model: Model, state: State, cs: CoordinateSet,

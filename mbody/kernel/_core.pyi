@@ -4,6 +4,7 @@ Every array argument is a C-contiguous float64 (int64 for F/I/Iu: I and Iu) buff
 exactly the size the model implies; a wrong one raises ValueError naming it.
 """
 
+from collections.abc import Callable
 from typing import Any, overload
 
 import numpy as np
@@ -156,6 +157,10 @@ LP_STEP: int
 LP_ROUNDING: int
 LP_STEADY: int
 LP_MOVING: int
+LP_STOP: int
+STOP_NONE: int
+STOP_STIFFNESS: int
+STOP_SYSTEM: int
 LINEARIZE_PARAMS: int
 LI_STEADY: int
 LI_UNSTEADY: int
@@ -181,6 +186,14 @@ LI_UNCONVERGED: int
 LI_RESTING: int
 LI_NORM: int
 LINEARIZE_INFO: int
+STAGE_GENERALIZED: int
+STAGE_DAMPING: int
+STAGE_STIFFNESS: int
+STAGE_SYSTEM: int
+STAGE_HESSENBERG: int
+STAGE_SCHUR: int
+STAGE_VECTORS: int
+STAGES: int
 
 def solve_layout(n: int, m: int, planar: bool) -> tuple[int, int, int]: ...
 
@@ -229,9 +242,11 @@ class Unknowns:
     def energy_samples(self, t: _F, Y: _F, lam: _F, ACC: _F, ENERGY: _F) -> int: ...
     def generalized(self, t: float, y: _F, lam: _F, Iq: _I, cols: _I, qdot: _F | None,
                     out: _F) -> None: ...
+    def independence(self, t: float, y: _F, Iq: _I, cols: _I, colscale: _F, out: _F) -> None: ...
     def generalized_perturbed(self, t: float, y: _F, lam: _F, Iq: _I, cols: _I, qdot: _F,
                               P: _F, out: _F) -> None: ...
     def linearize(self, t: float, y: _F, lam: _F, Iq: _I, cols: _I, scales: _F, quasi: _I,
-                  skip: _I, params: _F, out: _F) -> None: ...
+                  skip: _I, params: _F, out: _F,
+                  progress: Callable[[int, int, int], object] | None = None) -> None: ...
     def differences(self, t: float, y: _F, lam: _F, Iq: _I, cols: _I, qdot: _F, h: _F,
                     hu: _F, fscale: _F, rounding: float, skip: _I, out: _F) -> None: ...

@@ -17,6 +17,10 @@ if TYPE_CHECKING:
     from mbody.equations.symbolic.lagrange import SymbolicLagrange
 
 DIGITS = 6
+MAX_WRITTEN = 200
+"""Most coordinates whose equations are written out (text and LaTeX): each row of M has a
+term per coordinate, so a model of two thousand bodies would print four million terms
+nobody reads; the exports (-o) hold every number."""
 
 
 def _row(coef: np.ndarray, names: list[str], rhs: float) -> str:
@@ -51,9 +55,10 @@ def cleaned(g: Generalized) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndar
     return q, M, f, qdd
 
 
-def generalized_text(g: Generalized) -> str:
+def generalized_text(g: Generalized, max_written: int = MAX_WRITTEN) -> str:
     """The equations ``M q'' = f`` at the state, with the coordinates, their values and
-    rates, what each is, the accelerations they give and f split by source."""
+    rates, what each is, the accelerations they give and f split by source; with more
+    than `max_written` coordinates, every line but the equations (their k² terms)."""
     model = g.model
     cs = g.coordinate_set
     q_shown, M_shown, f_shown, qdd_shown = cleaned(g)
@@ -77,7 +82,10 @@ def generalized_text(g: Generalized) -> str:
                f"{'s' if len(held) != 1 else ''})")
     names = [c.acceleration_label for c in cs.items]
     effort_rows = {r: e for e, r in g.coordinate_set.efforts}
-    for i in range(k):
+    if k > max_written:
+        out.append(f"  ({k} equations of up to {k} terms each: not written out above "
+                   f"{max_written} coordinates; -o FILE.npz, .mat or .json exports M, f and T)")
+    for i in range(k if k <= max_written else 0):
         row = _row(M_shown[i], names, float(f_shown[i]))
         if i in effort_rows:
             row += f" + {effort_rows[i]}"
@@ -118,7 +126,8 @@ def coordinate_latex(label: str, order: int = 0, quasi: bool = False) -> str:
 
 
 def generalized_latex(g: Generalized) -> str:
-    """``M q'' = f`` at the state as a LaTeX ``aligned`` block (numbers)."""
+    """``M q'' = f`` at the state as a LaTeX ``aligned`` block (numbers); see
+    `too_many_to_write` for a large model."""
     cs = g.coordinate_set
     names = [coordinate_latex(c.label, 2, c.quasi) for c in cs.items]
     effort_rows = {r: e for e, r in cs.efforts}
@@ -138,6 +147,15 @@ def generalized_latex(g: Generalized) -> str:
             rhs += f" + {latex_symbol(effort_rows[i])}"
         rows.append(f"{lhs or '0'} &= {rhs}")
     return "\\begin{aligned}\n" + " \\\\\n".join(rows) + "\n\\end{aligned}"
+
+
+def too_many_to_write(k: int, max_written: int = MAX_WRITTEN) -> str:
+    """Why the equations of `k` coordinates are not written as LaTeX ('' when they are)."""
+    if k <= max_written:
+        return ""
+    return (f"the equations of {k} coordinates (up to {k} terms each) are too many for a "
+            f"document: --latex writes at most {max_written}; -o FILE.npz, .mat or .json "
+            "exports M, f and T")
 
 
 def _symbol_latex(name: str) -> str:

@@ -13,6 +13,9 @@ if TYPE_CHECKING:
     from mbody.solve.linearize import Linearization, Mode
 
 DIGITS = 6
+MAX_SHAPES = 200
+"""Most coordinates whose mode shapes are written out (a line per mode, an amplitude per
+coordinate: k² numbers); ``mbody modes --json`` gives every one."""
 
 
 def _eigenvalue(m: Mode) -> str:
@@ -44,8 +47,9 @@ def verdict(lin: Linearization) -> str:
             f"{num(1.0 / m.eigenvalue.real, 4)} s){extra}")
 
 
-def modes_text(lin: Linearization, about: str = "") -> str:
-    """The table, the shapes and the verdict (`about`: how the state was chosen)."""
+def modes_text(lin: Linearization, about: str = "", max_shapes: int = MAX_SHAPES) -> str:
+    """The table, the shapes (up to `max_shapes` coordinates) and the verdict (`about`: how
+    the state was chosen)."""
     model = lin.model
     out = [f"model '{model.name}': linearised about "
            + (about or f"the state at t = {lin.state.t:g} s")]
@@ -64,7 +68,11 @@ def modes_text(lin: Linearization, about: str = "") -> str:
         out.append(f"{k:4d}  {m.kind:11s}  {_eigenvalue(m):>22s}  {w:>12s}  {f:>10s}  "
                    f"{z:>8s}")
     moving = [(k, m) for k, m in enumerate(lin.modes, start=1) if m.kind != "neutral"]
-    if moving:
+    if moving and len(lin.coordinates) > max_shapes:
+        out.append("")
+        out.append(f"shapes: not written out above {max_shapes} coordinates (an amplitude "
+                   f"per coordinate for each of {len(moving)} modes); --json gives them")
+    elif moving:
         out.append("")
         out.append("shapes (each coordinate's amplitude, the largest 1; complex: "
                    "magnitude∠phase in degrees):")

@@ -33,7 +33,15 @@ from mbody.model.expressions import compile_expression
 from mbody.model.model import Model, State
 from mbody.solve.configure import move, project
 from mbody.solve.kinematics import kinematics
-from mbody.solve.linearize import STEADY_RTOL, Linearization, free_coordinates, linearize
+from mbody.solve.linearize import (
+    STAGES,
+    STEADY_RTOL,
+    Linearization,
+    free_coordinates,
+    linearized,
+    stiffness,
+)
+from mbody.util.progress import Progress, progress_of
 
 NEWTON_STEPS = 50
 """Newton steps at most (a few from a nearby start)."""
@@ -106,16 +114,29 @@ def held(model: Model, t: float) -> Model:
     return dataclasses.replace(model, drivers=table)
 
 
-def find_equilibrium(model: Model, *, start: State | None = None, t: float = 0.0
-                     ) -> Equilibrium:
-    """An equilibrium near `start` (default: the file's pose), the drivers held at time t
-    (module doc); `Equilibrium.found` says whether Newton's method converged."""
+@dataclass(frozen=True)
+class _Newton:
+    """Where Newton's method ended: the held model, its free coordinates, the start and
+    the last state at rest, whether f vanished there, the steps and the best ratio."""
+
+    model: Model
+    cs: CoordinateSet
+    begin: State
+    state: State
+    found: bool
+    steps: int
+    best: float
+
+
+def _newton(model: Model, start: State | None, t: float, bar: Progress) -> _Newton:
+    """Newton's method for f(q, 0) = 0 from `start` (module doc), its steps on `bar`."""
     if not isinstance(model, Model):
         model = checked_model(model)
     t = real_number(t, "t", "a number of seconds")
     begin = (model.initial if start is None else checked_state(model, start, "start")
              ).replace(t=t)
     m = held(model, t)
+    bar.step("choosing the coordinates")
     cs = free_coordinates(m)
     zero = np.zeros(len(cs))
     state = _at_rest(m, cs, kinematics(m, float(t), start=begin))
@@ -129,29 +150,42 @@ def find_equilibrium(model: Model, *, start: State | None = None, t: float = 0.0
             break
         if steps == NEWTON_STEPS:
             break
-        lin = linearize(m, state, coordinates=cs.labels)
+        bar.context = f"equilibrium, Newton step {steps + 1} (f at {ratio:.1e} of its terms): "
+        K = stiffness(m, state, cs, bar)
+        bar.context = ""
         try:
-            dq = np.linalg.lstsq(lin.K, g.f, rcond=1e-12)[0]
+            dq = np.linalg.lstsq(K, g.f, rcond=1e-12)[0]
         except np.linalg.LinAlgError:
             break
         size = float(np.max(np.abs(dq) / cs.scales)) if len(dq) else 0.0
         if size > 0.5:  # at most half a radian (or half the model's size) a step
             dq *= 0.5 / size
         state = project(m, cs, move(m, state, g.T @ dq))
-    state = _at_rest(m, cs, state)
-    stiffness = np.zeros(0)
-    stable: bool | None = None
-    if found and len(cs):
-        lin = linearize(m, state, coordinates=cs.labels)
-        stiffness = _squared_frequencies(lin)
-        stable = lin.stable
+    return _Newton(m, cs, begin, _at_rest(m, cs, state), found, steps, best)
+
+
+def find_equilibrium(model: Model, *, start: State | None = None, t: float = 0.0,
+                     progress: bool | Progress = False) -> Equilibrium:
+    """An equilibrium near `start` (default: the file's pose), the drivers held at time t
+    (module doc); `Equilibrium.found` says whether Newton's method converged (`progress`:
+    as `equilibrium`'s)."""
+    with progress_of(progress, f"equilibrium {getattr(model, 'name', '')}", STAGES) as bar:
+        run = _newton(model, start, t, bar)
+        m, cs, state, begin = run.model, run.cs, run.state, run.begin
+        squared = np.zeros(0)
+        stable: bool | None = None
+        if run.found and len(cs):
+            lin = linearized(m, state, cs, bar)
+            squared = _squared_frequencies(lin)
+            stable = lin.stable
     moved = (float(np.linalg.norm(state.position - begin.position, axis=1).max(initial=0.0)),
              float((2 * np.arccos(np.abs((state.quaternion * begin.quaternion).sum(axis=1))
                                   .clip(0, 1))).max(initial=0.0)))
-    return Equilibrium(state, found, moved, stiffness, stable, steps, best)
+    return Equilibrium(state, run.found, moved, squared, stable, run.steps, run.best)
 
 
-def equilibrium(model: Model, *, start: State | None = None, t: float = 0.0) -> State:
+def equilibrium(model: Model, *, start: State | None = None, t: float = 0.0,
+                progress: bool | Progress = False) -> State:
     """A configuration at rest where every acceleration vanishes, near `start` (the file's
     pose by default), the drivers held at time t (`find_equilibrium` says more: how far
     it moved, whether it is stable).
@@ -164,6 +198,10 @@ def equilibrium(model: Model, *, start: State | None = None, t: float = 0.0) -> 
         Where Newton's method starts (its velocities are dropped).
     t : float
         Time (s) at which the drivers are held and the loads taken.
+    progress : bool or Progress
+        Say on standard error what is being computed (each Newton step's stiffness), once
+        it has taken a second (`mbody.util.progress`; or the steps on a `Progress` of the
+        caller's).
 
     Returns
     -------
@@ -178,11 +216,14 @@ def equilibrium(model: Model, *, start: State | None = None, t: float = 0.0) -> 
     MbodyError
         A `model` or `start` that is not one of this model (`mbody.model.arguments`).
     """
-    found = find_equilibrium(model, start=start, t=t)
-    if not found.found:
+    with progress_of(progress, f"equilibrium {getattr(model, 'name', '')}", STAGES) as bar:
+        run = _newton(model, start, t, bar)
+    if not run.found:  # the message find_equilibrium's result gives
+        found = Equilibrium(run.state, False, (0.0, 0.0), np.zeros(0), None, run.steps,
+                            run.best)
         raise NoEquilibriumError(f"{model.name!r}: {found}; the loads may never balance (a "
                                  "constant torque on a free wheel), or start nearer one")
-    return found.state
+    return run.state
 
 
 def _at_rest(model: Model, cs: CoordinateSet, state: State) -> State:

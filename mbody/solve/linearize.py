@@ -46,6 +46,8 @@ from mbody.kernel import _core
 from mbody.model.arguments import checked_model, checked_state
 from mbody.model.model import Model, State
 from mbody.solve.configure import move
+from mbody.solve.modal_bounds import modal_bounds
+from mbody.util.progress import Progress, progress_of
 
 STEP = 1e-2
 """The largest of the three position steps (rad; times the model's size for lengths)."""
@@ -78,9 +80,32 @@ _ROW = (_core.MODE_RE, _core.MODE_IM, _core.MODE_KIND, _core.MODE_FREQUENCY,
 _KINDS = {_core.MODE_NEUTRAL: "neutral", _core.MODE_OSCILLATION: "oscillation",
           _core.MODE_GROWTH: "growth", _core.MODE_DECAY: "decay"}
 
+CORE_SPECTRUM_LIMIT = 150
+"""Largest first-order system (rows of A) whose eigenvalues the compiled core finds itself:
+its QR iteration is written for the small systems of a course's models, where the call
+around the arithmetic is what costs. A larger one's are LAPACK's (``scipy.linalg.eig``
+with the left vectors: blocked, about ten times faster at a thousand rows), with the same
+error bounds, order and modes (`_lapack_spectrum`)."""
+
 _PARAMS = np.zeros(_core.LINEARIZE_PARAMS)
-_PARAMS[[_core.LP_STEP, _core.LP_ROUNDING, _core.LP_STEADY, _core.LP_MOVING]] = (
-    STEP, ROUNDING, STEADY_RTOL, MOVING_RTOL)
+_PARAMS[[_core.LP_STEP, _core.LP_ROUNDING, _core.LP_STEADY, _core.LP_MOVING,
+         _core.LP_STOP]] = (STEP, ROUNDING, STEADY_RTOL, MOVING_RTOL, _core.STOP_NONE)
+_SYSTEM_PARAMS = _PARAMS.copy()  # up to A: its spectrum found here (a large system)
+_SYSTEM_PARAMS[_core.LP_STOP] = _core.STOP_SYSTEM
+_STIFFNESS_PARAMS = _PARAMS.copy()  # up to K: no first-order system, no spectrum
+_STIFFNESS_PARAMS[_core.LP_STOP] = _core.STOP_STIFFNESS
+
+STAGES = {
+    _core.STAGE_GENERALIZED: "the equations M q'' = f",
+    _core.STAGE_DAMPING: "damping D = -df/dq'",
+    _core.STAGE_STIFFNESS: "stiffness K = -df/dq",
+    _core.STAGE_SYSTEM: "first-order system",
+    _core.STAGE_HESSENBERG: "eigenvalues (Hessenberg form)",
+    _core.STAGE_SCHUR: "eigenvalues (QR iteration)",
+    _core.STAGE_VECTORS: "mode shapes",
+}
+"""What each of the compiled core's stages of a linearisation is, for its progress bars
+(`mbody.util.progress`)."""
 
 
 @dataclass(frozen=True)
@@ -305,7 +330,9 @@ class Linearization:
     def eigenvalue_errors(self) -> np.ndarray:
         """A bound on each eigenvalue's error (1/s), in `eigenvalues`' order: κ_i ‖δA‖ for
         a simple one (κ_i its condition ‖x_i‖ ‖y_i‖ / |y_iᴴ x_i|), at most `tolerance`
-        (the bound of a double one); at least 1e3 ε ‖A‖."""
+        (the bound of a double one); where that exceeds `LOOSE` of an eigenvalue and every
+        coordinate is kept, the smaller of it and the bound from the modes of K's
+        symmetric part (`mbody.solve.modal_bounds`: free of ‖M⁻¹‖); at least 1e3 ε ‖A‖."""
         return self._spectrum[2]
 
     @cached_property
@@ -421,7 +448,8 @@ def _skip(model: Model, cs: CoordinateSet) -> np.ndarray:
 
 
 def linearize(model: Model, state: State | None = None, *,
-              coordinates: Sequence[str] | None = None) -> Linearization:
+              coordinates: Sequence[str] | None = None, progress: bool | Progress = False
+              ) -> Linearization:
     """Linearise `model` about `state` (default: its initial state), an equilibrium or a
     steady motion (module doc).
 
@@ -434,6 +462,11 @@ def linearize(model: Model, state: State | None = None, *,
         steady motion.
     coordinates : sequence of str, optional
         The free coordinates (default: `Assembly.generalized`'s, less the drivers').
+    progress : bool or Progress
+        Say on standard error what is being computed, once it has taken a second (tqdm
+        bars, `mbody.util.progress`; or the steps on a `Progress` of the caller's): a
+        model of hundreds of coordinates takes seconds, of thousands minutes, most of it
+        the eigenvalues (their cost grows as the cube of the number of coordinates).
 
     Returns
     -------
@@ -449,21 +482,38 @@ def linearize(model: Model, state: State | None = None, *,
     if not isinstance(model, Model):
         model = checked_model(model)
     state = model.initial if state is None else checked_state(model, state, "state")
-    cs = free_coordinates(model, coordinates)
+    if progress is False:  # the usual call: no bars to set up (a small model's takes µs)
+        return linearized(model, state, free_coordinates(model, coordinates))
+    with progress_of(progress, f"linearize {model.name}", STAGES) as bar:
+        bar.step("choosing the coordinates")
+        cs = free_coordinates(model, coordinates)
+        return linearized(model, state, cs, bar)
+
+
+def linearized(model: Model, state: State, cs: CoordinateSet, bar: Progress | None = None
+               ) -> Linearization:
+    """`linearize` for a checked `state` and the coordinate set `cs` (the drivers held),
+    its progress on `bar`."""
     at = _offsets(len(cs.cols), len(cs))
     out = np.empty(at.end)
     ws = workspace(model)
+    large = 2 * at.k > CORE_SPECTRUM_LIMIT
     ws.solver(cs.held).linearize(float(state.t), ws.pack_state(state), cs.held.lam, cs.Iq,
                                  cs.cols, cs.scales, cs.quasi_int, _skip(model, cs),
-                                 _PARAMS, out)
-    _, _, warnings = checked(model, state, cs, out[:at.ngen])
+                                 _SYSTEM_PARAMS if large else _PARAMS, out,
+                                 bar.callback if bar is not None else None)
+    pivot, _, warnings = checked(model, state, cs, out[:at.ngen])
     info = out[at.info:at.spectrum].tolist()
     if info[_core.LI_SINGULAR]:
         raise MbodyError(f"the generalized mass of '{model.name}' is not positive definite "
                          "at this state: a motion of the coordinates carries no mass")
+    if large:
+        _spectrum_here(out, at, info, bar)
     if info[_core.LI_UNCONVERGED]:
         raise MbodyError(f"the eigenvalues of '{model.name}'s linearisation did not converge "
                          "(the QR iteration's limit)")
+    if _tightened(out, at, info, ROUNDING / max(pivot, np.finfo(float).tiny), bar):
+        _modes_here(out, at, info)
     if not info[_core.LI_RESTING]:
         residual = out[at.resid:at.resid + at.k]
         worst = int(np.argmax(np.abs(residual)))
@@ -476,6 +526,149 @@ def linearize(model: Model, state: State | None = None, *,
         warnings += (f"not a steady motion: {cs.labels[j]} moves ({out[at.qdot + j]:.4g} "
                      f"{cs.items[j].rate_unit}) and the forces depend on it",)
     return Linearization(model, state, cs, warnings, out, at, info)
+
+
+def _spectrum_here(out: np.ndarray, at: _Offsets, info: list[float],
+                   bar: Progress | None) -> None:
+    """What `mb_linearize` does after A when it stopped there (``STOP_SYSTEM``): A's
+    spectrum (the core's for a small A, else `_lapack_spectrum`), the growing count, the
+    modes (``mb_modes``) and the oscillations' frequencies and damping ratios, into `out`
+    and `info` as the core lays them out."""
+    k = at.k
+    nz = int(info[_core.LI_KEPT]) + k
+    if nz == 0:
+        return
+    A = out[at.resid + 2 * k:at.resid + 2 * k + nz * nz].reshape(nz, nz)
+    spec = out[at.spectrum:at.spectrum + 3 * nz + 2 * nz * nz]
+    dA, tol = info[_core.LI_DA], info[_core.LI_TOL]
+    if nz <= CORE_SPECTRUM_LIMIT:
+        if _core.spectrum(A, dA, tol, spec):
+            info[_core.LI_UNCONVERGED] = 1.0
+            return
+    elif not _lapack_spectrum(A, dA, tol, spec, bar):
+        info[_core.LI_UNCONVERGED] = 1.0
+        return
+    if bar is not None:
+        bar.step(f"mode shapes ({nz} eigenvalues)")
+    _modes_here(out, at, info)
+
+
+def _modes_here(out: np.ndarray, at: _Offsets, info: list[float]) -> None:
+    """`mb_linearize`'s last steps from A's spectrum in `out`: the growing count, the
+    modes (``mb_modes``), the oscillations' frequencies and damping ratios."""
+    k = at.k
+    nz = int(info[_core.LI_KEPT]) + k
+    spec = out[at.spectrum:at.spectrum + 3 * nz + 2 * nz * nz]
+    w, err = spec[:2 * nz].view(complex), spec[2 * nz + 2 * nz * nz:]
+    info[_core.LI_GROWING] = float(np.count_nonzero(~(w.real <= err)))
+    kept = np.flatnonzero(out[at.resid + k:at.resid + 2 * k] == 0).astype(np.int64)
+    modes = out[at.modes:at.modes + _core.MODE_W * nz + 2 * nz * k]
+    m = _core.modes(spec, k, kept, modes)
+    info[_core.LI_MODES] = float(m)
+    rows = modes[:_core.MODE_W * m].reshape(m, _core.MODE_W)
+    osc = rows[rows[:, _core.MODE_KIND] == _core.MODE_OSCILLATION]
+    count = len(osc)
+    out[at.oscillations:at.oscillations + count] = osc[:, _core.MODE_FREQUENCY]
+    out[at.oscillations + count:at.oscillations + 2 * count] = osc[:, _core.MODE_DAMPING]
+    info[_core.LI_OSCILLATIONS] = float(count)
+
+
+LOOSE = 1e-6
+"""A first-order system's bound above this fraction of its eigenvalue is loose enough to
+be worth `_tightened`'s (an O(k³) computation a small model's call does without)."""
+
+
+def _tightened(out: np.ndarray, at: _Offsets, info: list[float], m_rel: float,
+               bar: Progress | None) -> bool:
+    """Whether the eigenvalues' bounds in `out` were lowered to the modal bounds of K's
+    symmetric part (`mbody.solve.modal_bounds`; both are bounds: the smaller is kept):
+    tried when every coordinate is kept and a bound is `LOOSE`."""
+    k = at.k
+    nz = int(info[_core.LI_KEPT]) + k
+    if k == 0 or nz != 2 * k:
+        return False
+    spec = out[at.spectrum:at.spectrum + 3 * nz + 2 * nz * nz]
+    w, err = spec[:2 * nz].view(complex), spec[2 * nz + 2 * nz * nz:]
+    d = out[at.ngen:at.ngen + 4 * k * k].reshape(4, k, k)
+    if not np.any(err > LOOSE * np.abs(w)) or not np.all(np.diagonal(d[0]) > 0.0):
+        return False  # tight already, or K not positive definite (a free or cyclic motion)
+    if bar is not None:
+        bar.step(f"error bounds from the modes of K's symmetric part ({k} x {k})")
+    M = out[at.M:at.M + k * k].reshape(k, k)
+    modal = modal_bounds(M, d[0], d[1], d[2], d[3], m_rel, w)
+    if modal is None:
+        return False
+    A = out[at.resid + 2 * k:at.resid + 2 * k + nz * nz].reshape(nz, nz)
+    floor = 1e3 * np.finfo(float).eps * float(np.abs(A).sum(axis=1).max())  # as the core's
+    tighter = np.maximum(np.minimum(err, modal), floor)
+    if not np.any(tighter < err):
+        return False
+    err[:] = tighter
+    return True
+
+
+def _lapack_spectrum(A: np.ndarray, dA: float, tol: float, spec: np.ndarray,
+                     bar: Progress | None) -> bool:
+    """`mb_spectrum` by LAPACK (``geev`` with both vectors): into `spec` as the core lays
+    it out, the same quantities: each eigenvalue's bound κ_i ‖δA‖ (κ_i = ‖x_i‖ ‖y_i‖ /
+    |y_iᴴ x_i| from its right and left vectors), at most `tol`, at least 1e3 ε ‖A‖∞;
+    unit right vectors with their largest entry real and positive; the order by real part
+    then imaginary part, ties kept in LAPACK's order. False when LAPACK did not
+    converge."""
+    import scipy.linalg  # large systems only: ~0.2 s to import
+
+    nz = len(A)
+    if bar is not None:
+        bar.step(f"eigenvalues and their vectors ({nz} x {nz}, LAPACK)")
+    try:
+        w, yl, xr = scipy.linalg.eig(A, left=True, right=True)
+    except (np.linalg.LinAlgError, ValueError):
+        return False
+    floor = 1e3 * np.finfo(float).eps * float(np.abs(A).sum(axis=1).max())
+    nx, ny = np.linalg.norm(xr, axis=0), np.linalg.norm(yl, axis=0)
+    yx = np.abs(np.einsum("ij,ij->j", yl.conj(), xr))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        kappa = np.where(yx > 0.0, nx * ny / yx, np.inf)
+    top = np.argmax(np.abs(xr), axis=0)  # the first of the largest, as the core's
+    big = np.abs(xr[top, np.arange(nz)])
+    phase = np.where(big > 0.0, xr[top, np.arange(nz)].conj() / np.where(big > 0, big, 1.0),
+                     1.0)
+    V = xr * (phase / np.where(nx > 0.0, nx, 1.0))
+    order = np.lexsort((w.imag, w.real))
+    w, V, kappa = w[order], V[:, order], kappa[order]
+    first = kappa * dA
+    err = np.maximum(np.where(np.isfinite(first), np.minimum(first, tol), tol), floor)
+    spec[:2 * nz] = w.astype(complex).view(float)
+    spec[2 * nz:2 * nz + 2 * nz * nz] = np.ascontiguousarray(V, dtype=complex).view(
+        float).reshape(-1)
+    spec[2 * nz + 2 * nz * nz:] = err
+    return True
+
+
+def stiffness(model: Model, state: State, cs: CoordinateSet, bar: Progress | None = None
+              ) -> np.ndarray:
+    """K = −∂f/∂q at `state` as `linearize` computes it (its coordinates left out zeroed),
+    without the first-order system and its eigenvalues: what a Newton step needs.
+
+    Raises
+    ------
+    MbodyError
+        The coordinates singular at the state; a generalized mass that is not positive
+        definite.
+    """
+    at = _offsets(len(cs.cols), len(cs))
+    out = np.empty(at.end)
+    ws = workspace(model)
+    ws.solver(cs.held).linearize(float(state.t), ws.pack_state(state), cs.held.lam, cs.Iq,
+                                 cs.cols, cs.scales, cs.quasi_int, _skip(model, cs),
+                                 _STIFFNESS_PARAMS, out,
+                                 bar.callback if bar is not None else None)
+    checked(model, state, cs, out[:at.ngen])
+    if out[at.info + _core.LI_SINGULAR]:
+        raise MbodyError(f"the generalized mass of '{model.name}' is not positive definite "
+                         "at this state: a motion of the coordinates carries no mass")
+    k = at.k
+    return out[at.ngen:at.ngen + k * k].reshape(k, k).copy()
 
 
 def loads_stiffness(lin: Linearization) -> np.ndarray:

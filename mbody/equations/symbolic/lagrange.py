@@ -39,6 +39,7 @@ from mbody import conventions as cv
 from mbody.equations.coordinates import CoordinateSet
 from mbody.errors import MbodyError
 from mbody.kernel import _core
+from mbody.util.progress import Progress
 
 if TYPE_CHECKING:
     from mbody.model.model import Model
@@ -169,8 +170,11 @@ class SymbolicLagrange:
         return "$$\\begin{aligned}" + symbolic_latex(self) + "\\end{aligned}$$"
 
 
-def symbolic_lagrange(model: Model, cs: CoordinateSet) -> SymbolicLagrange:
-    """The symbolic Lagrange equations of a planar tree (module doc).
+def symbolic_lagrange(model: Model, cs: CoordinateSet, bar: Progress | None = None
+                      ) -> SymbolicLagrange:
+    """The symbolic Lagrange equations of a planar tree (module doc); `bar` shows the rows
+    of M and of the velocity terms as they are made (sympy's expansions: seconds for ten
+    coordinates, their cost growing as the fourth power).
 
     Raises
     ------
@@ -266,7 +270,10 @@ def symbolic_lagrange(model: Model, cs: CoordinateSet) -> SymbolicLagrange:
     dpos = [[_diff(positions[i], qk) for qk in q] for i in range(n)]
     dth = [[sp.diff(thetas[i], qk) for qk in q] for i in range(n)]
     M = sp.zeros(k, k)
+    bar = bar if bar is not None else Progress(False, "")
+    bar.step(f"the mass matrix M(q) in symbols ({k} rows)", k)
     for a in range(k):
+        bar.update(a)
         for b in range(a, k):
             e = sp.Add(*(mass[i] * _dot(dpos[i][a], dpos[i][b]) + inertia[i] * dth[i][a] * dth[i][b]
                          for i in range(n)))
@@ -274,7 +281,9 @@ def symbolic_lagrange(model: Model, cs: CoordinateSet) -> SymbolicLagrange:
     # velocity terms: −Σ Γ_klm q'_l q'_m
     dM = [M.diff(qm) for qm in q]
     f = [sp.Integer(0)] * k
+    bar.step(f"the velocity terms in symbols ({k} rows)", k)
     for a in range(k):
+        bar.update(a)
         terms = []
         for b in range(k):
             for m_ in range(k):

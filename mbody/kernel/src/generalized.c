@@ -52,43 +52,96 @@ int mb_coordinates_check(const mb_model *md, int64_t nq, const int64_t *Iq, int6
     return 0;
 }
 
-/* The scratch of one evaluation (allocated per call: a few small arrays). */
+/* Columns of T and M_q are solved for one at a time and written BLOCK at a time across
+ * their rows (row-major outputs: a column's entries are nq apart, a cache line each). */
+#define BLOCK 8
+
+/* The scratch of one evaluation (allocated per call). C = [G_U^T; A^T] (r x N) is kept by
+ * columns, its rows in the order of their first column (`pos`: an original row's place), so
+ * that the Householder QR below works only within the band that the bodies' order leaves
+ * (a chain in file order: a few columns wide); the columns' touched rows [clo, chi] are
+ * what the next factorisation clears. */
 typedef struct {
     int64_t n, N, nq, mu, r;
-    double *C, *B, *fp, *scale, *beta, *rdiag, *y, *arow, *agam, *r6, *Ma, *lam;
-    int64_t *col_of; /* 6 n: active column index, or -1 */
+    double *C, *B, *fp, *scale, *beta, *rdiag, *y, *arow, *agam, *r6, *Ma, *lam, *tmp;
+    double *block; /* BLOCK (N + nq): a few columns of T or M_q gathered before they are
+                    * written across their rows */
+    int64_t *col_of;       /* 6 n: active column index, or -1 */
+    int64_t *bfirst, *blast; /* n: a body's first and last column (-1: none) */
+    int64_t *pos, *first, *last; /* r: a row's place; by place, its first and last column */
+    int64_t *rlo, *rhi;          /* r: a row's first and last column (original order) */
+    int64_t *vend, *rend, *rbeg; /* N: reflector k's last row, R's row k's last column,
+                                  * R's column k's first row */
+    int64_t *clo, *chi, *count; /* N: the rows of column j written; N + 2: the sort's */
+    int64_t *off, W; /* N: column j holds rows off_j .. off_j + W - 1 (`band`), at C + j W */
+    double *dbuf;    /* the doubles above but C */
+    int64_t *ibuf;   /* the indices above */
 } gen_scratch;
 
-static void scratch_free(gen_scratch *s) {
-    free(s->C), free(s->B), free(s->fp), free(s->scale), free(s->beta), free(s->rdiag), free(s->y), free(s->arow);
-    free(s->agam), free(s->r6), free(s->Ma), free(s->lam), free(s->col_of);
-}
+static void scratch_free(gen_scratch *s) { free(s->C), free(s->dbuf), free(s->ibuf); }
 
+/* The scratch's arrays, carved from two allocations (one of doubles, one of indices: a
+ * small model's evaluation costs a few microseconds, and each allocation a little of it);
+ * C is made by `band` on the first factorisation. 0, or -1 when memory ran out. */
 static int scratch_new(gen_scratch *s, const mb_model *md, const mb_unknowns *u, int64_t nq,
                        int64_t nc, const int64_t *cols) {
     memset(s, 0, sizeof(*s));
     s->n = md->n, s->N = nc, s->nq = nq, s->mu = u->mu, s->r = u->mu + nq;
     int64_t r = s->r > 0 ? s->r : 1, N = nc > 0 ? nc : 1, n = md->n > 0 ? md->n : 1;
-    s->C = calloc((size_t)(r * N), sizeof(double));
-    s->B = calloc((size_t)(3 * r + N), sizeof(double));
-    s->fp = calloc((size_t)r, sizeof(double));
-    s->scale = calloc((size_t)N, sizeof(double));
-    s->beta = calloc((size_t)N, sizeof(double));
-    s->rdiag = calloc((size_t)N, sizeof(double));
-    s->y = calloc((size_t)(13 * n), sizeof(double));
-    s->arow = calloc((size_t)(12 * (nq > 0 ? nq : 1)), sizeof(double));
-    s->agam = calloc((size_t)(nq > 0 ? nq : 1), sizeof(double));
-    s->r6 = calloc((size_t)(6 * n), sizeof(double));
-    s->Ma = calloc((size_t)(6 * n), sizeof(double));
-    s->lam = calloc((size_t)(md->m > 0 ? md->m : 1), sizeof(double));
-    s->col_of = calloc((size_t)(6 * n), sizeof(int64_t));
-    if (!s->C || !s->B || !s->fp || !s->scale || !s->beta || !s->rdiag || !s->y || !s->arow || !s->agam || !s->r6 ||
-        !s->Ma || !s->lam || !s->col_of) {
+    int64_t q1 = nq > 0 ? nq : 1, m1 = md->m > 0 ? md->m : 1;
+    int64_t nd = (3 * r + N) + r + 3 * N + 13 * n + 13 * q1 + 12 * n + m1 + r +
+                 BLOCK * (N + q1);
+    int64_t ni = 8 * n + 5 * r + 7 * N + 2;
+    s->dbuf = calloc((size_t)nd, sizeof(double));
+    s->ibuf = calloc((size_t)ni, sizeof(int64_t));
+    if (s->dbuf == NULL || s->ibuf == NULL) {
         scratch_free(s);
         return -1;
     }
-    for (int64_t i = 0; i < 6 * md->n; i++) s->col_of[i] = -1;
+    double *d = s->dbuf;
+    s->B = d, d += 3 * r + N;
+    s->fp = d, d += r;
+    s->scale = d, d += N;
+    s->beta = d, d += N;
+    s->rdiag = d, d += N;
+    s->y = d, d += 13 * n;
+    s->arow = d, d += 12 * q1;
+    s->agam = d, d += q1;
+    s->r6 = d, d += 6 * n;
+    s->Ma = d, d += 6 * n;
+    s->lam = d, d += m1;
+    s->tmp = d, d += r;
+    s->block = d;
+    int64_t *i = s->ibuf;
+    s->col_of = i, i += 6 * n;
+    s->bfirst = i, i += n;
+    s->blast = i, i += n;
+    s->pos = i, i += r;
+    s->first = i, i += r;
+    s->last = i, i += r;
+    s->rlo = i, i += r;
+    s->rhi = i, i += r;
+    s->vend = i, i += N;
+    s->rend = i, i += N;
+    s->rbeg = i, i += N;
+    s->clo = i, i += N;
+    s->chi = i, i += N;
+    s->count = i, i += N + 2;
+    s->off = i;
+    for (int64_t k = 0; k < 6 * md->n; k++) s->col_of[k] = -1;
     for (int64_t j = 0; j < nc; j++) s->col_of[cols[j]] = j;
+    for (int64_t b = 0; b < md->n; b++) {
+        s->bfirst[b] = s->blast[b] = -1;
+        for (int a = 0; a < 6; a++) {
+            int64_t j = s->col_of[6 * b + a];
+            if (j < 0) continue;
+            if (s->bfirst[b] < 0) s->bfirst[b] = j;
+            s->blast[b] = j;
+        }
+    }
+    for (int64_t j = 0; j < nc; j++) s->clo[j] = 0, s->chi[j] = -1; /* nothing written */
+    for (int64_t k = 0; k < nc; k++) /* no factors yet: every solve gives 0 */
+        s->vend[k] = k - 1, s->rend[k] = k, s->rbeg[k] = k;
     return 0;
 }
 
@@ -187,93 +240,211 @@ static void coordinate_row(const mb_model *md, const mb_work *w, const double *y
     }
 }
 
-/* C (r x N) is kept by columns (column j at C + j r): each step of the QR below runs down
- * columns, so that its loops read memory in order (the same sums in the same order as by
- * rows, so the same numbers). */
+/* C (r x N) is kept by columns, each in W doubles: column j's rows off_j .. off_j + W - 1
+ * (`band`: every row it holds from its first entry to the last the QR's fill reaches), so
+ * that a banded C takes N W doubles, a chain's a few columns wide, and the QR below runs
+ * down short columns that sit side by side in memory. */
+
+/* Row i of C (original order: the held components, then the coordinates) touches the
+ * columns of bodies c and p (p < 0: none): its first and last column (first N: none). */
+static void row_span(gen_scratch *s, int64_t i, int64_t c, int64_t p) {
+    int64_t a = s->bfirst[c], b = s->blast[c];
+    if (p >= 0 && s->bfirst[p] >= 0) {
+        if (a < 0 || s->bfirst[p] < a) a = s->bfirst[p];
+        if (s->blast[p] > b) b = s->blast[p];
+    }
+    s->rlo[i] = a >= 0 ? a : s->N, s->rhi[i] = b;
+}
+
+/* The rows' places by their first column (a stable counting sort: rows without columns
+ * last), with each place's first and last column. */
+static void sort_rows(gen_scratch *s) {
+    int64_t r = s->r, N = s->N, *count = s->count;
+    const int64_t *lo = s->rlo, *hi = s->rhi;
+    for (int64_t j = 0; j <= N + 1; j++) count[j] = 0;
+    for (int64_t i = 0; i < r; i++) count[lo[i] + 1]++;
+    for (int64_t j = 0; j <= N; j++) count[j + 1] += count[j];
+    for (int64_t i = 0; i < r; i++) {
+        int64_t p = count[lo[i]]++;
+        s->pos[i] = p, s->first[p] = lo[i], s->last[p] = hi[i];
+    }
+}
+
+/* The rows each column of C holds while it is factored, from the rows' spans alone (their
+ * places and first and last columns, sort_rows's): a row's entries from its first column
+ * to its last, and each QR step's rows in the columns it reaches (the fill): off and W,
+ * then C of N W doubles. Once per scratch: the spans are those of the bodies, whatever
+ * the positions. Returns 0, or -1 when memory ran out. */
+static int band(gen_scratch *s) {
+    int64_t r = s->r, N = s->N, *off = s->off, *top = s->clo, *last = s->rhi;
+    for (int64_t j = 0; j < N; j++) off[j] = INT64_MAX, top[j] = -1;
+    for (int64_t p = 0; p < r; p++)
+        for (int64_t c = s->first[p]; c <= s->last[p] && c < N; c++) {
+            if (p < off[c]) off[c] = p;
+            if (p > top[c]) top[c] = p;
+        }
+    if (r >= N) { /* qr_factor's steps, without the arithmetic (rhi: free until row_span) */
+        memcpy(last, s->last, sizeof(int64_t) * (size_t)r);
+        for (int64_t k = 0, e = -1; k < N; k++) {
+            while (e + 1 < r && s->first[e + 1] <= k) e++;
+            int64_t hi = e > k ? e : k, L = k;
+            for (int64_t p = k; p <= hi; p++) L = last[p] > L ? last[p] : L;
+            for (int64_t c = k; c <= L; c++) {
+                if (k < off[c]) off[c] = k;
+                if (hi > top[c]) top[c] = hi;
+            }
+            for (int64_t p = k; p <= hi; p++) last[p] = L;
+        }
+    }
+    int64_t W = 1;
+    for (int64_t j = 0; j < N; j++) {
+        if (top[j] < 0) off[j] = 0, top[j] = 0; /* holds nothing */
+        if (top[j] - off[j] + 1 > W) W = top[j] - off[j] + 1;
+    }
+    s->W = W;
+    for (int64_t j = 0; j < N; j++) s->clo[j] = 0, s->chi[j] = -1; /* nothing written */
+    s->C = calloc((size_t)(N > 0 ? N : 1) * (size_t)W, sizeof(double));
+    return s->C != NULL ? 0 : -1;
+}
+
+/* Adds a row (child side [0..5] on body c, parent side [6..11] on body p) into C's row at
+ * place `at`, noting the rows each column holds. */
+static void put_c_row(gen_scratch *s, int64_t at, const double *row, int64_t c, int64_t p) {
+    for (int side = 0; side < 2; side++) {
+        int64_t b = side ? p : c;
+        if (b < 0) continue;
+        for (int a = 0; a < 6; a++) {
+            int64_t j = s->col_of[6 * b + a];
+            if (j < 0) continue;
+            s->C[j * s->W + at - s->off[j]] += row[6 * side + a];
+            if (at < s->clo[j] || s->chi[j] < s->clo[j]) s->clo[j] = at;
+            if (at > s->chi[j]) s->chi[j] = at;
+        }
+    }
+}
+
+/* Clears what the last factorisation wrote in C. */
+static void clear_c(gen_scratch *s) {
+    for (int64_t j = 0; j < s->N; j++) {
+        if (s->chi[j] >= s->clo[j])
+            memset(s->C + j * s->W + s->clo[j] - s->off[j], 0,
+                   sizeof(double) * (size_t)(s->chi[j] - s->clo[j] + 1));
+        s->clo[j] = 0, s->chi[j] = -1;
+    }
+}
 
 /* Householder QR of C (in place) with its columns scaled to unit length first (scale: the
  * factors): the reflectors' vectors stay in C on and below the diagonal (beta their
- * factors), R's strict upper triangle above it, R's diagonal in rdiag. Returns the
- * smallest |R_kk| over the largest (0 when r < N). */
-static double qr_factor(double *C, int64_t r, int64_t N, double *scale, double *beta,
-                        double *rdiag) {
-    for (int64_t j = 0; j < N; j++) rdiag[j] = 0.0;
+ * factors, vend their last rows), R's strict upper triangle above it (rend: the last
+ * column of each of its rows; rbeg: the first row of each of its columns), R's diagonal in
+ * rdiag. Step k touches only the rows whose first column is at most k (the rows are in
+ * that order: rows below them are still zero in column k) and the columns those rows
+ * reach: the QR of a banded C costs its band's width squared per column, and gives the
+ * numbers of the dense QR of C's rows in this order. Returns the smallest |R_kk| over the
+ * largest (0 when r < N), which does not depend on the rows' order (R^T R = C^T C). */
+static double qr_factor(gen_scratch *s) {
+    int64_t r = s->r, N = s->N, W = s->W;
+    const int64_t *off = s->off;
+    double *C = s->C;
     for (int64_t j = 0; j < N; j++) {
-        double s = 0.0, *col = C + j * r;
-        for (int64_t i = 0; i < r; i++) s += col[i] * col[i];
-        s = s > 0.0 ? 1.0 / sqrt(s) : 1.0;
-        scale[j] = s;
-        for (int64_t i = 0; i < r; i++) col[i] *= s;
+        double sum = 0.0, *col = C + j * W;
+        int64_t o = off[j];
+        s->rdiag[j] = 0.0, s->beta[j] = 0.0;
+        s->vend[j] = j - 1, s->rend[j] = j, s->rbeg[j] = j;
+        for (int64_t i = s->clo[j]; i <= s->chi[j]; i++) sum += col[i - o] * col[i - o];
+        sum = sum > 0.0 ? 1.0 / sqrt(sum) : 1.0;
+        s->scale[j] = sum;
+        for (int64_t i = s->clo[j]; i <= s->chi[j]; i++) col[i - o] *= sum;
     }
     if (r < N) return 0.0; /* fewer rows than columns: the motion is not determined */
     double big = 0.0, small = INFINITY;
+    int64_t e = -1;
     for (int64_t k = 0; k < N; k++) {
-        double *v = C + k * r, norm = 0.0;
-        for (int64_t i = k; i < r; i++) norm += v[i] * v[i];
+        while (e + 1 < r && s->first[e + 1] <= k) e++;
+        int64_t hi = e > k ? e : k, L = k;
+        for (int64_t p = k; p <= hi; p++) L = s->last[p] > L ? s->last[p] : L;
+        double *v = C + k * W + k - off[k], norm = 0.0; /* v[i - k]: row i */
+        int64_t h = hi - k;
+        for (int64_t i = 0; i <= h; i++) norm += v[i] * v[i];
         norm = sqrt(norm);
-        double x0 = v[k];
+        double x0 = v[0];
         double alpha = x0 >= 0.0 ? -norm : norm;
-        v[k] = x0 - alpha;
+        v[0] = x0 - alpha;
         double vv = 0.0;
-        for (int64_t i = k; i < r; i++) vv += v[i] * v[i];
-        beta[k] = vv > 0.0 ? 2.0 / vv : 0.0;
-        for (int64_t c = k + 1; c < N; c++) {
-            double s = 0.0, *col = C + c * r;
-            for (int64_t i = k; i < r; i++) s += v[i] * col[i];
-            s *= beta[k];
-            for (int64_t i = k; i < r; i++) col[i] -= s * v[i];
+        for (int64_t i = 0; i <= h; i++) vv += v[i] * v[i];
+        double bk = vv > 0.0 ? 2.0 / vv : 0.0;
+        for (int64_t c = k + 1; c <= L; c++) {
+            double sum = 0.0, *col = C + c * W + k - off[c]; /* col[i - k]: row i */
+            for (int64_t i = 0; i <= h; i++) sum += v[i] * col[i];
+            sum *= bk;
+            for (int64_t i = 0; i <= h; i++) col[i] -= sum * v[i];
+            if (s->chi[c] < s->clo[c] || k < s->clo[c]) s->clo[c] = k;
+            if (hi > s->chi[c]) s->chi[c] = hi;
+            if (s->rbeg[c] == c) s->rbeg[c] = k; /* the first step to reach column c */
         }
-        rdiag[k] = alpha;
+        if (s->chi[k] < s->clo[k] || k < s->clo[k]) s->clo[k] = k;
+        if (hi > s->chi[k]) s->chi[k] = hi;
+        for (int64_t p = k; p <= hi; p++) s->last[p] = L; /* the rows now reach L */
+        s->beta[k] = bk, s->vend[k] = hi, s->rend[k] = L, s->rdiag[k] = alpha;
         big = fmax(big, fabs(alpha));
         small = fmin(small, fabs(alpha));
     }
     return big > 0.0 ? small / big : 0.0;
 }
 
-/* b (r) <- the least-squares solution x (N) of C x = b in its first N entries, with the
- * factors of qr_factor. Returns the residual's norm (the part of b outside C's range: 0
- * for a consistent system). */
-static double qr_solve(const double *C, int64_t r, int64_t N, const double *scale,
-                       const double *beta, const double *rdiag, double *b) {
-    double resid = 0.0;
-    for (int64_t k = 0; k < N; k++) {
-        const double *v = C + k * r;
-        double s = 0.0;
-        for (int64_t i = k; i < r; i++) s += v[i] * b[i];
-        s *= beta[k];
-        for (int64_t i = k; i < r; i++) b[i] -= s * v[i];
+/* b (r, the rows in their original order) <- the least-squares solution x (N) of C x = b
+ * in its first N entries, with the factors of qr_factor. Returns the residual's norm (the
+ * part of b outside C's range: 0 for a consistent system). */
+static double qr_solve(const gen_scratch *s, double *b) {
+    int64_t r = s->r, N = s->N, W = s->W;
+    const int64_t *off = s->off;
+    const double *C = s->C;
+    double *t = s->tmp, resid = 0.0;
+    for (int64_t i = 0; i < r; i++) t[s->pos[i]] = b[i];
+    for (int64_t k = 0; k < N; k++) { /* Q^T b */
+        int64_t h = s->vend[k] - k;
+        if (h < 0) continue; /* no reflector (not factored) */
+        const double *v = C + k * W + k - off[k];
+        double sum = 0.0, *tk = t + k;
+        for (int64_t i = 0; i <= h; i++) sum += v[i] * tk[i];
+        sum *= s->beta[k];
+        for (int64_t i = 0; i <= h; i++) tk[i] -= sum * v[i];
     }
-    for (int64_t i = N; i < r; i++) resid += b[i] * b[i];
+    for (int64_t i = N; i < r; i++) resid += t[i] * t[i];
     for (int64_t k = N - 1; k >= 0; k--) {
-        double s = b[k];
-        for (int64_t j = k + 1; j < N; j++) s -= C[j * r + k] * b[j];
-        b[k] = rdiag[k] != 0.0 ? s / rdiag[k] : 0.0;
+        double sum = t[k];
+        for (int64_t j = k + 1; j <= s->rend[k]; j++) sum -= C[j * W + k - off[j]] * b[j];
+        b[k] = s->rdiag[k] != 0.0 ? sum / s->rdiag[k] : 0.0;
     }
-    for (int64_t k = 0; k < N; k++) b[k] *= scale[k];
+    for (int64_t k = 0; k < N; k++) b[k] *= s->scale[k];
     return sqrt(resid);
 }
 
-/* x (N) <- the last `nq` entries of Q1 R^-T D x (r entries before selection; work: r
- * doubles): (C^+)^T D x restricted to the coordinates' rows, i.e. T^T x when T is
- * C^+ [0; I] (the transposed solve: one vector instead of nq columns of T). */
-static void qr_transposed(const double *C, int64_t r, int64_t N, const double *scale,
-                          const double *beta, const double *rdiag, const double *x,
-                          int64_t first, int64_t nq, double *out, double *work) {
+/* out (nq) <- the coordinates' entries of Q1 R^-T D x (work: r + N doubles): (C^+)^T D x
+ * restricted to the coordinates' rows, i.e. T^T x when T is C^+ [0; I] (the transposed
+ * solve: one vector instead of nq columns of T). */
+static void qr_transposed(const gen_scratch *s, const double *x, double *out, double *work) {
+    int64_t r = s->r, N = s->N, W = s->W;
+    const int64_t *off = s->off;
+    const double *C = s->C;
     for (int64_t k = 0; k < N; k++) { /* R^T z = D x, forward */
-        const double *col = C + k * r;
-        double s = scale[k] * x[k];
-        for (int64_t j = 0; j < k; j++) s -= col[j] * work[j];
-        work[k] = rdiag[k] != 0.0 ? s / rdiag[k] : 0.0;
+        const double *col = C + k * W;
+        int64_t o = off[k];
+        double sum = s->scale[k] * x[k];
+        for (int64_t j = s->rbeg[k]; j < k; j++) sum -= col[j - o] * work[j];
+        work[k] = s->rdiag[k] != 0.0 ? sum / s->rdiag[k] : 0.0;
     }
     for (int64_t i = N; i < r; i++) work[i] = 0.0;
     for (int64_t k = N - 1; k >= 0; k--) { /* Q [z; 0] = H_0 ... H_{N-1} [z; 0] */
-        const double *v = C + k * r;
-        double s = 0.0;
-        for (int64_t i = k; i < r; i++) s += v[i] * work[i];
-        s *= beta[k];
-        for (int64_t i = k; i < r; i++) work[i] -= s * v[i];
+        int64_t h = s->vend[k] - k;
+        if (h < 0) continue; /* no reflector (not factored) */
+        const double *v = C + k * W + k - off[k];
+        double sum = 0.0, *wk = work + k;
+        for (int64_t i = 0; i <= h; i++) sum += v[i] * wk[i];
+        sum *= s->beta[k];
+        for (int64_t i = 0; i <= h; i++) wk[i] -= sum * v[i];
     }
-    for (int64_t k = 0; k < nq; k++) out[k] = work[first + k];
+    for (int64_t k = 0; k < s->nq; k++) out[k] = work[s->pos[s->mu + k]];
 }
 
 /* Adds row (child side [0..5] on body c, parent side [6..11] on body p) into a matrix row
@@ -319,19 +490,27 @@ static void rows_at(const mb_model *md, mb_work *w, gen_scratch *s, int64_t nq,
 
 /* Stage 1 at positions s->y: rotations, the rows and C's QR (kept in s), the coordinates'
  * rows and bodies (cc, cp) and values; the drivers' rates f' of the held components into
- * s->fp. Returns the pivot ratio. */
+ * s->fp. Returns the pivot ratio, or -1 when memory ran out (C is made on the first call:
+ * after that, never). */
 static double factor(const mb_model *md, const mb_unknowns *u, mb_work *w, gen_scratch *s,
                      int64_t nq, const int64_t *Iq, int64_t *cc, int64_t *cp, double *qval) {
-    int64_t n = md->n, N = s->N, mu = s->mu, r = s->r;
+    int64_t n = md->n, mu = s->mu;
     mb_rotations(n, s->y + 3 * n, w->R);
     rows_at(md, w, s, nq, Iq, cc, cp, qval);
-    memset(s->C, 0, sizeof(double) * r * N);
+    clear_c(s);
+    for (int64_t k = 0; k < mu; k++) {
+        int64_t j = md->comps_i[4 * u->U[k]];
+        row_span(s, k, md->joints_i[3 * j + 1], md->joints_i[3 * j]);
+    }
+    for (int64_t k = 0; k < nq; k++) row_span(s, mu + k, cc[k], cp[k]);
+    sort_rows(s);
+    if (s->C == NULL && band(s) < 0) return -1.0; /* no memory: the caller's error */
     for (int64_t k = 0; k < mu; k++) {
         int64_t i = u->U[k], j = md->comps_i[4 * i];
         double row[12];
         memcpy(row, w->child6 + 6 * i, 6 * sizeof(double));
         memcpy(row + 6, w->parent6 + 6 * i, 6 * sizeof(double));
-        put_row(s, s->C + k, r, row, md->joints_i[3 * j + 1], md->joints_i[3 * j]);
+        put_c_row(s, s->pos[k], row, md->joints_i[3 * j + 1], md->joints_i[3 * j]);
         s->fp[k] = 0.0;
         if (md->comps_i[4 * i + 3] >= 0) {
             double f[3];
@@ -339,8 +518,8 @@ static double factor(const mb_model *md, const mb_unknowns *u, mb_work *w, gen_s
             s->fp[k] = f[1];
         }
     }
-    for (int64_t k = 0; k < nq; k++) put_row(s, s->C + mu + k, r, s->arow + 12 * k, cc[k], cp[k]);
-    return qr_factor(s->C, r, N, s->scale, s->beta, s->rdiag);
+    for (int64_t k = 0; k < nq; k++) put_c_row(s, s->pos[mu + k], s->arow + 12 * k, cc[k], cp[k]);
+    return qr_factor(s);
 }
 
 /* Stage 2 with C factored at s->y's positions (the last mb_columns_at there): v = T q' +
@@ -357,12 +536,12 @@ static void forces(const mb_model *md, const mb_unknowns *u, mb_work *w, gen_scr
     if (ve != NULL) {
         for (int64_t k = 0; k < mu; k++) g[k] = s->fp[k];
         for (int64_t k = 0; k < nq; k++) g[mu + k] = 0.0;
-        qr_solve(s->C, r, N, s->scale, s->beta, s->rdiag, g);
+        qr_solve(s, g);
         for (int64_t i = 0; i < N; i++) ve[i] = g[i];
     }
     for (int64_t k = 0; k < mu; k++) g[k] = s->fp[k];
     for (int64_t k = 0; k < nq; k++) g[mu + k] = qd[k];
-    qr_solve(s->C, r, N, s->scale, s->beta, s->rdiag, g);
+    qr_solve(s, g);
     double *v = s->y + 7 * n, *om = s->y + 10 * n;
     memset(v, 0, sizeof(double) * 6 * n);
     for (int64_t i = 0; i < 6 * n; i++) {
@@ -378,7 +557,7 @@ static void forces(const mb_model *md, const mb_unknowns *u, mb_work *w, gen_scr
                        s->agam + k, NULL);
     for (int64_t k = 0; k < mu; k++) g[k] = w->gamma[u->U[k]];
     for (int64_t k = 0; k < nq; k++) g[mu + k] = s->agam[k];
-    qr_solve(s->C, r, N, s->scale, s->beta, s->rdiag, g);
+    qr_solve(s, g);
     for (int64_t i = 0; i < N; i++) a0[i] = g[i];
     /* Q - b + G_K lam_K at the state */
     mb_loads_at(md, w);
@@ -412,50 +591,56 @@ static void forces(const mb_model *md, const mb_unknowns *u, mb_work *w, gen_scr
             x[j] = s->r6[6 * b + a] - Ma;
         }
     }
-    qr_transposed(s->C, r, N, s->scale, s->beta, s->rdiag, x, mu, nq, fq, work);
+    qr_transposed(s, x, fq, work);
 }
 
-/* T (N x nq) from the factors: C T = [0; I]; returns the residual's norm (0 on the
- * configuration manifold). */
-static double transformation(gen_scratch *s, int64_t nq, double *T) {
+/* T (N x nq) from the factors: C T = [0; I], row-major (the output's layout), or
+ * by_columns (T's column k at T + k N: what the perturbed states read); returns the
+ * residual's norm (0 on the configuration manifold). */
+static double transformation(gen_scratch *s, int64_t nq, double *T, int by_columns) {
     int64_t N = s->N, mu = s->mu, r = s->r;
     double *g = s->B, resid = 0.0;
-    for (int64_t k = 0; k < nq; k++) {
-        memset(g, 0, sizeof(double) * r);
-        g[mu + k] = 1.0;
-        double e = qr_solve(s->C, r, N, s->scale, s->beta, s->rdiag, g);
-        resid += e * e;
-        for (int64_t i = 0; i < N; i++) T[i * nq + k] = g[i];
+    for (int64_t k0 = 0; k0 < nq; k0 += BLOCK) {
+        int64_t w = nq - k0 < BLOCK ? nq - k0 : BLOCK;
+        for (int64_t b = 0; b < w; b++) {
+            memset(g, 0, sizeof(double) * r);
+            g[mu + k0 + b] = 1.0;
+            double e = qr_solve(s, g);
+            resid += e * e;
+            memcpy(by_columns ? T + (k0 + b) * N : s->block + b * N, g, sizeof(double) * N);
+        }
+        if (!by_columns)
+            for (int64_t i = 0; i < N; i++)
+                for (int64_t b = 0; b < w; b++) T[i * nq + k0 + b] = s->block[b * N + i];
     }
     return sqrt(resid);
 }
 
-/* M_q = T^T M T, body by body. */
-static void mass(const mb_model *md, const gen_scratch *s, int64_t nq, const double *T,
-                 double *Mq) {
-    int64_t nq1 = nq > 0 ? nq : 1;
-    double MT[6 * nq1];
-    memset(Mq, 0, sizeof(double) * nq * nq);
-    for (int64_t b = 0; b < md->n; b++) {
-        const double *body = md->bodies + MB_BODY_W * b, *J = body + B_J;
-        int64_t jc[6];
-        for (int a = 0; a < 6; a++) jc[a] = s->col_of[6 * b + a];
-        for (int64_t k = 0; k < nq; k++) {
-            double tc[6];
-            for (int a = 0; a < 6; a++) tc[a] = jc[a] >= 0 ? T[jc[a] * nq + k] : 0.0;
-            for (int a = 0; a < 3; a++) {
-                MT[a * nq + k] = body[B_MASS] * tc[a];
-                MT[(3 + a) * nq + k] = J[3 * a] * tc[3] + J[3 * a + 1] * tc[4] + J[3 * a + 2] * tc[5];
+/* M_q = T^T M T a column at a time: M_q e_l = T^T (M T e_l) by the transposed solve
+ * (qr_transposed), at the band's cost per column rather than T's size (a chain's T is
+ * half full); BLOCK columns read and written at a time. */
+static void mass(const mb_model *md, gen_scratch *s, int64_t nq, const double *T, double *Mq) {
+    int64_t N = s->N, r = s->r;
+    double *work = s->B + 2 * r, *xs = s->block, *cols = s->block + BLOCK * N;
+    for (int64_t l0 = 0; l0 < nq; l0 += BLOCK) {
+        int64_t w = nq - l0 < BLOCK ? nq - l0 : BLOCK;
+        for (int64_t b = 0; b < md->n; b++) { /* M T e_l for BLOCK columns l */
+            const double *body = md->bodies + MB_BODY_W * b, *J = body + B_J;
+            int64_t jc[6];
+            for (int a = 0; a < 6; a++) jc[a] = s->col_of[6 * b + a];
+            for (int64_t c = 0; c < w; c++) {
+                double tc[6], *x = xs + c * N;
+                for (int a = 0; a < 6; a++) tc[a] = jc[a] >= 0 ? T[jc[a] * nq + l0 + c] : 0.0;
+                for (int a = 0; a < 3; a++) {
+                    if (jc[a] >= 0) x[jc[a]] = body[B_MASS] * tc[a];
+                    if (jc[3 + a] >= 0)
+                        x[jc[3 + a]] = J[3 * a] * tc[3] + J[3 * a + 1] * tc[4] + J[3 * a + 2] * tc[5];
+                }
             }
         }
-        for (int a = 0; a < 6; a++) {
-            if (jc[a] < 0) continue;
-            const double *Ta = T + jc[a] * nq;
-            for (int64_t k = 0; k < nq; k++) {
-                if (Ta[k] == 0.0) continue;
-                for (int64_t l = 0; l < nq; l++) Mq[k * nq + l] += Ta[k] * MT[a * nq + l];
-            }
-        }
+        for (int64_t c = 0; c < w; c++) qr_transposed(s, xs + c * N, cols + c * nq, work);
+        for (int64_t k = 0; k < nq; k++)
+            for (int64_t c = 0; c < w; c++) Mq[k * nq + l0 + c] = cols[c * nq + k];
     }
     for (int64_t k = 0; k < nq; k++) /* symmetric in exact arithmetic: made so */
         for (int64_t l = k + 1; l < nq; l++) {
@@ -475,9 +660,13 @@ int mb_generalized(const mb_model *md, const mb_unknowns *u, mb_work *w, double 
     double *T = out, *ve = T + N * nq, *a0 = ve + N, *Mq = a0 + N, *fq = Mq + nq * nq;
     double *qv = fq + nq, *qd = qv + nq, *scale = qd + nq, *info = scale + nq;
     double ratio = factor(md, u, w, &s, nq, Iq, cc, cp, qv);
+    if (ratio < 0.0) {
+        scratch_free(&s);
+        return -1;
+    }
     for (int64_t k = 0; k < nq; k++)
         qd[k] = qdot ? qdot[k] : row_dot_v(s.arow + 12 * k, cc[k], cp[k], y, n, s.col_of);
-    double resid = transformation(&s, nq, T);
+    double resid = transformation(&s, nq, T, 0);
     forces(md, u, w, &s, nq, Iq, qd, lam, ve, a0, fq);
     mass(md, &s, nq, T, Mq);
     info[MB_GI_RANK] = ratio;
@@ -526,14 +715,18 @@ int mb_generalized(const mb_model *md, const mb_unknowns *u, mb_work *w, double 
         }
         sum[a >= 3] += gravity + fmax(fabs(b[c]), gyro) + known + Ma;
     }
-    for (int64_t k = 0; k < nq; k++) {
-        double tau[2] = {0.0, 0.0};
-        for (int64_t c = 0; c < 6 * n; c++) {
-            int64_t j = s.col_of[c];
-            if (j >= 0) tau[c % 6 >= 3] = fmax(tau[c % 6 >= 3], fabs(T[j * nq + k]));
-        }
-        scale[k] = fmax(tau[0] * sum[0] + tau[1] * sum[1], fabs(fq[k]));
+    /* T's largest entries per column and group, row by row (Q's 12 n >= 2 nq doubles are
+     * free now) */
+    double *tau = Q;
+    for (int64_t k = 0; k < 2 * nq; k++) tau[k] = 0.0;
+    for (int64_t c = 0; c < 6 * n; c++) {
+        int64_t j = s.col_of[c], g = c % 6 >= 3;
+        if (j < 0) continue;
+        const double *row = T + j * nq;
+        for (int64_t k = 0; k < nq; k++) tau[2 * k + g] = fmax(tau[2 * k + g], fabs(row[k]));
     }
+    for (int64_t k = 0; k < nq; k++)
+        scale[k] = fmax(tau[2 * k] * sum[0] + tau[2 * k + 1] * sum[1], fabs(fq[k]));
     free(Q);
     scratch_free(&s);
     return 0;
@@ -565,44 +758,149 @@ static void move(const mb_model *md, const gen_scratch *s, const double *y0, con
     }
 }
 
+/* f_q at states near y0: its positions moved along v = T(y0) dq for a unit time, its rates
+ * q0' + du. C is factored again only when the positions move (the rates alone reuse y0's
+ * factors). */
+typedef struct {
+    gen_scratch s;
+    double *T0, *a0, *d, *ystart, *qd;
+    int64_t *cc, *cp;
+    int factored; /* C's factors are those of y0's positions */
+} perturber;
+
+static void perturber_free(perturber *e) {
+    free(e->T0), free(e->cc);
+    scratch_free(&e->s);
+}
+
+static int perturber_new(perturber *e, const mb_model *md, const mb_unknowns *u, mb_work *w,
+                         double t, const double *y0, int64_t nq, const int64_t *Iq, int64_t nc,
+                         const int64_t *cols) {
+    if (scratch_new(&e->s, md, u, nq, nc, cols) < 0) return -1;
+    int64_t N = nc, n = md->n, nq1 = nq > 0 ? nq : 1, N1 = N > 0 ? N : 1;
+    e->T0 = malloc(sizeof(double) * (size_t)(N * nq1 + 2 * N1 + 13 * (n > 0 ? n : 1) + nq1));
+    e->cc = malloc(sizeof(int64_t) * (size_t)(2 * nq1));
+    if (e->T0 == NULL || e->cc == NULL) {
+        free(e->T0), free(e->cc);
+        scratch_free(&e->s);
+        return -1;
+    }
+    e->a0 = e->T0 + N * nq, e->d = e->a0 + N1, e->ystart = e->d + N1;
+    e->qd = e->ystart + 13 * (n > 0 ? n : 1), e->cp = e->cc + nq1;
+    mb_eval_all(md, w, t);
+    memcpy(e->s.y, y0, sizeof(double) * 13 * n);
+    memcpy(e->ystart, y0, sizeof(double) * 13 * n);
+    if (factor(md, u, w, &e->s, nq, Iq, e->cc, e->cp, NULL) < 0.0) {
+        perturber_free(e);
+        return -1;
+    }
+    transformation(&e->s, nq, e->T0, 1); /* by columns */
+    e->factored = 1;
+    return 0;
+}
+
+/* f (nq) with the positions moved by dq and the rates by du (nq each), or, dq NULL, by hq
+ * along coordinate j alone and the rate of j by hu (the same numbers as those vectors). */
+static void perturbed_f(perturber *e, const mb_model *md, const mb_unknowns *u, mb_work *w,
+                        const double *lam, const int64_t *Iq, const double *qdot0,
+                        const double *dq, const double *du, int64_t j, double hq, double hu,
+                        double *f) {
+    gen_scratch *s = &e->s;
+    int64_t N = s->N, nq = s->nq;
+    int moved = 0;
+    if (dq != NULL)
+        for (int64_t k = 0; k < nq; k++) moved |= dq[k] != 0.0;
+    else
+        moved = hq != 0.0;
+    if (moved || !e->factored) {
+        /* d = T0 dq, T0 by columns: each d_i sums over k in order, as a row times dq */
+        for (int64_t i = 0; i < N; i++) e->d[i] = 0.0;
+        if (dq != NULL) {
+            for (int64_t k = 0; k < nq; k++)
+                for (int64_t i = 0; i < N; i++) e->d[i] += e->T0[k * N + i] * dq[k];
+        } else if (moved) {
+            for (int64_t i = 0; i < N; i++) e->d[i] += e->T0[j * N + i] * hq;
+        }
+        move(md, s, e->ystart, e->d, s->y);
+        factor(md, u, w, s, nq, Iq, e->cc, e->cp, NULL);
+        e->factored = !moved;
+    }
+    for (int64_t k = 0; k < nq; k++)
+        e->qd[k] = qdot0[k] + (du != NULL ? du[k] : k == j ? hu : 0.0);
+    forces(md, u, w, s, nq, Iq, e->qd, lam, NULL, e->a0, f);
+}
+
 int mb_generalized_perturbed(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
                              const double *y0, const double *lam, int64_t nq,
                              const int64_t *Iq, int64_t nc, const int64_t *cols,
                              const double *qdot0, int64_t np, const double *P, double *fout) {
+    perturber e;
+    if (perturber_new(&e, md, u, w, t, y0, nq, Iq, nc, cols) < 0) return -1;
+    for (int64_t p = 0; p < np; p++) {
+        const double *dq = P + 2 * nq * p, *du = dq + nq;
+        perturbed_f(&e, md, u, w, lam, Iq, qdot0, dq, du, 0, 0.0, 0.0, fout + nq * p);
+    }
+    perturber_free(&e);
+    return 0;
+}
+
+int mb_independence(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
+                    const double *y, int64_t nq, const int64_t *Iq, int64_t nc,
+                    const int64_t *cols, const double *colscale, double *out) {
     gen_scratch s;
     if (scratch_new(&s, md, u, nq, nc, cols) < 0) return -1;
-    int64_t N = nc, n = md->n, nq1 = nq > 0 ? nq : 1, cc[nq1], cp[nq1];
-    double *buf = malloc(sizeof(double) * (size_t)(N * nq1 + 3 * (N > 0 ? N : 1) + 13 * (n > 0 ? n : 1)));
-    if (buf == NULL) {
+    int64_t N = nc, n = md->n, r = s.r, nq1 = nq > 0 ? nq : 1, cc[nq1], cp[nq1];
+    double *g = malloc(sizeof(double) * (size_t)((r > N ? r : N) + r + 1));
+    if (g == NULL) {
         scratch_free(&s);
         return -1;
     }
-    double *T0 = buf, *a0 = T0 + N * nq + N, *d = a0 + N, *ystart = d + N;
-    double qd[nq1];
+    double *rownorm = g + (r > N ? r : N);
+    memcpy(s.y, y, sizeof(double) * 13 * n);
     mb_eval_all(md, w, t);
-    memcpy(s.y, y0, sizeof(double) * 13 * n);
-    memcpy(ystart, y0, sizeof(double) * 13 * n);
-    factor(md, u, w, &s, nq, Iq, cc, cp, NULL);
-    transformation(&s, nq, T0);
-    int factored = 1; /* C's factors are those of y0's positions */
-    for (int64_t p = 0; p < np; p++) {
-        const double *dq = P + 2 * nq * p, *du = dq + nq;
-        int moved = 0;
-        for (int64_t k = 0; k < nq; k++) moved |= dq[k] != 0.0;
-        if (moved || !factored) {
-            for (int64_t i = 0; i < N; i++) {
-                double x = 0.0;
-                for (int64_t k = 0; k < nq; k++) x += T0[i * nq + k] * dq[k];
-                d[i] = x;
-            }
-            move(md, &s, ystart, d, s.y);
-            factor(md, u, w, &s, nq, Iq, cc, cp, NULL);
-            factored = !moved;
-        }
-        for (int64_t k = 0; k < nq; k++) qd[k] = qdot0[k] + du[k];
-        forces(md, u, w, &s, nq, Iq, qd, lam, NULL, a0, fout + nq * p);
+    double ratio = factor(md, u, w, &s, nq, Iq, cc, cp, NULL);
+    if (ratio < 0.0) {
+        free(g);
+        scratch_free(&s);
+        return -1;
     }
-    free(buf);
+    out[r] = r == N ? ratio : 0.0;
+    for (int64_t i = 0; i < r; i++) out[i] = 0.0;
+    if (r == N && ratio > 0.0) {
+        /* |(C S)_i| from the rows as factor put them (C's columns are scaled since: undo) */
+        for (int64_t i = 0; i < r; i++) rownorm[i] = 0.0;
+        for (int64_t i = 0; i < r; i++) {
+            double row[12];
+            int64_t c, p;
+            if (i < s.mu) {
+                int64_t comp = u->U[i], j = md->comps_i[4 * comp];
+                memcpy(row, w->child6 + 6 * comp, 6 * sizeof(double));
+                memcpy(row + 6, w->parent6 + 6 * comp, 6 * sizeof(double));
+                c = md->joints_i[3 * j + 1], p = md->joints_i[3 * j];
+            } else {
+                memcpy(row, s.arow + 12 * (i - s.mu), 12 * sizeof(double));
+                c = cc[i - s.mu], p = cp[i - s.mu];
+            }
+            for (int side = 0; side < 2; side++) {
+                int64_t b = side ? p : c;
+                if (b < 0) continue;
+                for (int a = 0; a < 6; a++) {
+                    int64_t j = s.col_of[6 * b + a];
+                    if (j >= 0) rownorm[i] += row[6 * side + a] * colscale[j] * row[6 * side + a] * colscale[j];
+                }
+            }
+            rownorm[i] = sqrt(rownorm[i]);
+        }
+        for (int64_t i = 0; i < r; i++) { /* column i of C^-1, in the scaled units */
+            for (int64_t k = 0; k < r; k++) g[k] = k == i;
+            qr_solve(&s, g);
+            double sum = 0.0;
+            for (int64_t k = 0; k < N; k++) sum += (g[k] / colscale[k]) * (g[k] / colscale[k]);
+            double norm = rownorm[i] * sqrt(sum);
+            out[i] = norm > 0.0 ? 1.0 / norm : 0.0;
+        }
+    }
+    free(g);
     scratch_free(&s);
     return 0;
 }
@@ -631,123 +929,100 @@ int mb_coordinate_rows(const mb_model *md, mb_work *w, double t, const double *y
     return 0;
 }
 
-/* f at y0's positions moved by +-scale h_j along coordinate j, for each j with want[j]:
- * into fl + (3 j + level) 2 nq (the + step's f, then the - step's). */
-static int steps_at(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
-                    const double *y0, const double *lam, int64_t nq, const int64_t *Iq,
-                    int64_t nc, const int64_t *cols, const double *qdot0, const double *h,
-                    const int *want, int level, double scale, double *fl) {
-    int64_t count = 0, n2 = 2 * nq;
-    for (int64_t j = 0; j < nq; j++) count += want[j] ? 1 : 0;
-    if (count == 0) return 0;
-    double *P = calloc((size_t)(2 * count * n2 + 2 * count * nq), sizeof(double));
-    if (P == NULL) return -1;
-    double *f = P + 2 * count * n2;
-    int64_t row = 0;
-    for (int64_t j = 0; j < nq; j++) {
-        if (!want[j]) continue;
-        P[row * n2 + j] = scale * h[j];
-        P[(row + 1) * n2 + j] = -scale * h[j];
-        row += 2;
-    }
-    int status = mb_generalized_perturbed(md, u, w, t, y0, lam, nq, Iq, nc, cols, qdot0,
-                                          2 * count, P, f);
-    row = 0;
-    for (int64_t j = 0; j < nq && status == 0; j++) {
-        if (!want[j]) continue;
-        memcpy(fl + (3 * j + level) * n2, f + row * nq, sizeof(double) * (size_t)n2);
-        row += 2;
-    }
-    free(P);
-    return status;
-}
-
 int mb_differences(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
                    const double *y0, const double *lam, int64_t nq, const int64_t *Iq,
                    int64_t nc, const int64_t *cols, const double *qdot0, const double *h,
                    const double *hu, const double *fscale, const double *f0, double rounding,
-                   const int64_t *skip, double *out) {
-    int64_t n2 = 2 * nq, nq1 = nq > 0 ? nq : 1;
-    /* f at +-h (the rates' rows too: they reuse one factorisation), then +-h/2 where the
-     * +-h ones are not flat, then +-h/4 where the differences at h and h/2 disagree */
-    double *fl = calloc((size_t)(3 * nq1 * n2 + n2 * nq1 + n2 * n2 + 1), sizeof(double));
-    int *want = calloc((size_t)(3 * nq1), sizeof(int));
-    if (fl == NULL || want == NULL) {
-        free(fl), free(want);
+                   const int64_t *skip, const mb_progress *progress, double *out) {
+    /* a column at a time (memory: a few vectors of nq): the rates' first, all at y0's
+     * positions (one factorisation); then each position's f at +-h, at +-h/2 unless the
+     * +-h ones are flat, at +-h/4 where the differences at h and h/2 disagree */
+    int64_t nq1 = nq > 0 ? nq : 1, kk = nq * nq;
+    double *fl = malloc(sizeof(double) * (size_t)(6 * nq1));
+    perturber e;
+    if (fl == NULL) return -1;
+    if (nq > 0 && perturber_new(&e, md, u, w, t, y0, nq, Iq, nc, cols) < 0) {
+        free(fl);
         return -1;
     }
-    double *fu = fl + 3 * nq * n2, *P = fu + n2 * nq;
-    int *flat = want + nq1, *third = flat + nq1;
-    for (int64_t j = 0; j < nq; j++) {
-        P[(2 * j) * n2 + nq + j] = hu[j];
-        P[(2 * j + 1) * n2 + nq + j] = -hu[j];
-        want[j] = !skip[j];
-    }
-    int status = nq > 0 ? mb_generalized_perturbed(md, u, w, t, y0, lam, nq, Iq, nc, cols,
-                                                   qdot0, 2 * nq, P, fu) : 0;
-    if (status == 0) status = steps_at(md, u, w, t, y0, lam, nq, Iq, nc, cols, qdot0, h, want,
-                                       0, 1.0, fl);
-    /* flat: f at +-h equals f at the state within one evaluation's rounding in every row
-     * (a coordinate the forces do not depend on: a body's position under uniform
-     * gravity, a cyclic spin); its column is its central difference */
-    for (int64_t j = 0; j < nq && status == 0; j++) {
-        flat[j] = 0;
-        if (skip[j] || f0 == NULL) continue;
-        const double *fp = fl + 3 * j * n2, *fm = fp + nq;
-        int same = 1;
-        for (int64_t i = 0; i < nq && same; i++) {
-            double tol = 4.0 * rounding * fscale[i];
-            same = fabs(fp[i] - f0[i]) <= tol && fabs(fm[i] - f0[i]) <= tol;
+    double *K = out, *Kerr = K + kk, *D = Kerr + kk, *Derr = D + kk;
+    int status = 0;
+    for (int64_t j = 0; j < nq && status == 0; j++) { /* D = -df/dq', exact for quadratic f */
+        if (mb_report(progress, MB_STAGE_DAMPING, j, nq)) {
+            status = MB_STOPPED;
+            break;
         }
-        flat[j] = same;
-        want[j] = !skip[j] && !same;
-    }
-    if (status == 0) status = steps_at(md, u, w, t, y0, lam, nq, Iq, nc, cols, qdot0, h, want,
-                                       1, 0.5, fl);
-    /* a column whose two differences agree within their rounding has nothing left for a
-     * third step to extrapolate away (a coordinate the forces depend on linearly): it
-     * stops at one extrapolation */
-    for (int64_t j = 0; j < nq && status == 0; j++) {
-        third[j] = 0;
-        if (!want[j]) continue;
-        const double *fj = fl + 3 * j * n2;
-        for (int64_t i = 0; i < nq && !third[j]; i++) {
-            double d0 = (fj[i] - fj[nq + i]) / (2.0 * h[j]);
-            double d1 = (fj[2 * nq + i] - fj[3 * nq + i]) / (1.0 * h[j]);
-            third[j] = !(fabs(d0 - d1) <= 4.0 * rounding * fscale[i] / (0.25 * h[j]));
-        }
-    }
-    if (status == 0) status = steps_at(md, u, w, t, y0, lam, nq, Iq, nc, cols, qdot0, h, third,
-                                       2, 0.25, fl);
-    double *K = out, *Kerr = K + nq * nq, *D = Kerr + nq * nq, *Derr = D + nq * nq;
-    for (int64_t j = 0; j < nq && status == 0; j++) {
-        const double *fj = fl + 3 * j * n2, *fr = fu + 2 * j * nq;
+        perturbed_f(&e, md, u, w, lam, Iq, qdot0, NULL, NULL, j, 0.0, hu[j], fl);
+        perturbed_f(&e, md, u, w, lam, Iq, qdot0, NULL, NULL, j, 0.0, -hu[j], fl + nq);
         for (int64_t i = 0; i < nq; i++) {
-            double round_err = 4.0 * rounding * fscale[i] / (0.25 * h[j]);
-            double d0 = (fj[0 * nq + i] - fj[1 * nq + i]) / (2.0 * h[j]);
-            if (skip[j]) {
-                K[i * nq + j] = Kerr[i * nq + j] = 0.0;
-            } else if (flat[j]) {
-                K[i * nq + j] = -d0;
-                Kerr[i * nq + j] = fabs(d0) + round_err;
-            } else {
-                double d1 = (fj[2 * nq + i] - fj[3 * nq + i]) / (1.0 * h[j]);
+            D[i * nq + j] = -(fl[i] - fl[nq + i]) / (2.0 * hu[j]);
+            double big = fmax(fscale[i], fmax(fabs(fl[i]), fabs(fl[nq + i])));
+            Derr[i * nq + j] = 4.0 * rounding * big / hu[j];
+        }
+    }
+    for (int64_t j = 0; j < nq && status == 0; j++) {
+        if (mb_report(progress, MB_STAGE_STIFFNESS, j, nq)) {
+            status = MB_STOPPED;
+            break;
+        }
+        if (skip[j]) {
+            for (int64_t i = 0; i < nq; i++) K[i * nq + j] = Kerr[i * nq + j] = 0.0;
+            continue;
+        }
+        /* fl: [f(+h), f(-h), f(+h/2), f(-h/2), f(+h/4), f(-h/4)] */
+        for (int level = 0; level < 3; level++) {
+            double step = h[j] / (double)(1 << level);
+            perturbed_f(&e, md, u, w, lam, Iq, qdot0, NULL, NULL, j, step, 0.0,
+                        fl + 2 * level * nq);
+            perturbed_f(&e, md, u, w, lam, Iq, qdot0, NULL, NULL, j, -step, 0.0,
+                        fl + (2 * level + 1) * nq);
+            int more = 0;
+            if (level == 0) {
+                /* flat: f at +-h equals f at the state within one evaluation's rounding in
+                 * every row (a coordinate the forces do not depend on: a body's position
+                 * under uniform gravity, a cyclic spin); its column is its central
+                 * difference */
+                int same = f0 != NULL;
+                for (int64_t i = 0; i < nq && same; i++) {
+                    double tol = 4.0 * rounding * fscale[i];
+                    same = fabs(fl[i] - f0[i]) <= tol && fabs(fl[nq + i] - f0[i]) <= tol;
+                }
+                more = !same;
+            } else if (level == 1) {
+                /* a column whose two differences agree within their rounding has nothing
+                 * left for a third step to extrapolate away (a coordinate the forces
+                 * depend on linearly): it stops at one extrapolation */
+                for (int64_t i = 0; i < nq && !more; i++) {
+                    double d0 = (fl[i] - fl[nq + i]) / (2.0 * h[j]);
+                    double d1 = (fl[2 * nq + i] - fl[3 * nq + i]) / (1.0 * h[j]);
+                    more = !(fabs(d0 - d1) <= 4.0 * rounding * fscale[i] / (0.25 * h[j]));
+                }
+            }
+            for (int64_t i = 0; i < nq; i++) {
+                double round_err = 4.0 * rounding * fscale[i] / (0.25 * h[j]);
+                double d0 = (fl[i] - fl[nq + i]) / (2.0 * h[j]);
+                if (level == 0 && !more) { /* flat */
+                    K[i * nq + j] = -d0;
+                    Kerr[i * nq + j] = fabs(d0) + round_err;
+                    continue;
+                }
+                if (level == 0) continue;
+                double d1 = (fl[2 * nq + i] - fl[3 * nq + i]) / (1.0 * h[j]);
                 double r1 = (4.0 * d1 - d0) / 3.0;
-                if (third[j]) {
-                    double d2 = (fj[4 * nq + i] - fj[5 * nq + i]) / (0.5 * h[j]);
+                if (level == 2) {
+                    double d2 = (fl[4 * nq + i] - fl[5 * nq + i]) / (0.5 * h[j]);
                     double r2 = (4.0 * d2 - d1) / 3.0;
                     K[i * nq + j] = -(16.0 * r2 - r1) / 15.0;
                     Kerr[i * nq + j] = fabs(r1 - r2) / 15.0 + round_err;
-                } else { /* |d0 - d1| within rounding: d1's truncation is below it too */
+                } else if (!more) { /* |d0 - d1| within rounding: d1's truncation too */
                     K[i * nq + j] = -r1;
                     Kerr[i * nq + j] = fabs(d0 - d1) + round_err;
                 }
             }
-            D[i * nq + j] = -(fr[i] - fr[nq + i]) / (2.0 * hu[j]);
-            double big = fmax(fscale[i], fmax(fabs(fr[i]), fabs(fr[nq + i])));
-            Derr[i * nq + j] = 4.0 * rounding * big / hu[j];
+            if (!more) break;
         }
     }
-    free(fl), free(want);
+    if (nq > 0) perturber_free(&e);
+    free(fl);
     return status;
 }

@@ -58,6 +58,11 @@ struct mb_work {
     mb_ns *ns;
 };
 
+/* Reports a step of a long call (kernel.h, mb_progress): nonzero means stop. */
+static inline int mb_report(const mb_progress *p, int stage, int64_t done, int64_t total) {
+    return p != NULL && p->report != NULL ? p->report(p->ctx, stage, done, total) : 0;
+}
+
 /* spatial.c */
 void mb_rotations(int64_t n, const double *q, double *R);
 void mb_minv(const double *body, const double *g, double *out);

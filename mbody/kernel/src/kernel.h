@@ -264,6 +264,22 @@ int mb_energy_samples(const mb_model *md, const mb_unknowns *u, mb_work *w,
                       int64_t stride, double *ACC, double *ENERGY);
 
 /* ---------------------------------------------------------------------------------------
+ * The progress of a long call (the linearisation of a large model): report(ctx, stage,
+ * done, total) is called before each step of its loops (a column of the differences, a
+ * row of the first-order system, an eigenvalue), a few thousand times for a model of a
+ * thousand coordinates and a handful for a small one; a nonzero return stops the call,
+ * which then returns MB_STOPPED (its output is not to be used). NULL: not reported.
+ * ------------------------------------------------------------------------------------- */
+typedef struct {
+    int (*report)(void *ctx, int stage, int64_t done, int64_t total);
+    void *ctx;
+} mb_progress;
+enum { MB_STAGE_GENERALIZED = 0, MB_STAGE_DAMPING = 1, MB_STAGE_STIFFNESS = 2,
+       MB_STAGE_SYSTEM = 3, MB_STAGE_HESSENBERG = 4, MB_STAGE_SCHUR = 5, MB_STAGE_VECTORS = 6,
+       MB_STAGES = 7 };
+enum { MB_STOPPED = -2 };
+
+/* ---------------------------------------------------------------------------------------
  * Generalized coordinates (generalized.c). A coordinate is a rate row a_k^T v, Iq
  * (nq x MB_GQ_W) [kind, index, axis, rule]:
  *   MB_GQ_TURN        joint `index`'s turn about its joint-frame axis `axis` (fixed in the
@@ -308,6 +324,14 @@ int mb_coordinate_rows(const mb_model *md, mb_work *w, double t, const double *y
 int mb_generalized(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
                    const double *y, const double *lam, int64_t nq, const int64_t *Iq,
                    int64_t nc, const int64_t *cols, const double *qdot, double *out);
+/* How far each of the rows of B = D_r [G_U^T; A^T] S (S = diag(colscale), D_r scaling each
+ * row to unit length) is from the span of the others, for a square B: out (r + 1) [d_i =
+ * 1 / |B^-1 e_i| (0: B singular) | the pivot ratio of mb_generalized's QR (0: B not square
+ * or singular)], at the band's cost per row. A lower bound on B's smallest singular value
+ * is 1 / sqrt(sum 1 / d_i^2). Returns 0, or -1 when memory ran out. */
+int mb_independence(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
+                    const double *y, int64_t nq, const int64_t *Iq, int64_t nc,
+                    const int64_t *cols, const double *colscale, double *out);
 /* f_q at np perturbed states, P (np x 2 nq) rows [dq | du]: the positions of y0 moved along
  * v = T(y0) dq for a unit time (x + v, q (x) exp(w / 2)), the rates q0' + du: fout (np x
  * nq). For the linearisation's differences (its curves have the tangents T e_k). */
@@ -327,12 +351,13 @@ int mb_generalized_perturbed(const mb_model *md, const mb_unknowns *u, mb_work *
  * A coordinate with skip[j] != 0 is known not to enter f (a free body's position without
  * springs...): its K column is 0 without evaluations.
  * out: [K | K_err | D | D_err], each nq x nq (row i: the equation, column j: the
- * coordinate). Returns 0, or -1 when memory ran out. */
+ * coordinate), a column at a time (D's, then K's: MB_STAGE_DAMPING, MB_STAGE_STIFFNESS
+ * reported before each). Returns 0, MB_STOPPED, or -1 when memory ran out. */
 int mb_differences(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
                    const double *y0, const double *lam, int64_t nq, const int64_t *Iq,
                    int64_t nc, const int64_t *cols, const double *qdot0, const double *h,
                    const double *hu, const double *fscale, const double *f0, double rounding,
-                   const int64_t *skip, double *out);
+                   const int64_t *skip, const mb_progress *progress, double *out);
 /* The linearisation about (t, y) (linearize.c): mb_generalized there, mb_differences with
  * steps params[MB_LP_STEP] x scales (positions) and the rates' scale (rates), the residual
  * q'' = M^-1 f, steadiness (every |f_i| <= params[MB_LP_STEADY] f_scale_i, and no moving
@@ -349,10 +374,15 @@ int mb_differences(const mb_model *md, const mb_unknowns *u, mb_work *w, double 
  * K | K_err | D | D_err (nq x nq each) | q'' (nq) | left out (nq, 0/1) | A (nz x nz in a
  * slot of (2 nq)^2) | info (MB_LINEARIZE_INFO) | spectrum (of nz, in a slot of
  * 6 nq + 8 nq^2) | modes (of nz, in a slot of 12 nq + 4 nq^2) | the OSCILLATIONS modes'
- * frequencies, then their damping ratios (in a slot of 4 nq)], nz = kept + nq. Returns
- * 0, or -1 when memory ran out. */
+ * frequencies, then their damping ratios (in a slot of 4 nq)], nz = kept + nq.
+ * params[MB_LP_STOP]: MB_STOP_STIFFNESS stops once K, D, q'' and the left-out flags are
+ * made (info's STEADY, UNSTEADY, RESTING, KEPT and SINGULAR set: what a Newton step for an
+ * equilibrium needs, without A and its O(nz^3) spectrum); MB_STOP_SYSTEM once A and its
+ * info (TOL, DA, NORM) are (the caller finds the spectrum: LAPACK's, for a large A). Its
+ * stages are reported (MB_STAGE_*). Returns 0, MB_STOPPED, or -1 when memory ran out. */
 enum { MB_LP_STEP = 0, MB_LP_ROUNDING = 1, MB_LP_STEADY = 2, MB_LP_MOVING = 3,
-       MB_LINEARIZE_PARAMS = 4 };
+       MB_LP_STOP = 4, MB_LINEARIZE_PARAMS = 5 };
+enum { MB_STOP_NONE = 0, MB_STOP_STIFFNESS = 1, MB_STOP_SYSTEM = 2 };
 enum { MB_LI_STEADY = 0, MB_LI_UNSTEADY = 1, MB_LI_TOL = 2, MB_LI_KEPT = 3,
        MB_LI_SINGULAR = 4, MB_LI_DA = 5, MB_LI_NORM = 6, MB_LI_RESTING = 7,
        MB_LI_GROWING = 8, MB_LI_MODES = 9, MB_LI_UNCONVERGED = 10, MB_LI_OSCILLATIONS = 11,
@@ -360,7 +390,8 @@ enum { MB_LI_STEADY = 0, MB_LI_UNSTEADY = 1, MB_LI_TOL = 2, MB_LI_KEPT = 3,
 int mb_linearize(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
                  const double *y, const double *lam, int64_t nq, const int64_t *Iq,
                  int64_t nc, const int64_t *cols, const double *scales, const int64_t *quasi,
-                 const int64_t *skip, const double *params, double *out);
+                 const int64_t *skip, const double *params, const mb_progress *progress,
+                 double *out);
 
 /* spectrum.c: the eigenvalues of the real n x n matrix A (row-major), by real part then
  * imaginary part, with unit right eigenvectors (largest entry real and positive) and a
@@ -368,9 +399,11 @@ int mb_linearize(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
  * number |x| |y| / |y^H x|, dA the bound on A's error), at most tol, at least
  * 1e3 eps |A|_inf (tol where kappa dA is not finite: a Jordan block). out (float64,
  * 2 n + 2 n^2 + n): [eigenvalues (n complex, interleaved re, im) | V (n x n complex,
- * row-major, column k the k-th eigenvalue's vector) | bounds (n)]. Returns 0, 1 when the
- * QR iteration did not converge, or -1 when memory ran out. */
-int mb_spectrum(const double *A, int64_t n, double dA, double tol, double *out);
+ * row-major, column k the k-th eigenvalue's vector) | bounds (n)]. Its stages are reported
+ * (MB_STAGE_HESSENBERG, MB_STAGE_SCHUR: eigenvalues found, MB_STAGE_VECTORS). Returns 0, 1
+ * when the QR iteration did not converge, MB_STOPPED, or -1 when memory ran out. */
+int mb_spectrum(const double *A, int64_t n, double dA, double tol,
+                const mb_progress *progress, double *out);
 /* The modes of a spectrum (mb_spectrum's out, n eigenvalues) of a linearisation with k
  * coordinates, nk of them kept (their indices in kept; z = (their delta q, all delta q')):
  * one of each conjugate pair, classified as neutral (|lambda| within its bound: a free or

@@ -29,7 +29,8 @@ static int cholesky(const double *A, int64_t k, double *L) {
 int mb_linearize(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
                  const double *y, const double *lam, int64_t nq, const int64_t *Iq,
                  int64_t nc, const int64_t *cols, const double *scales, const int64_t *quasi,
-                 const int64_t *skip, const double *params, double *out) {
+                 const int64_t *skip, const double *params, const mb_progress *progress,
+                 double *out) {
     int64_t k = nq, N = nc, kk = k * k;
     double step = params[MB_LP_STEP], rounding = params[MB_LP_ROUNDING];
     double steady_rtol = params[MB_LP_STEADY], moving_rtol = params[MB_LP_MOVING];
@@ -38,6 +39,7 @@ int mb_linearize(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
     double *K = gen + ngen, *Kerr = K + kk, *D = Kerr + kk, *Derr = D + kk;
     double *resid = Derr + kk, *left = resid + k, *A = left + k, *info = A + 4 * kk;
     memset(info, 0, sizeof(double) * MB_LINEARIZE_INFO);
+    if (mb_report(progress, MB_STAGE_GENERALIZED, 0, 1)) return MB_STOPPED;
     if (mb_generalized(md, u, w, t, y, lam, nq, Iq, nc, cols, NULL, gen) < 0) return -1;
     const double *M = gen + N * k + 2 * N, *f = M + kk, *qd = f + 2 * k, *F = qd + k;
     const double *ginfo = F + k;
@@ -46,9 +48,9 @@ int mb_linearize(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
         info[MB_LI_STEADY] = info[MB_LI_RESTING] = k == 0;
         return 0;
     }
-    double *buf = malloc(sizeof(double) * (size_t)(2 * kk + 4 * k));
+    double *buf = malloc(sizeof(double) * (size_t)(2 * kk + 6 * k));
     if (buf == NULL) return -1;
-    double *L = buf, *Minv = L + kk, *h = Minv + kk, *hu = h + k, *x = hu + k;
+    double *L = buf, *Minv = L + kk, *h = Minv + kk, *hu = h + k, *x = hu + k, *acc = x + k;
     if (cholesky(M, k, L) < 0) {
         info[MB_LI_SINGULAR] = 1.0;
         free(buf);
@@ -66,10 +68,11 @@ int mb_linearize(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
      * QR: its pivot ratio bounds the condition from below; the factor is what its
      * backward stability allows) */
     rounding /= fmax(ginfo[MB_GI_RANK], 1e-8);
-    if (mb_differences(md, u, w, t, y, lam, nq, Iq, nc, cols, qd, h, hu, F, f, rounding,
-                       skip, K) < 0) {
+    int status = mb_differences(md, u, w, t, y, lam, nq, Iq, nc, cols, qd, h, hu, F, f,
+                                rounding, skip, progress, K);
+    if (status < 0) {
         free(buf);
-        return -1;
+        return status;
     }
     /* q'' = M^-1 f; steady when every f_i is below steady_rtol of its terms */
     int steady = 1;
@@ -97,19 +100,57 @@ int mb_linearize(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
         if (moving && !cyclic && unsteady == 0) unsteady = j + 1;
     }
     if (unsteady) steady = 0;
+    if (params[MB_LP_STOP] == MB_STOP_STIFFNESS) { /* K and what comes with it only */
+        info[MB_LI_STEADY] = steady;
+        info[MB_LI_UNSTEADY] = (double)unsteady;
+        info[MB_LI_KEPT] = (double)nk;
+        free(buf);
+        return 0;
+    }
     /* A = [[0, E], [-M^-1 K_kept, -M^-1 D]] (nz = nk + k); tolerance sqrt(dA |A|) */
     int64_t nz = nk + k;
     memset(A, 0, sizeof(double) * nz * nz);
-    for (int64_t j = 0; j < k; j++) { /* M^-1 column by column */
-        for (int64_t i = 0; i < k; i++) x[i] = i == j;
-        mb_cho_solve_dense(L, k, k, x);
-        for (int64_t i = 0; i < k; i++) Minv[i * k + j] = x[i];
+    /* M^-1 = L^-T L^-1 I, every column at once: row i of Minv is updated by whole rows,
+     * each entry by the same operations in the same order as mb_cho_solve_dense on its
+     * column (so the same numbers), the forward pass skipping the zeros above the
+     * diagonal of L^-1 */
+    for (int64_t i = 0; i < k; i++) {
+        if (mb_report(progress, MB_STAGE_SYSTEM, i, 3 * k)) {
+            free(buf);
+            return MB_STOPPED;
+        }
+        double *row = Minv + i * k;
+        for (int64_t c = 0; c < k; c++) row[c] = i == c;
+        for (int64_t p = 0; p < i; p++) {
+            double l = L[i * k + p];
+            const double *above = Minv + p * k;
+            for (int64_t c = 0; c <= i; c++) row[c] -= l * above[c];
+        }
+        for (int64_t c = 0; c <= i; c++) row[c] /= L[i * k + i];
+    }
+    for (int64_t i = k - 1; i >= 0; i--) {
+        if (mb_report(progress, MB_STAGE_SYSTEM, 2 * k - 1 - i, 3 * k)) {
+            free(buf);
+            return MB_STOPPED;
+        }
+        double *row = Minv + i * k;
+        for (int64_t p = i + 1; p < k; p++) {
+            double l = L[p * k + i];
+            const double *below = Minv + p * k;
+            for (int64_t c = 0; c < k; c++) row[c] -= l * below[c];
+        }
+        for (int64_t c = 0; c < k; c++) row[c] /= L[i * k + i];
     }
     int64_t r = 0;
     for (int64_t j = 0; j < k; j++)
         if (!left[j]) A[r * nz + nk + j] = 1.0, r++;
     double minv = 0.0, errK = 0.0, errD = 0.0;
+    double *sk = acc, *sd = h; /* h's and hu's 2 k doubles are free now */
     for (int64_t i = 0; i < k; i++) {
+        if (mb_report(progress, MB_STAGE_SYSTEM, 2 * k + i, 3 * k)) {
+            free(buf);
+            return MB_STOPPED;
+        }
         double a = 0.0, b = 0.0, c = 0.0;
         for (int64_t j = 0; j < k; j++) {
             a += fabs(Minv[i * k + j]);
@@ -117,16 +158,20 @@ int mb_linearize(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
             c += fabs(Derr[i * k + j]);
         }
         minv = fmax(minv, a), errK = fmax(errK, b), errD = fmax(errD, c);
+        /* row i of M^-1 K and M^-1 D, by whole rows of K and D (each sum over p in the
+         * same order as a dot product of a row and a column would take it) */
+        for (int64_t j = 0; j < k; j++) sk[j] = 0.0, sd[j] = 0.0;
+        for (int64_t p = 0; p < k; p++) {
+            double m = Minv[i * k + p];
+            const double *Kp = K + p * k, *Dp = D + p * k;
+            for (int64_t j = 0; j < k; j++) sk[j] += m * Kp[j];
+            for (int64_t j = 0; j < k; j++) sd[j] += m * Dp[j];
+        }
         double *row = A + (nk + i) * nz;
         int64_t col = 0;
         for (int64_t j = 0; j < k; j++) {
-            double sk = 0.0, sd = 0.0;
-            for (int64_t p = 0; p < k; p++) {
-                sk += Minv[i * k + p] * K[p * k + j];
-                sd += Minv[i * k + p] * D[p * k + j];
-            }
-            if (!left[j]) row[col++] = -sk;
-            row[nk + j] = -sd;
+            if (!left[j]) row[col++] = -sk[j];
+            row[nk + j] = -sd[j];
         }
     }
     double nA = 0.0;
@@ -142,15 +187,19 @@ int mb_linearize(const mb_model *md, const mb_unknowns *u, mb_work *w, double t,
     info[MB_LI_KEPT] = (double)nk;
     info[MB_LI_DA] = minv * (errK + errD);
     info[MB_LI_NORM] = nA;
+    if (params[MB_LP_STOP] == MB_STOP_SYSTEM) {
+        free(buf);
+        return 0;
+    }
     /* the spectrum of A and its modes, in the same call (the verdict needs them all) */
     double *spec = info + MB_LINEARIZE_INFO, *modes = spec + 6 * k + 8 * kk;
     int64_t *kept = (int64_t *)x; /* x's k doubles are free now */
     for (int64_t j = 0, c = 0; j < k; j++)
         if (!left[j]) kept[c++] = j;
-    int status = mb_spectrum(A, nz, info[MB_LI_DA], info[MB_LI_TOL], spec);
+    status = mb_spectrum(A, nz, info[MB_LI_DA], info[MB_LI_TOL], progress, spec);
     if (status != 0) {
         free(buf);
-        if (status < 0) return -1;
+        if (status < 0) return status;
         info[MB_LI_UNCONVERGED] = 1.0;
         return 0;
     }

@@ -60,6 +60,19 @@ static int check_nargs(Py_ssize_t nargs, Py_ssize_t want, const char *name) {
     return 0;
 }
 
+/* A long call's progress (kernel.h, mb_progress) in Python: ctx is a callable taking (stage,
+ * done, total), or NULL. Ctrl-C (a pending signal) or an exception from the callable stops
+ * the call; its error is then the one set. */
+static int report_progress(void *ctx, int stage, int64_t done, int64_t total) {
+    if (PyErr_CheckSignals() < 0) return 1;
+    if (ctx == NULL) return 0;
+    PyObject *r = PyObject_CallFunction((PyObject *)ctx, "iLL", stage, (long long)done,
+                                        (long long)total);
+    if (r == NULL) return 1;
+    Py_DECREF(r);
+    return 0;
+}
+
 /* -- Model --------------------------------------------------------------------------- */
 
 typedef struct {
@@ -806,6 +819,46 @@ y_:
     return NULL;
 }
 
+PyDoc_STRVAR(independence_doc,
+"independence(t, y, Iq, cols, colscale, out)\n\nHow far each row of B = D_r [G_U^T; A^T] S "
+"(S = diag(colscale), rows\nscaled to unit length) is from the span of the others, for a "
+"square B (kernel.h,\nmb_independence): out (r + 1) [1 / |B^-1 e_i| | the QR's pivot ratio], "
+"0 where B\nis singular or not square.");
+
+static PyObject *Unknowns_independence(UnknownsObject *self, PyObject *const *args,
+                                       Py_ssize_t nargs) {
+    Py_buffer y, Iq, cols, scale, out;
+    double t;
+    if (unknowns_ready(self) < 0 || check_nargs(nargs, 6, "independence") < 0 ||
+        get_double(args[0], &t, "t") < 0)
+        return NULL;
+    const mb_model *md = &self->model->md;
+    if (get_state(md, args[1], &y, 0, 0) < 0) return NULL;
+    if (get_coordinates(md, args[2], args[3], &Iq, &cols) < 0) {
+        PyBuffer_Release(&y);
+        return NULL;
+    }
+    Py_ssize_t nq = Iq.len / 8 / MB_GQ_W, N = cols.len / 8;
+    int ok = get_buffer(args[4], &scale, 0, 1, N, "colscale") == 0;
+    if (ok && get_buffer(args[5], &out, 1, 1, self->u.mu + nq + 1, "out") < 0) {
+        PyBuffer_Release(&scale);
+        ok = 0;
+    }
+    int status = 0;
+    if (ok) {
+        status = mb_independence(md, &self->u, self->w, t, y.buf, nq, Iq.buf, N, cols.buf,
+                                 scale.buf, out.buf);
+        PyBuffer_Release(&out);
+        PyBuffer_Release(&scale);
+    }
+    PyBuffer_Release(&cols);
+    PyBuffer_Release(&Iq);
+    PyBuffer_Release(&y);
+    if (!ok) return NULL;
+    if (status < 0) return PyErr_NoMemory();
+    Py_RETURN_NONE;
+}
+
 PyDoc_STRVAR(generalized_perturbed_doc,
 "generalized_perturbed(t, y, lam, Iq, cols, qdot, P, out)\n\nf_q at perturbed states "
 "(kernel.h, mb_generalized_perturbed): P (np x 2 nq) rows\n[dq | du]: y's positions moved "
@@ -882,6 +935,7 @@ static PyObject *Unknowns_differences(UnknownsObject *self, PyObject *const *arg
         return NULL;
     }
     Py_ssize_t nq = Iq.len / 8 / MB_GQ_W, N = cols.len / 8;
+    mb_progress signals = {report_progress, NULL};
     int got = 0, ok = 1;
     for (; got < 4; got++)
         if (get_buffer(args[5 + got], &v[got], 0, 1, nq, names[got]) < 0) break;
@@ -893,7 +947,7 @@ static PyObject *Unknowns_differences(UnknownsObject *self, PyObject *const *arg
     if (ok) {
         status = mb_differences(md, &self->u, self->w, t, y.buf, lam.buf, nq, Iq.buf, N,
                                 cols.buf, v[0].buf, v[1].buf, v[2].buf, v[3].buf, NULL,
-                                rounding, skip.buf, out.buf);
+                                rounding, skip.buf, &signals, out.buf);
         PyBuffer_Release(&out);
     }
     if (have_skip) PyBuffer_Release(&skip);
@@ -902,24 +956,35 @@ static PyObject *Unknowns_differences(UnknownsObject *self, PyObject *const *arg
     PyBuffer_Release(&Iq);
     PyBuffer_Release(&lam);
     PyBuffer_Release(&y);
-    if (!ok) return NULL;
+    if (!ok || status == MB_STOPPED) return NULL;
     if (status < 0) return PyErr_NoMemory();
     Py_RETURN_NONE;
 }
 
 PyDoc_STRVAR(linearize_doc,
-"linearize(t, y, lam, Iq, cols, scales, quasi, skip, params, out)\n\nThe linearisation "
-"about (t, y) (kernel.h, mb_linearize): out [generalized's out | K | K_err\n| D | D_err | "
-"q'' | left out | A ((2 nq)^2 slot) | info (LINEARIZE_INFO)]; scales (nq):\n1 or the model's "
-"length; quasi, skip (nq, int64); params (LINEARIZE_PARAMS).");
+"linearize(t, y, lam, Iq, cols, scales, quasi, skip, params, out, progress=None)\n\nThe "
+"linearisation about (t, y) (kernel.h, mb_linearize): out [generalized's out | K |\nK_err "
+"| D | D_err | q'' | left out | A ((2 nq)^2 slot) | info (LINEARIZE_INFO)]; scales\n(nq): 1 "
+"or the model's length; quasi, skip (nq, int64); params (LINEARIZE_PARAMS).\nprogress: "
+"called as progress(stage, done, total) before each step (STAGE_*);\nan exception it "
+"raises, or Ctrl-C, stops the call.");
 
 static PyObject *Unknowns_linearize(UnknownsObject *self, PyObject *const *args,
                                     Py_ssize_t nargs) {
     Py_buffer y, lam, Iq, cols, scales, quasi, skip, params, out;
     double t;
-    if (unknowns_ready(self) < 0 || check_nargs(nargs, 10, "linearize") < 0 ||
-        get_double(args[0], &t, "t") < 0)
+    if (unknowns_ready(self) < 0 || get_double(args[0], &t, "t") < 0) return NULL;
+    if (nargs != 10 && nargs != 11) {
+        PyErr_Format(PyExc_TypeError, "linearize() takes 10 or 11 arguments (%zd given)",
+                     nargs);
         return NULL;
+    }
+    PyObject *callback = nargs == 11 && args[10] != Py_None ? args[10] : NULL;
+    if (callback != NULL && !PyCallable_Check(callback)) {
+        PyErr_SetString(PyExc_TypeError, "progress: expected a callable or None");
+        return NULL;
+    }
+    mb_progress progress = {report_progress, callback};
     const mb_model *md = &self->model->md;
     if (get_state(md, args[1], &y, 0, 0) < 0) return NULL;
     if (get_buffer(args[2], &lam, 0, 1, md->m, "lam") < 0) {
@@ -943,7 +1008,7 @@ static PyObject *Unknowns_linearize(UnknownsObject *self, PyObject *const *args,
     if (stage == 4 && get_buffer(args[9], &out, 1, 1, size, "out") == 0) stage = 5;
     if (stage == 5) {
         status = mb_linearize(md, &self->u, self->w, t, y.buf, lam.buf, nq, Iq.buf, N, cols.buf,
-                              scales.buf, quasi.buf, skip.buf, params.buf, out.buf);
+                              scales.buf, quasi.buf, skip.buf, params.buf, &progress, out.buf);
         PyBuffer_Release(&out);
     }
     if (stage >= 4) PyBuffer_Release(&params);
@@ -954,7 +1019,7 @@ static PyObject *Unknowns_linearize(UnknownsObject *self, PyObject *const *args,
     PyBuffer_Release(&Iq);
     PyBuffer_Release(&lam);
     PyBuffer_Release(&y);
-    if (stage < 5) return NULL;
+    if (stage < 5 || status == MB_STOPPED) return NULL;
     if (status < 0) return PyErr_NoMemory();
     Py_RETURN_NONE;
 }
@@ -1296,6 +1361,8 @@ static PyMethodDef Unknowns_methods[] = {
     {"schur", (PyCFunction)(void (*)(void))Unknowns_schur, METH_FASTCALL, schur_doc},
     {"generalized", (PyCFunction)(void (*)(void))Unknowns_generalized, METH_FASTCALL,
      generalized_doc},
+    {"independence", (PyCFunction)(void (*)(void))Unknowns_independence, METH_FASTCALL,
+     independence_doc},
     {"generalized_perturbed", (PyCFunction)(void (*)(void))Unknowns_generalized_perturbed,
      METH_FASTCALL, generalized_perturbed_doc},
     {"differences", (PyCFunction)(void (*)(void))Unknowns_differences, METH_FASTCALL,
@@ -1379,9 +1446,11 @@ static PyObject *spectrum(PyObject *mod, PyObject *const *args, Py_ssize_t nargs
         PyBuffer_Release(&A);
         return NULL;
     }
-    int status = mb_spectrum(A.buf, n, dA, tol, out.buf);
+    mb_progress signals = {report_progress, NULL};
+    int status = mb_spectrum(A.buf, n, dA, tol, &signals, out.buf);
     PyBuffer_Release(&out);
     PyBuffer_Release(&A);
+    if (status == MB_STOPPED) return NULL;
     if (status < 0) return PyErr_NoMemory();
     return PyLong_FromLong(status);
 }
@@ -1479,7 +1548,10 @@ PyMODINIT_FUNC PyInit__core(void) {
         {"GI_RANK", MB_GI_RANK}, {"GI_RESIDUAL", MB_GI_RESIDUAL},
         {"GENERALIZED_INFO", MB_GENERALIZED_INFO},
         {"LP_STEP", MB_LP_STEP}, {"LP_ROUNDING", MB_LP_ROUNDING}, {"LP_STEADY", MB_LP_STEADY},
-        {"LP_MOVING", MB_LP_MOVING}, {"LINEARIZE_PARAMS", MB_LINEARIZE_PARAMS},
+        {"LP_MOVING", MB_LP_MOVING}, {"LP_STOP", MB_LP_STOP},
+        {"STOP_NONE", MB_STOP_NONE}, {"STOP_STIFFNESS", MB_STOP_STIFFNESS},
+        {"STOP_SYSTEM", MB_STOP_SYSTEM},
+        {"LINEARIZE_PARAMS", MB_LINEARIZE_PARAMS},
         {"LI_STEADY", MB_LI_STEADY}, {"LI_UNSTEADY", MB_LI_UNSTEADY}, {"LI_TOL", MB_LI_TOL},
         {"LI_KEPT", MB_LI_KEPT}, {"LI_SINGULAR", MB_LI_SINGULAR}, {"LI_DA", MB_LI_DA},
         {"LI_NORM", MB_LI_NORM}, {"LI_RESTING", MB_LI_RESTING},
@@ -1491,6 +1563,10 @@ PyMODINIT_FUNC PyInit__core(void) {
         {"MODE_NEUTRAL", MB_MODE_NEUTRAL}, {"MODE_OSCILLATION", MB_MODE_OSCILLATION},
         {"MODE_GROWTH", MB_MODE_GROWTH}, {"MODE_DECAY", MB_MODE_DECAY},
         {"LINEARIZE_INFO", MB_LINEARIZE_INFO},
+        {"STAGE_GENERALIZED", MB_STAGE_GENERALIZED}, {"STAGE_DAMPING", MB_STAGE_DAMPING},
+        {"STAGE_STIFFNESS", MB_STAGE_STIFFNESS}, {"STAGE_SYSTEM", MB_STAGE_SYSTEM},
+        {"STAGE_HESSENBERG", MB_STAGE_HESSENBERG}, {"STAGE_SCHUR", MB_STAGE_SCHUR},
+        {"STAGE_VECTORS", MB_STAGE_VECTORS}, {"STAGES", MB_STAGES},
     };
     for (size_t i = 0; i < sizeof(constants) / sizeof(constants[0]); i++)
         if (PyModule_AddIntConstant(m, constants[i].name, constants[i].value) < 0) goto fail;

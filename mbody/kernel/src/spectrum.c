@@ -63,6 +63,25 @@ static double householder(const double *x, int64_t len, double *v) {
     return 2.0 / (v[0] * v[0] + s);
 }
 
+/* reflect_rows for a long reflector (the Hessenberg reduction's), by whole rows: s (c1 -
+ * c0 + 1 doubles) gathers v^T H row by row, each of its entries the same sum in the same
+ * order as reflect_rows's (so the same numbers), reading memory in order. */
+static void reflect_rows_long(double *H, int64_t n, const double *v, double beta, int64_t len,
+                              int64_t r0, int64_t c0, int64_t c1, double *s) {
+    int64_t w = c1 - c0 + 1;
+    for (int64_t j = 0; j < w; j++) s[j] = 0.0;
+    for (int64_t i = 0; i < len; i++) {
+        const double *row = H + (r0 + i) * n + c0;
+        double vi = v[i];
+        for (int64_t j = 0; j < w; j++) s[j] += vi * row[j];
+    }
+    for (int64_t j = 0; j < w; j++) s[j] *= beta;
+    for (int64_t i = 0; i < len; i++) {
+        double *row = H + (r0 + i) * n + c0, vi = v[i];
+        for (int64_t j = 0; j < w; j++) row[j] -= s[j] * vi;
+    }
+}
+
 /* H[r0..r0+len-1, c0..c1] <- (I - beta v v^T) H[...] (rows), row-major n x n. */
 static void reflect_rows(double *H, int64_t n, const double *v, double beta, int64_t len,
                          int64_t r0, int64_t c0, int64_t c1) {
@@ -85,18 +104,22 @@ static void reflect_cols(double *H, int64_t n, const double *v, double beta, int
     }
 }
 
-/* H <- Z^T H Z upper Hessenberg, Z (n x n) orthogonal accumulated. */
-static void hessenberg(double *H, int64_t n, double *Z, double *x, double *v) {
+/* H <- Z^T H Z upper Hessenberg, Z (n x n) orthogonal accumulated (x, v, s: n doubles of
+ * scratch each). 0, or MB_STOPPED. */
+static int hessenberg(double *H, int64_t n, double *Z, double *x, double *v, double *s,
+                      const mb_progress *progress) {
     for (int64_t k = 0; k + 2 < n; k++) {
+        if (mb_report(progress, MB_STAGE_HESSENBERG, k, n)) return MB_STOPPED;
         int64_t len = n - k - 1;
         for (int64_t i = 0; i < len; i++) x[i] = H[(k + 1 + i) * n + k];
         double beta = householder(x, len, v);
         if (beta == 0.0) continue;
-        reflect_rows(H, n, v, beta, len, k + 1, k, n - 1);
+        reflect_rows_long(H, n, v, beta, len, k + 1, k, n - 1, s);
         reflect_cols(H, n, v, beta, len, k + 1, 0, n - 1);
         reflect_cols(Z, n, v, beta, len, k + 1, 0, n - 1);
         for (int64_t i = k + 2; i < n; i++) H[i * n + k] = 0.0;
     }
+    return 0;
 }
 
 /* One Francis double-shift step on the active window l..m of H (full Schur updates: the
@@ -152,13 +175,15 @@ static void block_eigenvalues(double a, double b, double c, double d, double *wr
 }
 
 /* Real Schur form by Francis steps: T in H, Z accumulated; the eigenvalues in wr, wi and
- * each row's block start in start (the row itself for a 1 x 1 block). 0, or -1 when the
- * iteration did not converge. */
-static int schur(double *H, int64_t n, double *Z, double *wr, double *wi, int64_t *start) {
+ * each row's block start in start (the row itself for a 1 x 1 block). 0, -1 when the
+ * iteration did not converge, or MB_STOPPED. */
+static int schur(double *H, int64_t n, double *Z, double *wr, double *wi, int64_t *start,
+                 const mb_progress *progress) {
     double norm = 0.0;
     for (int64_t i = 0; i < n * n; i++) norm = fmax(norm, fabs(H[i]));
     int64_t m = n - 1, its = 0;
     while (m >= 0) {
+        if (its == 0 && mb_report(progress, MB_STAGE_SCHUR, n - 1 - m, n)) return MB_STOPPED;
         int64_t l = m;
         for (; l > 0; l--) { /* a negligible subdiagonal splits the problem */
             double s = fabs(H[(l - 1) * n + l - 1]) + fabs(H[l * n + l]);
@@ -224,10 +249,13 @@ static void rescale(double complex *x, int64_t n) {
 }
 
 /* x with T x = lam x (x zero below the block starting at k) and u with u^T T = lam u^T
- * (u zero above it), T quasi-triangular with blocks given by start. */
-static void vectors(const double *T, int64_t n, const int64_t *start, int64_t k,
-                    double complex lam, double smin, double complex *x, double complex *u) {
+ * (u zero above it), T quasi-triangular with blocks given by start; TT its transpose (u's
+ * sums run down T's columns: along TT's rows, in memory order). */
+static void vectors(const double *T, const double *TT, int64_t n, const int64_t *start,
+                    int64_t k, double complex lam, double smin, double complex *x,
+                    double complex *u) {
 #define Tt(i, j) T[(i) * n + (j)]
+#define TTt(i, j) TT[(j) * n + (i)]
     int64_t ks = start[k], size = (ks + 1 < n && start[ks + 1] == ks) ? 2 : 1;
     for (int64_t i = 0; i < n; i++) x[i] = u[i] = 0.0;
     if (size == 1) {
@@ -263,19 +291,20 @@ static void vectors(const double *T, int64_t n, const int64_t *start, int64_t k,
     for (int64_t j = ks + size; j < n;) { /* forward substitution for the left vector */
         if (j + 1 < n && start[j + 1] == j) {
             double complex e = 0.0, f = 0.0;
-            for (int64_t i = ks; i < j; i++) e -= u[i] * Tt(i, j), f -= u[i] * Tt(i, j + 1);
+            for (int64_t i = ks; i < j; i++) e -= u[i] * TTt(i, j), f -= u[i] * TTt(i, j + 1);
             solve2(Tt(j, j) - lam, Tt(j + 1, j), Tt(j, j + 1), Tt(j + 1, j + 1) - lam, e, f,
                    smin, &u[j], &u[j + 1]);
             j += 2;
         } else {
             double complex e = 0.0;
-            for (int64_t i = ks; i < j; i++) e -= u[i] * Tt(i, j);
+            for (int64_t i = ks; i < j; i++) e -= u[i] * TTt(i, j);
             u[j] = guarded_div(e, Tt(j, j) - lam, smin);
             j += 1;
         }
         rescale(u, n);
     }
 #undef Tt
+#undef TTt
 }
 
 /* order (n) <- the indices sorted by first, then by second (NULL: none), equal keys kept
@@ -297,17 +326,18 @@ static void stable_order(int64_t n, const double *first, const double *second,
     }
 }
 
-int mb_spectrum(const double *A, int64_t n, double dA, double tol, double *out) {
+int mb_spectrum(const double *A, int64_t n, double dA, double tol,
+                const mb_progress *progress, double *out) {
     double complex *w_out = (double complex *)out, *V_out = w_out + n;
     double *err_out = out + 2 * (n + n * n);
     if (n == 0) return 0;
-    double *buf = malloc(sizeof(double) * (size_t)(2 * n * n + 6 * n) +
+    double *buf = malloc(sizeof(double) * (size_t)(3 * n * n + 7 * n) +
                          sizeof(double complex) * (size_t)(4 * n) +
                          sizeof(int64_t) * (size_t)(2 * n));
     if (buf == NULL) return -1;
-    double *H = buf, *Z = H + n * n, *d = Z + n * n, *wr = d + n, *wi = wr + n;
-    double *kappa = wi + n, *tmp = kappa + n, *tmp2 = tmp + n;
-    double complex *x = (double complex *)(tmp2 + n), *u = x + n, *v = u + n, *l = v + n;
+    double *H = buf, *Z = H + n * n, *HT = Z + n * n, *d = HT + n * n, *wr = d + n;
+    double *wi = wr + n, *kappa = wi + n, *tmp = kappa + n, *tmp2 = tmp + n, *tmp3 = tmp2 + n;
+    double complex *x = (double complex *)(tmp3 + n), *u = x + n, *v = u + n, *l = v + n;
     int64_t *start = (int64_t *)(l + n), *order = start + n;
     /* the floor of every bound: rounding of A itself (1e3 eps |A|_inf) */
     double normA = 0.0;
@@ -321,18 +351,25 @@ int mb_spectrum(const double *A, int64_t n, double dA, double tol, double *out) 
     balance(H, n, d);
     for (int64_t i = 0; i < n * n; i++) Z[i] = 0.0;
     for (int64_t i = 0; i < n; i++) Z[i * n + i] = 1.0;
-    hessenberg(H, n, Z, tmp, tmp2);
-    if (schur(H, n, Z, wr, wi, start) < 0) {
+    int status = hessenberg(H, n, Z, tmp, tmp2, tmp3, progress);
+    if (status == 0) status = schur(H, n, Z, wr, wi, start, progress);
+    if (status != 0) {
         free(buf);
-        return 1;
+        return status == MB_STOPPED ? MB_STOPPED : 1;
     }
     double normT = 0.0;
     for (int64_t i = 0; i < n * n; i++) normT = fmax(normT, fabs(H[i]));
+    for (int64_t i = 0; i < n; i++)
+        for (int64_t j = 0; j < n; j++) HT[j * n + i] = H[i * n + j];
     for (int64_t k = 0; k < n; k++) {
+        if (mb_report(progress, MB_STAGE_VECTORS, k, n)) {
+            free(buf);
+            return MB_STOPPED;
+        }
         if (wi[k] < 0.0) continue; /* the conjugate of the one before it */
         double complex lam = wr[k] + wi[k] * _Complex_I;
         double smin = fmax(DBL_EPSILON * fmax(cabs(lam), normT), DBL_MIN);
-        vectors(H, n, start, k, lam, smin, x, u);
+        vectors(H, HT, n, start, k, lam, smin, x, u);
         double complex ux = 0.0;
         double nv = 0.0, nl = 0.0, big = 0.0;
         int64_t at = 0;
