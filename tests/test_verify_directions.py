@@ -372,7 +372,7 @@ def test_every_row_with_its_accelerations_written_from_any_other_is_correct(name
     if not answers:
         pytest.skip("no body of one degree of freedom with a row to write another way")
     v = verify(m, answers, asm=asm)
-    for c, (b, label, w, right) in zip(v.checks, expect, strict=True):
+    for c, (_, label, w, right) in zip(v.checks, expect, strict=True):
         if right:
             assert c.correct and c.row == label, (name, label, w, c.eq, c.explanation)
         else:

@@ -827,7 +827,7 @@ class _Diagnoser:
         if self.br.kinematics is not None:
             for r, t, _, words, text, _ in list(out):
                 put = self.put_in(t)
-                if put is not None and put.relations:
+                if put is not None and put.changed:
                     t2 = put.row
                     out.append((r, t2, t, words, text, True))
         return out

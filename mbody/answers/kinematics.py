@@ -69,7 +69,8 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -129,15 +130,35 @@ class PutIn:
     row : Row
         The row plus the relations used (module doc): zero on every acceleration the
         student did not write, noise cleaned.
-    relations : tuple of Relation
-        What was put in, in words: each of the row's accelerations the student did not
-        write, in terms of those written (one relation for their sum as the row has it,
-        when the joints do not fix them one by one); or, when only relations among the
-        written accelerations were used, that relation. Empty when nothing was put in.
+    kinematics : BodyKinematics
+        Whose relations.
+    t : Row
+        The row as it was.
+    nu : (r,) array
+        The combination of the relations added (module doc).
+    written : frozenset of str
+        The accelerations the student wrote.
     """
 
     row: Row
-    relations: tuple[Relation, ...]
+    kinematics: BodyKinematics
+    t: Row
+    nu: np.ndarray
+    written: frozenset[str]
+
+    @property
+    def changed(self) -> bool:
+        """Whether any relation was put in."""
+        return bool(np.any(self.nu != 0.0))
+
+    @cached_property
+    def relations(self) -> tuple[Relation, ...]:
+        """What was put in, in words: each of the row's accelerations the student did
+        not write, in terms of those written (one relation for their sum as the row has
+        it, when the joints do not fix them one by one); or, when only relations among
+        the written accelerations were used, that relation. Empty when nothing was put
+        in. (Worked out when asked: only a verdict's words need it.)"""
+        return self.kinematics.used(self.t, self.nu, self.written)
 
 
 @dataclass(frozen=True, eq=False)
@@ -167,6 +188,9 @@ class BodyKinematics:
     accelerations: tuple[str, ...]
     K: np.ndarray
     d: np.ndarray
+    _svd: dict = field(default_factory=dict, repr=False, compare=False)
+    """K_Uᵀ's SVD by the unwritten accelerations U: a student's equations write the same
+    few sets, each compared with many rows."""
 
     @property
     def dependent(self) -> set[str]:
@@ -234,18 +258,33 @@ class BodyKinematics:
         K, accs = self.K, self.accelerations
         U = [j for j, a in enumerate(accs) if a not in written]
         tU = np.array([t.get(accs[j]) for j in U])
-        solved = _unwritten(K[:, U], tU)
+        if not tU.any():  # nothing to eliminate: the row as it is
+            return PutIn(t, self, t, np.zeros(K.shape[0]), frozenset(written))
+        key = tuple(U)
+        if key not in self._svd:
+            self._svd[key] = _factor(K[:, U])
+        solved = _unwritten(self._svd[key], K[:, U], tU)
         if solved is None:
             return None
         nu, N = solved
-        if student is not None and any(t.get(accs[j]) != 0.0 for j in U):
+        if student is not None and N.shape[1]:
             N = self._choices(N, t, written)
             if N.shape[1]:
                 beta = self._closest(t, nu, N, student, written, free or set())
                 if beta is not None:
                     nu = nu + N @ beta
         unwritten = {accs[j] for j in U}
-        return PutIn(self._plus(t, nu, unwritten), self._used(t, nu, written, U))
+        return PutIn(self._plus(t, nu, unwritten), self, t, nu, frozenset(written))
+
+    @cached_property
+    def _column_size(self) -> np.ndarray:
+        """The largest entry of each column of K (each acceleration's)."""
+        return np.abs(self.K).max(axis=0, initial=0.0)
+
+    @cached_property
+    def _d_size(self) -> float:
+        """The largest entry of d."""
+        return float(np.abs(self.d).max(initial=0.0))
 
     def _choices(self, N: np.ndarray, t: Row, written: set[str]) -> np.ndarray:
         """The part of N (relations among the written accelerations) that only moves the
@@ -269,14 +308,14 @@ class BodyKinematics:
         Each added term's magnitude, for the noise, is |ν|₁ times the largest entry it
         is made of: ν carries the solve's rounding (about 1e-16 of |ν|₁, over the
         smallest singular value it divides by), which a term may not show."""
-        add = nu @ self.K
+        add = (nu @ self.K).tolist()
         l1 = float(np.abs(nu).sum())
-        size = np.maximum(np.abs(nu) @ np.abs(self.K), l1 * np.abs(self.K).max(axis=0, initial=0.0))
+        size = (l1 * self._column_size).tolist()
         coef = dict(t.coef)
         mag = {k: abs(v) for k, v in t.coef.items()}
         touched: set[str] = set()
-        extra = [(a, float(add[j]), float(size[j])) for j, a in enumerate(self.accelerations)]
-        extra.append((CONST, -float(nu @ self.d), l1 * float(np.abs(self.d).max(initial=0.0))))
+        extra = list(zip(self.accelerations, add, size, strict=True))
+        extra.append((CONST, -float(nu @ self.d), l1 * self._d_size))
         for key, v, m in extra:
             if key in unwritten:
                 coef.pop(key, None)
@@ -323,10 +362,11 @@ class BodyKinematics:
             return None
         return x[1:] / x[0] * math.ldexp(1.0, et)
 
-    def _used(self, t: Row, nu: np.ndarray, written: set[str], U: list[int]) -> tuple[
+    def used(self, t: Row, nu: np.ndarray, written: frozenset[str]) -> tuple[
             Relation, ...]:
         """What νᵀR puts into t, in words (`PutIn.relations`)."""
         accs, K, d = self.accelerations, self.K, self.d
+        U = [j for j, a in enumerate(accs) if a not in written]
         delta, delta_c = nu @ K, -float(nu @ d)
         W = [j for j, a in enumerate(accs) if a in written]
         D = [j for j in U if t.get(accs[j]) != 0.0]
@@ -364,15 +404,23 @@ class BodyKinematics:
                           {accs[w]: delta[w] for w in W}, delta_c, ref, ref_c),)
 
 
-def _unwritten(KU: np.ndarray, tU: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+def _factor(KU: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+    """K_Uᵀ's SVD (left, singular values, right) and its rank."""
+    if KU.shape[1] == 0:
+        r = KU.shape[0]
+        return np.zeros((0, 0)), np.zeros(0), np.eye(r), 0
+    left, sv, right = np.linalg.svd(KU.T, full_matrices=True)
+    return left, sv, right, int(np.count_nonzero(sv > _RANK))  # K's rows: sv <= 1
+
+
+def _unwritten(factor: tuple[np.ndarray, np.ndarray, np.ndarray, int], KU: np.ndarray,
+               tU: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
     """ν₀ and N of the module doc: the least-squares solution of K_Uᵀ ν = −t_U (None when
     it leaves a residual: t cannot be written without the unwritten accelerations), and
-    the null space of K_Uᵀ, as columns."""
-    r = KU.shape[0]
+    the null space of K_Uᵀ, as columns; `factor` is K_Uᵀ's `_factor`."""
+    left, sv, right, rank = factor
     if KU.shape[1] == 0:
-        return np.zeros(r), np.eye(r)
-    left, sv, right = np.linalg.svd(KU.T, full_matrices=True)
-    rank = int(np.count_nonzero(sv > _RANK))  # K's rows are orthonormal: sv <= 1
+        return np.zeros(KU.shape[0]), right
     nu = right[:rank].T @ ((left[:, :rank].T @ -tU) / sv[:rank])
     residual = KU.T @ nu + tU
     if np.abs(residual).max(initial=0.0) > _SOLVED * float(np.abs(tU).max(initial=0.0)):
