@@ -93,15 +93,16 @@ singular (the relations' rows are orthonormal): else the next one in order is tr
 
 @dataclass(frozen=True)
 class Relation:
-    """One of the body's accelerations in terms of its free ones: ``acc = Σ coef z +
-    const``.
+    """One of the body's accelerations in terms of others: ``acc = Σ coef z + const``.
 
     Parameters
     ----------
     acc : str
-        The dependent acceleration (``a_x``).
+        The acceleration written in terms of the others (``a_x``; or a sum, as a row
+        has it, ``0.866025 a_x + 0.5 a_y``, when the joints fix only the sum from the
+        others).
     coef : dict of str to float
-        Free acceleration -> coefficient (m per rad/s² from an angular one).
+        Other acceleration -> coefficient (m per rad/s² from an angular one).
     const : float
         The velocity terms (m/s² or rad/s²).
     """
