@@ -788,7 +788,7 @@ class _Diagnoser:
         pivot = [row_text(self.br.about_fixed_point(e, p)) for e in self.br.euler
                  for p in self.br.points if p.fixed and self.br.kinematics is not None
                  and e.acc == u]
-        where = (f"the moment equation about a fixed pivot at its own scale, I_P α = M_P "
+        where = (f"the moment equation about the fixed pivot, I_P α = M_P "
                  f"({pivot[0]}), or " if pivot else "")
         return Diagnosis(
             SOLVED_VALUE, row.text, row.label,
