@@ -13,6 +13,7 @@ and the terms that differ are reported.
 from __future__ import annotations
 
 import itertools
+import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
@@ -775,6 +776,8 @@ class _Diagnoser:
             return None
         c = self.s.get(u)
         value, target = -self.s.get(CONST) / c, float(sol[label])
+        if not (math.isfinite(value) and math.isfinite(target)):
+            return None  # a solve that gave no number says nothing of this one
         ref = max(abs(target), self.s.err(CONST) / abs(c))
         if abs(value - target) > max(self.tol * ref, _ZERO):
             return None
