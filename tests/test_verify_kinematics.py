@@ -11,6 +11,7 @@ mistake diagnosed as it was without the relations.
 from __future__ import annotations
 
 import dataclasses
+import math
 from pathlib import Path
 
 import numpy as np
@@ -217,6 +218,15 @@ def test_the_usual_mistakes_stay_diagnosed_as_without_the_kinematics(name):
                 assert "kinematics" in after.details or \
                     after.details.get("form") == "fixed_pivot", (name, what)
                 assert _holds(m, b, s), (name, what, after.explanation)
+                # and it is a moment equation about a point (the mistake's, or one on
+                # the same axis), whose transport term the joints hold at 0: only a
+                # moment taken about a point with I_G, or a reaction left out (one
+                # through that point); never a Newton row, a sign, a load, the gyroscopic
+                # term
+                dropped = what.partition(" without ")[2]
+                assert after.details.get("form") in ("transport", "fixed_pivot") and (
+                    what.endswith(" with I_G") or dropped in br.joints
+                ), (name, what, after.explanation)
                 now_true += 1
             elif before.diagnosis != "not_an_equation_of_this_body":
                 assert (after.diagnosis, after.row) == (before.diagnosis, before.row), (
@@ -264,6 +274,84 @@ def test_a_reaction_replaced_by_its_solved_value_is_not_made_a_pivot_equation():
     # with one degree of freedom is not taken as the moment about the pivot
     c = one(mbody.load(MODELS / "pendulum.yaml"), "rod", "2*a_y = 15.9435 - 19.62")
     assert c.diagnosis == "reaction_treated_as_known", c.explanation
+
+
+# == review R5-2: numbers put in for reactions, or the answer, are not a pivot equation ===
+
+def _pendulum_solution():
+    m = mbody.load(MODELS / "pendulum.yaml")
+    return m, mbody.assemble(m).solve()
+
+
+def test_both_pin_forces_replaced_by_their_values_are_treated_as_known():
+    # the review's [1]: the Euler row about G with O.Fx and O.Fy replaced by their solved
+    # values (from Assembly.solve, written to six figures) was `correct`, "moments about
+    # joint O, a fixed pivot"
+    m, sol = _pendulum_solution()
+    fx, fy = sol.reactions["O.Fx"], sol.reactions["O.Fy"]
+    for eq in (f"I_G*alpha = -0.433013*({fx:.6g}) - 0.25*({fy:.6g})",
+               f"I_G*alpha = {-0.4330127 * fx - 0.25 * fy:.6g}"):
+        c = one(m, "rod", eq)
+        assert (c.diagnosis, c.row) == ("reaction_treated_as_known", "rod.theta"), eq
+        assert c.details["reactions"] == ["O.Fx", "O.Fy"]
+        assert "I_P" not in c.explanation
+
+
+def test_a_pin_force_replaced_by_its_value_with_a_g_from_the_pin_is_treated_as_known():
+    # the review's [5]: Newton's row along x with a_x = 0.433013 alpha and O.Fx's value,
+    # the case docs/verify.md promises stays reaction_treated_as_known, written in alpha
+    m, sol = _pendulum_solution()
+    fx, fy = sol.reactions["O.Fx"], sol.reactions["O.Fy"]
+    c = one(m, "rod", f"m*0.433013*alpha = {fx:.6g}")
+    assert (c.diagnosis, c.row) == ("reaction_treated_as_known", "rod.x"), c.explanation
+    assert c.details["value_used"] == pytest.approx(fx, rel=1e-5)
+    assert c.details["kinematics"] == ["a_x = 0.433013 alpha"]
+    c = one(m, "rod", f"m*0.25*alpha = {fy:.6g} - m*g")
+    assert (c.diagnosis, c.row) == ("reaction_treated_as_known", "rod.y"), c.explanation
+    assert c.details["value_used"] == pytest.approx(fy, rel=1e-5)
+
+
+def test_the_answer_copied_is_a_solved_value_and_covers_no_row():
+    # alpha = -7.3529, copied from `mbody solve`, was `correct` and covered rod.theta
+    m, sol = _pendulum_solution()
+    alpha = sol["rod.theta"]
+    eqs = [f"alpha = {alpha:.6g}", f"-alpha = {-alpha:.6g}", f"{alpha:.6g} = alpha",
+           "alpha = -m*g*0.5*sin(theta)/(I_G + m*0.5^2)"]
+    v = verify(m, [{"body": "rod", "eq": eq} for eq in eqs])
+    for c in v.checks:
+        assert (c.diagnosis, c.row) == ("solved_value_not_an_equation", "rod.theta"), c.eq
+        assert c.details["value_solved"] == pytest.approx(alpha, rel=1e-12)
+        assert "I_P α = M_P" in c.explanation
+    assert {u.row for u in v.uncovered} == {"rod.x", "rod.y", "rod.theta"}
+    # a reaction's value alone, and a value on a body with no fixed pivot
+    c = one(m, "rod", f"O.Fx = {sol.reactions['O.Fx']:.6g}")
+    assert (c.diagnosis, c.row) == ("solved_value_not_an_equation", "rod.x"), c.explanation
+    dp = mbody.load(MODELS / "double_pendulum.yaml")
+    c = one(dp, "lower", f"alpha = {mbody.assemble(dp).solve()['lower.theta']:.6g}")
+    assert c.diagnosis == "solved_value_not_an_equation", c.explanation
+    # a value that is not the solution is no solved value
+    assert one(m, "rod", f"alpha = {2 * alpha:.6g}").diagnosis == \
+        "not_an_equation_of_this_body"
+
+
+@pytest.mark.parametrize("moving_rod", [False, True], ids=["at rest", "at 3 rad/s"])
+def test_the_moment_about_the_fixed_pin_stays_correct_written_any_way(moving_rod, moving):
+    """I_P alpha = M_P about the pin (the pin's forces pass through it), I_P = I_G +
+    m d², d = 0.5 m, M_P = -m g d sin(theta): as written, with numbers, divided by m
+    ((k_G² + d²) alpha = -g d sin theta) or by anything else, it is `correct`; it holds
+    at the solution."""
+    m = moving if moving_rod else mbody.load(MODELS / "pendulum.yaml")
+    mass, inertia = 2.0, float(m.J[0][2, 2])
+    i_p, m_p = inertia + mass * 0.25, -mass * 9.81 * 0.5 * math.sin(math.radians(30))
+    assert mbody.assemble(m).solve()["rod.theta"] * i_p == pytest.approx(m_p, rel=1e-9)
+    eqs = ["(I_G + m*0.5^2)*alpha = -m*g*0.5*sin(theta)",
+           "(I_G/m + 0.5^2)*alpha = -g*0.5*sin(theta)",
+           f"{i_p:.6g}*alpha = {m_p:.6g}", f"{m_p:.6g} = {i_p:.6g}*alpha",
+           f"{2 * i_p:.6g}*alpha = {2 * m_p:.6g}", f"{i_p / 9.81:.6g}*alpha = -m*0.5*0.5"]
+    v = verify(m, [{"body": "rod", "eq": eq} for eq in eqs])
+    for c in v.checks:
+        assert c.correct and c.row == "rod.theta", (c.eq, c.diagnosis, c.explanation)
+        assert c.details["form"] == "fixed_pivot"
 
 
 def test_a_moment_equation_is_not_read_as_a_newton_row_with_kinematics():

@@ -115,3 +115,28 @@ def test_rounding_is_said_only_of_a_row_with_every_term_in_place(eq):
 def test_numbers_to_four_figures_stay_correct():
     assert check("pendulum", "rod", "I_G*alpha = -0.4330*O.Fx - 0.2500*O.Fy").correct
     assert check("pendulum", "rod", "m*a_y = O.Fy - m*9.81").correct
+
+
+# == R5-10: the moving pivot's I_P has the label's meaning ================================
+
+def test_moments_about_a_moving_pin_with_its_inertia_say_so_in_the_meaning():
+    # the lower rod of the double pendulum about its pin A, which moves with the upper
+    # rod: I_A alpha = M_A does not hold there (no transport term r x m a_G)
+    c = check("double_pendulum", "lower", "(I_G + m*0.25^2)*alpha = -m*g*0.176777")
+    assert (c.diagnosis, c.details["form"]) == ("wrong_moment_point", "moving_pivot")
+    assert "A moves" in c.explanation and "I_P" in c.explanation
+    # the headline the class summary keeps says the same as the explanation
+    assert c.meaning == MEANINGS["wrong_moment_point"]
+    assert "I_P" in c.meaning and "moves" in c.meaning and "transport term" in c.meaning
+    # and about it with I_G, the other case the meaning covers
+    c = check("double_pendulum", "lower", "I_G*alpha = -m*g*0.176777")
+    assert c.diagnosis == "wrong_moment_point" and "I_G α alone" in c.explanation
+    assert "with I_G" in c.meaning
+
+
+def test_the_solved_value_label_is_listed_before_the_last_two():
+    order = list(DIAGNOSES)
+    assert order.index("reaction_treated_as_known") < \
+        order.index("solved_value_not_an_equation") < order.index("rounded_too_coarsely")
+    assert MEANINGS["solved_value_not_an_equation"] == \
+        DIAGNOSES["solved_value_not_an_equation"]

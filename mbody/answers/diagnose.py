@@ -13,6 +13,7 @@ and the terms that differ are reported.
 from __future__ import annotations
 
 import itertools
+import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
@@ -20,7 +21,7 @@ import numpy as np
 
 from mbody import joint_types
 from mbody.answers.compare import CONST, Fit, Row, consensus, matches, rounded_off, same
-from mbody.answers.kinematics import Relation
+from mbody.answers.kinematics import PutIn, Relation
 from mbody.answers.rows import BodyRows, MomentPoint, TrueRow
 from mbody.answers.text import differences, rounding, row_text
 from mbody.answers.text import num as _num
@@ -39,6 +40,7 @@ MISSING_APPLIED_LOAD = "missing_applied_load"
 APPLIED_LOAD_SIGN = "applied_load_sign"
 LEVER_ARM_SIGN = "lever_arm_sign"
 ROUNDED_TOO_COARSELY = "rounded_too_coarsely"
+SOLVED_VALUE = "solved_value_not_an_equation"
 NOT_AN_EQUATION = "not_an_equation_of_this_body"
 
 DIAGNOSES = {
@@ -52,8 +54,9 @@ DIAGNOSES = {
                                  "tensor's products of inertia left out",
     SINGLE_INERTIA_IN_SPACE: "one scalar inertia where the tensor's principal moments "
                              "differ",
-    WRONG_MOMENT_POINT: "moments taken about another point (a joint, the origin) with I_G "
-                        "and without the transport term",
+    WRONG_MOMENT_POINT: "moments taken about another point (a joint, the origin) without "
+                        "the transport term r × m a_G: with I_G, or with I_P = I_G + m d² "
+                        "about a point that moves",
     MISSING_REACTION: "an unknown reaction left out",
     REACTION_SIGN: "a reaction with the wrong sign (the third law: −R on the parent)",
     LEVER_ARM_SIGN: "a reaction's moment about G with the wrong sign (r × F: r from G to "
@@ -61,6 +64,8 @@ DIAGNOSES = {
     MISSING_APPLIED_LOAD: "an applied force or moment (or gravity) left out",
     APPLIED_LOAD_SIGN: "an applied force or moment (or gravity) with the wrong sign",
     REACTION_TREATED_AS_KNOWN: "an unknown reaction replaced by a number",
+    SOLVED_VALUE: "one unknown's value, as the equations of motion give it (a result "
+                  "such as alpha = -7.3529), not an equation of the body's free body",
     ROUNDED_TOO_COARSELY: "right but for a number rounded too coarsely (a few percent off, "
                           "beyond the tolerance)",
     NOT_AN_EQUATION: "none of the above explains it",
@@ -134,9 +139,11 @@ def diagnose(s: Row, br: BodyRows, tol: float,
     tol : float
         Relative tolerance on each coefficient (see `mbody.answers.compare`).
     solved : callable, optional
-        Returns the reactions' values at this state (solved), or None; asked only when
-        reactions may have been replaced by numbers, to tell whether the numbers are
-        their values (else the equation is not that mistake) and to say what they are.
+        Returns the values solved at this state, or None: the reactions by label
+        (``O.Fx``) and the accelerations by their coordinate's label (``rod.theta``).
+        Asked only when reactions may have been replaced by numbers, to tell whether the
+        numbers are their values (else the equation is not that mistake) and to say what
+        they are, and when an equation of one unknown may be its value.
 
     Returns
     -------
@@ -166,49 +173,102 @@ class _Diagnoser:
             # kinematics: those that change a reaction or the constant, which the
             # kinematics cannot (the others change acceleration terms, which they do)
             self.kinematic = True
+            # (a reaction replaced by its value too: m*0.433013*alpha = -6.3678 is
+            # Newton's row along x with a_x from the pin and O.Fx's solved value)
             for step in (self.gyroscopic, self.gyroscopic_sign, self.missing_reaction,
-                         self.reaction_sign, self.missing_load, self.load_sign):
+                         self.reaction_sign, self.missing_load, self.load_sign,
+                         self.treated_as_known):
                 self.last = None
                 found = step()
                 if found is not None:
                     return self.with_kinematics(found)
             self.kinematic = False
-        return self.rounded() or self.closest()
+        return self.solved_value() or self.rounded() or self.closest()
 
     # -- helpers -----------------------------------------------------------------------
     kinematic = False
     """Whether the mistakes are tried with the joints' kinematics put in the rows."""
     last: Row | None = None
     """The variant of the last match in that mode."""
+    compared: Row | None = None
+    """The row the last `match` compared with (the variant, with the kinematics put in
+    in that mode)."""
 
-    def match(self, t: Row, free: tuple[str, ...] = ()) -> Fit | None:
+    def match(self, t: Row, free: tuple[str, ...] = (), anchored: bool = False) -> Fit | None:
+        """The fit of the student's row to the variant `t` (with the joints' kinematics
+        put in, in that mode), within the tolerance.
+
+        `anchored`: the caller pins the factor and the constant itself (a reaction
+        replaced by a number: the scale of a row of one term, the reactions' values), so
+        that a variant without reactions may be compared with the kinematics put in."""
+        self.compared = t
         if not self.kinematic:
             return matches(self.s, t, self.tol, free)
-        if not (t.unknowns & set(self.br.joints)):
+        if not anchored and not (t.unknowns & set(self.br.joints)):
             # nothing anchors it: with the kinematics put in, a body with one degree of
             # freedom makes every reaction-free row a multiple of its equation of motion
             # (m a_y = 0 would be Newton's x row without O.Fx: 0.866 alpha = 0)
             return None
-        t2 = self.kinematic_row(t)
-        if t2 is None or any(k in self.dependent() and k not in self.s.unknowns
-                             for k in free):
+        if any(k in self.involved() and k not in self.s.unknowns for k in free):
             return None  # a coefficient left open that the kinematics replace
+        t2 = self.kinematic_row(t, free)
+        if t2 is None:
+            return None
+        self.compared = t2
         f = matches(self.s, t2, self.tol, free)
         if f is not None:
             self.last = t
         return f
 
-    def kinematic_row(self, t: Row) -> Row | None:
-        """`t` with the joints' kinematics put in for the accelerations the student did
-        not write; None when the student writes one the kinematics replace that `t`
-        lacks (m a_y = ... is Newton's row along y, not along x with a_y put in)."""
+    def kinematic_row(self, t: Row, free: tuple[str, ...] = ()) -> Row | None:
+        """`t` written in the accelerations the student wrote, with the joints'
+        kinematics put in for the others (`BodyKinematics.put_in`: in whichever
+        direction the student used them); None when that cannot be done (m a_y = ... on
+        a pendulum is not Newton's row along x with a_x put in: a_x = 1.73205 a_y is
+        that row's, and m a_y is not its 3.4641 a_y)."""
+        put = self.put_in(t, free)
+        return put.row if put is not None else None
+
+    def put_in(self, t: Row, free: tuple[str, ...] = ()) -> PutIn | None:
         kin = self.br.kinematics
         if kin is None:
             return None
-        kept = self.s.unknowns & kin.dependent
-        if not kept <= t.keys:
-            return None
-        return kin.substitute(t, keep=kept)
+        return kin.put_in(t, self.s, free)
+
+    def at_its_scale(self, t: Row, f: Fit) -> bool:
+        """Whether a form that is not one of the body's rows (about a fixed pivot, with
+        the kinematics put in) matched at factor `f` is that form, and not a result.
+
+        With one acceleration as its only unknown (a body of one degree of freedom:
+        I_P alpha = M_P) a form fixes no scale, and every equation c alpha = c alpha*
+        matches it, whatever it was made of. At factor ±1 it is the form as written;
+        scaled (the same divided by m: (k_G² + d²) alpha = −g d sin θ) it is still that
+        law, except where the scale gives it away as something else: coefficient 1, the
+        value itself (``alpha = -7.3529``, `solved_value`); or one of the body's rows
+        with its reactions' values put in, at that row's own scale (``I_G*alpha =
+        -1.2286``, ``m*0.433013*alpha = -6.3678``: `treated_as_known`)."""
+        single = len(t.unknowns) == 1 and not (t.unknowns & set(self.br.joints))
+        if not single or abs(abs(f.k) - 1.0) <= self.tol:
+            return True
+        (u,) = t.unknowns
+        if abs(abs(self.s.get(u)) - 1.0) <= self.tol * max(1.0, self.s.err(u)):
+            return False  # the value: "alpha = -7.3529"
+        return not self.reaction_put_in()
+
+    def reaction_put_in(self) -> bool:
+        """Whether the student's equation is `treated_as_known` of a row, as written or
+        with the joints' kinematics put in (state restored)."""
+        kinematic, last = self.kinematic, self.last
+        try:
+            self.kinematic = False
+            if self.treated_as_known() is not None:
+                return True
+            if self.br.kinematics is None:
+                return False
+            self.kinematic = True
+            return self.treated_as_known() is not None
+        finally:
+            self.kinematic, self.last = kinematic, last
 
     def with_kinematics(self, d: Diagnosis) -> Diagnosis:
         """`d`, found with the joints' kinematics put in, saying so."""
@@ -268,17 +328,21 @@ class _Diagnoser:
         for e in self.br.euler:
             for p in self.br.points:
                 t = self.br.transport(e, p, keep_acc=True)
-                if self.match(t) is not None:
+                f = self.match(t)
+                if f is not None and self.at_its_scale(t, f):
                     return Diagnosis(
                         CORRECT, row_text(t), e.label,
                         f"These are moments about {_point(p)}, with the transport term "
                         f"r × m a_G: the same law as {self.words(e)}, taken about another "
                         "point.", {"point": p.name, "form": "transport"})
                 # the pivot's kinematics are the joint's: only where the joint is held
-                if p.fixed and kin is not None and \
-                        self.match(self.br.about_fixed_point(e, p)) is not None:
+                if not p.fixed or kin is None:
+                    continue
+                pivot = self.br.about_fixed_point(e, p)
+                f = self.match(pivot)
+                if f is not None and self.at_its_scale(pivot, f):
                     return Diagnosis(
-                        CORRECT, row_text(self.br.about_fixed_point(e, p)), e.label,
+                        CORRECT, row_text(pivot), e.label,
                         f"These are moments about {_point(p)}, a fixed pivot, with the "
                         f"inertia about it (I_P = I_G + m d²): {self.words(e)} combined with "
                         "Newton's through the pivot's kinematics.",
@@ -298,7 +362,7 @@ class _Diagnoser:
             if t is None or self.unanchored(r.row, r.acc):
                 continue
             f = matches(self.s, t, self.tol)
-            if f is not None:
+            if f is not None and self.at_its_scale(t, f):
                 return Diagnosis(CORRECT, r.text, r.label,
                                  f"This is {self.words(r)}{self.scaled(f)}, "
                                  f"{self.kinematics_words(r.row)}.",
@@ -309,7 +373,8 @@ class _Diagnoser:
                 t = self.kinematic_row(written)
                 if t is None or self.unanchored(written, e.acc):
                     continue
-                if matches(self.s, t, self.tol) is None:
+                f = matches(self.s, t, self.tol)
+                if f is None or not self.at_its_scale(t, f):
                     continue
                 return Diagnosis(
                     CORRECT, row_text(written), e.label,
@@ -332,11 +397,12 @@ class _Diagnoser:
         return ((", scaled" if abs(abs(f.k) - 1.0) > self.tol else "")
                 + (" and rearranged" if f.k < 0 else ""))
 
-    def replaced(self, t: Row) -> list[Relation]:
-        """The relations put into `t` (a true row as written) for the student."""
-        kin = self.br.kinematics
-        assert kin is not None
-        return kin.replaced(t, keep=self.s.unknowns)
+    def replaced(self, t: Row, free: tuple[str, ...] = ()) -> list[Relation]:
+        """The relations put into `t` (a true row as written) for the student, in
+        words: each acceleration of `t` the student did not write, in terms of those
+        written."""
+        put = self.put_in(t, free)
+        return list(put.relations) if put is not None else []
 
     def kinematics_words(self, t: Row) -> str:
         """"with a_x written from the kinematics of joint O (a_x = 0.433013 alpha at
@@ -618,14 +684,17 @@ class _Diagnoser:
             if not gone:
                 continue
             t = r.row.without(gone)
-            f = self.match(t, free=(CONST,))
+            f = self.match(t, free=(CONST,), anchored=True)
             if f is None:
                 continue
-            if len(t.unknowns) == 1 and abs(abs(f.k) - 1.0) > self.tol:
+            compared = self.compared if self.compared is not None else t
+            if len(compared.unknowns) == 1 and abs(abs(f.k) - 1.0) > self.tol:
                 continue  # one term fixes no scale: ask that it be written as in the row
             # the student's constant, brought to the true row's scale, minus the true one
-            extra = self.s.get(CONST) / f.k - r.row.get(CONST)
-            if not self.stands_for(r, gone, extra, f.k):
+            # (with the kinematics put in, their velocity terms are the row's too)
+            base = compared.get(CONST)
+            extra = self.s.get(CONST) / f.k - base
+            if not self.stands_for(r, gone, extra, f.k, base):
                 continue  # some other number: not these reactions' share of the row
             details: dict = {"reactions": gone}
             if len(gone) == 1:
@@ -659,20 +728,23 @@ class _Diagnoser:
                 " on the right side.", details)
         return None
 
-    def stands_for(self, r: TrueRow, gone: list[str], extra: float, k: float) -> bool:
+    def stands_for(self, r: TrueRow, gone: list[str], extra: float, k: float,
+                   base: float) -> bool:
         """Whether `extra`, what the student's constant adds to the row `r` (at its scale)
         in place of the reactions `gone`, is what those reactions contribute at this
         state: their solved values, the static guess that they balance the rest of the
         row (the student's constant 0), or each one's static value from the Newton row
         it alone carries (``O.Fy = m g``). Within the tolerance on rounded numbers: the
-        student's numbers or the magnitudes of the terms that make the contribution."""
+        student's numbers or the magnitudes of the terms that make the contribution.
+        `base` is the constant of the row compared (`r`'s, with the velocity terms of
+        the joints' kinematics when they are put in)."""
         own = self.s.err(CONST) / abs(k)
 
         def near(target: float, size: float) -> bool:
             ref = max(own, r.row.err(CONST) + size)
             return abs(extra - target) <= self.tol * ref
 
-        if near(-r.row.get(CONST), abs(r.row.get(CONST))):
+        if near(-base, abs(base)):
             return True
         static = {}
         for n in self.br.rows:
@@ -688,6 +760,47 @@ class _Diagnoser:
             if near(sum(parts), sum(abs(p) for p in parts)):
                 return True
         return False
+
+    def solved_value(self) -> Diagnosis | None:
+        """An equation of one unknown whose value is the one the equations of motion
+        give (``alpha = -7.3529``, copied from `mbody solve`): a result, not one of the
+        body's equations (one that is, such as a free body's ``alpha_1 = -3``, is
+        `correct` before this is asked)."""
+        if len(self.s.unknowns) != 1:
+            return None
+        (u,) = self.s.unknowns
+        row = next((r for r in self.br.rows if r.acc == u), None)
+        label = row.label if row is not None else u
+        sol = self.solved()
+        if sol is None or label not in sol:
+            return None
+        c = self.s.get(u)
+        value, target = -self.s.get(CONST) / c, float(sol[label])
+        if not (math.isfinite(value) and math.isfinite(target)):
+            return None  # a solve that gave no number says nothing of this one
+        ref = max(abs(target), self.s.err(CONST) / abs(c))
+        if abs(value - target) > max(self.tol * ref, _ZERO):
+            return None
+        if row is None:  # a reaction: the first row it is in
+            row = next((r for r in self.br.rows if u in r.row.unknowns), self.br.rows[0])
+            unit = " N m" if _is_moment(u) else " N"
+            whose = f" (a reaction of joint {self.br.joints[u][0]})"
+        else:
+            unit = " rad/s²" if row.euler else " m/s²"
+            whose = ""
+        pivot = [row_text(self.br.about_fixed_point(e, p)) for e in self.br.euler
+                 for p in self.br.points if p.fixed and self.br.kinematics is not None
+                 and e.acc == u]
+        where = (f"the moment equation about the fixed pivot, I_P α = M_P "
+                 f"({pivot[0]}), or " if pivot else "")
+        return Diagnosis(
+            SOLVED_VALUE, row.text, row.label,
+            f"This says {u} = {_num(value)}{unit}{whose}, its value at this state as the "
+            f"equations of motion give it ({_num(target)}{unit} solved with the joints): "
+            f"a result, not an equation of {self.br.body}'s free body. Write the equation "
+            f"it comes from: {where}{self.words(row)} with every force on the free body, "
+            f"the reactions as unknowns: {row.text}.",
+            {"unknown": u, "value": value, "value_solved": target})
 
     def candidates(self) -> list[tuple[TrueRow, Row, str, str]]:
         """What an equation that is none of the mistakes is compared with: (the row, the
@@ -716,8 +829,9 @@ class _Diagnoser:
         out = [(r, t, t, words, text, False) for r, t, words, text in self.candidates()]
         if self.br.kinematics is not None:
             for r, t, _, words, text, _ in list(out):
-                t2 = self.kinematic_row(t)
-                if t2 is not None and self.replaced(t):
+                put = self.put_in(t)
+                if put is not None and put.changed:
+                    t2 = put.row
                     out.append((r, t2, t, words, text, True))
         return out
 
@@ -759,7 +873,7 @@ class _Diagnoser:
             # equation in alpha is a moment equation, however many reactions it shares
             # with a Newton row (with the kinematics put in, the row's acceleration may be
             # one they replace); a row as written before the same with the kinematics
-            away = r.acc not in s.unknowns and not (kinematic and r.acc in self.dependent())
+            away = r.acc not in s.unknowns and not (kinematic and r.acc in self.involved())
             key = (away, len(wrong) - shared, len(wrong), kinematic, f.error)
             if best is None or key < best[0]:
                 best = (key, r, t, written, words, text, f, wrong)
@@ -805,9 +919,10 @@ class _Diagnoser:
                 return True
         return False
 
-    def dependent(self) -> set[str]:
+    def involved(self) -> set[str]:
+        """The accelerations the joints' relations involve (none without them)."""
         kin = self.br.kinematics
-        return {rel.acc for rel in kin.relations} if kin is not None else set()
+        return kin.involved if kin is not None else set()
 
     def load_sign(self) -> Diagnosis | None:
         """A row with one applied load or gravity of the wrong sign (the gyroscopic
@@ -848,6 +963,11 @@ class _Diagnoser:
         used = [r.label for j, r in enumerate(self.br.rows) if x[j] != 0.0]
         return (f"This equation holds (it combines the rows {', '.join(used)}), but it is not "
                 "one of the body's Newton-Euler rows: write each one on its own.")
+
+
+_ZERO = 1e-9
+"""A value this close to 0 (m/s², rad/s², N) is 0: `solved_value` takes a solved 1e-17
+as the 0 a student writes."""
 
 
 def _is_moment(label: str) -> bool:

@@ -495,9 +495,11 @@ def check(model: Model, sheet: Answers, *, tol: float, asm: Assembly,
     solved: list[Mapping[str, float] | None] = []
 
     def reactions() -> Mapping[str, float] | None:
+        """The reactions by label and the accelerations by coordinate, solved."""
         if not solved:
             try:
-                solved.append(dict(asm.solve().reactions))
+                sol = asm.solve()
+                solved.append({**sol.as_dict(), **dict(sol.reactions)})
             except MbodyError:
                 solved.append(None)
         return solved[0]
