@@ -126,6 +126,17 @@ def test_json_whole_number_of_millions_of_digits(exports, tmp_path):
     assert jsontext.loads("[-" + "9" * 4300 + "]") == [-int("9" * 4300)]  # at the bound
 
 
+def test_json_version_of_thousands_of_digits_is_named_by_its_size(exports, tmp_path):
+    """A version past a float's range: the message gives its power of ten, not its 4000
+    digits (nor an OverflowError converting it)."""
+    doc = json.loads((exports / "p.json").read_text())
+    path = tmp_path / "future.json"
+    path.write_text(json.dumps(doc).replace('"version": ' + str(doc["version"]),
+                                            '"version": 1' + "0" * 3999, 1))
+    text = refused(path, "export format version about 1e3999 is newer than this mbody")
+    assert len(text) < 400
+
+
 def test_json_matrix_shape_is_checked_before_the_matrix_is_made(exports, tmp_path):
     """A shape of 10^12 x 10^12 with no entries: its column pointers alone were 8 TB (a
     MemoryError)."""

@@ -69,3 +69,14 @@ def test_a_data_file_over_a_budget_of_one_byte_says_byte():
     """Before: 'at most 1 bytes is read'."""
     assert over_budget("r.npz", 2, 2, 1, "more") == ("r.npz: holds 2 bytes of data; at most "
                                                      "1 byte is read (more)")
+
+
+@pytest.mark.parametrize("sign, power, text", [(1, 400, "about 1e400"),
+                                               (-1, 5000, "-about 1e5000"),
+                                               (1, 299, "1e299"), (1, 2, "100")])
+def test_a_count_past_a_floats_range_prints_its_power_of_ten(sign, power, text):
+    """`formatting.number` of an int beyond 1e308 (a count from a huge quotient, a file's
+    version): no OverflowError from float(), no thousands of digits."""
+    from mbody.util.formatting import number
+
+    assert number(sign * 10**power) == text

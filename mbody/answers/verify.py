@@ -470,9 +470,9 @@ def check(model: Model, sheet: Answers, *, tol: float, asm: Assembly,
             continue
         if a.body not in model.index:
             hint = did_you_mean(a.body, model.body_names) if hinted(issues) else ""
-            shown = ", ".join(model.body_names[:10]) + (" ..." if model.n > 10 else "")
             issues.append(sheet.issue(a, f"no body named {a.body!r} in model "
-                                      f"'{model.name}' (its bodies: {shown})",
+                                      f"'{model.name}' (its bodies: "
+                                      f"{name_list(model.body_names, 10)})",
                                       body=True, hint=hint))
             continue
         if a.body not in vocab:

@@ -10,6 +10,7 @@ model's) size for a length, a solver's own tolerance for what it solved for.
 
 from __future__ import annotations
 
+import math
 import re
 
 import numpy as np
@@ -41,6 +42,10 @@ def number(x: float) -> str:
     (10 000 000)."""
     if isinstance(x, int) and abs(x) < 10**12:
         return f"{x:,}".replace(",", " ")
+    if isinstance(x, int) and abs(x) >= 10**300:
+        # past a float's range (and past what str() of an int converts in linear time):
+        # its power of ten (math.log10 takes an int of any size)
+        return f"{'-' if x < 0 else ''}about 1e{math.floor(math.log10(abs(x)))}"
     x = float(x)
     return re.sub(r"e\+?(-?)0*(\d)", r"e\1\2", f"{x:g}")
 

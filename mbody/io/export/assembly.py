@@ -34,6 +34,7 @@ from mbody.model.arguments import KnownValues
 from mbody.model.model import Model, State
 from mbody.simulate.trajectory import FORMAT as TRAJECTORY_FORMAT
 from mbody.util import jsontext
+from mbody.util.formatting import number
 
 FORMAT = "mbody-export"
 """The format tag every export carries; a reader refuses any other."""
@@ -630,8 +631,8 @@ def check_format(path: Path, fmt: str, version: int) -> None:
     if fmt != FORMAT:
         raise MbodyError(f"{path}: not an mbody export (format {fmt!r})")
     if version > VERSION:
-        raise MbodyError(f"{path}: export format version {version} is newer than this mbody "
-                         f"reads ({VERSION}); upgrade mbody")
+        raise MbodyError(f"{path}: export format version {number(version)} is newer than "
+                         f"this mbody reads ({VERSION}); upgrade mbody")
 
 
 def build(path: Path, get: Callable[[str], Any], M: sp.spmatrix | np.ndarray,
