@@ -361,6 +361,12 @@ def option_names() -> dict[str, str]:
     return dict(_FLAGS.get() or {})
 
 
+def g_text(x: float) -> str:
+    """`x` as %g writes it, its exponent as people write it: 1e-6, 2.5e13 (not 1e-06,
+    2.5e+13); the one home of that rule (`mbody.util.formatting.number` uses it)."""
+    return re.sub(r"e\+?(-?)0*(\d)", r"e\1\2", f"{x:g}")
+
+
 def option_setting(keyword: str, value: object) -> str:
     """The option `keyword` set to `value`, as a message says what was given or advises:
     ``--max-steps 1000`` on the command line (a switch, `value` True, by its flag alone:
@@ -368,8 +374,7 @@ def option_setting(keyword: str, value: object) -> str:
     ``method='Radau'``; a float as %g writes it, its exponent as people write it:
     ``1e-6``)."""
     flag = (_FLAGS.get() or {}).get(keyword)
-    shown = (re.sub(r"e\+?(-?)0*(\d)", r"e\1\2", f"{value:g}") if isinstance(value, float)
-             else str(value))
+    shown = g_text(value) if isinstance(value, float) else str(value)
     if flag is None:
         return f"{keyword}={value!r}" if isinstance(value, str) else f"{keyword}={shown}"
     return flag if value is True else f"{flag} {shown}"

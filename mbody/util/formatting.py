@@ -11,9 +11,10 @@ model's) size for a length, a solver's own tolerance for what it solved for.
 from __future__ import annotations
 
 import math
-import re
 
 import numpy as np
+
+from mbody.errors import g_text
 
 NOISE = 1e-12
 """A magnitude below which a number with no scale of its own is rounding (a rotation's
@@ -46,8 +47,7 @@ def number(x: float) -> str:
         # past a float's range (and past what str() of an int converts in linear time):
         # its power of ten (math.log10 takes an int of any size)
         return f"{'-' if x < 0 else ''}about 1e{math.floor(math.log10(abs(x)))}"
-    x = float(x)
-    return re.sub(r"e\+?(-?)0*(\d)", r"e\1\2", f"{x:g}")
+    return g_text(float(x))
 
 
 _BINARY_UNITS = ("KiB", "MiB", "GiB", "TiB", "PiB", "EiB")
