@@ -343,3 +343,15 @@ def test_a_run_of_too_many_samples_says_how_many_in_a_few_words(slider_crank):
         mbody.kinematic_run(mbody.load(slider_crank), 1e300, 3600)
     assert str(refused.value).startswith("3.6e303 samples (1e300 s at 3600 fps) is more than "
                                          "10 000 000; lower fps or t_end")
+
+
+@pytest.mark.parametrize("step", ["360 deg", "1 rev", "400 deg"])
+def test_a_step_of_a_turn_or_more_gives_the_row_at_zero(slider_crank, step):
+    """A step of a whole turn or more on a run that turns fully: the one row at 0 (the
+    count was a turn over the step, below 1 for a whole turn, and refused: review
+    R6-4), equal to that angle asked directly."""
+    model = mbody.load(slider_crank)
+    table = mbody.kinematic_at(model, every=step)
+    assert len(table.t) == 1
+    np.testing.assert_allclose(table.values, mbody.kinematic_at(model, "0 deg").values,
+                               rtol=0, atol=RTOL * float(np.abs(table.values).max()))

@@ -337,9 +337,10 @@ def test_the_answer_copied_is_a_solved_value_and_covers_no_row():
 @pytest.mark.parametrize("moving_rod", [False, True], ids=["at rest", "at 3 rad/s"])
 def test_the_moment_about_the_fixed_pin_stays_correct_written_any_way(moving_rod, moving):
     """I_P alpha = M_P about the pin (the pin's forces pass through it), I_P = I_G +
-    m d², d = 0.5 m, M_P = -m g d sin(theta): as written, with numbers, divided by m
-    ((k_G² + d²) alpha = -g d sin theta) or by anything else, it is `correct`; it holds
-    at the solution."""
+    m d², d = 0.5 m, M_P = -m g d sin(theta): as written, with numbers, or divided by m
+    ((k_G² + d²) alpha = -g d sin theta), it is `correct`; it holds at the solution. Any
+    other multiple says no more than alpha's value (the answer doubled, or the law with
+    another mass, would pass too: review R6-1) and is `solved_value_not_an_equation`."""
     m = moving if moving_rod else mbody.load(MODELS / "pendulum.yaml")
     mass, inertia = 2.0, float(m.J[0][2, 2])
     i_p, m_p = inertia + mass * 0.25, -mass * 9.81 * 0.5 * math.sin(math.radians(30))
@@ -347,11 +348,22 @@ def test_the_moment_about_the_fixed_pin_stays_correct_written_any_way(moving_rod
     eqs = ["(I_G + m*0.5^2)*alpha = -m*g*0.5*sin(theta)",
            "(I_G/m + 0.5^2)*alpha = -g*0.5*sin(theta)",
            f"{i_p:.6g}*alpha = {m_p:.6g}", f"{m_p:.6g} = {i_p:.6g}*alpha",
-           f"{2 * i_p:.6g}*alpha = {2 * m_p:.6g}", f"{i_p / 9.81:.6g}*alpha = -m*0.5*0.5"]
+           f"{-i_p:.6g}*alpha = {-m_p:.6g}", f"{i_p / mass:.6g}*alpha = {m_p / mass:.6g}"]
     v = verify(m, [{"body": "rod", "eq": eq} for eq in eqs])
     for c in v.checks:
         assert c.correct and c.row == "rod.theta", (c.eq, c.diagnosis, c.explanation)
         assert c.details["form"] == "fixed_pivot"
+    # other multiples: the answer scaled, the law with a 5 kg rod for the model's 2 kg
+    # (its inertia comes from its shape: the mass cancels), or divided by g
+    k_g2 = (0.05**2 + 1.0**2) / 12.0
+    others = [f"{2 * i_p:.6g}*alpha = {2 * m_p:.6g}", f"{i_p / 9.81:.6g}*alpha = -m*0.5*0.5",
+              f"10*alpha = {10 * m_p / i_p:.6g}",
+              f"5*({k_g2:.8g} + 0.5^2)*alpha = -5*9.81*0.5*sin(theta)"]
+    wrong = verify(m, [{"body": "rod", "eq": eq} for eq in others], require="rod.theta")
+    for c in wrong.checks:
+        assert not c.correct and c.diagnosis == "solved_value_not_an_equation", \
+            (c.eq, c.diagnosis)
+    assert wrong.covered == 0 and not wrong.all_correct
 
 
 def test_a_moment_equation_is_not_read_as_a_newton_row_with_kinematics():

@@ -123,9 +123,11 @@ def test_every_shipped_answer_has_the_same_diagnosis_at_any_scale(scale):
     """Each equation of every shipped answers file, its row multiplied by a power of two
     (exactly, 2^-600 is about 2.4e-181), gets the same diagnosis, row and details.
 
-    But one, by design: a Newton row of one unknown with a reaction written as a number
-    (pendulum: m*a_y = 19.62 - m*g) fixes no scale of its own, so it is called
-    `reaction_treated_as_known` only when written at the row's scale."""
+    But two, by design, equations of one unknown that fix no scale of their own: a Newton
+    row with a reaction written as a number (pendulum: m*a_y = 19.62 - m*g) is called
+    `reaction_treated_as_known` only when written at the row's scale; and the moment
+    about a fixed pivot (I_P alpha = M_P) is `correct` only as written or divided by m
+    (any other multiple says no more than alpha's value: review R6-1)."""
     for path in sorted((MODELS / "answers").glob("*.yaml")):
         model = mbody.load(MODELS / path.name)
         asm = mbody.assemble(model)
@@ -140,6 +142,9 @@ def test_every_shipped_answer_has_the_same_diagnosis_at_any_scale(scale):
             plain, scaled = diagnose(row, rows, 1e-3), diagnose(row.scaled(scale), rows, 1e-3)
             if plain.diagnosis == "reaction_treated_as_known" and len(row.unknowns) == 1:
                 assert scaled.diagnosis == "not_an_equation_of_this_body"
+                continue
+            if plain.details.get("form") == "fixed_pivot" and len(row.unknowns) == 1:
+                assert plain.diagnosis == "correct" != scaled.diagnosis, (path.name, a.eq)
                 continue
             assert (scaled.diagnosis, scaled.row, scaled.expected) == \
                 (plain.diagnosis, plain.row, plain.expected), (path.name, a.eq)

@@ -241,14 +241,21 @@ class _Diagnoser:
 
         With one acceleration as its only unknown (a body of one degree of freedom:
         I_P alpha = M_P) a form fixes no scale, and every equation c alpha = c alpha*
-        matches it, whatever it was made of. At factor ±1 it is the form as written;
-        scaled (the same divided by m: (k_G² + d²) alpha = −g d sin θ) it is still that
-        law, except where the scale gives it away as something else: coefficient 1, the
-        value itself (``alpha = -7.3529``, `solved_value`); or one of the body's rows
+        matches it, whatever it was made of: ``2*alpha = -14.7059`` (the answer, doubled)
+        or the same law with another mass (5 kg for the model's 2 kg: the mass cancels
+        where the inertia comes from the shape) would pass at any factor (review R6-1).
+        So it is that law only at the two scales people write it at: factor ±1 (as
+        written) and ±1/m (divided by the mass: (k_G² + d²) alpha = −g d sin θ); and
+        even then not where the scale gives it away as something else: coefficient 1,
+        the value itself (``alpha = -7.3529``, `solved_value`); or one of the body's rows
         with its reactions' values put in, at that row's own scale (``I_G*alpha =
         -1.2286``, ``m*0.433013*alpha = -6.3678``: `treated_as_known`)."""
         single = len(t.unknowns) == 1 and not (t.unknowns & set(self.br.joints))
-        if not single or abs(abs(f.k) - 1.0) <= self.tol:
+        if not single:
+            return True
+        if abs(abs(f.k) - 1.0) > self.tol and abs(abs(f.k) * self.br.mass - 1.0) > self.tol:
+            return False  # a multiple of the law that says only alpha's value
+        if abs(abs(f.k) - 1.0) <= self.tol:
             return True
         (u,) = t.unknowns
         if abs(abs(self.s.get(u)) - 1.0) <= self.tol * max(1.0, self.s.err(u)):

@@ -274,7 +274,7 @@ def add_progress_options(command: argparse.ArgumentParser, what: str = "the prog
     command.add_argument("--progress", action="store_true",
                          help=f"show {what} on stderr even when it is not a terminal")
     command.add_argument("--no-progress", action="store_true",
-                         help=f"no {what.removeprefix('the ')} on stderr")
+                         help=f"do not show {what} on stderr")
 
 
 def show_progress(a: argparse.Namespace) -> bool:

@@ -635,8 +635,8 @@ def _every(model: Model, run: Trajectory, step: Asked) -> list[Asked]:
     F = np.asarray(d.laws[step.driver][0](t), dtype=float) * np.ones(len(t))
     lo, hi = float(F.min()), float(F.max())
     if angle and _turns_fully(d.laws[step.driver][0], t):  # a full turn: 0 up to 360 deg
-        first = 0
-        last = math.ceil(_check_count(TURN / step.value * (1 - 1e-12), step)) - 1
+        first = 0  # the rows 0, step, ... below a turn: a step of a whole turn has one
+        last = math.ceil(_check_count(max(TURN / step.value * (1 - 1e-12), 1.0), step)) - 1
     else:
         a, b = lo / step.value - 1e-9, hi / step.value + 1e-9
         _check_count(b - a + 1, step)
