@@ -389,3 +389,26 @@ def test_beyond_the_bound_fewer_relations_never_a_wrong_one(monkeypatch):
     monkeypatch.setattr(kinematics, "MAX_COORDINATES", 3)  # the lower rod alone
     assert body_rows(asm, "lower").kinematics is None
     assert body_rows(asm, "upper").kinematics.sources == ("joint O",)
+
+
+def test_a_fast_cranks_moment_about_its_pivot_keeps_the_constants_tolerance():
+    """About a fixed pivot the centripetal terms' moments cancel (d x (w x (w x d)) = 0 in
+    the plane); their sizes once widened the constant's tolerance with w² (review R6-2):
+    at 600 rad/s a constant 0.2 % off passed. Now the constant is compared at its own
+    magnitude, as about G."""
+    from mbody.answers.rows import body_rows
+
+    model = mbody.load(MODELS / "slider_crank.yaml").with_values(
+        {"bodies.crank.angular_velocity": 600})
+    rows = body_rows(mbody.assemble(model), "crank")
+    (pivot,) = [p for p in rows.points if p.name == "joint O"]
+    t = rows.about_fixed_point(rows.euler[0], pivot)
+    assert t.err("1") == pytest.approx(abs(t.get("1")), rel=1e-12)
+
+    def written(off: float) -> str:
+        c = t.coef
+        return (f"{c['alpha']:.6g}*alpha = {-c['1'] * off:.6g} + {-c['A.Fx']:.6g}*A.Fx"
+                f" + {-c['A.Fy']:.6g}*A.Fy")
+
+    v = verify(model, [{"body": "crank", "eq": written(off)} for off in (1.0, 1.002)])
+    assert [c.diagnosis for c in v.checks] == ["correct", "rounded_too_coarsely"]

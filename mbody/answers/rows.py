@@ -228,13 +228,18 @@ class BodyRows:
         A = _denoise(A, size)
         a0 = _denoise(a0, size * float(self.omega @ self.omega)) if gyro else 0.0 * a0
         accs = (PLANAR_ACCELERATIONS if self.planar else SPATIAL_ACCELERATIONS)[:3]
+        net = 0.0  # the velocity terms' constant: added once, at its own magnitude
         for j, a in enumerate(accs[: 2 if self.planar else 3]):
             c = row.get(a)
             if c == 0.0:
                 continue
             sub = {al: float(A[j, k]) for k, al in enumerate(alphas) if A[j, k] != 0.0}
-            sub[CONST] = float(a0[j])
+            net += c * float(a0[j])
             row = row.without([a]).plus(Row.of(sub), c)
+        # the centripetal terms' moments about a fixed point cancel (exactly, in the plane:
+        # d x (w x (w x d)) = 0 for w along z): their sizes added one by one would widen
+        # the constant's tolerance by terms nobody writes (review R6-2), growing with w²
+        row = row.plus(Row.of({CONST: net}))
         return row.cleaned(absolute=self.joints)
 
     def _lever(self, point: MomentPoint) -> np.ndarray:
