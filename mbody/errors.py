@@ -354,6 +354,28 @@ def option_name(keyword: str, value: str = "", typed: str = "") -> str:
     return f"{keyword}={value}" if value else keyword
 
 
+def comma_words(given: str | Iterable[object], keyword: str, expected: str) -> list[str]:
+    """The words of an argument that takes a text of comma-separated words or a sequence
+    of such texts (``--require lower,upper.theta``, repeatable; ``require=["lower"]``),
+    each stripped, empty ones kept (the caller says what an empty one means).
+
+    Raises
+    ------
+    MbodyTypeError
+        An item that is not text, or `given` neither text nor a sequence: "<option>:
+        expected <expected>, got <type>".
+    """
+    texts = [given] if isinstance(given, str) else \
+        list(given) if isinstance(given, Iterable) else [given]
+    words: list[str] = []
+    for text in texts:
+        if not isinstance(text, str):
+            raise MbodyTypeError(f"{option_name(keyword)}: expected {expected}, got "
+                                 f"{type(text).__name__}")
+        words += [w.strip() for w in text.split(",")]
+    return words
+
+
 def option_names() -> dict[str, str]:
     """The flags `options_named` set around this call ({} outside a command): what a
     piece of work done elsewhere (a sweep's cases on a cluster's workers) names its

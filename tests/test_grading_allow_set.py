@@ -101,3 +101,16 @@ def test_the_command_line(files, tmp_path):
             "--allow-set", "bodies.lower.mass", "--allow-set", "bodies.lower.inertia")
     assert r.returncode == 1
     assert "a file may set bodies.lower.mass, bodies.lower.inertia" in r.stdout
+
+
+@pytest.mark.parametrize("given", [5, [1], ["bodies.lower.mass", 2.5]])
+def test_require_and_allow_set_take_text_or_a_sequence_of_text(files, given):
+    """Both read their words the same way (`errors.comma_words`): anything else is an
+    MbodyTypeError naming the argument (a bare int was a raw TypeError from list())."""
+    from mbody.errors import MbodyTypeError
+
+    model = mbody.load(MODEL)
+    with pytest.raises(MbodyTypeError, match="^allow_set: expected paths"):
+        mbody.verify(model, files["eve"], allow_set=given)
+    with pytest.raises(MbodyTypeError, match="^require: expected words"):
+        mbody.verify(model, files["eve"], require=given)

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 from mbody.answers.load import Answers
 from mbody.answers.text import equation_text
 from mbody.equations.assemble import Assembly
-from mbody.errors import MbodyError, did_you_mean, option_name
+from mbody.errors import MbodyError, comma_words, did_you_mean, option_name
 from mbody.model.model import Model
 
 ALL, ANSWERED, LAGRANGE = "all", "answered", "lagrange"
@@ -164,14 +164,9 @@ def requirement(model: Model, require: str | Sequence[str] | None) -> Requiremen
         return Requirement()
     if isinstance(require, Requirement):
         return require
-    given = [require] if isinstance(require, str) else list(require)
-    words: list[str] = []
     flag = option_name("require")
-    for g in given:
-        if not isinstance(g, str):
-            raise MbodyError(f"{flag}: expected words such as 'all' or 'lower,upper.theta', "
-                             f"got {type(g).__name__}")
-        words += [w.strip() for w in g.split(",") if w.strip()]
+    words = [w for w in comma_words(require, "require",
+                                    "words such as 'all' or 'lower,upper.theta'") if w]
     if not words:
         raise MbodyError(f"{flag}: no rows named; give all, answered, lagrange, a body's "
                          "name or a row's label (upper.theta)")

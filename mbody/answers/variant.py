@@ -31,8 +31,8 @@ from mbody.answers.load import Answers, AnswersError, Setting
 from mbody.errors import (
     Issue,
     MbodyError,
-    MbodyTypeError,
     ModelError,
+    comma_words,
     option_name,
     option_setting,
 )
@@ -60,14 +60,7 @@ def allow_list(model: Model, patterns: str | Sequence[str] | None
     """
     if patterns is None:
         return None
-    if isinstance(patterns, str):
-        patterns = [patterns]
-    out: list[str] = []
-    for given in patterns:
-        if not isinstance(given, str):
-            raise MbodyTypeError(f"{option_name('allow_set')}: expected paths such as "
-                                 f"bodies.rod.mass, got {type(given).__name__}")
-        out += [p.strip() for p in given.split(",")]
+    out = comma_words(patterns, "allow_set", "paths such as bodies.rod.mass")
     if any(not p for p in out):
         raise MbodyError(f"{option_name('allow_set')}: an empty path; expected paths such "
                          "as bodies.rod.mass, separated by commas")
