@@ -13,6 +13,7 @@ import pytest
 import mbody
 from mbody.answers.load import AnswersError
 from mbody.answers.summary import grade
+from mbody.answers.variant import allow_list
 from mbody.errors import MbodyError
 
 MODEL = Path(__file__).resolve().parents[1] / "models" / "double_pendulum.yaml"
@@ -68,6 +69,14 @@ def test_wildcards_whole_entries_and_lists_allow(files, allow):
     assert mbody.verify(mbody.load(MODEL), files["eve"], allow_set=allow).correct == 2
 
 
+@pytest.mark.parametrize("allow", ["*", "bodies.*", "bodies.lower.*", "bodies.*.inertia",
+                                   "gravity.?", "joints.*.at.0", "bodies.*.color"])
+def test_a_pattern_matching_some_path_of_the_model_is_accepted(allow):
+    """Matched against every path the model file could take, the keys it leaves out
+    (a colour) and the components of those it gives (a joint point's x) included."""
+    assert allow_list(mbody.load(MODEL), allow) == (allow,)
+
+
 def test_a_component_is_allowed_by_its_path(tmp_path):
     f = tmp_path / "g.yaml"
     f.write_text('set: {gravity.1: -9.81}\nequations:\n  - {body: lower, eq: "m*a_x = A.Fx"}\n')
@@ -80,6 +89,10 @@ def test_a_component_is_allowed_by_its_path(tmp_path):
     ("bodies.lower.mas", "did you mean 'mass'"),
     ("bodies.lower.mass,", "an empty path"),
     ("gravty", "gravity"),
+    # a pattern matching no path (review R6-6): would refuse every file that sets a value
+    ("bodies.*.mas", "matches no path of the model.*did you mean 'bodies.upper.mass'"),
+    ("gravity[1]", "matches no path.*did you mean 'gravity.1'"),
+    ("joints.*.speed", "matches no path"),
 ])
 def test_a_pattern_naming_nothing_is_refused_before_any_file(files, allow, said):
     with pytest.raises(MbodyError, match=said):

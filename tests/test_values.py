@@ -236,3 +236,21 @@ def test_convert_writes_the_model_with_the_values_set(tmp_path):
             "bodies.rod.mas=2")
     assert p.returncode == 2 and "did you mean 'mass'" in p.stderr
     assert not (tmp_path / "q.yaml").exists()
+
+
+@pytest.mark.parametrize("file", sorted((ROOT / "models").glob("*.yaml")), ids=lambda p: p.stem)
+def test_every_settable_path_resolves_and_every_entry_key_is_listed(file):
+    """`settable_paths` (what an ``--allow-set`` pattern is matched against) lists only
+    paths `resolve` accepts, and every body's and joint's keys."""
+    from mbody.model.values import entry_names, resolve, settable_paths
+
+    model = mbody.load(file)
+    doc, names = model.source.read(), entry_names(model)
+    paths = settable_paths(doc, names)
+    assert len(paths) == len(set(paths))
+    for p in paths:
+        resolve(doc, p, names)  # raises on a path that names nothing
+    for body in model.body_names:
+        assert f"bodies.{body}.mass" in paths and f"bodies.{body}.color" in paths
+    assert "gravity" in paths
+    assert ("gravity.0" in paths) == ("gravity" in doc.data)  # components of what it gives

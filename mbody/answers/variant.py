@@ -33,11 +33,12 @@ from mbody.errors import (
     MbodyError,
     ModelError,
     comma_words,
+    did_you_mean,
     option_name,
     option_setting,
 )
 from mbody.model.model import Model
-from mbody.model.values import apply, edits, entry_names, resolve
+from mbody.model.values import apply, edits, entry_names, resolve, settable_paths
 
 WILDCARDS = "*?["
 """The characters that make a pattern of `allow_list` match several paths (fnmatch's)."""
@@ -55,7 +56,8 @@ def allow_list(model: Model, patterns: str | Sequence[str] | None
     ------
     MbodyError
         A pattern without wildcards that names nothing in the model file (with the
-        model's did-you-mean), or an empty pattern; `mbody.errors.MbodyTypeError` for
+        model's did-you-mean), one with wildcards that matches none of its paths, or an
+        empty pattern; `mbody.errors.MbodyTypeError` for
         what is not text.
     """
     if patterns is None:
@@ -68,9 +70,19 @@ def allow_list(model: Model, patterns: str | Sequence[str] | None
     if src is not None:
         doc = src.read()
         names = entry_names(model)
+        paths: list[str] | None = None
         for p in out:
             if any(c in p for c in WILDCARDS):
-                continue  # a pattern: it may match no student's path, which is no error
+                # a pattern that matches no path of the model allows nothing: a typo
+                # that would refuse every file setting a value
+                paths = settable_paths(doc, names) if paths is None else paths
+                if not any(allowed(path, (p,)) for path in paths):
+                    hint = did_you_mean(p, paths)
+                    raise MbodyError(
+                        f"{option_setting('allow_set', p)}: the pattern matches no path of "
+                        "the model; paths are section.name.key[.component], such as "
+                        f"bodies.*.mass or gravity.1" + (f" ({hint})" if hint else ""))
+                continue
             head, _, name = p.partition(".")
             if name in names.get(head, ()):
                 continue  # a whole entry (bodies.lower): every key of it
@@ -85,8 +97,7 @@ def allow_list(model: Model, patterns: str | Sequence[str] | None
 
 def allowed(path: str, patterns: Sequence[str]) -> bool:
     """Whether the ``set:`` path `path` is one `patterns` (`allow_list`) allow."""
-    return any(fnmatchcase(path, p) or path.startswith((p + ".", p + "["))
-               for p in patterns)
+    return any(fnmatchcase(path, p) or path.startswith(p + ".") for p in patterns)
 
 
 def variant(model: Model, sheet: Answers, allow: Sequence[str] | None = None) -> Model:

@@ -143,6 +143,36 @@ def resolve(doc: Document, given: str, names: Mapping[str, Sequence[str]]) -> Pa
     return _inside(doc, (*at, key), parts[3:], given, fail)
 
 
+def settable_paths(doc: Document, names: Mapping[str, Sequence[str]]) -> list[str]:
+    """Every path `resolve` accepts in `doc`: each entry's keys (those the file leaves out
+    too, which a value may add; not ``name``), the components of the values it gives, and
+    ``gravity`` with its components; for matching a pattern (``bodies.*.mass``) against
+    the model. As many as the document's values, plus each entry's unused keys."""
+    out: list[str] = []
+
+    def inside(prefix: str, value: Any) -> None:
+        out.append(prefix)
+        if isinstance(value, list):
+            for i, v in enumerate(value):
+                inside(f"{prefix}.{i}", v)
+        elif isinstance(value, dict):
+            for k, v in value.items():
+                inside(f"{prefix}.{k}", v)
+
+    data = doc.data if isinstance(doc.data, dict) else {}
+    for head in TOP:
+        inside(head, data.get(head, _ABSENT))
+    for head in SECTIONS:
+        entries = data.get(head)
+        for i, name in enumerate(names.get(head, ())):
+            entry = entries[i] if isinstance(entries, list) and i < len(entries) else {}
+            for key in _keys(head, entry):
+                if key != "name":
+                    inside(f"{head}.{name}.{key}",
+                           entry.get(key, _ABSENT) if isinstance(entry, dict) else _ABSENT)
+    return out
+
+
 def _example_key(section: str) -> str:
     return {"bodies": "mass", "loads": "force", "joints": "at", "drivers": "speed"}[section]
 
