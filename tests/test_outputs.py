@@ -337,6 +337,23 @@ def test_two_outputs_onto_one_device_are_written_through(tmp_path, capsys):
     assert code == 0, err
 
 
+@pytest.mark.skipif(sys.platform != "linux", reason="/dev/stdout")
+def test_two_outputs_on_standard_output_pass_wherever_it_goes(tmp_path):
+    """Review R6-5: -o and --csv both /dev/stdout were refused when the shell redirected
+    stdout to a file and accepted on a pipe; both are written through the descriptor, one
+    after the other, so both pass, and the file holds both, in order."""
+    out = tmp_path / "both.out"
+    args = ("kinematics", PENDULUM.parent / "slider_crank_driven.yaml", "--t-end", "0.05",
+            "--csv", "/dev/stdout", "-o", "/dev/stdout")
+    with open(out, "wb") as fh:
+        p = cli(*args, stdout=fh)
+    assert p.returncode == 0, p.stderr
+    piped = cli(*args)
+    assert piped.returncode == 0, piped.stderr
+    assert out.read_bytes() == piped.stdout
+    assert piped.stdout.startswith(b"PK") and b"motor (deg),t (s)" in piped.stdout  # npz, table
+
+
 def test_every_command_that_writes_has_force():
     from mbody.cli import build_parser
 

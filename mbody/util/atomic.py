@@ -225,8 +225,15 @@ def refuse_one_file_twice(outputs: Iterable[tuple[str, str]]) -> None:
     there (a link, a hard link, another spelling of the path), else by the path with its
     links followed. `outputs` are (option, path) pairs, as `refuse_overwriting_inputs`
     takes them. A device or a named pipe is written through, not replaced: two outputs
-    there (``/dev/null``) pass."""
+    there (``/dev/null``) pass; so do two on the command's own standard output, written
+    one after the other through its descriptor (`_plan`), whether it goes to a terminal,
+    a pipe or a file."""
     seen: dict[object, tuple[str, str]] = {}
+    fd = _stdout_fd()
+    try:
+        out = os.fstat(fd) if fd is not None else None
+    except (OSError, ValueError):
+        out = None
     for flag, path in outputs:
         try:
             st = os.stat(path)
@@ -237,6 +244,8 @@ def refuse_one_file_twice(outputs: Iterable[tuple[str, str]]) -> None:
         else:
             if not (stat.S_ISREG(st.st_mode) or stat.S_ISDIR(st.st_mode)):
                 continue
+            if out is not None and os.path.samestat(st, out):
+                continue  # the standard output, appended to, never replaced
             key = (st.st_dev, st.st_ino)
         if key in seen:
             first, where = seen[key]
