@@ -78,7 +78,7 @@ class DOP853:
                  filter_first: bool = False):
         y0 = np.array(y0, dtype=float).ravel()
         self.n = n = len(y0)
-        atol_vector = not isinstance(atol, float | int) and np.ndim(atol) > 0
+        atol_vector = not isinstance(atol, (float, int)) and np.ndim(atol) > 0
         self.state = np.zeros(_core.DOP_STATE_SIZE)
         self.work = np.zeros(_core.dop853_work_size(n))
         s = self.state

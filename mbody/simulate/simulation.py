@@ -263,23 +263,17 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     if initial is not None:
         initial = checked_state(model, initial, "initial")
     given: KnownValues | None = None if known is None else known_values(model, known)
-    varying = _varying_expressions(model, given)
-    _check_span(varying, t_end)
-    if dynamics is None and initial is None and fully_driven(model):
+    plan = _prepared(model, given, dynamics, initial, method)
+    _check_span(plan.varying, t_end)
+    if plan.driven:
         # the drivers fix the motion: each sample's kinematics then its reactions, no
         # integration (mbody.simulate.kinematic)
         return kinematic_run(with_known(model, given), t_end, fps, axes=axes)
-    rhs = state_derivative(model, given, dynamics)
-    run_model = rhs.model  # the model with `known`'s values in its known reactions
-    mechanism = dynamics is None and _has_unknown_reactions(run_model, None)
+    varying, rhs, run_model = plan.varying, plan.rhs, plan.run_model
+    mechanism, projecting, ratio = plan.mechanism, plan.projecting, plan.ratio
+    y0 = plan.y0.copy()
     n = model.n
     planar = model.dimension == cv.PLANAR
-    # the joints held by projecting the state after every step (mbody.simulate.projection);
-    # scipy's integrators keep their own history of y, so Baumgarte's terms hold them
-    projecting = mechanism and method in CORE
-    if projecting:
-        rhs.rate = 0.0
-    y0, ratio = _start(run_model, initial, rhs.unknowns if projecting else None)
     size = len(y0)
     bar = _Progress(progress, t_end, model.name or "simulate")
     t_eval = _sample_times(model, K, fps, t_end)
@@ -768,6 +762,48 @@ def potential_energy(model: Model, traj: Trajectory, lengths: np.ndarray | None 
                                      lengths=True).lengths
         V = V + 0.5 * np.sum(sp.stiffness * (lengths - sp.rest_length) ** 2, axis=1)
     return V
+
+
+class _Prepared:
+    """What a run needs before it steps, from its model and the arguments that change the
+    equations (`known`, `dynamics`, `initial`, the method's family) alone (`_prepared`)."""
+
+    __slots__ = ("varying", "driven", "rhs", "run_model", "mechanism", "projecting", "y0",
+                 "ratio")
+
+    def __init__(self, model: Model, given: KnownValues | None, dynamics: Dynamics | None,
+                 initial: State | None, core: bool):
+        self.varying = _varying_expressions(model, given)
+        """(what, expression) of every load and known reaction varying in time."""
+        self.driven = dynamics is None and initial is None and fully_driven(model)
+        """The drivers fix the motion: a kinematic run, nothing below is made."""
+        if self.driven:
+            return
+        self.rhs = rhs = state_derivative(model, given, dynamics)
+        self.run_model = rhs.model  # the model with `known`'s values in its known reactions
+        self.mechanism = dynamics is None and _has_unknown_reactions(rhs.model, None)
+        # the joints held by projecting the state after every step
+        # (mbody.simulate.projection); scipy's integrators keep their own history of y, so
+        # Baumgarte's terms hold them
+        self.projecting = self.mechanism and core
+        if self.projecting:
+            rhs.rate = 0.0
+        self.y0, self.ratio = _start(rhs.model, initial,
+                                     rhs.unknowns if self.projecting else None)
+        """The first state (core's layout; a copy is stepped) and its geometric ratio."""
+
+
+def _prepared(model: Model, given: KnownValues | None, dynamics: Dynamics | None,
+              initial: State | None, method: str) -> _Prepared:
+    """`_Prepared` for this run: made once per model and method family for the model's
+    own runs (nothing in `known`, no `dynamics`, no `initial`: a tolerance study, a
+    benchmark, a sweep's repeats), else made for the run. Its parts are never changed by
+    a run (the right-hand side's rate is set here, once)."""
+    core = method in CORE
+    if not given and dynamics is None and initial is None:
+        return _memo(model, ("prepared", core),
+                     lambda: _Prepared(model, None, None, None, core))
+    return _Prepared(model, given, dynamics, initial, core)
 
 
 def _memo(model: Model, key: tuple, make: Callable[[], _T]) -> _T:

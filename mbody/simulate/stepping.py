@@ -45,6 +45,14 @@ IMPLICIT = ("Radau", "BDF", "LSODA")
 """The methods for stiff problems (LSODA switches to BDF when it finds stiffness)."""
 
 
+_MECH_SETTINGS = np.zeros(_core.MECH_PARAMS)
+_MECH_SETTINGS[_core.MECH_ROBUST] = STAGE_PIVOT_RTOL
+_MECH_SETTINGS[_core.MECH_ITERS] = ITERATIONS
+_MECH_SETTINGS[_core.MECH_STAGE_ITERS] = STAGE_ITERATIONS
+"""The core's settings of a mechanism's run (``_core.MECH_*``) but its Baumgarte rate, which
+each run's right-hand side sets; the known reaction values follow them."""
+
+
 class CoreRun:
     """DOP853 in the compiled core from (0, y0) to t_bound (tolerances, largest step), on
     the right-hand side `rhs`; with `project`, the state is moved onto the joints of
@@ -59,11 +67,8 @@ class CoreRun:
         self.rhs, self.projecting = rhs, project
         core = True if project else None
         if rhs.solver is not None:
-            params = np.concatenate(([0.0] * _core.MECH_PARAMS, rhs.lam))
+            params = np.concatenate((_MECH_SETTINGS, rhs.lam))
             params[_core.MECH_RATE] = rhs.rate
-            params[_core.MECH_ROBUST] = STAGE_PIVOT_RTOL
-            params[_core.MECH_ITERS] = ITERATIONS
-            params[_core.MECH_STAGE_ITERS] = STAGE_ITERATIONS
             self.solver = DOP853(rhs.solver, 0.0, y0, t_bound, rtol=rtol, atol=atol,
                                  max_step=max_step, params=params, project=core,
                                  stage=core, tangent=core, refresh=REFRESH_ATOL,
