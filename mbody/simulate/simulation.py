@@ -269,9 +269,12 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
         # the drivers fix the motion: each sample's kinematics then its reactions, no
         # integration (mbody.simulate.kinematic)
         return kinematic_run(with_known(model, given), t_end, fps, axes=axes)
-    varying, rhs, run_model = plan.varying, plan.rhs, plan.run_model
-    mechanism, projecting, ratio = plan.mechanism, plan.projecting, plan.ratio
-    y0 = plan.y0.copy()
+    varying, mechanism, projecting = plan.varying, plan.mechanism, plan.projecting
+    rhs = state_derivative(model, given, dynamics)
+    if projecting:
+        rhs.rate = 0.0
+    run_model = rhs.model  # the model with `known`'s values in its known reactions
+    y0, ratio = plan.y0.copy(), plan.ratio
     n = model.n
     planar = model.dimension == cv.PLANAR
     size = len(y0)
@@ -766,10 +769,11 @@ def potential_energy(model: Model, traj: Trajectory, lengths: np.ndarray | None 
 
 class _Prepared:
     """What a run needs before it steps, from its model and the arguments that change the
-    equations (`known`, `dynamics`, `initial`, the method's family) alone (`_prepared`)."""
+    equations (`known`, `dynamics`, `initial`, the method's family) alone (`_prepared`).
+    Nothing in it refers to the model: kept in the model's workspace, it must not keep
+    the model alive."""
 
-    __slots__ = ("varying", "driven", "rhs", "run_model", "mechanism", "projecting", "y0",
-                 "ratio")
+    __slots__ = ("varying", "driven", "mechanism", "projecting", "y0", "ratio")
 
     def __init__(self, model: Model, given: KnownValues | None, dynamics: Dynamics | None,
                  initial: State | None, core: bool):
@@ -779,17 +783,15 @@ class _Prepared:
         """The drivers fix the motion: a kinematic run, nothing below is made."""
         if self.driven:
             return
-        self.rhs = rhs = state_derivative(model, given, dynamics)
-        self.run_model = rhs.model  # the model with `known`'s values in its known reactions
-        self.mechanism = dynamics is None and _has_unknown_reactions(rhs.model, None)
+        run_model = with_known(model, given)
+        self.mechanism = dynamics is None and _has_unknown_reactions(run_model, None)
         # the joints held by projecting the state after every step
         # (mbody.simulate.projection); scipy's integrators keep their own history of y, so
         # Baumgarte's terms hold them
         self.projecting = self.mechanism and core
-        if self.projecting:
-            rhs.rate = 0.0
-        self.y0, self.ratio = _start(rhs.model, initial,
-                                     rhs.unknowns if self.projecting else None)
+        self.y0, self.ratio = _start(
+            run_model, initial,
+            workspace(run_model).file_unknowns if self.projecting else None)
         """The first state (core's layout; a copy is stepped) and its geometric ratio."""
 
 
@@ -797,8 +799,7 @@ def _prepared(model: Model, given: KnownValues | None, dynamics: Dynamics | None
               initial: State | None, method: str) -> _Prepared:
     """`_Prepared` for this run: made once per model and method family for the model's
     own runs (nothing in `known`, no `dynamics`, no `initial`: a tolerance study, a
-    benchmark, a sweep's repeats), else made for the run. Its parts are never changed by
-    a run (the right-hand side's rate is set here, once)."""
+    benchmark, a sweep's repeats), else made for the run."""
     core = method in CORE
     if not given and dynamics is None and initial is None:
         return _memo(model, ("prepared", core),
