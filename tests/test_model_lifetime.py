@@ -23,6 +23,11 @@ def _runs(model: mbody.Model) -> None:
     mbody.simulate(model, 0.2, 10, rtol=1e-6, atol=1e-8)  # the prepared run, again
     mbody.simulate(model, 0.2, 10, method="RK45", rtol=1e-6, atol=1e-8)
     mbody.assemble(model, model.initial).solve()
+    mbody.solve_many(model, [model.initial, model.initial])
+    if model.drivers is not None and len(model.drivers.names):
+        mbody.kinematic_at(model, [0.0, 0.01])
+    else:
+        mbody.linearize(model, model.initial)
 
 
 @pytest.mark.parametrize("name", ["pendulum", "slider_crank", "heavy_top",
