@@ -15,7 +15,9 @@ import numpy as np
 import pytest
 from test_cli import MODELS, fails, mbody, succeeds
 
+import mbody as mbody_api
 from mbody.io.export.generalized import read_generalized
+from mbody.simulate.modes import mode_trajectory
 
 
 def test_lagrange_prints_the_equations_and_the_accelerations():
@@ -94,6 +96,22 @@ def test_animate_a_mode(tmp_path):
     assert "no mode 9" in err
     err = fails(2, "animate", MODELS / "double_pendulum.yaml", "--equilibrium")
     assert "--equilibrium only applies with --mode" in err
+
+
+def test_animating_a_mode_about_a_state_not_at_rest_says_so(tmp_path):
+    """Review R7-4: the pendulum starts at 30 degrees, not at rest; `mbody modes` gives no
+    verdict there, and `animate --mode` played the tangent system's mode without a word.
+    The run's warnings (Python) and the command's (stderr) now say it; about the
+    equilibrium, nothing is said."""
+    lin = mbody_api.linearize(mbody_api.load(MODELS / "pendulum.yaml"))
+    traj = mode_trajectory(lin, 1)
+    assert any("not an equilibrium" in w for w in traj.info["warnings"])
+    p = mbody("animate", MODELS / "pendulum.yaml", "--mode", "1", "-o", tmp_path / "m.html")
+    assert p.returncode == 0 and "not an equilibrium" in p.stderr
+    assert "--equilibrium plays the mode" in p.stderr
+    p = mbody("animate", MODELS / "pendulum.yaml", "--mode", "1", "--equilibrium",
+              "-o", tmp_path / "e.html")
+    assert p.returncode == 0 and "warning" not in p.stderr
 
 
 def test_modes_of_a_fully_driven_mechanism_says_nothing_oscillates():

@@ -99,6 +99,10 @@ def _mode(a: argparse.Namespace):
     traj = mode_trajectory(lin, a.mode, fps=a.fps or FPS)
     for w in traj.info.get("warnings", []):
         print(f"mbody: warning: {w}", file=sys.stderr)
+    if lin.stable is None and not a.equilibrium:  # as `mbody modes` says it (review R7-4)
+        print("mbody: warning: so the motion played is not an oscillation about rest; "
+              "--equilibrium plays the mode about the static equilibrium nearest the pose",
+              file=sys.stderr)
     return traj, model
 
 

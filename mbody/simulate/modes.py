@@ -124,9 +124,10 @@ def mode_trajectory(lin: Linearization, k: int, *, periods: float = 3.0, fps: fl
         om.append(s.omega)
     info = {"mode": k, "eigenvalue": [lam.real, lam.imag], "kind": mode.kind,
             "amplitude": a, "frequency_hz": mode.frequency_hz,
-            "warnings": [] if mode.kind == "oscillation" else
+            # the linearisation's own (a state not at rest: the tangent system's modes)
+            "warnings": list(lin.warnings) + ([] if mode.kind == "oscillation" else
             [f"mode {k} does not oscillate ({mode.kind}): its shape is played back and forth "
-             "at 1 Hz"]}
+             "at 1 Hz"])}
     shapes, colors = appearance(model)
     return Trajectory.from_states(
         t, np.array(pos), np.array(quat), np.array(vel), np.array(om),
