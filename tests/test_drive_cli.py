@@ -172,3 +172,26 @@ def test_check_says_which_velocities_the_drivers_rates_set(tmp_path):
     # without drivers nothing changes, and no such line is printed
     plain = mbody("check", "models/double_pendulum.yaml")
     assert "assembled velocities" not in plain.stdout
+
+
+@pytest.mark.parametrize("name", ["slider_crank_driven", "scotch_yoke", "flyball_governor"])
+def test_equilibrium_of_a_speed_driven_model_holds_its_drivers_without_a_warning(name):
+    """Review R7-5: the equilibrium holds each driver at its pose, at rest; its reactions
+    were solved with the file's speeds, so the state at rest 'broke' every speed driver
+    (warning: G^T v -62.8 rad/s). The values are those of either assembly: at rest no
+    velocity term acts."""
+    import mbody as api
+    from mbody.solve.equilibrium import find_equilibrium, held
+
+    text = mbody("equilibrium", f"models/{name}.yaml")
+    assert text.returncode == 0 and "motor" in text.stdout
+    assert "breaks joint constraints" not in text.stdout + text.stderr, text.stdout
+    p = mbody("equilibrium", f"models/{name}.yaml", "--json")
+    out = json.loads(p.stdout)
+    model = api.load(ROOT / "models" / f"{name}.yaml")
+    state = find_equilibrium(model).state
+    for route in (model, held(model, 0.0)):
+        sol = api.assemble(route, state).solve()
+        for label, value in out["reactions"].items():
+            scale = max(abs(v) for v in out["reactions"].values()) or 1.0
+            assert abs(sol.reactions[label] - value) <= 1e-9 * scale, label

@@ -29,14 +29,17 @@ def equilibrium(a: argparse.Namespace) -> int:
 
     from mbody.equations.assemble import assemble
     from mbody.present.text import pose_text, reaction_table_text, world_reaction_text
-    from mbody.solve.equilibrium import find_equilibrium
+    from mbody.solve.equilibrium import find_equilibrium, held
     from mbody.solve.linearize import STEADY_RTOL
     from mbody.util import jsontext
 
     model = load_model(a.model)
     found = find_equilibrium(model, t=a.t)
     state = found.state
-    asm = assemble(model, state)
+    # the reactions of the model as the equilibrium holds it: its drivers at their pose,
+    # at rest (with the file's speeds, the state at rest would break every speed driver,
+    # review R7-5); the same values, since at rest no velocity term acts
+    asm = assemble(held(model, a.t), state)
     sol = asm.solve(axes=a.axes) if found.found and model.reactions else None
     if a.json:
         jsontext.dump({
