@@ -591,3 +591,22 @@ def test_help_states_the_simulation_defaults_and_gravity():
     assert f"when SOURCE is a model (default {sig['t_end'].default:g};" in text
     assert f"(default {sig['fps'].default:g};" in text
     assert "gravity (m g at each mass centre)" in text
+
+
+def test_cli_says_when_the_frames_alias_a_spin_and_refuses_a_run_files_rate(tmp_path):
+    """Review R7-16/17: the flywheel reaches 400 rad/s (63.7 rev/s), more than half a turn
+    a frame at 60 fps; `simulate` warned of it, `animate` of the same run did not, and a
+    run file's --fps was ignored silently."""
+    flywheel = ROOT / "models" / "practice_2_flywheel.yaml"
+    p = _cli("animate", flywheel, "-o", "f.html", cwd=tmp_path)
+    assert p.returncode == 0 and "spin faster than 60 fps can show" in p.stderr, p.stderr
+    p = _cli("animate", flywheel, "--fps", "130", "--t-end", "2", "-o", "g.html", cwd=tmp_path)
+    assert p.returncode == 0 and "spin faster" not in p.stderr  # 130 fps shows 63.7 rev/s
+    run = mbody.simulate(mbody.load(flywheel), 10.0, 60).save(tmp_path / "fw.npz")
+    p = _cli("animate", run, "-o", "h.html", cwd=tmp_path)
+    assert p.returncode == 0 and "spin faster" in p.stderr and "simulate the model again" \
+        in p.stderr
+    for flag in ("--fps", "--t-end"):
+        p = _cli("animate", run, flag, "2", "-o", "i.html", cwd=tmp_path)
+        assert p.returncode == 2 and f"{flag} does not apply to a run file" in p.stderr
+        assert not (tmp_path / "i.html").exists()

@@ -106,6 +106,20 @@ def _mode(a: argparse.Namespace):
     return traj, model
 
 
+def _warn(traj: Any, run_file: bool) -> None:
+    """The run's warnings on stderr, as `mbody simulate` gives them: every one of a run
+    made here; of a run file's, the spin its frames alias (review R7-16: the page shows
+    that spin turning slower or backwards), the others said when it was made."""
+    from mbody.simulate.simulation import SPIN_WARNING
+
+    for w in traj.info.get("warnings", []):
+        if run_file and not w.startswith(SPIN_WARNING):
+            continue
+        hint = ("; this page's frames are the run file's samples: simulate the model again "
+                "with that --fps" if run_file and w.startswith(SPIN_WARNING) else "")
+        print(f"mbody: warning: {w}{hint}", file=sys.stderr)
+
+
 def _with_values(a: argparse.Namespace) -> tuple[Any, Any]:
     """(source, model) for `resolve`: with ``--set``, the model files read with the
     values set (`load_model`); a run file's motion is computed already."""
@@ -116,9 +130,9 @@ def _with_values(a: argparse.Namespace) -> tuple[Any, Any]:
     model = load_model(a.model) if a.model else None
     if a.source.lower().endswith((".yaml", ".yml", ".xml", ".urdf")):
         return load_model(a.source), model
-    with open(a.source, "rb") as fh:
-        run = fh.read(4) == b"PK\x03\x04" or a.source.lower().endswith(".npz")
-    if not run:
+    from mbody.present.animate.source import is_run_file
+
+    if not is_run_file(a.source):
         return load_model(a.source), model
     if model is None:
         raise MbodyError(f"--set changes a model's values, and {a.source} is a run whose "
@@ -133,6 +147,7 @@ def _stop(signum: int, frame: FrameType | None) -> None:  # SIGTERM ends --live 
 
 def animate(a: argparse.Namespace) -> int:
     from mbody.present.animate import LiveViewer, build_scene, page_html, resolve
+    from mbody.present.animate.source import is_run_file
     from mbody.util.atomic import write_atomic
 
     if a.hold is not None and not a.live:
@@ -161,8 +176,15 @@ def animate(a: argparse.Namespace) -> int:
     if a.mode is not None:
         traj, model = _mode(a)
     else:
+        run_file = Path(a.source).is_file() and is_run_file(a.source)  # else: no such file
+        for flag, value in (("--t-end", a.t_end), ("--fps", a.fps)):
+            if run_file and value is not None:  # review R7-17: it was ignored silently
+                raise MbodyError(f"{flag} does not apply to a run file ({a.source} plays "
+                                 f"as saved); simulate the model again with {flag}, or "
+                                 "animate the model file itself")
         source_arg, model_arg = _with_values(a)
         traj, model = resolve(source_arg, model_arg, t_end=a.t_end, fps=a.fps)
+        _warn(traj, run_file)
     extra = [b for b in model.body_names if b not in traj.body_names]
     if extra and (a.forces or a.reactions):  # loads are evaluated at the run's states
         raise MbodyError(f"the model {model.name!r} has bodies the run {a.source} does not "

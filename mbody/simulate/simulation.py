@@ -421,6 +421,9 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     return traj
 
 
+SPIN_WARNING = "spin faster than "
+"""How the warning of a spin the frame rate aliases begins (`_spin_warning`): an animation
+of the samples would show it turning slower or backwards."""
 BROKEN_START = "the initial state breaks joint constraints: "
 """How the warning of a start off its joints begins (`_broken_start`)."""
 
@@ -708,7 +711,7 @@ def _spin_warning(traj: Trajectory, peak: np.ndarray | None = None) -> str | Non
     if len(fast) > 3:
         listed += f" and {len(fast) - 3} more bod{'y' if len(fast) == 4 else 'ies'}"
     need = math.ceil(2 * peak[fast[0]] / (2 * np.pi))
-    return (f"spin faster than {fps:g} fps can show: {listed}. A body turning more than "
+    return (f"{SPIN_WARNING}{fps:g} fps can show: {listed}. A body turning more than "
             f"half a revolution between frames (|omega| / 2 pi > fps / 2 = {fps / 2:g} "
             f"rev/s) looks in an animation as if it turned slower or backwards; use "
             f"--fps {need} or more")

@@ -43,7 +43,7 @@ def resolve(source: Source, model: Model | str | os.PathLike[str] | None = None,
         path = Path(source)
         if not path.is_file():
             raise MbodyError(f"{path}: no such file")
-        if _is_npz(path):
+        if is_run_file(path):
             source = _load_trajectory(path)
             if model is None:
                 model = _model_of(source, path)
@@ -60,9 +60,11 @@ def resolve(source: Source, model: Model | str | os.PathLike[str] | None = None,
     return source, model
 
 
-def _is_npz(path: Path) -> bool:
+def is_run_file(path: str | os.PathLike[str]) -> bool:
+    """Whether the file at `path` is a run (.npz: a zip archive, whatever its name)
+    rather than a model."""
     with open(path, "rb") as fh:
-        return fh.read(4) == b"PK\x03\x04" or path.suffix == ".npz"
+        return fh.read(4) == b"PK\x03\x04" or Path(path).suffix.lower() == ".npz"
 
 
 def _load_trajectory(path: Path) -> Trajectory:
