@@ -195,3 +195,19 @@ def test_equilibrium_of_a_speed_driven_model_holds_its_drivers_without_a_warning
         for label, value in out["reactions"].items():
             scale = max(abs(v) for v in out["reactions"].values()) or 1.0
             assert abs(sol.reactions[label] - value) <= 1e-9 * scale, label
+
+
+def test_simulate_of_a_fully_driven_model_refuses_integrator_options():
+    """Review R7-17: a fully driven model's run is kinematic; --method, --rtol, --max-steps
+    were ignored without a word. They are refused; without them the run is made."""
+    p = mbody("simulate", "models/scotch_yoke.yaml", "--method", "Radau", "--rtol", "1e-6",
+              "--t-end", "0.1")
+    assert p.returncode == 2 and "--method, --rtol do not apply" in p.stderr, p.stderr
+    assert "fully driven" in p.stderr and "Traceback" not in p.stderr
+    p = mbody("simulate", "models/scotch_yoke.yaml", "--max-wall", "5", "--t-end", "0.1")
+    assert p.returncode == 2 and "--max-wall does not apply" in p.stderr
+    p = mbody("simulate", "models/scotch_yoke.yaml", "--t-end", "0.1", "--no-progress")
+    assert p.returncode == 0 and "kinematic run" in p.stdout
+    p = mbody("simulate", "models/pendulum.yaml", "--rtol", "1e-6", "--t-end", "0.1",
+              "--no-progress")
+    assert p.returncode == 0, p.stderr

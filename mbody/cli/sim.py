@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import math
+from typing import TYPE_CHECKING
 
 from mbody.cli.common import (
     EXIT_OK,
@@ -22,6 +23,9 @@ from mbody.cli.common import (
     show_progress,
 )
 from mbody.errors import MbodyError
+
+if TYPE_CHECKING:
+    from mbody.model.model import Model
 
 T_END_MIN, T_END_MAX, FPS_MAX, SAMPLES_MAX = 1e-9, 1e9, 1e6, 10_000_000
 """Bounds of --t-end (s), --fps and of the samples t_end x fps gives (as
@@ -116,6 +120,7 @@ def simulate(a: argparse.Namespace) -> int:
     check_samples(a.t_end, a.fps)
     output_suffix(a.output, "-o", "a run file (.npz)", (".npz",), a.force)
     model = load_model(a.model)
+    _refuse_integrator_options(a, model)
     if a.output:  # fail now, not after a long integration
         from mbody.util.atomic import ensure_writable
 
@@ -131,6 +136,23 @@ def simulate(a: argparse.Namespace) -> int:
         traj.save(a.output)
     print(summary(traj, a.output), file=output_stream(a.output))
     return EXIT_OK
+
+
+def _refuse_integrator_options(a: argparse.Namespace, model: Model) -> None:
+    """A fully driven model's run is kinematic (each sample solved, nothing integrated):
+    an integrator's option given for it would be ignored (review R7-17), so it is refused."""
+    from mbody.simulate.kinematic import fully_driven
+
+    given = [flag for flag, value in (("--method", a.method != "DOP853" and a.method),
+                                      ("--rtol", a.rtol), ("--atol", a.atol),
+                                      ("--max-steps", a.max_steps), ("--max-wall", a.max_wall))
+             if value is not None and value is not False]
+    if given and fully_driven(model):
+        raise MbodyError(f"{', '.join(given)} {'does' if len(given) == 1 else 'do'} not apply: "
+                         f"{model.name!r} is fully driven, so its run is kinematic (each "
+                         "sample's pose solved from the drivers, nothing integrated); leave "
+                         f"{'it' if len(given) == 1 else 'them'} out (mbody kinematics MODEL "
+                         "makes the same run)")
 
 
 def check_samples(t_end: float, fps: float, flags: str = "--t-end x --fps") -> None:
