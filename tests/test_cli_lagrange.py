@@ -114,6 +114,19 @@ def test_animating_a_mode_about_a_state_not_at_rest_says_so(tmp_path):
     assert p.returncode == 0 and "warning" not in p.stderr
 
 
+def test_no_verdict_on_a_moving_state_does_not_send_the_user_to_rest():
+    """Review R7-18: the ball-jointed heavy top precesses steadily, but its body-axis
+    rates turn: no verdict, and the hint was --equilibrium, a top at rest without its
+    spin. A moving state's hint says what makes a motion steady; a state at rest keeps
+    --equilibrium's."""
+    top = succeeds("modes", MODELS / "heavy_top.yaml")
+    assert "no verdict" in top and "gimbals" in top
+    assert "--equilibrium would drop the motion" in top
+    swung = succeeds("modes", MODELS / "pendulum.yaml")
+    assert "no verdict" in swung and "--equilibrium linearises about the static" in swung
+    assert "gimbals" not in swung
+
+
 def test_modes_of_a_fully_driven_mechanism_says_nothing_oscillates():
     """The driven slider-crank has no free coordinate: a verdict saying so (the fuzzer
     found an internal error here: the largest of no eigenvalue errors)."""

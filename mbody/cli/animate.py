@@ -81,6 +81,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def _mode(a: argparse.Namespace):
     """(trajectory, model) of `mbody animate MODEL --mode K`."""
+    import numpy as np
+
     from mbody.cli.common import load_model
     from mbody.simulate.modes import mode_trajectory
     from mbody.solve.linearize import linearize
@@ -99,7 +101,8 @@ def _mode(a: argparse.Namespace):
     traj = mode_trajectory(lin, a.mode, fps=a.fps or FPS)
     for w in traj.info.get("warnings", []):
         print(f"mbody: warning: {w}", file=sys.stderr)
-    if lin.stable is None and not a.equilibrium:  # as `mbody modes` says it (review R7-4)
+    at_rest = not (np.any(lin.state.velocity) or np.any(lin.state.omega))
+    if lin.stable is None and not a.equilibrium and at_rest:  # as `mbody modes` (R7-4)
         print("mbody: warning: so the motion played is not an oscillation about rest; "
               "--equilibrium plays the mode about the static equilibrium nearest the pose",
               file=sys.stderr)

@@ -32,9 +32,15 @@ def verdict(lin: Linearization) -> str:
         return ("no free coordinate: the drivers prescribe every degree of freedom, so "
                 "nothing oscillates about this motion (mbody kinematics MODEL gives it)")
     if lin.stable is None:
+        moving = bool(np.any(lin.state.velocity) or np.any(lin.state.omega))
         return ("no verdict: the state is not an equilibrium or a steady motion; the "
-                "eigenvalues are those of the tangent system at this instant (mbody modes "
-                "--equilibrium linearises about the static equilibrium nearest it)")
+                "eigenvalues are those of the tangent system at this instant "
+                + ("(a steady motion is one whose coordinates' rates stay constant: a top's "
+                   "precession written with gimbals, revolute joints, not a ball joint, "
+                   "whose body-axis rates turn as it precesses; mbody modes --equilibrium "
+                   "would drop the motion and linearise about rest)" if moving else
+                   "(mbody modes --equilibrium linearises about the static equilibrium "
+                   "nearest it)"))
     neutral = sum(1 for m in lin.modes if m.kind == "neutral")
     extra = (f"; {neutral} neutral mode{'s' if neutral != 1 else ''} (λ = 0: a free or "
              "cyclic motion)") if neutral else ""
