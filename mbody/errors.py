@@ -191,6 +191,7 @@ SYNONYMS: Mapping[str, tuple[str, str]] = {
     "k": ("stiffness", ""), "spring_constant": ("stiffness", ""), "c": ("damping", ""),
     "free_length": ("rest_length", ""), "L0": ("rest_length", ""),
     "quat": ("quaternion", ""), "g": ("gravity", ""),
+    "name": ("model", "the model's name"),
 }
 """Words a textbook or another program uses for what mbody names otherwise: word ->
 (mbody's name, a note). A hint names mbody's word only where it is one of the choices

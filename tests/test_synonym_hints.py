@@ -47,6 +47,13 @@ def test_a_synonym_is_named(tmp_path, text, key, message, hint):
     assert [(i.key, i.message, i.hint) for i in found] == [(key, message, hint)]
 
 
+def test_a_models_name_written_name_is_named_model(tmp_path):
+    """Review R7-14: `name:` at the top (a body's key, a natural guess for the model's)."""
+    found = issues(tmp_path, f"name: arm\nbodies: [{BODY}}}]\n")
+    assert [(i.key, i.hint) for i in found] == [("name", "mbody calls it 'model': the "
+                                                 "model's name")]
+
+
 def test_inertia_written_I_is_one_problem(tmp_path):
     """`I: 0.1` for `inertia`: the hint names the key, so its absence is not reported
     as well (as for a misspelt key)."""

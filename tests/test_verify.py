@@ -382,6 +382,11 @@ def test_parser_is_safe_and_points_at_its_errors():
                  "a_x = 0 = 0", "a_x", "= 3", "sin a_x = 0", "(a_x = 0"):
         with pytest.raises(EquationError):
             parse_equation(text)
+    # '==', a comparison's spelling (review R7-14): said as such, at the first '='
+    with pytest.raises(EquationError) as exc:
+        parse_equation("m*a_x == O.Fx")
+    assert exc.value.position == 6 and "'=='" in str(exc.value) and "one '='" in \
+        exc.value.hint
     # a dotted name is only ever looked up in the vocabulary
     with pytest.raises(AnswersError, match="no reaction component 'a_x.__class__'"):
         verify(model("pendulum"), [("rod", "a_x.__class__ = 0")])

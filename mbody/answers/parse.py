@@ -230,6 +230,9 @@ class _Parser(OperatorParser):
         elif kind == "end":
             raise EquationError(self.text, pos, "the equation ends too early")
         elif kind == "op" and value == "=":
+            if pos > 0 and self.text[pos - 1] == "=":  # '==': a comparison's spelling
+                raise EquationError(self.text, pos - 1, "'==' between the two sides",
+                                    "an equation has one '=': m*a_x = O.Fx")
             raise EquationError(self.text, pos, "nothing on the left of '='"
                                 if pos == self.tokens[0][2] else "unexpected '='",
                                 "write 0 if that side is zero")
