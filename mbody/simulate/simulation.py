@@ -35,7 +35,7 @@ from typing import TypeVar
 import numpy as np
 
 from mbody import conventions as cv
-from mbody.equations.constraints import joint_errors
+from mbody.equations.joints import joint_errors
 from mbody.equations.workspace import Unknowns, workspace
 from mbody.equations.world import check_axes
 from mbody.errors import (
