@@ -179,8 +179,8 @@ def joint_errors(model: Model, state: State, cols: ReactionColumns | None = None
     size = max(size, float(np.abs(model.joint_table.B_r_child).max()), 1e-3)
     speed = max(float(np.abs(v6).max()), 1e-3)
     out = []
-    broken = np.flatnonzero(enforced & ((np.abs(ph) > JOINT_TOL * size)
-                                        | (np.abs(gtv) > JOINT_TOL * speed)))
+    broken = (enforced & ((np.abs(ph) > JOINT_TOL * size)
+                          | (np.abs(gtv) > JOINT_TOL * speed))).nonzero()[0]
     for k in broken[:limit]:
         unit = ("rad", "rad/s") if rt.is_moment[k] else ("m", "m/s")
         out.append(f"{rt.labels[k]} (phi {ph[k]:.3g} {unit[0]}, G^T v {gtv[k]:.3g} {unit[1]})")

@@ -235,7 +235,7 @@ def pack_unknowns_of(child_all: np.ndarray, parent_all: np.ndarray, n: int, U: n
     body, side, where = body[keep], side[keep], where[keep]
     order = np.lexsort((where, body))
     body, side, where = body[order], side[order], where[order]
-    inc_ptr = np.searchsorted(body, np.arange(n + 1))
+    inc_ptr = body.searchsorted(np.arange(n + 1))
     bw = 0
     for b in range(n):  # per body, at plan time only
         w = where[inc_ptr[b]:inc_ptr[b + 1]]

@@ -705,12 +705,12 @@ def _spin_warning(traj: Trajectory, peak: np.ndarray | None = None) -> str | Non
         return None
     rate = np.abs(w) if traj.dimension == cv.PLANAR else np.linalg.norm(w, axis=2)
     peak = rate.max(axis=0)  # (n,) rad/s
-    fast = [i for i in np.argsort(-peak, kind="stable") if peak[i] / (2 * np.pi) > fps / 2]
+    fast = [i for i in (-peak).argsort(kind="stable") if peak[i] / (2 * np.pi) > fps / 2]
     if not fast:
         return None
     listed = ", ".join(f"{traj.body_names[i]} at up to {peak[i]:.4g} rad/s "
                        f"({peak[i] / (2 * np.pi):.3g} rev/s, at t = "
-                       f"{traj.t[int(np.argmax(rate[:, i]))]:.3g} s)" for i in fast[:3])
+                       f"{traj.t[int(rate[:, i].argmax())]:.3g} s)" for i in fast[:3])
     if len(fast) > 3:
         listed += f" and {len(fast) - 3} more bod{'y' if len(fast) == 4 else 'ies'}"
     need = math.ceil(2 * peak[fast[0]] / (2 * np.pi))
