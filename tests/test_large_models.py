@@ -273,6 +273,24 @@ def test_a_large_file_is_read_without_its_records():
     assert len(model.reactions) == 5 * 2000 and model.reactions[-1] == "j1999.My"
 
 
+
+def test_a_run_keeps_each_bodys_look_without_making_records():
+    """A run carries every body's shape and colour (what draws it without the file), read
+    from the body table: the same values the records hold, with none of them made for it,
+    nor a joint record for its conservation reasons."""
+    model = mbody.load(ROOT / "models" / "gyroscope_gimbals.yaml")
+    traj = mbody.simulate(model, t_end=0.05, fps=20, rtol=1e-6, atol=1e-8)
+    assert model.bodies._records._made.count(None) == model.n  # type: ignore[attr-defined]
+    assert model.joints._made.count(None) == len(model.joints)  # type: ignore[attr-defined]
+    assert traj.info["momentum_not_conserved"].count("joints to ground") == 1
+    records = [model.bodies[b] for b in model.body_names]
+    assert traj.shapes == tuple(b.shape for b in records)
+    assert traj.colors == tuple(b.color for b in records)
+    assert any(c is not None for c in traj.colors) and any(s is not None for s in traj.shapes)
+    grounded = [j.name for j in model.joints if j.parent == cv.GROUND]
+    assert grounded and traj.info["momentum_not_conserved"].endswith(
+        "joints to ground: " + ", ".join(grounded))
+
 def _edit(text: str, pattern: str, new: str, nth: int = 7) -> str:
     """`text` with the `nth` match of `pattern` (a regex) replaced by `new`."""
     m = list(re.finditer(pattern, text, re.M))[nth]

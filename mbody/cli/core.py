@@ -61,7 +61,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def check(a: argparse.Namespace) -> int:
     from mbody.equations.assemble import assemble as _assemble
-    from mbody.equations.constraints import joint_errors
+    from mbody.equations.joints import joint_errors
     from mbody.equations.topology import topology
     from mbody.present.text import model_summary
 

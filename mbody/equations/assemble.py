@@ -17,10 +17,10 @@ from typing import TYPE_CHECKING, TypeVar
 import numpy as np
 
 from mbody import conventions as cv
-from mbody.equations.constraints import ConstraintJacobian, joint_errors
+from mbody.equations.constraints import ConstraintJacobian
 from mbody.equations.fbd import body_equations
 from mbody.equations.generalized import Generalized, generalized
-from mbody.equations.joints import ReactionColumns, g_matrix, reaction_columns
+from mbody.equations.joints import ReactionColumns, g_matrix, joint_errors, reaction_columns
 from mbody.equations.loads import AppliedLoads, wrench_parts
 from mbody.equations.solution import (
     INCONSISTENT,

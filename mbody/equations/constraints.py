@@ -29,7 +29,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+# `joint_errors` and `JOINT_TOL` live in `joints` (a simulation checks its start without
+# this module's ConstraintJacobian); imported here too, for their old path
+from mbody.equations.joints import JOINT_TOL as JOINT_TOL
 from mbody.equations.joints import ReactionColumns, reaction_columns
+from mbody.equations.joints import joint_errors as joint_errors
 from mbody.errors import not_found
 from mbody.model.model import Model, State
 from mbody.util.frozen import Frozen
@@ -110,39 +114,3 @@ class ConstraintJacobian(Frozen):
         return (f"<ConstraintJacobian G^T: {m} constraints x {n} coordinates, "
                 f"{self.matrix.nnz} nonzero, max |phi| {worst:.3g}; .row(label), "
                 f".toarray(), .rows, .columns>")
-
-
-JOINT_TOL = 1e-6
-"""Relative size of φ (to the model's extent) and of Gᵀ v (to its largest speed) above
-which a state is said to break a joint."""
-
-
-def joint_errors(model: Model, state: State, cols: ReactionColumns | None = None,
-                 enforced: np.ndarray | None = None, limit: int = 8,
-                 gtv: np.ndarray | None = None) -> list[str]:
-    """The enforced constraints (default: those of unknown reactions) that `state` breaks,
-    as text: position errors φ ≠ 0 and relative velocities Gᵀ v ≠ 0 (see `phi`). At most
-    `limit` are described; a last entry counts the rest."""
-    rt = model.reaction_table
-    if not len(rt.labels):
-        return []
-    if enforced is None:
-        enforced = np.array([lab not in model.known_reactions for lab in rt.labels])
-
-    v6 = np.concatenate((state.velocity, state.omega), axis=1)
-    cols = reaction_columns(model, state) if cols is None else cols
-    if gtv is None:  # (m,) Gᵀ v, unless the caller has it already
-        gtv = cols.gtv
-    ph = cols.phi
-    size = float(np.ptp(state.position, axis=0).max()) if model.n > 1 else 0.0
-    size = max(size, float(np.abs(model.joint_table.B_r_child).max()), 1e-3)
-    speed = max(float(np.abs(v6).max()), 1e-3)
-    out = []
-    broken = np.flatnonzero(enforced & ((np.abs(ph) > JOINT_TOL * size)
-                                        | (np.abs(gtv) > JOINT_TOL * speed)))
-    for k in broken[:limit]:
-        unit = ("rad", "rad/s") if rt.is_moment[k] else ("m", "m/s")
-        out.append(f"{rt.labels[k]} (phi {ph[k]:.3g} {unit[0]}, G^T v {gtv[k]:.3g} {unit[1]})")
-    if len(broken) > limit:
-        out.append(f"{len(broken) - limit} more")
-    return out

@@ -1,6 +1,7 @@
 """Joint reactions -> the columns of G (computed by the compiled core, `mbody.kernel`,
 one constraint primitive per component), and what is built from them: the sparse G, a
-dense block of it, the wrench of given reaction values.
+dense block of it, the wrench of given reaction values, the joints a state breaks
+(`joint_errors`).
 
 Column c holds what a unit value of reaction component c puts into the bodies' rows.
 With e the component's joint axis in world axes (the joint frame is fixed to the parent)
@@ -149,3 +150,40 @@ def constraint_velocity(model: Model, cols: ReactionColumns, state: State) -> np
     """(m,) Gᵀ v: per component, the relative velocity its joint forbids (m/s or rad/s;
     a driven component's minus its law's rate), as the core computed it with `cols`."""
     return cols.gtv
+
+
+JOINT_TOL = 1e-6
+"""Relative size of φ (to the model's extent) and of Gᵀ v (to its largest speed) above
+which a state is said to break a joint."""
+
+
+def joint_errors(model: Model, state: State, cols: ReactionColumns | None = None,
+                 enforced: np.ndarray | None = None, limit: int = 8,
+                 gtv: np.ndarray | None = None) -> list[str]:
+    """The enforced constraints (default: those of unknown reactions) that `state` breaks,
+    as text: position errors φ ≠ 0 and relative velocities Gᵀ v ≠ 0 (the columns' `phi`
+    and `gtv`, `mbody.equations.constraints`). At most
+    `limit` are described; a last entry counts the rest."""
+    rt = model.reaction_table
+    if not len(rt.labels):
+        return []
+    if enforced is None:
+        enforced = np.array([lab not in model.known_reactions for lab in rt.labels])
+
+    v6 = np.concatenate((state.velocity, state.omega), axis=1)
+    cols = reaction_columns(model, state) if cols is None else cols
+    if gtv is None:  # (m,) Gᵀ v, unless the caller has it already
+        gtv = cols.gtv
+    ph = cols.phi
+    size = float(np.ptp(state.position, axis=0).max()) if model.n > 1 else 0.0
+    size = max(size, float(np.abs(model.joint_table.B_r_child).max()), 1e-3)
+    speed = max(float(np.abs(v6).max()), 1e-3)
+    out = []
+    broken = (enforced & ((np.abs(ph) > JOINT_TOL * size)
+                          | (np.abs(gtv) > JOINT_TOL * speed))).nonzero()[0]
+    for k in broken[:limit]:
+        unit = ("rad", "rad/s") if rt.is_moment[k] else ("m", "m/s")
+        out.append(f"{rt.labels[k]} (phi {ph[k]:.3g} {unit[0]}, G^T v {gtv[k]:.3g} {unit[1]})")
+    if len(broken) > limit:
+        out.append(f"{len(broken) - limit} more")
+    return out

@@ -137,7 +137,7 @@ class Workspace:
         for label, v in given.items():  # the given values are few
             k = index[label]
             mask[k], lam[k] = False, float(v)
-        return Unknowns(mask, np.flatnonzero(mask), lam, mask.tobytes())
+        return Unknowns(mask, mask.nonzero()[0], lam, mask.tobytes())
 
     @cached_property
     def file_unknowns(self) -> Unknowns:

@@ -305,6 +305,18 @@ class BodyRecords(Mapping[str, Body]):
 
         self._records = Records(names, make, ("body", "bodies"))
 
+    @property
+    def shapes(self) -> tuple[dict[str, Any] | None, ...]:
+        """Each body's `shape` as the file gives it (None: not given), in the stacking
+        order, without making a record per body (what a run keeps to be drawn)."""
+        return tuple(self._shape)
+
+    @property
+    def colors(self) -> tuple[str | None, ...]:
+        """Each body's `color` as the file gives it (None: not given), in the stacking
+        order, without making a record per body."""
+        return tuple(self._color)
+
     def __getitem__(self, name: str | int) -> Body:
         """The body named `name`, or at index `name` in the stacking order
         (``model.bodies[0]``); KeyError with a did-you-mean, IndexError with the range."""

@@ -36,6 +36,7 @@ from mbody import conventions as cv
 from mbody.errors import Issue, MbodyError, ModelError, TrajectoryFileError, real_number, wrong_type
 from mbody.loading import loads
 from mbody.model.model import State, count
+from mbody.model.records import BodyRecords
 from mbody.model.yaml_write import dump_document
 from mbody.util import jsontext
 from mbody.util.atomic import atomic_path
@@ -828,6 +829,8 @@ def model_text(model) -> str:
 def appearance(model) -> tuple[tuple[dict | None, ...], tuple[str | None, ...]]:
     """(shapes, colors): each body's drawing shape and colour as the file gives them (None:
     the default), in body order, what a trajectory keeps to be drawn without the file."""
+    if isinstance(model.bodies, BodyRecords):  # a file's model: no record made per body
+        return model.bodies.shapes, model.bodies.colors
     bodies = [model.bodies[b] for b in model.body_names]
     return tuple(b.shape for b in bodies), tuple(b.color for b in bodies)
 

@@ -95,7 +95,9 @@ MAX_DEPTH = 64
 """Deepest nesting of arrays and objects `loads` parses (as for a model file's YAML,
 `mbody.model.loader.MAX_DEPTH`); what mbody writes nests 4 deep at most."""
 
-_NOT_MARKS = bytes(b for b in range(256) if b not in b'"[]{}')
+_NOT_MARKS = bytes(range(256)).translate(None, b'"[]{}')
+"""Every byte but a quote or a bracket: what `nesting` deletes (one C call at import,
+where a generator over the 256 bytes took 0.02 ms of every simulation's start)."""
 
 
 def nesting(text: str) -> int:
