@@ -21,7 +21,8 @@ from mbody.errors import Issue, did_you_mean
 from mbody.model.loader import Document, Path_, Unrepresentable, dotted
 
 _REQUIRED_HINTS = {
-    ("", "dimension"): "2 for a planar model, 3 for a spatial one",
+    ("", "dimension"): "2 for a planar model, 3 for a spatial one; the rest of the file is "
+                       "checked once it is given, since every vector's length depends on it",
     ("", "bodies"): "a list of bodies, each with at least name, mass and inertia",
     ("bodies", "name"): "a name without spaces or dots",
     ("bodies", "mass"): "the mass in kg, a number > 0",
