@@ -59,10 +59,14 @@ def modes_text(lin: Linearization, about: str = "", max_shapes: int = MAX_SHAPES
     model = lin.model
     out = [f"model '{model.name}': linearised about "
            + (about or f"the state at t = {lin.state.t:g} s")]
-    out.append(f"coordinates: {', '.join(lin.coordinates)}"
+    out.append(f"coordinates: {', '.join(lin.coordinates) or 'none'}"
                + (f" (left out, symmetries of the motion: {', '.join(lin.left_out)})"
                   if lin.left_out else ""))
     out.append("")
+    if not len(lin.coordinates):  # no table to show (review R7-14): the verdict says why
+        out.append(verdict(lin))
+        out.extend(f"warning: {w}" for w in lin.warnings)
+        return "\n".join(out)
     head = (f"{'mode':>4s}  {'kind':11s}  {'eigenvalue (1/s)':>22s}  {'ω_n (rad/s)':>12s}  "
             f"{'f_n (Hz)':>10s}  {'ζ':>8s}")
     out.append(head)
