@@ -435,6 +435,9 @@ def test_a_kinematic_run_stops_at_a_dead_centre_with_the_distance_left():
                        r"rock = ") as err:
         kinematic_run(model, 2 * math.pi, 100)
     t_stop = float(err.value.args[0].split("t = ")[1].split(" s")[0])
+    # the driver's angle there in degrees, as the rest of kinematics gives it (R7-14)
+    rock = float(err.value.args[0].split("rock = ")[1].split(" deg")[0])
+    assert rock == pytest.approx(math.degrees(psi0 + t_stop), rel=1e-5)
     # the first sample past the limit: within one sample (0.01 s) of it
     assert 0.0 < t_stop - swing <= 0.01 + 1e-9
 

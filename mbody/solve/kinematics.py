@@ -141,7 +141,9 @@ def _cannot_close(model: Model, t: float, phi: np.ndarray, bad: np.ndarray,
     drivers = model.drivers
     at = ""
     if drivers is not None and len(drivers):
-        values = [f"{name} = {float(law[0](t)):.6g} {'rad' if c == 'M' else 'm'}"
+        # an angle in degrees, as every other kinematics output gives it (review R7-14)
+        values = [f"{name} = {math.degrees(float(law[0](t))):.6g} deg" if c == "M" else
+                  f"{name} = {float(law[0](t)):.6g} m"
                   for name, law, c in zip(drivers.names, drivers.laws, drivers.component,
                                           strict=True)]
         at = f" with {', '.join(values)}"
