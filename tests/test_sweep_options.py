@@ -288,3 +288,13 @@ def test_kinematics_fps_too_low_is_warned_with_the_fps_to_give(capsys, tmp_path)
     with open(tmp_path / "w.csv", newline="") as fh:
         rows = list(csv.reader(fh))
     assert rows[1][-1].startswith("run=kinematics; t-end=0.1; fps=200; model=")
+
+
+def test_kinematics_fps_of_too_many_instants_is_a_failed_case(tmp_path):
+    """2 s at 10^6 a second is 2 000 001 instants, beyond what a case takes: the case
+    fails and says to lower the fps given (not the default sampling's wording)."""
+    result = mbody.run_sweep(DRIVEN, {"bodies.rod.mass": [0.4, 0.8]}, tmp_path / "f.csv",
+                             run="kinematics", t_end=2.0, fps=1e6, workers=0)
+    assert result.errors == ["an end of 2 s at 1e6 samples a second (fps) is 2 000 001 "
+                             "instants; at most 1 000 000 a case: give a lower fps (or "
+                             "steps), or an earlier end"] * 2

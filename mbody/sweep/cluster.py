@@ -77,16 +77,16 @@ class Report:
         The seconds of `wall` spent starting (or reaching) the cluster.
     lost : int
         Chunks lost with their workers, their cases written as failed.
-    pilot : int
-        The cases run first in this process to time them, before the chunks were sized
-        (`_pilot`; none when the chunk size is given).
-    pilot_wall : float
-        The seconds of `wall` the pilot took.
     sparse : int
         Cases run whose ``peak:`` columns come from too few samples a revolution
         (`Rows.sparse`).
     sparsest : Sparsest or None
         The one of them with the fewest (`Rows.sparsest`).
+    pilot : int
+        The cases run first in this process to time them, before the chunks were sized
+        (`_pilot`; none when the chunk size is given).
+    pilot_wall : float
+        The seconds of `wall` the pilot took.
     """
 
     cases: int = 0
@@ -146,7 +146,6 @@ class Report:
                          f"{_workers(self.lost)}, written as failed")
         return (f"{count(self.cases, 'case')} in {self.wall:.1f} s on {self.where} "
                 f"({'; '.join(parts)})")
-
 
 
 def run(job: Job, todo: Sequence[int], results: Results, *, scheduler: str | None = None,

@@ -43,7 +43,7 @@ import numpy as np
 
 from mbody import conventions as cv
 from mbody.equations.solution import singular_mass_error
-from mbody.errors import MbodyError, option_name, option_setting, options_named
+from mbody.errors import MbodyError, g_text, option_name, option_setting, options_named
 from mbody.kernel import _core
 from mbody.model.model import Model, State, from_source
 from mbody.model.source import Source
@@ -70,9 +70,9 @@ SIMULATE_FPS = 60.0
 """A ``simulate`` run's samples a second without `Settings.fps`: `mbody.simulate`'s
 default (a test keeps them equal)."""
 APPLIES = {"t_end": ("kinematics", "simulate"), "revolutions": ("kinematics", "simulate"),
-           "steps": ("kinematics",), "fps": ("kinematics", "simulate"),
-           "equilibrium": ("modes",)}
-"""The runs that use each setting (`check_run` refuses it with another run), ..."""
+           "steps": ("kinematics",), "fps": ("kinematics", "simulate")}
+"""The runs that use each setting (`check_run` refuses it with another run; and
+``equilibrium``, ``modes`` only, in words of its own), ..."""
 USE = {"t_end": "the end of each case's run", "revolutions": "the end of each case's run",
        "steps": "its instants, evenly spaced", "fps": "samples per second"}
 """... and what it is to them."""
@@ -550,7 +550,7 @@ def instants(ctx: Context, case: Case, span: float) -> np.ndarray:
     most = LIMITS["steps"]
     if count > most.hi:
         given = s.fps is not None
-        raise MbodyError(f"an end of {span:g} s at {fps:g} samples a second "
+        raise MbodyError(f"an end of {g_text(span)} s at {g_text(fps)} samples a second "
                          + (f"({option_name('fps')})" if given
                             else "(mbody kinematics' sampling)")
                          + f" is {number(count)} instants; at most {number(int(most.hi))} a "
