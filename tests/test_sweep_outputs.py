@@ -361,7 +361,8 @@ RERUNS = [
      "--steps 11 (this sweep: 21)"),
     (SLIDER_KIN, {**SLIDER_KIN, "t_end": None, "revolutions": 1.0},
      "t_end=0.05 (this sweep: revolutions=1)", "--t-end 0.05 (this sweep: 1 rev)"),
-    (SLIDER_KIN, {**SLIDER_KIN, "run": "simulate", "fps": 200.0},
+    # --steps is refused with --run simulate (review R7-11): not carried over
+    (SLIDER_KIN, {"run": "simulate", "t_end": SLIDER_KIN["t_end"], "fps": 200.0},
      "run='kinematics' (this sweep: run='simulate')", "--run kinematics (this sweep: simulate)"),
     ({"run": "simulate", "t_end": 0.02, "fps": 100.0},
      {"run": "simulate", "t_end": 0.02, "fps": 400.0}, "fps=100 (this sweep: fps=400)",

@@ -465,7 +465,7 @@ def test_a_local_cluster_from_python(driven_file, tmp_path):
                            run="kinematics", revolutions=1.0, steps=37)
     there = mbody.run_sweep(driven_file, GRID, tmp_path / "there.csv", workers=1, chunk=2,
                             run="kinematics", revolutions=1.0, steps=37)
-    assert there.report.where == "a local cluster of 1 worker processes"
+    assert there.report.where == "a local cluster of 1 worker process"
     assert there.header == here.header
     for a, b in zip(there.rows, here.rows, strict=True):
         x, y = floats(a[3:-2]), floats(b[3:-2])

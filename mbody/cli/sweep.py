@@ -66,20 +66,24 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--run", dest="run_kind", choices=RUN_NAMES, default="solve",
                    help="what each case computes (default solve)")
     s.add_argument("--t-end", type=_end_time(), metavar="T",
-                   help="kinematics, simulate: the end, in seconds or in turns of the first "
-                   "driver that turns ('1 rev': one turn at each case's speed)")
+                   help="the end of each case's run, required for kinematics and simulate "
+                   "(no default; refused with solve and modes): seconds, or turns of the "
+                   "first driver that turns ('1 rev': one turn at each case's speed)")
     s.add_argument("--steps", type=limited("steps"), metavar="K",
-                   help="kinematics: K instants evenly spaced from 0 to the end, both "
+                   help="kinematics only: K instants evenly spaced from 0 to the end, both "
                    "included (default: as mbody kinematics samples, 360 a revolution of "
                    "the first driver at each case's speed when it turns at a constant "
                    "rate, else 100 a second; and the end)")
     # those defaults are mbody.simulate.kinematic.default_fps's (a test keeps them equal)
-    s.add_argument("--fps", type=limited("fps"),
-                   default=60.0, metavar="F", help="simulate: samples per second (default 60)")
+    s.add_argument("--fps", type=limited("fps"), metavar="F",
+                   help="simulate: samples per second (default 60); kinematics: F samples "
+                   "a second from 0, as mbody kinematics --fps (and the end), instead of "
+                   "--steps")
     s.add_argument("--equilibrium", action="store_true",
-                   help="modes: linearise each case about the static equilibrium nearest its "
-                   "initial pose, as mbody modes --equilibrium (Newton's method; stable or "
-                   "not); without it, about the initial state, which may not be one")
+                   help="modes only: linearise each case about the static equilibrium "
+                   "nearest its initial pose, as mbody modes --equilibrium (Newton's "
+                   "method; stable or not); without it, about the initial state, which may "
+                   "not be one")
     s.add_argument("--out", "-o", dest="output", required=True, metavar="FILE",
                    help="the results: .csv or .parquet (an unfinished one resumes)")
     s.add_argument("--scheduler", metavar="ADDRESS",
@@ -107,14 +111,16 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def sweep(a: argparse.Namespace) -> int:
     """`mbody.sweep.study.run_sweep` with the command's arguments, and what it says."""
+    from mbody.sweep.runs import Settings, check_run
     from mbody.sweep.study import SweepInterrupted, check_request, run_sweep
 
-    check_request(a.grid, a.output, a.samples, a.seed)  # before the model file is read
-    model = load_model(a.model)
     t_end, revs = None, None
     if a.t_end is not None:
         unit, x = a.t_end
         t_end, revs = (x, None) if unit == "s" else (None, x)
+    check_request(a.grid, a.output, a.samples, a.seed)  # before the model file is read
+    check_run(Settings(a.run_kind, t_end, revs, a.steps, a.fps, a.equilibrium))
+    model = load_model(a.model)
     say = output_stream(a.output)
     try:
         result = run_sweep(model, a.grid, a.output, run=a.run_kind, t_end=t_end,

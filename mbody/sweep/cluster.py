@@ -30,6 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from mbody.errors import MbodyError, option_name, option_setting
+from mbody.model.reprs import count
 from mbody.sweep.runs import Job, Rows, Sparsest, run_chunk
 from mbody.sweep.table import Results
 
@@ -42,6 +43,12 @@ PILOT_SECONDS = 0.3
 """Work measured here before the chunks are sized (its rows are kept)."""
 CONNECT_SECONDS = 30.0
 """How long a scheduler and its first worker are waited for."""
+HERE = "this process"
+"""`Report.where` of cases run in the caller's process."""
+
+
+def _workers(n: int) -> str:
+    return "worker" if n == 1 else "workers"
 
 
 @dataclass
@@ -51,7 +58,7 @@ class Report:
     Parameters
     ----------
     cases : int
-        The cases run (here, to measure them, and in chunks).
+        The cases run: the pilot's, then the chunks'.
     chunks : int
         The chunks run.
     chunk : int
@@ -75,13 +82,18 @@ class Report:
         (`Rows.sparse`).
     sparsest : Sparsest or None
         The one of them with the fewest (`Rows.sparsest`).
+    pilot : int
+        The cases run first in this process to time them, before the chunks were sized
+        (`_pilot`; none when the chunk size is given).
+    pilot_wall : float
+        The seconds of `wall` the pilot took.
     """
 
     cases: int = 0
     chunks: int = 0
     chunk: int = 0
     workers: int = 0
-    where: str = "this process"
+    where: str = HERE
     work: float = 0.0
     cpu: float = 0.0
     wall: float = 0.0
@@ -89,28 +101,51 @@ class Report:
     lost: int = 0
     sparse: int = 0
     sparsest: Sparsest | None = None
+    pilot: int = 0
+    pilot_wall: float = 0.0
 
     @property
     def busy(self) -> float:
-        """The share of the workers' wall-clock time spent on cases (the rest: starting,
-        scheduling, moving data, waiting for the last chunks)."""
-        span = (self.wall - self.start) * max(self.workers, 1)
+        """The share of the workers' wall-clock time, while they had chunks, spent on
+        cases (the rest: scheduling, moving data, waiting for the last chunks); the
+        pilot, run before, and the cluster's start are not theirs."""
+        span = (self.wall - self.pilot_wall - self.start) * max(self.workers, 1)
         return self.work / span if span > 0 else 1.0
 
     def text(self) -> str:
-        """The summary line ``mbody sweep`` prints.
+        """The summary line ``mbody sweep`` prints: the cases, and how they ran, the
+        pilot's and the chunks' adding up to them.
 
         Returns
         -------
         str
         """
-        return (f"{self.cases} cases in {self.wall:.1f} s on {self.where} "
-                f"({self.chunks} chunk(s) of up to {self.chunk} cases; the workers spent "
-                f"{100 * min(self.busy, 1.0):.0f}% of their time on cases, "
-                f"{self.cpu:.1f} s of processor time"
-                + (f", {self.start:.1f} s starting the cluster" if self.start else "")
-                + (f"; {self.lost} chunk(s) lost with their workers, written as failed"
-                   if self.lost else "") + ")")
+        here = self.where == HERE
+        runs = []
+        if self.pilot:  # on a cluster, the pilot ran here, not on the workers
+            runs.append(count(self.pilot, "pilot case") + ("" if here else " here"))
+        if self.chunks:
+            runs.append(f"{count(self.chunks, 'chunk')} of up to {count(self.chunk, 'case')}"
+                        + ("" if here else f" on the {_workers(self.workers)}"))
+        how = ", then ".join(runs) if runs else "no cases"
+        if self.pilot and not self.chunks:
+            how += ", no chunks"
+        parts = [how]
+        if self.chunks:
+            who = HERE if here else f"the {_workers(self.workers)}"
+            their = "its" if here or self.workers == 1 else "their"
+            parts.append(f"{who} spent {100 * min(self.busy, 1.0):.0f}% of {their} time on "
+                         f"cases, {self.cpu:.1f} s of processor time"
+                         + (f", {self.start:.1f} s starting the cluster" if self.start
+                            else ""))
+        else:
+            parts.append(f"{self.cpu:.1f} s of processor time")
+        if self.lost:
+            parts.append(f"{count(self.lost, 'chunk')} lost with "
+                         f"{'its' if self.lost == 1 else 'their'} "
+                         f"{_workers(self.lost)}, written as failed")
+        return (f"{count(self.cases, 'case')} in {self.wall:.1f} s on {self.where} "
+                f"({'; '.join(parts)})")
 
 
 def run(job: Job, todo: Sequence[int], results: Results, *, scheduler: str | None = None,
@@ -143,9 +178,11 @@ def run(job: Job, todo: Sequence[int], results: Results, *, scheduler: str | Non
     """
     from tqdm import tqdm  # type: ignore[import-untyped]  # tqdm ships no types
 
+    todo = list(todo)
+    if needs_cluster(todo, scheduler, workers, chunk):  # before any case, or any file
+        require_dask()
     begin = time.perf_counter()
     report = Report()
-    todo = list(todo)
     bar = tqdm(total=len(results.done) + len(todo), initial=len(results.done), unit="case",
                disable=not progress, file=sys.stderr, mininterval=0.5, smoothing=0.1,
                dynamic_ncols=True)
@@ -163,7 +200,10 @@ def run(job: Job, todo: Sequence[int], results: Results, *, scheduler: str | Non
             on_chunk(rows)
 
     try:
+        before = len(todo)
         per_case, todo = _pilot(job, todo, take, chunk)
+        report.pilot = before - len(todo)
+        report.pilot_wall = time.perf_counter() - begin
         if workers == 0 and scheduler is None:
             size = chunk or max(1, min(len(todo), round(CHUNK_SECONDS / per_case)))
             report.chunk = size
@@ -174,13 +214,38 @@ def run(job: Job, todo: Sequence[int], results: Results, *, scheduler: str | Non
                 take(rows)
             report.workers = 1
         elif todo:
-            _on_dask(job, todo, per_case, chunk, scheduler, workers, take, report, begin,
-                     len(results.outputs))
+            _on_dask(job, todo, per_case, chunk, scheduler, workers, take, report,
+                     time.perf_counter(), len(results.outputs))
     finally:
         bar.close()
         results.close()
         report.wall = time.perf_counter() - begin
     return report
+
+
+def needs_cluster(todo: Sequence[int], scheduler: str | None, workers: int | None,
+                  chunk: int | None) -> bool:
+    """Whether `run` will send chunks to a Dask cluster: not with ``workers=0`` (and no
+    `scheduler`), nor when the one case left is the pilot's (`_pilot` runs at least
+    one case here unless the `chunk` size is given)."""
+    if workers == 0 and scheduler is None:
+        return False
+    return len(todo) > (0 if chunk is not None else 1)
+
+
+def require_dask() -> None:
+    """Refuse a sweep that needs Dask where ``dask.distributed`` cannot be imported (the
+    ``sweep`` extra not installed): said before any case runs, so that nothing is
+    computed or journalled for a command that fails."""
+    try:
+        import dask.distributed  # noqa: F401  # what `_on_dask` imports
+    except ImportError:
+        raise MbodyError(_no_dask()) from None
+
+
+def _no_dask() -> str:  # noqa: N802 - a message, built when said (the caller's names)
+    return ("sweeps run on Dask (dask.distributed): pip install 'mbody[sweep]' "
+            f"(or {option_setting('workers', 0)} to run them in this process)")
 
 
 def _chunks(todo: Sequence[int], size: int) -> list[list[int]]:
@@ -213,10 +278,8 @@ def _on_dask(job: Job, todo: list[int], per_case: float, chunk: int | None,
              report: Report, begin: float, width: int) -> None:
     try:
         from dask.distributed import Client, LocalCluster, as_completed
-    except ImportError:
-        raise MbodyError("sweeps run on Dask (dask.distributed): pip install 'mbody[sweep]' "
-                         f"(or {option_setting('workers', 0)} to run them in this process)"
-                         ) from None
+    except ImportError:  # `require_dask` said so first; kept for a direct call
+        raise MbodyError(_no_dask()) from None
     cluster = None
     try:
         if scheduler is None:
@@ -236,7 +299,8 @@ def _on_dask(job: Job, todo: list[int], per_case: float, chunk: int | None,
                     "the machine may be short of memory or busy: give fewer "
                     f"{option_name('workers')}, or {option_setting('workers', 0)} to run the "
                     "cases in this process (the same sweep resumes)") from None
-            report.where = f"a local cluster of {n} worker processes"
+            report.where = ("a local cluster of "
+                            f"{count(n, 'worker process', 'worker processes')}")
         else:
             try:
                 client = Client(scheduler, timeout=CONNECT_SECONDS, set_as_default=False)
@@ -245,7 +309,7 @@ def _on_dask(job: Job, todo: list[int], per_case: float, chunk: int | None,
                 raise MbodyError(f"{option_setting('scheduler', scheduler)}: no cluster "
                                  f"answered ({exc})") from None
             n = len(client.scheduler_info()["workers"])
-            report.where = f"the cluster at {scheduler} ({n} workers)"
+            report.where = f"the cluster at {scheduler} ({count(n, 'worker')})"
         report.workers = n
         report.start = time.perf_counter() - begin
         size = chunk or max(1, min(round(CHUNK_SECONDS / per_case),

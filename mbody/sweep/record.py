@@ -9,9 +9,9 @@ holds the last two, as ``name=value`` pairs joined by ``; ``::
 
 - ``run``: always; ``t-end`` (seconds, or ``N rev``) for ``kinematics`` and
   ``simulate``; ``steps`` for ``kinematics`` (the number given, or the default
-  sampling, ``360 a turn`` or ``100 a second``: `sampling`); ``fps`` for ``simulate``;
-  ``equilibrium`` (``yes`` or ``no``) for ``modes``. A setting a run does not use is
-  not recorded, so it can change without making the rows another sweep's.
+  sampling, ``360 a turn`` or ``100 a second``: `sampling`), or ``fps`` when given
+  instead; ``fps`` for ``simulate``; ``equilibrium`` (``yes`` or ``no``) for ``modes``.
+  A run is given only the settings it uses (`mbody.sweep.runs.check_run`).
 - ``model``: the first 16 hexadecimal digits of the SHA-256 of the model's document
   (the file as parsed: comments and layout aside) with the values set for every case
   (``--set PATH=VALUE``, `Model.with_values`) written in, and the step `mbody.load`
@@ -83,10 +83,11 @@ def record(settings: Settings, model: Model) -> str:
         end = (f"{_number(settings.revolutions)} rev" if settings.revolutions is not None
                else _number(settings.t_end) if settings.t_end is not None else "")
         pairs.append(("t-end", end))
-    if settings.run == "kinematics":
-        pairs.append(("steps", sampling(settings, model)))
+    if settings.run == "kinematics":  # its instants: by --fps, or by --steps or default
+        pairs.append(("fps", _number(settings.fps)) if settings.fps is not None
+                     else ("steps", sampling(settings, model)))
     if settings.run == "simulate":
-        pairs.append(("fps", _number(settings.fps)))
+        pairs.append(("fps", _number(settings.frame_rate)))
     if settings.run == "modes":
         pairs.append(("equilibrium", "yes" if settings.equilibrium else "no"))
     pairs.append(("model", model_digest(model)))

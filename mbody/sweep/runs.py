@@ -7,9 +7,9 @@ output columns.
   one, then a solve at each (a driven mechanism's kinetostatics); columns
   ``final:<coordinate>`` and ``peak:<label>``. The instants are ``mbody kinematics``'s
   by default (`instants`: one a degree of the first driver, at each case's own rate,
-  when it turns at a constant rate, else 100 a second; and T), or `steps` of them evenly
-  spaced.
-- ``simulate``: `mbody.simulate` to T; the same columns.
+  when it turns at a constant rate, else 100 a second; and T), `fps` a second as
+  ``mbody kinematics --fps`` samples (and T), or `steps` of them evenly spaced.
+- ``simulate``: `mbody.simulate` to T, `fps` samples a second; the same columns.
 - ``modes``: the natural frequencies about the initial state (or, with `equilibrium`,
   about the static equilibrium nearest it), and what ``mbody modes`` says with them;
   columns ``frequency:<k>``, ``growth:<k>``, ``steady`` and ``stable``
@@ -43,7 +43,7 @@ import numpy as np
 
 from mbody import conventions as cv
 from mbody.equations.solution import singular_mass_error
-from mbody.errors import MbodyError, option_name, option_setting, options_named
+from mbody.errors import MbodyError, g_text, option_name, option_setting, options_named
 from mbody.kernel import _core
 from mbody.model.model import Model, State, from_source
 from mbody.model.source import Source
@@ -66,6 +66,16 @@ from mbody.util.formatting import number
 
 RUNS = ("solve", "kinematics", "simulate", "modes")
 """What ``--run`` names."""
+SIMULATE_FPS = 60.0
+"""A ``simulate`` run's samples a second without `Settings.fps`: `mbody.simulate`'s
+default (a test keeps them equal)."""
+APPLIES = {"t_end": ("kinematics", "simulate"), "revolutions": ("kinematics", "simulate"),
+           "steps": ("kinematics",), "fps": ("kinematics", "simulate")}
+"""The runs that use each setting (`check_run` refuses it with another run; and
+``equilibrium``, ``modes`` only, in words of its own), ..."""
+USE = {"t_end": "the end of each case's run", "revolutions": "the end of each case's run",
+       "steps": "its instants, evenly spaced", "fps": "samples per second"}
+"""... and what it is to them."""
 SOLVE_BLOCK = 50_000
 """Most states solved in one call of the core (a block's arrays stay a few tens of MB)."""
 
@@ -85,9 +95,11 @@ class Settings:
         time it takes at its rate at t = 0, in each case.
     steps : int or None
         The ``kinematics`` run's instants, from 0 to the end (both included), evenly
-        spaced; None: as ``mbody kinematics`` samples each case (`instants`).
-    fps : float
-        The ``simulate`` run's samples per second.
+        spaced; None: `fps`, or as ``mbody kinematics`` samples each case (`instants`).
+    fps : float or None
+        Samples per second: the ``simulate`` run's (None: `SIMULATE_FPS`, as
+        `frame_rate` says), or the ``kinematics`` run's, as ``mbody kinematics --fps``
+        samples (None: `steps`, or its default sampling).
     equilibrium : bool
         The ``modes`` run about the static equilibrium nearest each case's initial pose
         (``mbody modes --equilibrium``), not about the initial state.
@@ -97,8 +109,13 @@ class Settings:
     t_end: float | None = None
     revolutions: float | None = None
     steps: int | None = None
-    fps: float = 60.0
+    fps: float | None = None
     equilibrium: bool = False
+
+    @property
+    def frame_rate(self) -> float:
+        """The ``simulate`` run's samples per second (`fps`, or `SIMULATE_FPS`)."""
+        return self.fps if self.fps is not None else SIMULATE_FPS
 
 
 @dataclass(frozen=True)
@@ -216,15 +233,44 @@ def turns_end(n: str) -> str:
     return f"{flag} '{n} rev'" if flag != "revolutions" else f"revolutions={n}"
 
 
-def check_settings(model: Model, settings: Settings) -> None:
-    """Refuse settings the model cannot run, before any case is."""
-    if settings.run not in RUNS:
-        raise MbodyError(f"unknown run {settings.run!r}; expected one of {', '.join(RUNS)}")
-    if settings.equilibrium and settings.run != "modes":
+_RUN_IS = {"solve": "is one solve of each case at its initial state",
+           "modes": "linearises each case at one state",
+           "simulate": "is sampled at {fps} (default {default:g})"}
+"""What each run does, where a setting it does not use is refused (`check_run`)."""
+
+
+def check_run(settings: Settings) -> None:
+    """Refuse a run that is not one of `RUNS`, and a setting the run does not use
+    (`APPLIES`), naming the setting, the runs it goes with and what the run does; and
+    both ways of giving a ``kinematics`` run's instants. Needs no model: made before the
+    model file is read."""
+    run = settings.run
+    if run not in RUNS:
+        raise MbodyError(f"unknown run {run!r}; expected one of {', '.join(RUNS)}")
+    if settings.equilibrium and run != "modes":
         raise MbodyError(f"{option_name('equilibrium', 'True')} goes with "
                          f"{option_setting('run', 'modes')} (it linearises each case about "
-                         f"its static equilibrium); the {settings.run} run starts from each "
+                         f"its static equilibrium); the {run} run starts from each "
                          "case's initial state")
+    for keyword, value in (("t_end", settings.t_end), ("revolutions", settings.revolutions),
+                           ("steps", settings.steps), ("fps", settings.fps)):
+        if value is None or run in APPLIES[keyword]:
+            continue
+        does = _RUN_IS[run].format(fps=option_name("fps"), default=SIMULATE_FPS)
+        goes = " or ".join(option_setting("run", r) for r in APPLIES[keyword])
+        raise MbodyError(f"{option_name(keyword)} goes with {goes} ({USE[keyword]}); the "
+                         f"{run} run {does}")
+    if run == "kinematics" and settings.steps is not None and settings.fps is not None:
+        steps, fps = option_name("steps"), option_name("fps")
+        raise MbodyError(f"{steps} and {fps}: give the kinematics run's instants one way, "
+                         f"{option_name('steps', 'K', 'K')} (K evenly spaced from 0 to the "
+                         f"end) or {option_name('fps', 'F', 'F')} (F a second, as mbody "
+                         "kinematics --fps samples)")
+
+
+def check_settings(model: Model, settings: Settings) -> None:
+    """Refuse settings the model cannot run, before any case is (`check_run` first)."""
+    check_run(settings)
     if settings.run in ("kinematics", "simulate"):
         if settings.t_end is None and settings.revolutions is None:
             raise MbodyError(f"the {settings.run} run needs {_an_end()}")
@@ -366,7 +412,7 @@ def sampling(ctx: Context, indices: Sequence[int], cases: Sequence[Case | None],
         if error is not None or case is None or case.extras is None:
             continue
         span = _end(ctx, case)
-        per_second = s.fps if s.run == "simulate" else _per_second(ctx, case, span)
+        per_second = s.frame_rate if s.run == "simulate" else _per_second(ctx, case, span)
         fewest = None
         for d in ctx.turning:
             rate = float(case.extras[d])
@@ -386,12 +432,13 @@ def sampling_warning(settings: Settings, grid: Grid, count: int, ran: int,
                      sparsest: Sparsest | None) -> str | None:
     """The warning of a sweep whose `count` of `ran` cases have fewer than `PEAK_SAMPLES`
     samples a revolution (`sampling`): the sparsest case, how low its peaks can read, and
-    the --steps (kinematics) or --fps (simulate) that gives every case enough."""
+    the --steps (kinematics) or --fps (simulate, or kinematics with --fps) that gives
+    every case enough."""
     if not count or sparsest is None:
         return None
     text = sparse_text(sparsest.driver, sparsest.rate, sparsest.per_turn,
                        f"case {sparsest.case} ({grid.shown(sparsest.case)}) has")
-    if settings.run == "kinematics":  # the driver's turns in that case's run
+    if settings.run == "kinematics" and settings.fps is None:  # its turns in that run
         turns = sparsest.span * abs(sparsest.rate) / (2.0 * math.pi)
         need = option_setting("steps", math.ceil(PEAK_SAMPLES * turns * (1.0 - 1e-12)) + 1)
     else:
@@ -482,27 +529,35 @@ def _turn(ctx: Context, case: Case) -> float | None:
 
 def _per_second(ctx: Context, case: Case, span: float) -> float:
     """The samples a second of a case's ``kinematics`` run of `span` s (`instants`)."""
-    steps = ctx.job.settings.steps
-    return (steps - 1) / span if steps is not None else default_fps(_turn(ctx, case))
+    s = ctx.job.settings
+    if s.steps is not None:
+        return (s.steps - 1) / span
+    return s.fps if s.fps is not None else default_fps(_turn(ctx, case))
 
 
 def instants(ctx: Context, case: Case, span: float) -> np.ndarray:
     """The instants of a case's ``kinematics`` run from 0 to `span` s: `Settings.steps`
-    of them evenly spaced, or by default ``mbody kinematics``'s samples, k / fps with
-    fps its default for the case (`default_fps`: `SAMPLES_A_TURN` a revolution of the
-    first driver at the case's rate, when it turns at a constant one), and `span` itself
-    when they fall short of it (so that ``final:`` is the end's, as with `steps`)."""
-    steps = ctx.job.settings.steps
-    if steps is not None:
-        return np.linspace(0.0, span, steps)
+    of them evenly spaced, or ``mbody kinematics``'s samples, k / fps with fps
+    `Settings.fps` (as ``mbody kinematics --fps``) or by default the case's
+    (`default_fps`: `SAMPLES_A_TURN` a revolution of the first driver at the case's
+    rate, when it turns at a constant one), and `span` itself when they fall short of it
+    (so that ``final:`` is the end's, as with `steps`)."""
+    s = ctx.job.settings
+    if s.steps is not None:
+        return np.linspace(0.0, span, s.steps)
     fps = _per_second(ctx, case, span)
     count = math.floor(span * fps + 1e-9) + 1  # as `sample_times` counts
     most = LIMITS["steps"]
     if count > most.hi:
-        raise MbodyError(f"an end of {span:g} s at {fps:g} samples a second (mbody "
-                         f"kinematics' sampling) is {number(count)} instants; at most "
-                         f"{number(int(most.hi))} a case: give {option_name('steps')}, or "
-                         "an earlier end")
+        given = s.fps is not None
+        raise MbodyError(f"an end of {g_text(span)} s at {g_text(fps)} samples a second "
+                         + (f"({option_name('fps')})" if given
+                            else "(mbody kinematics' sampling)")
+                         + f" is {number(count)} instants; at most {number(int(most.hi))} a "
+                         "case: give "
+                         + (f"a lower {option_name('fps')} (or {option_name('steps')})"
+                            if given else option_name("steps"))
+                         + ", or an earlier end")
     t = sample_times(span, fps)
     return np.append(t, span) if last_sample_warning(span, fps) else t
 
@@ -632,7 +687,7 @@ def _per_model(ctx: Context, values: list[dict[str, Any]], cases: list[Case], on
 
 
 def _simulate(ctx: Context, model: Model, case: Case) -> np.ndarray:
-    traj = simulate(model, t_end=_end(ctx, case), fps=ctx.job.settings.fps)
+    traj = simulate(model, t_end=_end(ctx, case), fps=ctx.job.settings.frame_rate)
     last = traj.state(len(traj.t) - 1)
     peaks = np.full(len(model.reactions), np.nan)
     labels = list(traj.reaction_labels)

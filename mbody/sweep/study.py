@@ -30,7 +30,14 @@ from mbody.sweep.grid import Grid, grid_of
 from mbody.sweep.limits import LIMITS
 from mbody.sweep.modes import not_steady_warning
 from mbody.sweep.record import record
-from mbody.sweep.runs import Job, Settings, check_settings, columns, sampling_warning
+from mbody.sweep.runs import (
+    Job,
+    Settings,
+    check_run,
+    check_settings,
+    columns,
+    sampling_warning,
+)
 from mbody.sweep.table import ERROR, Results, journal_of, output_format
 from mbody.util.atomic import refuse_overwriting_inputs
 
@@ -254,7 +261,7 @@ def run_sweep(model: Model | str | os.PathLike[str],
               values: Mapping[str, Any] | Sequence[str] | str,
               out: str | os.PathLike[str], *, run: str = "solve",
               t_end: float | None = None, revolutions: float | None = None,
-              steps: int | None = None, fps: float = 60.0, equilibrium: bool = False,
+              steps: int | None = None, fps: float | None = None, equilibrium: bool = False,
               samples: int | None = None, seed: int = 0, workers: int | None = None,
               scheduler: str | None = None, chunk: int | None = None,
               progress: bool = False, force: bool = False) -> SweepResult:
@@ -290,7 +297,7 @@ def run_sweep(model: Model | str | os.PathLike[str],
         analysis and a solve at each instant (`steps`); `mbody.simulate`; the natural
         frequencies.
     t_end : float, optional
-        ``kinematics`` and ``simulate``: the end (s).
+        ``kinematics`` and ``simulate`` (which need it, or `revolutions`): the end (s).
     revolutions : float, optional
         Or the end in turns of the first driver that turns, at each case's own rate
         (``--t-end "1 rev"`` is ``revolutions=1``).
@@ -300,8 +307,10 @@ def run_sweep(model: Model | str | os.PathLike[str],
         360 times a revolution of the first driver at the case's own rate when it turns
         at a constant rate, else 100 times a second
         (`mbody.simulate.kinematic.default_fps`), and at the end itself.
-    fps : float
-        ``simulate``: samples per second.
+    fps : float, optional
+        Samples per second: ``simulate``'s (default 60, as `mbody.simulate`), or
+        ``kinematics``' instead of `steps`, k / fps from 0 as ``mbody kinematics --fps``
+        samples (and the end itself when they fall short of it).
     equilibrium : bool
         ``modes``: about the static equilibrium nearest each case's initial pose (as
         ``mbody modes --equilibrium``), not about its initial state.
@@ -339,8 +348,10 @@ def run_sweep(model: Model | str | os.PathLike[str],
         command says ``--set bodies.rod.mass``): the output's extension, a malformed
         range, a value listed that is not finite (NaN, inf), a path given twice, a path
         the model file does not have (located, with a did-you-mean), `equilibrium`,
-        `progress` or `force` not True or False, settings the run or the model cannot
-        take (``kinematics`` without an end, of a model not fully driven), an output
+        `progress` or `force` not True or False, a setting the run does not use
+        (`steps` with ``run="simulate"``, `t_end` with ``"solve"``...: refused, not
+        ignored), settings the run or the model cannot take (``kinematics`` without an
+        end, of a model not fully driven, with both `steps` and `fps`), an output
         that is the model's file (however named) or a folder, an output holding another
         sweep's rows or rows computed with other settings (without `force`); or a
         cluster that cannot be started or reached.
@@ -364,6 +375,8 @@ def run_sweep(model: Model | str | os.PathLike[str],
     if scheduler is not None and not isinstance(scheduler, str):
         raise MbodyError(f"{option_name('scheduler')}: expected an address such as "
                          f"tcp://HOST:PORT, got {scheduler!r}")
+    settings = Settings(run, t_end, revolutions, steps, fps, bool(equilibrium))
+    check_run(settings)  # a setting the run does not use: before the model is read
     said: list[str] = []
     if not isinstance(model, Model):
         if not isinstance(model, str | os.PathLike):
@@ -380,7 +393,6 @@ def run_sweep(model: Model | str | os.PathLike[str],
         raise MbodyError("this model has no document to set values in")
     # every path names something in the file, before any case runs
     edits(model.source.read(), [(p, None) for p in grid.paths], entry_names(model))
-    settings = Settings(run, t_end, revolutions, steps, fps, bool(equilibrium))
     check_settings(model, settings)
     recorded = record(settings, model)
     results = Results(out, columns(model, settings), grid, recorded, force=bool(force))
