@@ -159,3 +159,23 @@ def test_a_prefixed_rate_is_converted_not_respelt(capsys, typed, converted):
     assert code == 2
     assert "did you mean" not in err
     assert f"units take no prefix: {converted}; units: rad/s, deg/s, rpm" in err
+
+
+# == fbd -o is a folder (R7-10) ================================================================
+
+@pytest.mark.parametrize("suffix", [".svg", ".PNG", ".pdf"])
+def test_fbd_refuses_a_picture_name_for_its_folder(capsys, tmp_path, suffix):
+    target = tmp_path / f"fbd{suffix}"
+    code, out, err = run(capsys, "fbd", PENDULUM, "-o", target)
+    assert (code, out) == (2, "")
+    assert err == (f"mbody: error: -o {target}: fbd -o is a folder; the pictures are named "
+                   f"fbd_<body>.<format> inside it; did you mean -o {tmp_path} "
+                   f"--image-format {suffix[1:].lower()}?\n")
+    assert list(tmp_path.iterdir()) == []  # no folder made under that name
+
+
+def test_fbd_writes_into_an_existing_folder_named_like_a_picture(capsys, tmp_path):
+    (tmp_path / "old.svg").mkdir()
+    code, _, err = run(capsys, "fbd", PENDULUM, "-o", tmp_path / "old.svg")
+    assert code == 0, err
+    assert (tmp_path / "old.svg" / "fbd_rod.svg").is_file()

@@ -107,6 +107,12 @@ def fbd(a: argparse.Namespace) -> int:
 
     parse_view(a.view)  # a bad view is reported before any work
     out = Path(a.output)
+    if out.suffix.lower() in PICTURE_SUFFIXES and not out.is_dir():
+        # a picture's name where the folder goes: it would become a folder of that name
+        fmt = out.suffix.lower().lstrip(".")
+        raise MbodyError(f"-o {a.output}: fbd -o is a folder; the pictures are named "
+                         f"fbd_<body>.<format> inside it; did you mean -o "
+                         f"{out.parent} --image-format {fmt}?")
     if out.exists() and not out.is_dir():
         raise MbodyError(f"-o {a.output}: not a folder (fbd writes one picture per body)")
     model = load_model(a.model)
