@@ -7,6 +7,7 @@ prefix are told to convert, never pointed to a value 1000 times off."""
 from __future__ import annotations
 
 import json
+import math
 
 import pytest
 from test_cli_near_miss import DRIVEN, PENDULUM, usage_and_message
@@ -179,3 +180,35 @@ def test_fbd_writes_into_an_existing_folder_named_like_a_picture(capsys, tmp_pat
     code, _, err = run(capsys, "fbd", PENDULUM, "-o", tmp_path / "old.svg")
     assert code == 0, err
     assert (tmp_path / "old.svg" / "fbd_rod.svg").is_file()
+
+
+# == wording: plurals by count, check's driver law (R7-14) =====================================
+
+def test_graph_counts_one_body_and_one_joint_in_the_singular(capsys, tmp_path):
+    target = tmp_path / "g.svg"
+    code, out, err = run(capsys, "graph", PENDULUM, "-o", target)
+    assert code == 0, err
+    assert out == f"wrote {target}  (1 body, 1 joint, mobility 1)\n"
+
+
+def test_one_answers_file_is_counted_in_the_singular(capsys, tmp_path):
+    answers = tmp_path / "ana.yaml"
+    answers.write_text('equations:\n  - {body: rod, eq: "m*a_x = O.Fx"}\n')
+    code, out, err = run(capsys, "verify", PENDULUM, answers, "--summary",
+                         tmp_path / "c.csv")
+    assert code in (0, 1), err
+    assert out.startswith("1 answers file for model 'physical-pendulum': ")
+    assert "file(s)" not in out
+
+
+@pytest.mark.parametrize(("speed", "law"), [("600 rpm", "0.523599 + 62.8319*t"),
+                                            ("-600 rpm", "0.523599 - 62.8319*t")])
+def test_check_prints_a_speed_law_to_six_digits_with_its_sign(capsys, speed, law):
+    code, out, err = run(capsys, "check", DRIVEN, "--set", f"drivers.motor.speed={speed}")
+    assert code == 0, err
+    assert f"  motor          O: {law} (rad, t in s); effort motor.M\n" in out
+    # the law itself keeps every digit: 600 rpm is 20 pi rad/s from 30 deg
+    model = mbody.load(DRIVEN).with_values({"drivers.motor.speed": speed})
+    f = model.drivers.laws[0][0]
+    sign = 1 if speed[0] != "-" else -1
+    assert float(f(1.0)) == pytest.approx(math.pi / 6 + sign * 20 * math.pi, rel=1e-15)

@@ -140,6 +140,7 @@ def fbd(a: argparse.Namespace) -> int:
 def graph(a: argparse.Namespace) -> int:
     from mbody.equations.assemble import assemble
     from mbody.equations.topology import topology
+    from mbody.model.reprs import count
     from mbody.present.draw import FORMATS, graph_scene, save_figure
 
     fmt = Path(a.output).suffix.lstrip(".").lower() if a.output else None
@@ -152,8 +153,9 @@ def graph(a: argparse.Namespace) -> int:
         print(graph_text(model, topo))
         return EXIT_OK
     path = save_figure(graph_scene(model, topo), a.output, fmt)
-    print(f"wrote {path}  ({model.n} bodies, {len(model.joints)} joints, "
-          f"mobility {topo.mobility})", file=output_stream(a.output))
+    print(f"wrote {path}  ({count(model.n, 'body', 'bodies')}, "
+          f"{count(len(model.joints), 'joint')}, mobility {topo.mobility})",
+          file=output_stream(a.output))
     return EXIT_OK
 
 
