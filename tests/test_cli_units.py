@@ -212,3 +212,18 @@ def test_check_prints_a_speed_law_to_six_digits_with_its_sign(capsys, speed, law
     f = model.drivers.laws[0][0]
     sign = 1 if speed[0] != "-" else -1
     assert float(f(1.0)) == pytest.approx(math.pi / 6 + sign * 20 * math.pi, rel=1e-15)
+
+
+# == kinematics --csv labels its rows with the law's value (R7-8) ===============================
+
+def test_the_csv_of_a_run_labels_its_samples_without_rounding_noise(capsys, tmp_path):
+    target = tmp_path / "k.csv"
+    code, _, err = run(capsys, "kinematics", DRIVEN, "--csv", target)
+    assert code == 0, err
+    lines = target.read_text().splitlines()
+    assert lines[0].startswith("motor (deg),t (s),")
+    # 600 rpm from 30 deg, a sample a degree (3600 a second) over one turn: 30 .. 390 deg
+    labels = [float(line.split(",")[0]) for line in lines[1:]]
+    assert labels == [30.0 + k for k in range(361)]
+    times = [float(line.split(",")[1]) for line in lines[1:]]
+    assert times[0] == 0.0 and times[-1] == pytest.approx(0.1, rel=1e-15)
