@@ -36,13 +36,14 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
     s.add_argument("--t-end", type=seconds_or_turns(-T_END_MAX, T_END_MAX),
                    default=None, metavar="T",
-                   help="the run's end, s, or turns after --t-start of the first driver "
+                   help="the run's end, s ('0.5', '500 ms'), or turns after --t-start of "
+                   "the first driver "
                    "when it turns at a constant rate ('1 rev', as sweep's --t-end) "
                    "(default: one such turn, else 1 s); the samples are --t-start + k/fps, "
                    "and a warning names the last one when it falls before T")
     s.add_argument("--t-start", type=seconds("a number of seconds", -T_END_MAX, T_END_MAX),
                    default=0.0, metavar="SECONDS", help="the first sample's time, s "
-                   "(default 0)")
+                   "('0.01', '10 ms'; default 0)")
     s.add_argument("--fps", type=bounded("a number of samples per second", 0, FPS_MAX,
                                          lo_open=True),
                    default=None, metavar="N", help="samples per second (default: 360 per "
