@@ -294,8 +294,8 @@ def test_turns_need_a_driver_at_a_constant_rate(capsys, tmp_path):
 
 
 @pytest.mark.parametrize(("typed", "expected"), [
-    ("1 turn", "expected a time in seconds from -1e9 to 1e9, or turns such as '1 rev', "
-               "got '1 turn'"),
+    ("1 turn", "expected a time in seconds from -1e9 to 1e9 (or with its unit, such as "
+               "'100 ms'), or turns such as '1 rev', got '1 turn'"),
     ("0 rev", "expected a number of turns above 0 up to 1e6, got '0 rev'"),
 ])
 def test_a_bad_end_time_says_which_forms_are_accepted(capsys, typed, expected):

@@ -147,14 +147,14 @@ def test_convert_format_names_the_input_and_to_the_output(tmp_path, capsys):
 # == numbers in bounds ===========================================================================
 
 BOUNDS = [
-    (["simulate", "{m}", "--t-end", "1e308"], "argument --t-end: expected a number of seconds "
-     "from 1e-9 to 1e9, got '1e308'"),
-    (["simulate", "{m}", "--t-end", "nan"], "argument --t-end: expected a number of seconds "
-     "from 1e-9 to 1e9, got 'nan'"),
-    (["simulate", "{m}", "--t-end=-inf"], "argument --t-end: expected a number of seconds "
-     "from 1e-9 to 1e9, got '-inf'"),
-    (["simulate", "{m}", "--t-end", "0"], "argument --t-end: expected a number of seconds "
-     "from 1e-9 to 1e9, got '0'"),
+    (["simulate", "{m}", "--t-end", "1e308"], "argument --t-end: expected a time in seconds "
+     "from 1e-9 to 1e9, or turns such as '1 rev', got '1e308'"),
+    (["simulate", "{m}", "--t-end", "nan"], "argument --t-end: expected a time in seconds "
+     "from 1e-9 to 1e9, or turns such as '1 rev', got 'nan'"),
+    (["simulate", "{m}", "--t-end=-inf"], "argument --t-end: expected a time in seconds "
+     "from 1e-9 to 1e9, or turns such as '1 rev', got '-inf'"),
+    (["simulate", "{m}", "--t-end", "0"], "argument --t-end: expected a time in seconds "
+     "from 1e-9 to 1e9, or turns such as '1 rev', got '0'"),
     (["simulate", "{m}", "--fps", "1e400"], "argument --fps: expected a number of samples per "
      "second above 0 up to 1e6, got '1e400'"),
     (["simulate", "{m}", "--t-end", "1e9", "--fps", "1e6"], "--t-end x --fps asks for 1e15 "
@@ -214,8 +214,9 @@ def test_a_tiny_span_and_the_bounds_in_help(capsys):
     assert "1 samples at 60 fps" in out
     # a denormal span overflowed the simulator's step-rate estimate (exit 70)
     code, out, err = run(capsys, "simulate", PENDULUM, "--t-end=5e-324")
-    assert (code, last_line(err)) == (2, "mbody: error: argument --t-end: expected a number "
-                                      "of seconds from 1e-9 to 1e9, got '5e-324'")
+    assert (code, last_line(err)) == (2, "mbody: error: argument --t-end: expected a time "
+                                      "in seconds from 1e-9 to 1e9, or turns such as '1 rev', "
+                                      "got '5e-324'")
     code, out, _ = run(capsys, "simulate", "--help")
     text = " ".join(out.split())
     assert "(default 10; from 1e-9 to 1e9, and t_end x fps at most 10 000 000 samples)" in text

@@ -114,7 +114,7 @@ def test_the_command_line(answers, tmp_path):
     out = tmp_path / "class.csv"
     p = run("verify", str(MODEL), *map(str, answers), "--summary", str(out))
     assert p.returncode == 1, p.stderr  # some equations are wrong
-    assert f"wrote {out}" in p.stdout and "7 answers file(s)" in p.stdout
+    assert f"wrote {out}" in p.stdout and "7 answers files" in p.stdout
     assert out.read_text() == grade(mbody.load(MODEL), answers).csv()
     p = run("verify", str(MODEL), str(answers[0]), "--summary", str(tmp_path / "x.txt"))
     assert p.returncode == 2 and ".csv or .html" in p.stderr
@@ -198,7 +198,7 @@ def test_a_folder_a_device_or_a_pipe_among_the_files_is_a_row(answers, tmp_path)
     out = tmp_path / "class.csv"
     p = run("verify", str(MODEL), str(answers[0]), *map(str, odd), "--summary", str(out))
     assert p.returncode == 1, p.stderr
-    assert f"{1 + len(odd)} answers file(s)" in p.stdout and f"wrote {out}" in p.stdout
+    assert f"{1 + len(odd)} answers files" in p.stdout and f"wrote {out}" in p.stdout
     rows, _ = tables(out.read_text())
     assert rows[1][:4] == [str(answers[0]), "Ana Example", "4", "4"]
     errors = {Path(r[0]).name: r[-1] for r in rows[2:]}

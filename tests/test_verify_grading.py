@@ -76,7 +76,7 @@ def test_one_row_written_three_times_is_not_all_correct(tmp_path, capsys):
     assert [rows[1][k] for k in pick] == ["3", "3", "1", "3", "2"]
     a, b = summary.graded
     assert a.all_correct and not b.all_correct and b.incomplete
-    assert summary.text().startswith("2 answers file(s) for model 'physical-pendulum': "
+    assert summary.text().startswith("2 answers files for model 'physical-pendulum': "
                                      "1 all correct, 1 incomplete")
     assert "rows asked for: every row of the model; 4 of 6 given" in summary.text()
     # the command line: Ben keeps the class from exit 0; Ana alone is all correct

@@ -31,6 +31,7 @@ from mbody.answers.variant import allow_list, variant
 from mbody.answers.verify import MEANINGS, TOLERANCE, Check, Verification, check, tolerance
 from mbody.equations.assemble import Assembly, assemble
 from mbody.model.model import Model
+from mbody.model.reprs import count
 from mbody.model.values import plain
 from mbody.util.formatting import spreadsheet_text
 
@@ -247,7 +248,7 @@ class ClassSummary:
         bad = sum(1 for g in self.graded if g.verification is None)
         eqs = sum(g.equations for g in self.graded)
         right = sum(g.correct for g in self.graded)
-        lines = [f"{n} answers file(s) for model '{self.model}': {ok} all correct"
+        lines = [f"{count(n, 'answers file')} for model '{self.model}': {ok} all correct"
                  + (f", {short} incomplete (every equation right, rows missing)"
                     if short else "")
                  + (f", {partly} with entries that could not be read" if partly else "")
@@ -256,10 +257,12 @@ class ClassSummary:
                  f"rows asked for: {self.required.removeprefix('the rows asked for: ')}; "
                  f"{sum(g.covered for g in self.graded)} of "
                  f"{sum(g.asked for g in self.graded)} given"
-                 + (f" in the {n - bad} file(s) checked" if bad else "")]
+                 + (f" in the {count(n - bad, 'file')} checked" if bad else "")]
         setting = sum(1 for g in self.graded if g.values)
         if setting or self.allowed is not None:
-            lines.append(f"{setting} file(s) set their own values (the set column); "
+            lines.append(f"{count(setting, 'file')} "
+                         + ("sets its own values" if setting == 1 else "set their own values")
+                         + " (the set column); "
                          + (f"a file may set {', '.join(self.allowed) or 'none'}"
                             if self.allowed is not None else
                             "any path was allowed: --allow-set PATHS says which a "
@@ -267,7 +270,8 @@ class ClassSummary:
         top = self.mistakes[:5]
         if top:
             lines.append("most frequent mistakes:")
-            lines += [f"  {m.equations:4d} x {m.diagnosis} ({m.row}) in {m.students} file(s)"
+            lines += [f"  {m.equations:4d} x {m.diagnosis} ({m.row}) in "
+                      f"{count(m.students, 'file')}"
                       for m in top]
         return "\n".join(lines)
 

@@ -18,6 +18,7 @@ from mbody.cli.common import (
     output_stream,
     output_suffix,
     regular_file,
+    seconds,
 )
 from mbody.cli.sim import T_END_MAX, T_END_MIN
 from mbody.errors import MbodyError
@@ -57,7 +58,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "point; dark red: couple)")
     s.add_argument("--body", metavar="NAME", action="append",
                    help="draw only this body (repeatable)")
-    s.add_argument("--t-end", type=bounded("a number of seconds", T_END_MIN, T_END_MAX),
+    s.add_argument("--t-end", type=seconds("a number of seconds", T_END_MIN, T_END_MAX),
                    metavar="S", help=f"seconds to simulate when SOURCE is a model (default "
                    f"{T_END:g}; a run file plays its own length; t_end x fps at most "
                    f"{number(FRAMES_MAX)} frames)")
@@ -66,7 +67,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    f"{FPS:g}; at most {number(FPS_MAX)})")
     s.add_argument("--live", action="store_true",
                    help="serve the live viewer on 127.0.0.1 and print its URL; Ctrl-C stops")
-    s.add_argument("--hold", type=bounded("a number of seconds", 0, HOLD_MAX, lo_open=True),
+    s.add_argument("--hold", type=seconds("a number of seconds", 0, HOLD_MAX, lo_open=True),
                    metavar="S",
                    help="with --live: stop after S seconds instead of waiting for Ctrl-C "
                    f"(at most {number(HOLD_MAX)})")

@@ -98,6 +98,46 @@ def bounded(what: str, lo: float, hi: float, *, integer: bool = False,
     return parse
 
 
+def seconds(what: str, lo: float, hi: float, *, lo_open: bool = False
+            ) -> Callable[[str], float]:
+    """An argparse type for a time in seconds (`what`: ``"a number of seconds"``): a
+    number from `lo` to `hi`, as `bounded` reads it, or a time with its unit as
+    ``kinematics --at`` reads one (``'2 s'``, ``'100 ms'``, ``'1 min'``:
+    `mbody.model.checks.si_quantity`), held to the same range in seconds."""
+    number_of_seconds = bounded(what, lo, hi, lo_open=lo_open)
+
+    def parse(text: str) -> float:
+        try:
+            return number_of_seconds(text)
+        except argparse.ArgumentTypeError as exc:
+            from mbody.model.checks import si_quantity
+
+            if _is_number(text):
+                raise  # out of range
+            quantity = si_quantity(text)
+            if quantity is None or quantity[1] != "s":
+                expected = str(exc).rsplit(", got ", 1)[0]
+                raise argparse.ArgumentTypeError(
+                    f"{expected} (or with its unit, such as '100 ms'), got {text!r}"
+                ) from None
+            try:
+                return number_of_seconds(repr(quantity[0]))
+            except argparse.ArgumentTypeError:
+                raise exc from None
+
+    parse.__name__ = what
+    return parse
+
+
+def _is_number(text: str) -> bool:
+    """Whether `text` is a number as float() reads it (nan and inf too)."""
+    try:
+        float(text)
+    except (ValueError, OverflowError):
+        return False
+    return True
+
+
 _TURNS = re.compile(r"\s*([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)\s*(rev|revs|revolutions?)\s*")
 TURNS_MAX = 1e6
 """Most turns an end time may be given in (``--t-end '1e6 rev'``)."""
@@ -105,11 +145,12 @@ TURNS_MAX = 1e6
 
 def seconds_or_turns(lo: float, hi: float, *, lo_open: bool = False,
                      turns_max: float = TURNS_MAX) -> Callable[[str], tuple[str, float]]:
-    """An argparse type for an end time (``--t-end`` of kinematics and sweep): seconds
-    from `lo` to `hi` (as `bounded`), or turns of the mechanism's turning driver written
-    ``'1 rev'`` (also ``revs``, ``revolution(s)``), above 0 up to `turns_max`. Gives
+    """An argparse type for an end time (``--t-end`` of simulate, kinematics and sweep):
+    seconds from `lo` to `hi` (as `seconds`: ``'0.5'``, ``'500 ms'``), or turns of the
+    mechanism's turning driver written ``'1 rev'`` (also ``revs``, ``revolution(s)``),
+    above 0 up to `turns_max`. Gives
     ``("s", seconds)`` or ``("rev", turns)``; each command says which driver's turn."""
-    seconds = bounded("a time in seconds", lo, hi, lo_open=lo_open)
+    in_seconds = seconds("a time in seconds", lo, hi, lo_open=lo_open)
 
     def parse(text: str) -> tuple[str, float]:
         m = _TURNS.fullmatch(text)
@@ -121,8 +162,8 @@ def seconds_or_turns(lo: float, hi: float, *, lo_open: bool = False,
                     f"{text!r}")
             return ("rev", x)
         try:
-            return ("s", seconds(text))
-        except argparse.ArgumentTypeError as exc:  # bounded's "expected ..., got ..."
+            return ("s", in_seconds(text))
+        except argparse.ArgumentTypeError as exc:  # seconds' "expected ..., got ..."
             expected = str(exc).rsplit(", got ", 1)[0]
             raise argparse.ArgumentTypeError(
                 f"{expected}, or turns such as '1 rev', got {text!r}") from None

@@ -107,6 +107,12 @@ def fbd(a: argparse.Namespace) -> int:
 
     parse_view(a.view)  # a bad view is reported before any work
     out = Path(a.output)
+    if out.suffix.lower() in PICTURE_SUFFIXES and not out.is_dir():
+        # a picture's name where the folder goes: it would become a folder of that name
+        fmt = out.suffix.lower().lstrip(".")
+        raise MbodyError(f"-o {a.output}: fbd -o is a folder; the pictures are named "
+                         f"fbd_<body>.<format> inside it; did you mean -o "
+                         f"{out.parent} --image-format {fmt}?")
     if out.exists() and not out.is_dir():
         raise MbodyError(f"-o {a.output}: not a folder (fbd writes one picture per body)")
     model = load_model(a.model)
@@ -134,6 +140,7 @@ def fbd(a: argparse.Namespace) -> int:
 def graph(a: argparse.Namespace) -> int:
     from mbody.equations.assemble import assemble
     from mbody.equations.topology import topology
+    from mbody.model.reprs import count
     from mbody.present.draw import FORMATS, graph_scene, save_figure
 
     fmt = Path(a.output).suffix.lstrip(".").lower() if a.output else None
@@ -146,8 +153,9 @@ def graph(a: argparse.Namespace) -> int:
         print(graph_text(model, topo))
         return EXIT_OK
     path = save_figure(graph_scene(model, topo), a.output, fmt)
-    print(f"wrote {path}  ({model.n} bodies, {len(model.joints)} joints, "
-          f"mobility {topo.mobility})", file=output_stream(a.output))
+    print(f"wrote {path}  ({count(model.n, 'body', 'bodies')}, "
+          f"{count(len(model.joints), 'joint')}, mobility {topo.mobility})",
+          file=output_stream(a.output))
     return EXIT_OK
 
 

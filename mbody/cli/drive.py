@@ -13,6 +13,7 @@ from mbody.cli.common import (
     load_model,
     output_stream,
     output_suffix,
+    seconds,
     seconds_or_turns,
 )
 from mbody.errors import MbodyError, given_twice
@@ -35,13 +36,14 @@ def register(sub: argparse._SubParsersAction) -> None:
     s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
     s.add_argument("--t-end", type=seconds_or_turns(-T_END_MAX, T_END_MAX),
                    default=None, metavar="T",
-                   help="the run's end, s, or turns after --t-start of the first driver "
+                   help="the run's end, s ('0.5', '500 ms'), or turns after --t-start of "
+                   "the first driver "
                    "when it turns at a constant rate ('1 rev', as sweep's --t-end) "
                    "(default: one such turn, else 1 s); the samples are --t-start + k/fps, "
                    "and a warning names the last one when it falls before T")
-    s.add_argument("--t-start", type=bounded("a number of seconds", -T_END_MAX, T_END_MAX),
+    s.add_argument("--t-start", type=seconds("a number of seconds", -T_END_MAX, T_END_MAX),
                    default=0.0, metavar="SECONDS", help="the first sample's time, s "
-                   "(default 0)")
+                   "('0.01', '10 ms'; default 0)")
     s.add_argument("--fps", type=bounded("a number of samples per second", 0, FPS_MAX,
                                          lo_open=True),
                    default=None, metavar="N", help="samples per second (default: 360 per "
@@ -90,34 +92,10 @@ def parse_points(pairs: list[str]) -> dict[str, tuple[str, list[float]]]:
     return out
 
 
-def end_time(given: tuple[str, float] | None, t_start: float, turn: float | None) -> float:
-    """The last sample's time (s): `given` by --t-end in seconds or in turns of `turn`
-    s each (the first driver's, when it turns at a constant rate), else one turn, else
-    1 s, after `t_start`. An end in turns is held to --t-end's bound in seconds."""
-    from mbody.cli.sim import T_END_MAX
-    from mbody.simulate.kinematic import DEFAULT_SPAN
-
-    if given is not None and given[0] == "s":
-        return given[1]
-    if turn is None:
-        if given is None:
-            return t_start + DEFAULT_SPAN
-        raise MbodyError(f"--t-end {given[1]:g} rev: this model's first driver does not turn "
-                         "at a constant rate, so a turn has no fixed time; give the end in "
-                         "seconds")
-    turns = given[1] if given is not None else 1.0
-    t_end = t_start + turns * turn
-    if not abs(t_end) <= T_END_MAX:  # a driver barely turning: 1e-90 rad/s
-        said = f"--t-end {turns:g} rev" if given is not None else "the default end (a turn)"
-        raise MbodyError(f"{said} is t = {t_end:.3g} s ({turns:g} x {turn:.3g} s, the first "
-                         f"driver's turn); at most {T_END_MAX:g} s: give --t-end in seconds")
-    return t_end
-
-
 def kinematics(a: argparse.Namespace) -> int:
     import sys
 
-    from mbody.cli.sim import check_samples
+    from mbody.cli.sim import check_samples, end_time
     from mbody.model.reprs import count
     from mbody.simulate.instants import Instants, asked_instants, kinematic_at
     from mbody.simulate.kinematic import default_sampling, kinematic_run, revolution, summary

@@ -100,9 +100,43 @@ def split_value(command: argparse.ArgumentParser, words: Sequence[str],
             while (j < len(words) and ":" in words[j - 1] and words[j] in extras
                    and not option_like(words[j])):  # a range goes on: 'rpm:1200 rpm:4'
                 j += 1
-            return (f"a value with a space is one argument: quote it, {words[i - 2]} "
-                    f"'{' '.join(words[i - 1:j])}'")
+            option, quoted = words[i - 2], " ".join(words[i - 1:j])
+            return (unit_refused(action, option, quoted) or "a value with a space is one "
+                    f"argument: quote it, {option} '{quoted}'")
     return ""
+
+
+def unit_refused(action: argparse.Action, option: str, quoted: str) -> str:
+    """Why `option`'s value `quoted` (a number and its unit, which the shell split) would
+    be refused even quoted, and what to write instead; '' when it may be accepted (the
+    option's type takes it, or a --set path's key reads that unit: ``'600 rpm'`` as a
+    driver's speed). A --set or --known value is given in SI units without its unit
+    (`mbody.model.values.unit_refused`, `mbody.model.arguments.known_unit_refused`)."""
+    if callable(action.type):
+        try:
+            action.type(quoted)
+        except (argparse.ArgumentTypeError, ValueError) as exc:
+            return f"quoted, {option} '{quoted}' is refused too: {exc}"
+        return ""
+    name, sep, value = quoted.partition("=")
+    if not sep or option not in ("--set", "--known"):
+        return ""
+    if option == "--set":
+        from mbody.model.values import unit_refused as refused_at_key
+
+        refused = refused_at_key(name, value)
+    else:
+        from mbody.model.arguments import known_unit, known_unit_refused
+
+        refused = known_unit_refused(name, value)
+        if refused is not None:
+            refused = (f"takes no unit ({refused[0]}; values are in {known_unit(name)})",
+                       refused[1])
+    if refused is None:
+        return ""
+    hint, meant = refused
+    return (f"{name} {hint}"
+            + (f": write {option} {name}={meant}" if meant is not None else ""))
 
 
 def unrecognized_message(command_name: str, command: argparse.ArgumentParser,

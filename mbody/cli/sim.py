@@ -20,6 +20,8 @@ from mbody.cli.common import (
     output_suffix,
     parse_known,
     regular_file,
+    seconds,
+    seconds_or_turns,
     show_progress,
 )
 from mbody.errors import MbodyError
@@ -52,11 +54,12 @@ def register(sub: argparse._SubParsersAction) -> None:
                        "with the run. Prints the run summary with the drift of energy, "
                        "angular momentum and joints; saves the trajectory with -o.")
     s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
-    s.add_argument("--t-end", type=bounded("a number of seconds", T_END_MIN, T_END_MAX),
-                   default=10.0, metavar="SECONDS",
-                   help=f"simulated time, s (default 10; from {number(T_END_MIN)} to "
-                   f"{number(T_END_MAX)}, and "
-                   f"t_end x fps at most {number(SAMPLES_MAX)} samples)")
+    s.add_argument("--t-end", type=seconds_or_turns(T_END_MIN, T_END_MAX),
+                   default=("s", 10.0), metavar="T",
+                   help="simulated time: seconds ('2.5', '500 ms'), or turns of the first "
+                   "driver when it turns at a constant rate ('2 rev', as kinematics' "
+                   f"--t-end) (default 10; from {number(T_END_MIN)} to {number(T_END_MAX)}, "
+                   f"and t_end x fps at most {number(SAMPLES_MAX)} samples)")
     s.add_argument("--fps", default=60.0, metavar="N",
                    type=bounded("a number of samples per second", 0, FPS_MAX, lo_open=True),
                    help=f"output samples per second (default 60; at most {number(FPS_MAX)})")
@@ -76,7 +79,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                                 zero="no limit"),
                    help=f"stop with a message after N integrator steps (default 1000000, "
                    f"at most {number(MAX_STEPS)}; 0: no limit)")
-    s.add_argument("--max-wall", type=bounded("a number of seconds", 0, MAX_WALL, lo_open=True),
+    s.add_argument("--max-wall", type=seconds("a number of seconds", 0, MAX_WALL, lo_open=True),
                    default=None, metavar="SECONDS",
                    help="stop with a message after this much wall-clock time (default: no "
                    f"limit; at most {number(MAX_WALL)} s)")
@@ -117,16 +120,21 @@ def simulate(a: argparse.Namespace) -> int:
     from mbody.simulate.simulation import simulate as _simulate
 
     max_steps = DEFAULT_MAX_STEPS if a.max_steps is None else int(a.max_steps)
-    check_samples(a.t_end, a.fps)
+    unit, given = a.t_end
+    if unit == "s":  # before the model is read
+        check_samples(given, a.fps)
     output_suffix(a.output, "-o", "a run file (.npz)", (".npz",), a.force)
     model = load_model(a.model)
     _refuse_integrator_options(a, model)
+    t_end = given if unit == "s" else turns_end(model, given)
+    if unit != "s":
+        check_samples(t_end, a.fps)
     if a.output:  # fail now, not after a long integration
         from mbody.util.atomic import ensure_writable
 
         ensure_writable(a.output)
     known = parse_known(a.known)
-    traj = _simulate(model, a.t_end, a.fps,
+    traj = _simulate(model, t_end, a.fps,
                      rtol=DEFAULT_RTOL if a.rtol is None else a.rtol,
                      atol=DEFAULT_ATOL if a.atol is None else a.atol, method=a.method,
                      known=known,
@@ -153,6 +161,44 @@ def _refuse_integrator_options(a: argparse.Namespace, model: Model) -> None:
                          "sample's pose solved from the drivers, nothing integrated); leave "
                          f"{'it' if len(given) == 1 else 'them'} out (mbody kinematics MODEL "
                          "makes the same run)")
+
+
+def end_time(given: tuple[str, float] | None, t_start: float, turn: float | None) -> float:
+    """The last sample's time (s): `given` by --t-end in seconds or in turns of `turn`
+    s each (the first driver's, when it turns at a constant rate), else one turn, else
+    1 s, after `t_start`. An end in turns is held to --t-end's bound in seconds."""
+    from mbody.simulate.kinematic import DEFAULT_SPAN
+
+    if given is not None and given[0] == "s":
+        return given[1]
+    if turn is None:
+        if given is None:
+            return t_start + DEFAULT_SPAN
+        raise MbodyError(f"--t-end {given[1]:g} rev: this model's first driver does not turn "
+                         "at a constant rate, so a turn has no fixed time; give the end in "
+                         "seconds")
+    turns = given[1] if given is not None else 1.0
+    t_end = t_start + turns * turn
+    if not abs(t_end) <= T_END_MAX:  # a driver barely turning: 1e-90 rad/s
+        said = f"--t-end {turns:g} rev" if given is not None else "the default end (a turn)"
+        raise MbodyError(f"{said} is t = {t_end:.3g} s ({turns:g} x {turn:.3g} s, the first "
+                         f"driver's turn); at most {T_END_MAX:g} s: give --t-end in seconds")
+    return t_end
+
+
+def turns_end(model, turns: float) -> float:
+    """The time (s) of `turns` turns of `model`'s first driver from t = 0 (``--t-end '2
+    rev'``), as kinematics reads it (`end_time`), within --t-end's range."""
+    from mbody.simulate.kinematic import revolution
+
+    if not len(model.drivers or ()):
+        raise MbodyError(f"--t-end {turns:g} rev: this model has no driver, so a turn has no "
+                         "fixed time; give the end in seconds")
+    t_end = end_time(("rev", turns), 0.0, revolution(model))
+    if t_end < T_END_MIN:
+        raise MbodyError(f"--t-end {turns:g} rev is t = {t_end:.3g} s; at least "
+                         f"{number(T_END_MIN)} s: give --t-end in seconds")
+    return t_end
 
 
 def check_samples(t_end: float, fps: float, flags: str = "--t-end x --fps") -> None:

@@ -5,7 +5,14 @@ from __future__ import annotations
 import argparse
 import sys
 
-from mbody.cli.common import EXIT_OK, EXIT_UNMET, MODEL_HELP, add_axes_option, bounded, load_model
+from mbody.cli.common import (
+    EXIT_OK,
+    EXIT_UNMET,
+    MODEL_HELP,
+    add_axes_option,
+    load_model,
+    seconds,
+)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -17,9 +24,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         "stiffness's eigenvalues (stable, unstable or neutral) and the reactions that carry "
         "the loads at rest. Exit 1 when none is found.")
     s.add_argument("model", metavar="MODEL", help=MODEL_HELP)
-    s.add_argument("--t", type=bounded("a time in seconds", -1e9, 1e9), default=0.0, metavar="T",
-                   help="time (s) at which the drivers are held and the loads evaluated "
-                   "(default 0)")
+    s.add_argument("--t", type=seconds("a time in seconds", -1e9, 1e9), default=0.0,
+                   metavar="T", help="time (s) at which the drivers are held and the loads "
+                   "evaluated (default 0)")
     s.add_argument("--json", action="store_true", help="machine-readable output")
     add_axes_option(s)
     s.set_defaults(run=equilibrium)

@@ -22,7 +22,9 @@ from typing import Any
 
 import numpy as np
 
+from mbody import joint_types
 from mbody.errors import MbodyError, MbodyTypeError, did_you_mean, option_entry
+from mbody.model.checks import number_hint, si_quantity
 from mbody.model.expressions import Expression, ExpressionError, compile_expression
 from mbody.model.model import Model, State
 from mbody.model.reprs import count, name_list
@@ -137,6 +139,13 @@ def known_values(model: Model, known: Any, *, expressions: bool = True,
             try:
                 v = compile_expression(v)
             except ExpressionError as exc:
+                refused = known_unit_refused(label, v)
+                if refused is not None:
+                    raise MbodyError(
+                        f"{option_entry(argument, label)}: expected a number in "
+                        f"{known_unit(label)}" + (" or an expression of t" if expressions
+                                                  else "")
+                        + f", got {v!r} ({refused[0]})") from None
                 raise MbodyError(f"{option_entry(argument, label)}: {exc}") from None
         if isinstance(v, Expression):
             if v.constant:
@@ -158,6 +167,29 @@ def known_values(model: Model, known: Any, *, expressions: bool = True,
                              f"(N or N m), got {value!r}")
         out[label] = value
     return out
+
+
+def known_unit(label: str) -> str:
+    """The unit of a known reaction value by its label: N for a force, N m for a moment
+    (``O.Mz``, ``motor.M``); 'N or N m' for a label that names no component."""
+    try:
+        return joint_types.unit(label)
+    except KeyError:
+        return "N or N m"
+
+
+def known_unit_refused(label: str, text: str) -> tuple[str, str | None] | None:
+    """What to write for a known value `text` given with a unit (``'3 N'``, ``'3N'``,
+    ``'2 kN*m'``): `mbody.model.checks.number_hint`'s advice for the label's unit, and the
+    number in it (``'3'``, ``'2000'``) when the unit converts to it; None when `text` is
+    not a number with a unit mbody knows (a misspelt expression keeps its own message)."""
+    plain = text.replace("*", " ")
+    si = si_quantity(plain)
+    if si is None:
+        return None
+    unit = known_unit(label)
+    meant = f"{si[0]:.6g}" if si[1] == unit else None
+    return number_hint(plain, unit if unit in ("N", "N m") else None), meant
 
 
 def known_at(model: Model, known: Any, t: float, argument: str = "known") -> dict[str, float]:

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from typing import Any
 
 import numpy as np
@@ -176,7 +176,7 @@ class Checker:
             return None
         if isinstance(value, bool) or not isinstance(value, int | float):
             self.err(path, f"expected a number, got {_kind(value)}",
-                     _number_hint(value, key_unit(path)))
+                     number_hint(value, key_unit(path)))
             return None
         try:
             x = float(value)
@@ -344,7 +344,7 @@ _ANGLE_WORDS = re.compile(r"\s*([-+]?[\d.eE+-]+)\s*(°|degrees?|degs|grad|radian
                           re.IGNORECASE)
 
 
-def _number_hint(value: Any, expected: str | None = None) -> str:
+def number_hint(value: Any, expected: str | None = None) -> str:
     """What was probably meant by text where a number goes: '1,5', '1.5 kg'. `expected`
     is the SI unit the key's number is in (`key_unit`: '' for a pure number), None when
     not known: a unit of another quantity is then named as such, never converted into
@@ -374,6 +374,24 @@ def _number_hint(value: Any, expected: str | None = None) -> str:
         return f"{bare}: {number} {unit} is {float(number) * factor:.6g} {to}"
     return (f"numbers are in SI units (kg, m, s, N, rad), written without the unit: "
             f"convert {value.strip()!r} to SI first")
+
+
+SI_PREFIXES = {"k": 1e3, "M": 1e6, "G": 1e9, "m": 1e-3, "µ": 1e-6, "u": 1e-6}
+"""The SI prefixes a newcomer puts before a unit that takes none (``'0.6 krpm'``)."""
+
+
+def prefixed(value: str, units: Iterable[str]) -> str | None:
+    """`value` converted when its unit is one of `units` with an SI prefix, which mbody
+    does not read: ``'0.6 krpm'`` -> ``'0.6 krpm is 600 rpm'`` (a close spelling, 'rpm',
+    would be 1000 times off); None otherwise."""
+    written = written_quantity(value)
+    if written is None:
+        return None
+    x, unit = written
+    factor = SI_PREFIXES.get(unit[:1])
+    if factor is None or unit[1:] not in units or unit in units:
+        return None
+    return f"{x:g} {unit} is {x * factor:.6g} {unit[1:]}"
 
 
 def key_unit(path: Path_) -> str | None:
@@ -458,7 +476,7 @@ _KEY_UNITS: dict[str, str] = {
 def _angle_hint(value: str, unit: str) -> str:
     """'30°', '30 degrees' -> write '30 deg'."""
     written = angle_spelling(value, unit)
-    return f"write '{written}'" if written else _number_hint(
+    return f"write '{written}'" if written else number_hint(
         value, "rad" if unit == "deg" else "rad/s")
 
 

@@ -30,7 +30,7 @@ from mbody import conventions as cv
 from mbody import joint_types
 from mbody.errors import closest, did_you_mean
 from mbody.model.calculus import derivative
-from mbody.model.checks import MAX_MAGNITUDE
+from mbody.model.checks import MAX_MAGNITUDE, prefixed
 from mbody.model.expressions import Expression, ExpressionError, compile_expression
 
 if TYPE_CHECKING:
@@ -46,6 +46,8 @@ _DEG = re.compile(r"(?<![\w.])((?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*deg\b")
 _RATE_UNITS = {"rad/s": 1.0, "deg/s": math.pi / 180.0, "rpm": 2.0 * math.pi / 60.0,
                "rev/min": 2.0 * math.pi / 60.0, "rev/s": 2.0 * math.pi, "Hz": 2.0 * math.pi}
 _SPEED_UNITS = {"m/s": 1.0, "mm/s": 1e-3, "cm/s": 1e-2}
+SPEED_UNITS = (*_RATE_UNITS, *_SPEED_UNITS)
+"""The units a driver's ``speed`` may be written in (a rotation's, a translation's)."""
 _UNIT_NUMBER = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S.*?)?\s*")
 
 
@@ -162,9 +164,11 @@ def _law(c: Checker, p: Path_, d: dict, key: str, motion: joint_types.Motion
             if not m or (unit and unit not in units):
                 example = ("10.47, '100 rpm' or '90 deg/s'" if rotation
                            else "0.2 or '200 mm/s'")
-                meant = _unit_meant(unit, units) if m else None
+                converted = prefixed(value, units)
+                meant = _unit_meant(unit, units) if m and converted is None else None
                 c.err((*p, key), f"expected a {what} like {example}, got '{value}'",
                       (f"did you mean '{m.group(1)} {meant}'? " if m and meant else "")
+                      + (f"units take no prefix: {converted}; " if converted else "")
                       + f"units: {', '.join(units)}")
                 return None, None
             factor = units.get(unit, 1.0)

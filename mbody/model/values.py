@@ -25,8 +25,15 @@ from typing import Any
 import numpy as np
 
 from mbody.errors import Issue, MbodyError, ModelError, did_you_mean
-from mbody.model.checks import _show
-from mbody.model.drivers import DRIVER_KEYS
+from mbody.model.checks import (
+    _show,
+    key_unit,
+    number_hint,
+    prefixed,
+    si_quantity,
+    written_quantity,
+)
+from mbody.model.drivers import DRIVER_KEYS, SPEED_UNITS
 from mbody.model.loader import Document, Path_, dotted, load_text
 from mbody.model.validate import BODY_KEYS, JOINT_KEYS, LOAD_KEYS, Spec, validate
 
@@ -92,6 +99,39 @@ def parse_assignment(text: str, flag: str = "--set") -> tuple[str, str]:
         raise MbodyError(f"{flag} expects PATH=VALUE (for example bodies.rod.mass=2), got "
                          f"{text!r}")
     return path.strip(), value.strip()
+
+
+UNIT_KEYS: dict[str, tuple[str, ...]] = {
+    "angle": ("deg", "rad"), "euler": ("deg", "rad"), "angular_velocity": ("deg/s", "rad/s"),
+    "speed": SPEED_UNITS}
+"""A model file's keys that read a number written with a unit, and its units (text such
+as ``"30 deg"``); every other key's number is written without one."""
+
+
+def unit_refused(path: str, text: str) -> tuple[str, str | None] | None:
+    """Why `text`, a number with a unit (``'2 kg'``), is refused at `path`
+    (``bodies.rod.mass``), by the path's last key: what the key takes and
+    `mbody.model.checks.number_hint`'s advice (``"takes no unit (numbers are in SI
+    units, ...)"``), and the number to write instead (``'2'``, ``'0.5'`` for ``'500
+    g'``) when the unit converts to the key's. None when the key reads that unit
+    (``'600 rpm'`` as a driver's speed) or `text` is not a number with a unit (an
+    expression, a range)."""
+    written = written_quantity(text)
+    keys = [k for k in path.replace("[", ".").replace("]", "").split(".")
+            if k and not k.lstrip("-").isdigit()]
+    units = UNIT_KEYS.get(keys[-1], ()) if keys else ()
+    if written is None or not keys or written[1] in units:
+        return None
+    if units:
+        converted = prefixed(text, units)
+        return (f"takes a number in SI units or with a unit ({', '.join(units)}; "
+                + (f"units take no prefix: {converted})" if converted else
+                   f"got {written[1]!r})"), None)
+    expected = key_unit((keys[-1],))
+    si = si_quantity(text)
+    meant = (f"{si[0]:.6g}" if si is not None and expected is not None and si[1] == expected
+             else None)
+    return f"takes no unit ({number_hint(text, expected)})", meant
 
 
 def resolve(doc: Document, given: str, names: Mapping[str, Sequence[str]]) -> Path_:

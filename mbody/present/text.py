@@ -26,6 +26,15 @@ def _plural(k: int, word: str) -> str:
     return f"{k} {word[:-1]}ies" if word.endswith("y") else f"{k} {word}s"  # body -> bodies
 
 
+def _speed_law(offset: float, rate: float) -> str:
+    """A ``speed`` driver's law as `check` prints it, 6 significant digits like the rest:
+    ``0.523599 - 62.8319*t`` (the law itself keeps every digit: `DriverTable.laws`)."""
+    term = f"{_n(abs(rate))}*t"
+    if offset == 0:
+        return term if rate >= 0 else f"-{term}"
+    return f"{_n(offset)} {'-' if rate < 0 else '+'} {term}"
+
+
 def model_summary(model: Model, topo: Topology) -> str:
     dim = model.dimension
     kind = "planar" if dim == cv.PLANAR else "spatial"
@@ -87,11 +96,14 @@ def model_summary(model: Model, topo: Topology) -> str:
     drivers = model.drivers
     if drivers is not None and len(drivers):
         out.append(f"drivers ({len(drivers)}):")
-        for name, j, (law, _, _), label in zip(drivers.names, drivers.joint.tolist(),
-                                                drivers.laws, drivers.labels, strict=True):
+        for k, (name, j, (law, _, _), label) in enumerate(zip(
+                drivers.names, drivers.joint.tolist(), drivers.laws, drivers.labels,
+                strict=True)):
             unit = "rad" if label.endswith(".M") else "m"
-            out.append(f"  {name:<14} {model.joints[j].name}: {law.text} ({unit}, t in s); "
-                       f"effort {label}")
+            rate = drivers.speed[k] if k < len(drivers.speed) else None
+            out.append(f"  {name:<14} {model.joints[j].name}: "
+                       f"{law.text if rate is None else _speed_law(drivers.offset[k], rate)} "
+                       f"({unit}, t in s); effort {label}")
     unknown = [r for r in model.reactions if r not in model.known_reactions]
     out.append(f"reaction unknowns ({len(unknown)}): " + (", ".join(unknown[:40]) or "none")
                + (" ..." if len(unknown) > 40 else ""))

@@ -58,7 +58,7 @@ from mbody.simulate.kinematic import (
 from mbody.simulate.peaks import reaction_unit
 from mbody.simulate.trajectory import Trajectory
 from mbody.util.atomic import write_atomic
-from mbody.util.formatting import NOISE, num, number, spreadsheet_text
+from mbody.util.formatting import NOISE, num, number, rounded_to, spreadsheet_text
 from mbody.util.frozen import Frozen
 
 MAX_INSTANTS = 100_000
@@ -162,11 +162,16 @@ class Instants(Frozen):
                 + [("t", "s")] + list(zip(self.labels, self.units, strict=True)))
 
     def rows(self) -> np.ndarray:
-        """(K, k + 1 + m) the columns of `header` as numbers."""
+        """(K, k + 1 + m) the columns of `header` as numbers. The drivers' columns, which
+        label the rows, are rounded at `NOISE` of the column's scale (at least a turn
+        for an angle, as `text` takes it): a law's 30 deg reads 30.0, not its conversion
+        from radians, 29.999999999999996 (what `csv` and `json` write too)."""
         coords = self.coordinates.copy()
         for i, kind in enumerate(self.kinds):
             if kind == "angle":
                 coords[:, i] = np.degrees(coords[:, i])
+            scale = float(np.abs(coords[:, i]).max(initial=360.0 if kind == "angle" else 0.0))
+            coords[:, i] = rounded_to(coords[:, i], scale)
         return np.column_stack((coords, self.t, self.values))
 
     def text(self) -> str:

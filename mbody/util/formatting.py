@@ -104,6 +104,16 @@ def clean(x: np.ndarray, rel: float = 1e-10) -> np.ndarray:
     return np.where(np.abs(x) <= rel * top, 0.0, x)
 
 
+def rounded_to(x: np.ndarray, scale: float, rel: float = NOISE) -> np.ndarray:
+    """`x` rounded to the decimal place of `rel` times `scale` (the column's largest
+    magnitude, or more): a label computed through a conversion (a law's radians in
+    degrees, 29.999999999999996) written as the value it stands for (30.0)."""
+    x = np.asarray(x, dtype=float)
+    if not (scale > 0 and math.isfinite(scale)):
+        return x
+    return np.round(x, -math.floor(math.log10(rel * scale)))
+
+
 FORMULA_STARTS = ("=", "+", "-", "@", "\t", "\r", "\0")
 """The first characters that make a spreadsheet (Excel, LibreOffice, Google Sheets) read a
 CSV cell as a formula (OWASP's CSV injection list, with ASVS's NUL)."""
