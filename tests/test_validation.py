@@ -968,3 +968,29 @@ def test_a_misspelt_required_key_is_one_problem_not_two(tmp_path):
     assert len(issues) == 1
     assert (issues[0].line, issues[0].column) == (4, 5)
     assert "unknown key 'mas'" in issues[0].message and "'mass'" in issues[0].hint
+
+
+@pytest.mark.parametrize(("written", "rad_per_s"), [
+    ("100 rpm", 100 * 2 * math.pi / 60), ("30 rev/min", math.pi), ("1 rev/s", 2 * math.pi),
+    ("2 Hz", 4 * math.pi), ("90 deg/s", math.pi / 2), ("1.5 rad/s", 1.5)])
+def test_a_bodys_angular_velocity_takes_a_drivers_rate_units(written, rad_per_s):
+    """Review R7-13: a driver's speed took rpm, rev/s and Hz, a body's angular velocity
+    refused them; one table now serves both (the same conversion, to the last bit)."""
+    root = Path(__file__).resolve().parents[1] / "models"
+    planar = mbody.load(root / "pendulum.yaml").with_values(
+        {"bodies.rod.angular_velocity": written})
+    assert planar.initial.omega[0, 2] == pytest.approx(rad_per_s, rel=4e-16, abs=0)
+    spatial = mbody.load(root / "heavy_top.yaml")
+    name = spatial.body_names[0]
+    w = spatial.with_values({f"bodies.{name}.angular_velocity": [written, 0, 0]}).initial
+    assert w.omega[0, 0] == planar.initial.omega[0, 2]
+    driven = mbody.load(root / "slider_crank_driven.yaml").with_values(
+        {"drivers.motor.speed": written})
+    assert driven.drivers.laws[0][1](0.0) == planar.initial.omega[0, 2]
+
+
+def test_a_prefixed_rate_unit_is_refused_with_its_conversion():
+    root = Path(__file__).resolve().parents[1] / "models"
+    with pytest.raises(ModelError, match="0.1 krpm is 100 rpm"):
+        mbody.load(root / "pendulum.yaml").with_values(
+            {"bodies.rod.angular_velocity": "0.1 krpm"})

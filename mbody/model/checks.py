@@ -40,7 +40,11 @@ _REQUIRED_HINTS = {
 }
 """Hints for missing required keys, by (top-level section, key)."""
 _ANGLE = re.compile(r"\s*([-+]?[0-9.eE+-]+)\s*(deg|rad)\s*")
-_RATE = re.compile(r"\s*([-+]?[0-9.eE+-]+)\s*(deg/s|rad/s)\s*")
+RATE_UNITS = {"rad/s": 1.0, "deg/s": math.pi / 180.0, "rpm": 2.0 * math.pi / 60.0,
+              "rev/min": 2.0 * math.pi / 60.0, "rev/s": 2.0 * math.pi, "Hz": 2.0 * math.pi}
+"""The units an angular rate may be written in, a body's `angular_velocity` and a turning
+driver's `speed` alike: rad/s per one."""
+_RATE = re.compile(r"\s*([-+]?[0-9.eE+-]+)\s*(deg/s|rad/s|rpm|rev/min|rev/s|Hz)\s*")
 _TOL = 1e-6
 MAX_MAGNITUDE = 1e100
 """Largest number accepted: squares and triple products must stay finite in float64."""
@@ -218,8 +222,11 @@ class Checker:
             m = (_RATE if rate else _ANGLE).fullmatch(value)
             unit = "deg/s" if rate else "deg"
             if not m:
+                like = "'30 deg/s' or '100 rpm'" if rate else "'30 deg'"
+                hint = (prefixed(value, RATE_UNITS) if rate else None) or _angle_hint(value,
+                                                                                      unit)
                 self.err(path, f"expected a number (radians{'/s' if rate else ''}) or a string "
-                         f"like '30 {unit}', got '{_show(value)}'", _angle_hint(value, unit))
+                         f"like {like}, got '{_show(value)}'", hint)
                 return None
             try:
                 written = float(m.group(1))
@@ -230,7 +237,9 @@ class Checker:
                             else written)
             if y is None:
                 return None
-            x = math.radians(y) if m.group(2).startswith("deg") else y
+            unit_written = m.group(2)
+            x = (math.radians(y) if unit_written.startswith("deg") else
+                 y * RATE_UNITS[unit_written] if rate and unit_written != "rad/s" else y)
         else:
             z = self.number(path, value)
             if z is None:

@@ -19,7 +19,6 @@ f′ and f″ come from `mbody.model.calculus`.
 
 from __future__ import annotations
 
-import math
 import re
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -30,7 +29,7 @@ from mbody import conventions as cv
 from mbody import joint_types
 from mbody.errors import closest, did_you_mean
 from mbody.model.calculus import derivative
-from mbody.model.checks import MAX_MAGNITUDE, prefixed
+from mbody.model.checks import MAX_MAGNITUDE, RATE_UNITS, prefixed
 from mbody.model.expressions import Expression, ExpressionError, compile_expression
 
 if TYPE_CHECKING:
@@ -43,8 +42,7 @@ EFFORT = {joint_types.ROTATION: "M", joint_types.TRANSLATION: "F"}
 
 _DEG = re.compile(r"(?<![\w.])((?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*deg\b")
 """A number followed by ``deg`` inside a law: the number in degrees."""
-_RATE_UNITS = {"rad/s": 1.0, "deg/s": math.pi / 180.0, "rpm": 2.0 * math.pi / 60.0,
-               "rev/min": 2.0 * math.pi / 60.0, "rev/s": 2.0 * math.pi, "Hz": 2.0 * math.pi}
+_RATE_UNITS = RATE_UNITS  # one table for every angular rate (checks.RATE_UNITS)
 _SPEED_UNITS = {"m/s": 1.0, "mm/s": 1e-3, "cm/s": 1e-2}
 SPEED_UNITS = (*_RATE_UNITS, *_SPEED_UNITS)
 """The units a driver's ``speed`` may be written in (a rotation's, a translation's)."""
