@@ -522,6 +522,19 @@ def test_simulate_refuses_a_span_where_an_expression_is_not_finite(tmp_path, cap
     assert len(started) == 1
 
 
+def test_a_span_is_checked_again_at_each_run_until_it_passes():
+    """The check's result is kept per model and t_end (a span that passed is not sampled
+    again), so a span that failed must fail at every run, and a shorter one pass."""
+    model = mbody.loads(SINGULAR.replace("{expr}", "1/(t-1)"))
+    for _ in range(2):
+        with pytest.raises(mbody.MbodyError, match="is not finite at t = 1 s"):
+            mbody.simulate(model, 2.0, 10)
+    for _ in range(2):
+        assert len(mbody.simulate(model, 0.5, 10)) == 6
+    with pytest.raises(mbody.MbodyError, match="is not finite at t = 1 s"):
+        mbody.simulate(model, 2.0, 10)
+
+
 @pytest.mark.parametrize("t_end", [1e-9, 0.001, 10.0, 1234.5, 1e9])
 def test_the_check_of_expressions_samples_a_bounded_number_of_times(t_end):
     """Every millisecond up to MAX_CHECK_SAMPLES points, then coarser: the check before a

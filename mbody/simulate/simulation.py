@@ -267,7 +267,9 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
         initial = checked_state(model, initial, "initial")
     given: KnownValues | None = None if known is None else known_values(model, known)
     plan = _prepared(model, given, dynamics, initial, method)
-    _check_span(plan.varying, t_end)
+    if t_end not in plan.spans_checked:  # a span of the same model's runs, checked once
+        _check_span(plan.varying, t_end)
+        plan.spans_checked.add(t_end)
     if plan.driven:
         # the drivers fix the motion: each sample's kinematics then its reactions, no
         # integration (mbody.simulate.kinematic)
@@ -779,12 +781,15 @@ class _Prepared:
     Nothing in it refers to the model: kept in the model's workspace, it must not keep
     the model alive."""
 
-    __slots__ = ("varying", "driven", "mechanism", "projecting", "y0", "ratio")
+    __slots__ = ("varying", "spans_checked", "driven", "mechanism", "projecting", "y0",
+                 "ratio")
 
     def __init__(self, model: Model, given: KnownValues | None, dynamics: Dynamics | None,
                  initial: State | None, core: bool):
         self.varying = _varying_expressions(model, given)
         """(what, expression) of every load and known reaction varying in time."""
+        self.spans_checked: set[float] = set()
+        """The t_end whose span 0 .. t_end `_check_span` found them finite over."""
         self.driven = dynamics is None and initial is None and fully_driven(model)
         """The drivers fix the motion: a kinematic run, nothing below is made."""
         if self.driven:
