@@ -601,9 +601,11 @@ def test_numbers_in_expressions_keep_the_range(tmp_path, capsys, expr, message):
      "'1.5 kg' (numbers are in SI units, written without the unit: 1.5)"),
     ("    mass: 500 g\n", "m.yaml:6:11: bodies[0].mass: expected a number, got the text "
      "'500 g' (numbers are in SI units, written without the unit: 500 g is 0.5 kg)"),
-    ("    angular_velocity: 60 rpm\n", "m.yaml:6:23: bodies[0].angular_velocity: expected a "
-     "number (radians/s) or a string like '30 deg/s', got '60 rpm' (numbers are in SI units, "
-     "written without the unit: 60 rpm is 6.28319 rad/s)"),
+    # '60 rpm' is read since a body's rate takes a driver's units (review R7-13); a unit
+    # with a prefix is not, and says what it is
+    ("    angular_velocity: 0.06 krpm\n", "m.yaml:6:23: bodies[0].angular_velocity: expected "
+     "a number (radians/s) or a string like '30 deg/s' or '100 rpm', got '0.06 krpm' (0.06 "
+     "krpm is 60 rpm)"),
     ("    mass: 3 stone\n", "m.yaml:6:11: bodies[0].mass: expected a number, got the text "
      "'3 stone' (numbers are in SI units (kg, m, s, N, rad), written without the unit: "
      "convert '3 stone' to SI first)"),
@@ -612,8 +614,8 @@ def test_numbers_in_expressions_keep_the_range(tmp_path, capsys, expr, message):
     ("    angle: 30 degrees\n", "m.yaml:6:12: bodies[0].angle: expected a number (radians) or "
      "a string like '30 deg', got '30 degrees' (write '30 deg')"),
     ("    angular_velocity: 90 degrees/s\n", "m.yaml:6:23: bodies[0].angular_velocity: "
-     "expected a number (radians/s) or a string like '30 deg/s', got '90 degrees/s' (write "
-     "'90 deg/s')"),
+     "expected a number (radians/s) or a string like '30 deg/s' or '100 rpm', got '90 "
+     "degrees/s' (write '90 deg/s')"),
 ])
 def test_units_and_decimal_commas_get_a_did_you_mean(tmp_path, capsys, line, message):
     text = ("dimension: 2\nbodies:\n  - name: a\n    inertia: 1\n"
