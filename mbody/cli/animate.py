@@ -60,11 +60,11 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="draw only this body (repeatable)")
     s.add_argument("--t-end", type=seconds("a number of seconds", T_END_MIN, T_END_MAX),
                    metavar="S", help=f"seconds to simulate when SOURCE is a model (default "
-                   f"{T_END:g}; a run file plays its own length; t_end x fps at most "
-                   f"{number(FRAMES_MAX)} frames)")
+                   f"{T_END:g}; refused with a run file, which plays as saved; t_end x fps "
+                   f"at most {number(FRAMES_MAX)} frames)")
     s.add_argument("--fps", type=bounded("a number of frames per second", 0, FPS_MAX, lo_open=True),
                    metavar="N", help=f"frames per second when SOURCE is a model (default "
-                   f"{FPS:g}; at most {number(FPS_MAX)})")
+                   f"{FPS:g}; at most {number(FPS_MAX)}; refused with a run file)")
     s.add_argument("--live", action="store_true",
                    help="serve the live viewer on 127.0.0.1 and print its URL; Ctrl-C stops")
     s.add_argument("--hold", type=seconds("a number of seconds", 0, HOLD_MAX, lo_open=True),
