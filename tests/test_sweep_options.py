@@ -165,6 +165,12 @@ REFUSED = [
     (["--run", "modes", "--t-end", "1"], "--t-end", "modes",
      "--t-end goes with --run kinematics or --run simulate (the end of each case's run); "
      "the modes run linearises each case at one state"),
+    # every option the run does not use is named, not the first alone
+    (["--run", "solve", "--t-end", "1", "--steps", "7", "--fps", "3"], "--t-end", "solve",
+     "--t-end goes with --run kinematics or --run simulate (the end of each case's run); "
+     "--steps goes with --run kinematics (its instants, evenly spaced); --fps goes with "
+     "--run kinematics or --run simulate (samples per second); the solve run is one solve "
+     "of each case at its initial state"),
     (["--run", "modes", "--fps", "30"], "--fps", "modes", None),
     (["--run", "modes", "--steps", "30"], "--steps", "modes", None),
 ]
@@ -198,6 +204,9 @@ def test_an_option_the_run_does_not_use_is_refused(capsys, tmp_path, options, fl
      "the solve run is one solve of each case at its initial state"),
     ({"run": "simulate", "t_end": 1.0, "steps": 5}, "steps goes with run='kinematics' (its "
      "instants, evenly spaced); the simulate run is sampled at fps (default 60)"),
+    ({"steps": 7, "fps": 60.0}, "steps goes with run='kinematics' (its instants, evenly "
+     "spaced); fps goes with run='kinematics' or run='simulate' (samples per second); the "
+     "solve run is one solve of each case at its initial state"),
     ({"run": "kinematics", "t_end": 0.1, "steps": 11, "fps": 100.0},
      "steps and fps: give the kinematics run's instants one way, steps=K (K evenly spaced "
      "from 0 to the end) or fps=F (F a second, as mbody kinematics --fps samples)"),

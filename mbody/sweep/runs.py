@@ -252,14 +252,20 @@ def check_run(settings: Settings) -> None:
                          f"{option_setting('run', 'modes')} (it linearises each case about "
                          f"its static equilibrium); the {run} run starts from each "
                          "case's initial state")
-    for keyword, value in (("t_end", settings.t_end), ("revolutions", settings.revolutions),
-                           ("steps", settings.steps), ("fps", settings.fps)):
-        if value is None or run in APPLIES[keyword]:
-            continue
+    # every setting the run does not use, in one message (not the first alone)
+    unused = [keyword for keyword, value in (
+        ("t_end", settings.t_end), ("revolutions", settings.revolutions),
+        ("steps", settings.steps), ("fps", settings.fps))
+        if value is not None and run not in APPLIES[keyword]]
+    if unused:
         does = _RUN_IS[run].format(fps=option_name("fps"), default=SIMULATE_FPS)
-        goes = " or ".join(option_setting("run", r) for r in APPLIES[keyword])
-        raise MbodyError(f"{option_name(keyword)} goes with {goes} ({USE[keyword]}); the "
-                         f"{run} run {does}")
+        named: dict[str, str] = {}  # t_end and revolutions are one --t-end on the command line
+        for k in unused:
+            named.setdefault(option_name(k), k)
+        goes = [f"{name} goes with "
+                f"{' or '.join(option_setting('run', r) for r in APPLIES[k])} ({USE[k]})"
+                for name, k in named.items()]
+        raise MbodyError(f"{'; '.join(goes)}; the {run} run {does}")
     if run == "kinematics" and settings.steps is not None and settings.fps is not None:
         steps, fps = option_name("steps"), option_name("fps")
         raise MbodyError(f"{steps} and {fps}: give the kinematics run's instants one way, "
