@@ -10,6 +10,7 @@ from mbody.equations.coordinates import size
 from mbody.equations.fbd_text import body_text, force_cells
 from mbody.equations.topology import Topology
 from mbody.model.model import Model, State
+from mbody.model.reprs import count
 from mbody.util.formatting import LENGTH_RTOL, NOISE, quiet
 from mbody.util.formatting import clean as _clean
 from mbody.util.formatting import num as _n
@@ -18,12 +19,6 @@ from mbody.util.formatting import vec as _v
 
 __all__ = ["assembly_text", "body_text", "force_cells", "graph_summary", "model_summary",
            "pose_text", "reaction_table_text", "solution_text", "world_reaction_text"]
-
-
-def _plural(k: int, word: str) -> str:
-    if k == 1:
-        return f"{k} {word}"
-    return f"{k} {word[:-1]}ies" if word.endswith("y") else f"{k} {word}s"  # body -> bodies
 
 
 def _speed_law(offset: float, rate: float) -> str:
@@ -38,8 +33,8 @@ def _speed_law(offset: float, rate: float) -> str:
 def model_summary(model: Model, topo: Topology) -> str:
     dim = model.dimension
     kind = "planar" if dim == cv.PLANAR else "spatial"
-    out = [f"model {model.name!r}: {kind}, {_plural(model.n, 'body')}, "
-           f"{_plural(len(model.loads), 'load')}, {_plural(len(model.joints), 'joint')}"
+    out = [f"model {model.name!r}: {kind}, {count(model.n, 'body', 'bodies')}, "
+           f"{count(len(model.loads), 'load')}, {count(len(model.joints), 'joint')}"
            + (f"  [{model.file}]" if model.file else "")]
     if model.description:
         out.append(f"  {model.description.strip()}")
@@ -188,9 +183,9 @@ def graph_summary(model: Model, topo: Topology) -> str:
     # the counts of model.graph's nodes and edges, without building it (networkx is slow
     # to import)
     lines = [f"graph: {model.n + 1} nodes (bodies + ground), "
-             f"{_plural(len(model.joints), 'joint edge')}; "
+             f"{count(len(model.joints), 'joint edge')}; "
              + ("a tree (no closed loops)" if topo.is_tree
-                else f"{_plural(topo.loops, 'closed loop')}")]
+                else f"{count(topo.loops, 'closed loop')}")]
     lines.append(f"  connected parts: {len(topo.parts)}")
     for p in topo.parts[:10]:
         text = ", ".join(p[:12]) + (" ..." if len(p) > 12 else "")
