@@ -269,6 +269,8 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     plan = _prepared(model, given, dynamics, initial, method)
     if t_end not in plan.spans_checked:  # a span of the same model's runs, checked once
         _check_span(plan.varying, t_end)
+        if len(plan.spans_checked) >= SPANS_KEPT:  # a sweep of t_end: kept bounded
+            plan.spans_checked.clear()
         plan.spans_checked.add(t_end)
     if plan.driven:
         # the drivers fix the motion: each sample's kinematics then its reactions, no
@@ -449,6 +451,9 @@ CHUNK_WALL = 0.1
 """Seconds of wall time after which a compiled call comes back for the loop to look at its
 budgets, progress and Ctrl-C: a steady pace whatever a step costs (a fixed count of steps
 was either many round trips on a cheap model or seconds between looks on a dear one)."""
+
+SPANS_KEPT = 64
+"""Spans (t_end) whose check of the varying loads a model keeps before it starts over."""
 
 PREDICT_FROM = 1000
 """Steps after which (and after twice, four times as many...) a run's total cost is
