@@ -82,9 +82,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def _mode(a: argparse.Namespace):
     """(trajectory, model) of `mbody animate MODEL --mode K`."""
-    import numpy as np
-
     from mbody.cli.common import load_model
+    from mbody.present.modes import moves
     from mbody.simulate.modes import mode_trajectory
     from mbody.solve.linearize import linearize
 
@@ -102,8 +101,7 @@ def _mode(a: argparse.Namespace):
     traj = mode_trajectory(lin, a.mode, fps=a.fps or FPS)
     for w in traj.info.get("warnings", []):
         print(f"mbody: warning: {w}", file=sys.stderr)
-    at_rest = not (np.any(lin.state.velocity) or np.any(lin.state.omega))
-    if lin.stable is None and not a.equilibrium and at_rest:  # as `mbody modes` (R7-4)
+    if lin.stable is None and not a.equilibrium and not moves(lin):  # as `mbody modes`
         print("mbody: warning: so the motion played is not an oscillation about rest; "
               "--equilibrium plays the mode about the static equilibrium nearest the pose",
               file=sys.stderr)
@@ -116,12 +114,11 @@ def _warn(traj: Any, run_file: bool) -> None:
     that spin turning slower or backwards), the others said when it was made."""
     from mbody.simulate.simulation import SPIN_WARNING
 
+    hint = ("; this page's frames are the run file's samples: simulate the model again "
+            "with that --fps" if run_file else "")
     for w in traj.info.get("warnings", []):
-        if run_file and not w.startswith(SPIN_WARNING):
-            continue
-        hint = ("; this page's frames are the run file's samples: simulate the model again "
-                "with that --fps" if run_file and w.startswith(SPIN_WARNING) else "")
-        print(f"mbody: warning: {w}{hint}", file=sys.stderr)
+        if not run_file or w.startswith(SPIN_WARNING):
+            print(f"mbody: warning: {w}{hint}", file=sys.stderr)
 
 
 def _with_values(a: argparse.Namespace) -> tuple[Any, Any]:

@@ -26,19 +26,24 @@ def _eigenvalue(m: Mode) -> str:
     return num(lam.real, DIGITS)
 
 
+def moves(lin: Linearization) -> bool:
+    """Whether the state linearised about moves (a velocity or a rate not 0): without a
+    verdict, `--equilibrium` would then drop that motion, not only find rest."""
+    return bool(np.any(lin.state.velocity) or np.any(lin.state.omega))
+
+
 def verdict(lin: Linearization) -> str:
     """One line: stable, unstable (which mode grows, its time constant) or no verdict."""
     if not len(lin.coordinates):
         return ("no free coordinate: the drivers prescribe every degree of freedom, so "
                 "nothing oscillates about this motion (mbody kinematics MODEL gives it)")
     if lin.stable is None:
-        moving = bool(np.any(lin.state.velocity) or np.any(lin.state.omega))
         return ("no verdict: the state is not an equilibrium or a steady motion; the "
                 "eigenvalues are those of the tangent system at this instant "
                 + ("(a steady motion is one whose coordinates' rates stay constant: a top's "
                    "precession written with gimbals, revolute joints, not a ball joint, "
                    "whose body-axis rates turn as it precesses; mbody modes --equilibrium "
-                   "would drop the motion and linearise about rest)" if moving else
+                   "would drop the motion and linearise about rest)" if moves(lin) else
                    "(mbody modes --equilibrium linearises about the static equilibrium "
                    "nearest it)"))
     neutral = sum(1 for m in lin.modes if m.kind == "neutral")
