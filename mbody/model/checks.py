@@ -44,7 +44,8 @@ RATE_UNITS = {"rad/s": 1.0, "deg/s": math.pi / 180.0, "rpm": 2.0 * math.pi / 60.
               "rev/min": 2.0 * math.pi / 60.0, "rev/s": 2.0 * math.pi, "Hz": 2.0 * math.pi}
 """The units an angular rate may be written in, a body's `angular_velocity` and a turning
 driver's `speed` alike: rad/s per one."""
-_RATE = re.compile(r"\s*([-+]?[0-9.eE+-]+)\s*(deg/s|rad/s|rpm|rev/min|rev/s|Hz)\s*")
+_RATE = re.compile(r"\s*([-+]?[0-9.eE+-]+)\s*("
+                   + "|".join(re.escape(u) for u in RATE_UNITS) + r")\s*")
 _TOL = 1e-6
 MAX_MAGNITUDE = 1e100
 """Largest number accepted: squares and triple products must stay finite in float64."""

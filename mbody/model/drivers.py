@@ -42,9 +42,8 @@ EFFORT = {joint_types.ROTATION: "M", joint_types.TRANSLATION: "F"}
 
 _DEG = re.compile(r"(?<![\w.])((?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*deg\b")
 """A number followed by ``deg`` inside a law: the number in degrees."""
-_RATE_UNITS = RATE_UNITS  # one table for every angular rate (checks.RATE_UNITS)
 _SPEED_UNITS = {"m/s": 1.0, "mm/s": 1e-3, "cm/s": 1e-2}
-SPEED_UNITS = (*_RATE_UNITS, *_SPEED_UNITS)
+SPEED_UNITS = (*RATE_UNITS, *_SPEED_UNITS)
 """The units a driver's ``speed`` may be written in (a rotation's, a translation's)."""
 _UNIT_NUMBER = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S.*?)?\s*")
 
@@ -154,7 +153,7 @@ def _law(c: Checker, p: Path_, d: dict, key: str, motion: joint_types.Motion
     value = d[key]
     rotation = motion.what == joint_types.ROTATION
     if key == "speed":
-        units = _RATE_UNITS if rotation else _SPEED_UNITS
+        units = RATE_UNITS if rotation else _SPEED_UNITS
         if isinstance(value, str):
             m = _UNIT_NUMBER.fullmatch(value)
             unit = (m.group(2) or "") if m else ""
