@@ -78,6 +78,8 @@ def test_simulate_in_turns_of_a_model_without_drivers_says_to_give_seconds(capsy
     ("kinematics", DRIVEN, "--t-end", "0.1", "s"),
     ("kinematics", DRIVEN, "--t-end", "100", "ms"),
     ("check", PENDULUM, "--set", "bodies.rod.angle=30", "deg"),
+    # a body's rate reads a driver's units (review R7-13): quoting it works
+    ("check", PENDULUM, "--set", "bodies.rod.angular_velocity=100", "rpm"),
 ])
 def test_the_quotes_suggested_are_accepted(capsys, args):
     code, _, err = run(capsys, *args)

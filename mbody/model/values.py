@@ -26,6 +26,7 @@ import numpy as np
 
 from mbody.errors import Issue, MbodyError, ModelError, did_you_mean
 from mbody.model.checks import (
+    RATE_UNITS,
     _show,
     key_unit,
     number_hint,
@@ -102,7 +103,7 @@ def parse_assignment(text: str, flag: str = "--set") -> tuple[str, str]:
 
 
 UNIT_KEYS: dict[str, tuple[str, ...]] = {
-    "angle": ("deg", "rad"), "euler": ("deg", "rad"), "angular_velocity": ("deg/s", "rad/s"),
+    "angle": ("deg", "rad"), "euler": ("deg", "rad"), "angular_velocity": tuple(RATE_UNITS),
     "speed": SPEED_UNITS}
 """A model file's keys that read a number written with a unit, and its units (text such
 as ``"30 deg"``); every other key's number is written without one."""
