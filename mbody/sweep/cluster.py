@@ -243,7 +243,7 @@ def require_dask() -> None:
         raise MbodyError(_no_dask()) from None
 
 
-def _no_dask() -> str:  # noqa: N802 - a message, built when said (the caller's names)
+def _no_dask() -> str:  # a message, built when said (in the caller's names)
     return ("sweeps run on Dask (dask.distributed): pip install 'mbody[sweep]' "
             f"(or {option_setting('workers', 0)} to run them in this process)")
 
