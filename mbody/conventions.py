@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from mbody import joint_types
+from mbody.errors import MbodyError
 
 PLANAR, SPATIAL = 2, 3
 
@@ -68,6 +69,17 @@ SIGN_RULE = (
 )
 
 EQUATION = "M vdot + b = Q + G lambda"
+
+
+AXES = ("joint", "world")
+"""The axes reactions are given in: each component along its joint frame (the default),
+or each joint's force and moment on its child in world axes (`mbody.equations.world`)."""
+
+
+def check_axes(axes: str) -> None:
+    """Refuse anything but one of `AXES` (an `MbodyError`)."""
+    if axes not in AXES:
+        raise MbodyError(f"axes must be 'joint' or 'world', got {axes!r}")
 
 
 def coordinate_labels(names: list[str], dimension: int) -> list[str]:

@@ -11,8 +11,11 @@ An import inside a function is kept only where it saves start-up time: the targe
 a slow library (scipy, matplotlib, networkx, meshcat, numba, tqdm, sympy,
 mujoco, defusedxml, nbformat, nbclient) when imported, or the
 importer is a command module (`mbody.cli`: every command registers its arguments at
-start-up, and must not load what only another command uses). Any other import inside a
-function hides a dependency for nothing: it is listed, and the exit code is 1.
+start-up, and must not load what only another command uses), or the import is one of
+`DEFERRED`: a module every simulation imports leaves for later one that only some runs,
+or only a run file's reading and writing, use (a fresh process's first `mbody.simulate`
+pays for every module it imports: issue 24). Any other import inside a function hides a
+dependency for nothing: it is listed, and the exit code is 1.
 ``--verbose`` lists every import made inside a function, with its reason.
 
 One upward import is allowed by design, a display hook: a notebook display method of an
@@ -47,6 +50,22 @@ PACKAGE = ROOT / "mbody"
 SLOW = ("scipy", "matplotlib", "networkx", "meshcat", "numba", "tqdm", "sympy", "mujoco",
         "defusedxml", "nbformat", "nbclient")
 """Libraries that take tens to hundreds of milliseconds to import."""
+
+
+DEFERRED = {
+    ("mbody.simulate.simulation", "mbody.simulate.kinematic"):
+        "a fully driven model's run, the drivers' figures of a run with drivers, and the "
+        "summary's driver lines",
+    ("mbody.simulate.simulation", "mbody.simulate.axes"): "a run stored in world axes",
+    ("mbody.simulate.trajectory", "mbody.util.atomic"): "writing a run file",
+    ("mbody.simulate.trajectory", "mbody.util.npzfile"): "reading a run file",
+    ("mbody.simulate.trajectory", "mbody.util.jsontext"): "reading a run file",
+    ("mbody.simulate.trajectory", "mbody.model.yaml_write"):
+        "the model text of a run of a model not read from a YAML file",
+}
+"""(importer, imported) -> the only work that needs the imported module: imports a simulation's
+modules make inside a function, kept out of a fresh process's first `mbody.simulate`
+(together 1.1 ms of its 4 ms on the double pendulum; issue 24)."""
 
 
 DISPLAY_HOOKS = ("_repr_html_", "_repr_latex_", "_repr_svg_", "_repr_png_", "_repr_pretty_")
@@ -233,6 +252,8 @@ def main(argv: list[str] | None = None) -> int:
             why = f"a display hook ({imp.function})"
         elif imp.target in slow:
             why = "loads a slow library"
+        elif (imp.source, imp.target) in DEFERRED:
+            why = f"deferred: needed only for {DEFERRED[imp.source, imp.target]}"
         else:
             why = "NEEDLESS"
             needless.append(imp)

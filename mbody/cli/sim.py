@@ -149,7 +149,7 @@ def simulate(a: argparse.Namespace) -> int:
 def _refuse_integrator_options(a: argparse.Namespace, model: Model) -> None:
     """A fully driven model's run is kinematic (each sample solved, nothing integrated):
     an integrator's option given for it would be ignored (review R7-17), so it is refused."""
-    from mbody.simulate.kinematic import fully_driven
+    from mbody.solve.kinematics import fully_driven
 
     given = [flag for flag, value in (("--method", a.method != "DOP853" and a.method),
                                       ("--rtol", a.rtol), ("--atol", a.atol),

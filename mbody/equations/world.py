@@ -23,23 +23,11 @@ import numpy as np
 
 from mbody import conventions as cv
 from mbody.equations.joints import ReactionColumns
-from mbody.errors import MbodyError
 from mbody.joint_types import base as jb
 from mbody.model.model import Model
 
 if TYPE_CHECKING:
     import scipy.sparse as sp
-
-AXES = ("joint", "world")
-"""The axes reactions are given in: each component along its joint frame (the default),
-or each joint's force and moment on its child in world axes (this module)."""
-
-
-def check_axes(axes: str) -> None:
-    """Refuse anything but one of `AXES` (an `MbodyError`)."""
-    if axes not in AXES:
-        raise MbodyError(f"axes must be 'joint' or 'world', got {axes!r}")
-
 
 def world_reactions(model: Model, cols: ReactionColumns, values: Mapping[str, float]
                     ) -> dict[str, float]:

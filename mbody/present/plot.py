@@ -23,7 +23,7 @@ from matplotlib.figure import Figure
 
 from mbody import conventions as cv
 from mbody import joint_types
-from mbody.equations.world import check_axes
+from mbody.conventions import check_axes
 from mbody.errors import MbodyError, option_name, option_setting
 from mbody.present.draw.fonts import drawable
 from mbody.simulate.axes import in_world_axes

@@ -18,9 +18,9 @@ import numpy as np
 from mbody import __version__, joint_types
 from mbody import conventions as cv
 from mbody.answers.verify import check_assembly_of
+from mbody.conventions import check_axes
 from mbody.equations.assemble import Assembly, Solution, assemble
 from mbody.equations.topology import topology
-from mbody.equations.world import check_axes
 from mbody.errors import MbodyError
 from mbody.model.model import Model
 from mbody.present.answers import answers_section

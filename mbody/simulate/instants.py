@@ -35,7 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mbody.equations.world import check_axes
+from mbody.conventions import check_axes
 from mbody.errors import (
     MbodyError,
     not_found,
@@ -48,15 +48,10 @@ from mbody.model.arguments import checked_model
 from mbody.model.checks import MAX_ANGLE, angle_spelling, si_quantity, written_quantity
 from mbody.model.model import Model
 from mbody.simulate.axes import sample_states, world_series
-from mbody.simulate.kinematic import (
-    MAX_SAMPLES,
-    carry,
-    default_sampling,
-    kinematic_run,
-    require_fully_driven,
-)
+from mbody.simulate.kinematic import carry, default_sampling, kinematic_run
 from mbody.simulate.peaks import reaction_unit
-from mbody.simulate.trajectory import Trajectory
+from mbody.simulate.trajectory import MAX_SAMPLES, Trajectory
+from mbody.solve.kinematics import require_fully_driven
 from mbody.util.atomic import write_atomic
 from mbody.util.formatting import NOISE, num, number, rounded_to, spreadsheet_text
 from mbody.util.frozen import Frozen

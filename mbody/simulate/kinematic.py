@@ -26,11 +26,11 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from mbody import conventions as cv
+from mbody.conventions import check_axes
 from mbody.equations.joints import reaction_columns
 from mbody.equations.solution import singular_mass_error
 from mbody.equations.workspace import workspace
-from mbody.equations.world import check_axes
-from mbody.errors import MbodyError, did_you_mean, option_name, real_number, wrong_type
+from mbody.errors import MbodyError, did_you_mean, real_number, wrong_type
 from mbody.kernel import _core
 from mbody.model.arguments import checked_model
 from mbody.model.checks import MAX_MAGNITUDE
@@ -41,8 +41,10 @@ from mbody.simulate.trajectory import (
     Trajectory,
     appearance,
     keep_planar_angles,
+    last_sample_warning,
     model_text,
     model_values,
+    sample_times,
 )
 from mbody.solve.kinematics import (
     CLOSE_RTOL,
@@ -50,8 +52,8 @@ from mbody.solve.kinematics import (
     _cannot_close,
     _size,
     _state,
+    require_fully_driven,
 )
-from mbody.util.formatting import number
 from mbody.util.spatial import quat_to_matrix
 
 MAX_NEWTON = 60
@@ -60,74 +62,12 @@ step; more only near a dead centre)."""
 ROUNDING_UNITS = 8.0
 """Rounding units of the largest driver's coordinate a Newton step may stay at
 (`newton_tolerance`): the last step of a closed loop is about one of them."""
-MAX_SAMPLES = 10_000_000
-"""Samples at most in one run (memory: the states and solves of every sample are kept)."""
-
 BodyPoints = Mapping[str, tuple[str, Sequence[float]] | str]
 """name -> (body, point in the body's axes from its mass centre, m), or the command line's
 ``"BODY:X,Y[,Z]"`` text for the same: points to follow."""
 POINTS_FORM = ("a mapping name -> (body, [x, y(, z)]) or name -> 'body:x,y(,z)', such as "
                "{'P': ('coupler', [0.1, 0.05])}")
 """What `kinematic_run`'s ``points`` takes, in words (its error messages)."""
-
-
-def sample_times(t_end: float, fps: float, t_start: float = 0.0) -> np.ndarray:
-    """The sample times t_start, t_start + 1/fps, ... up to t_end (a last sample 1e-9 of
-    a step short of t_end counts: t_end * fps need not be a whole number in floats)."""
-    if not (math.isfinite(t_end) and math.isfinite(fps) and fps > 0 and t_end > t_start):
-        raise MbodyError(f"a kinematic run needs t_end > {t_start:g} s and fps > 0, got "
-                         f"t_end {t_end!r}, fps {fps!r}")
-    steps = (t_end - t_start) * fps + 1e-9  # a float: compared before it is an int
-    if not steps + 1 <= MAX_SAMPLES:
-        many = number(steps + 1) if math.isfinite(steps) else "more than 1e308"
-        raise MbodyError(f"{many} samples ({number(t_end - t_start)} s at {number(fps)} fps) "
-                         f"is more than {number(MAX_SAMPLES)}; lower {option_name('fps')} or "
-                         f"{option_name('t_end')}")
-    return t_start + np.arange(int(math.floor(steps)) + 1) / fps
-
-
-def last_sample_warning(t_end: float, fps: float, t_start: float = 0.0) -> str | None:
-    """The warning of a run whose last sample falls short of `t_end`: the samples are at
-    t_start + k / fps, and (t_end - t_start) · fps is not a whole number (to within the
-    rounding `sample_times` allows); None when it is, the usual case."""
-    span = t_end - t_start
-    x = span * fps
-    whole = math.floor(x + 1e-9)
-    if x - whole <= 1e-9 * max(1.0, x):
-        return None
-    last = t_start + whole / fps
-    return (f"the last sample is at t = {last:.6g} s, short of t_end = {t_end:g} s: samples "
-            f"are every 1/fps = {1 / fps:.6g} s, and {'(t_end - t_start)' if t_start else 't_end'}"
-            f" * fps = {x:.6g} is not a whole number; for a sample at t_end, use fps = "
-            f"{math.ceil(x) / span:.6g} (or a multiple of it) or t_end = "
-            f"{t_start + math.ceil(x) / fps:.6g}")
-
-
-def freedom(model: Model) -> int:
-    """The degrees of freedom the joints and drivers leave (the model's coordinates less
-    the generic rank of the enforced constraints): 0 for a fully driven mechanism."""
-    ws = workspace(model)
-    solver = ws.solver(ws.file_unknowns)
-    return len(model.coordinates) - int(solver.generic_rank)
-
-
-def fully_driven(model: Model) -> bool:
-    """The model has drivers and they leave it no freedom (`freedom` is 0)."""
-    d = model.drivers
-    return d is not None and len(d.names) > 0 and freedom(model) == 0
-
-
-def require_fully_driven(model: Model) -> None:
-    """Refuse (`MbodyError`) a mechanism whose drivers leave degrees of freedom: their
-    motion follows from the forces, and only an integration (`mbody.simulate`) finds it."""
-    free = freedom(model)
-    if free:
-        d = model.drivers
-        have = len(d.names) if d is not None else 0
-        raise MbodyError(f"{model.name!r} is not fully driven: its {have} driver(s) leave "
-                         f"{free} degree(s) of freedom, whose motion follows from the "
-                         "forces; integrate it with mbody simulate (mbody.simulate), which "
-                         "follows the drivers and integrates the rest")
 
 
 def kinematic_run(model: Model, t_end: float, fps: float, *, t_start: float = 0.0,

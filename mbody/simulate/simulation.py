@@ -35,9 +35,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from mbody import conventions as cv
+from mbody.conventions import check_axes
 from mbody.equations.joints import joint_errors
 from mbody.equations.workspace import Unknowns, workspace
-from mbody.equations.world import check_axes
 from mbody.errors import (
     MbodyError,
     UnknownReactionsError,
@@ -55,20 +55,18 @@ from mbody.model.arguments import (
 )
 from mbody.model.expressions import Expression, check_times, first_nonfinite
 from mbody.model.model import Model, State
-from mbody.simulate.axes import world_series
-from mbody.simulate.kinematic import (
-    driven_figures,
-    driven_lines,
-    fully_driven,
-    kinematic_run,
-    last_sample_warning,
-)
-from mbody.simulate.kinematic import summary as kinematic_summary
 from mbody.simulate.mechanism import BAUMGARTE_RATE, conserved_figures, sample_figures
 from mbody.simulate.projection import STAGE_PIVOT_RTOL, JointProjection
 from mbody.simulate.stepping import CORE, IMPLICIT, start
-from mbody.simulate.trajectory import Trajectory, appearance, model_text, model_values
+from mbody.simulate.trajectory import (
+    Trajectory,
+    appearance,
+    last_sample_warning,
+    model_text,
+    model_values,
+)
 from mbody.solve.dynamics import Dynamics, StateDerivative, accelerations
+from mbody.solve.kinematics import fully_driven
 
 if TYPE_CHECKING:  # a TypeVar made at run time is 0.02 ms of every simulation's start
     from typing import TypeVar
@@ -274,7 +272,10 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
         plan.spans_checked.add(t_end)
     if plan.driven:
         # the drivers fix the motion: each sample's kinematics then its reactions, no
-        # integration (mbody.simulate.kinematic)
+        # integration. Imported here, as below: only some runs need these modules, and a
+        # fresh process's first run pays for every module it imports (issue 24)
+        from mbody.simulate.kinematic import kinematic_run
+
         return kinematic_run(with_known(model, given), t_end, fps, axes=axes)
     varying, mechanism, projecting = plan.varying, plan.mechanism, plan.projecting
     rhs = state_derivative(model, given, dynamics)
@@ -388,6 +389,8 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
         lam = np.zeros((K, 0))
     stored, values = labels, lam
     if axes == "world" and labels and lam.shape[1] == len(labels):
+        from mbody.simulate.axes import world_series
+
         stored, values = world_series(run_model, t_eval, Y, lam)
     info = {
         "integrator": method, "rtol": rtol, "atol": atol, "t_end": t_end, "fps": fps,
@@ -417,6 +420,8 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     traj.series.update(series)  # run_model: `known` is among its reactions
     info.update(drift)
     if mechanism and run_model.drivers is not None and len(run_model.drivers.names):
+        from mbody.simulate.kinematic import driven_figures
+
         assert rhs.unknowns is not None
         driven_figures(run_model, traj, Y, lam, rhs.unknowns)
     broken = info.get("initial_joint_errors")
@@ -1037,6 +1042,9 @@ def summary(traj: Trajectory, path: str | os.PathLike[str] | None = None) -> str
     """The run in a few lines: integrator, cost, and drift of the conserved quantities;
     a run with drivers adds their peaks and energy check; a kinematic run (a fully driven
     mechanism) has its own (`mbody.simulate.kinematic.summary`)."""
+    from mbody.simulate.kinematic import driven_lines
+    from mbody.simulate.kinematic import summary as kinematic_summary
+
     i = traj.info
     if i.get("kinematic"):
         return kinematic_summary(traj, None if path is None else str(path))

@@ -23,28 +23,36 @@ from __future__ import annotations
 
 import functools
 import json
+import math
 import numbers
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from mbody import conventions as cv
-from mbody.errors import Issue, MbodyError, ModelError, TrajectoryFileError, real_number, wrong_type
+from mbody.errors import (
+    Issue,
+    MbodyError,
+    ModelError,
+    TrajectoryFileError,
+    option_name,
+    real_number,
+    wrong_type,
+)
 from mbody.loading import loads
 from mbody.model.model import State, count
 from mbody.model.records import BodyRecords
-from mbody.model.yaml_write import dump_document
-from mbody.util import jsontext
-from mbody.util.atomic import atomic_path
 from mbody.util.budget import checked_max_bytes
-from mbody.util.formatting import size_text
+from mbody.util.formatting import number, size_text
 from mbody.util.frozen import Frozen
-from mbody.util.npzfile import Member, NpzArchive
 from mbody.util.spatial import planar_quat
+
+if TYPE_CHECKING:
+    from mbody.util.npzfile import Member, NpzArchive
 
 FORMAT = "mbody-trajectory"
 FORMAT_VERSION = 1
@@ -58,6 +66,42 @@ keys and values (`mbody.model.loader.MAX_NODES`), so more than any such model ha
 or reaction components. Each name read becomes a Python text of some 60 bytes beyond its
 characters (where the file spends 4 bytes a character): the two lists take at most an
 eighth of the budget in memory beyond it. ``--max-bytes`` raises both."""
+
+MAX_SAMPLES = 10_000_000
+"""Samples at most in one run (memory: the states and solves of every sample are kept)."""
+
+
+def sample_times(t_end: float, fps: float, t_start: float = 0.0) -> np.ndarray:
+    """The sample times t_start, t_start + 1/fps, ... up to t_end (a last sample 1e-9 of
+    a step short of t_end counts: t_end * fps need not be a whole number in floats)."""
+    if not (math.isfinite(t_end) and math.isfinite(fps) and fps > 0 and t_end > t_start):
+        raise MbodyError(f"a kinematic run needs t_end > {t_start:g} s and fps > 0, got "
+                         f"t_end {t_end!r}, fps {fps!r}")
+    steps = (t_end - t_start) * fps + 1e-9  # a float: compared before it is an int
+    if not steps + 1 <= MAX_SAMPLES:
+        many = number(steps + 1) if math.isfinite(steps) else "more than 1e308"
+        raise MbodyError(f"{many} samples ({number(t_end - t_start)} s at {number(fps)} fps) "
+                         f"is more than {number(MAX_SAMPLES)}; lower {option_name('fps')} or "
+                         f"{option_name('t_end')}")
+    return t_start + np.arange(int(math.floor(steps)) + 1) / fps
+
+
+def last_sample_warning(t_end: float, fps: float, t_start: float = 0.0) -> str | None:
+    """The warning of a run whose last sample falls short of `t_end`: the samples are at
+    t_start + k / fps, and (t_end - t_start) · fps is not a whole number (to within the
+    rounding `sample_times` allows); None when it is, the usual case."""
+    span = t_end - t_start
+    x = span * fps
+    whole = math.floor(x + 1e-9)
+    if x - whole <= 1e-9 * max(1.0, x):
+        return None
+    last = t_start + whole / fps
+    return (f"the last sample is at t = {last:.6g} s, short of t_end = {t_end:g} s: samples "
+            f"are every 1/fps = {1 / fps:.6g} s, and {'(t_end - t_start)' if t_start else 't_end'}"
+            f" * fps = {x:.6g} is not a whole number; for a sample at t_end, use fps = "
+            f"{math.ceil(x) / span:.6g} (or a multiple of it) or t_end = "
+            f"{t_start + math.ceil(x) / fps:.6g}")
+
 
 _ARRAYS = ("t", "position", "velocity", "orientation", "angular_velocity", "reactions",
            "mass", "inertia", "gravity")
@@ -498,6 +542,11 @@ class Trajectory(Frozen):
             data[k] = np.array(getattr(self, k))
         for k, v in self.series.items():
             data[_SERIES + k] = np.asarray(v, dtype=float)
+        # imported here, as the reader's and the model writer's modules below: a run
+        # needs none of them, and a fresh process's first run pays for every module it
+        # imports (issue 24)
+        from mbody.util.atomic import atomic_path
+
         with atomic_path(path, suffix=".npz") as tmp, open(tmp, "wb") as fh:
             np.savez_compressed(fh, **data)
         return Path(path)
@@ -551,6 +600,8 @@ class Trajectory(Frozen):
             kind = ("a YAML model file? run 'mbody simulate MODEL -o run.npz' first"
                     if p.suffix in (".yaml", ".yml") else "not a .npz archive")
             raise TrajectoryFileError(f"{name}: not an mbody trajectory file ({kind})")
+        from mbody.util.npzfile import NpzArchive
+
         with NpzArchive(p, "trajectory file", max_bytes=max_bytes, error=TrajectoryFileError,
                         more=_MORE) as z:
             fields = _read_run(z)
@@ -731,6 +782,8 @@ def _check_finite(name: str, arrays: dict[str, np.ndarray], body_names: tuple[st
 def _json(z: NpzArchive, key: str, kind: type, problem: Any) -> Any:
     """Entry `key`: JSON text (nesting bounded: `jsontext.loads`) of a `kind` value that
     `problem(value)` finds nothing wrong with."""
+    from mbody.util import jsontext
+
     try:
         value = jsontext.loads(_text(z, key))
     except ValueError as exc:
@@ -816,6 +869,8 @@ def model_text(model) -> str:
         # rest of a short run's bookkeeping
         return _text_lines(source.text)
     if source is not None and source.document is not None:
+        from mbody.model.yaml_write import dump_document
+
         return dump_document(source.document.data, source=source.file)
     if not model.file or model.file.startswith("<"):
         return ""

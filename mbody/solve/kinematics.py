@@ -232,3 +232,30 @@ def placed(model: Model) -> Model:
                               model.initial, state, CLOSE_RTOL)
     return dataclasses.replace(model, initial=state, file_state=model.initial, joints=joints,
                                reaction_table=table)
+
+
+def freedom(model: Model) -> int:
+    """The degrees of freedom the joints and drivers leave (the model's coordinates less
+    the generic rank of the enforced constraints): 0 for a fully driven mechanism."""
+    ws = workspace(model)
+    solver = ws.solver(ws.file_unknowns)
+    return len(model.coordinates) - int(solver.generic_rank)
+
+
+def fully_driven(model: Model) -> bool:
+    """The model has drivers and they leave it no freedom (`freedom` is 0)."""
+    d = model.drivers
+    return d is not None and len(d.names) > 0 and freedom(model) == 0
+
+
+def require_fully_driven(model: Model) -> None:
+    """Refuse (`MbodyError`) a mechanism whose drivers leave degrees of freedom: their
+    motion follows from the forces, and only an integration (`mbody.simulate`) finds it."""
+    free = freedom(model)
+    if free:
+        d = model.drivers
+        have = len(d.names) if d is not None else 0
+        raise MbodyError(f"{model.name!r} is not fully driven: its {have} driver(s) leave "
+                         f"{free} degree(s) of freedom, whose motion follows from the "
+                         "forces; integrate it with mbody simulate (mbody.simulate), which "
+                         "follows the drivers and integrates the rest")

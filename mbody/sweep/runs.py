@@ -47,18 +47,14 @@ from mbody.errors import MbodyError, g_text, option_name, option_setting, option
 from mbody.kernel import _core
 from mbody.model.model import Model, State, from_source
 from mbody.model.source import Source
-from mbody.simulate.kinematic import (
-    default_fps,
-    last_sample_warning,
-    require_fully_driven,
-    revolution,
-    sample_times,
-)
+from mbody.simulate.kinematic import default_fps, revolution
 from mbody.simulate.peaks import PEAK_SAMPLES, samples_a_turn, sparse_text, steady_turning
 from mbody.simulate.simulation import simulate
+from mbody.simulate.trajectory import last_sample_warning, sample_times
 from mbody.solve.batch import Evaluator, closed
 from mbody.solve.family import Case, Family
 from mbody.solve.kinematics import kinematics as kinematics_at
+from mbody.solve.kinematics import require_fully_driven
 from mbody.sweep import modes
 from mbody.sweep.grid import Grid
 from mbody.sweep.limits import LIMITS

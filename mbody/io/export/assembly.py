@@ -24,10 +24,11 @@ import scipy.sparse as sp
 
 from mbody import conventions as cv
 from mbody import joint_types
+from mbody.conventions import check_axes
 from mbody.equations.assemble import Assembly, Solution
 from mbody.equations.pack import pack_columns_model, pack_unknowns_of
 from mbody.equations.solution import METHODS, singular_mass_error
-from mbody.equations.world import check_axes, world_map
+from mbody.equations.world import world_map
 from mbody.errors import MbodyError, not_found, wrong_type
 from mbody.kernel import _core
 from mbody.model.arguments import KnownValues
