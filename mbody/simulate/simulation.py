@@ -282,7 +282,7 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
     if projecting:
         rhs.rate = 0.0
     run_model = rhs.model  # the model with `known`'s values in its known reactions
-    y0, ratio = plan.y0.copy(), plan.ratio
+    y0, ratio = plan.y0, plan.ratio  # read only: each run steps its own copy
     n = model.n
     planar = model.dimension == cv.PLANAR
     size = len(y0)
@@ -408,13 +408,14 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
         info["model_values"] = values_set
     pose: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] = (
         (x[..., :2], v[..., :2], Y[:, 13 * n:], w[..., 2]) if planar else (x, v, q, w))
-    shapes, colors = _memo(model, ("appearance",), lambda: appearance(model))
+    shapes, colors, text = _memo(model, ("carried",),
+                                 lambda: (*appearance(model), model_text(model)))
     traj = Trajectory(
         t_eval, *pose, body_names=model.body_names, dimension=model.dimension,
         model_name=model.name, model_file=model.file, reaction_labels=stored,
         reactions=values, info=info, mass=np.array(model.mass), inertia=np.array(model.J),
         shapes=shapes, colors=colors, gravity=np.array(model.gravity),
-        model_yaml=_memo(model, ("text",), lambda: model_text(model)))
+        model_yaml=text)
     series, drift, spin_peak = _drift(run_model, t_eval, Y, dynamics is None,
                                       ideal_joints=mechanism, lengths=lengths)
     traj.series.update(series)  # run_model: `known` is among its reactions

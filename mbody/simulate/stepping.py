@@ -76,7 +76,7 @@ class CoreRun:
         else:  # a Python right-hand side (`dynamics`), called from the core's loop
             self.solver = DOP853(rhs, 0.0, y0, t_bound, rtol=rtol, atol=atol,
                                  max_step=max_step)
-        self._raise_stop()
+        self._raise_stop(self.solver.status)
         self._marks = np.empty((MARKS, 2))
         self._marked = 0
         self._marking = False
@@ -147,12 +147,14 @@ class CoreRun:
                                                         self.projecting, self._marks)
         else:
             k = self.solver.sampled(t_stop, max_steps, t_eval, k, Y, self.projecting)
-        self._raise_stop()
-        return k, TOO_SMALL_STEP if self.status == "failed" else None
+        status = self.solver.status
+        self._raise_stop(status)
+        return k, TOO_SMALL_STEP if status == "failed" else None
 
-    def _raise_stop(self) -> None:
-        """A callback that stopped the run: a motion without mass (the core's code)."""
-        if self.solver.status == "stopped":
+    def _raise_stop(self, status: str) -> None:
+        """A callback that stopped the run (`status` "stopped"): a motion without mass
+        (the core's code)."""
+        if status == "stopped":
             raise status_error(self.rhs.model, self.solver.code)
 
 
@@ -249,11 +251,13 @@ class ScipyRun:
 def start(method: str, rhs: StateDerivative, y0: np.ndarray, t_bound: float, rtol: float,
           atol: float, max_step: float = math.inf, *, project: bool = False,
           filter_first: bool = False) -> CoreRun | ScipyRun:
-    """The run of `method` from (0, y0): the core's (`CORE`) or scipy's."""
+    """The run of `method` from (0, y0): the core's (`CORE`) or scipy's; each steps a
+    copy of y0, which is left as it is."""
     if method in CORE:
         return CoreRun(rhs, y0, t_bound, rtol, atol, max_step, project=project,
                        filter_first=filter_first)
     if project:
         raise ValueError(f"{method} is scipy's: it does not project (Baumgarte's terms hold "
                          "the joints)")
-    return ScipyRun(method, rhs, y0, t_bound, rtol, atol, max_step)
+    # scipy's solvers may keep y0 itself as their state
+    return ScipyRun(method, rhs, y0.copy(), t_bound, rtol, atol, max_step)
