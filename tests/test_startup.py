@@ -178,6 +178,33 @@ def test_a_plain_simulate_imports_only_what_it_needs(name: str):
     assert loaded(code, PLAIN_SIMULATE) == []
 
 
+DEFERRED_BY_A_RUN = ("mbody.simulate.kinematic", "mbody.simulate.axes", "mbody.util.atomic",
+                     "mbody.util.npzfile", "mbody.util.jsontext", "mbody.model.yaml_write")
+"""What an integrated run of a model read from a YAML file leaves out: the kinematic run,
+world axes, the run file's reader and writer (tools/check_imports.py, `DEFERRED`; a fresh
+process's first simulate pays for every module it imports, 1 ms for these)."""
+
+
+@pytest.mark.parametrize("name", ["pendulum", "double_pendulum", "heavy_top",
+                                  "spring_mass_damper", "torque_free_asymmetric"])
+def test_an_integrated_run_leaves_what_only_other_runs_need(name: str):
+    path = ROOT / "models" / f"{name}.yaml"
+    code = f"import mbody\nmbody.simulate(mbody.load({str(path)!r}), t_end=0.5)"
+    assert loaded(code, DEFERRED_BY_A_RUN) == []
+
+
+def test_a_deferred_module_is_there_when_its_work_is():
+    """A fully driven model's run, world axes and a saved run do import them."""
+    driven = ROOT / "models" / "slider_crank_driven.yaml"
+    code = (f"import mbody, tempfile, os\nmbody.simulate(mbody.load({str(driven)!r}), "
+            "t_end=0.05)\n"
+            f"tr = mbody.simulate(mbody.load({str(ROOT / 'models' / 'pendulum.yaml')!r}), "
+            "t_end=0.5, axes='world')\n"
+            "d = tempfile.mkdtemp()\ntr.save(os.path.join(d, 'run.npz'))\n"
+            "mbody.Trajectory.load(os.path.join(d, 'run.npz'))")
+    assert loaded(code, DEFERRED_BY_A_RUN) == sorted(DEFERRED_BY_A_RUN[:-1])
+
+
 # -- numpy in place of scipy on the start-up path: the same numbers ---------------------
 
 SEQUENCES = [a + b + c for a in "xyz" for b in "xyz" for c in "xyz" if a != b != c]
