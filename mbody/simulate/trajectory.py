@@ -13,7 +13,9 @@ A trajectory carries what is needed to draw and check it without the model file:
 names, masses, inertia tensors (body axes, about the mass centres), shapes and colours,
 gravity, and the model's YAML text when it came from a file. `save` writes one ``.npz``
 file (format tag ``mbody-trajectory``, version `FORMAT_VERSION`); `Trajectory.load`
-reads it back and raises `TrajectoryFileError` for anything else.
+reads it back and raises `TrajectoryFileError` for anything else. Every kind of run
+samples at t_start + k / fps (`sample_times`, and `last_sample_warning` when the last
+sample falls short of t_end).
 
     T = ½ Σ m vᵀv + ½ Σ ωᵀ J ω          (kinetic energy)
     H = Σ (x × m v + W_R_B J ω)          (angular momentum about the world origin)
