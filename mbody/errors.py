@@ -125,6 +125,11 @@ class TrajectoryFileError(MbodyError):
     """A trajectory file is unreadable, truncated or of the wrong kind."""
 
 
+AT_LEAST_ONE_SAMPLE = "a run holds at least one sample"
+"""Why a trajectory without samples is refused (`Trajectory.need_samples`, and reading a
+run file: `mbody.simulate.run_file`)."""
+
+
 def wrong_type(argument: str, expected: str, got: object, hint: str = "") -> MbodyTypeError:
     """The `MbodyTypeError` "<argument> must be <expected>, got <what got is>[; <hint>]".
 

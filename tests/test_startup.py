@@ -178,8 +178,9 @@ def test_a_plain_simulate_imports_only_what_it_needs(name: str):
     assert loaded(code, PLAIN_SIMULATE) == []
 
 
-DEFERRED_BY_A_RUN = ("mbody.simulate.kinematic", "mbody.simulate.axes", "mbody.util.atomic",
-                     "mbody.util.npzfile", "mbody.util.jsontext", "mbody.model.yaml_write")
+DEFERRED_BY_A_RUN = ("mbody.simulate.kinematic", "mbody.simulate.axes",
+                     "mbody.simulate.run_file", "mbody.util.atomic", "mbody.util.npzfile",
+                     "mbody.util.jsontext", "mbody.model.yaml_write")
 """What an integrated run of a model read from a YAML file leaves out: the kinematic run,
 world axes, the run file's reader and writer (tools/check_imports.py, `DEFERRED`; a fresh
 process's first simulate pays for every module it imports, 1 ms for these)."""

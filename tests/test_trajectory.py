@@ -14,7 +14,8 @@ import mbody
 from mbody.cli import main
 from mbody.equations.constraints import ConstraintJacobian
 from mbody.errors import TrajectoryFileError
-from mbody.simulate.trajectory import FORMAT, FORMAT_VERSION, Trajectory
+from mbody.simulate.run_file import FORMAT, FORMAT_VERSION
+from mbody.simulate.trajectory import Trajectory
 
 MODELS = Path(__file__).resolve().parent.parent / "models"
 

@@ -57,15 +57,13 @@ DEFERRED = {
         "a fully driven model's run, the drivers' figures of a run with drivers, and the "
         "summary's driver lines",
     ("mbody.simulate.simulation", "mbody.simulate.axes"): "a run stored in world axes",
-    ("mbody.simulate.trajectory", "mbody.util.atomic"): "writing a run file",
-    ("mbody.simulate.trajectory", "mbody.util.npzfile"): "reading a run file",
-    ("mbody.simulate.trajectory", "mbody.util.jsontext"): "reading a run file",
+    ("mbody.simulate.trajectory", "mbody.simulate.run_file"): "saving and loading a run",
     ("mbody.simulate.trajectory", "mbody.model.yaml_write"):
         "the model text of a run of a model not read from a YAML file",
 }
 """(importer, imported) -> the only work that needs the imported module: imports a simulation's
 modules make inside a function, kept out of a fresh process's first `mbody.simulate`
-(together 1.1 ms of its 4 ms on the double pendulum; issue 24)."""
+(together 1.2 ms of its 4.3 ms on the double pendulum; issue 24)."""
 
 
 DISPLAY_HOOKS = ("_repr_html_", "_repr_latex_", "_repr_svg_", "_repr_png_", "_repr_pretty_")

@@ -33,7 +33,7 @@ from mbody.errors import MbodyError, not_found, wrong_type
 from mbody.kernel import _core
 from mbody.model.arguments import KnownValues
 from mbody.model.model import Model, State
-from mbody.simulate.trajectory import FORMAT as TRAJECTORY_FORMAT
+from mbody.simulate.run_file import FORMAT as TRAJECTORY_FORMAT
 from mbody.util import jsontext
 from mbody.util.formatting import number
 
