@@ -104,12 +104,13 @@ def check_formulas(model: mbody.Model, g: dict, tag: str) -> None:
     ws.core.columns(t, y, *cols.values())
     # Gᵀ v sums column entries times velocities: its rounding is relative to the size of
     # those terms, not to the sum, which is itself rounding (~1e-16) where v keeps the
-    # joints (the file's states)
+    # joints (the file's states; at the moved ones the sum is of the terms' size)
     terms = float(np.max(np.abs(np.concatenate((g["child6"].ravel(), g["parent6"].ravel()))),
                          initial=0.0)) * float(np.max(np.abs(y[7 * n:13 * n]), initial=0.0))
     for key in ("child6", "parent6", "gamma", "phi", "gtv"):
         # φ at the file's pose is rounding (~1e-16 m): compared on the length scale
         scale = 1.0 if key == "phi" and tag == "file" else max(
-            float(np.max(np.abs(g[key]), initial=0.0)), terms if key == "gtv" else 0.0,
+            float(np.max(np.abs(g[key]), initial=0.0)),
+            terms if key == "gtv" and tag == "file" else 0.0,
             1e-300)
         assert np.max(np.abs(cols[key] - g[key]), initial=0.0) <= 1e-12 * scale, key

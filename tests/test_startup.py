@@ -183,7 +183,8 @@ DEFERRED_BY_A_RUN = ("mbody.simulate.kinematic", "mbody.simulate.axes",
                      "mbody.util.jsontext", "mbody.model.yaml_write")
 """What an integrated run of a model read from a YAML file leaves out: the kinematic run,
 world axes, the run file's reader and writer (tools/check_imports.py, `DEFERRED`; a fresh
-process's first simulate pays for every module it imports, 1 ms for these)."""
+process's first simulate pays for every module it imports: about 1 ms for these,
+docs/performance.md)."""
 
 
 @pytest.mark.parametrize("name", ["pendulum", "double_pendulum", "heavy_top",
@@ -194,16 +195,44 @@ def test_an_integrated_run_leaves_what_only_other_runs_need(name: str):
     assert loaded(code, DEFERRED_BY_A_RUN) == []
 
 
-def test_a_deferred_module_is_there_when_its_work_is():
-    """A fully driven model's run, world axes and a saved run do import them."""
-    driven = ROOT / "models" / "slider_crank_driven.yaml"
-    code = (f"import mbody, tempfile, os\nmbody.simulate(mbody.load({str(driven)!r}), "
-            "t_end=0.05)\n"
-            f"tr = mbody.simulate(mbody.load({str(ROOT / 'models' / 'pendulum.yaml')!r}), "
-            "t_end=0.5, axes='world')\n"
-            "d = tempfile.mkdtemp()\ntr.save(os.path.join(d, 'run.npz'))\n"
-            "mbody.Trajectory.load(os.path.join(d, 'run.npz'))")
-    assert loaded(code, DEFERRED_BY_A_RUN) == sorted(DEFERRED_BY_A_RUN[:-1])
+def _run_file(tmp: Path) -> Path:
+    traj = mbody.simulate(mbody.load(ROOT / "models" / "pendulum.yaml"), t_end=0.5)
+    return traj.save(tmp / "run.npz")
+
+
+WORK_AND_ITS_MODULES = {
+    "a fully driven model's run": (
+        "mbody.simulate(mbody.load({models}/'slider_crank_driven.yaml'), t_end=0.05)",
+        ["mbody.simulate.axes", "mbody.simulate.kinematic"]),
+    "world axes": (
+        "mbody.simulate(mbody.load({models}/'pendulum.yaml'), t_end=0.5, axes='world')",
+        ["mbody.simulate.axes"]),
+    "saving a run": (
+        "mbody.simulate(mbody.load({models}/'pendulum.yaml'), t_end=0.5).save({tmp}/'r.npz')",
+        ["mbody.simulate.run_file", "mbody.util.atomic", "mbody.util.jsontext",
+         "mbody.util.npzfile"]),
+    "loading a run": (
+        "mbody.Trajectory.load({run})",
+        ["mbody.simulate.run_file", "mbody.util.atomic", "mbody.util.jsontext",
+         "mbody.util.npzfile"]),
+    "a model read from a dictionary": (
+        "import yaml\nspec = yaml.safe_load(({models}/'pendulum.yaml').read_text())\n"
+        "mbody.simulate(mbody.load(spec), t_end=0.5)",
+        ["mbody.model.yaml_write", "mbody.util.atomic"]),
+}
+"""Work that needs deferred modules -> (its code, the deferred modules it imports)."""
+
+
+@pytest.mark.parametrize("work", list(WORK_AND_ITS_MODULES))
+def test_a_deferred_module_is_there_when_its_work_is(work: str, tmp_path: Path):
+    """Each piece of work in a fresh process of its own imports the deferred modules it
+    needs, and no other."""
+    code, expected = WORK_AND_ITS_MODULES[work]
+    run = _run_file(tmp_path) if "{run}" in code else None
+    code = code.format(models=f"Path({str(ROOT / 'models')!r})", tmp=f"Path({str(tmp_path)!r})",
+                       run=repr(str(run)))
+    assert loaded("from pathlib import Path\nimport mbody\n" + code,
+                  DEFERRED_BY_A_RUN) == expected
 
 
 # -- numpy in place of scipy on the start-up path: the same numbers ---------------------

@@ -910,7 +910,7 @@ def exudyn_accuracy(quick: bool, repeat: int) -> None:
 
 
 def run(quick: bool, repeat: int, sim_limit: float, accuracy_runs: bool,
-        first_runs: int = 3) -> None:
+        first_runs: int = 5) -> None:
     try:
         import mujoco
 

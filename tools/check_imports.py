@@ -54,8 +54,8 @@ SLOW = ("scipy", "matplotlib", "networkx", "meshcat", "numba", "tqdm", "sympy", 
 
 DEFERRED = {
     ("mbody.simulate.simulation", "mbody.simulate.kinematic"):
-        "a fully driven model's run, the drivers' figures of a run with drivers, and the "
-        "summary's driver lines",
+        "a fully driven model's run, and the drivers' figures and summary lines of a run "
+        "with drivers",
     ("mbody.simulate.simulation", "mbody.simulate.axes"): "a run stored in world axes",
     ("mbody.simulate.trajectory", "mbody.simulate.run_file"): "saving and loading a run",
     ("mbody.simulate.trajectory", "mbody.model.yaml_write"):
@@ -63,7 +63,7 @@ DEFERRED = {
 }
 """(importer, imported) -> the only work that needs the imported module: imports a simulation's
 modules make inside a function, kept out of a fresh process's first `mbody.simulate`
-(together 1.2 ms of its 4.3 ms on the double pendulum; issue 24)."""
+(about 1 ms of its 4.3 ms on the double pendulum: docs/performance.md; issue 24)."""
 
 
 DISPLAY_HOOKS = ("_repr_html_", "_repr_latex_", "_repr_svg_", "_repr_png_", "_repr_pretty_")

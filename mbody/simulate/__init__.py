@@ -2,8 +2,8 @@
 
 `simulation` (the run: sampling, budgets, progress, summary), `stepping` (the integrator
 classes, and the compiled DOP853 steps), `mechanism` (accelerations with the reactions
-solved at every step), `projection` (the state moved back onto its joints) and
-`trajectory` (the `Trajectory` and its file).
+solved at every step), `projection` (the state moved back onto its joints),
+`trajectory` (the `Trajectory`) and `run_file` (its file).
 
 The names below are imported on first use: reading a saved `Trajectory` must not import
 scipy's integrators.

@@ -64,7 +64,6 @@ _INFO_KINDS = {
 notebook's table, `animate`, `in_world_axes`); other entries are kept as they are."""
 
 
-
 def write_run(traj: Trajectory, path: str | os.PathLike[str]) -> Path:
     """`traj` into the run file `path` (`Trajectory.save`), atomically: a temporary file
     renamed into place."""

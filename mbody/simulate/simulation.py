@@ -1043,11 +1043,10 @@ def summary(traj: Trajectory, path: str | os.PathLike[str] | None = None) -> str
     """The run in a few lines: integrator, cost, and drift of the conserved quantities;
     a run with drivers adds their peaks and energy check; a kinematic run (a fully driven
     mechanism) has its own (`mbody.simulate.kinematic.summary`)."""
-    from mbody.simulate.kinematic import driven_lines
-    from mbody.simulate.kinematic import summary as kinematic_summary
-
     i = traj.info
     if i.get("kinematic"):
+        from mbody.simulate.kinematic import summary as kinematic_summary
+
         return kinematic_summary(traj, None if path is None else str(path))
     lines = [
         f"simulated {traj.model_name!r}: {traj.n} bod{'y' if traj.n == 1 else 'ies'}, "
@@ -1080,7 +1079,10 @@ def summary(traj: Trajectory, path: str | os.PathLike[str] | None = None) -> str
             not i.get("peaks"):
         lines.append("reactions stored in world axes: each joint's force and moment on its "
                      "child along world x, y, z")
-    lines.extend(driven_lines(traj))
+    if i.get("peaks") or "driver_work" in i:  # a run with drivers: their lines
+        from mbody.simulate.kinematic import driven_lines
+
+        lines.extend(driven_lines(traj))
     lines.extend(f"warning: {w}" for w in i.get("warnings", ()))
     if path is not None:
         lines.append(f"wrote {path}")

@@ -12,10 +12,10 @@ Arrays have a leading time axis K and a body axis n, as in the contract (section
 A trajectory carries what is needed to draw and check it without the model file: body
 names, masses, inertia tensors (body axes, about the mass centres), shapes and colours,
 gravity, and the model's YAML text when it came from a file. `save` writes one ``.npz``
-file (format tag ``mbody-trajectory``, version `FORMAT_VERSION`); `Trajectory.load`
-reads it back and raises `TrajectoryFileError` for anything else. Every kind of run
-samples at t_start + k / fps (`sample_times`, and `last_sample_warning` when the last
-sample falls short of t_end).
+file (format tag ``mbody-trajectory``, version
+`mbody.simulate.run_file.FORMAT_VERSION`); `Trajectory.load` reads it back and raises
+`TrajectoryFileError` for anything else. Runs sample at t_start + k / fps
+(`sample_times`; `last_sample_warning` when the last sample falls short of t_end).
 
     T = ½ Σ m vᵀv + ½ Σ ωᵀ J ω          (kinetic energy)
     H = Σ (x × m v + W_R_B J ω)          (angular momentum about the world origin)
@@ -60,7 +60,7 @@ def sample_times(t_end: float, fps: float, t_start: float = 0.0) -> np.ndarray:
     """The sample times t_start, t_start + 1/fps, ... up to t_end (a last sample 1e-9 of
     a step short of t_end counts: t_end * fps need not be a whole number in floats)."""
     if not (math.isfinite(t_end) and math.isfinite(fps) and fps > 0 and t_end > t_start):
-        raise MbodyError(f"a kinematic run needs t_end > {t_start:g} s and fps > 0, got "
+        raise MbodyError(f"a run needs t_end > {t_start:g} s and fps > 0, got "
                          f"t_end {t_end!r}, fps {fps!r}")
     steps = (t_end - t_start) * fps + 1e-9  # a float: compared before it is an int
     if not steps + 1 <= MAX_SAMPLES:
@@ -519,7 +519,7 @@ class Trajectory(Frozen):
         ----------
         path : str or os.PathLike
             A trajectory ``.npz`` file (format ``mbody-trajectory``, version at most
-            `FORMAT_VERSION`).
+            `mbody.simulate.run_file.FORMAT_VERSION`).
         max_bytes : int, optional
             The most data read, inflated (default `mbody.util.budget.DATA_BYTES`, 1 GiB,
             or the command line's ``--max-bytes``); a file that holds more is refused
@@ -541,6 +541,7 @@ class Trajectory(Frozen):
         from mbody.simulate.run_file import read_run  # deferred: only loading needs it
 
         return cls(**read_run(path, max_bytes), run_file=str(path))
+
 
 def model_text(model) -> str:
     """The model as mbody YAML text, what a trajectory keeps so that it can be drawn,
