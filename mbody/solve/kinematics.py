@@ -14,7 +14,9 @@ solution found is the one nearest the start (the file's pose, or the previous in
 solution along a run: its branch). The accelerations follow from the constraint
 equations with the forces, `mbody.assemble(model, state).solve()`: for a fully driven
 mechanism they are the motion the drivers impose, and the reactions with the drivers'
-efforts are what it takes (kinetostatics).
+efforts are what it takes (kinetostatics). Whether the drivers leave any freedom, the
+degrees of freedom of the joints and drivers together, is `freedom` (`fully_driven`: none
+left, so a run is kinematic).
 """
 
 from __future__ import annotations
