@@ -114,8 +114,7 @@ def read_run(path: str | os.PathLike[str], max_bytes: int | None) -> dict[str, A
         raise TrajectoryFileError(f"{name}: not an mbody trajectory file ({kind})")
     with NpzArchive(p, "trajectory file", max_bytes=max_bytes, error=TrajectoryFileError,
                     more=_MORE) as z:
-        fields = _fields(z)
-    return fields
+        return _fields(z)
 
 
 def _fields(z: NpzArchive) -> dict[str, Any]:
