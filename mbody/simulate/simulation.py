@@ -311,7 +311,7 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
             k, msg = run.advance(t_end if marking else min(rate.next, t_end), limit, t_eval,
                                  k, Y)
             steps, status = run.steps, run.status
-            if status == "failed" or not math.isfinite(float(run.y.sum())):
+            if status == "failed" or not math.isfinite(np.add.reduce(run.y)):
                 culprit = _blame_expression(varying, run.t, run.t, run.step_size)
                 raise MbodyError(
                     f"the integration stopped at t = {run.t:.6g} s: "
@@ -403,13 +403,13 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
                                "samples divided by |q|",
         **joint_info, "reaction_axes": axes,
     }
-    values_set = model_values(model)
+    shapes, colors, text, values_set = _memo(
+        model, ("carried",), lambda: (*appearance(model), model_text(model),
+                                      tuple(map(tuple, model_values(model)))))
     if values_set:  # what Trajectory.model sets again on the text it carries
-        info["model_values"] = values_set
+        info["model_values"] = [list(pair) for pair in values_set]
     pose: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] = (
         (x[..., :2], v[..., :2], Y[:, 13 * n:], w[..., 2]) if planar else (x, v, q, w))
-    shapes, colors, text = _memo(model, ("carried",),
-                                 lambda: (*appearance(model), model_text(model)))
     traj = Trajectory(
         t_eval, *pose, body_names=model.body_names, dimension=model.dimension,
         model_name=model.name, model_file=model.file, reaction_labels=stored,
@@ -641,21 +641,24 @@ class _StepRate:
     def steps_at(self, marks: Iterable[Sequence[float]]) -> None:
         """The run passed each (t, steps) of `marks`, in time order (the core's notes
         where a window ends, `CoreRun.marks`): the windows ending there are counted."""
-        start, mark, nxt, peak = self.start, self.mark, self.next, self.peak
+        # locals only in the loop: it runs for every window of every run, and is most of
+        # a short run's time outside the integration (issue 24)
+        start, (t0, n0), nxt, peak = self.start, self.mark, self.next, self.peak
+        t_end, width, floor, least = self.t_end, self.width, math.floor, self.MIN_STEPS
+        too_fast = math.inf if start is None else self.FACTOR * start[1]
         for t, steps in marks:
-            if t < nxt and t < self.t_end:
+            if t < nxt and t < t_end:
                 continue
-            t0, n0 = mark
             r = (steps - n0) / (t - t0)
             if start is None:
-                start = (t, r)
-            elif r > self.FACTOR * start[1] and steps - n0 >= self.MIN_STEPS:
+                start, too_fast = (t, r), self.FACTOR * r
+            elif r > too_fast and steps - n0 >= least:
                 self.slow.append((t0, t, r))
             if r > peak:
                 peak = r
-            mark = (t, steps)
-            nxt = (math.floor(t / self.width) + 1) * self.width
-        self.start, self.mark, self.next, self.peak = start, mark, nxt, peak
+            t0, n0 = t, steps
+            nxt = (floor(t / width) + 1) * width
+        self.start, self.mark, self.next, self.peak = start, (t0, n0), nxt, peak
 
     def figures(self, steps: int) -> dict:
         """Steps per simulated second: over the first part, the busiest window, overall."""
@@ -835,9 +838,14 @@ def _memo(model: Model, key: tuple, make: Callable[[], _T]) -> _T:
     benchmark) does not redo it. Values are never changed by their users."""
     memo = workspace(model).memo
     key = (__name__, *key)
-    if key not in memo:
-        memo[key] = make()
-    return memo[key]  # type: ignore[return-value]  # each key's maker fixes its type
+    value = memo.get(key, _NONE)
+    if value is _NONE:
+        value = memo[key] = make()
+    return value  # type: ignore[return-value]  # each key's maker fixes its type
+
+
+_NONE = object()
+"""`_memo`'s mark of a key not made yet (a made value may be None)."""
 
 
 def _start(model: Model, initial: State | None, projected: Unknowns | None
@@ -891,8 +899,9 @@ def _initial_joint_errors(model: Model, initial: State | None) -> list[str]:
 
 
 def _has_unknown_reactions(model: Model, known: Mapping[str, float | str] | None) -> bool:
-    given = set(model.known_reactions) | set(getattr(model, "known_expressions", {}))
-    return bool(set(model.reactions) - given - set(known or {}))
+    """Whether a reaction of `model` has no value in its file or in `known`."""
+    given = model.known_reactions.keys() | model.known_expressions.keys() | (known or {}).keys()
+    return not given.issuperset(model.reaction_table.labels)
 
 
 def _named(names: list[str], most: int = 3) -> str:

@@ -117,6 +117,10 @@ Dynamics = Callable[[Model, State], np.ndarray]
 """f(model, state) -> (n, 6) accelerations [a_G (world, m/s²), ω̇ (body axes, rad/s²)]."""
 
 
+_NO_VALUES = np.zeros(0)
+_NO_VALUES.flags.writeable = False
+
+
 class StateDerivative:
     """ẏ = f(t, y) for the packed state a simulation integrates (the core's layout),
 
@@ -142,8 +146,8 @@ class StateDerivative:
         self.size = 13 * n + (n if self.planar else 0)
         self.solver: _core.Unknowns | None = None
         """The core's solver of `unknowns` (None: `dynamics` serves)."""
-        self.lam = np.zeros(0)
-        """The given reaction values (0 on the unknown components)."""
+        self.lam = _NO_VALUES
+        """The given reaction values (0 on the unknown components; read only)."""
         if unknowns is not None:
             self.solver = workspace(model).solver(unknowns)
             self.lam = np.ascontiguousarray(unknowns.lam, dtype=float)
