@@ -278,9 +278,8 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
 
         return kinematic_run(with_known(model, given), t_end, fps, axes=axes)
     varying, mechanism, projecting = plan.varying, plan.mechanism, plan.projecting
-    rhs = state_derivative(model, given, dynamics)
-    if projecting:
-        rhs.rate = 0.0
+    # no Baumgarte terms where the core projects, nor where no joint is held
+    rhs = state_derivative(model, given, dynamics, projected=projecting or not mechanism)
     run_model = rhs.model  # the model with `known`'s values in its known reactions
     y0, ratio = plan.y0, plan.ratio  # read only: each run steps its own copy
     n = model.n
@@ -714,7 +713,8 @@ def _spin_warning(traj: Trajectory, peak: np.ndarray | None = None) -> str | Non
     each body's largest |ω| (rad/s) when known (the core's, `conserved_figures`): the
     samples are then looked at only when a body is that fast."""
     fps = traj.info["fps"]
-    if peak is not None and not any(p / (2 * np.pi) > fps / 2 for p in peak.tolist()):
+    # the fastest body's test alone (division is monotonic); a NaN is never fast
+    if peak is not None and not max(peak.tolist(), default=0.0) / (2 * math.pi) > fps / 2:
         return None
     w = traj.angular_velocity
     if traj.n == 0 or not len(w):
@@ -737,17 +737,22 @@ def _spin_warning(traj: Trajectory, peak: np.ndarray | None = None) -> str | Non
 
 
 def state_derivative(model: Model, known: KnownValues | None = None,
-                     dynamics: Dynamics | None = None) -> StateDerivative:
+                     dynamics: Dynamics | None = None, *, projected: bool | None = None
+                     ) -> StateDerivative:
     """ẏ = f(t, y), what `simulate` integrates (`mbody.solve.dynamics.StateDerivative`): the
     compiled core's, with the reactions not given in the file or in `known` solved at every
-    call (Baumgarte-stabilised, α = β = `BAUMGARTE_RATE`; `simulate` turns that off where it
-    projects), or `dynamics` when given. Its `model` is `model` with `known`'s values
+    call (Baumgarte-stabilised, α = β = `BAUMGARTE_RATE`), or `dynamics` when given.
+    `projected`: True leaves Baumgarte's terms out (a run that projects the state onto the
+    joints, or whose model holds none: `simulate` knows which); None leaves them out only
+    for a model without unknown reactions. Its `model` is `model` with `known`'s values
     among its known reactions (numbers, or expressions of t that the core evaluates)."""
     if dynamics is not None:
         return StateDerivative(model, dynamics)
     run_model = with_known(model, known)
-    rate = BAUMGARTE_RATE if _has_unknown_reactions(run_model, None) else 0.0
-    return StateDerivative(run_model, unknowns=workspace(run_model).file_unknowns, rate=rate)
+    if projected is None:
+        projected = not _has_unknown_reactions(run_model, None)
+    return StateDerivative(run_model, unknowns=workspace(run_model).file_unknowns,
+                           rate=0.0 if projected else BAUMGARTE_RATE)
 
 
 def with_known(model: Model, known: KnownValues | None) -> Model:
@@ -995,15 +1000,13 @@ def _drift(model: Model, t: np.ndarray, Y: np.ndarray, default_dynamics: bool, *
     (`mbody.simulate.mechanism.conserved_figures`). `lengths`: the springs' lengths at the
     samples (K, s), when the run has them (else the core computes them). Also returns
     each body's largest |ω| over the samples (n,), from the same pass."""
-    why = (_memo(model, ("conservation", default_dynamics, ideal_joints),
-                 lambda: conservation(model, default_dynamics, ideal_joints))
-           if not known else conservation(model, default_dynamics, ideal_joints, known))
+    why, about = (_memo(model, ("conservation", default_dynamics, ideal_joints),
+                        lambda: _conserved(model, default_dynamics, ideal_joints))
+                  if not known else _conserved(model, default_dynamics, ideal_joints, known))
     if len(model.springs.names) and lengths is None:
         lengths = sample_figures(model, workspace(model).file_unknowns, t, Y,
                                  reactions=False, lengths=True).lengths
     kind = why["angular_momentum_kind"]
-    about = ("spins" if kind.startswith("spin") else
-             "mass centre" if kind.endswith("system's mass centre") else "world origin")
     c = conserved_figures(model, Y, about, lengths)
     T, V, H = c.kinetic_energy, c.potential_energy, c.angular_momentum
     E = T + V
@@ -1020,6 +1023,16 @@ def _drift(model: Model, t: np.ndarray, Y: np.ndarray, default_dynamics: bool, *
         "angular_momentum_initial": H[0].tolist(),
         "angular_momentum_not_conserved": why["angular_momentum"],
     }, c.spin_peak
+
+
+def _conserved(model: Model, default_dynamics: bool, ideal_joints: bool,
+               known: Mapping[str, float | str] | None = None) -> tuple[dict, str]:
+    """(`conservation`'s reasons, the point its angular momentum is taken about: a key of
+    `mbody.simulate.mechanism.ANGULAR_MOMENTUM_ABOUT`)."""
+    why = conservation(model, default_dynamics, ideal_joints, known)
+    kind = why["angular_momentum_kind"]
+    return why, ("spins" if kind.startswith("spin") else
+                 "mass centre" if kind.endswith("system's mass centre") else "world origin")
 
 
 def conserved_lines(info: Mapping) -> list[tuple[str, str]]:
