@@ -119,6 +119,8 @@ Dynamics = Callable[[Model, State], np.ndarray]
 
 _NO_VALUES = np.zeros(0)
 _NO_VALUES.flags.writeable = False
+"""The given reaction values of a right-hand side without unknowns (`dynamics`): none,
+one shared read-only array rather than one made per run."""
 
 
 class StateDerivative:
