@@ -154,6 +154,36 @@ def test_conserved_figures_refuse_missing_lengths_and_bad_sizes():
                            np.zeros(1), np.zeros(3), np.zeros(6), np.zeros(1))
 
 
+@pytest.mark.parametrize("K", [5, 6])
+@pytest.mark.parametrize("about", sorted(ANGULAR_MOMENTUM_ABOUT))
+@pytest.mark.parametrize("dimension", [2, 3])
+def test_sample_passes_take_each_sample_as_alone(K: int, about: str, dimension: int):
+    """The passes work on two samples at once (src/samples.c), the last of an odd count
+    paired with itself: each sample's T, V, H, peak spin and normalised quaternion are
+    those of the same pass over that sample alone, to the last bit (a lane never sees the
+    other)."""
+    build = planar_model if dimension == 2 else spatial_model
+    model = mbody.load(build(2, n=3, n_springs=1, known=False))
+    n = model.n
+    Y = random_samples(model, K, np.random.default_rng(K))
+    t = np.zeros(K)
+    lengths = sample_figures(model, workspace(model).file_unknowns, t, Y, reactions=False,
+                             lengths=True).lengths
+    whole = conserved_figures(model, Y, about, lengths)
+    alone = [conserved_figures(model, Y[k:k + 1], about, lengths[k:k + 1]) for k in range(K)]
+    for k, c in enumerate(alone):
+        assert whole.kinetic_energy[k] == c.kinetic_energy[0]
+        assert whole.potential_energy[k] == c.potential_energy[0]
+        assert (whole.angular_momentum[k] == c.angular_momentum[0]).all()
+    assert (whole.spin_peak == np.max([c.spin_peak for c in alone], axis=0)).all()
+    Y[:, 3 * n:7 * n] *= 1.25  # quaternions off the unit sphere
+    rows = [Y[k:k + 1].copy() for k in range(K)]
+    _core.unit_samples(Y, n, dimension == 2)
+    for k, row in enumerate(rows):
+        _core.unit_samples(row, n, dimension == 2)
+        assert (Y[k] == row[0]).all()
+
+
 @pytest.mark.parametrize("dimension", [2, 3])
 def test_unit_samples_equal_numpy(dimension: int):
     """Unit quaternions and the planar angles on their branch, as simulate did in numpy
