@@ -278,7 +278,7 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
 
         return kinematic_run(with_known(model, given), t_end, fps, axes=axes)
     varying, mechanism, projecting = plan.varying, plan.mechanism, plan.projecting
-    # no Baumgarte terms where the core projects, nor where no joint is held
+    # no Baumgarte terms where the core projects, nor where no reaction is unknown
     rhs = state_derivative(model, given, dynamics, projected=projecting or not mechanism)
     run_model = rhs.model  # the model with `known`'s values in its known reactions
     y0, ratio = plan.y0, plan.ratio  # read only: each run steps its own copy
@@ -713,9 +713,12 @@ def _spin_warning(traj: Trajectory, peak: np.ndarray | None = None) -> str | Non
     each body's largest |ω| (rad/s) when known (the core's, `conserved_figures`): the
     samples are then looked at only when a body is that fast."""
     fps = traj.info["fps"]
-    # the fastest body's test alone (division is monotonic); a NaN is never fast
-    if peak is not None and not max(peak.tolist(), default=0.0) / (2 * math.pi) > fps / 2:
-        return None
+    if peak is not None:
+        # the fastest body's test alone (division is monotonic); max() returns a NaN that
+        # comes first, and a NaN is never fast: then each body is looked at below
+        top = max(peak.tolist(), default=0.0)
+        if top == top and not top / (2 * math.pi) > fps / 2:
+            return None
     w = traj.angular_velocity
     if traj.n == 0 or not len(w):
         return None
@@ -743,9 +746,10 @@ def state_derivative(model: Model, known: KnownValues | None = None,
     compiled core's, with the reactions not given in the file or in `known` solved at every
     call (Baumgarte-stabilised, α = β = `BAUMGARTE_RATE`), or `dynamics` when given.
     `projected`: True leaves Baumgarte's terms out (a run that projects the state onto the
-    joints, or whose model holds none: `simulate` knows which); None leaves them out only
-    for a model without unknown reactions. Its `model` is `model` with `known`'s values
-    among its known reactions (numbers, or expressions of t that the core evaluates)."""
+    joints, or whose model has no unknown reaction: `simulate` knows which); None leaves
+    them out only for a model without unknown reactions. Its `model` is `model` with
+    `known`'s values among its known reactions (numbers, or expressions of t that the core
+    evaluates)."""
     if dynamics is not None:
         return StateDerivative(model, dynamics)
     run_model = with_known(model, known)

@@ -1,5 +1,6 @@
 /* A run's figures at its output samples (mechanism.h: mb_samples): the reactions, the
  * springs' lengths and the joints' drift, one pass over the samples in C. */
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -58,19 +59,20 @@ static double max_nan(double a, double b) {
  * -ffp-contract=off); SSE2 on x86-64, NEON on arm64, both in their baselines. An odd
  * sample out is paired with itself. */
 typedef double v2 __attribute__((vector_size(16)));
-typedef int64_t v2i __attribute__((vector_size(16)));
+/* long long lanes: the type Clang gives a comparison of v2s (GCC: the same size) */
+typedef long long v2i __attribute__((vector_size(16)));
 
 static inline v2 pair(double a, double b) { return (v2){a, b}; }
 
 static inline v2 vsqrt(v2 a) { return (v2){sqrt(a[0]), sqrt(a[1])}; }
 
-static inline v2 vabs(v2 a) { return (v2)((v2i)a & (v2i){INT64_MAX, INT64_MAX}); }
+static inline v2 vabs(v2 a) { return (v2)((v2i)a & (v2i){LLONG_MAX, LLONG_MAX}); }
 
 /* max_nan lane by lane */
 static inline v2 vmax_nan(v2 a, v2 b) {
-    const v2i take_b = b > a, nan = (a != a) | (b != b);
+    const v2i take_b = (v2i)(b > a), either_nan = (v2i)(a != a) | (v2i)(b != b);
     const v2 larger = (v2)(((v2i)b & take_b) | ((v2i)a & ~take_b));
-    return (v2)(((v2i)pair(NAN, NAN) & nan) | ((v2i)larger & ~nan));
+    return (v2)(((v2i)pair(NAN, NAN) & either_nan) | ((v2i)larger & ~either_nan));
 }
 
 static inline v2 vnorm3(const v2 *a) { return vsqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]); }
@@ -247,8 +249,8 @@ double mb_unit_samples(int64_t n, int planar, int64_t K, double *Y, int64_t stri
     const double pi = 3.141592653589793, two_pi = 6.283185307179586; /* numpy's pi, 2 pi */
     if (!planar) { /* two samples at once (a short run's samples outnumber its steps) */
         v2 worst = pair(0.0, 0.0);
-        for (int64_t i = 0; i < n; i++)
-            for (int64_t k = 0; k < K; k += 2) {
+        for (int64_t k = 0; k < K; k += 2)
+            for (int64_t i = 0; i < n; i++) {
                 double *qa = Y + k * stride + 3 * n + 4 * i;
                 double *qb = k + 1 < K ? qa + stride : qa;
                 v2 q[4];
