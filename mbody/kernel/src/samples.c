@@ -247,44 +247,37 @@ int mb_conservation(int64_t n, int planar, const double *mass, const double *J,
 
 double mb_unit_samples(int64_t n, int planar, int64_t K, double *Y, int64_t stride) {
     const double pi = 3.141592653589793, two_pi = 6.283185307179586; /* numpy's pi, 2 pi */
-    if (!planar) { /* two samples at once (a short run's samples outnumber its steps) */
-        v2 worst = pair(0.0, 0.0);
-        for (int64_t k = 0; k < K; k += 2)
-            for (int64_t i = 0; i < n; i++) {
-                double *qa = Y + k * stride + 3 * n + 4 * i;
-                double *qb = k + 1 < K ? qa + stride : qa;
-                v2 q[4];
-                for (int a = 0; a < 4; a++) q[a] = pair(qa[a], qb[a]);
-                const v2 norm = vsqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-                worst = vmax_nan(worst, vabs(norm - 1.0));
-                for (int a = 0; a < 4; a++) {
-                    q[a] /= norm;
-                    qa[a] = q[a][0];
-                    qb[a] = q[a][1];
-                }
-            }
-        return max_nan(worst[0], worst[1]);
-    }
-    double worst = 0.0;
-    for (int64_t k = 0; k < K; k++) {
-        double *y = Y + k * stride;
+    /* two samples at once (a short run's samples outnumber its steps) */
+    v2 worst = pair(0.0, 0.0);
+    for (int64_t k = 0; k < K; k += 2)
         for (int64_t i = 0; i < n; i++) {
-            double *q = y + 3 * n + 4 * i;
-            const double norm = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-            const double e = fabs(norm - 1.0);
-            if (e > worst || e != e) worst = e;
-            for (int a = 0; a < 4; a++) q[a] /= norm;
-            /* the carried angle moved onto q's own, on its branch */
-            double *theta = y + 13 * n + i;
-            const double a = 2.0 * atan2(q[3], q[0]) - *theta + pi;
-            double r = fmod(a, two_pi); /* numpy's remainder: the sign of the divisor */
-            if (r != 0.0) {
-                if (r < 0.0) r += two_pi;
-            } else {
-                r = 0.0;
+            double *qa = Y + k * stride + 3 * n + 4 * i;
+            double *qb = k + 1 < K ? qa + stride : qa;
+            v2 q[4];
+            for (int a = 0; a < 4; a++) q[a] = pair(qa[a], qb[a]);
+            const v2 norm = vsqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+            worst = vmax_nan(worst, vabs(norm - 1.0));
+            for (int a = 0; a < 4; a++) {
+                q[a] /= norm;
+                qa[a] = q[a][0];
+                qb[a] = q[a][1];
             }
-            *theta += r - pi;
         }
-    }
-    return worst;
+    if (planar) /* each carried angle moved onto its unit q's own, on its branch */
+        for (int64_t k = 0; k < K; k++) {
+            double *y = Y + k * stride;
+            for (int64_t i = 0; i < n; i++) {
+                const double *q = y + 3 * n + 4 * i;
+                double *theta = y + 13 * n + i;
+                const double a = 2.0 * atan2(q[3], q[0]) - *theta + pi;
+                double r = fmod(a, two_pi); /* numpy's remainder: the sign of the divisor */
+                if (r != 0.0) {
+                    if (r < 0.0) r += two_pi;
+                } else {
+                    r = 0.0;
+                }
+                *theta += r - pi;
+            }
+        }
+    return max_nan(worst[0], worst[1]);
 }
