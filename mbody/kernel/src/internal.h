@@ -112,7 +112,8 @@ void mb_add_g(const mb_model *md, const mb_unknowns *u, const double *child6,
 void mb_orthonormal(double *Q, int64_t rows, int64_t cols);
 void mb_cho_solve_dense(const double *L, int64_t ld, int64_t r, double *x);
 /* Solve M a - G_U lam = r6, G_U^T a = gam (gam includes stab); returns the singular
- * code, writes rank, berr, path. */
+ * code, writes rank, berr, path. berr NULL with refine 0: no backward error is computed
+ * (nor the refinement it would decide). */
 int mb_constrained(const mb_model *md, const mb_unknowns *u, mb_work *w, int refine,
                    int64_t *rank, double *berr, int *path);
 void mb_dot_add(double *s, double *c, double a, double b);

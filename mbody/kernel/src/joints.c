@@ -80,14 +80,16 @@ static void joint_geometry(const mb_model *md, mb_work *w, const double *y, int6
                        Rp[3 * a + 2] * row[J_BRP + 2]);
     }
     joint_velocities(md, w, y, j);
-    /* R_rel = (R_p P_E3)^T (R_c C_E3), for the moment components' phi */
+    /* R_rel = (R_p P_E3)^T (R_c C_E3), for the moment components' phi; R_c C_E3 made
+     * once (each entry the same sum as when it was made per entry of R_rel) */
+    double RC[9];
+    for (int k = 0; k < 3; k++)
+        for (int b = 0; b < 3; b++)
+            RC[3 * k + b] = Rc[3 * k] * CE[b] + Rc[3 * k + 1] * CE[3 + b] + Rc[3 * k + 2] * CE[6 + b];
     for (int a = 0; a < 3; a++)
         for (int b = 0; b < 3; b++) {
             double acc = 0.0;
-            for (int k = 0; k < 3; k++) {
-                double ck = Rc[3 * k] * CE[b] + Rc[3 * k + 1] * CE[3 + b] + Rc[3 * k + 2] * CE[6 + b];
-                acc += WE[3 * k + a] * ck;
-            }
+            for (int k = 0; k < 3; k++) acc += WE[3 * k + a] * RC[3 * k + b];
             Rrel[3 * a + b] = acc;
         }
 }

@@ -357,27 +357,15 @@ static int64_t redundant(const mb_model *md, const mb_unknowns *u, mb_work *w) {
     return r;
 }
 
-int mb_constrained(const mb_model *md, const mb_unknowns *u, mb_work *w, int refine,
-                   int64_t *rank_out, double *berr_out, int *path_out) {
-    int64_t n = md->n, mu = u->mu, bw = u->bw, W = bw + 1;
-    double *acc = w->acc, *lamU = w->lamU;
-    minv_all(md, w->r6, acc);
-    memset(w->nonunique, 0, (size_t)mu);
-    *rank_out = 0, *berr_out = 0.0, *path_out = 0;
-    if (mu == 0) return 0;
-    memset(w->Sb, 0, sizeof(double) * mu * W);
-    mb_schur(md, u, md->bodies, w->child6, w->parent6, w->Sb, 1);
-    /* lam = S^-1 (gam - G_U^T M^-1 r), a = M^-1 (r + G_U lam) */
-    gt(md, u, w->child6, w->parent6, acc, lamU);
-    for (int64_t k = 0; k < mu; k++) lamU[k] = w->gam[k] - lamU[k];
-    /* |K|_F^2 = |M|_F^2 + 2 |G_U|_F^2, for the backward error */
+/* |K|_F = sqrt(|M|_F^2 + 2 |G_U|_F^2), the scale of the backward error (`residual`). */
+static double norm_k(const mb_model *md, const mb_unknowns *u, const mb_work *w) {
     double nk = 0.0;
-    for (int64_t i = 0; i < n; i++) {
+    for (int64_t i = 0; i < md->n; i++) {
         const double *body = md->bodies + MB_BODY_W * i;
         nk += 3.0 * body[B_MASS] * body[B_MASS];
         for (int a = 0; a < 9; a++) nk += body[B_J + a] * body[B_J + a];
     }
-    for (int64_t k = 0; k < mu; k++) {
+    for (int64_t k = 0; k < u->mu; k++) {
         int64_t i = u->U[k];
         int has_p = parent_of(md, i) >= 0;
         for (int r = 0; r < 6; r++) {
@@ -385,7 +373,23 @@ int mb_constrained(const mb_model *md, const mb_unknowns *u, mb_work *w, int ref
             if (has_p) nk += 2.0 * w->parent6[6 * i + r] * w->parent6[6 * i + r];
         }
     }
-    double normK = sqrt(nk);
+    return sqrt(nk);
+}
+
+int mb_constrained(const mb_model *md, const mb_unknowns *u, mb_work *w, int refine,
+                   int64_t *rank_out, double *berr_out, int *path_out) {
+    int64_t n = md->n, mu = u->mu, bw = u->bw, W = bw + 1;
+    double *acc = w->acc, *lamU = w->lamU;
+    minv_all(md, w->r6, acc);
+    memset(w->nonunique, 0, (size_t)mu);
+    *rank_out = 0, *path_out = 0;
+    if (berr_out != NULL) *berr_out = 0.0;
+    if (mu == 0) return 0;
+    memset(w->Sb, 0, sizeof(double) * mu * W);
+    mb_schur(md, u, md->bodies, w->child6, w->parent6, w->Sb, 1);
+    /* lam = S^-1 (gam - G_U^T M^-1 r), a = M^-1 (r + G_U lam) */
+    gt(md, u, w->child6, w->parent6, acc, lamU);
+    for (int64_t k = 0; k < mu; k++) lamU[k] = w->gam[k] - lamU[k];
     int64_t rank = mu;
     int path = 0;
     memcpy(w->S0, w->Sb, sizeof(double) * mu * W);
@@ -403,21 +407,27 @@ int mb_constrained(const mb_model *md, const mb_unknowns *u, mb_work *w, int ref
         path = 2;
         rank = md->planar ? -1 : redundant(md, u, w);
         if (rank >= 0) {
-            double berr = residual(md, u, w, normK, w->r1, w->r2);
+            double berr = residual(md, u, w, norm_k(md, u, w), w->r1, w->r2);
             if (berr > REDUNDANT_BERR) {
                 rank = -1;
             } else {
-                *rank_out = rank, *berr_out = berr, *path_out = path;
+                *rank_out = rank, *path_out = path;
+                if (berr_out != NULL) *berr_out = berr;
                 return 0;
             }
         }
         path = 1;
         int singular = mb_null_space(md, u, w, refine, &rank);
         if (singular) {
-            *rank_out = rank, *berr_out = 0.0, *path_out = path;
+            *rank_out = rank, *path_out = path;
             return singular;
         }
     }
+    *rank_out = rank, *path_out = path;
+    /* the backward error, and the refinement it decides, only for a caller that asks
+     * (a simulation's right-hand side does not: a sixth of a small model's evaluation) */
+    if (!refine && berr_out == NULL) return 0;
+    double normK = norm_k(md, u, w);
     double berr = residual(md, u, w, normK, w->r1, w->r2);
     if (refine && path == 0 && berr > 1e-15) {
         solve_again(md, u, w, w->r1, w->r2, w->dacc, w->dlam);
@@ -425,6 +435,6 @@ int mb_constrained(const mb_model *md, const mb_unknowns *u, mb_work *w, int ref
         for (int64_t k = 0; k < mu; k++) lamU[k] += w->dlam[k];
         berr = residual(md, u, w, normK, w->r1, w->r2);
     }
-    *rank_out = rank, *berr_out = berr, *path_out = path;
+    if (berr_out != NULL) *berr_out = berr;
     return 0;
 }
