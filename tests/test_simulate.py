@@ -357,6 +357,41 @@ def test_initial_joint_errors_are_the_runs_own_start_each_time():
     assert mbody.simulate(model, 0.1, 10, initial=off).info["initial_joint_errors"] == moved
 
 
+def test_a_file_start_off_its_joints_is_described_whatever_the_gate():
+    """The file's own start is described (`joint_errors`) only when the core's count
+    (`Workspace.breaks_joints`) says it may break a joint. A file whose rod starts moving
+    along its pin is described; and over states near the shipped models' starts, on
+    both sides of the thresholds, the gate says False only where `joint_errors` finds
+    nothing (the core's scales are never larger)."""
+    from mbody.equations.joints import joint_errors
+    from mbody.equations.workspace import workspace
+
+    text = (MODELS / "pendulum.yaml").read_text().replace(
+        "position: [0.25, -0.4330127018922193]",
+        "position: [0.25, -0.4330127018922193]\n    velocity: [0, 1e-3]")
+    moving = mbody.loads(text)
+    run = mbody.simulate(moving, 0.1, 10)
+    assert run.info["initial_joint_errors"] == joint_errors(moving, moving.initial) != []
+    assert run.info["warnings"][0].startswith("the initial state breaks joint constraints")
+
+    rng = np.random.default_rng(7)
+    seen = set()
+    for name in ("pendulum", "double_pendulum", "fourbar_planar", "fourbar_spatial",
+                 "slider_crank", "heavy_top", "gyroscope_gimbals", "screw_jack", "bricard"):
+        model = mbody.load(MODELS / f"{name}.yaml")
+        ws, s0 = workspace(model), model.initial
+        for _ in range(30):
+            scale = 10.0 ** rng.uniform(-12, -3)
+            state = s0.replace(
+                position=s0.position + scale * rng.standard_normal(s0.position.shape),
+                velocity=s0.velocity + scale * rng.standard_normal(s0.velocity.shape))
+            described = joint_errors(model, state)
+            gate = ws.breaks_joints(state)
+            assert gate or not described, (name, scale, described)
+            seen.add(bool(described))
+    assert seen == {True, False}  # both sides of the thresholds were tried
+
+
 def test_a_run_keeps_the_model_text_after_the_file_is_gone(tmp_path):
     """The trajectory keeps the text the model was read from (line ends as a text file
     reads them), with the file since removed: it can still be drawn and checked."""

@@ -225,13 +225,28 @@ class Workspace:
         return max(r0, self._rank_at(solver, unknowns, y1))
 
     def _rank_at(self, solver: _core.Unknowns, unknowns: Unknowns, y: np.ndarray) -> int:
-        m = len(unknowns.mask)
-        N, _, o_info = _core.solve_layout(self.model.n, m, self.planar)
-        out = np.empty(o_info + _core.INFO)
-        solver.solve(0.0, y, unknowns.lam, out)
-        if out[o_info + _core.ST_SINGULAR]:
+        info = self._solve_info(solver, unknowns, 0.0, y)
+        if info[_core.ST_SINGULAR]:
             return len(unknowns.U)  # no rank to learn from here: assume none lost
-        return int(out[o_info + _core.ST_RANK])
+        return int(info[_core.ST_RANK])
+
+    def _solve_info(self, solver: _core.Unknowns, unknowns: Unknowns, t: float,
+                    y: np.ndarray) -> np.ndarray:
+        """The info slots (``_core.ST_*``) of the core's solve at (t, y)."""
+        N, _, o_info = _core.solve_layout(self.model.n, len(unknowns.mask), self.planar)
+        out = np.empty(o_info + _core.INFO)
+        solver.solve(t, y, unknowns.lam, out)
+        return out[o_info:]
+
+    def breaks_joints(self, state: State) -> bool:
+        """Whether `state` may break a joint the file's unknown reactions enforce: the
+        core's count of the components past `mbody.equations.joints.JOINT_TOL` (its
+        scales never larger than `joint_errors`'s, so False means that `joint_errors`
+        finds none; True, or a count not made, asks it to describe them)."""
+        unknowns = self.file_unknowns
+        info = self._solve_info(self.solver(unknowns), unknowns, float(state.t),
+                                self.state_vector(state))
+        return bool(info[_core.ST_BROKEN] != 0)  # a NaN count too: not known to be none
 
     def _size(self) -> float:
         """The model's length scale: the spread of its mass centres and joint points."""

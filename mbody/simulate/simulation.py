@@ -903,8 +903,11 @@ def _initial_joint_errors(model: Model, initial: State | None) -> list[str]:
     the model's own initial state's (worked out once per model)."""
     if initial is not None:
         return joint_errors(model, initial)
-    return list(_memo(model, ("initial_joint_errors",),
-                      lambda: tuple(joint_errors(model, model.initial))))
+    # the core's count first: a file's pose on its joints (the usual case) needs no
+    # description, and describing takes a model's first run a few tens of microseconds
+    return list(_memo(model, ("initial_joint_errors",), lambda: tuple(
+        joint_errors(model, model.initial) if workspace(model).breaks_joints(model.initial)
+        else ())))
 
 
 def _has_unknown_reactions(model: Model, known: Mapping[str, float | str] | None) -> bool:
