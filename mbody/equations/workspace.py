@@ -242,11 +242,11 @@ class Workspace:
         """Whether `state` may break a joint the file's unknown reactions enforce: the
         core's count of the components past `mbody.equations.joints.JOINT_TOL` (its
         scales never larger than `joint_errors`'s, so False means that `joint_errors`
-        finds none; True, or a count not made, asks it to describe them)."""
+        finds none; True asks it to describe them)."""
         unknowns = self.file_unknowns
         info = self._solve_info(self.solver(unknowns), unknowns, float(state.t),
                                 self.state_vector(state))
-        return bool(info[_core.ST_BROKEN] != 0)  # a NaN count too: not known to be none
+        return bool(info[_core.ST_BROKEN] > 0)
 
     def _size(self) -> float:
         """The model's length scale: the spread of its mass centres and joint points."""
