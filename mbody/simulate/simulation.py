@@ -380,7 +380,7 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
         joint_info = {"joint_stabilisation": held,
                       "joint_position_drift": figures.position_drift,
                       "joint_velocity_drift": figures.velocity_drift,
-                      "initial_joint_errors": _initial_joint_errors(model, initial),
+                      "initial_joint_errors": _initial_joint_errors(model, initial, given),
                       "projection_evaluations": run.refreshed}
     elif dynamics is None and labels:
         lam = known_reaction_dynamics(model, given).reactions_at(t_eval)
@@ -898,16 +898,18 @@ def _sample_times(model: Model, K: int, fps: float, t_end: float) -> np.ndarray:
     return t.copy()
 
 
-def _initial_joint_errors(model: Model, initial: State | None) -> list[str]:
+def _initial_joint_errors(model: Model, initial: State | None,
+                          given: KnownValues | None) -> list[str]:
     """The joints the run's first state breaks, as text (`joint_errors`): `initial`'s, or
     the model's own initial state's (worked out once per model)."""
     if initial is not None:
         return joint_errors(model, initial)
-    # the core's count first: a file's pose on its joints (the usual case) needs no
-    # description, and describing takes a model's first run a few tens of microseconds
+    # the core's count first, where the run has made the solver it needs (a run with
+    # `known` solves another set of unknowns): a file's pose on its joints, the usual
+    # case, needs no description, and describing takes a first run tens of microseconds
     return list(_memo(model, ("initial_joint_errors",), lambda: tuple(
-        joint_errors(model, model.initial) if workspace(model).breaks_joints(model.initial)
-        else ())))
+        joint_errors(model, model.initial)
+        if given or workspace(model).breaks_joints(model.initial) else ())))
 
 
 def _has_unknown_reactions(model: Model, known: Mapping[str, float | str] | None) -> bool:
