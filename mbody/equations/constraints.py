@@ -24,7 +24,6 @@ kernel.h: one per kind of component) and read here from its columns:
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -36,7 +35,7 @@ from mbody.equations.joints import ReactionColumns, reaction_columns
 from mbody.equations.joints import joint_errors as joint_errors
 from mbody.errors import not_found
 from mbody.model.model import Model, State
-from mbody.util.frozen import Frozen
+from mbody.util.frozen import Frozen, dataclass_on_first_look
 
 if TYPE_CHECKING:
     import scipy.sparse as sp
@@ -55,7 +54,7 @@ def gamma(model: Model, state: State, cols: ReactionColumns,
     return cols.gamma
 
 
-@dataclass(eq=False, init=False, repr=False)  # no ==: its fields are arrays; Frozen
+@dataclass_on_first_look(eq=False, init=False, repr=False)  # no ==: its fields are arrays; Frozen
 class ConstraintJacobian(Frozen):
     """The velocity-level constraint Jacobian of the joints, Φ_v = Gᵀ, with labels.
 

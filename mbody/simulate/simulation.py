@@ -723,16 +723,21 @@ def _spin_warning(traj: Trajectory, peak: np.ndarray | None = None) -> str | Non
     if traj.n == 0 or not len(w):
         return None
     rate = np.abs(w) if traj.dimension == cv.PLANAR else np.linalg.norm(w, axis=2)
-    peak = rate.max(axis=0)  # (n,) rad/s
-    fast = [i for i in (-peak).argsort(kind="stable") if peak[i] / (2 * np.pi) > fps / 2]
+    at = rate.argmax(axis=0)  # (n,) the sample of each body's largest |ω|
+    # one figure per body from here: Python floats (numpy's first stable argsort and
+    # scalar formatting in a process cost a first run tens of microseconds)
+    peaks = rate[at, range(traj.n)].tolist()  # (n,) rad/s
+    fast = sorted((i for i, p in enumerate(peaks) if p / (2 * math.pi) > fps / 2),
+                  key=lambda i: -peaks[i])  # fastest first; a tie keeps file order
     if not fast:
         return None
-    listed = ", ".join(f"{traj.body_names[i]} at up to {peak[i]:.4g} rad/s "
-                       f"({peak[i] / (2 * np.pi):.3g} rev/s, at t = "
-                       f"{traj.t[int(rate[:, i].argmax())]:.3g} s)" for i in fast[:3])
+    times = traj.t[at].tolist()
+    listed = ", ".join(f"{traj.body_names[i]} at up to {peaks[i]:.4g} rad/s "
+                       f"({peaks[i] / (2 * math.pi):.3g} rev/s, at t = "
+                       f"{times[i]:.3g} s)" for i in fast[:3])
     if len(fast) > 3:
         listed += f" and {len(fast) - 3} more bod{'y' if len(fast) == 4 else 'ies'}"
-    need = math.ceil(2 * peak[fast[0]] / (2 * np.pi))
+    need = math.ceil(2 * peaks[fast[0]] / (2 * math.pi))
     return (f"{SPIN_WARNING}{fps:g} fps can show: {listed}. A body turning more than "
             f"half a revolution between frames (|omega| / 2 pi > fps / 2 = {fps / 2:g} "
             f"rev/s) looks in an animation as if it turned slower or backwards; use "

@@ -28,7 +28,7 @@ import math
 import numbers
 import os
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 from typing import Any
 
@@ -49,7 +49,7 @@ from mbody.loading import loads
 from mbody.model.model import State, count
 from mbody.model.records import BodyRecords
 from mbody.util.formatting import number
-from mbody.util.frozen import Frozen
+from mbody.util.frozen import Frozen, dataclass_on_first_look
 from mbody.util.spatial import planar_quat
 
 MAX_SAMPLES = 10_000_000
@@ -118,7 +118,7 @@ class StoredModelError(ModelError):
         return f"{self.where} is not a valid model:\n" + "\n".join(lines)
 
 
-@dataclass(eq=False, init=False, repr=False)  # __init__ and __repr__ below; Frozen
+@dataclass_on_first_look(eq=False, init=False, repr=False)  # __init__ and __repr__ below; Frozen
 class Trajectory(Frozen):
     """The motion of every body over time, as `simulate` returns it.
 
