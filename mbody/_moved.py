@@ -21,7 +21,8 @@ MOVED = {
     "loads": "equations.loads", "joints": "equations.joints",
     "constraints": "equations.constraints", "fbd": "equations.fbd",
     "assemble": "equations.assemble", "dynamics": "solve.dynamics",
-    "mechanism": "simulate.mechanism", "projection": "simulate.projection",
+    "mechanism": "simulate.mechanism", "projection": "simulate.mechanism",
+    "simulate.projection": "simulate.mechanism",
     "stepping": "simulate.stepping", "trajectory": "simulate.trajectory",
     "text": "present.text", "latex": "present.latex", "draw": "present.draw",
     "report": "present.report", "plot": "present.plot", "animate": "present.animate",
@@ -31,8 +32,9 @@ MOVED = {
     "commands.draw": "cli.draw", "commands.export": "cli.export",
     "commands.mechanism": "cli.mechanism", "commands.sim": "cli.sim",
 }
-"""Old path under mbody -> new path under mbody (release 0.2, and the shared utilities'
-move to `mbody.util` in 0.3; the aliases go in 0.4).
+"""Old path under mbody -> new path under mbody (release 0.2, the shared utilities' move
+to `mbody.util` in 0.3, and `simulate.projection`'s into `simulate.mechanism`, which holds
+both ways of keeping a run on its joints; the aliases go in 0.4).
 ``mbody.model`` and ``mbody.simulate`` are packages now that export the old modules'
 public names; ``mbody.cli.main`` is still the command's entry point. The numeric modules
 that the compiled core replaced (``kernels``, ``plan``, ``blockplan``, ``kkt``,

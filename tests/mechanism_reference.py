@@ -1,5 +1,5 @@
 """A simulation's mechanism callbacks written in Python over single calls of the compiled
-core (`Unknowns.derivative`, `Unknowns.project`), as mbody.simulate.projection's Python
+core (`Unknowns.derivative`, `Unknowns.project`), as mbody.simulate.mechanism's Python
 path computed them before the C glue (mbody/kernel/src/mechanism.c) took over: the
 reference that glue is held to step for step (tests/test_stepping.py, test_singular.py).
 """
@@ -12,7 +12,7 @@ from mbody.equations.workspace import Unknowns, workspace
 from mbody.kernel import _core
 from mbody.kernel.dop853 import DOP853
 from mbody.model.model import Model
-from mbody.simulate.projection import ITERATIONS, STAGE_ITERATIONS, STAGE_PIVOT_RTOL
+from mbody.simulate.mechanism import ITERATIONS, STAGE_ITERATIONS, STAGE_PIVOT_RTOL
 from mbody.simulate.stepping import REFRESH_ATOL
 from mbody.util.spatial import quaternion_rate
 

@@ -92,6 +92,18 @@ def test_an_old_module_path_is_the_new_module_with_a_warning(old, new):
     assert module.__spec__.name == f"mbody.{new}"
 
 
+
+def test_the_projection_module_moved_into_the_mechanism_module_keeps_its_path():
+    """`mbody.simulate.projection` (its own module until both ways of holding a run's
+    joints went to `mechanism`): the same module, with a warning, whose names are there."""
+    sys.modules.pop("mbody.simulate.projection", None)
+    with pytest.warns(DeprecationWarning,
+                      match="mbody.simulate.projection moved to mbody.simulate.mechanism"):
+        module = importlib.import_module("mbody.simulate.projection")
+    assert module is importlib.import_module("mbody.simulate.mechanism")
+    for name in ("JointProjection", "ITERATIONS", "STAGE_ITERATIONS", "STAGE_PIVOT_RTOL"):
+        assert hasattr(module, name), name
+
 def test_the_public_api_has_numpydoc_docstrings():
     """Every object docs/reference.md renders documents its parameters and returns
     (numpydoc's validator), so the generated reference cannot drift from the code."""

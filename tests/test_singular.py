@@ -236,7 +236,7 @@ def test_fourbar_chain_crossing_in_c_equals_the_python_callbacks():
     from mechanism_reference import Callbacks
 
     from mbody.simulate import state_derivative
-    from mbody.simulate.projection import STAGE_PIVOT_RTOL, JointProjection
+    from mbody.simulate.mechanism import STAGE_PIVOT_RTOL, JointProjection
 
     model = mbody.loads(CHAIN.yaml(0.3, 0.0))
     fast = mbody.simulate(model, 0.6, 60, rtol=1e-10, atol=1e-12)

@@ -18,7 +18,7 @@ import mbody
 from mbody.equations.workspace import workspace
 from mbody.kernel.dop853 import DOP853
 from mbody.simulate import simulation, state_derivative
-from mbody.simulate.projection import STAGE_PIVOT_RTOL, JointProjection
+from mbody.simulate.mechanism import STAGE_PIVOT_RTOL, JointProjection
 from mbody.simulate.simulation import _has_unknown_reactions
 from mbody.simulate.stepping import CoreRun
 from mbody.solve.dynamics import StateDerivative
@@ -231,7 +231,7 @@ def test_a_driven_joint_is_followed_by_the_run():
     from mbody.equations.pack import Component, pack_model, pack_unknowns
     from mbody.kernel import _core
     from mbody.model.expressions import compile_expression
-    from mbody.simulate.projection import ITERATIONS, STAGE_ITERATIONS
+    from mbody.simulate.mechanism import ITERATIONS, STAGE_ITERATIONS
     from mbody.simulate.stepping import REFRESH_ATOL
 
     model = mbody.load(PIN)

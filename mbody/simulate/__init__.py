@@ -2,7 +2,7 @@
 
 `simulation` (the run: sampling, budgets, progress, summary), `stepping` (the integrator
 classes, and the compiled DOP853 steps), `mechanism` (accelerations with the reactions
-solved at every step), `projection` (the state moved back onto its joints),
+solved at every step, the state moved back onto its joints, the figures at the samples),
 `trajectory` (the `Trajectory`) and `run_file` (its file).
 
 The names below are imported on first use: reading a saved `Trajectory` must not import

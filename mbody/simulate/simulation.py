@@ -55,8 +55,13 @@ from mbody.model.arguments import (
 )
 from mbody.model.expressions import Expression, check_times, first_nonfinite
 from mbody.model.model import Model, State
-from mbody.simulate.mechanism import BAUMGARTE_RATE, conserved_figures, sample_figures
-from mbody.simulate.projection import STAGE_PIVOT_RTOL, JointProjection
+from mbody.simulate.mechanism import (
+    BAUMGARTE_RATE,
+    STAGE_PIVOT_RTOL,
+    JointProjection,
+    conserved_figures,
+    sample_figures,
+)
 from mbody.simulate.stepping import CORE, IMPLICIT, start
 from mbody.simulate.trajectory import (
     Trajectory,
@@ -825,7 +830,7 @@ class _Prepared:
         run_model = with_known(model, given)
         self.mechanism = dynamics is None and _has_unknown_reactions(run_model, None)
         # the joints held by projecting the state after every step
-        # (mbody.simulate.projection); scipy's integrators keep their own history of y, so
+        # (mbody.simulate.mechanism); scipy's integrators keep their own history of y, so
         # Baumgarte's terms hold them
         self.projecting = self.mechanism and core
         self.y0, self.ratio = _start(

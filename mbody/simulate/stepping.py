@@ -4,7 +4,7 @@
   Nørsett and Wanner; its steps are scipy's DOP853's, tests/test_dop853.py). With the
   core's right-hand side (`mbody.solve.dynamics.StateDerivative` on the compiled core)
   the whole run is in C: the stages, the step-size control, the projection onto the
-  joints after each step (`mbody.simulate.projection`: the stage projection and the
+  joints after each step (`mbody.simulate.mechanism`: the stage projection and the
   error along the joints near singular positions too), the loads' and laws' expressions
   of t, the dense output at the output samples and their projection. `CoreRun.advance`
   returns to Python only every so many steps (progress, budgets). A `dynamics` given in
@@ -27,7 +27,7 @@ import numpy as np
 from mbody.errors import MbodyError, option_name, option_setting
 from mbody.kernel import _core
 from mbody.kernel.dop853 import DOP853, TOO_SMALL_STEP
-from mbody.simulate.projection import ITERATIONS, STAGE_ITERATIONS, STAGE_PIVOT_RTOL
+from mbody.simulate.mechanism import ITERATIONS, STAGE_ITERATIONS, STAGE_PIVOT_RTOL
 from mbody.solve.dynamics import StateDerivative, status_error
 
 REFRESH_ATOL = 1e-2
