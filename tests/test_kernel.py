@@ -474,6 +474,65 @@ def test_bad_buffers_are_clear_errors():
 
 
 
+def incidence_by_sorting(child_all: np.ndarray, parent_all: np.ndarray, n: int,
+                         U: np.ndarray) -> np.ndarray:
+    """Iu as numpy made it before the core did (kernel.h's layout): the incidence sorted
+    by (body, position in U), child side first, and bw from each body's first and last."""
+    mu = len(U)
+    pos = np.arange(mu)
+    body = np.concatenate((child_all[U], parent_all[U]))
+    side = np.concatenate((np.zeros(mu, np.int64), np.ones(mu, np.int64)))
+    where = np.concatenate((pos, pos))
+    keep = body >= 0
+    body, side, where = body[keep], side[keep], where[keep]
+    order = np.lexsort((where, body))
+    body, side, where = body[order], side[order], where[order]
+    inc_ptr = body.searchsorted(np.arange(n + 1))
+    bw = max((int(where[inc_ptr[b + 1] - 1] - where[inc_ptr[b]]) for b in range(n)
+              if inc_ptr[b + 1] > inc_ptr[b]), default=0)
+    inc = np.stack((where, side), axis=1).ravel()
+    return np.concatenate(([mu, bw, len(where)], U, inc_ptr, inc)).astype(np.int64)
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_the_cores_unknowns_array_is_the_sorted_incidence(seed):
+    """`_core.pack_unknowns` (one pass in U's order) against the sort it replaced, on
+    random mechanisms: some components to the ground, U any subset in any order."""
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 30))
+    m = int(rng.integers(1, 120))
+    child = rng.integers(0, n, m)
+    parent = np.where(rng.random(m) < 0.3, -1, (child + rng.integers(1, n + 1, m)) % (n + 1) - 1)
+    parent[parent == child] = -1  # a component joins two bodies, or a body to the ground
+    U = rng.permutation(m)[:int(rng.integers(0, m + 1))]
+    out = np.full(3 + 5 * len(U) + n + 1, -7, dtype=np.int64)
+    used = _core.pack_unknowns(child, parent, n, U, out)
+    np.testing.assert_array_equal(out[:used], incidence_by_sorting(child, parent, n, U))
+
+
+def test_every_shipped_models_unknowns_array_is_the_sorted_incidence():
+    for path in MODELS:
+        model = mbody.load(path)
+        U = np.arange(len(model.reactions))
+        jt, joint = model.joint_table, model.reaction_table.joint
+        np.testing.assert_array_equal(
+            pack_unknowns(model, U),
+            incidence_by_sorting(jt.child[joint], jt.parent[joint], model.n, U), path.name)
+
+
+def test_the_cores_unknowns_array_refuses_what_it_cannot_hold():
+    child, parent, U = np.array([0, 1]), np.array([-1, 0]), np.array([0, 1])
+    with pytest.raises(ValueError, match="out: expected at least 16 values"):
+        _core.pack_unknowns(child, parent, 2, U, np.empty(15, np.int64))
+    for c, p, u, n in [([0, 2], [-1, 0], [0, 1], 2), ([0, 1], [-1, -2], [0, 1], 2),
+                       ([0, 1], [-1, 0], [0, 2], 2)]:
+        with pytest.raises(ValueError, match="index out of range"):
+            _core.pack_unknowns(np.array(c), np.array(p), n, np.array(u),
+                                np.empty(40, np.int64))
+    with pytest.raises(ValueError, match="parent: expected 2 values"):
+        _core.pack_unknowns(child, parent[:1], 2, U, np.empty(40, np.int64))
+
+
 
 
 

@@ -196,6 +196,8 @@ STAGE_VECTORS: int
 STAGES: int
 
 def solve_layout(n: int, m: int, planar: bool) -> tuple[int, int, int]: ...
+def pack_unknowns(child: np.ndarray, parent: np.ndarray, n: int, U: np.ndarray,
+                  out: np.ndarray) -> int: ...
 
 class Model:
     n: int

@@ -152,6 +152,14 @@ int mb_model_view(mb_model *md, const double *F, int64_t nF, const int64_t *I, i
  * pack.py packs a model whose I equals md's. No copy, no check beyond md's own. */
 void mb_model_rebase(mb_model *out, const mb_model *md, const double *F0, const double *F);
 int mb_unknowns_view(mb_unknowns *u, const mb_model *md, const int64_t *Iu, int64_t nIu);
+/* Iu (above) of the components U (mu of the m components, in solve order): each one's
+ * bodies child[U[k]] and parent[U[k]] (-1 the ground) among n. Per body, its entries in
+ * U's order, a component's child side before its parent side; bw the largest spread of
+ * one body's positions. Written into out (room for MB_IU_ROOM(n, mu) values); returns
+ * the length of Iu; -1 when an index is out of range, -2 when memory runs out. */
+#define MB_IU_ROOM(n, mu) (3 + 5 * (mu) + (n) + 1)
+int64_t mb_pack_unknowns(const int64_t *child, const int64_t *parent, int64_t m, int64_t n,
+                         const int64_t *U, int64_t mu, int64_t *out);
 
 /* Scratch memory for evaluations of one (model, unknowns): allocated once, reused. */
 typedef struct mb_work mb_work;

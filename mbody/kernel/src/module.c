@@ -1424,6 +1424,53 @@ static PyObject *solve_layout(PyObject *mod, PyObject *args) {
     return Py_BuildValue("(LLL)", N, N, N + 3 * m);
 }
 
+PyDoc_STRVAR(pack_unknowns_doc,
+"pack_unknowns(child, parent, n, U, out) -> int\n\nIu (kernel.h) of the components U "
+"(int64, in solve order), from every component's\nchild and parent body (int64, m each; "
+"-1 the ground) among n bodies, into out (int64,\nat least 3 + 5 mu + n + 1 values). "
+"Returns the length of Iu; a ValueError when an\nindex is out of range.");
+
+static PyObject *pack_unknowns(PyObject *mod, PyObject *const *args, Py_ssize_t nargs) {
+    Py_buffer child, parent, U, out;
+    if (check_nargs(nargs, 5, "pack_unknowns") < 0) return NULL;
+    long long n = PyLong_AsLongLong(args[2]);
+    if (n == -1 && PyErr_Occurred()) return NULL;
+    if (get_buffer(args[0], &child, 0, 0, -1, "child") < 0) return NULL;
+    if (get_buffer(args[1], &parent, 0, 0, child.len / 8, "parent") < 0) {
+        PyBuffer_Release(&child);
+        return NULL;
+    }
+    if (get_buffer(args[3], &U, 0, 0, -1, "U") < 0) {
+        PyBuffer_Release(&parent);
+        PyBuffer_Release(&child);
+        return NULL;
+    }
+    int64_t mu = U.len / 8;
+    if (get_buffer(args[4], &out, 1, 0, -1, "out") < 0) {
+        PyBuffer_Release(&U);
+        PyBuffer_Release(&parent);
+        PyBuffer_Release(&child);
+        return NULL;
+    }
+    int room = n >= 0 && out.len / 8 >= MB_IU_ROOM(n, mu);
+    int64_t used = room ? mb_pack_unknowns(child.buf, parent.buf, child.len / 8, n, U.buf,
+                                           mu, out.buf)
+                        : -1;
+    PyBuffer_Release(&out);
+    PyBuffer_Release(&U);
+    PyBuffer_Release(&parent);
+    PyBuffer_Release(&child);
+    if (!room)
+        return PyErr_Format(PyExc_ValueError, "out: expected at least %lld values for n = %lld "
+                            "bodies and %lld unknowns", (long long)MB_IU_ROOM(n, mu), n,
+                            (long long)mu);
+    if (used == -2) return PyErr_NoMemory();
+    if (used < 0)
+        return PyErr_Format(PyExc_ValueError, "U, child or parent: an index out of range "
+                            "(U in 0..m-1, bodies in -1..n-1)");
+    return PyLong_FromLongLong(used);
+}
+
 PyDoc_STRVAR(spectrum_doc,
 "spectrum(A, dA, tol, out) -> int\n\nThe eigenvalues, unit right eigenvectors and error "
 "bounds of the\nsquare float64 matrix A (kernel.h, mb_spectrum), into out (float64, "
@@ -1507,6 +1554,8 @@ int mb_dop853_register(PyObject *m);
 
 static PyMethodDef methods[] = {
     {"solve_layout", solve_layout, METH_VARARGS, solve_layout_doc},
+    {"pack_unknowns", (PyCFunction)(void (*)(void))pack_unknowns, METH_FASTCALL,
+     pack_unknowns_doc},
     {"spectrum", (PyCFunction)(void (*)(void))spectrum, METH_FASTCALL, spectrum_doc},
     {"modes", (PyCFunction)(void (*)(void))modes, METH_FASTCALL, modes_doc},
     {NULL, NULL, 0, NULL},

@@ -136,6 +136,41 @@ int mb_unknowns_view(mb_unknowns *u, const mb_model *md, const int64_t *Iu, int6
     return 0;
 }
 
+int64_t mb_pack_unknowns(const int64_t *child, const int64_t *parent, int64_t m, int64_t n,
+                         const int64_t *U, int64_t mu, int64_t *out) {
+    if (mu < 0 || n < 0) return -1;
+    int64_t *Uo = out + 3, *inc_ptr = Uo + mu, *inc = inc_ptr + n + 1;
+    for (int64_t b = 0; b <= n; b++) inc_ptr[b] = 0;
+    for (int64_t k = 0; k < mu; k++) { /* count each body's entries */
+        if (bad_index(U[k], 0, m)) return -1;
+        const int64_t ends[2] = {child[U[k]], parent[U[k]]};
+        for (int side = 0; side < 2; side++) {
+            if (bad_index(ends[side], -1, n)) return -1;
+            if (ends[side] >= 0) inc_ptr[ends[side] + 1]++;
+        }
+        Uo[k] = U[k];
+    }
+    for (int64_t b = 0; b < n; b++) inc_ptr[b + 1] += inc_ptr[b];
+    int64_t *next = malloc((size_t)(n > 0 ? n : 1) * sizeof(int64_t)); /* each body's fill */
+    if (next == NULL) return -2;
+    memcpy(next, inc_ptr, (size_t)n * sizeof(int64_t));
+    int64_t bw = 0;
+    for (int64_t k = 0; k < mu; k++) { /* in U's order: each body's positions ascending */
+        const int64_t ends[2] = {child[U[k]], parent[U[k]]};
+        for (int side = 0; side < 2; side++) {
+            int64_t b = ends[side];
+            if (b < 0) continue;
+            int64_t x = next[b]++;
+            inc[2 * x] = k, inc[2 * x + 1] = side;
+            int64_t spread = k - inc[2 * inc_ptr[b]]; /* from the body's first position */
+            if (spread > bw) bw = spread;
+        }
+    }
+    free(next);
+    out[0] = mu, out[1] = bw, out[2] = inc_ptr[n];
+    return 3 + mu + n + 1 + 2 * inc_ptr[n];
+}
+
 #define ALLOC(ptr, count)                                                               \
     do {                                                                                \
         size_t c_ = (size_t)(count);                                                    \
