@@ -53,7 +53,7 @@ class _Alias(importlib.abc.MetaPathFinder, importlib.abc.Loader):
 
     def create_module(self, spec) -> ModuleType:
         new = f"mbody.{MOVED[spec.name.removeprefix('mbody.')]}"
-        warnings.warn(f"{spec.name} moved to {new}; the old path goes in mbody 0.3",
+        warnings.warn(f"{spec.name} moved to {new}; the old path goes in mbody 0.4",
                       DeprecationWarning, stacklevel=2)
         module = importlib.import_module(new)
         self._specs[spec.name] = module.__spec__

@@ -6,6 +6,7 @@ only when one looks: a process that simulates and never introspects pays nothing
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import subprocess
 import sys
@@ -93,6 +94,74 @@ def test_threads_looking_at_once_make_it_once():
     for t in threads:
         t.join()
     assert len(seen) == 8 and all(s is seen[0] for s in seen)
+
+
+def test_before_the_first_look_the_class_is_as_the_dataclass_leaves_it():
+    """Its Field defaults are plain class attributes (or none), as after ``@dataclass``:
+    an instance missing a field does not read a Field object."""
+    lazy, eager = _record(dataclass_on_first_look), _record(dataclass)
+    assert type(lazy.__dict__["__dataclass_fields__"]).__name__ == "_OnFirstLook"
+    for name in ("a", "b", "c"):
+        assert (name in lazy.__dict__) == (name in eager.__dict__), name
+    assert lazy.c == eager.c == "c"
+    assert not hasattr(lazy.__new__(lazy), "b")
+
+
+@pytest.mark.skipif(sys.version_info < (3, 13), reason="copy.replace is Python 3.13's")
+def test_copy_replace_works_before_any_other_look():
+    lazy = _record(dataclass_on_first_look)
+    r = copy.replace(lazy(1), a=2)  # type: ignore[attr-defined]
+    assert (r.a, r.c) == (2, "c")
+
+
+def test_what_cannot_be_deferred_is_refused():
+    for options in ({}, {"eq": False, "init": False}, {"eq": False, "init": False,
+                                                      "repr": False, "frozen": True}):
+        with pytest.raises(TypeError, match="eq=False, init=False, repr=False"):
+            dataclass_on_first_look(**options)
+
+    class Bare(Frozen):
+        a: int
+
+    with pytest.raises(TypeError, match="needs a docstring"):
+        dataclass_on_first_look(eq=False, init=False, repr=False)(Bare)
+
+
+def test_a_thread_never_sees_the_class_half_made():
+    """One thread makes the dataclass (a first look) while another reads it without
+    going through a look of its own (`fields`, a positional ``match``), the interpreter
+    switching threads every microsecond: the reader sees the class before or after,
+    never between (a version that removed the looks before making the class failed a
+    trial in 15)."""
+    interval = sys.getswitchinterval()
+    sys.setswitchinterval(1e-6)
+    failures: list[str] = []
+    try:
+        for _ in range(150):
+            lazy = _record(dataclass_on_first_look)
+            go, stop = threading.Event(), threading.Event()
+
+            def read(cls=lazy, go=go, stop=stop) -> None:
+                go.wait()
+                while not stop.is_set():
+                    try:
+                        dataclasses.fields(cls)
+                        match cls(1):
+                            case cls(a):
+                                assert a == 1
+                    except Exception as exc:  # noqa: BLE001 - any failure is the finding
+                        failures.append(f"{type(exc).__name__}: {exc}")
+                        return
+
+            reader = threading.Thread(target=read)
+            reader.start()
+            go.set()
+            lazy.__dataclass_params__  # noqa: B018 - the first look
+            stop.set()
+            reader.join()
+    finally:
+        sys.setswitchinterval(interval)
+    assert failures == []
 
 
 def test_a_run_does_not_make_the_trajectory_a_dataclass_until_asked():

@@ -522,8 +522,17 @@ def test_every_shipped_models_unknowns_array_is_the_sorted_incidence():
 
 def test_the_cores_unknowns_array_refuses_what_it_cannot_hold():
     child, parent, U = np.array([0, 1]), np.array([-1, 0]), np.array([0, 1])
-    with pytest.raises(ValueError, match="out: expected at least 16 values"):
+    with pytest.raises(ValueError, match=r"out: expected at least 3 \+ 5 mu \+ n \+ 1 "
+                       r"values for n = 2 bodies and mu = 2 unknowns, got 15"):
         _core.pack_unknowns(child, parent, 2, U, np.empty(15, np.int64))
+    none = np.zeros(0, np.int64)
+    with pytest.raises(ValueError, match="out: expected at least"):  # no overflow to pass
+        _core.pack_unknowns(none, none, 2**63 - 4, none, np.empty(8, np.int64))
+    with pytest.raises(ValueError, match="n: expected n >= 0"):
+        _core.pack_unknowns(none, none, -1, none, np.empty(8, np.int64))
+    out = np.zeros(3 + 5 * 50 + 2, np.int64)  # an input inside out: refused, not read
+    with pytest.raises(ValueError, match="shares memory"):
+        _core.pack_unknowns(out[60:110], np.full(50, -1), 1, np.arange(50), out)
     for c, p, u, n in [([0, 2], [-1, 0], [0, 1], 2), ([0, 1], [-1, -2], [0, 1], 2),
                        ([0, 1], [-1, 0], [0, 2], 2)]:
         with pytest.raises(ValueError, match="index out of range"):

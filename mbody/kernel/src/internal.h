@@ -13,7 +13,7 @@ enum { L_BR = 0, L_VALUE = 3 };
 enum { S_RA = 0, S_RB = 3, S_STIFF = 6, S_REST = 7, S_DAMP = 8 };
 enum { J_BRC = 0, J_BRP = 3, J_CAX2 = 6, J_PE3 = 9, J_CE3 = 18, J_LLEN = 27 };
 
-/* The solves' tolerances, as mbody.solve.nullspace, kkt and mbody.simulate.projection. */
+/* The solves' tolerances, as mbody.solve.nullspace, kkt and mbody.simulate.mechanism. */
 #define G_RANK_RTOL 1e-12   /* rank of G_U's scaled geometry: sigma > this * sigma_max */
 #define PIVOT_RTOL 1e-6     /* a Cholesky pivot of S keeping less of its diagonal: untrusted */
 #define SINGULAR_RTOL 1e-14 /* the reduced mass matrix's pivots: a motion without mass */

@@ -1,7 +1,7 @@
 /* A simulation's problem as the integrator's callbacks (dop853.h's mb_ode): the core's
  * right-hand side (mb_derivative: the unknown reactions solved at every evaluation,
  * Baumgarte's terms when rate > 0) and, for a mechanism held by projection
- * (mbody.simulate.projection), the coordinate projection after every accepted step
+ * (mbody.simulate.mechanism), the coordinate projection after every accepted step
  * (mb_project), the stage projection of filtered steps and the part of an error estimate
  * along the joints. With these bound in C a whole run steps without Python.
  *

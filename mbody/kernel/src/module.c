@@ -1452,18 +1452,31 @@ static PyObject *pack_unknowns(PyObject *mod, PyObject *const *args, Py_ssize_t 
         PyBuffer_Release(&child);
         return NULL;
     }
-    int room = n >= 0 && out.len / 8 >= MB_IU_ROOM(n, mu);
-    int64_t used = room ? mb_pack_unknowns(child.buf, parent.buf, child.len / 8, n, U.buf,
-                                           mu, out.buf)
-                        : -1;
+    /* n and mu bounded by out's size first: then the sum cannot overflow */
+    Py_ssize_t have = out.len / 8;
+    int room = n >= 0 && n <= have && mu <= have && 4 + 5 * mu + n <= have;
+    /* out is written while the inputs are read again: they may not share its memory */
+    const char *o0 = out.buf, *o1 = o0 + out.len;
+    int apart = 1;
+    const Py_buffer *ins[3] = {&child, &parent, &U};
+    for (int i = 0; i < 3; i++) {
+        const char *a0 = ins[i]->buf, *a1 = a0 + ins[i]->len;
+        if (a0 < o1 && o0 < a1) apart = 0;
+    }
+    int64_t used = room && apart ? mb_pack_unknowns(child.buf, parent.buf, child.len / 8, n,
+                                                    U.buf, mu, out.buf)
+                                 : -1;
     PyBuffer_Release(&out);
     PyBuffer_Release(&U);
     PyBuffer_Release(&parent);
     PyBuffer_Release(&child);
+    if (n < 0) return PyErr_Format(PyExc_ValueError, "n: expected n >= 0 bodies, got %lld", n);
     if (!room)
-        return PyErr_Format(PyExc_ValueError, "out: expected at least %lld values for n = %lld "
-                            "bodies and %lld unknowns", (long long)MB_IU_ROOM(n, mu), n,
-                            (long long)mu);
+        return PyErr_Format(PyExc_ValueError, "out: expected at least 3 + 5 mu + n + 1 values "
+                            "for n = %lld bodies and mu = %lld unknowns, got %zd", n,
+                            (long long)mu, have);
+    if (!apart)
+        return PyErr_Format(PyExc_ValueError, "out: shares memory with child, parent or U");
     if (used == -2) return PyErr_NoMemory();
     if (used < 0)
         return PyErr_Format(PyExc_ValueError, "U, child or parent: an index out of range "

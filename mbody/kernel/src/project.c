@@ -1,4 +1,4 @@
-/* The coordinate projection (mbody.simulate.projection's JointProjection calls it):
+/* The coordinate projection (mbody.simulate.mechanism's JointProjection calls it):
  * positions moved onto the enforced joints by
  * Gauss-Newton steps M D - G_U mu = 0, G_U^T D = -phi_U (the smallest move in the
  * kinetic metric), then velocities by the mass-orthogonal projection
