@@ -179,12 +179,12 @@ def test_a_plain_simulate_imports_only_what_it_needs(name: str):
 
 
 DEFERRED_BY_A_RUN = ("mbody.simulate.kinematic", "mbody.simulate.axes",
-                     "mbody.simulate.run_file", "mbody.util.atomic", "mbody.util.npzfile",
-                     "mbody.util.jsontext", "mbody.model.yaml_write")
+                     "mbody.simulate.budget", "mbody.simulate.run_file", "mbody.util.atomic",
+                     "mbody.util.npzfile", "mbody.util.jsontext", "mbody.model.yaml_write")
 """What an integrated run of a model read from a YAML file leaves out: the kinematic run,
-world axes, the run file's reader and writer (tools/check_imports.py, `DEFERRED`; a fresh
-process's first simulate pays for every module it imports: about 1 ms for these,
-docs/performance.md)."""
+world axes, what a run over its budget is told, the run file's reader and writer
+(tools/check_imports.py, `DEFERRED`; a fresh process's first simulate pays for every
+module it imports: about 1 ms for these, docs/performance.md)."""
 
 
 @pytest.mark.parametrize("name", ["pendulum", "double_pendulum", "heavy_top",
@@ -215,6 +215,11 @@ WORK_AND_ITS_MODULES = {
         "mbody.Trajectory.load({run})",
         ["mbody.simulate.run_file", "mbody.util.atomic", "mbody.util.jsontext",
          "mbody.util.npzfile"]),
+    "a run stopped by its step budget": (
+        "try:\n    mbody.simulate(mbody.load({models}/'pendulum.yaml'), t_end=5, max_steps=3)\n"
+        "except mbody.MbodyError as e:\n    assert 'the step budget' in str(e)\n"
+        "else:\n    raise AssertionError('the budget did not stop the run')",
+        ["mbody.simulate.budget"]),
     "a model read from a dictionary": (
         "import yaml\nspec = yaml.safe_load(({models}/'pendulum.yaml').read_text())\n"
         "mbody.simulate(mbody.load(spec), t_end=0.5)",

@@ -57,6 +57,8 @@ DEFERRED = {
         "a fully driven model's run, and the drivers' figures and summary lines of a run "
         "with drivers",
     ("mbody.simulate.simulation", "mbody.simulate.axes"): "a run stored in world axes",
+    ("mbody.simulate.simulation", "mbody.simulate.budget"):
+        "a run that outgrows its step or wall-time budget, or whose integration fails",
     ("mbody.simulate.trajectory", "mbody.simulate.run_file"): "saving and loading a run",
     ("mbody.simulate.trajectory", "mbody.model.yaml_write"):
         "the model text of a run of a model not read from a YAML file",
