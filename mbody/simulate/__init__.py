@@ -1,10 +1,10 @@
 """Motion over time: `simulate(model, t_end, fps) -> Trajectory`.
 
 `simulation` (the run: sampling, budgets, progress, summary), `budget` (what a run over
-its budget, or failing, is told), `stepping` (the integrator
-classes, and the compiled DOP853 steps), `mechanism` (accelerations with the reactions
-solved at every step, the state moved back onto its joints, the figures at the samples),
-`trajectory` (the `Trajectory`) and `run_file` (its file).
+its budget, or failing, is told), `stepping` (the integrator classes, and the compiled
+DOP853 steps), `mechanism` (accelerations with the reactions solved at every step, the
+state moved back onto its joints, the figures at the samples), `trajectory` (the
+`Trajectory`) and `run_file` (its file).
 
 The names below are imported on first use: reading a saved `Trajectory` must not import
 scipy's integrators.
