@@ -233,7 +233,7 @@ class Workspace:
     def _solve_info(self, solver: _core.Unknowns, unknowns: Unknowns, t: float,
                     y: np.ndarray) -> np.ndarray:
         """The info slots (``_core.ST_*``) of the core's solve at (t, y)."""
-        N, _, o_info = _core.solve_layout(self.model.n, len(unknowns.mask), self.planar)
+        _, _, o_info = _core.solve_layout(self.model.n, len(unknowns.mask), self.planar)
         out = np.empty(o_info + _core.INFO)
         solver.solve(t, y, unknowns.lam, out)
         return out[o_info:]

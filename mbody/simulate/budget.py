@@ -11,6 +11,7 @@ the step rate a run keeps to judge its pace is `simulation._StepRate`.
 from __future__ import annotations
 
 import math
+from typing import Protocol
 
 import numpy as np
 
@@ -19,6 +20,12 @@ from mbody.model.expressions import Expression, check_times
 from mbody.model.model import Model
 from mbody.simulate.stepping import IMPLICIT
 
+
+class Pace(Protocol):
+    """A run's pace so far in words (`simulation._StepRate`), made only for a message."""
+
+    def so_far(self, t: float, steps: int) -> str: ...
+
 PREDICT_FACTOR = 1.5
 """A run predicted to need this many times its step or wall-time budget stops at once."""
 SPIN_STEPS_PER_RAD = 50.0
@@ -26,12 +33,11 @@ SPIN_STEPS_PER_RAD = 50.0
 that spin (DOP853 at rtol 1e-10 takes about 1.5 steps per radian of a free spin)."""
 
 
-def predict(model: Model, method: str, t: float, t_end: float, steps: int, so_far: str,
+def predict(model: Model, method: str, t: float, t_end: float, steps: int, rate: Pace,
             max_steps: int | None, max_wall: float | None, elapsed: float) -> None:
     """Stop now, with the cause and what to do, a run whose pace so far needs more than
     `PREDICT_FACTOR` times a budget: a very stiff model or a fast spin otherwise takes
-    minutes to reach the budget (hours without one) and ends with nothing. `so_far`:
-    the run's pace in words (`_StepRate.so_far`)."""
+    minutes to reach the budget (hours without one) and ends with nothing."""
     if t <= 0:
         return
     need_steps = steps * t_end / t
@@ -49,7 +55,7 @@ def predict(model: Model, method: str, t: float, t_end: float, steps: int, so_fa
     cause, remedies = cost_cause(model, steps / t, method)
     raise MbodyError(
         f"the simulation was stopped early: after {steps} steps it is at t = {t:.3g} s of "
-        f"{t_end:g} s ({so_far}); at that rate the whole run needs {over}. "
+        f"{t_end:g} s ({rate.so_far(t, steps)}); at that rate the whole run needs {over}. "
         f"{cause} To go on: {remedies}, or {raise_it}. No trajectory is kept (rerun with "
         f"{option_setting('t_end', figure(t))} to see the motion up to here).")
 
@@ -108,13 +114,12 @@ INERTIA_SPREAD = 1e10
 (relative 1e-16 of the largest, divided by the smallest) is blamed for short steps."""
 
 
-def budget_message(what: str, t: float, t_end: float, so_far: str, estimate: str,
-                   raise_it: str) -> str:
-    """The one paragraph a run stopped by a budget reports (`so_far`: its pace in words,
-    `_StepRate.so_far`)."""
+def budget_message(what: str, t: float, t_end: float, steps: int, rate: Pace,
+                   estimate: str, raise_it: str) -> str:
+    """The one paragraph a run stopped by a budget reports."""
     t_end_ = option_name("t_end")
     return (f"the simulation stopped at {what}, at t = {t:.6g} s of {t_end:g} s: "
-            f"{so_far}; {estimate}. No trajectory is kept (rerun with "
+            f"{rate.so_far(t, steps)}; {estimate}. No trajectory is kept (rerun with "
             f"{option_setting('t_end', figure(t))} to see the motion up to here). To go on: "
             f"a shorter {t_end_}, a looser {option_name('rtol')} (e.g. 1e-8), a stiff "
             f"integrator such as {option_setting('method', 'Radau')} if the model is stiff "

@@ -335,16 +335,15 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
                     check_at = 2 * steps
                     from mbody.simulate.budget import predict
 
-                    predict(model, method, run.t, t_end, steps, rate.so_far(run.t, steps),
-                            max_steps, max_wall, time.perf_counter() - wall)
+                    predict(model, method, run.t, t_end, steps, rate, max_steps, max_wall,
+                            time.perf_counter() - wall)
                 if max_steps is not None and steps >= max_steps:
                     from mbody.simulate.budget import budget_message
 
                     raise MbodyError(budget_message(
                         f"the step budget: {steps} steps "
                         f"({option_setting('max_steps', max_steps)})",
-                        run.t, t_end, rate.so_far(run.t, steps),
-                        f"at that rate the whole run needs "
+                        run.t, t_end, steps, rate, f"at that rate the whole run needs "
                         f"about {steps * t_end / run.t:.2g} steps" if run.t > 0 else
                         "the steps do not advance the time",
                         f"raise {option_name('max_steps')}"))
@@ -360,8 +359,7 @@ def simulate(model: Model, t_end: float = 10.0, fps: float = 60, *,
                         raise MbodyError(budget_message(
                             f"the wall-time budget: {now - wall:.3g} s "
                             f"({option_setting('max_wall', float(max_wall))})", run.t, t_end,
-                            rate.so_far(run.t, steps),
-                            f"at that pace the rest of the run takes about "
+                            steps, rate, f"at that pace the rest of the run takes about "
                             f"{pace * (t_end - run.t):.2g} s more" if math.isfinite(pace)
                             else "no simulated time has passed yet",
                             f"raise {option_name('max_wall')}"))
